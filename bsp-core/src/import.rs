@@ -1,0 +1,237 @@
+//! Turning input faces (`f64` vertex loops) into exact convex polygons.
+
+use glam::DVec3;
+
+use crate::grid::{Grid, GridPoint};
+use crate::plane::Plane;
+use crate::polygon::{support_plane, FaceDefect, Polygon};
+use crate::{Error, Side};
+
+/// What happened to the input faces on the way to convex polygons.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ImportReport {
+    /// Number of input faces.
+    pub faces: usize,
+    /// Number of convex polygons produced.
+    pub polygons: usize,
+    /// Faces split into triangles, with the reason (non-planar after
+    /// snapping, or non-convex).
+    pub triangulated: Vec<(usize, FaceDefect)>,
+    /// Faces that produced no polygon at all, with the reason.
+    pub dropped: Vec<(usize, FaceDefect)>,
+}
+
+impl ImportReport {
+    /// A one-paragraph human summary, empty when every face was kept whole.
+    pub fn summary(&self) -> String {
+        let mut s = String::new();
+        let list = |v: &[(usize, FaceDefect)]| {
+            v.iter()
+                .take(5)
+                .map(|(f, d)| format!("face {f} ({d})"))
+                .collect::<Vec<_>>()
+                .join(", ")
+                + if v.len() > 5 { ", ..." } else { "" }
+        };
+        if !self.triangulated.is_empty() {
+            s += &format!(
+                "{} face(s) triangulated: {}\n",
+                self.triangulated.len(),
+                list(&self.triangulated)
+            );
+        }
+        if !self.dropped.is_empty() {
+            s += &format!(
+                "{} degenerate face(s) dropped: {}\n",
+                self.dropped.len(),
+                list(&self.dropped)
+            );
+        }
+        s
+    }
+}
+
+/// Snaps `faces` to `grid` and turns each into convex polygons tagged with
+/// the face's index.
+///
+/// Planar convex faces stay one polygon whatever their vertex count;
+/// non-convex planar faces are triangulated by exact ear clipping;
+/// non-planar faces (after snapping) are fan-triangulated; faces with no
+/// area are dropped. The report says which faces were changed and why.
+///
+/// ```
+/// use bsp_core::{Grid, import_faces};
+/// use glam::DVec3;
+/// let quad = [DVec3::new(0., 0., 0.), DVec3::new(1., 0., 0.), DVec3::new(1., 1., 0.), DVec3::new(0., 1., 0.)];
+/// let grid = Grid::fit_points(&quad).unwrap();
+/// let (polys, report) = import_faces(&grid, [&quad[..]]).unwrap();
+/// assert_eq!((polys.len(), polys[0].len()), (1, 4));
+/// assert!(report.dropped.is_empty() && report.triangulated.is_empty());
+/// ```
+pub fn import_faces<'a>(
+    grid: &Grid,
+    faces: impl IntoIterator<Item = &'a [DVec3]>,
+) -> Result<(Vec<Polygon>, ImportReport), Error> {
+    let mut out = Vec::new();
+    let mut report = ImportReport::default();
+    let mut pts: Vec<GridPoint> = Vec::new();
+    for (fi, face) in faces.into_iter().enumerate() {
+        report.faces += 1;
+        pts.clear();
+        for (vi, p) in face.iter().enumerate() {
+            let g = grid.snap(*p).map_err(|e| Error::Snap {
+                face: fi,
+                vertex: vi,
+                value: p.to_array(),
+                reason: e,
+            })?;
+            pts.push(g);
+        }
+        let tag = fi as u32;
+        match Polygon::from_grid_points(&pts, tag) {
+            Ok(p) => out.push(p),
+            Err(defect @ (FaceDefect::NonConvex | FaceDefect::NonPlanar)) => {
+                let tris = triangulate(&pts, defect);
+                let before = out.len();
+                out.extend(
+                    tris.iter()
+                        .filter_map(|t| Polygon::from_grid_points(t, tag).ok()),
+                );
+                if out.len() == before {
+                    report.dropped.push((fi, defect));
+                } else {
+                    report.triangulated.push((fi, defect));
+                }
+            }
+            Err(defect) => report.dropped.push((fi, defect)),
+        }
+    }
+    report.polygons = out.len();
+    Ok((out, report))
+}
+
+/// Triangles covering the loop: exact ear clipping for planar loops, a fan
+/// otherwise (or when ear clipping finds no ear, i.e. the loop is not
+/// simple).
+fn triangulate(pts: &[GridPoint], defect: FaceDefect) -> Vec<[GridPoint; 3]> {
+    let mut v: Vec<GridPoint> = Vec::with_capacity(pts.len());
+    for p in pts {
+        if v.last() != Some(p) {
+            v.push(*p);
+        }
+    }
+    while v.len() > 1 && v.first() == v.last() {
+        v.pop();
+    }
+    if defect == FaceDefect::NonConvex
+        && let Ok(plane) = support_plane(&v)
+        && let Some(t) = ear_clip(&v, &plane)
+    {
+        return t;
+    }
+    (1..v.len().saturating_sub(1))
+        .map(|i| [v[0], v[i], v[i + 1]])
+        .collect()
+}
+
+/// Exact ear clipping of a planar loop, counter-clockwise about `plane`.
+fn ear_clip(v: &[GridPoint], plane: &Plane) -> Option<Vec<[GridPoint; 3]>> {
+    let ax = plane.dominant_axis();
+    let (a, b) = if plane.normal()[ax] > 0 {
+        ((ax + 1) % 3, (ax + 2) % 3)
+    } else {
+        ((ax + 2) % 3, (ax + 1) % 3)
+    };
+    let p2 = |p: GridPoint| (p[a] as i128, p[b] as i128);
+    let orient = |p: GridPoint, q: GridPoint, r: GridPoint| {
+        let (p, q, r) = (p2(p), p2(q), p2(r));
+        ((q.0 - p.0) * (r.1 - p.1) - (q.1 - p.1) * (r.0 - p.0)).signum()
+    };
+    let mut idx: Vec<usize> = (0..v.len()).collect();
+    let mut tris = Vec::with_capacity(v.len());
+    while idx.len() > 3 {
+        let m = idx.len();
+        let mut found = None;
+        for i in 0..m {
+            let (pa, pb, pc) = (v[idx[(i + m - 1) % m]], v[idx[i]], v[idx[(i + 1) % m]]);
+            if orient(pa, pb, pc) <= 0 {
+                continue;
+            }
+            let blocked = idx.iter().any(|&j| {
+                let p = v[j];
+                p != pa
+                    && p != pb
+                    && p != pc
+                    && orient(pa, pb, p) >= 0
+                    && orient(pb, pc, p) >= 0
+                    && orient(pc, pa, p) >= 0
+            });
+            if !blocked {
+                found = Some(i);
+                break;
+            }
+        }
+        let i = found?;
+        let m = idx.len();
+        tris.push([v[idx[(i + m - 1) % m]], v[idx[i]], v[idx[(i + 1) % m]]]);
+        idx.remove(i);
+    }
+    tris.push([v[idx[0]], v[idx[1]], v[idx[2]]]);
+    // every triangle must keep the loop's orientation
+    tris.iter()
+        .all(|t| orient(t[0], t[1], t[2]) >= 0)
+        .then_some(tris)
+}
+
+/// `true` if every vertex of every polygon lies exactly on its support plane
+/// (used by tests of importers).
+pub fn all_planar(polys: &[Polygon]) -> bool {
+    polys
+        .iter()
+        .all(|p| p.vertices().iter().all(|v| v.classify(p.support()) == Side::On))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn import(face: &[[f64; 3]]) -> (Vec<Polygon>, ImportReport) {
+        let f: Vec<DVec3> = face.iter().map(|p| DVec3::from_array(*p)).collect();
+        let grid = Grid::new(DVec3::ZERO, 0).unwrap();
+        import_faces(&grid, [&f[..]]).unwrap()
+    }
+
+    #[test]
+    fn l_shape_is_ear_clipped() {
+        let (p, r) = import(&[
+            [0., 0., 0.],
+            [2., 0., 0.],
+            [2., 1., 0.],
+            [1., 1., 0.],
+            [1., 2., 0.],
+            [0., 2., 0.],
+        ]);
+        assert_eq!(p.len(), 4);
+        assert_eq!(r.triangulated, vec![(0, FaceDefect::NonConvex)]);
+        assert!(p.iter().all(|q| q.support().normal() == [0, 0, 1]));
+    }
+
+    #[test]
+    fn non_planar_quad_is_fanned_and_degenerate_dropped() {
+        let (p, r) = import(&[[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 1.]]);
+        assert_eq!(p.len(), 2);
+        assert_eq!(r.triangulated, vec![(0, FaceDefect::NonPlanar)]);
+        let (p, r) = import(&[[0., 0., 0.], [1., 1., 1.], [2., 2., 2.]]);
+        assert!(p.is_empty());
+        assert_eq!(r.dropped, vec![(0, FaceDefect::ZeroArea)]);
+    }
+
+    #[test]
+    fn bad_coordinates_name_face_and_vertex() {
+        let f = [DVec3::ZERO, DVec3::X, DVec3::new(f64::NAN, 0.0, 0.0)];
+        let grid = Grid::new(DVec3::ZERO, 0).unwrap();
+        let e = import_faces(&grid, [&f[..]]).unwrap_err();
+        assert!(matches!(e, Error::Snap { face: 0, vertex: 2, .. }), "{e}");
+        assert!(e.to_string().contains("face 0"));
+    }
+}

@@ -1,0 +1,242 @@
+//! Planes with integer coefficients.
+
+use crate::grid::{GridPoint, ViewPoint};
+use crate::Side;
+
+/// Exclusive bound on the absolute value of a normal component: `2^55`.
+pub const MAX_NORMAL_BITS: u32 = 55;
+/// Exclusive bound on the absolute value of an offset: `2^83`.
+pub const MAX_OFFSET_BITS: u32 = 83;
+
+/// An oriented plane `n · x + d = 0` with integer coefficients, reduced so
+/// that `gcd(n.x, n.y, n.z, d) = 1`.
+///
+/// Points with `n · x + d > 0` are in [`Side::Front`]. Because the
+/// coefficients are reduced, two planes describe the same oriented plane if
+/// and only if they are equal, and opposite planes are exact negations.
+///
+/// Every plane satisfies `|n_i| < 2^55` and `|d| < 2^83` (the budget of a
+/// plane through three grid points); see `docs/architecture.md`.
+#[derive(Clone, Copy, Debug)]
+pub struct Plane {
+    n: [i64; 3],
+    /// `d` rounded to `f64`, cached for the floating-point filter.
+    d_approx: f64,
+    d: i128,
+}
+
+impl PartialEq for Plane {
+    fn eq(&self, o: &Plane) -> bool {
+        self.n == o.n && self.d == o.d
+    }
+}
+impl Eq for Plane {}
+impl std::hash::Hash for Plane {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        self.n.hash(h);
+        self.d.hash(h);
+    }
+}
+
+fn gcd(mut a: u128, mut b: u128) -> u128 {
+    while b != 0 {
+        (a, b) = (b, a % b);
+    }
+    a
+}
+
+impl Plane {
+    /// A plane from raw coefficients, reduced by their GCD.
+    ///
+    /// Returns `None` if the normal is zero or the reduced coefficients
+    /// exceed the budget (`|n_i| < 2^55`, `|d| < 2^83`).
+    ///
+    /// ```
+    /// use bsp_core::Plane;
+    /// let p = Plane::new([0, 0, 4], -8).unwrap();
+    /// assert_eq!((p.normal(), p.offset()), ([0, 0, 1], -2));
+    /// assert!(Plane::new([0, 0, 0], 1).is_none());
+    /// ```
+    pub fn new(n: [i64; 3], d: i128) -> Option<Plane> {
+        if n == [0, 0, 0] {
+            return None;
+        }
+        let mut g = d.unsigned_abs();
+        for c in n {
+            g = gcd(g, c.unsigned_abs() as u128);
+        }
+        let g = g as i128;
+        let n = n.map(|c| (c as i128 / g) as i64);
+        let d = d / g;
+        let fits = n.iter().all(|c| c.unsigned_abs() < 1u64 << MAX_NORMAL_BITS)
+            && d.unsigned_abs() < 1u128 << MAX_OFFSET_BITS;
+        fits.then(|| Plane {
+            n,
+            d_approx: d as f64,
+            d,
+        })
+    }
+
+    /// The plane through three grid points, oriented so that `a, b, c` run
+    /// counter-clockwise seen from the front (right-hand normal).
+    /// `None` if they are collinear.
+    ///
+    /// ```
+    /// use bsp_core::{Plane, Side};
+    /// let p = Plane::through([0, 0, 0], [1, 0, 0], [0, 1, 0]).unwrap();
+    /// assert_eq!(p.classify_grid([5, 5, 1]), Side::Front);
+    /// assert_eq!(p.classify_grid([5, 5, 0]), Side::On);
+    /// ```
+    pub fn through(a: GridPoint, b: GridPoint, c: GridPoint) -> Option<Plane> {
+        let u = sub(b, a);
+        let v = sub(c, a);
+        let n = cross(u, v);
+        let d = -dot_wide(n, a);
+        Plane::new(n, d)
+    }
+
+    /// The plane through the edge `a → b` of a polygon with support `support`
+    /// that contains the axis direction along which `support`'s normal is
+    /// largest, oriented so that the polygon's interior is on its back.
+    ///
+    /// Its coefficients are small: `|n_i| < 2^27`, `|d| < 2^54`.
+    pub(crate) fn edge(a: GridPoint, b: GridPoint, support: &Plane) -> Option<Plane> {
+        let k = support.dominant_axis();
+        let e = sub(b, a);
+        // e × axis_k
+        let mut n = match k {
+            0 => [0, e[2], -e[1]],
+            1 => [-e[2], 0, e[0]],
+            _ => [e[1], -e[0], 0],
+        };
+        if support.n[k] < 0 {
+            n = n.map(|c| -c);
+        }
+        let d = -dot_wide(n, a);
+        Plane::new(n, d)
+    }
+
+    /// Index of the normal's component of largest magnitude.
+    pub fn dominant_axis(&self) -> usize {
+        let a = self.n.map(|c| c.unsigned_abs());
+        if a[0] >= a[1] && a[0] >= a[2] {
+            0
+        } else if a[1] >= a[2] {
+            1
+        } else {
+            2
+        }
+    }
+
+    /// The same plane with the opposite orientation.
+    pub fn flip(&self) -> Plane {
+        Plane {
+            n: self.n.map(|c| -c),
+            d_approx: -self.d_approx,
+            d: -self.d,
+        }
+    }
+
+    /// The integer normal.
+    pub fn normal(&self) -> [i64; 3] {
+        self.n
+    }
+
+    /// The integer offset `d`.
+    pub fn offset(&self) -> i128 {
+        self.d
+    }
+
+    /// The normal and offset rounded to `f64`.
+    pub fn approx(&self) -> [f64; 4] {
+        [
+            self.n[0] as f64,
+            self.n[1] as f64,
+            self.n[2] as f64,
+            self.d_approx,
+        ]
+    }
+
+    /// `true` if both planes are the same plane with either orientation.
+    pub fn is_coincident(&self, o: &Plane) -> bool {
+        self == o || (self.n == o.n.map(|c| -c) && self.d == -o.d)
+    }
+
+    /// `true` if the normals point the same way (positive dot product).
+    pub fn same_direction(&self, o: &Plane) -> bool {
+        let s: i128 = (0..3).map(|i| self.n[i] as i128 * o.n[i] as i128).sum();
+        s > 0
+    }
+
+    /// Exact side of a grid point. Uses 128-bit integers: `|n·p + d| < 2^84`.
+    #[inline]
+    pub fn classify_grid(&self, p: GridPoint) -> Side {
+        let v = self.n[0] as i128 * p[0] as i128
+            + self.n[1] as i128 * p[1] as i128
+            + self.n[2] as i128 * p[2] as i128
+            + self.d;
+        Side::from_sign(v.signum() as i32)
+    }
+
+    /// Exact side of a viewpoint. `|n·p + d| < 2^120` for viewpoints within
+    /// [`crate::MAX_VIEW_COORD`].
+    #[inline]
+    pub fn classify_viewpoint(&self, p: ViewPoint) -> Side {
+        let p = p.0;
+        let v = self.n[0] as i128 * p[0] as i128
+            + self.n[1] as i128 * p[1] as i128
+            + self.n[2] as i128 * p[2] as i128
+            + self.d;
+        Side::from_sign(v.signum() as i32)
+    }
+}
+
+pub(crate) fn sub(a: GridPoint, b: GridPoint) -> [i64; 3] {
+    [
+        a[0] as i64 - b[0] as i64,
+        a[1] as i64 - b[1] as i64,
+        a[2] as i64 - b[2] as i64,
+    ]
+}
+
+/// Cross product of grid differences (`|u_i|, |v_i| < 2^27`): `< 2^55`.
+pub(crate) fn cross(u: [i64; 3], v: [i64; 3]) -> [i64; 3] {
+    [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ]
+}
+
+fn dot_wide(n: [i64; 3], p: GridPoint) -> i128 {
+    n[0] as i128 * p[0] as i128 + n[1] as i128 * p[1] as i128 + n[2] as i128 * p[2] as i128
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::MAX_COORD;
+
+    #[test]
+    fn extreme_grid_points_stay_in_budget() {
+        let m = MAX_COORD;
+        let p = Plane::through([-m, -m, -m], [m, -m, m], [-m, m, m]).unwrap();
+        assert!(p.normal().iter().all(|c| c.unsigned_abs() < 1 << 55));
+        // a plane whose gcd is 1 with near-maximal coefficients
+        let p = Plane::through([-m, -m + 1, m], [m, -m, -m + 2], [m - 3, m, -m]).unwrap();
+        for v in [[-m, -m + 1, m], [m, -m, -m + 2], [m - 3, m, -m]] {
+            assert_eq!(p.classify_grid(v), Side::On);
+        }
+        let e = Plane::edge([-m, -m + 1, m], [m, -m, -m + 2], &p).unwrap();
+        assert_eq!(e.classify_grid([m - 3, m, -m]), Side::Back);
+    }
+
+    #[test]
+    fn reduced_planes_compare_exactly() {
+        let a = Plane::through([0, 0, 0], [2, 0, 0], [0, 2, 0]).unwrap();
+        let b = Plane::through([5, 5, 0], [1, 7, 0], [9, 9, 0]).unwrap();
+        assert!(a.is_coincident(&b));
+        assert_eq!(a.flip().flip(), a);
+        assert!(Plane::through([0, 0, 0], [1, 1, 1], [2, 2, 2]).is_none());
+    }
+}

@@ -1,0 +1,493 @@
+//! Convex polygons in plane-based form, exact classification and splitting.
+
+use smallvec::SmallVec;
+
+use crate::grid::GridPoint;
+use crate::plane::{cross, sub, Plane};
+use crate::point::Point;
+
+/// Exact side of a point relative to a plane.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Side {
+    /// `n · p + d > 0`.
+    Front,
+    /// `n · p + d < 0`.
+    Back,
+    /// `n · p + d = 0`.
+    On,
+}
+
+impl Side {
+    #[inline]
+    pub(crate) fn from_sign(s: i32) -> Side {
+        match s {
+            1 => Side::Front,
+            -1 => Side::Back,
+            _ => Side::On,
+        }
+    }
+}
+
+/// Exact position of a polygon relative to a plane.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PolygonSide {
+    /// Every vertex is in front or on, at least one in front.
+    Front,
+    /// Every vertex is behind or on, at least one behind.
+    Back,
+    /// The polygon lies in the plane; `same_orientation` tells whether its
+    /// normal points the same way as the plane's.
+    Coplanar {
+        /// Normals agree.
+        same_orientation: bool,
+    },
+    /// Vertices strictly on both sides.
+    Spanning,
+}
+
+/// The result of splitting a polygon by a plane.
+#[derive(Clone, Debug)]
+pub enum Split {
+    /// Entirely in front (possibly touching the plane).
+    Front(Polygon),
+    /// Entirely behind (possibly touching the plane).
+    Back(Polygon),
+    /// In the plane.
+    Coplanar {
+        /// The polygon, unchanged.
+        polygon: Polygon,
+        /// Normals agree.
+        same_orientation: bool,
+    },
+    /// Cut into two convex pieces sharing the cut edge's two vertices.
+    Spanning {
+        /// The piece in front.
+        front: Polygon,
+        /// The piece behind.
+        back: Polygon,
+    },
+}
+
+/// Why an input face could not become one convex polygon.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FaceDefect {
+    /// Fewer than three distinct vertices.
+    TooFewVertices,
+    /// All vertices on one line, or zero enclosed area.
+    ZeroArea,
+    /// Not all vertices lie in one plane (after snapping).
+    NonPlanar,
+    /// Planar but not convex (or not simple).
+    NonConvex,
+}
+
+impl std::fmt::Display for FaceDefect {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            FaceDefect::TooFewVertices => "fewer than three distinct vertices",
+            FaceDefect::ZeroArea => "zero area (collinear vertices)",
+            FaceDefect::NonPlanar => "vertices not in one plane",
+            FaceDefect::NonConvex => "not convex",
+        })
+    }
+}
+
+/// A convex polygon: a support plane and a cycle of edge planes.
+///
+/// Vertex `i` is the intersection of the support plane with edge planes
+/// `i - 1` and `i`; edge plane `i` bounds the edge from vertex `i` to vertex
+/// `i + 1`, with the polygon's interior behind it. Vertices run
+/// counter-clockwise seen from the support plane's front. The vertices are
+/// cached as exact [`Point`]s; new ones are created only where a split cuts
+/// an edge, and both pieces share them.
+#[derive(Clone, Debug)]
+pub struct Polygon {
+    support: Plane,
+    edges: SmallVec<[Plane; 4]>,
+    verts: SmallVec<[Point; 4]>,
+    tag: u32,
+}
+
+fn dedupe_cyclic(points: &[GridPoint]) -> Vec<GridPoint> {
+    let mut v: Vec<GridPoint> = Vec::with_capacity(points.len());
+    for p in points {
+        if v.last() != Some(p) {
+            v.push(*p);
+        }
+    }
+    while v.len() > 1 && v.first() == v.last() {
+        v.pop();
+    }
+    v
+}
+
+/// Removes vertices whose two edges are collinear (straight-through points
+/// and zero-area spikes); they do not change the enclosed region.
+fn remove_collinear(v: &mut Vec<GridPoint>) {
+    let mut changed = true;
+    while changed && v.len() >= 3 {
+        changed = false;
+        let k = v.len();
+        for i in 0..k {
+            let prev = v[(i + k - 1) % k];
+            let next = v[(i + 1) % k];
+            if cross(sub(v[i], prev), sub(next, v[i])) == [0, 0, 0] {
+                v.remove(i);
+                changed = true;
+                break;
+            }
+        }
+        // removing a spike can make two neighbours equal
+        let d = dedupe_cyclic(v);
+        if d.len() != v.len() {
+            *v = d;
+            changed = true;
+        }
+    }
+}
+
+/// The support plane of a planar loop, oriented by its winding; `None` if
+/// the enclosed area is zero.
+pub(crate) fn support_plane(v: &[GridPoint]) -> Result<Plane, FaceDefect> {
+    let k = v.len();
+    let mut plane = None;
+    'outer: for i in 1..k {
+        for j in i + 1..k {
+            if let Some(p) = Plane::through(v[0], v[i], v[j]) {
+                plane = Some(p);
+                break 'outer;
+            }
+        }
+    }
+    let plane = plane.ok_or(FaceDefect::ZeroArea)?;
+    if v.iter().any(|p| plane.classify_grid(*p) != crate::Side::On) {
+        return Err(FaceDefect::NonPlanar);
+    }
+    // orientation: twice the projected signed area along the dominant axis
+    let ax = plane.dominant_axis();
+    let (a, b) = ((ax + 1) % 3, (ax + 2) % 3);
+    let mut area2: i128 = 0;
+    for i in 0..k {
+        let p = v[i];
+        let q = v[(i + 1) % k];
+        area2 += p[a] as i128 * q[b] as i128 - q[a] as i128 * p[b] as i128;
+    }
+    if area2 == 0 {
+        return Err(FaceDefect::ZeroArea);
+    }
+    let n = plane.normal()[ax];
+    Ok(if (area2 > 0) == (n > 0) { plane } else { plane.flip() })
+}
+
+impl Polygon {
+    /// A polygon from grid points in counter-clockwise order.
+    ///
+    /// Repeated and collinear vertices are removed first; the rest must be
+    /// planar and strictly convex.
+    ///
+    /// ```
+    /// use bsp_core::{Polygon, FaceDefect};
+    /// let sq = Polygon::from_grid_points(&[[0, 0, 0], [2, 0, 0], [2, 2, 0], [1, 2, 0], [0, 2, 0]], 7).unwrap();
+    /// assert_eq!(sq.len(), 4); // the collinear vertex is gone
+    /// assert_eq!(sq.support().normal(), [0, 0, 1]);
+    /// let bow = Polygon::from_grid_points(&[[0, 0, 0], [2, 2, 0], [2, 0, 0], [0, 2, 0]], 0);
+    /// assert!(bow.is_err());
+    /// ```
+    pub fn from_grid_points(points: &[GridPoint], tag: u32) -> Result<Polygon, FaceDefect> {
+        let mut v = dedupe_cyclic(points);
+        if v.len() < 3 {
+            return Err(FaceDefect::TooFewVertices);
+        }
+        let support = support_plane(&v)?;
+        remove_collinear(&mut v);
+        if v.len() < 3 {
+            return Err(FaceDefect::ZeroArea);
+        }
+        let k = v.len();
+        let edges: SmallVec<[Plane; 4]> = (0..k)
+            .map(|i| {
+                Plane::edge(v[i], v[(i + 1) % k], &support)
+                    .expect("edge plane of two distinct grid points fits the budget")
+            })
+            .collect();
+        for (i, e) in edges.iter().enumerate() {
+            for (j, p) in v.iter().enumerate() {
+                if j != i && j != (i + 1) % k && e.classify_grid(*p) != crate::Side::Back {
+                    return Err(FaceDefect::NonConvex);
+                }
+            }
+        }
+        Ok(Polygon {
+            support,
+            edges,
+            verts: v.into_iter().map(Point::Grid).collect(),
+            tag,
+        })
+    }
+
+    /// The support plane.
+    pub fn support(&self) -> &Plane {
+        &self.support
+    }
+
+    /// The edge planes; plane `i` bounds the edge from vertex `i` to `i + 1`.
+    pub fn edge_planes(&self) -> &[Plane] {
+        &self.edges
+    }
+
+    /// The exact vertices, counter-clockwise.
+    pub fn vertices(&self) -> &[Point] {
+        &self.verts
+    }
+
+    /// Number of vertices.
+    pub fn len(&self) -> usize {
+        self.verts.len()
+    }
+
+    /// Always `false`: a polygon has at least three vertices.
+    pub fn is_empty(&self) -> bool {
+        self.verts.is_empty()
+    }
+
+    /// The caller's tag, carried unchanged into every fragment (e.g. the
+    /// index of the input face).
+    pub fn tag(&self) -> u32 {
+        self.tag
+    }
+
+    /// Vertices in grid coordinates, correctly rounded to `f64`.
+    pub fn vertices_f64(&self) -> Vec<[f64; 3]> {
+        self.verts.iter().map(Point::to_f64).collect()
+    }
+
+    /// Exact position relative to `plane`.
+    pub fn classify(&self, plane: &Plane) -> PolygonSide {
+        if self.support == *plane {
+            return PolygonSide::Coplanar {
+                same_orientation: true,
+            };
+        }
+        if self.support == plane.flip() {
+            return PolygonSide::Coplanar {
+                same_orientation: false,
+            };
+        }
+        let (mut front, mut back) = (false, false);
+        for v in &self.verts {
+            match v.classify(plane) {
+                crate::Side::Front => front = true,
+                crate::Side::Back => back = true,
+                crate::Side::On => {}
+            }
+            if front && back {
+                return PolygonSide::Spanning;
+            }
+        }
+        match (front, back) {
+            (true, _) => PolygonSide::Front,
+            (_, true) => PolygonSide::Back,
+            // a non-degenerate polygon with every vertex on `plane` lies in
+            // it, and reduced planes are then equal up to sign: unreachable
+            // for valid polygons, answered consistently anyway
+            _ => PolygonSide::Coplanar {
+                same_orientation: self.support.same_direction(plane),
+            },
+        }
+    }
+
+    /// Splits by `plane`. The two pieces of a spanning polygon are convex,
+    /// cover it exactly, and share the same two exact vertices on the cut.
+    pub fn split(self, plane: &Plane) -> Split {
+        match self.classify(plane) {
+            PolygonSide::Front => return Split::Front(self),
+            PolygonSide::Back => return Split::Back(self),
+            PolygonSide::Coplanar { same_orientation } => {
+                return Split::Coplanar {
+                    polygon: self,
+                    same_orientation,
+                };
+            }
+            PolygonSide::Spanning => {}
+        }
+        let sides: SmallVec<[crate::Side; 8]> =
+            self.verts.iter().map(|v| v.classify(plane)).collect();
+        let (front, back) = self.split_with_sides(plane, &sides);
+        Split::Spanning { front, back }
+    }
+
+    fn split_with_sides(&self, plane: &Plane, sides: &[crate::Side]) -> (Polygon, Polygon) {
+        use crate::Side::{Back, Front, On};
+        let cut_front = plane.flip();
+        let cut_back = *plane;
+        let k = self.verts.len();
+        let mut f = Builder::new(self.support, self.tag);
+        let mut b = Builder::new(self.support, self.tag);
+        for i in 0..k {
+            let j = if i + 1 == k { 0 } else { i + 1 };
+            let (vi, ei) = (&self.verts[i], &self.edges[i]);
+            match (sides[i], sides[j]) {
+                (Front, Back) | (Back, Front) => {
+                    let x = Point::from_planes(&self.support, ei, plane)
+                        .expect("a spanning edge meets the cutting plane in one point");
+                    if sides[i] == Front {
+                        f.push(vi.clone(), *ei);
+                        f.push(x.clone(), cut_front);
+                        b.push(x, *ei);
+                    } else {
+                        b.push(vi.clone(), *ei);
+                        b.push(x.clone(), cut_back);
+                        f.push(x, *ei);
+                    }
+                }
+                (Front, _) => f.push(vi.clone(), *ei),
+                (Back, _) => b.push(vi.clone(), *ei),
+                (On, Back) => {
+                    f.push(vi.clone(), cut_front);
+                    b.push(vi.clone(), *ei);
+                }
+                (On, _) => {
+                    f.push(vi.clone(), *ei);
+                    b.push(vi.clone(), cut_back);
+                }
+            }
+        }
+        (f.finish(), b.finish())
+    }
+
+    /// Checks the representation invariants exactly: every vertex lies on
+    /// the support plane and on its two edge planes, and strictly behind
+    /// every other edge plane (strict convexity).
+    pub fn sanity_check(&self) -> Result<(), String> {
+        let k = self.verts.len();
+        if k < 3 || self.edges.len() != k {
+            return Err(format!("{k} vertices, {} edges", self.edges.len()));
+        }
+        for (i, v) in self.verts.iter().enumerate() {
+            if v.classify(&self.support) != crate::Side::On {
+                return Err(format!("vertex {i} is off the support plane"));
+            }
+            for (j, e) in self.edges.iter().enumerate() {
+                let incident = j == i || (j + 1) % k == i;
+                let s = v.classify(e);
+                if incident && s != crate::Side::On {
+                    return Err(format!("vertex {i} is off its edge plane {j}"));
+                }
+                if !incident && s != crate::Side::Back {
+                    return Err(format!("vertex {i} is not strictly inside edge plane {j}"));
+                }
+            }
+            if self.edges[i].is_coincident(&self.support) {
+                return Err(format!("edge plane {i} is the support plane"));
+            }
+        }
+        Ok(())
+    }
+}
+
+struct Builder {
+    support: Plane,
+    tag: u32,
+    edges: SmallVec<[Plane; 4]>,
+    verts: SmallVec<[Point; 4]>,
+}
+
+impl Builder {
+    fn new(support: Plane, tag: u32) -> Builder {
+        Builder {
+            support,
+            tag,
+            edges: SmallVec::new(),
+            verts: SmallVec::new(),
+        }
+    }
+    fn push(&mut self, v: Point, outgoing: Plane) {
+        self.verts.push(v);
+        self.edges.push(outgoing);
+    }
+    fn finish(self) -> Polygon {
+        debug_assert!(self.verts.len() >= 3, "a split piece has at least 3 vertices");
+        Polygon {
+            support: self.support,
+            edges: self.edges,
+            verts: self.verts,
+            tag: self.tag,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> Polygon {
+        Polygon::from_grid_points(&[[0, 0, 0], [4, 0, 0], [4, 4, 0], [0, 4, 0]], 1).unwrap()
+    }
+
+    #[test]
+    fn split_through_vertices_shares_them() {
+        let diag = Plane::new([1, -1, 0], 0).unwrap();
+        match square().split(&diag) {
+            Split::Spanning { front, back } => {
+                assert_eq!(front.len(), 3);
+                assert_eq!(back.len(), 3);
+                front.sanity_check().unwrap();
+                back.sanity_check().unwrap();
+                assert!(front.vertices().iter().all(|v| matches!(v, Point::Grid(_))));
+            }
+            other => panic!("expected a span, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn split_across_edges_creates_shared_implicit_vertices() {
+        let cut = Plane::new([1, 0, 0], -1).unwrap(); // x = 1
+        let Split::Spanning { front, back } = square().split(&cut) else {
+            panic!("expected a span")
+        };
+        front.sanity_check().unwrap();
+        back.sanity_check().unwrap();
+        let shared: Vec<_> = front
+            .vertices()
+            .iter()
+            .filter(|v| back.vertices().iter().any(|w| w.same_point(v)))
+            .collect();
+        assert_eq!(shared.len(), 2);
+        assert_eq!(front.tag(), 1);
+    }
+
+    #[test]
+    fn touching_and_coplanar() {
+        let sq = square();
+        let touch = Plane::new([1, 0, 0], 0).unwrap(); // x = 0, an edge
+        assert_eq!(sq.classify(&touch), PolygonSide::Front);
+        let z = Plane::new([0, 0, 1], 0).unwrap();
+        assert_eq!(
+            sq.classify(&z),
+            PolygonSide::Coplanar {
+                same_orientation: true
+            }
+        );
+        assert_eq!(
+            sq.classify(&z.flip()),
+            PolygonSide::Coplanar {
+                same_orientation: false
+            }
+        );
+    }
+
+    #[test]
+    fn defects_are_named() {
+        let e = |p: &[GridPoint]| Polygon::from_grid_points(p, 0).unwrap_err();
+        assert_eq!(e(&[[0, 0, 0], [1, 0, 0], [0, 0, 0]]), FaceDefect::TooFewVertices);
+        assert_eq!(e(&[[0, 0, 0], [1, 0, 0], [2, 0, 0]]), FaceDefect::ZeroArea);
+        assert_eq!(
+            e(&[[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 1]]),
+            FaceDefect::NonPlanar
+        );
+        assert_eq!(
+            e(&[[0, 0, 0], [4, 0, 0], [4, 4, 0], [2, 1, 0], [0, 4, 0]]),
+            FaceDefect::NonConvex
+        );
+    }
+}

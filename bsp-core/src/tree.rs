@@ -1,0 +1,536 @@
+//! BSP trees: autopartition build, painter's-order traversal, solid
+//! membership, invariants.
+//!
+//! Nothing here recurses without a bound: build, traversal, membership and
+//! checks use explicit stacks, and the recursive traversal hands over to the
+//! iterative one past [`RECURSION_LIMIT`] levels.
+
+use crate::grid::ViewPoint;
+use crate::plane::Plane;
+use crate::point::Point;
+use crate::polygon::{Polygon, PolygonSide, Split};
+use crate::Side;
+
+/// Index of a node in [`BspTree::nodes`].
+pub type NodeId = u32;
+
+/// A leaf cell's solid label.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Cell {
+    /// Inside the solid.
+    In,
+    /// Outside the solid.
+    Out,
+}
+
+/// A child reference: an inner node or a leaf cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Link {
+    /// An inner node.
+    Node(NodeId),
+    /// A leaf cell.
+    Cell(Cell),
+}
+
+/// An inner node: a partitioning plane and the polygons lying in it.
+#[derive(Clone, Debug)]
+pub struct Node {
+    /// The partitioning plane (the support plane of the polygon that chose it).
+    pub plane: Plane,
+    /// Polygons in the plane, of either orientation.
+    pub polygons: Vec<Polygon>,
+    /// Subtree in front of the plane.
+    pub front: Link,
+    /// Subtree behind the plane.
+    pub back: Link,
+}
+
+/// Where a point lies relative to a solid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Membership {
+    /// Strictly inside.
+    Inside,
+    /// Strictly outside.
+    Outside,
+    /// On the boundary.
+    Boundary,
+}
+
+/// Drawing order of a traversal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Order {
+    /// Farthest first (painter's algorithm).
+    BackToFront,
+    /// Nearest first (as from a light, for shadows).
+    FrontToBack,
+}
+
+/// Levels the recursive traversal descends before it continues with an
+/// explicit stack.
+pub const RECURSION_LIMIT: usize = 2048;
+
+/// Options of the autopartition build.
+///
+/// At every node, `candidates` polygons of the node's list are tried as
+/// the partitioning plane; each is scored on a sample of `sample` polygons
+/// as `split_weight * spanning + |front - back|`, and the lowest score wins.
+/// More candidates and larger samples cost build time and save fragments.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct BuildOptions {
+    /// Candidate planes tried per node.
+    pub candidates: usize,
+    /// Polygons each candidate is scored on.
+    pub sample: usize,
+    /// Cost of one split relative to one unit of imbalance.
+    pub split_weight: u32,
+    /// Seed of the deterministic sampling.
+    pub seed: u64,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        BuildOptions {
+            candidates: 8,
+            sample: 48,
+            split_weight: 4,
+            seed: 0x5eed_b5b7,
+        }
+    }
+}
+
+impl BuildOptions {
+    /// Sets [`BuildOptions::candidates`] (at least 1).
+    pub fn with_candidates(mut self, n: usize) -> Self {
+        self.candidates = n.max(1);
+        self
+    }
+    /// Sets [`BuildOptions::sample`] (at least 1).
+    pub fn with_sample(mut self, n: usize) -> Self {
+        self.sample = n.max(1);
+        self
+    }
+    /// Sets [`BuildOptions::split_weight`].
+    pub fn with_split_weight(mut self, w: u32) -> Self {
+        self.split_weight = w;
+        self
+    }
+    /// Sets [`BuildOptions::seed`].
+    pub fn with_seed(mut self, s: u64) -> Self {
+        self.seed = s;
+        self
+    }
+}
+
+/// Size figures of a tree.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TreeStats {
+    /// Inner nodes.
+    pub nodes: usize,
+    /// Polygons stored (fragments after splitting).
+    pub polygons: usize,
+    /// Longest root-to-leaf path, counted in inner nodes.
+    pub depth: usize,
+    /// Leaf cells labelled [`Cell::In`].
+    pub in_cells: usize,
+    /// Leaf cells labelled [`Cell::Out`].
+    pub out_cells: usize,
+}
+
+/// A BSP tree over convex polygons, stored as an arena of nodes.
+///
+/// Leaves carry solid labels: an empty list behind a plane is [`Cell::In`],
+/// in front [`Cell::Out`] (Thibault & Naylor). For a closed, consistently
+/// oriented mesh this makes the tree a solid and [`BspTree::classify_point`]
+/// exact point membership; for an open polygon soup the labels carry no
+/// meaning, and the tree is used for ordering only.
+#[derive(Clone, Debug)]
+pub struct BspTree {
+    nodes: Vec<Node>,
+    root: Link,
+}
+
+struct SplitMix(u64);
+impl SplitMix {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn below(&mut self, n: usize) -> usize {
+        ((self.next() >> 32) * n as u64 >> 32) as usize
+    }
+}
+
+#[derive(Clone, Copy)]
+enum Slot {
+    Root,
+    Front(NodeId),
+    Back(NodeId),
+}
+
+fn choose_plane(polys: &[Polygon], opts: &BuildOptions, rng: &mut SplitMix) -> Plane {
+    let n = polys.len();
+    if n <= 2 {
+        return *polys[0].support();
+    }
+    let k = opts.candidates.min(n);
+    let s = opts.sample.min(n);
+    let sample: Vec<usize> = if s == n {
+        (0..n).collect()
+    } else {
+        (0..s).map(|_| rng.below(n)).collect()
+    };
+    let mut best = (u64::MAX, *polys[0].support());
+    for c in 0..k {
+        let plane = if k == n {
+            *polys[c].support()
+        } else {
+            *polys[rng.below(n)].support()
+        };
+        let (mut f, mut b, mut sp) = (0u64, 0u64, 0u64);
+        for &i in &sample {
+            match polys[i].classify(&plane) {
+                PolygonSide::Front => f += 1,
+                PolygonSide::Back => b += 1,
+                PolygonSide::Spanning => sp += 1,
+                PolygonSide::Coplanar { .. } => {}
+            }
+        }
+        let score = opts.split_weight as u64 * sp + f.abs_diff(b);
+        if score < best.0 {
+            best = (score, plane);
+        }
+    }
+    best.1
+}
+
+impl BspTree {
+    /// An autopartition of `polygons`: every partitioning plane is the
+    /// support plane of an input polygon; coplanar polygons of both
+    /// orientations stay at their node. Uses an explicit stack, so any
+    /// depth is fine.
+    pub fn build(polygons: Vec<Polygon>, opts: &BuildOptions) -> BspTree {
+        let mut tree = BspTree {
+            nodes: Vec::new(),
+            root: Link::Cell(Cell::Out),
+        };
+        let mut rng = SplitMix(opts.seed);
+        let mut stack: Vec<(Vec<Polygon>, Slot)> = vec![(polygons, Slot::Root)];
+        while let Some((polys, slot)) = stack.pop() {
+            let link = if polys.is_empty() {
+                Link::Cell(match slot {
+                    Slot::Back(_) => Cell::In,
+                    Slot::Front(_) | Slot::Root => Cell::Out,
+                })
+            } else {
+                let plane = choose_plane(&polys, opts, &mut rng);
+                let (mut on, mut front, mut back) = (Vec::new(), Vec::new(), Vec::new());
+                for p in polys {
+                    match p.split(&plane) {
+                        Split::Front(p) => front.push(p),
+                        Split::Back(p) => back.push(p),
+                        Split::Coplanar { polygon, .. } => on.push(polygon),
+                        Split::Spanning { front: f, back: b } => {
+                            front.push(f);
+                            back.push(b);
+                        }
+                    }
+                }
+                let id = tree.nodes.len() as NodeId;
+                tree.nodes.push(Node {
+                    plane,
+                    polygons: on,
+                    front: Link::Cell(Cell::Out),
+                    back: Link::Cell(Cell::In),
+                });
+                stack.push((back, Slot::Back(id)));
+                stack.push((front, Slot::Front(id)));
+                Link::Node(id)
+            };
+            match slot {
+                Slot::Root => tree.root = link,
+                Slot::Front(id) => tree.nodes[id as usize].front = link,
+                Slot::Back(id) => tree.nodes[id as usize].back = link,
+            }
+        }
+        tree
+    }
+
+    /// The root link.
+    pub fn root(&self) -> Link {
+        self.root
+    }
+
+    /// All inner nodes (indexed by [`NodeId`]).
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// One node.
+    pub fn node(&self, id: NodeId) -> &Node {
+        &self.nodes[id as usize]
+    }
+
+    /// Every stored polygon, in node order.
+    pub fn polygons(&self) -> impl Iterator<Item = &Polygon> {
+        self.nodes.iter().flat_map(|n| n.polygons.iter())
+    }
+
+    /// Node count, fragment count, depth and leaf counts.
+    pub fn stats(&self) -> TreeStats {
+        let mut s = TreeStats {
+            nodes: self.nodes.len(),
+            polygons: self.nodes.iter().map(|n| n.polygons.len()).sum(),
+            ..TreeStats::default()
+        };
+        let mut stack = vec![(self.root, 0usize)];
+        while let Some((link, d)) = stack.pop() {
+            match link {
+                Link::Cell(c) => {
+                    s.depth = s.depth.max(d);
+                    match c {
+                        Cell::In => s.in_cells += 1,
+                        Cell::Out => s.out_cells += 1,
+                    }
+                }
+                Link::Node(id) => {
+                    let n = &self.nodes[id as usize];
+                    stack.push((n.front, d + 1));
+                    stack.push((n.back, d + 1));
+                }
+            }
+        }
+        s
+    }
+
+    fn children_in_order(&self, n: &Node, eye: ViewPoint, order: Order) -> (Link, Link) {
+        let eye_in_front = n.plane.classify_viewpoint(eye) != Side::Back;
+        if eye_in_front == (order == Order::BackToFront) {
+            (n.back, n.front)
+        } else {
+            (n.front, n.back)
+        }
+    }
+
+    /// Visits every polygon in `order` as seen from `eye`, with an explicit
+    /// stack. Polygons in the same node (coplanar) come out together.
+    ///
+    /// ```
+    /// use bsp_core::{BspTree, BuildOptions, Order, Polygon, ViewPoint};
+    /// let near = Polygon::from_grid_points(&[[0, 0, 1], [4, 0, 1], [0, 4, 1]], 0).unwrap();
+    /// let far = Polygon::from_grid_points(&[[0, 0, 0], [4, 0, 0], [0, 4, 0]], 1).unwrap();
+    /// let tree = BspTree::build(vec![near, far], &BuildOptions::default());
+    /// let mut tags = vec![];
+    /// tree.traverse(ViewPoint::new([1, 1, 10]).unwrap(), Order::BackToFront, |p| tags.push(p.tag()));
+    /// assert_eq!(tags, vec![1, 0]);
+    /// ```
+    pub fn traverse(&self, eye: ViewPoint, order: Order, mut visit: impl FnMut(&Polygon)) {
+        self.traverse_from(self.root, eye, order, &mut visit);
+    }
+
+    fn traverse_from(
+        &self,
+        start: Link,
+        eye: ViewPoint,
+        order: Order,
+        visit: &mut impl FnMut(&Polygon),
+    ) {
+        enum Item {
+            Visit(Link),
+            Emit(NodeId),
+        }
+        let mut stack = vec![Item::Visit(start)];
+        while let Some(item) = stack.pop() {
+            match item {
+                Item::Visit(Link::Cell(_)) => {}
+                Item::Visit(Link::Node(id)) => {
+                    let n = &self.nodes[id as usize];
+                    let (first, second) = self.children_in_order(n, eye, order);
+                    stack.push(Item::Visit(second));
+                    stack.push(Item::Emit(id));
+                    stack.push(Item::Visit(first));
+                }
+                Item::Emit(id) => self.nodes[id as usize].polygons.iter().for_each(&mut *visit),
+            }
+        }
+    }
+
+    /// The same order as [`BspTree::traverse`], by recursion; past
+    /// [`RECURSION_LIMIT`] levels it continues with an explicit stack, so
+    /// a degenerate chain cannot overflow the call stack.
+    pub fn traverse_recursive(&self, eye: ViewPoint, order: Order, mut visit: impl FnMut(&Polygon)) {
+        self.recurse(self.root, eye, order, &mut visit, 0);
+    }
+
+    fn recurse(
+        &self,
+        link: Link,
+        eye: ViewPoint,
+        order: Order,
+        visit: &mut impl FnMut(&Polygon),
+        depth: usize,
+    ) {
+        let Link::Node(id) = link else { return };
+        if depth >= RECURSION_LIMIT {
+            return self.traverse_from(link, eye, order, visit);
+        }
+        let n = &self.nodes[id as usize];
+        let (first, second) = self.children_in_order(n, eye, order);
+        self.recurse(first, eye, order, visit, depth + 1);
+        n.polygons.iter().for_each(&mut *visit);
+        self.recurse(second, eye, order, visit, depth + 1);
+    }
+
+    /// Exact point membership for a solid tree (see the type's docs).
+    ///
+    /// A point on a partitioning plane is looked up on both sides; it is on
+    /// the boundary exactly when the cells around it disagree. Every
+    /// subtree is entered at most once, so the cost is bounded by the tree
+    /// size.
+    pub fn classify_point(&self, p: &Point) -> Membership {
+        let (mut saw_in, mut saw_out) = (false, false);
+        let mut stack = vec![self.root];
+        while let Some(link) = stack.pop() {
+            match link {
+                Link::Cell(Cell::In) => saw_in = true,
+                Link::Cell(Cell::Out) => saw_out = true,
+                Link::Node(id) => {
+                    let n = &self.nodes[id as usize];
+                    match p.classify(&n.plane) {
+                        Side::Front => stack.push(n.front),
+                        Side::Back => stack.push(n.back),
+                        Side::On => {
+                            stack.push(n.front);
+                            stack.push(n.back);
+                        }
+                    }
+                }
+            }
+            if saw_in && saw_out {
+                return Membership::Boundary;
+            }
+        }
+        if saw_in {
+            Membership::Inside
+        } else {
+            Membership::Outside
+        }
+    }
+
+    /// Checks the tree invariants exactly: the links form a tree reaching
+    /// every node once; every stored polygon is valid and lies in its
+    /// node's plane; every polygon of a subtree lies on that subtree's
+    /// side of each ancestor plane (touching it at most).
+    ///
+    /// Costs `O(polygons × depth)`; meant for tests and fuzzing.
+    pub fn sanity_check(&self) -> Result<(), String> {
+        let mut seen = vec![false; self.nodes.len()];
+        // (link, index into `path` where this link's ancestors end)
+        let mut path: Vec<(Plane, Side)> = Vec::new();
+        let mut stack: Vec<(Link, usize, Option<(Plane, Side)>)> = vec![(self.root, 0, None)];
+        while let Some((link, depth, edge)) = stack.pop() {
+            path.truncate(depth);
+            if let Some(e) = edge {
+                path.push(e);
+            }
+            let Link::Node(id) = link else { continue };
+            let Some(flag) = seen.get_mut(id as usize) else {
+                return Err(format!("link to missing node {id}"));
+            };
+            if std::mem::replace(flag, true) {
+                return Err(format!("node {id} is reached twice"));
+            }
+            let n = &self.nodes[id as usize];
+            if n.polygons.is_empty() {
+                return Err(format!("node {id} holds no polygon"));
+            }
+            for (k, p) in n.polygons.iter().enumerate() {
+                p.sanity_check()
+                    .map_err(|e| format!("node {id} polygon {k}: {e}"))?;
+                if !p.support().is_coincident(&n.plane) {
+                    return Err(format!("node {id} polygon {k} is not in the node plane"));
+                }
+                for (a, (plane, side)) in path.iter().enumerate() {
+                    let ok = match (p.classify(plane), side) {
+                        (PolygonSide::Front, Side::Front) | (PolygonSide::Back, Side::Back) => true,
+                        _ => false,
+                    };
+                    if !ok {
+                        return Err(format!(
+                            "node {id} polygon {k} is not on the {side:?} side of ancestor {a}"
+                        ));
+                    }
+                }
+            }
+            let d = path.len();
+            stack.push((n.front, d, Some((n.plane, Side::Front))));
+            stack.push((n.back, d, Some((n.plane, Side::Back))));
+        }
+        if let Some(i) = seen.iter().position(|s| !s) {
+            return Err(format!("node {i} is unreachable"));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube(lo: i32, hi: i32) -> Vec<Polygon> {
+        let c = |x, y, z| [x, y, z];
+        let (l, h) = (lo, hi);
+        let quads = [
+            [c(l, l, l), c(l, h, l), c(h, h, l), c(h, l, l)],
+            [c(l, l, h), c(h, l, h), c(h, h, h), c(l, h, h)],
+            [c(l, l, l), c(h, l, l), c(h, l, h), c(l, l, h)],
+            [c(l, h, l), c(l, h, h), c(h, h, h), c(h, h, l)],
+            [c(l, l, l), c(l, l, h), c(l, h, h), c(l, h, l)],
+            [c(h, l, l), c(h, h, l), c(h, h, h), c(h, l, h)],
+        ];
+        quads
+            .iter()
+            .enumerate()
+            .map(|(i, q)| Polygon::from_grid_points(q, i as u32).unwrap())
+            .collect()
+    }
+
+    #[test]
+    fn cube_membership() {
+        let t = BspTree::build(cube(0, 4), &BuildOptions::default());
+        t.sanity_check().unwrap();
+        let m = |p: [i32; 3]| t.classify_point(&Point::Grid(p));
+        assert_eq!(m([2, 2, 2]), Membership::Inside);
+        assert_eq!(m([5, 2, 2]), Membership::Outside);
+        assert_eq!(m([4, 2, 2]), Membership::Boundary);
+        assert_eq!(m([4, 4, 4]), Membership::Boundary);
+        assert_eq!(m([4, 5, 4]), Membership::Outside);
+        assert_eq!(t.stats().nodes, 6);
+    }
+
+    #[test]
+    fn deep_chain_does_not_overflow() {
+        // the side faces of a convex prism over the parabola y = x^2: every
+        // face has all others behind it, so the tree is a chain as deep as
+        // the face count whatever the heuristic picks
+        let n = 5_000;
+        let polys: Vec<Polygon> = (-n..n)
+            .map(|i: i32| {
+                let (a, b) = ([i, i * i, 0], [i + 1, (i + 1) * (i + 1), 0]);
+                let up = |p: [i32; 3]| [p[0], p[1], 1];
+                Polygon::from_grid_points(&[a, b, up(b), up(a)], (i + n) as u32).unwrap()
+            })
+            .collect();
+        let t = BspTree::build(polys, &BuildOptions::default());
+        assert_eq!(t.stats().depth, 2 * n as usize);
+        let eye = ViewPoint::new([0, -10, 0]).unwrap();
+        let (mut a, mut b) = (vec![], vec![]);
+        t.traverse_recursive(eye, Order::FrontToBack, |p| a.push(p.tag()));
+        t.traverse(eye, Order::FrontToBack, |p| b.push(p.tag()));
+        assert_eq!(a.len(), 2 * n as usize);
+        assert_eq!(a, b);
+    }
+}
