@@ -263,15 +263,8 @@ impl Polygon {
 
     /// Exact position relative to `plane`.
     pub fn classify(&self, plane: &Plane) -> PolygonSide {
-        if self.support == *plane {
-            return PolygonSide::Coplanar {
-                same_orientation: true,
-            };
-        }
-        if self.support == plane.flip() {
-            return PolygonSide::Coplanar {
-                same_orientation: false,
-            };
+        if let Some(c) = self.coplanar_with(plane) {
+            return c;
         }
         let (mut front, mut back) = (false, false);
         for v in &self.verts {
@@ -284,13 +277,35 @@ impl Polygon {
                 return PolygonSide::Spanning;
             }
         }
+        self.side_from(front, back, plane)
+    }
+
+    /// Coplanar answer from plane identity alone: reduced planes are equal
+    /// exactly when they coincide.
+    #[inline]
+    fn coplanar_with(&self, plane: &Plane) -> Option<PolygonSide> {
+        if self.support == *plane {
+            Some(PolygonSide::Coplanar {
+                same_orientation: true,
+            })
+        } else if self.support == plane.flip() {
+            Some(PolygonSide::Coplanar {
+                same_orientation: false,
+            })
+        } else {
+            None
+        }
+    }
+
+    fn side_from(&self, front: bool, back: bool, plane: &Plane) -> PolygonSide {
         match (front, back) {
-            (true, _) => PolygonSide::Front,
-            (_, true) => PolygonSide::Back,
+            (true, true) => PolygonSide::Spanning,
+            (true, false) => PolygonSide::Front,
+            (false, true) => PolygonSide::Back,
             // a non-degenerate polygon with every vertex on `plane` lies in
             // it, and reduced planes are then equal up to sign: unreachable
             // for valid polygons, answered consistently anyway
-            _ => PolygonSide::Coplanar {
+            (false, false) => PolygonSide::Coplanar {
                 same_orientation: self.support.same_direction(plane),
             },
         }
@@ -298,22 +313,31 @@ impl Polygon {
 
     /// Splits by `plane`. The two pieces of a spanning polygon are convex,
     /// cover it exactly, and share the same two exact vertices on the cut.
+    /// Each vertex is classified once.
     pub fn split(self, plane: &Plane) -> Split {
-        match self.classify(plane) {
-            PolygonSide::Front => return Split::Front(self),
-            PolygonSide::Back => return Split::Back(self),
-            PolygonSide::Coplanar { same_orientation } => {
-                return Split::Coplanar {
-                    polygon: self,
-                    same_orientation,
-                };
+        let side = match self.coplanar_with(plane) {
+            Some(c) => c,
+            None => {
+                let sides: SmallVec<[crate::Side; 8]> =
+                    self.verts.iter().map(|v| v.classify(plane)).collect();
+                let front = sides.contains(&crate::Side::Front);
+                let back = sides.contains(&crate::Side::Back);
+                if front && back {
+                    let (front, back) = self.split_with_sides(plane, &sides);
+                    return Split::Spanning { front, back };
+                }
+                self.side_from(front, back, plane)
             }
-            PolygonSide::Spanning => {}
+        };
+        match side {
+            PolygonSide::Front => Split::Front(self),
+            PolygonSide::Back => Split::Back(self),
+            PolygonSide::Coplanar { same_orientation } => Split::Coplanar {
+                polygon: self,
+                same_orientation,
+            },
+            PolygonSide::Spanning => unreachable!("spanning handled above"),
         }
-        let sides: SmallVec<[crate::Side; 8]> =
-            self.verts.iter().map(|v| v.classify(plane)).collect();
-        let (front, back) = self.split_with_sides(plane, &sides);
-        Split::Spanning { front, back }
     }
 
     fn split_with_sides(&self, plane: &Plane, sides: &[crate::Side]) -> (Polygon, Polygon) {
