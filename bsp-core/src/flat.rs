@@ -7,11 +7,11 @@
 //! node count, and traversal is a loop over a small explicit stack of
 //! `u32`s, without recursion.
 
+use crate::Side;
 use crate::grid::ViewPoint;
 use crate::plane::Plane;
 use crate::polygon::Polygon;
 use crate::tree::{BspTree, Cell, Link, Order};
-use crate::Side;
 
 const IN: u32 = u32::MAX;
 const OUT: u32 = u32::MAX - 1;

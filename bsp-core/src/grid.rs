@@ -233,11 +233,23 @@ mod tests {
     #[test]
     fn snap_rejects_nan_and_far_points() {
         let g = Grid::fit(DVec3::ZERO, DVec3::ONE).unwrap();
-        assert_eq!(g.snap(DVec3::new(f64::NAN, 0.0, 0.0)), Err(SnapError::NonFinite));
-        assert_eq!(g.snap(DVec3::new(f64::INFINITY, 0.0, 0.0)), Err(SnapError::NonFinite));
-        assert_eq!(g.snap(DVec3::new(1e9, 0.0, 0.0)), Err(SnapError::OutOfRange));
+        assert_eq!(
+            g.snap(DVec3::new(f64::NAN, 0.0, 0.0)),
+            Err(SnapError::NonFinite)
+        );
+        assert_eq!(
+            g.snap(DVec3::new(f64::INFINITY, 0.0, 0.0)),
+            Err(SnapError::NonFinite)
+        );
+        assert_eq!(
+            g.snap(DVec3::new(1e9, 0.0, 0.0)),
+            Err(SnapError::OutOfRange)
+        );
         assert!(g.snap_viewpoint(DVec3::new(1e9, 0.0, 0.0)).is_ok());
-        assert_eq!(g.snap_viewpoint(DVec3::new(1e300, 0.0, 0.0)), Err(SnapError::OutOfRange));
+        assert_eq!(
+            g.snap_viewpoint(DVec3::new(1e300, 0.0, 0.0)),
+            Err(SnapError::OutOfRange)
+        );
     }
 
     #[test]

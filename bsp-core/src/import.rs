@@ -4,7 +4,7 @@ use glam::DVec3;
 
 use crate::grid::{Grid, GridPoint};
 use crate::plane::Plane;
-use crate::polygon::{support_plane, FaceDefect, Polygon};
+use crate::polygon::{FaceDefect, Polygon, support_plane};
 use crate::{Error, Side};
 
 /// What happened to the input faces on the way to convex polygons.
@@ -186,9 +186,11 @@ fn ear_clip(v: &[GridPoint], plane: &Plane) -> Option<Vec<[GridPoint; 3]>> {
 /// `true` if every vertex of every polygon lies exactly on its support plane
 /// (used by tests of importers).
 pub fn all_planar(polys: &[Polygon]) -> bool {
-    polys
-        .iter()
-        .all(|p| p.vertices().iter().all(|v| v.classify(p.support()) == Side::On))
+    polys.iter().all(|p| {
+        p.vertices()
+            .iter()
+            .all(|v| v.classify(p.support()) == Side::On)
+    })
 }
 
 #[cfg(test)]
@@ -231,7 +233,17 @@ mod tests {
         let f = [DVec3::ZERO, DVec3::X, DVec3::new(f64::NAN, 0.0, 0.0)];
         let grid = Grid::new(DVec3::ZERO, 0).unwrap();
         let e = import_faces(&grid, [&f[..]]).unwrap_err();
-        assert!(matches!(e, Error::Snap { face: 0, vertex: 2, .. }), "{e}");
+        assert!(
+            matches!(
+                e,
+                Error::Snap {
+                    face: 0,
+                    vertex: 2,
+                    ..
+                }
+            ),
+            "{e}"
+        );
         assert!(e.to_string().contains("face 0"));
     }
 }

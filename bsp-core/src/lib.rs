@@ -38,17 +38,27 @@
 mod flat;
 mod grid;
 mod import;
+mod mesh;
+mod partition;
 mod plane;
 mod point;
 mod polygon;
+mod topology;
 mod tree;
+
 
 pub use flat::FlatBsp;
 pub use grid::{Grid, GridPoint, SnapError, ViewPoint, GRID_BITS, MAX_COORD, MAX_VIEW_COORD};
 pub use import::{all_planar, import_faces, ImportReport};
+pub use mesh::TriMesh;
+pub use partition::{
+    box_section, merge, merge_smaller_into_larger, BoolOp, CellOp, Overlay, PLink, PNode, Partition,
+    BOX_HALF,
+};
 pub use plane::{Plane, MAX_NORMAL_BITS, MAX_OFFSET_BITS};
 pub use point::{Implicit, Point};
 pub use polygon::{FaceDefect, Polygon, PolygonSide, Side, Split};
+pub use topology::{check_closed_manifold, TopologyError};
 pub use tree::{
     BspTree, BuildOptions, Cell, Link, Membership, Node, NodeId, Order, TreeStats,
     RECURSION_LIMIT,

@@ -1,7 +1,7 @@
 //! Planes with integer coefficients.
 
-use crate::grid::{GridPoint, ViewPoint};
 use crate::Side;
+use crate::grid::{GridPoint, ViewPoint};
 
 /// Exclusive bound on the absolute value of a normal component: `2^55`.
 pub const MAX_NORMAL_BITS: u32 = 55;
@@ -70,7 +70,7 @@ impl Plane {
         let d = d / g;
         let fits = n.iter().all(|c| c.unsigned_abs() < 1u64 << MAX_NORMAL_BITS)
             && d.unsigned_abs() < 1u128 << MAX_OFFSET_BITS;
-        fits.then(|| Plane {
+        fits.then_some(Plane {
             n,
             d_approx: d as f64,
             d,

@@ -3,9 +3,9 @@
 use bnum::cast::As;
 use bnum::types::{I256, U256, U512};
 
+use crate::Side;
 use crate::grid::GridPoint;
 use crate::plane::Plane;
-use crate::Side;
 
 /// An exact point: either an input grid point or the intersection of three
 /// planes of the input budget, held in homogeneous integer coordinates.
@@ -158,6 +158,20 @@ impl Point {
         }
     }
 
+    /// Grid coordinates as `f64`, within a few ulps of the exact values
+    /// (from the cached roundings: fast, but not canonical — use
+    /// [`Point::to_f64`] for output).
+    #[inline]
+    pub fn approx_f64(&self) -> [f64; 3] {
+        match self {
+            Point::Grid(g) => g.map(|c| c as f64),
+            Point::Implicit(i) => {
+                let a = &i.approx;
+                [a[0] / a[3], a[1] / a[3], a[2] / a[3]]
+            }
+        }
+    }
+
     /// Grid coordinates as `f64`, each the correctly rounded value of the
     /// exact rational coordinate. Equal points give equal results however
     /// they were constructed.
@@ -179,15 +193,15 @@ impl Point {
             Point::Implicit(i) => {
                 let w = i.h[3];
                 let mut out = [0i32; 3];
-                for k in 0..3 {
-                    if !(i.h[k] % w).is_zero() {
+                for (o, h) in out.iter_mut().zip(&i.h[..3]) {
+                    if !(*h % w).is_zero() {
                         return None;
                     }
-                    let q = i.h[k] / w;
+                    let q = *h / w;
                     if q.unsigned_abs().bits() > 31 {
                         return None;
                     }
-                    out[k] = q.as_::<i32>();
+                    *o = q.as_::<i32>();
                 }
                 (out.iter().all(|c| c.abs() <= crate::MAX_COORD)).then_some(out)
             }

@@ -3,7 +3,7 @@
 use smallvec::SmallVec;
 
 use crate::grid::GridPoint;
-use crate::plane::{cross, sub, Plane};
+use crate::plane::{Plane, cross, sub};
 use crate::point::Point;
 
 /// Exact side of a point relative to a plane.
@@ -46,6 +46,8 @@ pub enum PolygonSide {
 }
 
 /// The result of splitting a polygon by a plane.
+// By value on purpose: the pieces move straight into the caller's lists.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 pub enum Split {
     /// Entirely in front (possibly touching the plane).
@@ -176,7 +178,11 @@ pub(crate) fn support_plane(v: &[GridPoint]) -> Result<Plane, FaceDefect> {
         return Err(FaceDefect::ZeroArea);
     }
     let n = plane.normal()[ax];
-    Ok(if (area2 > 0) == (n > 0) { plane } else { plane.flip() })
+    Ok(if (area2 > 0) == (n > 0) {
+        plane
+    } else {
+        plane.flip()
+    })
 }
 
 impl Polygon {
@@ -223,6 +229,45 @@ impl Polygon {
             verts: v.into_iter().map(Point::Grid).collect(),
             tag,
         })
+    }
+
+    /// A polygon from its support plane and cycle of edge planes (edge
+    /// plane `i` bounds the edge from vertex `i` to `i + 1`, interior
+    /// behind), computing the vertices. `None` if two consecutive planes do
+    /// not meet the support plane in one point. The caller guarantees
+    /// convexity (checked by [`Polygon::sanity_check`]).
+    pub fn from_planes(support: Plane, edges: &[Plane], tag: u32) -> Option<Polygon> {
+        let k = edges.len();
+        if k < 3 {
+            return None;
+        }
+        let verts = (0..k)
+            .map(|i| Point::from_planes(&support, &edges[(i + k - 1) % k], &edges[i]))
+            .collect::<Option<SmallVec<[Point; 4]>>>()?;
+        Some(Polygon {
+            support,
+            edges: edges.iter().copied().collect(),
+            verts,
+            tag,
+        })
+    }
+
+    /// The same polygon seen from the other side: flipped support plane,
+    /// reversed vertex order, same edge planes.
+    pub fn flipped(&self) -> Polygon {
+        let k = self.verts.len();
+        Polygon {
+            support: self.support.flip(),
+            edges: (0..k).map(|j| self.edges[(2 * k - 2 - j) % k]).collect(),
+            verts: self.verts.iter().rev().cloned().collect(),
+            tag: self.tag,
+        }
+    }
+
+    /// The same polygon with another tag.
+    pub fn with_tag(mut self, tag: u32) -> Polygon {
+        self.tag = tag;
+        self
     }
 
     /// The support plane.
@@ -430,7 +475,10 @@ impl Builder {
         self.edges.push(outgoing);
     }
     fn finish(self) -> Polygon {
-        debug_assert!(self.verts.len() >= 3, "a split piece has at least 3 vertices");
+        debug_assert!(
+            self.verts.len() >= 3,
+            "a split piece has at least 3 vertices"
+        );
         Polygon {
             support: self.support,
             edges: self.edges,
@@ -503,7 +551,10 @@ mod tests {
     #[test]
     fn defects_are_named() {
         let e = |p: &[GridPoint]| Polygon::from_grid_points(p, 0).unwrap_err();
-        assert_eq!(e(&[[0, 0, 0], [1, 0, 0], [0, 0, 0]]), FaceDefect::TooFewVertices);
+        assert_eq!(
+            e(&[[0, 0, 0], [1, 0, 0], [0, 0, 0]]),
+            FaceDefect::TooFewVertices
+        );
         assert_eq!(e(&[[0, 0, 0], [1, 0, 0], [2, 0, 0]]), FaceDefect::ZeroArea);
         assert_eq!(
             e(&[[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 1]]),

@@ -5,11 +5,14 @@
 //! checks use explicit stacks, and the recursive traversal hands over to the
 //! iterative one past [`RECURSION_LIMIT`] levels.
 
+use crate::Side;
 use crate::grid::ViewPoint;
 use crate::plane::Plane;
 use crate::point::Point;
 use crate::polygon::{Polygon, PolygonSide, Split};
-use crate::Side;
+
+/// An ancestor's plane and the side of it a subtree lies on.
+pub(crate) type Ancestor = (Plane, Side);
 
 /// Index of a node in [`BspTree::nodes`].
 pub type NodeId = u32;
@@ -86,6 +89,17 @@ pub struct BuildOptions {
     pub split_weight: u32,
     /// Seed of the deterministic sampling.
     pub seed: u64,
+    /// Lists longer than this are first cut by an axis-aligned plane
+    /// through the median polygon position (a *balance cut*) instead of a
+    /// polygon's plane; 0 (the default) builds a pure autopartition.
+    ///
+    /// A convex mesh makes an autopartition a chain as deep as its face
+    /// count; balance cuts bound the depth by about `log2(n / threshold)`
+    /// plus the length of the chains inside cells of `threshold` polygons,
+    /// at the price of some extra fragments. A cut is only made when both
+    /// sides keep polygons, so every empty leaf still hangs below a
+    /// polygon's plane and the solid labelling stays valid.
+    pub cut_threshold: usize,
 }
 
 impl Default for BuildOptions {
@@ -95,6 +109,7 @@ impl Default for BuildOptions {
             sample: 48,
             split_weight: 4,
             seed: 0x5eed_b5b7,
+            cut_threshold: 0,
         }
     }
 }
@@ -113,6 +128,11 @@ impl BuildOptions {
     /// Sets [`BuildOptions::split_weight`].
     pub fn with_split_weight(mut self, w: u32) -> Self {
         self.split_weight = w;
+        self
+    }
+    /// Sets [`BuildOptions::cut_threshold`] (0 disables balance cuts).
+    pub fn with_cut_threshold(mut self, n: usize) -> Self {
+        self.cut_threshold = n;
         self
     }
     /// Sets [`BuildOptions::seed`].
@@ -160,7 +180,7 @@ impl SplitMix {
         z ^ (z >> 31)
     }
     fn below(&mut self, n: usize) -> usize {
-        ((self.next() >> 32) * n as u64 >> 32) as usize
+        (((self.next() >> 32) * n as u64) >> 32) as usize
     }
 }
 
@@ -169,6 +189,50 @@ enum Slot {
     Root,
     Front(NodeId),
     Back(NodeId),
+}
+
+/// Splits a list by `plane` into (coplanar, front, back).
+fn partition_list(
+    polys: Vec<Polygon>,
+    plane: &Plane,
+) -> (Vec<Polygon>, Vec<Polygon>, Vec<Polygon>) {
+    let (mut on, mut front, mut back) = (Vec::new(), Vec::new(), Vec::new());
+    for p in polys {
+        match p.split(plane) {
+            Split::Front(p) => front.push(p),
+            Split::Back(p) => back.push(p),
+            Split::Coplanar { polygon, .. } => on.push(polygon),
+            Split::Spanning { front: f, back: b } => {
+                front.push(f);
+                back.push(b);
+            }
+        }
+    }
+    (on, front, back)
+}
+
+/// An axis-aligned plane `x_k = m` through the median of the polygons'
+/// first-vertex coordinate along the longest axis of their bounding box.
+/// How the plane is chosen does not affect exactness, so `f64` is fine here.
+fn balance_cut(polys: &[Polygon]) -> Option<Plane> {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    let mut firsts: Vec<[f64; 3]> = Vec::with_capacity(polys.len());
+    for p in polys {
+        let v = p.vertices()[0].approx_f64();
+        for k in 0..3 {
+            lo[k] = lo[k].min(v[k]);
+            hi[k] = hi[k].max(v[k]);
+        }
+        firsts.push(v);
+    }
+    let k = (0..3).max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))?;
+    let mid = firsts.len() / 2;
+    firsts.select_nth_unstable_by(mid, |a, b| a[k].total_cmp(&b[k]));
+    let m = firsts[mid][k].round() as i128;
+    let mut n = [0i64; 3];
+    n[k] = 1;
+    Plane::new(n, -m)
 }
 
 fn choose_plane(polys: &[Polygon], opts: &BuildOptions, rng: &mut SplitMix) -> Plane {
@@ -226,19 +290,29 @@ impl BspTree {
                     Slot::Front(_) | Slot::Root => Cell::Out,
                 })
             } else {
-                let plane = choose_plane(&polys, opts, &mut rng);
-                let (mut on, mut front, mut back) = (Vec::new(), Vec::new(), Vec::new());
-                for p in polys {
-                    match p.split(&plane) {
-                        Split::Front(p) => front.push(p),
-                        Split::Back(p) => back.push(p),
-                        Split::Coplanar { polygon, .. } => on.push(polygon),
-                        Split::Spanning { front: f, back: b } => {
-                            front.push(f);
-                            back.push(b);
-                        }
+                let cut = if opts.cut_threshold > 0 && polys.len() > opts.cut_threshold {
+                    balance_cut(&polys)
+                } else {
+                    None
+                };
+                let (mut polys, mut parts) = (polys, None);
+                if let Some(plane) = cut {
+                    let (on, front, back) = partition_list(polys, &plane);
+                    if !front.is_empty() && !back.is_empty() {
+                        parts = Some((plane, on, front, back));
+                        polys = Vec::new();
+                    } else {
+                        polys = on.into_iter().chain(front).chain(back).collect();
                     }
                 }
+                let (plane, on, front, back) = match parts {
+                    Some(p) => p,
+                    None => {
+                        let plane = choose_plane(&polys, opts, &mut rng);
+                        let (on, front, back) = partition_list(polys, &plane);
+                        (plane, on, front, back)
+                    }
+                };
                 let id = tree.nodes.len() as NodeId;
                 tree.nodes.push(Node {
                     plane,
@@ -353,7 +427,10 @@ impl BspTree {
                     stack.push(Item::Emit(id));
                     stack.push(Item::Visit(first));
                 }
-                Item::Emit(id) => self.nodes[id as usize].polygons.iter().for_each(&mut *visit),
+                Item::Emit(id) => self.nodes[id as usize]
+                    .polygons
+                    .iter()
+                    .for_each(&mut *visit),
             }
         }
     }
@@ -361,7 +438,12 @@ impl BspTree {
     /// The same order as [`BspTree::traverse`], by recursion; past
     /// [`RECURSION_LIMIT`] levels it continues with an explicit stack, so
     /// a degenerate chain cannot overflow the call stack.
-    pub fn traverse_recursive(&self, eye: ViewPoint, order: Order, mut visit: impl FnMut(&Polygon)) {
+    pub fn traverse_recursive(
+        &self,
+        eye: ViewPoint,
+        order: Order,
+        mut visit: impl FnMut(&Polygon),
+    ) {
         self.recurse(self.root, eye, order, &mut visit, 0);
     }
 
@@ -430,7 +512,7 @@ impl BspTree {
         let mut seen = vec![false; self.nodes.len()];
         // (link, index into `path` where this link's ancestors end)
         let mut path: Vec<(Plane, Side)> = Vec::new();
-        let mut stack: Vec<(Link, usize, Option<(Plane, Side)>)> = vec![(self.root, 0, None)];
+        let mut stack: Vec<(Link, usize, Option<Ancestor>)> = vec![(self.root, 0, None)];
         while let Some((link, depth, edge)) = stack.pop() {
             path.truncate(depth);
             if let Some(e) = edge {
@@ -444,8 +526,12 @@ impl BspTree {
                 return Err(format!("node {id} is reached twice"));
             }
             let n = &self.nodes[id as usize];
-            if n.polygons.is_empty() {
-                return Err(format!("node {id} holds no polygon"));
+            // a node without polygons is a balance cut: both sides hold
+            // polygons, so neither child is a leaf
+            if n.polygons.is_empty()
+                && (matches!(n.front, Link::Cell(_)) || matches!(n.back, Link::Cell(_)))
+            {
+                return Err(format!("node {id} holds no polygon but has a leaf child"));
             }
             for (k, p) in n.polygons.iter().enumerate() {
                 p.sanity_check()
@@ -454,10 +540,10 @@ impl BspTree {
                     return Err(format!("node {id} polygon {k} is not in the node plane"));
                 }
                 for (a, (plane, side)) in path.iter().enumerate() {
-                    let ok = match (p.classify(plane), side) {
-                        (PolygonSide::Front, Side::Front) | (PolygonSide::Back, Side::Back) => true,
-                        _ => false,
-                    };
+                    let ok = matches!(
+                        (p.classify(plane), side),
+                        (PolygonSide::Front, Side::Front) | (PolygonSide::Back, Side::Back)
+                    );
                     if !ok {
                         return Err(format!(
                             "node {id} polygon {k} is not on the {side:?} side of ancestor {a}"

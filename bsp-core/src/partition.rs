@@ -1,0 +1,1059 @@
+//! Labelled BSP partitions and their merging (Naylor, Amanatides &
+//! Thibault 1990): set operations ∪ ∩ − and the overlay "+".
+//!
+//! A [`Partition`] is a BSP tree whose leaves carry a label (a [`Cell`] for
+//! solids, a pair of labels for an overlay) and whose nodes know their
+//! *sub-hyperplane*: the convex polygon where the node's plane meets the
+//! node's region, bounded by the grid's box. Sub-hyperplanes are ordinary
+//! plane-based [`Polygon`]s whose edge planes are ancestor planes and box
+//! planes, so they stay inside the arithmetic budget however often they are
+//! split.
+//!
+//! Merging partitions the second tree by the first tree's sub-hyperplanes
+//! and combines the labels of coinciding cells with a [`CellOp`]. Every
+//! operation here runs on explicit work stacks.
+
+use crate::Side;
+use crate::grid::MAX_COORD;
+use crate::plane::Plane;
+use crate::point::Point;
+use crate::polygon::{Polygon, PolygonSide, Split};
+use crate::tree::{Ancestor, BspTree, Cell, Link, Membership};
+
+/// Half-width of the box that bounds every sub-hyperplane: `2^26`, just
+/// outside every grid coordinate.
+pub const BOX_HALF: i64 = MAX_COORD as i64 + 1;
+
+/// A child reference of a [`Partition`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PLink<L> {
+    /// An inner node (index into [`Partition::nodes`]).
+    Node(u32),
+    /// A leaf with its label.
+    Leaf(L),
+}
+
+/// An inner node of a [`Partition`].
+#[derive(Clone, Debug)]
+pub struct PNode<L> {
+    /// The partitioning plane.
+    pub plane: Plane,
+    /// The sub-hyperplane: `plane` ∩ this node's region (within the box).
+    pub shp: Polygon,
+    /// Input polygons lying in `plane` within this node's region.
+    pub polygons: Vec<Polygon>,
+    /// Subtree in front.
+    pub front: PLink<L>,
+    /// Subtree behind.
+    pub back: PLink<L>,
+}
+
+/// A BSP partition of the grid's box with labelled cells.
+#[derive(Clone, Debug)]
+pub struct Partition<L> {
+    nodes: Vec<PNode<L>>,
+    root: PLink<L>,
+}
+
+/// How merging combines the labels of two coinciding cells.
+pub trait CellOp<A, B> {
+    /// The label of the result.
+    type Out;
+    /// The label of `c1 ∩ c2`.
+    fn apply(&self, a: A, b: B) -> Self::Out;
+    /// The result when the first cell has label `a`, if it does not depend
+    /// on the second (e.g. `In ∪ anything = In`); saves visiting a subtree.
+    fn left(&self, a: A) -> Option<Self::Out> {
+        let _ = a;
+        None
+    }
+    /// As [`CellOp::left`], for the second cell.
+    fn right(&self, b: B) -> Option<Self::Out> {
+        let _ = b;
+        None
+    }
+}
+
+/// The Boolean set operations on solid partitions (Table 1 of the core
+/// paper).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BoolOp {
+    /// A ∪ B.
+    Union,
+    /// A ∩ B.
+    Intersection,
+    /// A − B.
+    Difference,
+}
+
+impl CellOp<Cell, Cell> for BoolOp {
+    type Out = Cell;
+    fn apply(&self, a: Cell, b: Cell) -> Cell {
+        let (a, b) = (a == Cell::In, b == Cell::In);
+        let r = match self {
+            BoolOp::Union => a || b,
+            BoolOp::Intersection => a && b,
+            BoolOp::Difference => a && !b,
+        };
+        if r { Cell::In } else { Cell::Out }
+    }
+    fn left(&self, a: Cell) -> Option<Cell> {
+        match (self, a) {
+            (BoolOp::Union, Cell::In) => Some(Cell::In),
+            (BoolOp::Intersection | BoolOp::Difference, Cell::Out) => Some(Cell::Out),
+            _ => None,
+        }
+    }
+    fn right(&self, b: Cell) -> Option<Cell> {
+        match (self, b) {
+            (BoolOp::Union, Cell::In) => Some(Cell::In),
+            (BoolOp::Intersection, Cell::Out) | (BoolOp::Difference, Cell::In) => Some(Cell::Out),
+            _ => None,
+        }
+    }
+}
+
+/// The overlay "+": every cell of the result is a non-empty `c1 ∩ c2`
+/// labelled with both labels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Overlay;
+
+impl<A, B> CellOp<A, B> for Overlay {
+    type Out = (A, B);
+    fn apply(&self, a: A, b: B) -> (A, B) {
+        (a, b)
+    }
+}
+
+/// An operation with its arguments swapped (to insert the smaller tree).
+struct Swapped<'a, O>(&'a O);
+
+impl<A, B, O: CellOp<A, B>> CellOp<B, A> for Swapped<'_, O> {
+    type Out = O::Out;
+    fn apply(&self, b: B, a: A) -> O::Out {
+        self.0.apply(a, b)
+    }
+    fn left(&self, b: B) -> Option<O::Out> {
+        self.0.right(b)
+    }
+    fn right(&self, a: A) -> Option<O::Out> {
+        self.0.left(a)
+    }
+}
+
+/// The box plane `sign · x_axis - BOX_HALF = 0` (interior behind).
+fn box_plane(axis: usize, sign: i64) -> Plane {
+    let mut n = [0i64; 3];
+    n[axis] = sign;
+    Plane::new(n, -(BOX_HALF as i128)).expect("box planes are in budget")
+}
+
+/// `plane` ∩ the grid's box, as a convex polygon whose edge planes are box
+/// planes. Every plane through grid points meets the box.
+pub fn box_section(plane: &Plane) -> Option<Polygon> {
+    let k = plane.dominant_axis();
+    let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+    // counter-clockwise in (a, b) seen along +k: the sides b = -B, a = +B,
+    // b = +B, a = -B
+    let mut edges = vec![
+        box_plane(b, -1),
+        box_plane(a, 1),
+        box_plane(b, 1),
+        box_plane(a, -1),
+    ];
+    if plane.normal()[k] < 0 {
+        edges.reverse();
+    }
+    let mut poly = Polygon::from_planes(*plane, &edges, 0)?;
+    for sign in [1, -1] {
+        poly = match poly.split(&box_plane(k, sign)) {
+            Split::Back(p) => p,
+            Split::Spanning { back, .. } => back,
+            Split::Front(_) | Split::Coplanar { .. } => return None,
+        };
+    }
+    Some(poly)
+}
+
+/// Keeps the part of `poly` on `side` of `plane`; `None` if nothing with
+/// positive area is left.
+fn clip(poly: Polygon, plane: &Plane, side: Side) -> Option<Polygon> {
+    match (poly.split(plane), side) {
+        (Split::Front(p), Side::Front) | (Split::Back(p), Side::Back) => Some(p),
+        (Split::Spanning { front, .. }, Side::Front) => Some(front),
+        (Split::Spanning { back, .. }, Side::Back) => Some(back),
+        _ => None,
+    }
+}
+
+impl Partition<Cell> {
+    /// The solid partition of a solid BSP tree (see [`BspTree`]): the same
+    /// planes, polygons and cells, with each node's sub-hyperplane computed
+    /// by clipping its plane's box section by the ancestors' half-spaces.
+    pub fn from_tree(tree: &BspTree) -> Partition<Cell> {
+        let mut out = Partition {
+            nodes: Vec::with_capacity(tree.nodes().len()),
+            root: PLink::Leaf(Cell::Out),
+        };
+        let conv = |l: Link| match l {
+            Link::Cell(c) => PLink::Leaf(c),
+            Link::Node(_) => PLink::Leaf(Cell::Out), // patched below
+        };
+        // (tree link, depth, edge to parent, slot to patch)
+        let mut path: Vec<(Plane, Side)> = Vec::new();
+        type Item = (Link, usize, Option<Ancestor>, Option<(u32, Side)>);
+        let mut stack: Vec<Item> = vec![(tree.root(), 0, None, None)];
+        while let Some((link, depth, edge, slot)) = stack.pop() {
+            path.truncate(depth);
+            if let Some(e) = edge {
+                path.push(e);
+            }
+            let v = match link {
+                Link::Cell(c) => PLink::Leaf(c),
+                Link::Node(id) => {
+                    let n = tree.node(id);
+                    let mut shp =
+                        box_section(&n.plane).expect("a plane through grid points meets the box");
+                    // nearest ancestors first: they cut the box section
+                    // down early, and the far ones then rarely split it
+                    for (p, s) in path.iter().rev() {
+                        shp = clip(shp, p, *s)
+                            .expect("a node's plane meets its region (its polygons lie there)");
+                    }
+                    let me = out.nodes.len() as u32;
+                    out.nodes.push(PNode {
+                        plane: n.plane,
+                        shp,
+                        polygons: n.polygons.clone(),
+                        front: conv(n.front),
+                        back: conv(n.back),
+                    });
+                    let d = path.len();
+                    stack.push((
+                        n.back,
+                        d,
+                        Some((n.plane, Side::Back)),
+                        Some((me, Side::Back)),
+                    ));
+                    stack.push((
+                        n.front,
+                        d,
+                        Some((n.plane, Side::Front)),
+                        Some((me, Side::Front)),
+                    ));
+                    PLink::Node(me)
+                }
+            };
+            match slot {
+                None => out.root = v,
+                Some((p, Side::Front)) => out.nodes[p as usize].front = v,
+                Some((p, _)) => out.nodes[p as usize].back = v,
+            }
+        }
+        out
+    }
+
+    /// Exact point membership (see [`BspTree::classify_point`]).
+    pub fn classify_point(&self, p: &Point) -> Membership {
+        let labels = self.locate(p);
+        let has_in = labels.contains(&Cell::In);
+        let has_out = labels.contains(&Cell::Out);
+        match (has_in, has_out) {
+            (true, true) => Membership::Boundary,
+            (true, false) => Membership::Inside,
+            _ => Membership::Outside,
+        }
+    }
+
+    /// The complement: every label flipped.
+    pub fn complement(&self) -> Partition<Cell> {
+        self.map_labels(|c| match c {
+            Cell::In => Cell::Out,
+            Cell::Out => Cell::In,
+        })
+    }
+
+    /// `self op other`, inserting the smaller tree into the larger.
+    pub fn boolean(&self, other: &Partition<Cell>, op: BoolOp) -> Partition<Cell> {
+        merge_smaller_into_larger(self, other, &op)
+    }
+
+    /// The boundary of the solid: the pieces of every sub-hyperplane that
+    /// separate an `In` cell from an `Out` cell, oriented outward (front
+    /// toward `Out`). Tags are 0.
+    pub fn boundary(&self) -> Vec<Polygon> {
+        let mut out = Vec::new();
+        for n in &self.nodes {
+            for (piece, front) in self.push_down(n.shp.clone(), n.front) {
+                for (piece, back) in self.push_down(piece, n.back) {
+                    match (front, back) {
+                        (Cell::Out, Cell::In) => out.push(piece),
+                        (Cell::In, Cell::Out) => out.push(piece.flipped()),
+                        _ => {}
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Merges, choosing which tree to partition by the other's planes so that
+/// the smaller one is inserted.
+pub fn merge_smaller_into_larger<A, B, O>(
+    a: &Partition<A>,
+    b: &Partition<B>,
+    op: &O,
+) -> Partition<O::Out>
+where
+    A: Copy,
+    B: Copy,
+    O: CellOp<A, B>,
+    O::Out: Copy + PartialEq,
+{
+    if a.nodes.len() >= b.nodes.len() {
+        merge(a, b, op)
+    } else {
+        merge(b, a, &Swapped(op))
+    }
+}
+
+#[derive(Clone, Copy)]
+enum BSlot {
+    Front(u32),
+    Back(u32),
+    Temp(usize),
+}
+
+#[derive(Clone, Copy)]
+enum OSlot {
+    Root,
+    Front(u32),
+    Back(u32),
+}
+
+#[derive(Clone, Copy)]
+enum BSource<B> {
+    Link(PLink<B>),
+    Temp(usize),
+}
+
+// Tasks live briefly on the work stack; boxing the polygon would cost an
+// allocation per task for no gain.
+#[allow(clippy::large_enum_variant)]
+enum Task<A, B> {
+    Partition {
+        t: PLink<B>,
+        h: Polygon,
+        plus: BSlot,
+        minus: BSlot,
+        collect: u32,
+    },
+    Merge {
+        a: PLink<A>,
+        b: BSource<B>,
+        out: OSlot,
+    },
+    CopyA {
+        a: PLink<A>,
+        b: B,
+        out: OSlot,
+    },
+    CopyB {
+        a: A,
+        b: PLink<B>,
+        out: OSlot,
+    },
+}
+
+/// Merges two partitions of the same box: `a`'s structure is kept and `b`
+/// is partitioned by `a`'s sub-hyperplanes (so `b` should be the smaller;
+/// see [`merge_smaller_into_larger`]). Each cell of the result is a
+/// non-empty intersection of a cell of each input, labelled
+/// `op.apply(label_a, label_b)`; polygons of both inputs are carried to the
+/// result's nodes. The result is reduced (nodes whose two children are
+/// leaves with equal labels collapse).
+pub fn merge<A, B, O>(a: &Partition<A>, b: &Partition<B>, op: &O) -> Partition<O::Out>
+where
+    A: Copy,
+    B: Copy,
+    O: CellOp<A, B>,
+    O::Out: Copy + PartialEq,
+{
+    let mut bn: Vec<PNode<B>> = b.nodes.clone();
+    let mut temps: Vec<Option<PLink<B>>> = Vec::new();
+    let mut out: Partition<O::Out> = Partition {
+        nodes: Vec::new(),
+        root: PLink::Leaf(op.apply(first_leaf(a), first_leaf(b))),
+    };
+    let mut stack: Vec<Task<A, B>> = vec![Task::Merge {
+        a: a.root,
+        b: BSource::Link(b.root),
+        out: OSlot::Root,
+    }];
+
+    fn put_b<B: Copy>(bn: &mut [PNode<B>], temps: &mut [Option<PLink<B>>], s: BSlot, v: PLink<B>) {
+        match s {
+            BSlot::Front(i) => bn[i as usize].front = v,
+            BSlot::Back(i) => bn[i as usize].back = v,
+            BSlot::Temp(i) => temps[i] = Some(v),
+        }
+    }
+    fn put_o<L>(out: &mut Partition<L>, s: OSlot, v: PLink<L>) {
+        match s {
+            OSlot::Root => out.root = v,
+            OSlot::Front(i) => out.nodes[i as usize].front = v,
+            OSlot::Back(i) => out.nodes[i as usize].back = v,
+        }
+    }
+
+    while let Some(task) = stack.pop() {
+        match task {
+            Task::Merge {
+                a: la,
+                b: sb,
+                out: slot,
+            } => {
+                let lb = match sb {
+                    BSource::Link(l) => l,
+                    BSource::Temp(i) => temps[i].take().expect("partition result is ready"),
+                };
+                match (la, lb) {
+                    (PLink::Leaf(x), _) if op.left(x).is_some() => put_o(
+                        &mut out,
+                        slot,
+                        PLink::Leaf(op.left(x).unwrap_or_else(|| unreachable!())),
+                    ),
+                    (_, PLink::Leaf(y)) if op.right(y).is_some() => put_o(
+                        &mut out,
+                        slot,
+                        PLink::Leaf(op.right(y).unwrap_or_else(|| unreachable!())),
+                    ),
+                    (PLink::Leaf(x), _) => stack.push(Task::CopyB {
+                        a: x,
+                        b: lb,
+                        out: slot,
+                    }),
+                    (_, PLink::Leaf(y)) => stack.push(Task::CopyA {
+                        a: la,
+                        b: y,
+                        out: slot,
+                    }),
+                    (PLink::Node(ia), PLink::Node(_)) => {
+                        let na = &a.nodes[ia as usize];
+                        let me = out.nodes.len() as u32;
+                        out.nodes.push(PNode {
+                            plane: na.plane,
+                            shp: na.shp.clone(),
+                            polygons: na.polygons.clone(),
+                            front: PLink::Leaf(out.root_label()),
+                            back: PLink::Leaf(out.root_label()),
+                        });
+                        put_o(&mut out, slot, PLink::Node(me));
+                        let (tp, tm) = (temps.len(), temps.len() + 1);
+                        temps.push(None);
+                        temps.push(None);
+                        stack.push(Task::Merge {
+                            a: na.back,
+                            b: BSource::Temp(tm),
+                            out: OSlot::Back(me),
+                        });
+                        stack.push(Task::Merge {
+                            a: na.front,
+                            b: BSource::Temp(tp),
+                            out: OSlot::Front(me),
+                        });
+                        stack.push(Task::Partition {
+                            t: lb,
+                            h: na.shp.clone(),
+                            plus: BSlot::Temp(tp),
+                            minus: BSlot::Temp(tm),
+                            collect: me,
+                        });
+                    }
+                }
+            }
+            Task::CopyA {
+                a: la,
+                b: y,
+                out: slot,
+            } => match la {
+                PLink::Leaf(x) => put_o(&mut out, slot, PLink::Leaf(op.apply(x, y))),
+                PLink::Node(ia) => {
+                    let na = &a.nodes[ia as usize];
+                    let me = out.push_copy(na.plane, &na.shp, &na.polygons);
+                    put_o(&mut out, slot, PLink::Node(me));
+                    stack.push(Task::CopyA {
+                        a: na.back,
+                        b: y,
+                        out: OSlot::Back(me),
+                    });
+                    stack.push(Task::CopyA {
+                        a: na.front,
+                        b: y,
+                        out: OSlot::Front(me),
+                    });
+                }
+            },
+            Task::CopyB {
+                a: x,
+                b: lb,
+                out: slot,
+            } => match lb {
+                PLink::Leaf(y) => put_o(&mut out, slot, PLink::Leaf(op.apply(x, y))),
+                PLink::Node(ib) => {
+                    let nb = &bn[ib as usize];
+                    let me = out.push_copy(nb.plane, &nb.shp, &nb.polygons);
+                    let (f, bk) = (nb.front, nb.back);
+                    put_o(&mut out, slot, PLink::Node(me));
+                    stack.push(Task::CopyB {
+                        a: x,
+                        b: bk,
+                        out: OSlot::Back(me),
+                    });
+                    stack.push(Task::CopyB {
+                        a: x,
+                        b: f,
+                        out: OSlot::Front(me),
+                    });
+                }
+            },
+            Task::Partition {
+                t,
+                h,
+                plus,
+                minus,
+                collect,
+            } => {
+                let PLink::Node(it) = t else {
+                    put_b(&mut bn, &mut temps, plus, t);
+                    put_b(&mut bn, &mut temps, minus, t);
+                    continue;
+                };
+                let hp = *h.support();
+                let (s, front, back) = {
+                    let n = &bn[it as usize];
+                    (n.plane, n.front, n.back)
+                };
+                if s == hp || s == hp.flip() {
+                    let polys = std::mem::take(&mut bn[it as usize].polygons);
+                    out.nodes[collect as usize].polygons.extend(polys);
+                    let (p, m) = if s == hp {
+                        (front, back)
+                    } else {
+                        (back, front)
+                    };
+                    put_b(&mut bn, &mut temps, plus, p);
+                    put_b(&mut bn, &mut temps, minus, m);
+                    continue;
+                }
+                let side_of_s = bn[it as usize].shp.classify(&hp);
+                match h.split(&s) {
+                    Split::Spanning {
+                        front: h_plus,
+                        back: h_minus,
+                    } => {
+                        let node = &mut bn[it as usize];
+                        let shp = node.shp.clone();
+                        let Split::Spanning {
+                            front: s_plus,
+                            back: s_minus,
+                        } = shp.split(&hp)
+                        else {
+                            panic!("sub-hyperplanes of one region span each other symmetrically");
+                        };
+                        let (mut pp, mut pm) = (Vec::new(), Vec::new());
+                        for poly in std::mem::take(&mut node.polygons) {
+                            match poly.split(&hp) {
+                                Split::Front(q) => pp.push(q),
+                                Split::Back(q) => pm.push(q),
+                                Split::Spanning { front: f, back: b } => {
+                                    pp.push(f);
+                                    pm.push(b);
+                                }
+                                Split::Coplanar { .. } => {
+                                    unreachable!("a node polygon lies in the node plane, not in h")
+                                }
+                            }
+                        }
+                        node.shp = s_plus;
+                        node.polygons = pp;
+                        let m = bn.len() as u32;
+                        bn.push(PNode {
+                            plane: s,
+                            shp: s_minus,
+                            polygons: pm,
+                            front,
+                            back,
+                        });
+                        put_b(&mut bn, &mut temps, plus, PLink::Node(it));
+                        put_b(&mut bn, &mut temps, minus, PLink::Node(m));
+                        stack.push(Task::Partition {
+                            t: back,
+                            h: h_minus,
+                            plus: BSlot::Back(it),
+                            minus: BSlot::Back(m),
+                            collect,
+                        });
+                        stack.push(Task::Partition {
+                            t: front,
+                            h: h_plus,
+                            plus: BSlot::Front(it),
+                            minus: BSlot::Front(m),
+                            collect,
+                        });
+                    }
+                    Split::Front(h) => {
+                        // `b`'s back region does not meet h: it lies on the
+                        // side of h where the node's sub-hyperplane is
+                        let s_in_front = match side_of_s {
+                            PolygonSide::Front => true,
+                            PolygonSide::Back => false,
+                            other => panic!("inconsistent sub-hyperplanes: {other:?}"),
+                        };
+                        let (keep, pass) = if s_in_front {
+                            (plus, minus)
+                        } else {
+                            (minus, plus)
+                        };
+                        put_b(&mut bn, &mut temps, keep, PLink::Node(it));
+                        let (p, m) = if s_in_front {
+                            (BSlot::Front(it), pass)
+                        } else {
+                            (pass, BSlot::Front(it))
+                        };
+                        stack.push(Task::Partition {
+                            t: front,
+                            h,
+                            plus: p,
+                            minus: m,
+                            collect,
+                        });
+                    }
+                    Split::Back(h) => {
+                        let s_in_front = match side_of_s {
+                            PolygonSide::Front => true,
+                            PolygonSide::Back => false,
+                            other => panic!("inconsistent sub-hyperplanes: {other:?}"),
+                        };
+                        let (keep, pass) = if s_in_front {
+                            (plus, minus)
+                        } else {
+                            (minus, plus)
+                        };
+                        put_b(&mut bn, &mut temps, keep, PLink::Node(it));
+                        let (p, m) = if s_in_front {
+                            (BSlot::Back(it), pass)
+                        } else {
+                            (pass, BSlot::Back(it))
+                        };
+                        stack.push(Task::Partition {
+                            t: back,
+                            h,
+                            plus: p,
+                            minus: m,
+                            collect,
+                        });
+                    }
+                    Split::Coplanar { .. } => unreachable!("coincident planes handled above"),
+                }
+            }
+        }
+    }
+    out.reduce();
+    out
+}
+
+fn first_leaf<L: Copy>(p: &Partition<L>) -> L {
+    let mut l = p.root;
+    loop {
+        match l {
+            PLink::Leaf(x) => return x,
+            PLink::Node(i) => l = p.nodes[i as usize].front,
+        }
+    }
+}
+
+impl<L: Copy> Partition<L> {
+    /// A partition with a single cell.
+    pub fn leaf(label: L) -> Partition<L> {
+        Partition {
+            nodes: Vec::new(),
+            root: PLink::Leaf(label),
+        }
+    }
+
+    /// The root link.
+    pub fn root(&self) -> PLink<L> {
+        self.root
+    }
+
+    /// All inner nodes.
+    pub fn nodes(&self) -> &[PNode<L>] {
+        &self.nodes
+    }
+
+    fn root_label(&self) -> L {
+        first_leaf(self)
+    }
+
+    fn push_copy(&mut self, plane: Plane, shp: &Polygon, polygons: &[Polygon]) -> u32 {
+        let l = self.root_label();
+        self.nodes.push(PNode {
+            plane,
+            shp: shp.clone(),
+            polygons: polygons.to_vec(),
+            front: PLink::Leaf(l),
+            back: PLink::Leaf(l),
+        });
+        (self.nodes.len() - 1) as u32
+    }
+
+    /// The same partition with every label mapped.
+    pub fn map_labels<M: Copy>(&self, f: impl Fn(L) -> M) -> Partition<M> {
+        let m = |l: PLink<L>| match l {
+            PLink::Node(i) => PLink::Node(i),
+            PLink::Leaf(x) => PLink::Leaf(f(x)),
+        };
+        Partition {
+            nodes: self
+                .nodes
+                .iter()
+                .map(|n| PNode {
+                    plane: n.plane,
+                    shp: n.shp.clone(),
+                    polygons: n.polygons.clone(),
+                    front: m(n.front),
+                    back: m(n.back),
+                })
+                .collect(),
+            root: m(self.root),
+        }
+    }
+
+    /// Labels of every cell whose closure contains `p` (one label for a
+    /// point inside a cell; several for a point on sub-hyperplanes).
+    pub fn locate(&self, p: &Point) -> Vec<L> {
+        let mut out = Vec::new();
+        let mut stack = vec![self.root];
+        while let Some(l) = stack.pop() {
+            match l {
+                PLink::Leaf(x) => out.push(x),
+                PLink::Node(i) => {
+                    let n = &self.nodes[i as usize];
+                    match p.classify(&n.plane) {
+                        Side::Front => stack.push(n.front),
+                        Side::Back => stack.push(n.back),
+                        Side::On => {
+                            stack.push(n.front);
+                            stack.push(n.back);
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Splits `poly` down the subtree at `link`: the pieces with the label
+    /// of the cell each lands in. A piece lying in a node's plane goes to
+    /// the front.
+    pub fn push_down(&self, poly: Polygon, link: PLink<L>) -> Vec<(Polygon, L)> {
+        let mut out = Vec::new();
+        let mut stack = vec![(poly, link)];
+        while let Some((p, l)) = stack.pop() {
+            match l {
+                PLink::Leaf(x) => out.push((p, x)),
+                PLink::Node(i) => {
+                    let n = &self.nodes[i as usize];
+                    match p.split(&n.plane) {
+                        Split::Front(q) | Split::Coplanar { polygon: q, .. } => {
+                            stack.push((q, n.front))
+                        }
+                        Split::Back(q) => stack.push((q, n.back)),
+                        Split::Spanning { front, back } => {
+                            stack.push((front, n.front));
+                            stack.push((back, n.back));
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Collapses nodes whose children are leaves with equal labels, and
+    /// drops the nodes no longer reachable.
+    pub fn reduce(&mut self)
+    where
+        L: PartialEq,
+    {
+        if let PLink::Node(r) = self.root {
+            // post-order: children are final before their parent is looked at
+            let mut order = Vec::with_capacity(self.nodes.len());
+            let mut stack = vec![r];
+            while let Some(i) = stack.pop() {
+                order.push(i);
+                let n = &self.nodes[i as usize];
+                for c in [n.front, n.back] {
+                    if let PLink::Node(j) = c {
+                        stack.push(j);
+                    }
+                }
+            }
+            let mut collapsed: Vec<Option<L>> = vec![None; self.nodes.len()];
+            for &i in order.iter().rev() {
+                let n = &self.nodes[i as usize];
+                let get = |l: PLink<L>| match l {
+                    PLink::Leaf(x) => Some(x),
+                    PLink::Node(j) => collapsed[j as usize],
+                };
+                let (f, b) = (get(n.front), get(n.back));
+                let newf = f.map_or(n.front, PLink::Leaf);
+                let newb = b.map_or(n.back, PLink::Leaf);
+                let n = &mut self.nodes[i as usize];
+                n.front = newf;
+                n.back = newb;
+                if let (Some(x), Some(y)) = (f, b)
+                    && x == y
+                {
+                    collapsed[i as usize] = Some(x);
+                }
+            }
+            if let Some(x) = collapsed[r as usize] {
+                self.root = PLink::Leaf(x);
+            }
+        }
+        self.compact();
+    }
+
+    /// Renumbers the reachable nodes in pre-order and drops the rest.
+    fn compact(&mut self) {
+        let PLink::Node(r) = self.root else {
+            self.nodes.clear();
+            return;
+        };
+        let mut new_id = vec![u32::MAX; self.nodes.len()];
+        let mut order = Vec::new();
+        let mut stack = vec![r];
+        while let Some(i) = stack.pop() {
+            new_id[i as usize] = order.len() as u32;
+            order.push(i);
+            let n = &self.nodes[i as usize];
+            for c in [n.back, n.front] {
+                if let PLink::Node(j) = c {
+                    stack.push(j);
+                }
+            }
+        }
+        let remap = |l: PLink<L>| match l {
+            PLink::Node(j) => PLink::Node(new_id[j as usize]),
+            leaf => leaf,
+        };
+        let mut old: Vec<Option<PNode<L>>> = std::mem::take(&mut self.nodes)
+            .into_iter()
+            .map(Some)
+            .collect();
+        self.nodes = order
+            .iter()
+            .map(|&i| {
+                let mut n = old[i as usize].take().expect("each node is reached once");
+                n.front = remap(n.front);
+                n.back = remap(n.back);
+                n
+            })
+            .collect();
+        self.root = PLink::Node(0);
+    }
+
+    /// Checks the invariants exactly: a tree over all nodes; every node's
+    /// sub-hyperplane is a valid polygon in its plane, and lies on the
+    /// correct side of every ancestor (touching at most); node polygons lie
+    /// in the plane and inside the sub-hyperplane's region side of ancestors.
+    pub fn sanity_check(&self) -> Result<(), String> {
+        let mut seen = vec![false; self.nodes.len()];
+        let mut path: Vec<(Plane, Side)> = Vec::new();
+        let mut stack: Vec<(PLink<L>, usize, Option<Ancestor>)> = vec![(self.root, 0, None)];
+        while let Some((link, depth, edge)) = stack.pop() {
+            path.truncate(depth);
+            if let Some(e) = edge {
+                path.push(e);
+            }
+            let PLink::Node(id) = link else { continue };
+            let Some(flag) = seen.get_mut(id as usize) else {
+                return Err(format!("link to missing node {id}"));
+            };
+            if std::mem::replace(flag, true) {
+                return Err(format!("node {id} reached twice"));
+            }
+            let n = &self.nodes[id as usize];
+            n.shp
+                .sanity_check()
+                .map_err(|e| format!("node {id} sub-hyperplane: {e}"))?;
+            if *n.shp.support() != n.plane {
+                return Err(format!("node {id} sub-hyperplane is not in its plane"));
+            }
+            for poly in std::iter::once(&n.shp).chain(n.polygons.iter()) {
+                if !poly.support().is_coincident(&n.plane) {
+                    return Err(format!("node {id}: a polygon is not in the node plane"));
+                }
+                for (a, (p, s)) in path.iter().enumerate() {
+                    let ok = matches!(
+                        (poly.classify(p), s),
+                        (PolygonSide::Front, Side::Front) | (PolygonSide::Back, Side::Back)
+                    );
+                    if !ok {
+                        return Err(format!("node {id}: not on the {s:?} side of ancestor {a}"));
+                    }
+                }
+            }
+            let d = path.len();
+            stack.push((n.front, d, Some((n.plane, Side::Front))));
+            stack.push((n.back, d, Some((n.plane, Side::Back))));
+        }
+        if let Some(i) = seen.iter().position(|s| !s) {
+            return Err(format!("node {i} is unreachable"));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tree::BuildOptions;
+
+    fn cube(lo: [i32; 3], hi: [i32; 3]) -> Vec<Polygon> {
+        let (l, h) = (lo, hi);
+        let c = |x: bool, y: bool, z: bool| {
+            [
+                if x { h[0] } else { l[0] },
+                if y { h[1] } else { l[1] },
+                if z { h[2] } else { l[2] },
+            ]
+        };
+        let (f, t) = (false, true);
+        let quads = [
+            [c(f, f, f), c(f, t, f), c(t, t, f), c(t, f, f)],
+            [c(f, f, t), c(t, f, t), c(t, t, t), c(f, t, t)],
+            [c(f, f, f), c(t, f, f), c(t, f, t), c(f, f, t)],
+            [c(f, t, f), c(f, t, t), c(t, t, t), c(t, t, f)],
+            [c(f, f, f), c(f, f, t), c(f, t, t), c(f, t, f)],
+            [c(t, f, f), c(t, t, f), c(t, t, t), c(t, f, t)],
+        ];
+        quads
+            .iter()
+            .map(|q| Polygon::from_grid_points(q, 0).unwrap())
+            .collect()
+    }
+
+    fn solid(lo: [i32; 3], hi: [i32; 3]) -> Partition<Cell> {
+        let t = BspTree::build(cube(lo, hi), &BuildOptions::default());
+        let p = Partition::from_tree(&t);
+        p.sanity_check().unwrap();
+        p
+    }
+
+    #[test]
+    fn box_section_of_tilted_plane() {
+        let p = Plane::through([0, 0, 0], [1, 0, 1], [0, 1, 3]).unwrap();
+        let s = box_section(&p).unwrap();
+        s.sanity_check().unwrap();
+        assert_eq!(*s.support(), p);
+    }
+
+    #[test]
+    fn two_boxes_all_operations() {
+        let a = solid([0, 0, 0], [4, 4, 4]);
+        let b = solid([2, 2, 2], [6, 6, 6]);
+        let grid_pts =
+            (-1..8).flat_map(|x| (-1..8).flat_map(move |y| (-1..8).map(move |z| [x, y, z])));
+        for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
+            let r = a.boolean(&b, op);
+            r.sanity_check().unwrap();
+            let r2 = merge(&b, &a, &Swapped(&op));
+            r2.sanity_check().unwrap();
+            for p in grid_pts.clone() {
+                let pt = Point::Grid(p);
+                let (ma, mb) = (a.classify_point(&pt), b.classify_point(&pt));
+                let m = r.classify_point(&pt);
+                assert_eq!(m, r2.classify_point(&pt));
+                if ma != Membership::Boundary && mb != Membership::Boundary {
+                    let exp = op.apply(
+                        if ma == Membership::Inside {
+                            Cell::In
+                        } else {
+                            Cell::Out
+                        },
+                        if mb == Membership::Inside {
+                            Cell::In
+                        } else {
+                            Cell::Out
+                        },
+                    );
+                    let got = match m {
+                        Membership::Inside => Cell::In,
+                        Membership::Outside => Cell::Out,
+                        Membership::Boundary => panic!("{p:?} {op:?}: boundary"),
+                    };
+                    assert_eq!(got, exp, "{p:?} {op:?}");
+                }
+            }
+            assert!(!r.boundary().is_empty());
+        }
+        for (op, vol) in [
+            (BoolOp::Union, 120.0),
+            (BoolOp::Intersection, 8.0),
+            (BoolOp::Difference, 56.0),
+        ] {
+            let m = crate::TriMesh::from_polygons(&a.boolean(&b, op).boundary());
+            m.check_watertight().unwrap();
+            assert_eq!(m.volume_f64(), vol, "{op:?}");
+            assert_eq!(
+                m.volume_exact(),
+                num_rational::BigRational::from_integer((vol as i64).into())
+            );
+        }
+        let empty = a.boolean(&a, BoolOp::Difference);
+        assert!(
+            matches!(empty.root(), PLink::Leaf(Cell::Out)),
+            "A - A is empty"
+        );
+        let same = a.boolean(&a, BoolOp::Union);
+        assert_eq!(same.boundary().len(), 6);
+    }
+
+    #[test]
+    fn overlay_labels_every_cell() {
+        let a = solid([0, 0, 0], [4, 4, 4]);
+        let b = solid([1, 2, 3], [6, 5, 7]);
+        let o = merge_smaller_into_larger(&a, &b, &Overlay);
+        o.sanity_check().unwrap();
+        for x in -1..8 {
+            for y in -1..8 {
+                for z in -1..9 {
+                    // points at half-integers avoid every plane: use doubled coordinates
+                    let p = Point::from_planes(
+                        &Plane::new([2, 0, 0], -(2 * x as i128 + 1)).unwrap(),
+                        &Plane::new([0, 2, 0], -(2 * y as i128 + 1)).unwrap(),
+                        &Plane::new([0, 0, 2], -(2 * z as i128 + 1)).unwrap(),
+                    )
+                    .unwrap();
+                    let cells = o.locate(&p);
+                    assert_eq!(cells.len(), 1);
+                    let to = |m| {
+                        if m == Membership::Inside {
+                            Cell::In
+                        } else {
+                            Cell::Out
+                        }
+                    };
+                    assert_eq!(
+                        cells[0],
+                        (to(a.classify_point(&p)), to(b.classify_point(&p)))
+                    );
+                }
+            }
+        }
+    }
+}

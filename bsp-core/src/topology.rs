@@ -1,0 +1,223 @@
+//! Combinatorial checks of indexed meshes: closed, consistently oriented
+//! 2-manifolds.
+
+use std::collections::HashMap;
+
+/// Why an indexed mesh is not a closed, consistently oriented 2-manifold.
+/// Faces are 0-based indices into the list given; edges are vertex indices.
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum TopologyError {
+    /// A face repeats a vertex or has fewer than three.
+    DegenerateFace {
+        /// The face.
+        face: usize,
+    },
+    /// The edge `a → b` of `face` has no face using `b → a`: the surface is
+    /// open there.
+    OpenEdge {
+        /// Start vertex.
+        a: u32,
+        /// End vertex.
+        b: u32,
+        /// The face using `a → b`.
+        face: usize,
+    },
+    /// Two faces use the edge `a → b` in the same direction: their
+    /// orientations disagree.
+    Misoriented {
+        /// Start vertex.
+        a: u32,
+        /// End vertex.
+        b: u32,
+        /// The two faces.
+        faces: [usize; 2],
+    },
+    /// More than two faces share the edge `{a, b}`.
+    NonManifoldEdge {
+        /// One end.
+        a: u32,
+        /// The other end.
+        b: u32,
+        /// How many faces use it.
+        count: usize,
+        /// The first face using it.
+        face: usize,
+    },
+    /// The faces around a vertex form more than one fan (a pinch).
+    NonManifoldVertex {
+        /// The vertex.
+        vertex: u32,
+    },
+}
+
+impl std::fmt::Display for TopologyError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TopologyError::DegenerateFace { face } => {
+                write!(f, "face {face} repeats a vertex or has fewer than three")
+            }
+            TopologyError::OpenEdge { a, b, face } => {
+                write!(
+                    f,
+                    "edge {a}-{b} of face {face} is a boundary edge (the mesh is not closed)"
+                )
+            }
+            TopologyError::Misoriented { a, b, faces } => write!(
+                f,
+                "faces {} and {} both use edge {a}->{b} in the same direction (inconsistent orientation)",
+                faces[0], faces[1]
+            ),
+            TopologyError::NonManifoldEdge { a, b, count, face } => {
+                write!(f, "edge {a}-{b} (face {face}) is shared by {count} faces")
+            }
+            TopologyError::NonManifoldVertex { vertex } => {
+                write!(f, "vertex {vertex} joins separate fans of faces (a pinch)")
+            }
+        }
+    }
+}
+
+impl std::error::Error for TopologyError {}
+
+/// Checks that `faces` (vertex index loops) form a closed, consistently
+/// oriented 2-manifold: every directed edge is used once and its reverse
+/// once, and the faces around every vertex form a single fan. Reports the
+/// first problem in face order.
+///
+/// ```
+/// use bsp_core::check_closed_manifold;
+/// let tet = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+/// assert!(check_closed_manifold(tet.iter().map(|f| &f[..])).is_ok());
+/// assert!(check_closed_manifold(tet[..3].iter().map(|f| &f[..])).is_err());
+/// ```
+pub fn check_closed_manifold<'a>(
+    faces: impl IntoIterator<Item = &'a [u32]>,
+) -> Result<(), TopologyError> {
+    let faces: Vec<&[u32]> = faces.into_iter().collect();
+    // directed edge -> first face using it
+    let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
+    let mut undirected: HashMap<(u32, u32), (usize, usize)> = HashMap::new();
+    for (fi, f) in faces.iter().enumerate() {
+        let k = f.len();
+        let mut sorted = f.to_vec();
+        sorted.sort_unstable();
+        sorted.dedup();
+        if k < 3 || sorted.len() != k {
+            return Err(TopologyError::DegenerateFace { face: fi });
+        }
+        for i in 0..k {
+            let (a, b) = (f[i], f[(i + 1) % k]);
+            if let Some(&other) = directed.get(&(a, b)) {
+                return Err(TopologyError::Misoriented {
+                    a,
+                    b,
+                    faces: [other, fi],
+                });
+            }
+            directed.insert((a, b), fi);
+            let e = undirected.entry((a.min(b), a.max(b))).or_insert((0, fi));
+            e.0 += 1;
+            if e.0 > 2 {
+                return Err(TopologyError::NonManifoldEdge {
+                    a: a.min(b),
+                    b: a.max(b),
+                    count: e.0,
+                    face: e.1,
+                });
+            }
+        }
+    }
+    for (fi, f) in faces.iter().enumerate() {
+        let k = f.len();
+        for i in 0..k {
+            let (a, b) = (f[i], f[(i + 1) % k]);
+            if !directed.contains_key(&(b, a)) {
+                return Err(TopologyError::OpenEdge { a, b, face: fi });
+            }
+        }
+    }
+    // vertex links: around each vertex v, face f with ... u -> v -> w ...
+    // maps u to w; a single fan means one cycle covering all incident faces
+    let mut next: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut incident: HashMap<u32, usize> = HashMap::new();
+    for f in &faces {
+        let k = f.len();
+        for i in 0..k {
+            let (u, v, w) = (f[(i + k - 1) % k], f[i], f[(i + 1) % k]);
+            next.insert((v, u), w);
+            *incident.entry(v).or_default() += 1;
+        }
+    }
+    let mut start_of: HashMap<u32, u32> = HashMap::new();
+    for &(v, u) in next.keys() {
+        start_of.entry(v).or_insert(u);
+    }
+    let mut verts: Vec<u32> = start_of.keys().copied().collect();
+    verts.sort_unstable();
+    for v in verts {
+        let start = start_of[&v];
+        let mut u = start;
+        let mut steps = 0usize;
+        loop {
+            u = next[&(v, u)];
+            steps += 1;
+            if u == start || steps > incident[&v] {
+                break;
+            }
+        }
+        if steps != incident[&v] {
+            return Err(TopologyError::NonManifoldVertex { vertex: v });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check(f: &[&[u32]]) -> Result<(), TopologyError> {
+        check_closed_manifold(f.iter().copied())
+    }
+
+    #[test]
+    fn finds_each_defect() {
+        let tet: [&[u32]; 4] = [&[0, 2, 1], &[0, 1, 3], &[0, 3, 2], &[1, 2, 3]];
+        assert_eq!(check(&tet), Ok(()));
+        assert!(matches!(
+            check(&tet[..3]),
+            Err(TopologyError::OpenEdge { .. })
+        ));
+        let flipped: [&[u32]; 4] = [&[0, 1, 2], &[0, 1, 3], &[0, 3, 2], &[1, 2, 3]];
+        assert!(matches!(
+            check(&flipped),
+            Err(TopologyError::Misoriented { .. })
+        ));
+        assert!(matches!(
+            check(&[&[0, 1, 1]]),
+            Err(TopologyError::DegenerateFace { face: 0 })
+        ));
+        // two tetrahedra sharing only vertex 0: a pinch
+        let pinch: [&[u32]; 8] = [
+            &[0, 2, 1],
+            &[0, 1, 3],
+            &[0, 3, 2],
+            &[1, 2, 3],
+            &[0, 5, 4],
+            &[0, 4, 6],
+            &[0, 6, 5],
+            &[4, 5, 6],
+        ];
+        assert_eq!(
+            check(&pinch),
+            Err(TopologyError::NonManifoldVertex { vertex: 0 })
+        );
+        // three faces on one edge
+        let fin: [&[u32]; 3] = [&[0, 1, 2], &[1, 0, 3], &[0, 1, 4]];
+        assert!(matches!(
+            check(&fin),
+            Err(TopologyError::Misoriented { .. } | TopologyError::NonManifoldEdge { .. })
+        ));
+    }
+}

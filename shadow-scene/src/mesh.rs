@@ -1,0 +1,315 @@
+//! The mesh type and its geometric helpers.
+
+use std::collections::{HashMap, HashSet};
+
+use glam::DVec3;
+
+/// One face of a mesh: a loop of vertex indices.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Face {
+    /// Indices into [`Mesh::positions`], in the file's order.
+    pub vertices: Vec<u32>,
+    /// 1-based source line of the face, 0 for generated faces.
+    pub line: usize,
+    /// Index into [`Mesh::groups`].
+    pub group: u32,
+}
+
+/// A polygon mesh or soup in input units.
+///
+/// Faces keep their vertex count: quads stay quads and n-gons stay n-gons.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<DVec3>,
+    /// Faces, in the file's order.
+    pub faces: Vec<Face>,
+    /// Group / object names (at least one, "default", in meshes made by
+    /// this crate's readers).
+    pub groups: Vec<String>,
+}
+
+/// Bit pattern of a position, with `-0.0` read as `0.0`, so that equal
+/// values get equal keys.
+fn key(p: DVec3) -> [u64; 3] {
+    // adding +0.0 turns -0.0 into +0.0 and leaves every other value alone
+    [p.x, p.y, p.z].map(|c| (c + 0.0).to_bits())
+}
+
+impl Mesh {
+    /// The positions of face `i`'s vertices.
+    pub fn face_points(&self, i: usize) -> Vec<DVec3> {
+        self.faces[i]
+            .vertices
+            .iter()
+            .map(|&v| self.positions[v as usize])
+            .collect()
+    }
+
+    /// Every face as a loop of positions.
+    pub fn face_loops(&self) -> Vec<Vec<DVec3>> {
+        (0..self.faces.len()).map(|i| self.face_points(i)).collect()
+    }
+
+    /// The axis-aligned bounding box `(min, max)` of all positions, `None`
+    /// for a mesh without positions.
+    ///
+    /// ```
+    /// use shadow_scene::parse_obj;
+    /// use glam::DVec3;
+    /// let m = parse_obj("v 0 0 0\nv 2 1 0\nv 0 1 -3\nf 1 2 3\n", "t.obj").unwrap();
+    /// assert_eq!(m.bounds(), Some((DVec3::new(0., 0., -3.), DVec3::new(2., 1., 0.))));
+    /// ```
+    pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
+        let first = *self.positions.first()?;
+        Some(
+            self.positions
+                .iter()
+                .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))),
+        )
+    }
+
+    /// Number of triangles a fan triangulation of every face would give
+    /// (`n - 2` per face of `n` vertices).
+    ///
+    /// ```
+    /// let room = shadow_scene::room();
+    /// assert!(room.triangle_count() > room.faces.len());
+    /// ```
+    pub fn triangle_count(&self) -> usize {
+        self.faces
+            .iter()
+            .map(|f| f.vertices.len().saturating_sub(2))
+            .sum()
+    }
+
+    /// The index of the group called `name`.
+    ///
+    /// ```
+    /// let room = shadow_scene::room();
+    /// let axes = room.group_index("axes").unwrap();
+    /// assert!(room.faces.iter().any(|f| f.group == axes));
+    /// assert_eq!(room.group_index("no such group"), None);
+    /// ```
+    pub fn group_index(&self, name: &str) -> Option<u32> {
+        self.groups.iter().position(|g| g == name).map(|i| i as u32)
+    }
+
+    /// The index of the group called `name`, appended if it is new.
+    pub fn add_group(&mut self, name: &str) -> u32 {
+        self.group_index(name).unwrap_or_else(|| {
+            self.groups.push(name.to_string());
+            (self.groups.len() - 1) as u32
+        })
+    }
+
+    /// The name of face `i`'s group (`""` if the group index is out of
+    /// range).
+    ///
+    /// ```
+    /// let room = shadow_scene::room();
+    /// assert_eq!(room.group_name(0), "floor");
+    /// ```
+    pub fn group_name(&self, i: usize) -> &str {
+        self.groups
+            .get(self.faces[i].group as usize)
+            .map_or("", String::as_str)
+    }
+
+    /// Merges vertices with exactly equal positions (`-0.0` equals `0.0`)
+    /// and drops positions no face uses; faces keep their order and
+    /// vertex loops.
+    ///
+    /// ```
+    /// use shadow_scene::{Face, Mesh};
+    /// use glam::DVec3;
+    /// let mut m = Mesh {
+    ///     positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::X, DVec3::Y, DVec3::ONE],
+    ///     faces: vec![
+    ///         Face { vertices: vec![0, 1, 2], line: 0, group: 0 },
+    ///         Face { vertices: vec![3, 5, 4], line: 0, group: 0 },
+    ///     ],
+    ///     groups: vec!["default".into()],
+    /// };
+    /// m.weld();
+    /// assert_eq!(m.positions.len(), 4);
+    /// assert_eq!(m.faces[1].vertices, vec![1, 3, 2]);
+    /// ```
+    pub fn weld(&mut self) {
+        let mut index: HashMap<[u64; 3], u32> = HashMap::new();
+        let mut positions = Vec::new();
+        let mut map = vec![u32::MAX; self.positions.len()];
+        for f in &mut self.faces {
+            for v in &mut f.vertices {
+                let old = *v as usize;
+                if map[old] == u32::MAX {
+                    let p = self.positions[old];
+                    map[old] = *index.entry(key(p)).or_insert_with(|| {
+                        positions.push(p);
+                        (positions.len() - 1) as u32
+                    });
+                }
+                *v = map[old];
+            }
+        }
+        self.positions = positions;
+    }
+
+    /// `true` if every directed edge `a → b` of every face appears exactly
+    /// once and its reverse `b → a` exactly once: the faces (compared by
+    /// vertex index, so weld first) bound closed, consistently oriented
+    /// surfaces without T-junctions.
+    ///
+    /// ```
+    /// let chair = shadow_scene::scene("chair").unwrap();
+    /// assert!(chair.is_closed_oriented());
+    /// ```
+    pub fn is_closed_oriented(&self) -> bool {
+        let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
+        for f in &self.faces {
+            let n = f.vertices.len();
+            for i in 0..n {
+                *edges
+                    .entry((f.vertices[i], f.vertices[(i + 1) % n]))
+                    .or_default() += 1;
+            }
+        }
+        edges
+            .iter()
+            .all(|(&(a, b), &c)| c == 1 && edges.get(&(b, a)) == Some(&1))
+    }
+
+    /// The signed volume enclosed by the faces (positive for closed
+    /// surfaces whose faces are counter-clockwise seen from outside), in
+    /// `f64`.
+    ///
+    /// ```
+    /// let cube = shadow_scene::scene("cube").unwrap();
+    /// assert_eq!(cube.signed_volume(), 1.0);
+    /// ```
+    pub fn signed_volume(&self) -> f64 {
+        let mut six_v = 0.0;
+        for f in &self.faces {
+            let p = |i: usize| self.positions[f.vertices[i] as usize];
+            for i in 1..f.vertices.len().saturating_sub(1) {
+                six_v += p(0).dot(p(i).cross(p(i + 1)));
+            }
+        }
+        six_v / 6.0
+    }
+
+    /// Moves every face of group `name` by `offset`; vertices the group
+    /// shares with other groups are duplicated first, so other groups stay
+    /// where they are. Returns the number of faces moved, `None` if there
+    /// is no such group.
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// let mut room = shadow_scene::room();
+    /// let (lo, _) = room.bounds().unwrap();
+    /// let moved = room.translate_group("axes", DVec3::new(0.5, 0.0, 0.0)).unwrap();
+    /// assert!(moved > 0);
+    /// assert_eq!(room.bounds().unwrap().0, lo);
+    /// ```
+    pub fn translate_group(&mut self, name: &str, offset: DVec3) -> Option<usize> {
+        let g = self.group_index(name)?;
+        let others: HashSet<u32> = self
+            .faces
+            .iter()
+            .filter(|f| f.group != g)
+            .flat_map(|f| f.vertices.iter().copied())
+            .collect();
+        let mut moved: HashMap<u32, u32> = HashMap::new();
+        let mut count = 0;
+        for f in self.faces.iter_mut().filter(|f| f.group == g) {
+            count += 1;
+            for v in &mut f.vertices {
+                *v = *moved.entry(*v).or_insert_with(|| {
+                    let p = self.positions[*v as usize] + offset;
+                    if others.contains(v) {
+                        self.positions.push(p);
+                        (self.positions.len() - 1) as u32
+                    } else {
+                        self.positions[*v as usize] = p;
+                        *v
+                    }
+                });
+            }
+        }
+        Some(count)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tetra() -> Mesh {
+        Mesh {
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+            faces: [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]
+                .iter()
+                .map(|v| Face {
+                    vertices: v.to_vec(),
+                    line: 0,
+                    group: 0,
+                })
+                .collect(),
+            groups: vec!["default".into()],
+        }
+    }
+
+    #[test]
+    fn tetra_is_closed_with_positive_volume() {
+        let t = tetra();
+        assert!(t.is_closed_oriented());
+        assert_eq!(t.signed_volume(), 1.0 / 6.0);
+        assert_eq!(t.triangle_count(), 4);
+    }
+
+    #[test]
+    fn flipped_or_open_mesh_is_detected() {
+        let mut t = tetra();
+        t.faces[0].vertices.reverse();
+        assert!(!t.is_closed_oriented());
+        let mut t = tetra();
+        t.faces.pop();
+        assert!(!t.is_closed_oriented());
+    }
+
+    #[test]
+    fn weld_treats_negative_zero_as_zero_and_drops_unused() {
+        let mut t = tetra();
+        t.positions.push(DVec3::new(-0.0, 0.0, -0.0));
+        t.positions.push(DVec3::splat(9.0));
+        t.faces[0].vertices[0] = 4;
+        t.weld();
+        assert_eq!(t.positions.len(), 4);
+        assert!(t.is_closed_oriented());
+    }
+
+    #[test]
+    fn translate_group_splits_shared_vertices() {
+        let mut t = tetra();
+        let g = t.add_group("lid");
+        t.faces[3].group = g;
+        assert_eq!(t.translate_group("lid", DVec3::Z), Some(1));
+        // the three vertices of the lid were shared, so they were copied
+        assert_eq!(t.positions.len(), 7);
+        assert_eq!(
+            t.face_points(3),
+            vec![
+                DVec3::new(1., 0., 1.),
+                DVec3::new(0., 1., 1.),
+                DVec3::new(0., 0., 2.)
+            ]
+        );
+        assert_eq!(t.face_points(0), vec![DVec3::ZERO, DVec3::Y, DVec3::X]);
+        assert_eq!(t.translate_group("nothing", DVec3::Z), None);
+    }
+
+    #[test]
+    fn bounds_of_empty_mesh_is_none() {
+        assert_eq!(Mesh::default().bounds(), None);
+    }
+}

@@ -1,0 +1,453 @@
+//! Wavefront OBJ: a hand-written reader that keeps n-gons and reports the
+//! line of every error, and a simple writer.
+
+use std::io::Write;
+use std::path::Path;
+
+use glam::DVec3;
+
+use crate::{Face, Mesh, SceneError};
+
+/// Reads a Wavefront OBJ file (see [`parse_obj`] for what is understood).
+///
+/// Bytes that are not UTF-8 are replaced, so they only matter where a
+/// number or index is expected.
+pub fn read_obj(path: &Path) -> Result<Mesh, SceneError> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        path: name.clone(),
+        source,
+    })?;
+    parse_obj(&String::from_utf8_lossy(&bytes), &name)
+}
+
+/// Parses the text of a Wavefront OBJ file; `path_for_messages` names the
+/// file in errors.
+///
+/// Understood statements:
+/// - `v x y z [w]` (a trailing `r g b` vertex colour is accepted too; `w`
+///   and colours are ignored),
+/// - `f` with `i`, `i/t`, `i//n` or `i/t/n` vertices, where negative
+///   indices count back from the last vertex read so far; faces keep every
+///   vertex (quads stay quads),
+/// - `g` and `o`, which start a group (a bare `g` returns to `"default"`);
+///   names reused later continue the same group,
+/// - `#` comments, blank lines, and a `\` at the end of a line joining it
+///   to the next.
+///
+/// Everything else (`vt`, `vn`, `vp`, `s`, `usemtl`, `mtllib`, `l`, `p`,
+/// curves, unknown statements) is ignored.
+///
+/// Errors ([`SceneError::Parse`], with the 1-based line where the
+/// statement starts): a number that does not parse, a NaN or infinite
+/// coordinate, a vertex index of 0 or out of range, a face with fewer than
+/// three vertices.
+///
+/// ```
+/// use shadow_scene::parse_obj;
+/// let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\ng top\nf -4 -3 -2 -1\n";
+/// let mesh = parse_obj(text, "quad.obj").unwrap();
+/// assert_eq!(mesh.faces[0].vertices, vec![0, 1, 2, 3]);
+/// assert_eq!(mesh.group_name(0), "top");
+///
+/// let err = parse_obj("v 0 0 0\nf 1 2 3\n", "bad.obj").unwrap_err();
+/// assert_eq!(err.to_string(), "bad.obj:2: face index 2 out of range (1..=1)");
+/// ```
+pub fn parse_obj(text: &str, path_for_messages: &str) -> Result<Mesh, SceneError> {
+    let mut mesh = Mesh {
+        groups: vec!["default".to_string()],
+        ..Mesh::default()
+    };
+    let mut group = 0u32;
+    let mut lines = text.lines().enumerate();
+    let mut statement = String::new();
+    while let Some((i, first)) = lines.next() {
+        let line = i + 1;
+        statement.clear();
+        let mut current = first;
+        loop {
+            let trimmed = current.trim_end();
+            match trimmed.strip_suffix('\\') {
+                Some(head) => {
+                    statement.push_str(head);
+                    statement.push(' ');
+                    match lines.next() {
+                        Some((_, next)) => current = next,
+                        None => break,
+                    }
+                }
+                None => {
+                    statement.push_str(trimmed);
+                    break;
+                }
+            }
+        }
+        let content = statement.split('#').next().unwrap_or("");
+        let mut tokens = content.split_whitespace();
+        let Some(keyword) = tokens.next() else {
+            continue;
+        };
+        let err = |message: String| SceneError::Parse {
+            path: path_for_messages.to_string(),
+            line,
+            message,
+        };
+        match keyword {
+            "v" => {
+                let p = parse_vertex(tokens).map_err(err)?;
+                mesh.positions.push(p);
+            }
+            "f" => {
+                let vertices = parse_face(tokens, mesh.positions.len()).map_err(err)?;
+                mesh.faces.push(Face {
+                    vertices,
+                    line,
+                    group,
+                });
+            }
+            "g" | "o" => {
+                let name = tokens.collect::<Vec<_>>().join(" ");
+                group = mesh.add_group(if name.is_empty() { "default" } else { &name });
+            }
+            _ => {}
+        }
+    }
+    Ok(mesh)
+}
+
+fn parse_number(token: &str) -> Result<f64, String> {
+    token
+        .parse::<f64>()
+        .map_err(|_| format!("could not parse `{token}` as a number"))
+}
+
+fn parse_vertex<'a>(tokens: impl Iterator<Item = &'a str>) -> Result<DVec3, String> {
+    let tokens: Vec<&str> = tokens.collect();
+    let numbers = tokens
+        .iter()
+        .map(|t| parse_number(t))
+        .collect::<Result<Vec<f64>, String>>()?;
+    if !matches!(numbers.len(), 3 | 4 | 6 | 7) {
+        return Err(format!(
+            "vertex has {} number(s); expected `v x y z [w]`, optionally followed by `r g b`",
+            numbers.len()
+        ));
+    }
+    for (t, x) in tokens.iter().zip(&numbers).take(3) {
+        if !x.is_finite() {
+            return Err(format!("coordinate `{t}` is not finite"));
+        }
+    }
+    Ok(DVec3::new(numbers[0], numbers[1], numbers[2]))
+}
+
+fn parse_face<'a>(
+    tokens: impl Iterator<Item = &'a str>,
+    vertex_count: usize,
+) -> Result<Vec<u32>, String> {
+    let mut out = Vec::new();
+    for token in tokens {
+        let mut parts = token.split('/');
+        let index = parts.next().unwrap_or("");
+        let rest: Vec<&str> = parts.collect();
+        if rest.len() > 2 {
+            return Err(format!("malformed face vertex `{token}`"));
+        }
+        for extra in rest.iter().filter(|s| !s.is_empty()) {
+            extra.parse::<i64>().map_err(|_| {
+                format!("could not parse `{extra}` as a texture or normal index in `{token}`")
+            })?;
+        }
+        let i = index
+            .parse::<i64>()
+            .map_err(|_| format!("could not parse `{index}` as a vertex index in `{token}`"))?;
+        out.push(resolve_index(i, vertex_count)?);
+    }
+    if out.len() < 3 {
+        return Err(format!(
+            "face has {} vertex(es), needs at least 3",
+            out.len()
+        ));
+    }
+    Ok(out)
+}
+
+/// The 0-based vertex of a 1-based or negative (relative) OBJ index.
+fn resolve_index(i: i64, n: usize) -> Result<u32, String> {
+    let n64 = n as i64;
+    let resolved = match i {
+        0 => return Err("face index 0 is invalid (OBJ indices start at 1)".to_string()),
+        _ if n == 0 => {
+            return Err(format!(
+                "face index {i} out of range (no vertices defined yet)"
+            ));
+        }
+        1.. if i <= n64 => i - 1,
+        1.. => return Err(format!("face index {i} out of range (1..={n})")),
+        _ if -i <= n64 => n64 + i,
+        _ => return Err(format!("face index {i} out of range (-{n}..=-1)")),
+    };
+    u32::try_from(resolved)
+        .map_err(|_| format!("face index {i} exceeds the supported vertex count"))
+}
+
+/// Writes `mesh` as Wavefront OBJ: every position as `v` (shortest
+/// representation that reads back to the same `f64`), faces as 1-based
+/// `f` lines, and a `g` line whenever the group changes.
+///
+/// ```
+/// use shadow_scene::{parse_obj, write_obj};
+/// let chair = shadow_scene::scene("chair").unwrap();
+/// let mut text = Vec::new();
+/// write_obj(&chair, &mut text).unwrap();
+/// let back = parse_obj(std::str::from_utf8(&text).unwrap(), "chair.obj").unwrap();
+/// assert_eq!(back.positions, chair.positions);
+/// assert_eq!(back.faces.len(), chair.faces.len());
+/// ```
+pub fn write_obj<W: Write>(mesh: &Mesh, mut out: W) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "# shadow-scene: {} vertices, {} faces",
+        mesh.positions.len(),
+        mesh.faces.len()
+    )?;
+    for p in &mesh.positions {
+        writeln!(out, "v {:?} {:?} {:?}", p.x, p.y, p.z)?;
+    }
+    let mut current = None;
+    for f in &mesh.faces {
+        if current != Some(f.group) {
+            current = Some(f.group);
+            let name = mesh
+                .groups
+                .get(f.group as usize)
+                .map(|s| s.split_whitespace().collect::<Vec<_>>().join(" "))
+                .filter(|s| !s.is_empty())
+                .unwrap_or_else(|| "default".to_string());
+            writeln!(out, "g {name}")?;
+        }
+        out.write_all(b"f")?;
+        for v in &f.vertices {
+            write!(out, " {}", v + 1)?;
+        }
+        out.write_all(b"\n")?;
+    }
+    out.flush()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Mesh, SceneError> {
+        parse_obj(text, "test.obj")
+    }
+
+    /// The line and message of a parse error.
+    fn error(text: &str) -> (usize, String) {
+        match parse(text).unwrap_err() {
+            SceneError::Parse {
+                path,
+                line,
+                message,
+            } => {
+                assert_eq!(path, "test.obj");
+                (line, message)
+            }
+            e => panic!("expected a parse error, got {e:?}"),
+        }
+    }
+
+    const CUBE: &str = "\
+# a unit cube made of quads
+mtllib cube.mtl
+o cube
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+v 0 0 1
+v 1 0 1
+v 1 1 1
+v 0 1 1
+vt 0 0
+vn 0 0 1
+usemtl wood
+s off
+f 1 4 3 2
+f 5 6 7 8
+f 1/1 2/1 6/1 5/1
+f 2//1 3//1 7//1 6//1
+f 3/1/1 4/1/1 8/1/1 7/1/1
+f 4 1 5 8
+";
+
+    #[test]
+    fn cube_of_quads_keeps_quads() {
+        let m = parse(CUBE).unwrap();
+        assert_eq!(m.positions.len(), 8);
+        assert_eq!(m.faces.len(), 6);
+        assert!(m.faces.iter().all(|f| f.vertices.len() == 4));
+        assert_eq!(m.faces[0].vertices, vec![0, 3, 2, 1]);
+        assert_eq!(m.faces[0].line, 16);
+        assert_eq!(m.groups, vec!["default", "cube"]);
+        assert!(m.faces.iter().all(|f| f.group == 1));
+        assert!(m.is_closed_oriented());
+        assert_eq!(m.signed_volume(), 1.0);
+    }
+
+    #[test]
+    fn n_gons_are_kept_whole() {
+        let mut text = String::new();
+        for k in 0..7 {
+            let a = k as f64 * std::f64::consts::TAU / 7.0;
+            text += &format!("v {} {} 0\n", a.cos(), a.sin());
+        }
+        text += "f 1 2 3 4 5 6 7\n";
+        let m = parse(&text).unwrap();
+        assert_eq!(m.faces[0].vertices, (0..7).collect::<Vec<u32>>());
+    }
+
+    #[test]
+    fn negative_indices_are_relative_to_the_vertices_so_far() {
+        let m = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 0 0 1\nf -4 -1 -3\n").unwrap();
+        assert_eq!(m.faces[0].vertices, vec![0, 1, 2]);
+        assert_eq!(m.faces[1].vertices, vec![0, 3, 1]);
+        let (line, msg) = error("v 0 0 0\nv 1 0 0\nf -1 -2 -3\n");
+        assert_eq!(
+            (line, msg.as_str()),
+            (3, "face index -3 out of range (-2..=-1)")
+        );
+    }
+
+    #[test]
+    fn groups_and_objects() {
+        let m = parse(
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\ng legs\nf 1 2 3\no table top\nf 1 2 3\ng legs\nf 1 2 3\ng\nf 1 2 3\n",
+        )
+        .unwrap();
+        assert_eq!(m.groups, vec!["default", "legs", "table top"]);
+        let groups: Vec<u32> = m.faces.iter().map(|f| f.group).collect();
+        assert_eq!(groups, vec![0, 1, 2, 1, 0]);
+        assert_eq!(m.group_name(2), "table top");
+    }
+
+    #[test]
+    fn comments_blank_lines_crlf_and_continuations() {
+        let m = parse("# header\r\n\r\nv 0 0 0 # origin\r\nv 1 \\\r\n 0 0\r\nv 0 1 0\r\nf 1 2 \\\n3\n\nf 1 2 x\n")
+            .unwrap_err();
+        // the continued face starts on line 7; the bad face is on line 10
+        assert_eq!(m.line(), Some(10));
+        let m =
+            parse("# header\r\n\r\nv 0 0 0 # origin\r\nv 1 \\\r\n 0 0\r\nv 0 1 0\r\nf 1 2 \\\n3\n")
+                .unwrap();
+        assert_eq!(m.positions[1], DVec3::X);
+        assert_eq!(m.faces[0].vertices, vec![0, 1, 2]);
+        assert_eq!(m.faces[0].line, 7);
+    }
+
+    #[test]
+    fn ignored_statements() {
+        let m = parse(
+            "v 0 0 0\nv 1 0 0 1\nv 0 1 0 0.5 0.5 0.5\nvt 0.5 0.5\nvn 0 0 1\nvp 0.1\nl 1 2\np 1\ncurv 0 1 1 2\nusemtl red\ns 1\nfoo bar\nf 1 2 3\n",
+        )
+        .unwrap();
+        assert_eq!(m.positions.len(), 3);
+        assert_eq!(m.faces.len(), 1);
+    }
+
+    #[test]
+    fn unparsable_numbers_name_the_line() {
+        let (line, msg) = error("v 0 0 0\nv 1 0 0\nv 0 1.0.0 0\n");
+        assert_eq!(
+            (line, msg.as_str()),
+            (3, "could not parse `1.0.0` as a number")
+        );
+        let (line, msg) = error("v 0 0\n");
+        assert_eq!(line, 1);
+        assert!(msg.starts_with("vertex has 2 number(s)"), "{msg}");
+        let (line, msg) = error("v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 three\n");
+        assert_eq!(line, 5);
+        assert!(msg.contains("`three`"), "{msg}");
+        let (line, _) = error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/a 2 3\n");
+        assert_eq!(line, 4);
+        let (line, msg) = error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n");
+        assert_eq!((line, msg.as_str()), (4, "malformed face vertex `1/1/1/1`"));
+    }
+
+    #[test]
+    fn non_finite_coordinates_are_rejected() {
+        for (bad, tok) in [
+            ("nan", "nan"),
+            ("inf", "inf"),
+            ("-Infinity", "-Infinity"),
+            ("1e999", "1e999"),
+        ] {
+            let (line, msg) = error(&format!("v 0 0 0\n# bad one next\nv 0 {bad} 0\n"));
+            assert_eq!(line, 3);
+            assert_eq!(msg, format!("coordinate `{tok}` is not finite"));
+        }
+    }
+
+    #[test]
+    fn index_zero_and_out_of_range() {
+        let (line, msg) = error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
+        assert_eq!(
+            (line, msg.as_str()),
+            (4, "face index 0 is invalid (OBJ indices start at 1)")
+        );
+        let (line, msg) = error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9999\n");
+        assert_eq!(
+            (line, msg.as_str()),
+            (5, "face index 9999 out of range (1..=3)")
+        );
+        let (line, msg) = error("f 1 2 3\n");
+        assert_eq!(
+            (line, msg.as_str()),
+            (1, "face index 1 out of range (no vertices defined yet)")
+        );
+        // a face may only use vertices defined before it
+        let (line, _) = error("v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n");
+        assert_eq!(line, 3);
+        let (line, _) = error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n");
+        assert_eq!(line, 4);
+    }
+
+    #[test]
+    fn faces_need_three_vertices() {
+        let (line, msg) = error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n\nf 1 2\n");
+        assert_eq!(
+            (line, msg.as_str()),
+            (6, "face has 2 vertex(es), needs at least 3")
+        );
+        let (line, _) = error("v 0 0 0\nf\n");
+        assert_eq!(line, 2);
+    }
+
+    #[test]
+    fn write_then_read_round_trips() {
+        let m = parse(CUBE).unwrap();
+        let mut buf = Vec::new();
+        write_obj(&m, &mut buf).unwrap();
+        let text = String::from_utf8(buf).unwrap();
+        assert!(text.contains("\ng cube\nf 1 4 3 2\n"), "{text}");
+        let back = parse(&text).unwrap();
+        assert_eq!(back.positions, m.positions);
+        let loops = |m: &Mesh| {
+            (0..m.faces.len())
+                .map(|i| (m.faces[i].vertices.clone(), m.group_name(i).to_string()))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(loops(&back), loops(&m));
+    }
+
+    #[test]
+    fn write_keeps_awkward_coordinates_exact() {
+        let mut m = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        m.positions[0] = DVec3::new(0.1 + 0.2, -1e-300, 1.7976931348623157e308);
+        let mut buf = Vec::new();
+        write_obj(&m, &mut buf).unwrap();
+        let back = parse(std::str::from_utf8(&buf).unwrap()).unwrap();
+        assert_eq!(back.positions[0], m.positions[0]);
+    }
+}

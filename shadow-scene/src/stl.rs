@@ -1,0 +1,184 @@
+//! STL (binary and ASCII) through the `stl_io` crate.
+
+use std::borrow::Cow;
+use std::io::Cursor;
+use std::path::Path;
+
+use glam::DVec3;
+
+use crate::{Face, Mesh, SceneError};
+
+/// Reads a binary or ASCII STL file; see [`parse_stl`].
+pub fn read_stl(path: &Path) -> Result<Mesh, SceneError> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        path: name.clone(),
+        source,
+    })?;
+    parse_stl(&bytes, &name)
+}
+
+/// Parses the bytes of a binary or ASCII STL file; `path_for_messages`
+/// names the file in errors.
+///
+/// Every facet becomes a triangle face in group `"default"`; vertices with
+/// exactly equal positions (after the exact widening of `f32` to `f64`) are
+/// welded, so neighbouring triangles share them. A binary file whose header
+/// happens to start with `solid` is recognised by its size. Errors say
+/// which triangle is bad; the line is 0 as `stl_io` does not report lines.
+///
+/// ```
+/// use shadow_scene::parse_stl;
+/// let text = b"solid t
+/// facet normal 0 0 1
+///   outer loop
+///     vertex 0 0 0
+///     vertex 1 0 0
+///     vertex 0 1 0
+///   endloop
+/// endfacet
+/// endsolid t
+/// ";
+/// let mesh = parse_stl(text, "t.stl").unwrap();
+/// assert_eq!((mesh.positions.len(), mesh.faces.len()), (3, 1));
+/// ```
+pub fn parse_stl(bytes: &[u8], path_for_messages: &str) -> Result<Mesh, SceneError> {
+    let err = |message: String| SceneError::Parse {
+        path: path_for_messages.to_string(),
+        line: 0,
+        message,
+    };
+    let mut data = Cow::Borrowed(bytes);
+    if looks_binary(bytes) && bytes.starts_with(b"solid") {
+        // stl_io takes any file starting with "solid " for ASCII; the
+        // 80-byte header of a binary file is free text, so hide the word
+        let mut owned = bytes.to_vec();
+        owned[..5].copy_from_slice(b"SOLID");
+        data = Cow::Owned(owned);
+    }
+    let mut cursor = Cursor::new(&data[..]);
+    let reader =
+        stl_io::create_stl_reader(&mut cursor).map_err(|e| err(format!("invalid STL: {e}")))?;
+    let mut mesh = Mesh {
+        groups: vec!["default".to_string()],
+        ..Mesh::default()
+    };
+    for (i, triangle) in reader.enumerate() {
+        let t = triangle.map_err(|e| err(format!("invalid STL at triangle {}: {e}", i + 1)))?;
+        let base = mesh.positions.len() as u32;
+        for v in t.vertices {
+            let p = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
+            if !p.is_finite() {
+                return Err(err(format!(
+                    "triangle {} has a NaN or infinite coordinate",
+                    i + 1
+                )));
+            }
+            mesh.positions.push(p);
+        }
+        mesh.faces.push(Face {
+            vertices: vec![base, base + 1, base + 2],
+            line: 0,
+            group: 0,
+        });
+    }
+    mesh.weld();
+    Ok(mesh)
+}
+
+/// `true` if the size matches the binary layout: an 80-byte header, a
+/// triangle count, and 50 bytes per triangle.
+fn looks_binary(bytes: &[u8]) -> bool {
+    bytes.len() >= 84 && {
+        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
+        84 + 50 * n == bytes.len() as u64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A binary STL of `triangles` with the given 80-byte header start.
+    fn binary(header: &[u8], triangles: &[[[f32; 3]; 3]]) -> Vec<u8> {
+        let mut out = vec![0u8; 80];
+        out[..header.len()].copy_from_slice(header);
+        out.extend((triangles.len() as u32).to_le_bytes());
+        for t in triangles {
+            out.extend([0f32; 3].iter().flat_map(|c| c.to_le_bytes()));
+            for v in t {
+                out.extend(v.iter().flat_map(|c| c.to_le_bytes()));
+            }
+            out.extend([0u8; 2]);
+        }
+        out
+    }
+
+    const TETRA: [[[f32; 3]; 3]; 4] = [
+        [[0., 0., 0.], [0., 1., 0.], [1., 0., 0.]],
+        [[0., 0., 0.], [1., 0., 0.], [0., 0., 1.]],
+        [[0., 0., 0.], [0., 0., 1.], [0., 1., 0.]],
+        [[1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
+    ];
+
+    #[test]
+    fn binary_tetra_is_welded_and_closed() {
+        let m = parse_stl(&binary(b"made by a test", &TETRA), "t.stl").unwrap();
+        assert_eq!((m.positions.len(), m.faces.len()), (4, 4));
+        assert!(m.is_closed_oriented());
+        assert_eq!(m.signed_volume(), 1.0 / 6.0);
+    }
+
+    #[test]
+    fn binary_with_solid_header_is_still_binary() {
+        let m = parse_stl(&binary(b"solid but binary", &TETRA), "t.stl").unwrap();
+        assert_eq!(m.faces.len(), 4);
+    }
+
+    #[test]
+    fn ascii_tetra() {
+        let mut text = String::from("solid tetra\n");
+        for t in TETRA {
+            text += "facet normal 0 0 0\nouter loop\n";
+            for v in t {
+                text += &format!("vertex {} {} {}\n", v[0], v[1], v[2]);
+            }
+            text += "endloop\nendfacet\n";
+        }
+        text += "endsolid tetra\n";
+        let m = parse_stl(text.as_bytes(), "t.stl").unwrap();
+        assert_eq!((m.positions.len(), m.faces.len()), (4, 4));
+        assert!(m.is_closed_oriented());
+    }
+
+    #[test]
+    fn errors_name_the_file() {
+        let e = parse_stl(b"", "empty.stl").unwrap_err();
+        assert!(e.to_string().starts_with("empty.stl: invalid STL"), "{e}");
+        let mut bytes = binary(b"", &TETRA);
+        bytes.truncate(bytes.len() - 10);
+        let e = parse_stl(&bytes, "cut.stl").unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("cut.stl: invalid STL at triangle 4"),
+            "{e}"
+        );
+        let mut bad = TETRA;
+        bad[2][1][0] = f32::NAN;
+        let e = parse_stl(&binary(b"", &bad), "nan.stl").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "nan.stl: triangle 3 has a NaN or infinite coordinate"
+        );
+        let e = parse_stl(
+            b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 zero\n",
+            "a.stl",
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("a.stl: invalid STL at triangle 1"),
+            "{e}"
+        );
+    }
+}
