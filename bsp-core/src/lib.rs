@@ -48,20 +48,19 @@ mod tree;
 
 
 pub use flat::FlatBsp;
-pub use grid::{Grid, GridPoint, SnapError, ViewPoint, GRID_BITS, MAX_COORD, MAX_VIEW_COORD};
-pub use import::{all_planar, import_faces, ImportReport};
+pub use grid::{GRID_BITS, Grid, GridPoint, MAX_COORD, MAX_VIEW_COORD, SnapError, ViewPoint};
+pub use import::{ImportReport, all_planar, import_faces};
 pub use mesh::TriMesh;
 pub use partition::{
-    box_section, merge, merge_smaller_into_larger, BoolOp, CellOp, Overlay, PLink, PNode, Partition,
-    BOX_HALF,
+    BOX_HALF, BoolOp, CellOp, Overlay, PLink, PNode, Partition, box_section, merge,
+    merge_smaller_into_larger, solid_build_options,
 };
-pub use plane::{Plane, MAX_NORMAL_BITS, MAX_OFFSET_BITS};
+pub use plane::{MAX_NORMAL_BITS, MAX_OFFSET_BITS, Plane};
 pub use point::{Implicit, Point};
 pub use polygon::{FaceDefect, Polygon, PolygonSide, Side, Split};
-pub use topology::{check_closed_manifold, TopologyError};
+pub use topology::{TopologyError, check_closed_manifold};
 pub use tree::{
-    BspTree, BuildOptions, Cell, Link, Membership, Node, NodeId, Order, TreeStats,
-    RECURSION_LIMIT,
+    BspTree, BuildOptions, Cell, Link, Membership, Node, NodeId, Order, RECURSION_LIMIT, TreeStats,
 };
 
 /// Re-export of the wide integer type used for homogeneous coordinates.
@@ -94,10 +93,7 @@ impl std::fmt::Display for Error {
                 vertex,
                 value,
                 reason,
-            } => write!(
-                f,
-                "face {face}, vertex {vertex} {value:?}: {reason}"
-            ),
+            } => write!(f, "face {face}, vertex {vertex} {value:?}: {reason}"),
             Error::InvalidGrid(why) => write!(f, "invalid grid: {why}"),
         }
     }

@@ -185,28 +185,52 @@ impl TriMesh {
 
     /// The exact signed volume in grid units³ (divide by `scale³` of the
     /// grid for input units; the scale is a power of two, so that is exact
-    /// too). Triangles whose vertices share a denominator are summed in
-    /// integers first; big rationals only join the groups.
+    /// too), as an unreduced fraction (reducing it costs a gcd of very long
+    /// integers; `Ratio`'s comparisons do not need it).
+    ///
+    /// Triangles whose vertices share a denominator are summed in integers;
+    /// the groups are then added pairwise in a balanced tree without
+    /// reduction, so the cost grows with the total size of the
+    /// denominators, not quadratically.
     pub fn volume_exact(&self) -> BigRational {
-        let mut groups: HashMap<BigInt, BigInt> = HashMap::new();
+        let (num, den) = self.six_volume();
+        BigRational::new_raw(num, den * BigInt::from(6))
+    }
+
+    /// Six times the exact volume as `(numerator, denominator)`,
+    /// denominator positive and not reduced.
+    pub fn six_volume(&self) -> (BigInt, BigInt) {
         let hom: Vec<[BigInt; 4]> = self
             .vertices
             .iter()
             .map(|p| p.homogeneous().map(|c| to_bigint(&c)))
             .collect();
+        let mut groups: HashMap<BigInt, BigInt> = HashMap::new();
         for t in &self.triangles {
             let [a, b, c] = t.map(|i| &hom[i as usize]);
             let det = &a[0] * (&b[1] * &c[2] - &b[2] * &c[1])
                 - &a[1] * (&b[0] * &c[2] - &b[2] * &c[0])
                 + &a[2] * (&b[0] * &c[1] - &b[1] * &c[0]);
-            let den = &a[3] * &b[3] * &c[3];
-            *groups.entry(den).or_default() += det;
+            *groups.entry(&a[3] * &b[3] * &c[3]).or_default() += det;
         }
-        let mut sum = BigRational::from_integer(BigInt::from(0));
-        for (den, num) in groups {
-            sum += BigRational::new(num, den);
+        let mut terms: Vec<(BigInt, BigInt)> = groups.into_iter().map(|(d, n)| (n, d)).collect();
+        // deterministic order, whatever the hash map did
+        terms.sort_by(|x, y| x.1.cmp(&y.1));
+        while terms.len() > 1 {
+            let mut next = Vec::with_capacity(terms.len().div_ceil(2));
+            let mut it = terms.into_iter();
+            while let Some((n1, d1)) = it.next() {
+                next.push(match it.next() {
+                    Some((n2, d2)) if d1 == d2 => (n1 + n2, d1),
+                    Some((n2, d2)) => (n1 * &d2 + n2 * &d1, d1 * d2),
+                    None => (n1, d1),
+                });
+            }
+            terms = next;
         }
-        sum / BigRational::from_integer(BigInt::from(6))
+        terms
+            .pop()
+            .unwrap_or_else(|| (BigInt::from(0), BigInt::from(1)))
     }
 
     /// Surface area in grid units², in `f64`.

@@ -15,10 +15,11 @@
 
 use crate::Side;
 use crate::grid::MAX_COORD;
+use crate::mesh::TriMesh;
 use crate::plane::Plane;
 use crate::point::Point;
 use crate::polygon::{Polygon, PolygonSide, Split};
-use crate::tree::{Ancestor, BspTree, Cell, Link, Membership};
+use crate::tree::{Ancestor, BspTree, BuildOptions, Cell, Link, Membership};
 
 /// Half-width of the box that bounds every sub-hyperplane: `2^26`, just
 /// outside every grid coordinate.
@@ -186,7 +187,28 @@ fn clip(poly: Polygon, plane: &Plane, side: Side) -> Option<Polygon> {
     }
 }
 
+/// Options of [`Partition::solid`]: the BSP build with balance cuts every
+/// 64 polygons, which keeps convex meshes from turning into chains.
+pub fn solid_build_options() -> BuildOptions {
+    BuildOptions::default().with_cut_threshold(64)
+}
+
 impl Partition<Cell> {
+    /// The solid bounded by `polygons`, which must tile the boundary of a
+    /// closed, consistently oriented solid (outward normals). Node polygons
+    /// are not kept: set operations only need cells and sub-hyperplanes.
+    pub fn solid(polygons: Vec<Polygon>) -> Partition<Cell> {
+        let tree = BspTree::build(polygons, &solid_build_options());
+        let mut p = Partition::from_tree(&tree);
+        p.clear_polygons();
+        p
+    }
+
+    /// The boundary as a watertight triangle mesh (see [`TriMesh`]).
+    pub fn to_mesh(&self) -> TriMesh {
+        TriMesh::from_polygons(&self.boundary())
+    }
+
     /// The solid partition of a solid BSP tree (see [`BspTree`]): the same
     /// planes, polygons and cells, with each node's sub-hyperplane computed
     /// by clipping its plane's box section by the ancestors' half-spaces.
@@ -683,6 +705,13 @@ impl<L: Copy> Partition<L> {
         }
     }
 
+    /// Drops the input polygons carried by the nodes.
+    pub fn clear_polygons(&mut self) {
+        for n in &mut self.nodes {
+            n.polygons = Vec::new();
+        }
+    }
+
     /// The root link.
     pub fn root(&self) -> PLink<L> {
         self.root
@@ -921,7 +950,6 @@ impl<L: Copy> Partition<L> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tree::BuildOptions;
 
     fn cube(lo: [i32; 3], hi: [i32; 3]) -> Vec<Polygon> {
         let (l, h) = (lo, hi);

@@ -5,12 +5,15 @@
 //!              -o OUT.svg [--width W] [--height H] [--fov DEG]
 //! shadow stats [INPUT | --scene NAME]
 //! shadow demo  [-o room.svg]
+//! shadow csg   union|intersection|difference A B -o OUT [--weld] [--stats]
 //! ```
 //!
 //! Every command loads a mesh (OBJ or STL) or a built-in scene, snaps it
 //! to an exact integer grid, builds a BSP tree, and uses it: `view` draws
 //! it with the painter's algorithm in the tree's exact back-to-front order,
-//! `stats` reports the tree's figures, `demo` renders the built-in room.
+//! `stats` reports the tree's figures, `demo` renders the built-in room,
+//! `csg` computes an exact Boolean operation of two closed meshes and
+//! writes the watertight result (OBJ or binary STL).
 //! Errors go to stderr as `error: ...` with exit code 1.
 
 use std::path::{Path, PathBuf};
@@ -21,6 +24,7 @@ use clap::{Args, Parser, Subcommand};
 use glam::DVec3;
 
 mod color;
+mod csg;
 mod pipeline;
 mod render;
 
@@ -46,6 +50,8 @@ enum Command {
     Stats(SourceArgs),
     /// Render the built-in room from a viewpoint that shows all of it.
     Demo(DemoArgs),
+    /// Exact union, intersection or difference of two closed meshes.
+    Csg(csg::CsgArgs),
 }
 
 /// Where the mesh comes from: a file or a built-in scene (exactly one).
@@ -255,6 +261,7 @@ fn main() -> ExitCode {
         Command::View(a) => view(a),
         Command::Stats(a) => stats(a),
         Command::Demo(a) => demo(a),
+        Command::Csg(a) => csg::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,31 +1,8 @@
-//! End-to-end tests of the `shadow` binary.
+//! `view`, `stats` and `demo`.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
-fn shadow(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_shadow"))
-        .args(args)
-        .output()
-        .expect("the shadow binary runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// A fresh path in cargo's per-test scratch directory.
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("shadow-cli-tests");
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
-    let _ = std::fs::remove_file(&p);
-    p
-}
+use crate::{assert_failed_with, scratch, shadow, stderr, stdout};
 
 fn teapot() -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -48,16 +25,6 @@ fn svg_polygons(path: &Path) -> usize {
         "every polygon closed (plus the background rect)"
     );
     polys
-}
-
-fn assert_failed_with(o: &Output, needles: &[&str]) {
-    assert_eq!(o.status.code(), Some(1), "stderr: {}", stderr(o));
-    let err = stderr(o);
-    assert!(err.starts_with("error: "), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "`{n}` not in {err:?}");
-    }
-    assert!(!err.contains("panicked"), "{err}");
 }
 
 #[test]

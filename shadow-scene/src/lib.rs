@@ -14,7 +14,8 @@
 //!
 //! or generated in code ([`scene`], [`room`]): the test room of Liu & Wu's
 //! real-time shadow paper, with a movable coordinate-axis object. Meshes
-//! are written back with [`write_obj`].
+//! are written back with [`write_obj`] or [`write_stl`] (binary), or
+//! [`save`]d with the format chosen by extension.
 //!
 //! This crate does not depend on the exact kernel; it hands `f64` face
 //! loops ([`Mesh::face_loops`]) to whoever snaps them.
@@ -53,7 +54,42 @@ pub use error::SceneError;
 pub use mesh::{Face, Mesh};
 pub use obj::{parse_obj, read_obj, write_obj};
 pub use scenes::{SCENE_NAMES, room, scene};
-pub use stl::{parse_stl, read_stl};
+pub use stl::{parse_stl, read_stl, stl_collisions, write_stl};
+
+/// A mesh file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum MeshFormat {
+    /// Wavefront OBJ (`.obj`).
+    Obj,
+    /// STL (`.stl`): read as binary or ASCII, written as binary.
+    Stl,
+}
+
+impl MeshFormat {
+    /// The format named by `path`'s extension (`.obj` or `.stl`, in any
+    /// case); other extensions give [`SceneError::UnknownFormat`].
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use shadow_scene::MeshFormat;
+    /// assert_eq!(MeshFormat::from_path(Path::new("a/b.STL")).unwrap(), MeshFormat::Stl);
+    /// assert!(MeshFormat::from_path(Path::new("model.ply")).is_err());
+    /// ```
+    pub fn from_path(path: &Path) -> Result<MeshFormat, SceneError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("obj") => Ok(MeshFormat::Obj),
+            Some("stl") => Ok(MeshFormat::Stl),
+            _ => Err(SceneError::UnknownFormat {
+                path: path.display().to_string(),
+            }),
+        }
+    }
+}
 
 /// Reads an OBJ or STL file, chosen by its extension (`.obj` or `.stl`,
 /// in any case); other extensions give [`SceneError::UnknownFormat`].
@@ -65,17 +101,34 @@ pub use stl::{parse_stl, read_stl};
 /// assert!(matches!(err, SceneError::UnknownFormat { .. }));
 /// ```
 pub fn load(path: &Path) -> Result<Mesh, SceneError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("obj") => read_obj(path),
-        Some("stl") => read_stl(path),
-        _ => Err(SceneError::UnknownFormat {
-            path: path.display().to_string(),
-        }),
+    match MeshFormat::from_path(path)? {
+        MeshFormat::Obj => read_obj(path),
+        MeshFormat::Stl => read_stl(path),
     }
+}
+
+/// Writes `mesh` as OBJ ([`write_obj`]) or binary STL ([`write_stl`]),
+/// chosen by `path`'s extension as for [`load`]. Errors name the file.
+///
+/// ```
+/// use std::path::Path;
+/// use shadow_scene::{save, SceneError};
+/// let cube = shadow_scene::scene("cube").unwrap();
+/// let err = save(Path::new("cube.ply"), &cube).unwrap_err();
+/// assert!(matches!(err, SceneError::UnknownFormat { .. }));
+/// ```
+pub fn save(path: &Path, mesh: &Mesh) -> Result<(), SceneError> {
+    let format = MeshFormat::from_path(path)?;
+    let io = |source| SceneError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let file = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+    match format {
+        MeshFormat::Obj => write_obj(mesh, file),
+        MeshFormat::Stl => write_stl(mesh, file),
+    }
+    .map_err(io)
 }
 
 #[cfg(test)]
@@ -101,6 +154,23 @@ mod tests {
         assert_eq!(load(&stl).unwrap().faces.len(), 1);
         let none = temp("tri", b"");
         assert!(matches!(load(&none), Err(SceneError::UnknownFormat { .. })));
+    }
+
+    #[test]
+    fn save_then_load_in_both_formats() {
+        let chair = scene("chair").unwrap();
+        let dir = temp("unused", b"").with_file_name("");
+        for name in ["chair.obj", "chair.STL"] {
+            let p = dir.join(name);
+            save(&p, &chair).unwrap();
+            let back = load(&p).unwrap();
+            assert!(back.is_closed_oriented(), "{name}");
+            assert_eq!(back.triangle_count(), chair.triangle_count(), "{name}");
+            assert_eq!(back.signed_volume(), chair.signed_volume(), "{name}");
+        }
+        let e = save(&dir.join("no_such_dir").join("x.obj"), &chair).unwrap_err();
+        assert!(matches!(e, SceneError::Io { .. }));
+        assert!(e.to_string().contains("x.obj"), "{e}");
     }
 
     #[test]

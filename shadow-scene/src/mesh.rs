@@ -155,6 +155,31 @@ impl Mesh {
         self.positions = positions;
     }
 
+    /// How many of the vertices used by faces repeat the position of
+    /// another used vertex (`-0.0` equals `0.0`): the number of vertices
+    /// [`Mesh::weld`] would merge away. Non-zero for files that store the
+    /// corners of every face separately.
+    ///
+    /// ```
+    /// use shadow_scene::parse_obj;
+    /// let soup = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 4 6 5\n", "s.obj").unwrap();
+    /// assert_eq!(soup.repeated_positions(), 2);
+    /// ```
+    pub fn repeated_positions(&self) -> usize {
+        let mut used = vec![false; self.positions.len()];
+        for v in self.faces.iter().flat_map(|f| &f.vertices) {
+            used[*v as usize] = true;
+        }
+        let mut seen: HashSet<[u64; 3]> = HashSet::new();
+        let mut repeats = 0;
+        for (p, _) in self.positions.iter().zip(&used).filter(|(_, u)| **u) {
+            if !seen.insert(key(*p)) {
+                repeats += 1;
+            }
+        }
+        repeats
+    }
+
     /// `true` if every directed edge `a → b` of every face appears exactly
     /// once and its reverse `b → a` exactly once: the faces (compared by
     /// vertex index, so weld first) bound closed, consistently oriented
@@ -285,6 +310,26 @@ mod tests {
         t.faces[0].vertices[0] = 4;
         t.weld();
         assert_eq!(t.positions.len(), 4);
+        assert!(t.is_closed_oriented());
+    }
+
+    #[test]
+    fn repeated_positions_counts_what_weld_merges() {
+        let mut t = tetra();
+        assert_eq!(t.repeated_positions(), 0);
+        // face 3 gets its own copies of all three corners, plus an unused
+        // position equal to a used one (which does not count)
+        let n = t.positions.len() as u32;
+        for v in t.faces[3].vertices.clone() {
+            t.positions.push(t.positions[v as usize]);
+        }
+        t.faces[3].vertices = vec![n, n + 1, n + 2];
+        t.positions.push(DVec3::ZERO);
+        assert_eq!(t.repeated_positions(), 3);
+        let before = t.positions.len();
+        t.weld();
+        assert_eq!(before - t.positions.len(), 3 + 1);
+        assert_eq!(t.repeated_positions(), 0);
         assert!(t.is_closed_oriented());
     }
 

@@ -1,8 +1,10 @@
 //! STL (binary and ASCII) through the `stl_io` crate.
 
 use std::borrow::Cow;
-use std::io::Cursor;
+use std::io::{Cursor, Write};
 use std::path::Path;
+
+use std::collections::{HashMap, HashSet};
 
 use glam::DVec3;
 
@@ -86,6 +88,86 @@ pub fn parse_stl(bytes: &[u8], path_for_messages: &str) -> Result<Mesh, SceneErr
     Ok(mesh)
 }
 
+/// Writes `mesh` as binary STL (through `stl_io`).
+///
+/// Faces with more than three vertices are fan-triangulated from their
+/// first vertex, which is right for convex faces. Each facet's normal is
+/// the unit normal of its triangle (zero for a triangle without area).
+/// Binary STL stores `f32`: every coordinate is rounded to the nearest
+/// `f32`, so positions that differ by less than an `f32` step may become
+/// equal (see [`stl_collisions`]); groups are not stored.
+///
+/// ```
+/// use shadow_scene::{parse_stl, write_stl};
+/// let cube = shadow_scene::scene("cube").unwrap();
+/// let mut bytes = Vec::new();
+/// write_stl(&cube, &mut bytes).unwrap();
+/// assert_eq!(bytes.len(), 84 + 50 * cube.triangle_count());
+/// let back = parse_stl(&bytes, "cube.stl").unwrap();
+/// assert!(back.is_closed_oriented());
+/// assert_eq!(back.signed_volume(), cube.signed_volume());
+/// ```
+pub fn write_stl<W: Write>(mesh: &Mesh, mut out: W) -> std::io::Result<()> {
+    let mut triangles = Vec::with_capacity(mesh.triangle_count());
+    let to32 = |p: DVec3| stl_io::Vector::new([p.x as f32, p.y as f32, p.z as f32]);
+    for f in &mesh.faces {
+        let p = |i: usize| mesh.positions[f.vertices[i] as usize];
+        for i in 1..f.vertices.len().saturating_sub(1) {
+            let (a, b, c) = (p(0), p(i), p(i + 1));
+            let n = (b - a).cross(c - a).normalize_or_zero();
+            triangles.push(stl_io::Triangle {
+                normal: to32(n),
+                vertices: [to32(a), to32(b), to32(c)],
+            });
+        }
+    }
+    if u32::try_from(triangles.len()).is_err() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "binary STL holds at most 2^32 - 1 triangles",
+        ));
+    }
+    stl_io::write_stl(&mut out, triangles.iter())?;
+    out.flush()
+}
+
+/// How many of the vertices used by faces would share their `f32`
+/// rounding with another used vertex of a different `f64` position: the
+/// vertices that [`write_stl`] followed by [`parse_stl`] would merge.
+/// When it is not zero the written surface may no longer be closed.
+///
+/// ```
+/// use glam::DVec3;
+/// use shadow_scene::{stl_collisions, Face, Mesh};
+/// let mesh = Mesh {
+///     positions: vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0 + 1e-12, 0.0, 0.0), DVec3::Y],
+///     faces: vec![Face { vertices: vec![0, 1, 3], line: 0, group: 0 }, Face { vertices: vec![0, 3, 2], line: 0, group: 0 }],
+///     groups: vec!["default".into()],
+/// };
+/// assert_eq!(stl_collisions(&mesh), 1);
+/// ```
+pub fn stl_collisions(mesh: &Mesh) -> usize {
+    let mut used = vec![false; mesh.positions.len()];
+    for v in mesh.faces.iter().flat_map(|f| &f.vertices) {
+        used[*v as usize] = true;
+    }
+    let key64 = |p: DVec3| [p.x, p.y, p.z].map(|c| (c + 0.0).to_bits());
+    let key32 = |p: DVec3| [p.x, p.y, p.z].map(|c| (c as f32 + 0.0).to_bits());
+    let mut by32: HashMap<[u32; 3], [u64; 3]> = HashMap::new();
+    let mut distinct64: HashSet<[u64; 3]> = HashSet::new();
+    let mut collisions = 0;
+    for (p, _) in mesh.positions.iter().zip(&used).filter(|(_, u)| **u) {
+        if !distinct64.insert(key64(*p)) {
+            continue; // an exact repeat: merged by any reader, not by rounding
+        }
+        let first = *by32.entry(key32(*p)).or_insert(key64(*p));
+        if first != key64(*p) {
+            collisions += 1;
+        }
+    }
+    collisions
+}
+
 /// `true` if the size matches the binary layout: an 80-byte header, a
 /// triangle count, and 50 bytes per triangle.
 fn looks_binary(bytes: &[u8]) -> bool {
@@ -149,6 +231,53 @@ mod tests {
         let m = parse_stl(text.as_bytes(), "t.stl").unwrap();
         assert_eq!((m.positions.len(), m.faces.len()), (4, 4));
         assert!(m.is_closed_oriented());
+    }
+
+    #[test]
+    fn write_then_read_round_trips_and_fans_quads() {
+        let mut m = parse_stl(&binary(b"", &TETRA), "t.stl").unwrap();
+        let mut bytes = Vec::new();
+        write_stl(&m, &mut bytes).unwrap();
+        assert_eq!(bytes.len(), 84 + 50 * 4);
+        let back = parse_stl(&bytes, "back.stl").unwrap();
+        assert_eq!(back, m);
+        // the stored normal of the slanted face is its unit normal
+        let t = stl_io::create_stl_reader(&mut Cursor::new(&bytes))
+            .unwrap()
+            .nth(3)
+            .unwrap()
+            .unwrap();
+        let s = (1.0 / 3f64.sqrt()) as f32;
+        assert_eq!(t.normal.0, [s, s, s]);
+        // a quad becomes two triangles, a pentagon three
+        m.positions.push(DVec3::new(1., 1., 0.));
+        m.faces = vec![Face {
+            vertices: vec![0, 1, 4, 2],
+            line: 0,
+            group: 0,
+        }];
+        let mut bytes = Vec::new();
+        write_stl(&m, &mut bytes).unwrap();
+        let back = parse_stl(&bytes, "quad.stl").unwrap();
+        assert_eq!(back.faces.len(), 2);
+        assert_eq!(back.faces[0].vertices, vec![0, 1, 2]);
+        assert_eq!(back.faces[1].vertices, vec![0, 2, 3]);
+    }
+
+    #[test]
+    fn f32_rounding_collisions_are_counted() {
+        let mut m = parse_stl(&binary(b"", &TETRA), "t.stl").unwrap();
+        assert_eq!(stl_collisions(&m), 0);
+        // a position a hair off a used one, used by a face
+        let near = DVec3::new(1.0 + 1e-12, 0.0, 0.0);
+        assert!(m.positions.contains(&DVec3::X));
+        m.positions.push(near);
+        m.faces[0].vertices[0] = 4;
+        assert_eq!(stl_collisions(&m), 1);
+        // exact repeats are not collisions
+        m.positions.push(near);
+        m.faces[1].vertices[0] = 5;
+        assert_eq!(stl_collisions(&m), 1);
     }
 
     #[test]

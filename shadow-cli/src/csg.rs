@@ -1,0 +1,806 @@
+//! `shadow csg`: exact Boolean operations (∪ ∩ −) on closed meshes.
+//!
+//! Load both operands → validate each as a closed, consistently oriented
+//! 2-manifold → snap both to one grid → build a solid BSP partition of
+//! each → merge → boundary as a watertight triangle mesh → write. Every
+//! decision after snapping is exact; the only roundings are the input
+//! snap and the final conversion of exact vertices to `f64` (and to `f32`
+//! for STL).
+
+use std::io::Write;
+use std::panic;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, anyhow, bail};
+use bsp_core::{
+    BoolOp, Grid, ImportReport, MAX_COORD, Membership, Partition, Point, TopologyError,
+    TriMesh, check_closed_manifold, import_faces,
+};
+use clap::{Args, ValueEnum};
+use num_rational::BigRational;
+use num_traits::ToPrimitive;
+use shadow_scene::{Face, Mesh, MeshFormat};
+
+/// A Boolean operation as named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(crate) enum Operation {
+    /// A ∪ B.
+    Union,
+    /// A ∩ B.
+    Intersection,
+    /// A − B.
+    Difference,
+}
+
+impl Operation {
+    fn name(self) -> &'static str {
+        match self {
+            Operation::Union => "union",
+            Operation::Intersection => "intersection",
+            Operation::Difference => "difference",
+        }
+    }
+
+    fn kernel(self) -> BoolOp {
+        match self {
+            Operation::Union => BoolOp::Union,
+            Operation::Intersection => BoolOp::Intersection,
+            Operation::Difference => BoolOp::Difference,
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct CsgArgs {
+    /// The operation (difference is A minus B).
+    #[arg(value_enum)]
+    pub(crate) op: Operation,
+    /// First operand (.obj or .stl): a closed, consistently oriented mesh.
+    pub(crate) a: PathBuf,
+    /// Second operand (.obj or .stl).
+    pub(crate) b: PathBuf,
+    /// Output file: .obj, or .stl for binary STL.
+    #[arg(short, long, value_name = "OUT")]
+    pub(crate) output: PathBuf,
+    /// Merge vertices with exactly equal positions first (for files that
+    /// repeat the vertices of every face; STL input is always welded).
+    #[arg(long)]
+    pub(crate) weld: bool,
+    /// Print counts, the exact volume and the time of each phase.
+    #[arg(long)]
+    pub(crate) stats: bool,
+}
+
+/// One input mesh with what messages need to point into its file.
+struct Operand {
+    /// The file, as given.
+    name: String,
+    mesh: Mesh,
+    /// The faces' vertex loops as in the file, kept when `--weld` renumbered
+    /// them, so that messages quote the file's indices.
+    file_loops: Option<Vec<Vec<u32>>>,
+}
+
+impl Operand {
+    fn load(path: &Path, weld: bool) -> Result<Operand> {
+        let mut mesh = shadow_scene::load(path)?;
+        let file_loops = weld.then(|| {
+            let loops = mesh.faces.iter().map(|f| f.vertices.clone()).collect();
+            mesh.weld();
+            loops
+        });
+        Ok(Operand {
+            name: path.display().to_string(),
+            mesh,
+            file_loops,
+        })
+    }
+
+    /// `file:line` of face `face` for text formats, else `file`.
+    fn locate(&self, face: usize) -> String {
+        match self.mesh.faces.get(face).map(|f| f.line) {
+            Some(line) if line > 0 => format!("{}:{line}", self.name),
+            _ => self.name.clone(),
+        }
+    }
+
+    /// Vertex `v` (a mesh index) of face `face` as the user can find it:
+    /// its index as written in the file (1-based) when the format has
+    /// indices, else its coordinates.
+    fn vertex(&self, face: usize, v: u32) -> String {
+        let f = &self.mesh.faces[face];
+        if f.line == 0 {
+            let p = self.mesh.positions[v as usize];
+            return format!("({}, {}, {})", p.x, p.y, p.z);
+        }
+        let at = f.vertices.iter().position(|&x| x == v);
+        let in_file = match (&self.file_loops, at) {
+            (Some(loops), Some(i)) => loops[face][i],
+            _ => v,
+        };
+        (in_file + 1).to_string()
+    }
+
+    /// Checks that the faces form a closed, consistently oriented
+    /// 2-manifold; the error names the file, line, face and edge.
+    fn validate(&self) -> Result<()> {
+        check_closed_manifold(self.mesh.faces.iter().map(|f| f.vertices.as_slice()))
+            .map_err(|e| anyhow!(self.topology_message(&e)))
+    }
+
+    fn topology_message(&self, e: &TopologyError) -> String {
+        let v = |face, x| self.vertex(face, x);
+        let (face, what) = match *e {
+            TopologyError::OpenEdge { a, b, face } => (
+                Some(face),
+                format!(
+                    "edge {}-{} of face {face} is a boundary edge (the mesh is not closed)",
+                    v(face, a),
+                    v(face, b)
+                ),
+            ),
+            TopologyError::Misoriented {
+                a,
+                b,
+                faces: [first, face],
+            } => {
+                let first_at = match self.mesh.faces[first].line {
+                    0 => String::new(),
+                    line => format!(" (line {line})"),
+                };
+                (
+                    Some(face),
+                    format!(
+                        "face {face} uses edge {}->{} in the same direction as face {first}{first_at} \
+                         (the faces are not consistently oriented)",
+                        v(face, a),
+                        v(face, b)
+                    ),
+                )
+            }
+            TopologyError::NonManifoldEdge { a, b, face, .. } => (
+                Some(face),
+                format!(
+                    "edge {}-{} of face {face} is shared by more than two faces (the mesh is not a 2-manifold)",
+                    v(face, a),
+                    v(face, b)
+                ),
+            ),
+            TopologyError::DegenerateFace { face } => {
+                let f = &self.mesh.faces[face];
+                // without a line to look at, show the corners
+                let corners = if f.line == 0 {
+                    let c: Vec<String> = f.vertices.iter().map(|&x| v(face, x)).collect();
+                    format!(" {}", c.join(" "))
+                } else {
+                    String::new()
+                };
+                let welded = if self.file_loops.is_some() {
+                    " (after --weld merged equal positions)"
+                } else {
+                    ""
+                };
+                (
+                    Some(face),
+                    format!("face {face}{corners} repeats a vertex{welded}"),
+                )
+            }
+            TopologyError::NonManifoldVertex { vertex } => {
+                let face = self
+                    .mesh
+                    .faces
+                    .iter()
+                    .position(|f| f.vertices.contains(&vertex));
+                let what = match face {
+                    Some(face) => format!(
+                        "vertex {} of face {face} joins separate fans of faces (a pinch: the mesh is not a 2-manifold there)",
+                        v(face, vertex)
+                    ),
+                    None => e.to_string(),
+                };
+                (face, what)
+            }
+            _ => (None, e.to_string()),
+        };
+        let at = face.map_or_else(|| self.name.clone(), |f| self.locate(f));
+        let hint = if self.file_loops.is_none() && self.mesh.repeated_positions() > 0 {
+            "; if the file repeats vertices per face, try --weld"
+        } else {
+            ""
+        };
+        format!("{at}: {what}{hint}")
+    }
+}
+
+/// Wall time of each phase, in order.
+#[derive(Default)]
+struct Phases(Vec<(&'static str, Duration)>);
+
+impl Phases {
+    fn run<T>(&mut self, name: &'static str, f: impl FnOnce() -> T) -> T {
+        let start = Instant::now();
+        let out = f();
+        self.0.push((name, start.elapsed()));
+        out
+    }
+}
+
+/// A Boolean operation's result and the figures `--stats` prints.
+struct Outcome {
+    /// The result in input units: one triangle face per triangle, one
+    /// group named after the operation.
+    mesh: Mesh,
+    /// The exact result (grid units).
+    exact: TriMesh,
+    grid: Grid,
+    reports: [ImportReport; 2],
+    /// BSP nodes of A, B and the result.
+    nodes: [usize; 3],
+}
+
+/// Snaps both operands to one grid, builds their solids, merges them and
+/// extracts the watertight boundary. Prints import summaries to stderr.
+fn compute(a: &Operand, b: &Operand, op: Operation, phases: &mut Phases) -> Result<Outcome> {
+    let (grid, [(polys_a, report_a), (polys_b, report_b)]) =
+        phases.run("snap/import", || -> Result<_> {
+            let grid = Grid::fit_points(a.mesh.positions.iter().chain(&b.mesh.positions))
+                .context("cannot fit a grid to the two meshes")?;
+            let import = |o: &Operand| {
+                let loops = o.mesh.face_loops();
+                import_faces(&grid, loops.iter().map(Vec::as_slice))
+                    .with_context(|| format!("{}: cannot snap the faces to the grid", o.name))
+            };
+            Ok((grid, [import(a)?, import(b)?]))
+        })?;
+    for (o, report) in [(a, &report_a), (b, &report_b)] {
+        let summary = report.summary();
+        if !summary.is_empty() {
+            eprint!("{}: {summary}", o.name);
+        }
+        if !report.dropped.is_empty() {
+            eprintln!(
+                "warning: {}: {} face(s) have no area on the grid (step 2^{}) and were dropped; \
+                 the solid may not be closed",
+                o.name,
+                report.dropped.len(),
+                -grid.scale().log2()
+            );
+        }
+    }
+    let pa = phases.run("build A", || Partition::solid(polys_a));
+    bounded(&pa, a, &report_a)?;
+    let pb = phases.run("build B", || Partition::solid(polys_b));
+    bounded(&pb, b, &report_b)?;
+    let result = phases.run("merge", || pa.boolean(&pb, op.kernel()));
+    let (exact, mesh) = phases.run("boundary+mesh", || {
+        let exact = result.to_mesh();
+        let mesh = Mesh {
+            positions: exact
+                .vertices_f64()
+                .into_iter()
+                .map(|v| grid.to_world(v))
+                .collect(),
+            faces: exact
+                .triangles
+                .iter()
+                .map(|t| Face {
+                    vertices: t.to_vec(),
+                    line: 0,
+                    group: 0,
+                })
+                .collect(),
+            groups: vec![op.name().to_string()],
+        };
+        (exact, mesh)
+    });
+    phases
+        .run("check", || exact.check_watertight())
+        .map_err(|e| {
+            anyhow!(
+                "internal error: the {} of {} and {} is not watertight ({e}); this is a bug in the \
+                 exact kernel, not a problem with the input, and nothing was written — please report \
+                 it with both input files",
+                op.name(),
+                a.name,
+                b.name
+            )
+        })?;
+    Ok(Outcome {
+        mesh,
+        exact,
+        grid,
+        reports: [report_a, report_b],
+        nodes: [pa.nodes().len(), pb.nodes().len(), result.nodes().len()],
+    })
+}
+
+/// Fails if the solid of `o` contains a point far outside every input:
+/// its faces then face inward and bound the unbounded complement.
+fn bounded(p: &Partition<bsp_core::Cell>, o: &Operand, report: &ImportReport) -> Result<()> {
+    // the grid is fitted so that the inputs use at most half its range
+    if p.classify_point(&Point::Grid([MAX_COORD; 3])) == Membership::Inside {
+        bail!(
+            "{}: the faces are oriented inward (clockwise seen from outside){}: the solid they bound \
+             is unbounded; reverse every face's vertex order",
+            o.name,
+            if report.dropped.is_empty() {
+                ""
+            } else {
+                ", or faces dropped on the grid left it open"
+            }
+        );
+    }
+    Ok(())
+}
+
+/// The exact volume in input units, rounded once to `f64`.
+fn exact_volume(mesh: &TriMesh, grid: &Grid) -> f64 {
+    let (num, den) = mesh.six_volume();
+    // scale = 2^k exactly, so volume / scale^3 is a power-of-two shift
+    let k = 3 * grid.scale().log2() as i64;
+    let (num, den) = if k >= 0 {
+        (num, (den * 6) << k as usize)
+    } else {
+        (num << k.unsigned_abs() as usize, den * 6)
+    };
+    BigRational::new_raw(num, den).to_f64().unwrap_or(f64::NAN)
+}
+
+/// Runs `f`, turning a panic into an error that says it is a bug (the
+/// kernel panics only on broken internal invariants).
+fn guarded<T>(f: impl FnOnce() -> Result<T>) -> Result<T> {
+    static LAST: Mutex<Option<String>> = Mutex::new(None);
+    let previous = panic::take_hook();
+    panic::set_hook(Box::new(|info| {
+        let payload = info.payload();
+        let message = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "(no message)".to_string());
+        let at = info
+            .location()
+            .map(|l| format!(" ({}:{})", l.file(), l.line()))
+            .unwrap_or_default();
+        *LAST.lock().unwrap_or_else(|e| e.into_inner()) = Some(format!("{message}{at}"));
+    }));
+    let result = panic::catch_unwind(panic::AssertUnwindSafe(f));
+    panic::set_hook(previous);
+    result.unwrap_or_else(|_| {
+        let detail = LAST
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take()
+            .unwrap_or_default();
+        Err(anyhow!(
+            "internal error: {detail}; this is a bug, not a problem with the input, and nothing \
+             was written — please report it with both input files"
+        ))
+    })
+}
+
+/// `shadow csg`.
+pub(crate) fn run(args: &CsgArgs) -> Result<()> {
+    let total = Instant::now();
+    // fail on a bad output name before doing any work
+    MeshFormat::from_path(&args.output)?;
+    let mut phases = Phases::default();
+    let (a, b) = phases.run("load", || -> Result<_> {
+        Ok((
+            Operand::load(&args.a, args.weld)?,
+            Operand::load(&args.b, args.weld)?,
+        ))
+    })?;
+    phases.run("validate", || -> Result<()> {
+        a.validate()?;
+        b.validate()
+    })?;
+    let out = guarded(|| compute(&a, &b, args.op, &mut phases))?;
+    phases.run("write", || shadow_scene::save(&args.output, &out.mesh))?;
+    let total = total.elapsed();
+
+    let (tris, verts) = (out.mesh.faces.len(), out.mesh.positions.len());
+    let mut report = format!(
+        "wrote {}: {} of {} and {}, {tris} triangles, {verts} vertices\n",
+        args.output.display(),
+        args.op.name(),
+        a.name,
+        b.name
+    );
+    if tris == 0 {
+        eprintln!("note: the {} is empty", args.op.name());
+    }
+    let coincide = out.mesh.repeated_positions();
+    if coincide > 0 {
+        eprintln!(
+            "warning: {coincide} distinct exact vertices coincide once rounded to f64 input units; \
+             their triangles are degenerate in the file"
+        );
+    }
+    if MeshFormat::from_path(&args.output)? == MeshFormat::Stl {
+        let merged = shadow_scene::stl_collisions(&out.mesh);
+        if merged > 0 {
+            eprintln!(
+                "warning: {merged} vertices coincide once rounded to f32 for STL; the file may \
+                 not be closed when read back (write .obj to keep full precision)"
+            );
+        }
+    }
+    if args.stats {
+        report += &stats_text(args.op, [&a, &b], &out, &phases, total);
+    }
+    emit(&report)
+}
+
+/// Writes to stdout; a closed pipe (`shadow csg ... --stats | head`) is
+/// not an error.
+fn emit(text: &str) -> Result<()> {
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|()| stdout.flush())
+    {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(e).context("could not write to stdout")
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The `--stats` report. Computes the exact volume, which is timed on its
+/// own (after "total", as only `--stats` pays for it).
+fn stats_text(
+    op: Operation,
+    operands: [&Operand; 2],
+    out: &Outcome,
+    phases: &Phases,
+    total: Duration,
+) -> String {
+    let mut s = format!("operation:      {}\n", op.name());
+    for ((label, o), r) in ["A", "B"].iter().zip(operands).zip(&out.reports) {
+        s += &format!(
+            "input {label}:        {}: {} triangles ({} faces), {} polygons after import \
+             ({} faces triangulated, {} dropped)\n",
+            o.name,
+            o.mesh.triangle_count(),
+            o.mesh.faces.len(),
+            r.polygons,
+            r.triangulated.len(),
+            r.dropped.len()
+        );
+    }
+    s += &format!(
+        "grid step:      2^{} = {:.3e} units\n",
+        -out.grid.scale().log2(),
+        out.grid.step()
+    );
+    s += &format!(
+        "bsp nodes:      A {}, B {}, result {}\n",
+        out.nodes[0], out.nodes[1], out.nodes[2]
+    );
+    s += &format!(
+        "output:         {} triangles, {} vertices\n",
+        out.mesh.faces.len(),
+        out.mesh.positions.len()
+    );
+    let start = Instant::now();
+    let exact = exact_volume(&out.exact, &out.grid);
+    let exact_time = start.elapsed();
+    let k = out.grid.scale();
+    s += &format!(
+        "volume:         {exact} (exact, rounded once); {} (f64 sum)\n",
+        out.exact.volume_f64() / (k * k * k)
+    );
+    s += "time (ms):\n";
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    for (name, d) in &phases.0 {
+        s += &format!("  {name:<15}{:10.3}\n", ms(*d));
+    }
+    s += &format!("  {:<15}{:10.3}\n", "total", ms(total));
+    s += &format!("  {:<15}{:10.3}\n", "exact volume", ms(exact_time));
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_bigint::BigInt;
+    use num_traits::{One, Zero};
+    use shadow_scene::parse_obj;
+
+    const CUBE: &str = "\
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+v 0 0 1
+v 1 0 1
+v 1 1 1
+v 0 1 1
+f 1 4 3 2
+f 5 6 7 8
+f 1 2 6 5
+f 2 3 7 6
+f 3 4 8 7
+f 4 1 5 8
+";
+
+    fn operand(text: &str, name: &str, weld: bool) -> Operand {
+        let mut mesh = parse_obj(text, name).unwrap();
+        let file_loops = weld.then(|| {
+            let l = mesh.faces.iter().map(|f| f.vertices.clone()).collect();
+            mesh.weld();
+            l
+        });
+        Operand {
+            name: name.to_string(),
+            mesh,
+            file_loops,
+        }
+    }
+
+    /// The cube scaled by `s` and moved by `d`, as OBJ text with relative
+    /// face indices (so that such texts can be concatenated).
+    fn cube(s: f64, d: [f64; 3]) -> String {
+        CUBE.lines()
+            .map(|l| {
+                if let Some(v) = l.strip_prefix("v ") {
+                    let c: Vec<f64> = v.split(' ').map(|x| x.parse().unwrap()).collect();
+                    format!(
+                        "v {} {} {}\n",
+                        c[0] * s + d[0],
+                        c[1] * s + d[1],
+                        c[2] * s + d[2]
+                    )
+                } else {
+                    let f = l.strip_prefix("f ").unwrap();
+                    let rel: Vec<String> = f
+                        .split(' ')
+                        .map(|i| (i.parse::<i32>().unwrap() - 9).to_string())
+                        .collect();
+                    format!("f {}\n", rel.join(" "))
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn open_mesh_names_line_face_and_file_indices() {
+        // drop the top face (line 10)
+        let text: String = CUBE
+            .lines()
+            .filter(|l| *l != "f 5 6 7 8")
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let e = operand(&text, "open.obj", false).validate().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "open.obj:10: edge 6-5 of face 1 is a boundary edge (the mesh is not closed)"
+        );
+    }
+
+    #[test]
+    fn misoriented_face_names_both_faces() {
+        let text = CUBE.replace("f 2 3 7 6", "f 6 7 3 2");
+        let e = operand(&text, "flip.obj", false).validate().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "flip.obj:12: face 3 uses edge 6->7 in the same direction as face 1 (line 10) \
+             (the faces are not consistently oriented)"
+        );
+    }
+
+    #[test]
+    fn unwelded_file_gets_the_hint_and_welded_indices_map_back() {
+        // every face with its own four vertices: 24 positions
+        let m = parse_obj(CUBE, "c.obj").unwrap();
+        let mut text = String::new();
+        let mut faces = String::new();
+        for (i, f) in m.faces.iter().enumerate() {
+            for v in &f.vertices {
+                let p = m.positions[*v as usize];
+                text += &format!("v {} {} {}\n", p.x, p.y, p.z);
+            }
+            let k = 4 * i + 1;
+            faces += &format!("f {} {} {} {}\n", k, k + 1, k + 2, k + 3);
+        }
+        let text = text + &faces;
+        let e = operand(&text, "soup.obj", false).validate().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "soup.obj:25: edge 1-2 of face 0 is a boundary edge (the mesh is not closed); \
+             if the file repeats vertices per face, try --weld"
+        );
+        operand(&text, "soup.obj", true).validate().unwrap();
+        // with --weld, a defect is still reported with the file's indices
+        let broken = text.replace("f 5 6 7 8\n", "");
+        let e = operand(&broken, "soup.obj", true).validate().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "soup.obj:26: edge 11-12 of face 1 is a boundary edge (the mesh is not closed)"
+        );
+    }
+
+    #[test]
+    fn pinch_and_degenerate_faces() {
+        // two cubes sharing only the corner (1, 1, 1), which --weld merges
+        let two = cube(1.0, [0.0; 3]) + &cube(1.0, [1.0; 3]);
+        operand(&two, "two.obj", false).validate().unwrap();
+        let e = operand(&two, "pinch.obj", true).validate().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "pinch.obj:10: vertex 7 of face 1 joins separate fans of faces \
+             (a pinch: the mesh is not a 2-manifold there)"
+        );
+        let e = operand(&CUBE.replace("f 1 4 3 2", "f 1 4 3 1"), "d.obj", false)
+            .validate()
+            .unwrap_err();
+        assert_eq!(e.to_string(), "d.obj:9: face 0 repeats a vertex");
+    }
+
+    #[test]
+    fn stl_defects_name_coordinates() {
+        let m = parse_obj(CUBE, "c.obj").unwrap();
+        let mut mesh = m.clone();
+        for f in &mut mesh.faces {
+            f.line = 0;
+        }
+        mesh.faces.remove(1);
+        let o = Operand {
+            name: "open.stl".into(),
+            mesh,
+            file_loops: None,
+        };
+        assert_eq!(
+            o.validate().unwrap_err().to_string(),
+            "open.stl: edge (1, 0, 1)-(0, 0, 1) of face 1 is a boundary edge (the mesh is not closed)"
+        );
+        let mut mesh = o.mesh;
+        mesh.faces[0].vertices = vec![0, 3, 0];
+        let o = Operand {
+            name: "sliver.stl".into(),
+            mesh,
+            file_loops: None,
+        };
+        assert_eq!(
+            o.validate().unwrap_err().to_string(),
+            "sliver.stl: face 0 (0, 0, 0) (0, 1, 0) (0, 0, 0) repeats a vertex"
+        );
+    }
+
+    #[test]
+    fn overlapping_cubes_exactly() {
+        let a = operand(&cube(4.0, [0.0; 3]), "a.obj", false);
+        let b = operand(&cube(4.0, [2.0; 3]), "b.obj", false);
+        for (op, vol) in [
+            (Operation::Union, 120.0),
+            (Operation::Intersection, 8.0),
+            (Operation::Difference, 56.0),
+        ] {
+            let mut phases = Phases::default();
+            let out = compute(&a, &b, op, &mut phases).unwrap();
+            assert_eq!(exact_volume(&out.exact, &out.grid), vol, "{op:?}");
+            assert_eq!(out.mesh.signed_volume(), vol, "{op:?}");
+            assert!(out.mesh.is_closed_oriented());
+            assert_eq!(out.mesh.groups, vec![op.name()]);
+            let names: Vec<&str> = phases.0.iter().map(|p| p.0).collect();
+            assert_eq!(
+                names,
+                [
+                    "snap/import",
+                    "build A",
+                    "build B",
+                    "merge",
+                    "boundary+mesh",
+                    "check"
+                ]
+            );
+        }
+        // disjoint: empty intersection
+        let far = operand(&cube(1.0, [10.0; 3]), "far.obj", false);
+        let out = compute(&a, &far, Operation::Intersection, &mut Phases::default()).unwrap();
+        assert!(out.mesh.faces.is_empty());
+        assert_eq!(out.nodes[2], 0);
+    }
+
+    #[test]
+    fn exact_volume_scales_by_the_grid() {
+        // a 3/4-unit cube at 1/8 offsets: the grid is finer than 1, so the
+        // exact volume is divided by a power of two
+        let a = operand(&cube(0.75, [0.125; 3]), "a.obj", false);
+        let b = operand(&cube(0.75, [0.5; 3]), "b.obj", false);
+        let out = compute(&a, &b, Operation::Union, &mut Phases::default()).unwrap();
+        assert!(out.grid.scale() > 1.0);
+        assert_eq!(
+            exact_volume(&out.exact, &out.grid),
+            2.0 * 0.421875 - 0.052734375
+        );
+        // a coarse grid (scale < 1) multiplies instead
+        let a = operand(&cube(4e9, [0.0; 3]), "a.obj", false);
+        let b = operand(&cube(4e9, [2e9; 3]), "b.obj", false);
+        let out = compute(&a, &b, Operation::Intersection, &mut Phases::default()).unwrap();
+        assert!(out.grid.scale() < 1.0);
+        assert_eq!(exact_volume(&out.exact, &out.grid), 8e27);
+    }
+
+    #[test]
+    fn exact_volume_agrees_with_the_kernel() {
+        // tilted planes make implicit vertices with many denominators
+        let tet = |d: [f64; 3]| {
+            let v = [
+                [0.0, 0.0, 0.0],
+                [3.0, 0.2, 0.1],
+                [0.3, 2.9, 0.7],
+                [0.4, 0.5, 3.1],
+            ];
+            let mut t = String::new();
+            for p in v {
+                t += &format!("v {} {} {}\n", p[0] + d[0], p[1] + d[1], p[2] + d[2]);
+            }
+            t + "f -4 -2 -3\nf -4 -3 -1\nf -4 -1 -2\nf -3 -2 -1\n"
+        };
+        let a = operand(&tet([0.0; 3]), "a.obj", false);
+        let b = operand(&tet([0.7, 0.6, 0.5]), "b.obj", false);
+        let c = operand(&cube(1.3, [0.45, 0.35, 0.25]), "c.obj", false);
+        a.validate().unwrap();
+        for (x, y, op) in [
+            (&a, &b, Operation::Union),
+            (&a, &b, Operation::Intersection),
+            (&a, &b, Operation::Difference),
+            (&a, &c, Operation::Difference),
+            (&c, &b, Operation::Union),
+        ] {
+            let out = compute(x, y, op, &mut Phases::default()).unwrap();
+            assert!(out.exact.vertices.iter().any(|p| p.as_grid().is_none()));
+            let (num, den) = out.exact.six_volume();
+            let kernel = out.exact.volume_exact() * BigRational::from_integer(6.into());
+            assert_eq!(num * kernel.denom(), kernel.numer() * den, "{op:?}");
+            assert!(exact_volume(&out.exact, &out.grid) > 0.0);
+        }
+        assert_eq!(
+            TriMesh::default().six_volume(),
+            (BigInt::zero(), BigInt::one())
+        );
+    }
+
+    #[test]
+    fn inward_faces_are_rejected() {
+        let mut inside_out = String::new();
+        for l in CUBE.lines() {
+            match l.strip_prefix("f ") {
+                Some(f) => {
+                    let mut v: Vec<&str> = f.split(' ').collect();
+                    v.reverse();
+                    inside_out += &format!("f {}\n", v.join(" "));
+                }
+                None => inside_out += &format!("{l}\n"),
+            }
+        }
+        let a = operand(&inside_out, "inv.obj", false);
+        a.validate().unwrap();
+        let b = operand(CUBE, "b.obj", false);
+        let e = compute(&a, &b, Operation::Union, &mut Phases::default())
+            .err()
+            .unwrap();
+        assert!(
+            e.to_string()
+                .starts_with("inv.obj: the faces are oriented inward"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn guarded_turns_a_panic_into_an_error() {
+        let e = guarded(|| -> Result<()> { panic!("inconsistent sub-hyperplanes") }).unwrap_err();
+        let s = e.to_string();
+        assert!(
+            s.starts_with("internal error: inconsistent sub-hyperplanes ("),
+            "{s}"
+        );
+        assert!(s.contains("csg.rs:"), "{s}");
+        assert!(s.contains("this is a bug"), "{s}");
+        assert_eq!(guarded(|| Ok(7)).unwrap(), 7);
+    }
+}

@@ -1,0 +1,398 @@
+//! `csg`: every result is read back from the file it was written to and
+//! checked to be closed and consistently oriented, with the volume it must
+//! have.
+
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+use bsp_core::check_closed_manifold;
+use glam::DVec3;
+use shadow_scene::Mesh;
+
+use crate::{assert_failed_with, scratch, shadow, stderr, stdout};
+
+/// The axis-aligned cube `[lo, lo + size]³` as OBJ quads, counter-clockwise
+/// seen from outside; faces on lines 9 to 14.
+fn cube_obj(lo: [f64; 3], size: f64) -> String {
+    let mut s = String::new();
+    for i in 0..8 {
+        let bit = |b: usize| if i >> b & 1 == 1 { size } else { 0.0 };
+        // vertex order: 1 (0,0,0) 2 (1,0,0) 3 (1,1,0) 4 (0,1,0), then z = 1
+        let (x, y) = [(0.0, 0.0), (size, 0.0), (size, size), (0.0, size)][i % 4];
+        s += &format!("v {} {} {}\n", lo[0] + x, lo[1] + y, lo[2] + bit(2));
+    }
+    s + "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n"
+}
+
+fn write(name: &str, text: &str) -> PathBuf {
+    let p = scratch(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../data/meshes")
+        .join(name)
+}
+
+/// Runs `shadow csg op a b -o out extra...`.
+fn csg(op: &str, a: &Path, b: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "csg",
+        op,
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    shadow(&args)
+}
+
+/// Reads `path` back, checks that it is a closed, consistently oriented
+/// triangle mesh, and returns it.
+fn closed_result(path: &Path) -> Mesh {
+    let m = shadow_scene::load(path).unwrap();
+    assert!(m.faces.iter().all(|f| f.vertices.len() == 3));
+    check_closed_manifold(m.faces.iter().map(|f| f.vertices.as_slice()))
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    m
+}
+
+fn assert_ok(o: &Output) {
+    assert!(o.status.success(), "stderr: {}", stderr(o));
+}
+
+/// The value after `key` on the `--stats` line starting with it.
+fn stat<'a>(out: &'a str, key: &str) -> &'a str {
+    out.lines()
+        .find_map(|l| l.strip_prefix(key))
+        .unwrap_or_else(|| panic!("no `{key}` in {out}"))
+        .trim()
+}
+
+#[test]
+fn two_cubes_all_operations_exact_volume() {
+    let a = write("cube_a.obj", &cube_obj([0.0; 3], 4.0));
+    let b = write("cube_b.obj", &cube_obj([2.0; 3], 4.0));
+    for (op, vol, a, b) in [
+        ("union", 120.0, &a, &b),
+        ("intersection", 8.0, &a, &b),
+        ("difference", 56.0, &a, &b),
+        ("difference", 56.0, &b, &a),
+    ] {
+        let out = scratch(&format!("cubes_{op}.obj"));
+        let o = csg(op, a, b, &out, &[]);
+        assert_ok(&o);
+        assert!(
+            stdout(&o).starts_with(&format!("wrote {}: {op} of ", out.display())),
+            "{}",
+            stdout(&o)
+        );
+        assert_eq!(stderr(&o), "", "no warnings for clean input");
+        let m = closed_result(&out);
+        assert_eq!(m.signed_volume(), vol, "{op}");
+        assert_eq!(m.groups, vec!["default", op]);
+        // every output vertex is a cube corner or a crossing of cube
+        // planes: integers here
+        assert!(m.positions.iter().all(|p| *p == p.round()));
+    }
+}
+
+#[test]
+fn stats_report_counts_volume_and_phases() {
+    let a = write("stats_a.obj", &cube_obj([0.0; 3], 4.0));
+    let b = write("stats_b.obj", &cube_obj([2.0; 3], 4.0));
+    let out = scratch("stats_union.obj");
+    let o = csg("union", &a, &b, &out, &["--stats"]);
+    assert_ok(&o);
+    let s = stdout(&o);
+    assert!(stat(&s, "input A:").contains("12 triangles (6 faces), 6 polygons"));
+    assert_eq!(
+        stat(&s, "volume:"),
+        "120 (exact, rounded once); 120 (f64 sum)"
+    );
+    let nodes = stat(&s, "bsp nodes:");
+    assert!(
+        nodes.starts_with("A ") && nodes.contains(", result "),
+        "{nodes}"
+    );
+    let m = closed_result(&out);
+    assert_eq!(
+        stat(&s, "output:"),
+        format!(
+            "{} triangles, {} vertices",
+            m.faces.len(),
+            m.positions.len()
+        )
+    );
+    for phase in [
+        "load",
+        "validate",
+        "snap/import",
+        "build A",
+        "build B",
+        "merge",
+        "boundary+mesh",
+        "write",
+        "total",
+    ] {
+        let ms: f64 = stat(&s, &format!("  {phase} ")).parse().unwrap();
+        assert!(ms >= 0.0, "{phase}");
+    }
+}
+
+#[test]
+fn stl_in_and_out_round_trip() {
+    let cube = |lo, size| shadow_scene::parse_obj(&cube_obj(lo, size), "cube.obj").unwrap();
+    let a = scratch("cube_a.stl");
+    let b = scratch("cube_b.stl");
+    shadow_scene::save(&a, &cube([0.0; 3], 4.0)).unwrap();
+    shadow_scene::save(&b, &cube([2.0; 3], 4.0)).unwrap();
+    let out = scratch("cubes_union.stl");
+    assert_ok(&csg("union", &a, &b, &out, &[]));
+    let m = closed_result(&out);
+    assert_eq!(m.signed_volume(), 120.0);
+    let bytes = std::fs::metadata(&out).unwrap().len();
+    assert_eq!(bytes, 84 + 50 * m.faces.len() as u64, "binary STL");
+    // STL output back in as an operand, with an OBJ, to OBJ
+    let c = write("cube_c.obj", &cube_obj([3.0, 3.0, -1.0], 2.0));
+    let out2 = scratch("stl_minus_obj.obj");
+    assert_ok(&csg("difference", &out, &c, &out2, &[]));
+    // the part of [3,5]x[3,5]x[-1,1] inside the union is [3,4]^2 x [0,1]
+    assert_eq!(closed_result(&out2).signed_volume(), 120.0 - 1.0);
+}
+
+#[test]
+fn sphere_minus_translated_copy() {
+    let sphere_path = data("pyvista_sphere.obj");
+    let sphere = shadow_scene::load(&sphere_path).unwrap();
+    let mut moved = sphere.clone();
+    for p in &mut moved.positions {
+        *p += DVec3::new(37.5, 21.25, 10.0);
+    }
+    let moved_path = scratch("sphere_moved.obj");
+    shadow_scene::save(&moved_path, &moved).unwrap();
+    let volume = |op: &str| {
+        let out = scratch(&format!("sphere_{op}.obj"));
+        let o = csg(op, &sphere_path, &moved_path, &out, &["--stats"]);
+        assert_ok(&o);
+        let m = closed_result(&out);
+        let v = m.signed_volume();
+        // the exact volume printed by --stats agrees with the file's
+        let exact: f64 = stat(&stdout(&o), "volume:")
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!((exact - v).abs() <= 1e-9 * v, "{op}: {exact} vs {v}");
+        v
+    };
+    let (diff, inter, union) = (
+        volume("difference"),
+        volume("intersection"),
+        volume("union"),
+    );
+    let whole = sphere.signed_volume();
+    assert!(diff > 0.1 * whole && inter > 0.1 * whole, "they overlap");
+    assert!((diff + inter - whole).abs() <= 1e-9 * whole);
+    assert!((union - (2.0 * whole - inter)).abs() <= 1e-9 * whole);
+}
+
+#[test]
+fn eight_union_box() {
+    let eight = data("cgal_eight.obj");
+    // a bar through one of the eight's holes and out of its side, with
+    // coordinates on every grid (so that its volume is exact)
+    let bar = cube_obj([0.0; 3], 1.0)
+        .lines()
+        .map(|l| match l.strip_prefix("v ") {
+            Some(v) => {
+                let c: Vec<f64> = v.split(' ').map(|x| x.parse().unwrap()).collect();
+                let (x, y, z) = (c[0] * 0.5, c[1] * 0.125 - 0.0625, c[2] * 0.625 - 0.3125);
+                format!("v {x} {y} {z}\n")
+            }
+            None => format!("{l}\n"),
+        })
+        .collect::<String>();
+    let bar_path = write("bar.obj", &bar);
+    let bar_volume = 0.5 * 0.125 * 0.625;
+    let volume = |op: &str, b: &Path| {
+        let out = scratch(&format!("eight_{op}.obj"));
+        assert_ok(&csg(op, &eight, b, &out, &[]));
+        closed_result(&out).signed_volume()
+    };
+    let union = volume("union", &bar_path);
+    let inter = volume("intersection", &bar_path);
+    let diff = volume("difference", &bar_path);
+    assert!(inter > 0.0 && inter < bar_volume);
+    assert!((union - (diff + bar_volume)).abs() <= 1e-12 * union);
+    // A ∪ A is A as snapped to the grid: the two parts add up to it
+    let snapped = volume("union", &eight);
+    assert!((diff + inter - snapped).abs() <= 1e-12 * snapped);
+    // and snapping moves the volume very little
+    let whole = shadow_scene::load(&eight).unwrap().signed_volume();
+    assert!((snapped - whole).abs() <= 1e-6 * whole);
+}
+
+#[test]
+fn open_mesh_names_edge_face_and_line() {
+    let open = write(
+        "open.obj",
+        &cube_obj([0.0; 3], 1.0).replace("f 5 6 7 8\n", ""),
+    );
+    let b = write("open_b.obj", &cube_obj([0.5; 3], 1.0));
+    let out = scratch("open_out.obj");
+    let o = csg("union", &open, &b, &out, &[]);
+    assert_failed_with(
+        &o,
+        &[&format!(
+            "error: {}:10: edge 6-5 of face 1 is a boundary edge (the mesh is not closed)\n",
+            open.display()
+        )],
+    );
+    assert!(!stderr(&o).contains("--weld"), "the file is welded");
+    assert!(!out.exists());
+    // as the second operand too
+    let o = csg("union", &b, &open, &out, &[]);
+    assert_failed_with(&o, &["open.obj:10: edge 6-5 of face 1"]);
+}
+
+#[test]
+fn misoriented_face_names_both_faces_and_lines() {
+    let flipped = write(
+        "flipped.obj",
+        &cube_obj([0.0; 3], 1.0).replace("f 2 3 7 6", "f 6 7 3 2"),
+    );
+    let b = write("flipped_b.obj", &cube_obj([0.5; 3], 1.0));
+    let o = csg("difference", &b, &flipped, &scratch("flipped_out.obj"), &[]);
+    assert_failed_with(
+        &o,
+        &[&format!(
+            "{}:12: face 3 uses edge 6->7 in the same direction as face 1 (line 10) \
+             (the faces are not consistently oriented)",
+            flipped.display()
+        )],
+    );
+}
+
+#[test]
+fn unwelded_input_needs_weld() {
+    // every face with its own copies of its corners (as many exporters do)
+    let cube = shadow_scene::parse_obj(&cube_obj([0.0; 3], 4.0), "c.obj").unwrap();
+    let (mut verts, mut faces) = (String::new(), String::new());
+    for f in &cube.faces {
+        let base = verts.lines().count() + 1;
+        for v in &f.vertices {
+            let p = cube.positions[*v as usize];
+            verts += &format!("v {} {} {}\n", p.x, p.y, p.z);
+        }
+        faces += &format!("f {} {} {} {}\n", base, base + 1, base + 2, base + 3);
+    }
+    let soup = write("soup.obj", &(verts + &faces));
+    let b = write("soup_b.obj", &cube_obj([2.0; 3], 4.0));
+    let out = scratch("soup_union.obj");
+    let o = csg("union", &soup, &b, &out, &[]);
+    assert_failed_with(
+        &o,
+        &[
+            &format!(
+                "{}:25: edge 1-2 of face 0 is a boundary edge",
+                soup.display()
+            ),
+            "; if the file repeats vertices per face, try --weld",
+        ],
+    );
+    assert!(!out.exists());
+    let o = csg("union", &soup, &b, &out, &["--weld"]);
+    assert_ok(&o);
+    assert_eq!(closed_result(&out).signed_volume(), 120.0);
+}
+
+#[test]
+fn inward_facing_input_is_refused() {
+    let mut text = cube_obj([0.0; 3], 1.0);
+    for (l, r) in [
+        ("f 1 4 3 2", "f 2 3 4 1"),
+        ("f 5 6 7 8", "f 8 7 6 5"),
+        ("f 1 2 6 5", "f 5 6 2 1"),
+        ("f 2 3 7 6", "f 6 7 3 2"),
+        ("f 3 4 8 7", "f 7 8 4 3"),
+        ("f 4 1 5 8", "f 8 5 1 4"),
+    ] {
+        text = text.replace(l, r);
+    }
+    let inv = write("inside_out.obj", &text);
+    let b = write("inside_out_b.obj", &cube_obj([0.5; 3], 1.0));
+    let o = csg("union", &b, &inv, &scratch("inside_out_result.obj"), &[]);
+    assert_failed_with(
+        &o,
+        &["inside_out.obj: the faces are oriented inward", "reverse"],
+    );
+}
+
+#[test]
+fn argument_and_file_errors() {
+    let a = write("args_a.obj", &cube_obj([0.0; 3], 1.0));
+    let out = scratch("args_out.obj");
+    let o = csg("xor", &a, &a, &out, &[]);
+    assert_failed_with(
+        &o,
+        &["invalid value 'xor'", "union", "intersection", "difference"],
+    );
+    let missing = scratch("no_such_mesh.obj");
+    let o = csg("union", &a, &missing, &out, &[]);
+    assert_failed_with(&o, &["no_such_mesh.obj"]);
+    let o = csg("union", &a, &a, &scratch("result.ply"), &[]);
+    assert_failed_with(&o, &["result.ply", "unknown mesh format"]);
+    let o = csg(
+        "union",
+        &a,
+        &a,
+        &scratch("no_such_dir").join("out.obj"),
+        &[],
+    );
+    assert_failed_with(&o, &["out.obj"]);
+    let o = shadow(&["csg", "union", a.to_str().unwrap()]);
+    assert_failed_with(&o, &["<B>"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn disjoint_intersection_is_empty_but_written() {
+    let a = write("apart_a.obj", &cube_obj([0.0; 3], 1.0));
+    let b = write("apart_b.obj", &cube_obj([5.0; 3], 1.0));
+    let out = scratch("apart.obj");
+    let o = csg("intersection", &a, &b, &out, &[]);
+    assert_ok(&o);
+    assert!(stderr(&o).contains("the intersection is empty"));
+    assert!(closed_result(&out).faces.is_empty());
+    let o = csg("union", &a, &b, &out, &[]);
+    assert_ok(&o);
+    assert_eq!(closed_result(&out).signed_volume(), 2.0);
+}
+
+#[test]
+fn dropped_faces_are_reported() {
+    // a unit cube whose top edge 5-6 carries an extra vertex 9, and a
+    // closing sliver face 5 9 6 without area
+    let text = cube_obj([0.0; 3], 1.0)
+        .replace("f 1 4 3 2\n", "v 0.5 0 1\nf 1 4 3 2\n")
+        .replace("f 1 2 6 5\n", "f 1 2 6 9 5\n")
+        + "f 5 9 6\n";
+    let sliver = write("sliver.obj", &text);
+    let b = write("sliver_b.obj", &cube_obj([0.5; 3], 1.0));
+    let out = scratch("sliver_union.obj");
+    let o = csg("union", &sliver, &b, &out, &["--stats"]);
+    assert_ok(&o);
+    let err = stderr(&o);
+    assert!(
+        err.contains("sliver.obj: 1 degenerate face(s) dropped: face 6"),
+        "{err}"
+    );
+    assert!(err.contains("the solid may not be closed"), "{err}");
+    assert!(stat(&stdout(&o), "input A:").ends_with("(0 faces triangulated, 1 dropped)"));
+    assert_eq!(closed_result(&out).signed_volume(), 2.0 - 0.125);
+}

@@ -1,0 +1,42 @@
+//! End-to-end tests of the `shadow` binary: one test binary, one module
+//! per command family.
+
+mod cli;
+mod csg;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn shadow(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_shadow"))
+        .args(args)
+        .output()
+        .expect("the shadow binary runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A fresh path in cargo's per-test scratch directory.
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("shadow-cli-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    let _ = std::fs::remove_file(&p);
+    p
+}
+
+fn assert_failed_with(o: &Output, needles: &[&str]) {
+    assert_eq!(o.status.code(), Some(1), "stderr: {}", stderr(o));
+    let err = stderr(o);
+    assert!(err.starts_with("error: "), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "`{n}` not in {err:?}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+}
