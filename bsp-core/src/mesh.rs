@@ -16,6 +16,7 @@ use num_rational::BigRational;
 use smallvec::SmallVec;
 
 use crate::Side;
+use crate::plane::Plane;
 use crate::point::Point;
 use crate::polygon::Polygon;
 
@@ -26,6 +27,8 @@ pub struct TriMesh {
     pub vertices: Vec<Point>,
     /// Counter-clockwise triangles (indices into `vertices`).
     pub triangles: Vec<[u32; 3]>,
+    /// The support plane of each triangle's polygon.
+    pub planes: Vec<Plane>,
 }
 
 /// An exact conversion of a wide integer.
@@ -42,6 +45,23 @@ pub(crate) fn to_bigint(x: &crate::I256) -> BigInt {
 
 fn key(p: &Point) -> [u64; 3] {
     p.to_f64().map(|c| (c + 0.0).to_bits())
+}
+
+fn cross_wide(a: [i64; 3], b: [i64; 3]) -> [i128; 3] {
+    let m = |x: i64, y: i64| x as i128 * y as i128;
+    [
+        m(a[1], b[2]) - m(a[2], b[1]),
+        m(a[2], b[0]) - m(a[0], b[2]),
+        m(a[0], b[1]) - m(a[1], b[0]),
+    ]
+}
+
+fn cross3(a: &[crate::I256; 3], b: &[crate::I256; 3]) -> [crate::I256; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// Exact comparison of two points' coordinate `k`.
@@ -94,6 +114,7 @@ impl TriMesh {
         let xs: Vec<f64> = by_x.iter().map(|&i| coords[i as usize][0]).collect();
 
         let mut triangles = Vec::new();
+        let mut planes = Vec::new();
         for (poly, cs) in polys.iter().zip(&corners) {
             let k = cs.len();
             // boundary loop: (vertex, edge ids it lies on)
@@ -128,12 +149,176 @@ impl TriMesh {
                         .map(|v| (v, SmallVec::from_slice(&[i as u32]))),
                 );
             }
+            let before = triangles.len();
             clip_ears(ring, k as u32, &mut triangles);
+            planes.extend(std::iter::repeat_n(
+                *poly.support(),
+                triangles.len() - before,
+            ));
         }
-        TriMesh {
+        let mut mesh = TriMesh {
             vertices,
             triangles,
+            planes,
+        };
+        mesh.split_non_manifold();
+        mesh
+    }
+
+    /// Makes the mesh a 2-manifold where the solid touches itself along an
+    /// edge or at a vertex (two boxes sharing an edge, say): around an edge
+    /// used by more than two triangles, the triangles are sorted by angle
+    /// (exactly) and each is paired with its neighbour across the solid's
+    /// interior; then every vertex gets one copy per fan of triangles
+    /// connected through paired edges. The copies are the same exact point.
+    fn split_non_manifold(&mut self) {
+        if crate::topology::check_closed_manifold(self.triangles.iter().map(|t| &t[..])).is_ok() {
+            return; // the common case
         }
+        let t = &self.triangles;
+        let mut by_edge: HashMap<(u32, u32), SmallVec<[(u32, u8); 2]>> = HashMap::new();
+        for (ti, tri) in t.iter().enumerate() {
+            for c in 0..3u8 {
+                let (a, b) = (tri[c as usize], tri[(c as usize + 1) % 3]);
+                by_edge.entry((a, b)).or_default().push((ti as u32, c));
+            }
+        }
+        // union-find over corners (triangle, corner index)
+        let mut parent: Vec<u32> = (0..3 * t.len() as u32).collect();
+        fn find(p: &mut [u32], mut x: u32) -> u32 {
+            while p[x as usize] != x {
+                p[x as usize] = p[p[x as usize] as usize];
+                x = p[x as usize];
+            }
+            x
+        }
+        let unite = |p: &mut Vec<u32>, x: u32, y: u32| {
+            let (a, b) = (find(p, x), find(p, y));
+            if a != b {
+                p[a as usize] = b;
+            }
+        };
+        let corner = |tri: u32, c: u8| 3 * tri + c as u32;
+        let mut pairs: Vec<((u32, u8), (u32, u8))> = Vec::new();
+        for (&(a, b), ab) in &by_edge {
+            if a > b {
+                continue; // each undirected edge once
+            }
+            let ba = by_edge.get(&(b, a)).map(|v| &v[..]).unwrap_or(&[]);
+            if ab.len() == 1 && ba.len() == 1 {
+                pairs.push((ab[0], ba[0]));
+            } else if !ab.is_empty() && ab.len() == ba.len() {
+                pairs.extend(self.pair_around_edge(a, b, ab, ba));
+            }
+        }
+        for ((t1, c1), (t2, c2)) in pairs {
+            // t1 uses a -> b at corner c1 (a at c1, b at c1 + 1); t2 uses b -> a
+            let (a1, b1) = (corner(t1, c1), corner(t1, (c1 + 1) % 3));
+            let (b2, a2) = (corner(t2, c2), corner(t2, (c2 + 1) % 3));
+            unite(&mut parent, a1, a2);
+            unite(&mut parent, b1, b2);
+        }
+        let mut copy_of: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut first_class: HashMap<u32, u32> = HashMap::new();
+        for ti in 0..self.triangles.len() {
+            for c in 0..3u8 {
+                let v = self.triangles[ti][c as usize];
+                let class = find(&mut parent, corner(ti as u32, c));
+                let fc = *first_class.entry(v).or_insert(class);
+                let id = if fc == class {
+                    v
+                } else {
+                    *copy_of.entry((v, class)).or_insert_with(|| {
+                        self.vertices.push(self.vertices[v as usize].clone());
+                        (self.vertices.len() - 1) as u32
+                    })
+                };
+                self.triangles[ti][c as usize] = id;
+            }
+        }
+    }
+
+    /// Pairs each `b -> a` use of the edge with the `a -> b` use next to it
+    /// across the interior, by exact angular order around the edge.
+    fn pair_around_edge(
+        &self,
+        a: u32,
+        b: u32,
+        ab: &[(u32, u8)],
+        ba: &[(u32, u8)],
+    ) -> Vec<((u32, u8), (u32, u8))> {
+        use bnum::types::I256 as W;
+        let plane = |t: u32| self.planes[t as usize];
+        let all: Vec<((u32, u8), bool)> = ab
+            .iter()
+            .map(|&x| (x, true))
+            .chain(ba.iter().map(|&x| (x, false)))
+            .collect();
+        // the edge direction: the cross product of two incident planes that
+        // are not parallel, signed to run from a to b
+        let n0 = plane(all[0].0.0).normal();
+        let d = all
+            .iter()
+            .map(|x| cross_wide(n0, plane(x.0.0).normal()))
+            .find(|c| c.iter().any(|v| *v != 0))
+            .expect("the planes around a boundary edge are not all parallel");
+        let (pa, pb) = (&self.vertices[a as usize], &self.vertices[b as usize]);
+        let k = (0..3).find(|&k| d[k] != 0).expect("non-zero direction");
+        let forward = (cmp_axis(pa, pb, k) == Ordering::Less) == (d[k] > 0);
+        let d: [W; 3] = d.map(|c| if forward { W::from(c) } else { -W::from(c) });
+        // u = n × d for a -> b, d × n for b -> a: the direction from the
+        // edge into the triangle
+        let us: Vec<[W; 3]> = all
+            .iter()
+            .map(|&((t, _), is_ab)| {
+                let n = plane(t).normal().map(|c| W::from(c as i128));
+                let u = cross3(&n, &d);
+                if is_ab { u } else { u.map(|c| -c) }
+            })
+            .collect();
+        let big = |x: W| x.as_::<I512>();
+        let triple = |u: &[W; 3], v: &[W; 3]| -> Ordering {
+            // sign of (u × v) · d
+            let c = [
+                big(u[1]) * big(v[2]) - big(u[2]) * big(v[1]),
+                big(u[2]) * big(v[0]) - big(u[0]) * big(v[2]),
+                big(u[0]) * big(v[1]) - big(u[1]) * big(v[0]),
+            ];
+            (c[0] * big(d[0]) + c[1] * big(d[1]) + c[2] * big(d[2])).cmp(&I512::ZERO)
+        };
+        let dot = |u: &[W; 3], v: &[W; 3]| {
+            big(u[0]) * big(v[0]) + big(u[1]) * big(v[1]) + big(u[2]) * big(v[2])
+        };
+        let u0 = us[0];
+        let half = |u: &[W; 3]| match triple(&u0, u) {
+            Ordering::Greater => 0,
+            Ordering::Less => 1,
+            Ordering::Equal => {
+                if dot(&u0, u) > I512::ZERO {
+                    0
+                } else {
+                    1
+                }
+            }
+        };
+        let mut order: Vec<usize> = (0..all.len()).collect();
+        order.sort_by(|&i, &j| {
+            half(&us[i])
+                .cmp(&half(&us[j]))
+                .then_with(|| triple(&us[j], &us[i]))
+        });
+        // counter-clockwise about d: the wedge after a b -> a triangle is
+        // inside the solid, and the next triangle must be an a -> b one
+        let m = order.len();
+        let mut out = Vec::new();
+        for (i, &o) in order.iter().enumerate() {
+            if !all[o].1 {
+                let next = order[(i + 1) % m];
+                debug_assert!(all[next].1, "uses of a boundary edge alternate");
+                out.push((all[next].0, all[o].0));
+            }
+        }
+        out
     }
 
     /// Vertex coordinates (grid units), correctly rounded.

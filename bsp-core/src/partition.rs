@@ -983,6 +983,39 @@ mod tests {
     }
 
     #[test]
+    fn touching_solids_give_manifold_meshes() {
+        let a = solid([0, 0, 0], [2, 2, 2]);
+        for (lo, hi, vol) in [
+            ([2, 2, 0], [4, 4, 2], 16), // shares an edge
+            ([2, 2, 2], [4, 4, 4], 16), // shares a vertex
+            ([2, 0, 0], [4, 2, 2], 16), // shares a face
+            ([1, 1, 2], [3, 3, 4], 16), // overlapping face region
+            ([0, 0, 0], [2, 2, 2], 8),  // the same solid
+        ] {
+            let b = solid(lo, hi);
+            let u = a.boolean(&b, BoolOp::Union);
+            u.sanity_check().unwrap();
+            let m = u.to_mesh();
+            m.check_watertight()
+                .unwrap_or_else(|e| panic!("{lo:?}: {e}"));
+            crate::check_closed_manifold(m.triangles.iter().map(|t| &t[..]))
+                .unwrap_or_else(|e| panic!("{lo:?}: {e}"));
+            assert_eq!(
+                m.volume_exact(),
+                num_rational::BigRational::from_integer(vol.into())
+            );
+        }
+        // a cube minus one touching it along an edge is the cube itself
+        let b = solid([2, 2, 0], [4, 4, 2]);
+        let d = a.boolean(&b, BoolOp::Difference).to_mesh();
+        d.check_watertight().unwrap();
+        assert_eq!(
+            d.volume_exact(),
+            num_rational::BigRational::from_integer(8.into())
+        );
+    }
+
+    #[test]
     fn box_section_of_tilted_plane() {
         let p = Plane::through([0, 0, 0], [1, 0, 1], [0, 1, 3]).unwrap();
         let s = box_section(&p).unwrap();
