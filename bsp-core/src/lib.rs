@@ -56,7 +56,7 @@ pub use partition::{
     merge_smaller_into_larger, solid_build_options,
 };
 pub use plane::{MAX_NORMAL_BITS, MAX_OFFSET_BITS, Plane};
-pub use point::{Implicit, Point};
+pub use point::{rational_to_f64, Implicit, Point};
 pub use polygon::{FaceDefect, Polygon, PolygonSide, Side, Split};
 pub use topology::{TopologyError, check_closed_manifold};
 pub use tree::{
@@ -64,7 +64,7 @@ pub use tree::{
 };
 
 /// Re-export of the wide integer type used for homogeneous coordinates.
-pub use bnum::types::I256;
+pub use bnum::types::{I256, I512};
 
 /// Errors of this crate.
 #[derive(Clone, Debug, PartialEq)]

@@ -64,6 +64,9 @@ fn cross3(a: &[crate::I256; 3], b: &[crate::I256; 3]) -> [crate::I256; 3] {
     ]
 }
 
+/// A triangle and the index of one of its corners.
+type Corner = (u32, u8);
+
 /// Exact comparison of two points' coordinate `k`.
 fn cmp_axis(p: &Point, q: &Point, k: usize) -> Ordering {
     if let (Point::Grid(a), Point::Grid(b)) = (p, q) {
@@ -176,7 +179,7 @@ impl TriMesh {
             return; // the common case
         }
         let t = &self.triangles;
-        let mut by_edge: HashMap<(u32, u32), SmallVec<[(u32, u8); 2]>> = HashMap::new();
+        let mut by_edge: HashMap<(u32, u32), SmallVec<[Corner; 2]>> = HashMap::new();
         for (ti, tri) in t.iter().enumerate() {
             for c in 0..3u8 {
                 let (a, b) = (tri[c as usize], tri[(c as usize + 1) % 3]);

@@ -1,7 +1,7 @@
 //! Exact points: grid points and implicit intersections of three planes.
 
 use bnum::cast::As;
-use bnum::types::{I256, U256, U512};
+use bnum::types::{I256, I512, U512};
 
 use crate::Side;
 use crate::grid::GridPoint;
@@ -225,16 +225,32 @@ impl Point {
 
 /// The `f64` nearest to `num / den` (ties to even), `den > 0`.
 fn ratio_to_f64(num: I256, den: I256) -> f64 {
+    rational_to_f64(num.as_::<I512>(), den.as_::<I512>())
+}
+
+/// The `f64` nearest to the rational `num / den` (round to nearest, ties
+/// to even). Requires `den > 0` and `|num|, den < 2^456`; the result is
+/// then exact in the sense that equal rationals give equal `f64`s however
+/// they are written.
+///
+/// ```
+/// use bsp_core::rational_to_f64;
+/// use bsp_core::I512;
+/// assert_eq!(rational_to_f64(I512::from(1i32), I512::from(3i32)), 1.0 / 3.0);
+/// assert_eq!(rational_to_f64(I512::from(-4i32), I512::from(2i32)), -2.0);
+/// ```
+pub fn rational_to_f64(num: I512, den: I512) -> f64 {
     if num.is_zero() {
         return 0.0;
     }
     let neg = num.is_negative();
-    let a: U256 = num.unsigned_abs();
-    let b: U256 = den.unsigned_abs();
+    let a: U512 = num.unsigned_abs();
+    let b: U512 = den.unsigned_abs();
     let (la, lb) = (a.bits() as i32, b.bits() as i32);
+    assert!(la <= 456 && lb <= 456 && lb > 0, "rational_to_f64: operands out of range");
     // choose shift so that q = floor(a 2^shift / b) has 55 or 56 bits
     let shift = 55 - (la - lb);
-    let (mut n, mut d) = (a.as_::<U512>(), b.as_::<U512>());
+    let (mut n, mut d) = (a, b);
     if shift >= 0 {
         n <<= shift as u32;
     } else {

@@ -1,0 +1,213 @@
+//! Fragments: convex pieces of scene polygons bounded by input planes and
+//! shadow planes.
+
+use bsp_core::{Plane, Polygon, Side};
+use smallvec::SmallVec;
+
+use crate::wide::{WPoint, WidePlane};
+
+/// One edge plane of a fragment: an input plane (kept in its small form so
+/// that shadow planes can be built from it) or a shadow plane.
+#[derive(Clone, Copy, Debug)]
+pub struct Edge {
+    /// The plane, widened.
+    pub wide: WidePlane,
+    /// `Some` for an input plane.
+    pub input: Option<Plane>,
+}
+
+impl Edge {
+    fn input(p: &Plane) -> Edge {
+        Edge {
+            wide: WidePlane::from_plane(p),
+            input: Some(*p),
+        }
+    }
+    fn shadow(p: WidePlane) -> Edge {
+        Edge {
+            wide: p,
+            input: None,
+        }
+    }
+}
+
+/// A convex piece of a scene polygon, with one lit flag per light.
+///
+/// Like [`bsp_core::Polygon`]: vertex `i` is the support plane ∩ edge
+/// `i - 1` ∩ edge `i`; the interior is behind every edge plane; vertices run
+/// counter-clockwise seen from the front of the support plane.
+#[derive(Clone, Debug)]
+pub struct Fragment {
+    pub(crate) support: Plane,
+    pub(crate) edges: SmallVec<[Edge; 4]>,
+    pub(crate) verts: SmallVec<[Box<WPoint>; 4]>,
+    pub(crate) face: u32,
+    pub(crate) lit: SmallVec<[bool; 2]>,
+}
+
+/// Where a fragment lies relative to a plane.
+// Moved straight into the caller's stack; boxing would add an allocation.
+#[allow(clippy::large_enum_variant)]
+pub(crate) enum FragSplit {
+    Front(Fragment),
+    Back(Fragment),
+    /// In the plane (only for planes containing the light and the fragment:
+    /// an edge-on polygon).
+    On(Fragment),
+    Spanning(Fragment, Fragment),
+}
+
+impl Fragment {
+    /// A whole scene polygon, tagged with its face index, no flags yet.
+    pub fn from_polygon(p: &Polygon) -> Fragment {
+        Fragment {
+            support: *p.support(),
+            edges: p.edge_planes().iter().map(Edge::input).collect(),
+            verts: p
+                .vertices()
+                .iter()
+                .map(|v| Box::new(WPoint::from_point(v)))
+                .collect(),
+            face: p.tag(),
+            lit: SmallVec::new(),
+        }
+    }
+
+    /// The input face this fragment belongs to.
+    pub fn face(&self) -> u32 {
+        self.face
+    }
+
+    /// One flag per light, in the order the lights were given: `true` where
+    /// the light reaches the fragment's front side unobstructed.
+    pub fn lit(&self) -> &[bool] {
+        &self.lit
+    }
+
+    /// The support plane (the face's plane).
+    pub fn support(&self) -> &Plane {
+        &self.support
+    }
+
+    /// The exact vertices.
+    pub fn vertices(&self) -> impl Iterator<Item = &WPoint> {
+        self.verts.iter().map(|b| &**b)
+    }
+
+    /// Number of vertices.
+    pub fn len(&self) -> usize {
+        self.verts.len()
+    }
+
+    /// Always `false`: a fragment has at least three vertices.
+    pub fn is_empty(&self) -> bool {
+        self.verts.is_empty()
+    }
+
+    /// The edge planes (edge `i` runs from vertex `i` to `i + 1`).
+    pub fn edges(&self) -> &[Edge] {
+        &self.edges
+    }
+
+    /// Vertices in grid coordinates, correctly rounded.
+    pub fn vertices_f64(&self) -> Vec<[f64; 3]> {
+        self.verts.iter().map(|v| v.to_f64()).collect()
+    }
+
+    pub(crate) fn split(self, h: &WidePlane) -> FragSplit {
+        let sides: SmallVec<[Side; 8]> = self.verts.iter().map(|v| v.classify(h)).collect();
+        let front = sides.contains(&Side::Front);
+        let back = sides.contains(&Side::Back);
+        match (front, back) {
+            (true, false) => FragSplit::Front(self),
+            (false, true) => FragSplit::Back(self),
+            (false, false) => FragSplit::On(self),
+            (true, true) => {
+                let (f, b) = self.split_with_sides(h, &sides);
+                FragSplit::Spanning(f, b)
+            }
+        }
+    }
+
+    fn split_with_sides(&self, h: &WidePlane, sides: &[Side]) -> (Fragment, Fragment) {
+        let support = WidePlane::from_plane(&self.support);
+        let cut_front = Edge::shadow(h.flip());
+        let cut_back = Edge::shadow(*h);
+        let k = self.verts.len();
+        let mut f = self.empty_like();
+        let mut b = self.empty_like();
+        for i in 0..k {
+            let j = if i + 1 == k { 0 } else { i + 1 };
+            let (vi, ei) = (&self.verts[i], &self.edges[i]);
+            match (sides[i], sides[j]) {
+                (Side::Front, Side::Back) | (Side::Back, Side::Front) => {
+                    let x = Box::new(
+                        WPoint::from_planes(&support, &ei.wide, h)
+                            .expect("a spanning edge meets the cutting plane in one point"),
+                    );
+                    if sides[i] == Side::Front {
+                        f.push(vi.clone(), *ei);
+                        f.push(x.clone(), cut_front);
+                        b.push(x, *ei);
+                    } else {
+                        b.push(vi.clone(), *ei);
+                        b.push(x.clone(), cut_back);
+                        f.push(x, *ei);
+                    }
+                }
+                (Side::Front, _) => f.push(vi.clone(), *ei),
+                (Side::Back, _) => b.push(vi.clone(), *ei),
+                (Side::On, Side::Back) => {
+                    f.push(vi.clone(), cut_front);
+                    b.push(vi.clone(), *ei);
+                }
+                (Side::On, _) => {
+                    f.push(vi.clone(), *ei);
+                    b.push(vi.clone(), cut_back);
+                }
+            }
+        }
+        (f, b)
+    }
+
+    fn empty_like(&self) -> Fragment {
+        Fragment {
+            support: self.support,
+            edges: SmallVec::new(),
+            verts: SmallVec::new(),
+            face: self.face,
+            lit: self.lit.clone(),
+        }
+    }
+
+    fn push(&mut self, v: Box<WPoint>, e: Edge) {
+        self.verts.push(v);
+        self.edges.push(e);
+    }
+
+    /// Checks the invariants exactly: every vertex on the support plane and
+    /// on its two edge planes, strictly inside the others.
+    pub fn sanity_check(&self) -> Result<(), String> {
+        let k = self.verts.len();
+        if k < 3 || self.edges.len() != k {
+            return Err(format!("{k} vertices, {} edges", self.edges.len()));
+        }
+        let support = WidePlane::from_plane(&self.support);
+        for (i, v) in self.verts.iter().enumerate() {
+            if v.classify(&support) != Side::On {
+                return Err(format!("vertex {i} is off the support plane"));
+            }
+            for (j, e) in self.edges.iter().enumerate() {
+                let incident = j == i || (j + 1) % k == i;
+                let s = v.classify(&e.wide);
+                if incident && s != Side::On {
+                    return Err(format!("vertex {i} is off its edge plane {j}"));
+                }
+                if !incident && s != Side::Back {
+                    return Err(format!("vertex {i} is not strictly inside edge plane {j}"));
+                }
+            }
+        }
+        Ok(())
+    }
+}

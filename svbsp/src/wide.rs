@@ -1,0 +1,217 @@
+//! The shadow tier of exact arithmetic: shadow planes and the points where
+//! they cut scene polygons.
+//!
+//! Bounds (see `docs/shadows.md`): a shadow plane through a light `L` with
+//! `|L_i| < 2^26` (or a sun direction with `|D_i| < 2^26`) and the edge
+//! `P ∩ E` of an input-budget polygon is `P(L)·E − E(L)·P`, with
+//! `|P(L)|, |E(L)| < 2^84`, so its normal is below `2^140` and its offset
+//! below `2^168`. Every fragment vertex is its polygon's support plane
+//! (`2^55`, `2^83`) cut by two edge planes of either tier: `|w| < 2^338`,
+//! `|x_i| < 2^366`, and a classification against a shadow plane is below
+//! `2^509` — inside a signed 512-bit integer.
+
+use bnum::cast::As;
+use bsp_core::{I256, I512, Plane, Side};
+
+/// `2^-48`: the filter's relative error bound (see bsp-core's
+/// architecture note: at most 8 roundings of `2^-53` per evaluation).
+const FILTER_REL: f64 = 1.0 / (1u64 << 48) as f64;
+
+/// A plane with wide integer coefficients: an input plane, or a shadow
+/// plane through the light.
+#[derive(Clone, Copy, Debug)]
+pub struct WidePlane {
+    n: [I256; 3],
+    d: I256,
+    approx: [f64; 4],
+}
+
+fn side_of(v: I512) -> Side {
+    if v.is_negative() {
+        Side::Back
+    } else if v.is_zero() {
+        Side::On
+    } else {
+        Side::Front
+    }
+}
+
+impl PartialEq for WidePlane {
+    fn eq(&self, o: &WidePlane) -> bool {
+        self.n == o.n && self.d == o.d
+    }
+}
+
+impl WidePlane {
+    fn new(n: [I256; 3], d: I256) -> WidePlane {
+        WidePlane {
+            approx: [n[0].as_(), n[1].as_(), n[2].as_(), d.as_()],
+            n,
+            d,
+        }
+    }
+
+    /// An input plane, widened.
+    pub fn from_plane(p: &Plane) -> WidePlane {
+        let n = p.normal().map(|c| I256::from(c as i128));
+        WidePlane::new(n, I256::from(p.offset()))
+    }
+
+    /// The normal.
+    pub fn normal(&self) -> &[I256; 3] {
+        &self.n
+    }
+
+    /// The offset.
+    pub fn offset(&self) -> I256 {
+        self.d
+    }
+
+    /// The plane `a · e − b · p` of the pencil through the line `p ∩ e`,
+    /// negated when `negate`.
+    pub(crate) fn pencil(a: i128, e: &Plane, b: i128, p: &Plane, negate: bool) -> WidePlane {
+        let (a, b) = (I256::from(a), I256::from(b));
+        let (ne, np) = (e.normal(), p.normal());
+        let mut n = [I256::ZERO; 3];
+        for k in 0..3 {
+            n[k] = a * I256::from(ne[k] as i128) - b * I256::from(np[k] as i128);
+        }
+        let mut d = a * I256::from(e.offset()) - b * I256::from(p.offset());
+        if negate {
+            n = n.map(|c| -c);
+            d = -d;
+        }
+        WidePlane::new(n, d)
+    }
+
+    /// The same plane, opposite orientation.
+    pub fn flip(&self) -> WidePlane {
+        WidePlane::new(self.n.map(|c| -c), -self.d)
+    }
+
+    /// `true` if the normal is zero (a degenerate pencil member).
+    pub fn is_degenerate(&self) -> bool {
+        self.n.iter().all(|c| c.is_zero())
+    }
+}
+
+/// An exact point in homogeneous coordinates `(x, y, z, w)`, `w > 0`, with
+/// `f64` roundings for the filter.
+#[derive(Clone, Debug)]
+pub struct WPoint {
+    h: [I512; 4],
+    approx: [f64; 4],
+}
+
+fn wide(x: I256) -> I512 {
+    x.as_::<I512>()
+}
+
+fn cross(a: &[I512; 3], b: &[I512; 3]) -> [I512; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+impl WPoint {
+    /// A scene point (grid or implicit), widened.
+    pub fn from_point(p: &bsp_core::Point) -> WPoint {
+        WPoint::from_h(p.homogeneous().map(wide))
+    }
+
+    fn from_h(h: [I512; 4]) -> WPoint {
+        WPoint {
+            approx: h.map(|c| c.as_::<f64>()),
+            h,
+        }
+    }
+
+    /// The intersection of three planes, `None` if they do not meet in one
+    /// point.
+    pub fn from_planes(p1: &WidePlane, p2: &WidePlane, p3: &WidePlane) -> Option<WPoint> {
+        let n = |p: &WidePlane| p.n.map(wide);
+        let (n1, n2, n3) = (n(p1), n(p2), n(p3));
+        let (c23, c31, c12) = (cross(&n2, &n3), cross(&n3, &n1), cross(&n1, &n2));
+        let w = n1[0] * c23[0] + n1[1] * c23[1] + n1[2] * c23[2];
+        if w.is_zero() {
+            return None;
+        }
+        let (d1, d2, d3) = (wide(p1.d), wide(p2.d), wide(p3.d));
+        let mut h = [I512::ZERO; 4];
+        for k in 0..3 {
+            h[k] = -(c23[k] * d1 + c31[k] * d2 + c12[k] * d3);
+        }
+        h[3] = w;
+        if w.is_negative() {
+            h = h.map(|c| -c);
+        }
+        Some(WPoint::from_h(h))
+    }
+
+    /// Exact side of `plane`: the filter, then 512-bit arithmetic.
+    pub fn classify(&self, plane: &WidePlane) -> Side {
+        let p = &plane.approx;
+        let a = &self.approx;
+        let t = [p[0] * a[0], p[1] * a[1], p[2] * a[2], p[3] * a[3]];
+        let v = (t[0] + t[1]) + (t[2] + t[3]);
+        let m = (t[0].abs() + t[1].abs()) + (t[2].abs() + t[3].abs());
+        let bound = m * FILTER_REL;
+        if v > bound {
+            return Side::Front;
+        }
+        if v < -bound {
+            return Side::Back;
+        }
+        self.classify_exact(plane)
+    }
+
+    /// The exact path alone.
+    pub fn classify_exact(&self, plane: &WidePlane) -> Side {
+        let h = &self.h;
+        let v = wide(plane.n[0]) * h[0]
+            + wide(plane.n[1]) * h[1]
+            + wide(plane.n[2]) * h[2]
+            + wide(plane.d) * h[3];
+        side_of(v)
+    }
+
+    /// Homogeneous coordinates, `w > 0`.
+    pub fn homogeneous(&self) -> &[I512; 4] {
+        &self.h
+    }
+
+    /// Grid coordinates, each correctly rounded (equal points give equal
+    /// results).
+    pub fn to_f64(&self) -> [f64; 3] {
+        let w = self.h[3];
+        [0, 1, 2].map(|k| bsp_core::rational_to_f64(self.h[k], w))
+    }
+
+    /// Exact equality of the represented points.
+    pub fn same_point(&self, o: &WPoint) -> bool {
+        use bnum::types::I1024;
+        let big = |x: I512| x.as_::<I1024>();
+        (0..3).all(|k| big(self.h[k]) * big(o.h[3]) == big(o.h[k]) * big(self.h[3]))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pencil_contains_line_and_light() {
+        let p = Plane::new([0, 0, 1], 0).unwrap(); // z = 0
+        let e = Plane::new([1, 0, 0], -2).unwrap(); // x = 2
+        let light = [0i128, 0, 5];
+        let a = p.offset() + p.normal()[2] as i128 * light[2]; // p(L) = 5
+        let b = e.offset(); // e(L) = -2
+        let s = WidePlane::pencil(a, &e, b, &p, false);
+        let on = |x: [i32; 3]| WPoint::from_point(&bsp_core::Point::Grid(x)).classify(&s);
+        assert_eq!(on([0, 0, 5]), Side::On);
+        assert_eq!(on([2, 7, 0]), Side::On);
+        assert_eq!(on([1, 0, 0]), Side::Back); // interior side of e, on p
+    }
+}
