@@ -402,7 +402,50 @@ impl BspTree {
     /// assert_eq!(tags, vec![1, 0]);
     /// ```
     pub fn traverse(&self, eye: ViewPoint, order: Order, mut visit: impl FnMut(&Polygon)) {
-        self.traverse_from(self.root, eye, order, &mut visit);
+        self.traverse_nodes(eye, order, |_, n| n.polygons.iter().for_each(&mut visit));
+    }
+
+    /// Visits every node in `order` from `eye` (explicit stack): the
+    /// node's id and the node, whose `polygons` are its coplanar polygons.
+    /// The polygon sequence is the one [`BspTree::traverse`] produces.
+    pub fn traverse_nodes(
+        &self,
+        eye: ViewPoint,
+        order: Order,
+        mut visit: impl FnMut(NodeId, &Node),
+    ) {
+        enum Item {
+            Visit(Link),
+            Emit(NodeId),
+        }
+        let mut stack = vec![Item::Visit(self.root)];
+        while let Some(item) = stack.pop() {
+            match item {
+                Item::Visit(Link::Cell(_)) => {}
+                Item::Visit(Link::Node(id)) => {
+                    let n = &self.nodes[id as usize];
+                    let (first, second) = self.children_in_order(n, eye, order);
+                    stack.push(Item::Visit(second));
+                    stack.push(Item::Emit(id));
+                    stack.push(Item::Visit(first));
+                }
+                Item::Emit(id) => visit(id, &self.nodes[id as usize]),
+            }
+        }
+    }
+
+    /// Index of the first polygon of every node in the node-major order of
+    /// [`BspTree::polygons`], plus the total at the end: node `i` holds
+    /// polygons `first[i]..first[i + 1]`.
+    pub fn polygon_offsets(&self) -> Vec<usize> {
+        let mut first = Vec::with_capacity(self.nodes.len() + 1);
+        let mut k = 0;
+        for n in &self.nodes {
+            first.push(k);
+            k += n.polygons.len();
+        }
+        first.push(k);
+        first
     }
 
     fn traverse_from(

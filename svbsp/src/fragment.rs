@@ -42,6 +42,7 @@ pub struct Fragment {
     pub(crate) edges: SmallVec<[Edge; 4]>,
     pub(crate) verts: SmallVec<[Box<WPoint>; 4]>,
     pub(crate) face: u32,
+    pub(crate) polygon: u32,
     pub(crate) lit: SmallVec<[bool; 2]>,
 }
 
@@ -58,8 +59,9 @@ pub(crate) enum FragSplit {
 }
 
 impl Fragment {
-    /// A whole scene polygon, tagged with its face index, no flags yet.
-    pub fn from_polygon(p: &Polygon) -> Fragment {
+    /// A whole scene polygon, tagged with its face index and its index in
+    /// the scene tree's polygon order, no flags yet.
+    pub fn from_polygon(p: &Polygon, polygon: u32) -> Fragment {
         Fragment {
             support: *p.support(),
             edges: p.edge_planes().iter().map(Edge::input).collect(),
@@ -69,6 +71,7 @@ impl Fragment {
                 .map(|v| Box::new(WPoint::from_point(v)))
                 .collect(),
             face: p.tag(),
+            polygon,
             lit: SmallVec::new(),
         }
     }
@@ -76,6 +79,15 @@ impl Fragment {
     /// The input face this fragment belongs to.
     pub fn face(&self) -> u32 {
         self.face
+    }
+
+    /// Index of the scene polygon this fragment is a piece of, in the
+    /// node-major order of [`bsp_core::BspTree::polygons`] (node `i` holds
+    /// polygons `polygon_offsets()[i]..polygon_offsets()[i + 1]`): draw
+    /// fragments in painter's order by visiting nodes with
+    /// [`bsp_core::BspTree::traverse_nodes`].
+    pub fn polygon(&self) -> u32 {
+        self.polygon
     }
 
     /// One flag per light, in the order the lights were given: `true` where
@@ -176,6 +188,7 @@ impl Fragment {
             edges: SmallVec::new(),
             verts: SmallVec::new(),
             face: self.face,
+            polygon: self.polygon,
             lit: self.lit.clone(),
         }
     }

@@ -224,6 +224,9 @@ pub struct ShadowStats {
 /// With several lights, each light refines the previous fragments, so the
 /// result is the overlay of the per-light partitions of every face: each
 /// fragment is entirely lit or entirely shadowed for every light.
+///
+/// Fragments come out grouped by scene polygon, in the node-major polygon
+/// order of the tree ([`Fragment::polygon`]).
 pub fn shadow_fragments(
     tree: &BspTree,
     lights: &[Light],
@@ -232,16 +235,12 @@ pub fn shadow_fragments(
         l.validate()?;
     }
     // per scene polygon: its current fragments
-    let mut polys: Vec<&Polygon> = Vec::new();
-    let mut first: Vec<usize> = vec![0; tree.nodes().len() + 1];
-    for (i, n) in tree.nodes().iter().enumerate() {
-        first[i] = polys.len();
-        polys.extend(n.polygons.iter());
-    }
-    first[tree.nodes().len()] = polys.len();
+    let polys: Vec<&Polygon> = tree.polygons().collect();
+    let first = tree.polygon_offsets();
     let mut frags: Vec<Vec<Fragment>> = polys
         .iter()
-        .map(|p| vec![Fragment::from_polygon(p)])
+        .enumerate()
+        .map(|(i, p)| vec![Fragment::from_polygon(p, i as u32)])
         .collect();
     let mut stats = ShadowStats {
         polygons: polys.len(),
@@ -286,7 +285,11 @@ pub fn shadow_fragments(
                 }
                 inside.clear();
                 outside.clear();
-                sv.filter(Fragment::from_polygon(polys[pi]), &mut inside, &mut outside);
+                sv.filter(
+                    Fragment::from_polygon(polys[pi], pi as u32),
+                    &mut inside,
+                    &mut outside,
+                );
                 for (f, slot) in outside.drain(..) {
                     let planes = shadow_planes(&f, light, a);
                     sv.graft(slot, &planes);
