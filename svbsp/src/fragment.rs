@@ -3,30 +3,35 @@
 
 use bsp_core::{Plane, Polygon, Side};
 use smallvec::SmallVec;
+use std::sync::Arc;
 
 use crate::wide::{WPoint, WidePlane};
 
 /// One edge plane of a fragment: an input plane (kept in its small form so
-/// that shadow planes can be built from it) or a shadow plane.
-#[derive(Clone, Copy, Debug)]
-pub struct Edge {
-    /// The plane, widened.
-    pub wide: WidePlane,
-    /// `Some` for an input plane.
-    pub input: Option<Plane>,
+/// that shadow planes can be built from it) or a shadow plane (shared with
+/// the shadow tree that made it).
+#[derive(Clone, Debug)]
+pub enum Edge {
+    /// An input plane.
+    Input(Plane),
+    /// A shadow plane.
+    Shadow(Arc<WidePlane>),
 }
 
 impl Edge {
-    fn input(p: &Plane) -> Edge {
-        Edge {
-            wide: WidePlane::from_plane(p),
-            input: Some(*p),
+    /// The plane in wide form.
+    pub fn wide(&self) -> WidePlane {
+        match self {
+            Edge::Input(p) => WidePlane::from_plane(p),
+            Edge::Shadow(w) => **w,
         }
     }
-    fn shadow(p: WidePlane) -> Edge {
-        Edge {
-            wide: p,
-            input: None,
+
+    /// The input plane, if this edge is one.
+    pub fn input(&self) -> Option<&Plane> {
+        match self {
+            Edge::Input(p) => Some(p),
+            Edge::Shadow(_) => None,
         }
     }
 }
@@ -64,7 +69,7 @@ impl Fragment {
     pub fn from_polygon(p: &Polygon, polygon: u32) -> Fragment {
         Fragment {
             support: *p.support(),
-            edges: p.edge_planes().iter().map(Edge::input).collect(),
+            edges: p.edge_planes().iter().map(|e| Edge::Input(*e)).collect(),
             verts: p
                 .vertices()
                 .iter()
@@ -126,7 +131,8 @@ impl Fragment {
         self.verts.iter().map(|v| v.to_f64()).collect()
     }
 
-    pub(crate) fn split(self, h: &WidePlane) -> FragSplit {
+    /// Splits by the shadow plane `h` (`h_flip` is its flip, shared).
+    pub(crate) fn split(self, h: &Arc<WidePlane>, h_flip: &Arc<WidePlane>) -> FragSplit {
         let sides: SmallVec<[Side; 8]> = self.verts.iter().map(|v| v.classify(h)).collect();
         let front = sides.contains(&Side::Front);
         let back = sides.contains(&Side::Back);
@@ -135,16 +141,21 @@ impl Fragment {
             (false, true) => FragSplit::Back(self),
             (false, false) => FragSplit::On(self),
             (true, true) => {
-                let (f, b) = self.split_with_sides(h, &sides);
+                let (f, b) = self.split_with_sides(h, h_flip, &sides);
                 FragSplit::Spanning(f, b)
             }
         }
     }
 
-    fn split_with_sides(&self, h: &WidePlane, sides: &[Side]) -> (Fragment, Fragment) {
+    fn split_with_sides(
+        &self,
+        h: &Arc<WidePlane>,
+        h_flip: &Arc<WidePlane>,
+        sides: &[Side],
+    ) -> (Fragment, Fragment) {
         let support = WidePlane::from_plane(&self.support);
-        let cut_front = Edge::shadow(h.flip());
-        let cut_back = Edge::shadow(*h);
+        let cut_front = Edge::Shadow(h_flip.clone());
+        let cut_back = Edge::Shadow(h.clone());
         let k = self.verts.len();
         let mut f = self.empty_like();
         let mut b = self.empty_like();
@@ -154,28 +165,28 @@ impl Fragment {
             match (sides[i], sides[j]) {
                 (Side::Front, Side::Back) | (Side::Back, Side::Front) => {
                     let x = Box::new(
-                        WPoint::from_planes(&support, &ei.wide, h)
+                        WPoint::from_support_planes(&support, &ei.wide(), h)
                             .expect("a spanning edge meets the cutting plane in one point"),
                     );
                     if sides[i] == Side::Front {
-                        f.push(vi.clone(), *ei);
-                        f.push(x.clone(), cut_front);
-                        b.push(x, *ei);
+                        f.push(vi.clone(), ei.clone());
+                        f.push(x.clone(), cut_front.clone());
+                        b.push(x, ei.clone());
                     } else {
-                        b.push(vi.clone(), *ei);
-                        b.push(x.clone(), cut_back);
-                        f.push(x, *ei);
+                        b.push(vi.clone(), ei.clone());
+                        b.push(x.clone(), cut_back.clone());
+                        f.push(x, ei.clone());
                     }
                 }
-                (Side::Front, _) => f.push(vi.clone(), *ei),
-                (Side::Back, _) => b.push(vi.clone(), *ei),
+                (Side::Front, _) => f.push(vi.clone(), ei.clone()),
+                (Side::Back, _) => b.push(vi.clone(), ei.clone()),
                 (Side::On, Side::Back) => {
-                    f.push(vi.clone(), cut_front);
-                    b.push(vi.clone(), *ei);
+                    f.push(vi.clone(), cut_front.clone());
+                    b.push(vi.clone(), ei.clone());
                 }
                 (Side::On, _) => {
-                    f.push(vi.clone(), *ei);
-                    b.push(vi.clone(), cut_back);
+                    f.push(vi.clone(), ei.clone());
+                    b.push(vi.clone(), cut_back.clone());
                 }
             }
         }
@@ -212,7 +223,7 @@ impl Fragment {
             }
             for (j, e) in self.edges.iter().enumerate() {
                 let incident = j == i || (j + 1) % k == i;
-                let s = v.classify(&e.wide);
+                let s = v.classify(&e.wide());
                 if incident && s != Side::On {
                     return Err(format!("vertex {i} is off its edge plane {j}"));
                 }

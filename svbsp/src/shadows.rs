@@ -2,7 +2,9 @@
 
 use bsp_core::{BspTree, Link, MAX_COORD, Plane, Polygon};
 
-use crate::fragment::{FragSplit, Fragment};
+use std::sync::Arc;
+
+use crate::fragment::{Edge, FragSplit, Fragment};
 use crate::wide::WidePlane;
 
 /// A light source, on the scene's grid.
@@ -78,7 +80,8 @@ enum Slot {
 }
 
 struct SvNode {
-    plane: WidePlane,
+    plane: Arc<WidePlane>,
+    flipped: Arc<WidePlane>,
     front: SvLink,
     back: SvLink,
 }
@@ -113,7 +116,7 @@ impl ShadowTree {
                 SvLink::Out => outside.push((f, slot)),
                 SvLink::Node(i) => {
                     let n = &self.nodes[i as usize];
-                    match f.split(&n.plane) {
+                    match f.split(&n.plane, &n.flipped) {
                         FragSplit::Front(f) => stack.push((f, n.front, Slot::Front(i))),
                         FragSplit::Back(f) => stack.push((f, n.back, Slot::Back(i))),
                         // a fragment in a shadow plane contains the light in
@@ -132,11 +135,12 @@ impl ShadowTree {
 
     /// Replaces the `Out` leaf at `slot` by the shadow volume bounded by
     /// `planes` (interior behind each).
-    fn graft(&mut self, slot: Slot, planes: &[WidePlane]) {
+    fn graft(&mut self, slot: Slot, planes: &[Arc<WidePlane>]) {
         let mut link = SvLink::In;
         for p in planes.iter().rev() {
             self.nodes.push(SvNode {
-                plane: *p,
+                plane: p.clone(),
+                flipped: Arc::new(p.flip()),
                 front: SvLink::Out,
                 back: link,
             });
@@ -152,17 +156,20 @@ impl ShadowTree {
 
 /// The shadow planes of a fragment that faces or backs onto `light`
 /// (`a = light.eval(support) != 0`), oriented with the volume behind them.
-/// An edge that is already a shadow plane of this light is its own shadow
-/// plane; an input edge `E` gives `sign(a) (a E − E(L) P)`. No plane grows
-/// beyond the shadow tier.
-fn shadow_planes(f: &Fragment, light: &Light, a: i128) -> Vec<WidePlane> {
+///
+/// An input edge `E` gives `sign(a) (a E − E(L) P)`. An edge that is
+/// already a shadow plane was made by a split on the way to the fragment's
+/// leaf, so the leaf's region already lies on the fragment's side of it:
+/// it would add nothing, and is left out. No plane grows beyond the shadow
+/// tier.
+fn shadow_planes(f: &Fragment, light: &Light, a: i128) -> Vec<Arc<WidePlane>> {
     f.edges()
         .iter()
-        .filter_map(|e| match &e.input {
-            None => Some(e.wide),
-            Some(ep) => {
+        .filter_map(|e| match e {
+            Edge::Shadow(_) => None,
+            Edge::Input(ep) => {
                 let s = WidePlane::pencil(a, ep, light.eval(ep), f.support(), a < 0);
-                (!s.is_degenerate()).then_some(s)
+                (!s.is_degenerate()).then(|| Arc::new(s))
             }
         })
         .collect()

@@ -24,6 +24,30 @@ pub struct WidePlane {
     n: [I256; 3],
     d: I256,
     approx: [f64; 4],
+    form: Form,
+}
+
+/// How a plane was made, kept for cheap exact evaluation at grid points.
+#[derive(Clone, Copy, Debug)]
+enum Form {
+    /// An input plane.
+    Input(Plane),
+    /// `s (a e − b p)` with `s = ±1`.
+    Pencil {
+        a: i128,
+        e: Plane,
+        b: i128,
+        p: Plane,
+        negate: bool,
+    },
+}
+
+fn value_at_grid(p: &Plane, g: [i32; 3]) -> i128 {
+    let n = p.normal();
+    n[0] as i128 * g[0] as i128
+        + n[1] as i128 * g[1] as i128
+        + n[2] as i128 * g[2] as i128
+        + p.offset()
 }
 
 fn side_of(v: I512) -> Side {
@@ -43,18 +67,39 @@ impl PartialEq for WidePlane {
 }
 
 impl WidePlane {
-    fn new(n: [I256; 3], d: I256) -> WidePlane {
+    fn new(n: [I256; 3], d: I256, form: Form) -> WidePlane {
         WidePlane {
             approx: [n[0].as_(), n[1].as_(), n[2].as_(), d.as_()],
             n,
             d,
+            form,
         }
     }
 
     /// An input plane, widened.
     pub fn from_plane(p: &Plane) -> WidePlane {
         let n = p.normal().map(|c| I256::from(c as i128));
-        WidePlane::new(n, I256::from(p.offset()))
+        WidePlane::new(n, I256::from(p.offset()), Form::Input(*p))
+    }
+
+    /// The exact side of a grid point, in at most 256 bits.
+    fn classify_grid(&self, g: [i32; 3]) -> Side {
+        match &self.form {
+            Form::Input(p) => p.classify_grid(g),
+            Form::Pencil { a, e, b, p, negate } => {
+                // |a|, |b|, |e(g)|, |p(g)| < 2^84: products below 2^168
+                let v = I256::from(*a) * I256::from(value_at_grid(e, g))
+                    - I256::from(*b) * I256::from(value_at_grid(p, g));
+                let v = if *negate { -v } else { v };
+                if v.is_negative() {
+                    Side::Back
+                } else if v.is_zero() {
+                    Side::On
+                } else {
+                    Side::Front
+                }
+            }
+        }
     }
 
     /// The normal.
@@ -81,12 +126,29 @@ impl WidePlane {
             n = n.map(|c| -c);
             d = -d;
         }
-        WidePlane::new(n, d)
+        let form = Form::Pencil {
+            a: a.as_::<i128>(),
+            e: *e,
+            b: b.as_::<i128>(),
+            p: *p,
+            negate,
+        };
+        WidePlane::new(n, d, form)
     }
 
     /// The same plane, opposite orientation.
     pub fn flip(&self) -> WidePlane {
-        WidePlane::new(self.n.map(|c| -c), -self.d)
+        let form = match self.form {
+            Form::Input(p) => Form::Input(p.flip()),
+            Form::Pencil { a, e, b, p, negate } => Form::Pencil {
+                a,
+                e,
+                b,
+                p,
+                negate: !negate,
+            },
+        };
+        WidePlane::new(self.n.map(|c| -c), -self.d, form)
     }
 
     /// `true` if the normal is zero (a degenerate pencil member).
@@ -101,10 +163,27 @@ impl WidePlane {
 pub struct WPoint {
     h: [I512; 4],
     approx: [f64; 4],
+    grid: Option<[i32; 3]>,
 }
 
 fn wide(x: I256) -> I512 {
     x.as_::<I512>()
+}
+
+/// The full 512-bit product of two 256-bit integers (16 limb products,
+/// where a 512-bit multiplication takes 64).
+fn wmul(a: I256, b: I256) -> I512 {
+    let neg = a.is_negative() != b.is_negative();
+    let (lo, hi) = a.unsigned_abs().widening_mul(b.unsigned_abs());
+    let mut digits = [0u64; 8];
+    digits[..4].copy_from_slice(lo.digits());
+    digits[4..].copy_from_slice(hi.digits());
+    let m = bnum::types::U512::from_digits(digits).as_::<I512>();
+    if neg { -m } else { m }
+}
+
+fn narrow(x: I512) -> I256 {
+    x.as_::<I256>()
 }
 
 fn cross(a: &[I512; 3], b: &[I512; 3]) -> [I512; 3] {
@@ -118,13 +197,18 @@ fn cross(a: &[I512; 3], b: &[I512; 3]) -> [I512; 3] {
 impl WPoint {
     /// A scene point (grid or implicit), widened.
     pub fn from_point(p: &bsp_core::Point) -> WPoint {
-        WPoint::from_h(p.homogeneous().map(wide))
+        let mut w = WPoint::from_h(p.homogeneous().map(wide));
+        if let bsp_core::Point::Grid(g) = p {
+            w.grid = Some(*g);
+        }
+        w
     }
 
     fn from_h(h: [I512; 4]) -> WPoint {
         WPoint {
             approx: h.map(|c| c.as_::<f64>()),
             h,
+            grid: None,
         }
     }
 
@@ -150,6 +234,46 @@ impl WPoint {
         Some(WPoint::from_h(h))
     }
 
+    /// The intersection of an input plane `p` (normal below `2^55`, offset
+    /// below `2^83`: a fragment's support plane) with two planes of either
+    /// tier: the same point as [`WPoint::from_planes`], computed from
+    /// 256 × 256-bit products only.
+    pub fn from_support_planes(p: &WidePlane, e: &WidePlane, h: &WidePlane) -> Option<WPoint> {
+        let (n1, n2, n3) = (&p.n, &e.n, &h.n);
+        let cross_small = |a: &[I256; 3], b: &[I256; 3]| {
+            // one factor is the support normal: |component| < 2^196
+            [
+                narrow(wmul(a[1], b[2]) - wmul(a[2], b[1])),
+                narrow(wmul(a[2], b[0]) - wmul(a[0], b[2])),
+                narrow(wmul(a[0], b[1]) - wmul(a[1], b[0])),
+            ]
+        };
+        let c12 = cross_small(n1, n2);
+        let c31 = cross_small(n3, n1);
+        let w = wmul(n3[0], c12[0]) + wmul(n3[1], c12[1]) + wmul(n3[2], c12[2]);
+        if w.is_zero() {
+            return None;
+        }
+        // c23_k d1 with c23 = n2 × n3, as (n2_i d1) n3_j − (n2_j d1) n3_i:
+        // |n2_i d1| < 2^223 fits 256 bits
+        let d1 = p.d;
+        let n2d = [n2[0] * d1, n2[1] * d1, n2[2] * d1];
+        let c23d1 = [
+            wmul(n2d[1], n3[2]) - wmul(n2d[2], n3[1]),
+            wmul(n2d[2], n3[0]) - wmul(n2d[0], n3[2]),
+            wmul(n2d[0], n3[1]) - wmul(n2d[1], n3[0]),
+        ];
+        let mut out = [I512::ZERO; 4];
+        for k in 0..3 {
+            out[k] = -(c23d1[k] + wmul(c31[k], e.d) + wmul(c12[k], h.d));
+        }
+        out[3] = w;
+        if w.is_negative() {
+            out = out.map(|c| -c);
+        }
+        Some(WPoint::from_h(out))
+    }
+
     /// Exact side of `plane`: the filter, then 512-bit arithmetic.
     pub fn classify(&self, plane: &WidePlane) -> Side {
         let p = &plane.approx;
@@ -167,8 +291,13 @@ impl WPoint {
         self.classify_exact(plane)
     }
 
-    /// The exact path alone.
+    /// The exact path alone: grid points against input planes and shadow
+    /// planes in at most 256 bits (a shadow plane's value at a grid point is
+    /// `a e(g) − b p(g)`), everything else in 512 bits.
     pub fn classify_exact(&self, plane: &WidePlane) -> Side {
+        if let Some(g) = self.grid {
+            return plane.classify_grid(g);
+        }
         let h = &self.h;
         let v = wide(plane.n[0]) * h[0]
             + wide(plane.n[1]) * h[1]
@@ -200,6 +329,24 @@ impl WPoint {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fast_intersection_matches_general() {
+        let p = WidePlane::from_plane(&Plane::through([0, 0, 0], [7, 1, 0], [2, 9, 1]).unwrap());
+        let e = WidePlane::from_plane(&Plane::through([1, 2, 3], [5, -4, 2], [0, 0, 9]).unwrap());
+        let a = Plane::new([3, -1, 2], 11).unwrap();
+        let b = Plane::new([1, 4, -5], -2).unwrap();
+        let h = WidePlane::pencil(123_456_789, &a, -987_654_321, &b, false);
+        for (x, y) in [(&e, &h), (&h, &e), (&h, &h.flip())] {
+            let fast = WPoint::from_support_planes(&p, x, y);
+            let slow = WPoint::from_planes(&p, x, y);
+            match (fast, slow) {
+                (Some(f), Some(s)) => assert_eq!(f.homogeneous(), s.homogeneous()),
+                (None, None) => {}
+                _ => panic!("one found a point, the other not"),
+            }
+        }
+    }
 
     #[test]
     fn pencil_contains_line_and_light() {
