@@ -176,17 +176,6 @@ pub fn box_section(plane: &Plane) -> Option<Polygon> {
     Some(poly)
 }
 
-/// Keeps the part of `poly` on `side` of `plane`; `None` if nothing with
-/// positive area is left.
-fn clip(poly: Polygon, plane: &Plane, side: Side) -> Option<Polygon> {
-    match (poly.split(plane), side) {
-        (Split::Front(p), Side::Front) | (Split::Back(p), Side::Back) => Some(p),
-        (Split::Spanning { front, .. }, Side::Front) => Some(front),
-        (Split::Spanning { back, .. }, Side::Back) => Some(back),
-        _ => None,
-    }
-}
-
 /// Options of [`Partition::solid`]: the BSP build with balance cuts every
 /// 64 polygons, which keeps convex meshes from turning into chains.
 pub fn solid_build_options() -> BuildOptions {
@@ -239,8 +228,11 @@ impl Partition<Cell> {
                     // nearest ancestors first: they cut the box section
                     // down early, and the far ones then rarely split it
                     for (p, s) in path.iter().rev() {
-                        shp = clip(shp, p, *s)
-                            .expect("a node's plane meets its region (its polygons lie there)");
+                        let kept = shp.clip(p, *s);
+                        assert!(
+                            kept,
+                            "a node's plane meets its region (its polygons lie there)"
+                        );
                     }
                     let me = out.nodes.len() as u32;
                     out.nodes.push(PNode {

@@ -385,6 +385,57 @@ impl Polygon {
         }
     }
 
+    /// Keeps only the part on side `keep` (`Front` or `Back`) of `plane`,
+    /// in place; returns `false` if no part with positive area is left (the
+    /// polygon is then unchanged and should be dropped). Cheaper than
+    /// [`Polygon::split`] when one piece is not wanted: nothing is moved
+    /// unless the polygon spans the plane, and only the kept piece is built.
+    pub fn clip(&mut self, plane: &Plane, keep: crate::Side) -> bool {
+        use crate::Side::{Back, Front, On};
+        debug_assert!(keep != On, "keep the front or the back");
+        if self.coplanar_with(plane).is_some() {
+            return false;
+        }
+        let sides: SmallVec<[crate::Side; 8]> =
+            self.verts.iter().map(|v| v.classify(plane)).collect();
+        let away = if keep == Front { Back } else { Front };
+        let has_keep = sides.contains(&keep);
+        let has_away = sides.contains(&away);
+        match (has_keep, has_away) {
+            (true, false) => return true,
+            (false, _) => return false,
+            (true, true) => {}
+        }
+        let cut = if keep == Front { plane.flip() } else { *plane };
+        let k = self.verts.len();
+        let mut out = Builder::new(self.support, self.tag);
+        for i in 0..k {
+            let j = if i + 1 == k { 0 } else { i + 1 };
+            let (vi, ei) = (&self.verts[i], &self.edges[i]);
+            let (si, sj) = (sides[i], sides[j]);
+            if si == away {
+                if sj == keep {
+                    let x = Point::from_planes(&self.support, ei, plane)
+                        .expect("a spanning edge meets the cutting plane in one point");
+                    out.push(x, *ei);
+                }
+                continue;
+            }
+            if si == keep && sj == away {
+                let x = Point::from_planes(&self.support, ei, plane)
+                    .expect("a spanning edge meets the cutting plane in one point");
+                out.push(vi.clone(), *ei);
+                out.push(x, cut);
+            } else if si == On && sj == away {
+                out.push(vi.clone(), cut);
+            } else {
+                out.push(vi.clone(), *ei);
+            }
+        }
+        *self = out.finish();
+        true
+    }
+
     fn split_with_sides(&self, plane: &Plane, sides: &[crate::Side]) -> (Polygon, Polygon) {
         use crate::Side::{Back, Front, On};
         let cut_front = plane.flip();
@@ -491,6 +542,7 @@ impl Builder {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Side;
 
     fn square() -> Polygon {
         Polygon::from_grid_points(&[[0, 0, 0], [4, 0, 0], [4, 4, 0], [0, 4, 0]], 1).unwrap()
@@ -526,6 +578,37 @@ mod tests {
             .collect();
         assert_eq!(shared.len(), 2);
         assert_eq!(front.tag(), 1);
+    }
+
+    #[test]
+    fn clip_keeps_the_same_piece_as_split() {
+        let planes = [
+            Plane::new([1, 0, 0], -1).unwrap(),
+            Plane::new([1, -1, 0], 0).unwrap(),
+            Plane::new([3, 1, 0], -7).unwrap(),
+            Plane::new([1, 0, 0], 0).unwrap(),
+        ];
+        for plane in planes {
+            for keep in [Side::Front, Side::Back] {
+                let mut c = square();
+                let kept = c.clip(&plane, keep);
+                let expected = match (square().split(&plane), keep) {
+                    (Split::Front(p), Side::Front) | (Split::Back(p), Side::Back) => Some(p),
+                    (Split::Spanning { front, .. }, Side::Front) => Some(front),
+                    (Split::Spanning { back, .. }, Side::Back) => Some(back),
+                    _ => None,
+                };
+                assert_eq!(kept, expected.is_some());
+                if let Some(e) = expected {
+                    c.sanity_check().unwrap();
+                    assert_eq!(c.len(), e.len());
+                    for (a, b) in c.vertices().iter().zip(e.vertices()) {
+                        assert!(a.same_point(b));
+                    }
+                    assert_eq!(c.edge_planes(), e.edge_planes());
+                }
+            }
+        }
     }
 
     #[test]
