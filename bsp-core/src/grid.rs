@@ -161,7 +161,13 @@ impl Grid {
         if !p.is_finite() {
             return Err(SnapError::NonFinite);
         }
-        let g = ((p - self.origin) * self.scale).round();
+        // `origin * scale` is an integer and `p * scale` is exact (a power of
+        // two), so rounding `p * scale` first and subtracting after gives the
+        // nearest grid point: `(p - origin) * scale` would round the
+        // difference before scaling and could land on the wrong side of a
+        // midpoint. The subtraction of two integer-valued doubles is exact
+        // here: either both are small, or they are within 2^27 of each other.
+        let g = (p * self.scale).round() - self.origin * self.scale;
         if !g.is_finite() {
             return Err(SnapError::OutOfRange);
         }

@@ -97,7 +97,9 @@ pub struct BuildOptions {
     /// count; balance cuts bound the depth by about `log2(n / threshold)`
     /// plus the length of the chains inside cells of `threshold` polygons,
     /// at the price of some extra fragments. A cut is only made when both
-    /// sides keep polygons, so every empty leaf still hangs below a
+    /// sides keep polygons and neither keeps more than three quarters of
+    /// them (spanning polygons count twice); otherwise the node is an
+    /// ordinary autopartition node. So every empty leaf still hangs below a
     /// polygon's plane and the solid labelling stays valid.
     pub cut_threshold: usize,
 }
@@ -211,6 +213,28 @@ fn partition_list(
     (on, front, back)
 }
 
+/// `true` if cutting by `plane` leaves each side with at most three
+/// quarters of the polygons (spanning ones count on both sides) and neither
+/// side empty. Decided before anything is split, so a rejected cut costs no
+/// fragments; without it, long parallel slivers would be cut again and
+/// again next to the previous cut.
+fn cut_balances(polys: &[Polygon], plane: &Plane) -> bool {
+    let (mut front, mut back) = (0usize, 0usize);
+    for p in polys {
+        match p.classify(plane) {
+            PolygonSide::Front => front += 1,
+            PolygonSide::Back => back += 1,
+            PolygonSide::Spanning => {
+                front += 1;
+                back += 1;
+            }
+            PolygonSide::Coplanar { .. } => {}
+        }
+    }
+    let limit = polys.len() * 3 / 4;
+    front > 0 && back > 0 && front <= limit && back <= limit
+}
+
 /// An axis-aligned plane `x_k = m` through the median of the polygons'
 /// first-vertex coordinate along the longest axis of their bounding box.
 /// How the plane is chosen does not affect exactness, so `f64` is fine here.
@@ -296,14 +320,10 @@ impl BspTree {
                     None
                 };
                 let (mut polys, mut parts) = (polys, None);
-                if let Some(plane) = cut {
+                if let Some(plane) = cut.filter(|c| cut_balances(&polys, c)) {
                     let (on, front, back) = partition_list(polys, &plane);
-                    if !front.is_empty() && !back.is_empty() {
-                        parts = Some((plane, on, front, back));
-                        polys = Vec::new();
-                    } else {
-                        polys = on.into_iter().chain(front).chain(back).collect();
-                    }
+                    parts = Some((plane, on, front, back));
+                    polys = Vec::new();
                 }
                 let (plane, on, front, back) = match parts {
                     Some(p) => p,
