@@ -15,8 +15,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
 use bsp_core::{
-    BoolOp, Grid, ImportReport, MAX_COORD, Membership, Partition, Point, TopologyError,
-    TriMesh, check_closed_manifold, import_faces,
+    BoolOp, Grid, ImportReport, MAX_COORD, Membership, Partition, Point, TopologyError, TriMesh,
+    check_closed_manifold, import_faces,
 };
 use clap::{Args, ValueEnum};
 use num_rational::BigRational;
@@ -216,10 +216,10 @@ impl Operand {
 
 /// Wall time of each phase, in order.
 #[derive(Default)]
-struct Phases(Vec<(&'static str, Duration)>);
+pub(crate) struct Phases(pub(crate) Vec<(&'static str, Duration)>);
 
 impl Phases {
-    fn run<T>(&mut self, name: &'static str, f: impl FnOnce() -> T) -> T {
+    pub(crate) fn run<T>(&mut self, name: &'static str, f: impl FnOnce() -> T) -> T {
         let start = Instant::now();
         let out = f();
         self.0.push((name, start.elapsed()));
@@ -349,8 +349,9 @@ fn exact_volume(mesh: &TriMesh, grid: &Grid) -> f64 {
 }
 
 /// Runs `f`, turning a panic into an error that says it is a bug (the
-/// kernel panics only on broken internal invariants).
-fn guarded<T>(f: impl FnOnce() -> Result<T>) -> Result<T> {
+/// kernel panics only on broken internal invariants) and asks for a
+/// report with `inputs`.
+pub(crate) fn guarded<T>(inputs: &str, f: impl FnOnce() -> Result<T>) -> Result<T> {
     static LAST: Mutex<Option<String>> = Mutex::new(None);
     let previous = panic::take_hook();
     panic::set_hook(Box::new(|info| {
@@ -376,7 +377,7 @@ fn guarded<T>(f: impl FnOnce() -> Result<T>) -> Result<T> {
             .unwrap_or_default();
         Err(anyhow!(
             "internal error: {detail}; this is a bug, not a problem with the input, and nothing \
-             was written — please report it with both input files"
+             was written — please report it with {inputs}"
         ))
     })
 }
@@ -397,7 +398,7 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
         a.validate()?;
         b.validate()
     })?;
-    let out = guarded(|| compute(&a, &b, args.op, &mut phases))?;
+    let out = guarded("both input files", || compute(&a, &b, args.op, &mut phases))?;
     phases.run("write", || shadow_scene::save(&args.output, &out.mesh))?;
     let total = total.elapsed();
 
@@ -436,7 +437,7 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
 
 /// Writes to stdout; a closed pipe (`shadow csg ... --stats | head`) is
 /// not an error.
-fn emit(text: &str) -> Result<()> {
+pub(crate) fn emit(text: &str) -> Result<()> {
     let mut stdout = std::io::stdout().lock();
     match stdout
         .write_all(text.as_bytes())
@@ -793,14 +794,17 @@ f 4 1 5 8
 
     #[test]
     fn guarded_turns_a_panic_into_an_error() {
-        let e = guarded(|| -> Result<()> { panic!("inconsistent sub-hyperplanes") }).unwrap_err();
+        let e = guarded("both input files", || -> Result<()> {
+            panic!("inconsistent sub-hyperplanes")
+        })
+        .unwrap_err();
         let s = e.to_string();
         assert!(
             s.starts_with("internal error: inconsistent sub-hyperplanes ("),
             "{s}"
         );
         assert!(s.contains("csg.rs:"), "{s}");
-        assert!(s.contains("this is a bug"), "{s}");
-        assert_eq!(guarded(|| Ok(7)).unwrap(), 7);
+        assert!(s.ends_with("please report it with both input files"), "{s}");
+        assert_eq!(guarded("x", || Ok(7)).unwrap(), 7);
     }
 }

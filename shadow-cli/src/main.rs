@@ -1,16 +1,21 @@
 //! `shadow`: the command-line front end of the exact BSP shadow toolkit.
 //!
 //! ```text
-//! shadow view  [INPUT | --scene NAME] --eye X,Y,Z [--target X,Y,Z] [--up X,Y,Z]
-//!              -o OUT.svg [--width W] [--height H] [--fov DEG]
-//! shadow stats [INPUT | --scene NAME]
-//! shadow demo  [-o room.svg]
-//! shadow csg   union|intersection|difference A B -o OUT [--weld] [--stats]
+//! shadow shadows [INPUT | --scene NAME] [--light X,Y,Z]... [--sun X,Y,Z]...
+//!                -o OUT.json|OUT.obj|OUT.svg [--eye X,Y,Z] [--target X,Y,Z]
+//!                [--up X,Y,Z] [--width W] [--height H] [--fov DEG] [--stats]
+//! shadow view    [INPUT | --scene NAME] --eye X,Y,Z [--target X,Y,Z] [--up X,Y,Z]
+//!                -o OUT.svg [--width W] [--height H] [--fov DEG]
+//! shadow stats   [INPUT | --scene NAME]
+//! shadow demo    [-o room.svg]
+//! shadow csg     union|intersection|difference A B -o OUT [--weld] [--stats]
 //! ```
 //!
 //! Every command loads a mesh (OBJ or STL) or a built-in scene, snaps it
-//! to an exact integer grid, builds a BSP tree, and uses it: `view` draws
-//! it with the painter's algorithm in the tree's exact back-to-front order,
+//! to an exact integer grid, builds a BSP tree, and uses it: `shadows`
+//! cuts every face into exactly lit and shadowed fragments for point
+//! lights and suns (see `docs/shadows.md`), `view` draws the scene with
+//! the painter's algorithm in the tree's exact back-to-front order,
 //! `stats` reports the tree's figures, `demo` renders the built-in room,
 //! `csg` computes an exact Boolean operation of two closed meshes and
 //! writes the watertight result (OBJ or binary STL).
@@ -25,8 +30,10 @@ use glam::DVec3;
 
 mod color;
 mod csg;
+mod lights;
 mod pipeline;
 mod render;
+mod shadows;
 
 use pipeline::Prepared;
 use render::View;
@@ -35,7 +42,8 @@ use render::View;
 #[command(
     name = "shadow",
     version,
-    about = "Exact BSP hidden-surface rendering and statistics for polygon scenes"
+    about = "Exact BSP shadows, hidden-surface rendering, Boolean operations and statistics for \
+             polygon scenes"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -44,6 +52,9 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Exact lit and shadowed fragments for point lights and suns, as
+    /// JSON, OBJ or an SVG view.
+    Shadows(Box<shadows::ShadowsArgs>),
     /// Render a mesh or built-in scene to SVG in exact BSP back-to-front order.
     View(ViewArgs),
     /// Print import and BSP tree statistics of a mesh or built-in scene.
@@ -258,6 +269,7 @@ fn main() -> ExitCode {
         }
     };
     let result = match &cli.command {
+        Command::Shadows(a) => shadows::run(a),
         Command::View(a) => view(a),
         Command::Stats(a) => stats(a),
         Command::Demo(a) => demo(a),

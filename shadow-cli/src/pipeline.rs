@@ -12,6 +12,9 @@ pub(crate) struct Prepared {
     pub(crate) grid: Grid,
     pub(crate) report: ImportReport,
     pub(crate) tree: BspTree,
+    /// Wall time of snapping and importing the faces.
+    pub(crate) import_time: Duration,
+    /// Wall time of the BSP build.
     pub(crate) build_time: Duration,
 }
 
@@ -22,6 +25,13 @@ impl Prepared {
     pub(crate) fn new(mesh: Mesh, name: &str) -> Result<Prepared> {
         let grid = Grid::fit_points(&mesh.positions)
             .with_context(|| format!("{name}: cannot fit a grid to the positions"))?;
+        Prepared::on_grid(mesh, name, grid)
+    }
+
+    /// As [`Prepared::new`], on a given grid (one shared with other
+    /// operands, such as lights). Faces are tagged with their index.
+    pub(crate) fn on_grid(mesh: Mesh, name: &str, grid: Grid) -> Result<Prepared> {
+        let start = Instant::now();
         let loops = mesh.face_loops();
         let (polys, report) = import_faces(&grid, loops.iter().map(Vec::as_slice))
             .with_context(|| format!("{name}: cannot import the faces"))?;
@@ -29,6 +39,7 @@ impl Prepared {
         if !summary.is_empty() {
             eprint!("{name}: {summary}");
         }
+        let import_time = start.elapsed();
         let start = Instant::now();
         let tree = BspTree::build(polys, &BuildOptions::default());
         let build_time = start.elapsed();
@@ -37,6 +48,7 @@ impl Prepared {
             grid,
             report,
             tree,
+            import_time,
             build_time,
         })
     }

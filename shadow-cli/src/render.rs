@@ -8,7 +8,7 @@
 use std::fmt::Write;
 
 use anyhow::{Result, bail};
-use bsp_core::{Order, Side};
+use bsp_core::{BspTree, Order, Plane, Polygon, Side, ViewPoint};
 use glam::DVec3;
 
 use crate::color::{face_colors, hex};
@@ -89,6 +89,11 @@ impl Camera {
         })
     }
 
+    /// The unit viewing direction.
+    pub(crate) fn forward(&self) -> DVec3 {
+        self.forward
+    }
+
     /// World point to camera space.
     pub(crate) fn to_camera(&self, p: DVec3) -> DVec3 {
         let d = p - self.eye;
@@ -146,101 +151,204 @@ const KEY_WEIGHT: f64 = 0.58;
 /// some modelling.
 const HEAD_WEIGHT: f64 = 0.25;
 
-/// Draws every polygon of the tree back to front as seen from the view's
-/// eye snapped to the grid.
-pub(crate) fn render_svg(p: &Prepared, view: &View) -> Result<Rendered> {
-    let Some((lo, hi)) = p.mesh.bounds() else {
-        bail!("nothing to draw: the mesh has no vertices");
-    };
-    if p.mesh.faces.is_empty() {
-        bail!("nothing to draw: the mesh has no faces");
-    }
-    let eye_vp = p.grid.snap_viewpoint(view.eye).map_err(|e| {
-        anyhow::anyhow!(
-            "eye {},{},{}: {e} (too far from the scene)",
-            view.eye.x,
-            view.eye.y,
-            view.eye.z
-        )
-    })?;
-    let eye = p.grid.viewpoint_to_world(eye_vp);
-    let target = view.target.unwrap_or((lo + hi) * 0.5);
-    let cam = Camera::look_at(eye, target, view.up, view.width, view.height, view.fov_deg)?;
-    let diagonal = (hi - lo).length().max(p.grid.step());
-    let planes = cam.clip_planes(1e-4 * diagonal.max((eye - target).length()));
-    let colors = face_colors(&p.mesh);
-    let key = (cam.right * KEY.x + cam.up * KEY.y + cam.forward * KEY.z).normalize();
-
-    // the exact back-to-front order; within one plane, faces turned away
-    // from the eye go first so that touching solids do not bleed
-    let mut items = Vec::new();
-    p.tree.traverse(eye_vp, Order::BackToFront, |poly| {
-        let facing = poly.support().classify_viewpoint(eye_vp);
-        if facing != Side::On {
-            items.push((poly.clone(), facing == Side::Front));
+/// The exact painter's order of the tree's polygons from `eye`: indices
+/// into the node-major sequence of [`bsp_core::BspTree::polygons`], each
+/// with `true` when the polygon's front faces the eye. Polygons seen
+/// edge-on are left out; within one plane, polygons turned away from the
+/// eye come first so that touching solids do not bleed.
+pub(crate) fn painter_order(tree: &BspTree, eye: ViewPoint) -> Vec<(usize, bool)> {
+    let first = tree.polygon_offsets();
+    let mut items: Vec<(usize, bool, Plane)> = Vec::new();
+    tree.traverse_nodes(eye, Order::BackToFront, |id, node| {
+        for (k, poly) in node.polygons.iter().enumerate() {
+            let facing = poly.support().classify_viewpoint(eye);
+            if facing != Side::On {
+                items.push((
+                    first[id as usize] + k,
+                    facing == Side::Front,
+                    *poly.support(),
+                ));
+            }
         }
     });
     let mut start = 0;
     while start < items.len() {
-        let plane = *items[start].0.support();
+        let plane = items[start].2;
         let mut end = start + 1;
-        while end < items.len() && items[end].0.support().is_coincident(&plane) {
+        while end < items.len() && items[end].2.is_coincident(&plane) {
             end += 1;
         }
-        items[start..end].sort_by_key(|(_, toward)| *toward);
+        items[start..end].sort_by_key(|&(_, toward, _)| toward);
         start = end;
     }
+    items
+        .into_iter()
+        .map(|(i, toward, _)| (i, toward))
+        .collect()
+}
 
-    let (w, h) = (view.width, view.height);
-    let mut svg = String::new();
-    let _ = writeln!(svg, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
-    let _ = writeln!(
-        svg,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}">"#
-    );
-    let _ = writeln!(
-        svg,
-        "<!-- shadow view: BSP back-to-front order from eye {:.4},{:.4},{:.4} -->",
-        eye.x, eye.y, eye.z
-    );
-    let _ = writeln!(svg, r##"<rect width="{w}" height="{h}" fill="#e9ecf0"/>"##);
-    let _ = writeln!(svg, r#"<g stroke-width="0.7" stroke-linejoin="round">"#);
-    let mut drawn = 0;
-    for (poly, toward) in &items {
-        let mut pts: Vec<DVec3> = poly
-            .vertices_f64()
-            .into_iter()
-            .map(|g| cam.to_camera(p.grid.to_world(g)))
-            .collect();
-        for (n, d) in planes {
+/// An SVG being drawn from a camera: polygons in input units go in one
+/// after the other (painter's order is the caller's), clipped to the
+/// near plane and the widened view frustum.
+pub(crate) struct Canvas {
+    pub(crate) cam: Camera,
+    planes: [(DVec3, f64); 5],
+    /// The eye snapped to the grid, and in input units.
+    pub(crate) eye_vp: ViewPoint,
+    pub(crate) eye: DVec3,
+    svg: String,
+    drawn: usize,
+}
+
+impl Canvas {
+    /// Sets up the camera of `view` for the scene `p` (the eye snapped to
+    /// the grid) and writes the SVG header; `what` names the drawing in a
+    /// comment. Polygons are stroked `stroke` pixels wide in their fill
+    /// colour, which closes anti-aliasing seams between neighbours.
+    pub(crate) fn new(p: &Prepared, view: &View, what: &str, stroke: f64) -> Result<Canvas> {
+        let Some((lo, hi)) = p.mesh.bounds() else {
+            bail!("nothing to draw: the mesh has no vertices");
+        };
+        if p.mesh.faces.is_empty() {
+            bail!("nothing to draw: the mesh has no faces");
+        }
+        let eye_vp = p.grid.snap_viewpoint(view.eye).map_err(|e| {
+            anyhow::anyhow!(
+                "eye {},{},{}: {e} (too far from the scene)",
+                view.eye.x,
+                view.eye.y,
+                view.eye.z
+            )
+        })?;
+        let eye = p.grid.viewpoint_to_world(eye_vp);
+        let target = view.target.unwrap_or((lo + hi) * 0.5);
+        let cam = Camera::look_at(eye, target, view.up, view.width, view.height, view.fov_deg)?;
+        let diagonal = (hi - lo).length().max(p.grid.step());
+        let planes = cam.clip_planes(1e-4 * diagonal.max((eye - target).length()));
+        let (w, h) = (view.width, view.height);
+        let mut svg = String::new();
+        let _ = writeln!(svg, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
+        let _ = writeln!(
+            svg,
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}">"#
+        );
+        let _ = writeln!(
+            svg,
+            "<!-- {what}: BSP back-to-front order from eye {:.4},{:.4},{:.4} -->",
+            eye.x, eye.y, eye.z
+        );
+        let _ = writeln!(svg, r##"<rect width="{w}" height="{h}" fill="#e9ecf0"/>"##);
+        let _ = writeln!(
+            svg,
+            r#"<g stroke-width="{stroke}" stroke-linejoin="round">"#
+        );
+        Ok(Canvas {
+            cam,
+            planes,
+            eye_vp,
+            eye,
+            svg,
+            drawn: 0,
+        })
+    }
+
+    /// A convex polygon given in input units, clipped and projected to
+    /// pixels; `None` if nothing of it is in view.
+    fn project(&self, world: impl IntoIterator<Item = DVec3>) -> Option<Vec<(f64, f64)>> {
+        let mut pts: Vec<DVec3> = world.into_iter().map(|w| self.cam.to_camera(w)).collect();
+        for (n, d) in self.planes {
             if pts.len() < 3 {
-                break;
+                return None;
             }
             pts = clip(&pts, n, d);
         }
-        if pts.len() < 3 {
-            continue;
+        (pts.len() >= 3).then(|| pts.iter().map(|c| self.cam.project(*c)).collect())
+    }
+
+    /// Draws a convex polygon given in input units, filled and stroked
+    /// with `fill` (the stroke hides anti-aliasing seams between pieces).
+    /// Nothing is drawn if it lies outside the view.
+    pub(crate) fn polygon(&mut self, world: impl IntoIterator<Item = DVec3>, fill: &str) {
+        let Some(pts) = self.project(world) else {
+            return;
+        };
+        self.svg.push_str("<polygon points=\"");
+        for (i, (x, y)) in pts.iter().enumerate() {
+            let _ = write!(self.svg, "{}{x:.2},{y:.2}", if i > 0 { " " } else { "" });
         }
-        let nrm = poly.support().normal().map(|c| c as f64);
-        let mut normal = DVec3::from_array(nrm).normalize();
+        let _ = writeln!(self.svg, "\" fill=\"{fill}\" stroke=\"{fill}\"/>");
+        self.drawn += 1;
+    }
+
+    /// Draws convex polygons that tile a region of one plane (given in
+    /// input units) as one path of one colour, so that the edges they share
+    /// leave no anti-aliasing seam. Returns how many pieces were in view.
+    pub(crate) fn region<I>(&mut self, pieces: impl IntoIterator<Item = I>, fill: &str) -> usize
+    where
+        I: IntoIterator<Item = DVec3>,
+    {
+        let mut d = String::new();
+        let mut drawn = 0;
+        for piece in pieces {
+            let Some(pts) = self.project(piece) else {
+                continue;
+            };
+            for (i, (x, y)) in pts.iter().enumerate() {
+                let _ = write!(d, "{}{x:.2},{y:.2}", if i == 0 { "M" } else { "L" });
+            }
+            d.push('Z');
+            drawn += 1;
+        }
+        if drawn > 0 {
+            let _ = writeln!(
+                self.svg,
+                "<path d=\"{d}\" fill=\"{fill}\" stroke=\"{fill}\"/>"
+            );
+            self.drawn += drawn;
+        }
+        drawn
+    }
+
+    /// Closes the SVG.
+    pub(crate) fn finish(mut self) -> Rendered {
+        self.svg.push_str("</g>\n</svg>\n");
+        Rendered {
+            svg: self.svg,
+            drawn: self.drawn,
+            eye: self.eye,
+        }
+    }
+}
+
+/// Draws every polygon of the tree back to front as seen from the view's
+/// eye snapped to the grid.
+pub(crate) fn render_svg(p: &Prepared, view: &View) -> Result<Rendered> {
+    let mut canvas = Canvas::new(p, view, "shadow view", 0.7)?;
+    let colors = face_colors(&p.mesh);
+    let cam = &canvas.cam;
+    let key = (cam.right * KEY.x + cam.up * KEY.y + cam.forward * KEY.z).normalize();
+    let forward = cam.forward;
+    let polys: Vec<&Polygon> = p.tree.polygons().collect();
+    for (i, toward) in painter_order(&p.tree, canvas.eye_vp) {
+        let poly = polys[i];
+        let mut normal = unit_normal(poly.support());
         if !toward {
             normal = -normal;
         }
         // one light value per plane: the head light shines along the view
         let light = AMBIENT
             + KEY_WEIGHT * normal.dot(key).max(0.0)
-            + HEAD_WEIGHT * (-normal.dot(cam.forward)).max(0.0);
+            + HEAD_WEIGHT * (-normal.dot(forward)).max(0.0);
         let fill = hex(colors[poly.tag() as usize], light);
-        svg.push_str("<polygon points=\"");
-        for (i, c) in pts.iter().enumerate() {
-            let (x, y) = cam.project(*c);
-            let _ = write!(svg, "{}{x:.2},{y:.2}", if i > 0 { " " } else { "" });
-        }
-        let _ = writeln!(svg, "\" fill=\"{fill}\" stroke=\"{fill}\"/>");
-        drawn += 1;
+        let world = poly.vertices_f64().into_iter().map(|g| p.grid.to_world(g));
+        canvas.polygon(world, &fill);
     }
-    svg.push_str("</g>\n</svg>\n");
-    Ok(Rendered { svg, drawn, eye })
+    Ok(canvas.finish())
+}
+
+/// The unit normal of a plane, in `f64`.
+pub(crate) fn unit_normal(plane: &Plane) -> DVec3 {
+    DVec3::from_array(plane.normal().map(|c| c as f64)).normalize()
 }
 
 #[cfg(test)]

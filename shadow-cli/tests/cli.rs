@@ -195,7 +195,7 @@ fn source_and_argument_errors() {
 fn help_succeeds() {
     let o = shadow(&["--help"]);
     assert!(o.status.success());
-    for cmd in ["view", "stats", "demo"] {
+    for cmd in ["shadows", "view", "stats", "demo"] {
         assert!(stdout(&o).contains(cmd));
     }
 }

@@ -3,6 +3,7 @@
 
 mod cli;
 mod csg;
+mod shadows;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -6,7 +6,7 @@
 //! of the true value: shadow planes (through a light and a fragment edge)
 //! have their own exact tier, 140-bit normals and 168-bit offsets, and their
 //! intersections with scene polygons are classified in 512-bit integers
-//! behind an `f64` filter (see `docs/shadows.md`).
+//! behind an `f64` filter (see `docs/architecture.md`, "The shadow tier").
 //!
 //! # Example
 //!

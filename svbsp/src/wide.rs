@@ -1,7 +1,7 @@
 //! The shadow tier of exact arithmetic: shadow planes and the points where
 //! they cut scene polygons.
 //!
-//! Bounds (see `docs/shadows.md`): a shadow plane through a light `L` with
+//! Bounds (see `docs/architecture.md`, "The shadow tier"): a shadow plane through a light `L` with
 //! `|L_i| < 2^26` (or a sun direction with `|D_i| < 2^26`) and the edge
 //! `P ∩ E` of an input-budget polygon is `P(L)·E − E(L)·P`, with
 //! `|P(L)|, |E(L)| < 2^84`, so its normal is below `2^140` and its offset

@@ -1,0 +1,458 @@
+//! `shadows`: JSON schema, exact shadow polygons, OBJ groups, SVG, errors.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use crate::{assert_failed_with, scratch, shadow, stderr, stdout};
+
+/// A 2 × 2 floor at z = 0 (face 0, facing up) and a 0.5 × 0.5 occluder
+/// at z = 1 (face 1, facing up) over `[0.5, 1]²`.
+fn floor_and_occluder() -> PathBuf {
+    let path = scratch("floor_and_occluder.obj");
+    std::fs::write(
+        &path,
+        "v 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\n\
+         v 0.5 0.5 1\nv 1 0.5 1\nv 1 1 1\nv 0.5 1 1\n\
+         f 1 2 3 4\nf 5 6 7 8\n",
+    )
+    .unwrap();
+    path
+}
+
+/// Runs `shadow shadows INPUT ARGS... -o OUT.json` and parses the output.
+fn shadows_json(input: &Path, args: &[&str], name: &str) -> Value {
+    let out = scratch(name);
+    let mut argv = vec!["shadows", input.to_str().unwrap()];
+    argv.extend(args);
+    argv.extend(["-o", out.to_str().unwrap()]);
+    let o = shadow(&argv);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).starts_with(&format!("wrote {}", out.display())),
+        "{}",
+        stdout(&o)
+    );
+    serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).expect("valid JSON")
+}
+
+fn point(v: &Value) -> [f64; 3] {
+    let a = v.as_array().expect("a point is an array");
+    assert_eq!(a.len(), 3, "{v}");
+    [0, 1, 2].map(|k| {
+        let c = a[k].as_f64().expect("a coordinate is a number");
+        assert!(c.is_finite());
+        c
+    })
+}
+
+/// Checks the required schema; returns the number of lights.
+fn check_schema(doc: &Value) -> usize {
+    let lights = doc["lights"].as_array().expect("lights");
+    for l in lights {
+        match l["kind"].as_str() {
+            Some("point") => {
+                point(&l["position"]);
+            }
+            Some("directional") => {
+                let d = point(&l["direction"]);
+                let len = d.iter().map(|c| c * c).sum::<f64>().sqrt();
+                assert!((len - 1.0).abs() < 1e-15, "normalized: {len}");
+            }
+            _ => panic!("bad light {l}"),
+        }
+    }
+    let faces = doc["faces"].as_u64().expect("faces") as usize;
+    let frags = doc["fragments"].as_array().expect("fragments");
+    for f in frags {
+        let face = f["face"].as_u64().expect("face index") as usize;
+        assert!(face < faces, "{f}");
+        let vs = f["vertices"].as_array().expect("vertices");
+        assert!(vs.len() >= 3, "{f}");
+        vs.iter().for_each(|v| {
+            point(v);
+        });
+        let lit = f["lit"].as_array().expect("lit");
+        assert_eq!(lit.len(), lights.len(), "{f}");
+        assert!(lit.iter().all(Value::is_boolean), "{f}");
+    }
+    lights.len()
+}
+
+fn vertices(f: &Value) -> Vec<[f64; 3]> {
+    f["vertices"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(point)
+        .collect()
+}
+
+/// The fragments of `face` with `lit` flags.
+fn fragments<'a>(doc: &'a Value, face: u64, lit: &[bool]) -> Vec<&'a Value> {
+    let lit: Vec<Value> = lit.iter().map(|&b| Value::Bool(b)).collect();
+    doc["fragments"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["face"] == face && f["lit"].as_array().unwrap() == &lit)
+        .collect()
+}
+
+/// Twice the signed area of the polygon's projection on the xy plane.
+fn xy_area2(v: &[[f64; 3]]) -> f64 {
+    (0..v.len())
+        .map(|i| {
+            let (a, b) = (v[i], v[(i + 1) % v.len()]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum()
+}
+
+fn sorted(mut v: Vec<[f64; 3]>) -> Vec<[f64; 3]> {
+    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    v
+}
+
+#[test]
+fn a_point_light_casts_the_exact_shadow_in_input_units() {
+    let doc = shadows_json(
+        &floor_and_occluder(),
+        &["--light", "0.75,0.75,2"],
+        "point.json",
+    );
+    assert_eq!(check_schema(&doc), 1);
+    assert_eq!(doc["faces"], 2);
+    assert_eq!(
+        doc["lights"][0],
+        serde_json::json!({"kind": "point", "position": [0.75, 0.75, 2.0]})
+    );
+    // from height 2 through height 1 the occluder's shadow doubles in
+    // size about the light's foot: [0.25, 1.25]²
+    let shadow = fragments(&doc, 0, &[false]);
+    assert_eq!(shadow.len(), 1, "{shadow:?}");
+    let v = vertices(shadow[0]);
+    assert_eq!(
+        sorted(v.clone()),
+        vec![
+            [0.25, 0.25, 0.0],
+            [0.25, 1.25, 0.0],
+            [1.25, 0.25, 0.0],
+            [1.25, 1.25, 0.0]
+        ]
+    );
+    assert!(xy_area2(&v) > 0.0, "counter-clockwise seen from above");
+    assert_eq!(shadow[0]["area"], 1.0);
+    // the rest of the floor and the whole occluder are lit
+    let lit_floor: f64 = fragments(&doc, 0, &[true])
+        .iter()
+        .map(|f| f["area"].as_f64().unwrap())
+        .sum();
+    assert!((lit_floor - 3.0).abs() < 1e-12, "{lit_floor}");
+    assert_eq!(fragments(&doc, 1, &[false]).len(), 0);
+    let s = &doc["summary"];
+    assert!((s["area"].as_f64().unwrap() - 4.25).abs() < 1e-12, "{s}");
+    assert!((s["cast_shadow_area"][0].as_f64().unwrap() - 1.0).abs() < 1e-12);
+    assert!((s["lit_area"][0].as_f64().unwrap() - 3.25).abs() < 1e-12);
+}
+
+#[test]
+fn lights_come_first_then_suns_and_suns_are_normalized() {
+    // the sun is given first on the command line but numbered after the
+    // point light; straight overhead it casts the occluder's own outline
+    let doc = shadows_json(
+        &floor_and_occluder(),
+        &["--sun", "0,0,5", "--light", "0.75,0.75,2"],
+        "order.json",
+    );
+    assert_eq!(check_schema(&doc), 2);
+    assert_eq!(doc["lights"][0]["kind"], "point");
+    assert_eq!(
+        doc["lights"][1],
+        serde_json::json!({"kind": "directional", "direction": [0.0, 0.0, 1.0]})
+    );
+    // in both shadows: the occluder's outline [0.5, 1]²
+    let both = fragments(&doc, 0, &[false, false]);
+    assert_eq!(both.len(), 1);
+    assert_eq!(
+        sorted(vertices(both[0])),
+        vec![
+            [0.5, 0.5, 0.0],
+            [0.5, 1.0, 0.0],
+            [1.0, 0.5, 0.0],
+            [1.0, 1.0, 0.0]
+        ]
+    );
+    // the ring around it is in the point light's shadow only
+    let ring: f64 = fragments(&doc, 0, &[false, true])
+        .iter()
+        .map(|f| f["area"].as_f64().unwrap())
+        .sum();
+    assert!((ring - 0.75).abs() < 1e-12, "{ring}");
+    assert!(fragments(&doc, 0, &[true, false]).is_empty());
+}
+
+#[test]
+fn every_face_of_a_closed_scene_appears() {
+    let doc = shadows_json(
+        Path::new(&unit_cube()),
+        &["--light", "3,2,5", "--sun", "-1,0.5,2"],
+        "cube.json",
+    );
+    assert_eq!(check_schema(&doc), 2);
+    assert_eq!(doc["faces"], 6);
+    let seen: BTreeSet<u64> = doc["fragments"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["face"].as_u64().unwrap())
+        .collect();
+    assert_eq!(seen, (0..6).collect());
+    // a convex solid does not shadow itself: a face is lit exactly when
+    // it faces the light (top, +x and +y faces for the point light)
+    for f in doc["fragments"].as_array().unwrap() {
+        let face = f["face"].as_u64().unwrap();
+        assert_eq!(f["lit"][0], matches!(face, 1 | 3 | 4), "{f}");
+    }
+}
+
+/// A unit cube as an OBJ file.
+fn unit_cube() -> String {
+    let path = scratch("unit_cube.obj");
+    std::fs::write(
+        &path,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+         f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+    )
+    .unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn room_json_covers_every_face_with_its_default_light() {
+    let out = scratch("room.json");
+    let o = shadow(&["shadows", "--scene", "room", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("the room's default light (--light "),
+        "{}",
+        stdout(&o)
+    );
+    let doc: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(check_schema(&doc), 1);
+    let faces = doc["faces"].as_u64().unwrap();
+    let seen: BTreeSet<u64> = doc["fragments"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["face"].as_u64().unwrap())
+        .collect();
+    assert_eq!(seen, (0..faces).collect());
+    // some of the floor (face 5, facing the light) is in cast shadow
+    assert!(!fragments(&doc, 5, &[false]).is_empty());
+    assert!(!fragments(&doc, 5, &[true]).is_empty());
+}
+
+/// A face of an OBJ file: its `g` line's names and its vertex indices
+/// (0-based).
+type ObjFace = (String, Vec<usize>);
+
+/// Parses an OBJ written by `shadows`: positions and faces.
+fn read_obj(path: &Path) -> (Vec<[f64; 3]>, Vec<ObjFace>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let (mut pos, mut faces, mut group) = (Vec::new(), Vec::new(), String::new());
+    for line in text.lines() {
+        let mut t = line.split_whitespace();
+        match t.next() {
+            Some("v") => {
+                let c: Vec<f64> = t.map(|x| x.parse().unwrap()).collect();
+                pos.push([c[0], c[1], c[2]]);
+            }
+            Some("g") => group = t.collect::<Vec<_>>().join(" "),
+            Some("f") => faces.push((
+                group.clone(),
+                t.map(|x| x.parse::<usize>().unwrap() - 1).collect(),
+            )),
+            _ => {}
+        }
+    }
+    (pos, faces)
+}
+
+#[test]
+fn obj_has_lit_and_shadow_groups_and_shared_vertices() {
+    let out = scratch("shadows.obj");
+    let input = floor_and_occluder();
+    let o = shadow(&[
+        "shadows",
+        input.to_str().unwrap(),
+        "--light",
+        "0.75,0.75,2",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (pos, faces) = read_obj(&out);
+    let groups: BTreeSet<&str> = faces.iter().map(|(g, _)| g.as_str()).collect();
+    assert_eq!(groups, BTreeSet::from(["lit", "shadow"]));
+    let shadow_faces: Vec<&Vec<usize>> = faces
+        .iter()
+        .filter(|(g, _)| g == "shadow")
+        .map(|(_, f)| f)
+        .collect();
+    assert_eq!(shadow_faces.len(), 1);
+    let square: Vec<[f64; 3]> = shadow_faces[0].iter().map(|&i| pos[i]).collect();
+    assert_eq!(sorted(square)[0], [0.25, 0.25, 0.0]);
+    // welded: no position twice, and every corner of the shadow square is
+    // shared with a lit fragment around it
+    let distinct: BTreeSet<[u64; 3]> = pos.iter().map(|p| p.map(f64::to_bits)).collect();
+    assert_eq!(distinct.len(), pos.len());
+    for &v in shadow_faces[0] {
+        assert!(faces.iter().any(|(g, f)| g == "lit" && f.contains(&v)));
+    }
+
+    // two lights: combination groups beside `lit`
+    let o = shadow(&[
+        "shadows",
+        input.to_str().unwrap(),
+        "--light",
+        "0.75,0.75,2",
+        "--sun",
+        "0,0,1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, faces) = read_obj(&out);
+    let groups: BTreeSet<&str> = faces.iter().map(|(g, _)| g.as_str()).collect();
+    assert_eq!(
+        groups,
+        BTreeSet::from(["lit lit_0_1", "lit lit_1", "shadow"])
+    );
+}
+
+#[test]
+fn svg_of_the_room_and_of_a_file() {
+    let out = scratch("room_shadows.svg");
+    let o = shadow(&["shadows", "--scene", "room", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stderr(&o), "");
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert!(svg.starts_with("<?xml") && svg.trim_end().ends_with("</svg>"));
+    assert!(svg.matches("<path d=\"M").count() > 300);
+
+    let input = floor_and_occluder();
+    let o = shadow(&[
+        "shadows",
+        input.to_str().unwrap(),
+        "--light",
+        "0.75,0.75,2",
+        "--eye",
+        "1,-3,3",
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "320",
+        "--height",
+        "240",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert!(svg.contains(r#"width="320" height="240""#));
+    // the lit floor, its shadow and the occluder: three colours
+    let fills: BTreeSet<&str> = svg
+        .split("fill=\"")
+        .skip(2) // the background
+        .map(|s| &s[..7])
+        .collect();
+    assert_eq!(fills.len(), 3, "{fills:?}");
+}
+
+#[test]
+fn stats_report_areas_and_the_quantized_sun() {
+    let out = scratch("stats.json");
+    let o = shadow(&[
+        "shadows",
+        floor_and_occluder().to_str().unwrap(),
+        "--light",
+        "0.75,0.75,2",
+        "--sun",
+        "1,2,7",
+        "-o",
+        out.to_str().unwrap(),
+        "--stats",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = stdout(&o);
+    for key in [
+        "fragments:",
+        "light 0:         point light --light 0.75,0.75,2, on the grid",
+        "light 1:         sun --sun 1,2,7, integer direction 9586980,19173961,67108863",
+        "degrees from the given one",
+        "time:",
+        "area:            4.250000",
+        "light 0 area:    lit 3.250000 (76.5%), in shadow 1.000000 (23.5%): cast 1.000000",
+        "faces with the most cast shadow",
+    ] {
+        assert!(s.contains(key), "`{key}` not in {s}");
+    }
+}
+
+#[test]
+fn shadows_errors() {
+    let input = floor_and_occluder();
+    let input = input.to_str().unwrap();
+    let never = scratch("never.json");
+    let out = never.to_str().unwrap();
+
+    let o = shadow(&["shadows", input, "-o", out]);
+    assert_failed_with(&o, &["no light", "--light X,Y,Z", "--sun X,Y,Z"]);
+
+    let o = shadow(&["shadows", input, "--light", "0,0,1e9", "-o", out]);
+    assert_failed_with(
+        &o,
+        &[
+            "light 0 (--light 0,0,1000000000): outside the grid",
+            "--sun",
+        ],
+    );
+
+    let o = shadow(&[
+        "shadows", input, "--sun", "0,0,0", "--light", "1,1,3", "-o", out,
+    ]);
+    assert_failed_with(&o, &["light 1 (--sun 0,0,0): the sun direction is zero"]);
+
+    let png = scratch("out.png");
+    let o = shadow(&[
+        "shadows",
+        input,
+        "--light",
+        "1,1,3",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_failed_with(
+        &o,
+        &["out.png: unknown output format (use .json, .obj or .svg)"],
+    );
+    assert!(!png.exists());
+
+    let svg = scratch("no_eye.svg");
+    let o = shadow(&[
+        "shadows",
+        input,
+        "--light",
+        "1,1,3",
+        "-o",
+        svg.to_str().unwrap(),
+    ]);
+    assert_failed_with(&o, &["SVG output needs a viewpoint", "--eye"]);
+
+    let o = shadow(&["shadows", "--scene", "cube", "-o", out]);
+    assert_failed_with(&o, &["no light"]);
+    let o = shadow(&["shadows", input, "--light", "1,nan,3", "-o", out]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("not a finite number"));
+    assert!(!never.exists());
+}
