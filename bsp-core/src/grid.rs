@@ -73,7 +73,16 @@ const FIT_FRACTION: f64 = 0.5;
 
 impl Grid {
     /// A grid with the given origin and power-of-two `log2_scale`
-    /// (grid units per input unit is `2^log2_scale`).
+    /// (grid units per input unit is `2^log2_scale`). The origin is rounded
+    /// to the nearest multiple of the grid step, so that it is itself a
+    /// grid point and snapping is an exact nearest-point rounding.
+    ///
+    /// ```
+    /// use bsp_core::Grid;
+    /// use glam::DVec3;
+    /// let g = Grid::new(DVec3::new(0.25, 0.0, 0.0), 0).unwrap();
+    /// assert_eq!(g.origin(), DVec3::ZERO);
+    /// ```
     pub fn new(origin: DVec3, log2_scale: i32) -> Result<Grid, Error> {
         if !origin.is_finite() {
             return Err(Error::InvalidGrid("origin is not finite"));
@@ -81,10 +90,12 @@ impl Grid {
         if !(-1000..=1000).contains(&log2_scale) {
             return Err(Error::InvalidGrid("log2_scale outside -1000..=1000"));
         }
-        Ok(Grid {
-            origin,
-            scale: 2f64.powi(log2_scale),
-        })
+        let scale = 2f64.powi(log2_scale);
+        let origin = (origin * scale).round() / scale;
+        if !origin.is_finite() {
+            return Err(Error::InvalidGrid("origin too large for the scale"));
+        }
+        Ok(Grid { origin, scale })
     }
 
     /// The finest grid on which the box `[min, max]` takes at most half of

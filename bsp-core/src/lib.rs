@@ -56,7 +56,7 @@ pub use partition::{
     merge_smaller_into_larger, solid_build_options,
 };
 pub use plane::{MAX_NORMAL_BITS, MAX_OFFSET_BITS, Plane};
-pub use point::{rational_to_f64, Implicit, Point};
+pub use point::{Implicit, Point, rational_to_f64};
 pub use polygon::{FaceDefect, Polygon, PolygonSide, Side, Split};
 pub use topology::{TopologyError, check_closed_manifold};
 pub use tree::{

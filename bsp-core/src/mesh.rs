@@ -178,16 +178,68 @@ impl TriMesh {
         if crate::topology::check_closed_manifold(self.triangles.iter().map(|t| &t[..])).is_ok() {
             return; // the common case
         }
-        let t = &self.triangles;
+        let original = self.triangles.clone();
+        let n_vertices = self.vertices.len();
         let mut by_edge: HashMap<(u32, u32), SmallVec<[Corner; 2]>> = HashMap::new();
-        for (ti, tri) in t.iter().enumerate() {
+        for (ti, tri) in original.iter().enumerate() {
             for c in 0..3u8 {
                 let (a, b) = (tri[c as usize], tri[(c as usize + 1) % 3]);
                 by_edge.entry((a, b)).or_default().push((ti as u32, c));
             }
         }
+        let mut crowded: Vec<(u32, u32)> = by_edge
+            .iter()
+            .filter(|&(&(a, b), ab)| a < b && ab.len() > 1)
+            .map(|(&e, _)| e)
+            .collect();
+        crowded.sort_unstable();
+        // Around an edge the solid touches itself at, the uses pair up across
+        // the interior wedges or across the exterior ones. Either gives a
+        // 2-manifold where the pairing leaves the edge's two sheets in
+        // different fans at an endpoint, so that the endpoint can be copied;
+        // which one does depends on how the sheets join away from the edge.
+        // Start with interior pairing everywhere and switch the edges that
+        // still come out crowded.
+        let mut exterior: std::collections::HashSet<(u32, u32)> = Default::default();
+        for _round in 0..3 {
+            self.triangles = original.clone();
+            self.vertices.truncate(n_vertices);
+            self.pair_and_copy(&by_edge, &exterior);
+            let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
+            for tri in &self.triangles {
+                for c in 0..3 {
+                    *uses.entry((tri[c], tri[(c + 1) % 3])).or_default() += 1;
+                }
+            }
+            // an original crowded edge still crowded after copying?
+            let mut changed = false;
+            for &(a, b) in &crowded {
+                let still = by_edge[&(a, b)].iter().any(|&(t, c)| {
+                    let tri = self.triangles[t as usize];
+                    let e = (tri[c as usize], tri[(c as usize + 1) % 3]);
+                    uses[&e] > 1
+                });
+                if still && exterior.insert((a, b)) {
+                    changed = true;
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+    }
+
+    /// One round of [`TriMesh::split_non_manifold`]: pairs the uses of every
+    /// edge (around crowded ones across the interior, or the exterior for
+    /// the edges in `exterior`), then gives every vertex one copy per fan of
+    /// corners joined through paired edges.
+    fn pair_and_copy(
+        &mut self,
+        by_edge: &HashMap<(u32, u32), SmallVec<[Corner; 2]>>,
+        exterior: &std::collections::HashSet<(u32, u32)>,
+    ) {
         // union-find over corners (triangle, corner index)
-        let mut parent: Vec<u32> = (0..3 * t.len() as u32).collect();
+        let mut parent: Vec<u32> = (0..3 * self.triangles.len() as u32).collect();
         fn find(p: &mut [u32], mut x: u32) -> u32 {
             while p[x as usize] != x {
                 p[x as usize] = p[p[x as usize] as usize];
@@ -202,8 +254,8 @@ impl TriMesh {
             }
         };
         let corner = |tri: u32, c: u8| 3 * tri + c as u32;
-        let mut pairs: Vec<((u32, u8), (u32, u8))> = Vec::new();
-        for (&(a, b), ab) in &by_edge {
+        let mut pairs: Vec<(Corner, Corner)> = Vec::new();
+        for (&(a, b), ab) in by_edge {
             if a > b {
                 continue; // each undirected edge once
             }
@@ -211,7 +263,7 @@ impl TriMesh {
             if ab.len() == 1 && ba.len() == 1 {
                 pairs.push((ab[0], ba[0]));
             } else if !ab.is_empty() && ab.len() == ba.len() {
-                pairs.extend(self.pair_around_edge(a, b, ab, ba));
+                pairs.extend(self.pair_around_edge(a, b, ab, ba, exterior.contains(&(a, b))));
             }
         }
         for ((t1, c1), (t2, c2)) in pairs {
@@ -241,15 +293,17 @@ impl TriMesh {
         }
     }
 
-    /// Pairs each `b -> a` use of the edge with the `a -> b` use next to it
-    /// across the interior, by exact angular order around the edge.
+    /// Pairs each `a -> b` use of the edge with a `b -> a` use next to it,
+    /// across the interior (or the exterior), by exact angular order around
+    /// the edge.
     fn pair_around_edge(
         &self,
         a: u32,
         b: u32,
-        ab: &[(u32, u8)],
-        ba: &[(u32, u8)],
-    ) -> Vec<((u32, u8), (u32, u8))> {
+        ab: &[Corner],
+        ba: &[Corner],
+        exterior: bool,
+    ) -> Vec<(Corner, Corner)> {
         use bnum::types::I256 as W;
         let plane = |t: u32| self.planes[t as usize];
         let all: Vec<((u32, u8), bool)> = ab
@@ -311,14 +365,17 @@ impl TriMesh {
                 .then_with(|| triple(&us[j], &us[i]))
         });
         // counter-clockwise about d: the wedge after a b -> a triangle is
-        // inside the solid, and the next triangle must be an a -> b one
+        // inside the solid, the wedge after an a -> b one outside; uses of
+        // the edge alternate
         let m = order.len();
         let mut out = Vec::new();
         for (i, &o) in order.iter().enumerate() {
-            if !all[o].1 {
-                let next = order[(i + 1) % m];
-                debug_assert!(all[next].1, "uses of a boundary edge alternate");
-                out.push((all[next].0, all[o].0));
+            let next = order[(i + 1) % m];
+            debug_assert!(all[next].1 != all[o].1, "uses of a boundary edge alternate");
+            match (all[o].1, exterior) {
+                (false, false) => out.push((all[next].0, all[o].0)),
+                (true, true) => out.push((all[o].0, all[next].0)),
+                _ => {}
             }
         }
         out
