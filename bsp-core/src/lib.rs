@@ -46,6 +46,7 @@ mod polygon;
 mod topology;
 mod tree;
 
+pub mod check;
 
 pub use flat::FlatBsp;
 pub use grid::{GRID_BITS, Grid, GridPoint, MAX_COORD, MAX_VIEW_COORD, SnapError, ViewPoint};

@@ -247,7 +247,10 @@ pub fn rational_to_f64(num: I512, den: I512) -> f64 {
     let a: U512 = num.unsigned_abs();
     let b: U512 = den.unsigned_abs();
     let (la, lb) = (a.bits() as i32, b.bits() as i32);
-    assert!(la <= 456 && lb <= 456 && lb > 0, "rational_to_f64: operands out of range");
+    assert!(
+        la <= 456 && lb <= 456 && lb > 0,
+        "rational_to_f64: operands out of range"
+    );
     // choose shift so that q = floor(a 2^shift / b) has 55 or 56 bits
     let shift = 55 - (la - lb);
     let (mut n, mut d) = (a, b);

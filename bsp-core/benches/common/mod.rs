@@ -1,0 +1,135 @@
+//! Scene generators shared by the benches: fixed seeds, everything built
+//! in code (no data files).
+
+#![allow(dead_code, unreachable_pub)]
+
+use bsp_core::{BspTree, BuildOptions, Grid, GridPoint, Plane, Polygon, import_faces};
+use glam::DVec3;
+
+/// `SplitMix64`: a small deterministic generator.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    /// Uniform in `[0, 1)`.
+    pub fn f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Uniform in `[lo, hi)`.
+    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.f64()
+    }
+    /// Uniform integer in `[-m, m]`.
+    pub fn coord(&mut self, m: i32) -> i32 {
+        (self.next_u64() % (2 * m as u64 + 1)) as i64 as i32 - m
+    }
+    pub fn grid_point(&mut self, m: i32) -> GridPoint {
+        [self.coord(m), self.coord(m), self.coord(m)]
+    }
+    pub fn unit_vector(&mut self) -> DVec3 {
+        loop {
+            let v = DVec3::new(
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+            );
+            let l = v.length();
+            if l > 0.1 && l <= 1.0 {
+                return v / l;
+            }
+        }
+    }
+}
+
+/// A generic plane through three random grid points of the full range
+/// (coefficients near the budget).
+pub fn random_plane(rng: &mut Rng, m: i32) -> Plane {
+    loop {
+        if let Some(p) = Plane::through(rng.grid_point(m), rng.grid_point(m), rng.grid_point(m)) {
+            return p;
+        }
+    }
+}
+
+/// `n` random triangles in the cube `[-1, 1]^3`, each with edges of about
+/// `size` (in cube units).
+pub fn soup_faces(n: usize, size: f64, seed: u64) -> Vec<[DVec3; 3]> {
+    let mut rng = Rng::new(seed);
+    (0..n)
+        .map(|_| {
+            let c = DVec3::new(
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            );
+            let u = rng.unit_vector();
+            let w = u.any_orthonormal_vector();
+            let v = u.cross(w);
+            let a = rng.range(0.0, std::f64::consts::TAU);
+            let p = |t: f64| c + (w * t.cos() + v * t.sin()) * size * 0.6;
+            [p(a), p(a + 2.1), p(a + 4.2)]
+        })
+        .collect()
+}
+
+/// A random triangle soup of `n` triangles whose size shrinks with
+/// `n^(-1/3)` (each triangle's edge is about half the mean spacing), so the
+/// expected number of triangles a plane meets grows like `n^(2/3)`.
+pub fn soup(n: usize, seed: u64) -> Vec<Polygon> {
+    let size = (n as f64).powf(-1.0 / 3.0);
+    import(&soup_faces(n, size, seed))
+}
+
+/// A closed torus (major radius 1, minor 0.4) of `2 u v` triangles,
+/// consistently oriented outwards.
+pub fn torus_faces(u: usize, v: usize) -> Vec<[DVec3; 3]> {
+    let (r0, r1) = (1.0, 0.4);
+    let p = |i: usize, j: usize| {
+        let a = (i % u) as f64 / u as f64 * std::f64::consts::TAU;
+        let b = (j % v) as f64 / v as f64 * std::f64::consts::TAU;
+        DVec3::new(
+            (r0 + r1 * b.cos()) * a.cos(),
+            (r0 + r1 * b.cos()) * a.sin(),
+            r1 * b.sin(),
+        )
+    };
+    let mut faces = Vec::with_capacity(2 * u * v);
+    for i in 0..u {
+        for j in 0..v {
+            let (a, b, c, d) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
+            faces.push([a, b, c]);
+            faces.push([a, c, d]);
+        }
+    }
+    faces
+}
+
+/// A torus of about `n` triangles (`u = 2 v`).
+pub fn torus(n: usize) -> Vec<Polygon> {
+    let v = ((n as f64 / 4.0).sqrt().round() as usize).max(3);
+    import(&torus_faces(2 * v, v))
+}
+
+/// The grid every bench scene is snapped to: fitted to `[-1.5, 1.5]^3`.
+pub fn grid() -> Grid {
+    Grid::fit(DVec3::splat(-1.5), DVec3::splat(1.5)).expect("a finite box")
+}
+
+pub fn import(faces: &[[DVec3; 3]]) -> Vec<Polygon> {
+    let (polys, _report) =
+        import_faces(&grid(), faces.iter().map(|f| &f[..])).expect("faces inside the grid");
+    polys
+}
+
+pub fn build(polys: Vec<Polygon>) -> BspTree {
+    BspTree::build(polys, &BuildOptions::default())
+}
