@@ -430,8 +430,13 @@ impl TriMesh {
 
     /// The exact signed volume in grid units³ (divide by `scale³` of the
     /// grid for input units; the scale is a power of two, so that is exact
-    /// too), as an unreduced fraction (reducing it costs a gcd of very long
-    /// integers; `Ratio`'s comparisons do not need it).
+    /// too), as an unreduced fraction.
+    ///
+    /// Reducing costs a gcd of very long integers (millions of bits for a
+    /// boolean of real meshes), and so does `Ratio` arithmetic, whose
+    /// comparisons of unreduced values can also recurse deeply. For large
+    /// meshes, compare [`TriMesh::six_volume`] pairs by cross-multiplication
+    /// instead (`n1 * d2 == n2 * d1`, denominators positive).
     ///
     /// Triangles whose vertices share a denominator are summed in integers;
     /// the groups are then added pairwise in a balanced tree without
