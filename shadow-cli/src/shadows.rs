@@ -401,7 +401,10 @@ fn fragments_per_polygon(tree: &BspTree, frags: &[Fragment]) -> Result<Vec<Vec<u
     let mut per = vec![Vec::new(); n];
     for (j, f) in frags.iter().enumerate() {
         let Some(slot) = per.get_mut(f.polygon() as usize) else {
-            bail!("internal error: fragment {j} names BSP polygon {} of {n}", f.polygon());
+            bail!(
+                "internal error: fragment {j} names BSP polygon {} of {n}",
+                f.polygon()
+            );
         };
         slot.push(j);
     }
