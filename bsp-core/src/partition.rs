@@ -617,9 +617,16 @@ where
                             collect,
                         });
                     }
-                    Split::Front(h) => {
-                        // `b`'s back region does not meet h: it lies on the
-                        // side of h where the node's sub-hyperplane is
+                    one_side @ (Split::Front(_) | Split::Back(_)) => {
+                        // H lies on one side of s: the subtree on the other
+                        // side does not meet h, so it lies on the side of h
+                        // where the node's sub-hyperplane is; only the
+                        // subtree on H's side is partitioned further
+                        let (h, h_in_front) = match one_side {
+                            Split::Front(h) => (h, true),
+                            Split::Back(h) => (h, false),
+                            _ => unreachable!("matched one side"),
+                        };
                         let s_in_front = match side_of_s {
                             PolygonSide::Front => true,
                             PolygonSide::Back => false,
@@ -631,38 +638,18 @@ where
                             (minus, plus)
                         };
                         put_b(&mut bn, &mut temps, keep, PLink::Node(it));
-                        let (p, m) = if s_in_front {
-                            (BSlot::Front(it), pass)
+                        let (child, slot) = if h_in_front {
+                            (front, BSlot::Front(it))
                         } else {
-                            (pass, BSlot::Front(it))
+                            (back, BSlot::Back(it))
+                        };
+                        let (p, m) = if s_in_front {
+                            (slot, pass)
+                        } else {
+                            (pass, slot)
                         };
                         stack.push(Task::Partition {
-                            t: front,
-                            h,
-                            plus: p,
-                            minus: m,
-                            collect,
-                        });
-                    }
-                    Split::Back(h) => {
-                        let s_in_front = match side_of_s {
-                            PolygonSide::Front => true,
-                            PolygonSide::Back => false,
-                            other => panic!("inconsistent sub-hyperplanes: {other:?}"),
-                        };
-                        let (keep, pass) = if s_in_front {
-                            (plus, minus)
-                        } else {
-                            (minus, plus)
-                        };
-                        put_b(&mut bn, &mut temps, keep, PLink::Node(it));
-                        let (p, m) = if s_in_front {
-                            (BSlot::Back(it), pass)
-                        } else {
-                            (pass, BSlot::Back(it))
-                        };
-                        stack.push(Task::Partition {
-                            t: back,
+                            t: child,
                             h,
                             plus: p,
                             minus: m,

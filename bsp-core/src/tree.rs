@@ -434,11 +434,22 @@ impl BspTree {
         order: Order,
         mut visit: impl FnMut(NodeId, &Node),
     ) {
+        self.traverse_nodes_from(self.root, eye, order, &mut visit);
+    }
+
+    /// [`BspTree::traverse_nodes`] of the subtree at `start`.
+    fn traverse_nodes_from(
+        &self,
+        start: Link,
+        eye: ViewPoint,
+        order: Order,
+        visit: &mut impl FnMut(NodeId, &Node),
+    ) {
         enum Item {
             Visit(Link),
             Emit(NodeId),
         }
-        let mut stack = vec![Item::Visit(self.root)];
+        let mut stack = vec![Item::Visit(start)];
         while let Some(item) = stack.pop() {
             match item {
                 Item::Visit(Link::Cell(_)) => {}
@@ -475,27 +486,9 @@ impl BspTree {
         order: Order,
         visit: &mut impl FnMut(&Polygon),
     ) {
-        enum Item {
-            Visit(Link),
-            Emit(NodeId),
-        }
-        let mut stack = vec![Item::Visit(start)];
-        while let Some(item) = stack.pop() {
-            match item {
-                Item::Visit(Link::Cell(_)) => {}
-                Item::Visit(Link::Node(id)) => {
-                    let n = &self.nodes[id as usize];
-                    let (first, second) = self.children_in_order(n, eye, order);
-                    stack.push(Item::Visit(second));
-                    stack.push(Item::Emit(id));
-                    stack.push(Item::Visit(first));
-                }
-                Item::Emit(id) => self.nodes[id as usize]
-                    .polygons
-                    .iter()
-                    .for_each(&mut *visit),
-            }
-        }
+        self.traverse_nodes_from(start, eye, order, &mut |_, n: &Node| {
+            n.polygons.iter().for_each(&mut *visit)
+        });
     }
 
     /// The same order as [`BspTree::traverse`], by recursion; past
