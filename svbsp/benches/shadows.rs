@@ -22,8 +22,8 @@
 //! `/proc/thread-self/schedstat`, 4 ms resolution), so that waiting for a
 //! core on a shared machine does not count; `SVBSP_BENCH_CLOCK=wall`
 //! measures wall time instead. `SVBSP_BENCH_SIZES=27,258` restricts the
-//! sizes (default: all five; the whole run takes 15–20 minutes on a
-//! loaded 2-core machine).
+//! sizes (default: all five; the whole run takes about 9 minutes on a
+//! 2-core machine at load 3, more under heavier load).
 
 use std::hint::black_box;
 use std::time::Duration;

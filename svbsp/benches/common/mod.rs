@@ -551,8 +551,8 @@ pub struct Ray {
 }
 
 /// Self-intersection margin of the shadow rays, in grid units of distance
-/// along the ray (one grid step: `2^-21` of a unit in these scenes, about
-/// `1e-7` of the scene's size).
+/// along the ray (one grid step: `2^-21` of a unit in these scenes,
+/// `2.4e-8` of their width).
 pub const RAY_EPS: f64 = 1.0;
 
 /// The shadow rays of the baseline: for every fragment and light where the
