@@ -275,8 +275,12 @@ mod tests {
         assert_eq!(g.snap(DVec3::splat(7.0)).unwrap(), [0, 0, 0]);
         let g = Grid::fit(DVec3::splat(-1e300), DVec3::splat(1e300)).unwrap();
         assert!(g.snap(DVec3::splat(1e300)).is_ok());
-        let g = Grid::fit(DVec3::splat(-1e-300), DVec3::splat(1e-300)).unwrap();
-        assert!(g.snap(DVec3::splat(1e-300)).is_ok());
+        let g = Grid::fit(
+            DVec3::splat(-(2f64.powi(-997))),
+            DVec3::splat(2f64.powi(-997)),
+        )
+        .unwrap();
+        assert!(g.snap(DVec3::splat(2f64.powi(-997))).is_ok());
         assert!(Grid::fit(DVec3::splat(f64::NAN), DVec3::ONE).is_err());
     }
 }
