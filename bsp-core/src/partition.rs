@@ -19,7 +19,9 @@ use crate::mesh::TriMesh;
 use crate::plane::Plane;
 use crate::point::Point;
 use crate::polygon::{Polygon, PolygonSide, Split};
-use crate::tree::{Ancestor, BspTree, BuildOptions, Cell, Link, Membership};
+use crate::tree::{
+    Ancestor, BspTree, BuildOptions, Cell, Link, Membership, check_ancestors, walk_checked,
+};
 
 /// Half-width of the box that bounds every sub-hyperplane: `2^26`, just
 /// outside every grid coordinate.
@@ -879,50 +881,34 @@ impl<L: Copy> Partition<L> {
     /// correct side of every ancestor (touching at most); node polygons lie
     /// in the plane and inside the sub-hyperplane's region side of ancestors.
     pub fn sanity_check(&self) -> Result<(), String> {
-        let mut seen = vec![false; self.nodes.len()];
-        let mut path: Vec<(Plane, Side)> = Vec::new();
-        let mut stack: Vec<(PLink<L>, usize, Option<Ancestor>)> = vec![(self.root, 0, None)];
-        while let Some((link, depth, edge)) = stack.pop() {
-            path.truncate(depth);
-            if let Some(e) = edge {
-                path.push(e);
-            }
-            let PLink::Node(id) = link else { continue };
-            let Some(flag) = seen.get_mut(id as usize) else {
-                return Err(format!("link to missing node {id}"));
-            };
-            if std::mem::replace(flag, true) {
-                return Err(format!("node {id} reached twice"));
-            }
-            let n = &self.nodes[id as usize];
-            n.shp
-                .sanity_check()
-                .map_err(|e| format!("node {id} sub-hyperplane: {e}"))?;
-            if *n.shp.support() != n.plane {
-                return Err(format!("node {id} sub-hyperplane is not in its plane"));
-            }
-            for poly in std::iter::once(&n.shp).chain(n.polygons.iter()) {
-                if !poly.support().is_coincident(&n.plane) {
-                    return Err(format!("node {id}: a polygon is not in the node plane"));
+        let link = |l: PLink<L>| match l {
+            PLink::Node(id) => Some(id),
+            PLink::Leaf(_) => None,
+        };
+        walk_checked(
+            self.nodes.len(),
+            link(self.root),
+            |id| {
+                let n = &self.nodes[id as usize];
+                (n.plane, link(n.front), link(n.back))
+            },
+            |id, path| {
+                let n = &self.nodes[id as usize];
+                n.shp
+                    .sanity_check()
+                    .map_err(|e| format!("node {id} sub-hyperplane: {e}"))?;
+                if *n.shp.support() != n.plane {
+                    return Err(format!("node {id} sub-hyperplane is not in its plane"));
                 }
-                for (a, (p, s)) in path.iter().enumerate() {
-                    let ok = matches!(
-                        (poly.classify(p), s),
-                        (PolygonSide::Front, Side::Front) | (PolygonSide::Back, Side::Back)
-                    );
-                    if !ok {
-                        return Err(format!("node {id}: not on the {s:?} side of ancestor {a}"));
+                for poly in std::iter::once(&n.shp).chain(n.polygons.iter()) {
+                    if !poly.support().is_coincident(&n.plane) {
+                        return Err(format!("node {id}: a polygon is not in the node plane"));
                     }
+                    check_ancestors(poly, path).map_err(|e| format!("node {id}: {e}"))?;
                 }
-            }
-            let d = path.len();
-            stack.push((n.front, d, Some((n.plane, Side::Front))));
-            stack.push((n.back, d, Some((n.plane, Side::Back))));
-        }
-        if let Some(i) = seen.iter().position(|s| !s) {
-            return Err(format!("node {i} is unreachable"));
-        }
-        Ok(())
+                Ok(())
+            },
+        )
     }
 }
 

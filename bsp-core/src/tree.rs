@@ -565,57 +565,92 @@ impl BspTree {
     ///
     /// Costs `O(polygons × depth)`; meant for tests and fuzzing.
     pub fn sanity_check(&self) -> Result<(), String> {
-        let mut seen = vec![false; self.nodes.len()];
-        // (link, index into `path` where this link's ancestors end)
-        let mut path: Vec<(Plane, Side)> = Vec::new();
-        let mut stack: Vec<(Link, usize, Option<Ancestor>)> = vec![(self.root, 0, None)];
-        while let Some((link, depth, edge)) = stack.pop() {
-            path.truncate(depth);
-            if let Some(e) = edge {
-                path.push(e);
-            }
-            let Link::Node(id) = link else { continue };
-            let Some(flag) = seen.get_mut(id as usize) else {
-                return Err(format!("link to missing node {id}"));
-            };
-            if std::mem::replace(flag, true) {
-                return Err(format!("node {id} is reached twice"));
-            }
-            let n = &self.nodes[id as usize];
-            // a node without polygons is a balance cut: both sides hold
-            // polygons, so neither child is a leaf
-            if n.polygons.is_empty()
-                && (matches!(n.front, Link::Cell(_)) || matches!(n.back, Link::Cell(_)))
-            {
-                return Err(format!("node {id} holds no polygon but has a leaf child"));
-            }
-            for (k, p) in n.polygons.iter().enumerate() {
-                p.sanity_check()
-                    .map_err(|e| format!("node {id} polygon {k}: {e}"))?;
-                if !p.support().is_coincident(&n.plane) {
-                    return Err(format!("node {id} polygon {k} is not in the node plane"));
+        let link = |l: Link| match l {
+            Link::Node(id) => Some(id),
+            Link::Cell(_) => None,
+        };
+        walk_checked(
+            self.nodes.len(),
+            link(self.root),
+            |id| {
+                let n = &self.nodes[id as usize];
+                (n.plane, link(n.front), link(n.back))
+            },
+            |id, path| {
+                let n = &self.nodes[id as usize];
+                // a node without polygons is a balance cut: both sides hold
+                // polygons, so neither child is a leaf
+                if n.polygons.is_empty()
+                    && (matches!(n.front, Link::Cell(_)) || matches!(n.back, Link::Cell(_)))
+                {
+                    return Err(format!("node {id} holds no polygon but has a leaf child"));
                 }
-                for (a, (plane, side)) in path.iter().enumerate() {
-                    let ok = matches!(
-                        (p.classify(plane), side),
-                        (PolygonSide::Front, Side::Front) | (PolygonSide::Back, Side::Back)
-                    );
-                    if !ok {
-                        return Err(format!(
-                            "node {id} polygon {k} is not on the {side:?} side of ancestor {a}"
-                        ));
+                for (k, p) in n.polygons.iter().enumerate() {
+                    p.sanity_check()
+                        .map_err(|e| format!("node {id} polygon {k}: {e}"))?;
+                    if !p.support().is_coincident(&n.plane) {
+                        return Err(format!("node {id} polygon {k} is not in the node plane"));
                     }
+                    check_ancestors(p, path).map_err(|e| format!("node {id} polygon {k}: {e}"))?;
                 }
-            }
-            let d = path.len();
-            stack.push((n.front, d, Some((n.plane, Side::Front))));
-            stack.push((n.back, d, Some((n.plane, Side::Back))));
-        }
-        if let Some(i) = seen.iter().position(|s| !s) {
-            return Err(format!("node {i} is unreachable"));
-        }
-        Ok(())
+                Ok(())
+            },
+        )
     }
+}
+
+/// Walks a tree of `count` nodes from `root` with an explicit stack,
+/// checking that the links form a tree over all of them (no missing,
+/// repeated or unreachable node), and calls `visit` with each node and its
+/// ancestors (plane and the side the node lies on), root first. `node`
+/// gives a node's plane and its front and back child nodes.
+pub(crate) fn walk_checked(
+    count: usize,
+    root: Option<u32>,
+    node: impl Fn(u32) -> (Plane, Option<u32>, Option<u32>),
+    mut visit: impl FnMut(u32, &[Ancestor]) -> Result<(), String>,
+) -> Result<(), String> {
+    let mut seen = vec![false; count];
+    let mut path: Vec<Ancestor> = Vec::new();
+    // (node, number of ancestors above its parent, edge from its parent)
+    let mut stack: Vec<(Option<u32>, usize, Option<Ancestor>)> = vec![(root, 0, None)];
+    while let Some((id, depth, edge)) = stack.pop() {
+        path.truncate(depth);
+        if let Some(e) = edge {
+            path.push(e);
+        }
+        let Some(id) = id else { continue };
+        let Some(flag) = seen.get_mut(id as usize) else {
+            return Err(format!("link to missing node {id}"));
+        };
+        if std::mem::replace(flag, true) {
+            return Err(format!("node {id} is reached twice"));
+        }
+        visit(id, &path)?;
+        let (plane, front, back) = node(id);
+        let d = path.len();
+        stack.push((front, d, Some((plane, Side::Front))));
+        stack.push((back, d, Some((plane, Side::Back))));
+    }
+    if let Some(i) = seen.iter().position(|s| !s) {
+        return Err(format!("node {i} is unreachable"));
+    }
+    Ok(())
+}
+
+/// Checks that `poly` lies on the recorded side of every ancestor plane
+/// (touching it at most).
+pub(crate) fn check_ancestors(poly: &Polygon, path: &[Ancestor]) -> Result<(), String> {
+    for (a, (plane, side)) in path.iter().enumerate() {
+        let ok = matches!(
+            (poly.classify(plane), side),
+            (PolygonSide::Front, Side::Front) | (PolygonSide::Back, Side::Back)
+        );
+        if !ok {
+            return Err(format!("not on the {side:?} side of ancestor {a}"));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
