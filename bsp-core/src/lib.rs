@@ -35,19 +35,26 @@
 //!
 //! None.
 
+mod exact;
 mod flat;
 mod grid;
 mod import;
 mod mesh;
 mod partition;
+mod pieces;
 mod plane;
 mod point;
 mod polygon;
+mod regions;
+mod sanity;
 mod topology;
 mod tree;
 
 pub mod check;
 
+pub use exact::{
+    FILTER_REL, Homogeneous, approx, filter_side, filter_side_err, ratio_to_f64_exact,
+};
 pub use flat::FlatBsp;
 pub use grid::{GRID_BITS, Grid, GridPoint, MAX_COORD, MAX_VIEW_COORD, SnapError, ViewPoint};
 pub use import::{ImportReport, all_planar, import_faces};
@@ -56,9 +63,12 @@ pub use partition::{
     BOX_HALF, BoolOp, CellOp, Overlay, PLink, PNode, Partition, box_section, merge,
     merge_smaller_into_larger, solid_build_options,
 };
+pub use pieces::{ArenaMark, EdgeRef, Lazy, Piece, PieceArena, Sides, Vertex, VertexRef};
 pub use plane::{MAX_NORMAL_BITS, MAX_OFFSET_BITS, Plane};
 pub use point::{Implicit, Point, rational_to_f64};
-pub use polygon::{FaceDefect, Polygon, PolygonSide, Side, Split};
+pub use polygon::{FaceDefect, Polygon, PolygonSide, Side, Split, split_loop};
+pub use regions::{Region, merge_cells};
+pub use sanity::{ConvexParts, SanityError, check_convex};
 pub use topology::{TopologyError, check_closed_manifold};
 pub use tree::{
     BspTree, BuildOptions, Cell, Link, Membership, Node, NodeId, Order, RECURSION_LIMIT, TreeStats,

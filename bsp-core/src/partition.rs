@@ -19,9 +19,8 @@ use crate::mesh::TriMesh;
 use crate::plane::Plane;
 use crate::point::Point;
 use crate::polygon::{Polygon, PolygonSide, Split};
-use crate::tree::{
-    Ancestor, BspTree, BuildOptions, Cell, Link, Membership, check_ancestors, walk_checked,
-};
+use crate::sanity::{Ancestor, SanityError, walk_checked};
+use crate::tree::{BspTree, BuildOptions, Cell, Link, Membership, check_ancestors};
 
 /// Half-width of the box that bounds every sub-hyperplane: `2^26`, just
 /// outside every grid coordinate.
@@ -880,7 +879,7 @@ impl<L: Copy> Partition<L> {
     /// sub-hyperplane is a valid polygon in its plane, and lies on the
     /// correct side of every ancestor (touching at most); node polygons lie
     /// in the plane and inside the sub-hyperplane's region side of ancestors.
-    pub fn sanity_check(&self) -> Result<(), String> {
+    pub fn sanity_check(&self) -> Result<(), SanityError> {
         let link = |l: PLink<L>| match l {
             PLink::Node(id) => Some(id),
             PLink::Leaf(_) => None,
@@ -894,17 +893,19 @@ impl<L: Copy> Partition<L> {
             },
             |id, path| {
                 let n = &self.nodes[id as usize];
-                n.shp
-                    .sanity_check()
-                    .map_err(|e| format!("node {id} sub-hyperplane: {e}"))?;
+                n.shp.sanity_check().map_err(|e| SanityError::Polygon {
+                    node: id,
+                    polygon: None,
+                    error: Box::new(e),
+                })?;
                 if *n.shp.support() != n.plane {
-                    return Err(format!("node {id} sub-hyperplane is not in its plane"));
+                    return Err(SanityError::OffNodePlane { node: id });
                 }
                 for poly in std::iter::once(&n.shp).chain(n.polygons.iter()) {
                     if !poly.support().is_coincident(&n.plane) {
-                        return Err(format!("node {id}: a polygon is not in the node plane"));
+                        return Err(SanityError::OffNodePlane { node: id });
                     }
-                    check_ancestors(poly, path).map_err(|e| format!("node {id}: {e}"))?;
+                    check_ancestors(id, poly, path)?;
                 }
                 Ok(())
             },

@@ -38,6 +38,29 @@ impl std::hash::Hash for Plane {
     }
 }
 
+/// Binary gcd of two `u64`s (`gcd(0, b) = b`).
+#[inline]
+fn gcd64(a: u64, b: u64) -> u64 {
+    if a == 0 {
+        return b;
+    }
+    if b == 0 {
+        return a;
+    }
+    let shift = (a | b).trailing_zeros();
+    let (mut a, mut b) = (a >> a.trailing_zeros(), b);
+    loop {
+        b >>= b.trailing_zeros();
+        if a > b {
+            std::mem::swap(&mut a, &mut b);
+        }
+        b -= a;
+        if b == 0 {
+            return a << shift;
+        }
+    }
+}
+
 fn gcd(mut a: u128, mut b: u128) -> u128 {
     while b != 0 {
         (a, b) = (b, a % b);
@@ -61,13 +84,20 @@ impl Plane {
         if n == [0, 0, 0] {
             return None;
         }
-        let mut g = d.unsigned_abs();
-        for c in n {
-            g = gcd(g, c.unsigned_abs() as u128);
+        // the normal's gcd first (binary, in 64 bits): usually 1, and then
+        // the offset need not be looked at
+        let mut g = gcd64(
+            gcd64(n[0].unsigned_abs(), n[1].unsigned_abs()),
+            n[2].unsigned_abs(),
+        );
+        if g > 1 {
+            g = gcd(g as u128, d.unsigned_abs() % g as u128) as u64;
         }
-        let g = g as i128;
-        let n = n.map(|c| (c as i128 / g) as i64);
-        let d = d / g;
+        let (n, d) = if g > 1 {
+            (n.map(|c| c / g as i64), d / g as i128)
+        } else {
+            (n, d)
+        };
         let fits = n.iter().all(|c| c.unsigned_abs() < 1u64 << MAX_NORMAL_BITS)
             && d.unsigned_abs() < 1u128 << MAX_OFFSET_BITS;
         fits.then_some(Plane {
@@ -229,6 +259,27 @@ mod tests {
         }
         let e = Plane::edge([-m, -m + 1, m], [m, -m, -m + 2], &p).unwrap();
         assert_eq!(e.classify_grid([m - 3, m, -m]), Side::Back);
+    }
+
+    #[test]
+    fn gcds_agree() {
+        for (a, b) in [
+            (0u64, 0u64),
+            (0, 7),
+            (12, 18),
+            (1 << 40, 3 << 38),
+            (97, 89),
+            (u64::MAX, 3),
+        ] {
+            assert_eq!(gcd64(a, b) as u128, gcd(a as u128, b as u128), "{a} {b}");
+        }
+        // the offset takes part in the reduction
+        let p = Plane::new([6, 12, 18], 9).unwrap();
+        assert_eq!((p.normal(), p.offset()), ([2, 4, 6], 3));
+        let p = Plane::new([6, 12, 18], 7).unwrap();
+        assert_eq!((p.normal(), p.offset()), ([6, 12, 18], 7));
+        let p = Plane::new([-4, 0, 0], -(1i128 << 80)).unwrap();
+        assert_eq!((p.normal(), p.offset()), ([-1, 0, 0], -(1i128 << 78)));
     }
 
     #[test]

@@ -1,39 +1,56 @@
 //! Exact points: grid points and implicit intersections of three planes.
 
+use std::sync::Arc;
+
 use bnum::cast::As;
-use bnum::types::{I256, I512, U512};
+use bnum::types::{I256, I512};
 
 use crate::Side;
+use crate::exact::Homogeneous;
 use crate::grid::GridPoint;
 use crate::plane::Plane;
 
 /// An exact point: either an input grid point or the intersection of three
 /// planes of the input budget, held in homogeneous integer coordinates.
+///
+/// Implicit points are reference-counted: a split makes a new vertex once
+/// and both pieces share it.
 #[derive(Clone, Debug)]
 pub enum Point {
     /// An input vertex on the grid.
     Grid(GridPoint),
     /// The intersection of three planes.
-    Implicit(Box<Implicit>),
+    Implicit(Arc<Implicit>),
 }
 
 /// The homogeneous coordinates `(x, y, z, w)`, `w > 0`, of the intersection
-/// of three planes, with their `f64` roundings for the filter.
+/// of three input-tier planes, in 256-bit integers, with their `f64`
+/// approximations for the filter.
 ///
 /// Bounds: `|w| < 2^168`, `|x|, |y|, |z| < 2^196`; see
 /// `docs/architecture.md`.
-#[derive(Clone, Debug)]
-pub struct Implicit {
-    h: [I256; 4],
-    approx: [f64; 4],
-}
-
-/// `2^-48`: relative error bound of the filter (8 rounding errors of
-/// `2^-53` are at most `2^-50`; a factor 4 margin).
-const FILTER_REL: f64 = 1.0 / (1u64 << 48) as f64;
+pub type Implicit = Homogeneous<4>;
 
 fn wide(x: i128) -> I256 {
     I256::from(x)
+}
+
+/// The exact product of two `i128`s with magnitudes below `2^127`, as a
+/// 256-bit integer: four 64 × 64-bit products (a general 256-bit
+/// multiplication takes sixteen).
+#[inline]
+pub(crate) fn mul_wide(a: i128, b: i128) -> I256 {
+    const M: u128 = u64::MAX as u128;
+    let (ua, ub) = (a.unsigned_abs(), b.unsigned_abs());
+    let (a0, a1) = (ua & M, ua >> 64);
+    let (b0, b1) = (ub & M, ub >> 64);
+    let (p00, p01, p10, p11) = (a0 * b0, a0 * b1, a1 * b0, a1 * b1);
+    let t1 = (p00 >> 64) + (p01 & M) + (p10 & M);
+    let t2 = (t1 >> 64) + (p01 >> 64) + (p10 >> 64) + (p11 & M);
+    let t3 = (t2 >> 64) + (p11 >> 64);
+    let u = bnum::types::U256::from_digits([p00 as u64, t1 as u64, t2 as u64, t3 as u64]);
+    let v = u.as_::<I256>();
+    if (a < 0) != (b < 0) { -v } else { v }
 }
 
 fn cross_wide(a: [i64; 3], b: [i64; 3]) -> [i128; 3] {
@@ -45,7 +62,7 @@ fn cross_wide(a: [i64; 3], b: [i64; 3]) -> [i128; 3] {
     ]
 }
 
-impl Implicit {
+impl Homogeneous<4> {
     /// The intersection of three planes, or `None` if they do not meet in a
     /// single point.
     pub fn from_planes(p1: &Plane, p2: &Plane, p3: &Plane) -> Option<Implicit> {
@@ -56,36 +73,24 @@ impl Implicit {
         // |c| < 2^111; det = n1 · c23, |det| < 2^168
         let mut w = I256::ZERO;
         for i in 0..3 {
-            w += wide(n1[i] as i128) * wide(c23[i]);
+            w += mul_wide(n1[i] as i128, c23[i]);
         }
         if w.is_zero() {
             return None;
         }
-        let (d1, d2, d3) = (wide(p1.offset()), wide(p2.offset()), wide(p3.offset()));
+        let (d1, d2, d3) = (p1.offset(), p2.offset(), p3.offset());
         // x · det = -(c23 d1 + c31 d2 + c12 d3); |x| < 3 · 2^111 · 2^83 < 2^196
         let mut h = [I256::ZERO; 4];
         for i in 0..3 {
-            h[i] = -(wide(c23[i]) * d1 + wide(c31[i]) * d2 + wide(c12[i]) * d3);
+            h[i] = -(mul_wide(c23[i], d1) + mul_wide(c31[i], d2) + mul_wide(c12[i], d3));
         }
         h[3] = w;
-        if w.is_negative() {
-            for c in &mut h {
-                *c = -*c;
-            }
-        }
-        Some(Implicit::from_homogeneous(h))
-    }
-
-    fn from_homogeneous(h: [I256; 4]) -> Implicit {
-        Implicit {
-            approx: h.map(|c| c.as_::<f64>()),
-            h,
-        }
+        Homogeneous::new(h)
     }
 
     /// The homogeneous coordinates `(x, y, z, w)` with `w > 0`.
     pub fn homogeneous(&self) -> &[I256; 4] {
-        &self.h
+        self.coords()
     }
 
     /// Side of `plane`, decided by the floating-point filter when it can
@@ -102,38 +107,42 @@ impl Implicit {
     /// the sign.
     #[inline]
     pub fn classify_filtered(&self, plane: &Plane) -> Option<Side> {
-        let p = plane.approx();
-        let a = &self.approx;
-        let t = [p[0] * a[0], p[1] * a[1], p[2] * a[2], p[3] * a[3]];
-        let v = (t[0] + t[1]) + (t[2] + t[3]);
-        let m = (t[0].abs() + t[1].abs()) + (t[2].abs() + t[3].abs());
-        let bound = m * FILTER_REL;
-        if v > bound {
-            Some(Side::Front)
-        } else if v < -bound {
-            Some(Side::Back)
-        } else {
-            None
-        }
+        self.filter(&plane.approx())
     }
 
     /// The exact path: the sign of `n · (x, y, z) + d w` in 256 bits
     /// (`< 2^254` in magnitude).
     pub fn classify_exact(&self, plane: &Plane) -> Side {
         let n = plane.normal();
-        let h = &self.h;
+        let h = self.coords();
         let v = wide(n[0] as i128) * h[0]
             + wide(n[1] as i128) * h[1]
             + wide(n[2] as i128) * h[2]
             + wide(plane.offset()) * h[3];
         Side::from_sign(v.signum().as_::<i32>())
     }
+
+    /// The correctly rounded Cartesian coordinates (see
+    /// [`Homogeneous::round_with`]).
+    pub fn to_f64(&self) -> [f64; 3] {
+        self.round_with::<9>()
+    }
+
+    /// Exact equality of the represented points.
+    pub fn same_point(&self, o: &Implicit) -> bool {
+        self.same_with::<8>(o)
+    }
+
+    /// Exact comparison of coordinate `k` with another point's.
+    pub fn cmp_axis(&self, o: &Implicit, k: usize) -> std::cmp::Ordering {
+        self.cmp_axis_with::<8>(o, k)
+    }
 }
 
 impl Point {
     /// The intersection of three planes (see [`Implicit::from_planes`]).
     pub fn from_planes(p1: &Plane, p2: &Plane, p3: &Plane) -> Option<Point> {
-        Implicit::from_planes(p1, p2, p3).map(|i| Point::Implicit(Box::new(i)))
+        Implicit::from_planes(p1, p2, p3).map(|i| Point::Implicit(Arc::new(i)))
     }
 
     /// Exact side of `plane`.
@@ -154,21 +163,18 @@ impl Point {
                 wide(g[2] as i128),
                 I256::ONE,
             ],
-            Point::Implicit(i) => i.h,
+            Point::Implicit(i) => *i.coords(),
         }
     }
 
     /// Grid coordinates as `f64`, within a few ulps of the exact values
-    /// (from the cached roundings: fast, but not canonical — use
+    /// (from the cached approximations: fast, but not canonical — use
     /// [`Point::to_f64`] for output).
     #[inline]
     pub fn approx_f64(&self) -> [f64; 3] {
         match self {
             Point::Grid(g) => g.map(|c| c as f64),
-            Point::Implicit(i) => {
-                let a = &i.approx;
-                [a[0] / a[3], a[1] / a[3], a[2] / a[3]]
-            }
+            Point::Implicit(i) => i.approx_f64(),
         }
     }
 
@@ -178,11 +184,7 @@ impl Point {
     pub fn to_f64(&self) -> [f64; 3] {
         match self {
             Point::Grid(g) => g.map(|c| c as f64),
-            Point::Implicit(i) => [
-                ratio_to_f64(i.h[0], i.h[3]),
-                ratio_to_f64(i.h[1], i.h[3]),
-                ratio_to_f64(i.h[2], i.h[3]),
-            ],
+            Point::Implicit(i) => i.to_f64(),
         }
     }
 
@@ -191,19 +193,10 @@ impl Point {
         match self {
             Point::Grid(g) => Some(*g),
             Point::Implicit(i) => {
-                let w = i.h[3];
-                let mut out = [0i32; 3];
-                for (o, h) in out.iter_mut().zip(&i.h[..3]) {
-                    if !(*h % w).is_zero() {
-                        return None;
-                    }
-                    let q = *h / w;
-                    if q.unsigned_abs().bits() > 31 {
-                        return None;
-                    }
-                    *o = q.as_::<i32>();
-                }
-                (out.iter().all(|c| c.abs() <= crate::MAX_COORD)).then_some(out)
+                let c = i.as_integer()?;
+                c.iter()
+                    .all(|v| v.abs() <= crate::MAX_COORD as i64)
+                    .then(|| c.map(|v| v as i32))
             }
         }
     }
@@ -212,26 +205,24 @@ impl Point {
     pub fn same_point(&self, o: &Point) -> bool {
         match (self, o) {
             (Point::Grid(a), Point::Grid(b)) => a == b,
-            _ => {
-                let a = self.homogeneous();
-                let b = o.homogeneous();
-                // a/aw == b/bw  <=>  a * bw == b * aw, in 512 bits
-                let big = |x: I256| x.as_::<bnum::types::I512>();
-                (0..3).all(|k| big(a[k]) * big(b[3]) == big(b[k]) * big(a[3]))
+            (Point::Implicit(a), Point::Implicit(b)) => a.same_point(b),
+            (Point::Grid(g), Point::Implicit(i)) | (Point::Implicit(i), Point::Grid(g)) => {
+                let h = i.coords();
+                (0..3).all(|k| h[k] == wide(g[k] as i128) * h[3])
             }
         }
     }
 }
 
 /// The `f64` nearest to `num / den` (ties to even), `den > 0`.
+#[cfg(test)]
 fn ratio_to_f64(num: I256, den: I256) -> f64 {
-    rational_to_f64(num.as_::<I512>(), den.as_::<I512>())
+    crate::exact::ratio_to_f64_exact::<4, 9>(&num, &den)
 }
 
 /// The `f64` nearest to the rational `num / den` (round to nearest, ties
-/// to even). Requires `den > 0` and `|num|, den < 2^456`; the result is
-/// then exact in the sense that equal rationals give equal `f64`s however
-/// they are written.
+/// to even), by long division. Requires `den > 0`; equal rationals give
+/// equal `f64`s however they are written.
 ///
 /// ```
 /// use bsp_core::rational_to_f64;
@@ -240,40 +231,11 @@ fn ratio_to_f64(num: I256, den: I256) -> f64 {
 /// assert_eq!(rational_to_f64(I512::from(-4i32), I512::from(2i32)), -2.0);
 /// ```
 pub fn rational_to_f64(num: I512, den: I512) -> f64 {
-    if num.is_zero() {
-        return 0.0;
-    }
-    let neg = num.is_negative();
-    let a: U512 = num.unsigned_abs();
-    let b: U512 = den.unsigned_abs();
-    let (la, lb) = (a.bits() as i32, b.bits() as i32);
     assert!(
-        la <= 456 && lb <= 456 && lb > 0,
-        "rational_to_f64: operands out of range"
+        den.is_positive(),
+        "rational_to_f64: the denominator must be positive"
     );
-    // choose shift so that q = floor(a 2^shift / b) has 55 or 56 bits
-    let shift = 55 - (la - lb);
-    let (mut n, mut d) = (a, b);
-    if shift >= 0 {
-        n <<= shift as u32;
-    } else {
-        d <<= (-shift) as u32;
-    }
-    let q = n / d;
-    let sticky = !(n % d).is_zero();
-    let mut q: u64 = q.as_::<u64>();
-    let qbits = 64 - q.leading_zeros() as i32;
-    let extra = qbits - 53;
-    debug_assert!((2..=3).contains(&extra));
-    let rem = q & ((1u64 << extra) - 1);
-    q >>= extra;
-    let half = 1u64 << (extra - 1);
-    if rem > half || (rem == half && (sticky || q & 1 == 1)) {
-        q += 1;
-    }
-    let e = extra - shift;
-    let v = q as f64 * 2f64.powi(e);
-    if neg { -v } else { v }
+    crate::exact::ratio_to_f64_exact::<8, 9>(&num, &den)
 }
 
 #[cfg(test)]
@@ -294,6 +256,21 @@ mod tests {
         assert_eq!(r((1 << 54) + 2 + 1, 2), 9007199254740994.0);
         let big = I256::from(1i128 << 100) * I256::from(1i128 << 95) + I256::ONE;
         assert_eq!(ratio_to_f64(big, I256::ONE), 2f64.powi(195));
+    }
+
+    #[test]
+    fn wide_products_are_exact() {
+        let cases = [
+            (0i128, 5i128),
+            (-1, 1),
+            (i128::MAX, i128::MAX),
+            (-(1 << 126), (1 << 120) + 12345),
+            (0x1234_5678_9abc_def0_1234_5678, -0x0fed_cba9_8765_4321_0fed),
+        ];
+        for (a, b) in cases {
+            assert_eq!(mul_wide(a, b), I256::from(a) * I256::from(b), "{a} * {b}");
+            assert_eq!(mul_wide(b, -a), I256::from(b) * I256::from(-a));
+        }
     }
 
     #[test]

@@ -5,6 +5,7 @@ use smallvec::SmallVec;
 use crate::grid::GridPoint;
 use crate::plane::{Plane, cross, sub};
 use crate::point::Point;
+use crate::sanity::{ConvexParts, SanityError, check_convex};
 
 /// Exact side of a point relative to a plane.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -406,102 +407,139 @@ impl Polygon {
             (false, _) => return false,
             (true, true) => {}
         }
-        let cut = if keep == Front { plane.flip() } else { *plane };
-        let k = self.verts.len();
         let mut out = Builder::new(self.support, self.tag);
-        for i in 0..k {
-            let j = if i + 1 == k { 0 } else { i + 1 };
-            let (vi, ei) = (&self.verts[i], &self.edges[i]);
-            let (si, sj) = (sides[i], sides[j]);
-            if si == away {
-                if sj == keep {
-                    let x = Point::from_planes(&self.support, ei, plane)
-                        .expect("a spanning edge meets the cutting plane in one point");
-                    out.push(x, *ei);
-                }
-                continue;
-            }
-            if si == keep && sj == away {
-                let x = Point::from_planes(&self.support, ei, plane)
-                    .expect("a spanning edge meets the cutting plane in one point");
-                out.push(vi.clone(), *ei);
-                out.push(x, cut);
-            } else if si == On && sj == away {
-                out.push(vi.clone(), cut);
-            } else {
-                out.push(vi.clone(), *ei);
-            }
+        let support = self.support;
+        let edges = &self.edges;
+        let crossing = |i: usize| {
+            Point::from_planes(&support, &edges[i], plane)
+                .expect("a spanning edge meets the cutting plane in one point")
+        };
+        let push = |v, e| out.push(v, e);
+        if keep == Front {
+            split_loop(
+                &self.verts,
+                edges,
+                &sides,
+                plane.flip(),
+                *plane,
+                crossing,
+                push,
+                |_, _| {},
+            );
+        } else {
+            split_loop(
+                &self.verts,
+                edges,
+                &sides,
+                plane.flip(),
+                *plane,
+                crossing,
+                |_, _| {},
+                push,
+            );
         }
         *self = out.finish();
         true
     }
 
     fn split_with_sides(&self, plane: &Plane, sides: &[crate::Side]) -> (Polygon, Polygon) {
-        use crate::Side::{Back, Front, On};
-        let cut_front = plane.flip();
-        let cut_back = *plane;
-        let k = self.verts.len();
         let mut f = Builder::new(self.support, self.tag);
         let mut b = Builder::new(self.support, self.tag);
-        for i in 0..k {
-            let j = if i + 1 == k { 0 } else { i + 1 };
-            let (vi, ei) = (&self.verts[i], &self.edges[i]);
-            match (sides[i], sides[j]) {
-                (Front, Back) | (Back, Front) => {
-                    let x = Point::from_planes(&self.support, ei, plane)
-                        .expect("a spanning edge meets the cutting plane in one point");
-                    if sides[i] == Front {
-                        f.push(vi.clone(), *ei);
-                        f.push(x.clone(), cut_front);
-                        b.push(x, *ei);
-                    } else {
-                        b.push(vi.clone(), *ei);
-                        b.push(x.clone(), cut_back);
-                        f.push(x, *ei);
-                    }
-                }
-                (Front, _) => f.push(vi.clone(), *ei),
-                (Back, _) => b.push(vi.clone(), *ei),
-                (On, Back) => {
-                    f.push(vi.clone(), cut_front);
-                    b.push(vi.clone(), *ei);
-                }
-                (On, _) => {
-                    f.push(vi.clone(), *ei);
-                    b.push(vi.clone(), cut_back);
-                }
-            }
-        }
+        split_loop(
+            &self.verts,
+            &self.edges,
+            sides,
+            plane.flip(),
+            *plane,
+            |i| {
+                Point::from_planes(&self.support, &self.edges[i], plane)
+                    .expect("a spanning edge meets the cutting plane in one point")
+            },
+            |v, e| f.push(v, e),
+            |v, e| b.push(v, e),
+        );
         (f.finish(), b.finish())
     }
 
     /// Checks the representation invariants exactly: every vertex lies on
     /// the support plane and on its two edge planes, and strictly behind
     /// every other edge plane (strict convexity).
-    pub fn sanity_check(&self) -> Result<(), String> {
-        let k = self.verts.len();
-        if k < 3 || self.edges.len() != k {
-            return Err(format!("{k} vertices, {} edges", self.edges.len()));
+    pub fn sanity_check(&self) -> Result<(), SanityError> {
+        check_convex(self)
+    }
+}
+
+impl ConvexParts for Polygon {
+    fn vertex_count(&self) -> usize {
+        self.verts.len()
+    }
+    fn edge_count(&self) -> usize {
+        self.edges.len()
+    }
+    fn support_side(&self, i: usize) -> crate::Side {
+        self.verts[i].classify(&self.support)
+    }
+    fn edge_side(&self, i: usize, j: usize) -> crate::Side {
+        self.verts[i].classify(&self.edges[j])
+    }
+    fn edge_is_support(&self, j: usize) -> bool {
+        self.edges[j].is_coincident(&self.support)
+    }
+}
+
+/// The two pieces of a convex loop cut by a plane, from the exact side of
+/// each vertex: the combinatorial part of every split in the workspace,
+/// whatever the vertex type `V` (an exact point, or an index into an
+/// arena) and edge type `E` (a plane, or a reference to one).
+///
+/// `verts[i]` lies between `edges[i - 1]` and `edges[i]`; `sides` holds
+/// each vertex's side of the cutting plane, with at least one `Front` and
+/// one `Back`. The pieces come out through `front` and `back` as (vertex,
+/// outgoing edge) pairs in loop order: vertices on the plane go to both
+/// pieces; each crossing edge `i` gets one new vertex, `crossing(i)`,
+/// called once and given to both pieces; the front piece's cut edge is
+/// `cut_front` (the cutting plane flipped, so that the piece lies behind
+/// it) and the back piece's `cut_back`.
+#[allow(clippy::too_many_arguments)]
+pub fn split_loop<V: Clone, E: Clone>(
+    verts: &[V],
+    edges: &[E],
+    sides: &[crate::Side],
+    cut_front: E,
+    cut_back: E,
+    mut crossing: impl FnMut(usize) -> V,
+    mut front: impl FnMut(V, E),
+    mut back: impl FnMut(V, E),
+) {
+    use crate::Side::{Back, Front, On};
+    let k = verts.len();
+    for i in 0..k {
+        let j = if i + 1 == k { 0 } else { i + 1 };
+        let (vi, ei) = (&verts[i], &edges[i]);
+        match (sides[i], sides[j]) {
+            (Front, Back) => {
+                let x = crossing(i);
+                front(vi.clone(), ei.clone());
+                front(x.clone(), cut_front.clone());
+                back(x, ei.clone());
+            }
+            (Back, Front) => {
+                let x = crossing(i);
+                back(vi.clone(), ei.clone());
+                back(x.clone(), cut_back.clone());
+                front(x, ei.clone());
+            }
+            (Front, _) => front(vi.clone(), ei.clone()),
+            (Back, _) => back(vi.clone(), ei.clone()),
+            (On, Back) => {
+                front(vi.clone(), cut_front.clone());
+                back(vi.clone(), ei.clone());
+            }
+            (On, _) => {
+                front(vi.clone(), ei.clone());
+                back(vi.clone(), cut_back.clone());
+            }
         }
-        for (i, v) in self.verts.iter().enumerate() {
-            if v.classify(&self.support) != crate::Side::On {
-                return Err(format!("vertex {i} is off the support plane"));
-            }
-            for (j, e) in self.edges.iter().enumerate() {
-                let incident = j == i || (j + 1) % k == i;
-                let s = v.classify(e);
-                if incident && s != crate::Side::On {
-                    return Err(format!("vertex {i} is off its edge plane {j}"));
-                }
-                if !incident && s != crate::Side::Back {
-                    return Err(format!("vertex {i} is not strictly inside edge plane {j}"));
-                }
-            }
-            if self.edges[i].is_coincident(&self.support) {
-                return Err(format!("edge plane {i} is the support plane"));
-            }
-        }
-        Ok(())
     }
 }
 

@@ -10,9 +10,7 @@ use crate::grid::ViewPoint;
 use crate::plane::Plane;
 use crate::point::Point;
 use crate::polygon::{Polygon, PolygonSide, Split};
-
-/// An ancestor's plane and the side of it a subtree lies on.
-pub(crate) type Ancestor = (Plane, Side);
+use crate::sanity::{Ancestor, SanityError, walk_checked};
 
 /// Index of a node in [`BspTree::nodes`].
 pub type NodeId = u32;
@@ -400,8 +398,7 @@ impl BspTree {
         s
     }
 
-    fn children_in_order(&self, n: &Node, eye: ViewPoint, order: Order) -> (Link, Link) {
-        let eye_in_front = n.plane.classify_viewpoint(eye) != Side::Back;
+    fn children_in_order(n: &Node, eye_in_front: bool, order: Order) -> (Link, Link) {
         if eye_in_front == (order == Order::BackToFront) {
             (n.back, n.front)
         } else {
@@ -434,14 +431,29 @@ impl BspTree {
         order: Order,
         mut visit: impl FnMut(NodeId, &Node),
     ) {
-        self.traverse_nodes_from(self.root, eye, order, &mut visit);
+        let front = |p: &Plane| p.classify_viewpoint(eye) != Side::Back;
+        self.traverse_nodes_from(self.root, &front, order, &mut visit);
     }
 
-    /// [`BspTree::traverse_nodes`] of the subtree at `start`.
+    /// [`BspTree::traverse_nodes`] for a viewpoint given by the side it
+    /// takes of each plane: `in_front(plane)` is `true` when the viewpoint
+    /// is in front of `plane` (or on it). A point at infinity, such as a
+    /// sun's direction `D`, is in front when `n · D >= 0`.
+    pub fn traverse_nodes_by(
+        &self,
+        in_front: impl Fn(&Plane) -> bool,
+        order: Order,
+        mut visit: impl FnMut(NodeId, &Node),
+    ) {
+        self.traverse_nodes_from(self.root, &in_front, order, &mut visit);
+    }
+
+    /// The node traversal of the subtree at `start`, with an explicit
+    /// stack: the one implementation behind every traversal order.
     fn traverse_nodes_from(
         &self,
         start: Link,
-        eye: ViewPoint,
+        in_front: &impl Fn(&Plane) -> bool,
         order: Order,
         visit: &mut impl FnMut(NodeId, &Node),
     ) {
@@ -455,7 +467,7 @@ impl BspTree {
                 Item::Visit(Link::Cell(_)) => {}
                 Item::Visit(Link::Node(id)) => {
                     let n = &self.nodes[id as usize];
-                    let (first, second) = self.children_in_order(n, eye, order);
+                    let (first, second) = Self::children_in_order(n, in_front(&n.plane), order);
                     stack.push(Item::Visit(second));
                     stack.push(Item::Emit(id));
                     stack.push(Item::Visit(first));
@@ -486,7 +498,8 @@ impl BspTree {
         order: Order,
         visit: &mut impl FnMut(&Polygon),
     ) {
-        self.traverse_nodes_from(start, eye, order, &mut |_, n: &Node| {
+        let front = |p: &Plane| p.classify_viewpoint(eye) != Side::Back;
+        self.traverse_nodes_from(start, &front, order, &mut |_, n: &Node| {
             n.polygons.iter().for_each(&mut *visit)
         });
     }
@@ -516,7 +529,8 @@ impl BspTree {
             return self.traverse_from(link, eye, order, visit);
         }
         let n = &self.nodes[id as usize];
-        let (first, second) = self.children_in_order(n, eye, order);
+        let in_front = n.plane.classify_viewpoint(eye) != Side::Back;
+        let (first, second) = Self::children_in_order(n, in_front, order);
         self.recurse(first, eye, order, visit, depth + 1);
         n.polygons.iter().for_each(&mut *visit);
         self.recurse(second, eye, order, visit, depth + 1);
@@ -564,7 +578,7 @@ impl BspTree {
     /// side of each ancestor plane (touching it at most).
     ///
     /// Costs `O(polygons × depth)`; meant for tests and fuzzing.
-    pub fn sanity_check(&self) -> Result<(), String> {
+    pub fn sanity_check(&self) -> Result<(), SanityError> {
         let link = |l: Link| match l {
             Link::Node(id) => Some(id),
             Link::Cell(_) => None,
@@ -583,15 +597,18 @@ impl BspTree {
                 if n.polygons.is_empty()
                     && (matches!(n.front, Link::Cell(_)) || matches!(n.back, Link::Cell(_)))
                 {
-                    return Err(format!("node {id} holds no polygon but has a leaf child"));
+                    return Err(SanityError::BareCut { node: id });
                 }
                 for (k, p) in n.polygons.iter().enumerate() {
-                    p.sanity_check()
-                        .map_err(|e| format!("node {id} polygon {k}: {e}"))?;
+                    p.sanity_check().map_err(|e| SanityError::Polygon {
+                        node: id,
+                        polygon: Some(k),
+                        error: Box::new(e),
+                    })?;
                     if !p.support().is_coincident(&n.plane) {
-                        return Err(format!("node {id} polygon {k} is not in the node plane"));
+                        return Err(SanityError::OffNodePlane { node: id });
                     }
-                    check_ancestors(p, path).map_err(|e| format!("node {id} polygon {k}: {e}"))?;
+                    check_ancestors(id, p, path)?;
                 }
                 Ok(())
             },
@@ -599,55 +616,24 @@ impl BspTree {
     }
 }
 
-/// Walks a tree of `count` nodes from `root` with an explicit stack,
-/// checking that the links form a tree over all of them (no missing,
-/// repeated or unreachable node), and calls `visit` with each node and its
-/// ancestors (plane and the side the node lies on), root first. `node`
-/// gives a node's plane and its front and back child nodes.
-pub(crate) fn walk_checked(
-    count: usize,
-    root: Option<u32>,
-    node: impl Fn(u32) -> (Plane, Option<u32>, Option<u32>),
-    mut visit: impl FnMut(u32, &[Ancestor]) -> Result<(), String>,
-) -> Result<(), String> {
-    let mut seen = vec![false; count];
-    let mut path: Vec<Ancestor> = Vec::new();
-    // (node, number of ancestors above its parent, edge from its parent)
-    let mut stack: Vec<(Option<u32>, usize, Option<Ancestor>)> = vec![(root, 0, None)];
-    while let Some((id, depth, edge)) = stack.pop() {
-        path.truncate(depth);
-        if let Some(e) = edge {
-            path.push(e);
-        }
-        let Some(id) = id else { continue };
-        let Some(flag) = seen.get_mut(id as usize) else {
-            return Err(format!("link to missing node {id}"));
-        };
-        if std::mem::replace(flag, true) {
-            return Err(format!("node {id} is reached twice"));
-        }
-        visit(id, &path)?;
-        let (plane, front, back) = node(id);
-        let d = path.len();
-        stack.push((front, d, Some((plane, Side::Front))));
-        stack.push((back, d, Some((plane, Side::Back))));
-    }
-    if let Some(i) = seen.iter().position(|s| !s) {
-        return Err(format!("node {i} is unreachable"));
-    }
-    Ok(())
-}
-
-/// Checks that `poly` lies on the recorded side of every ancestor plane
-/// (touching it at most).
-pub(crate) fn check_ancestors(poly: &Polygon, path: &[Ancestor]) -> Result<(), String> {
+/// Checks that `poly`, held by node `node`, lies on the recorded side of
+/// every ancestor plane (touching it at most).
+pub(crate) fn check_ancestors(
+    node: NodeId,
+    poly: &Polygon,
+    path: &[Ancestor],
+) -> Result<(), SanityError> {
     for (a, (plane, side)) in path.iter().enumerate() {
         let ok = matches!(
             (poly.classify(plane), side),
             (PolygonSide::Front, Side::Front) | (PolygonSide::Back, Side::Back)
         );
         if !ok {
-            return Err(format!("not on the {side:?} side of ancestor {a}"));
+            return Err(SanityError::WrongSide {
+                node,
+                ancestor: a,
+                side: *side,
+            });
         }
     }
     Ok(())

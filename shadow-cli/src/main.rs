@@ -32,6 +32,7 @@ mod color;
 mod csg;
 mod lights;
 mod pipeline;
+mod progress;
 mod render;
 mod shadows;
 
@@ -222,6 +223,10 @@ fn stats(args: &SourceArgs) -> Result<()> {
         p.grid.step()
     );
     println!(
+        "import time:     {:.2} ms",
+        p.import_time.as_secs_f64() * 1e3
+    );
+    println!(
         "build time:      {:.2} ms",
         p.build_time.as_secs_f64() * 1e3
     );
@@ -256,6 +261,7 @@ fn fmt_vec(v: DVec3) -> String {
 }
 
 fn main() -> ExitCode {
+    progress::clean_up_on_interrupt();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => {

@@ -8,8 +8,9 @@
 use std::fmt::Write;
 
 use anyhow::{Result, bail};
-use bsp_core::{BspTree, Order, Plane, Polygon, Side, ViewPoint};
+use bsp_core::{BspTree, Grid, Order, Plane, Polygon, Side, ViewPoint};
 use glam::DVec3;
+use shadow_scene::Mesh;
 
 use crate::color::{face_colors, hex};
 use crate::pipeline::Prepared;
@@ -205,14 +206,20 @@ impl Canvas {
     /// the grid) and writes the SVG header; `what` names the drawing in a
     /// comment. Polygons are stroked `stroke` pixels wide in their fill
     /// colour, which closes anti-aliasing seams between neighbours.
-    pub(crate) fn new(p: &Prepared, view: &View, what: &str, stroke: f64) -> Result<Canvas> {
-        let Some((lo, hi)) = p.mesh.bounds() else {
+    pub(crate) fn new(
+        mesh: &Mesh,
+        grid: &Grid,
+        view: &View,
+        what: &str,
+        stroke: f64,
+    ) -> Result<Canvas> {
+        let Some((lo, hi)) = mesh.bounds() else {
             bail!("nothing to draw: the mesh has no vertices");
         };
-        if p.mesh.faces.is_empty() {
+        if mesh.faces.is_empty() {
             bail!("nothing to draw: the mesh has no faces");
         }
-        let eye_vp = p.grid.snap_viewpoint(view.eye).map_err(|e| {
+        let eye_vp = grid.snap_viewpoint(view.eye).map_err(|e| {
             anyhow::anyhow!(
                 "eye {},{},{}: {e} (too far from the scene)",
                 view.eye.x,
@@ -220,10 +227,10 @@ impl Canvas {
                 view.eye.z
             )
         })?;
-        let eye = p.grid.viewpoint_to_world(eye_vp);
+        let eye = grid.viewpoint_to_world(eye_vp);
         let target = view.target.unwrap_or((lo + hi) * 0.5);
         let cam = Camera::look_at(eye, target, view.up, view.width, view.height, view.fov_deg)?;
-        let diagonal = (hi - lo).length().max(p.grid.step());
+        let diagonal = (hi - lo).length().max(grid.step());
         let planes = cam.clip_planes(1e-4 * diagonal.max((eye - target).length()));
         let (w, h) = (view.width, view.height);
         let mut svg = String::new();
@@ -323,7 +330,7 @@ impl Canvas {
 /// Draws every polygon of the tree back to front as seen from the view's
 /// eye snapped to the grid.
 pub(crate) fn render_svg(p: &Prepared, view: &View) -> Result<Rendered> {
-    let mut canvas = Canvas::new(p, view, "shadow view", 0.7)?;
+    let mut canvas = Canvas::new(&p.mesh, &p.grid, view, "shadow view", 0.7)?;
     let colors = face_colors(&p.mesh);
     let cam = &canvas.cam;
     let key = (cam.right * KEY.x + cam.up * KEY.y + cam.forward * KEY.z).normalize();

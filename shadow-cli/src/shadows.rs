@@ -1,33 +1,53 @@
 //! `shadow shadows`: exact lit and shadowed fragments of a scene for
 //! point lights and suns, written as JSON, OBJ or a rendered SVG.
 //!
-//! Load → one grid for the scene and its point lights → import (faces
-//! tagged with their index in the input) → BSP tree → shadow-volume BSP
-//! fragments (`svbsp`) → output. Every lit/shadowed decision is exact for
-//! the snapped scene, the snapped point lights and the quantized sun
-//! directions; the outputs round the exact fragment vertices once to `f64`
-//! grid units and map them back to input units. Areas and the SVG's
-//! projection and shading are plain `f64` on those vertices.
+//! Load → one grid for the scene and its point lights (`svbsp`) → import
+//! (faces tagged with their index in the input) → one shadow-volume tree
+//! per light → every face shaded and written, chunk by chunk: the chunks
+//! are shaded and formatted in parallel and written in order, so the file
+//! is the same for every thread count and memory stays bounded. Every
+//! lit/shadowed decision is exact for the snapped scene, the snapped point
+//! lights and the quantized sun directions; the outputs round the exact
+//! fragment vertices once to `f64` grid units and map them back to input
+//! units. Areas and the SVG's projection and shading are plain `f64` on
+//! those vertices.
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::io::Write;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
-use bsp_core::{BspTree, Plane, Polygon};
-use clap::Args;
+use bsp_core::{BspTree, BuildOptions, Grid, ImportReport, Polygon, import_faces};
+use clap::{Args, ValueEnum};
 use glam::DVec3;
+use rayon::prelude::*;
 use serde::Serialize;
-use shadow_scene::{Face, Mesh};
-use svbsp::{Fragment, Light, ShadowStats, shadow_fragments};
+use shadow_scene::Mesh;
+use svbsp::{
+    Areas, Batch, CHUNK, LightSpec, PlacedLight, ShadeOptions, Shadows, chin_feiner, polygon_area,
+    receivers,
+};
 
 use crate::color::{face_colors, hex};
 use crate::csg::{Phases, emit, guarded};
-use crate::lights::{LightArg, SceneLight, place_lights, shared_grid};
-use crate::pipeline::Prepared;
+use crate::lights::{describe, place_lights, shared_grid};
+use crate::progress::{Output, Progress};
 use crate::render::{Canvas, Rendered, View, painter_order, unit_normal};
 use crate::{DEMO_EYE, DEMO_TARGET, ImageArgs, SourceArgs, load_source, parse_vec3};
+
+/// Which algorithm computes the shadows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(crate) enum Algorithm {
+    /// Partitioned shadow volumes: every face cut only where a shadow
+    /// boundary crosses it (the default).
+    Psv,
+    /// Chin & Feiner's shadow-volume BSP tree over the scene's BSP: the
+    /// fragments are pieces of the BSP's polygons.
+    ChinFeiner,
+}
 
 #[derive(Args, Debug)]
 pub(crate) struct ShadowsArgs {
@@ -59,10 +79,19 @@ pub(crate) struct ShadowsArgs {
     pub(crate) up: Option<DVec3>,
     #[command(flatten)]
     pub(crate) image: ImageArgs,
+    /// The algorithm.
+    #[arg(long, value_enum, default_value_t = Algorithm::Psv)]
+    pub(crate) algorithm: Algorithm,
+    /// Worker threads [default: one per core].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) threads: Option<u32>,
     /// Print counts, timings, the area in light and in shadow of each
     /// light, and the faces with the most shadow cast on them.
     #[arg(long)]
     pub(crate) stats: bool,
+    /// No progress bar and no notes on stderr (errors still go there).
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
 }
 
 /// The point light used for `--scene room` when no light is given: just
@@ -74,6 +103,10 @@ pub(crate) const ROOM_LIGHT: DVec3 = DVec3::new(0.9, 0.3, 2.45);
 
 /// How many faces `--stats` lists.
 const TOP_FACES: usize = 10;
+
+/// Receivers shaded per round: each round is shaded and formatted in
+/// parallel (in chunks of [`CHUNK`]), then written.
+const ROUND: usize = CHUNK * 32;
 
 /// The output format, by the file's extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -101,137 +134,66 @@ impl Format {
     }
 }
 
-/// A fragment in input units, with what the outputs need.
-#[derive(Clone, Debug)]
-struct Piece {
-    face: u32,
-    /// Vertices in input units, counter-clockwise seen from the front.
-    world: Vec<DVec3>,
-    lit: Vec<bool>,
-    /// Per light: the light is strictly in front of the fragment's plane
-    /// (an unlit fragment is then in cast shadow, else in attached shadow).
-    facing: Vec<bool>,
-    /// Area in input units².
-    area: f64,
-    support: Plane,
+/// A scene ready to be shaded: its mesh, grid, lights and polygons.
+struct Scene {
+    mesh: Mesh,
+    name: String,
+    grid: Grid,
+    lights: Vec<PlacedLight>,
+    polys: Vec<Polygon>,
+    report: ImportReport,
 }
 
-/// The area of a planar polygon.
-fn polygon_area(pts: &[DVec3]) -> f64 {
-    let Some(&o) = pts.first() else {
-        return 0.0;
-    };
-    let mut n = DVec3::ZERO;
-    for w in pts[1..].windows(2) {
-        n += (w[0] - o).cross(w[1] - o);
+/// What a run reports.
+#[derive(Default)]
+struct Figures {
+    fragments: usize,
+    receivers: usize,
+    shadow_nodes: usize,
+    bsp_polygons: Option<usize>,
+    extra: String,
+}
+
+// ------------------------------------------------------ vertices and area
+
+/// The batch's vertices in input units, each converted once; an error
+/// names a face whose vertex leaves `f64`'s range.
+fn world_vertices(b: &Batch, grid: &Grid) -> Result<Vec<DVec3>> {
+    let world: Vec<DVec3> = (0..b.vertex_count() as u32)
+        .map(|v| grid.to_world(b.rounded(v)))
+        .collect();
+    if let Some(bad) = world.iter().position(|v| !v.is_finite()) {
+        let face = b
+            .fragments()
+            .find(|f| f.rings().flatten().any(|&v| v as usize == bad))
+            .map(|f| f.face())
+            .unwrap_or(0);
+        bail!(
+            "a vertex of face {face} is not finite in input units (grid step {:e}): the \
+             coordinates are too large for f64",
+            grid.step()
+        );
     }
-    0.5 * n.length()
+    Ok(world)
 }
 
-fn pieces(p: &Prepared, frags: &[Fragment], lights: &[SceneLight]) -> Result<Vec<Piece>> {
-    frags
-        .iter()
+/// Per fragment of a batch: its face, area, lit and facing flags.
+type AreaRecord = (u32, f64, u64, u64);
+
+fn area_records(b: &Batch, world: &[DVec3]) -> Vec<AreaRecord> {
+    let mut buf = Vec::new();
+    b.fragments()
         .map(|f| {
-            let world: Vec<DVec3> = f
-                .vertices_f64()
-                .into_iter()
-                .map(|g| p.grid.to_world(g))
-                .collect();
-            if world.iter().any(|v| !v.is_finite()) {
-                bail!(
-                    "a vertex of face {} is not finite in input units (grid step {:e}): the \
-                     coordinates are too large for f64",
-                    f.face(),
-                    p.grid.step()
-                );
+            let mut area = 0.0;
+            for (k, ring) in f.rings().enumerate() {
+                buf.clear();
+                buf.extend(ring.iter().map(|&v| world[v as usize]));
+                let a = polygon_area(&buf);
+                area += if k == 0 { a } else { -a };
             }
-            Ok(Piece {
-                face: f.face(),
-                area: polygon_area(&world),
-                world,
-                lit: f.lit().to_vec(),
-                facing: lights
-                    .iter()
-                    .map(|l| l.light.eval(f.support()) > 0)
-                    .collect(),
-                support: *f.support(),
-            })
+            (f.face(), area, f.lit_mask(), f.facing_mask())
         })
         .collect()
-}
-
-/// Areas in input units², in total, per light and per input face.
-#[derive(Clone, Debug, PartialEq)]
-struct Areas {
-    total: f64,
-    /// Per light: lit by it.
-    lit: Vec<f64>,
-    /// Per light: facing it but blocked.
-    cast: Vec<f64>,
-    /// Per light: facing away from it (or edge-on).
-    attached: Vec<f64>,
-    /// Lit by no light.
-    dark: f64,
-    /// Per input face: its area and, per light, its area in cast shadow.
-    faces: Vec<(f64, Vec<f64>)>,
-}
-
-impl Areas {
-    fn new(pieces: &[Piece], lights: usize, faces: usize) -> Areas {
-        let mut a = Areas {
-            total: 0.0,
-            lit: vec![0.0; lights],
-            cast: vec![0.0; lights],
-            attached: vec![0.0; lights],
-            dark: 0.0,
-            faces: vec![(0.0, vec![0.0; lights]); faces],
-        };
-        for p in pieces {
-            a.total += p.area;
-            let face = &mut a.faces[p.face as usize];
-            face.0 += p.area;
-            for i in 0..lights {
-                if p.lit[i] {
-                    a.lit[i] += p.area;
-                } else if p.facing[i] {
-                    a.cast[i] += p.area;
-                    face.1[i] += p.area;
-                } else {
-                    a.attached[i] += p.area;
-                }
-            }
-            if !p.lit.contains(&true) {
-                a.dark += p.area;
-            }
-        }
-        a
-    }
-
-    /// Per light: the area in shadow, cast or attached.
-    fn shadow(&self) -> Vec<f64> {
-        self.cast
-            .iter()
-            .zip(&self.attached)
-            .map(|(c, a)| c + a)
-            .collect()
-    }
-
-    /// Faces with cast shadow, most shadow (summed over the lights) first.
-    fn most_shaded(&self, n: usize) -> Vec<usize> {
-        let sum = |f: usize| self.faces[f].1.iter().sum::<f64>();
-        let mut faces: Vec<usize> = (0..self.faces.len()).filter(|&f| sum(f) > 0.0).collect();
-        faces.sort_by(|&a, &b| sum(b).total_cmp(&sum(a)).then(a.cmp(&b)));
-        faces.truncate(n);
-        faces
-    }
-}
-
-fn percent(part: f64, whole: f64) -> f64 {
-    if whole > 0.0 {
-        100.0 * part / whole
-    } else {
-        0.0
-    }
 }
 
 // ---------------------------------------------------------------- JSON
@@ -244,14 +206,6 @@ enum JsonLight {
 }
 
 #[derive(Serialize)]
-struct JsonFragment<'a> {
-    face: u32,
-    vertices: Vec<[f64; 3]>,
-    lit: &'a [bool],
-    area: f64,
-}
-
-#[derive(Serialize)]
 struct JsonSummary {
     area: f64,
     lit_area: Vec<f64>,
@@ -260,22 +214,14 @@ struct JsonSummary {
     dark_area: f64,
 }
 
-/// `{"lights": [...], "faces": N, "fragments": [...], "summary": {...}}`,
-/// one fragment per line.
-fn write_json(
-    out: &mut impl Write,
-    lights: &[SceneLight],
-    faces: usize,
-    pieces: &[Piece],
-    areas: &Areas,
-) -> Result<()> {
+fn json_header(out: &mut impl Write, lights: &[PlacedLight], faces: usize) -> Result<()> {
     let lights: Vec<JsonLight> = lights
         .iter()
         .map(|l| match l.light {
-            Light::Point(_) => JsonLight::Point {
+            svbsp::Light::Point(_) => JsonLight::Point {
                 position: l.world.to_array(),
             },
-            Light::Directional(_) => JsonLight::Directional {
+            svbsp::Light::Directional(_) => JsonLight::Directional {
                 direction: l.world.to_array(),
             },
         })
@@ -283,16 +229,10 @@ fn write_json(
     write!(out, "{{\"lights\":")?;
     serde_json::to_writer(&mut *out, &lights)?;
     write!(out, ",\"faces\":{faces},\"fragments\":[")?;
-    for (i, p) in pieces.iter().enumerate() {
-        out.write_all(if i == 0 { b"\n" } else { b",\n" })?;
-        let f = JsonFragment {
-            face: p.face,
-            vertices: p.world.iter().map(|v| v.to_array()).collect(),
-            lit: &p.lit,
-            area: p.area,
-        };
-        serde_json::to_writer(&mut *out, &f)?;
-    }
+    Ok(())
+}
+
+fn json_footer(out: &mut impl Write, areas: &Areas) -> Result<()> {
     write!(out, "\n],\"summary\":")?;
     let summary = JsonSummary {
         area: areas.total,
@@ -306,75 +246,167 @@ fn write_json(
     Ok(())
 }
 
+fn push_f64(s: &mut Vec<u8>, x: f64) {
+    // serde_json writes floats the same way: shortest round trip
+    let mut b = zmij::Buffer::new();
+    s.extend_from_slice(b.format_finite(x).as_bytes());
+}
+
+fn push_point(s: &mut Vec<u8>, p: DVec3) {
+    s.push(b'[');
+    push_f64(s, p.x);
+    s.push(b',');
+    push_f64(s, p.y);
+    s.push(b',');
+    push_f64(s, p.z);
+    s.push(b']');
+}
+
+fn push_ring(s: &mut Vec<u8>, ring: &[u32], world: &[DVec3]) {
+    s.push(b'[');
+    for (i, &v) in ring.iter().enumerate() {
+        if i > 0 {
+            s.push(b',');
+        }
+        push_point(s, world[v as usize]);
+    }
+    s.push(b']');
+}
+
+/// The fragments of a batch as JSON lines, each preceded by `,\n`.
+fn json_fragments(b: &Batch, world: &[DVec3], records: &[AreaRecord], lights: usize) -> Vec<u8> {
+    let mut s = Vec::with_capacity(b.len() * 160);
+    for (f, rec) in b.fragments().zip(records) {
+        s.extend_from_slice(b",\n{\"face\":");
+        s.extend_from_slice(itoa::Buffer::new().format(f.face()).as_bytes());
+        s.extend_from_slice(b",\"vertices\":");
+        push_ring(&mut s, f.outer(), world);
+        if f.hole_count() > 0 {
+            s.extend_from_slice(b",\"holes\":[");
+            for (k, ring) in f.rings().skip(1).enumerate() {
+                if k > 0 {
+                    s.push(b',');
+                }
+                push_ring(&mut s, ring, world);
+            }
+            s.push(b']');
+        }
+        s.extend_from_slice(b",\"lit\":[");
+        for j in 0..lights {
+            if j > 0 {
+                s.push(b',');
+            }
+            s.extend_from_slice(if f.lit(j) { b"true" } else { b"false" });
+        }
+        s.extend_from_slice(b"],\"area\":");
+        push_f64(&mut s, rec.1);
+        s.push(b'}');
+    }
+    s
+}
+
 // ----------------------------------------------------------------- OBJ
 
 /// The OBJ group of a fragment: `shadow` when no light reaches it, else
 /// `lit`, and with several lights also `lit_I_J...` naming exactly the
 /// lights that reach it (an OBJ `g` line with two names puts the faces in
 /// both groups).
-fn obj_group(lit: &[bool]) -> String {
-    let on: Vec<String> = (0..lit.len())
-        .filter(|&i| lit[i])
+fn obj_group(lit: u64, lights: usize) -> String {
+    let on: Vec<String> = (0..lights)
+        .filter(|&i| lit >> i & 1 == 1)
         .map(|i| i.to_string())
         .collect();
-    match (on.is_empty(), lit.len()) {
+    match (on.is_empty(), lights) {
         (true, _) => "shadow".to_string(),
         (false, 1) => "lit".to_string(),
         (false, _) => format!("lit lit_{}", on.join("_")),
     }
 }
 
-/// The fragments as an OBJ mesh: one polygon per fragment, vertices with
-/// equal coordinates shared, faces grouped (lit combinations in order,
-/// `shadow` last). Returns the mesh and how many of its faces repeat a
-/// vertex (distinct exact vertices that round to one `f64` triple).
-fn obj_mesh(pieces: &[Piece]) -> (Mesh, usize) {
-    let mut order: Vec<usize> = (0..pieces.len()).collect();
-    // lit-by sets in lexicographic order of their light lists, none last
-    let key = |i: usize| {
-        let on: Vec<usize> = (0..pieces[i].lit.len())
-            .filter(|&k| pieces[i].lit[k])
-            .collect();
-        (on.is_empty(), on)
-    };
-    order.sort_by_key(|&i| key(i));
-    let mut mesh = Mesh::default();
-    for i in order {
-        let p = &pieces[i];
-        let name = obj_group(&p.lit);
-        let group = mesh.add_group(&name);
-        let first = mesh.positions.len() as u32;
-        mesh.positions.extend(&p.world);
-        mesh.faces.push(Face {
-            vertices: (first..first + p.world.len() as u32).collect(),
-            line: 0,
-            group,
-        });
-    }
-    mesh.weld();
-    let degenerate = mesh
-        .faces
-        .iter()
-        .filter(|f| {
-            let mut v = f.vertices.clone();
-            v.sort_unstable();
-            v.windows(2).any(|w| w[0] == w[1])
-        })
-        .count();
-    (mesh, degenerate)
+/// Writes OBJ text incrementally: positions welded by exact equality of
+/// their `f64` coordinates over the whole file, a `g` line whenever the
+/// group changes.
+struct ObjWriter {
+    index: HashMap<[u64; 3], u32>,
+    group: Option<u64>,
+    faces: usize,
+    degenerate: usize,
 }
 
-fn write_obj_file(
+impl ObjWriter {
+    fn new() -> ObjWriter {
+        ObjWriter {
+            index: HashMap::new(),
+            group: None,
+            faces: 0,
+            degenerate: 0,
+        }
+    }
+
+    /// Writes every convex piece of the batch's fragments.
+    fn batch(
+        &mut self,
+        out: &mut impl Write,
+        b: &Batch,
+        world: &[DVec3],
+        lights: usize,
+    ) -> Result<()> {
+        let mut text = Vec::with_capacity(b.len() * 64);
+        let mut ids: Vec<u32> = Vec::new();
+        for f in b.fragments() {
+            if self.group != Some(f.lit_mask()) {
+                self.group = Some(f.lit_mask());
+                writeln!(text, "g {}", obj_group(f.lit_mask(), lights))?;
+            }
+            for piece in f.pieces() {
+                ids.clear();
+                for &v in piece {
+                    let p = world[v as usize];
+                    let next = self.index.len() as u32 + 1;
+                    let id = *self
+                        .index
+                        .entry(p.to_array().map(f64::to_bits))
+                        .or_insert_with(|| {
+                            text.extend_from_slice(b"v ");
+                            for (k, c) in p.to_array().into_iter().enumerate() {
+                                if k > 0 {
+                                    text.push(b' ');
+                                }
+                                push_f64(&mut text, c);
+                            }
+                            text.push(b'\n');
+                            next
+                        });
+                    ids.push(id);
+                }
+                let mut sorted = ids.clone();
+                sorted.sort_unstable();
+                if sorted.windows(2).any(|w| w[0] == w[1]) {
+                    self.degenerate += 1;
+                }
+                text.push(b'f');
+                for id in &ids {
+                    text.push(b' ');
+                    text.extend_from_slice(itoa::Buffer::new().format(*id).as_bytes());
+                }
+                text.push(b'\n');
+                self.faces += 1;
+            }
+        }
+        out.write_all(&text)?;
+        Ok(())
+    }
+}
+
+fn obj_header(
     out: &mut impl Write,
     name: &str,
-    lights: &[SceneLight],
+    lights: &[PlacedLight],
     faces: usize,
-    mesh: &Mesh,
 ) -> Result<()> {
     writeln!(
         out,
-        "# shadow shadows: {} fragments of {faces} faces of {name}",
-        mesh.faces.len()
+        "# shadow shadows: the fragments of {faces} faces of {name}"
     )?;
     for (i, l) in lights.iter().enumerate() {
         writeln!(out, "# light {i}: {}", describe(l))?;
@@ -388,28 +420,14 @@ fn write_obj_file(
     } else {
         writeln!(out, "# groups: lit, shadow")?;
     }
-    shadow_scene::write_obj(mesh, &mut *out)?;
+    writeln!(
+        out,
+        "# each fragment as its convex pieces, faces in input order, vertices welded"
+    )?;
     Ok(())
 }
 
 // ----------------------------------------------------------------- SVG
-
-/// For every BSP polygon (node-major order, as [`BspTree::polygons`]),
-/// the indices of its fragments ([`Fragment::polygon`]).
-fn fragments_per_polygon(tree: &BspTree, frags: &[Fragment]) -> Result<Vec<Vec<usize>>> {
-    let n = tree.polygons().count();
-    let mut per = vec![Vec::new(); n];
-    for (j, f) in frags.iter().enumerate() {
-        let Some(slot) = per.get_mut(f.polygon() as usize) else {
-            bail!(
-                "internal error: fragment {j} names BSP polygon {} of {n}",
-                f.polygon()
-            );
-        };
-        slot.push(j);
-    }
-    Ok(per)
-}
 
 /// Light reaching every surface: no surface is darker than this.
 const AMBIENT: f64 = 0.28;
@@ -424,48 +442,59 @@ const DIFFUSE: f64 = 0.72;
 /// it. The cosine is taken at the face's centre, so a face's lit
 /// fragments share one shade and only the shadow boundaries show.
 fn brightness(
-    p: &Piece,
+    lit: u64,
     normal: DVec3,
     centre: DVec3,
-    lights: &[SceneLight],
+    lights: &[PlacedLight],
     forward: DVec3,
 ) -> f64 {
     let weight = DIFFUSE / lights.len().max(1) as f64;
     let mut b = AMBIENT + AMBIENT_FACING * (-normal.dot(forward)).max(0.0);
-    for (l, &lit) in lights.iter().zip(&p.lit) {
-        if !lit {
+    for (j, l) in lights.iter().enumerate() {
+        if lit >> j & 1 == 0 {
             continue;
         }
         let to_light = match l.light {
-            Light::Point(_) => (l.world - centre).normalize_or_zero(),
-            Light::Directional(_) => l.world,
+            svbsp::Light::Point(_) => (l.world - centre).normalize_or_zero(),
+            svbsp::Light::Directional(_) => l.world,
         };
         b += weight * normal.dot(to_light).max(0.0);
     }
     b
 }
 
+/// Draws the fragments of the scene tree's polygons (`batch`, receiver =
+/// polygon index) in the tree's painter's order.
 fn render(
-    p: &Prepared,
+    scene: &Scene,
+    tree: &BspTree,
     view: &View,
-    frags: &[Fragment],
-    pieces: &[Piece],
-    lights: &[SceneLight],
+    batch: &Batch,
+    world: &[DVec3],
 ) -> Result<Rendered> {
     // fragments meet along many more edges than whole polygons: a wider
     // stroke keeps their seams closed
-    let mut canvas = Canvas::new(p, view, "shadow shadows", 1.0)?;
-    let per_polygon = fragments_per_polygon(&p.tree, frags)?;
-    let colors = face_colors(&p.mesh);
-    let centres: Vec<DVec3> = (0..p.mesh.faces.len())
+    let mut canvas = Canvas::new(&scene.mesh, &scene.grid, view, "shadow shadows", 1.0)?;
+    let mut per_polygon: Vec<Vec<usize>> = vec![Vec::new(); tree.polygons().count()];
+    for (j, f) in batch.fragments().enumerate() {
+        let slot = per_polygon.get_mut(f.receiver() as usize).ok_or_else(|| {
+            anyhow!(
+                "internal error: fragment {j} names BSP polygon {}",
+                f.receiver()
+            )
+        })?;
+        slot.push(j);
+    }
+    let colors = face_colors(&scene.mesh);
+    let centres: Vec<DVec3> = (0..scene.mesh.faces.len())
         .map(|f| {
-            let pts = p.mesh.face_points(f);
+            let pts = scene.mesh.face_points(f);
             pts.iter().sum::<DVec3>() / pts.len().max(1) as f64
         })
         .collect();
     let forward = canvas.cam.forward();
-    let polys: Vec<&Polygon> = p.tree.polygons().collect();
-    let order = painter_order(&p.tree, canvas.eye_vp);
+    let polys: Vec<&Polygon> = tree.polygons().collect();
+    let order = painter_order(tree, canvas.eye_vp);
     // runs of coplanar polygons facing the same way: their fragments tile
     // the plane without overlap, so each colour is drawn as one region
     let mut start = 0;
@@ -482,25 +511,30 @@ fn render(
         let mut regions: Vec<(String, Vec<usize>)> = Vec::new();
         for &(poly, _) in &order[start..end] {
             for &j in &per_polygon[poly] {
-                let piece = &pieces[j];
-                let face = piece.face as usize;
+                let f = batch.fragment(j);
+                let face = f.face() as usize;
                 let b = if toward {
-                    let normal = unit_normal(&piece.support);
-                    brightness(piece, normal, centres[face], lights, forward)
+                    let normal = unit_normal(f.support());
+                    brightness(f.lit_mask(), normal, centres[face], &scene.lights, forward)
                 } else {
                     // the back of a surface: no light is in front of it
                     AMBIENT
                 };
                 let fill = hex(colors[face], b);
-                match regions.iter_mut().find(|(f, _)| *f == fill) {
+                match regions.iter_mut().find(|(c, _)| *c == fill) {
                     Some((_, members)) => members.push(j),
                     None => regions.push((fill, vec![j])),
                 }
             }
         }
         for (fill, members) in &regions {
-            let rings = members.iter().map(|&j| pieces[j].world.iter().copied());
-            canvas.region(rings, fill);
+            let pieces = members.iter().flat_map(|&j| {
+                batch
+                    .fragment(j)
+                    .pieces()
+                    .map(|p| p.iter().map(|&v| world[v as usize]))
+            });
+            canvas.region(pieces, fill);
         }
         start = end;
     }
@@ -528,33 +562,19 @@ fn svg_view(args: &ShadowsArgs, is_room: bool) -> Result<View> {
 
 // ------------------------------------------------------------- command
 
-/// A light in words: the flag that gave it and what became of it on the
-/// grid (the outputs have the exact values).
-fn describe(l: &SceneLight) -> String {
-    match l.light {
-        Light::Point(_) => {
-            let moved = l.world.distance(l.arg.value());
-            if moved == 0.0 {
-                format!("point light {}, on the grid", l.arg.flag())
-            } else {
-                format!(
-                    "point light {}, snapped to the grid {moved:.1e} units away",
-                    l.arg.flag()
-                )
-            }
-        }
-        Light::Directional(q) => format!(
-            "sun {}, integer direction {},{},{}",
-            l.arg.flag(),
-            q[0],
-            q[1],
-            q[2]
-        ),
+/// `shadow shadows`.
+pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
+    match args.threads {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build()
+            .context("cannot start the worker threads")?
+            .install(|| run_here(args)),
+        None => run_here(args),
     }
 }
 
-/// `shadow shadows`.
-pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
+fn run_here(args: &ShadowsArgs) -> Result<()> {
     let total = Instant::now();
     // fail on a bad output name or a missing viewpoint before doing any work
     let format = Format::from_path(&args.output)?;
@@ -563,11 +583,16 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
         Format::Svg => Some(svg_view(args, is_room)?),
         _ => None,
     };
+    let note = |s: &str| {
+        if !args.quiet {
+            eprintln!("{s}");
+        }
+    };
     if view.is_none() && (args.eye.is_some() || args.target.is_some() || args.up.is_some()) {
-        eprintln!("note: --eye, --target and --up only apply to SVG output");
+        note("note: --eye, --target and --up only apply to SVG output");
     }
-    let mut specs: Vec<LightArg> = args.lights.iter().map(|&p| LightArg::Point(p)).collect();
-    specs.extend(args.suns.iter().map(|&d| LightArg::Sun(d)));
+    let mut specs: Vec<LightSpec> = args.lights.iter().map(|&p| LightSpec::Point(p)).collect();
+    specs.extend(args.suns.iter().map(|&d| LightSpec::Sun(d)));
     let default_light = specs.is_empty();
     if default_light {
         if !is_room {
@@ -576,127 +601,326 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
                  (a light at infinity); both can be repeated"
             );
         }
-        specs.push(LightArg::Point(ROOM_LIGHT));
+        specs.push(LightSpec::Point(ROOM_LIGHT));
     }
 
+    let progress = Progress::new(!args.quiet);
     let mut phases = Phases::default();
+    progress.phase("loading", 1);
     let (mesh, name) = phases.run("load", || load_source(&args.source))?;
-    let grid = shared_grid(&mesh.positions, &specs).with_context(|| name.clone())?;
-    let lights = place_lights(&grid, &specs)?;
-    let prepared = Prepared::on_grid(mesh, &name, grid)?;
-    phases.0.push(("snap/import", prepared.import_time));
-    phases.0.push(("build", prepared.build_time));
-    let kernel: Vec<Light> = lights.iter().map(|l| l.light).collect();
+    if mesh.faces.is_empty() {
+        bail!("{name}: no faces");
+    }
+    progress.phase("snapping", 1);
+    let scene = phases.run("snap/import", || -> Result<Scene> {
+        let grid = shared_grid(&mesh.positions, &specs).with_context(|| name.clone())?;
+        let lights = place_lights(&grid, &specs)?;
+        let loops = mesh.face_loops();
+        let (polys, report) = import_faces(&grid, loops.iter().map(Vec::as_slice))
+            .with_context(|| format!("{name}: cannot import the faces"))?;
+        Ok(Scene {
+            mesh,
+            name,
+            grid,
+            lights,
+            polys,
+            report,
+        })
+    })?;
+    let summary = scene.report.summary();
+    if !summary.is_empty() {
+        note(&format!("{}: {}", scene.name, summary.trim_end()));
+    }
+    let kernel: Vec<svbsp::Light> = scene.lights.iter().map(|l| l.light).collect();
+    let faces = scene.mesh.faces.len();
     let report_with = "the input and the command line";
-    let (frags, sv_stats) = guarded(report_with, || {
-        phases.run("shadows", || {
-            shadow_fragments(&prepared.tree, &kernel).map_err(|e| anyhow!("{e}"))
-        })
-    })?;
-    let faces = prepared.mesh.faces.len();
-    let (pieces, areas) = phases.run("areas", || -> Result<_> {
-        let pieces = pieces(&prepared, &frags, &lights)?;
-        let areas = Areas::new(&pieces, lights.len(), faces);
-        Ok((pieces, areas))
-    })?;
+    let mut areas = Areas::new(kernel.len(), faces);
+    let mut out = Output::create(&args.output)?;
+    let write_err = || format!("could not write {}", args.output.display());
 
-    let written = phases.run("write", || -> Result<String> {
-        let create = || {
-            std::fs::File::create(&args.output)
-                .map(std::io::BufWriter::new)
-                .with_context(|| format!("could not write {}", args.output.display()))
-        };
-        let write_err = || format!("could not write {}", args.output.display());
-        Ok(match format {
-            Format::Json => {
-                let mut out = create()?;
-                write_json(&mut out, &lights, faces, &pieces, &areas).with_context(write_err)?;
-                out.flush().with_context(write_err)?;
-                String::new()
-            }
-            Format::Obj => {
-                let (mesh, degenerate) = obj_mesh(&pieces);
-                let mut out = create()?;
-                write_obj_file(&mut out, &name, &lights, faces, &mesh).with_context(write_err)?;
-                if degenerate > 0 {
-                    eprintln!(
-                        "warning: {degenerate} fragment(s) have distinct exact vertices that \
-                         coincide once rounded to f64 input units; they are degenerate in the file"
-                    );
-                }
-                format!(", {} vertices", mesh.positions.len())
-            }
-            Format::Svg => {
-                let view = view.as_ref().expect("SVG output has a view");
-                let r = guarded(report_with, || {
-                    render(&prepared, view, &frags, &pieces, &lights)
-                })?;
-                let mut out = create()?;
-                out.write_all(r.svg.as_bytes())
-                    .and_then(|()| out.flush())
-                    .with_context(write_err)?;
-                format!(
-                    ", {} drawn, eye {:.3},{:.3},{:.3}",
-                    r.drawn, r.eye.x, r.eye.y, r.eye.z
+    let figures = guarded(report_with, || -> Result<Figures> {
+        let mut fig = Figures::default();
+        // the fragments of every face, or for the SVG of every BSP polygon
+        let (batches, tree): (Option<Batch>, Option<BspTree>) = match (args.algorithm, format) {
+            (Algorithm::Psv, Format::Json | Format::Obj) => {
+                progress.phase("shadow trees", kernel.len() as u64);
+                let shadows = phases
+                    .run("trees", || Shadows::new(&scene.polys, &kernel))
+                    .map_err(|e| anyhow!("{e}"))?;
+                fig.shadow_nodes = shadows.volumes().iter().map(|v| v.node_count()).sum();
+                let ranges = receivers(&scene.polys);
+                fig.receivers = ranges.len();
+                stream(
+                    args,
+                    format,
+                    &scene,
+                    &shadows,
+                    &ranges,
+                    &mut out,
+                    &mut areas,
+                    &mut fig,
+                    &mut phases,
+                    &progress,
                 )
+                .with_context(write_err)?;
+                (None, None)
             }
-        })
+            (Algorithm::Psv, Format::Svg) => {
+                progress.phase("scene tree", 1);
+                let tree = phases.run("bsp", || {
+                    BspTree::build(scene.polys.clone(), &BuildOptions::default())
+                });
+                progress.phase("shadow trees", kernel.len() as u64);
+                let shadows = phases
+                    .run("trees", || Shadows::new(&scene.polys, &kernel))
+                    .map_err(|e| anyhow!("{e}"))?;
+                fig.shadow_nodes = shadows.volumes().iter().map(|v| v.node_count()).sum();
+                let polys: Vec<Polygon> = tree.polygons().cloned().collect();
+                fig.bsp_polygons = Some(polys.len());
+                fig.receivers = polys.len();
+                progress.phase("shading", polys.len() as u64);
+                let batch = phases.run("shading", || {
+                    let ranges: Vec<Range<usize>> = (0..polys.len()).map(|i| i..i + 1).collect();
+                    let parts: Vec<Batch> = ranges
+                        .par_chunks(CHUNK)
+                        .enumerate()
+                        .map(|(i, rs)| {
+                            let b = shadows.shade_ranges(
+                                &polys,
+                                rs,
+                                (i * CHUNK) as u32,
+                                &ShadeOptions::default(),
+                            );
+                            progress.inc(rs.len() as u64);
+                            b
+                        })
+                        .collect();
+                    let mut all = Batch::new();
+                    for b in &parts {
+                        all.append(b);
+                    }
+                    all
+                });
+                (Some(batch), Some(tree))
+            }
+            (Algorithm::ChinFeiner, _) => {
+                progress.phase("scene tree", 1);
+                let tree = phases.run("bsp", || {
+                    BspTree::build(scene.polys.clone(), &BuildOptions::default())
+                });
+                fig.bsp_polygons = Some(tree.polygons().count());
+                fig.receivers = tree.polygons().count();
+                progress.phase("Chin & Feiner", 1);
+                let cf = phases
+                    .run("shadows", || chin_feiner(&tree, &kernel))
+                    .map_err(|e| anyhow!("{e}"))?;
+                fig.shadow_nodes = cf.shadow_nodes;
+                (Some(Batch::from_chin_feiner(&cf, &kernel)), Some(tree))
+            }
+        };
+        if let Some(batch) = batches {
+            progress.phase("writing", 1);
+            let world = world_vertices(&batch, &scene.grid)?;
+            let records = area_records(&batch, &world);
+            for r in &records {
+                areas.add(r.0, r.1, r.2, r.3);
+            }
+            fig.fragments = batch.len();
+            phases
+                .run("write", || -> Result<()> {
+                    match format {
+                        Format::Json => {
+                            json_header(&mut out, &scene.lights, faces)?;
+                            let text = json_fragments(&batch, &world, &records, kernel.len());
+                            out.write_all(text.get(1..).unwrap_or_default())?;
+                            json_footer(&mut out, &areas)?;
+                        }
+                        Format::Obj => {
+                            obj_header(&mut out, &scene.name, &scene.lights, faces)?;
+                            let mut w = ObjWriter::new();
+                            w.batch(&mut out, &batch, &world, kernel.len())?;
+                            fig.extra = format!(", {} vertices", w.index.len());
+                            warn_degenerate(&w, args.quiet);
+                        }
+                        Format::Svg => {
+                            let view = view.as_ref().expect("SVG output has a view");
+                            let tree = tree.as_ref().expect("SVG is drawn over the scene tree");
+                            let r = render(&scene, tree, view, &batch, &world)?;
+                            out.write_all(r.svg.as_bytes())?;
+                            fig.extra = format!(
+                                ", {} drawn, eye {:.3},{:.3},{:.3}",
+                                r.drawn, r.eye.x, r.eye.y, r.eye.z
+                            );
+                        }
+                    }
+                    Ok(())
+                })
+                .with_context(write_err)?;
+        }
+        Ok(fig)
     })?;
+    out.commit()?;
+    progress.finish();
     let total = total.elapsed();
 
     let lit_share = percent(areas.total - areas.dark, areas.total);
-    let light_count = match (lights.len(), default_light) {
-        (_, true) => format!("the room's default light ({})", specs[0].flag()),
+    let light_count = match (scene.lights.len(), default_light) {
+        (_, true) => format!(
+            "the room's default light ({})",
+            crate::lights::flag(&specs[0])
+        ),
         (1, false) => "1 light".to_string(),
         (n, false) => format!("{n} lights"),
     };
     let mut report = format!(
-        "wrote {}: {} fragments of {faces} faces of {name}{written}; {light_count}, \
+        "wrote {}: {} fragments of {faces} faces of {}{}; {light_count}, \
          {lit_share:.1}% of the area lit\n",
         args.output.display(),
-        pieces.len(),
+        figures.fragments,
+        scene.name,
+        figures.extra,
     );
     if args.stats {
-        report += &stats_text(&prepared, &lights, &sv_stats, &areas, &phases, total);
+        report += &stats_text(&scene, &figures, &areas, &phases, total);
     }
     emit(&report)
 }
 
+fn warn_degenerate(w: &ObjWriter, quiet: bool) {
+    if w.degenerate > 0 && !quiet {
+        eprintln!(
+            "warning: {} fragment piece(s) have distinct exact vertices that coincide once \
+             rounded to f64 input units; they are degenerate in the file",
+            w.degenerate
+        );
+    }
+}
+
+/// A chunk of receivers shaded: the fragments, their vertices in input
+/// units, their areas and (for JSON) their text.
+type Shaded = (Batch, Vec<DVec3>, Vec<AreaRecord>, Vec<u8>);
+
+/// Shades the receivers round by round (each round in parallel) and
+/// writes each round as soon as it is done.
+#[allow(clippy::too_many_arguments)]
+fn stream(
+    args: &ShadowsArgs,
+    format: Format,
+    scene: &Scene,
+    shadows: &Shadows,
+    ranges: &[Range<usize>],
+    out: &mut Output,
+    areas: &mut Areas,
+    fig: &mut Figures,
+    phases: &mut Phases,
+    progress: &Progress,
+) -> Result<()> {
+    let lights = scene.lights.len();
+    let faces = scene.mesh.faces.len();
+    let opts = ShadeOptions::default().with_pieces(format == Format::Obj);
+    let mut obj = ObjWriter::new();
+    match format {
+        Format::Json => json_header(out, &scene.lights, faces)?,
+        _ => obj_header(out, &scene.name, &scene.lights, faces)?,
+    }
+    let (mut shading, mut writing) = (Duration::ZERO, Duration::ZERO);
+    let mut first = true;
+    progress.phase("shading", ranges.len() as u64);
+    for (r, round) in ranges.chunks(ROUND).enumerate() {
+        let start = Instant::now();
+        let parts: Vec<Result<Shaded>> = round
+            .par_chunks(CHUNK)
+            .enumerate()
+            .map(|(i, rs)| {
+                let first_receiver = (r * ROUND + i * CHUNK) as u32;
+                let b = shadows.shade_ranges(&scene.polys, rs, first_receiver, &opts);
+                let world = world_vertices(&b, &scene.grid)?;
+                let records = area_records(&b, &world);
+                let text = match format {
+                    Format::Json => json_fragments(&b, &world, &records, lights),
+                    _ => Vec::new(),
+                };
+                progress.inc(rs.len() as u64);
+                Ok((b, world, records, text))
+            })
+            .collect();
+        shading += start.elapsed();
+        let start = Instant::now();
+        for part in parts {
+            let (b, world, records, text) = part?;
+            fig.fragments += b.len();
+            for rec in &records {
+                areas.add(rec.0, rec.1, rec.2, rec.3);
+            }
+            match format {
+                Format::Json => {
+                    let body = if first && !text.is_empty() {
+                        first = false;
+                        &text[1..]
+                    } else {
+                        &text[..]
+                    };
+                    out.write_all(body)?;
+                }
+                _ => obj.batch(out, &b, &world, lights)?,
+            }
+        }
+        writing += start.elapsed();
+    }
+    match format {
+        Format::Json => json_footer(out, areas)?,
+        _ => {
+            fig.extra = format!(", {} vertices", obj.index.len());
+            warn_degenerate(&obj, args.quiet);
+        }
+    }
+    phases.0.push(("shading", shading));
+    phases.0.push(("write", writing));
+    Ok(())
+}
+
+fn percent(part: f64, whole: f64) -> f64 {
+    if whole > 0.0 {
+        100.0 * part / whole
+    } else {
+        0.0
+    }
+}
+
 /// The `--stats` report.
 fn stats_text(
-    p: &Prepared,
-    lights: &[SceneLight],
-    sv: &ShadowStats,
+    scene: &Scene,
+    fig: &Figures,
     areas: &Areas,
     phases: &Phases,
-    total: std::time::Duration,
+    total: Duration,
 ) -> String {
-    let t = p.tree.stats();
+    let faces = scene.mesh.faces.len();
+    let lights = &scene.lights;
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "faces:           {} ({} polygons after import: {} faces triangulated, {} dropped)",
-        p.mesh.faces.len(),
-        p.report.polygons,
-        p.report.triangulated.len(),
-        p.report.dropped.len()
+        "faces:           {faces} ({} polygons after import: {} faces triangulated, {} dropped)",
+        scene.report.polygons,
+        scene.report.triangulated.len(),
+        scene.report.dropped.len()
     );
     let _ = writeln!(
         s,
         "grid step:       2^{} = {:.3e} units",
-        -p.grid.scale().log2(),
-        p.grid.step()
+        -scene.grid.scale().log2(),
+        scene.grid.step()
     );
+    if let Some(n) = fig.bsp_polygons {
+        let _ = writeln!(s, "bsp:             {n} polygons");
+    }
     let _ = writeln!(
         s,
-        "bsp:             {} polygons, {} nodes, depth {}",
-        t.polygons, t.nodes, t.depth
-    );
-    let _ = writeln!(
-        s,
-        "fragments:       {} ({} shadow-tree nodes over {} light{})",
-        sv.fragments,
-        sv.shadow_nodes,
+        "fragments:       {} ({:.3} per face; {} receivers, {} shadow-tree nodes over {} light{})",
+        fig.fragments,
+        fig.fragments as f64 / faces.max(1) as f64,
+        fig.receivers,
+        fig.shadow_nodes,
         lights.len(),
         if lights.len() == 1 { "" } else { "s" }
     );
@@ -718,9 +942,10 @@ fn stats_text(
         .collect();
     let _ = writeln!(
         s,
-        "time:            {}; total {:.2} ms",
+        "time:            {}; total {:.2} ms ({} threads)",
         times.join(", "),
-        total.as_secs_f64() * 1e3
+        total.as_secs_f64() * 1e3,
+        rayon::current_num_threads()
     );
     let _ = writeln!(
         s,
@@ -765,10 +990,10 @@ fn stats_text(
     }
     let _ = writeln!(s, "{header}");
     for f in top {
-        let (area, cast) = &areas.faces[f];
-        let mut line = format!("  {f:>7}  {:<12} {area:>12.6}", p.mesh.group_name(f));
-        for c in cast {
-            line += &format!("  {:>20}", format!("{c:.6} ({:.1}%)", percent(*c, *area)));
+        let area = areas.face_area(f);
+        let mut line = format!("  {f:>7}  {:<12} {area:>12.6}", scene.mesh.group_name(f));
+        for c in areas.face_cast(f) {
+            line += &format!("  {:>20}", format!("{c:.6} ({:.1}%)", percent(*c, area)));
         }
         let _ = writeln!(s, "{line}");
     }
@@ -778,50 +1003,6 @@ fn stats_text(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn piece(face: u32, lit: &[bool], facing: &[bool], area: f64) -> Piece {
-        Piece {
-            face,
-            world: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
-            lit: lit.to_vec(),
-            facing: facing.to_vec(),
-            area,
-            support: Plane::new([0, 0, 1], 0).unwrap(),
-        }
-    }
-
-    #[test]
-    fn fragments_are_found_in_their_bsp_polygons() {
-        let specs = [
-            LightArg::Point(ROOM_LIGHT),
-            LightArg::Sun(DVec3::new(-1.0, 2.0, 4.0)),
-        ];
-        let mesh = shadow_scene::room();
-        let grid = shared_grid(&mesh.positions, &specs).unwrap();
-        let lights = place_lights(&grid, &specs).unwrap();
-        let p = Prepared::on_grid(mesh, "room", grid).unwrap();
-        let kernel: Vec<Light> = lights.iter().map(|l| l.light).collect();
-        let (frags, _) = shadow_fragments(&p.tree, &kernel).unwrap();
-        let per = fragments_per_polygon(&p.tree, &frags).unwrap();
-        let pieces = pieces(&p, &frags, &lights).unwrap();
-        // every polygon gets fragments, every fragment one polygon, and
-        // the fragments of a polygon cover its area
-        assert_eq!(per.iter().map(Vec::len).sum::<usize>(), frags.len());
-        for (poly, members) in p.tree.polygons().zip(&per) {
-            assert!(!members.is_empty());
-            let world: Vec<DVec3> = poly
-                .vertices_f64()
-                .into_iter()
-                .map(|g| p.grid.to_world(g))
-                .collect();
-            let area = polygon_area(&world);
-            let covered: f64 = members.iter().map(|&j| pieces[j].area).sum();
-            assert!(
-                (covered - area).abs() <= 1e-9 * area.max(1.0),
-                "{covered} vs {area}"
-            );
-        }
-    }
 
     #[test]
     fn formats_by_extension() {
@@ -843,54 +1024,23 @@ mod tests {
     }
 
     #[test]
-    fn areas_split_lit_cast_and_attached() {
-        let pieces = [
-            piece(0, &[true, false], &[true, true], 2.0),
-            piece(0, &[false, false], &[true, false], 3.0),
-            piece(1, &[false, true], &[false, true], 5.0),
-        ];
-        let a = Areas::new(&pieces, 2, 3);
-        assert_eq!(a.total, 10.0);
-        assert_eq!(a.lit, vec![2.0, 5.0]);
-        assert_eq!(a.cast, vec![3.0, 2.0]);
-        assert_eq!(a.attached, vec![5.0, 3.0]);
-        assert_eq!(a.shadow(), vec![8.0, 5.0]);
-        assert_eq!(a.dark, 3.0);
-        assert_eq!(a.faces[0], (5.0, vec![3.0, 2.0]));
-        assert_eq!(a.faces[1], (5.0, vec![0.0, 0.0]));
-        assert_eq!(a.faces[2], (0.0, vec![0.0, 0.0]));
-        assert_eq!(a.most_shaded(10), vec![0]);
-    }
-
-    #[test]
-    fn polygon_areas() {
-        let sq = [
-            DVec3::new(1.0, 1.0, 5.0),
-            DVec3::new(3.0, 1.0, 5.0),
-            DVec3::new(3.0, 4.0, 5.0),
-            DVec3::new(1.0, 4.0, 5.0),
-        ];
-        assert_eq!(polygon_area(&sq), 6.0);
-        assert_eq!(polygon_area(&sq[..2]), 0.0);
-        assert_eq!(polygon_area(&[]), 0.0);
-    }
-
-    #[test]
     fn obj_groups_name_the_lights() {
-        assert_eq!(obj_group(&[true]), "lit");
-        assert_eq!(obj_group(&[false]), "shadow");
-        assert_eq!(obj_group(&[true, false, true]), "lit lit_0_2");
-        assert_eq!(obj_group(&[false, false]), "shadow");
-        let pieces = [
-            piece(0, &[false, false], &[true, true], 1.0),
-            piece(0, &[false, true], &[true, true], 1.0),
-            piece(1, &[true, true], &[true, true], 1.0),
-        ];
-        let (mesh, degenerate) = obj_mesh(&pieces);
-        // the three triangles share their corners
-        assert_eq!((mesh.positions.len(), degenerate), (3, 0));
-        let names: Vec<&str> = (0..3).map(|f| mesh.group_name(f)).collect();
-        assert_eq!(names, ["lit lit_0_1", "lit lit_1", "shadow"]);
+        assert_eq!(obj_group(0b1, 1), "lit");
+        assert_eq!(obj_group(0b0, 1), "shadow");
+        assert_eq!(obj_group(0b101, 3), "lit lit_0_2");
+        assert_eq!(obj_group(0b00, 2), "shadow");
+    }
+
+    #[test]
+    fn json_numbers_are_serde_jsons() {
+        for x in [0.0, -0.5, 1.0, 1e-7, 123456.789, 2f64.powi(60), -3.25e-300] {
+            let mut s = Vec::new();
+            push_f64(&mut s, x);
+            assert_eq!(
+                String::from_utf8(s).unwrap(),
+                serde_json::to_string(&x).unwrap()
+            );
+        }
     }
 
     #[test]
@@ -917,5 +1067,18 @@ mod tests {
         let v = svg_view(&file, false).unwrap();
         assert_eq!((v.eye, v.target), (DVec3::new(1.0, 2.0, 3.0), None));
         assert_eq!(file.suns.len(), 2);
+        let file = parse(&[
+            "a.obj",
+            "--sun",
+            "0,0,1",
+            "--algorithm",
+            "chin-feiner",
+            "--threads",
+            "3",
+            "-q",
+        ]);
+        assert_eq!(file.algorithm, Algorithm::ChinFeiner);
+        assert_eq!(file.threads, Some(3));
+        assert!(file.quiet);
     }
 }

@@ -1,35 +1,61 @@
-//! Exact shadows with shadow-volume BSP trees (Chin & Feiner 1989).
+//! Exact shadows: every face of a scene cut into fragments, each exactly
+//! lit or in shadow for every light (point lights and suns).
 //!
-//! Given a scene's BSP tree ([`bsp_core::BspTree`]) and lights on the same
-//! grid, [`shadow_fragments`] cuts every polygon into convex fragments, each
-//! exactly lit or in shadow for every light. Every decision is the exact sign
-//! of the true value: shadow planes (through a light and a fragment edge)
-//! have their own exact tier, 140-bit normals and 168-bit offsets, and their
-//! intersections with scene polygons are classified in 512-bit integers
-//! behind an `f64` filter (see `docs/architecture.md`, "The shadow tier").
+//! [`Shadows`] builds one partitioned shadow-volume tree per light
+//! (Gerhards et al. 2015: every occluder's volume, bounded by planes
+//! through the light and its edges and capped by its own plane) and
+//! filters every face through them. A face is cut only where a shadow
+//! boundary crosses it: cuts that do not separate lit from shadowed parts
+//! are undone, and the pieces left are merged into maximal regions, so a
+//! uniformly lit face is one fragment — its own polygon — and a fragment
+//! is a connected part of a face with one set of flags (an outer boundary
+//! and possibly holes). All planes stay in the input tier of `bsp-core`
+//! (the plane through a grid light and two grid vertices is one), so
+//! every decision is the exact sign of a 256-bit value behind an `f64`
+//! filter. Faces are independent and shaded in parallel (rayon); the
+//! output does not depend on the thread count.
+//!
+//! [`chin_feiner`] is Chin & Feiner's (1989) BSP-ordered algorithm, on
+//! which the core paper's dynamic pipeline builds; its shadow planes pass
+//! through split edges and need a wider tier (see `docs/architecture.md`).
+//! The two agree exactly on every face's lit area (tested).
 //!
 //! # Example
 //!
 //! ```
-//! use bsp_core::{BspTree, BuildOptions, Polygon};
+//! use bsp_core::Polygon;
 //! use svbsp::{shadow_fragments, Light};
 //!
 //! let floor = Polygon::from_grid_points(&[[0, 0, 0], [8, 0, 0], [8, 8, 0], [0, 8, 0]], 0).unwrap();
 //! let roof = Polygon::from_grid_points(&[[2, 2, 4], [4, 2, 4], [4, 4, 4], [2, 4, 4]], 1).unwrap();
-//! let tree = BspTree::build(vec![floor, roof], &BuildOptions::default());
-//! let (fragments, _stats) = shadow_fragments(&tree, &[Light::Point([3, 3, 8])]).unwrap();
-//! let shadowed = fragments.iter().filter(|f| f.face() == 0 && !f.lit()[0]).count();
-//! assert_eq!(shadowed, 1);
+//! let (fragments, _stats) = shadow_fragments(&[floor, roof], &[Light::Point([3, 3, 8])]).unwrap();
+//! // the floor: a lit square ring around one shadowed square; the roof: lit
+//! let floor: Vec<_> = fragments.fragments().filter(|f| f.face() == 0).collect();
+//! assert_eq!(floor.len(), 2);
+//! assert_eq!(floor.iter().find(|f| f.lit(0)).unwrap().hole_count(), 1);
+//! assert_eq!(fragments.len(), 3);
 //! ```
 //!
 //! # Feature flags
 //!
 //! None.
 
-mod fragment;
-mod shadows;
+mod areas;
+mod chin_feiner;
+mod engine;
+mod light;
+mod psv;
 mod wide;
 
-pub use fragment::{Edge, Fragment};
-pub use shadows::{Light, LightError, ShadowStats, shadow_fragments};
+pub use areas::{Areas, fragment_area, polygon_area};
+pub use chin_feiner::{CfFragment, CfFragments, chin_feiner};
+pub use engine::{
+    Batch, CHUNK, FragmentRef, Scratch, ShadeOptions, ShadowError, ShadowStats, Shadows, receivers,
+    shadow_fragments,
+};
+pub use light::{
+    LIGHT_RANGE_BITS, Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, angle_between,
+    place_lights, quantize_direction, shared_grid,
+};
+pub use psv::{ShadowVolumes, VolumeError};
 pub use wide::{WPoint, WidePlane};

@@ -11,11 +11,7 @@
 //! `2^509` — inside a signed 512-bit integer.
 
 use bnum::cast::As;
-use bsp_core::{I256, I512, Plane, Side};
-
-/// `2^-48`: the filter's relative error bound (see bsp-core's
-/// architecture note: at most 8 roundings of `2^-53` per evaluation).
-const FILTER_REL: f64 = 1.0 / (1u64 << 48) as f64;
+use bsp_core::{Homogeneous, I256, I512, Plane, Side, approx};
 
 /// A plane with wide integer coefficients: an input plane, or a shadow
 /// plane through the light.
@@ -69,7 +65,7 @@ impl PartialEq for WidePlane {
 impl WidePlane {
     fn new(n: [I256; 3], d: I256, form: Form) -> WidePlane {
         WidePlane {
-            approx: [n[0].as_(), n[1].as_(), n[2].as_(), d.as_()],
+            approx: [approx(&n[0]), approx(&n[1]), approx(&n[2]), approx(&d)],
             n,
             d,
             form,
@@ -157,12 +153,13 @@ impl WidePlane {
     }
 }
 
-/// An exact point in homogeneous coordinates `(x, y, z, w)`, `w > 0`, with
-/// `f64` roundings for the filter.
+/// An exact point of the shadow tier: homogeneous coordinates `(x, y, z,
+/// w)`, `w > 0`, in 512-bit integers ([`bsp_core::Homogeneous`]), and its
+/// grid coordinates when it is a grid point (classified in at most 256
+/// bits then).
 #[derive(Clone, Debug)]
 pub struct WPoint {
-    h: [I512; 4],
-    approx: [f64; 4],
+    h: Homogeneous<8>,
     grid: Option<[i32; 3]>,
 }
 
@@ -197,19 +194,19 @@ fn cross(a: &[I512; 3], b: &[I512; 3]) -> [I512; 3] {
 impl WPoint {
     /// A scene point (grid or implicit), widened.
     pub fn from_point(p: &bsp_core::Point) -> WPoint {
-        let mut w = WPoint::from_h(p.homogeneous().map(wide));
-        if let bsp_core::Point::Grid(g) = p {
-            w.grid = Some(*g);
-        }
-        w
+        let h = Homogeneous::new(p.homogeneous().map(wide)).expect("a scene point is finite");
+        let grid = match p {
+            bsp_core::Point::Grid(g) => Some(*g),
+            bsp_core::Point::Implicit(_) => None,
+        };
+        WPoint { h, grid }
     }
 
-    fn from_h(h: [I512; 4]) -> WPoint {
-        WPoint {
-            approx: h.map(|c| c.as_::<f64>()),
-            h,
+    fn from_h(h: [I512; 4]) -> Option<WPoint> {
+        Some(WPoint {
+            h: Homogeneous::new(h)?,
             grid: None,
-        }
+        })
     }
 
     /// The intersection of three planes, `None` if they do not meet in one
@@ -219,19 +216,13 @@ impl WPoint {
         let (n1, n2, n3) = (n(p1), n(p2), n(p3));
         let (c23, c31, c12) = (cross(&n2, &n3), cross(&n3, &n1), cross(&n1, &n2));
         let w = n1[0] * c23[0] + n1[1] * c23[1] + n1[2] * c23[2];
-        if w.is_zero() {
-            return None;
-        }
         let (d1, d2, d3) = (wide(p1.d), wide(p2.d), wide(p3.d));
         let mut h = [I512::ZERO; 4];
         for k in 0..3 {
             h[k] = -(c23[k] * d1 + c31[k] * d2 + c12[k] * d3);
         }
         h[3] = w;
-        if w.is_negative() {
-            h = h.map(|c| -c);
-        }
-        Some(WPoint::from_h(h))
+        WPoint::from_h(h)
     }
 
     /// The intersection of an input plane `p` (normal below `2^55`, offset
@@ -251,9 +242,6 @@ impl WPoint {
         let c12 = cross_small(n1, n2);
         let c31 = cross_small(n3, n1);
         let w = wmul(n3[0], c12[0]) + wmul(n3[1], c12[1]) + wmul(n3[2], c12[2]);
-        if w.is_zero() {
-            return None;
-        }
         // c23_k d1 with c23 = n2 × n3, as (n2_i d1) n3_j − (n2_j d1) n3_i:
         // |n2_i d1| < 2^223 fits 256 bits
         let d1 = p.d;
@@ -268,27 +256,16 @@ impl WPoint {
             out[k] = -(c23d1[k] + wmul(c31[k], e.d) + wmul(c12[k], h.d));
         }
         out[3] = w;
-        if w.is_negative() {
-            out = out.map(|c| -c);
-        }
-        Some(WPoint::from_h(out))
+        WPoint::from_h(out)
     }
 
-    /// Exact side of `plane`: the filter, then 512-bit arithmetic.
+    /// Exact side of `plane`: the shared filter, then the exact path.
+    #[inline]
     pub fn classify(&self, plane: &WidePlane) -> Side {
-        let p = &plane.approx;
-        let a = &self.approx;
-        let t = [p[0] * a[0], p[1] * a[1], p[2] * a[2], p[3] * a[3]];
-        let v = (t[0] + t[1]) + (t[2] + t[3]);
-        let m = (t[0].abs() + t[1].abs()) + (t[2].abs() + t[3].abs());
-        let bound = m * FILTER_REL;
-        if v > bound {
-            return Side::Front;
+        match self.h.filter(&plane.approx) {
+            Some(s) => s,
+            None => self.classify_exact(plane),
         }
-        if v < -bound {
-            return Side::Back;
-        }
-        self.classify_exact(plane)
     }
 
     /// The exact path alone: grid points against input planes and shadow
@@ -298,7 +275,7 @@ impl WPoint {
         if let Some(g) = self.grid {
             return plane.classify_grid(g);
         }
-        let h = &self.h;
+        let h = self.h.coords();
         let v = wide(plane.n[0]) * h[0]
             + wide(plane.n[1]) * h[1]
             + wide(plane.n[2]) * h[2]
@@ -308,21 +285,21 @@ impl WPoint {
 
     /// Homogeneous coordinates, `w > 0`.
     pub fn homogeneous(&self) -> &[I512; 4] {
-        &self.h
+        self.h.coords()
     }
 
     /// Grid coordinates, each correctly rounded (equal points give equal
     /// results).
     pub fn to_f64(&self) -> [f64; 3] {
-        let w = self.h[3];
-        [0, 1, 2].map(|k| bsp_core::rational_to_f64(self.h[k], w))
+        match self.grid {
+            Some(g) => g.map(f64::from),
+            None => self.h.round_with::<17>(),
+        }
     }
 
     /// Exact equality of the represented points.
     pub fn same_point(&self, o: &WPoint) -> bool {
-        use bnum::types::I1024;
-        let big = |x: I512| x.as_::<I1024>();
-        (0..3).all(|k| big(self.h[k]) * big(o.h[3]) == big(o.h[k]) * big(self.h[3]))
+        self.h.same_with::<16>(&o.h)
     }
 }
 

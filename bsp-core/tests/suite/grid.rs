@@ -186,7 +186,7 @@ proptest! {
         prop_assert!(all_planar(&polys));
         for p in &polys {
             if let Err(e) = p.sanity_check() {
-                return Err(TestCaseError::fail(e));
+                return Err(TestCaseError::fail(e.to_string()));
             }
             for v in p.vertices() {
                 prop_assert!(snapped.contains(&v.as_grid().expect("grid vertex")));

@@ -218,7 +218,7 @@ fn check_tiling(polys: &[Polygon], l2: &[P2], l3: &[GridPoint]) -> Result<(), Te
     let mut pieces: Vec<Vec<P2>> = Vec::new();
     for p in polys {
         if let Err(e) = p.sanity_check() {
-            return Err(TestCaseError::fail(e));
+            return Err(TestCaseError::fail(e.to_string()));
         }
         let mut v = Vec::new();
         for x in p.vertices() {
@@ -313,7 +313,7 @@ proptest! {
         }
         for p in &polys {
             if let Err(e) = p.sanity_check() {
-                return Err(TestCaseError::fail(e));
+                return Err(TestCaseError::fail(e.to_string()));
             }
             prop_assert_eq!(p.len(), 3);
             for v in p.vertices() {

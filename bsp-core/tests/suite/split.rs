@@ -152,7 +152,7 @@ fn check_construction(case: &PolyCase) -> Result<Polygon, TestCaseError> {
         Err(e) => return Err(TestCaseError::fail(format!("{e}: {case:?}"))),
     };
     if let Err(e) = poly.sanity_check() {
-        return Err(TestCaseError::fail(e));
+        return Err(TestCaseError::fail(e.to_string()));
     }
     assert_is_rotation(&poly, &case.hull)?;
     let hq: Vec<Q3> = case.hull.iter().map(|g| grid_q(*g)).collect();
@@ -170,7 +170,7 @@ fn check_construction(case: &PolyCase) -> Result<Polygon, TestCaseError> {
         o
     );
     if let Err(e) = is_strictly_convex(&hq, &n) {
-        return Err(TestCaseError::fail(e));
+        return Err(TestCaseError::fail(e.to_string()));
     }
     // edge plane i holds vertices i and i + 1 and has the rest strictly behind
     let k = hq.len();

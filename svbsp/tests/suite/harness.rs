@@ -1,13 +1,21 @@
-//! Runs a scene through the tree build and `shadow_fragments`, then checks
-//! the result with the oracle: exact tiling of every face, and every flag
-//! against ray casting on interior samples.
+//! Runs a scene through both shadow algorithms and checks them with the
+//! oracle: the fast path's fragments (maximal regions and their convex
+//! pieces) tile every face exactly, are as large as they can be, and carry
+//! the flags the ray oracle gives at interior samples; shuffling the input
+//! changes no face's exact lit area; Chin & Feiner's fragments on scene
+//! trees tile every face, carry the oracle's flags, and give exactly the
+//! same area per face and set of flags as the fast path.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashMap};
 
 use bsp_core::{BspTree, BuildOptions, Polygon};
-use svbsp::{Fragment, Light, ShadowStats, shadow_fragments};
+use num_traits::{ToPrimitive, Zero};
+use svbsp::{Batch, CfFragments, Light, ShadowStats, chin_feiner, shadow_fragments};
 
-use crate::oracle::{Face, FlagStats, Scene, check_flags, check_pieces, check_tiling};
+use crate::oracle::{
+    Face, FlagStats, HPoint, PieceRef, Q, Region, Scene, area_of, check_flags, check_regions,
+    check_tiling,
+};
 
 /// Which fragments get their flags checked.
 #[derive(Clone, Copy, Debug)]
@@ -22,27 +30,49 @@ pub(crate) enum Sample {
 /// How to check a scene.
 #[derive(Clone, Debug)]
 pub(crate) struct Opts {
-    /// Tree build seeds (each gives another tree for the same scene).
+    /// Scene tree seeds for Chin & Feiner (each gives another tree).
     pub(crate) seeds: Vec<u64>,
     pub(crate) sample: Sample,
-    /// Check pairwise disjointness of each face's fragments.
+    /// Check pairwise disjointness of each face's pieces.
     pub(crate) disjoint: bool,
+    /// Rerun on the polygons in another order and compare.
+    pub(crate) shuffled: bool,
 }
 
 impl Default for Opts {
     fn default() -> Opts {
         Opts {
-            seeds: vec![BuildOptions::default().seed, 1, 0xdead_beef],
+            seeds: vec![BuildOptions::default().seed, 1],
             sample: Sample::All,
             disjoint: true,
+            shuffled: true,
         }
     }
 }
 
-/// What a checked run produced (for the first seed), and the flag figures
-/// summed over the seeds.
+/// One fragment of the fast path, simplified for assertions.
+pub(crate) struct Frag {
+    face: u32,
+    lit: Vec<bool>,
+    holes: usize,
+}
+
+impl Frag {
+    pub(crate) fn face(&self) -> u32 {
+        self.face
+    }
+    pub(crate) fn lit(&self) -> &[bool] {
+        &self.lit
+    }
+    pub(crate) fn holes(&self) -> usize {
+        self.holes
+    }
+}
+
+/// What a checked run produced, and the flag figures summed over the
+/// checks.
 pub(crate) struct Checked {
-    pub(crate) frags: Vec<Fragment>,
+    pub(crate) frags: Vec<Frag>,
     pub(crate) stats: ShadowStats,
     pub(crate) flags: FlagStats,
 }
@@ -52,15 +82,20 @@ impl Checked {
     pub(crate) fn flags_of(&self, face: u32, j: usize) -> Vec<bool> {
         self.frags
             .iter()
-            .filter(|f| f.face() == face)
-            .map(|f| f.lit()[j])
+            .filter(|f| f.face == face)
+            .map(|f| f.lit[j])
             .collect()
     }
 
     /// Number of fragments lit by light `j`, and in shadow of it.
     pub(crate) fn count(&self, j: usize) -> (usize, usize) {
-        let lit = self.frags.iter().filter(|f| f.lit()[j]).count();
+        let lit = self.frags.iter().filter(|f| f.lit[j]).count();
         (lit, self.frags.len() - lit)
+    }
+
+    /// Number of fragments of face `face`.
+    pub(crate) fn fragments_of(&self, face: u32) -> usize {
+        self.frags.iter().filter(|f| f.face == face).count()
     }
 }
 
@@ -85,8 +120,7 @@ pub(crate) fn scene_of(loops: &[Vec<[i32; 3]>]) -> Scene {
     )
 }
 
-/// Checks a scene given as loops, with every fragment sampled, on three
-/// trees.
+/// Checks a scene given as loops, with every fragment sampled.
 pub(crate) fn check_loops(loops: &[Vec<[i32; 3]>], lights: &[Light]) -> Result<Checked, String> {
     let polys = polygons(loops)?;
     check(&polys, &scene_of(loops), lights, &Opts::default())
@@ -100,14 +134,84 @@ pub(crate) fn assert_loops(loops: &[Vec<[i32; 3]>], lights: &[Light]) -> Checked
     }
 }
 
-fn pick(frags: &[Fragment], scene: &Scene, lights: &[Light], n: usize) -> BTreeSet<usize> {
+fn flags(mask: u64, n: usize) -> Vec<bool> {
+    (0..n).map(|i| mask >> i & 1 == 1).collect()
+}
+
+/// The fast path's fragments as regions with exact vertices.
+pub(crate) fn regions_of(batch: &Batch, lights: usize) -> Vec<Region> {
+    let pt = |v: u32| HPoint::of_vertex(batch.vertex(v).expect("exact vertices"));
+    batch
+        .fragments()
+        .map(|f| Region {
+            face: f.face() as usize,
+            lit: flags(f.lit_mask(), lights),
+            rings: f
+                .rings()
+                .map(|r| r.iter().map(|&v| pt(v)).collect())
+                .collect(),
+            pieces: f
+                .pieces()
+                .map(|p| p.iter().map(|&v| pt(v)).collect())
+                .collect(),
+        })
+        .collect()
+}
+
+/// Exact area (as a multiple of the face's) per face and set of flags.
+type Areas = HashMap<(usize, Vec<bool>), Q>;
+
+fn areas_of<'a>(
+    scene: &Scene,
+    pieces: impl Iterator<Item = (usize, &'a [bool], &'a [HPoint])>,
+) -> Areas {
+    let mut out: Areas = HashMap::new();
+    for (face, lit, verts) in pieces {
+        *out.entry((face, lit.to_vec())).or_insert_with(Q::zero) +=
+            area_of(&scene.faces[face], verts);
+    }
+    out
+}
+
+fn compare_areas(what: &str, a: &Areas, b: &Areas) -> Result<(), String> {
+    let keys: BTreeSet<&(usize, Vec<bool>)> = a.keys().chain(b.keys()).collect();
+    for k in keys {
+        let (x, y) = (
+            a.get(k).cloned().unwrap_or_else(Q::zero),
+            b.get(k).cloned().unwrap_or_else(Q::zero),
+        );
+        if x != y {
+            return Err(format!(
+                "{what}: face {} with flags {:?} has {} of its area lit that way, not {}",
+                k.0,
+                k.1,
+                y.to_f64().unwrap_or(f64::NAN),
+                x.to_f64().unwrap_or(f64::NAN)
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The indices of the items to check: all, or per light up to `n` of each
+/// kind (lit, cast shadow, attached shadow) spread over the list.
+fn pick(
+    items: &[(usize, Vec<bool>)],
+    scene: &Scene,
+    lights: &[Light],
+    sample: Sample,
+) -> BTreeSet<usize> {
+    let n = match sample {
+        Sample::All => return (0..items.len()).collect(),
+        Sample::PerKind(n) => n,
+    };
     let mut out = BTreeSet::new();
     for (j, light) in lights.iter().enumerate() {
         let mut kinds: [Vec<usize>; 3] = Default::default();
-        for (i, f) in frags.iter().enumerate() {
-            let k = if !scene.faces[f.face() as usize].faces_light(light) {
+        for (i, (face, lit)) in items.iter().enumerate() {
+            let k = if !scene.faces[*face].faces_light(light) {
                 2
-            } else if f.lit()[j] {
+            } else if lit[j] {
                 0
             } else {
                 1
@@ -122,52 +226,132 @@ fn pick(frags: &[Fragment], scene: &Scene, lights: &[Light], n: usize) -> BTreeS
     out
 }
 
-/// Builds the tree for each seed, runs the shadows and checks the output:
-/// tiling of every face, flags on the chosen fragments.
+/// A fixed permutation of `n` items.
+fn shuffle(n: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..n).collect();
+    let mut s = 0x2545_f491_4f6c_dd1du64;
+    for i in (1..n).rev() {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        order.swap(i, (s % (i as u64 + 1)) as usize);
+    }
+    order
+}
+
+/// Runs both algorithms and checks everything (see the module docs).
 pub(crate) fn check(
     polys: &[Polygon],
     scene: &Scene,
     lights: &[Light],
     opts: &Opts,
 ) -> Result<Checked, String> {
-    let mut first: Option<Checked> = None;
-    let mut flags = FlagStats::default();
-    for &seed in &opts.seeds {
-        let tree = BspTree::build(polys.to_vec(), &BuildOptions::default().with_seed(seed));
-        let (frags, stats) = shadow_fragments(&tree, lights).map_err(|e| e.to_string())?;
-        let ctx = |e: String| format!("tree seed {seed}: {e}");
-        if stats.fragments != frags.len() {
-            return Err(ctx(format!(
-                "stats say {} fragments, {} came out",
-                stats.fragments,
-                frags.len()
-            )));
-        }
-        check_tiling(scene, &frags, opts.disjoint).map_err(ctx)?;
-        let tree_polys: Vec<&Polygon> = tree.polygons().collect();
-        check_pieces(scene, &tree_polys, &frags).map_err(ctx)?;
-        let chosen: Box<dyn Iterator<Item = &Fragment>> = match opts.sample {
-            Sample::All => Box::new(frags.iter()),
-            Sample::PerKind(n) => Box::new(
-                pick(&frags, scene, lights, n)
-                    .into_iter()
-                    .map(|i| &frags[i]),
-            ),
-        };
-        for f in chosen {
-            check_flags(scene, lights, f, &mut flags).map_err(ctx)?;
-        }
-        if first.is_none() {
-            first = Some(Checked {
-                frags,
-                stats,
-                flags: FlagStats::default(),
-            });
+    let n = lights.len();
+    let (batch, stats) = shadow_fragments(polys, lights).map_err(|e| e.to_string())?;
+    if stats.fragments != batch.len() {
+        return Err(format!(
+            "stats say {} fragments, {} came out",
+            stats.fragments,
+            batch.len()
+        ));
+    }
+    let regions = regions_of(&batch, n);
+    let pieces: Vec<(usize, Vec<HPoint>)> = regions
+        .iter()
+        .flat_map(|r| r.pieces.iter().map(move |p| (r.face, p.clone())))
+        .collect();
+    check_tiling(scene, &pieces, opts.disjoint).map_err(|e| format!("fast path: {e}"))?;
+    check_regions(scene, &regions).map_err(|e| format!("fast path: {e}"))?;
+    let mut flag_stats = FlagStats::default();
+    let items: Vec<(usize, Vec<bool>)> = regions.iter().map(|r| (r.face, r.lit.clone())).collect();
+    for i in pick(&items, scene, lights, opts.sample) {
+        let r = &regions[i];
+        for p in &r.pieces {
+            let piece = PieceRef {
+                face: r.face,
+                lit: &r.lit,
+                verts: p,
+            };
+            check_flags(scene, lights, &piece, &mut flag_stats)
+                .map_err(|e| format!("fast path: {e}"))?;
         }
     }
-    let mut out = first.ok_or("no seeds")?;
-    out.flags = flags;
-    Ok(out)
+    let areas = areas_of(
+        scene,
+        regions
+            .iter()
+            .flat_map(|r| r.pieces.iter().map(move |p| (r.face, &r.lit[..], &p[..]))),
+    );
+    if opts.shuffled {
+        let order = shuffle(polys.len());
+        let moved: Vec<Polygon> = order.iter().map(|&i| polys[i].clone()).collect();
+        let (b, _) = shadow_fragments(&moved, lights).map_err(|e| e.to_string())?;
+        let r = regions_of(&b, n);
+        let other = areas_of(
+            scene,
+            r.iter()
+                .flat_map(|r| r.pieces.iter().map(move |p| (r.face, &r.lit[..], &p[..]))),
+        );
+        compare_areas("shuffled input", &areas, &other)?;
+    }
+    for &seed in &opts.seeds {
+        let ctx = |e: String| format!("Chin & Feiner, tree seed {seed}: {e}");
+        let tree = BspTree::build(polys.to_vec(), &BuildOptions::default().with_seed(seed));
+        let cf = chin_feiner(&tree, lights).map_err(|e| e.to_string())?;
+        check_chin_feiner(scene, lights, &cf, opts, &areas, &mut flag_stats).map_err(ctx)?;
+    }
+    let frags = batch
+        .fragments()
+        .map(|f| Frag {
+            face: f.face(),
+            lit: flags(f.lit_mask(), n),
+            holes: f.hole_count(),
+        })
+        .collect();
+    Ok(Checked {
+        frags,
+        stats,
+        flags: flag_stats,
+    })
+}
+
+/// Chin & Feiner's fragments: valid convex polygons that tile the faces,
+/// with the oracle's flags (sampled as `opts` says), and the same exact
+/// area per face and flags as the fast path.
+fn check_chin_feiner(
+    scene: &Scene,
+    lights: &[Light],
+    cf: &CfFragments,
+    opts: &Opts,
+    areas: &Areas,
+    stats: &mut FlagStats,
+) -> Result<(), String> {
+    let n = lights.len();
+    let mut pieces: Vec<(usize, Vec<HPoint>)> = Vec::with_capacity(cf.len());
+    let mut items = Vec::with_capacity(cf.len());
+    for f in cf.iter() {
+        f.sanity_check()
+            .map_err(|e| format!("fragment of face {}: sanity_check: {e}", f.face()))?;
+        pieces.push((f.face() as usize, f.vertices().map(HPoint::of).collect()));
+        items.push((f.face() as usize, flags(f.lit_mask(), n)));
+    }
+    check_tiling(scene, &pieces, opts.disjoint)?;
+    for i in pick(&items, scene, lights, opts.sample) {
+        let piece = PieceRef {
+            face: items[i].0,
+            lit: &items[i].1,
+            verts: &pieces[i].1,
+        };
+        check_flags(scene, lights, &piece, stats)?;
+    }
+    let mine = areas_of(
+        scene,
+        items
+            .iter()
+            .zip(&pieces)
+            .map(|((face, lit), (_, v))| (*face, &lit[..], &v[..])),
+    );
+    compare_areas("against the fast path", areas, &mine)
 }
 
 /// The floor `[0, 8]^2` with the roof `[2, 4]^2` at height 4 over it.
@@ -185,52 +369,91 @@ fn the_flag_check_rejects_another_lights_flags() {
     // the oracle for a light elsewhere
     let loops = floor_and_roof();
     let scene = scene_of(&loops);
-    let tree = BspTree::build(polygons(&loops).unwrap(), &BuildOptions::default());
     let here = [Light::Point([3, 3, 8])];
-    let (frags, _) = shadow_fragments(&tree, &here).unwrap();
+    let (b, _) = shadow_fragments(&polygons(&loops).unwrap(), &here).unwrap();
+    let regions = regions_of(&b, 1);
     let mut stats = FlagStats::default();
-    for f in &frags {
-        check_flags(&scene, &here, f, &mut stats).unwrap();
-    }
-    for other in [Light::Point([7, 7, 8]), Light::Directional([0, 0, 1])] {
-        let errors = frags
+    let check_all = |lights: &[Light], stats: &mut FlagStats| {
+        regions
             .iter()
-            .filter(|f| check_flags(&scene, &[other], f, &mut stats).is_err())
-            .count();
-        assert!(errors > 0, "{other:?}");
+            .flat_map(|r| r.pieces.iter().map(move |p| (r, p)))
+            .filter(|(r, p)| {
+                let piece = PieceRef {
+                    face: r.face,
+                    lit: &r.lit,
+                    verts: p,
+                };
+                check_flags(&scene, lights, &piece, stats).is_err()
+            })
+            .count()
+    };
+    assert_eq!(check_all(&here, &mut stats), 0);
+    for other in [Light::Point([7, 7, 8]), Light::Directional([0, 0, 1])] {
+        assert!(check_all(&[other], &mut stats) > 0, "{other:?}");
     }
 }
 
 #[test]
-fn the_tiling_check_rejects_a_missing_or_repeated_fragment() {
+fn the_tiling_and_region_checks_reject_broken_output() {
     let loops = floor_and_roof();
     let scene = scene_of(&loops);
-    let tree = BspTree::build(polygons(&loops).unwrap(), &BuildOptions::default());
-    let (frags, _) = shadow_fragments(&tree, &[Light::Point([3, 3, 8])]).unwrap();
-    check_tiling(&scene, &frags, true).unwrap();
-    let floor: Vec<usize> = (0..frags.len()).filter(|&i| frags[i].face() == 0).collect();
+    let (b, _) = shadow_fragments(&polygons(&loops).unwrap(), &[Light::Point([3, 3, 8])]).unwrap();
+    let regions = regions_of(&b, 1);
+    let pieces: Vec<(usize, Vec<HPoint>)> = regions
+        .iter()
+        .flat_map(|r| r.pieces.iter().map(move |p| (r.face, p.clone())))
+        .collect();
+    check_tiling(&scene, &pieces, true).unwrap();
+    check_regions(&scene, &regions).unwrap();
+    let floor: Vec<usize> = (0..pieces.len()).filter(|&i| pieces[i].0 == 0).collect();
     assert!(floor.len() > 1);
     for &i in &floor {
-        let mut fewer = frags.clone();
+        let mut fewer = pieces.clone();
         fewer.remove(i);
         assert!(check_tiling(&scene, &fewer, false).is_err());
-        let mut more = frags.clone();
-        more.push(frags[i].clone());
+        let mut more = pieces.clone();
+        more.push(pieces[i].clone());
         assert!(check_tiling(&scene, &more, false).is_err());
     }
-    // a fragment swapped in from another scene: same area, wrong place
-    let moved = vec![
-        vec![[0, 0, 0], [8, 0, 0], [8, 8, 0], [0, 8, 0]],
-        vec![[4, 4, 4], [6, 4, 4], [6, 6, 4], [4, 6, 4]],
-    ];
-    let tree2 = BspTree::build(polygons(&moved).unwrap(), &BuildOptions::default());
-    let (frags2, _) = shadow_fragments(&tree2, &[Light::Point([5, 5, 8])]).unwrap();
-    let dark = |fs: &[Fragment]| {
-        fs.iter()
-            .position(|f| f.face() == 0 && !f.lit()[0])
-            .expect("a shadow on the floor")
-    };
-    let mut swapped = frags.clone();
-    swapped[dark(&frags)] = frags2[dark(&frags2)].clone();
-    assert!(check_tiling(&scene, &swapped, true).is_err());
+    // a region split in two along a cut with equal flags on both sides
+    let lit = regions
+        .iter()
+        .position(|r| r.face == 0 && r.lit[0])
+        .unwrap();
+    assert!(regions[lit].pieces.len() > 1);
+    let mut split: Vec<Region> = Vec::new();
+    for (i, r) in regions.iter().enumerate() {
+        if i == lit {
+            for p in &r.pieces {
+                split.push(Region {
+                    face: r.face,
+                    lit: r.lit.clone(),
+                    rings: vec![p.clone()],
+                    pieces: vec![p.clone()],
+                });
+            }
+        } else {
+            split.push(Region {
+                face: r.face,
+                lit: r.lit.clone(),
+                rings: r.rings.clone(),
+                pieces: r.pieces.clone(),
+            });
+        }
+    }
+    let e = check_regions(&scene, &split).unwrap_err();
+    assert!(e.contains("touch along an edge"), "{e}");
+    // a hole turned the wrong way
+    let mut turned: Vec<Region> = regions
+        .iter()
+        .map(|r| Region {
+            face: r.face,
+            lit: r.lit.clone(),
+            rings: r.rings.clone(),
+            pieces: r.pieces.clone(),
+        })
+        .collect();
+    assert_eq!(turned[lit].rings.len(), 2);
+    turned[lit].rings[1].reverse();
+    assert!(check_regions(&scene, &turned).is_err());
 }

@@ -61,6 +61,7 @@ fn check_mesh(
         seeds: vec![BuildOptions::default().seed],
         sample: Sample::PerKind(per_kind),
         disjoint: true,
+        shuffled: true,
     };
     let checked = check(&polys, &scene, &lights, &opts)
         .unwrap_or_else(|e| panic!("{name}, lights {lights:?}: {e}"));

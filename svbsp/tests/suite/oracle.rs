@@ -22,11 +22,11 @@
 
 use std::collections::HashMap;
 
-use bsp_core::{I256, I512, Polygon};
+use bsp_core::{I256, I512, Polygon, Vertex};
 use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::{One, Signed, ToPrimitive, Zero};
-use svbsp::{Fragment, Light, WPoint};
+use svbsp::{Light, WPoint};
 
 /// An exact rational.
 pub(crate) type Q = BigRational;
@@ -118,6 +118,22 @@ impl HPoint {
         HPoint {
             x: [0, 1, 2].map(|k| big(h[k])),
             w,
+        }
+    }
+
+    /// The exact point of a fragment vertex of the fast path.
+    pub(crate) fn of_vertex(v: &Vertex) -> HPoint {
+        match v {
+            Vertex::Grid(g) => HPoint::grid(g.map(i64::from)),
+            Vertex::Implicit(i) => {
+                let h = i.coords();
+                let w = big256(h[3]);
+                assert!(w.is_positive(), "homogeneous w must be positive: {h:?}");
+                HPoint {
+                    x: [0, 1, 2].map(|k| big256(h[k])),
+                    w,
+                }
+            }
         }
     }
 
@@ -546,26 +562,40 @@ pub(crate) struct FlagStats {
     pub(crate) cast: usize,
 }
 
-/// Checks every flag of `frag` against the oracle on interior samples.
+/// A convex piece to check: its face, its flags and its exact vertices.
+pub(crate) struct PieceRef<'a> {
+    pub(crate) face: usize,
+    pub(crate) lit: &'a [bool],
+    pub(crate) verts: &'a [HPoint],
+}
+
+impl PieceRef<'_> {
+    fn f64s(&self) -> Vec<[f64; 3]> {
+        self.verts.iter().map(HPoint::f64).collect()
+    }
+}
+
+/// Checks every flag of a convex piece against the oracle on interior
+/// samples.
 pub(crate) fn check_flags(
     scene: &Scene,
     lights: &[Light],
-    frag: &Fragment,
+    frag: &PieceRef<'_>,
     stats: &mut FlagStats,
 ) -> Result<(), String> {
-    let own = frag.face() as usize;
-    let verts: Vec<HPoint> = frag.vertices().map(HPoint::of).collect();
+    let own = frag.face;
+    let verts = frag.verts;
     let g = &scene.faces[own];
-    if frag.lit().len() != lights.len() {
+    if frag.lit.len() != lights.len() {
         return Err(format!(
             "fragment of face {own} has {} flags for {} lights",
-            frag.lit().len(),
+            frag.lit.len(),
             lights.len()
         ));
     }
-    let mut pts = samples(&verts, 1);
+    let mut pts = samples(verts, 1);
     for (j, light) in lights.iter().enumerate() {
-        let flag = frag.lit()[j];
+        let flag = frag.lit[j];
         stats.pairs += 1;
         if !g.faces_light(light) {
             stats.attached += 1;
@@ -573,7 +603,7 @@ pub(crate) fn check_flags(
                 return Err(format!(
                     "face {own} does not have light {j} ({light:?}) strictly in front, \
                      yet a fragment is lit: {:?}",
-                    frag.vertices_f64()
+                    frag.f64s()
                 ));
             }
             continue;
@@ -593,10 +623,10 @@ pub(crate) fn check_flags(
                     return Err(format!(
                         "light {j} ({light:?}): every sample of a fragment of face {own} is \
                          degenerate; fragment {:?}",
-                        frag.vertices_f64()
+                        frag.f64s()
                     ));
                 }
-                pts.push(samples(&verts, generic + 1).pop().expect("one more"));
+                pts.push(samples(verts, generic + 1).pop().expect("one more"));
             }
             let x = &pts[next];
             next += 1;
@@ -607,7 +637,7 @@ pub(crate) fn check_flags(
                     // shadow boundary through the sample would put some
                     // vertex, and the point toward it, on its far side)
                     stats.degenerate += 1;
-                    for v in &verts {
+                    for v in verts {
                         let probe = HPoint::combine(&[x.clone(), v.clone()], &[(1 << 30) - 1, 1]);
                         match scene.verdict(light, own, &probe) {
                             Verdict::Degenerate { .. } => {}
@@ -618,7 +648,7 @@ pub(crate) fn check_flags(
                                      {p:?}; fragment {:?}",
                                     if flag { "lit" } else { "shadowed" },
                                     probe.f64(),
-                                    frag.vertices_f64()
+                                    frag.f64s()
                                 ));
                             }
                             _ => stats.probes += 1,
@@ -634,7 +664,7 @@ pub(crate) fn check_flags(
                              ray oracle says {v:?} at {:?}; fragment {:?}",
                             if flag { "lit" } else { "shadowed" },
                             x.f64(),
-                            frag.vertices_f64()
+                            frag.f64s()
                         ));
                     }
                 }
@@ -692,121 +722,124 @@ fn separated(a: &[HPoint], b: &[HPoint], ax: usize, ccw: bool) -> bool {
 /// `[min; -max]`.
 type Boxed = (Vec<HPoint>, [f64; 6]);
 
-/// Checks that fragments tile their faces exactly: every fragment passes
-/// `sanity_check` and, recomputed here, has its vertices on their edge
-/// planes and strictly behind the others; it has the face's support plane,
-/// lies in the face's plane and inside the face, and has an area vector
-/// that is a positive multiple of the face's; per face, those multiples
-/// add up to exactly one (so the area vectors add up to the face's), and
-/// (with `disjoint`) no two fragments overlap. Together these say each
-/// face is covered exactly once.
+fn boxed(verts: &[HPoint]) -> [f64; 6] {
+    // a box around the exact vertices (the margin dwarfs the float error),
+    // to skip exact tests on far pairs
+    let mut bb = [f64::INFINITY; 6];
+    for v in verts {
+        for (k, x) in v.f64().into_iter().enumerate() {
+            let m = 1e-9 * (x.abs() + 1.0);
+            bb[k] = bb[k].min(x - m);
+            bb[k + 3] = bb[k + 3].min(-(x + m));
+        }
+    }
+    bb
+}
+
+fn boxes_apart(a: &[f64; 6], b: &[f64; 6]) -> bool {
+    (0..3).any(|k| -a[k + 3] < b[k] || -b[k + 3] < a[k])
+}
+
+/// The dominant axis of face `g`'s normal, and whether loops that run
+/// counter-clockwise about the normal run counter-clockwise in the
+/// projection along it.
+fn projection(g: &Face) -> (usize, bool) {
+    let ax = (0..3)
+        .max_by(|&a, &b| g.n[a].abs().cmp(&g.n[b].abs()))
+        .expect("three axes");
+    (ax, g.n[ax].is_positive())
+}
+
+/// A polygon's area as a multiple of its face's (signed: positive when it
+/// runs counter-clockwise about the face's normal).
+pub(crate) fn area_of(g: &Face, verts: &[HPoint]) -> Q {
+    let (a, den) = area2(verts);
+    Q::new(zdot(&a, &g.n), den * zdot(&g.n, &g.n))
+}
+
+/// Checks that convex pieces tile their faces exactly: each piece is
+/// strictly convex (recomputed here), lies in its face's plane and inside
+/// the face, runs counter-clockwise about the face's normal; per face the
+/// areas add up to exactly the face's, and (with `disjoint`) no two pieces
+/// overlap. Together these say each face is covered exactly once.
 pub(crate) fn check_tiling(
     scene: &Scene,
-    frags: &[Fragment],
+    pieces: &[(usize, Vec<HPoint>)],
     disjoint: bool,
 ) -> Result<(), String> {
     let mut sums: Vec<Q> = vec![Q::zero(); scene.faces.len()];
     let mut per_face: HashMap<usize, Vec<Boxed>> = HashMap::new();
-    for (i, f) in frags.iter().enumerate() {
-        let fi = f.face() as usize;
-        let ctx = || format!("fragment {i} of face {fi} {:?}", f.vertices_f64());
+    for (i, (fi, verts)) in pieces.iter().enumerate() {
+        let fi = *fi;
+        let ctx = || {
+            format!(
+                "piece {i} of face {fi} {:?}",
+                verts.iter().map(HPoint::f64).collect::<Vec<_>>()
+            )
+        };
         let g = scene
             .faces
             .get(fi)
-            .ok_or_else(|| format!("fragment {i} has unknown face {fi}"))?;
-        f.sanity_check()
-            .map_err(|e| format!("{}: sanity_check: {e}", ctx()))?;
-        let s = f.support();
-        if plane_key(&s.normal().map(BigInt::from), &BigInt::from(s.offset())) != g.key {
-            return Err(format!(
-                "{}: support plane {s:?} is not the face's plane",
-                ctx()
-            ));
+            .ok_or_else(|| format!("piece {i} has unknown face {fi}"))?;
+        let k = verts.len();
+        if k < 3 {
+            return Err(format!("{}: fewer than three vertices", ctx()));
         }
-        let verts: Vec<HPoint> = f.vertices().map(HPoint::of).collect();
-        for (k, v) in verts.iter().enumerate() {
+        for (m, v) in verts.iter().enumerate() {
             if !g.eval(v).is_zero() {
-                return Err(format!("{}: vertex {k} is off the face's plane", ctx()));
+                return Err(format!("{}: vertex {m} is off the face's plane", ctx()));
             }
             if g.locate(v) == Loc::Outside {
-                return Err(format!("{}: vertex {k} is outside the face", ctx()));
+                return Err(format!("{}: vertex {m} is outside the face", ctx()));
             }
         }
-        // the edge planes, recomputed: edge j holds vertices j and j + 1
-        // and has the others strictly behind it
-        let k = verts.len();
-        if f.edges().len() != k {
-            return Err(format!(
-                "{}: {} edges for {k} vertices",
-                ctx(),
-                f.edges().len()
-            ));
-        }
-        for (j, e) in f.edges().iter().enumerate() {
-            let w = e.wide();
-            let n = w.normal().map(big256);
-            let d = big256(w.offset());
-            for (m, v) in verts.iter().enumerate() {
-                let s = zdot(&n, &v.x) + &d * &v.w;
-                let on = m == j || m == (j + 1) % k;
-                if on && !s.is_zero() || !on && !s.is_negative() {
-                    return Err(format!(
-                        "{}: vertex {m} is {} edge plane {j}",
-                        ctx(),
-                        if on { "off" } else { "not strictly behind" }
-                    ));
-                }
+        let (ax, ccw) = projection(g);
+        for m in 0..k {
+            let o = orient2(&verts[m], &verts[(m + 1) % k], &verts[(m + 2) % k], ax);
+            let wrong = if ccw {
+                !o.is_positive()
+            } else {
+                !o.is_negative()
+            };
+            if wrong {
+                return Err(format!(
+                    "{}: not strictly convex counter-clockwise at vertex {}",
+                    ctx(),
+                    (m + 1) % k
+                ));
             }
         }
-        let (a, den) = area2(&verts);
-        let along = zdot(&a, &g.n);
-        if zcross(&a, &g.n).iter().any(|c| !c.is_zero()) || !along.is_positive() {
-            return Err(format!(
-                "{}: area vector is not a positive multiple of the face's",
-                ctx()
-            ));
+        let a = area_of(g, verts);
+        if !a.is_positive() {
+            return Err(format!("{}: area is not positive", ctx()));
         }
-        // a = (along / (den |n|^2)) n
-        sums[fi] += Q::new(along, den * zdot(&g.n, &g.n));
+        sums[fi] += a;
         if disjoint {
-            // a box around the exact vertices (the margin dwarfs the
-            // float error), to skip exact tests on far pairs
-            let mut bb = [f64::INFINITY; 6];
-            for v in &verts {
-                for (k, x) in v.f64().into_iter().enumerate() {
-                    let m = 1e-9 * (x.abs() + 1.0);
-                    bb[k] = bb[k].min(x - m);
-                    bb[k + 3] = bb[k + 3].min(-(x + m));
-                }
-            }
-            per_face.entry(fi).or_default().push((verts, bb));
+            per_face
+                .entry(fi)
+                .or_default()
+                .push((verts.clone(), boxed(verts)));
         }
     }
     for (fi, s) in sums.iter().enumerate() {
         if !s.is_one() {
             return Err(format!(
-                "face {fi}: fragment areas add up to {} times the face's area",
+                "face {fi}: piece areas add up to {} times the face's area",
                 s.to_f64().unwrap_or(f64::NAN)
             ));
         }
     }
     for (fi, list) in &per_face {
-        let g = &scene.faces[*fi];
-        let ax = (0..3)
-            .max_by(|&a, &b| g.n[a].abs().cmp(&g.n[b].abs()))
-            .expect("three axes");
-        let ccw = g.n[ax].is_positive();
+        let (ax, ccw) = projection(&scene.faces[*fi]);
         for i in 0..list.len() {
             for j in i + 1..list.len() {
                 let (a, ba) = &list[i];
                 let (b, bb) = &list[j];
-                // boxes stored as [min; -max]
-                let apart = (0..3).any(|k| -ba[k + 3] < bb[k] || -bb[k + 3] < ba[k]);
-                if apart || separated(a, b, ax, ccw) || separated(b, a, ax, ccw) {
+                if boxes_apart(ba, bb) || separated(a, b, ax, ccw) || separated(b, a, ax, ccw) {
                     continue;
                 }
                 return Err(format!(
-                    "face {fi}: two fragments overlap: {:?} and {:?}",
+                    "face {fi}: two pieces overlap: {:?} and {:?}",
                     a.iter().map(HPoint::f64).collect::<Vec<_>>(),
                     b.iter().map(HPoint::f64).collect::<Vec<_>>()
                 ));
@@ -816,67 +849,149 @@ pub(crate) fn check_tiling(
     Ok(())
 }
 
-/// Checks [`Fragment::polygon`]: fragments come out grouped by scene
-/// polygon in the tree's order, each names a tree polygon of its face, and
-/// the fragments of each tree polygon add up to its area exactly (with
-/// [`check_tiling`], they tile it).
-pub(crate) fn check_pieces(
-    scene: &Scene,
-    tree_polys: &[&Polygon],
-    frags: &[Fragment],
-) -> Result<(), String> {
-    let mut sums: Vec<Q> = vec![Q::zero(); tree_polys.len()];
-    let mut last = 0;
-    for (i, f) in frags.iter().enumerate() {
-        let pi = f.polygon() as usize;
-        if pi < last {
-            return Err(format!(
-                "fragment {i} of tree polygon {pi} comes after one of polygon {last}"
-            ));
-        }
-        last = pi;
-        let p = tree_polys.get(pi).ok_or_else(|| {
-            format!(
-                "fragment {i} names tree polygon {pi} of {}",
-                tree_polys.len()
-            )
-        })?;
-        if p.tag() != f.face() {
-            return Err(format!(
-                "fragment {i} of face {} names tree polygon {pi} of face {}",
-                f.face(),
-                p.tag()
-            ));
-        }
-        let g = &scene.faces[f.face() as usize];
-        let (a, den) = area2(&f.vertices().map(HPoint::of).collect::<Vec<_>>());
-        sums[pi] += Q::new(zdot(&a, &g.n), den * zdot(&g.n, &g.n));
-    }
-    for (pi, p) in tree_polys.iter().enumerate() {
-        let verts: Vec<HPoint> = p
-            .vertices()
-            .iter()
-            .map(|v| {
-                let h = v.homogeneous().map(big256);
-                assert!(h[3].is_positive(), "kernel point with w <= 0: {v:?}");
-                HPoint {
-                    x: [h[0].clone(), h[1].clone(), h[2].clone()],
-                    w: h[3].clone(),
+/// A fragment of the fast path, as the checks see it.
+pub(crate) struct Region {
+    pub(crate) face: usize,
+    pub(crate) lit: Vec<bool>,
+    /// The outer ring first, then the holes.
+    pub(crate) rings: Vec<Vec<HPoint>>,
+    /// Convex pieces whose union the fragment is.
+    pub(crate) pieces: Vec<Vec<HPoint>>,
+}
+
+/// Checks fragments that are regions: the outer ring runs
+/// counter-clockwise and each hole clockwise, every ring vertex lies in
+/// the face; the rings' signed areas add up to exactly the pieces' (so the
+/// rings bound the pieces' union); no ring has a vertex where it runs
+/// straight on; and the regions are as large as they can be: no two
+/// fragments of a face with the same flags share a stretch of boundary.
+pub(crate) fn check_regions(scene: &Scene, regions: &[Region]) -> Result<(), String> {
+    let mut by_face: HashMap<usize, Vec<usize>> = HashMap::new();
+    for (i, r) in regions.iter().enumerate() {
+        let g = &scene.faces[r.face];
+        let ctx = || format!("fragment {i} of face {}", r.face);
+        let (ax, ccw) = projection(g);
+        let mut ring_area = Q::zero();
+        for (k, ring) in r.rings.iter().enumerate() {
+            if ring.len() < 3 {
+                return Err(format!("{}: ring {k} has {} vertices", ctx(), ring.len()));
+            }
+            for v in ring {
+                if !g.eval(v).is_zero() || g.locate(v) == Loc::Outside {
+                    return Err(format!("{}: ring {k} leaves the face", ctx()));
                 }
-            })
-            .collect();
-        let g = &scene.faces[p.tag() as usize];
-        let (a, den) = area2(&verts);
-        let want = Q::new(zdot(&a, &g.n), den * zdot(&g.n, &g.n));
-        if sums[pi] != want {
+            }
+            let m = ring.len();
+            for j in 0..m {
+                if orient2(&ring[j], &ring[(j + 1) % m], &ring[(j + 2) % m], ax).is_zero() {
+                    let (a, c) = (&ring[j], &ring[(j + 2) % m]);
+                    // straight on, not a spike back
+                    let dot: Q = (0..3)
+                        .map(|d| {
+                            (&ring[(j + 1) % m].q()[d] - &a.q()[d])
+                                * (&c.q()[d] - &ring[(j + 1) % m].q()[d])
+                        })
+                        .fold(Q::zero(), |s, t| s + t);
+                    if dot.is_positive() {
+                        return Err(format!(
+                            "{}: ring {k} runs straight on at vertex {}",
+                            ctx(),
+                            (j + 1) % m
+                        ));
+                    }
+                }
+            }
+            let a = area_of(g, ring);
+            if (k == 0) != a.is_positive() {
+                return Err(format!(
+                    "{}: ring {k} runs the wrong way ({})",
+                    ctx(),
+                    if k == 0 { "outer" } else { "hole" }
+                ));
+            }
+            ring_area += a;
+        }
+        let piece_area = r
+            .pieces
+            .iter()
+            .map(|p| area_of(g, p))
+            .fold(Q::zero(), |s, t| s + t);
+        if ring_area != piece_area {
             return Err(format!(
-                "tree polygon {pi} (face {}): its fragments cover {} of its area",
-                p.tag(),
-                (&sums[pi] / &want).to_f64().unwrap_or(f64::NAN)
+                "{}: rings enclose {} of the face, pieces {}",
+                ctx(),
+                ring_area.to_f64().unwrap_or(f64::NAN),
+                piece_area.to_f64().unwrap_or(f64::NAN)
             ));
+        }
+        let _ = ccw;
+        by_face.entry(r.face).or_default().push(i);
+    }
+    // maximality: pieces of different fragments with the same flags never
+    // share a stretch of edge
+    for (face, list) in &by_face {
+        let (ax, _) = projection(&scene.faces[*face]);
+        let items: Vec<(usize, &Vec<HPoint>, [f64; 6])> = list
+            .iter()
+            .flat_map(|&i| regions[i].pieces.iter().map(move |p| (i, p, boxed(p))))
+            .collect();
+        for a in 0..items.len() {
+            for b in a + 1..items.len() {
+                let (ia, pa, ba) = &items[a];
+                let (ib, pb, bb) = &items[b];
+                if ia == ib || regions[*ia].lit != regions[*ib].lit || boxes_apart(ba, bb) {
+                    continue;
+                }
+                if share_edge(pa, pb, ax) {
+                    return Err(format!(
+                        "face {face}: fragments {ia} and {ib} have the same flags {:?} but \
+                         touch along an edge: a cut that separates nothing survived",
+                        regions[*ia].lit
+                    ));
+                }
+            }
         }
     }
     Ok(())
+}
+
+/// `true` if some edge of `a` and some edge of `b` overlap along a
+/// stretch of positive length (projected along axis `ax`).
+fn share_edge(a: &[HPoint], b: &[HPoint], ax: usize) -> bool {
+    let (u, v) = ((ax + 1) % 3, (ax + 2) % 3);
+    let (ka, kb) = (a.len(), b.len());
+    for i in 0..ka {
+        let (p, q) = (&a[i], &a[(i + 1) % ka]);
+        for j in 0..kb {
+            let (r, s) = (&b[j], &b[(j + 1) % kb]);
+            if !orient2(p, q, r, ax).is_zero() || !orient2(p, q, s, ax).is_zero() {
+                continue;
+            }
+            // collinear: compare the parameters along the longer axis
+            let (pq, qq, rq, sq) = (p.q(), q.q(), r.q(), s.q());
+            let t = if (&qq[u] - &pq[u]).abs() >= (&qq[v] - &pq[v]).abs() {
+                u
+            } else {
+                v
+            };
+            let (lo1, hi1) = if pq[t] < qq[t] {
+                (&pq[t], &qq[t])
+            } else {
+                (&qq[t], &pq[t])
+            };
+            let (lo2, hi2) = if rq[t] < sq[t] {
+                (&rq[t], &sq[t])
+            } else {
+                (&sq[t], &rq[t])
+            };
+            let lo = if lo1 > lo2 { lo1 } else { lo2 };
+            let hi = if hi1 < hi2 { hi1 } else { hi2 };
+            if lo < hi {
+                return true;
+            }
+        }
+    }
+    false
 }
 
 #[test]

@@ -2,7 +2,7 @@
 //! and the exact tiling check, on three different scene trees.
 
 use bsp_core::{BspTree, BuildOptions, MAX_COORD, Polygon};
-use svbsp::{Light, LightError, shadow_fragments};
+use svbsp::{Light, LightError, ShadowError, chin_feiner, shadow_fragments};
 
 use crate::harness::assert_loops;
 
@@ -48,6 +48,38 @@ fn cube_helper_faces_outward() {
             .count(),
         1
     );
+}
+
+#[test]
+fn uniform_faces_are_one_fragment_and_shadows_make_holes() {
+    // the floor: a lit ring around the roof's shadow; the roof and a
+    // tile far away are lit all over, each one fragment; a lit tile and a
+    // tile wholly in shadow stay whole too
+    let floor = up(0, 0, 8, 8, 0);
+    let roof = up(2, 2, 4, 4, 4);
+    let far = up(20, 20, 22, 22, 0);
+    let dark = up(3, 3, 4, 4, 1);
+    let c = assert_loops(&[floor, roof, far, dark], &[Light::Point([3, 3, 8])]);
+    assert_eq!(c.fragments_of(0), 2);
+    let lit: Vec<_> = c
+        .frags
+        .iter()
+        .filter(|f| f.face() == 0 && f.lit()[0])
+        .collect();
+    assert_eq!((lit.len(), lit[0].holes()), (1, 1));
+    for face in [1, 2, 3] {
+        assert_eq!(c.fragments_of(face), 1, "face {face}");
+    }
+    assert_eq!(c.flags_of(3, 0), [false]);
+    // two lights: the floor's fragments are the overlay of both shadows,
+    // still one per connected part with equal flags
+    let c = assert_loops(
+        &[up(0, 0, 8, 8, 0), up(2, 2, 4, 4, 4)],
+        &[Light::Point([3, 3, 8]), Light::Point([3, 3, 9])],
+    );
+    // both shadows are squares about (3, 3): [1, 5]^2 and [1.4, 4.6]^2
+    assert_eq!(c.fragments_of(0), 3);
+    assert_eq!(c.fragments_of(1), 1);
 }
 
 #[test]
@@ -279,27 +311,31 @@ fn no_lights_and_bad_lights() {
         Polygon::from_grid_points(&up(0, 0, 4, 4, 0), 0).unwrap(),
         Polygon::from_grid_points(&up(1, 1, 2, 2, 2), 1).unwrap(),
     ];
-    let tree = BspTree::build(polys, &BuildOptions::default());
-    let (frags, stats) = shadow_fragments(&tree, &[]).unwrap();
-    assert_eq!(frags.len(), stats.polygons);
-    assert!(frags.iter().all(|f| f.lit().is_empty()));
+    let (frags, stats) = shadow_fragments(&polys, &[]).unwrap();
+    assert_eq!((frags.len(), stats.receivers), (2, 2));
+    assert!(frags.fragments().all(|f| f.lit_mask() == 0));
+    let bad = |lights: &[Light]| match shadow_fragments(&polys, lights).unwrap_err() {
+        ShadowError::Light(e) => e,
+        e => panic!("{e}"),
+    };
     assert_eq!(
-        shadow_fragments(&tree, &[Light::Point([MAX_COORD + 1, 0, 0])]).unwrap_err(),
+        bad(&[Light::Point([MAX_COORD + 1, 0, 0])]),
         LightError::OutOfGrid
     );
     assert_eq!(
-        shadow_fragments(&tree, &[Light::Directional([0, 0, -MAX_COORD - 1])]).unwrap_err(),
+        bad(&[Light::Directional([0, 0, -MAX_COORD - 1])]),
         LightError::OutOfGrid
     );
     assert_eq!(
-        shadow_fragments(
-            &tree,
-            &[Light::Point([0, 0, 1]), Light::Directional([0, 0, 0])]
-        )
-        .unwrap_err(),
+        bad(&[Light::Point([0, 0, 1]), Light::Directional([0, 0, 0])]),
         LightError::ZeroDirection
     );
-    let empty = BspTree::build(Vec::new(), &BuildOptions::default());
-    let (frags, _) = shadow_fragments(&empty, &[Light::Point([0, 0, 1])]).unwrap();
+    let (frags, _) = shadow_fragments(&[], &[Light::Point([0, 0, 1])]).unwrap();
     assert!(frags.is_empty());
+    // the same for Chin & Feiner
+    let tree = BspTree::build(polys, &BuildOptions::default());
+    assert_eq!(
+        chin_feiner(&tree, &[Light::Directional([0, 0, 0])]).err(),
+        Some(LightError::ZeroDirection)
+    );
 }

@@ -1,0 +1,422 @@
+//! Exact homogeneous points of any integer width, and the one
+//! floating-point filter every tier uses.
+//!
+//! A point is `(x, y, z, w)` with `w > 0` in fixed-width integers
+//! (`bnum::BInt<N>`, `N` limbs of 64 bits), plus `f64` approximations of
+//! its four coordinates. The input tier (points where three input planes
+//! meet) uses `N = 4` (256 bits); the shadow tier of `svbsp` uses `N = 8`
+//! (512 bits). Everything here is written once for every width:
+//!
+//! - [`filter_side`]: the sign of a plane at a point from the `f64`
+//!   approximations, or `None` when rounding could have changed it;
+//! - correctly rounded conversion to `f64` ([`Homogeneous::round_with`]),
+//!   which multiplies and compares but does not divide in the common case;
+//! - exact comparison of coordinates and exact point identity.
+//!
+//! The error bounds are in `docs/architecture.md` ("The floating-point
+//! filter").
+
+use std::cmp::Ordering;
+
+use bnum::cast::As;
+use bnum::{BInt, BUint};
+
+use crate::Side;
+
+/// `2^-48`: the filter's relative error bound. Each of the eight inputs
+/// of a 4-term dot product carries a relative error of at most `3u`
+/// (`u = 2^-53`, see [`approx`]), each product one more rounding and the
+/// sum three: at most `10u · Σ|terms| < 2^-49.6 · Σ|terms|` in all, which
+/// this bound covers three times over.
+pub const FILTER_REL: f64 = 1.0 / (1u64 << 48) as f64;
+
+/// The sign of `plane · point` (four terms) when the `f64` evaluation
+/// certifies it, `None` when the value is too close to zero to tell.
+///
+/// Both arguments are approximations of exact integers with relative
+/// error at most `3 · 2^-53` each (as [`approx`] and plain `i64 as f64`
+/// conversions give). The answer is never wrong; `None` sends the caller
+/// to its exact path.
+#[inline]
+pub fn filter_side(plane: &[f64; 4], point: &[f64; 4]) -> Option<Side> {
+    let t = [
+        plane[0] * point[0],
+        plane[1] * point[1],
+        plane[2] * point[2],
+        plane[3] * point[3],
+    ];
+    let v = (t[0] + t[1]) + (t[2] + t[3]);
+    let m = (t[0].abs() + t[1].abs()) + (t[2].abs() + t[3].abs());
+    let bound = m * FILTER_REL;
+    if v > bound {
+        Some(Side::Front)
+    } else if v < -bound {
+        Some(Side::Back)
+    } else {
+        None
+    }
+}
+
+/// [`filter_side`] for a point whose approximations carry absolute
+/// errors: `|point[i] - x_i| <= err[i]` for the exact coordinates `x_i`.
+///
+/// With plane coefficients of relative error at most `3u`, the computed
+/// value differs from the true one by at most `8u · Σ|terms| + (1 + 5u) ·
+/// Σ|plane[i]| err[i]` (`u = 2^-53`); the bound used, `2^-48 · Σ|terms| +
+/// 1.0625 · Σ|plane[i]| err[i]`, covers it with room for the rounding of
+/// the bound itself. With `err = 0` this is [`filter_side`].
+#[inline]
+pub fn filter_side_err(plane: &[f64; 4], point: &[f64; 4], err: &[f64; 4]) -> Option<Side> {
+    let t = [
+        plane[0] * point[0],
+        plane[1] * point[1],
+        plane[2] * point[2],
+        plane[3] * point[3],
+    ];
+    let v = (t[0] + t[1]) + (t[2] + t[3]);
+    let m = (t[0].abs() + t[1].abs()) + (t[2].abs() + t[3].abs());
+    let e = (plane[0].abs() * err[0] + plane[1].abs() * err[1])
+        + (plane[2].abs() * err[2] + plane[3].abs() * err[3]);
+    let bound = m * FILTER_REL + e * 1.0625;
+    if v > bound {
+        Some(Side::Front)
+    } else if v < -bound {
+        Some(Side::Back)
+    } else {
+        None
+    }
+}
+
+/// `2^e` as an `f64`, for `-1022 <= e <= 1023`.
+#[inline]
+fn pow2(e: i32) -> f64 {
+    debug_assert!((-1022..=1023).contains(&e));
+    f64::from_bits(((1023 + e) as u64) << 52)
+}
+
+/// A fast approximation of a big integer, with relative error below
+/// `3 · 2^-53`: the top two non-zero 64-bit limbs, converted and added.
+#[inline]
+pub fn approx<const N: usize>(x: &BInt<N>) -> f64 {
+    let neg = x.is_negative();
+    let u = x.unsigned_abs();
+    let d = u.digits();
+    let mut i = N;
+    while i > 0 && d[i - 1] == 0 {
+        i -= 1;
+    }
+    let v = match i {
+        0 => return 0.0,
+        1 => d[0] as f64,
+        _ => (d[i - 1] as f64 * pow2(64) + d[i - 2] as f64) * pow2(64 * (i as i32 - 2)),
+    };
+    if neg { -v } else { v }
+}
+
+/// `a / b` for unsigned `a`, `b > 0`, correctly rounded (ties to even) by
+/// long division: `None` if `a` or `b` has more than `64 M - 64` bits.
+fn ratio_by_division<const M: usize>(a: BUint<M>, b: BUint<M>) -> Option<f64> {
+    if a.is_zero() {
+        return Some(0.0);
+    }
+    let (la, lb) = (a.bits() as i32, b.bits() as i32);
+    let room = 64 * M as i32 - 64;
+    if la > room || lb > room || lb == 0 {
+        return None;
+    }
+    // q = floor(a 2^shift / b) has 55 or 56 bits
+    let shift = 55 - (la - lb);
+    let (mut n, mut d) = (a, b);
+    if shift >= 0 {
+        if la + shift > 64 * M as i32 - 1 {
+            return None;
+        }
+        n <<= shift as u32;
+    } else {
+        if lb - shift > 64 * M as i32 - 1 {
+            return None;
+        }
+        d <<= (-shift) as u32;
+    }
+    let q = n / d;
+    let sticky = !(n % d).is_zero();
+    let mut q: u64 = q.as_::<u64>();
+    let qbits = 64 - q.leading_zeros() as i32;
+    let extra = qbits - 53;
+    let rem = q & ((1u64 << extra) - 1);
+    q >>= extra;
+    let half = 1u64 << (extra - 1);
+    if rem > half || (rem == half && (sticky || q & 1 == 1)) {
+        q += 1;
+    }
+    let e = extra - shift;
+    // q < 2^54 and |e| is moderate: the product is exact unless it
+    // overflows or underflows, which the callers' bounds exclude
+    Some(q as f64 * 2f64.powi(e))
+}
+
+/// Compares the positive rational `a / b` with `k · 2^e` exactly; `None`
+/// if the scaled operands would not fit `M` limbs.
+fn cmp_scaled<const M: usize>(a: &BUint<M>, b: &BUint<M>, k: u64, e: i32) -> Option<Ordering> {
+    let cap = 64 * M as i32 - 2;
+    let (sa, sb) = (e.min(0).unsigned_abs() as i32, e.max(0));
+    if a.bits() as i32 + sa > cap || b.bits() as i32 + 56 + sb > cap {
+        return None;
+    }
+    let lhs = *a << sa as u32;
+    let rhs = (*b * BUint::<M>::from(k)) << sb as u32;
+    Some(lhs.cmp(&rhs))
+}
+
+/// The correctly rounded (ties to even) value of `num / den`, `den > 0`,
+/// starting from an estimate `guess` within a few ulps: the estimate is
+/// accepted when the exact quotient lies between the midpoints to its
+/// neighbours, which takes two multiplications and two comparisons;
+/// otherwise it moves one ulp toward the quotient and tries again. Falls
+/// back to long division when the estimate is unusable.
+fn round_ratio<const N: usize, const M: usize>(num: &BInt<N>, den: &BInt<N>, guess: f64) -> f64 {
+    if num.is_zero() {
+        return 0.0;
+    }
+    let neg = num.is_negative();
+    let a: BUint<M> = num.unsigned_abs().as_::<BUint<M>>();
+    let b: BUint<M> = den.unsigned_abs().as_::<BUint<M>>();
+    let signed = |v: f64| if neg { -v } else { v };
+    let mut c = guess.abs();
+    // normal numbers only: the bounds of every tier keep coordinates far
+    // from the subnormal range, and anything else goes the slow way
+    if c.is_finite() && c >= pow2(-1000) && (guess < 0.0) == neg {
+        for _ in 0..16 {
+            let bits = c.to_bits();
+            let exp = ((bits >> 52) & 0x7ff) as i32;
+            if exp <= 2 || exp >= 0x7fe {
+                break;
+            }
+            let m = (bits & ((1u64 << 52) - 1)) | (1u64 << 52);
+            let e = exp - 1075;
+            // the midpoint above c, and the one below (closer at a power of two)
+            let hi = cmp_scaled(&a, &b, 2 * m + 1, e - 1);
+            let lo = if m == 1u64 << 52 {
+                cmp_scaled(&a, &b, 4 * m - 1, e - 2)
+            } else {
+                cmp_scaled(&a, &b, 2 * m - 1, e - 1)
+            };
+            let (Some(hi), Some(lo)) = (hi, lo) else {
+                break;
+            };
+            let even = m & 1 == 0;
+            match (lo, hi) {
+                (Ordering::Greater, Ordering::Less) => return signed(c),
+                (_, Ordering::Greater) => c = f64::from_bits(bits + 1),
+                (Ordering::Less, _) => c = f64::from_bits(bits - 1),
+                (_, Ordering::Equal) => {
+                    return signed(if even { c } else { f64::from_bits(bits + 1) });
+                }
+                (Ordering::Equal, _) => {
+                    return signed(if even { c } else { f64::from_bits(bits - 1) });
+                }
+            }
+        }
+    }
+    let v = ratio_by_division::<M>(a, b)
+        .expect("round_ratio: operands exceed the width chosen by the tier");
+    signed(v)
+}
+
+/// An exact point in homogeneous integer coordinates `(x, y, z, w)` with
+/// `w > 0`, of `64 N` bits each, and their `f64` approximations.
+#[derive(Clone, Debug)]
+pub struct Homogeneous<const N: usize> {
+    h: [BInt<N>; 4],
+    approx: [f64; 4],
+}
+
+impl<const N: usize> Homogeneous<N> {
+    /// The point `(x, y, z) / w`; the signs are flipped if `w < 0`.
+    /// `None` if `w = 0` (a point at infinity).
+    pub fn new(mut h: [BInt<N>; 4]) -> Option<Self> {
+        if h[3].is_zero() {
+            return None;
+        }
+        if h[3].is_negative() {
+            for c in &mut h {
+                *c = -*c;
+            }
+        }
+        Some(Homogeneous {
+            approx: [approx(&h[0]), approx(&h[1]), approx(&h[2]), approx(&h[3])],
+            h,
+        })
+    }
+
+    /// The homogeneous coordinates `(x, y, z, w)`, `w > 0`.
+    #[inline]
+    pub fn coords(&self) -> &[BInt<N>; 4] {
+        &self.h
+    }
+
+    /// The `f64` approximations of the four coordinates (relative error
+    /// below `3 · 2^-53` each).
+    #[inline]
+    pub fn approx(&self) -> &[f64; 4] {
+        &self.approx
+    }
+
+    /// The filter for a plane given by its `f64` coefficients `[a, b, c, d]`
+    /// (`a x + b y + c z + d w`): see [`filter_side`].
+    #[inline]
+    pub fn filter(&self, plane: &[f64; 4]) -> Option<Side> {
+        filter_side(plane, &self.approx)
+    }
+
+    /// Cartesian coordinates from the approximations: within a few ulps,
+    /// fast, not canonical.
+    #[inline]
+    pub fn approx_f64(&self) -> [f64; 3] {
+        let a = &self.approx;
+        [a[0] / a[3], a[1] / a[3], a[2] / a[3]]
+    }
+
+    /// The correctly rounded Cartesian coordinates, computing in `M`
+    /// limbs (`M >= 2N + 1` always suffices).
+    pub fn round_with<const M: usize>(&self) -> [f64; 3] {
+        let g = self.approx_f64();
+        [0, 1, 2].map(|k| round_ratio::<N, M>(&self.h[k], &self.h[3], g[k]))
+    }
+
+    /// Exact comparison of coordinate `k` (0, 1 or 2) with another point's,
+    /// computing in `M >= 2N` limbs when the `f64` approximations cannot
+    /// tell.
+    pub fn cmp_axis_with<const M: usize>(&self, o: &Self, k: usize) -> Ordering {
+        let (p, q) = (self.approx[k] / self.approx[3], o.approx[k] / o.approx[3]);
+        // each quotient is within 8u of the exact value (3u + 3u + u)
+        let tol = (p.abs() + q.abs()) * (16.0 / (1u64 << 53) as f64);
+        if p - q > tol {
+            return Ordering::Greater;
+        }
+        if q - p > tol {
+            return Ordering::Less;
+        }
+        let w = |x: &BInt<N>| (*x).as_::<BInt<M>>();
+        (w(&self.h[k]) * w(&o.h[3])).cmp(&(w(&o.h[k]) * w(&self.h[3])))
+    }
+
+    /// Exact equality of the represented points, in `M >= 2N` limbs.
+    pub fn same_with<const M: usize>(&self, o: &Self) -> bool {
+        (0..3).all(|k| self.cmp_axis_with::<M>(o, k) == Ordering::Equal)
+    }
+
+    /// `Some` integer coordinates if the point is a lattice point whose
+    /// coordinates fit `i64`.
+    pub fn as_integer(&self) -> Option<[i64; 3]> {
+        let w = self.h[3];
+        let mut out = [0i64; 3];
+        for (o, h) in out.iter_mut().zip(&self.h[..3]) {
+            if !(*h % w).is_zero() {
+                return None;
+            }
+            let q = *h / w;
+            if q.unsigned_abs().bits() > 62 {
+                return None;
+            }
+            *o = q.as_::<i64>();
+        }
+        Some(out)
+    }
+}
+
+/// The correctly rounded value of `num / den` (`den > 0`) for any width,
+/// by long division in `M` limbs. Slow; [`Homogeneous::round_with`] is
+/// the fast path.
+pub fn ratio_to_f64_exact<const N: usize, const M: usize>(num: &BInt<N>, den: &BInt<N>) -> f64 {
+    let neg = num.is_negative();
+    let v = ratio_by_division::<M>(
+        num.unsigned_abs().as_::<BUint<M>>(),
+        den.unsigned_abs().as_::<BUint<M>>(),
+    )
+    .expect("ratio_to_f64_exact: operands exceed the width");
+    if neg { -v } else { v }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bnum::types::{I256, I512};
+
+    fn i(v: i128) -> I256 {
+        I256::from(v)
+    }
+
+    #[test]
+    fn approx_is_close() {
+        let big = I256::from(3i128 << 100) * I256::from((1i128 << 90) + 12345) + I256::from(7);
+        let exact = ratio_to_f64_exact::<4, 9>(&big, &I256::ONE);
+        let a = approx(&big);
+        assert!(((a - exact) / exact).abs() < 3.0 / (1u64 << 53) as f64);
+        assert_eq!(approx(&i(-5)), -5.0);
+        assert_eq!(approx(&I256::ZERO), 0.0);
+        assert_eq!(approx(&i(1 << 70)), 2f64.powi(70));
+    }
+
+    #[test]
+    fn rounding_matches_division() {
+        // a deterministic sweep of awkward quotients
+        let mut s = 0x1234_5678_9abc_def0u64;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        for _ in 0..20_000 {
+            let shift = next() % 150;
+            let num = (I256::from(next() as i64) * I256::from((next() >> 3) as i64))
+                << (shift as u32 / 2);
+            let den = I256::from((next() >> 1) as i64 | 1) << (next() % 60) as u32;
+            let p = Homogeneous::<4>::new([num, -num, num + I256::ONE, den]).unwrap();
+            let got = p.round_with::<9>();
+            let want = [
+                ratio_to_f64_exact::<4, 9>(&num, &den),
+                ratio_to_f64_exact::<4, 9>(&-num, &den),
+                ratio_to_f64_exact::<4, 9>(&(num + I256::ONE), &den),
+            ];
+            assert_eq!(got, want, "{num} / {den}");
+        }
+    }
+
+    #[test]
+    fn ties_go_to_even() {
+        // (2^53 + 1) / 1 is a tie between 2^53 and 2^53 + 2
+        let p = Homogeneous::<4>::new([i((1 << 53) + 1), i((1 << 53) + 3), i(1), i(1)]).unwrap();
+        assert_eq!(p.round_with::<9>()[0], 9007199254740992.0);
+        assert_eq!(p.round_with::<9>()[1], 9007199254740996.0);
+        // 1/3 and a tie below a power of two
+        let q = Homogeneous::<4>::new([i(1), i(-2), i((1 << 54) - 1), i(3)]).unwrap();
+        assert_eq!(q.round_with::<9>()[0], 1.0 / 3.0);
+        assert_eq!(q.round_with::<9>()[1], -2.0 / 3.0);
+        let r = Homogeneous::<4>::new([i((1 << 54) - 1), i(0), i(0), i(2)]).unwrap();
+        assert_eq!(r.round_with::<9>()[0], ((1u64 << 54) - 1) as f64 / 2.0);
+    }
+
+    #[test]
+    fn comparisons_and_identity_are_exact() {
+        let a = Homogeneous::<4>::new([i(1), i(2), i(3), i(3)]).unwrap();
+        let b = Homogeneous::<4>::new([i(-2), i(-4), i(-6), i(-6)]).unwrap();
+        assert!(a.same_with::<8>(&b));
+        let c = Homogeneous::<4>::new([i(1 << 100), i(2), i(3), i((1 << 100) * 3 + 1)]).unwrap();
+        assert_eq!(c.cmp_axis_with::<8>(&a, 0), Ordering::Less);
+        assert_eq!(a.cmp_axis_with::<8>(&c, 0), Ordering::Greater);
+        assert!(!a.same_with::<8>(&c));
+        assert_eq!(
+            Homogeneous::<4>::new([i(6), i(-4), i(2), i(2)])
+                .unwrap()
+                .as_integer(),
+            Some([3, -2, 1])
+        );
+        assert_eq!(a.as_integer(), None);
+        assert!(Homogeneous::<4>::new([i(1), i(1), i(1), i(0)]).is_none());
+        let w =
+            Homogeneous::<8>::new([I512::from(5), I512::ONE, I512::ONE, I512::from(-10)]).unwrap();
+        assert_eq!(w.round_with::<17>(), [-0.5, -0.1, -0.1]);
+    }
+}

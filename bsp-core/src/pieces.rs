@@ -1,0 +1,714 @@
+//! Convex cells over shared arrays: the compact form in which polygons are
+//! cut again and again (shadow fragments, overlays).
+//!
+//! A [`PieceArena`] holds the vertices and planes of the cells that live on
+//! one support plane. A [`Piece`] is two short index lists: its vertices and
+//! the edge planes between them ([`EdgeRef`]: an index into the arena's
+//! planes and an orientation bit). A split makes each new vertex once, in
+//! the arena, and both pieces refer to it; nothing is deep-copied and no
+//! vertex is boxed. The vertices are stored inline ([`Vertex`]), so an
+//! arena that is cleared and refilled allocates nothing after warming up.
+//!
+//! The arena is a stack: [`PieceArena::mark`] and [`PieceArena::rollback`]
+//! drop every vertex and plane made since a mark, which the shadow
+//! filter uses to discard the pieces of a cut it undoes.
+
+use std::cmp::Ordering;
+
+use smallvec::SmallVec;
+
+use crate::Side;
+use crate::grid::GridPoint;
+use crate::plane::Plane;
+use crate::point::{Implicit, Point};
+use crate::polygon::{Polygon, split_loop};
+use crate::sanity::{ConvexParts, SanityError, check_convex};
+
+/// A vertex stored inline in a [`PieceArena`].
+#[derive(Clone, Debug)]
+pub enum Vertex {
+    /// An input grid point.
+    Grid(GridPoint),
+    /// The intersection of three input-tier planes.
+    Implicit(Implicit),
+}
+
+impl Vertex {
+    /// Exact side of `plane`: `i128` for grid points, the filter and then
+    /// 256-bit arithmetic for implicit points.
+    #[inline]
+    pub fn classify(&self, plane: &Plane) -> Side {
+        match self {
+            Vertex::Grid(g) => plane.classify_grid(*g),
+            Vertex::Implicit(i) => i.classify(plane),
+        }
+    }
+
+    /// The correctly rounded grid coordinates (equal points give equal
+    /// results however they were made).
+    pub fn to_f64(&self) -> [f64; 3] {
+        match self {
+            Vertex::Grid(g) => g.map(f64::from),
+            Vertex::Implicit(i) => i.to_f64(),
+        }
+    }
+
+    /// Grid coordinates within a few ulps (fast, not canonical).
+    #[inline]
+    pub fn approx_f64(&self) -> [f64; 3] {
+        match self {
+            Vertex::Grid(g) => g.map(f64::from),
+            Vertex::Implicit(i) => i.approx_f64(),
+        }
+    }
+
+    /// Exact comparison of coordinate `k` (0, 1 or 2).
+    pub fn cmp_axis(&self, o: &Vertex, k: usize) -> Ordering {
+        match (self, o) {
+            (Vertex::Grid(a), Vertex::Grid(b)) => a[k].cmp(&b[k]),
+            (Vertex::Implicit(a), Vertex::Implicit(b)) => a.cmp_axis(b, k),
+            (Vertex::Grid(g), Vertex::Implicit(i)) => cmp_grid_implicit(g[k], i, k),
+            (Vertex::Implicit(i), Vertex::Grid(g)) => cmp_grid_implicit(g[k], i, k).reverse(),
+        }
+    }
+
+    /// Exact equality of the represented points.
+    pub fn same_point(&self, o: &Vertex) -> bool {
+        (0..3).all(|k| self.cmp_axis(o, k) == Ordering::Equal)
+    }
+
+    /// The same point as a [`Point`].
+    pub fn to_point(&self) -> Point {
+        match self {
+            Vertex::Grid(g) => Point::Grid(*g),
+            Vertex::Implicit(i) => Point::Implicit(std::sync::Arc::new(i.clone())),
+        }
+    }
+
+    /// The same point from a [`Point`].
+    pub fn from_point(p: &Point) -> Vertex {
+        match p {
+            Point::Grid(g) => Vertex::Grid(*g),
+            Point::Implicit(i) => Vertex::Implicit((**i).clone()),
+        }
+    }
+}
+
+/// `g` against coordinate `k` of `i`: `g w` against `x_k`.
+fn cmp_grid_implicit(g: i32, i: &Implicit, k: usize) -> Ordering {
+    let h = i.coords();
+    (crate::I256::from(g) * h[3]).cmp(&h[k])
+}
+
+/// An edge plane of a cell: an index into [`PieceArena::planes`] and an
+/// orientation bit (the plane as stored, or flipped).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct EdgeRef(u32);
+
+impl EdgeRef {
+    /// Plane `index` of the arena, flipped if `flipped`.
+    #[inline]
+    pub fn new(index: u32, flipped: bool) -> EdgeRef {
+        EdgeRef(index << 1 | flipped as u32)
+    }
+
+    /// The index of the plane in the arena.
+    #[inline]
+    pub fn index(self) -> u32 {
+        self.0 >> 1
+    }
+
+    /// `true` if the edge is the stored plane flipped.
+    #[inline]
+    pub fn flipped(self) -> bool {
+        self.0 & 1 == 1
+    }
+}
+
+/// A convex cell: vertex `i` lies between edge planes `i - 1` and `i`; the
+/// interior is behind every edge plane; vertices run counter-clockwise
+/// seen from the front of the support plane, which the cells of one arena
+/// share.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Piece {
+    /// Vertex indices into [`PieceArena::vertices`].
+    pub verts: SmallVec<[u32; 6]>,
+    /// Edge planes (edge `i` runs from vertex `i` to vertex `i + 1`).
+    pub edges: SmallVec<[EdgeRef; 6]>,
+}
+
+/// Vertices and planes of pieces.
+///
+/// Vertices come in three kinds, stored apart: grid points (12 bytes),
+/// exact implicit points copied in from elsewhere ([`Implicit`], 160
+/// bytes), and *lazy* points made here by splits ([`Lazy`], 80 bytes): the
+/// indices of their three planes in the arena and `f64` approximations of
+/// their homogeneous coordinates with certified error bounds. A lazy point
+/// is classified by the filter ([`crate::filter_side_err`]) and computes
+/// its exact coordinates only when the filter cannot decide, or for
+/// output. A vertex id is an index into one of the three lists, tagged in
+/// its top two bits; [`PieceArena::dense`] maps ids to `0..len()` for
+/// per-vertex tables.
+#[derive(Clone, Debug, Default)]
+pub struct PieceArena {
+    grid: Vec<GridPoint>,
+    exact: Vec<Implicit>,
+    lazy: Vec<Lazy>,
+    /// The planes: supports, edges and cuts.
+    pub planes: Vec<Plane>,
+    /// Per plane: two grid points on its line of intersection with the
+    /// support plane it was added for (a polygon's edge), if known.
+    anchors: Vec<Option<[GridPoint; 2]>>,
+}
+
+const TAG: u32 = 3 << 30;
+const EXACT: u32 = 1 << 30;
+const LAZY: u32 = 2 << 30;
+
+/// An implicit vertex made by a split: the intersection of planes
+/// `planes` of its arena, with `f64` approximations `approx` of its
+/// homogeneous coordinates `(x, y, z, w)` (`w > 0`) and bounds `err` on
+/// their absolute errors.
+#[derive(Clone, Debug)]
+pub struct Lazy {
+    approx: [f64; 4],
+    err: [f64; 4],
+    planes: [u32; 3],
+    /// The exact point, once computed.
+    exact: Option<Box<Implicit>>,
+}
+
+/// `2^-49`: the bound, relative to the sum of the absolute values of its
+/// terms, on the error of a coordinate computed in `f64` by
+/// [`Lazy::new`] (at most `8.4 · 2^-53`; see `docs/architecture.md`).
+const LAZY_REL: f64 = 1.0 / (1u64 << 49) as f64;
+
+impl Lazy {
+    /// The intersection of `planes[i]` for the three indices, or `None` if
+    /// they do not meet in one point.
+    fn new(planes: &[Plane], idx: [u32; 3]) -> Option<Lazy> {
+        let [a, b, c] = idx.map(|i| planes[i as usize].approx());
+        let n = |p: &[f64; 4]| [p[0], p[1], p[2]];
+        let (n1, n2, n3) = (n(&a), n(&b), n(&c));
+        let cross = |u: [f64; 3], v: [f64; 3]| {
+            [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ]
+        };
+        // the absolute value of every expanded term, summed the same way
+        let cross_abs = |u: [f64; 3], v: [f64; 3]| {
+            [
+                (u[1] * v[2]).abs() + (u[2] * v[1]).abs(),
+                (u[2] * v[0]).abs() + (u[0] * v[2]).abs(),
+                (u[0] * v[1]).abs() + (u[1] * v[0]).abs(),
+            ]
+        };
+        let (c23, c31, c12) = (cross(n2, n3), cross(n3, n1), cross(n1, n2));
+        let (t23, t31, t12) = (cross_abs(n2, n3), cross_abs(n3, n1), cross_abs(n1, n2));
+        let mut w = n1[0] * c23[0] + n1[1] * c23[1] + n1[2] * c23[2];
+        let tw = n1[0].abs() * t23[0] + n1[1].abs() * t23[1] + n1[2].abs() * t23[2];
+        let ew = tw * LAZY_REL;
+        let mut x = [0.0; 3];
+        let mut err = [0.0; 4];
+        for k in 0..3 {
+            x[k] = -(c23[k] * a[3] + c31[k] * b[3] + c12[k] * c[3]);
+            err[k] = (t23[k] * a[3].abs() + t31[k] * b[3].abs() + t12[k] * c[3].abs()) * LAZY_REL;
+        }
+        err[3] = ew;
+        // the sign of w, exactly when the approximation cannot tell
+        let negative = if w.abs() > ew {
+            w < 0.0
+        } else {
+            let [p1, p2, p3] = idx.map(|i| &planes[i as usize]);
+            let det = exact_det(p1, p2, p3);
+            if det.is_zero() {
+                return None;
+            }
+            det.is_negative()
+        };
+        if negative {
+            x = x.map(|v| -v);
+            w = -w;
+        }
+        Some(Lazy {
+            approx: [x[0], x[1], x[2], w],
+            err,
+            planes: idx,
+            exact: None,
+        })
+    }
+
+    /// The exact point.
+    pub fn exact(&self, planes: &[Plane]) -> Implicit {
+        if let Some(e) = &self.exact {
+            return (**e).clone();
+        }
+        let [a, b, c] = self.planes.map(|i| &planes[i as usize]);
+        Implicit::from_planes(a, b, c).expect("a lazy point's planes meet in one point")
+    }
+
+    /// Exact side of `plane`: the filter on the approximations; then `On`
+    /// if `plane` is one of the three planes the point was made from; then
+    /// the exact coordinates, computed once and kept.
+    #[inline]
+    fn classify(
+        &mut self,
+        planes: &[Plane],
+        anchors: &[Option<[GridPoint; 2]>],
+        plane: &Plane,
+    ) -> Side {
+        if let Some(s) = crate::exact::filter_side_err(&plane.approx(), &self.approx, &self.err) {
+            return s;
+        }
+        if self.on_by_construction(planes, anchors, plane) {
+            return Side::On;
+        }
+        let [a, b, c] = self.planes.map(|i| &planes[i as usize]);
+        let e = self.exact.get_or_insert_with(|| {
+            Box::new(
+                Implicit::from_planes(a, b, c).expect("a lazy point's planes meet in one point"),
+            )
+        });
+        e.classify_exact(plane)
+    }
+
+    /// `true` if the point lies on `plane` because of how it was made:
+    /// `plane` is one of its three planes, or contains the line where its
+    /// support (the first plane) meets one of the other two, known by two
+    /// grid points.
+    #[inline]
+    fn on_by_construction(
+        &self,
+        planes: &[Plane],
+        anchors: &[Option<[GridPoint; 2]>],
+        plane: &Plane,
+    ) -> bool {
+        self.planes
+            .iter()
+            .any(|&i| planes[i as usize].is_coincident(plane))
+            || self.planes[1..].iter().any(|&i| {
+                anchors
+                    .get(i as usize)
+                    .copied()
+                    .flatten()
+                    .is_some_and(|[a, b]| {
+                        plane.classify_grid(a) == Side::On && plane.classify_grid(b) == Side::On
+                    })
+            })
+    }
+
+    /// [`Lazy::classify`] without keeping the exact point.
+    fn classify_shared(&self, planes: &[Plane], plane: &Plane) -> Side {
+        if let Some(s) = crate::exact::filter_side_err(&plane.approx(), &self.approx, &self.err) {
+            return s;
+        }
+        if self
+            .planes
+            .iter()
+            .any(|&i| planes[i as usize].is_coincident(plane))
+        {
+            return Side::On;
+        }
+        match &self.exact {
+            Some(e) => e.classify_exact(plane),
+            None => self.exact(planes).classify_exact(plane),
+        }
+    }
+}
+
+/// `n1 · (n2 × n3)` exactly.
+fn exact_det(p1: &Plane, p2: &Plane, p3: &Plane) -> crate::I256 {
+    let (n1, n2, n3) = (p1.normal(), p2.normal(), p3.normal());
+    let m = |x: i64, y: i64| x as i128 * y as i128;
+    let c = [
+        m(n2[1], n3[2]) - m(n2[2], n3[1]),
+        m(n2[2], n3[0]) - m(n2[0], n3[2]),
+        m(n2[0], n3[1]) - m(n2[1], n3[0]),
+    ];
+    (0..3)
+        .map(|i| crate::point::mul_wide(n1[i] as i128, c[i]))
+        .fold(crate::I256::ZERO, |s, t| s + t)
+}
+
+/// A vertex of a [`PieceArena`], borrowed.
+#[derive(Clone, Copy, Debug)]
+pub enum VertexRef<'a> {
+    /// A grid point.
+    Grid(GridPoint),
+    /// An exact implicit point.
+    Exact(&'a Implicit),
+    /// A lazy implicit point and the planes of its arena.
+    Lazy(&'a Lazy, &'a [Plane]),
+}
+
+impl VertexRef<'_> {
+    /// Exact side of `plane`.
+    #[inline]
+    pub fn classify(self, plane: &Plane) -> Side {
+        match self {
+            VertexRef::Grid(g) => plane.classify_grid(g),
+            VertexRef::Exact(i) => i.classify(plane),
+            VertexRef::Lazy(l, planes) => l.classify_shared(planes, plane),
+        }
+    }
+
+    /// An owned exact copy.
+    pub fn to_owned(self) -> Vertex {
+        match self {
+            VertexRef::Grid(g) => Vertex::Grid(g),
+            VertexRef::Exact(i) => Vertex::Implicit(i.clone()),
+            VertexRef::Lazy(l, planes) => Vertex::Implicit(l.exact(planes)),
+        }
+    }
+
+    /// The correctly rounded grid coordinates.
+    pub fn to_f64(self) -> [f64; 3] {
+        match self {
+            VertexRef::Grid(g) => g.map(f64::from),
+            VertexRef::Exact(i) => i.to_f64(),
+            VertexRef::Lazy(l, planes) => l.exact(planes).to_f64(),
+        }
+    }
+
+    /// Exact comparison of coordinate `k`.
+    pub fn cmp_axis(self, o: VertexRef<'_>, k: usize) -> Ordering {
+        self.to_owned().cmp_axis(&o.to_owned(), k)
+    }
+
+    /// Exact equality of the represented points.
+    pub fn same_point(self, o: VertexRef<'_>) -> bool {
+        self.to_owned().same_point(&o.to_owned())
+    }
+}
+
+/// Sizes of a [`PieceArena`] to go back to (see [`PieceArena::rollback`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ArenaMark {
+    grid: usize,
+    exact: usize,
+    lazy: usize,
+    planes: usize,
+}
+
+/// Where a cell lies relative to a plane, by its vertices' exact sides.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sides {
+    /// Some vertex is strictly in front.
+    pub front: bool,
+    /// Some vertex is strictly behind.
+    pub back: bool,
+}
+
+impl PieceArena {
+    /// An empty arena.
+    pub fn new() -> PieceArena {
+        PieceArena::default()
+    }
+
+    /// Empties the arena, keeping its memory.
+    pub fn clear(&mut self) {
+        self.grid.clear();
+        self.exact.clear();
+        self.lazy.clear();
+        self.planes.clear();
+        self.anchors.clear();
+    }
+
+    /// The current sizes.
+    #[inline]
+    pub fn mark(&self) -> ArenaMark {
+        ArenaMark {
+            grid: self.grid.len(),
+            exact: self.exact.len(),
+            lazy: self.lazy.len(),
+            planes: self.planes.len(),
+        }
+    }
+
+    /// Drops every vertex and plane added since `mark`. Pieces that refer
+    /// to them must be dropped too.
+    #[inline]
+    pub fn rollback(&mut self, mark: ArenaMark) {
+        self.grid.truncate(mark.grid);
+        self.exact.truncate(mark.exact);
+        self.lazy.truncate(mark.lazy);
+        self.planes.truncate(mark.planes);
+        self.anchors.truncate(mark.planes);
+    }
+
+    /// Adds a plane, returning its index.
+    #[inline]
+    pub fn add_plane(&mut self, p: Plane) -> u32 {
+        self.planes.push(p);
+        self.anchors.push(None);
+        (self.planes.len() - 1) as u32
+    }
+
+    /// Adds the plane of a polygon's edge from grid point `a` to `b`,
+    /// returning its index. Knowing the edge lets a vertex on it be found
+    /// on any plane through the edge without arithmetic.
+    #[inline]
+    pub fn add_edge_plane(&mut self, p: Plane, a: GridPoint, b: GridPoint) -> u32 {
+        self.planes.push(p);
+        self.anchors.push(Some([a, b]));
+        (self.planes.len() - 1) as u32
+    }
+
+    /// The two grid points known on plane `i`'s line with the support (see
+    /// [`PieceArena::add_edge_plane`]).
+    #[inline]
+    pub fn anchors(&self, i: u32) -> Option<[GridPoint; 2]> {
+        self.anchors[i as usize]
+    }
+
+    /// Adds a grid vertex, returning its id.
+    #[inline]
+    pub fn add_grid(&mut self, g: GridPoint) -> u32 {
+        self.grid.push(g);
+        (self.grid.len() - 1) as u32
+    }
+
+    /// Adds an exact implicit vertex, returning its id.
+    #[inline]
+    pub fn add_exact(&mut self, i: Implicit) -> u32 {
+        self.exact.push(i);
+        (self.exact.len() - 1) as u32 | EXACT
+    }
+
+    /// Adds the intersection of planes `idx` of this arena as a lazy
+    /// vertex, returning its id; `None` if they do not meet in one point.
+    pub fn add_meet(&mut self, idx: [u32; 3]) -> Option<u32> {
+        let l = Lazy::new(&self.planes, idx)?;
+        self.lazy.push(l);
+        Some((self.lazy.len() - 1) as u32 | LAZY)
+    }
+
+    /// Adds a vertex, returning its id.
+    pub fn add_vertex(&mut self, v: Vertex) -> u32 {
+        match v {
+            Vertex::Grid(g) => self.add_grid(g),
+            Vertex::Implicit(i) => self.add_exact(i),
+        }
+    }
+
+    /// Copies vertex `id` of another arena into this one (a lazy vertex
+    /// with its three planes).
+    pub fn copy_vertex(&mut self, from: &PieceArena, id: u32) -> u32 {
+        match from.vertex(id) {
+            VertexRef::Grid(g) => self.add_grid(g),
+            VertexRef::Exact(i) => self.add_exact(i.clone()),
+            VertexRef::Lazy(l, planes) => {
+                let anchors = &from.anchors;
+                let idx = l.planes.map(|i| {
+                    self.planes.push(planes[i as usize]);
+                    self.anchors.push(anchors[i as usize]);
+                    (self.planes.len() - 1) as u32
+                });
+                self.lazy.push(Lazy {
+                    planes: idx,
+                    ..l.clone()
+                });
+                (self.lazy.len() - 1) as u32 | LAZY
+            }
+        }
+    }
+
+    /// Vertex `id`.
+    #[inline]
+    pub fn vertex(&self, id: u32) -> VertexRef<'_> {
+        let i = (id & !TAG) as usize;
+        match id & TAG {
+            0 => VertexRef::Grid(self.grid[i]),
+            EXACT => VertexRef::Exact(&self.exact[i]),
+            _ => VertexRef::Lazy(&self.lazy[i], &self.planes),
+        }
+    }
+
+    /// Number of vertices.
+    pub fn len(&self) -> usize {
+        self.grid.len() + self.exact.len() + self.lazy.len()
+    }
+
+    /// `true` if the arena has no vertex.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// A dense index in `0..len()` for vertex `id`, valid until the next
+    /// vertex is added.
+    #[inline]
+    pub fn dense(&self, id: u32) -> usize {
+        let i = (id & !TAG) as usize;
+        match id & TAG {
+            0 => i,
+            EXACT => self.grid.len() + i,
+            _ => self.grid.len() + self.exact.len() + i,
+        }
+    }
+
+    /// The plane of an edge, oriented.
+    #[inline]
+    pub fn plane(&self, e: EdgeRef) -> Plane {
+        let p = self.planes[e.index() as usize];
+        if e.flipped() { p.flip() } else { p }
+    }
+
+    /// A piece from a polygon lying on this arena's support plane: its
+    /// vertices and edge planes are copied into the arena.
+    pub fn add_polygon(&mut self, p: &Polygon) -> Piece {
+        let mut c = Piece::default();
+        let vs = p.vertices();
+        let k = vs.len();
+        for (i, (v, e)) in vs.iter().zip(p.edge_planes()).enumerate() {
+            c.verts.push(self.add_vertex(Vertex::from_point(v)));
+            let plane = match (v, &vs[(i + 1) % k]) {
+                (Point::Grid(a), Point::Grid(b)) => self.add_edge_plane(*e, *a, *b),
+                _ => self.add_plane(*e),
+            };
+            c.edges.push(EdgeRef::new(plane, false));
+        }
+        c
+    }
+
+    /// The exact side of vertex `id` relative to `plane` (a lazy vertex
+    /// keeps its exact coordinates if they had to be computed).
+    #[inline]
+    pub fn classify(&mut self, id: u32, plane: &Plane) -> Side {
+        let i = (id & !TAG) as usize;
+        match id & TAG {
+            0 => plane.classify_grid(self.grid[i]),
+            EXACT => self.exact[i].classify(plane),
+            _ => self.lazy[i].classify(&self.planes, &self.anchors, plane),
+        }
+    }
+
+    /// The exact sides of `c`'s vertices relative to `plane`, written to
+    /// `out` (cleared first).
+    #[inline]
+    pub fn classify_into(
+        &mut self,
+        c: &Piece,
+        plane: &Plane,
+        out: &mut SmallVec<[Side; 8]>,
+    ) -> Sides {
+        out.clear();
+        let (mut front, mut back) = (false, false);
+        for &v in &c.verts {
+            let s = self.classify(v, plane);
+            front |= s == Side::Front;
+            back |= s == Side::Back;
+            out.push(s);
+        }
+        Sides { front, back }
+    }
+
+    /// Splits `c` by plane `cut` given its vertices' sides, which must
+    /// include both `Front` and `Back`: the front and back pieces. `support`
+    /// and `cut` are indices into [`PieceArena::planes`]. Each crossing edge
+    /// gets one new (lazy) vertex, shared by both pieces.
+    pub fn split(&mut self, support: u32, c: &Piece, cut: u32, sides: &[Side]) -> (Piece, Piece) {
+        let mut f = Piece::default();
+        let mut b = Piece::default();
+        split_loop(
+            &c.verts,
+            &c.edges,
+            sides,
+            EdgeRef::new(cut, true),
+            EdgeRef::new(cut, false),
+            |i| {
+                self.add_meet([support, c.edges[i].index(), cut])
+                    .expect("a spanning edge meets the cutting plane in one point")
+            },
+            |v, e| {
+                f.verts.push(v);
+                f.edges.push(e);
+            },
+            |v, e| {
+                b.verts.push(v);
+                b.edges.push(e);
+            },
+        );
+        (f, b)
+    }
+
+    /// Checks `c`'s invariants exactly (see [`check_convex`]).
+    pub fn sanity_check(&self, support: &Plane, c: &Piece) -> Result<(), SanityError> {
+        check_convex(&PieceView {
+            arena: self,
+            support,
+            cell: c,
+        })
+    }
+}
+
+struct PieceView<'a> {
+    arena: &'a PieceArena,
+    support: &'a Plane,
+    cell: &'a Piece,
+}
+
+impl ConvexParts for PieceView<'_> {
+    fn vertex_count(&self) -> usize {
+        self.cell.verts.len()
+    }
+    fn edge_count(&self) -> usize {
+        self.cell.edges.len()
+    }
+    fn support_side(&self, i: usize) -> Side {
+        self.arena.vertex(self.cell.verts[i]).classify(self.support)
+    }
+    fn edge_side(&self, i: usize, j: usize) -> Side {
+        let p = self.arena.plane(self.cell.edges[j]);
+        self.arena.vertex(self.cell.verts[i]).classify(&p)
+    }
+    fn edge_is_support(&self, j: usize) -> bool {
+        self.arena
+            .plane(self.cell.edges[j])
+            .is_coincident(self.support)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn split_shares_new_vertices_and_keeps_invariants() {
+        let sq =
+            Polygon::from_grid_points(&[[0, 0, 0], [4, 0, 0], [4, 4, 0], [0, 4, 0]], 0).unwrap();
+        let mut a = PieceArena::new();
+        let support = *sq.support();
+        let sup = a.add_plane(support);
+        let c = a.add_polygon(&sq);
+        a.sanity_check(&support, &c).unwrap();
+        let cut = a.add_plane(Plane::new([1, 0, 0], -1).unwrap());
+        let mut sides = SmallVec::new();
+        let s = a.classify_into(&c, &a.planes[cut as usize].clone(), &mut sides);
+        assert!(s.front && s.back);
+        let before = a.mark();
+        let (f, b) = a.split(sup, &c, cut, &sides);
+        assert_eq!(a.len(), 4 + 2);
+        a.sanity_check(&support, &f).unwrap();
+        a.sanity_check(&support, &b).unwrap();
+        let shared = f.verts.iter().filter(|v| b.verts.contains(v)).count();
+        assert_eq!(shared, 2);
+        // rolling back removes the new vertices
+        a.rollback(before);
+        assert_eq!(a.len(), 4);
+    }
+
+    #[test]
+    fn vertex_comparisons_are_exact_across_kinds() {
+        let x = Plane::new([1, 0, 0], -3).unwrap();
+        let y = Plane::new([0, 2, 0], 10).unwrap();
+        let z = Plane::new([0, 0, -1], 7).unwrap();
+        let i = Vertex::Implicit(Implicit::from_planes(&x, &y, &z).unwrap());
+        let g = Vertex::Grid([3, -5, 7]);
+        assert!(i.same_point(&g) && g.same_point(&i));
+        assert_eq!(Vertex::Grid([4, 0, 0]).cmp_axis(&i, 0), Ordering::Greater);
+        assert_eq!(i.cmp_axis(&Vertex::Grid([4, 0, 0]), 0), Ordering::Less);
+        assert_eq!(i.to_f64(), [3.0, -5.0, 7.0]);
+    }
+}

@@ -1,0 +1,159 @@
+//! Areas in input units: per light, the area lit, in cast shadow (facing
+//! the light but blocked) and in attached shadow (facing away), and per
+//! face its area in cast shadow.
+//!
+//! Areas are plain `f64`, from the correctly rounded fragment vertices
+//! mapped to input units; the fragments themselves are exact.
+
+use bsp_core::Grid;
+use glam::DVec3;
+
+use crate::engine::FragmentRef;
+
+/// The area of a planar polygon (any orientation).
+pub fn polygon_area(pts: &[DVec3]) -> f64 {
+    let Some(&o) = pts.first() else {
+        return 0.0;
+    };
+    let mut n = DVec3::ZERO;
+    for w in pts[1..].windows(2) {
+        n += (w[0] - o).cross(w[1] - o);
+    }
+    0.5 * n.length()
+}
+
+/// A fragment's area in input units: its outer ring's less its holes'.
+pub fn fragment_area(f: &FragmentRef<'_>, grid: &Grid, buf: &mut Vec<DVec3>) -> f64 {
+    let mut area = 0.0;
+    for (k, ring) in f.rings().enumerate() {
+        buf.clear();
+        buf.extend(ring.iter().map(|&v| grid.to_world(f.batch().rounded(v))));
+        let a = polygon_area(buf);
+        area += if k == 0 { a } else { -a };
+    }
+    area
+}
+
+/// Area totals, per light and per face.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Areas {
+    lights: usize,
+    /// Total area of every fragment (each face once).
+    pub total: f64,
+    /// Per light: lit by it.
+    pub lit: Vec<f64>,
+    /// Per light: facing it but blocked.
+    pub cast: Vec<f64>,
+    /// Per light: facing away from it (or edge-on).
+    pub attached: Vec<f64>,
+    /// Lit by no light.
+    pub dark: f64,
+    face_area: Vec<f64>,
+    /// `faces × lights`: area in cast shadow.
+    face_cast: Vec<f64>,
+}
+
+impl Areas {
+    /// Zero areas for `lights` lights and `faces` faces.
+    pub fn new(lights: usize, faces: usize) -> Areas {
+        Areas {
+            lights,
+            total: 0.0,
+            lit: vec![0.0; lights],
+            cast: vec![0.0; lights],
+            attached: vec![0.0; lights],
+            dark: 0.0,
+            face_area: vec![0.0; faces],
+            face_cast: vec![0.0; faces * lights],
+        }
+    }
+
+    /// Adds a fragment of `face` with area `area`, lit by the lights of
+    /// `lit` (bit `i`: light `i`), whose face has the lights of `facing`
+    /// strictly in front.
+    pub fn add(&mut self, face: u32, area: f64, lit: u64, facing: u64) {
+        let f = face as usize;
+        self.total += area;
+        self.face_area[f] += area;
+        for i in 0..self.lights {
+            if lit >> i & 1 == 1 {
+                self.lit[i] += area;
+            } else if facing >> i & 1 == 1 {
+                self.cast[i] += area;
+                self.face_cast[f * self.lights + i] += area;
+            } else {
+                self.attached[i] += area;
+            }
+        }
+        if lit == 0 {
+            self.dark += area;
+        }
+    }
+
+    /// Per light: the area in shadow, cast or attached.
+    pub fn shadow(&self) -> Vec<f64> {
+        self.cast
+            .iter()
+            .zip(&self.attached)
+            .map(|(c, a)| c + a)
+            .collect()
+    }
+
+    /// The area of face `f`.
+    pub fn face_area(&self, f: usize) -> f64 {
+        self.face_area[f]
+    }
+
+    /// Face `f`'s area in cast shadow of each light.
+    pub fn face_cast(&self, f: usize) -> &[f64] {
+        &self.face_cast[f * self.lights..(f + 1) * self.lights]
+    }
+
+    /// Up to `n` faces with cast shadow, most shadow (summed over the
+    /// lights) first, ties by index.
+    pub fn most_shaded(&self, n: usize) -> Vec<usize> {
+        let sum = |f: usize| self.face_cast(f).iter().sum::<f64>();
+        let mut faces: Vec<usize> = (0..self.face_area.len())
+            .filter(|&f| sum(f) > 0.0)
+            .collect();
+        faces.sort_by(|&a, &b| sum(b).total_cmp(&sum(a)).then(a.cmp(&b)));
+        faces.truncate(n);
+        faces
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn areas_split_lit_cast_and_attached() {
+        let mut a = Areas::new(2, 3);
+        a.add(0, 2.0, 0b01, 0b11);
+        a.add(0, 3.0, 0b00, 0b01);
+        a.add(1, 5.0, 0b10, 0b10);
+        assert_eq!(a.total, 10.0);
+        assert_eq!(a.lit, vec![2.0, 5.0]);
+        assert_eq!(a.cast, vec![3.0, 2.0]);
+        assert_eq!(a.attached, vec![5.0, 3.0]);
+        assert_eq!(a.shadow(), vec![8.0, 5.0]);
+        assert_eq!(a.dark, 3.0);
+        assert_eq!((a.face_area(0), a.face_cast(0)), (5.0, &[3.0, 2.0][..]));
+        assert_eq!((a.face_area(1), a.face_cast(1)), (5.0, &[0.0, 0.0][..]));
+        assert_eq!(a.face_area(2), 0.0);
+        assert_eq!(a.most_shaded(10), vec![0]);
+    }
+
+    #[test]
+    fn polygon_areas() {
+        let sq = [
+            DVec3::new(1.0, 1.0, 5.0),
+            DVec3::new(3.0, 1.0, 5.0),
+            DVec3::new(3.0, 4.0, 5.0),
+            DVec3::new(1.0, 4.0, 5.0),
+        ];
+        assert_eq!(polygon_area(&sq), 6.0);
+        assert_eq!(polygon_area(&sq[..2]), 0.0);
+        assert_eq!(polygon_area(&[]), 0.0);
+    }
+}

@@ -1,0 +1,769 @@
+//! Exact lit and shadowed fragments of every receiver, from the
+//! partitioned shadow volumes of each light.
+//!
+//! A receiver is a face: one or more convex polygons on one support plane
+//! (a non-convex face is imported as several). For each light that faces
+//! it, each of its current pieces is filtered through that light's tree;
+//! a cut made on the way is undone when both sides turn out alike, so a
+//! piece comes back whole unless a shadow boundary crosses it. After the
+//! last light, the pieces with equal flags that touch along an edge are
+//! merged into maximal regions ([`bsp_core::merge_cells`]): a fragment is a
+//! connected part of the face with one set of flags, an outer boundary
+//! and possibly holes. A face lit (or shadowed) all over by every light
+//! is one fragment: its own polygon.
+//!
+//! Faces are independent of one another once the trees exist, so they are
+//! shaded in parallel; each face's result depends only on the face and the
+//! trees, and results are concatenated in face order, so the output is the
+//! same for every thread count.
+
+use std::ops::Range;
+
+use bsp_core::{ArenaMark, Piece, PieceArena, Plane, Polygon, Side, Vertex, merge_cells};
+use rayon::prelude::*;
+use smallvec::SmallVec;
+
+use crate::light::{Light, LightError, MAX_LIGHTS};
+use crate::psv::{LIT, SHADOW, ShadowVolumes, VolumeError};
+
+/// Why shadows cannot be computed.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum ShadowError {
+    /// A light is unusable.
+    Light(LightError),
+    /// An occluder is unusable.
+    Volume(VolumeError),
+}
+
+impl std::fmt::Display for ShadowError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ShadowError::Light(e) => e.fmt(f),
+            ShadowError::Volume(e) => e.fmt(f),
+        }
+    }
+}
+
+impl std::error::Error for ShadowError {}
+
+impl From<LightError> for ShadowError {
+    fn from(e: LightError) -> ShadowError {
+        ShadowError::Light(e)
+    }
+}
+
+impl From<VolumeError> for ShadowError {
+    fn from(e: VolumeError) -> ShadowError {
+        ShadowError::Volume(e)
+    }
+}
+
+/// Options of [`Shadows::shade`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct ShadeOptions {
+    /// Also record each fragment's convex pieces (for formats that need
+    /// convex polygons, such as OBJ).
+    pub pieces: bool,
+}
+
+impl Default for ShadeOptions {
+    fn default() -> ShadeOptions {
+        ShadeOptions { pieces: true }
+    }
+}
+
+impl ShadeOptions {
+    /// Sets [`ShadeOptions::pieces`].
+    pub fn with_pieces(mut self, pieces: bool) -> ShadeOptions {
+        self.pieces = pieces;
+        self
+    }
+}
+
+/// The shadow volumes of a scene for a list of lights, ready to shade
+/// receivers.
+#[derive(Clone, Debug)]
+pub struct Shadows {
+    lights: Vec<Light>,
+    volumes: Vec<ShadowVolumes>,
+}
+
+/// Consecutive polygons that form one receiver: the same face (tag) and
+/// the same support plane. An imported face that was triangulated because
+/// it is not convex is one receiver; one that was triangulated because it
+/// is not planar is one per plane.
+pub fn receivers(polys: &[Polygon]) -> Vec<Range<usize>> {
+    let mut out: Vec<Range<usize>> = Vec::new();
+    for (i, p) in polys.iter().enumerate() {
+        match out.last_mut() {
+            Some(r)
+                if polys[r.start].tag() == p.tag() && polys[r.start].support() == p.support() =>
+            {
+                r.end = i + 1
+            }
+            _ => out.push(i..i + 1),
+        }
+    }
+    out
+}
+
+impl Shadows {
+    /// Builds one shadow-volume tree per light from `occluders` (polygons
+    /// with grid vertices, e.g. from [`bsp_core::import_faces`]), the
+    /// lights in parallel.
+    pub fn new(occluders: &[Polygon], lights: &[Light]) -> Result<Shadows, ShadowError> {
+        if lights.len() > MAX_LIGHTS {
+            return Err(LightError::TooMany(lights.len()).into());
+        }
+        for l in lights {
+            l.validate()?;
+        }
+        let volumes = lights
+            .par_iter()
+            .map(|&l| ShadowVolumes::build(l, occluders))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Shadows {
+            lights: lights.to_vec(),
+            volumes,
+        })
+    }
+
+    /// The lights, in order: bit `i` of a fragment's flags is light `i`.
+    pub fn lights(&self) -> &[Light] {
+        &self.lights
+    }
+
+    /// The shadow-volume tree of each light.
+    pub fn volumes(&self) -> &[ShadowVolumes] {
+        &self.volumes
+    }
+
+    /// Shades one receiver (polygons on one support plane, all tagged with
+    /// the same face), appending its fragments to `out`. `receiver` is
+    /// recorded with each fragment (e.g. the receiver's index).
+    pub fn shade(
+        &self,
+        polys: &[Polygon],
+        receiver: u32,
+        opts: &ShadeOptions,
+        scratch: &mut Scratch,
+        out: &mut Batch,
+    ) {
+        let Some(first) = polys.first() else { return };
+        let support = *first.support();
+        let face = first.tag();
+        let s = scratch;
+        s.arena.clear();
+        s.cur.clear();
+        let sup = s.arena.add_plane(support);
+        for p in polys {
+            debug_assert!(p.support() == &support && p.tag() == face);
+            let c = s.arena.add_polygon(p);
+            s.cur.push((c, 0));
+        }
+        let mut facing = 0u64;
+        for (j, (light, sv)) in self.lights.iter().zip(&self.volumes).enumerate() {
+            if !light.faces(&support) {
+                continue; // attached shadow: the flag stays 0
+            }
+            facing |= 1 << j;
+            s.next.clear();
+            for (piece, flags) in s.cur.drain(..) {
+                s.out.clear();
+                filter(
+                    sv,
+                    &mut s.arena,
+                    sup,
+                    piece,
+                    &mut s.out,
+                    &mut s.stack,
+                    &mut s.sides,
+                );
+                for (p, lit) in s.out.drain(..) {
+                    s.next.push((p, flags | (lit as u64) << j));
+                }
+            }
+            std::mem::swap(&mut s.cur, &mut s.next);
+        }
+        out.push_receiver(face, receiver, facing, &support, s, polys.len() == 1, opts);
+    }
+
+    /// Shades the receivers `ranges` of `polys` (see [`receivers`]) into
+    /// one batch, in order; receiver `i` of the list is recorded as
+    /// `first_receiver + i`.
+    pub fn shade_ranges(
+        &self,
+        polys: &[Polygon],
+        ranges: &[Range<usize>],
+        first_receiver: u32,
+        opts: &ShadeOptions,
+    ) -> Batch {
+        let mut scratch = Scratch::default();
+        let mut out = Batch::new();
+        for (i, r) in ranges.iter().enumerate() {
+            self.shade(
+                &polys[r.clone()],
+                first_receiver + i as u32,
+                opts,
+                &mut scratch,
+                &mut out,
+            );
+        }
+        out
+    }
+
+    /// Shades every receiver of `polys`, in parallel, into one batch in
+    /// receiver order (the same for every thread count).
+    pub fn shade_all(&self, polys: &[Polygon], opts: &ShadeOptions) -> Batch {
+        let ranges = receivers(polys);
+        let batches: Vec<Batch> = ranges
+            .par_chunks(CHUNK)
+            .enumerate()
+            .map(|(i, chunk)| self.shade_ranges(polys, chunk, (i * CHUNK) as u32, opts))
+            .collect();
+        let mut out = Batch::new();
+        for b in &batches {
+            out.append(b);
+        }
+        out
+    }
+}
+
+/// Receivers per parallel task in [`Shadows::shade_all`].
+pub const CHUNK: usize = 512;
+
+/// Work space of [`Shadows::shade`], reused from receiver to receiver so
+/// that shading allocates nothing once warm.
+#[derive(Default)]
+pub struct Scratch {
+    arena: PieceArena,
+    cur: Vec<(Piece, u64)>,
+    next: Vec<(Piece, u64)>,
+    out: Vec<(Piece, bool)>,
+    stack: Vec<Task>,
+    sides: SmallVec<[Side; 8]>,
+    rounded: Vec<Option<[f64; 3]>>,
+    remap: Vec<u32>,
+    pieces: Vec<Piece>,
+    labels: Vec<u64>,
+}
+
+enum Task {
+    Visit(Piece, u32),
+    /// Both pieces of `parent`'s cut start at `out[mark]`; the arena held
+    /// `arena` before the cut.
+    Merge {
+        parent: Piece,
+        mark: usize,
+        arena: ArenaMark,
+    },
+}
+
+/// Filters `piece` through a shadow-volume tree: the lit and shadowed
+/// pieces go to `out`. A cut whose two sides come back as single pieces
+/// with the same flag is undone (the parent piece is kept, the arena rolled
+/// back), so only cuts that separate lit from shadow survive.
+fn filter(
+    sv: &ShadowVolumes,
+    arena: &mut PieceArena,
+    support: u32,
+    piece: Piece,
+    out: &mut Vec<(Piece, bool)>,
+    stack: &mut Vec<Task>,
+    sides: &mut SmallVec<[Side; 8]>,
+) {
+    stack.clear();
+    stack.push(Task::Visit(piece, sv.root));
+    while let Some(t) = stack.pop() {
+        match t {
+            Task::Visit(p, LIT) => out.push((p, true)),
+            Task::Visit(p, SHADOW) => out.push((p, false)),
+            Task::Visit(p, id) => {
+                let n = &sv.nodes[id as usize];
+                let s = arena.classify_into(&p, &n.plane, sides);
+                let (front, back) = match (n.cap, s.front, s.back) {
+                    // a cap: the part behind it is hidden
+                    (true, _, false) => {
+                        stack.push(Task::Visit(p, n.front));
+                        continue;
+                    }
+                    (true, false, true) => {
+                        out.push((p, false));
+                        continue;
+                    }
+                    (true, true, true) => (n.front, SHADOW),
+                    // a plane through the light
+                    (false, true, false) | (false, false, false) => {
+                        stack.push(Task::Visit(p, n.front));
+                        continue;
+                    }
+                    (false, false, true) => {
+                        stack.push(Task::Visit(p, n.back));
+                        continue;
+                    }
+                    (false, true, true) => (n.front, n.back),
+                };
+                let mark = arena.mark();
+                let cut = arena.add_plane(n.plane);
+                let (f, b) = arena.split(support, &p, cut, sides);
+                stack.push(Task::Merge {
+                    parent: p,
+                    mark: out.len(),
+                    arena: mark,
+                });
+                stack.push(Task::Visit(b, back));
+                stack.push(Task::Visit(f, front));
+            }
+            Task::Merge {
+                parent,
+                mark,
+                arena: am,
+            } => {
+                if out.len() == mark + 2 && out[mark].1 == out[mark + 1].1 {
+                    let lit = out[mark].1;
+                    out.truncate(mark);
+                    arena.rollback(am);
+                    out.push((parent, lit));
+                }
+            }
+        }
+    }
+}
+
+/// Fragments of many receivers in flat arrays: per fragment its face,
+/// receiver, flags and rings (the first ring is the outer boundary,
+/// counter-clockwise seen from the face's front; the others are holes,
+/// clockwise), and optionally its convex pieces; vertices exact and
+/// correctly rounded to `f64` grid coordinates, each stored once per
+/// receiver.
+#[derive(Clone, Debug)]
+pub struct Batch {
+    face: Vec<u32>,
+    receiver: Vec<u32>,
+    lit: Vec<u64>,
+    facing: Vec<u64>,
+    support: Vec<Plane>,
+    frag_ring: Vec<u32>,
+    ring_start: Vec<u32>,
+    ring_verts: Vec<u32>,
+    frag_piece: Vec<u32>,
+    piece_start: Vec<u32>,
+    piece_verts: Vec<u32>,
+    vertices: Vec<Vertex>,
+    rounded: Vec<[f64; 3]>,
+}
+
+impl Default for Batch {
+    fn default() -> Batch {
+        Batch::new()
+    }
+}
+
+/// One fragment of a [`Batch`].
+#[derive(Clone, Copy, Debug)]
+pub struct FragmentRef<'a> {
+    batch: &'a Batch,
+    index: usize,
+}
+
+impl<'a> FragmentRef<'a> {
+    /// The batch it belongs to (for its vertices).
+    pub fn batch(&self) -> &'a Batch {
+        self.batch
+    }
+
+    /// The input face (the polygons' tag).
+    pub fn face(&self) -> u32 {
+        self.batch.face[self.index]
+    }
+
+    /// The receiver it was shaded as (see [`Shadows::shade`]).
+    pub fn receiver(&self) -> u32 {
+        self.batch.receiver[self.index]
+    }
+
+    /// Bit `i` set: light `i` reaches the fragment's front side
+    /// unobstructed.
+    pub fn lit_mask(&self) -> u64 {
+        self.batch.lit[self.index]
+    }
+
+    /// `true` if light `i` reaches it.
+    pub fn lit(&self, i: usize) -> bool {
+        self.lit_mask() >> i & 1 == 1
+    }
+
+    /// Bit `i` set: light `i` is strictly in front of the face's plane
+    /// (an unlit fragment is then in cast shadow, else in attached shadow).
+    pub fn facing_mask(&self) -> u64 {
+        self.batch.facing[self.index]
+    }
+
+    /// The face's support plane.
+    pub fn support(&self) -> &'a Plane {
+        &self.batch.support[self.index]
+    }
+
+    /// The rings: the outer boundary first, then the holes; each a list of
+    /// vertex indices into the batch ([`Batch::vertex`], [`Batch::rounded`]).
+    pub fn rings(self) -> impl Iterator<Item = &'a [u32]> + 'a {
+        let b = self.batch;
+        let r = b.frag_ring[self.index] as usize..b.frag_ring[self.index + 1] as usize;
+        r.map(move |k| &b.ring_verts[b.ring_start[k] as usize..b.ring_start[k + 1] as usize])
+    }
+
+    /// The outer boundary.
+    pub fn outer(self) -> &'a [u32] {
+        self.rings().next().expect("a fragment has an outer ring")
+    }
+
+    /// Number of holes.
+    pub fn hole_count(&self) -> usize {
+        (self.batch.frag_ring[self.index + 1] - self.batch.frag_ring[self.index]) as usize - 1
+    }
+
+    /// Convex pieces whose union is the fragment (empty unless shaded with
+    /// [`ShadeOptions::pieces`]), counter-clockwise.
+    pub fn pieces(self) -> impl Iterator<Item = &'a [u32]> + 'a {
+        let b = self.batch;
+        let r = b.frag_piece[self.index] as usize..b.frag_piece[self.index + 1] as usize;
+        r.map(move |k| &b.piece_verts[b.piece_start[k] as usize..b.piece_start[k + 1] as usize])
+    }
+}
+
+impl Batch {
+    /// An empty batch.
+    pub fn new() -> Batch {
+        Batch {
+            face: Vec::new(),
+            receiver: Vec::new(),
+            lit: Vec::new(),
+            facing: Vec::new(),
+            support: Vec::new(),
+            frag_ring: vec![0],
+            ring_start: vec![0],
+            ring_verts: Vec::new(),
+            frag_piece: vec![0],
+            piece_start: vec![0],
+            piece_verts: Vec::new(),
+            vertices: Vec::new(),
+            rounded: Vec::new(),
+        }
+    }
+
+    /// Number of fragments.
+    pub fn len(&self) -> usize {
+        self.face.len()
+    }
+
+    /// `true` if there are no fragments.
+    pub fn is_empty(&self) -> bool {
+        self.face.is_empty()
+    }
+
+    /// Fragment `i`.
+    pub fn fragment(&self, i: usize) -> FragmentRef<'_> {
+        assert!(i < self.len(), "fragment {i} of {}", self.len());
+        FragmentRef {
+            batch: self,
+            index: i,
+        }
+    }
+
+    /// Every fragment, in order.
+    pub fn fragments(&self) -> impl ExactSizeIterator<Item = FragmentRef<'_>> + '_ {
+        (0..self.len()).map(move |index| FragmentRef { batch: self, index })
+    }
+
+    /// The exact vertex `v`; `None` in a batch made from Chin & Feiner's
+    /// fragments ([`Batch::from_chin_feiner`]), whose vertices are wider
+    /// than [`Vertex`].
+    pub fn vertex(&self, v: u32) -> Option<&Vertex> {
+        self.vertices.get(v as usize)
+    }
+
+    /// Vertex `v` in grid coordinates, correctly rounded.
+    pub fn rounded(&self, v: u32) -> [f64; 3] {
+        self.rounded[v as usize]
+    }
+
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.rounded.len()
+    }
+
+    /// Chin & Feiner's fragments in a batch, for the same outputs: each
+    /// fragment is one convex ring and one piece, its receiver the index of
+    /// its scene polygon; `lights` give the facing flags. Only the rounded
+    /// vertices are kept ([`Batch::vertex`] is `None`).
+    pub fn from_chin_feiner(cf: &crate::CfFragments, lights: &[Light]) -> Batch {
+        let mut b = Batch::new();
+        for f in cf.iter() {
+            let support = *f.support();
+            let facing = lights
+                .iter()
+                .enumerate()
+                .fold(0u64, |m, (j, l)| m | (l.faces(&support) as u64) << j);
+            b.face.push(f.face());
+            b.receiver.push(f.polygon());
+            b.lit.push(f.lit_mask());
+            b.facing.push(facing);
+            b.support.push(support);
+            let first = b.rounded.len() as u32;
+            b.rounded.extend(f.vertices_f64());
+            let last = b.rounded.len() as u32;
+            b.ring_verts.extend(first..last);
+            b.ring_start.push(b.ring_verts.len() as u32);
+            b.frag_ring.push((b.ring_start.len() - 1) as u32);
+            b.piece_verts.extend(first..last);
+            b.piece_start.push(b.piece_verts.len() as u32);
+            b.frag_piece.push((b.piece_start.len() - 1) as u32);
+        }
+        b
+    }
+
+    /// Appends another batch's fragments.
+    pub fn append(&mut self, o: &Batch) {
+        let (v0, r0, p0) = (
+            self.rounded.len() as u32,
+            (self.ring_start.len() - 1) as u32,
+            (self.piece_start.len() - 1) as u32,
+        );
+        let (rv0, pv0) = (self.ring_verts.len() as u32, self.piece_verts.len() as u32);
+        self.face.extend_from_slice(&o.face);
+        self.receiver.extend_from_slice(&o.receiver);
+        self.lit.extend_from_slice(&o.lit);
+        self.facing.extend_from_slice(&o.facing);
+        self.support.extend_from_slice(&o.support);
+        self.frag_ring
+            .extend(o.frag_ring[1..].iter().map(|r| r + r0));
+        self.ring_start
+            .extend(o.ring_start[1..].iter().map(|s| s + rv0));
+        self.ring_verts.extend(o.ring_verts.iter().map(|v| v + v0));
+        self.frag_piece
+            .extend(o.frag_piece[1..].iter().map(|r| r + p0));
+        self.piece_start
+            .extend(o.piece_start[1..].iter().map(|s| s + pv0));
+        self.piece_verts
+            .extend(o.piece_verts.iter().map(|v| v + v0));
+        self.vertices.extend_from_slice(&o.vertices);
+        self.rounded.extend_from_slice(&o.rounded);
+    }
+
+    /// A vertex of the scratch arena, added once per receiver.
+    fn take_vertex(&mut self, s: &mut Scratch, v: u32) -> u32 {
+        let d = s.arena.dense(v);
+        let slot = &mut s.remap[d];
+        if *slot == u32::MAX {
+            let vert = s.arena.vertex(v);
+            let r = s
+                .rounded
+                .get(d)
+                .copied()
+                .flatten()
+                .unwrap_or_else(|| vert.to_f64());
+            self.vertices.push(vert.to_owned());
+            self.rounded.push(r);
+            *slot = (self.vertices.len() - 1) as u32;
+        }
+        *slot
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn push_receiver(
+        &mut self,
+        face: u32,
+        receiver: u32,
+        facing: u64,
+        support: &Plane,
+        s: &mut Scratch,
+        single_polygon: bool,
+        opts: &ShadeOptions,
+    ) {
+        s.remap.clear();
+        s.remap.resize(s.arena.len(), u32::MAX);
+        s.rounded.clear();
+        let push_frag = |b: &mut Batch, lit: u64| {
+            b.face.push(face);
+            b.receiver.push(receiver);
+            b.lit.push(lit);
+            b.facing.push(facing);
+            b.support.push(*support);
+        };
+        if single_polygon && s.cur.len() == 1 {
+            // one piece: the receiver's own polygon, whole
+            let (piece, lit) = s.cur.pop().expect("one piece");
+            push_frag(self, lit);
+            for &v in &piece.verts {
+                let id = self.take_vertex(s, v);
+                self.ring_verts.push(id);
+            }
+            self.ring_start.push(self.ring_verts.len() as u32);
+            self.frag_ring.push((self.ring_start.len() - 1) as u32);
+            if opts.pieces {
+                let n = piece.verts.len();
+                let start = self.ring_verts.len() - n;
+                let copy: SmallVec<[u32; 8]> = self.ring_verts[start..].iter().copied().collect();
+                self.piece_verts.extend(copy);
+                self.piece_start.push(self.piece_verts.len() as u32);
+            }
+            self.frag_piece.push((self.piece_start.len() - 1) as u32);
+            return;
+        }
+        s.pieces.clear();
+        s.labels.clear();
+        for (p, l) in s.cur.drain(..) {
+            s.pieces.push(p);
+            s.labels.push(l);
+        }
+        let regions = merge_cells(&s.arena, support, &s.pieces, &s.labels, &mut s.rounded);
+        for r in &regions {
+            push_frag(self, r.label);
+            for ring in std::iter::once(&r.outer).chain(&r.holes) {
+                for &v in ring {
+                    let id = self.take_vertex(s, v);
+                    self.ring_verts.push(id);
+                }
+                self.ring_start.push(self.ring_verts.len() as u32);
+            }
+            self.frag_ring.push((self.ring_start.len() - 1) as u32);
+            if opts.pieces {
+                for &c in &r.cells {
+                    let verts = s.pieces[c as usize].verts.clone();
+                    for v in verts {
+                        let id = self.take_vertex(s, v);
+                        self.piece_verts.push(id);
+                    }
+                    self.piece_start.push(self.piece_verts.len() as u32);
+                }
+            }
+            self.frag_piece.push((self.piece_start.len() - 1) as u32);
+        }
+    }
+}
+
+/// Figures of one run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ShadowStats {
+    /// Receivers shaded (faces, or face parts in different planes).
+    pub receivers: usize,
+    /// Fragments produced.
+    pub fragments: usize,
+    /// Shadow-volume tree nodes, summed over the lights.
+    pub shadow_nodes: usize,
+}
+
+/// Exact lit and shadowed fragments of every face of `polys` (imported
+/// polygons with grid vertices, tagged with their face) for each of
+/// `lights`: every face is both occluder and receiver. A convenience over
+/// [`Shadows`]; receivers are shaded in parallel.
+pub fn shadow_fragments(
+    polys: &[Polygon],
+    lights: &[Light],
+) -> Result<(Batch, ShadowStats), ShadowError> {
+    let shadows = Shadows::new(polys, lights)?;
+    let batch = shadows.shade_all(polys, &ShadeOptions::default());
+    let stats = ShadowStats {
+        receivers: receivers(polys).len(),
+        fragments: batch.len(),
+        shadow_nodes: shadows.volumes.iter().map(ShadowVolumes::node_count).sum(),
+    };
+    Ok((batch, stats))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad(z: i32, lo: i32, hi: i32, tag: u32) -> Polygon {
+        Polygon::from_grid_points(&[[lo, lo, z], [hi, lo, z], [hi, hi, z], [lo, hi, z]], tag)
+            .unwrap()
+    }
+
+    fn ring_coords(b: &Batch, ring: &[u32]) -> Vec<[f64; 3]> {
+        let mut v: Vec<[f64; 3]> = ring.iter().map(|&i| b.rounded(i)).collect();
+        v.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        v
+    }
+
+    #[test]
+    fn occluder_casts_an_exact_square_hole() {
+        // floor 0..8 at z = 0, occluder 2..4 at z = 4, light above at z = 8
+        let polys = [quad(0, 0, 8, 0), quad(4, 2, 4, 1)];
+        let (b, stats) = shadow_fragments(&polys, &[Light::Point([3, 3, 8])]).unwrap();
+        // the floor: one lit ring with a hole, one shadowed square; the
+        // occluder: lit, whole
+        assert_eq!((b.len(), stats.fragments), (3, 3));
+        let floor: Vec<_> = b.fragments().filter(|f| f.face() == 0).collect();
+        let lit = floor.iter().find(|f| f.lit(0)).unwrap();
+        let dark = floor.iter().find(|f| !f.lit(0)).unwrap();
+        assert_eq!(lit.hole_count(), 1);
+        assert_eq!(dark.hole_count(), 0);
+        // the shadow of [2,4]^2 at height 4 from (3,3,8) on z = 0 is [1,5]^2
+        let sq = vec![
+            [1.0, 1.0, 0.0],
+            [1.0, 5.0, 0.0],
+            [5.0, 1.0, 0.0],
+            [5.0, 5.0, 0.0],
+        ];
+        assert_eq!(ring_coords(&b, dark.outer()), sq);
+        assert_eq!(ring_coords(&b, lit.rings().nth(1).unwrap()), sq);
+        let occ: Vec<_> = b.fragments().filter(|f| f.face() == 1).collect();
+        assert_eq!(occ.len(), 1);
+        assert!(occ[0].lit(0));
+        assert_eq!(occ[0].outer().len(), 4);
+    }
+
+    #[test]
+    fn sun_and_back_faces() {
+        let floor = quad(0, 0, 8, 0);
+        let occ = quad(4, 2, 4, 1).flipped(); // faces down, still blocks
+        let polys = [floor, occ];
+        let (b, _) = shadow_fragments(
+            &polys,
+            &[Light::Directional([0, 0, 1]), Light::Point([3, 3, -8])],
+        )
+        .unwrap();
+        let dark: Vec<_> = b
+            .fragments()
+            .filter(|f| f.face() == 0 && !f.lit(0))
+            .collect();
+        assert_eq!(dark.len(), 1);
+        assert_eq!(
+            ring_coords(&b, dark[0].outer()),
+            vec![
+                [2.0, 2.0, 0.0],
+                [2.0, 4.0, 0.0],
+                [4.0, 2.0, 0.0],
+                [4.0, 4.0, 0.0]
+            ]
+        );
+        // the occluder faces away from the sun and the light below is
+        // blocked by the floor
+        assert!(
+            b.fragments()
+                .filter(|f| f.face() == 1)
+                .all(|f| !f.lit(0) && !f.lit(1))
+        );
+        // the floor faces up: the light below leaves it in attached shadow
+        assert!(b.fragments().filter(|f| f.face() == 0).all(|f| !f.lit(1)));
+        assert!(
+            b.fragments()
+                .filter(|f| f.face() == 0)
+                .all(|f| f.facing_mask() == 1)
+        );
+    }
+
+    #[test]
+    fn uniform_faces_stay_whole_and_pieces_cover_fragments() {
+        let polys = [quad(0, 0, 8, 0), quad(4, 2, 4, 1), quad(6, -20, -10, 2)];
+        let (b, _) = shadow_fragments(&polys, &[Light::Point([3, 3, 8])]).unwrap();
+        let far: Vec<_> = b.fragments().filter(|f| f.face() == 2).collect();
+        assert_eq!(far.len(), 1);
+        for f in b.fragments() {
+            assert!(f.pieces().count() >= 1);
+        }
+    }
+}

@@ -1,0 +1,915 @@
+//! Partitioned shadow volumes (Gerhards, Mora, Aveneau & Ghazanfarpour
+//! 2015), exactly: one BSP tree per light over the shadow volumes of every
+//! occluder.
+//!
+//! An occluder's volume is bounded by one plane through the light and
+//! each of its edges (for a sun, parallel to the direction) and capped by
+//! the occluder's own plane, oriented so that the light is in front: the
+//! points behind the cap and inside every edge plane are exactly the
+//! points the occluder hides. Because of the cap, volumes can be inserted
+//! in any order and a receiver can be filtered through the finished tree
+//! whatever its position: the lit region is the complement of the union
+//! of the volumes, which the tree's leaves partition.
+//!
+//! An occluder descends the tree clipped to the region of each node it
+//! reaches (its part on each side of a plane through the light; its part
+//! in front of a cap, since everything it hides behind the cap is hidden
+//! already), so it reaches exactly the leaves its volume meets. At a lit
+//! leaf its volume is grafted: its cap, and those of its edge planes that
+//! bound its clipped part there and that the path does not already
+//! enforce (a neighbour's shared edge, a plane of the skeleton). The parts
+//! of the volume outside the leaf's region are cut off by the region
+//! itself.
+//!
+//! The tree is built in two phases. First a *skeleton*: planes through the
+//! light, chosen top-down among the occluders' edge planes so that each
+//! splits its occluders evenly and cuts few (sampled, like
+//! [`bsp_core::BspTree::build`]), the occluders clipped along, until at
+//! most a few hundred reach each leaf. Then below each leaf the occluders
+//! that reach it are inserted nearest first, so that far ones mostly stop
+//! at the caps of near ones. Inserting a whole scene nearest first from
+//! the root would instead let the first occluders' planes run across
+//! everything behind them and cut every later occluder: the balanced
+//! skeleton keeps the tree near linear in the scene size. Below the first
+//! few skeleton levels the subtrees are independent and built in
+//! parallel; each is a function of its occluders alone, so the tree is
+//! the same for every thread count.
+//!
+//! Every plane is an input-tier plane (an occluder's support plane, or the
+//! plane through the light and two grid vertices), so occluders and
+//! receivers are cut in the input tier: 256-bit vertices behind the `f64`
+//! filter.
+
+use bsp_core::{EdgeRef, GridPoint, Piece, PieceArena, Plane, Point, Polygon, Side};
+use rayon::prelude::*;
+use smallvec::SmallVec;
+
+use crate::light::Light;
+
+/// A leaf: lit.
+pub(crate) const LIT: u32 = u32::MAX;
+/// A leaf: in shadow (behind a cap).
+pub(crate) const SHADOW: u32 = u32::MAX - 1;
+
+/// A node of a shadow-volume tree.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Node {
+    pub(crate) plane: Plane,
+    /// Child in front of the plane: a node index, [`LIT`] or [`SHADOW`].
+    pub(crate) front: u32,
+    /// Child behind the plane.
+    pub(crate) back: u32,
+    /// A cap (an occluder's plane, light in front; behind is shadow)
+    /// rather than a plane through the light.
+    pub(crate) cap: bool,
+}
+
+/// Why shadow volumes cannot be built.
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum VolumeError {
+    /// An occluder has a vertex that is not a grid point (a piece cut by
+    /// another plane): shadow planes through it would leave the input tier.
+    ImplicitOccluder {
+        /// The occluder's index in the input.
+        index: usize,
+    },
+}
+
+impl std::fmt::Display for VolumeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            VolumeError::ImplicitOccluder { index } => write!(
+                f,
+                "occluder {index} has a vertex off the grid: occluders must be imported \
+                 polygons, not pieces of a split"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for VolumeError {}
+
+/// The occluders that face or back onto the light, nearest first, as
+/// flat arrays.
+struct Occluders {
+    /// Vertices of occluder `i`: `verts[start[i]..start[i + 1]]`.
+    verts: Vec<GridPoint>,
+    /// The shadow plane of each edge (edge `j` from vertex `j` to `j + 1`),
+    /// interior behind: also the occluder's edge planes as a polygon.
+    edges: Vec<Plane>,
+    start: Vec<u32>,
+    support: Vec<Plane>,
+    cap: Vec<Plane>,
+}
+
+impl Occluders {
+    fn len(&self) -> usize {
+        self.support.len()
+    }
+
+    fn range(&self, i: u32) -> std::ops::Range<usize> {
+        self.start[i as usize] as usize..self.start[i as usize + 1] as usize
+    }
+
+    fn verts(&self, i: u32) -> &[GridPoint] {
+        &self.verts[self.range(i)]
+    }
+
+    fn edges(&self, i: u32) -> &[Plane] {
+        &self.edges[self.range(i)]
+    }
+
+    /// Prepares every polygon (in parallel) and orders them nearest
+    /// first, ties by input order.
+    fn new(light: &Light, polys: &[Polygon]) -> Result<Occluders, VolumeError> {
+        let grid = |p: &Polygon| -> SmallVec<[GridPoint; 4]> {
+            p.vertices()
+                .iter()
+                .map(|v| match v {
+                    Point::Grid(g) => *g,
+                    Point::Implicit(_) => unreachable!("checked"),
+                })
+                .collect()
+        };
+        // the order first: keys of the polygons not edge-on
+        let keyed: Vec<Option<(f64, u32)>> = polys
+            .par_iter()
+            .enumerate()
+            .map(|(index, p)| {
+                if p.vertices().iter().any(|v| matches!(v, Point::Implicit(_))) {
+                    return Err(VolumeError::ImplicitOccluder { index });
+                }
+                if light.eval(p.support()) == 0 {
+                    return Ok(None);
+                }
+                Ok(Some((sort_key(light, &grid(p)), index as u32)))
+            })
+            .collect::<Result<_, _>>()?;
+        let mut order: Vec<(f64, u32)> = keyed.into_iter().flatten().collect();
+        order.par_sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        // then the planes, chunk by chunk in parallel
+        struct Chunk {
+            verts: Vec<GridPoint>,
+            edges: Vec<Plane>,
+            counts: Vec<u32>,
+            support: Vec<Plane>,
+            cap: Vec<Plane>,
+        }
+        let chunks: Vec<Chunk> = order
+            .par_chunks(4096)
+            .map(|part| {
+                let mut c = Chunk {
+                    verts: Vec::with_capacity(part.len() * 3),
+                    edges: Vec::with_capacity(part.len() * 3),
+                    counts: Vec::with_capacity(part.len()),
+                    support: Vec::with_capacity(part.len()),
+                    cap: Vec::with_capacity(part.len()),
+                };
+                for &(_, i) in part {
+                    let p = &polys[i as usize];
+                    let verts = grid(p);
+                    let k = verts.len();
+                    for j in 0..k {
+                        let e = light
+                            .edge_plane(verts[j], verts[(j + 1) % k], verts[(j + 2) % k])
+                            .expect("a light off the plane is off every edge line");
+                        c.edges.push(e);
+                    }
+                    c.verts.extend_from_slice(&verts);
+                    c.counts.push(k as u32);
+                    let support = *p.support();
+                    c.support.push(support);
+                    c.cap.push(if light.eval(&support) > 0 {
+                        support
+                    } else {
+                        support.flip()
+                    });
+                }
+                c
+            })
+            .collect();
+        let n = order.len();
+        let mut o = Occluders {
+            verts: Vec::with_capacity(chunks.iter().map(|c| c.verts.len()).sum()),
+            edges: Vec::with_capacity(chunks.iter().map(|c| c.edges.len()).sum()),
+            start: Vec::with_capacity(n + 1),
+            support: Vec::with_capacity(n),
+            cap: Vec::with_capacity(n),
+        };
+        o.start.push(0);
+        for c in chunks {
+            for k in c.counts {
+                let last = *o.start.last().expect("starts at 0");
+                o.start.push(last + k);
+            }
+            o.verts.extend_from_slice(&c.verts);
+            o.edges.extend_from_slice(&c.edges);
+            o.support.extend_from_slice(&c.support);
+            o.cap.extend_from_slice(&c.cap);
+        }
+        Ok(o)
+    }
+}
+
+/// The insertion order's key of a polygon with grid vertices: its
+/// distance from the light (for a sun, its position along the direction),
+/// nearest first.
+fn sort_key(light: &Light, verts: &[GridPoint]) -> f64 {
+    match light {
+        Light::Point(l) => verts
+            .iter()
+            .map(|v| {
+                (0..3)
+                    .map(|j| (v[j] as f64 - l[j] as f64).powi(2))
+                    .sum::<f64>()
+            })
+            .fold(f64::INFINITY, f64::min),
+        Light::Directional(d) => -verts
+            .iter()
+            .map(|v| (0..3).map(|j| v[j] as f64 * d[j] as f64).sum::<f64>())
+            .fold(f64::NEG_INFINITY, f64::max),
+    }
+}
+
+/// A plane on a path from the root, with its side and an
+/// orientation-free key for quick comparison.
+#[derive(Clone, Copy, Debug)]
+struct Step {
+    key: u64,
+    plane: Plane,
+    side: Side,
+}
+
+impl Step {
+    fn new(plane: Plane, side: Side) -> Step {
+        Step {
+            key: plane_key(&plane),
+            plane,
+            side,
+        }
+    }
+}
+
+/// A hash of a plane that is the same for both orientations.
+#[inline]
+fn plane_key(p: &Plane) -> u64 {
+    let n = p.normal();
+    let first = n.iter().copied().find(|&c| c != 0).unwrap_or(0);
+    let s: i64 = if first < 0 { -1 } else { 1 };
+    let d = p.offset() * s as i128;
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for x in [
+        (n[0] * s) as u64,
+        (n[1] * s) as u64,
+        (n[2] * s) as u64,
+        d as u64,
+        (d >> 64) as u64,
+    ] {
+        h = (h ^ x).wrapping_mul(0x0100_0000_01b3).rotate_left(29);
+    }
+    h
+}
+
+/// `true` if `path` already keeps its region behind `e`: the path went
+/// behind `e`, or in front of `e` flipped.
+fn enforced(path: &[Step], e: &Plane) -> bool {
+    let key = plane_key(e);
+    path.iter().any(|st| {
+        st.key == key
+            && ((st.side == Side::Back && st.plane == *e)
+                || (st.side == Side::Front && st.plane == e.flip()))
+    })
+}
+
+/// `true` if `e` (either orientation) is on `path`.
+fn on_path(path: &[Step], e: &Plane) -> bool {
+    let key = plane_key(e);
+    path.iter()
+        .any(|st| st.key == key && st.plane.is_coincident(e))
+}
+
+/// Occluders per skeleton leaf: lists longer than this are split further
+/// when a balanced plane is found.
+const LEAF_SIZE: usize = 192;
+/// Occluders drawn per skeleton node, each offering its edge planes.
+const CANDIDATES: usize = 4;
+/// Occluders each candidate plane is scored on.
+const SAMPLE: usize = 32;
+/// Weight of an occluder straddling a candidate against one unit of
+/// imbalance.
+const STRADDLE_WEIGHT: u64 = 3;
+/// Depth at which the skeleton stops splitting whatever the lists.
+const MAX_SKELETON_DEPTH: usize = 48;
+/// Skeleton subtrees made one after the other before the rest is built in
+/// parallel.
+const PARALLEL_TASKS: usize = 32;
+
+struct SplitMix(u64);
+impl SplitMix {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (((self.next() >> 32) * n as u64) >> 32) as usize
+    }
+}
+
+/// An occluder's part in a region: the occluder, the part (a piece of the
+/// pool), and where the occluder's edge planes start in the pool's arena
+/// (its support plane follows them).
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    occ: u32,
+    piece: u32,
+    base: u32,
+}
+
+/// Pieces of occluders and their vertices and planes.
+#[derive(Default)]
+struct Pool {
+    arena: PieceArena,
+    pieces: Vec<Piece>,
+}
+
+impl Pool {
+    /// Adds occluder `o` whole.
+    fn add_occluder(&mut self, occ: &Occluders, o: u32) -> Entry {
+        let base = self.arena.planes.len() as u32;
+        let verts = occ.verts(o);
+        let k = verts.len();
+        let mut piece = Piece::default();
+        for (j, (&v, e)) in verts.iter().zip(occ.edges(o)).enumerate() {
+            piece.verts.push(self.arena.add_grid(v));
+            let plane = self.arena.add_edge_plane(*e, v, verts[(j + 1) % k]);
+            piece.edges.push(EdgeRef::new(plane, false));
+        }
+        self.arena.add_plane(occ.support[o as usize]);
+        self.pieces.push(piece);
+        Entry {
+            occ: o,
+            piece: (self.pieces.len() - 1) as u32,
+            base,
+        }
+    }
+
+    /// Copies an entry of another pool: the occluder's planes, then the
+    /// part's vertices and cut planes.
+    fn copy_entry(&mut self, from: &Pool, occ: &Occluders, e: Entry) -> Entry {
+        let k = occ.range(e.occ).len() as u32;
+        let base = self.arena.planes.len() as u32;
+        for i in 0..=k {
+            let plane = from.arena.planes[(e.base + i) as usize];
+            match from.arena.anchors(e.base + i) {
+                Some([a, b]) => self.arena.add_edge_plane(plane, a, b),
+                None => self.arena.add_plane(plane),
+            };
+        }
+        let src = &from.pieces[e.piece as usize];
+        let mut piece = Piece::default();
+        for &v in &src.verts {
+            piece.verts.push(self.arena.copy_vertex(&from.arena, v));
+        }
+        for &r in &src.edges {
+            let gi = r.index();
+            let local = if (e.base..e.base + k).contains(&gi) {
+                base + gi - e.base
+            } else {
+                self.arena.add_plane(from.arena.planes[gi as usize])
+            };
+            piece.edges.push(EdgeRef::new(local, r.flipped()));
+        }
+        self.pieces.push(piece);
+        Entry {
+            occ: e.occ,
+            piece: (self.pieces.len() - 1) as u32,
+            base,
+        }
+    }
+}
+
+/// A region still to be partitioned: where it hangs, the planes above it,
+/// and the occluders whose volumes reach it, nearest first.
+struct Task {
+    slot: Option<(u32, Side)>,
+    path: Vec<Step>,
+    list: Vec<Entry>,
+}
+
+/// Nodes with local indices (links to other nodes of the same list).
+struct Subtree {
+    nodes: Vec<Node>,
+    grafted: usize,
+}
+
+impl Subtree {
+    fn link(&self, slot: Option<(u32, Side)>, root: u32) -> u32 {
+        match slot {
+            None => root,
+            Some((id, Side::Front)) => self.nodes[id as usize].front,
+            Some((id, _)) => self.nodes[id as usize].back,
+        }
+    }
+
+    fn set_link(&mut self, slot: Option<(u32, Side)>, root: &mut u32, to: u32) {
+        match slot {
+            None => *root = to,
+            Some((id, Side::Front)) => self.nodes[id as usize].front = to,
+            Some((id, _)) => self.nodes[id as usize].back = to,
+        }
+    }
+}
+
+/// The partitioned shadow volumes of one light.
+#[derive(Clone, Debug)]
+pub struct ShadowVolumes {
+    light: Light,
+    pub(crate) nodes: Vec<Node>,
+    pub(crate) root: u32,
+    grafted: usize,
+    skeleton: usize,
+}
+
+impl ShadowVolumes {
+    /// The shadow volumes of `occluders` (polygons with grid vertices,
+    /// whichever way they face) for `light`. Occluders in a plane through
+    /// the light hide no area and are left out. See the module docs for
+    /// how the tree is built.
+    pub fn build(light: Light, occluders: &[Polygon]) -> Result<ShadowVolumes, VolumeError> {
+        let occ = Occluders::new(&light, occluders)?;
+        let mut pool = Pool::default();
+        let list: Vec<Entry> = (0..occ.len() as u32)
+            .map(|o| pool.add_occluder(&occ, o))
+            .collect();
+        // the first levels one after the other, on one pool
+        let mut top = Subtree {
+            nodes: Vec::new(),
+            grafted: 0,
+        };
+        let mut root = LIT;
+        let mut rng = SplitMix(0x5eed_5a0d);
+        let mut sides = SmallVec::new();
+        // breadth first, so that the regions left for the parallel phase
+        // are of similar sizes
+        let mut ready: Vec<Task> = Vec::new();
+        let mut queue = std::collections::VecDeque::from([Task {
+            slot: None,
+            path: Vec::new(),
+            list,
+        }]);
+        while let Some(task) = queue.pop_front() {
+            if queue.len() + ready.len() + 1 >= PARALLEL_TASKS {
+                ready.push(task);
+                continue;
+            }
+            match split_task(
+                &occ, &mut pool, task, &mut rng, &mut sides, &mut top, &mut root,
+            ) {
+                Ok((front, back)) => {
+                    queue.push_back(front);
+                    queue.push_back(back);
+                }
+                Err(task) => ready.push(task),
+            }
+        }
+        let skeleton_top = top.nodes.len();
+        // each pending region on its own pool, in parallel
+        let parts: Vec<(Subtree, u32, usize)> = ready
+            .par_iter()
+            .enumerate()
+            .map(|(i, task)| {
+                let mut own = Pool::default();
+                let list = task
+                    .list
+                    .iter()
+                    .map(|&e| own.copy_entry(&pool, &occ, e))
+                    .collect();
+                let local = Task {
+                    slot: None,
+                    path: task.path.clone(),
+                    list,
+                };
+                build_region(&occ, &mut own, local, 0x5eed_5a0d ^ (i as u64 + 1))
+            })
+            .collect();
+        drop(pool);
+        let mut nodes = top.nodes;
+        let mut grafted = top.grafted;
+        let mut skeleton = skeleton_top;
+        for (task, (sub, sub_root, sub_skeleton)) in ready.iter().zip(parts) {
+            let off = nodes.len() as u32;
+            let shift = |l: u32| if l >= SHADOW { l } else { l + off };
+            nodes.extend(sub.nodes.into_iter().map(|mut n| {
+                n.front = shift(n.front);
+                n.back = shift(n.back);
+                n
+            }));
+            let r = shift(sub_root);
+            match task.slot {
+                None => root = r,
+                Some((id, Side::Front)) => nodes[id as usize].front = r,
+                Some((id, _)) => nodes[id as usize].back = r,
+            }
+            grafted += sub.grafted;
+            skeleton += sub_skeleton;
+        }
+        Ok(ShadowVolumes {
+            light,
+            nodes,
+            root,
+            grafted,
+            skeleton,
+        })
+    }
+
+    /// The light.
+    pub fn light(&self) -> Light {
+        self.light
+    }
+
+    /// Number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Number of nodes of the skeleton (planes through the light chosen
+    /// for balance, above the volumes).
+    pub fn skeleton_count(&self) -> usize {
+        self.skeleton
+    }
+
+    /// Number of volumes grafted (an occluder spanning several leaves
+    /// counts once per leaf).
+    pub fn grafted(&self) -> usize {
+        self.grafted
+    }
+
+    /// Longest root-to-leaf path, in nodes.
+    pub fn depth(&self) -> usize {
+        let mut best = 0;
+        let mut stack = vec![(self.root, 0usize)];
+        while let Some((link, d)) = stack.pop() {
+            if link >= SHADOW {
+                best = best.max(d);
+                continue;
+            }
+            let n = &self.nodes[link as usize];
+            stack.push((n.front, d + 1));
+            stack.push((n.back, d + 1));
+        }
+        best
+    }
+
+    /// Checks the tree exactly: every link is a node or a leaf, each node
+    /// reached once, every plane through the light passes through it and
+    /// every cap has it strictly in front with nothing behind.
+    pub fn sanity_check(&self) -> Result<(), String> {
+        let mut seen = vec![false; self.nodes.len()];
+        let mut stack = vec![self.root];
+        while let Some(link) = stack.pop() {
+            if link >= SHADOW {
+                continue;
+            }
+            let Some(n) = self.nodes.get(link as usize) else {
+                return Err(format!("link to missing node {link}"));
+            };
+            if std::mem::replace(&mut seen[link as usize], true) {
+                return Err(format!("node {link} reached twice"));
+            }
+            let at = self.light.eval(&n.plane);
+            if n.cap && at <= 0 {
+                return Err(format!("cap {link} does not face the light"));
+            }
+            if !n.cap && at != 0 {
+                return Err(format!("shadow plane {link} misses the light"));
+            }
+            if n.cap && n.back != SHADOW {
+                return Err(format!("cap {link} has something behind it"));
+            }
+            stack.push(n.front);
+            stack.push(n.back);
+        }
+        match seen.iter().position(|s| !s) {
+            Some(i) => Err(format!("node {i} is unreachable")),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Splits `task` by a balanced plane through the light (a new node of
+/// `tree` at the task's slot), clipping its occluders' parts: the front and
+/// back tasks; or the task back if it is small enough or no plane splits it.
+#[allow(clippy::too_many_arguments)]
+fn split_task(
+    occ: &Occluders,
+    pool: &mut Pool,
+    task: Task,
+    rng: &mut SplitMix,
+    sides: &mut SmallVec<[Side; 8]>,
+    tree: &mut Subtree,
+    root: &mut u32,
+) -> Result<(Task, Task), Task> {
+    if task.list.len() <= LEAF_SIZE || task.path.len() >= MAX_SKELETON_DEPTH {
+        return Err(task);
+    }
+    let Some(plane) = choose_split(occ, pool, &task, rng, sides) else {
+        return Err(task);
+    };
+    let cut = pool.arena.add_plane(plane);
+    let (mut front, mut back) = (Vec::new(), Vec::new());
+    for e in task.list {
+        let p = &pool.pieces[e.piece as usize];
+        let sd = pool.arena.classify_into(p, &plane, sides);
+        match (sd.front, sd.back) {
+            (false, true) => back.push(e),
+            (true, true) => {
+                let sup = e.base + occ.range(e.occ).len() as u32;
+                let (f, b) = pool
+                    .arena
+                    .split(sup, &pool.pieces[e.piece as usize], cut, sides);
+                pool.pieces.push(f);
+                front.push(Entry {
+                    piece: (pool.pieces.len() - 1) as u32,
+                    ..e
+                });
+                pool.pieces.push(b);
+                back.push(Entry {
+                    piece: (pool.pieces.len() - 1) as u32,
+                    ..e
+                });
+            }
+            // an occluder part in a plane through the light is edge-on:
+            // it cannot happen, and would hide nothing
+            _ => front.push(e),
+        }
+    }
+    let id = tree.nodes.len() as u32;
+    tree.nodes.push(Node {
+        plane,
+        front: LIT,
+        back: LIT,
+        cap: false,
+    });
+    tree.set_link(task.slot, root, id);
+    let child = |side: Side, list: Vec<Entry>| {
+        let mut path = task.path.clone();
+        path.push(Step::new(plane, side));
+        Task {
+            slot: Some((id, side)),
+            path,
+            list,
+        }
+    };
+    Ok((child(Side::Front, front), child(Side::Back, back)))
+}
+
+/// The whole tree below one region, on its own pool: the rest of the
+/// skeleton, then each leaf's occluders inserted nearest first. Returns
+/// the nodes, the root link and the number of skeleton nodes.
+fn build_region(occ: &Occluders, pool: &mut Pool, task: Task, seed: u64) -> (Subtree, u32, usize) {
+    let mut tree = Subtree {
+        nodes: Vec::new(),
+        grafted: 0,
+    };
+    let mut root = LIT;
+    let mut rng = SplitMix(seed);
+    let mut sides = SmallVec::new();
+    let mut leaves = Vec::new();
+    let mut stack = vec![task];
+    while let Some(task) = stack.pop() {
+        match split_task(occ, pool, task, &mut rng, &mut sides, &mut tree, &mut root) {
+            Ok((front, back)) => {
+                stack.push(back);
+                stack.push(front);
+            }
+            Err(task) => leaves.push(task),
+        }
+    }
+    let skeleton = tree.nodes.len();
+    let entries: usize = leaves.iter().map(|l| l.list.len()).sum();
+    tree.nodes.reserve(entries * 3);
+    let mut scratch = InsertScratch::default();
+    for leaf in &leaves {
+        for &e in &leaf.list {
+            insert(&mut tree, &mut root, occ, pool, e, leaf, &mut scratch);
+        }
+    }
+    (tree, root, skeleton)
+}
+
+/// A plane through the light among the edge planes of a few occluders of
+/// `task`, splitting a sample of its occluders most evenly with the
+/// fewest straddling; `None` if none leaves occluders wholly on each side.
+fn choose_split(
+    occ: &Occluders,
+    pool: &mut Pool,
+    task: &Task,
+    rng: &mut SplitMix,
+    sides: &mut SmallVec<[Side; 8]>,
+) -> Option<Plane> {
+    let n = task.list.len();
+    let sample: SmallVec<[usize; SAMPLE]> = if n <= SAMPLE {
+        (0..n).collect()
+    } else {
+        (0..SAMPLE).map(|_| rng.below(n)).collect()
+    };
+    let mut best: Option<(u64, Plane)> = None;
+    for _ in 0..CANDIDATES {
+        let o = task.list[rng.below(n)].occ;
+        for e in occ.edges(o) {
+            if on_path(&task.path, e) {
+                continue;
+            }
+            let (mut f, mut b, mut both) = (0u64, 0u64, 0u64);
+            for &i in &sample {
+                let p = &pool.pieces[task.list[i].piece as usize];
+                let sd = pool.arena.classify_into(p, e, sides);
+                match (sd.front, sd.back) {
+                    (true, true) => both += 1,
+                    (true, false) => f += 1,
+                    (false, true) => b += 1,
+                    (false, false) => {}
+                }
+            }
+            if f == 0 || b == 0 {
+                continue;
+            }
+            let score = STRADDLE_WEIGHT * both + f.abs_diff(b);
+            if best.is_none_or(|(s, _)| score < s) {
+                best = Some((score, *e));
+            }
+        }
+    }
+    best.map(|(_, p)| p)
+}
+
+/// Where a piece goes next: the piece, the link it reaches, the depth of
+/// its path and the slot it came through.
+type Visit = (Piece, u32, usize, Option<(u32, Side)>);
+
+/// Work space of [`insert`].
+#[derive(Default)]
+struct InsertScratch {
+    stack: Vec<Visit>,
+    path: Vec<Step>,
+    sides: SmallVec<[Side; 8]>,
+}
+
+/// Inserts entry `e` (an occluder clipped to the region of `leaf`) below
+/// the leaf: it descends to the lit leaves its volume meets. The pieces it
+/// is cut into live in the pool's arena until it is grafted, then the
+/// arena is rolled back.
+#[allow(clippy::too_many_arguments)]
+fn insert(
+    tree: &mut Subtree,
+    root: &mut u32,
+    occ: &Occluders,
+    pool: &mut Pool,
+    e: Entry,
+    leaf: &Task,
+    s: &mut InsertScratch,
+) {
+    let mark = pool.arena.mark();
+    let k = occ.range(e.occ).len() as u32;
+    let sup = e.base + k;
+    let piece = pool.pieces[e.piece as usize].clone();
+    s.stack.clear();
+    s.path.clear();
+    s.path.extend_from_slice(&leaf.path);
+    let base = leaf.path.len();
+    s.stack
+        .push((piece, tree.link(leaf.slot, *root), base, leaf.slot));
+    let mut first = true;
+    let arena = &mut pool.arena;
+    while let Some((p, link, depth, edge)) = s.stack.pop() {
+        s.path.truncate(depth);
+        if !first && let Some((id, side)) = edge {
+            s.path.push(Step::new(tree.nodes[id as usize].plane, side));
+        }
+        first = false;
+        if link == SHADOW {
+            continue;
+        }
+        if link == LIT {
+            graft(tree, root, occ, e, &p, edge, &s.path);
+            continue;
+        }
+        let n = tree.nodes[link as usize];
+        let sd = arena.classify_into(&p, &n.plane, &mut s.sides);
+        let d = s.path.len();
+        let front = Some((link, Side::Front));
+        let back = Some((link, Side::Back));
+        match (n.cap, sd.front, sd.back) {
+            // behind a cap (or in its plane): hidden already
+            (true, false, _) => {}
+            (true, true, false) | (false, true, false) | (false, false, false) => {
+                s.stack.push((p, n.front, d, front))
+            }
+            (false, false, true) => s.stack.push((p, n.back, d, back)),
+            (true, true, true) => {
+                let cut = arena.add_plane(n.plane);
+                let (f, _) = arena.split(sup, &p, cut, &s.sides);
+                s.stack.push((f, n.front, d, front));
+            }
+            (false, true, true) => {
+                let cut = arena.add_plane(n.plane);
+                let (f, b) = arena.split(sup, &p, cut, &s.sides);
+                s.stack.push((b, n.back, d, back));
+                s.stack.push((f, n.front, d, front));
+            }
+        }
+    }
+    arena.rollback(mark);
+}
+
+/// Replaces the lit leaf below `slot` by the volume of `entry`'s
+/// occluder, where `part` is what of it reaches the leaf: the occluder's
+/// edge planes that bound `part` and that the path does not already
+/// enforce, then the cap.
+fn graft(
+    tree: &mut Subtree,
+    root: &mut u32,
+    occ: &Occluders,
+    entry: Entry,
+    part: &Piece,
+    slot: Option<(u32, Side)>,
+    path: &[Step],
+) {
+    let o = entry.occ;
+    let mut keep: SmallVec<[Plane; 4]> = SmallVec::new();
+    for (i, e) in occ.edges(o).iter().enumerate() {
+        let plane = entry.base + i as u32;
+        let bounds = part.edges.iter().any(|r| r.index() == plane);
+        if bounds && !enforced(path, e) {
+            keep.push(*e);
+        }
+    }
+    let first = tree.nodes.len() as u32;
+    for (i, e) in keep.iter().enumerate() {
+        tree.nodes.push(Node {
+            plane: *e,
+            front: LIT,
+            back: first + i as u32 + 1,
+            cap: false,
+        });
+    }
+    tree.nodes.push(Node {
+        plane: occ.cap[o as usize],
+        front: LIT,
+        back: SHADOW,
+        cap: true,
+    });
+    tree.grafted += 1;
+    tree.set_link(slot, root, first);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad(z: i32, lo: i32, hi: i32) -> Polygon {
+        Polygon::from_grid_points(&[[lo, lo, z], [hi, lo, z], [hi, hi, z], [lo, hi, z]], 0).unwrap()
+    }
+
+    #[test]
+    fn volumes_are_sane_and_share_edges() {
+        // a 4 x 4 field of unit squares at height 4, light above: a shared
+        // edge's plane is not added again below its neighbour's
+        let mut polys = Vec::new();
+        for i in 0..4 {
+            for j in 0..4 {
+                polys.push(
+                    Polygon::from_grid_points(
+                        &[[i, j, 4], [i + 1, j, 4], [i + 1, j + 1, 4], [i, j + 1, 4]],
+                        0,
+                    )
+                    .unwrap(),
+                );
+            }
+        }
+        for light in [Light::Point([2, 2, 9]), Light::Directional([1, 1, 5])] {
+            let sv = ShadowVolumes::build(light, &polys).unwrap();
+            sv.sanity_check().unwrap();
+            assert_eq!(sv.grafted(), 16);
+            assert!(sv.node_count() < 16 * 5, "{}", sv.node_count());
+            // with a ground below, which the squares partly hide
+            let mut more = polys.clone();
+            more.push(quad(0, -10, 10));
+            let sv = ShadowVolumes::build(light, &more).unwrap();
+            sv.sanity_check().unwrap();
+            assert!(sv.grafted() > 16);
+        }
+    }
+
+    #[test]
+    fn implicit_occluders_are_rejected() {
+        let mut q = quad(0, 0, 4);
+        assert!(q.clip(&Plane::new([1, 0, 0], -1).unwrap(), Side::Back));
+        let e = ShadowVolumes::build(Light::Point([0, 0, 9]), &[q]).unwrap_err();
+        assert_eq!(e, VolumeError::ImplicitOccluder { index: 0 });
+    }
+}
