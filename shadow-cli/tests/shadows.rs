@@ -456,3 +456,107 @@ fn shadows_errors() {
     assert!(stderr(&o).contains("not a finite number"));
     assert!(!never.exists());
 }
+
+#[test]
+fn output_is_the_same_for_every_thread_count() {
+    // the 33k-face bunny spans several rounds of chunks; two point lights
+    // and a sun
+    for ext in ["json", "obj"] {
+        let mut outputs = Vec::new();
+        for threads in ["1", "2", "3"] {
+            let out = scratch(&format!("threads_{threads}.{ext}"));
+            let o = shadow(&[
+                "shadows",
+                "--scene",
+                "bunny-33k",
+                "--light",
+                "4,16,6",
+                "--light",
+                "-6,12,2",
+                "--sun",
+                "0.3,1,0.2",
+                "--threads",
+                threads,
+                "-o",
+                out.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{}", stderr(&o));
+            outputs.push(std::fs::read(&out).unwrap());
+        }
+        assert!(outputs[0].len() > 1_000_000, "{ext}: {}", outputs[0].len());
+        assert!(outputs.iter().all(|o| *o == outputs[0]), "{ext} differs");
+    }
+}
+
+#[test]
+fn uniformly_lit_faces_are_single_fragments_of_their_own_polygon() {
+    // a unit cube lit from one side: every face is uniformly lit or in
+    // attached shadow, so every face is exactly one fragment, its own
+    // square with its own corners
+    let doc = shadows_json(
+        Path::new(&unit_cube()),
+        &["--light", "3,2,5"],
+        "one_each.json",
+    );
+    let frags = doc["fragments"].as_array().unwrap();
+    assert_eq!(frags.len(), 6);
+    for f in frags {
+        let v = vertices(f);
+        assert_eq!(v.len(), 4, "{f}");
+        assert!(
+            v.iter().all(|p| p.iter().all(|c| *c == 0.0 || *c == 1.0)),
+            "{f}"
+        );
+        assert!(f.get("holes").is_none(), "{f}");
+    }
+}
+
+#[test]
+fn a_shadow_inside_a_face_is_a_hole_in_its_lit_fragment() {
+    // the occluder's shadow [0.25, 1.25]² lies inside the 2 × 2 floor: the
+    // lit floor is one fragment with one hole, the shadow's square
+    let doc = shadows_json(
+        &floor_and_occluder(),
+        &["--light", "0.75,0.75,2"],
+        "hole.json",
+    );
+    let lit = fragments(&doc, 0, &[true]);
+    assert_eq!(lit.len(), 1);
+    assert_eq!(sorted(vertices(lit[0]))[0], [0.0, 0.0, 0.0]);
+    let holes = lit[0]["holes"].as_array().expect("a hole");
+    assert_eq!(holes.len(), 1);
+    let hole: Vec<[f64; 3]> = holes[0].as_array().unwrap().iter().map(point).collect();
+    assert!(
+        xy_area2(&hole) < 0.0,
+        "holes run clockwise seen from the front"
+    );
+    assert_eq!(
+        sorted(hole),
+        vec![
+            [0.25, 0.25, 0.0],
+            [0.25, 1.25, 0.0],
+            [1.25, 0.25, 0.0],
+            [1.25, 1.25, 0.0]
+        ]
+    );
+    assert_eq!(lit[0]["area"], 3.0);
+}
+
+#[test]
+fn chin_feiner_gives_the_same_areas() {
+    let a = shadows_json(
+        &floor_and_occluder(),
+        &["--light", "0.75,0.75,2"],
+        "psv.json",
+    );
+    let b = shadows_json(
+        &floor_and_occluder(),
+        &["--light", "0.75,0.75,2", "--algorithm", "chin-feiner"],
+        "cf.json",
+    );
+    assert_eq!(a["summary"], b["summary"]);
+    // Chin & Feiner's fragments are convex pieces of the BSP's polygons:
+    // never fewer than the fast path's
+    let n = |d: &Value| d["fragments"].as_array().unwrap().len();
+    assert!(n(&b) >= n(&a), "{} {}", n(&a), n(&b));
+}

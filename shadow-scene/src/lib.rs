@@ -47,12 +47,14 @@ mod error;
 mod mesh;
 mod obj;
 mod prim;
+mod scan;
 mod scenes;
 mod stl;
 
 pub use error::SceneError;
 pub use mesh::{Face, Mesh};
 pub use obj::{parse_obj, read_obj, write_obj};
+pub use scan::{MAX_SUBDIVISIONS, bunny, sqrt3_subdivide};
 pub use scenes::{SCENE_NAMES, room, scene};
 pub use stl::{parse_stl, read_stl, stl_collisions, write_stl};
 

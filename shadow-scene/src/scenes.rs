@@ -11,14 +11,27 @@ use crate::Mesh;
 use crate::prim::{Axis, Builder, SQUARE, q, regular};
 
 /// Names accepted by [`scene`].
-pub const SCENE_NAMES: &[&str] = &["room", "chair", "cube"];
+pub const SCENE_NAMES: &[&str] = &[
+    "room",
+    "chair",
+    "cube",
+    "bunny",
+    "bunny-11k",
+    "bunny-33k",
+    "bunny-99k",
+    "bunny-298k",
+    "bunny-893k",
+];
 
 /// A built-in scene by name (see [`SCENE_NAMES`]): `"room"` is [`room`],
 /// `"chair"` one swivel chair of the room standing at the origin, `"cube"`
-/// the unit cube `[0, 1]³`.
+/// the unit cube `[0, 1]³`, `"bunny"` the Stanford bunny (3 674 faces) on
+/// a ground quad, and `"bunny-11k"` to `"bunny-893k"` the same refined by
+/// one to five √3-subdivisions ([`crate::bunny`]) to 11 022 to 892 782
+/// faces.
 ///
 /// ```
-/// for name in shadow_scene::SCENE_NAMES {
+/// for name in ["room", "chair", "cube", "bunny"] {
 ///     let mesh = shadow_scene::scene(name).unwrap();
 ///     assert!(!mesh.faces.is_empty());
 /// }
@@ -37,6 +50,12 @@ pub fn scene(name: &str) -> Option<Mesh> {
             b.group("cube").cuboid(DVec3::ZERO, DVec3::ONE);
             Some(b.finish())
         }
+        "bunny" => crate::bunny(0),
+        "bunny-11k" => crate::bunny(1),
+        "bunny-33k" => crate::bunny(2),
+        "bunny-99k" => crate::bunny(3),
+        "bunny-298k" => crate::bunny(4),
+        "bunny-893k" => crate::bunny(5),
         _ => None,
     }
 }
