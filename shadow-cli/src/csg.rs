@@ -85,7 +85,7 @@ struct Operand {
 
 impl Operand {
     fn load(path: &Path, weld: bool) -> Result<Operand> {
-        let mut mesh = shadow_scene::load(path)?;
+        let mut mesh = crate::load_mesh(path, false)?;
         let file_loops = weld.then(|| {
             let loops = mesh.faces.iter().map(|f| f.vertices.clone()).collect();
             mesh.weld();

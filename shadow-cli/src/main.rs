@@ -71,7 +71,8 @@ enum Command {
 struct SourceArgs {
     /// Mesh file (.obj or .stl).
     input: Option<PathBuf>,
-    /// Built-in scene instead of a file (room, chair, cube).
+    /// Built-in scene instead of a file (room, chair, cube, bunny, or the
+    /// bunny refined to bunny-11k ... bunny-893k faces).
     #[arg(long, value_name = "NAME")]
     scene: Option<String>,
 }
@@ -156,9 +157,29 @@ fn parse_fov(s: &str) -> Result<f64, String> {
 const DEMO_EYE: DVec3 = DVec3::new(3.3, -7.4, 4.3);
 const DEMO_TARGET: DVec3 = DVec3::new(-0.15, 0.3, 0.45);
 
+/// Reads a mesh file: an error if it has no faces; a note on stderr
+/// (unless `quiet`) if the reader skipped unknown statements.
+fn load_mesh(path: &Path, quiet: bool) -> Result<shadow_scene::Mesh> {
+    let (mesh, notes) = shadow_scene::load_notes(path)?;
+    let name = path.display().to_string();
+    if let Some(m) = notes.message(&name)
+        && !quiet
+    {
+        eprintln!("note: {m}");
+    }
+    if mesh.faces.is_empty() {
+        bail!("{name}: no faces");
+    }
+    Ok(mesh)
+}
+
 fn load_source(src: &SourceArgs) -> Result<(shadow_scene::Mesh, String)> {
+    load_source_quiet(src, false)
+}
+
+fn load_source_quiet(src: &SourceArgs, quiet: bool) -> Result<(shadow_scene::Mesh, String)> {
     match (&src.input, &src.scene) {
-        (Some(path), None) => Ok((shadow_scene::load(path)?, path.display().to_string())),
+        (Some(path), None) => Ok((load_mesh(path, quiet)?, path.display().to_string())),
         (None, Some(name)) => {
             let mesh = shadow_scene::scene(name).with_context(|| {
                 format!(
@@ -375,7 +396,8 @@ mod tests {
         };
         assert_eq!(
             load_source(&unknown).unwrap_err().to_string(),
-            "unknown scene `kitchen` (available: room, chair, cube)"
+            "unknown scene `kitchen` (available: room, chair, cube, bunny, bunny-11k, bunny-33k, \
+             bunny-99k, bunny-298k, bunny-893k)"
         );
     }
 }

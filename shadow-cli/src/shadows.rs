@@ -36,7 +36,7 @@ use crate::csg::{Phases, emit, guarded};
 use crate::lights::{describe, place_lights, shared_grid};
 use crate::progress::{Output, Progress};
 use crate::render::{Canvas, Rendered, View, painter_order, unit_normal};
-use crate::{DEMO_EYE, DEMO_TARGET, ImageArgs, SourceArgs, load_source, parse_vec3};
+use crate::{DEMO_EYE, DEMO_TARGET, ImageArgs, SourceArgs, load_source_quiet, parse_vec3};
 
 /// Which algorithm computes the shadows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -607,10 +607,7 @@ fn run_here(args: &ShadowsArgs) -> Result<()> {
     let progress = Progress::new(!args.quiet);
     let mut phases = Phases::default();
     progress.phase("loading", 1);
-    let (mesh, name) = phases.run("load", || load_source(&args.source))?;
-    if mesh.faces.is_empty() {
-        bail!("{name}: no faces");
-    }
+    let (mesh, name) = phases.run("load", || load_source_quiet(&args.source, args.quiet))?;
     progress.phase("snapping", 1);
     let scene = phases.run("snap/import", || -> Result<Scene> {
         let grid = shared_grid(&mesh.positions, &specs).with_context(|| name.clone())?;

@@ -199,3 +199,118 @@ fn help_succeeds() {
         assert!(stdout(&o).contains(cmd));
     }
 }
+
+/// Writes `bytes` to a scratch file named `name`.
+fn file(name: &str, bytes: &[u8]) -> String {
+    let p = scratch(name);
+    std::fs::write(&p, bytes).unwrap();
+    p.display().to_string()
+}
+
+#[test]
+fn files_without_faces_are_errors_for_every_command() {
+    let empty = file(
+        "no_faces.obj",
+        b"# just vertices\nv 0 0 0\nv 1 0 0\nv 0 1 0\n",
+    );
+    let other = file(
+        "other.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    );
+    let out = scratch("never.out");
+    let out_svg = out.with_extension("svg");
+    let out_json = out.with_extension("json");
+    let out_obj = out.with_extension("obj");
+    let runs: [Vec<&str>; 5] = [
+        vec![
+            "shadows",
+            &empty,
+            "--light",
+            "0,0,5",
+            "-o",
+            out_json.to_str().unwrap(),
+        ],
+        vec![
+            "view",
+            &empty,
+            "--eye",
+            "3,3,3",
+            "-o",
+            out_svg.to_str().unwrap(),
+        ],
+        vec!["stats", &empty],
+        vec![
+            "csg",
+            "union",
+            &empty,
+            &other,
+            "-o",
+            out_obj.to_str().unwrap(),
+        ],
+        vec![
+            "csg",
+            "union",
+            &other,
+            &empty,
+            "-o",
+            out_obj.to_str().unwrap(),
+        ],
+    ];
+    for argv in runs {
+        let o = shadow(&argv);
+        assert_failed_with(&o, &[&format!("{empty}: no faces")]);
+    }
+    for p in [&out_svg, &out_json, &out_obj] {
+        assert!(!p.exists(), "{}", p.display());
+    }
+}
+
+#[test]
+fn binary_files_are_errors_naming_the_file() {
+    let png = file(
+        "picture.obj",
+        b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\x00",
+    );
+    let o = shadow(&["stats", &png]);
+    assert_failed_with(&o, &[&format!("{png}:3: binary data"), "not an OBJ file"]);
+    let junk: Vec<u8> = (0..600u32).map(|i| (i * 7919 % 251) as u8).collect();
+    let stl = file("junk.stl", &junk);
+    let o = shadow(&["stats", &stl]);
+    assert_failed_with(&o, &[&stl, "invalid STL"]);
+}
+
+#[test]
+fn unknown_statements_are_reported_once_with_the_first_line() {
+    // a typo (`V` for `v`) and a stray line; standard statements the
+    // reader does not use pass quietly
+    let typo = file(
+        "typo.obj",
+        b"mtllib a.mtl\nv 0 0 0\nv 1 0 0\nvt 0 0\nvn 0 0 1\nV 0 1 0\nv 0 1 0\nusemtl red\ns off\nhello there\nf 1 2 3\n",
+    );
+    let o = shadow(&["stats", &typo]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        stderr(&o),
+        format!("note: {typo}: skipped 2 unknown statements, the first `V` on line 6\n")
+    );
+    let clean = file(
+        "clean.obj",
+        b"mtllib a.mtl\no thing\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\ns 1\nf 1 2 3\n",
+    );
+    let o = shadow(&["stats", &clean]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stderr(&o), "");
+    // --quiet silences the note for shadows
+    let out = scratch("typo.json");
+    let o = shadow(&[
+        "shadows",
+        &typo,
+        "--light",
+        "0,0,5",
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stderr(&o), "");
+}

@@ -53,7 +53,7 @@ mod stl;
 
 pub use error::SceneError;
 pub use mesh::{Face, Mesh};
-pub use obj::{parse_obj, read_obj, write_obj};
+pub use obj::{ObjNotes, parse_obj, parse_obj_notes, read_obj, read_obj_notes, write_obj};
 pub use scan::{MAX_SUBDIVISIONS, bunny, sqrt3_subdivide};
 pub use scenes::{SCENE_NAMES, room, scene};
 pub use stl::{parse_stl, read_stl, stl_collisions, write_stl};
@@ -103,9 +103,15 @@ impl MeshFormat {
 /// assert!(matches!(err, SceneError::UnknownFormat { .. }));
 /// ```
 pub fn load(path: &Path) -> Result<Mesh, SceneError> {
+    load_notes(path).map(|(m, _)| m)
+}
+
+/// [`load`], with what an OBJ reader skipped (see [`ObjNotes`]; STL has
+/// nothing to skip).
+pub fn load_notes(path: &Path) -> Result<(Mesh, ObjNotes), SceneError> {
     match MeshFormat::from_path(path)? {
-        MeshFormat::Obj => read_obj(path),
-        MeshFormat::Stl => read_stl(path),
+        MeshFormat::Obj => read_obj_notes(path),
+        MeshFormat::Stl => Ok((read_stl(path)?, ObjNotes::default())),
     }
 }
 
@@ -187,6 +193,19 @@ mod tests {
         let e = load(&missing).unwrap_err();
         assert!(matches!(e, SceneError::Io { .. }));
         assert!(e.to_string().starts_with(&missing.display().to_string()));
+    }
+
+    #[test]
+    fn binary_files_are_not_obj() {
+        let bin = temp("image.obj", b"v 0 0 0\n\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR");
+        let e = load(&bin).unwrap_err();
+        assert_eq!(e.line(), Some(4));
+        assert!(e.to_string().contains("binary data"), "{e}");
+        assert!(e.to_string().contains("not an OBJ file"), "{e}");
+        // random bytes named .stl are not STL either
+        let junk: Vec<u8> = (0..1000u32).map(|i| (i * 7919 % 251) as u8).collect();
+        let stl = temp("junk.stl", &junk);
+        assert!(matches!(load(&stl), Err(SceneError::Parse { .. })));
     }
 
     #[test]

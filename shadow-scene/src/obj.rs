@@ -13,13 +13,103 @@ use crate::{Face, Mesh, SceneError};
 /// Bytes that are not UTF-8 are replaced, so they only matter where a
 /// number or index is expected.
 pub fn read_obj(path: &Path) -> Result<Mesh, SceneError> {
+    read_obj_notes(path).map(|(m, _)| m)
+}
+
+/// [`read_obj`], with what the reader skipped. A file with a NUL byte is
+/// binary, not OBJ: an error naming the line it is on.
+pub fn read_obj_notes(path: &Path) -> Result<(Mesh, ObjNotes), SceneError> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
         path: name.clone(),
         source,
     })?;
-    parse_obj(&String::from_utf8_lossy(&bytes), &name)
+    if let Some(at) = bytes.iter().position(|&b| b == 0) {
+        let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
+        return Err(SceneError::Parse {
+            path: name,
+            line,
+            message: format!("binary data (a NUL byte at byte {at}): not an OBJ file"),
+        });
+    }
+    parse_obj_notes(&String::from_utf8_lossy(&bytes), &name)
 }
+
+/// Statements an OBJ reader skipped because it does not know them (a typo
+/// such as `V 1 2 3`, or text that is not OBJ). Standard statements it
+/// does not use (`vt`, `vn`, `usemtl`, `s`, ...) are not counted.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ObjNotes {
+    /// How many statements were unknown.
+    pub unknown: usize,
+    /// The first one: its 1-based line and its keyword.
+    pub first_unknown: Option<(usize, String)>,
+}
+
+impl ObjNotes {
+    /// A one-line note for the user, or `None` if nothing was skipped.
+    ///
+    /// ```
+    /// use shadow_scene::parse_obj_notes;
+    /// let (_, notes) = parse_obj_notes("v 0 0 0\nV 1 0 0\nV 0 1 0\n", "typo.obj").unwrap();
+    /// assert_eq!(
+    ///     notes.message("typo.obj").unwrap(),
+    ///     "typo.obj: skipped 2 unknown statements, the first `V` on line 2"
+    /// );
+    /// ```
+    pub fn message(&self, path: &str) -> Option<String> {
+        let (line, keyword) = self.first_unknown.as_ref()?;
+        let what = if self.unknown == 1 {
+            "statement".to_string()
+        } else {
+            format!("{} unknown statements, the first", self.unknown)
+        };
+        Some(if self.unknown == 1 {
+            format!("{path}: skipped an unknown {what} `{keyword}` on line {line}")
+        } else {
+            format!("{path}: skipped {what} `{keyword}` on line {line}")
+        })
+    }
+}
+
+/// Statements of the OBJ format this reader does not use: skipped quietly.
+const UNUSED: &[&str] = &[
+    "vt",
+    "vn",
+    "vp",
+    "s",
+    "usemtl",
+    "mtllib",
+    "usemap",
+    "maplib",
+    "l",
+    "p",
+    "curv",
+    "curv2",
+    "surf",
+    "parm",
+    "trim",
+    "hole",
+    "scrv",
+    "sp",
+    "end",
+    "con",
+    "cstype",
+    "deg",
+    "bmat",
+    "step",
+    "mg",
+    "bevel",
+    "c_interp",
+    "d_interp",
+    "lod",
+    "shadow_obj",
+    "trace_obj",
+    "ctech",
+    "stech",
+    "call",
+    "csh",
+];
 
 /// Parses the text of a Wavefront OBJ file; `path_for_messages` names the
 /// file in errors.
@@ -35,8 +125,9 @@ pub fn read_obj(path: &Path) -> Result<Mesh, SceneError> {
 /// - `#` comments, blank lines, and a `\` at the end of a line joining it
 ///   to the next.
 ///
-/// Everything else (`vt`, `vn`, `vp`, `s`, `usemtl`, `mtllib`, `l`, `p`,
-/// curves, unknown statements) is ignored.
+/// The other statements of the format (`vt`, `vn`, `vp`, `s`, `usemtl`,
+/// `mtllib`, `l`, `p`, curves and surfaces) are skipped; so are unknown
+/// ones, which [`parse_obj_notes`] counts.
 ///
 /// Errors ([`SceneError::Parse`], with the 1-based line where the
 /// statement starts): a number that does not parse, a NaN or infinite
@@ -54,6 +145,15 @@ pub fn read_obj(path: &Path) -> Result<Mesh, SceneError> {
 /// assert_eq!(err.to_string(), "bad.obj:2: face index 2 out of range (1..=1)");
 /// ```
 pub fn parse_obj(text: &str, path_for_messages: &str) -> Result<Mesh, SceneError> {
+    parse_obj_notes(text, path_for_messages).map(|(m, _)| m)
+}
+
+/// [`parse_obj`], with the unknown statements it skipped.
+pub fn parse_obj_notes(
+    text: &str,
+    path_for_messages: &str,
+) -> Result<(Mesh, ObjNotes), SceneError> {
+    let mut notes = ObjNotes::default();
     let mut mesh = Mesh {
         groups: vec!["default".to_string()],
         ..Mesh::default()
@@ -109,10 +209,17 @@ pub fn parse_obj(text: &str, path_for_messages: &str) -> Result<Mesh, SceneError
                 let name = tokens.collect::<Vec<_>>().join(" ");
                 group = mesh.add_group(if name.is_empty() { "default" } else { &name });
             }
-            _ => {}
+            k if UNUSED.contains(&k) => {}
+            k => {
+                notes.unknown += 1;
+                if notes.first_unknown.is_none() {
+                    let shown: String = k.chars().take(24).collect();
+                    notes.first_unknown = Some((line, shown));
+                }
+            }
         }
     }
-    Ok(mesh)
+    Ok((mesh, notes))
 }
 
 fn parse_number(token: &str) -> Result<f64, String> {
@@ -348,12 +455,30 @@ f 4 1 5 8
 
     #[test]
     fn ignored_statements() {
-        let m = parse(
-            "v 0 0 0\nv 1 0 0 1\nv 0 1 0 0.5 0.5 0.5\nvt 0.5 0.5\nvn 0 0 1\nvp 0.1\nl 1 2\np 1\ncurv 0 1 1 2\nusemtl red\ns 1\nfoo bar\nf 1 2 3\n",
-        )
-        .unwrap();
+        let text = "v 0 0 0\nv 1 0 0 1\nv 0 1 0 0.5 0.5 0.5\nvt 0.5 0.5\nvn 0 0 1\nvp 0.1\nl 1 2\np 1\ncurv 0 1 1 2\nmtllib a.mtl\nusemtl red\ns 1\no thing\nf 1 2 3\n";
+        let (m, notes) = parse_obj_notes(text, "ok.obj").unwrap();
         assert_eq!(m.positions.len(), 3);
         assert_eq!(m.faces.len(), 1);
+        // standard statements are skipped quietly
+        assert_eq!(notes, ObjNotes::default());
+        assert_eq!(notes.message("ok.obj"), None);
+    }
+
+    #[test]
+    fn unknown_statements_are_counted_with_the_first_line() {
+        let (m, notes) = parse_obj_notes(
+            "v 0 0 0\nV 1 0 0\nv 0 1 0\nfoo bar\nV 0 0 1\nf 1 2 1\n",
+            "t.obj",
+        )
+        .unwrap();
+        assert_eq!((m.positions.len(), m.faces.len()), (2, 1));
+        assert_eq!(notes.unknown, 3);
+        assert_eq!(notes.first_unknown, Some((2, "V".to_string())));
+        let (_, one) = parse_obj_notes("hello world\n", "prose.txt").unwrap();
+        assert_eq!(
+            one.message("prose.txt").unwrap(),
+            "prose.txt: skipped an unknown statement `hello` on line 1"
+        );
     }
 
     #[test]
