@@ -50,8 +50,6 @@ mod sanity;
 mod topology;
 mod tree;
 
-pub mod check;
-
 pub use exact::{
     FILTER_REL, Homogeneous, approx, filter_side, filter_side_err, ratio_to_f64_exact,
 };

@@ -57,5 +57,5 @@ pub use light::{
     LIGHT_RANGE_BITS, Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, angle_between,
     place_lights, quantize_direction, shared_grid,
 };
-pub use psv::{ShadowVolumes, VolumeError};
+pub use psv::{ShadowVolumes, VolumeError, VolumeSanity};
 pub use wide::{WPoint, WidePlane};

@@ -567,7 +567,7 @@ impl ShadowVolumes {
     /// Checks the tree exactly: every link is a node or a leaf, each node
     /// reached once, every plane through the light passes through it and
     /// every cap has it strictly in front with nothing behind.
-    pub fn sanity_check(&self) -> Result<(), String> {
+    pub fn sanity_check(&self) -> Result<(), VolumeSanity> {
         let mut seen = vec![false; self.nodes.len()];
         let mut stack = vec![self.root];
         while let Some(link) = stack.pop() {
@@ -575,30 +575,88 @@ impl ShadowVolumes {
                 continue;
             }
             let Some(n) = self.nodes.get(link as usize) else {
-                return Err(format!("link to missing node {link}"));
+                return Err(VolumeSanity::MissingNode { node: link });
             };
             if std::mem::replace(&mut seen[link as usize], true) {
-                return Err(format!("node {link} reached twice"));
+                return Err(VolumeSanity::NodeReachedTwice { node: link });
             }
             let at = self.light.eval(&n.plane);
             if n.cap && at <= 0 {
-                return Err(format!("cap {link} does not face the light"));
+                return Err(VolumeSanity::CapMissesLight { node: link });
             }
             if !n.cap && at != 0 {
-                return Err(format!("shadow plane {link} misses the light"));
+                return Err(VolumeSanity::PlaneMissesLight { node: link });
             }
             if n.cap && n.back != SHADOW {
-                return Err(format!("cap {link} has something behind it"));
+                return Err(VolumeSanity::SomethingBehindCap { node: link });
             }
             stack.push(n.front);
             stack.push(n.back);
         }
         match seen.iter().position(|s| !s) {
-            Some(i) => Err(format!("node {i} is unreachable")),
+            Some(i) => Err(VolumeSanity::Unreachable { node: i as u32 }),
             None => Ok(()),
         }
     }
 }
+
+/// Which invariant a shadow-volume tree breaks
+/// ([`ShadowVolumes::sanity_check`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum VolumeSanity {
+    /// A link names a node that does not exist.
+    MissingNode {
+        /// The link's target.
+        node: u32,
+    },
+    /// Two links lead to the same node.
+    NodeReachedTwice {
+        /// The node.
+        node: u32,
+    },
+    /// A node no link leads to.
+    Unreachable {
+        /// The node.
+        node: u32,
+    },
+    /// A cap does not have the light strictly in front.
+    CapMissesLight {
+        /// The node.
+        node: u32,
+    },
+    /// A shadow plane does not pass through the light.
+    PlaneMissesLight {
+        /// The node.
+        node: u32,
+    },
+    /// A cap's back is not a shadow leaf.
+    SomethingBehindCap {
+        /// The node.
+        node: u32,
+    },
+}
+
+impl std::fmt::Display for VolumeSanity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            VolumeSanity::MissingNode { node } => write!(f, "link to missing node {node}"),
+            VolumeSanity::NodeReachedTwice { node } => write!(f, "node {node} is reached twice"),
+            VolumeSanity::Unreachable { node } => write!(f, "node {node} is unreachable"),
+            VolumeSanity::CapMissesLight { node } => {
+                write!(f, "cap {node} does not have the light strictly in front")
+            }
+            VolumeSanity::PlaneMissesLight { node } => {
+                write!(f, "shadow plane {node} misses the light")
+            }
+            VolumeSanity::SomethingBehindCap { node } => {
+                write!(f, "cap {node} has something behind it")
+            }
+        }
+    }
+}
+
+impl std::error::Error for VolumeSanity {}
 
 /// Splits `task` by a balanced plane through the light (a new node of
 /// `tree` at the task's slot), clipping its occluders' parts: the front and

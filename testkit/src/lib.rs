@@ -1,4 +1,6 @@
-//! Self-checking drivers shared by the fuzz targets and the test suite.
+//! Self-checking drivers shared by the fuzz targets and the test suite of
+//! `bsp-core`; a `publish = false` crate, so that a user of `bsp-core`
+//! compiles only geometry.
 //!
 //! [`split_case`] and [`build_case`] turn arbitrary bytes into a geometric
 //! input ([`SplitInput`], [`BuildInput`]) and run the kernel on it,
@@ -13,7 +15,7 @@
 //! straight into a regression test:
 //!
 //! ```
-//! use bsp_core::check::SplitInput;
+//! use bsp_testkit::SplitInput;
 //! let input = SplitInput {
 //!     polygon: vec![[0, 0, 0], [4, 0, 0], [4, 4, 0], [0, 4, 0]],
 //!     cuts: vec![[[1, 0, 0], [1, 1, 0], [1, 0, 1]], [[0, 0, 0], [4, 4, 0], [0, 0, 1]]],
@@ -31,7 +33,7 @@ use std::fmt::{self, Debug};
 mod merge;
 pub use merge::{MergeInput, merge_case};
 
-use crate::{
+use bsp_core::{
     BspTree, BuildOptions, FlatBsp, GridPoint, Link, MAX_COORD, MAX_VIEW_COORD, Membership, NodeId,
     Order, Plane, Point, Polygon, PolygonSide, Side, Split, ViewPoint,
 };
@@ -43,8 +45,8 @@ const M: i64 = MAX_COORD as i64;
 /// expression, if an invariant fails.
 ///
 /// ```
-/// bsp_core::check::split_case(b"any bytes at all");
-/// bsp_core::check::split_case(&[]);
+/// bsp_testkit::split_case(b"any bytes at all");
+/// bsp_testkit::split_case(&[]);
 /// ```
 pub fn split_case(data: &[u8]) {
     SplitInput::decode(data).check();
@@ -55,8 +57,8 @@ pub fn split_case(data: &[u8]) {
 /// expression, if an invariant fails.
 ///
 /// ```
-/// bsp_core::check::build_case(b"any bytes at all");
-/// bsp_core::check::build_case(&[]);
+/// bsp_testkit::build_case(b"any bytes at all");
+/// bsp_testkit::build_case(&[]);
 /// ```
 pub fn build_case(data: &[u8]) {
     BuildInput::decode(data).check();
@@ -438,7 +440,7 @@ impl SplitInput {
     /// Decodes bytes (any bytes) into an input.
     ///
     /// ```
-    /// use bsp_core::check::SplitInput;
+    /// use bsp_testkit::SplitInput;
     /// let i = SplitInput::decode(&[]);
     /// assert_eq!(i.polygon.len(), 3);
     /// assert_eq!(i.cuts.len(), 1);
@@ -478,7 +480,7 @@ impl SplitInput {
     /// grid).
     ///
     /// ```
-    /// use bsp_core::check::SplitInput;
+    /// use bsp_testkit::SplitInput;
     /// let i = SplitInput { polygon: vec![[0, 0, 0], [9, 0, 0], [0, 9, 0]], cuts: vec![[[1, 0, 0], [1, 1, 0], [1, 0, 1]]] };
     /// assert_eq!(SplitInput::decode(&i.encode()), i);
     /// ```
@@ -982,7 +984,7 @@ impl BuildInput {
     /// Decodes bytes (any bytes) into an input.
     ///
     /// ```
-    /// use bsp_core::check::{BuildInput, Scene};
+    /// use bsp_testkit::{BuildInput, Scene};
     /// assert!(matches!(BuildInput::decode(&[]).scene, Scene::Box(_)));
     /// ```
     pub fn decode(data: &[u8]) -> BuildInput {
@@ -1029,7 +1031,7 @@ impl BuildInput {
     /// ±2^24, 1 to 3 eyes).
     ///
     /// ```
-    /// use bsp_core::check::{BuildInput, Scene};
+    /// use bsp_testkit::{BuildInput, Scene};
     /// let i = BuildInput {
     ///     scene: Scene::Soup(vec![vec![[0, 0, 0], [4, 0, 0], [0, 4, 0]]]),
     ///     candidates: 8, sample: 48, split_weight: 4, seed: 1,
@@ -1969,7 +1971,7 @@ mod tests {
     }
 
     /// Rewrites the `seed-*` files of `fuzz/corpus/` from the seeds above:
-    /// `cargo test -p bsp-core --lib check::tests::write_seed_corpus -- --ignored`.
+    /// `cargo test -p bsp-testkit --lib tests::write_seed_corpus -- --ignored`.
     #[test]
     #[ignore = "writes fuzz/corpus; run by hand after changing the seeds or the decoders"]
     fn write_seed_corpus() {

@@ -1,7 +1,7 @@
 //! The merge driver: two decoded solids and a set operation.
 
 use super::{BoxSolid, Bytes, decode_box, fail};
-use crate::{
+use bsp_core::{
     BoolOp, Cell, Membership, Overlay, Partition, Plane, Point, Polygon, check_closed_manifold,
 };
 
@@ -32,8 +32,8 @@ impl std::fmt::Debug for MergeInput {
 /// expression, if an invariant fails.
 ///
 /// ```
-/// bsp_core::check::merge_case(b"any bytes at all");
-/// bsp_core::check::merge_case(&[]);
+/// bsp_testkit::merge_case(b"any bytes at all");
+/// bsp_testkit::merge_case(&[]);
 /// ```
 pub fn merge_case(data: &[u8]) {
     MergeInput::decode(data).check();
@@ -108,7 +108,7 @@ impl MergeInput {
             .collect();
         probes.extend(half);
         if self.op == 3 {
-            let o = crate::merge_smaller_into_larger(&pa, &pb, &Overlay);
+            let o = bsp_core::merge_smaller_into_larger(&pa, &pb, &Overlay);
             if let Err(e) = o.sanity_check() {
                 fail(self, format_args!("overlay: {e}"));
             }
@@ -138,7 +138,7 @@ impl MergeInput {
             else {
                 continue;
             };
-            let expected = crate::CellOp::apply(&op, x, y);
+            let expected = bsp_core::CellOp::apply(&op, x, y);
             let got = r.classify_point(p);
             if cell(got) != Some(expected) {
                 fail(
