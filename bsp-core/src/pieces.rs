@@ -584,6 +584,23 @@ impl PieceArena {
         }
     }
 
+    /// Which sides of `plane` some vertex of `c` is strictly on.
+    #[inline]
+    pub fn sides(&mut self, c: &Piece, plane: &Plane) -> Sides {
+        let (mut front, mut back) = (false, false);
+        for &v in &c.verts {
+            match self.classify(v, plane) {
+                Side::Front => front = true,
+                Side::Back => back = true,
+                Side::On => {}
+            }
+            if front && back {
+                break;
+            }
+        }
+        Sides { front, back }
+    }
+
     /// The exact sides of `c`'s vertices relative to `plane`, written to
     /// `out` (cleared first).
     #[inline]

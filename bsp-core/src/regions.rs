@@ -147,6 +147,7 @@ fn canonical_ids(
     arena: &PieceArena,
     cells: &[Piece],
     rounded: &mut Vec<Option<[f64; 3]>>,
+    exact: &mut HashMap<u32, Vertex>,
 ) -> HashMap<u32, u32> {
     rounded.resize(arena.len(), None);
     let mut canon: HashMap<u32, u32> = HashMap::new();
@@ -156,12 +157,14 @@ fn canonical_ids(
             if canon.contains_key(&v) {
                 continue;
             }
-            let vert = arena.vertex(v);
+            // each vertex's exact coordinates once
+            let vert = arena.vertex(v).to_owned();
             let r = *rounded[arena.dense(v)].get_or_insert_with(|| vert.to_f64());
             let key = r.map(f64::to_bits);
             let bucket = seen.entry(key).or_default();
-            match bucket.iter().find(|&&w| arena.vertex(w).same_point(vert)) {
-                Some(&w) => {
+            let found = bucket.iter().copied().find(|w| exact[w].same_point(&vert));
+            match found {
+                Some(w) => {
                     canon.insert(v, w);
                 }
                 None => {
@@ -169,6 +172,7 @@ fn canonical_ids(
                     canon.insert(v, v);
                 }
             }
+            exact.insert(v, vert);
         }
     }
     canon
@@ -192,10 +196,11 @@ pub fn merge_cells(
     rounded: &mut Vec<Option<[f64; 3]>>,
 ) -> Vec<Region> {
     assert_eq!(cells.len(), labels.len(), "one label per cell");
-    let canon = canonical_ids(arena, cells, rounded);
+    let mut exact: HashMap<u32, Vertex> = HashMap::new();
+    let canon = canonical_ids(arena, cells, rounded, &mut exact);
     let (u_ax, v_ax, k_ax) = axes(support);
     let sigma: i32 = if support.normal()[k_ax] > 0 { 1 } else { -1 };
-    let vx = |i: u32| arena.vertex(i);
+    let vx = |i: u32| &exact[&i];
 
     // group the edges by line
     let mut lines: Vec<Line> = Vec::new();
@@ -383,7 +388,7 @@ pub fn merge_cells(
             continue;
         }
         for l in list {
-            if signed_area_sign(arena, rounded, &l, u_ax, v_ax) * sigma > 0 {
+            if signed_area_sign(arena, &exact, rounded, &l, u_ax, v_ax) * sigma > 0 {
                 debug_assert!(regions[ri].outer.is_empty(), "a region has one outer loop");
                 regions[ri].outer = l;
             } else {
@@ -443,6 +448,7 @@ fn cmp_clockwise(r: [i128; 2], a: [i128; 2], b: [i128; 2], sigma: i32) -> Orderi
 /// shoelace sum when its error bound certifies it, else exact rationals.
 fn signed_area_sign(
     arena: &PieceArena,
+    exact: &HashMap<u32, Vertex>,
     rounded: &[Option<[f64; 3]>],
     l: &[u32],
     u: usize,
@@ -467,7 +473,7 @@ fn signed_area_sign(
         return -1;
     }
     let q = |i: usize| -> [BigRational; 2] {
-        match arena.vertex(l[i % m]).to_owned() {
+        match &exact[&l[i % m]] {
             Vertex::Grid(g) => [
                 BigRational::from_integer(BigInt::from(g[u])),
                 BigRational::from_integer(BigInt::from(g[v])),

@@ -163,6 +163,7 @@ impl Shadows {
             let c = s.arena.add_polygon(p);
             s.cur.push((c, 0));
         }
+        s.whole = s.cur[0].0.clone();
         let mut facing = 0u64;
         for (j, (light, sv)) in self.lights.iter().zip(&self.volumes).enumerate() {
             if !light.faces(&support) {
@@ -179,6 +180,7 @@ impl Shadows {
                     piece,
                     &mut s.out,
                     &mut s.stack,
+                    &mut s.links,
                     &mut s.sides,
                 );
                 for (p, lit) in s.out.drain(..) {
@@ -243,6 +245,9 @@ pub struct Scratch {
     next: Vec<(Piece, u64)>,
     out: Vec<(Piece, bool)>,
     stack: Vec<Task>,
+    links: Vec<u32>,
+    /// The receiver's first polygon, as it was added.
+    whole: Piece,
     sides: SmallVec<[Side; 8]>,
     rounded: Vec<Option<[f64; 3]>>,
     remap: Vec<u32>,
@@ -262,9 +267,15 @@ enum Task {
 }
 
 /// Filters `piece` through a shadow-volume tree: the lit and shadowed
-/// pieces go to `out`. A cut whose two sides come back as single pieces
-/// with the same flag is undone (the parent piece is kept, the arena rolled
-/// back), so only cuts that separate lit from shadow survive.
+/// pieces go to `out`.
+///
+/// First a quick test without cuts ([`crate::psv::reach`]): a piece that
+/// can only reach leaves of one kind is all lit or all in shadow, and
+/// stays whole. Otherwise the piece descends cut by every plane it
+/// straddles; a cut whose two sides come back as single pieces with the
+/// same flag is undone (the parent piece is kept, the arena rolled back),
+/// so only cuts that separate lit from shadow survive.
+#[allow(clippy::too_many_arguments)]
 fn filter(
     sv: &ShadowVolumes,
     arena: &mut PieceArena,
@@ -272,39 +283,59 @@ fn filter(
     piece: Piece,
     out: &mut Vec<(Piece, bool)>,
     stack: &mut Vec<Task>,
+    links: &mut Vec<u32>,
     sides: &mut SmallVec<[Side; 8]>,
 ) {
+    match crate::psv::reach(
+        &sv.nodes,
+        sv.root,
+        arena,
+        &piece,
+        crate::psv::REACH_BUDGET,
+        links,
+    ) {
+        Some((true, false)) => return out.push((piece, true)),
+        Some((false, true)) => return out.push((piece, false)),
+        _ => {}
+    }
     stack.clear();
     stack.push(Task::Visit(piece, sv.root));
     while let Some(t) = stack.pop() {
         match t {
-            Task::Visit(p, LIT) => out.push((p, true)),
-            Task::Visit(p, SHADOW) => out.push((p, false)),
-            Task::Visit(p, id) => {
-                let n = &sv.nodes[id as usize];
-                let s = arena.classify_into(&p, &n.plane, sides);
+            Task::Visit(mut p, mut link) => loop {
+                if link == LIT {
+                    out.push((p, true));
+                    break;
+                }
+                if link == SHADOW {
+                    out.push((p, false));
+                    break;
+                }
+                let n = &sv.nodes[link as usize];
+                let s = arena.sides(&p, &n.plane);
                 let (front, back) = match (n.cap, s.front, s.back) {
                     // a cap: the part behind it is hidden
                     (true, _, false) => {
-                        stack.push(Task::Visit(p, n.front));
+                        link = n.front;
                         continue;
                     }
                     (true, false, true) => {
                         out.push((p, false));
-                        continue;
+                        break;
                     }
                     (true, true, true) => (n.front, SHADOW),
                     // a plane through the light
                     (false, true, false) | (false, false, false) => {
-                        stack.push(Task::Visit(p, n.front));
+                        link = n.front;
                         continue;
                     }
                     (false, false, true) => {
-                        stack.push(Task::Visit(p, n.back));
+                        link = n.back;
                         continue;
                     }
                     (false, true, true) => (n.front, n.back),
                 };
+                arena.classify_into(&p, &n.plane, sides);
                 let mark = arena.mark();
                 let cut = arena.add_plane(n.plane);
                 let (f, b) = arena.split(support, &p, cut, sides);
@@ -314,8 +345,9 @@ fn filter(
                     arena: mark,
                 });
                 stack.push(Task::Visit(b, back));
-                stack.push(Task::Visit(f, front));
-            }
+                p = f;
+                link = front;
+            },
             Task::Merge {
                 parent,
                 mark,
@@ -592,9 +624,12 @@ impl Batch {
             b.facing.push(facing);
             b.support.push(*support);
         };
-        if single_polygon && s.cur.len() == 1 {
-            // one piece: the receiver's own polygon, whole
-            let (piece, lit) = s.cur.pop().expect("one piece");
+        let uniform = s.cur.iter().all(|(_, l)| *l == s.cur[0].1);
+        if single_polygon && uniform {
+            // one set of flags all over: the receiver's own polygon, whole
+            let lit = s.cur[0].1;
+            s.cur.clear();
+            let piece = std::mem::take(&mut s.whole);
             push_frag(self, lit);
             for &v in &piece.verts {
                 let id = self.take_vertex(s, v);

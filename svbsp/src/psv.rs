@@ -424,6 +424,68 @@ impl Subtree {
     }
 }
 
+/// Nodes the quick test of [`reach`] may visit before the exact descent
+/// takes over.
+pub(crate) const REACH_BUDGET: usize = 256;
+
+/// The kinds of leaves a piece may reach below `root`, found without
+/// cutting it: at every node it goes to each side some vertex is on
+/// (behind a cap counts as shadow). A superset of the leaves its points
+/// reach, so one kind alone is the exact answer for all of it. `None` when
+/// more than `budget` nodes would be visited.
+pub(crate) fn reach(
+    nodes: &[Node],
+    root: u32,
+    arena: &mut PieceArena,
+    piece: &Piece,
+    budget: usize,
+    stack: &mut Vec<u32>,
+) -> Option<(bool, bool)> {
+    let (mut lit, mut shadow) = (false, false);
+    let mut visits = 0;
+    stack.clear();
+    stack.push(root);
+    while let Some(mut link) = stack.pop() {
+        loop {
+            if link == LIT {
+                lit = true;
+                break;
+            }
+            if link == SHADOW {
+                shadow = true;
+                break;
+            }
+            visits += 1;
+            if visits > budget {
+                return None;
+            }
+            let n = &nodes[link as usize];
+            let s = arena.sides(piece, &n.plane);
+            match (n.cap, s.front, s.back) {
+                // a cap: behind it is hidden, in it or in front is not
+                (true, false, true) => {
+                    shadow = true;
+                    break;
+                }
+                (true, front, back) => {
+                    shadow |= front && back;
+                    link = n.front;
+                }
+                (false, true, true) => {
+                    stack.push(n.back);
+                    link = n.front;
+                }
+                (false, false, true) => link = n.back,
+                (false, _, false) => link = n.front,
+            }
+        }
+        if lit && shadow {
+            break;
+        }
+    }
+    Some((lit, shadow))
+}
+
 /// The partitioned shadow volumes of one light.
 #[derive(Clone, Debug)]
 pub struct ShadowVolumes {
@@ -813,6 +875,7 @@ type Visit = (Piece, u32, usize, Option<(u32, Side)>);
 #[derive(Default)]
 struct InsertScratch {
     stack: Vec<Visit>,
+    links: Vec<u32>,
     path: Vec<Step>,
     sides: SmallVec<[Side; 8]>,
 }
@@ -831,54 +894,70 @@ fn insert(
     leaf: &Task,
     s: &mut InsertScratch,
 ) {
+    let start_link = tree.link(leaf.slot, *root);
+    let piece = pool.pieces[e.piece as usize].clone();
+    // an occluder hidden all over below the leaf adds nothing: found
+    // without cutting it
+    if let Some((false, _)) = reach(
+        &tree.nodes,
+        start_link,
+        &mut pool.arena,
+        &piece,
+        REACH_BUDGET,
+        &mut s.links,
+    ) {
+        return;
+    }
     let mark = pool.arena.mark();
     let k = occ.range(e.occ).len() as u32;
     let sup = e.base + k;
-    let piece = pool.pieces[e.piece as usize].clone();
     s.stack.clear();
     s.path.clear();
     s.path.extend_from_slice(&leaf.path);
-    let base = leaf.path.len();
     s.stack
-        .push((piece, tree.link(leaf.slot, *root), base, leaf.slot));
-    let mut first = true;
+        .push((piece, start_link, leaf.path.len(), leaf.slot));
     let arena = &mut pool.arena;
-    while let Some((p, link, depth, edge)) = s.stack.pop() {
+    let mut first = true;
+    while let Some((mut p, mut link, depth, mut edge)) = s.stack.pop() {
         s.path.truncate(depth);
         if !first && let Some((id, side)) = edge {
             s.path.push(Step::new(tree.nodes[id as usize].plane, side));
         }
         first = false;
-        if link == SHADOW {
-            continue;
-        }
-        if link == LIT {
-            graft(tree, root, occ, e, &p, edge, &s.path);
-            continue;
-        }
-        let n = tree.nodes[link as usize];
-        let sd = arena.classify_into(&p, &n.plane, &mut s.sides);
-        let d = s.path.len();
-        let front = Some((link, Side::Front));
-        let back = Some((link, Side::Back));
-        match (n.cap, sd.front, sd.back) {
-            // behind a cap (or in its plane): hidden already
-            (true, false, _) => {}
-            (true, true, false) | (false, true, false) | (false, false, false) => {
-                s.stack.push((p, n.front, d, front))
+        loop {
+            if link == SHADOW {
+                break;
             }
-            (false, false, true) => s.stack.push((p, n.back, d, back)),
-            (true, true, true) => {
-                let cut = arena.add_plane(n.plane);
-                let (f, _) = arena.split(sup, &p, cut, &s.sides);
-                s.stack.push((f, n.front, d, front));
+            if link == LIT {
+                graft(tree, root, occ, e, &p, edge, &s.path);
+                break;
             }
-            (false, true, true) => {
-                let cut = arena.add_plane(n.plane);
-                let (f, b) = arena.split(sup, &p, cut, &s.sides);
-                s.stack.push((b, n.back, d, back));
-                s.stack.push((f, n.front, d, front));
-            }
+            let n = tree.nodes[link as usize];
+            let sd = arena.sides(&p, &n.plane);
+            let next = match (n.cap, sd.front, sd.back) {
+                // behind a cap (or in its plane): hidden already
+                (true, false, _) => break,
+                (true, true, false) | (false, true, false) | (false, false, false) => Side::Front,
+                (false, false, true) => Side::Back,
+                (true, true, true) => {
+                    arena.classify_into(&p, &n.plane, &mut s.sides);
+                    let cut = arena.add_plane(n.plane);
+                    p = arena.split(sup, &p, cut, &s.sides).0;
+                    Side::Front
+                }
+                (false, true, true) => {
+                    arena.classify_into(&p, &n.plane, &mut s.sides);
+                    let cut = arena.add_plane(n.plane);
+                    let (f, b) = arena.split(sup, &p, cut, &s.sides);
+                    s.stack
+                        .push((b, n.back, s.path.len(), Some((link, Side::Back))));
+                    p = f;
+                    Side::Front
+                }
+            };
+            s.path.push(Step::new(n.plane, next));
+            edge = Some((link, next));
+            link = if next == Side::Front { n.front } else { n.back };
         }
     }
     arena.rollback(mark);

@@ -1,0 +1,171 @@
+//! Exact shadows against Chin & Feiner's algorithm and against a
+//! ray-casting baseline, in one run.
+//!
+//! Scenes (see `common`): Chin & Feiner's sizes (27, 258 and 1026
+//! polygons: a floor under floating boxes, tetrahedra and parallelograms),
+//! the paper's test room, a 10 000-polygon terrain with boxes, and the
+//! scanned bunny refined to 99 199 faces on its ground; one point light,
+//! and for some scenes four lights (three points and a sun).
+//!
+//! Groups, per scene:
+//! - `psv/<scene>`: `Shadows::new` and `shade_all` (the default path:
+//!   fragments per face, on every core);
+//! - `chin_feiner/<scene>`: the scene BSP (`BspTree::build`) and
+//!   `chin_feiner` (the baseline algorithm), up to 10 000 polygons;
+//! - `rays/<scene>`: the renderer's alternative, a BVH built over the
+//!   scene and one `f64` shadow ray per sample toward each light, for one
+//!   million samples spread over the faces by area (a 1-megapixel image's
+//!   worth), on every core: build and rays together.
+//!
+//! Before each scene one timed run prints the counts criterion cannot
+//! report: fragments per face, shadow-tree nodes, and the peak memory of
+//! the shadows in bytes per input face (from the process's peak resident
+//! size, reset before the run).
+//!
+//! Times are wall times: the work is parallel. `SVBSP_BENCH_SCENES=cf27,room`
+//! restricts the scenes (default: all; the whole run takes a few minutes
+//! on a 2-core machine).
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use bsp_core::{BspTree, BuildOptions};
+use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
+use svbsp::{ShadeOptions, Shadows, chin_feiner};
+
+mod common;
+
+use common::{Bvh, Prepared};
+
+const SCENES: [&str; 6] = [
+    "cf27",
+    "cf258",
+    "cf1026",
+    "room",
+    "terrain10000",
+    "bunny-99k",
+];
+
+fn scenes() -> Vec<String> {
+    match std::env::var("SVBSP_BENCH_SCENES") {
+        Ok(s) => s.split(',').map(|n| n.trim().to_string()).collect(),
+        Err(_) => SCENES.iter().map(|s| s.to_string()).collect(),
+    }
+}
+
+/// One point light everywhere; four lights for the larger scenes.
+fn light_sets(name: &str) -> &'static [usize] {
+    match name {
+        "cf1026" | "terrain10000" | "bunny-99k" | "room" => &[1, 4],
+        _ => &[1],
+    }
+}
+
+/// Samples of the ray baseline.
+const RAYS: usize = 1_000_000;
+
+fn configure(g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>, big: bool) {
+    g.sample_size(10);
+    if big {
+        g.sampling_mode(SamplingMode::Flat);
+        g.warm_up_time(Duration::from_millis(500));
+        g.measurement_time(Duration::from_secs(4));
+    } else {
+        g.warm_up_time(Duration::from_secs(1));
+        g.measurement_time(Duration::from_secs(3));
+    }
+}
+
+/// The exact shadows of `p` for its first `nl` lights.
+fn exact(p: &Prepared, nl: usize) -> (Shadows, svbsp::Batch) {
+    let shadows = Shadows::new(&p.polys, &p.lights[..nl]).expect("lights on the grid");
+    let b = shadows.shade_all(&p.polys, &ShadeOptions::default().with_pieces(false));
+    (shadows, b)
+}
+
+/// One timed run with the figures criterion cannot report.
+fn report(p: &Prepared, nl: usize) {
+    common::reset_peak();
+    let before = common::memory();
+    let t = Instant::now();
+    let (shadows, b) = exact(p, nl);
+    let time = t.elapsed();
+    let after = common::memory();
+    let nodes: usize = shadows.volumes().iter().map(|v| v.node_count()).sum();
+    let faces = p.polys.len();
+    let bytes = match (before, after) {
+        (Some((rss, _)), Some((_, peak))) => format!(
+            "{:.0} bytes per face at peak",
+            peak.saturating_sub(rss) as f64 / faces as f64
+        ),
+        _ => "memory not measured".to_string(),
+    };
+    eprintln!(
+        "{} / {nl} light(s): {faces} polygons, {} fragments ({:.3} per face), {nodes} \
+         shadow-tree nodes, {bytes}; {:.1} ms",
+        p.name,
+        b.len(),
+        b.len() as f64 / faces as f64,
+        time.as_secs_f64() * 1e3
+    );
+}
+
+fn bench_scene(c: &mut Criterion, name: &str) {
+    let spec = common::scene(name);
+    let p = common::prepare(&spec, &common::lights(&spec, 4));
+    let n = p.polys.len();
+    let big = n >= 10_000;
+    let sets = light_sets(name);
+    for &nl in sets {
+        report(&p, nl);
+    }
+
+    let mut g = c.benchmark_group(format!("psv/{name}"));
+    configure(&mut g, big);
+    g.throughput(Throughput::Elements(n as u64));
+    for &nl in sets {
+        g.bench_function(format!("{nl}light"), |b| {
+            b.iter(|| exact(black_box(&p), nl))
+        });
+    }
+    g.finish();
+
+    if n <= 10_000 {
+        let mut g = c.benchmark_group(format!("chin_feiner/{name}"));
+        configure(&mut g, big);
+        g.throughput(Throughput::Elements(n as u64));
+        for &nl in sets {
+            g.bench_function(format!("{nl}light"), |b| {
+                b.iter(|| {
+                    let tree = BspTree::build(p.polys.clone(), &BuildOptions::default());
+                    chin_feiner(&tree, &p.lights[..nl]).expect("lights on the grid")
+                })
+            });
+        }
+        g.finish();
+    }
+
+    let tris = common::triangles(&p.polys);
+    let samples = common::surface_samples(&tris, RAYS, 0x5a3e);
+    let mut g = c.benchmark_group(format!("rays/{name}"));
+    configure(&mut g, true);
+    g.throughput(Throughput::Elements(RAYS as u64));
+    for &nl in sets {
+        g.bench_function(format!("build+1M/{nl}light"), |b| {
+            b.iter(|| {
+                let bvh = Bvh::build(black_box(&tris));
+                common::shadow_ray_pass(&bvh, &samples, &p.lights_f64[..nl])
+            })
+        });
+    }
+    g.finish();
+}
+
+fn bench(c: &mut Criterion) {
+    for name in scenes() {
+        bench_scene(c, &name);
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
