@@ -72,10 +72,60 @@ pub fn import_faces<'a>(
     grid: &Grid,
     faces: impl IntoIterator<Item = &'a [DVec3]>,
 ) -> Result<(Vec<Polygon>, ImportReport), Error> {
+    import_from(grid, faces, 0)
+}
+
+/// [`import_faces`] of a slice of face loops, in parallel (rayon): the
+/// same polygons, tags and report in the same order whatever the thread
+/// count.
+///
+/// ```
+/// use bsp_core::{Grid, import_faces, import_faces_par};
+/// use glam::DVec3;
+/// let tri = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+/// let faces = vec![tri.clone(); 3];
+/// let grid = Grid::fit_points(&tri).unwrap();
+/// let (a, ra) = import_faces_par(&grid, &faces).unwrap();
+/// let (b, rb) = import_faces(&grid, faces.iter().map(|f| &f[..])).unwrap();
+/// assert_eq!((a.len(), ra), (b.len(), rb));
+/// assert_eq!(a[2].tag(), 2);
+/// ```
+pub fn import_faces_par(
+    grid: &Grid,
+    faces: &[Vec<DVec3>],
+) -> Result<(Vec<Polygon>, ImportReport), Error> {
+    use rayon::prelude::*;
+    const CHUNK: usize = 4096;
+    let parts: Vec<Result<(Vec<Polygon>, ImportReport), Error>> = faces
+        .par_chunks(CHUNK)
+        .enumerate()
+        .map(|(i, chunk)| import_from(grid, chunk.iter().map(|f| &f[..]), i * CHUNK))
+        .collect();
+    let mut out = Vec::with_capacity(faces.len());
+    let mut report = ImportReport::default();
+    // the first error in face order, as the sequential import gives
+    for part in parts {
+        let (polys, r) = part?;
+        out.extend(polys);
+        report.faces += r.faces;
+        report.polygons += r.polygons;
+        report.triangulated.extend(r.triangulated);
+        report.dropped.extend(r.dropped);
+    }
+    Ok((out, report))
+}
+
+/// [`import_faces`], numbering the faces from `first`.
+fn import_from<'a>(
+    grid: &Grid,
+    faces: impl IntoIterator<Item = &'a [DVec3]>,
+    first: usize,
+) -> Result<(Vec<Polygon>, ImportReport), Error> {
     let mut out = Vec::new();
     let mut report = ImportReport::default();
     let mut pts: Vec<GridPoint> = Vec::new();
     for (fi, face) in faces.into_iter().enumerate() {
+        let fi = fi + first;
         report.faces += 1;
         pts.clear();
         for (vi, p) in face.iter().enumerate() {

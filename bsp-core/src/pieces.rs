@@ -601,6 +601,24 @@ impl PieceArena {
         Sides { front, back }
     }
 
+    /// [`PieceArena::sides`] through a shared reference (a lazy vertex
+    /// that needs its exact coordinates computes them without keeping
+    /// them), for classifying in parallel.
+    pub fn sides_shared(&self, c: &Piece, plane: &Plane) -> Sides {
+        let (mut front, mut back) = (false, false);
+        for &v in &c.verts {
+            match self.vertex(v).classify(plane) {
+                Side::Front => front = true,
+                Side::Back => back = true,
+                Side::On => {}
+            }
+            if front && back {
+                break;
+            }
+        }
+        Sides { front, back }
+    }
+
     /// The exact sides of `c`'s vertices relative to `plane`, written to
     /// `out` (cleared first).
     #[inline]

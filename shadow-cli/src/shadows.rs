@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
-use bsp_core::{BspTree, BuildOptions, Grid, ImportReport, Polygon, import_faces};
+use bsp_core::{BspTree, BuildOptions, Grid, ImportReport, Polygon, import_faces_par};
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -613,7 +613,7 @@ fn run_here(args: &ShadowsArgs) -> Result<()> {
         let grid = shared_grid(&mesh.positions, &specs).with_context(|| name.clone())?;
         let lights = place_lights(&grid, &specs)?;
         let loops = mesh.face_loops();
-        let (polys, report) = import_faces(&grid, loops.iter().map(Vec::as_slice))
+        let (polys, report) = import_faces_par(&grid, &loops)
             .with_context(|| format!("{name}: cannot import the faces"))?;
         Ok(Scene {
             mesh,

@@ -111,8 +111,8 @@ pub fn receivers(polys: &[Polygon]) -> Vec<Range<usize>> {
 
 impl Shadows {
     /// Builds one shadow-volume tree per light from `occluders` (polygons
-    /// with grid vertices, e.g. from [`bsp_core::import_faces`]), the
-    /// lights in parallel.
+    /// with grid vertices, e.g. from [`bsp_core::import_faces`]), each in
+    /// parallel.
     pub fn new(occluders: &[Polygon], lights: &[Light]) -> Result<Shadows, ShadowError> {
         if lights.len() > MAX_LIGHTS {
             return Err(LightError::TooMany(lights.len()).into());
@@ -120,8 +120,10 @@ impl Shadows {
         for l in lights {
             l.validate()?;
         }
+        // one light after the other: each build is parallel inside, and
+        // only one build's working memory is alive at a time
         let volumes = lights
-            .par_iter()
+            .iter()
             .map(|&l| ShadowVolumes::build(l, occluders))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Shadows {

@@ -40,7 +40,7 @@
 //! receivers are cut in the input tier: 256-bit vertices behind the `f64`
 //! filter.
 
-use bsp_core::{EdgeRef, GridPoint, Piece, PieceArena, Plane, Point, Polygon, Side};
+use bsp_core::{EdgeRef, GridPoint, Piece, PieceArena, Plane, Point, Polygon, Side, Sides};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
@@ -304,6 +304,9 @@ const MAX_SKELETON_DEPTH: usize = 48;
 /// Skeleton subtrees made one after the other before the rest is built in
 /// parallel.
 const PARALLEL_TASKS: usize = 32;
+/// Lists at least this long are classified in parallel while the first
+/// skeleton levels are made.
+const PARALLEL_LIST: usize = 8192;
 
 struct SplitMix(u64);
 impl SplitMix {
@@ -739,14 +742,30 @@ fn split_task(
     let Some(plane) = choose_split(occ, pool, &task, rng, sides) else {
         return Err(task);
     };
+    // the sides of every part, in parallel for long lists
+    let reached: Vec<Sides> = if task.list.len() >= PARALLEL_LIST {
+        let pool = &*pool;
+        task.list
+            .par_iter()
+            .map(|e| {
+                pool.arena
+                    .sides_shared(&pool.pieces[e.piece as usize], &plane)
+            })
+            .collect()
+    } else {
+        task.list
+            .iter()
+            .map(|e| pool.arena.sides(&pool.pieces[e.piece as usize], &plane))
+            .collect()
+    };
     let cut = pool.arena.add_plane(plane);
     let (mut front, mut back) = (Vec::new(), Vec::new());
-    for e in task.list {
-        let p = &pool.pieces[e.piece as usize];
-        let sd = pool.arena.classify_into(p, &plane, sides);
+    for (e, sd) in task.list.into_iter().zip(reached) {
         match (sd.front, sd.back) {
             (false, true) => back.push(e),
             (true, true) => {
+                pool.arena
+                    .classify_into(&pool.pieces[e.piece as usize], &plane, sides);
                 let sup = e.base + occ.range(e.occ).len() as u32;
                 let (f, b) = pool
                     .arena
