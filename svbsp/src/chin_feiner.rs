@@ -430,12 +430,17 @@ pub fn chin_feiner(tree: &BspTree, lights: &[Light]) -> Result<CfFragments, Ligh
                 }
                 inside.clear();
                 outside.clear();
+                // the pieces of this pass only give their edges' planes:
+                // their points are dropped after the graft
+                let mark = t.points.len();
                 let whole = t.add_polygon(polys[pi], pi as u32);
                 sv.filter(&mut t, whole, &mut inside, &mut outside);
                 for (f, slot) in outside.drain(..) {
                     let planes = shadow_planes(&mut t, &f, light, a);
                     sv.graft(slot, &planes);
                 }
+                inside.clear();
+                t.points.truncate(mark);
             }
         }
         shadow_nodes += sv.nodes.len();
