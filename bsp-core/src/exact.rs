@@ -39,15 +39,23 @@ pub const FILTER_REL: f64 = 1.0 / (1u64 << 48) as f64;
 /// to its exact path.
 #[inline]
 pub fn filter_side(plane: &[f64; 4], point: &[f64; 4]) -> Option<Side> {
-    let t = [
-        plane[0] * point[0],
-        plane[1] * point[1],
-        plane[2] * point[2],
-        plane[3] * point[3],
-    ];
+    let (v, m) = dot4(plane, point);
+    sign_beyond(v, m * FILTER_REL)
+}
+
+/// The `f64` dot product of two 4-vectors, and the sum of its terms'
+/// absolute values.
+#[inline]
+fn dot4(a: &[f64; 4], b: &[f64; 4]) -> (f64, f64) {
+    let t = [a[0] * b[0], a[1] * b[1], a[2] * b[2], a[3] * b[3]];
     let v = (t[0] + t[1]) + (t[2] + t[3]);
     let m = (t[0].abs() + t[1].abs()) + (t[2].abs() + t[3].abs());
-    let bound = m * FILTER_REL;
+    (v, m)
+}
+
+/// The sign of `v` if it is beyond `±bound`.
+#[inline]
+fn sign_beyond(v: f64, bound: f64) -> Option<Side> {
     if v > bound {
         Some(Side::Front)
     } else if v < -bound {
@@ -67,24 +75,10 @@ pub fn filter_side(plane: &[f64; 4], point: &[f64; 4]) -> Option<Side> {
 /// the bound itself. With `err = 0` this is [`filter_side`].
 #[inline]
 pub fn filter_side_err(plane: &[f64; 4], point: &[f64; 4], err: &[f64; 4]) -> Option<Side> {
-    let t = [
-        plane[0] * point[0],
-        plane[1] * point[1],
-        plane[2] * point[2],
-        plane[3] * point[3],
-    ];
-    let v = (t[0] + t[1]) + (t[2] + t[3]);
-    let m = (t[0].abs() + t[1].abs()) + (t[2].abs() + t[3].abs());
+    let (v, m) = dot4(plane, point);
     let e = (plane[0].abs() * err[0] + plane[1].abs() * err[1])
         + (plane[2].abs() * err[2] + plane[3].abs() * err[3]);
-    let bound = m * FILTER_REL + e * 1.0625;
-    if v > bound {
-        Some(Side::Front)
-    } else if v < -bound {
-        Some(Side::Back)
-    } else {
-        None
-    }
+    sign_beyond(v, m * FILTER_REL + e * 1.0625)
 }
 
 /// `2^e` as an `f64`, for `-1022 <= e <= 1023`.

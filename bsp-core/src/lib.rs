@@ -69,7 +69,8 @@ pub use regions::{Region, merge_cells};
 pub use sanity::{ConvexParts, SanityError, check_convex};
 pub use topology::{TopologyError, check_closed_manifold};
 pub use tree::{
-    BspTree, BuildOptions, Cell, Link, Membership, Node, NodeId, Order, RECURSION_LIMIT, TreeStats,
+    BspTree, BuildOptions, Cell, Link, Membership, Node, NodeId, Order, RECURSION_LIMIT, SplitMix,
+    TreeStats,
 };
 
 /// Re-export of the wide integer type used for homogeneous coordinates.

@@ -401,6 +401,26 @@ pub struct Sides {
     pub back: bool,
 }
 
+impl Sides {
+    /// The sides some vertex of `c` is strictly on, given each vertex's
+    /// side; stops at the first vertex that makes both.
+    #[inline]
+    fn of(c: &Piece, mut side: impl FnMut(u32) -> Side) -> Sides {
+        let (mut front, mut back) = (false, false);
+        for &v in &c.verts {
+            match side(v) {
+                Side::Front => front = true,
+                Side::Back => back = true,
+                Side::On => {}
+            }
+            if front && back {
+                break;
+            }
+        }
+        Sides { front, back }
+    }
+}
+
 impl PieceArena {
     /// An empty arena.
     pub fn new() -> PieceArena {
@@ -587,36 +607,14 @@ impl PieceArena {
     /// Which sides of `plane` some vertex of `c` is strictly on.
     #[inline]
     pub fn sides(&mut self, c: &Piece, plane: &Plane) -> Sides {
-        let (mut front, mut back) = (false, false);
-        for &v in &c.verts {
-            match self.classify(v, plane) {
-                Side::Front => front = true,
-                Side::Back => back = true,
-                Side::On => {}
-            }
-            if front && back {
-                break;
-            }
-        }
-        Sides { front, back }
+        Sides::of(c, |v| self.classify(v, plane))
     }
 
     /// [`PieceArena::sides`] through a shared reference (a lazy vertex
     /// that needs its exact coordinates computes them without keeping
     /// them), for classifying in parallel.
     pub fn sides_shared(&self, c: &Piece, plane: &Plane) -> Sides {
-        let (mut front, mut back) = (false, false);
-        for &v in &c.verts {
-            match self.vertex(v).classify(plane) {
-                Side::Front => front = true,
-                Side::Back => back = true,
-                Side::On => {}
-            }
-            if front && back {
-                break;
-            }
-        }
-        Sides { front, back }
+        Sides::of(c, |v| self.vertex(v).classify(plane))
     }
 
     /// The exact sides of `c`'s vertices relative to `plane`, written to

@@ -407,37 +407,32 @@ impl Polygon {
             (false, _) => return false,
             (true, true) => {}
         }
-        let mut out = Builder::new(self.support, self.tag);
+        let out = std::cell::RefCell::new(Builder::new(self.support, self.tag));
         let support = self.support;
         let edges = &self.edges;
-        let crossing = |i: usize| {
-            Point::from_planes(&support, &edges[i], plane)
-                .expect("a spanning edge meets the cutting plane in one point")
-        };
-        let push = |v, e| out.push(v, e);
-        if keep == Front {
-            split_loop(
-                &self.verts,
-                edges,
-                &sides,
-                plane.flip(),
-                *plane,
-                crossing,
-                push,
-                |_, _| {},
-            );
-        } else {
-            split_loop(
-                &self.verts,
-                edges,
-                &sides,
-                plane.flip(),
-                *plane,
-                crossing,
-                |_, _| {},
-                push,
-            );
-        }
+        let (keep_front, keep_back) = (keep == Front, keep == Back);
+        split_loop(
+            &self.verts,
+            edges,
+            &sides,
+            plane.flip(),
+            *plane,
+            |i| {
+                Point::from_planes(&support, &edges[i], plane)
+                    .expect("a spanning edge meets the cutting plane in one point")
+            },
+            |v, e| {
+                if keep_front {
+                    out.borrow_mut().push(v, e)
+                }
+            },
+            |v, e| {
+                if keep_back {
+                    out.borrow_mut().push(v, e)
+                }
+            },
+        );
+        let out = out.into_inner();
         *self = out.finish();
         true
     }

@@ -170,17 +170,24 @@ pub struct BspTree {
     root: Link,
 }
 
-struct SplitMix(u64);
+/// `SplitMix64`: the small deterministic generator behind the sampled
+/// choices of the builders (the same seed gives the same tree).
+#[derive(Clone, Debug)]
+pub struct SplitMix(pub u64);
+
 impl SplitMix {
-    fn next(&mut self) -> u64 {
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
         z ^ (z >> 31)
     }
-    fn below(&mut self, n: usize) -> usize {
-        (((self.next() >> 32) * n as u64) >> 32) as usize
+
+    /// A number in `0..n` (`n < 2^32`).
+    pub fn below(&mut self, n: usize) -> usize {
+        (((self.next_u64() >> 32) * n as u64) >> 32) as usize
     }
 }
 

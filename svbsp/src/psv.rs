@@ -40,7 +40,10 @@
 //! receivers are cut in the input tier: 256-bit vertices behind the `f64`
 //! filter.
 
-use bsp_core::{EdgeRef, GridPoint, Piece, PieceArena, Plane, Point, Polygon, Side, Sides};
+use bsp_core::{
+    EdgeRef, GridPoint, Piece, PieceArena, Plane, Point, Polygon, SanityError, Side, Sides,
+    SplitMix,
+};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
@@ -307,20 +310,6 @@ const PARALLEL_TASKS: usize = 32;
 /// Lists at least this long are classified in parallel while the first
 /// skeleton levels are made.
 const PARALLEL_LIST: usize = 8192;
-
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (((self.next() >> 32) * n as u64) >> 32) as usize
-    }
-}
 
 /// An occluder's part in a region: the occluder, the part (a piece of the
 /// pool), and where the occluder's edge planes start in the pool's arena
@@ -640,10 +629,12 @@ impl ShadowVolumes {
                 continue;
             }
             let Some(n) = self.nodes.get(link as usize) else {
-                return Err(VolumeSanity::MissingNode { node: link });
+                return Err(VolumeSanity::Tree(SanityError::MissingNode { node: link }));
             };
             if std::mem::replace(&mut seen[link as usize], true) {
-                return Err(VolumeSanity::NodeReachedTwice { node: link });
+                return Err(VolumeSanity::Tree(SanityError::NodeReachedTwice {
+                    node: link,
+                }));
             }
             let at = self.light.eval(&n.plane);
             if n.cap && at <= 0 {
@@ -659,7 +650,9 @@ impl ShadowVolumes {
             stack.push(n.back);
         }
         match seen.iter().position(|s| !s) {
-            Some(i) => Err(VolumeSanity::Unreachable { node: i as u32 }),
+            Some(i) => Err(VolumeSanity::Tree(SanityError::Unreachable {
+                node: i as u32,
+            })),
             None => Ok(()),
         }
     }
@@ -667,24 +660,12 @@ impl ShadowVolumes {
 
 /// Which invariant a shadow-volume tree breaks
 /// ([`ShadowVolumes::sanity_check`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum VolumeSanity {
-    /// A link names a node that does not exist.
-    MissingNode {
-        /// The link's target.
-        node: u32,
-    },
-    /// Two links lead to the same node.
-    NodeReachedTwice {
-        /// The node.
-        node: u32,
-    },
-    /// A node no link leads to.
-    Unreachable {
-        /// The node.
-        node: u32,
-    },
+    /// The links do not form a tree over the nodes (a missing node, one
+    /// reached twice or one unreachable).
+    Tree(SanityError),
     /// A cap does not have the light strictly in front.
     CapMissesLight {
         /// The node.
@@ -705,9 +686,7 @@ pub enum VolumeSanity {
 impl std::fmt::Display for VolumeSanity {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            VolumeSanity::MissingNode { node } => write!(f, "link to missing node {node}"),
-            VolumeSanity::NodeReachedTwice { node } => write!(f, "node {node} is reached twice"),
-            VolumeSanity::Unreachable { node } => write!(f, "node {node} is unreachable"),
+            VolumeSanity::Tree(e) => e.fmt(f),
             VolumeSanity::CapMissesLight { node } => {
                 write!(f, "cap {node} does not have the light strictly in front")
             }
