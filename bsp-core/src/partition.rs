@@ -20,7 +20,7 @@ use crate::plane::Plane;
 use crate::point::Point;
 use crate::polygon::{Polygon, PolygonSide, Split};
 use crate::sanity::{Ancestor, SanityError, walk_checked};
-use crate::tree::{BspTree, BuildOptions, Cell, Link, Membership, check_ancestors};
+use crate::tree::{BspTree, BuildOptions, Cell, Link, Membership, Node, NodeId, check_ancestors};
 
 /// Half-width of the box that bounds every sub-hyperplane: `2^26`, just
 /// outside every grid coordinate.
@@ -718,6 +718,76 @@ impl<L: Copy> Partition<L> {
         (self.nodes.len() - 1) as u32
     }
 
+    /// The polygon BSP tree of this partition: the same planes, node
+    /// polygons and order, with each leaf's label mapped to a [`Cell`].
+    /// The overlay of two polygon trees (`merge(&a, &b, &Overlay)` of
+    /// [`Partition::from_tree`]s) turned back into a tree is the core
+    /// paper's `Bsp4 = Bsp2 + Bsp3`, ready for painter's-order traversal
+    /// and shadows. A node without polygons whose child is a leaf orders
+    /// nothing, and is replaced by its other child.
+    pub fn polygon_tree(&self, cell: impl Fn(L) -> Cell) -> BspTree {
+        // post-order: what each node becomes (a leaf or a kept node)
+        let mut order = Vec::with_capacity(self.nodes.len());
+        if let PLink::Node(r) = self.root {
+            let mut stack = vec![r];
+            while let Some(i) = stack.pop() {
+                order.push(i);
+                let n = &self.nodes[i as usize];
+                for c in [n.front, n.back] {
+                    if let PLink::Node(j) = c {
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        let mut repl: Vec<Option<PLink<L>>> = vec![None; self.nodes.len()];
+        let resolve = |repl: &[Option<PLink<L>>], l: PLink<L>| match l {
+            PLink::Node(j) => repl[j as usize].unwrap_or(l),
+            leaf => leaf,
+        };
+        for &i in order.iter().rev() {
+            let n = &self.nodes[i as usize];
+            if !n.polygons.is_empty() {
+                continue;
+            }
+            let (f, b) = (resolve(&repl, n.front), resolve(&repl, n.back));
+            repl[i as usize] = match (f, b) {
+                (PLink::Leaf(_), other) => Some(other),
+                (other, PLink::Leaf(_)) => Some(other),
+                _ => None,
+            };
+        }
+        // the kept nodes in pre-order
+        let mut nodes: Vec<Node> = Vec::new();
+        let root = resolve(&repl, self.root);
+        let mut stack: Vec<(PLink<L>, Option<(NodeId, Side)>)> = vec![(root, None)];
+        let mut root_link = Link::Cell(Cell::Out);
+        while let Some((l, slot)) = stack.pop() {
+            let link = match l {
+                PLink::Leaf(x) => Link::Cell(cell(x)),
+                PLink::Node(i) => {
+                    let n = &self.nodes[i as usize];
+                    let id = nodes.len() as NodeId;
+                    nodes.push(Node {
+                        plane: n.plane,
+                        polygons: n.polygons.clone(),
+                        front: Link::Cell(Cell::Out),
+                        back: Link::Cell(Cell::In),
+                    });
+                    stack.push((resolve(&repl, n.back), Some((id, Side::Back))));
+                    stack.push((resolve(&repl, n.front), Some((id, Side::Front))));
+                    Link::Node(id)
+                }
+            };
+            match slot {
+                None => root_link = link,
+                Some((p, Side::Front)) => nodes[p as usize].front = link,
+                Some((p, _)) => nodes[p as usize].back = link,
+            }
+        }
+        BspTree::from_parts(nodes, root_link)
+    }
+
     /// The same partition with every label mapped.
     pub fn map_labels<M: Copy>(&self, f: impl Fn(L) -> M) -> Partition<M> {
         let m = |l: PLink<L>| match l {
@@ -791,8 +861,8 @@ impl<L: Copy> Partition<L> {
         out
     }
 
-    /// Collapses nodes whose children are leaves with equal labels, and
-    /// drops the nodes no longer reachable.
+    /// Collapses nodes whose children are leaves with equal labels (unless
+    /// they carry input polygons), and drops the nodes no longer reachable.
     pub fn reduce(&mut self)
     where
         L: PartialEq,
@@ -823,8 +893,11 @@ impl<L: Copy> Partition<L> {
                 let n = &mut self.nodes[i as usize];
                 n.front = newf;
                 n.back = newb;
+                // a node that carries input polygons stays: the overlay of
+                // polygon trees ("+") must keep every polygon
                 if let (Some(x), Some(y)) = (f, b)
                     && x == y
+                    && n.polygons.is_empty()
                 {
                     collapsed[i as usize] = Some(x);
                 }

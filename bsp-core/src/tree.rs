@@ -358,6 +358,77 @@ impl BspTree {
         tree
     }
 
+    /// A tree from its nodes and root (indices into `nodes`; every node
+    /// reached once).
+    pub(crate) fn from_parts(nodes: Vec<Node>, root: Link) -> BspTree {
+        BspTree { nodes, root }
+    }
+
+    /// This tree's splitting choices replayed on other copies of its
+    /// polygons (moved, or snapped again after a motion), tagged as this
+    /// tree's polygons are: where this tree split by the plane of face
+    /// `t`, the replay splits by the plane of `t`'s new copy, without a
+    /// candidate search. Where a copy is missing from its node's list, or
+    /// polygons reach what was a leaf here, the replay chooses as
+    /// [`BspTree::build`] does with `fallback`. The result is the same
+    /// tree wherever the new coordinates keep every polygon on the same
+    /// side of every plane, and a valid autopartition in any case.
+    pub fn replay(&self, polygons: Vec<Polygon>, fallback: &BuildOptions) -> BspTree {
+        let mut tree = BspTree {
+            nodes: Vec::new(),
+            root: Link::Cell(Cell::Out),
+        };
+        let mut rng = SplitMix(fallback.seed);
+        // (the polygons, the node of this tree they stand at, the slot)
+        let mut stack: Vec<(Vec<Polygon>, Option<NodeId>, Slot)> =
+            vec![(polygons, self.root_id(), Slot::Root)];
+        while let Some((polys, at, slot)) = stack.pop() {
+            let link = if polys.is_empty() {
+                Link::Cell(match slot {
+                    Slot::Back(_) => Cell::In,
+                    Slot::Front(_) | Slot::Root => Cell::Out,
+                })
+            } else {
+                let old = at.map(|i| &self.nodes[i as usize]);
+                // the face whose plane this tree chose here
+                let chosen = old.and_then(|n| {
+                    let t = n.polygons.iter().find(|p| p.support() == &n.plane)?.tag();
+                    polys.iter().find(|p| p.tag() == t).map(|p| *p.support())
+                });
+                let plane = chosen.unwrap_or_else(|| choose_plane(&polys, fallback, &mut rng));
+                let (on, front, back) = partition_list(polys, &plane);
+                let id = tree.nodes.len() as NodeId;
+                tree.nodes.push(Node {
+                    plane,
+                    polygons: on,
+                    front: Link::Cell(Cell::Out),
+                    back: Link::Cell(Cell::In),
+                });
+                let child = |l: Link| match l {
+                    Link::Node(j) => Some(j),
+                    Link::Cell(_) => None,
+                };
+                let (f, b) = old.map_or((None, None), |n| (child(n.front), child(n.back)));
+                stack.push((back, b, Slot::Back(id)));
+                stack.push((front, f, Slot::Front(id)));
+                Link::Node(id)
+            };
+            match slot {
+                Slot::Root => tree.root = link,
+                Slot::Front(id) => tree.nodes[id as usize].front = link,
+                Slot::Back(id) => tree.nodes[id as usize].back = link,
+            }
+        }
+        tree
+    }
+
+    fn root_id(&self) -> Option<NodeId> {
+        match self.root {
+            Link::Node(i) => Some(i),
+            Link::Cell(_) => None,
+        }
+    }
+
     /// The root link.
     pub fn root(&self) -> Link {
         self.root

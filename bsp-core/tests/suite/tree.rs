@@ -5,8 +5,8 @@
 use std::collections::HashMap;
 
 use bsp_core::{
-    BspTree, BuildOptions, FlatBsp, GridPoint, MAX_COORD, Membership, Order, Plane, Point, Polygon,
-    RECURSION_LIMIT, Side, ViewPoint,
+    BspTree, BuildOptions, FlatBsp, GridPoint, MAX_COORD, Membership, Order, Overlay, Partition,
+    Plane, Point, Polygon, RECURSION_LIMIT, Side, ViewPoint, merge_smaller_into_larger,
 };
 use num_traits::One;
 use proptest::collection::vec;
@@ -222,6 +222,20 @@ pub(crate) fn check_scene(
         .collect();
     let count = polys.len();
     let tree = BspTree::build(polys, opts);
+    check_tree(&tree, input, count, eyes, rays, rng)
+}
+
+/// Checks a tree over the faces of `input` (tagged with their index;
+/// `count` of them made it in): invariants, figures, traversals and the
+/// painter's order from every eye.
+pub(crate) fn check_tree(
+    tree: &BspTree,
+    input: &[Vec<GridPoint>],
+    count: usize,
+    eyes: &[[i64; 3]],
+    rays: usize,
+    rng: &mut Rng,
+) -> Result<usize, TestCaseError> {
     if let Err(e) = tree.sanity_check() {
         return Err(TestCaseError::fail(format!("sanity_check: {e}")));
     }
@@ -235,15 +249,15 @@ pub(crate) fn check_scene(
     );
     prop_assert!(stats.depth <= stats.nodes);
     prop_assert!(stats.polygons >= count);
-    let flat = FlatBsp::new(&tree);
+    let flat = FlatBsp::new(tree);
     prop_assert_eq!(flat.len(), tree.nodes().len());
     prop_assert_eq!(flat.polygons().len(), stats.polygons);
-    let frags = Frags::new(&tree, input);
+    let frags = Frags::new(tree, input);
     let mut occluding = 0;
     for &e in eyes {
         let vp = ViewPoint::new(e).expect("viewpoint within range");
-        let b2f = check_traversals(&tree, &flat, &frags, vp, Order::BackToFront)?;
-        let f2b = check_traversals(&tree, &flat, &frags, vp, Order::FrontToBack)?;
+        let b2f = check_traversals(tree, &flat, &frags, vp, Order::BackToFront)?;
+        let f2b = check_traversals(tree, &flat, &frags, vp, Order::FrontToBack)?;
         if !frags.list.is_empty() {
             occluding += check_painter(&frags, e, &b2f, &f2b, rays, rng)?;
         }
@@ -282,6 +296,129 @@ proptest! {
     ) {
         let eyes: Vec<[i64; 3]> = eyes.iter().map(|e| make_eye(e, &input)).collect();
         check_scene(&input, &opts, &eyes, 10, &mut Rng(seed))?;
+    }
+}
+
+fn input_polygons(input: &[Vec<GridPoint>]) -> Vec<Polygon> {
+    input
+        .iter()
+        .enumerate()
+        .filter_map(|(i, l)| Polygon::from_grid_points(l, i as u32).ok())
+        .collect()
+}
+
+fn same_tree(a: &BspTree, b: &BspTree) -> bool {
+    a.root() == b.root()
+        && a.nodes().len() == b.nodes().len()
+        && a.nodes().iter().zip(b.nodes()).all(|(x, y)| {
+            x.plane == y.plane
+                && x.front == y.front
+                && x.back == y.back
+                && x.polygons.len() == y.polygons.len()
+                && x.polygons
+                    .iter()
+                    .zip(&y.polygons)
+                    .all(|(p, q)| same_polygon(p, q))
+        })
+}
+
+/// The same links, and the same tags in every node.
+fn same_shape(a: &BspTree, b: &BspTree) -> bool {
+    let tags = |n: &bsp_core::Node| n.polygons.iter().map(|p| p.tag()).collect::<Vec<_>>();
+    a.root() == b.root()
+        && a.nodes().len() == b.nodes().len()
+        && a.nodes()
+            .iter()
+            .zip(b.nodes())
+            .all(|(x, y)| x.front == y.front && x.back == y.back && tags(x) == tags(y))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(128))]
+
+    /// A tree's choices replayed on its own polygons give the same tree,
+    /// and on a copy moved by a grid vector (where every classification is
+    /// the same) a tree of the same shape; a replay on polygons moved
+    /// apart is still a correct painter's tree.
+    #[test]
+    fn replayed_trees_keep_their_shape_and_stay_correct(
+        input in scene(),
+        opts in options(),
+        eyes in vec(eye(), 1..3),
+        seed in any::<u64>(),
+        shift in prop::array::uniform3(-64i32..64),
+    ) {
+        let eyes: Vec<[i64; 3]> = eyes.iter().map(|e| make_eye(e, &input)).collect();
+        let polys = input_polygons(&input);
+        let count = polys.len();
+        let tree = BspTree::build(polys.clone(), &opts);
+        let again = tree.replay(polys, &opts);
+        prop_assert!(same_tree(&tree, &again), "replay differs from the tree");
+        let moved_by = |f: &dyn Fn(usize) -> [i32; 3]| -> Option<Vec<Vec<GridPoint>>> {
+            input
+                .iter()
+                .enumerate()
+                .map(|(i, l)| {
+                    let d = f(i);
+                    l.iter()
+                        .map(|p| {
+                            let q = [p[0] + d[0], p[1] + d[1], p[2] + d[2]];
+                            q.iter().all(|c| c.abs() <= MAX_COORD).then_some(q)
+                        })
+                        .collect()
+                })
+                .collect()
+        };
+        if let Some(moved) = moved_by(&|_| shift) {
+            let replay = tree.replay(input_polygons(&moved), &opts);
+            prop_assert!(same_shape(&replay, &tree), "a moved replay has another shape");
+            check_tree(&replay, &moved, count, &eyes, 6, &mut Rng(seed))?;
+        }
+        // every face moved its own way: the old choices may no longer fit
+        let mut rng = Rng(seed);
+        let offsets: Vec<[i32; 3]> = (0..input.len())
+            .map(|_| [0, 1, 2].map(|_| rng.below(129) as i32 - 64))
+            .collect();
+        if let Some(apart) = moved_by(&|i| offsets[i]) {
+            let ap = input_polygons(&apart);
+            let n = ap.len();
+            let replay = tree.replay(ap, &opts);
+            check_tree(&replay, &apart, n, &eyes, 6, &mut rng)?;
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(128))]
+
+    /// The overlay "+" of two polygon trees (the core paper's
+    /// `Bsp4 = Bsp2 + Bsp3`) keeps every polygon of both, and as a tree
+    /// orders them correctly for every eye.
+    #[test]
+    fn overlay_of_polygon_trees_is_a_painters_tree(
+        input in scene(),
+        opts in options(),
+        eyes in vec(eye(), 1..3),
+        seed in any::<u64>(),
+        cut in 0usize..8,
+    ) {
+        let eyes: Vec<[i64; 3]> = eyes.iter().map(|e| make_eye(e, &input)).collect();
+        let polys = input_polygons(&input);
+        let count = polys.len();
+        let k = cut.min(polys.len());
+        let a = BspTree::build(polys[..k].to_vec(), &opts);
+        let b = BspTree::build(polys[k..].to_vec(), &opts);
+        let (pa, pb) = (Partition::from_tree(&a), Partition::from_tree(&b));
+        let o = merge_smaller_into_larger(&pa, &pb, &Overlay);
+        if let Err(e) = o.sanity_check() {
+            return Err(TestCaseError::fail(format!("overlay: sanity_check: {e}")));
+        }
+        let tree = o.polygon_tree(|(x, _)| x);
+        let mut tags: Vec<u32> = tree.polygons().map(|p| p.tag()).collect();
+        tags.sort_unstable();
+        tags.dedup();
+        prop_assert_eq!(tags.len(), count, "every polygon is kept");
+        check_tree(&tree, &input, count, &eyes, 6, &mut Rng(seed))?;
     }
 }
 
