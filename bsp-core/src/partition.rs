@@ -760,7 +760,8 @@ impl<L: Copy> Partition<L> {
         // the kept nodes in pre-order
         let mut nodes: Vec<Node> = Vec::new();
         let root = resolve(&repl, self.root);
-        let mut stack: Vec<(PLink<L>, Option<(NodeId, Side)>)> = vec![(root, None)];
+        type Item<L> = (PLink<L>, Option<(NodeId, Side)>);
+        let mut stack: Vec<Item<L>> = vec![(root, None)];
         let mut root_link = Link::Cell(Cell::Out);
         while let Some((l, slot)) = stack.pop() {
             let link = match l {
