@@ -338,6 +338,53 @@ impl ConvexParts for CfFragment<'_> {
 }
 
 impl CfFragments {
+    /// The fragments with some faces overlaid by another run's fragments:
+    /// each fragment `q` of a face for which `base_of` lists fragments of
+    /// `base` (by index) is replaced by its non-empty intersections with
+    /// them, each lit by the lights that light both. With `base` the
+    /// static scene's fragments and `self` a run over the polygons that
+    /// moved and those near them, a face's flags become those of the whole
+    /// scene (a point is lit when neither run's occluders block it). The
+    /// intersections are exact: `q` is cut by the planes of each base
+    /// fragment's edges.
+    pub fn overlay<'b>(
+        self,
+        base: &CfFragments,
+        base_of: impl Fn(u32) -> Option<&'b [u32]>,
+    ) -> CfFragments {
+        let mut t = Tables {
+            points: self.points,
+            shadow: self.shadow,
+        };
+        let mut frags = Vec::with_capacity(self.frags.len());
+        for q in self.frags {
+            let Some(list) = base_of(q.face) else {
+                frags.push(q);
+                continue;
+            };
+            for &si in list {
+                let sf = base.get(si as usize);
+                let mut piece = Some(q.clone());
+                for j in 0..sf.f.edges.len() {
+                    let Some(r) = piece.take() else { break };
+                    let h = t.add_shadow(sf.plane(j));
+                    // the fragment lies behind its edge planes
+                    piece = t.split(r, h).1;
+                }
+                if let Some(mut r) = piece {
+                    r.lit &= sf.f.lit;
+                    frags.push(r);
+                }
+            }
+        }
+        CfFragments {
+            points: t.points,
+            shadow: t.shadow,
+            frags,
+            shadow_nodes: self.shadow_nodes,
+        }
+    }
+
     /// Number of fragments.
     pub fn len(&self) -> usize {
         self.frags.len()

@@ -34,6 +34,8 @@ pub enum ShadowError {
     Light(LightError),
     /// An occluder is unusable.
     Volume(VolumeError),
+    /// Trees given for lights they were not built for.
+    Mismatch,
 }
 
 impl std::fmt::Display for ShadowError {
@@ -41,6 +43,9 @@ impl std::fmt::Display for ShadowError {
         match self {
             ShadowError::Light(e) => e.fmt(f),
             ShadowError::Volume(e) => e.fmt(f),
+            ShadowError::Mismatch => {
+                write!(f, "the shadow trees were not built for the lights given")
+            }
         }
     }
 }
@@ -142,6 +147,34 @@ impl Shadows {
         &self.volumes
     }
 
+    /// Shadows from trees built elsewhere, one per light in order (for
+    /// example over different occluders per light). Errors if a tree's
+    /// light is not the light given for it.
+    pub fn from_volumes(
+        lights: &[Light],
+        volumes: Vec<ShadowVolumes>,
+    ) -> Result<Shadows, ShadowError> {
+        if lights.len() > MAX_LIGHTS {
+            return Err(LightError::TooMany(lights.len()).into());
+        }
+        if volumes.len() != lights.len() || volumes.iter().zip(lights).any(|(v, l)| v.light() != *l)
+        {
+            return Err(ShadowError::Mismatch);
+        }
+        Ok(Shadows {
+            lights: lights.to_vec(),
+            volumes,
+        })
+    }
+
+    /// Bit `j` set: light `j` is strictly in front of `support`.
+    pub fn facing(&self, support: &Plane) -> u64 {
+        self.lights
+            .iter()
+            .enumerate()
+            .fold(0, |m, (j, l)| m | (l.faces(support) as u64) << j)
+    }
+
     /// Shades one receiver (polygons on one support plane, all tagged with
     /// the same face), appending its fragments to `out`. `receiver` is
     /// recorded with each fragment (e.g. the receiver's index).
@@ -154,31 +187,99 @@ impl Shadows {
         out: &mut Batch,
     ) {
         let Some(first) = polys.first() else { return };
-        let support = *first.support();
-        let face = first.tag();
-        let s = scratch;
+        let start = Start::Uniform(self.facing(first.support()));
+        self.refine(polys, &start, receiver, opts, scratch, out);
+    }
+
+    /// [`Shadows::shade`], also returning the receiver's cells with their
+    /// flags when the flags are not the same all over (`None` when they
+    /// are: the receiver is then [`Start::Uniform`] with its fragments'
+    /// flags), for later refinement by other trees ([`Shadows::refine`]).
+    pub fn shade_keeping(
+        &self,
+        polys: &[Polygon],
+        receiver: u32,
+        opts: &ShadeOptions,
+        scratch: &mut Scratch,
+        out: &mut Batch,
+    ) -> Option<Cells> {
+        let first = polys.first()?;
+        let start = Start::Uniform(self.facing(first.support()));
+        self.filter_lights(polys, &start, scratch);
+        let s = &*scratch;
+        let uniform = s.cur.iter().all(|(_, l)| *l == s.cur[0].1);
+        let cells = (!uniform).then(|| Cells {
+            arena: s.arena.clone(),
+            cells: s.cur.clone(),
+            support: s.support,
+        });
+        self.finish(polys, receiver, opts, scratch, out);
+        cells
+    }
+
+    /// Refines a receiver already shaded for the same lights by other
+    /// occluders: each part still lit by light `j` is filtered through this
+    /// light `j`'s tree, and stays lit only where this tree lets the light
+    /// through; the result is regions as [`Shadows::shade`] makes them.
+    /// With the static scene's flags as `start` and trees of the occluders
+    /// that moved, this is a receiver's shadow from both.
+    pub fn refine(
+        &self,
+        polys: &[Polygon],
+        start: &Start<'_>,
+        receiver: u32,
+        opts: &ShadeOptions,
+        scratch: &mut Scratch,
+        out: &mut Batch,
+    ) {
+        if polys.is_empty() {
+            return;
+        }
+        self.filter_lights(polys, start, scratch);
+        self.finish(polys, receiver, opts, scratch, out);
+    }
+
+    /// Sets the scratch up with the receiver's cells as `start` says, and
+    /// filters every cell lit by a light through that light's tree.
+    fn filter_lights(&self, polys: &[Polygon], start: &Start<'_>, s: &mut Scratch) {
+        let support = *polys[0].support();
+        let face = polys[0].tag();
         s.arena.clear();
         s.cur.clear();
-        let sup = s.arena.add_plane(support);
-        for p in polys {
-            debug_assert!(p.support() == &support && p.tag() == face);
-            let c = s.arena.add_polygon(p);
-            s.cur.push((c, 0));
+        match start {
+            Start::Uniform(flags) => {
+                s.support = s.arena.add_plane(support);
+                for p in polys {
+                    debug_assert!(p.support() == &support && p.tag() == face);
+                    let c = s.arena.add_polygon(p);
+                    s.cur.push((c, *flags));
+                }
+                s.whole = s.cur[0].0.clone();
+            }
+            Start::Cells(cells) => {
+                s.arena.clone_from(&cells.arena);
+                s.cur.extend_from_slice(&cells.cells);
+                s.support = cells.support;
+                s.whole = s.arena.add_polygon(&polys[0]);
+            }
         }
-        s.whole = s.cur[0].0.clone();
-        let mut facing = 0u64;
-        for (j, (light, sv)) in self.lights.iter().zip(&self.volumes).enumerate() {
-            if !light.faces(&support) {
+        let facing = self.facing(&support);
+        for (j, sv) in self.volumes.iter().enumerate() {
+            let bit = 1u64 << j;
+            if facing & bit == 0 {
                 continue; // attached shadow: the flag stays 0
             }
-            facing |= 1 << j;
             s.next.clear();
             for (piece, flags) in s.cur.drain(..) {
+                if flags & bit == 0 {
+                    s.next.push((piece, flags));
+                    continue;
+                }
                 s.out.clear();
                 filter(
                     sv,
                     &mut s.arena,
-                    sup,
+                    s.support,
                     piece,
                     &mut s.out,
                     &mut s.stack,
@@ -186,12 +287,32 @@ impl Shadows {
                     &mut s.sides,
                 );
                 for (p, lit) in s.out.drain(..) {
-                    s.next.push((p, flags | (lit as u64) << j));
+                    s.next.push((p, flags & !bit | (lit as u64) << j));
                 }
             }
             std::mem::swap(&mut s.cur, &mut s.next);
         }
-        out.push_receiver(face, receiver, facing, &support, s, polys.len() == 1, opts);
+    }
+
+    fn finish(
+        &self,
+        polys: &[Polygon],
+        receiver: u32,
+        opts: &ShadeOptions,
+        s: &mut Scratch,
+        out: &mut Batch,
+    ) {
+        let support = *polys[0].support();
+        let facing = self.facing(&support);
+        out.push_receiver(
+            polys[0].tag(),
+            receiver,
+            facing,
+            &support,
+            s,
+            polys.len() == 1,
+            opts,
+        );
     }
 
     /// Shades the receivers `ranges` of `polys` (see [`receivers`]) into
@@ -243,6 +364,8 @@ pub const CHUNK: usize = 512;
 #[derive(Default)]
 pub struct Scratch {
     arena: PieceArena,
+    /// The support plane's index in the arena.
+    support: u32,
     cur: Vec<(Piece, u64)>,
     next: Vec<(Piece, u64)>,
     out: Vec<(Piece, bool)>,
@@ -255,6 +378,41 @@ pub struct Scratch {
     remap: Vec<u32>,
     pieces: Vec<Piece>,
     labels: Vec<u64>,
+}
+
+/// A receiver's convex cells with their flags (bit `j`: lit by light
+/// `j`), in their own arena: where [`Shadows::refine`] can start.
+#[derive(Clone, Debug)]
+pub struct Cells {
+    arena: PieceArena,
+    cells: Vec<(Piece, u64)>,
+    support: u32,
+}
+
+impl Cells {
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// `true` if there is no cell.
+    pub fn is_empty(&self) -> bool {
+        self.cells.is_empty()
+    }
+
+    /// The flags of each cell.
+    pub fn flags(&self) -> impl Iterator<Item = u64> + '_ {
+        self.cells.iter().map(|c| c.1)
+    }
+}
+
+/// Where [`Shadows::refine`] starts a receiver from.
+#[derive(Clone, Copy, Debug)]
+pub enum Start<'a> {
+    /// The receiver's polygons, all with these flags.
+    Uniform(u64),
+    /// Cells kept by [`Shadows::shade_keeping`].
+    Cells(&'a Cells),
 }
 
 enum Task {
@@ -511,9 +669,9 @@ impl Batch {
         (0..self.len()).map(move |index| FragmentRef { batch: self, index })
     }
 
-    /// The exact vertex `v`; `None` in a batch made from Chin & Feiner's
-    /// fragments ([`Batch::from_chin_feiner`]), whose vertices are wider
-    /// than [`Vertex`].
+    /// The exact vertex `v`; `None` in a batch made from (or with) Chin &
+    /// Feiner's fragments ([`Batch::from_chin_feiner`]), whose vertices are
+    /// wider than [`Vertex`].
     pub fn vertex(&self, v: u32) -> Option<&Vertex> {
         self.vertices.get(v as usize)
     }
@@ -535,55 +693,117 @@ impl Batch {
     pub fn from_chin_feiner(cf: &crate::CfFragments, lights: &[Light]) -> Batch {
         let mut b = Batch::new();
         for f in cf.iter() {
-            let support = *f.support();
-            let facing = lights
-                .iter()
-                .enumerate()
-                .fold(0u64, |m, (j, l)| m | (l.faces(&support) as u64) << j);
-            b.face.push(f.face());
-            b.receiver.push(f.polygon());
-            b.lit.push(f.lit_mask());
-            b.facing.push(facing);
-            b.support.push(support);
-            let first = b.rounded.len() as u32;
-            b.rounded.extend(f.vertices_f64());
-            let last = b.rounded.len() as u32;
-            b.ring_verts.extend(first..last);
-            b.ring_start.push(b.ring_verts.len() as u32);
-            b.frag_ring.push((b.ring_start.len() - 1) as u32);
-            b.piece_verts.extend(first..last);
-            b.piece_start.push(b.piece_verts.len() as u32);
-            b.frag_piece.push((b.piece_start.len() - 1) as u32);
+            b.push_chin_feiner(&f, lights);
         }
         b
     }
 
+    /// Appends one of Chin & Feiner's fragments (see
+    /// [`Batch::from_chin_feiner`]).
+    pub fn push_chin_feiner(&mut self, f: &crate::CfFragment<'_>, lights: &[Light]) {
+        let b = self;
+        let support = *f.support();
+        let facing = lights
+            .iter()
+            .enumerate()
+            .fold(0u64, |m, (j, l)| m | (l.faces(&support) as u64) << j);
+        b.face.push(f.face());
+        b.receiver.push(f.polygon());
+        b.lit.push(f.lit_mask());
+        b.facing.push(facing);
+        b.support.push(support);
+        let first = b.rounded.len() as u32;
+        b.rounded.extend(f.vertices_f64());
+        let last = b.rounded.len() as u32;
+        b.ring_verts.extend(first..last);
+        b.ring_start.push(b.ring_verts.len() as u32);
+        b.frag_ring.push((b.ring_start.len() - 1) as u32);
+        b.piece_verts.extend(first..last);
+        b.piece_start.push(b.piece_verts.len() as u32);
+        b.frag_piece.push((b.piece_start.len() - 1) as u32);
+    }
+
     /// Appends another batch's fragments.
     pub fn append(&mut self, o: &Batch) {
-        let (v0, r0, p0) = (
-            self.rounded.len() as u32,
+        self.append_range(o, 0..o.len());
+    }
+
+    /// Appends fragments `frags` of another batch (with the vertices they
+    /// use: the span of vertex indices from their lowest to their highest,
+    /// which is exactly theirs when `frags` covers whole receivers).
+    pub fn append_range(&mut self, o: &Batch, frags: Range<usize>) {
+        if frags.is_empty() {
+            return;
+        }
+        let rings = o.frag_ring[frags.start] as usize..o.frag_ring[frags.end] as usize;
+        let pieces = o.frag_piece[frags.start] as usize..o.frag_piece[frags.end] as usize;
+        let rv = o.ring_start[rings.start] as usize..o.ring_start[rings.end] as usize;
+        let pv = o.piece_start[pieces.start] as usize..o.piece_start[pieces.end] as usize;
+        let used = o.ring_verts[rv.clone()]
+            .iter()
+            .chain(&o.piece_verts[pv.clone()]);
+        let (lo, hi) = used.fold((u32::MAX, 0), |(lo, hi), &v| (lo.min(v), hi.max(v + 1)));
+        let v0 = self.rounded.len() as u32;
+        let shift = |v: u32| v - lo + v0;
+        let (r0, p0) = (
             (self.ring_start.len() - 1) as u32,
             (self.piece_start.len() - 1) as u32,
         );
         let (rv0, pv0) = (self.ring_verts.len() as u32, self.piece_verts.len() as u32);
-        self.face.extend_from_slice(&o.face);
-        self.receiver.extend_from_slice(&o.receiver);
-        self.lit.extend_from_slice(&o.lit);
-        self.facing.extend_from_slice(&o.facing);
-        self.support.extend_from_slice(&o.support);
-        self.frag_ring
-            .extend(o.frag_ring[1..].iter().map(|r| r + r0));
-        self.ring_start
-            .extend(o.ring_start[1..].iter().map(|s| s + rv0));
-        self.ring_verts.extend(o.ring_verts.iter().map(|v| v + v0));
-        self.frag_piece
-            .extend(o.frag_piece[1..].iter().map(|r| r + p0));
-        self.piece_start
-            .extend(o.piece_start[1..].iter().map(|s| s + pv0));
+        self.face.extend_from_slice(&o.face[frags.clone()]);
+        self.receiver.extend_from_slice(&o.receiver[frags.clone()]);
+        self.lit.extend_from_slice(&o.lit[frags.clone()]);
+        self.facing.extend_from_slice(&o.facing[frags.clone()]);
+        self.support.extend_from_slice(&o.support[frags.clone()]);
+        let (fr, fp) = (o.frag_ring[frags.start], o.frag_piece[frags.start]);
+        self.frag_ring.extend(
+            o.frag_ring[frags.start + 1..=frags.end]
+                .iter()
+                .map(|r| r - fr + r0),
+        );
+        self.frag_piece.extend(
+            o.frag_piece[frags.start + 1..=frags.end]
+                .iter()
+                .map(|r| r - fp + p0),
+        );
+        let (rs, ps) = (o.ring_start[rings.start], o.piece_start[pieces.start]);
+        self.ring_start.extend(
+            o.ring_start[rings.start + 1..=rings.end]
+                .iter()
+                .map(|s| s - rs + rv0),
+        );
+        self.piece_start.extend(
+            o.piece_start[pieces.start + 1..=pieces.end]
+                .iter()
+                .map(|s| s - ps + pv0),
+        );
+        self.ring_verts
+            .extend(o.ring_verts[rv].iter().map(|&v| shift(v)));
         self.piece_verts
-            .extend(o.piece_verts.iter().map(|v| v + v0));
-        self.vertices.extend_from_slice(&o.vertices);
-        self.rounded.extend_from_slice(&o.rounded);
+            .extend(o.piece_verts[pv].iter().map(|&v| shift(v)));
+        if lo < hi {
+            let span = lo as usize..hi as usize;
+            // exact vertices only while every part has them
+            if self.vertices.len() == self.rounded.len() && o.vertices.len() == o.rounded.len() {
+                self.vertices.extend_from_slice(&o.vertices[span.clone()]);
+            } else {
+                self.vertices.clear();
+            }
+            self.rounded.extend_from_slice(&o.rounded[span]);
+        }
+    }
+
+    /// Per receiver, in order, its range of fragments: consecutive
+    /// fragments with the same receiver number.
+    pub fn receiver_ranges(&self) -> Vec<(u32, Range<usize>)> {
+        let mut out: Vec<(u32, Range<usize>)> = Vec::new();
+        for (i, &r) in self.receiver.iter().enumerate() {
+            match out.last_mut() {
+                Some((last, range)) if *last == r => range.end = i + 1,
+                _ => out.push((r, i..i + 1)),
+            }
+        }
+        out
     }
 
     /// A vertex of the scratch arena, added once per receiver.

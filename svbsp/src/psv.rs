@@ -40,6 +40,8 @@
 //! receivers are cut in the input tier: 256-bit vertices behind the `f64`
 //! filter.
 
+use std::borrow::Borrow;
+
 use bsp_core::{
     EdgeRef, GridPoint, Piece, PieceArena, Plane, Point, Polygon, SanityError, Side, Sides,
     SplitMix,
@@ -125,7 +127,10 @@ impl Occluders {
 
     /// Prepares every polygon (in parallel) and orders them nearest
     /// first, ties by input order.
-    fn new(light: &Light, polys: &[Polygon]) -> Result<Occluders, VolumeError> {
+    fn new<P: Borrow<Polygon> + Sync>(
+        light: &Light,
+        polys: &[P],
+    ) -> Result<Occluders, VolumeError> {
         let grid = |p: &Polygon| -> SmallVec<[GridPoint; 4]> {
             p.vertices()
                 .iter()
@@ -140,6 +145,7 @@ impl Occluders {
             .par_iter()
             .enumerate()
             .map(|(index, p)| {
+                let p = p.borrow();
                 if p.vertices().iter().any(|v| matches!(v, Point::Implicit(_))) {
                     return Err(VolumeError::ImplicitOccluder { index });
                 }
@@ -170,7 +176,7 @@ impl Occluders {
                     cap: Vec::with_capacity(part.len()),
                 };
                 for &(_, i) in part {
-                    let p = &polys[i as usize];
+                    let p = polys[i as usize].borrow();
                     let verts = grid(p);
                     let k = verts.len();
                     for j in 0..k {
@@ -493,7 +499,12 @@ impl ShadowVolumes {
     /// whichever way they face) for `light`. Occluders in a plane through
     /// the light hide no area and are left out. See the module docs for
     /// how the tree is built.
-    pub fn build(light: Light, occluders: &[Polygon]) -> Result<ShadowVolumes, VolumeError> {
+    ///
+    /// `occluders` may be polygons or references to them.
+    pub fn build<P: Borrow<Polygon> + Sync>(
+        light: Light,
+        occluders: &[P],
+    ) -> Result<ShadowVolumes, VolumeError> {
         let occ = Occluders::new(&light, occluders)?;
         let mut pool = Pool::default();
         let list: Vec<Entry> = (0..occ.len() as u32)
