@@ -37,7 +37,12 @@
 mod cube;
 mod index;
 mod ortho;
+mod pipeline;
 
 pub use index::{
     MAX_CUBE_TILES, MAX_PLANE_TILES, Query, TileIndex, TilingError, TilingStats, tiles_for,
+};
+pub use pipeline::{
+    Dynamic, FragmentView, Frame, FrameStats, Motion, PipelineError, PipelineOptions, Prepared,
+    Strategy,
 };

@@ -1,0 +1,712 @@
+//! The core paper's real-time pipeline: a static scene whose shadows are
+//! computed once, and a moving object whose shadows, on itself and on the
+//! static polygons near it, are recomputed every frame.
+//!
+//! **Preprocess** ([`Dynamic::new`]): the static faces are imported on the
+//! grid, their shadows computed once for every light, and one
+//! [`TileIndex`] built per light; the dynamic object's faces are kept in
+//! input units, with (for the paper's strategy) its BSP tree `Bsp2`.
+//!
+//! **Per frame** ([`Dynamic::frame`]): the object's *original* coordinates
+//! are transformed by the frame's 4×4 matrix and snapped to the scene's
+//! grid; transforms are never composed on snapped coordinates, so frame
+//! `k` is the same whether or not frames `0..k` were computed, and
+//! rounding never accumulates. The snapped object's box, projected
+//! through each light's tiling, gives the *related* static polygons: the
+//! only ones that can shadow the object or be shadowed by it. Then:
+//!
+//! - [`Strategy::Paper`], as Liu & Wu give it: `Bsp2` replayed on the
+//!   moved faces ([`bsp_core::BspTree::replay`]), `Bsp3` built from the
+//!   related static polygons, `Bsp4 = Bsp2 + Bsp3` by the overlay merge,
+//!   and Chin & Feiner's shadows of `Bsp4`. A related static face's
+//!   fragments are those of `Bsp4` overlaid with its static fragments
+//!   (lit where both are lit); every other static face keeps its static
+//!   fragments.
+//! - [`Strategy::Fast`]: no `Bsp3` or `Bsp4`. Per light, one partitioned
+//!   shadow-volume tree over the moved faces and the related static
+//!   polygons (the tree does not depend on an order), through which the
+//!   moved faces are shaded; each related static face's static cells are
+//!   refined through the same tree ([`svbsp::Shadows::refine`]).
+//!
+//! Either way the frame's fragments are exact, and every face's lit area
+//! is exactly what [`svbsp::shadow_fragments`] computes from scratch on
+//! the frame's whole scene (tested over random motions).
+
+use std::ops::Range;
+use std::time::{Duration, Instant};
+
+use bsp_core::{
+    BspTree, BuildOptions, Grid, GridPoint, Overlay, Partition, Point, Polygon, import_faces_par,
+    merge_smaller_into_larger,
+};
+use glam::{DMat4, DVec3};
+use rayon::prelude::*;
+use svbsp::{
+    Batch, CHUNK, Cells, CfFragments, Light, Scratch, ShadeOptions, ShadowVolumes, Shadows, Start,
+    chin_feiner, receivers,
+};
+
+use crate::{Query, TileIndex, TilingError};
+
+/// How each frame's shadows are computed (see the module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Strategy {
+    /// Liu & Wu's pipeline: `Bsp4 = Bsp2 + Bsp3` and Chin & Feiner's
+    /// shadow-volume BSP tree.
+    Paper,
+    /// Partitioned shadow volumes of the moved and related polygons, no
+    /// per-frame BSP.
+    #[default]
+    Fast,
+}
+
+/// Options of [`Dynamic::new`].
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct PipelineOptions {
+    /// The per-frame strategy.
+    pub strategy: Strategy,
+    /// Tiles per side of every light's index; `None` for [`crate::tiles_for`].
+    pub tiles: Option<u32>,
+    /// Record each fragment's convex pieces (for OBJ output).
+    pub pieces: bool,
+}
+
+impl PipelineOptions {
+    /// Sets [`PipelineOptions::strategy`].
+    pub fn with_strategy(mut self, s: Strategy) -> Self {
+        self.strategy = s;
+        self
+    }
+    /// Sets [`PipelineOptions::tiles`].
+    pub fn with_tiles(mut self, n: Option<u32>) -> Self {
+        self.tiles = n;
+        self
+    }
+    /// Sets [`PipelineOptions::pieces`].
+    pub fn with_pieces(mut self, p: bool) -> Self {
+        self.pieces = p;
+        self
+    }
+}
+
+/// Why the pipeline cannot run.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum PipelineError {
+    /// A static face does not fit the grid.
+    Static(bsp_core::Error),
+    /// A face of the moved object does not fit the grid in this frame
+    /// (the error names the dynamic face).
+    Moved(bsp_core::Error),
+    /// The tiling of a light cannot be built.
+    Tiling(TilingError),
+    /// The shadows cannot be computed (a light or an occluder is unusable).
+    Shadow(String),
+}
+
+impl std::fmt::Display for PipelineError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PipelineError::Static(e) => write!(f, "static scene: {e}"),
+            PipelineError::Moved(e) => write!(f, "moved object: {e}"),
+            PipelineError::Tiling(e) => write!(f, "tiling: {e}"),
+            PipelineError::Shadow(e) => write!(f, "shadows: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for PipelineError {}
+
+/// A motion: frame `k` rotates the original coordinates by `k × degrees`
+/// about `axis` through `centre`, then translates them by `k × step`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Motion {
+    /// The rotation axis (any length; zero means no rotation).
+    pub axis: DVec3,
+    /// Degrees per frame, counter-clockwise about `axis`.
+    pub degrees: f64,
+    /// A point on the rotation axis.
+    pub centre: DVec3,
+    /// Translation per frame.
+    pub step: DVec3,
+}
+
+impl Motion {
+    /// The transform of frame `k` (frame 0 is the identity).
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// use tiling::Motion;
+    /// let m = Motion { axis: DVec3::Z, degrees: 90.0, centre: DVec3::X, step: DVec3::ZERO };
+    /// let p = m.matrix(1).transform_point3(DVec3::new(2.0, 0.0, 0.0));
+    /// assert!((p - DVec3::new(1.0, 1.0, 0.0)).length() < 1e-12);
+    /// ```
+    pub fn matrix(&self, k: u32) -> DMat4 {
+        let k = k as f64;
+        let rot = if self.axis.length_squared() > 0.0 && self.degrees != 0.0 {
+            DMat4::from_axis_angle(self.axis.normalize(), (k * self.degrees).to_radians())
+        } else {
+            DMat4::IDENTITY
+        };
+        DMat4::from_translation(k * self.step + self.centre)
+            * rot
+            * DMat4::from_translation(-self.centre)
+    }
+}
+
+/// Figures of the preprocessing.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Prepared {
+    /// Static faces.
+    pub static_faces: usize,
+    /// Static polygons (convex, as imported).
+    pub static_polygons: usize,
+    /// Static polygons after the static BSP's splits (`Bsp1`; the imported
+    /// count with the fast strategy, which builds none).
+    pub static_after_bsp: usize,
+    /// Static fragments of the static shadows.
+    pub static_after_shadow: usize,
+    /// Time to import the static faces.
+    pub t_import: Duration,
+    /// Time of the static shadows (and `Bsp1`).
+    pub t_shadows: Duration,
+    /// Time to build the tilings.
+    pub t_tiling: Duration,
+}
+
+/// Per-strategy static data.
+enum StaticShadows {
+    Fast {
+        batch: Batch,
+        /// Per static receiver, its fragments in `batch`.
+        frags: Vec<Range<usize>>,
+        /// Per static receiver, its cells when its flags vary.
+        cells: Vec<Option<Box<Cells>>>,
+    },
+    Paper {
+        cf: CfFragments,
+        /// Per static face, its fragments in `cf`.
+        of_face: Vec<Vec<u32>>,
+        /// `Bsp2`, built on the object as given.
+        bsp2: BspTree,
+    },
+}
+
+/// A static scene prepared once, and a moving object (see the module
+/// docs).
+pub struct Dynamic {
+    grid: Grid,
+    lights: Vec<Light>,
+    opts: PipelineOptions,
+    statics: Vec<Polygon>,
+    static_faces: usize,
+    receivers: Vec<Range<usize>>,
+    /// Static polygon → its receiver.
+    receiver_of: Vec<u32>,
+    /// Per static face, its polygons.
+    face_polys: Vec<Range<usize>>,
+    tilings: Vec<TileIndex>,
+    moving: Vec<Vec<DVec3>>,
+    shadows: StaticShadows,
+    prepared: Prepared,
+}
+
+/// One frame's figures: the columns of the core paper's Table 2.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameStats {
+    /// Static input faces.
+    pub static_polygons: usize,
+    /// Dynamic input faces.
+    pub dynamic_polygons: usize,
+    /// Dynamic polygons after the BSP's splits (`Bsp2`; the imported
+    /// convex polygons with the fast strategy).
+    pub dynamic_after_bsp: usize,
+    /// Static polygons after the static BSP's splits (see [`Prepared`]).
+    pub static_after_bsp: usize,
+    /// Static fragments of the static shadows.
+    pub static_after_shadow: usize,
+    /// Fragments made by this frame's shadow computation (the moved
+    /// object's and the related static faces').
+    pub dynamic_shadow_polygons: usize,
+    /// Fragments of the whole frame: the untouched static faces' and this
+    /// frame's.
+    pub total_drawn: usize,
+    /// Related static polygons (the union over the lights).
+    pub related: usize,
+    /// Time of the tiling queries.
+    pub t_tiling: Duration,
+    /// Time of the merge: `Bsp2` replayed, `Bsp3` built and merged (paper);
+    /// the shadow trees built (fast).
+    pub t_merge: Duration,
+    /// Time of the dynamic shadows.
+    pub t_dynamic_shadows: Duration,
+    /// Time of the whole frame, from transform to fragments.
+    pub t_frame: Duration,
+}
+
+/// One frame's result.
+pub struct Frame {
+    /// The moved object's polygons on the grid, tagged with their face's
+    /// number in the frame (static faces first, then dynamic).
+    pub moved: Vec<Polygon>,
+    /// The related static faces, ascending.
+    pub related_faces: Vec<u32>,
+    fragments: FrameFragments,
+    /// The Table 2 figures.
+    pub stats: FrameStats,
+}
+
+enum FrameFragments {
+    /// Per related static receiver (ascending) its fragments, then the
+    /// moved object's.
+    Fast {
+        batch: Batch,
+        related: Vec<(u32, Range<usize>)>,
+        moved: Range<usize>,
+    },
+    Paper(CfFragments),
+}
+
+fn grid_points(polys: &[Polygon]) -> impl Iterator<Item = GridPoint> + '_ {
+    polys
+        .iter()
+        .flat_map(|p| p.vertices().iter())
+        .filter_map(Point::as_grid)
+}
+
+impl Dynamic {
+    /// Prepares `statics` (face loops in input units) on `grid` for
+    /// `lights`, and keeps `moving` (the object's face loops in input
+    /// units, as given: frame 0). The grid must hold every position the
+    /// object takes.
+    pub fn new(
+        statics: &[Vec<DVec3>],
+        moving: &[Vec<DVec3>],
+        grid: Grid,
+        lights: &[Light],
+        opts: PipelineOptions,
+    ) -> Result<Dynamic, PipelineError> {
+        let mut prepared = Prepared {
+            static_faces: statics.len(),
+            ..Prepared::default()
+        };
+        let t = Instant::now();
+        let (polys, _) = import_faces_par(&grid, statics).map_err(PipelineError::Static)?;
+        prepared.static_polygons = polys.len();
+        prepared.t_import = t.elapsed();
+        let ranges = receivers(&polys);
+        let mut receiver_of = vec![0u32; polys.len()];
+        for (i, r) in ranges.iter().enumerate() {
+            receiver_of[r.clone()]
+                .iter_mut()
+                .for_each(|x| *x = i as u32);
+        }
+        let mut face_polys = vec![0..0; statics.len()];
+        for (i, p) in polys.iter().enumerate() {
+            let r = &mut face_polys[p.tag() as usize];
+            if r.start == r.end {
+                *r = i..i + 1;
+            } else {
+                r.end = i + 1;
+            }
+        }
+        let t = Instant::now();
+        let shadows = match opts.strategy {
+            Strategy::Fast => {
+                let sh = Shadows::new(&polys, lights)
+                    .map_err(|e| PipelineError::Shadow(e.to_string()))?;
+                let sopts = ShadeOptions::default().with_pieces(opts.pieces);
+                let parts: Vec<(Batch, Vec<Option<Box<Cells>>>)> = ranges
+                    .par_chunks(CHUNK)
+                    .enumerate()
+                    .map(|(c, chunk)| {
+                        let (mut s, mut b) = (Scratch::default(), Batch::new());
+                        let cells = chunk
+                            .iter()
+                            .enumerate()
+                            .map(|(i, r)| {
+                                let rec = (c * CHUNK + i) as u32;
+                                sh.shade_keeping(&polys[r.clone()], rec, &sopts, &mut s, &mut b)
+                                    .map(Box::new)
+                            })
+                            .collect();
+                        (b, cells)
+                    })
+                    .collect();
+                let mut batch = Batch::new();
+                let mut cells = Vec::with_capacity(ranges.len());
+                for (b, c) in parts {
+                    batch.append(&b);
+                    cells.extend(c);
+                }
+                let mut frags = vec![0..0; ranges.len()];
+                for (r, range) in batch.receiver_ranges() {
+                    frags[r as usize] = range;
+                }
+                prepared.static_after_bsp = polys.len();
+                prepared.static_after_shadow = batch.len();
+                StaticShadows::Fast {
+                    batch,
+                    frags,
+                    cells,
+                }
+            }
+            Strategy::Paper => {
+                let bsp1 = BspTree::build(polys.clone(), &BuildOptions::default());
+                let cf =
+                    chin_feiner(&bsp1, lights).map_err(|e| PipelineError::Shadow(e.to_string()))?;
+                let mut of_face = vec![Vec::new(); statics.len()];
+                for (i, f) in cf.iter().enumerate() {
+                    of_face[f.face() as usize].push(i as u32);
+                }
+                prepared.static_after_bsp = bsp1.stats().polygons;
+                prepared.static_after_shadow = cf.len();
+                let first = Self::snap_moving(&grid, moving, &DMat4::IDENTITY, statics.len())?;
+                let bsp2 = BspTree::build(first, &BuildOptions::default());
+                StaticShadows::Paper { cf, of_face, bsp2 }
+            }
+        };
+        prepared.t_shadows = t.elapsed();
+        let t = Instant::now();
+        let tilings = lights
+            .iter()
+            .map(|l| TileIndex::build(l, &polys, opts.tiles))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(PipelineError::Tiling)?;
+        prepared.t_tiling = t.elapsed();
+        Ok(Dynamic {
+            grid,
+            lights: lights.to_vec(),
+            opts,
+            statics: polys,
+            static_faces: statics.len(),
+            receivers: ranges,
+            receiver_of,
+            face_polys,
+            tilings,
+            moving: moving.to_vec(),
+            shadows,
+            prepared,
+        })
+    }
+
+    /// The preprocessing figures.
+    pub fn prepared(&self) -> &Prepared {
+        &self.prepared
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The lights.
+    pub fn lights(&self) -> &[Light] {
+        &self.lights
+    }
+
+    /// The static polygons, tagged with their face.
+    pub fn static_polygons(&self) -> &[Polygon] {
+        &self.statics
+    }
+
+    /// Number of static faces (the moved object's faces follow them).
+    pub fn static_faces(&self) -> usize {
+        self.static_faces
+    }
+
+    /// The tiling of each light.
+    pub fn tilings(&self) -> &[TileIndex] {
+        &self.tilings
+    }
+
+    /// The moved object's face loops in input units, as given.
+    pub fn moving(&self) -> &[Vec<DVec3>] {
+        &self.moving
+    }
+
+    /// The object's faces transformed by `m` and snapped to the grid,
+    /// tagged `first + face`.
+    fn snap_moving(
+        grid: &Grid,
+        moving: &[Vec<DVec3>],
+        m: &DMat4,
+        first: usize,
+    ) -> Result<Vec<Polygon>, PipelineError> {
+        let loops: Vec<Vec<DVec3>> = moving
+            .iter()
+            .map(|l| l.iter().map(|&p| m.transform_point3(p)).collect())
+            .collect();
+        let (polys, _) = import_faces_par(grid, &loops).map_err(PipelineError::Moved)?;
+        Ok(polys
+            .into_iter()
+            .map(|p| {
+                let t = p.tag() as usize + first;
+                p.with_tag(t as u32)
+            })
+            .collect())
+    }
+
+    /// The object moved by `m` (applied to its original coordinates) and
+    /// snapped: its polygons as [`Frame::moved`] has them.
+    pub fn moved(&self, m: &DMat4) -> Result<Vec<Polygon>, PipelineError> {
+        Self::snap_moving(&self.grid, &self.moving, m, self.static_faces)
+    }
+
+    /// The frame in which the object's original coordinates are
+    /// transformed by `m`.
+    pub fn frame(&self, m: &DMat4) -> Result<Frame, PipelineError> {
+        let start = Instant::now();
+        let moved = self.moved(m)?;
+        let mut stats = FrameStats {
+            static_polygons: self.static_faces,
+            dynamic_polygons: self.moving.len(),
+            static_after_bsp: self.prepared.static_after_bsp,
+            static_after_shadow: self.prepared.static_after_shadow,
+            ..FrameStats::default()
+        };
+        // the related static polygons, per light
+        let t = Instant::now();
+        let mut lo = [i32::MAX; 3];
+        let mut hi = [i32::MIN; 3];
+        for g in grid_points(&moved) {
+            for k in 0..3 {
+                lo[k] = lo[k].min(g[k]);
+                hi[k] = hi[k].max(g[k]);
+            }
+        }
+        let related: Vec<Vec<u32>> = if moved.is_empty() {
+            vec![Vec::new(); self.lights.len()]
+        } else {
+            self.tilings
+                .par_iter()
+                .map(|ix| {
+                    let mut q = Query::default();
+                    ix.query_box(lo, hi, &mut q).to_vec()
+                })
+                .collect()
+        };
+        let mut all: Vec<u32> = related.iter().flatten().copied().collect();
+        all.sort_unstable();
+        all.dedup();
+        stats.related = all.len();
+        let mut related_faces: Vec<u32> = all
+            .iter()
+            .map(|&p| self.statics[p as usize].tag())
+            .collect();
+        related_faces.dedup();
+        stats.t_tiling = t.elapsed();
+
+        let fragments = match &self.shadows {
+            StaticShadows::Fast {
+                batch,
+                frags,
+                cells,
+            } => {
+                let t = Instant::now();
+                let volumes = self
+                    .lights
+                    .iter()
+                    .zip(&related)
+                    .map(|(l, rel)| {
+                        let occ: Vec<&Polygon> = moved
+                            .iter()
+                            .chain(rel.iter().map(|&p| &self.statics[p as usize]))
+                            .collect();
+                        ShadowVolumes::build(*l, &occ)
+                    })
+                    .collect::<Result<Vec<_>, _>>()
+                    .map_err(|e| PipelineError::Shadow(e.to_string()))?;
+                let sh = Shadows::from_volumes(&self.lights, volumes)
+                    .map_err(|e| PipelineError::Shadow(e.to_string()))?;
+                stats.t_merge = t.elapsed();
+                let t = Instant::now();
+                let sopts = ShadeOptions::default().with_pieces(self.opts.pieces);
+                // the related static receivers still lit somewhere
+                let mut recs: Vec<u32> =
+                    all.iter().map(|&p| self.receiver_of[p as usize]).collect();
+                recs.dedup();
+                recs.retain(|&r| {
+                    let range = &frags[r as usize];
+                    cells[r as usize].is_some()
+                        || (range.start..range.end).any(|i| batch.fragment(i).lit_mask() != 0)
+                });
+                let starts: Vec<Start<'_>> = recs
+                    .iter()
+                    .map(|&r| match &cells[r as usize] {
+                        Some(c) => Start::Cells(c),
+                        None => Start::Uniform(batch.fragment(frags[r as usize].start).lit_mask()),
+                    })
+                    .collect();
+                let parts: Vec<Batch> = recs
+                    .par_chunks(64)
+                    .zip(starts.par_chunks(64))
+                    .map(|(rs, ss)| {
+                        let (mut s, mut b) = (Scratch::default(), Batch::new());
+                        for (&r, st) in rs.iter().zip(ss) {
+                            let polys = &self.statics[self.receivers[r as usize].clone()];
+                            sh.refine(polys, st, r, &sopts, &mut s, &mut b);
+                        }
+                        b
+                    })
+                    .collect();
+                let mut out = Batch::new();
+                for b in &parts {
+                    out.append(b);
+                }
+                let related_ranges = out.receiver_ranges();
+                let m0 = out.len();
+                let dynamic = sh.shade_all(&moved, &sopts);
+                out.append(&dynamic);
+                stats.t_dynamic_shadows = t.elapsed();
+                stats.dynamic_after_bsp = moved.len();
+                stats.dynamic_shadow_polygons = out.len();
+                let replaced: usize = related_ranges
+                    .iter()
+                    .map(|(r, _)| frags[*r as usize].len())
+                    .sum();
+                stats.total_drawn = batch.len() - replaced + out.len();
+                let len = out.len();
+                FrameFragments::Fast {
+                    batch: out,
+                    related: related_ranges,
+                    moved: m0..len,
+                }
+            }
+            StaticShadows::Paper { cf, of_face, bsp2 } => {
+                let t = Instant::now();
+                let b2 = bsp2.replay(moved.clone(), &BuildOptions::default());
+                stats.dynamic_after_bsp = b2.stats().polygons;
+                // whole faces: a related face's fragments all come from Bsp4
+                let near: Vec<Polygon> = related_faces
+                    .iter()
+                    .flat_map(|&f| self.statics[self.face_polys[f as usize].clone()].iter())
+                    .cloned()
+                    .collect();
+                let b3 = BspTree::build(near, &BuildOptions::default());
+                let b4 = merge_smaller_into_larger(
+                    &Partition::from_tree(&b2),
+                    &Partition::from_tree(&b3),
+                    &Overlay,
+                )
+                .polygon_tree(|(a, _)| a);
+                stats.t_merge = t.elapsed();
+                let t = Instant::now();
+                let shaded = chin_feiner(&b4, &self.lights)
+                    .map_err(|e| PipelineError::Shadow(e.to_string()))?;
+                let statics = self.static_faces as u32;
+                let out = shaded.overlay(cf, |face| {
+                    (face < statics).then(|| &of_face[face as usize][..])
+                });
+                stats.t_dynamic_shadows = t.elapsed();
+                stats.dynamic_shadow_polygons = out.len();
+                let replaced: usize = related_faces
+                    .iter()
+                    .map(|&f| of_face[f as usize].len())
+                    .sum();
+                stats.total_drawn = cf.len() - replaced + out.len();
+                FrameFragments::Paper(out)
+            }
+        };
+        stats.t_frame = start.elapsed();
+        Ok(Frame {
+            moved,
+            related_faces,
+            fragments,
+            stats,
+        })
+    }
+
+    /// The whole frame's fragments in face order (static faces, then the
+    /// moved object's): the static fragments of the faces the frame left
+    /// alone and the frame's own.
+    pub fn fragments(&self, frame: &Frame) -> Batch {
+        let mut out = Batch::new();
+        self.walk(frame, |part| match part {
+            Part::Batch(b, range) => out.append_range(b, range),
+            Part::Cf(cf, list) => {
+                for &i in list {
+                    out.push_chin_feiner(&cf.get(i as usize), &self.lights);
+                }
+            }
+        });
+        out
+    }
+
+    /// Visits every fragment of the frame with its exact vertices, in the
+    /// order of [`Dynamic::fragments`].
+    pub fn each_fragment(&self, frame: &Frame, mut visit: impl FnMut(FragmentView<'_>)) {
+        self.walk(frame, |part| match part {
+            Part::Batch(b, range) => range.for_each(|i| visit(FragmentView::Region(b.fragment(i)))),
+            Part::Cf(cf, list) => list
+                .iter()
+                .for_each(|&i| visit(FragmentView::Convex(cf.get(i as usize)))),
+        });
+    }
+
+    /// The frame's fragments part by part, in face order.
+    fn walk(&self, frame: &Frame, mut emit: impl FnMut(Part<'_>)) {
+        match (&self.shadows, &frame.fragments) {
+            (
+                StaticShadows::Fast { batch, frags, .. },
+                FrameFragments::Fast {
+                    batch: fb,
+                    related,
+                    moved,
+                },
+            ) => {
+                let mut next = related.iter().peekable();
+                let mut r = 0;
+                while r < frags.len() {
+                    if let Some((rr, range)) = next.peek()
+                        && *rr as usize == r
+                    {
+                        emit(Part::Batch(fb, range.clone()));
+                        next.next();
+                        r += 1;
+                        continue;
+                    }
+                    // a run of untouched receivers in one piece
+                    let stop = next.peek().map_or(frags.len(), |(rr, _)| *rr as usize);
+                    emit(Part::Batch(batch, frags[r].start..frags[stop - 1].end));
+                    r = stop;
+                }
+                emit(Part::Batch(fb, moved.clone()));
+            }
+            (StaticShadows::Paper { cf, of_face, .. }, FrameFragments::Paper(fc)) => {
+                let mut mine: Vec<Vec<u32>> =
+                    vec![Vec::new(); self.static_faces + self.moving.len()];
+                for (i, f) in fc.iter().enumerate() {
+                    mine[f.face() as usize].push(i as u32);
+                }
+                for (face, list) in mine.iter().enumerate() {
+                    let untouched = face < self.static_faces
+                        && frame.related_faces.binary_search(&(face as u32)).is_err();
+                    if untouched {
+                        emit(Part::Cf(cf, &of_face[face]));
+                    } else {
+                        emit(Part::Cf(fc, list));
+                    }
+                }
+            }
+            _ => unreachable!("a frame comes from its scene's strategy"),
+        }
+    }
+}
+
+/// A run of fragments of one source.
+enum Part<'a> {
+    Batch(&'a Batch, Range<usize>),
+    Cf(&'a CfFragments, &'a [u32]),
+}
+
+/// One fragment of a frame, with its exact vertices.
+#[derive(Clone, Copy)]
+pub enum FragmentView<'a> {
+    /// A region of the fast strategy (rings of exact [`bsp_core::Vertex`]
+    /// values, through [`Batch::vertex`]).
+    Region(svbsp::FragmentRef<'a>),
+    /// A convex fragment of the paper's strategy.
+    Convex(svbsp::CfFragment<'a>),
+}
