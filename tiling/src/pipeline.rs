@@ -175,7 +175,8 @@ pub struct Prepared {
     pub t_tiling: Duration,
 }
 
-/// Per-strategy static data.
+/// Per-strategy static data (one per scene: its size does not matter).
+#[allow(clippy::large_enum_variant)]
 enum StaticShadows {
     Fast {
         batch: Batch,
@@ -257,6 +258,8 @@ pub struct Frame {
     pub stats: FrameStats,
 }
 
+// one per frame: its size does not matter
+#[allow(clippy::large_enum_variant)]
 enum FrameFragments {
     /// Per related static receiver (ascending) its fragments, then the
     /// moved object's.
