@@ -31,7 +31,7 @@ type H = [BigInt; 4];
 fn of_vertex(v: &Vertex) -> H {
     match v {
         Vertex::Grid(g) => [big(g[0]), big(g[1]), big(g[2]), BigInt::from(1)],
-        Vertex::Implicit(i) => i.coords().clone().map(big),
+        Vertex::Implicit(i) => (*i.coords()).map(big),
     }
 }
 
@@ -91,10 +91,7 @@ fn frame_areas(d: &Dynamic, frame: &tiling::Frame) -> Areas {
             );
         }
         FragmentView::Convex(f) => {
-            let ring: Vec<H> = f
-                .vertices()
-                .map(|p| p.homogeneous().clone().map(big))
-                .collect();
+            let ring: Vec<H> = f.vertices().map(|p| (*p.homogeneous()).map(big)).collect();
             add(
                 &mut out,
                 f.face(),
