@@ -15,11 +15,11 @@
 //! boundary turns are kept.
 
 use std::cmp::Ordering;
-use std::collections::HashMap;
 
 use bnum::cast::As;
 use num_bigint::BigInt;
 use num_rational::BigRational;
+use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
 use crate::I256;
@@ -141,41 +141,49 @@ fn dot2(a: [i128; 2], b: [i128; 2]) -> I256 {
 }
 
 /// Canonical vertex ids: equal points get the id of their first
-/// occurrence. `rounded` (indexed by [`PieceArena::dense`]) receives the
-/// correctly rounded coordinates of every vertex used.
+/// occurrence, in `canon` (indexed by [`PieceArena::dense`], `u32::MAX`
+/// for vertices no cell uses); `exact` (the same indexing) receives every
+/// used vertex's exact coordinates and `rounded` its correctly rounded
+/// ones.
 fn canonical_ids(
     arena: &PieceArena,
     cells: &[Piece],
     rounded: &mut Vec<Option<[f64; 3]>>,
-    exact: &mut HashMap<u32, Vertex>,
-) -> HashMap<u32, u32> {
+    exact: &mut Vec<Option<Vertex>>,
+    canon: &mut Vec<u32>,
+) {
     rounded.resize(arena.len(), None);
-    let mut canon: HashMap<u32, u32> = HashMap::new();
-    let mut seen: HashMap<[u64; 3], SmallVec<[u32; 2]>> = HashMap::new();
+    exact.clear();
+    exact.resize(arena.len(), None);
+    canon.clear();
+    canon.resize(arena.len(), u32::MAX);
+    let mut seen: FxHashMap<[u64; 3], SmallVec<[u32; 2]>> = FxHashMap::default();
     for c in cells {
         for &v in &c.verts {
-            if canon.contains_key(&v) {
+            let d = arena.dense(v);
+            if canon[d] != u32::MAX {
                 continue;
             }
             // each vertex's exact coordinates once
             let vert = arena.vertex(v).to_owned();
-            let r = *rounded[arena.dense(v)].get_or_insert_with(|| vert.to_f64());
+            let r = *rounded[d].get_or_insert_with(|| vert.to_f64());
             let key = r.map(f64::to_bits);
             let bucket = seen.entry(key).or_default();
-            let found = bucket.iter().copied().find(|w| exact[w].same_point(&vert));
-            match found {
-                Some(w) => {
-                    canon.insert(v, w);
-                }
+            let found = bucket.iter().copied().find(|&w| {
+                exact[arena.dense(w)]
+                    .as_ref()
+                    .is_some_and(|x| x.same_point(&vert))
+            });
+            canon[d] = match found {
+                Some(w) => w,
                 None => {
                     bucket.push(v);
-                    canon.insert(v, v);
+                    v
                 }
-            }
-            exact.insert(v, vert);
+            };
+            exact[d] = Some(vert);
         }
     }
-    canon
 }
 
 /// Merges `cells` (tiling a region of the `support` plane without overlap,
@@ -195,20 +203,36 @@ pub fn merge_cells(
     labels: &[u64],
     rounded: &mut Vec<Option<[f64; 3]>>,
 ) -> Vec<Region> {
+    merge_cells_adjacent(arena, support, cells, labels, rounded, &mut Vec::new())
+}
+
+/// [`merge_cells`], also listing in `adjacent` every pair of cells
+/// `[a, b]` (`a < b`, each pair once, in increasing order) that share a
+/// piece of edge: what a later, local re-merge needs to know.
+pub fn merge_cells_adjacent(
+    arena: &PieceArena,
+    support: &Plane,
+    cells: &[Piece],
+    labels: &[u64],
+    rounded: &mut Vec<Option<[f64; 3]>>,
+    adjacent: &mut Vec<[u32; 2]>,
+) -> Vec<Region> {
     assert_eq!(cells.len(), labels.len(), "one label per cell");
-    let mut exact: HashMap<u32, Vertex> = HashMap::new();
-    let canon = canonical_ids(arena, cells, rounded, &mut exact);
+    adjacent.clear();
+    let (mut exact, mut canon_ids) = (Vec::new(), Vec::new());
+    canonical_ids(arena, cells, rounded, &mut exact, &mut canon_ids);
+    let canon = |v: u32| canon_ids[arena.dense(v)];
     let (u_ax, v_ax, k_ax) = axes(support);
     let sigma: i32 = if support.normal()[k_ax] > 0 { 1 } else { -1 };
-    let vx = |i: u32| &exact[&i];
+    let vx = |i: u32| exact[arena.dense(i)].as_ref().expect("a used vertex");
 
     // group the edges by line
     let mut lines: Vec<Line> = Vec::new();
-    let mut line_of: HashMap<LineKey, u32> = HashMap::new();
+    let mut line_of: FxHashMap<LineKey, u32> = FxHashMap::default();
     for (ci, c) in cells.iter().enumerate() {
         let k = c.verts.len();
         for j in 0..k {
-            let (a, b) = (canon[&c.verts[j]], canon[&c.verts[(j + 1) % k]]);
+            let (a, b) = (canon(c.verts[j]), canon(c.verts[(j + 1) % k]));
             if a == b {
                 continue;
             }
@@ -244,7 +268,7 @@ pub fn merge_cells(
         pts.sort_unstable();
         pts.dedup();
         pts.sort_by(|&a, &b| vx(a).cmp_axis(vx(b), t));
-        let pos: HashMap<u32, usize> = pts.iter().enumerate().map(|(i, &p)| (p, i)).collect();
+        let pos: FxHashMap<u32, usize> = pts.iter().enumerate().map(|(i, &p)| (p, i)).collect();
         let mut iv: Vec<(Option<u32>, Option<u32>)> =
             vec![(None, None); pts.len().saturating_sub(1)];
         for &(ci, a, b) in &line.edges {
@@ -264,10 +288,11 @@ pub fn merge_cells(
             }
         }
         for &(l, r) in &iv {
-            if let (Some(l), Some(r)) = (l, r)
-                && labels[l as usize] == labels[r as usize]
-            {
-                uf.union(l, r);
+            if let (Some(l), Some(r)) = (l, r) {
+                adjacent.push([l.min(r), l.max(r)]);
+                if labels[l as usize] == labels[r as usize] {
+                    uf.union(l, r);
+                }
             }
         }
         sides_of.push((pts, iv));
@@ -308,7 +333,7 @@ pub fn merge_cells(
     };
 
     // chain the pieces into loops
-    let mut outgoing: HashMap<(u32, u32), SmallVec<[u32; 2]>> = HashMap::new();
+    let mut outgoing: FxHashMap<(u32, u32), SmallVec<[u32; 2]>> = FxHashMap::default();
     for (i, s) in segs.iter().enumerate() {
         outgoing
             .entry((s.region, s.from))
@@ -359,7 +384,7 @@ pub fn merge_cells(
     }
 
     // corners only, then outer loop and holes per region
-    let mut by_region: HashMap<u32, usize> = HashMap::new();
+    let mut by_region: FxHashMap<u32, usize> = FxHashMap::default();
     let mut regions: Vec<Region> = Vec::new();
     let mut first_cell: Vec<u32> = Vec::new();
     let mut loop_lists: Vec<Vec<Vec<u32>>> = Vec::new();
@@ -403,6 +428,8 @@ pub fn merge_cells(
             regions[ri].cells.push(ci);
         }
     }
+    adjacent.sort_unstable();
+    adjacent.dedup();
     let mut order: Vec<usize> = (0..regions.len()).collect();
     order.sort_by_key(|&i| first_cell[i]);
     let mut out: Vec<Option<Region>> = regions.into_iter().map(Some).collect();
@@ -448,7 +475,7 @@ fn cmp_clockwise(r: [i128; 2], a: [i128; 2], b: [i128; 2], sigma: i32) -> Orderi
 /// shoelace sum when its error bound certifies it, else exact rationals.
 fn signed_area_sign(
     arena: &PieceArena,
-    exact: &HashMap<u32, Vertex>,
+    exact: &[Option<Vertex>],
     rounded: &[Option<[f64; 3]>],
     l: &[u32],
     u: usize,
@@ -473,7 +500,10 @@ fn signed_area_sign(
         return -1;
     }
     let q = |i: usize| -> [BigRational; 2] {
-        match &exact[&l[i % m]] {
+        match exact[arena.dense(l[i % m])]
+            .as_ref()
+            .expect("a used vertex")
+        {
             Vertex::Grid(g) => [
                 BigRational::from_integer(BigInt::from(g[u])),
                 BigRational::from_integer(BigInt::from(g[v])),

@@ -9,6 +9,10 @@
 //! shadow stats   [INPUT | --scene NAME]
 //! shadow demo    [-o room.svg]
 //! shadow csg     union|intersection|difference A B -o OUT [--weld] [--stats]
+//! shadow animate (--scene room | STATIC --dynamic DYNAMIC) [--light X,Y,Z]... [--sun X,Y,Z]...
+//!                [--frames N] [--spin AX,AY,AZ:DEG] [--spin-center X,Y,Z] [--step DX,DY,DZ]
+//!                -o DIR [--format svg|json|none] [--report FILE.csv] [--export-scene]
+//!                [--strategy paper|fast] [--tiles N]
 //! ```
 //!
 //! Every command loads a mesh (OBJ or STL) or a built-in scene, snaps it
@@ -18,7 +22,8 @@
 //! the painter's algorithm in the tree's exact back-to-front order,
 //! `stats` reports the tree's figures, `demo` renders the built-in room,
 //! `csg` computes an exact Boolean operation of two closed meshes and
-//! writes the watertight result (OBJ or binary STL).
+//! writes the watertight result (OBJ or binary STL), `animate` runs the
+//! core paper's real-time pipeline on a moving object (see `tiling`).
 //! Errors go to stderr as `error: ...` with exit code 1.
 
 use std::path::{Path, PathBuf};
@@ -28,6 +33,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
 use glam::DVec3;
 
+mod animate;
 mod color;
 mod csg;
 mod lights;
@@ -64,6 +70,9 @@ enum Command {
     Demo(DemoArgs),
     /// Exact union, intersection or difference of two closed meshes.
     Csg(csg::CsgArgs),
+    /// The core paper's real-time pipeline: a moving object's exact
+    /// shadows in a static scene, frame by frame, with Table 2's figures.
+    Animate(Box<animate::AnimateArgs>),
 }
 
 /// Where the mesh comes from: a file or a built-in scene (exactly one).
@@ -301,6 +310,7 @@ fn main() -> ExitCode {
         Command::Stats(a) => stats(a),
         Command::Demo(a) => demo(a),
         Command::Csg(a) => csg::run(a),
+        Command::Animate(a) => animate::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

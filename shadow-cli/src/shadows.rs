@@ -99,7 +99,7 @@ pub(crate) struct ShadowsArgs {
 /// behind it, so that the chairs, the shelf, the plant and the axis
 /// object all cast shadows on the floor, the rug and the walls where the
 /// demo's viewpoint sees them (the axis object's to the left of it).
-pub(crate) const ROOM_LIGHT: DVec3 = DVec3::new(0.9, 0.3, 2.45);
+pub(crate) const ROOM_LIGHT: DVec3 = shadow_scene::ROOM_LIGHT;
 
 /// How many faces `--stats` lists.
 const TOP_FACES: usize = 10;
@@ -158,7 +158,7 @@ struct Figures {
 
 /// The batch's vertices in input units, each converted once; an error
 /// names a face whose vertex leaves `f64`'s range.
-fn world_vertices(b: &Batch, grid: &Grid) -> Result<Vec<DVec3>> {
+pub(crate) fn world_vertices(b: &Batch, grid: &Grid) -> Result<Vec<DVec3>> {
     let world: Vec<DVec3> = (0..b.vertex_count() as u32)
         .map(|v| grid.to_world(b.rounded(v)))
         .collect();
@@ -178,9 +178,9 @@ fn world_vertices(b: &Batch, grid: &Grid) -> Result<Vec<DVec3>> {
 }
 
 /// Per fragment of a batch: its face, area, lit and facing flags.
-type AreaRecord = (u32, f64, u64, u64);
+pub(crate) type AreaRecord = (u32, f64, u64, u64);
 
-fn area_records(b: &Batch, world: &[DVec3]) -> Vec<AreaRecord> {
+pub(crate) fn area_records(b: &Batch, world: &[DVec3]) -> Vec<AreaRecord> {
     let mut buf = Vec::new();
     b.fragments()
         .map(|f| {
@@ -214,7 +214,11 @@ struct JsonSummary {
     dark_area: f64,
 }
 
-fn json_header(out: &mut impl Write, lights: &[PlacedLight], faces: usize) -> Result<()> {
+pub(crate) fn json_header(
+    out: &mut impl Write,
+    lights: &[PlacedLight],
+    faces: usize,
+) -> Result<()> {
     let lights: Vec<JsonLight> = lights
         .iter()
         .map(|l| match l.light {
@@ -232,7 +236,7 @@ fn json_header(out: &mut impl Write, lights: &[PlacedLight], faces: usize) -> Re
     Ok(())
 }
 
-fn json_footer(out: &mut impl Write, areas: &Areas) -> Result<()> {
+pub(crate) fn json_footer(out: &mut impl Write, areas: &Areas) -> Result<()> {
     write!(out, "\n],\"summary\":")?;
     let summary = JsonSummary {
         area: areas.total,
@@ -274,7 +278,12 @@ fn push_ring(s: &mut Vec<u8>, ring: &[u32], world: &[DVec3]) {
 }
 
 /// The fragments of a batch as JSON lines, each preceded by `,\n`.
-fn json_fragments(b: &Batch, world: &[DVec3], records: &[AreaRecord], lights: usize) -> Vec<u8> {
+pub(crate) fn json_fragments(
+    b: &Batch,
+    world: &[DVec3],
+    records: &[AreaRecord],
+    lights: usize,
+) -> Vec<u8> {
     let mut s = Vec::with_capacity(b.len() * 160);
     for (f, rec) in b.fragments().zip(records) {
         s.extend_from_slice(b",\n{\"face\":");
@@ -463,6 +472,16 @@ fn brightness(
     b
 }
 
+/// A fragment to draw: a part of BSP polygon `polygon` of face `face`,
+/// lit by the lights of `lit`, as convex pieces in input units.
+pub(crate) struct DrawFrag {
+    pub(crate) polygon: usize,
+    pub(crate) face: usize,
+    pub(crate) lit: u64,
+    pub(crate) normal: DVec3,
+    pub(crate) pieces: Vec<Vec<DVec3>>,
+}
+
 /// Draws the fragments of the scene tree's polygons (`batch`, receiver =
 /// polygon index) in the tree's painter's order.
 fn render(
@@ -472,28 +491,63 @@ fn render(
     batch: &Batch,
     world: &[DVec3],
 ) -> Result<Rendered> {
+    let frags: Vec<DrawFrag> = batch
+        .fragments()
+        .map(|f| DrawFrag {
+            polygon: f.receiver() as usize,
+            face: f.face() as usize,
+            lit: f.lit_mask(),
+            normal: unit_normal(f.support()),
+            pieces: f
+                .pieces()
+                .map(|p| p.iter().map(|&v| world[v as usize]).collect())
+                .collect(),
+        })
+        .collect();
+    render_frags(
+        &scene.mesh,
+        &scene.grid,
+        &scene.lights,
+        tree,
+        view,
+        &frags,
+        "shadow shadows",
+    )
+}
+
+/// Draws fragments of the tree's polygons in the tree's painter's order,
+/// each shaded by the lights that reach it.
+pub(crate) fn render_frags(
+    mesh: &Mesh,
+    grid: &Grid,
+    lights: &[PlacedLight],
+    tree: &BspTree,
+    view: &View,
+    frags: &[DrawFrag],
+    what: &str,
+) -> Result<Rendered> {
     // fragments meet along many more edges than whole polygons: a wider
     // stroke keeps their seams closed
-    let mut canvas = Canvas::new(&scene.mesh, &scene.grid, view, "shadow shadows", 1.0)?;
-    let mut per_polygon: Vec<Vec<usize>> = vec![Vec::new(); tree.polygons().count()];
-    for (j, f) in batch.fragments().enumerate() {
-        let slot = per_polygon.get_mut(f.receiver() as usize).ok_or_else(|| {
+    let mut canvas = Canvas::new(mesh, grid, view, what, 1.0)?;
+    let polys: Vec<&Polygon> = tree.polygons().collect();
+    let mut per_polygon: Vec<Vec<usize>> = vec![Vec::new(); polys.len()];
+    for (j, f) in frags.iter().enumerate() {
+        let slot = per_polygon.get_mut(f.polygon).ok_or_else(|| {
             anyhow!(
                 "internal error: fragment {j} names BSP polygon {}",
-                f.receiver()
+                f.polygon
             )
         })?;
         slot.push(j);
     }
-    let colors = face_colors(&scene.mesh);
-    let centres: Vec<DVec3> = (0..scene.mesh.faces.len())
+    let colors = face_colors(mesh);
+    let centres: Vec<DVec3> = (0..mesh.faces.len())
         .map(|f| {
-            let pts = scene.mesh.face_points(f);
+            let pts = mesh.face_points(f);
             pts.iter().sum::<DVec3>() / pts.len().max(1) as f64
         })
         .collect();
     let forward = canvas.cam.forward();
-    let polys: Vec<&Polygon> = tree.polygons().collect();
     let order = painter_order(tree, canvas.eye_vp);
     // runs of coplanar polygons facing the same way: their fragments tile
     // the plane without overlap, so each colour is drawn as one region
@@ -511,16 +565,14 @@ fn render(
         let mut regions: Vec<(String, Vec<usize>)> = Vec::new();
         for &(poly, _) in &order[start..end] {
             for &j in &per_polygon[poly] {
-                let f = batch.fragment(j);
-                let face = f.face() as usize;
+                let f = &frags[j];
                 let b = if toward {
-                    let normal = unit_normal(f.support());
-                    brightness(f.lit_mask(), normal, centres[face], &scene.lights, forward)
+                    brightness(f.lit, f.normal, centres[f.face], lights, forward)
                 } else {
                     // the back of a surface: no light is in front of it
                     AMBIENT
                 };
-                let fill = hex(colors[face], b);
+                let fill = hex(colors[f.face], b);
                 match regions.iter_mut().find(|(c, _)| *c == fill) {
                     Some((_, members)) => members.push(j),
                     None => regions.push((fill, vec![j])),
@@ -528,12 +580,9 @@ fn render(
             }
         }
         for (fill, members) in &regions {
-            let pieces = members.iter().flat_map(|&j| {
-                batch
-                    .fragment(j)
-                    .pieces()
-                    .map(|p| p.iter().map(|&v| world[v as usize]))
-            });
+            let pieces = members
+                .iter()
+                .flat_map(|&j| frags[j].pieces.iter().map(|p| p.iter().copied()));
             canvas.region(pieces, fill);
         }
         start = end;

@@ -43,6 +43,7 @@
 
 use std::path::Path;
 
+mod animated;
 mod error;
 mod mesh;
 mod obj;
@@ -51,6 +52,7 @@ mod scan;
 mod scenes;
 mod stl;
 
+pub use animated::{ANIMATED_NAMES, Animated, BUNNY_LIGHT, ROOM_LIGHT, animated, torus};
 pub use error::SceneError;
 pub use mesh::{Face, Mesh};
 pub use obj::{ObjNotes, parse_obj, parse_obj_notes, read_obj, read_obj_notes, write_obj};

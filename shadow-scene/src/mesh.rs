@@ -223,6 +223,48 @@ impl Mesh {
         six_v / 6.0
     }
 
+    /// The mesh split in two: the faces of every other group, and the
+    /// faces of group `name`, each with only the positions it uses (in
+    /// their order) and the same group list. `None` if there is no such
+    /// group.
+    ///
+    /// ```
+    /// let room = shadow_scene::room();
+    /// let (rest, axes) = room.split_off_group("axes").unwrap();
+    /// assert_eq!(rest.faces.len() + axes.faces.len(), room.faces.len());
+    /// assert!(axes.is_closed_oriented());
+    /// ```
+    pub fn split_off_group(&self, name: &str) -> Option<(Mesh, Mesh)> {
+        let g = self.group_index(name)?;
+        let part = |keep: &dyn Fn(&Face) -> bool| {
+            let mut map: HashMap<u32, u32> = HashMap::new();
+            let mut out = Mesh {
+                positions: Vec::new(),
+                faces: Vec::new(),
+                groups: self.groups.clone(),
+            };
+            for f in self.faces.iter().filter(|f| keep(f)) {
+                let vertices = f
+                    .vertices
+                    .iter()
+                    .map(|&v| {
+                        *map.entry(v).or_insert_with(|| {
+                            out.positions.push(self.positions[v as usize]);
+                            (out.positions.len() - 1) as u32
+                        })
+                    })
+                    .collect();
+                out.faces.push(Face {
+                    vertices,
+                    line: f.line,
+                    group: f.group,
+                });
+            }
+            out
+        };
+        Some((part(&|f| f.group != g), part(&|f| f.group == g)))
+    }
+
     /// Moves every face of group `name` by `offset`; vertices the group
     /// shares with other groups are duplicated first, so other groups stay
     /// where they are. Returns the number of faces moved, `None` if there

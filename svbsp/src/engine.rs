@@ -19,7 +19,7 @@
 
 use std::ops::Range;
 
-use bsp_core::{ArenaMark, Piece, PieceArena, Plane, Polygon, Side, Vertex, merge_cells};
+use bsp_core::{ArenaMark, Piece, PieceArena, Plane, Polygon, Side, Vertex, merge_cells_adjacent};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
@@ -194,7 +194,8 @@ impl Shadows {
     /// [`Shadows::shade`], also returning the receiver's cells with their
     /// flags when the flags are not the same all over (`None` when they
     /// are: the receiver is then [`Start::Uniform`] with its fragments'
-    /// flags), for later refinement by other trees ([`Shadows::refine`]).
+    /// flags), for later refinement by other trees
+    /// ([`Shadows::refine_cells`]).
     pub fn shade_keeping(
         &self,
         polys: &[Polygon],
@@ -208,13 +209,21 @@ impl Shadows {
         self.filter_lights(polys, &start, scratch);
         let s = &*scratch;
         let uniform = s.cur.iter().all(|(_, l)| *l == s.cur[0].1);
-        let cells = (!uniform).then(|| Cells {
+        if uniform {
+            self.finish(polys, receiver, opts, scratch, out, None);
+            return None;
+        }
+        let mut cells = Cells {
             arena: s.arena.clone(),
             cells: s.cur.clone(),
             support: s.support,
-        });
-        self.finish(polys, receiver, opts, scratch, out);
-        cells
+            region: Vec::new(),
+            adjacent: Vec::new(),
+        };
+        let mut info = (Vec::new(), Vec::new());
+        self.finish(polys, receiver, opts, scratch, out, Some(&mut info));
+        (cells.region, cells.adjacent) = info;
+        Some(cells)
     }
 
     /// Refines a receiver already shaded for the same lights by other
@@ -236,12 +245,104 @@ impl Shadows {
             return;
         }
         self.filter_lights(polys, start, scratch);
-        self.finish(polys, receiver, opts, scratch, out);
+        self.finish(polys, receiver, opts, scratch, out, None);
+    }
+
+    /// [`Shadows::refine`] that redoes only what these trees change:
+    /// nothing when every cell comes back whole with its flags
+    /// ([`Refined::Unchanged`]); from [`Start::Cells`], only the regions
+    /// the changed cells belong to, or merge with, are merged again, and
+    /// the receiver's other starting fragments stand ([`Refined::Some`]).
+    /// Either way the receiver's fragments are then those [`Shadows::refine`]
+    /// makes (the same regions, perhaps in another order).
+    pub fn refine_cells(
+        &self,
+        polys: &[Polygon],
+        start: &Start<'_>,
+        receiver: u32,
+        opts: &ShadeOptions,
+        scratch: &mut Scratch,
+        out: &mut Batch,
+    ) -> Refined {
+        if polys.is_empty() || !self.filter_lights(polys, start, scratch) {
+            return Refined::Unchanged;
+        }
+        let Start::Cells(cells) = start else {
+            self.finish(polys, receiver, opts, scratch, out, None);
+            return Refined::All;
+        };
+        let s = &mut *scratch;
+        let n = cells.cells.len();
+        // the cells that changed, and the flags of their pieces
+        let mut count = vec![0u32; n];
+        let mut changed = vec![false; n];
+        for ((_, flags), &o) in s.cur.iter().zip(&s.origin) {
+            count[o as usize] += 1;
+            changed[o as usize] |= *flags != cells.cells[o as usize].1;
+        }
+        for o in 0..n {
+            changed[o] |= count[o] != 1;
+        }
+        let regions = cells.region.iter().max().map_or(0, |&r| r as usize + 1);
+        let mut touched = vec![false; regions];
+        for o in 0..n {
+            if changed[o] {
+                touched[cells.region[o] as usize] = true;
+            }
+        }
+        // a changed cell's piece may now have the flags of a neighbouring
+        // region: that region is merged again too (its own cells did not
+        // change, so nothing spreads further)
+        let mut pieces_of: Vec<SmallVec<[u64; 2]>> = vec![SmallVec::new(); n];
+        for ((_, flags), &o) in s.cur.iter().zip(&s.origin) {
+            if changed[o as usize] {
+                pieces_of[o as usize].push(*flags);
+            }
+        }
+        for &[a, b] in &cells.adjacent {
+            for (x, y) in [(a, b), (b, a)] {
+                let ry = cells.region[y as usize] as usize;
+                if changed[x as usize]
+                    && !touched[ry]
+                    && pieces_of[x as usize].contains(&cells.cells[y as usize].1)
+                {
+                    touched[ry] = true;
+                }
+            }
+        }
+        if touched.iter().all(|&t| t) {
+            self.finish(polys, receiver, opts, scratch, out, None);
+            return Refined::All;
+        }
+        let keep: Vec<bool> = s
+            .origin
+            .iter()
+            .map(|&o| touched[cells.region[o as usize] as usize])
+            .collect();
+        let mut k = keep.iter();
+        s.cur.retain(|_| *k.next().expect("one flag per piece"));
+        let support = *polys[0].support();
+        out.push_receiver(
+            polys[0].tag(),
+            receiver,
+            self.facing(&support),
+            &support,
+            s,
+            false,
+            opts,
+            None,
+        );
+        Refined::Some(
+            (0..regions as u32)
+                .filter(|&r| !touched[r as usize])
+                .collect(),
+        )
     }
 
     /// Sets the scratch up with the receiver's cells as `start` says, and
     /// filters every cell lit by a light through that light's tree.
-    fn filter_lights(&self, polys: &[Polygon], start: &Start<'_>, s: &mut Scratch) {
+    /// Returns whether a cell was cut or changed its flags.
+    fn filter_lights(&self, polys: &[Polygon], start: &Start<'_>, s: &mut Scratch) -> bool {
         let support = *polys[0].support();
         let face = polys[0].tag();
         s.arena.clear();
@@ -263,16 +364,21 @@ impl Shadows {
                 s.whole = s.arena.add_polygon(&polys[0]);
             }
         }
+        s.origin.clear();
+        s.origin.extend(0..s.cur.len() as u32);
         let facing = self.facing(&support);
+        let mut changed = false;
         for (j, sv) in self.volumes.iter().enumerate() {
             let bit = 1u64 << j;
             if facing & bit == 0 {
                 continue; // attached shadow: the flag stays 0
             }
             s.next.clear();
-            for (piece, flags) in s.cur.drain(..) {
+            s.next_origin.clear();
+            for ((piece, flags), o) in s.cur.drain(..).zip(s.origin.drain(..)) {
                 if flags & bit == 0 {
                     s.next.push((piece, flags));
+                    s.next_origin.push(o);
                     continue;
                 }
                 s.out.clear();
@@ -286,14 +392,21 @@ impl Shadows {
                     &mut s.links,
                     &mut s.sides,
                 );
+                // one piece back, still lit: the cell as it was
+                changed |= s.out.len() != 1 || !s.out[0].1;
                 for (p, lit) in s.out.drain(..) {
                     s.next.push((p, flags & !bit | (lit as u64) << j));
+                    s.next_origin.push(o);
                 }
             }
             std::mem::swap(&mut s.cur, &mut s.next);
+            std::mem::swap(&mut s.origin, &mut s.next_origin);
         }
+        changed
     }
 
+    /// Merges the scratch's cells into regions and appends them; `info`
+    /// receives each cell's region and the cells' adjacency.
     fn finish(
         &self,
         polys: &[Polygon],
@@ -301,6 +414,7 @@ impl Shadows {
         opts: &ShadeOptions,
         s: &mut Scratch,
         out: &mut Batch,
+        info: Option<&mut MergeInfo>,
     ) {
         let support = *polys[0].support();
         let facing = self.facing(&support);
@@ -312,6 +426,7 @@ impl Shadows {
             s,
             polys.len() == 1,
             opts,
+            info,
         );
     }
 
@@ -368,6 +483,9 @@ pub struct Scratch {
     support: u32,
     cur: Vec<(Piece, u64)>,
     next: Vec<(Piece, u64)>,
+    /// Per piece of `cur` (`next`), the starting cell it came from.
+    origin: Vec<u32>,
+    next_origin: Vec<u32>,
     out: Vec<(Piece, bool)>,
     stack: Vec<Task>,
     links: Vec<u32>,
@@ -387,6 +505,28 @@ pub struct Cells {
     arena: PieceArena,
     cells: Vec<(Piece, u64)>,
     support: u32,
+    /// Per cell, its region: the index of its fragment among the
+    /// receiver's fragments.
+    region: Vec<u32>,
+    /// Pairs of cells that share a piece of edge.
+    adjacent: Vec<[u32; 2]>,
+}
+
+/// Each cell's region, and the pairs of adjacent cells.
+type MergeInfo = (Vec<u32>, Vec<[u32; 2]>);
+
+/// What [`Shadows::refine_cells`] did.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Refined {
+    /// Nothing changed and nothing was appended: the receiver's
+    /// fragments are the ones it started from.
+    Unchanged,
+    /// All of the receiver's fragments were appended.
+    All,
+    /// The starting fragments listed (indices among the receiver's
+    /// fragments, in order) stand; the fragments appended replace the
+    /// others.
+    Some(Vec<u32>),
 }
 
 impl Cells {
@@ -835,6 +975,7 @@ impl Batch {
         s: &mut Scratch,
         single_polygon: bool,
         opts: &ShadeOptions,
+        info: Option<&mut MergeInfo>,
     ) {
         s.remap.clear();
         s.remap.resize(s.arena.len(), u32::MAX);
@@ -875,7 +1016,24 @@ impl Batch {
             s.pieces.push(p);
             s.labels.push(l);
         }
-        let regions = merge_cells(&s.arena, support, &s.pieces, &s.labels, &mut s.rounded);
+        let mut adjacent = Vec::new();
+        let regions = merge_cells_adjacent(
+            &s.arena,
+            support,
+            &s.pieces,
+            &s.labels,
+            &mut s.rounded,
+            &mut adjacent,
+        );
+        if let Some((region, adj)) = info {
+            *region = vec![0; s.pieces.len()];
+            for (ri, r) in regions.iter().enumerate() {
+                for &c in &r.cells {
+                    region[c as usize] = ri as u32;
+                }
+            }
+            *adj = adjacent;
+        }
         for r in &regions {
             push_frag(self, r.label);
             for ring in std::iter::once(&r.outer).chain(&r.holes) {

@@ -42,8 +42,8 @@ use bsp_core::{
 use glam::{DMat4, DVec3};
 use rayon::prelude::*;
 use svbsp::{
-    Batch, CHUNK, Cells, CfFragments, Light, Scratch, ShadeOptions, ShadowVolumes, Shadows, Start,
-    chin_feiner, receivers,
+    Batch, CHUNK, Cells, CfFragments, Light, Refined, Scratch, ShadeOptions, ShadowVolumes,
+    Shadows, Start, chin_feiner, receivers,
 };
 
 use crate::{Query, TileIndex, TilingError};
@@ -265,7 +265,7 @@ enum FrameFragments {
     /// moved object's.
     Fast {
         batch: Batch,
-        related: Vec<(u32, Range<usize>)>,
+        related: Vec<(u32, Range<usize>, Option<Vec<u32>>)>,
         moved: Range<usize>,
     },
     Paper(CfFragments),
@@ -542,23 +542,38 @@ impl Dynamic {
                         None => Start::Uniform(batch.fragment(frags[r as usize].start).lit_mask()),
                     })
                     .collect();
-                let parts: Vec<Batch> = recs
-                    .par_chunks(64)
-                    .zip(starts.par_chunks(64))
+                // per receiver the fragments it keeps (None: all replaced)
+                type Done = (Batch, Vec<(u32, Range<usize>, Option<Vec<u32>>)>);
+                let parts: Vec<Done> = recs
+                    .par_chunks(16)
+                    .zip(starts.par_chunks(16))
                     .map(|(rs, ss)| {
                         let (mut s, mut b) = (Scratch::default(), Batch::new());
+                        let mut done = Vec::new();
                         for (&r, st) in rs.iter().zip(ss) {
                             let polys = &self.statics[self.receivers[r as usize].clone()];
-                            sh.refine(polys, st, r, &sopts, &mut s, &mut b);
+                            let first = b.len();
+                            // what the moved object leaves alone keeps its
+                            // static fragments
+                            match sh.refine_cells(polys, st, r, &sopts, &mut s, &mut b) {
+                                Refined::Unchanged => {}
+                                Refined::All => done.push((r, first..b.len(), None)),
+                                Refined::Some(kept) => done.push((r, first..b.len(), Some(kept))),
+                            }
                         }
-                        b
+                        (b, done)
                     })
                     .collect();
                 let mut out = Batch::new();
-                for b in &parts {
-                    out.append(b);
+                let mut related_ranges = Vec::new();
+                for (b, done) in parts {
+                    let off = out.len();
+                    out.append(&b);
+                    related_ranges.extend(
+                        done.into_iter()
+                            .map(|(r, range, kept)| (r, range.start + off..range.end + off, kept)),
+                    );
                 }
-                let related_ranges = out.receiver_ranges();
                 let m0 = out.len();
                 let dynamic = sh.shade_all(&moved, &sopts);
                 out.append(&dynamic);
@@ -567,7 +582,9 @@ impl Dynamic {
                 stats.dynamic_shadow_polygons = out.len();
                 let replaced: usize = related_ranges
                     .iter()
-                    .map(|(r, _)| frags[*r as usize].len())
+                    .map(|(r, _, kept)| {
+                        frags[*r as usize].len() - kept.as_ref().map_or(0, Vec::len)
+                    })
                     .sum();
                 stats.total_drawn = batch.len() - replaced + out.len();
                 let len = out.len();
@@ -662,16 +679,20 @@ impl Dynamic {
                 let mut next = related.iter().peekable();
                 let mut r = 0;
                 while r < frags.len() {
-                    if let Some((rr, range)) = next.peek()
+                    if let Some((rr, range, kept)) = next.peek()
                         && *rr as usize == r
                     {
+                        for &k in kept.iter().flatten() {
+                            let f = frags[r].start + k as usize;
+                            emit(Part::Batch(batch, f..f + 1));
+                        }
                         emit(Part::Batch(fb, range.clone()));
                         next.next();
                         r += 1;
                         continue;
                     }
                     // a run of untouched receivers in one piece
-                    let stop = next.peek().map_or(frags.len(), |(rr, _)| *rr as usize);
+                    let stop = next.peek().map_or(frags.len(), |(rr, _, _)| *rr as usize);
                     emit(Part::Batch(batch, frags[r].start..frags[stop - 1].end));
                     r = stop;
                 }

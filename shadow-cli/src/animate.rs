@@ -1,0 +1,614 @@
+//! `shadow animate`: the core paper's real-time pipeline, frame by frame.
+//!
+//! A static scene (a file or a built-in scene) and a moving object (a
+//! file, or the built-in scene's own: the room's coordinate-axis object,
+//! a torus around the bunny) → one grid for the scene, the lights and
+//! every position the object takes → the static shadows and the tiling of
+//! each light, once (`tiling::Dynamic`) → per frame, the object's original
+//! coordinates moved by the frame's transform and snapped, and the
+//! frame's shadows (see `tiling`'s docs) → per frame an SVG or JSON file,
+//! optionally the frame's scene as OBJ, and a row of the paper's Table 2
+//! in the CSV report.
+
+use std::fmt::Write as _;
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, anyhow, bail};
+use bsp_core::{BspTree, BuildOptions, Polygon};
+use clap::{Args, ValueEnum};
+use glam::{DMat4, DVec3};
+use shadow_scene::{Face, Mesh};
+use svbsp::{Areas, LightSpec, PlacedLight};
+use tiling::{Dynamic, FrameStats, Motion, PipelineOptions, Strategy};
+
+use crate::lights::{fmt_input, place_lights, shared_grid};
+use crate::progress::{Output, Progress};
+use crate::render::{View, unit_normal};
+use crate::shadows::{
+    DrawFrag, area_records, json_footer, json_fragments, json_header, render_frags, world_vertices,
+};
+use crate::{DEMO_EYE, DEMO_TARGET, ImageArgs, load_mesh, parse_vec3};
+
+/// What each frame writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(crate) enum FrameFormat {
+    /// A view of the shaded frame (`frame_0000.svg`).
+    Svg,
+    /// The fragments, in the schema of `shadow shadows` (`frame_0000.json`).
+    Json,
+    /// Nothing: for timing.
+    None,
+}
+
+/// The per-frame strategy.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(crate) enum StrategyArg {
+    /// Liu & Wu's pipeline: Bsp4 = Bsp2 + Bsp3 and Chin & Feiner's shadows.
+    Paper,
+    /// Partitioned shadow volumes of the moved and related polygons.
+    Fast,
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct AnimateArgs {
+    /// The static scene (.obj or .stl).
+    pub(crate) input: Option<PathBuf>,
+    /// A built-in animation instead of a file: room (the axis object
+    /// spins) or bunny, bunny-11k ... bunny-893k (a torus circles the
+    /// bunny).
+    #[arg(long, value_name = "NAME")]
+    pub(crate) scene: Option<String>,
+    /// The moving object (.obj or .stl) [default for --scene: the scene's
+    /// own].
+    #[arg(long, value_name = "FILE")]
+    pub(crate) dynamic: Option<PathBuf>,
+    /// A point light at X,Y,Z (input units); repeatable [default for
+    /// --scene: the scene's light].
+    #[arg(long = "light", value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) lights: Vec<DVec3>,
+    /// A light at infinity in the direction X,Y,Z toward the light;
+    /// repeatable.
+    #[arg(long = "sun", value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) suns: Vec<DVec3>,
+    /// Number of frames.
+    #[arg(long, default_value_t = 24, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub(crate) frames: u32,
+    /// Rotation per frame: axis and degrees, AX,AY,AZ:DEGREES [default for
+    /// --scene: the scene's; none for files].
+    #[arg(long, value_name = "AX,AY,AZ:DEG", value_parser = parse_spin, allow_hyphen_values = true)]
+    pub(crate) spin: Option<(DVec3, f64)>,
+    /// A point on the rotation axis [default: the centre of the moving
+    /// object's bounding box, or the scene's].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) spin_center: Option<DVec3>,
+    /// Translation per frame, applied after the rotation.
+    #[arg(long, value_name = "DX,DY,DZ", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) step: Option<DVec3>,
+    /// Output directory (created if missing).
+    #[arg(short, long, value_name = "DIR")]
+    pub(crate) output: PathBuf,
+    /// What each frame writes.
+    #[arg(long, value_enum, default_value_t = FrameFormat::Svg)]
+    pub(crate) format: FrameFormat,
+    /// One CSV row per frame: the columns of the paper's Table 2.
+    #[arg(long, value_name = "FILE.csv")]
+    pub(crate) report: Option<PathBuf>,
+    /// Also write each frame's whole scene as an OBJ file beside the frame's
+    /// own (the same name, .obj).
+    #[arg(long)]
+    pub(crate) export_scene: bool,
+    /// The per-frame strategy.
+    #[arg(long, value_enum, default_value_t = StrategyArg::Fast)]
+    pub(crate) strategy: StrategyArg,
+    /// Tiles per side of each light's tiling [default: the tiling crate's
+    /// rule].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub(crate) tiles: Option<u32>,
+    /// SVG eye position [default for the room: the demo's viewpoint; for
+    /// other scenes: in front of and above the scene].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) eye: Option<DVec3>,
+    /// SVG point looked at [default: the centre of the static scene].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) target: Option<DVec3>,
+    /// SVG up direction [default: +Z, or +Y when looking along Z].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) up: Option<DVec3>,
+    #[command(flatten)]
+    pub(crate) image: ImageArgs,
+    /// Worker threads [default: one per core].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) threads: Option<u32>,
+    /// No progress bar and no notes on stderr (errors still go there).
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
+/// Parses `AX,AY,AZ:DEGREES`.
+fn parse_spin(s: &str) -> Result<(DVec3, f64), String> {
+    let (axis, deg) = s
+        .rsplit_once(':')
+        .ok_or_else(|| format!("expected AX,AY,AZ:DEGREES, got `{s}`"))?;
+    let axis = parse_vec3(axis)?;
+    if axis.length_squared() == 0.0 {
+        return Err("the spin axis is zero".into());
+    }
+    let deg: f64 = deg
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{deg}` is not a number of degrees"))?;
+    if !deg.is_finite() {
+        return Err(format!("`{deg}` is not a finite number of degrees"));
+    }
+    Ok((axis, deg))
+}
+
+/// The Table 2 columns, in order.
+pub(crate) const REPORT_HEADER: &str = "frame,static_polygons,dynamic_polygons,dynamic_after_bsp,\
+static_after_bsp,static_after_shadow,dynamic_shadow_polygons,total_drawn,t_tiling_s,t_merge_s,\
+t_dynamic_shadows_s,t_frame_s";
+
+fn report_row(k: u32, s: &FrameStats) -> String {
+    let secs = |d: Duration| format!("{:.6}", d.as_secs_f64());
+    format!(
+        "{k},{},{},{},{},{},{},{},{},{},{},{}",
+        s.static_polygons,
+        s.dynamic_polygons,
+        s.dynamic_after_bsp,
+        s.static_after_bsp,
+        s.static_after_shadow,
+        s.dynamic_shadow_polygons,
+        s.total_drawn,
+        secs(s.t_tiling),
+        secs(s.t_merge),
+        secs(s.t_dynamic_shadows),
+        secs(s.t_frame)
+    )
+}
+
+/// The static scene, the moving object and the defaults that come with a
+/// built-in animation.
+struct Setup {
+    statics: Mesh,
+    moving: Mesh,
+    name: String,
+    spin: Option<(DVec3, f64)>,
+    centre: Option<DVec3>,
+    light: Option<DVec3>,
+    is_room: bool,
+}
+
+fn setup(args: &AnimateArgs) -> Result<Setup> {
+    let dynamic = |required: bool| -> Result<Option<Mesh>> {
+        match &args.dynamic {
+            Some(p) => Ok(Some(load_mesh(p, args.quiet)?)),
+            None if required => bail!(
+                "no moving object: give --dynamic FILE (the object that moves; STATIC is what \
+                 stays put)"
+            ),
+            None => Ok(None),
+        }
+    };
+    match (&args.input, &args.scene) {
+        (Some(path), None) => Ok(Setup {
+            statics: load_mesh(path, args.quiet)?,
+            moving: dynamic(true)?.unwrap_or_default(),
+            name: path.display().to_string(),
+            spin: None,
+            centre: None,
+            light: None,
+            is_room: false,
+        }),
+        (None, Some(name)) => {
+            let a = shadow_scene::animated(name).with_context(|| {
+                format!(
+                    "unknown animation `{name}` (available: {})",
+                    shadow_scene::ANIMATED_NAMES.join(", ")
+                )
+            })?;
+            Ok(Setup {
+                moving: dynamic(false)?.unwrap_or(a.moving),
+                statics: a.statics,
+                name: format!("scene {name}"),
+                spin: Some((a.axis, a.degrees)),
+                centre: a.centre,
+                light: Some(a.light),
+                is_room: name == "room",
+            })
+        }
+        (Some(_), Some(_)) => bail!("give either a STATIC file or --scene NAME, not both"),
+        (None, None) => bail!(
+            "no input: give a static scene file and --dynamic FILE, or --scene NAME (available: {})",
+            shadow_scene::ANIMATED_NAMES.join(", ")
+        ),
+    }
+}
+
+pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
+    match args.threads {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build()
+            .context("cannot start the worker threads")?
+            .install(|| run_here(args)),
+        None => run_here(args),
+    }
+}
+
+fn run_here(args: &AnimateArgs) -> Result<()> {
+    let total = Instant::now();
+    let note = |s: &str| {
+        if !args.quiet {
+            eprintln!("{s}");
+        }
+    };
+    let s = setup(args)?;
+    if s.moving.faces.is_empty() {
+        bail!("the moving object has no faces");
+    }
+    if s.statics.faces.is_empty() {
+        bail!("{}: no faces", s.name);
+    }
+    let mut specs: Vec<LightSpec> = args.lights.iter().map(|&p| LightSpec::Point(p)).collect();
+    specs.extend(args.suns.iter().map(|&d| LightSpec::Sun(d)));
+    if specs.is_empty() {
+        match s.light {
+            Some(l) => specs.push(LightSpec::Point(l)),
+            None => bail!(
+                "no light: give at least one --light X,Y,Z (a point light) or --sun X,Y,Z (a light \
+                 at infinity); both can be repeated"
+            ),
+        }
+    }
+    let (axis, degrees) = args.spin.or(s.spin).unwrap_or((DVec3::Z, 0.0));
+    let step = args.step.unwrap_or(DVec3::ZERO);
+    let (mlo, mhi) = s.moving.bounds().expect("the moving object has faces");
+    let centre = args.spin_center.or(s.centre).unwrap_or((mlo + mhi) * 0.5);
+    let motion = Motion {
+        axis,
+        degrees,
+        centre,
+        step,
+    };
+    if degrees == 0.0 && step == DVec3::ZERO && args.frames > 1 {
+        note("note: no motion given (--spin, --step): every frame is the same");
+    }
+    if args.format != FrameFormat::Svg
+        && (args.eye.is_some() || args.target.is_some() || args.up.is_some())
+    {
+        note("note: --eye, --target and --up only apply to SVG frames");
+    }
+    std::fs::create_dir_all(&args.output)
+        .with_context(|| format!("could not create {}", args.output.display()))?;
+
+    // one grid for every frame: the static scene, the lights and the box
+    // of every position the object takes
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for k in 0..args.frames {
+        let m = motion.matrix(k);
+        for p in &s.moving.positions {
+            let q = m.transform_point3(*p);
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+    }
+    let mut pts = s.statics.positions.clone();
+    pts.push(lo);
+    pts.push(hi);
+    let grid = shared_grid(&pts, &specs).with_context(|| s.name.clone())?;
+    let placed = place_lights(&grid, &specs)?;
+    let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
+    let strategy = match args.strategy {
+        StrategyArg::Paper => Strategy::Paper,
+        StrategyArg::Fast => Strategy::Fast,
+    };
+    let opts = PipelineOptions::default()
+        .with_strategy(strategy)
+        .with_tiles(args.tiles)
+        .with_pieces(args.format == FrameFormat::Svg);
+
+    let progress = Progress::new(!args.quiet);
+    progress.phase("preprocessing", 1);
+    let statics = s.statics.face_loops();
+    let moving = s.moving.face_loops();
+    let start = Instant::now();
+    let d = Dynamic::new(&statics, &moving, grid, &kernel, opts).map_err(|e| anyhow!("{e}"))?;
+    let t_pre = start.elapsed();
+    let view = (args.format == FrameFormat::Svg).then(|| frame_view(args, &s));
+    let mut report = match &args.report {
+        Some(p) => {
+            let mut o = Output::create(p)?;
+            writeln!(o, "{REPORT_HEADER}")?;
+            Some(o)
+        }
+        None => None,
+    };
+    progress.phase("frames", args.frames as u64);
+    let mut times: Vec<Duration> = Vec::with_capacity(args.frames as usize);
+    let mut related = 0usize;
+    let mut last = FrameStats::default();
+    for k in 0..args.frames {
+        let m = motion.matrix(k);
+        let frame = d
+            .frame(&m)
+            .map_err(|e| anyhow!("frame {k}: {e} (the grid holds every position the object takes; is a vertex not finite?)"))?;
+        times.push(frame.stats.t_frame);
+        related += frame.stats.related;
+        if let Some(r) = &mut report {
+            writeln!(r, "{}", report_row(k, &frame.stats))?;
+        }
+        let stem = args.output.join(format!("frame_{k:04}"));
+        if args.export_scene || args.format == FrameFormat::Svg {
+            let scene = frame_mesh(&s, &d, &m);
+            if args.export_scene {
+                let path = stem.with_extension("obj");
+                let mut o = Output::create(&path)?;
+                write_scene(&mut o, &scene, &d, k, &placed)
+                    .with_context(|| format!("could not write {}", path.display()))?;
+                o.commit()?;
+            }
+            if let Some(view) = &view {
+                let path = stem.with_extension("svg");
+                let svg = frame_svg(&d, &frame, &scene, &placed, view)?;
+                let mut o = Output::create(&path)?;
+                o.write_all(svg.as_bytes())
+                    .with_context(|| format!("could not write {}", path.display()))?;
+                o.commit()?;
+            }
+        }
+        if args.format == FrameFormat::Json {
+            let path = stem.with_extension("json");
+            let mut o = Output::create(&path)?;
+            frame_json(&mut o, &d, &frame, &placed)
+                .with_context(|| format!("could not write {}", path.display()))?;
+            o.commit()?;
+        }
+        last = frame.stats;
+        progress.inc(1);
+    }
+    if let Some(r) = report {
+        r.commit()?;
+    }
+    progress.finish();
+    let mut sorted = times.clone();
+    sorted.sort();
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    let median = sorted[sorted.len() / 2];
+    let mean = times.iter().sum::<Duration>() / times.len() as u32;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{} frames of {}: {} static faces, {} moving; {:?} strategy, {} light(s); frame time \
+         median {:.2} ms, mean {:.2} ms, max {:.2} ms; {:.0} related static polygons a frame; \
+         {} fragments in the last frame; preprocessing {:.1} ms, total {:.2} s",
+        args.frames,
+        s.name,
+        s.statics.faces.len(),
+        s.moving.faces.len(),
+        strategy,
+        kernel.len(),
+        ms(median),
+        ms(mean),
+        ms(*sorted.last().expect("at least one frame")),
+        related as f64 / args.frames as f64,
+        last.total_drawn,
+        ms(t_pre),
+        total.elapsed().as_secs_f64()
+    );
+    if args.format != FrameFormat::None || args.export_scene {
+        let _ = writeln!(out, "frames in {}", args.output.display());
+    }
+    crate::csg::emit(&out)
+}
+
+/// The camera for SVG frames.
+fn frame_view(args: &AnimateArgs, s: &Setup) -> View {
+    let (lo, hi) = s.statics.bounds().expect("the static scene has faces");
+    let c = (lo + hi) * 0.5;
+    let size = (hi - lo).length().max(1e-9);
+    let (eye, target) = match (args.eye, s.is_room) {
+        (Some(e), _) => (e, args.target),
+        (None, true) => (DEMO_EYE, Some(args.target.unwrap_or(DEMO_TARGET))),
+        // in front of the scene and above it, whichever axis is up
+        (None, false) => (
+            c + DVec3::new(0.35, -0.9, 0.6) * size + DVec3::new(0.0, 0.5, 0.0) * size,
+            Some(args.target.unwrap_or(c)),
+        ),
+    };
+    View {
+        eye,
+        target,
+        up: args.up,
+        width: args.image.width,
+        height: args.image.height,
+        fov_deg: args.image.fov,
+    }
+}
+
+/// The frame's whole scene in input units, faces numbered as the frame's
+/// fragments are (static first, then the moved object): every vertex is
+/// the frame's grid point mapped back to input units, so the file is
+/// exactly the scene the frame's shadows were computed for.
+fn frame_mesh(s: &Setup, d: &Dynamic, m: &DMat4) -> Mesh {
+    let grid = d.grid();
+    let snap = |p: DVec3| {
+        grid.snap(p)
+            .map(|g| grid.to_world(g.map(f64::from)))
+            .unwrap_or(p)
+    };
+    let mut mesh = Mesh {
+        positions: s.statics.positions.iter().map(|&p| snap(p)).collect(),
+        faces: s.statics.faces.clone(),
+        groups: s.statics.groups.clone(),
+    };
+    let first = mesh.positions.len() as u32;
+    mesh.positions.extend(
+        s.moving
+            .positions
+            .iter()
+            .map(|&p| snap(m.transform_point3(p))),
+    );
+    let gshift = mesh.groups.len() as u32;
+    mesh.groups
+        .extend(s.moving.groups.iter().map(|g| format!("moving_{g}")));
+    mesh.faces.extend(s.moving.faces.iter().map(|f| Face {
+        vertices: f.vertices.iter().map(|&v| v + first).collect(),
+        line: 0,
+        group: f.group + gshift,
+    }));
+    mesh
+}
+
+fn write_scene(
+    out: &mut impl Write,
+    mesh: &Mesh,
+    d: &Dynamic,
+    k: u32,
+    lights: &[PlacedLight],
+) -> Result<()> {
+    writeln!(
+        out,
+        "# shadow animate: frame {k}, {} static faces then {} moving ones; vertices are the \
+         frame's grid points",
+        d.static_faces(),
+        mesh.faces.len() - d.static_faces()
+    )?;
+    for (i, l) in lights.iter().enumerate() {
+        let kind = match l.light {
+            svbsp::Light::Point(_) => "point light at",
+            svbsp::Light::Directional(_) => "sun toward",
+        };
+        writeln!(out, "# light {i}: {kind} {}", fmt_input(l.world))?;
+    }
+    shadow_scene::write_obj(mesh, out)?;
+    Ok(())
+}
+
+fn frame_json(
+    out: &mut impl Write,
+    d: &Dynamic,
+    frame: &tiling::Frame,
+    lights: &[PlacedLight],
+) -> Result<()> {
+    let batch = d.fragments(frame);
+    let world = world_vertices(&batch, d.grid())?;
+    let records = area_records(&batch, &world);
+    let faces = d.static_faces() + d.moving().len();
+    let mut areas = Areas::new(lights.len(), faces);
+    for r in &records {
+        areas.add(r.0, r.1, r.2, r.3);
+    }
+    json_header(out, lights, faces)?;
+    let text = json_fragments(&batch, &world, &records, lights.len());
+    out.write_all(text.get(1..).unwrap_or_default())?;
+    json_footer(out, &areas)?;
+    Ok(())
+}
+
+/// Draws the frame: a BSP tree of the frame's polygons gives the painter's
+/// order, and each face's fragments are clipped (in `f64`, for the
+/// picture only) to the tree's pieces of the face.
+fn frame_svg(
+    d: &Dynamic,
+    frame: &tiling::Frame,
+    scene: &Mesh,
+    lights: &[PlacedLight],
+    view: &View,
+) -> Result<String> {
+    let grid = d.grid();
+    let mut polys: Vec<Polygon> = d.static_polygons().to_vec();
+    polys.extend(frame.moved.iter().cloned());
+    let tree = BspTree::build(polys, &BuildOptions::default());
+    let batch = d.fragments(frame);
+    let world = world_vertices(&batch, grid)?;
+    // the fragments' convex pieces, per face
+    let faces = d.static_faces() + d.moving().len();
+    let mut of_face: Vec<Vec<usize>> = vec![Vec::new(); faces];
+    for (j, f) in batch.fragments().enumerate() {
+        of_face[f.face() as usize].push(j);
+    }
+    let mut frags = Vec::new();
+    for (pi, p) in tree.polygons().enumerate() {
+        let outline: Vec<DVec3> = p
+            .vertices_f64()
+            .into_iter()
+            .map(|v| grid.to_world(v))
+            .collect();
+        let n = unit_normal(p.support());
+        let face = p.tag() as usize;
+        for &j in &of_face[face] {
+            let f = batch.fragment(j);
+            let mut pieces = Vec::new();
+            for piece in f.pieces() {
+                let mut poly: Vec<DVec3> = piece.iter().map(|&v| world[v as usize]).collect();
+                for e in 0..outline.len() {
+                    let (a, b) = (outline[e], outline[(e + 1) % outline.len()]);
+                    // inside: to the left of a → b seen from the normal
+                    let m = n.cross(b - a);
+                    poly = crate::render::clip(&poly, m, -m.dot(a));
+                    if poly.len() < 3 {
+                        break;
+                    }
+                }
+                if poly.len() >= 3 {
+                    pieces.push(poly);
+                }
+            }
+            if !pieces.is_empty() {
+                frags.push(DrawFrag {
+                    polygon: pi,
+                    face,
+                    lit: f.lit_mask(),
+                    normal: unit_normal(f.support()),
+                    pieces,
+                });
+            }
+        }
+    }
+    let r = render_frags(scene, grid, lights, &tree, view, &frags, "shadow animate")?;
+    Ok(r.svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spins_parse_with_clear_errors() {
+        assert_eq!(
+            parse_spin("0,0,1:15").unwrap(),
+            (DVec3::new(0.0, 0.0, 1.0), 15.0)
+        );
+        assert_eq!(
+            parse_spin("1,-1,0:-7.5").unwrap(),
+            (DVec3::new(1.0, -1.0, 0.0), -7.5)
+        );
+        assert_eq!(
+            parse_spin("0,0,1").unwrap_err(),
+            "expected AX,AY,AZ:DEGREES, got `0,0,1`"
+        );
+        assert_eq!(parse_spin("0,0,0:5").unwrap_err(), "the spin axis is zero");
+        assert_eq!(
+            parse_spin("0,0,1:x").unwrap_err(),
+            "`x` is not a number of degrees"
+        );
+    }
+
+    #[test]
+    fn report_has_the_papers_columns() {
+        assert_eq!(REPORT_HEADER.split(',').count(), 12);
+        let row = report_row(3, &FrameStats::default());
+        assert_eq!(row.split(',').count(), 12);
+        assert!(row.starts_with("3,0,0,"));
+    }
+
+    #[test]
+    fn frame_paths_are_numbered() {
+        use std::path::Path;
+        let p = Path::new("out").join(format!("frame_{:04}", 7));
+        assert_eq!(p.with_extension("svg"), Path::new("out/frame_0007.svg"));
+    }
+}
