@@ -65,7 +65,7 @@ pub use pieces::{ArenaMark, EdgeRef, Lazy, Piece, PieceArena, Sides, Vertex, Ver
 pub use plane::{MAX_NORMAL_BITS, MAX_OFFSET_BITS, Plane};
 pub use point::{Implicit, Point, rational_to_f64};
 pub use polygon::{FaceDefect, Polygon, PolygonSide, Side, Split, split_loop};
-pub use regions::{Region, merge_cells, merge_cells_adjacent};
+pub use regions::{MergeCache, MergedRegion, Region, Remerged, merge_cells, merge_cells_adjacent};
 pub use sanity::{ConvexParts, SanityError, check_convex};
 pub use topology::{TopologyError, check_closed_manifold};
 pub use tree::{

@@ -89,16 +89,6 @@ fn line_key(support: &Plane, e: &Plane) -> LineKey {
     LineKey { a, b, c }
 }
 
-/// One line with the cell edges on it.
-struct Line {
-    /// The 3D axis that parametrizes the line.
-    t_axis: usize,
-    /// Direction of increasing `t` in `(u, v)` coordinates.
-    dir: [i128; 2],
-    /// (cell, from, to) in canonical vertex ids.
-    edges: Vec<(u32, u32, u32)>,
-}
-
 struct UnionFind(Vec<u32>);
 impl UnionFind {
     fn find(&mut self, mut x: u32) -> u32 {
@@ -140,190 +130,227 @@ fn dot2(a: [i128; 2], b: [i128; 2]) -> I256 {
     I256::from(a[0]) * I256::from(b[0]) + I256::from(a[1]) * I256::from(b[1])
 }
 
-/// Canonical vertex ids: equal points get the id of their first
-/// occurrence, in `canon` (indexed by [`PieceArena::dense`], `u32::MAX`
-/// for vertices no cell uses); `exact` (the same indexing) receives every
-/// used vertex's exact coordinates and `rounded` its correctly rounded
-/// ones.
-fn canonical_ids(
-    arena: &PieceArena,
-    cells: &[Piece],
-    rounded: &mut Vec<Option<[f64; 3]>>,
-    exact: &mut Vec<Option<Vertex>>,
-    canon: &mut Vec<u32>,
-) {
-    rounded.resize(arena.len(), None);
-    exact.clear();
-    exact.resize(arena.len(), None);
-    canon.clear();
-    canon.resize(arena.len(), u32::MAX);
-    let mut seen: FxHashMap<[u64; 3], SmallVec<[u32; 2]>> = FxHashMap::default();
-    for c in cells {
-        for &v in &c.verts {
-            let d = arena.dense(v);
-            if canon[d] != u32::MAX {
-                continue;
-            }
-            // each vertex's exact coordinates once
-            let vert = arena.vertex(v).to_owned();
-            let r = *rounded[d].get_or_insert_with(|| vert.to_f64());
-            let key = r.map(f64::to_bits);
-            let bucket = seen.entry(key).or_default();
-            let found = bucket.iter().copied().find(|&w| {
-                exact[arena.dense(w)]
-                    .as_ref()
-                    .is_some_and(|x| x.same_point(&vert))
-            });
-            canon[d] = match found {
-                Some(w) => w,
-                None => {
-                    bucket.push(v);
-                    v
-                }
-            };
-            exact[d] = Some(vert);
+/// A point of a merge: its exact value, its correctly rounded
+/// coordinates, and the arena id it was first seen with.
+#[derive(Clone, Debug)]
+struct MPoint {
+    vertex: Vertex,
+    rounded: [f64; 3],
+    id: u32,
+}
+
+/// One line of a merge: the cell edges on it (cell, from, to, as point
+/// indices), its points in order along it, and per interval between
+/// consecutive points the cells on its left and on its right.
+#[derive(Clone, Debug)]
+struct MLine {
+    /// The 3D axis that parametrizes the line.
+    t_axis: usize,
+    /// Direction of increasing `t` in `(u, v)` coordinates.
+    dir: [i128; 2],
+    edges: Vec<(u32, u32, u32)>,
+    pts: Vec<u32>,
+    iv: Vec<Sides>,
+}
+
+/// Points by exact identity: a base table (a cache's, shared) and the
+/// points added for one merge, found by their rounded coordinates first.
+struct Points<'a> {
+    base: &'a [MPoint],
+    base_bits: Option<&'a FxHashMap<[u64; 3], SmallVec<[u32; 2]>>>,
+    extra: Vec<MPoint>,
+    extra_bits: FxHashMap<[u64; 3], SmallVec<[u32; 2]>>,
+}
+
+impl<'a> Points<'a> {
+    fn get(&self, i: u32) -> &MPoint {
+        let i = i as usize;
+        if i < self.base.len() {
+            &self.base[i]
+        } else {
+            &self.extra[i - self.base.len()]
+        }
+    }
+
+    /// The index of the point equal to `vertex`, added if new.
+    fn add(&mut self, vertex: Vertex, rounded: [f64; 3], id: u32) -> u32 {
+        let key = rounded.map(f64::to_bits);
+        if let Some(b) = self.base_bits.and_then(|m| m.get(&key))
+            && let Some(&i) = b
+                .iter()
+                .find(|&&i| self.base[i as usize].vertex.same_point(&vertex))
+        {
+            return i;
+        }
+        let n = self.base.len() as u32;
+        let bucket = self.extra_bits.entry(key).or_default();
+        if let Some(&i) = bucket
+            .iter()
+            .find(|&&i| self.extra[(i - n) as usize].vertex.same_point(&vertex))
+        {
+            return i;
+        }
+        let i = n + self.extra.len() as u32;
+        bucket.push(i);
+        self.extra.push(MPoint {
+            vertex,
+            rounded,
+            id,
+        });
+        i
+    }
+}
+
+/// The merge's frame: the support plane's projection axes and the sign
+/// that makes `cross2` counter-clockwise-positive seen from its front.
+#[derive(Clone, Copy, Debug)]
+struct Frame {
+    u: usize,
+    v: usize,
+    sigma: i32,
+}
+
+impl Frame {
+    fn of(support: &Plane) -> Frame {
+        let (u, v, k) = axes(support);
+        Frame {
+            u,
+            v,
+            sigma: if support.normal()[k] > 0 { 1 } else { -1 },
         }
     }
 }
 
-/// Merges `cells` (tiling a region of the `support` plane without overlap,
-/// vertices and planes in `arena`) into maximal connected regions of equal
-/// `labels`, with their boundary loops.
-///
-/// `rounded` is a cache of correctly rounded vertex coordinates, indexed
-/// by [`PieceArena::dense`]; it is filled for every vertex the cells use (the
-/// caller's output conversion can reuse it). Regions come in the order of
-/// their first cell.
-///
-/// Panics (an internal error) if two cells overlap along an edge.
-pub fn merge_cells(
-    arena: &PieceArena,
-    support: &Plane,
-    cells: &[Piece],
-    labels: &[u64],
-    rounded: &mut Vec<Option<[f64; 3]>>,
-) -> Vec<Region> {
-    merge_cells_adjacent(arena, support, cells, labels, rounded, &mut Vec::new())
+/// A new line for `key`.
+fn new_line(key: &LineKey, f: &Frame) -> MLine {
+    let (t_axis, dir) = if key.b.unsigned_abs() >= key.a.unsigned_abs() {
+        // u varies along the line: parametrize by u
+        let s = key.b.signum();
+        (f.u, [s * key.b, -s * key.a])
+    } else {
+        let s = -key.a.signum();
+        (f.v, [s * key.b, -s * key.a])
+    };
+    MLine {
+        t_axis,
+        dir,
+        edges: Vec::new(),
+        pts: Vec::new(),
+        iv: Vec::new(),
+    }
 }
 
-/// [`merge_cells`], also listing in `adjacent` every pair of cells
-/// `[a, b]` (`a < b`, each pair once, in increasing order) that share a
-/// piece of edge: what a later, local re-merge needs to know.
-pub fn merge_cells_adjacent(
-    arena: &PieceArena,
-    support: &Plane,
-    cells: &[Piece],
-    labels: &[u64],
-    rounded: &mut Vec<Option<[f64; 3]>>,
-    adjacent: &mut Vec<[u32; 2]>,
-) -> Vec<Region> {
-    assert_eq!(cells.len(), labels.len(), "one label per cell");
-    adjacent.clear();
-    let (mut exact, mut canon_ids) = (Vec::new(), Vec::new());
-    canonical_ids(arena, cells, rounded, &mut exact, &mut canon_ids);
-    let canon = |v: u32| canon_ids[arena.dense(v)];
-    let (u_ax, v_ax, k_ax) = axes(support);
-    let sigma: i32 = if support.normal()[k_ax] > 0 { 1 } else { -1 };
-    let vx = |i: u32| exact[arena.dense(i)].as_ref().expect("a used vertex");
-
-    // group the edges by line
-    let mut lines: Vec<Line> = Vec::new();
-    let mut line_of: FxHashMap<LineKey, u32> = FxHashMap::default();
-    for (ci, c) in cells.iter().enumerate() {
-        let k = c.verts.len();
-        for j in 0..k {
-            let (a, b) = (canon(c.verts[j]), canon(c.verts[(j + 1) % k]));
-            if a == b {
-                continue;
-            }
-            let key = line_key(support, &arena.plane(c.edges[j]));
-            let id = *line_of.entry(key).or_insert_with(|| {
-                let (t_axis, dir) = if key.b.unsigned_abs() >= key.a.unsigned_abs() {
-                    // u varies along the line: parametrize by u
-                    let s = key.b.signum();
-                    (u_ax, [s * key.b, -s * key.a])
-                } else {
-                    let s = -key.a.signum();
-                    (v_ax, [s * key.b, -s * key.a])
-                };
-                lines.push(Line {
-                    t_axis,
-                    dir,
-                    edges: Vec::new(),
-                });
-                (lines.len() - 1) as u32
-            });
-            lines[id as usize].edges.push((ci as u32, a, b));
+/// Sorts the line's points (its edges' ends, plus any already in `pts`)
+/// along it and finds the cells on each side of every interval.
+fn settle(line: &mut MLine, points: &Points<'_>) {
+    let t = line.t_axis;
+    line.pts
+        .extend(line.edges.iter().flat_map(|&(_, a, b)| [a, b]));
+    line.pts.sort_unstable();
+    line.pts.dedup();
+    line.pts
+        .sort_by(|&a, &b| points.get(a).vertex.cmp_axis(&points.get(b).vertex, t));
+    let pos: FxHashMap<u32, usize> = line.pts.iter().enumerate().map(|(i, &p)| (p, i)).collect();
+    line.iv.clear();
+    line.iv
+        .resize(line.pts.len().saturating_sub(1), (None, None));
+    for &(ci, a, b) in &line.edges {
+        let (pa, pb) = (pos[&a], pos[&b]);
+        let (lo, hi, left) = if pa < pb {
+            (pa, pb, true)
+        } else {
+            (pb, pa, false)
+        };
+        for slot in &mut line.iv[lo..hi] {
+            let s = if left { &mut slot.0 } else { &mut slot.1 };
+            assert!(
+                s.is_none() || *s == Some(ci),
+                "merge_cells: two cells overlap along an edge"
+            );
+            *s = Some(ci);
         }
     }
+}
 
-    // along each line, the cells on the left and on the right of every
-    // elementary interval
-    let mut uf = UnionFind((0..cells.len() as u32).collect());
-    // per line: sorted points, and per interval (left cell, right cell)
-    let mut sides_of: Vec<(Vec<u32>, Vec<Sides>)> = Vec::with_capacity(lines.len());
-    for line in &lines {
-        let t = line.t_axis;
-        let mut pts: Vec<u32> = line.edges.iter().flat_map(|&(_, a, b)| [a, b]).collect();
-        pts.sort_unstable();
-        pts.dedup();
-        pts.sort_by(|&a, &b| vx(a).cmp_axis(vx(b), t));
-        let pos: FxHashMap<u32, usize> = pts.iter().enumerate().map(|(i, &p)| (p, i)).collect();
-        let mut iv: Vec<(Option<u32>, Option<u32>)> =
-            vec![(None, None); pts.len().saturating_sub(1)];
-        for &(ci, a, b) in &line.edges {
-            let (pa, pb) = (pos[&a], pos[&b]);
-            let (lo, hi, left) = if pa < pb {
-                (pa, pb, true)
-            } else {
-                (pb, pa, false)
-            };
-            for slot in &mut iv[lo..hi] {
-                let s = if left { &mut slot.0 } else { &mut slot.1 };
-                assert!(
-                    s.is_none() || *s == Some(ci),
-                    "merge_cells: two cells overlap along an edge"
-                );
-                *s = Some(ci);
-            }
-        }
-        for &(l, r) in &iv {
+/// A region as point indices.
+#[derive(Clone, Debug, Default)]
+struct PRegion {
+    label: u64,
+    outer: Vec<u32>,
+    holes: Vec<Vec<u32>>,
+    cells: Vec<u32>,
+}
+
+/// The union-find of `labels.len()` cells whose edges lie on `lines`:
+/// cells that share a piece of edge and a label are united (the root of a
+/// set is its smallest cell). `adjacent` receives every pair of cells
+/// that share a piece of edge.
+fn unite(lines: &[&MLine], labels: &[u64], adjacent: Option<&mut Vec<[u32; 2]>>) -> UnionFind {
+    let mut uf = UnionFind((0..labels.len() as u32).collect());
+    let mut adj = adjacent;
+    for line in lines {
+        for &(l, r) in &line.iv {
             if let (Some(l), Some(r)) = (l, r) {
-                adjacent.push([l.min(r), l.max(r)]);
+                if let Some(a) = adj.as_deref_mut() {
+                    a.push([l.min(r), l.max(r)]);
+                }
                 if labels[l as usize] == labels[r as usize] {
                     uf.union(l, r);
                 }
             }
         }
-        sides_of.push((pts, iv));
     }
+    if let Some(a) = adj {
+        a.sort_unstable();
+        a.dedup();
+    }
+    uf
+}
 
+/// The regions of the cells labelled `labels` whose edges lie on `lines`
+/// (united in `uf`). Regions whose root `skip` names are neither traced
+/// nor returned.
+fn trace(
+    lines: &[&MLine],
+    labels: &[u64],
+    points: &Points<'_>,
+    f: Frame,
+    uf: &mut UnionFind,
+    skip: impl Fn(u32) -> bool,
+) -> Vec<PRegion> {
+    let n = labels.len();
     // boundary pieces, each with its region on the left
     let mut segs: Vec<Seg> = Vec::new();
-    for (li, (pts, iv)) in sides_of.iter().enumerate() {
-        for (i, &(l, r)) in iv.iter().enumerate() {
+    for (li, line) in lines.iter().enumerate() {
+        for (i, &(l, r)) in line.iv.iter().enumerate() {
             let same =
                 matches!((l, r), (Some(l), Some(r)) if labels[l as usize] == labels[r as usize]);
             if same {
                 continue;
             }
             if let Some(l) = l {
-                segs.push(Seg {
-                    from: pts[i],
-                    to: pts[i + 1],
-                    line: li as u32,
-                    forward: true,
-                    region: uf.find(l),
-                });
+                let region = uf.find(l);
+                if !skip(region) {
+                    segs.push(Seg {
+                        from: line.pts[i],
+                        to: line.pts[i + 1],
+                        line: li as u32,
+                        forward: true,
+                        region,
+                    });
+                }
             }
             if let Some(r) = r {
-                segs.push(Seg {
-                    from: pts[i + 1],
-                    to: pts[i],
-                    line: li as u32,
-                    forward: false,
-                    region: uf.find(r),
-                });
+                let region = uf.find(r);
+                if !skip(region) {
+                    segs.push(Seg {
+                        from: line.pts[i + 1],
+                        to: line.pts[i],
+                        line: li as u32,
+                        forward: false,
+                        region,
+                    });
+                }
             }
         }
     }
@@ -341,7 +368,6 @@ pub fn merge_cells_adjacent(
             .push(i as u32);
     }
     let mut used = vec![false; segs.len()];
-    // region root -> loops (as segment lists)
     let mut loops: Vec<(u32, Vec<u32>)> = Vec::new();
     for start in 0..segs.len() {
         if used[start] {
@@ -367,7 +393,7 @@ pub fn merge_cells_adjacent(
                             r,
                             dir_of(&segs[a as usize]),
                             dir_of(&segs[b as usize]),
-                            sigma,
+                            f.sigma,
                         )
                     })
                     .expect("a boundary piece continues")
@@ -385,8 +411,7 @@ pub fn merge_cells_adjacent(
 
     // corners only, then outer loop and holes per region
     let mut by_region: FxHashMap<u32, usize> = FxHashMap::default();
-    let mut regions: Vec<Region> = Vec::new();
-    let mut first_cell: Vec<u32> = Vec::new();
+    let mut regions: Vec<PRegion> = Vec::new();
     let mut loop_lists: Vec<Vec<Vec<u32>>> = Vec::new();
     for (region, path) in &loops {
         let m = path.len();
@@ -395,13 +420,10 @@ pub fn merge_cells_adjacent(
             .map(|i| segs[path[i] as usize].from)
             .collect();
         let idx = *by_region.entry(*region).or_insert_with(|| {
-            regions.push(Region {
+            regions.push(PRegion {
                 label: labels[*region as usize],
-                outer: Vec::new(),
-                holes: Vec::new(),
-                cells: Vec::new(),
+                ..PRegion::default()
             });
-            first_cell.push(*region);
             loop_lists.push(Vec::new());
             regions.len() - 1
         });
@@ -413,7 +435,7 @@ pub fn merge_cells_adjacent(
             continue;
         }
         for l in list {
-            if signed_area_sign(arena, &exact, rounded, &l, u_ax, v_ax) * sigma > 0 {
+            if signed_area_sign(points, &l, f.u, f.v) * f.sigma > 0 {
                 debug_assert!(regions[ri].outer.is_empty(), "a region has one outer loop");
                 regions[ri].outer = l;
             } else {
@@ -422,21 +444,439 @@ pub fn merge_cells_adjacent(
         }
     }
     // the cells of each region, and regions in the order of their first cell
-    for ci in 0..cells.len() as u32 {
+    for ci in 0..n as u32 {
         let root = uf.find(ci);
         if let Some(&ri) = by_region.get(&root) {
             regions[ri].cells.push(ci);
         }
     }
-    adjacent.sort_unstable();
-    adjacent.dedup();
-    let mut order: Vec<usize> = (0..regions.len()).collect();
-    order.sort_by_key(|&i| first_cell[i]);
-    let mut out: Vec<Option<Region>> = regions.into_iter().map(Some).collect();
-    order
+    regions.sort_by_key(|r| r.cells.first().copied().unwrap_or(u32::MAX));
+    regions
+}
+
+/// The points, lines and per-cell indices of `cells`.
+struct Built<'a> {
+    points: Points<'a>,
+    lines: Vec<MLine>,
+    line_of: FxHashMap<LineKey, u32>,
+    cell_points: Vec<SmallVec<[u32; 6]>>,
+    cell_lines: Vec<SmallVec<[u32; 6]>>,
+}
+
+fn build<'a>(arena: &PieceArena, support: &Plane, cells: &[Piece], f: &Frame) -> Built<'a> {
+    let mut points = Points {
+        base: &[],
+        base_bits: None,
+        extra: Vec::new(),
+        extra_bits: FxHashMap::default(),
+    };
+    let mut seen: FxHashMap<u32, u32> = FxHashMap::default();
+    let cell_points: Vec<SmallVec<[u32; 6]>> = cells
+        .iter()
+        .map(|c| {
+            c.verts
+                .iter()
+                .map(|&v| {
+                    *seen.entry(v).or_insert_with(|| {
+                        // each vertex's exact coordinates once
+                        let vert = arena.vertex(v).to_owned();
+                        let r = vert.to_f64();
+                        points.add(vert, r, v)
+                    })
+                })
+                .collect()
+        })
+        .collect();
+    let mut lines: Vec<MLine> = Vec::new();
+    let mut line_of: FxHashMap<LineKey, u32> = FxHashMap::default();
+    let mut cell_lines: Vec<SmallVec<[u32; 6]>> = Vec::with_capacity(cells.len());
+    for (ci, c) in cells.iter().enumerate() {
+        let pts = &cell_points[ci];
+        let k = pts.len();
+        let mut ls = SmallVec::new();
+        for j in 0..k {
+            let (a, b) = (pts[j], pts[(j + 1) % k]);
+            let key = line_key(support, &arena.plane(c.edges[j]));
+            let id = *line_of.entry(key).or_insert_with(|| {
+                lines.push(new_line(&key, f));
+                (lines.len() - 1) as u32
+            });
+            if a != b {
+                lines[id as usize].edges.push((ci as u32, a, b));
+            }
+            ls.push(id);
+        }
+        cell_lines.push(ls);
+    }
+    for line in &mut lines {
+        settle(line, &points);
+    }
+    Built {
+        points,
+        lines,
+        line_of,
+        cell_points,
+        cell_lines,
+    }
+}
+
+/// Merges `cells` (tiling a region of the `support` plane without overlap,
+/// vertices and planes in `arena`) into maximal connected regions of equal
+/// `labels`, with their boundary loops.
+///
+/// `rounded` is a cache of correctly rounded vertex coordinates, indexed
+/// by [`PieceArena::dense`]; it is filled for every vertex the cells use (the
+/// caller's output conversion can reuse it). Regions come in the order of
+/// their first cell.
+///
+/// Panics (an internal error) if two cells overlap along an edge.
+pub fn merge_cells(
+    arena: &PieceArena,
+    support: &Plane,
+    cells: &[Piece],
+    labels: &[u64],
+    rounded: &mut Vec<Option<[f64; 3]>>,
+) -> Vec<Region> {
+    merge_cells_adjacent(arena, support, cells, labels, rounded, &mut Vec::new())
+}
+
+/// [`merge_cells`], also listing in `adjacent` every pair of cells
+/// `[a, b]` (`a < b`, each pair once, in increasing order) that share a
+/// piece of edge.
+pub fn merge_cells_adjacent(
+    arena: &PieceArena,
+    support: &Plane,
+    cells: &[Piece],
+    labels: &[u64],
+    rounded: &mut Vec<Option<[f64; 3]>>,
+    adjacent: &mut Vec<[u32; 2]>,
+) -> Vec<Region> {
+    assert_eq!(cells.len(), labels.len(), "one label per cell");
+    adjacent.clear();
+    let f = Frame::of(support);
+    let b = build(arena, support, cells, &f);
+    rounded.resize(arena.len(), None);
+    for (c, pts) in cells.iter().zip(&b.cell_points) {
+        for (&v, &p) in c.verts.iter().zip(pts) {
+            rounded[arena.dense(v)] = Some(b.points.get(p).rounded);
+        }
+    }
+    let lines: Vec<&MLine> = b.lines.iter().collect();
+    let mut uf = unite(&lines, labels, Some(adjacent));
+    let regions = trace(&lines, labels, &b.points, f, &mut uf, |_| false);
+    let id = |p: &u32| b.points.get(*p).id;
+    regions
         .into_iter()
-        .map(|i| out[i].take().expect("each region once"))
+        .map(|r| Region {
+            label: r.label,
+            outer: r.outer.iter().map(id).collect(),
+            holes: r.holes.iter().map(|h| h.iter().map(id).collect()).collect(),
+            cells: r.cells,
+        })
         .collect()
+}
+
+/// A region merge kept for merging the same cells again after some of them
+/// change (the static shadows of a face under a moving object's).
+///
+/// It holds what a merge computes once: the cells' exact points, each
+/// edge's line, every line's points in order and the cells on both sides
+/// of each interval, and the regions. [`MergeCache::remerge`] then works
+/// only on the lines the changed cells touch and traces only the regions
+/// that change; the regions are the same as a full [`merge_cells`] of the
+/// new cells would make.
+#[derive(Clone, Debug)]
+pub struct MergeCache {
+    frame: Frame,
+    support: Plane,
+    points: Vec<MPoint>,
+    bits: FxHashMap<[u64; 3], SmallVec<[u32; 2]>>,
+    lines: Vec<MLine>,
+    line_of: FxHashMap<LineKey, u32>,
+    cell_points: Vec<SmallVec<[u32; 6]>>,
+    cell_lines: Vec<SmallVec<[u32; 6]>>,
+    labels: Vec<u64>,
+    /// Per cell, its region.
+    region_of: Vec<u32>,
+    /// Per region, its cell count.
+    region_size: Vec<u32>,
+}
+
+/// A merged region of a [`MergeCache::remerge`]: its label, its rings and
+/// cells as indices into the [`Remerged`] it belongs to.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MergedRegion {
+    /// The cells' label.
+    pub label: u64,
+    /// The outer boundary (point indices), counter-clockwise seen from
+    /// the front of the support plane; corners only.
+    pub outer: Vec<u32>,
+    /// The holes, each clockwise.
+    pub holes: Vec<Vec<u32>>,
+    /// The cells: cached cells `0..n`, then the new pieces `n..`.
+    pub cells: Vec<u32>,
+}
+
+/// The result of [`MergeCache::remerge`].
+#[derive(Clone, Debug)]
+pub struct Remerged {
+    base: usize,
+    extra: Vec<MPoint>,
+    piece_points: Vec<SmallVec<[u32; 6]>>,
+    /// The regions that differ from the cache's, in the order of their
+    /// first cell.
+    pub regions: Vec<MergedRegion>,
+    /// The cache's regions that stand as they were (indices, ascending).
+    pub standing: Vec<u32>,
+}
+
+impl Remerged {
+    /// Point `i`'s exact value and correctly rounded coordinates.
+    pub fn point<'c>(&'c self, cache: &'c MergeCache, i: u32) -> (&'c Vertex, [f64; 3]) {
+        let p = if (i as usize) < self.base {
+            &cache.points[i as usize]
+        } else {
+            &self.extra[i as usize - self.base]
+        };
+        (&p.vertex, p.rounded)
+    }
+
+    /// The points of cell `c` (a cached cell below the cache's cell count,
+    /// else a new piece).
+    pub fn cell_points<'c>(&'c self, cache: &'c MergeCache, c: u32) -> &'c [u32] {
+        let n = cache.cell_points.len();
+        if (c as usize) < n {
+            &cache.cell_points[c as usize]
+        } else {
+            &self.piece_points[c as usize - n]
+        }
+    }
+}
+
+impl MergeCache {
+    /// Merges `cells` as [`merge_cells`] does and keeps what a re-merge
+    /// needs. Returns the regions too, in the cache's region order.
+    pub fn new(
+        arena: &PieceArena,
+        support: &Plane,
+        cells: &[Piece],
+        labels: &[u64],
+    ) -> (MergeCache, Vec<Region>) {
+        assert_eq!(cells.len(), labels.len(), "one label per cell");
+        let f = Frame::of(support);
+        let b = build(arena, support, cells, &f);
+        let lines: Vec<&MLine> = b.lines.iter().collect();
+        let mut uf = unite(&lines, labels, None);
+        let regions = trace(&lines, labels, &b.points, f, &mut uf, |_| false);
+        let mut region_of = vec![0u32; cells.len()];
+        let mut region_size = Vec::with_capacity(regions.len());
+        for (ri, r) in regions.iter().enumerate() {
+            for &c in &r.cells {
+                region_of[c as usize] = ri as u32;
+            }
+            region_size.push(r.cells.len() as u32);
+        }
+        let id = |p: &u32| b.points.get(*p).id;
+        let out = regions
+            .into_iter()
+            .map(|r| Region {
+                label: r.label,
+                outer: r.outer.iter().map(id).collect(),
+                holes: r.holes.iter().map(|h| h.iter().map(id).collect()).collect(),
+                cells: r.cells,
+            })
+            .collect();
+        let cache = MergeCache {
+            frame: f,
+            support: *support,
+            points: b.points.extra,
+            bits: b.points.extra_bits,
+            lines: b.lines,
+            line_of: b.line_of,
+            cell_points: b.cell_points,
+            cell_lines: b.cell_lines,
+            labels: labels.to_vec(),
+            region_of,
+            region_size,
+        };
+        (cache, out)
+    }
+
+    /// Number of cached cells.
+    pub fn cell_count(&self) -> usize {
+        self.cell_points.len()
+    }
+
+    /// Number of cached regions.
+    pub fn region_count(&self) -> usize {
+        self.region_size.len()
+    }
+
+    /// Cell `c`'s region.
+    pub fn region_of(&self, c: u32) -> u32 {
+        self.region_of[c as usize]
+    }
+
+    /// The regions after a change: the cached cells listed in `removed`
+    /// are replaced by `pieces` (in `arena`, labelled `piece_labels`, on
+    /// the same support plane, covering exactly the removed cells), and
+    /// the cached cells in `relabel` take new labels. Only the lines the
+    /// change touches are redone, and only the regions that change are
+    /// traced: [`Remerged::standing`] lists the cached regions that stand.
+    pub fn remerge(
+        &self,
+        removed: &[u32],
+        relabel: &[(u32, u64)],
+        arena: &PieceArena,
+        pieces: &[Piece],
+        piece_labels: &[u64],
+    ) -> Remerged {
+        assert_eq!(pieces.len(), piece_labels.len(), "one label per piece");
+        let n = self.cell_points.len();
+        let f = self.frame;
+        let mut points = Points {
+            base: &self.points,
+            base_bits: Some(&self.bits),
+            extra: Vec::new(),
+            extra_bits: FxHashMap::default(),
+        };
+        let mut labels = self.labels.clone();
+        let mut changed = vec![false; n];
+        for &(c, l) in relabel {
+            labels[c as usize] = l;
+            changed[c as usize] = true;
+        }
+        let mut gone = vec![false; n];
+        for &c in removed {
+            gone[c as usize] = true;
+            changed[c as usize] = true;
+        }
+        labels.extend_from_slice(piece_labels);
+        // the new pieces' points and lines
+        let mut seen: FxHashMap<u32, u32> = FxHashMap::default();
+        let piece_points: Vec<SmallVec<[u32; 6]>> = pieces
+            .iter()
+            .map(|c| {
+                c.verts
+                    .iter()
+                    .map(|&v| {
+                        *seen.entry(v).or_insert_with(|| {
+                            let vert = arena.vertex(v).to_owned();
+                            let r = vert.to_f64();
+                            points.add(vert, r, v)
+                        })
+                    })
+                    .collect()
+            })
+            .collect();
+        // touched lines: copies of the cached ones, and new ones
+        let mut touched: FxHashMap<u32, MLine> = FxHashMap::default();
+        let mut fresh: Vec<MLine> = Vec::new();
+        let mut fresh_of: FxHashMap<LineKey, u32> = FxHashMap::default();
+        for &c in removed {
+            for &l in &self.cell_lines[c as usize] {
+                touched.entry(l).or_insert_with(|| {
+                    let mut line = self.lines[l as usize].clone();
+                    line.edges.retain(|e| !gone[e.0 as usize]);
+                    line
+                });
+            }
+        }
+        let nl = self.lines.len() as u32;
+        for (k, (c, pts)) in pieces.iter().zip(&piece_points).enumerate() {
+            let m = pts.len();
+            for j in 0..m {
+                let (a, b) = (pts[j], pts[(j + 1) % m]);
+                let key = line_key(&self.support, &arena.plane(c.edges[j]));
+                let line = match self.line_of.get(&key) {
+                    Some(&l) => touched.entry(l).or_insert_with(|| {
+                        let mut line = self.lines[l as usize].clone();
+                        line.edges.retain(|e| !gone[e.0 as usize]);
+                        line
+                    }),
+                    None => {
+                        let i = *fresh_of.entry(key).or_insert_with(|| {
+                            fresh.push(new_line(&key, &f));
+                            nl + fresh.len() as u32 - 1
+                        });
+                        &mut fresh[(i - nl) as usize]
+                    }
+                };
+                if a != b {
+                    line.edges.push(((n + k) as u32, a, b));
+                }
+            }
+        }
+        for line in touched.values_mut().chain(fresh.iter_mut()) {
+            settle(line, &points);
+        }
+        let mut all: Vec<&MLine> = Vec::with_capacity(self.lines.len() + fresh.len());
+        for (i, line) in self.lines.iter().enumerate() {
+            all.push(touched.get(&(i as u32)).unwrap_or(line));
+        }
+        all.extend(fresh.iter());
+        // a cached region stands when none of its cells changed and its
+        // cells make up a whole new region (nothing joined it)
+        let regions = self.region_size.len();
+        let mut intact = vec![true; regions];
+        for c in 0..n {
+            if changed[c] {
+                intact[self.region_of[c] as usize] = false;
+            }
+        }
+        let mut uf = unite(&all, &labels, None);
+        let mut size = vec![0u32; labels.len()];
+        for c in 0..labels.len() as u32 {
+            if (c as usize) < n && gone[c as usize] {
+                continue;
+            }
+            size[uf.find(c) as usize] += 1;
+        }
+        let mut standing_root = vec![false; labels.len()];
+        let mut standing = Vec::new();
+        let mut first = vec![u32::MAX; regions];
+        for c in (0..n).rev() {
+            first[self.region_of[c] as usize] = c as u32;
+        }
+        for r in 0..regions {
+            if !intact[r] {
+                continue;
+            }
+            let root = uf.find(first[r]);
+            if size[root as usize] == self.region_size[r] {
+                standing_root[root as usize] = true;
+                standing.push(r as u32);
+            }
+        }
+        let traced = trace(&all, &labels, &points, f, &mut uf, |root| {
+            standing_root[root as usize]
+        });
+        // removed cells have no edges left: they are not regions
+        let regions = traced
+            .into_iter()
+            .filter(|r| {
+                r.cells
+                    .iter()
+                    .any(|&c| (c as usize) >= n || !gone[c as usize])
+            })
+            .map(|mut r| {
+                r.cells.retain(|&c| (c as usize) >= n || !gone[c as usize]);
+                MergedRegion {
+                    label: r.label,
+                    outer: r.outer,
+                    holes: r.holes,
+                    cells: r.cells,
+                }
+            })
+            .collect();
+        Remerged {
+            base: self.points.len(),
+            extra: points.extra,
+            piece_points,
+            regions,
+            standing,
+        }
+    }
 }
 
 /// Orders `a` and `b` by the clockwise angle from `r` (seen from the
@@ -473,16 +913,9 @@ fn cmp_clockwise(r: [i128; 2], a: [i128; 2], b: [i128; 2], sigma: i32) -> Orderi
 
 /// The sign of a loop's signed area in `(u, v)` coordinates: the `f64`
 /// shoelace sum when its error bound certifies it, else exact rationals.
-fn signed_area_sign(
-    arena: &PieceArena,
-    exact: &[Option<Vertex>],
-    rounded: &[Option<[f64; 3]>],
-    l: &[u32],
-    u: usize,
-    v: usize,
-) -> i32 {
+fn signed_area_sign(points: &Points<'_>, l: &[u32], u: usize, v: usize) -> i32 {
     let m = l.len();
-    let p = |i: usize| rounded[arena.dense(l[i % m])].expect("rounded above");
+    let p = |i: usize| points.get(l[i % m]).rounded;
     let (mut s, mut t) = (0.0f64, 0.0f64);
     for i in 0..m {
         let (a, b) = (p(i), p(i + 1));
@@ -500,10 +933,7 @@ fn signed_area_sign(
         return -1;
     }
     let q = |i: usize| -> [BigRational; 2] {
-        match exact[arena.dense(l[i % m])]
-            .as_ref()
-            .expect("a used vertex")
-        {
+        match &points.get(l[i % m]).vertex {
             Vertex::Grid(g) => [
                 BigRational::from_integer(BigInt::from(g[u])),
                 BigRational::from_integer(BigInt::from(g[v])),

@@ -19,7 +19,10 @@
 
 use std::ops::Range;
 
-use bsp_core::{ArenaMark, Piece, PieceArena, Plane, Polygon, Side, Vertex, merge_cells_adjacent};
+use bsp_core::{
+    ArenaMark, EdgeRef, MergeCache, Piece, PieceArena, Plane, Polygon, Region, Remerged, Side,
+    Vertex, merge_cells,
+};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
@@ -207,22 +210,36 @@ impl Shadows {
         let first = polys.first()?;
         let start = Start::Uniform(self.facing(first.support()));
         self.filter_lights(polys, &start, scratch);
-        let s = &*scratch;
+        let s = &mut *scratch;
         let uniform = s.cur.iter().all(|(_, l)| *l == s.cur[0].1);
         if uniform {
-            self.finish(polys, receiver, opts, scratch, out, None);
+            self.finish(polys, receiver, opts, scratch, out);
             return None;
         }
-        let mut cells = Cells {
+        let support = *first.support();
+        s.pieces.clear();
+        s.labels.clear();
+        for (p, l) in &s.cur {
+            s.pieces.push(p.clone());
+            s.labels.push(*l);
+        }
+        let (merge, regions) = MergeCache::new(&s.arena, &support, &s.pieces, &s.labels);
+        let cells = Cells {
             arena: s.arena.clone(),
-            cells: s.cur.clone(),
+            cells: std::mem::take(&mut s.cur),
             support: s.support,
-            region: Vec::new(),
-            adjacent: Vec::new(),
+            merge,
         };
-        let mut info = (Vec::new(), Vec::new());
-        self.finish(polys, receiver, opts, scratch, out, Some(&mut info));
-        (cells.region, cells.adjacent) = info;
+        s.rounded.clear();
+        out.push_regions(
+            first.tag(),
+            receiver,
+            self.facing(&support),
+            &support,
+            s,
+            &regions,
+            opts,
+        );
         Some(cells)
     }
 
@@ -245,16 +262,24 @@ impl Shadows {
             return;
         }
         self.filter_lights(polys, start, scratch);
-        self.finish(polys, receiver, opts, scratch, out, None);
+        self.finish(polys, receiver, opts, scratch, out);
     }
 
     /// [`Shadows::refine`] that redoes only what these trees change:
     /// nothing when every cell comes back whole with its flags
-    /// ([`Refined::Unchanged`]); from [`Start::Cells`], only the regions
-    /// the changed cells belong to, or merge with, are merged again, and
-    /// the receiver's other starting fragments stand ([`Refined::Some`]).
-    /// Either way the receiver's fragments are then those [`Shadows::refine`]
-    /// makes (the same regions, perhaps in another order).
+    /// ([`Refined::Unchanged`]); from [`Start::Cells`], only the cells the
+    /// trees cut or shadow are filtered, the cached merge is redone only
+    /// where they are ([`MergeCache::remerge`]), and the receiver's other
+    /// starting fragments stand ([`Refined::Some`]). The receiver's
+    /// fragments are then those [`Shadows::refine`] makes (the same
+    /// regions, perhaps in another order).
+    ///
+    /// `may_change(cell, light)` may answer `false` for a cell (an index
+    /// into the starting cells; 0 for a [`Start::Uniform`] receiver) that
+    /// light `light`'s tree cannot shadow — a cheap culling test of the
+    /// caller's; it must never answer `false` for a cell the tree does
+    /// shadow.
+    #[allow(clippy::too_many_arguments)]
     pub fn refine_cells(
         &self,
         polys: &[Polygon],
@@ -263,80 +288,132 @@ impl Shadows {
         opts: &ShadeOptions,
         scratch: &mut Scratch,
         out: &mut Batch,
+        may_change: impl Fn(u32, usize) -> bool,
     ) -> Refined {
-        if polys.is_empty() || !self.filter_lights(polys, start, scratch) {
+        let Some(first) = polys.first() else {
             return Refined::Unchanged;
-        }
-        let Start::Cells(cells) = start else {
-            self.finish(polys, receiver, opts, scratch, out, None);
-            return Refined::All;
         };
-        let s = &mut *scratch;
-        let n = cells.cells.len();
-        // the cells that changed, and the flags of their pieces
-        let mut count = vec![0u32; n];
-        let mut changed = vec![false; n];
-        for ((_, flags), &o) in s.cur.iter().zip(&s.origin) {
-            count[o as usize] += 1;
-            changed[o as usize] |= *flags != cells.cells[o as usize].1;
-        }
-        for o in 0..n {
-            changed[o] |= count[o] != 1;
-        }
-        let regions = cells.region.iter().max().map_or(0, |&r| r as usize + 1);
-        let mut touched = vec![false; regions];
-        for o in 0..n {
-            if changed[o] {
-                touched[cells.region[o] as usize] = true;
-            }
-        }
-        // a changed cell's piece may now have the flags of a neighbouring
-        // region: that region is merged again too (its own cells did not
-        // change, so nothing spreads further)
-        let mut pieces_of: Vec<SmallVec<[u64; 2]>> = vec![SmallVec::new(); n];
-        for ((_, flags), &o) in s.cur.iter().zip(&s.origin) {
-            if changed[o as usize] {
-                pieces_of[o as usize].push(*flags);
-            }
-        }
-        for &[a, b] in &cells.adjacent {
-            for (x, y) in [(a, b), (b, a)] {
-                let ry = cells.region[y as usize] as usize;
-                if changed[x as usize]
-                    && !touched[ry]
-                    && pieces_of[x as usize].contains(&cells.cells[y as usize].1)
+        let cells = match start {
+            Start::Cells(c) => *c,
+            Start::Uniform(flags) => {
+                let bits = self.facing(first.support()) & flags;
+                if (0..self.lights.len()).all(|j| bits >> j & 1 == 0 || !may_change(0, j))
+                    || !self.filter_lights(polys, start, scratch)
                 {
-                    touched[ry] = true;
+                    return Refined::Unchanged;
+                }
+                self.finish(polys, receiver, opts, scratch, out);
+                return Refined::All;
+            }
+        };
+        let support = *first.support();
+        let facing = self.facing(&support);
+        let s = scratch;
+        // the cells that change: a quick test on the cached arena first,
+        // then the exact filter on a copy of the few it cannot settle
+        s.arena.clear();
+        s.support = s.arena.add_plane(support);
+        s.pieces.clear();
+        s.labels.clear();
+        let (mut removed, mut relabel) = (Vec::new(), Vec::new());
+        for (i, (piece, flags)) in cells.cells.iter().enumerate() {
+            let live = flags & facing;
+            let mut now = *flags;
+            let mut cut = 0u64;
+            for (j, sv) in self.volumes.iter().enumerate() {
+                let bit = 1u64 << j;
+                if live & bit == 0 || !may_change(i as u32, j) {
+                    continue;
+                }
+                match crate::psv::reach(
+                    &sv.nodes,
+                    sv.root,
+                    |p| cells.arena.sides_shared(piece, p),
+                    crate::psv::REACH_BUDGET,
+                    &mut s.links,
+                ) {
+                    Some((true, false)) => {}
+                    Some((false, true)) => now &= !bit,
+                    _ => cut |= bit,
                 }
             }
+            if cut == 0 {
+                if now != *flags {
+                    relabel.push((i as u32, now));
+                }
+                continue;
+            }
+            // the cell in the scratch arena, filtered by the lights that
+            // may cut it
+            let mut copy = Piece::default();
+            for (&v, &e) in piece.verts.iter().zip(&piece.edges) {
+                copy.verts.push(s.arena.copy_vertex(&cells.arena, v));
+                copy.edges
+                    .push(EdgeRef::new(s.arena.add_plane(cells.arena.plane(e)), false));
+            }
+            s.cur.clear();
+            s.cur.push((copy, now));
+            for (j, sv) in self.volumes.iter().enumerate() {
+                let bit = 1u64 << j;
+                if cut & bit == 0 {
+                    continue;
+                }
+                s.next.clear();
+                for (piece, flags) in s.cur.drain(..) {
+                    if flags & bit == 0 {
+                        s.next.push((piece, flags));
+                        continue;
+                    }
+                    s.out.clear();
+                    filter(
+                        sv,
+                        &mut s.arena,
+                        s.support,
+                        piece,
+                        &mut s.out,
+                        &mut s.stack,
+                        &mut s.links,
+                        &mut s.sides,
+                    );
+                    for (p, lit) in s.out.drain(..) {
+                        s.next.push((p, flags & !bit | (lit as u64) << j));
+                    }
+                }
+                std::mem::swap(&mut s.cur, &mut s.next);
+            }
+            if s.cur.len() == 1 {
+                let f = s.cur[0].1;
+                if f != *flags {
+                    relabel.push((i as u32, f));
+                }
+                continue;
+            }
+            removed.push(i as u32);
+            for (p, f) in s.cur.drain(..) {
+                s.pieces.push(p);
+                s.labels.push(f);
+            }
         }
-        if touched.iter().all(|&t| t) {
-            self.finish(polys, receiver, opts, scratch, out, None);
-            return Refined::All;
+        if removed.is_empty() && relabel.is_empty() {
+            return Refined::Unchanged;
         }
-        let keep: Vec<bool> = s
-            .origin
-            .iter()
-            .map(|&o| touched[cells.region[o as usize] as usize])
-            .collect();
-        let mut k = keep.iter();
-        s.cur.retain(|_| *k.next().expect("one flag per piece"));
-        let support = *polys[0].support();
-        out.push_receiver(
-            polys[0].tag(),
+        let merged = cells
+            .merge
+            .remerge(&removed, &relabel, &s.arena, &s.pieces, &s.labels);
+        out.push_remerged(
+            first.tag(),
             receiver,
-            self.facing(&support),
+            facing,
             &support,
-            s,
-            false,
+            &cells.merge,
+            &merged,
             opts,
-            None,
         );
-        Refined::Some(
-            (0..regions as u32)
-                .filter(|&r| !touched[r as usize])
-                .collect(),
-        )
+        if merged.standing.is_empty() {
+            Refined::All
+        } else {
+            Refined::Some(merged.standing)
+        }
     }
 
     /// Sets the scratch up with the receiver's cells as `start` says, and
@@ -364,8 +441,6 @@ impl Shadows {
                 s.whole = s.arena.add_polygon(&polys[0]);
             }
         }
-        s.origin.clear();
-        s.origin.extend(0..s.cur.len() as u32);
         let facing = self.facing(&support);
         let mut changed = false;
         for (j, sv) in self.volumes.iter().enumerate() {
@@ -374,11 +449,9 @@ impl Shadows {
                 continue; // attached shadow: the flag stays 0
             }
             s.next.clear();
-            s.next_origin.clear();
-            for ((piece, flags), o) in s.cur.drain(..).zip(s.origin.drain(..)) {
+            for (piece, flags) in s.cur.drain(..) {
                 if flags & bit == 0 {
                     s.next.push((piece, flags));
-                    s.next_origin.push(o);
                     continue;
                 }
                 s.out.clear();
@@ -396,17 +469,14 @@ impl Shadows {
                 changed |= s.out.len() != 1 || !s.out[0].1;
                 for (p, lit) in s.out.drain(..) {
                     s.next.push((p, flags & !bit | (lit as u64) << j));
-                    s.next_origin.push(o);
                 }
             }
             std::mem::swap(&mut s.cur, &mut s.next);
-            std::mem::swap(&mut s.origin, &mut s.next_origin);
         }
         changed
     }
 
-    /// Merges the scratch's cells into regions and appends them; `info`
-    /// receives each cell's region and the cells' adjacency.
+    /// Merges the scratch's cells into regions and appends them.
     fn finish(
         &self,
         polys: &[Polygon],
@@ -414,7 +484,6 @@ impl Shadows {
         opts: &ShadeOptions,
         s: &mut Scratch,
         out: &mut Batch,
-        info: Option<&mut MergeInfo>,
     ) {
         let support = *polys[0].support();
         let facing = self.facing(&support);
@@ -426,7 +495,6 @@ impl Shadows {
             s,
             polys.len() == 1,
             opts,
-            info,
         );
     }
 
@@ -483,9 +551,6 @@ pub struct Scratch {
     support: u32,
     cur: Vec<(Piece, u64)>,
     next: Vec<(Piece, u64)>,
-    /// Per piece of `cur` (`next`), the starting cell it came from.
-    origin: Vec<u32>,
-    next_origin: Vec<u32>,
     out: Vec<(Piece, bool)>,
     stack: Vec<Task>,
     links: Vec<u32>,
@@ -505,15 +570,10 @@ pub struct Cells {
     arena: PieceArena,
     cells: Vec<(Piece, u64)>,
     support: u32,
-    /// Per cell, its region: the index of its fragment among the
-    /// receiver's fragments.
-    region: Vec<u32>,
-    /// Pairs of cells that share a piece of edge.
-    adjacent: Vec<[u32; 2]>,
+    /// The cells' merge into the receiver's fragments, kept for redoing
+    /// it where they change.
+    merge: MergeCache,
 }
-
-/// Each cell's region, and the pairs of adjacent cells.
-type MergeInfo = (Vec<u32>, Vec<[u32; 2]>);
 
 /// What [`Shadows::refine_cells`] did.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -530,6 +590,31 @@ pub enum Refined {
 }
 
 impl Cells {
+    /// Per cell, a box of grid points that holds it: the floor and ceiling
+    /// of its vertices' correctly rounded coordinates widened by one step
+    /// (a rounded coordinate is within half a step of the exact one), for
+    /// culling tests such as [`Shadows::refine_cells`]'s.
+    pub fn bounds(&self) -> Vec<([i32; 3], [i32; 3])> {
+        self.cells
+            .iter()
+            .map(|(c, _)| {
+                let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+                for &v in &c.verts {
+                    let p = self.arena.vertex(v).to_f64();
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(p[k]);
+                        hi[k] = hi[k].max(p[k]);
+                    }
+                }
+                let m = bsp_core::MAX_COORD as f64;
+                (
+                    lo.map(|x| (x.floor() - 1.0).clamp(-m, m) as i32),
+                    hi.map(|x| (x.ceil() + 1.0).clamp(-m, m) as i32),
+                )
+            })
+            .collect()
+    }
+
     /// Number of cells.
     pub fn len(&self) -> usize {
         self.cells.len()
@@ -589,8 +674,7 @@ fn filter(
     match crate::psv::reach(
         &sv.nodes,
         sv.root,
-        arena,
-        &piece,
+        |p| arena.sides(&piece, p),
         crate::psv::REACH_BUDGET,
         links,
     ) {
@@ -965,6 +1049,21 @@ impl Batch {
         *slot
     }
 
+    fn push_meta(&mut self, face: u32, receiver: u32, lit: u64, facing: u64, support: &Plane) {
+        self.face.push(face);
+        self.receiver.push(receiver);
+        self.lit.push(lit);
+        self.facing.push(facing);
+        self.support.push(*support);
+    }
+
+    /// Closes the fragment's rings (each already pushed and closed) and
+    /// pieces.
+    fn close_fragment(&mut self) {
+        self.frag_ring.push((self.ring_start.len() - 1) as u32);
+        self.frag_piece.push((self.piece_start.len() - 1) as u32);
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn push_receiver(
         &mut self,
@@ -975,31 +1074,22 @@ impl Batch {
         s: &mut Scratch,
         single_polygon: bool,
         opts: &ShadeOptions,
-        info: Option<&mut MergeInfo>,
     ) {
-        s.remap.clear();
-        s.remap.resize(s.arena.len(), u32::MAX);
-        s.rounded.clear();
-        let push_frag = |b: &mut Batch, lit: u64| {
-            b.face.push(face);
-            b.receiver.push(receiver);
-            b.lit.push(lit);
-            b.facing.push(facing);
-            b.support.push(*support);
-        };
         let uniform = s.cur.iter().all(|(_, l)| *l == s.cur[0].1);
         if single_polygon && uniform {
             // one set of flags all over: the receiver's own polygon, whole
+            s.remap.clear();
+            s.remap.resize(s.arena.len(), u32::MAX);
+            s.rounded.clear();
             let lit = s.cur[0].1;
             s.cur.clear();
             let piece = std::mem::take(&mut s.whole);
-            push_frag(self, lit);
+            self.push_meta(face, receiver, lit, facing, support);
             for &v in &piece.verts {
                 let id = self.take_vertex(s, v);
                 self.ring_verts.push(id);
             }
             self.ring_start.push(self.ring_verts.len() as u32);
-            self.frag_ring.push((self.ring_start.len() - 1) as u32);
             if opts.pieces {
                 let n = piece.verts.len();
                 let start = self.ring_verts.len() - n;
@@ -1007,7 +1097,7 @@ impl Batch {
                 self.piece_verts.extend(copy);
                 self.piece_start.push(self.piece_verts.len() as u32);
             }
-            self.frag_piece.push((self.piece_start.len() - 1) as u32);
+            self.close_fragment();
             return;
         }
         s.pieces.clear();
@@ -1016,26 +1106,29 @@ impl Batch {
             s.pieces.push(p);
             s.labels.push(l);
         }
-        let mut adjacent = Vec::new();
-        let regions = merge_cells_adjacent(
-            &s.arena,
-            support,
-            &s.pieces,
-            &s.labels,
-            &mut s.rounded,
-            &mut adjacent,
-        );
-        if let Some((region, adj)) = info {
-            *region = vec![0; s.pieces.len()];
-            for (ri, r) in regions.iter().enumerate() {
-                for &c in &r.cells {
-                    region[c as usize] = ri as u32;
-                }
-            }
-            *adj = adjacent;
-        }
-        for r in &regions {
-            push_frag(self, r.label);
+        s.rounded.clear();
+        let regions = merge_cells(&s.arena, support, &s.pieces, &s.labels, &mut s.rounded);
+        self.push_regions(face, receiver, facing, support, s, &regions, opts);
+    }
+
+    /// Appends merged regions of the scratch's cells (`s.pieces`, vertices
+    /// in `s.arena`).
+    #[allow(clippy::too_many_arguments)]
+    fn push_regions(
+        &mut self,
+        face: u32,
+        receiver: u32,
+        facing: u64,
+        support: &Plane,
+        s: &mut Scratch,
+        regions: &[Region],
+        opts: &ShadeOptions,
+    ) {
+        s.remap.clear();
+        s.remap.resize(s.arena.len(), u32::MAX);
+        s.rounded.resize(s.arena.len(), None);
+        for r in regions {
+            self.push_meta(face, receiver, r.label, facing, support);
             for ring in std::iter::once(&r.outer).chain(&r.holes) {
                 for &v in ring {
                     let id = self.take_vertex(s, v);
@@ -1043,7 +1136,6 @@ impl Batch {
                 }
                 self.ring_start.push(self.ring_verts.len() as u32);
             }
-            self.frag_ring.push((self.ring_start.len() - 1) as u32);
             if opts.pieces {
                 for &c in &r.cells {
                     let verts = s.pieces[c as usize].verts.clone();
@@ -1054,7 +1146,51 @@ impl Batch {
                     self.piece_start.push(self.piece_verts.len() as u32);
                 }
             }
-            self.frag_piece.push((self.piece_start.len() - 1) as u32);
+            self.close_fragment();
+        }
+    }
+
+    /// Appends the regions of a re-merge (their points exact in the cache
+    /// or the re-merge).
+    #[allow(clippy::too_many_arguments)]
+    fn push_remerged(
+        &mut self,
+        face: u32,
+        receiver: u32,
+        facing: u64,
+        support: &Plane,
+        cache: &MergeCache,
+        m: &Remerged,
+        opts: &ShadeOptions,
+    ) {
+        let mut ids: rustc_hash::FxHashMap<u32, u32> = rustc_hash::FxHashMap::default();
+        let mut take = |b: &mut Batch, p: u32| {
+            *ids.entry(p).or_insert_with(|| {
+                let (v, r) = m.point(cache, p);
+                b.vertices.push(v.clone());
+                b.rounded.push(r);
+                (b.rounded.len() - 1) as u32
+            })
+        };
+        for r in &m.regions {
+            self.push_meta(face, receiver, r.label, facing, support);
+            for ring in std::iter::once(&r.outer).chain(&r.holes) {
+                for &p in ring {
+                    let id = take(self, p);
+                    self.ring_verts.push(id);
+                }
+                self.ring_start.push(self.ring_verts.len() as u32);
+            }
+            if opts.pieces {
+                for &c in &r.cells {
+                    for &p in m.cell_points(cache, c) {
+                        let id = take(self, p);
+                        self.piece_verts.push(id);
+                    }
+                    self.piece_start.push(self.piece_verts.len() as u32);
+                }
+            }
+            self.close_fragment();
         }
     }
 }

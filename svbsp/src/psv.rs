@@ -434,8 +434,7 @@ pub(crate) const REACH_BUDGET: usize = 256;
 pub(crate) fn reach(
     nodes: &[Node],
     root: u32,
-    arena: &mut PieceArena,
-    piece: &Piece,
+    mut sides: impl FnMut(&Plane) -> Sides,
     budget: usize,
     stack: &mut Vec<u32>,
 ) -> Option<(bool, bool)> {
@@ -458,7 +457,7 @@ pub(crate) fn reach(
                 return None;
             }
             let n = &nodes[link as usize];
-            let s = arena.sides(piece, &n.plane);
+            let s = sides(&n.plane);
             match (n.cap, s.front, s.back) {
                 // a cap: behind it is hidden, in it or in front is not
                 (true, false, true) => {
@@ -910,8 +909,7 @@ fn insert(
     if let Some((false, _)) = reach(
         &tree.nodes,
         start_link,
-        &mut pool.arena,
-        &piece,
+        |p| pool.arena.sides(&piece, p),
         REACH_BUDGET,
         &mut s.links,
     ) {

@@ -283,25 +283,43 @@ impl TileIndex {
         }
     }
 
-    /// The polygons whose projection may meet the projection of the
-    /// closed box `[lo, hi]` (grid points): every polygon whose projection
-    /// meets the box's, and some more (those sharing a tile with it). The
-    /// box is projected by its six faces, as the core paper does; a point
-    /// light inside the box sees it all around, and every polygon is
-    /// returned. The result, ascending, is in `q.found`.
-    pub fn query_box<'q>(&self, lo: GridPoint, hi: GridPoint, q: &'q mut Query) -> &'q [u32] {
+    /// The tiles the closed box `[lo, hi]` (grid points) meets, ascending
+    /// and without repeats, into `out`; `false` (and `out` empty) when it
+    /// meets every tile: a point light inside the box, or a box flat along
+    /// two axes.
+    pub fn box_tiles(
+        &self,
+        lo: GridPoint,
+        hi: GridPoint,
+        q: &mut Query,
+        out: &mut Vec<u32>,
+    ) -> bool {
+        out.clear();
+        if !self.box_spans(lo, hi, q) {
+            return false;
+        }
+        for s in &q.spans {
+            out.extend((s.lo..=s.hi).map(|c| self.tile(s, c)));
+        }
+        out.sort_unstable();
+        out.dedup();
+        true
+    }
+
+    /// The spans of the box's faces into `q.spans`; `false` when the box
+    /// meets every tile.
+    fn box_spans(&self, lo: GridPoint, hi: GridPoint, q: &mut Query) -> bool {
         let (lo, hi) = (lo.map(i64::from), hi.map(i64::from));
-        q.found.clear();
+        q.spans.clear();
         let inside = match self.projection {
             Projection::Cube(l) => (0..3).all(|k| lo[k] <= l[k] && l[k] <= hi[k]),
             Projection::Plane(_) => false,
         };
         // a box flat along two axes (a segment or a point) has no face
-        // with area: take every polygon rather than risk a miss
+        // with area: take every tile rather than risk a miss
         let flat = (0..3).filter(|&k| lo[k] >= hi[k]).count();
         if inside || flat >= 2 {
-            q.found.extend(0..self.polygons as u32);
-            return &q.found;
+            return false;
         }
         let c = |x: bool, y: bool, z: bool| {
             [
@@ -319,7 +337,6 @@ impl TileIndex {
             [c(f, f, f), c(t, f, f), c(t, t, f), c(f, t, f)],
             [c(f, f, t), c(f, t, t), c(t, t, t), c(t, f, t)],
         ];
-        q.spans.clear();
         for face in &faces {
             // a box flat along one axis: its four side faces are segments,
             // and its two big faces (the same quad) carry its projection
@@ -332,6 +349,21 @@ impl TileIndex {
             if v.len() >= 3 {
                 self.spans_into(&v, &mut q.work, &mut q.spans);
             }
+        }
+        true
+    }
+
+    /// The polygons whose projection may meet the projection of the
+    /// closed box `[lo, hi]` (grid points): every polygon whose projection
+    /// meets the box's, and some more (those sharing a tile with it). The
+    /// box is projected by its six faces, as the core paper does; a point
+    /// light inside the box sees it all around, and every polygon is
+    /// returned. The result, ascending, is in `q.found`.
+    pub fn query_box<'q>(&self, lo: GridPoint, hi: GridPoint, q: &'q mut Query) -> &'q [u32] {
+        q.found.clear();
+        if !self.box_spans(lo, hi, q) {
+            q.found.extend(0..self.polygons as u32);
+            return &q.found;
         }
         self.collect(q);
         &q.found

@@ -41,6 +41,7 @@ use bsp_core::{
 };
 use glam::{DMat4, DVec3};
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 use svbsp::{
     Batch, CHUNK, Cells, CfFragments, Light, Refined, Scratch, ShadeOptions, ShadowVolumes,
     Shadows, Start, chin_feiner, receivers,
@@ -184,6 +185,10 @@ enum StaticShadows {
         frags: Vec<Range<usize>>,
         /// Per static receiver, its cells when its flags vary.
         cells: Vec<Option<Box<Cells>>>,
+        /// Per static receiver with cells, per light, per cell: the tiles
+        /// of the cell's box (a frame leaves a cell alone when its box
+        /// meets none of the tiles of the moved object's box).
+        footprints: FxHashMap<u32, Vec<Vec<Vec<u32>>>>,
     },
     Paper {
         cf: CfFragments,
@@ -353,6 +358,7 @@ impl Dynamic {
                     batch,
                     frags,
                     cells,
+                    footprints: FxHashMap::default(),
                 }
             }
             Strategy::Paper => {
@@ -377,6 +383,42 @@ impl Dynamic {
             .map(|l| TileIndex::build(l, &polys, opts.tiles))
             .collect::<Result<Vec<_>, _>>()
             .map_err(PipelineError::Tiling)?;
+        // the tiles of every kept cell's box, per light
+        let mut shadows = shadows;
+        if let StaticShadows::Fast {
+            cells, footprints, ..
+        } = &mut shadows
+        {
+            let kept: Vec<(u32, &Cells)> = cells
+                .iter()
+                .enumerate()
+                .filter_map(|(r, c)| c.as_deref().map(|c| (r as u32, c)))
+                .collect();
+            let prints: Vec<(u32, Vec<Vec<Vec<u32>>>)> = kept
+                .par_iter()
+                .map(|&(r, c)| {
+                    let bounds = c.bounds();
+                    let mut q = Query::default();
+                    let per_light = tilings
+                        .iter()
+                        .map(|ix| {
+                            bounds
+                                .iter()
+                                .map(|&(lo, hi)| {
+                                    let mut t = Vec::new();
+                                    if !ix.box_tiles(lo, hi, &mut q, &mut t) {
+                                        t = vec![u32::MAX]; // every tile
+                                    }
+                                    t
+                                })
+                                .collect()
+                        })
+                        .collect();
+                    (r, per_light)
+                })
+                .collect();
+            footprints.extend(prints);
+        }
         prepared.t_tiling = t.elapsed();
         Ok(Dynamic {
             grid,
@@ -479,16 +521,23 @@ impl Dynamic {
                 hi[k] = hi[k].max(g[k]);
             }
         }
-        let related: Vec<Vec<u32>> = if moved.is_empty() {
-            vec![Vec::new(); self.lights.len()]
+        // per light: the related static polygons, and the tiles of the
+        // moved object's box (`None`: every tile)
+        let (related, box_tiles): (Vec<Vec<u32>>, Vec<Option<Vec<u32>>>) = if moved.is_empty() {
+            (
+                vec![Vec::new(); self.lights.len()],
+                vec![Some(Vec::new()); self.lights.len()],
+            )
         } else {
             self.tilings
                 .par_iter()
                 .map(|ix| {
                     let mut q = Query::default();
-                    ix.query_box(lo, hi, &mut q).to_vec()
+                    let mut tiles = Vec::new();
+                    let some = ix.box_tiles(lo, hi, &mut q, &mut tiles);
+                    (ix.query_box(lo, hi, &mut q).to_vec(), some.then_some(tiles))
                 })
-                .collect()
+                .unzip()
         };
         let mut all: Vec<u32> = related.iter().flatten().copied().collect();
         all.sort_unstable();
@@ -506,6 +555,7 @@ impl Dynamic {
                 batch,
                 frags,
                 cells,
+                footprints,
             } => {
                 let t = Instant::now();
                 let volumes = self
@@ -542,28 +592,44 @@ impl Dynamic {
                         None => Start::Uniform(batch.fragment(frags[r as usize].start).lit_mask()),
                     })
                     .collect();
+                // a cell may change only if its box's tiles meet the moved
+                // object's box's tiles
+                let meets = |r: u32, cell: u32, j: usize| -> bool {
+                    let Some(bt) = &box_tiles[j] else { return true };
+                    let Some(fp) = footprints.get(&r) else {
+                        return true;
+                    };
+                    let ct = &fp[j][cell as usize];
+                    ct.first() == Some(&u32::MAX) || ct.iter().any(|t| bt.binary_search(t).is_ok())
+                };
                 // per receiver the fragments it keeps (None: all replaced)
                 type Done = (Batch, Vec<(u32, Range<usize>, Option<Vec<u32>>)>);
-                let parts: Vec<Done> = recs
-                    .par_chunks(16)
-                    .zip(starts.par_chunks(16))
-                    .map(|(rs, ss)| {
-                        let (mut s, mut b) = (Scratch::default(), Batch::new());
-                        let mut done = Vec::new();
-                        for (&r, st) in rs.iter().zip(ss) {
-                            let polys = &self.statics[self.receivers[r as usize].clone()];
-                            let first = b.len();
-                            // what the moved object leaves alone keeps its
-                            // static fragments
-                            match sh.refine_cells(polys, st, r, &sopts, &mut s, &mut b) {
-                                Refined::Unchanged => {}
-                                Refined::All => done.push((r, first..b.len(), None)),
-                                Refined::Some(kept) => done.push((r, first..b.len(), Some(kept))),
+                let refine = || -> Vec<Done> {
+                    recs.par_chunks(16)
+                        .zip(starts.par_chunks(16))
+                        .map(|(rs, ss)| {
+                            let (mut s, mut b) = (Scratch::default(), Batch::new());
+                            let mut done = Vec::new();
+                            for (&r, st) in rs.iter().zip(ss) {
+                                let polys = &self.statics[self.receivers[r as usize].clone()];
+                                let first = b.len();
+                                // what the moved object leaves alone keeps
+                                // its static fragments
+                                let may = |c: u32, j: usize| meets(r, c, j);
+                                match sh.refine_cells(polys, st, r, &sopts, &mut s, &mut b, may) {
+                                    Refined::Unchanged => {}
+                                    Refined::All => done.push((r, first..b.len(), None)),
+                                    Refined::Some(kept) => {
+                                        done.push((r, first..b.len(), Some(kept)))
+                                    }
+                                }
                             }
-                        }
-                        (b, done)
-                    })
-                    .collect();
+                            (b, done)
+                        })
+                        .collect()
+                };
+                // the related static faces and the moved object side by side
+                let (parts, dynamic) = rayon::join(refine, || sh.shade_all(&moved, &sopts));
                 let mut out = Batch::new();
                 let mut related_ranges = Vec::new();
                 for (b, done) in parts {
@@ -575,7 +641,6 @@ impl Dynamic {
                     );
                 }
                 let m0 = out.len();
-                let dynamic = sh.shade_all(&moved, &sopts);
                 out.append(&dynamic);
                 stats.t_dynamic_shadows = t.elapsed();
                 stats.dynamic_after_bsp = moved.len();

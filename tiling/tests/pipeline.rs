@@ -157,8 +157,19 @@ fn check_motion(
                 );
             }
         }
-        // the assembled batch has every face's fragments, in face order
+        // the assembled batch has every face's fragments, in face order;
+        // the fast strategy's are maximal regions, as from scratch
         let b = d.fragments(&frame);
+        if strategy == Strategy::Fast {
+            let count = |x: &Batch| {
+                let mut m: BTreeMap<u32, usize> = BTreeMap::new();
+                for f in x.fragments() {
+                    *m.entry(f.face()).or_default() += 1;
+                }
+                m
+            };
+            assert_eq!(count(&b), count(&scratch), "frame {k}: fragments per face");
+        }
         assert_eq!(
             b.len(),
             frame.stats.total_drawn,
