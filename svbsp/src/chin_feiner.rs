@@ -352,6 +352,29 @@ impl CfFragments {
         base: &CfFragments,
         base_of: impl Fn(u32) -> Option<&'b [u32]>,
     ) -> CfFragments {
+        // boxes around the exact fragments, from their correctly rounded
+        // vertices widened by far more than the rounding: fragments whose
+        // boxes are apart do not overlap, and are not cut against each other
+        let bounds = |pts: &mut dyn Iterator<Item = [f64; 3]>| {
+            let mut b = [
+                f64::INFINITY,
+                f64::INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::NEG_INFINITY,
+                f64::NEG_INFINITY,
+            ];
+            for p in pts {
+                for k in 0..3 {
+                    let m = p[k].abs() * 1e-15;
+                    b[k] = b[k].min(p[k] - m);
+                    b[k + 3] = b[k + 3].max(p[k] + m);
+                }
+            }
+            b
+        };
+        let apart = |a: &[f64; 6], b: &[f64; 6]| (0..3).any(|k| a[k + 3] < b[k] || b[k + 3] < a[k]);
+        let mut base_box: Vec<Option<[f64; 6]>> = vec![None; base.frags.len()];
         let mut t = Tables {
             points: self.points,
             shadow: self.shadow,
@@ -362,8 +385,14 @@ impl CfFragments {
                 frags.push(q);
                 continue;
             };
+            let qb = bounds(&mut q.verts.iter().map(|&v| t.points[v as usize].to_f64()));
             for &si in list {
                 let sf = base.get(si as usize);
+                let sb = *base_box[si as usize]
+                    .get_or_insert_with(|| bounds(&mut sf.vertices().map(WPoint::to_f64)));
+                if apart(&qb, &sb) {
+                    continue;
+                }
                 let mut piece = Some(q.clone());
                 for j in 0..sf.f.edges.len() {
                     let Some(r) = piece.take() else { break };
