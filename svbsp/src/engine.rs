@@ -172,10 +172,135 @@ impl Shadows {
 
     /// Bit `j` set: light `j` is strictly in front of `support`.
     pub fn facing(&self, support: &Plane) -> u64 {
+        facing(&self.lights, support)
+    }
+
+    /// The trees as a [`ShadowSet`] (which has every shading method).
+    pub fn set(&self) -> ShadowSet<'_> {
+        ShadowSet {
+            lights: &self.lights,
+            trees: self
+                .volumes
+                .iter()
+                .enumerate()
+                .map(|(j, v)| (v, j))
+                .collect(),
+        }
+    }
+
+    /// This set's trees and `more`'s (built for the same lights, e.g. over
+    /// other occluders) as one [`ShadowSet`]: a point is lit by a light
+    /// when none of the light's trees blocks it. Errors if the lights
+    /// differ.
+    pub fn with<'a>(&'a self, more: &'a Shadows) -> Result<ShadowSet<'a>, ShadowError> {
+        if more.lights != self.lights {
+            return Err(ShadowError::Mismatch);
+        }
+        let mut set = self.set();
+        set.trees
+            .extend(more.volumes.iter().enumerate().map(|(j, v)| (v, j)));
+        Ok(set)
+    }
+
+    /// See [`ShadowSet::shade`].
+    pub fn shade(
+        &self,
+        polys: &[Polygon],
+        receiver: u32,
+        opts: &ShadeOptions,
+        scratch: &mut Scratch,
+        out: &mut Batch,
+    ) {
+        self.set().shade(polys, receiver, opts, scratch, out)
+    }
+
+    /// See [`ShadowSet::shade_keeping`].
+    pub fn shade_keeping(
+        &self,
+        polys: &[Polygon],
+        receiver: u32,
+        opts: &ShadeOptions,
+        scratch: &mut Scratch,
+        out: &mut Batch,
+    ) -> Option<Cells> {
+        self.set()
+            .shade_keeping(polys, receiver, opts, scratch, out)
+    }
+
+    /// See [`ShadowSet::refine`].
+    pub fn refine(
+        &self,
+        polys: &[Polygon],
+        start: &Start<'_>,
+        receiver: u32,
+        opts: &ShadeOptions,
+        scratch: &mut Scratch,
+        out: &mut Batch,
+    ) {
+        self.set()
+            .refine(polys, start, receiver, opts, scratch, out)
+    }
+
+    /// See [`ShadowSet::refine_cells`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn refine_cells(
+        &self,
+        polys: &[Polygon],
+        start: &Start<'_>,
+        receiver: u32,
+        opts: &ShadeOptions,
+        scratch: &mut Scratch,
+        out: &mut Batch,
+        may_change: impl Fn(u32, usize) -> bool,
+    ) -> Refined {
+        self.set()
+            .refine_cells(polys, start, receiver, opts, scratch, out, may_change)
+    }
+
+    /// See [`ShadowSet::shade_ranges`].
+    pub fn shade_ranges(
+        &self,
+        polys: &[Polygon],
+        ranges: &[Range<usize>],
+        first_receiver: u32,
+        opts: &ShadeOptions,
+    ) -> Batch {
+        self.set().shade_ranges(polys, ranges, first_receiver, opts)
+    }
+
+    /// See [`ShadowSet::shade_all`].
+    pub fn shade_all(&self, polys: &[Polygon], opts: &ShadeOptions) -> Batch {
+        self.set().shade_all(polys, opts)
+    }
+}
+
+/// Bit `j` set: light `j` is strictly in front of `support`.
+fn facing(lights: &[Light], support: &Plane) -> u64 {
+    lights
+        .iter()
+        .enumerate()
+        .fold(0, |m, (j, l)| m | (l.faces(support) as u64) << j)
+}
+
+/// Shadow trees, borrowed, with the light each one is for: every shading
+/// method. Usually one tree per light ([`Shadows::set`]); a light's
+/// occluders may also be split among several trees ([`Shadows::with`]),
+/// and a point is then lit by the light when none of its trees blocks it.
+#[derive(Clone, Debug)]
+pub struct ShadowSet<'a> {
+    lights: &'a [Light],
+    trees: SmallVec<[(&'a ShadowVolumes, usize); 4]>,
+}
+
+impl<'a> ShadowSet<'a> {
+    /// The lights.
+    pub fn lights(&self) -> &'a [Light] {
         self.lights
-            .iter()
-            .enumerate()
-            .fold(0, |m, (j, l)| m | (l.faces(support) as u64) << j)
+    }
+
+    /// Bit `j` set: light `j` is strictly in front of `support`.
+    pub fn facing(&self, support: &Plane) -> u64 {
+        facing(self.lights, support)
     }
 
     /// Shades one receiver (polygons on one support plane, all tagged with
@@ -194,11 +319,11 @@ impl Shadows {
         self.refine(polys, &start, receiver, opts, scratch, out);
     }
 
-    /// [`Shadows::shade`], also returning the receiver's cells with their
+    /// [`ShadowSet::shade`], also returning the receiver's cells with their
     /// flags when the flags are not the same all over (`None` when they
     /// are: the receiver is then [`Start::Uniform`] with its fragments'
     /// flags), for later refinement by other trees
-    /// ([`Shadows::refine_cells`]).
+    /// ([`ShadowSet::refine_cells`]).
     pub fn shade_keeping(
         &self,
         polys: &[Polygon],
@@ -246,7 +371,7 @@ impl Shadows {
     /// Refines a receiver already shaded for the same lights by other
     /// occluders: each part still lit by light `j` is filtered through this
     /// light `j`'s tree, and stays lit only where this tree lets the light
-    /// through; the result is regions as [`Shadows::shade`] makes them.
+    /// through; the result is regions as [`ShadowSet::shade`] makes them.
     /// With the static scene's flags as `start` and trees of the occluders
     /// that moved, this is a receiver's shadow from both.
     pub fn refine(
@@ -265,13 +390,13 @@ impl Shadows {
         self.finish(polys, receiver, opts, scratch, out);
     }
 
-    /// [`Shadows::refine`] that redoes only what these trees change:
+    /// [`ShadowSet::refine`] that redoes only what these trees change:
     /// nothing when every cell comes back whole with its flags
     /// ([`Refined::Unchanged`]); from [`Start::Cells`], only the cells the
     /// trees cut or shadow are filtered, the cached merge is redone only
     /// where they are ([`MergeCache::remerge`]), and the receiver's other
     /// starting fragments stand ([`Refined::Some`]). The receiver's
-    /// fragments are then those [`Shadows::refine`] makes (the same
+    /// fragments are then those [`ShadowSet::refine`] makes (the same
     /// regions, perhaps in another order).
     ///
     /// `may_change(cell, light)` may answer `false` for a cell (an index
@@ -320,7 +445,7 @@ impl Shadows {
             let live = flags & facing;
             let mut now = *flags;
             let mut cut = 0u64;
-            for (j, sv) in self.volumes.iter().enumerate() {
+            for &(sv, j) in &self.trees {
                 let bit = 1u64 << j;
                 if live & bit == 0 || !may_change(i as u32, j) {
                     continue;
@@ -353,7 +478,7 @@ impl Shadows {
             }
             s.cur.clear();
             s.cur.push((copy, now));
-            for (j, sv) in self.volumes.iter().enumerate() {
+            for &(sv, j) in &self.trees {
                 let bit = 1u64 << j;
                 if cut & bit == 0 {
                     continue;
@@ -443,7 +568,7 @@ impl Shadows {
         }
         let facing = self.facing(&support);
         let mut changed = false;
-        for (j, sv) in self.volumes.iter().enumerate() {
+        for &(sv, j) in &self.trees {
             let bit = 1u64 << j;
             if facing & bit == 0 {
                 continue; // attached shadow: the flag stays 0

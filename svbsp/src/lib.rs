@@ -50,8 +50,8 @@ mod wide;
 pub use areas::{Areas, fragment_area, polygon_area};
 pub use chin_feiner::{CfFragment, CfFragments, chin_feiner};
 pub use engine::{
-    Batch, CHUNK, Cells, FragmentRef, Refined, Scratch, ShadeOptions, ShadowError, ShadowStats,
-    Shadows, Start, receivers, shadow_fragments,
+    Batch, CHUNK, Cells, FragmentRef, Refined, Scratch, ShadeOptions, ShadowError, ShadowSet,
+    ShadowStats, Shadows, Start, receivers, shadow_fragments,
 };
 pub use light::{
     LIGHT_RANGE_BITS, Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, angle_between,

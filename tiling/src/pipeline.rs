@@ -180,6 +180,8 @@ pub struct Prepared {
 #[allow(clippy::large_enum_variant)]
 enum StaticShadows {
     Fast {
+        /// The static scene's shadow trees.
+        shadows: Shadows,
         batch: Batch,
         /// Per static receiver, its fragments in `batch`.
         frags: Vec<Range<usize>>,
@@ -240,6 +242,11 @@ pub struct FrameStats {
     pub total_drawn: usize,
     /// Related static polygons (the union over the lights).
     pub related: usize,
+    /// Fast strategy: the object's faces were shaded through the static
+    /// trees and a tree of the object alone (many related polygons may
+    /// block light on its way to the object), rather than through one tree
+    /// of the object and those polygons.
+    pub layered: bool,
     /// Time of the tiling queries.
     pub t_tiling: Duration,
     /// Time of the merge: `Bsp2` replayed, `Bsp3` built and merged (paper);
@@ -274,6 +281,38 @@ enum FrameFragments {
         moved: Range<usize>,
     },
     Paper(CfFragments),
+}
+
+/// `true` if every corner of the box `[lo, hi]` lies strictly on the other
+/// side of `plane` than `light`: no segment from the light to the plane
+/// reaches the box.
+fn box_behind(light: &Light, plane: &bsp_core::Plane, lo: GridPoint, hi: GridPoint) -> bool {
+    box_side(light, plane, lo, hi, false)
+}
+
+/// `true` if every corner of the box `[lo, hi]` lies strictly on the same
+/// side of `plane` as `light` (for a sun: the side its direction points
+/// to): no segment from the light to the box crosses the plane.
+fn box_before(light: &Light, plane: &bsp_core::Plane, lo: GridPoint, hi: GridPoint) -> bool {
+    box_side(light, plane, lo, hi, true)
+}
+
+fn box_side(
+    light: &Light,
+    plane: &bsp_core::Plane,
+    lo: GridPoint,
+    hi: GridPoint,
+    same: bool,
+) -> bool {
+    let want = match (light.eval(plane).signum(), same) {
+        (1, true) | (-1, false) => bsp_core::Side::Front,
+        (-1, true) | (1, false) => bsp_core::Side::Back,
+        _ => return false,
+    };
+    (0..8).all(|m: u32| {
+        let c = [0, 1, 2].map(|k| if m >> k & 1 == 1 { hi[k] } else { lo[k] });
+        plane.classify_grid(c) == want
+    })
 }
 
 fn grid_points(polys: &[Polygon]) -> impl Iterator<Item = GridPoint> + '_ {
@@ -355,6 +394,7 @@ impl Dynamic {
                 prepared.static_after_bsp = polys.len();
                 prepared.static_after_shadow = batch.len();
                 StaticShadows::Fast {
+                    shadows: sh,
                     batch,
                     frags,
                     cells,
@@ -552,34 +592,76 @@ impl Dynamic {
 
         let fragments = match &self.shadows {
             StaticShadows::Fast {
+                shadows: statics,
                 batch,
                 frags,
                 cells,
                 footprints,
             } => {
                 let t = Instant::now();
-                let volumes = self
+                // per light, the related static polygons that may block
+                // light on its way to the object: a polygon whose plane has
+                // the object's whole box on the light's side only receives
+                // its shadow
+                let blockers: Vec<Vec<&Polygon>> = self
                     .lights
                     .iter()
                     .zip(&related)
                     .map(|(l, rel)| {
-                        let occ: Vec<&Polygon> = moved
-                            .iter()
-                            .chain(rel.iter().map(|&p| &self.statics[p as usize]))
-                            .collect();
+                        rel.iter()
+                            .map(|&p| &self.statics[p as usize])
+                            .filter(|p| !box_before(l, p.support(), lo, hi))
+                            .collect()
+                    })
+                    .collect();
+                // few of them: one tree of the object and those; many: a
+                // tree of the object alone, and for the object's own faces
+                // the static trees too (a point is lit where neither blocks)
+                let layered = blockers.iter().map(Vec::len).sum::<usize>() * 4
+                    > moved.len() * self.lights.len();
+                stats.layered = layered;
+                let volumes = self
+                    .lights
+                    .iter()
+                    .zip(&blockers)
+                    .map(|(l, b)| {
+                        let occ: Vec<&Polygon> = if layered {
+                            moved.iter().collect()
+                        } else {
+                            moved.iter().chain(b.iter().copied()).collect()
+                        };
                         ShadowVolumes::build(*l, &occ)
                     })
                     .collect::<Result<Vec<_>, _>>()
                     .map_err(|e| PipelineError::Shadow(e.to_string()))?;
                 let sh = Shadows::from_volumes(&self.lights, volumes)
                     .map_err(|e| PipelineError::Shadow(e.to_string()))?;
+                let for_moved = if layered {
+                    statics
+                        .with(&sh)
+                        .map_err(|e| PipelineError::Shadow(e.to_string()))?
+                } else {
+                    sh.set()
+                };
                 stats.t_merge = t.elapsed();
                 let t = Instant::now();
                 let sopts = ShadeOptions::default().with_pieces(self.opts.pieces);
-                // the related static receivers still lit somewhere
-                let mut recs: Vec<u32> =
-                    all.iter().map(|&p| self.receiver_of[p as usize]).collect();
-                recs.dedup();
+                // the related static receivers, with the lights for which
+                // they may change: related for that light, still lit
+                // somewhere, and not with the whole box of the moved object
+                // behind their plane (a segment from the light to them
+                // then stays on the light's side)
+                let mut lights_of: FxHashMap<u32, u64> = FxHashMap::default();
+                for (j, rel) in related.iter().enumerate() {
+                    for &p in rel {
+                        let poly = &self.statics[p as usize];
+                        if !box_behind(&self.lights[j], poly.support(), lo, hi) {
+                            *lights_of.entry(self.receiver_of[p as usize]).or_default() |= 1 << j;
+                        }
+                    }
+                }
+                let mut recs: Vec<u32> = lights_of.keys().copied().collect();
+                recs.sort_unstable();
                 recs.retain(|&r| {
                     let range = &frags[r as usize];
                     cells[r as usize].is_some()
@@ -595,6 +677,9 @@ impl Dynamic {
                 // a cell may change only if its box's tiles meet the moved
                 // object's box's tiles
                 let meets = |r: u32, cell: u32, j: usize| -> bool {
+                    if lights_of[&r] >> j & 1 == 0 {
+                        return false;
+                    }
                     let Some(bt) = &box_tiles[j] else { return true };
                     let Some(fp) = footprints.get(&r) else {
                         return true;
@@ -629,7 +714,7 @@ impl Dynamic {
                         .collect()
                 };
                 // the related static faces and the moved object side by side
-                let (parts, dynamic) = rayon::join(refine, || sh.shade_all(&moved, &sopts));
+                let (parts, dynamic) = rayon::join(refine, || for_moved.shade_all(&moved, &sopts));
                 let mut out = Batch::new();
                 let mut related_ranges = Vec::new();
                 for (b, done) in parts {

@@ -110,7 +110,7 @@ fn nonzero(a: Areas) -> Areas {
 }
 
 /// Runs `frames` of `motion` with `strategy` and checks each against the
-/// computation from scratch. Returns the frames' related-face counts.
+/// computation from scratch. Returns the frames' figures.
 fn check_motion(
     statics: &[Vec<DVec3>],
     moving: &[Vec<DVec3>],
@@ -119,7 +119,7 @@ fn check_motion(
     frames: u32,
     strategy: Strategy,
     tiles: Option<u32>,
-) -> Vec<usize> {
+) -> Vec<tiling::FrameStats> {
     // one grid for every frame: the static scene, the lights and every
     // position the object takes
     let mut pts: Vec<DVec3> = statics.iter().flatten().copied().collect();
@@ -177,9 +177,15 @@ fn check_motion(
         );
         let faces: Vec<u32> = b.fragments().map(|f| f.face()).collect();
         assert!(faces.windows(2).all(|w| w[0] <= w[1]), "face order");
-        related.push(frame.related_faces.len());
+        related.push(frame.stats);
     }
     related
+}
+
+/// The number of static polygons the faces import to.
+fn d_polygons(st: &[Vec<DVec3>]) -> usize {
+    let grid = Grid::fit_points(st.iter().flatten()).unwrap();
+    bsp_core::import_faces_par(&grid, st).unwrap().0.len()
 }
 
 fn room_parts() -> (Vec<Vec<DVec3>>, Vec<Vec<DVec3>>) {
@@ -210,7 +216,10 @@ fn room_axis_spins_exactly_with_both_strategies() {
     };
     for s in [Strategy::Fast, Strategy::Paper] {
         let rel = check_motion(&st, &dy, &[LightSpec::Point(ROOM_LIGHT)], &spin, 4, s, None);
-        assert!(rel.iter().all(|&r| r > 0 && r < st.len()), "{rel:?}");
+        assert!(
+            rel.iter().all(|f| f.related > 0 && f.related < st.len()),
+            "{rel:?}"
+        );
     }
 }
 
@@ -254,7 +263,8 @@ fn room_axis_walks_through_the_chairs_shadows_and_up_to_the_light() {
         Some(8),
     );
     // around the light every static polygon is related
-    assert_eq!(*rel.last().unwrap(), st.len());
+    let all = d_polygons(&st);
+    assert_eq!(rel.last().unwrap().related, all);
     check_motion(
         &st,
         &dy,
@@ -376,6 +386,59 @@ proptest! {
         let s = if paper { Strategy::Paper } else { Strategy::Fast };
         check_motion(&st, &dy, &lights, &motion, 3, s, tiles);
     }
+}
+
+#[test]
+fn both_ways_of_shading_the_object_are_checked() {
+    // a tall block between the light and a tetrahedron: many related
+    // blockers (layered trees); the same with a small one (one tree)
+    let ground = vec![vec![
+        DVec3::new(-6.0, -6.0, 0.0),
+        DVec3::new(6.0, -6.0, 0.0),
+        DVec3::new(6.0, 6.0, 0.0),
+        DVec3::new(-6.0, 6.0, 0.0),
+    ]];
+    let light = [LightSpec::Point(DVec3::new(0.0, 0.0, 8.0))];
+    let slide = Motion {
+        axis: DVec3::Z,
+        degrees: 20.0,
+        centre: DVec3::new(0.3, 0.2, 1.0),
+        step: DVec3::new(0.2, 0.1, 0.0),
+    };
+    let mut many = ground.clone();
+    for i in 0..6 {
+        let z = 3.0 + i as f64 * 0.5;
+        many.extend(cuboid(
+            DVec3::new(-0.5, -0.5, z),
+            DVec3::new(0.9, 0.8, z + 0.2),
+        ));
+    }
+    let a = check_motion(
+        &many,
+        &tetra(DVec3::new(0.0, 0.0, 1.0), 0.5),
+        &light,
+        &slide,
+        3,
+        Strategy::Fast,
+        None,
+    );
+    let mut one = ground;
+    one.push(vec![
+        DVec3::new(-3.0, -3.0, 5.0),
+        DVec3::new(-2.0, -3.0, 5.0),
+        DVec3::new(-2.0, -2.0, 5.0),
+    ]);
+    let b = check_motion(
+        &one,
+        &cuboid(DVec3::new(0.0, 0.0, 1.0), DVec3::new(1.0, 1.0, 2.0)),
+        &light,
+        &slide,
+        3,
+        Strategy::Fast,
+        None,
+    );
+    assert!(a.iter().any(|f| f.layered), "no frame used layered trees");
+    assert!(b.iter().any(|f| !f.layered), "no frame used one tree");
 }
 
 #[test]
