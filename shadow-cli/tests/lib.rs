@@ -1,6 +1,7 @@
 //! End-to-end tests of the `shadow` binary: one test binary, one module
 //! per command family.
 
+mod animate;
 mod cli;
 mod csg;
 mod shadows;
