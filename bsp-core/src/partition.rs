@@ -74,6 +74,13 @@ pub trait CellOp<A, B> {
         let _ = b;
         None
     }
+    /// `true` if a node that carries input polygons must stay even when
+    /// its two sides end up as one cell: the overlay of polygon trees
+    /// keeps every polygon, a set operation drops the ones that no longer
+    /// bound anything.
+    fn keeps_polygons(&self) -> bool {
+        false
+    }
 }
 
 /// The Boolean set operations on solid partitions (Table 1 of the core
@@ -125,6 +132,9 @@ impl<A, B> CellOp<A, B> for Overlay {
     fn apply(&self, a: A, b: B) -> (A, B) {
         (a, b)
     }
+    fn keeps_polygons(&self) -> bool {
+        true
+    }
 }
 
 /// An operation with its arguments swapped (to insert the smaller tree).
@@ -140,6 +150,9 @@ impl<A, B, O: CellOp<A, B>> CellOp<B, A> for Swapped<'_, O> {
     }
     fn right(&self, a: A) -> Option<O::Out> {
         self.0.left(a)
+    }
+    fn keeps_polygons(&self) -> bool {
+        self.0.keeps_polygons()
     }
 }
 
@@ -662,7 +675,7 @@ where
             }
         }
     }
-    out.reduce();
+    out.reduce_nodes(op.keeps_polygons());
     out
 }
 
@@ -862,9 +875,18 @@ impl<L: Copy> Partition<L> {
         out
     }
 
-    /// Collapses nodes whose children are leaves with equal labels (unless
-    /// they carry input polygons), and drops the nodes no longer reachable.
+    /// Collapses nodes whose children are leaves with equal labels, and
+    /// drops the nodes no longer reachable.
     pub fn reduce(&mut self)
+    where
+        L: PartialEq,
+    {
+        self.reduce_nodes(false);
+    }
+
+    /// [`Partition::reduce`]; with `keep_polygons`, nodes that carry input
+    /// polygons stay.
+    fn reduce_nodes(&mut self, keep_polygons: bool)
     where
         L: PartialEq,
     {
@@ -894,11 +916,10 @@ impl<L: Copy> Partition<L> {
                 let n = &mut self.nodes[i as usize];
                 n.front = newf;
                 n.back = newb;
-                // a node that carries input polygons stays: the overlay of
-                // polygon trees ("+") must keep every polygon
+                // the overlay of polygon trees ("+") keeps every polygon
                 if let (Some(x), Some(y)) = (f, b)
                     && x == y
-                    && n.polygons.is_empty()
+                    && (!keep_polygons || n.polygons.is_empty())
                 {
                     collapsed[i as usize] = Some(x);
                 }
