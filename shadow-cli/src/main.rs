@@ -33,6 +33,7 @@ mod csg;
 mod lights;
 mod pipeline;
 mod progress;
+mod raster_cmd;
 mod render;
 mod shadows;
 
@@ -64,6 +65,14 @@ enum Command {
     Demo(DemoArgs),
     /// Exact union, intersection or difference of two closed meshes.
     Csg(csg::CsgArgs),
+    /// Render a scene and its shadows to PNG by the exact method or a
+    /// classic image-space one (shadow map, stencil volumes, ...).
+    Render(Box<raster_cmd::RenderArgs>),
+    /// Every shadow method side by side, with the share of pixels where
+    /// each disagrees with the exact shadows.
+    Compare(Box<raster_cmd::CompareArgs>),
+    /// Hidden-line drawing of convex polyhedra (Roberts' algorithm) to SVG.
+    Lines(Box<raster_cmd::LinesArgs>),
 }
 
 /// Where the mesh comes from: a file or a built-in scene (exactly one).
@@ -301,6 +310,9 @@ fn main() -> ExitCode {
         Command::Stats(a) => stats(a),
         Command::Demo(a) => demo(a),
         Command::Csg(a) => csg::run(a),
+        Command::Render(a) => raster_cmd::run_render(a),
+        Command::Compare(a) => raster_cmd::run_compare(a),
+        Command::Lines(a) => raster_cmd::run_lines(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,296 @@
+//! Images: Lambert shading of a visibility and a lit buffer, PNG and PGM
+//! output, side-by-side composites with labels.
+
+use std::io::Write;
+use std::path::Path;
+
+use glam::DVec3;
+
+use crate::hsr::{Frame, NONE, Visibility};
+use crate::scene::SceneLight;
+use crate::shadow::{LitBuffer, pixel_point, visible_normal};
+use crate::RasterError;
+
+/// An 8-bit RGB image, row-major from the top-left corner.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `3 · width · height` bytes.
+    pub rgb: Vec<u8>,
+}
+
+/// The background of images, as in the SVG views.
+pub const BACKGROUND: [u8; 3] = [0xe9, 0xec, 0xf0];
+
+/// Light reaching every surface, as in the SVG of `shadow shadows`.
+const AMBIENT: f64 = 0.28;
+/// More ambient on surfaces facing the viewer.
+const AMBIENT_FACING: f64 = 0.12;
+/// Total diffuse weight, shared among the lights.
+const DIFFUSE: f64 = 0.72;
+
+impl Image {
+    /// A `width × height` image filled with `color`.
+    pub fn new(width: u32, height: u32, color: [u8; 3]) -> Image {
+        let n = width as usize * height as usize;
+        Image {
+            width,
+            height,
+            rgb: color.iter().copied().cycle().take(3 * n).collect(),
+        }
+    }
+
+    /// The PNG encoding (fast deflate).
+    pub fn encode_png(&self) -> Vec<u8> {
+        let mut out = Vec::new();
+        {
+            let mut enc = png::Encoder::new(&mut out, self.width, self.height);
+            enc.set_color(png::ColorType::Rgb);
+            enc.set_depth(png::BitDepth::Eight);
+            enc.set_compression(png::Compression::Fast);
+            let mut w = enc.write_header().expect("a PNG header in memory");
+            w.write_image_data(&self.rgb).expect("PNG data in memory");
+        }
+        out
+    }
+
+    /// Writes the image as PNG.
+    pub fn write_png(&self, path: &Path) -> Result<(), RasterError> {
+        write_file(path, &self.encode_png())
+    }
+
+    /// Copies `o` into this image at `(x, y)` (clipped).
+    pub fn blit(&mut self, o: &Image, x: u32, y: u32) {
+        for row in 0..o.height.min(self.height.saturating_sub(y)) {
+            let n = o.width.min(self.width.saturating_sub(x)) as usize * 3;
+            let dst = ((y + row) as usize * self.width as usize + x as usize) * 3;
+            let src = row as usize * o.width as usize * 3;
+            self.rgb[dst..dst + n].copy_from_slice(&o.rgb[src..src + n]);
+        }
+    }
+
+    /// Draws `text` (5×7 capitals, digits and `.%-:/(),=+_`, scaled by
+    /// `scale`) with its top-left corner at `(x, y)`.
+    pub fn text(&mut self, text: &str, x: u32, y: u32, scale: u32, color: [u8; 3]) {
+        let mut cx = x;
+        for ch in text.chars() {
+            let rows = glyph(ch.to_ascii_uppercase());
+            for (r, bits) in rows.iter().enumerate() {
+                for c in 0..5 {
+                    if bits >> (4 - c) & 1 == 0 {
+                        continue;
+                    }
+                    for dy in 0..scale {
+                        for dx in 0..scale {
+                            let (px, py) = (cx + c * scale + dx, y + r as u32 * scale + dy);
+                            if px < self.width && py < self.height {
+                                let i = (py as usize * self.width as usize + px as usize) * 3;
+                                self.rgb[i..i + 3].copy_from_slice(&color);
+                            }
+                        }
+                    }
+                }
+            }
+            cx += 6 * scale;
+        }
+    }
+}
+
+pub(crate) fn write_file(path: &Path, bytes: &[u8]) -> Result<(), RasterError> {
+    let io = |e: std::io::Error| RasterError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    };
+    let mut f = std::fs::File::create(path).map_err(io)?;
+    f.write_all(bytes).map_err(io)
+}
+
+/// The mask of the first light: 0 where a pixel sees nothing, 255 where its
+/// visible surface is lit by the first light, 128 where it is not.
+pub fn mask(vis: &Visibility, lit: &LitBuffer) -> Vec<u8> {
+    vis.prim
+        .iter()
+        .enumerate()
+        .map(|(p, &prim)| match prim {
+            NONE => 0,
+            _ if lit.lights > 0 && lit.lit(p, 0) => 255,
+            _ => 128,
+        })
+        .collect()
+}
+
+/// A binary PGM (P5) of a mask.
+pub fn encode_pgm(width: u32, height: u32, mask: &[u8]) -> Vec<u8> {
+    let mut out = format!("P5\n{width} {height}\n255\n").into_bytes();
+    out.extend_from_slice(mask);
+    out
+}
+
+/// Writes a mask as binary PGM (P5).
+pub fn write_pgm(path: &Path, width: u32, height: u32, mask: &[u8]) -> Result<(), RasterError> {
+    write_file(path, &encode_pgm(width, height, mask))
+}
+
+/// Lambert shading: the face's colour times ambient light (more on
+/// surfaces facing the viewer) plus each light's cosine times the amount
+/// of it that reaches the pixel.
+pub(crate) fn shade(
+    frame: &Frame<'_>,
+    vis: &Visibility,
+    lit: &LitBuffer,
+    lights: &[SceneLight],
+    colors: &[DVec3],
+) -> Image {
+    use rayon::prelude::*;
+    let (w, h) = (vis.width, vis.height);
+    let mut img = Image::new(w, h, BACKGROUND);
+    let scene = frame.scene;
+    let view = frame.view();
+    let weight = DIFFUSE / lights.len().max(1) as f64;
+    let grey = DVec3::splat(0.7);
+    img.rgb
+        .par_chunks_mut(3 * w as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for x in 0..w as usize {
+                let pix = y * w as usize + x;
+                let prim = vis.prim[pix];
+                if prim == NONE {
+                    continue;
+                }
+                let n = visible_normal(frame, prim as usize);
+                let p = pixel_point(frame, vis, pix);
+                let dir = view.dir(x as f64 + 0.5, y as f64 + 0.5).normalize();
+                let mut b = AMBIENT + AMBIENT_FACING * (-n.dot(dir)).max(0.0);
+                for (j, l) in lights.iter().enumerate() {
+                    let a = lit.amount[pix * lit.lights + j] as f64;
+                    if a > 0.0 {
+                        b += weight * a * n.dot(l.world.toward(p)).max(0.0);
+                    }
+                }
+                let c = colors
+                    .get(scene.face[prim as usize] as usize)
+                    .copied()
+                    .unwrap_or(grey);
+                let v = (c * b).clamp(DVec3::ZERO, DVec3::ONE) * 255.0;
+                row[3 * x..3 * x + 3].copy_from_slice(&[
+                    v.x.round() as u8,
+                    v.y.round() as u8,
+                    v.z.round() as u8,
+                ]);
+            }
+        });
+    img
+}
+
+/// A 5×7 glyph: seven rows of five bits, most significant bit left.
+fn glyph(c: char) -> [u8; 7] {
+    match c {
+        '0' => [0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E],
+        '1' => [0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E],
+        '2' => [0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F],
+        '3' => [0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E],
+        '4' => [0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02],
+        '5' => [0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E],
+        '6' => [0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E],
+        '7' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08],
+        '8' => [0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E],
+        '9' => [0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C],
+        'A' => [0x0E, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
+        'B' => [0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E],
+        'C' => [0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E],
+        'D' => [0x1C, 0x12, 0x11, 0x11, 0x11, 0x12, 0x1C],
+        'E' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F],
+        'F' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10],
+        'G' => [0x0E, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0F],
+        'H' => [0x11, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
+        'I' => [0x0E, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E],
+        'J' => [0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0C],
+        'K' => [0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11],
+        'L' => [0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F],
+        'M' => [0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11],
+        'N' => [0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11],
+        'O' => [0x0E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
+        'P' => [0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10],
+        'Q' => [0x0E, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0D],
+        'R' => [0x1E, 0x11, 0x11, 0x1E, 0x14, 0x12, 0x11],
+        'S' => [0x0F, 0x10, 0x10, 0x0E, 0x01, 0x01, 0x1E],
+        'T' => [0x1F, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04],
+        'U' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
+        'V' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x0A, 0x04],
+        'W' => [0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0A],
+        'X' => [0x11, 0x11, 0x0A, 0x04, 0x0A, 0x11, 0x11],
+        'Y' => [0x11, 0x11, 0x11, 0x0A, 0x04, 0x04, 0x04],
+        'Z' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1F],
+        '.' => [0, 0, 0, 0, 0, 0x0C, 0x0C],
+        '%' => [0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03],
+        '-' => [0, 0, 0, 0x1F, 0, 0, 0],
+        ':' => [0, 0x0C, 0x0C, 0, 0x0C, 0x0C, 0],
+        '/' => [0, 0x01, 0x02, 0x04, 0x08, 0x10, 0],
+        '(' => [0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02],
+        ')' => [0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08],
+        ',' => [0, 0, 0, 0, 0x0C, 0x04, 0x08],
+        '=' => [0, 0, 0x1F, 0, 0x1F, 0, 0],
+        '+' => [0, 0x04, 0x04, 0x1F, 0x04, 0x04, 0],
+        '_' => [0, 0, 0, 0, 0, 0, 0x1F],
+        _ => [0; 7],
+    }
+}
+
+/// Panels side by side, `columns` to a row, each under a label bar.
+pub fn composite(panels: &[(String, Image)], columns: usize) -> Image {
+    let columns = columns.max(1);
+    let (pw, ph) = panels
+        .iter()
+        .fold((1, 1), |(w, h), (_, i)| (w.max(i.width), h.max(i.height)));
+    let bar = 22;
+    let gap = 4;
+    let rows = panels.len().div_ceil(columns).max(1) as u32;
+    let cols = columns.min(panels.len()).max(1) as u32;
+    let mut out = Image::new(
+        cols * pw + (cols + 1) * gap,
+        rows * (ph + bar) + (rows + 1) * gap,
+        [0x30, 0x33, 0x38],
+    );
+    for (k, (label, img)) in panels.iter().enumerate() {
+        let (c, r) = ((k % columns) as u32, (k / columns) as u32);
+        let x = gap + c * (pw + gap);
+        let y = gap + r * (ph + bar + gap);
+        out.text(label, x + 4, y + 4, 2, [0xf0, 0xf0, 0xf0]);
+        out.blit(img, x, y + bar);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn png_and_pgm_headers() {
+        let img = Image::new(3, 2, [1, 2, 3]);
+        let png = img.encode_png();
+        assert_eq!(&png[1..4], b"PNG");
+        let dec = png::Decoder::new(std::io::Cursor::new(png));
+        let mut r = dec.read_info().unwrap();
+        let mut buf = vec![0; r.output_buffer_size().unwrap()];
+        let info = r.next_frame(&mut buf).unwrap();
+        assert_eq!((info.width, info.height), (3, 2));
+        assert_eq!(&buf[..info.buffer_size()], &img.rgb[..]);
+        let pgm = encode_pgm(3, 2, &[0, 128, 255, 0, 0, 0]);
+        assert!(pgm.starts_with(b"P5\n3 2\n255\n"));
+        assert_eq!(pgm.len(), 11 + 6);
+    }
+
+    #[test]
+    fn labels_draw_pixels() {
+        let mut img = Image::new(40, 10, [0; 3]);
+        img.text("A1%", 0, 0, 1, [255; 3]);
+        assert!(img.rgb.iter().any(|&b| b == 255));
+        let c = composite(&[("X".into(), Image::new(4, 4, [9; 3]))], 3);
+        assert!(c.width >= 4 && c.height >= 4);
+    }
+}
