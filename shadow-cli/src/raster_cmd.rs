@@ -45,16 +45,13 @@ pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {
+    let s = s.trim();
     Method::from_name(s).ok_or_else(|| {
         format!(
             "unknown method `{s}` (available: {})",
             Method::ALL.map(Method::name).join(", ")
         )
     })
-}
-
-fn parse_methods(s: &str) -> Result<Vec<Method>, String> {
-    s.split(',').map(|m| parse_method(m.trim())).collect()
 }
 
 fn parse_hsr(s: &str) -> Result<Hsr, String> {
@@ -203,8 +200,8 @@ pub(crate) struct CompareArgs {
     #[arg(long, value_name = "WxH", default_value = "640x360", value_parser = parse_size)]
     pub(crate) size: (u32, u32),
     /// The methods to compare with exact, comma-separated [default: all].
-    #[arg(long, value_name = "M,M...", value_parser = parse_methods)]
-    pub(crate) methods: Option<Vec<Method>>,
+    #[arg(long, value_name = "M,M...", value_delimiter = ',', value_parser = parse_method)]
+    pub(crate) methods: Vec<Method>,
     #[command(flatten)]
     pub(crate) opts: MethodArgs,
     /// Panels per row.
@@ -300,7 +297,7 @@ pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> 
         (Some(e), _, _) => (e, centre),
         (None, true, _) => (DEMO_EYE, DEMO_TARGET),
         (None, _, true) => (
-            centre + DVec3::new(1.1 * half, 0.9 * half, 2.6 * half),
+            centre + DVec3::new(0.75 * half, 0.6 * half, 1.7 * half),
             centre - DVec3::Y * 0.25 * half,
         ),
         (None, false, false) => bail!(
@@ -433,7 +430,11 @@ pub(crate) fn run_compare(args: &CompareArgs) -> Result<()> {
     let shadow = args.opts.options()?;
     with_threads(args.scene.threads, || {
         let p = prepare(&args.scene, args.size, true)?;
-        let methods = args.methods.clone().unwrap_or_else(|| Method::ALL.to_vec());
+        let methods = if args.methods.is_empty() {
+            Method::ALL.to_vec()
+        } else {
+            args.methods.clone()
+        };
         let cmp = compare(&p.scene, &p.lights, &p.camera, &p.colors, &shadow, &methods)?;
         cmp.image(args.columns as usize, args.highlight)
             .write_png(&args.output)?;
@@ -476,10 +477,11 @@ pub(crate) fn run_lines(args: &LinesArgs) -> Result<()> {
         std::fs::write(&args.output, lines.svg(args.hidden))
             .with_context(|| format!("could not write {}", args.output.display()))?;
         emit(&format!(
-            "wrote {}: {} convex polyhedra, {} edges, {} visible and {} hidden parts; z-buffer \
-             check: {} of {} points agree\n",
+            "wrote {}: {} polyhedra ({} convex), {} edges, {} visible and {} hidden parts; \
+             z-buffer check: {} of {} points agree\n",
             args.output.display(),
             lines.polyhedra,
+            lines.convex,
             lines.edges,
             lines.visible.len(),
             lines.hidden.len(),
@@ -507,7 +509,6 @@ mod tests {
     fn methods_and_biases_parse() {
         assert_eq!(parse_method("shadow-map"), Ok(Method::ShadowMap));
         assert!(parse_method("phong").unwrap_err().contains("available: exact, raycast"));
-        assert_eq!(parse_methods("raycast, planar").unwrap().len(), 2);
         assert_eq!(parse_hsr("warnock"), Ok(Hsr::Warnock));
         assert!(parse_hsr("painter").is_err());
         assert_eq!(parse_bias("0.01"), Ok((0.01, 1.5)));

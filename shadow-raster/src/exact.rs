@@ -108,7 +108,7 @@ pub(crate) fn draw_fragments(
     let (w, h) = (vis.width as usize, vis.height as usize);
     let bins = Bins::new(&screen, h as u32);
     // per pixel: the fragment that took it
-    let mut taken = vec![NONE; w * h];
+    let mut taken = crate::raster::filled(w * h, NONE);
     for_bands(&mut taken, w as u32, &bins, |rows, polys, px| {
         let mut edges = Vec::new();
         for &s in polys {

@@ -31,7 +31,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
-use crate::raster::{Bins, Screen, for_bands, nearness, project_all, row_term};
+use crate::raster::{Bins, Screen, for_bands2, nearness, project_all, row_term};
 use crate::scene::RasterScene;
 use crate::view::View;
 use crate::{Camera, RasterError};
@@ -161,7 +161,8 @@ fn better(w: f64, id: u32, cur: (f64, u32)) -> bool {
 
 fn finish(width: usize, height: usize, buf: Vec<(f64, u32)>) -> Visibility {
     let (w, prim) = buf
-        .into_iter()
+        .into_par_iter()
+        .with_min_len(1 << 14)
         .map(|(w, p)| if p == NONE { (0.0, NONE) } else { (w, p) })
         .unzip();
     Visibility {
@@ -189,26 +190,34 @@ fn zbuffer(frame: &Frame<'_>) -> Visibility {
     let (w, h) = frame.size();
     let s = &frame.screen;
     let bins = Bins::new(s, h as u32);
-    let mut buf = vec![EMPTY; w * h];
-    for_bands(&mut buf, w as u32, &bins, |rows, polys, px| {
+    // nearness is positive in front of the eye: 0 is "nothing"
+    let mut near = crate::raster::filled(w * h, 0.0f64);
+    let mut prim = crate::raster::filled(w * h, NONE);
+    for_bands2(&mut near, &mut prim, w as u32, &bins, |rows, polys, nb, pb| {
         let mut edges = Vec::new();
         for &i in polys {
             let i = i as usize;
             let (k, id) = (s.coeffs[i], s.id[i]);
             s.spans(i, rows.clone(), w as i64, &mut edges, |y, xs| {
-                let row = &mut px[(y - rows.start) as usize * w..];
+                let base = (y - rows.start) as usize * w;
                 let rt = row_term(&k, y);
                 for x in xs {
                     let wv = k[0] * (x as f64 + 0.5) + rt;
-                    let cell = &mut row[x as usize];
-                    if better(wv, id, *cell) {
-                        *cell = (wv, id);
+                    let c = base + x as usize;
+                    if better(wv, id, (nb[c], pb[c])) {
+                        nb[c] = wv;
+                        pb[c] = id;
                     }
                 }
             });
         }
     });
-    finish(w, h, buf)
+    Visibility {
+        width: w as u32,
+        height: h as u32,
+        prim,
+        w: near,
+    }
 }
 
 fn scanline(frame: &Frame<'_>) -> Visibility {
@@ -259,7 +268,7 @@ struct Window {
 fn warnock(frame: &Frame<'_>) -> Visibility {
     let (w, h) = frame.size();
     let s = &frame.screen;
-    let mut buf = vec![EMPTY; w * h];
+    let mut buf = crate::raster::filled(w * h, EMPTY);
     let mut edges = Vec::new();
     let mut stack = vec![Window {
         x0: 0,
@@ -394,7 +403,7 @@ fn raycast(frame: &Frame<'_>) -> Visibility {
     // 1/512 pixel by which fixed point may move an edge
     let far = (eye - centre).length() + half;
     let pad = view.pixel_size(far) * 0.01 + 1e-12 * far;
-    let mut buf = vec![EMPTY; w * h];
+    let mut buf = crate::raster::filled(w * h, EMPTY);
     buf.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         let y = y as i64;
         let mut edges = Vec::new();
@@ -482,7 +491,7 @@ fn bsp(frame: &Frame<'_>) -> Visibility {
             )
         }
     }
-    let mut buf = vec![EMPTY; w * h];
+    let mut buf = crate::raster::filled(w * h, EMPTY);
     let rows_all: Vec<(i32, i32)> = order
         .iter()
         .map(|(p, _)| s.rows[frame.slot[*p as usize] as usize])

@@ -36,11 +36,10 @@ impl Image {
     /// A `width × height` image filled with `color`.
     pub fn new(width: u32, height: u32, color: [u8; 3]) -> Image {
         let n = width as usize * height as usize;
-        Image {
-            width,
-            height,
-            rgb: color.iter().copied().cycle().take(3 * n).collect(),
-        }
+        let mut rgb = crate::raster::filled(3 * n, 0u8);
+        use rayon::prelude::*;
+        rgb.par_chunks_mut(3).for_each(|px| px.copy_from_slice(&color));
+        Image { width, height, rgb }
     }
 
     /// The PNG encoding (fast deflate).

@@ -1,8 +1,8 @@
 //! Roberts' hidden-line algorithm for convex polyhedra (seed 004), with a
 //! cross-check against the z-buffer.
 //!
-//! The scene's objects (prims connected through shared vertices) must be
-//! closed convex polyhedra. Every edge between two faces of different
+//! The scene's polyhedra (prims joined across edges that exactly two of
+//! them share, in opposite directions) must be closed. Every edge between two faces of different
 //! planes is a candidate; an edge whose two faces both turn their back to
 //! the eye is self-hidden. The scene is mapped to *perspective space*,
 //! `(x/z, y/z, 1/z)` in camera coordinates, a projective map that keeps
@@ -15,6 +15,10 @@
 //! projection on `t` of the convex polygon they cut from
 //! `[0, 1] × [0, ∞)`. The visible parts are what is left after every other
 //! polyhedron.
+//!
+//! A closed polyhedron that is not convex (the room's flower pot) is cut
+//! into convex cells, the inside cells of its own BSP tree, and tested
+//! cell by cell, against its own edges too.
 
 use std::collections::HashMap;
 use std::fmt::Write;
@@ -23,7 +27,6 @@ use bsp_core::Plane;
 use glam::{DVec2, DVec3};
 
 use crate::hsr::{Frame, Hsr, NONE, visibility};
-use crate::maps::objects;
 use crate::scene::RasterScene;
 use crate::{Camera, RasterError};
 
@@ -45,8 +48,11 @@ pub struct HiddenLines {
     pub hidden: Vec<[DVec2; 2]>,
     /// Candidate edges (between faces of different planes).
     pub edges: usize,
-    /// Closed convex polyhedra.
+    /// Closed polyhedra.
     pub polyhedra: usize,
+    /// How many of them are convex (the others are cut into the convex
+    /// cells of their BSP tree).
+    pub convex: usize,
     /// The cross-check against the z-buffer.
     pub check: LineCheck,
 }
@@ -104,12 +110,40 @@ impl HiddenLines {
     }
 }
 
-/// A polyhedron in perspective space: its face planes `N · Q + D <= 0`
-/// inside, and its range of the third coordinate.
+/// A polyhedron in perspective space: convex cells, each the points with
+/// `N · Q + D < 0` for all its planes, whose union is the solid (one cell,
+/// its faces, for a convex polyhedron; the inside cells of its BSP tree
+/// otherwise), and its bounding box.
 struct Solid {
-    planes: Vec<(DVec3, f64)>,
+    cells: Vec<Vec<(DVec3, f64)>>,
+    convex: bool,
     lo: DVec3,
     hi: DVec3,
+}
+
+/// The inside cells of a closed polyhedron's BSP tree, each as the planes
+/// (oriented with the cell behind) along its path.
+fn bsp_cells(polys: Vec<bsp_core::Polygon>) -> Vec<Vec<Plane>> {
+    use bsp_core::{BspTree, BuildOptions, Cell, Link};
+    let tree = BspTree::build(polys, &BuildOptions::default());
+    let mut out = Vec::new();
+    let mut stack: Vec<(Link, Vec<Plane>)> = vec![(tree.root(), Vec::new())];
+    while let Some((link, path)) = stack.pop() {
+        match link {
+            Link::Cell(Cell::In) => out.push(path),
+            Link::Cell(_) => {}
+            Link::Node(id) => {
+                let n = tree.node(id);
+                let mut front = path.clone();
+                front.push(n.plane.flip());
+                let mut back = path;
+                back.push(n.plane);
+                stack.push((n.front, front));
+                stack.push((n.back, back));
+            }
+        }
+    }
+    out
 }
 
 /// Roberts' hidden lines of `scene` from `camera`.
@@ -121,7 +155,7 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
         crate::view::Kind::Orthographic { .. } => unreachable!("the camera is perspective"),
     };
     let (w, h) = (view.width as f64, view.height as f64);
-    let (obj, count) = objects(scene);
+    let (obj, count) = polyhedra(scene);
     let diag = scene.diagonal();
     let eye = camera.eye();
     // camera and perspective-space coordinates
@@ -174,23 +208,21 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
                 edges.push((o, a, b, i, j));
             }
         }
-        // convex: every vertex behind or on every face plane
+        // convex when every vertex is behind or on every face plane
         let mut planes: Vec<Plane> = prims.iter().map(|&i| *scene.polys[i].support()).collect();
         planes.sort_by_key(|p| (p.normal(), p.offset()));
         planes.dedup();
-        for p in &planes {
+        let convex = planes.iter().all(|p| {
             let (n, d) = crate::scene::world_plane(&scene.grid, p);
-            for &i in prims {
-                for v in scene.prim(i) {
-                    if n.dot(*v) + d > 1e-9 * diag {
-                        return Err(RasterError::NotConvex(format!(
-                            "{} is not convex; Roberts' algorithm needs convex polyhedra",
-                            describe()
-                        )));
-                    }
-                }
-            }
-        }
+            prims
+                .iter()
+                .all(|&i| scene.prim(i).iter().all(|v| n.dot(*v) + d <= 1e-9 * diag))
+        });
+        let cells = if convex {
+            vec![planes]
+        } else {
+            bsp_cells(prims.iter().map(|&i| scene.polys[i].clone()).collect())
+        };
         // perspective space
         let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
         for &i in prims {
@@ -206,18 +238,20 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
                 hi = hi.max(q);
             }
         }
-        let qplanes = planes
+        let to_qplane = |p: &Plane| {
+            let (n, d) = crate::scene::world_plane(&scene.grid, p);
+            // n · (eye + c.x r + c.y u + c.z f) + d = 0, times 1/c.z > 0
+            let (nr, nu, nf) = (n.dot(view.r), n.dot(view.u), n.dot(view.f));
+            let s = n.dot(eye) + d;
+            (DVec3::new(nr, nu, s), nf)
+        };
+        let cells = cells
             .iter()
-            .map(|p| {
-                let (n, d) = crate::scene::world_plane(&scene.grid, p);
-                // n · (eye + c.x r + c.y u + c.z f) + d = 0, times 1/c.z > 0
-                let (nr, nu, nf) = (n.dot(view.r), n.dot(view.u), n.dot(view.f));
-                let s = n.dot(eye) + d;
-                (DVec3::new(nr, nu, s), nf)
-            })
+            .map(|c| c.iter().map(to_qplane).collect())
             .collect();
         solids.push(Solid {
-            planes: qplanes,
+            cells,
+            convex,
             lo,
             hi,
         });
@@ -238,6 +272,7 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
         hidden: Vec::new(),
         edges: edges.len(),
         polyhedra: count,
+        convex: solids.iter().filter(|s| s.convex).count(),
         check: LineCheck::default(),
     };
     let vis = visibility(&frame, Hsr::ZBuffer);
@@ -251,7 +286,7 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
         let (elo, ehi) = (qa.min(qb), qa.max(qb));
         for (k, s) in solids.iter().enumerate() {
             // only a solid nearer than some of the edge, overlapping it on screen
-            if k == o
+            if (k == o && s.convex)
                 || s.hi.z <= elo.z
                 || s.hi.x < elo.x
                 || s.lo.x > ehi.x
@@ -260,8 +295,10 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
             {
                 continue;
             }
-            if let Some(iv) = hidden_interval(s, qa, qb) {
-                hidden.push(iv);
+            for cell in &s.cells {
+                if let Some(iv) = hidden_interval(cell, s.hi.z, qa, qb) {
+                    hidden.push(iv);
+                }
             }
         }
         let parts = subtract(&hidden);
@@ -291,7 +328,7 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
             let ok = if visible {
                 prim == NONE || own || zb >= z * (1.0 - 1e-3)
             } else {
-                prim != NONE && !own && zb < z
+                prim != NONE && (!own || !solids[o].convex) && zb < z
             };
             out.check.checked += 1;
             out.check.agree += ok as usize;
@@ -306,10 +343,59 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
     Ok(out)
 }
 
+/// The scene's polyhedra: prims joined across every edge that exactly two
+/// prims use, once in each direction (so solids touching along an edge or
+/// at a vertex stay apart). Returns each prim's polyhedron.
+fn polyhedra(scene: &RasterScene) -> (Vec<u32>, usize) {
+    let key = |p: DVec3| p.to_array().map(|c| (c + 0.0).to_bits());
+    let mut uses: HashMap<([u64; 3], [u64; 3]), Vec<(usize, bool)>> = HashMap::new();
+    for i in 0..scene.len() {
+        let pts = scene.prim(i);
+        for k in 0..pts.len() {
+            let (a, b) = (key(pts[k]), key(pts[(k + 1) % pts.len()]));
+            let (e, fwd) = if a < b { ((a, b), true) } else { ((b, a), false) };
+            uses.entry(e).or_default().push((i, fwd));
+        }
+    }
+    let mut parent: Vec<usize> = (0..scene.len()).collect();
+    fn find(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    let mut pairs: Vec<(usize, usize)> = uses
+        .values()
+        .filter(|u| u.len() == 2 && u[0].1 != u[1].1)
+        .map(|u| (u[0].0.min(u[1].0), u[0].0.max(u[1].0)))
+        .collect();
+    pairs.sort_unstable();
+    for (a, b) in pairs {
+        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+        if ra != rb {
+            parent[ra.max(rb)] = ra.min(rb);
+        }
+    }
+    let mut id = vec![u32::MAX; scene.len()];
+    let mut count = 0u32;
+    let obj = (0..scene.len())
+        .map(|i| {
+            let r = find(&mut parent, i);
+            if id[r] == u32::MAX {
+                id[r] = count;
+                count += 1;
+            }
+            id[r]
+        })
+        .collect();
+    (obj, count as usize)
+}
+
 /// The `t`-range of edge `qa → qb` hidden by solid `s`: the projection on
 /// `t` of `{(t, α) ∈ [0,1] × [0, A] : Nᵢ · (P(t) + α e₃) + Dᵢ < 0 ∀ i}`.
-fn hidden_interval(s: &Solid, qa: DVec3, qb: DVec3) -> Option<(f64, f64)> {
-    let depth = (s.hi.z - qa.z.min(qb.z)).max(0.0) * 2.0 + 1.0;
+fn hidden_interval(cell: &[(DVec3, f64)], top: f64, qa: DVec3, qb: DVec3) -> Option<(f64, f64)> {
+    let depth = (top - qa.z.min(qb.z)).max(0.0) * 2.0 + 1.0;
     let mut poly = vec![
         DVec2::new(0.0, 0.0),
         DVec2::new(1.0, 0.0),
@@ -317,7 +403,7 @@ fn hidden_interval(s: &Solid, qa: DVec3, qb: DVec3) -> Option<(f64, f64)> {
         DVec2::new(0.0, depth),
     ];
     let d = qb - qa;
-    for &(n, off) in &s.planes {
+    for &(n, off) in cell {
         // a t + b α + c < 0
         let (a, b, c) = (n.dot(d), n.z, n.dot(qa) + off);
         let margin = LINE_EPSILON * (a.abs() + b.abs() * depth + c.abs()).max(1e-300);

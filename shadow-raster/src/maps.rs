@@ -113,7 +113,7 @@ fn needed_faces(frame: &Frame<'_>, vis: &Visibility, light: RasterLight, j: usiz
 
 /// Draws every prim into a `size²` map of view `view`: `update(texel,
 /// nearness, prim)` for each covered texel, bands in parallel.
-fn draw_map<T: Copy + Send>(
+fn draw_map<T: Copy + Send + Sync>(
     scene: &RasterScene,
     view: &View,
     init: T,
@@ -127,7 +127,7 @@ fn draw_map<T: Copy + Send>(
         }
     });
     let bins = Bins::new(&screen, size);
-    let mut buf = vec![init; size as usize * size as usize];
+    let mut buf = crate::raster::filled(size as usize * size as usize, init);
     let w = size as usize;
     for_bands(&mut buf, size, &bins, |rows, polys, px| {
         let mut edges = Vec::new();
@@ -169,7 +169,7 @@ impl<T: Copy> LightMap<T> {
     }
 }
 
-fn build_map<T: Copy + Send>(
+fn build_map<T: Copy + Send + Sync>(
     frame: &Frame<'_>,
     vis: &Visibility,
     light: RasterLight,

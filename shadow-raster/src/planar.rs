@@ -139,7 +139,7 @@ pub(crate) fn planar(
                 proj.add([shadows[i].as_slice()], [0.0; 3], i as u32, out, sc);
             });
             let bins = Bins::new(&screen, h as u32);
-            let mut dark = vec![false; w * h];
+            let mut dark = crate::raster::filled(w * h, false);
             for_bands(&mut dark, w as u32, &bins, |rows, polys, px| {
                 let mut edges = Vec::new();
                 for &s in polys {

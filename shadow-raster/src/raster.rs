@@ -93,7 +93,8 @@ fn first_row(y: i64) -> i64 {
     ceil_div(y - HALF, SUB)
 }
 
-/// One edge, upper endpoint first (`y0 < y1`).
+/// One edge, upper endpoint first (`y0 < y1`), with the exact crossing of
+/// the row it was last used on, stepped from row to row without division.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Edge {
     x0: i64,
@@ -102,6 +103,15 @@ pub(crate) struct Edge {
     dy: i64,
     /// Rows whose centre it crosses.
     rows: (i64, i64),
+    /// The row `q`, `r` are for (`i64::MIN`: none yet).
+    next: i64,
+    /// `N = q·D + r`, `0 <= r < D`, with `N` the numerator of the crossing
+    /// at row `next` and `D = SUB · dy`.
+    q: i64,
+    r: i64,
+    /// One row's step of `N`, `SUB · dx = sq·D + sr`.
+    sq: i64,
+    sr: i64,
 }
 
 impl Edge {
@@ -113,22 +123,44 @@ impl Edge {
         if y0 == y1 {
             return None;
         }
+        let (dx, dy) = (x1 - x0, y1 - y0);
+        let d = SUB * dy;
         Some(Edge {
             x0,
             y0,
-            dx: x1 - x0,
-            dy: y1 - y0,
+            dx,
+            dy,
             rows: (first_row(y0), first_row(y1)),
+            next: i64::MIN,
+            q: 0,
+            r: 0,
+            sq: (SUB * dx).div_euclid(d),
+            sr: (SUB * dx).rem_euclid(d),
         })
     }
 
     /// The first pixel of row `y` whose centre is at or right of the
-    /// crossing.
+    /// crossing: `ceil(N / D)` with `N = x0·dy + dx·(yc − y0) − dy·SUB/2`
+    /// (`yc` the row's centre in fixed point), exactly. Rows asked in
+    /// increasing order cost no division after the first.
     #[inline]
-    fn crossing(&self, y: i64) -> i64 {
-        let py = y * SUB + HALF;
-        let num = self.x0 * self.dy + self.dx * (py - self.y0);
-        ceil_div(num - HALF * self.dy, SUB * self.dy)
+    fn crossing(&mut self, y: i64) -> i64 {
+        let d = SUB * self.dy;
+        if self.next != y {
+            let py = y * SUB + HALF;
+            let n = self.x0 * self.dy + self.dx * (py - self.y0) - HALF * self.dy;
+            self.q = n.div_euclid(d);
+            self.r = n.rem_euclid(d);
+        }
+        let x = self.q + (self.r > 0) as i64;
+        self.q += self.sq;
+        self.r += self.sr;
+        if self.r >= d {
+            self.q += 1;
+            self.r -= d;
+        }
+        self.next = y + 1;
+        x
     }
 }
 
@@ -243,11 +275,11 @@ pub(crate) fn row_term(k: &[f64; 3], y: i64) -> f64 {
 }
 
 /// Even-odd fill of `edges` on rows `rows`.
-fn fill(edges: &[Edge], rows: Range<i64>, width: i64, span: &mut impl FnMut(i64, Range<i64>)) {
+fn fill(edges: &mut [Edge], rows: Range<i64>, width: i64, span: &mut impl FnMut(i64, Range<i64>)) {
     let mut xs: Small<i64> = Small::new();
     for y in rows {
         xs.clear();
-        for e in edges {
+        for e in edges.iter_mut() {
             if e.rows.0 <= y && y < e.rows.1 {
                 xs.push(e.crossing(y));
             }
@@ -269,6 +301,22 @@ fn fill(edges: &[Edge], rows: Range<i64>, width: i64, span: &mut impl FnMut(i64,
             }
         }
     }
+}
+
+/// A pixel coordinate (within the guard band) in fixed point, rounded to
+/// nearest (without a library call: this runs for every vertex).
+#[inline]
+fn to_fixed(v: f64) -> i32 {
+    let s = v * SUB as f64;
+    let i = s as i64;
+    let f = s - i as f64;
+    (if f >= 0.5 {
+        i + 1
+    } else if f < -0.5 {
+        i - 1
+    } else {
+        i
+    }) as i32
 }
 
 /// Canonical intersection of segment `ab` with a plane, given the plane's
@@ -318,10 +366,7 @@ impl<'a> Projector<'a> {
     #[inline]
     fn fixed(&self, c: DVec3) -> [i32; 2] {
         let (x, y) = self.view.screen(c);
-        [
-            (x * SUB as f64).round() as i32,
-            (y * SUB as f64).round() as i32,
-        ]
+        [to_fixed(x), to_fixed(y)]
     }
 
     /// Adds one polygon (its rings in world coordinates) to `out`; nothing
@@ -471,6 +516,34 @@ pub(crate) fn for_bands<T: Send>(
         });
 }
 
+/// A vector of `n` copies of `v`, written in parallel: every page is first
+/// touched by a write on the thread that fills it (a zeroed allocation
+/// written later faults twice, copy-on-write, with TLB shootdowns).
+pub(crate) fn filled<T: Copy + Send + Sync>(n: usize, v: T) -> Vec<T> {
+    let mut out = Vec::with_capacity(n);
+    out.par_extend(rayon::iter::repeat_n(v, n));
+    out
+}
+
+/// [`for_bands`] over two images at once.
+pub(crate) fn for_bands2<T: Send, U: Send>(
+    a: &mut [T],
+    b: &mut [U],
+    width: u32,
+    bins: &Bins,
+    f: impl Fn(Range<i64>, &[u32], &mut [T], &mut [U]) + Sync,
+) {
+    let w = width as usize;
+    a.par_chunks_mut(BAND * w)
+        .zip(b.par_chunks_mut(BAND * w))
+        .enumerate()
+        .for_each(|(k, (ca, cb))| {
+            let y0 = (k * BAND) as i64;
+            let rows = y0..y0 + (ca.len() / w) as i64;
+            f(rows, bins.band(k), ca, cb);
+        });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -491,7 +564,7 @@ mod tests {
                     edges.push(e);
                 }
             }
-            fill(&edges, 0..h, w, &mut |y, xs| {
+            fill(&mut edges, 0..h, w, &mut |y, xs| {
                 for x in xs {
                     cov[(y * w + x) as usize] += 1;
                 }
@@ -576,7 +649,7 @@ mod tests {
             }
         }
         let mut n = 0;
-        fill(&edges, 0..10, 10, &mut |_, xs| n += xs.end - xs.start);
+        fill(&mut edges, 0..10, 10, &mut |_, xs| n += xs.end - xs.start);
         assert_eq!(n, 100 - 16);
     }
 

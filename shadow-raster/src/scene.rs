@@ -185,8 +185,10 @@ pub(crate) fn world_plane(grid: &Grid, p: &Plane) -> (DVec3, f64) {
 /// Prims grouped by the plane of the side the eye sees, for each prim the
 /// visible side's exact plane (`None` when seen edge-on).
 pub(crate) fn visible_planes(scene: &RasterScene, eye: DVec3) -> Vec<Option<Plane>> {
+    use rayon::prelude::*;
     let vp = scene.grid.snap_viewpoint(eye).ok();
     (0..scene.len())
+        .into_par_iter()
         .map(|i| match scene.eye_side(i, vp, eye) {
             Side::Front => Some(*scene.polys[i].support()),
             Side::Back => Some(scene.polys[i].support().flip()),

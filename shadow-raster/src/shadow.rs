@@ -175,7 +175,7 @@ impl LitBuffer {
     pub(crate) fn new(pixels: usize, lights: usize) -> LitBuffer {
         LitBuffer {
             lights,
-            amount: vec![0.0; pixels * lights],
+            amount: crate::raster::filled(pixels * lights, 0.0),
         }
     }
 

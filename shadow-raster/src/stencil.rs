@@ -19,8 +19,10 @@
 //!   clips is in front of every visible surface, so it stays right.
 //!
 //! A pixel is in shadow when its count is not zero. The visible prim and a
-//! front cap on it have bit-identical nearness (the same plane), so a
-//! surface never counts its own cap.
+//! front cap on it have bit-identical nearness (the same plane): z-pass
+//! counts strictly in front, so a surface never counts its own cap; z-fail
+//! counts at or behind, so it counts the cap it lies on together with the
+//! back face its ray leaves the volume by.
 
 use std::collections::HashMap;
 
@@ -146,7 +148,7 @@ pub(crate) fn stencil(
             proj.add([pts.as_slice()], k, sign as u32, out, sc);
         });
         let bins = Bins::new(&screen, h as u32);
-        let mut count = vec![0i32; w * h];
+        let mut count = crate::raster::filled(w * h, 0i32);
         for_bands(&mut count, w as u32, &bins, |rows, polys, px| {
             let mut edges = Vec::new();
             for &s in polys {
@@ -165,7 +167,10 @@ pub(crate) fn stencil(
                         let wv = k[0] * (x as f64 + 0.5) + rt;
                         let c = &mut px[base + x as usize];
                         if zfail {
-                            if wv < vis.w[v] {
+                            // at the surface's own depth counts as behind (a
+                            // GL_LESS depth test fails there): a surface on a
+                            // front cap sees the cap and leaves the volume
+                            if wv <= vis.w[v] {
                                 *c -= sign;
                             }
                         } else if wv > vis.w[v] {
