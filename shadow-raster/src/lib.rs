@@ -77,7 +77,7 @@ pub use error::RasterError;
 pub use hsr::{Hsr, NONE, Visibility, visible_surfaces};
 pub use image::{BACKGROUND, Image, composite, encode_pgm, mask, write_pgm};
 pub use lines::{HiddenLines, LINE_EPSILON, LineCheck, hidden_lines};
-pub use planar::planar_matrix;
+pub use planar::{PLANAR_MARGIN, planar_matrix};
 pub use scene::{RasterLight, RasterScene, SceneLight};
 pub use shadow::{LitBuffer, Method, RAY_EPSILON, ShadowFigures, ShadowOptions};
 pub use view::{Camera, MAX_SIZE};

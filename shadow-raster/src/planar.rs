@@ -27,6 +27,11 @@ use crate::raster::{Bins, for_bands, project_all};
 use crate::scene::{RasterLight, SceneLight};
 use crate::shadow::{LitBuffer, ShadowFigures, ShadowOptions, facing_only};
 
+/// Planar shadows clip occluders this fraction of the light's height
+/// below the light: a point at the light's height would project to
+/// infinity.
+pub const PLANAR_MARGIN: f64 = 1e-6;
+
 /// The 4×4 planar projection matrix `M = (P·L) I − L Pᵀ` (rows).
 pub fn planar_matrix(n: DVec3, d: f64, light: DVec4) -> [DVec4; 4] {
     let p = DVec4::new(n.x, n.y, n.z, d);
@@ -117,8 +122,11 @@ pub(crate) fn planar(
                     if opts.planar_clip {
                         poly = clip(&poly, nw, dw);
                         if let RasterLight::Point(p) = l.world {
-                            // below the plane through the light parallel to the receiver
-                            poly = clip(&poly, -nw, nw.dot(p));
+                            // below the plane through the light parallel to
+                            // the receiver (a hair below: a point at the
+                            // light's height projects to infinity)
+                            let h = nw.dot(p) + dw;
+                            poly = clip(&poly, -nw, dw + h * (1.0 - PLANAR_MARGIN));
                         }
                         if poly.len() < 3 {
                             return None;
