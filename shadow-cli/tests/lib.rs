@@ -3,6 +3,7 @@
 
 mod cli;
 mod csg;
+mod raster;
 mod shadows;
 
 use std::path::{Path, PathBuf};
@@ -32,7 +33,7 @@ fn scratch(name: &str) -> PathBuf {
     p
 }
 
-fn assert_failed_with(o: &Output, needles: &[&str]) {
+pub(crate) fn assert_failed_with(o: &Output, needles: &[&str]) {
     assert_eq!(o.status.code(), Some(1), "stderr: {}", stderr(o));
     let err = stderr(o);
     assert!(err.starts_with("error: "), "{err}");
