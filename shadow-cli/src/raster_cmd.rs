@@ -129,7 +129,7 @@ pub(crate) struct MethodArgs {
     pub(crate) map_size: u32,
     /// Shadow-map bias: C (input units) or C,S (S texel footprints times
     /// the tangent of the light's angle) [default: 0,1.5].
-    #[arg(long, value_name = "C[,S]", value_parser = parse_bias)]
+    #[arg(long, value_name = "C[,S]", value_parser = parse_bias, allow_hyphen_values = true)]
     pub(crate) bias: Option<(f64, f64)>,
     /// Percentage-closer filtering over K×K texels (odd K; 1: off).
     #[arg(long, value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=15))]
