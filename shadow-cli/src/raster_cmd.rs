@@ -146,7 +146,7 @@ pub(crate) struct MethodArgs {
 
 impl MethodArgs {
     fn options(&self) -> Result<ShadowOptions> {
-        if self.pcf % 2 == 0 {
+        if self.pcf.is_multiple_of(2) {
             bail!("--pcf {}: the kernel must be odd (1, 3, 5, ...)", self.pcf);
         }
         let d = ShadowOptions::default();
@@ -260,10 +260,7 @@ fn check_ext(path: &std::path::Path, ext: &str, flag: &str) -> Result<()> {
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case(ext));
     if !ok {
-        bail!(
-            "{}: {flag} must name a .{ext} file",
-            path.display()
-        );
+        bail!("{}: {flag} must name a .{ext} file", path.display());
     }
     Ok(())
 }
@@ -408,7 +405,10 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
                 ms(out.figures.time),
                 out.figures.primitives,
                 if out.figures.fallback_pixels > 0 {
-                    format!(", {} pixels settled by a point test", out.figures.fallback_pixels)
+                    format!(
+                        ", {} pixels settled by a point test",
+                        out.figures.fallback_pixels
+                    )
                 } else {
                     String::new()
                 }
@@ -500,15 +500,27 @@ mod tests {
         assert_eq!(parse_size("1920x1080"), Ok((1920, 1080)));
         assert_eq!(parse_size("64X48"), Ok((64, 48)));
         assert!(parse_size("1920").unwrap_err().contains("expected WxH"));
-        assert!(parse_size("0x10").unwrap_err().contains("between 1 and 16384"));
-        assert!(parse_size("axb").unwrap_err().contains("not a whole number"));
+        assert!(
+            parse_size("0x10")
+                .unwrap_err()
+                .contains("between 1 and 16384")
+        );
+        assert!(
+            parse_size("axb")
+                .unwrap_err()
+                .contains("not a whole number")
+        );
         assert!(parse_size("99999x2").unwrap_err().contains("width"));
     }
 
     #[test]
     fn methods_and_biases_parse() {
         assert_eq!(parse_method("shadow-map"), Ok(Method::ShadowMap));
-        assert!(parse_method("phong").unwrap_err().contains("available: exact, raycast"));
+        assert!(
+            parse_method("phong")
+                .unwrap_err()
+                .contains("available: exact, raycast")
+        );
         assert_eq!(parse_hsr("warnock"), Ok(Hsr::Warnock));
         assert!(parse_hsr("painter").is_err());
         assert_eq!(parse_bias("0.01"), Ok((0.01, 1.5)));

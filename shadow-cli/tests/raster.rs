@@ -55,8 +55,19 @@ fn every_method_renders() {
     ] {
         let out = scratch(&format!("room_{m}.png"));
         let o = shadow(&[
-            "render", "--scene", "room", "--size", "96x54", "--method", m, "--hsr", "scanline",
-            "--map-size", "256", "-o", out.to_str().unwrap(),
+            "render",
+            "--scene",
+            "room",
+            "--size",
+            "96x54",
+            "--method",
+            m,
+            "--hsr",
+            "scanline",
+            "--map-size",
+            "256",
+            "-o",
+            out.to_str().unwrap(),
         ]);
         assert!(o.status.success(), "{m}: {}", stderr(&o));
         assert_eq!(png_size(&out), (96, 54));
@@ -83,19 +94,37 @@ fn compare_writes_the_panels_and_the_report() {
     assert!(o.status.success(), "{}", stderr(&o));
     let report = std::fs::read_to_string(&csv).unwrap();
     let lines: Vec<&str> = report.lines().collect();
-    assert_eq!(lines[0], "method,disagree_pixels,visible_pixels,disagree_percent,ms");
+    assert_eq!(
+        lines[0],
+        "method,disagree_pixels,visible_pixels,disagree_percent,ms"
+    );
     assert_eq!(lines.len(), 8, "{report}");
     assert!(lines[1].starts_with("exact,0,"), "{report}");
     let (w, h) = png_size(&out);
     assert!(w > 4 * 96 && h > 2 * 54, "{w}x{h}");
     // a subset, and a wrong name
     let o = shadow(&[
-        "compare", "--scene", "room", "--size", "64x36", "--methods", "raycast,planar", "-o",
+        "compare",
+        "--scene",
+        "room",
+        "--size",
+        "64x36",
+        "--methods",
+        "raycast,planar",
+        "-o",
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("planar") && !stdout(&o).contains("texture"));
-    let o = shadow(&["compare", "--scene", "room", "--methods", "raycast,phong", "-o", "x.png"]);
+    let o = shadow(&[
+        "compare",
+        "--scene",
+        "room",
+        "--methods",
+        "raycast,phong",
+        "-o",
+        "x.png",
+    ]);
     assert_usage_error(&o, &["unknown method `phong`", "available: exact, raycast"]);
 }
 
@@ -103,7 +132,15 @@ fn compare_writes_the_panels_and_the_report() {
 fn lines_of_the_chair() {
     let out = scratch("chair_lines.svg");
     let o = shadow(&[
-        "lines", "--scene", "chair", "--eye", "2,-3,2", "--size", "320x240", "--hidden", "-o",
+        "lines",
+        "--scene",
+        "chair",
+        "--eye",
+        "2,-3,2",
+        "--size",
+        "320x240",
+        "--hidden",
+        "-o",
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -128,9 +165,13 @@ fn bad_sizes_and_methods_are_clear_errors() {
     assert_usage_error(&o, &["between 1 and 16384"]);
     let o = shadow(&["render", "--scene", "room", "--size", "wide", "-o", "x.png"]);
     assert_usage_error(&o, &["expected WxH"]);
-    let o = shadow(&["render", "--scene", "room", "--method", "phong", "-o", "x.png"]);
+    let o = shadow(&[
+        "render", "--scene", "room", "--method", "phong", "-o", "x.png",
+    ]);
     assert_usage_error(&o, &["unknown method `phong`", "shadow-map"]);
-    let o = shadow(&["render", "--scene", "room", "--hsr", "painter", "-o", "x.png"]);
+    let o = shadow(&[
+        "render", "--scene", "room", "--hsr", "painter", "-o", "x.png",
+    ]);
     assert_usage_error(&o, &["unknown visibility method", "warnock"]);
     let o = shadow(&["render", "--scene", "room", "--bias", "-1", "-o", "x.png"]);
     assert_usage_error(&o, &["not negative"]);
@@ -144,24 +185,51 @@ fn bad_runs_are_clear_errors() {
         let o = shadow(args);
         crate::assert_failed_with(&o, needles);
     };
-    fail(&["render", "--scene", "room", "-o", "x.jpg"], &["x.jpg", ".png"]);
     fail(
-        &["render", "--scene", "room", "--mask", "m.png", "-o", "x.png"],
+        &["render", "--scene", "room", "-o", "x.jpg"],
+        &["x.jpg", ".png"],
+    );
+    fail(
+        &[
+            "render", "--scene", "room", "--mask", "m.png", "-o", "x.png",
+        ],
         &["--mask", ".pgm"],
     );
-    fail(&["render", "--scene", "room", "--pcf", "4", "-o", "x.png"], &["--pcf 4", "odd"]);
     fail(
-        &["render", "--scene", "room", "--eye", "0.9,0.3,2.45", "--target", "0.9,0.3,2.45", "-o", "x.png"],
+        &["render", "--scene", "room", "--pcf", "4", "-o", "x.png"],
+        &["--pcf 4", "odd"],
+    );
+    fail(
+        &[
+            "render",
+            "--scene",
+            "room",
+            "--eye",
+            "0.9,0.3,2.45",
+            "--target",
+            "0.9,0.3,2.45",
+            "-o",
+            "x.png",
+        ],
         &["coincide"],
     );
     fail(
-        &["render", "--scene", "room", "--eye", "0,0,9", "--up", "0,0,1", "--target", "0,0,0", "-o", "x.png"],
+        &[
+            "render", "--scene", "room", "--eye", "0,0,9", "--up", "0,0,1", "--target", "0,0,0",
+            "-o", "x.png",
+        ],
         &["parallel"],
     );
     let teapot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/meshes/teapot.obj");
     let teapot = teapot.to_str().unwrap();
-    fail(&["render", teapot, "--light", "0,10,0", "-o", "x.png"], &["--eye"]);
-    fail(&["render", teapot, "--eye", "12,9,14", "-o", "x.png"], &["no light"]);
+    fail(
+        &["render", teapot, "--light", "0,10,0", "-o", "x.png"],
+        &["--eye"],
+    );
+    fail(
+        &["render", teapot, "--eye", "12,9,14", "-o", "x.png"],
+        &["no light"],
+    );
     fail(
         &["render", "--scene", "room", "--sun", "0,0,0", "-o", "x.png"],
         &["sun direction is zero"],
@@ -172,7 +240,15 @@ fn bad_runs_are_clear_errors() {
     );
     let missing = scratch("no_such_dir").join("out.png");
     fail(
-        &["render", "--scene", "room", "--size", "32x18", "-o", missing.to_str().unwrap()],
+        &[
+            "render",
+            "--scene",
+            "room",
+            "--size",
+            "32x18",
+            "-o",
+            missing.to_str().unwrap(),
+        ],
         &["out.png"],
     );
 }

@@ -62,14 +62,24 @@ fn frames(cr: &mut Criterion) {
             let opts = RenderOptions::default()
                 .with_method(Method::ShadowMap)
                 .with_shadow(ShadowOptions::default().with_map_size(2048));
-            g.bench_function(format!("{w}x{h}/frame zbuffer + shadow map 2048, {what}"), |b| {
-                b.iter(|| black_box(render(&s.scene, &s.lights, &cam, &[], &opts).unwrap()))
-            });
+            g.bench_function(
+                format!("{w}x{h}/frame zbuffer + shadow map 2048, {what}"),
+                |b| b.iter(|| black_box(render(&s.scene, &s.lights, &cam, &[], &opts).unwrap())),
+            );
         }
     }
     let cam = Camera::look_at(point.eye, point.target, DVec3::Y, 50.0, 1920, 1080).unwrap();
-    let out = render(&point.scene, &point.lights, &cam, &[], &RenderOptions::default().with_method(Method::ShadowMap)).unwrap();
-    g.bench_function("1920x1080/png encoding", |b| b.iter(|| black_box(out.image.encode_png())));
+    let out = render(
+        &point.scene,
+        &point.lights,
+        &cam,
+        &[],
+        &RenderOptions::default().with_method(Method::ShadowMap),
+    )
+    .unwrap();
+    g.bench_function("1920x1080/png encoding", |b| {
+        b.iter(|| black_box(out.image.encode_png()))
+    });
     g.finish();
 }
 

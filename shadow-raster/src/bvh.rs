@@ -161,15 +161,21 @@ impl Bvh {
         skip: u32,
     ) -> bool {
         let mut hit = false;
-        self.walk(o, d, tmax, |_| 0.0, |items| {
-            for &i in items {
-                if i != skip && prim_hit(scene.prim(i as usize), o, d, tmin, tmax) {
-                    hit = true;
-                    return -1.0;
+        self.walk(
+            o,
+            d,
+            tmax,
+            |_| 0.0,
+            |items| {
+                for &i in items {
+                    if i != skip && prim_hit(scene.prim(i as usize), o, d, tmin, tmax) {
+                        hit = true;
+                        return -1.0;
+                    }
                 }
-            }
-            tmax
-        });
+                tmax
+            },
+        );
         hit
     }
 }

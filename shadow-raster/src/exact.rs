@@ -18,11 +18,11 @@ use bsp_core::Plane;
 use glam::{DVec2, DVec3};
 use svbsp::{Batch, ShadeOptions, Shadows};
 
+use crate::RasterError;
 use crate::hsr::{Frame, NONE, Visibility};
 use crate::raster::{Bins, for_bands, project_all};
 use crate::scene::SceneLight;
 use crate::shadow::{LitBuffer, ShadowFigures, pixel_point};
-use crate::RasterError;
 
 /// The fragments of the scene's prims for the side the eye sees of each:
 /// every prim is an occluder; each receiver is a prim turned toward the
@@ -33,7 +33,8 @@ pub(crate) fn visible_side_fragments(
 ) -> Result<Batch, RasterError> {
     let scene = frame.scene;
     let exact: Vec<svbsp::Light> = lights.iter().map(|l| l.exact).collect();
-    let shadows = Shadows::new(&scene.polys, &exact).map_err(|e| RasterError::Shadows(e.to_string()))?;
+    let shadows =
+        Shadows::new(&scene.polys, &exact).map_err(|e| RasterError::Shadows(e.to_string()))?;
     let receivers: Vec<bsp_core::Polygon> = scene
         .polys
         .iter()
@@ -88,7 +89,12 @@ pub(crate) fn draw_fragments(
         .collect();
     let frag_group: Vec<u32> = batch
         .fragments()
-        .map(|f| groups.get(&(f.face(), *f.support())).copied().unwrap_or(NONE))
+        .map(|f| {
+            groups
+                .get(&(f.face(), *f.support()))
+                .copied()
+                .unwrap_or(NONE)
+        })
         .collect();
     let world: Vec<DVec3> = (0..batch.vertex_count() as u32)
         .map(|v| grid.to_world(batch.rounded(v)))
@@ -135,12 +141,11 @@ pub(crate) fn draw_fragments(
     }
     let mut lit = LitBuffer::new(w * h, lights);
     let mut fallback = 0;
-    for pix in 0..w * h {
-        let prim = vis.prim[pix];
+    for (pix, (&prim, &took)) in vis.prim.iter().zip(&taken).enumerate() {
         if prim == NONE {
             continue;
         }
-        let mut f = taken[pix];
+        let mut f = took;
         if f == NONE {
             let g = prim_group[prim as usize];
             let frags = &by_group[g as usize];
@@ -192,7 +197,10 @@ fn inside_fragment(batch: &Batch, f: usize, world: &[DVec3], n: DVec3, p: DVec3)
     for ring in batch.fragment(f).rings() {
         let k = ring.len();
         for i in 0..k {
-            let (a, b) = (flat(world[ring[i] as usize]), flat(world[ring[(i + 1) % k] as usize]));
+            let (a, b) = (
+                flat(world[ring[i] as usize]),
+                flat(world[ring[(i + 1) % k] as usize]),
+            );
             if (a.y > q.y) != (b.y > q.y) {
                 let x = a.x + (q.y - a.y) * (b.x - a.x) / (b.y - a.y);
                 if q.x < x {

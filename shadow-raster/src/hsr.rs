@@ -26,7 +26,7 @@
 //! Back-face culling (prims whose back faces the eye are left out) is an
 //! option of all five.
 
-use bsp_core::{BspTree, BuildOptions, Order, Plane, Side};
+use bsp_core::{BspTree, BuildOptions, Order, Plane};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -57,7 +57,13 @@ pub enum Hsr {
 
 impl Hsr {
     /// Every method, in the order of the docs.
-    pub const ALL: [Hsr; 5] = [Hsr::ZBuffer, Hsr::Scanline, Hsr::Warnock, Hsr::Raycast, Hsr::Bsp];
+    pub const ALL: [Hsr; 5] = [
+        Hsr::ZBuffer,
+        Hsr::Scanline,
+        Hsr::Warnock,
+        Hsr::Raycast,
+        Hsr::Bsp,
+    ];
 
     /// The method's name on the command line.
     pub fn name(self) -> &'static str {
@@ -94,7 +100,11 @@ pub struct Visibility {
 impl Visibility {
     /// Number of pixels where `self` and `o` see different prims.
     pub fn differences(&self, o: &Visibility) -> usize {
-        self.prim.iter().zip(&o.prim).filter(|(a, b)| a != b).count()
+        self.prim
+            .iter()
+            .zip(&o.prim)
+            .filter(|(a, b)| a != b)
+            .count()
     }
 }
 
@@ -105,6 +115,8 @@ pub(crate) struct Frame<'a> {
     pub(crate) camera: Camera,
     /// The exact plane of the side the eye sees of each prim.
     pub(crate) vis_plane: Vec<Option<Plane>>,
+    /// The unit normal (input units) of the side the eye sees of each prim.
+    pub(crate) vis_normal: Vec<DVec3>,
     /// The drawn prims (ids are prim indices).
     pub(crate) screen: Screen,
     /// For each prim, its index in `screen`, or [`NONE`].
@@ -112,7 +124,11 @@ pub(crate) struct Frame<'a> {
 }
 
 impl<'a> Frame<'a> {
-    pub(crate) fn new(scene: &'a RasterScene, camera: &Camera, cull: bool) -> Result<Frame<'a>, RasterError> {
+    pub(crate) fn new(
+        scene: &'a RasterScene,
+        camera: &Camera,
+        cull: bool,
+    ) -> Result<Frame<'a>, RasterError> {
         if scene.is_empty() {
             return Err(RasterError::EmptyScene);
         }
@@ -136,10 +152,17 @@ impl<'a> Frame<'a> {
         for (s, &id) in screen.id.iter().enumerate() {
             slot[id as usize] = s as u32;
         }
+        let vis_normal = (0..scene.len())
+            .map(|i| match vis_plane[i] {
+                Some(p) if p == *scene.polys[i].support() => scene.plane[i].0,
+                _ => -scene.plane[i].0,
+            })
+            .collect();
         Ok(Frame {
             scene,
             camera,
             vis_plane,
+            vis_normal,
             screen,
             slot,
         })
@@ -193,25 +216,31 @@ fn zbuffer(frame: &Frame<'_>) -> Visibility {
     // nearness is positive in front of the eye: 0 is "nothing"
     let mut near = crate::raster::filled(w * h, 0.0f64);
     let mut prim = crate::raster::filled(w * h, NONE);
-    for_bands2(&mut near, &mut prim, w as u32, &bins, |rows, polys, nb, pb| {
-        let mut edges = Vec::new();
-        for &i in polys {
-            let i = i as usize;
-            let (k, id) = (s.coeffs[i], s.id[i]);
-            s.spans(i, rows.clone(), w as i64, &mut edges, |y, xs| {
-                let base = (y - rows.start) as usize * w;
-                let rt = row_term(&k, y);
-                for x in xs {
-                    let wv = k[0] * (x as f64 + 0.5) + rt;
-                    let c = base + x as usize;
-                    if better(wv, id, (nb[c], pb[c])) {
-                        nb[c] = wv;
-                        pb[c] = id;
+    for_bands2(
+        &mut near,
+        &mut prim,
+        w as u32,
+        &bins,
+        |rows, polys, nb, pb| {
+            let mut edges = Vec::new();
+            for &i in polys {
+                let i = i as usize;
+                let (k, id) = (s.coeffs[i], s.id[i]);
+                s.spans(i, rows.clone(), w as i64, &mut edges, |y, xs| {
+                    let base = (y - rows.start) as usize * w;
+                    let rt = row_term(&k, y);
+                    for x in xs {
+                        let wv = k[0] * (x as f64 + 0.5) + rt;
+                        let c = base + x as usize;
+                        if better(wv, id, (nb[c], pb[c])) {
+                            nb[c] = wv;
+                            pb[c] = id;
+                        }
                     }
-                }
-            });
-        }
-    });
+                });
+            }
+        },
+    );
     Visibility {
         width: w as u32,
         height: h as u32,
@@ -283,7 +312,10 @@ fn warnock(frame: &Frame<'_>) -> Visibility {
             .into_iter()
             .filter(|&i| {
                 let ((r0, r1), (c0, c1)) = (s.rows[i as usize], s.cols[i as usize]);
-                (r0 as i64) < win.y1 && (r1 as i64) > win.y0 && (c0 as i64) < win.x1 && (c1 as i64) > win.x0
+                (r0 as i64) < win.y1
+                    && (r1 as i64) > win.y0
+                    && (c0 as i64) < win.x1
+                    && (c1 as i64) > win.x0
             })
             .collect();
         let (x0, y0, x1, y1) = (win.x0, win.y0, win.x1, win.y1);
@@ -320,7 +352,12 @@ fn warnock(frame: &Frame<'_>) -> Visibility {
             continue;
         }
         let (xm, ym) = ((x0 + x1) / 2, (y0 + y1) / 2);
-        let quads = [(x0, y0, xm, ym), (xm, y0, x1, ym), (x0, ym, xm, y1), (xm, ym, x1, y1)];
+        let quads = [
+            (x0, y0, xm, ym),
+            (xm, y0, x1, ym),
+            (x0, ym, xm, y1),
+            (xm, ym, x1, y1),
+        ];
         for (a, b, c, d) in quads {
             if a < c && b < d {
                 stack.push(Window {
@@ -357,10 +394,6 @@ fn surrounder(
         }
         (lo, hi)
     };
-    let far_max = list
-        .iter()
-        .map(|&i| range(i as usize).1)
-        .fold(f64::NEG_INFINITY, f64::max);
     for &c in list {
         let c = c as usize;
         let (lo, _) = range(c);
@@ -374,10 +407,12 @@ fn surrounder(
             .filter(|&&i| i as usize != c)
             .map(|&i| range(i as usize).1)
             .fold(f64::NEG_INFINITY, f64::max);
-        if others.is_finite() && !(lo > others + 1e-9 * others.abs().max(lo.abs())) {
+        let margin = 1e-9 * others.abs().max(lo.abs());
+        if others.is_finite()
+            && lo.partial_cmp(&(others + margin)) != Some(std::cmp::Ordering::Greater)
+        {
             continue;
         }
-        let _ = far_max;
         let mut rows_covered = 0;
         let mut whole = true;
         s.spans(c, y0..y1, x1, edges, |_, xs| {
@@ -411,20 +446,30 @@ fn raycast(frame: &Frame<'_>) -> Visibility {
             let x = x as i64;
             let d = view.dir(x as f64 + 0.5, y as f64 + 0.5);
             let mut best = EMPTY;
-            bvh.walk(eye, d, f64::INFINITY, |_| pad, |items| {
-                for &p in items {
-                    let si = frame.slot[p as usize];
-                    if si == NONE || !s.covers(si as usize, x, y, &mut edges) {
-                        continue;
+            bvh.walk(
+                eye,
+                d,
+                f64::INFINITY,
+                |_| pad,
+                |items| {
+                    for &p in items {
+                        let si = frame.slot[p as usize];
+                        if si == NONE || !s.covers(si as usize, x, y, &mut edges) {
+                            continue;
+                        }
+                        let wv = s.nearness(si as usize, x, y);
+                        if better(wv, p, best) {
+                            best = (wv, p);
+                        }
                     }
-                    let wv = s.nearness(si as usize, x, y);
-                    if better(wv, p, best) {
-                        best = (wv, p);
+                    // depth along d (whose f component is 1) of the best hit
+                    if best.1 == NONE {
+                        f64::INFINITY
+                    } else {
+                        1.0 / best.0 * (1.0 + 1e-9) + pad
                     }
-                }
-                // depth along d (whose f component is 1) of the best hit
-                if best.1 == NONE { f64::INFINITY } else { 1.0 / best.0 * (1.0 + 1e-9) + pad }
-            });
+                },
+            );
             *cell = best;
         }
     });
@@ -441,6 +486,10 @@ fn keeps_on(p: &Plane) -> bool {
     }
 }
 
+/// A splitting plane that bounds a BSP piece inside its prim: normal and
+/// offset in grid units, and whether points on it are kept.
+type Cut = (DVec3, f64, bool);
+
 fn bsp(frame: &Frame<'_>) -> Visibility {
     let (w, h) = frame.size();
     let s = &frame.screen;
@@ -456,9 +505,9 @@ fn bsp(frame: &Frame<'_>) -> Visibility {
         .collect();
     let tree = BspTree::build(polys, &BuildOptions::default());
     // pieces front to back; within a node, by prim
-    let mut order: Vec<(u32, Vec<(DVec3, f64, bool)>)> = Vec::new();
+    let mut order: Vec<(u32, Vec<Cut>)> = Vec::new();
     let eye = grid.snap_viewpoint(view.origin).ok();
-    let visit = |_: u32, node: &bsp_core::Node, order: &mut Vec<(u32, Vec<(DVec3, f64, bool)>)>| {
+    let visit = |_: u32, node: &bsp_core::Node, order: &mut Vec<(u32, Vec<Cut>)>| {
         let mut pieces: Vec<&bsp_core::Polygon> = node.polygons.iter().collect();
         pieces.sort_by_key(|p| p.tag());
         for piece in pieces {
@@ -531,7 +580,6 @@ fn bsp(frame: &Frame<'_>) -> Visibility {
                 });
             }
         });
-    let _ = Side::On;
     finish(w, h, buf)
 }
 

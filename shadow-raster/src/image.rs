@@ -6,10 +6,10 @@ use std::path::Path;
 
 use glam::DVec3;
 
+use crate::RasterError;
 use crate::hsr::{Frame, NONE, Visibility};
 use crate::scene::SceneLight;
 use crate::shadow::{LitBuffer, pixel_point, visible_normal};
-use crate::RasterError;
 
 /// An 8-bit RGB image, row-major from the top-left corner.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -38,7 +38,8 @@ impl Image {
         let n = width as usize * height as usize;
         let mut rgb = crate::raster::filled(3 * n, 0u8);
         use rayon::prelude::*;
-        rgb.par_chunks_mut(3).for_each(|px| px.copy_from_slice(&color));
+        rgb.par_chunks_mut(3)
+            .for_each(|px| px.copy_from_slice(&color));
         Image { width, height, rgb }
     }
 
@@ -288,7 +289,7 @@ mod tests {
     fn labels_draw_pixels() {
         let mut img = Image::new(40, 10, [0; 3]);
         img.text("A1%", 0, 0, 1, [255; 3]);
-        assert!(img.rgb.iter().any(|&b| b == 255));
+        assert!(img.rgb.contains(&255));
         let c = composite(&[("X".into(), Image::new(4, 4, [9; 3]))], 3);
         assert!(c.width >= 4 && c.height >= 4);
     }

@@ -27,7 +27,7 @@ use bsp_core::Plane;
 use glam::{DVec2, DVec3};
 
 use crate::hsr::{Frame, Hsr, NONE, visibility};
-use crate::scene::RasterScene;
+use crate::scene::{EdgeKey, RasterScene, point_key as key};
 use crate::{Camera, RasterError};
 
 /// Relative margin of Roberts' inequalities: a point must be inside a
@@ -169,7 +169,6 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
     for (i, &o) in obj.iter().enumerate() {
         members[o as usize].push(i);
     }
-    let key = |p: DVec3| p.to_array().map(|c| (c + 0.0).to_bits());
     let mut solids = Vec::with_capacity(count);
     // candidate edges: (object, a, b, the two prims)
     let mut edges: Vec<(usize, DVec3, DVec3, usize, usize)> = Vec::new();
@@ -182,7 +181,7 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
             )
         };
         // closed: every directed edge meets its reverse once
-        let mut directed: HashMap<([u64; 3], [u64; 3]), (usize, DVec3, DVec3)> = HashMap::new();
+        let mut directed: HashMap<EdgeKey, (usize, DVec3, DVec3)> = HashMap::new();
         for &i in prims {
             let pts = scene.prim(i);
             for k in 0..pts.len() {
@@ -204,7 +203,11 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
                     describe()
                 )));
             };
-            if ka < kb && !scene.polys[i].support().is_coincident(scene.polys[j].support()) {
+            if ka < kb
+                && !scene.polys[i]
+                    .support()
+                    .is_coincident(scene.polys[j].support())
+            {
                 edges.push((o, a, b, i, j));
             }
         }
@@ -347,13 +350,16 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
 /// prims use, once in each direction (so solids touching along an edge or
 /// at a vertex stay apart). Returns each prim's polyhedron.
 fn polyhedra(scene: &RasterScene) -> (Vec<u32>, usize) {
-    let key = |p: DVec3| p.to_array().map(|c| (c + 0.0).to_bits());
-    let mut uses: HashMap<([u64; 3], [u64; 3]), Vec<(usize, bool)>> = HashMap::new();
+    let mut uses: HashMap<EdgeKey, Vec<(usize, bool)>> = HashMap::new();
     for i in 0..scene.len() {
         let pts = scene.prim(i);
         for k in 0..pts.len() {
             let (a, b) = (key(pts[k]), key(pts[(k + 1) % pts.len()]));
-            let (e, fwd) = if a < b { ((a, b), true) } else { ((b, a), false) };
+            let (e, fwd) = if a < b {
+                ((a, b), true)
+            } else {
+                ((b, a), false)
+            };
             uses.entry(e).or_default().push((i, fwd));
         }
     }
@@ -411,7 +417,10 @@ fn hidden_interval(cell: &[(DVec3, f64)], top: f64, qa: DVec3, qb: DVec3) -> Opt
         let k = poly.len();
         for i in 0..k {
             let (p, q) = (poly[i], poly[(i + 1) % k]);
-            let (fp, fq) = (-(a * p.x + b * p.y + c) - margin, -(a * q.x + b * q.y + c) - margin);
+            let (fp, fq) = (
+                -(a * p.x + b * p.y + c) - margin,
+                -(a * q.x + b * q.y + c) - margin,
+            );
             if fp >= 0.0 {
                 next.push(p);
             }
@@ -424,8 +433,16 @@ fn hidden_interval(cell: &[(DVec3, f64)], top: f64, qa: DVec3, qb: DVec3) -> Opt
             return None;
         }
     }
-    let t0 = poly.iter().map(|p| p.x).fold(f64::INFINITY, f64::min).max(0.0);
-    let t1 = poly.iter().map(|p| p.x).fold(f64::NEG_INFINITY, f64::max).min(1.0);
+    let t0 = poly
+        .iter()
+        .map(|p| p.x)
+        .fold(f64::INFINITY, f64::min)
+        .max(0.0);
+    let t1 = poly
+        .iter()
+        .map(|p| p.x)
+        .fold(f64::NEG_INFINITY, f64::max)
+        .min(1.0);
     (t1 > t0).then_some((t0, t1))
 }
 
@@ -464,8 +481,14 @@ mod tests {
 
     #[test]
     fn interval_arithmetic() {
-        assert_eq!(subtract(&[(0.2, 0.4), (0.3, 0.5)]), vec![(0.0, 0.2), (0.5, 1.0)]);
+        assert_eq!(
+            subtract(&[(0.2, 0.4), (0.3, 0.5)]),
+            vec![(0.0, 0.2), (0.5, 1.0)]
+        );
         assert_eq!(subtract(&[(0.0, 1.0)]), Vec::<(f64, f64)>::new());
-        assert_eq!(merge(vec![(0.5, 0.6), (0.1, 0.2)]), vec![(0.1, 0.2), (0.5, 0.6)]);
+        assert_eq!(
+            merge(vec![(0.5, 0.6), (0.1, 0.2)]),
+            vec![(0.1, 0.2), (0.5, 0.6)]
+        );
     }
 }

@@ -37,22 +37,29 @@ fn light_views(scene: &RasterScene, light: RasterLight, size: u32) -> Vec<View> 
     };
     let near = 1e-6 * scene.diagonal();
     match light {
-        RasterLight::Point(l) => [DVec3::X, -DVec3::X, DVec3::Y, -DVec3::Y, DVec3::Z, -DVec3::Z]
-            .into_iter()
-            .map(|f| {
-                let (r, u) = frame_of(f);
-                View {
-                    kind: Kind::Perspective { kx: 1.0, ky: 1.0 },
-                    origin: l,
-                    r,
-                    u,
-                    f,
-                    width: size,
-                    height: size,
-                    near,
-                }
-            })
-            .collect(),
+        RasterLight::Point(l) => [
+            DVec3::X,
+            -DVec3::X,
+            DVec3::Y,
+            -DVec3::Y,
+            DVec3::Z,
+            -DVec3::Z,
+        ]
+        .into_iter()
+        .map(|f| {
+            let (r, u) = frame_of(f);
+            View {
+                kind: Kind::Perspective { kx: 1.0, ky: 1.0 },
+                origin: l,
+                r,
+                u,
+                f,
+                width: size,
+                height: size,
+                near,
+            }
+        })
+        .collect(),
         RasterLight::Sun(d) => {
             let centre = (scene.lo + scene.hi) * 0.5;
             let radius = 0.5 * scene.diagonal();
@@ -94,7 +101,13 @@ fn face_of(light: RasterLight, p: DVec3) -> usize {
 }
 
 /// The faces some visible pixel facing light `j` looks up.
-fn needed_faces(frame: &Frame<'_>, vis: &Visibility, light: RasterLight, j: usize, facing: &[u64]) -> [bool; 6] {
+fn needed_faces(
+    frame: &Frame<'_>,
+    vis: &Visibility,
+    light: RasterLight,
+    j: usize,
+    facing: &[u64],
+) -> [bool; 6] {
     let w = vis.width as usize;
     vis.prim
         .par_chunks(w)
@@ -164,11 +177,15 @@ impl<T: Copy> LightMap<T> {
         }
         let (x, y) = view.screen(c);
         let n = view.width as i64;
-        let (x, y) = ((x.floor() as i64).clamp(0, n - 1), (y.floor() as i64).clamp(0, n - 1));
+        let (x, y) = (
+            (x.floor() as i64).clamp(0, n - 1),
+            (y.floor() as i64).clamp(0, n - 1),
+        );
         Some((f, x, y, c))
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn build_map<T: Copy + Send + Sync>(
     frame: &Frame<'_>,
     vis: &Visibility,
@@ -251,9 +268,11 @@ pub(crate) fn shadow_map(
                     let mut pass = 0.0f32;
                     for dy in -half..=half {
                         for dx in -half..=half {
-                            let (tx, ty) = ((x + dx).clamp(0, size - 1), (y + dy).clamp(0, size - 1));
+                            let (tx, ty) =
+                                ((x + dx).clamp(0, size - 1), (y + dy).clamp(0, size - 1));
                             let wm = data[(ty * size + tx) as usize];
-                            let lit_here = wm == f32::NEG_INFINITY || z - bias <= view.depth(wm as f64);
+                            let lit_here =
+                                wm == f32::NEG_INFINITY || z - bias <= view.depth(wm as f64);
                             pass += lit_here as u8 as f32;
                         }
                     }
@@ -280,7 +299,7 @@ pub(crate) fn objects(scene: &RasterScene) -> (Vec<u32>, usize) {
     let mut first: HashMap<[u64; 3], u32> = HashMap::with_capacity(scene.pts.len());
     for i in 0..n {
         for p in scene.prim(i) {
-            let key = p.to_array().map(|c| (c + 0.0).to_bits());
+            let key = crate::scene::point_key(*p);
             let other = *first.entry(key).or_insert(i as u32);
             let (a, b) = (find(&mut parent, i as u32), find(&mut parent, other));
             if a != b {
@@ -318,14 +337,13 @@ pub(crate) fn texture(
     for (j, l) in lights.iter().enumerate() {
         // objects in the light's order, by their nearest vertex
         let mut key = vec![f64::INFINITY; count];
-        for i in 0..scene.len() {
+        for (i, &o) in obj.iter().enumerate() {
             for p in scene.prim(i) {
                 let k = match l.world {
                     RasterLight::Point(lp) => (*p - lp).length(),
                     RasterLight::Sun(d) => -p.dot(d),
                 };
-                let o = obj[i] as usize;
-                key[o] = key[o].min(k);
+                key[o as usize] = key[o as usize].min(k);
             }
         }
         let mut order: Vec<u32> = (0..count as u32).collect();
@@ -335,9 +353,18 @@ pub(crate) fn texture(
             rank[o as usize] = r as u32;
         }
         let prim_rank: Vec<u32> = obj.iter().map(|&o| rank[o as usize]).collect();
-        let (map, texels) = build_map(frame, vis, l.world, j, facing, opts.map_size, NONE, |t, _, prim| {
-            *t = (*t).min(prim_rank[prim as usize]);
-        });
+        let (map, texels) = build_map(
+            frame,
+            vis,
+            l.world,
+            j,
+            facing,
+            opts.map_size,
+            NONE,
+            |t, _, prim| {
+                *t = (*t).min(prim_rank[prim as usize]);
+            },
+        );
         fig.primitives += texels;
         lit.amount
             .par_chunks_mut(n * 256)

@@ -76,7 +76,10 @@ pub(crate) fn receivers(frame: &Frame<'_>, max: usize) -> Vec<Plane> {
         total += a;
         *area.entry(*scene.polys[i].support()).or_insert(0.0) += a;
     }
-    let mut planes: Vec<(Plane, f64)> = area.into_iter().filter(|(_, a)| *a >= 0.01 * total).collect();
+    let mut planes: Vec<(Plane, f64)> = area
+        .into_iter()
+        .filter(|(_, a)| *a >= 0.01 * total)
+        .collect();
     planes.sort_by(|a, b| {
         b.1.total_cmp(&a.1)
             .then_with(|| (a.0.normal(), a.0.offset()).cmp(&(b.0.normal(), b.0.offset())))
@@ -126,7 +129,7 @@ pub(crate) fn planar(
                             // the receiver (a hair below: a point at the
                             // light's height projects to infinity)
                             let h = nw.dot(p) + dw;
-                            poly = clip(&poly, -nw, dw + h * (1.0 - PLANAR_MARGIN));
+                            poly = clip(&poly, -nw, h * (1.0 - PLANAR_MARGIN) - dw);
                         }
                         if poly.len() < 3 {
                             return None;

@@ -109,7 +109,8 @@ pub(crate) struct Edge {
     /// at row `next` and `D = SUB · dy`.
     q: i64,
     r: i64,
-    /// One row's step of `N`, `SUB · dx = sq·D + sr`.
+    /// One row's step of `N`, `SUB · dx = sq·D + sr` (`sq = i64::MIN`: not
+    /// computed yet).
     sq: i64,
     sr: i64,
 }
@@ -118,31 +119,33 @@ impl Edge {
     /// The edge between two fixed-point points; `None` if horizontal.
     #[inline]
     fn new(a: [i32; 2], b: [i32; 2]) -> Option<Edge> {
-        let (a, b) = if (a[1], a[0]) <= (b[1], b[0]) { (a, b) } else { (b, a) };
+        let (a, b) = if (a[1], a[0]) <= (b[1], b[0]) {
+            (a, b)
+        } else {
+            (b, a)
+        };
         let (x0, y0, x1, y1) = (a[0] as i64, a[1] as i64, b[0] as i64, b[1] as i64);
         if y0 == y1 {
             return None;
         }
-        let (dx, dy) = (x1 - x0, y1 - y0);
-        let d = SUB * dy;
         Some(Edge {
             x0,
             y0,
-            dx,
-            dy,
+            dx: x1 - x0,
+            dy: y1 - y0,
             rows: (first_row(y0), first_row(y1)),
             next: i64::MIN,
             q: 0,
             r: 0,
-            sq: (SUB * dx).div_euclid(d),
-            sr: (SUB * dx).rem_euclid(d),
+            sq: i64::MIN,
+            sr: 0,
         })
     }
 
     /// The first pixel of row `y` whose centre is at or right of the
     /// crossing: `ceil(N / D)` with `N = x0·dy + dx·(yc − y0) − dy·SUB/2`
     /// (`yc` the row's centre in fixed point), exactly. Rows asked in
-    /// increasing order cost no division after the first.
+    /// increasing order cost no division after the second.
     #[inline]
     fn crossing(&mut self, y: i64) -> i64 {
         let d = SUB * self.dy;
@@ -153,13 +156,19 @@ impl Edge {
             self.r = n.rem_euclid(d);
         }
         let x = self.q + (self.r > 0) as i64;
-        self.q += self.sq;
-        self.r += self.sr;
-        if self.r >= d {
-            self.q += 1;
-            self.r -= d;
+        if y + 1 < self.rows.1 {
+            if self.sq == i64::MIN {
+                self.sq = (SUB * self.dx).div_euclid(d);
+                self.sr = (SUB * self.dx).rem_euclid(d);
+            }
+            self.q += self.sq;
+            self.r += self.sr;
+            if self.r >= d {
+                self.q += 1;
+                self.r -= d;
+            }
+            self.next = y + 1;
         }
-        self.next = y + 1;
         x
     }
 }
@@ -203,7 +212,8 @@ impl Screen {
         self.pts.extend_from_slice(&o.pts);
         self.ring_start
             .extend(o.ring_start[1..].iter().map(|s| s + p0));
-        self.poly_ring.extend(o.poly_ring[1..].iter().map(|s| s + r0));
+        self.poly_ring
+            .extend(o.poly_ring[1..].iter().map(|s| s + r0));
         self.rows.extend_from_slice(&o.rows);
         self.cols.extend_from_slice(&o.cols);
         self.coeffs.extend_from_slice(&o.coeffs);
@@ -596,7 +606,7 @@ mod tests {
             let fan: Vec<Vec<[i32; 2]>> = (0..ring.len())
                 .map(|k| vec![c, ring[k], ring[(k + 1) % ring.len()]])
                 .collect();
-            let whole = coverage(&[ring.clone()], 16, 16);
+            let whole = coverage(std::slice::from_ref(&ring), 16, 16);
             let parts = coverage(&fan, 16, 16);
             assert_eq!(whole, parts, "centre {centre:?}");
             assert!(parts.iter().all(|&c| c <= 1));
@@ -605,7 +615,12 @@ mod tests {
         for i in 0..4 {
             for j in 0..4 {
                 let (x, y) = (1.5 + 3.0 * i as f64, 0.5 + 3.0 * j as f64);
-                squares.push(vec![fx(x, y), fx(x + 3.0, y), fx(x + 3.0, y + 3.0), fx(x, y + 3.0)]);
+                squares.push(vec![
+                    fx(x, y),
+                    fx(x + 3.0, y),
+                    fx(x + 3.0, y + 3.0),
+                    fx(x, y + 3.0),
+                ]);
             }
         }
         let cov = coverage(&squares, 16, 16);
@@ -622,14 +637,12 @@ mod tests {
         // a square whose sides run through pixel centres: the top and left
         // sides are in, the bottom and right ones out
         let sq = vec![fx(2.5, 2.5), fx(5.5, 2.5), fx(5.5, 5.5), fx(2.5, 5.5)];
-        let cov = coverage(&[sq.clone()], 8, 8);
+        let cov = coverage(std::slice::from_ref(&sq), 8, 8);
         let covered: Vec<(usize, usize)> = (0..64)
             .filter(|&i| cov[i] == 1)
             .map(|i| (i % 8, i / 8))
             .collect();
-        let want: Vec<(usize, usize)> = (2..5)
-            .flat_map(|y| (2..5).map(move |x| (x, y)))
-            .collect();
+        let want: Vec<(usize, usize)> = (2..5).flat_map(|y| (2..5).map(move |x| (x, y))).collect();
         assert_eq!(covered, want);
         // the same square the other way round covers the same pixels
         let rev: Vec<[i32; 2]> = sq.into_iter().rev().collect();
@@ -657,9 +670,16 @@ mod tests {
     fn clipping_shares_cut_points() {
         // two triangles sharing an edge that crosses the near plane: their
         // clipped, projected edges coincide and they tile without overlap
-        let cam = Camera::look_at(DVec3::new(0.0, -1.0, 0.3), DVec3::new(0.0, 5.0, 0.0), DVec3::Z, 70.0, 32, 32)
-            .unwrap()
-            .with_near(0.5);
+        let cam = Camera::look_at(
+            DVec3::new(0.0, -1.0, 0.3),
+            DVec3::new(0.0, 5.0, 0.0),
+            DVec3::Z,
+            70.0,
+            32,
+            32,
+        )
+        .unwrap()
+        .with_near(0.5);
         let (a, b) = (DVec3::new(-0.2, -3.0, 0.0), DVec3::new(0.3, 6.0, 0.0));
         let t1 = [a, b, DVec3::new(-4.0, 2.0, 0.0)];
         let t2 = [b, a, DVec3::new(4.0, 1.0, 0.0)];

@@ -152,7 +152,12 @@ impl RasterScene {
 
     /// The side of prim `i`'s exact plane the point `eye` (input units)
     /// is on: the eye is snapped to the grid for an exact answer.
-    pub(crate) fn eye_side(&self, i: usize, eye: Option<bsp_core::ViewPoint>, world: DVec3) -> Side {
+    pub(crate) fn eye_side(
+        &self,
+        i: usize,
+        eye: Option<bsp_core::ViewPoint>,
+        world: DVec3,
+    ) -> Side {
         match eye {
             Some(vp) => self.polys[i].support().classify_viewpoint(vp),
             None => {
@@ -169,6 +174,17 @@ impl RasterScene {
         }
     }
 }
+
+/// The bits of a point's coordinates (`-0.0` read as `0.0`): equal points,
+/// equal keys. Vertices shared by prims are equal bit for bit (each is one
+/// exact vertex rounded once).
+#[inline]
+pub(crate) fn point_key(p: DVec3) -> [u64; 3] {
+    p.to_array().map(|c| (c + 0.0).to_bits())
+}
+
+/// An edge by its two endpoints' keys.
+pub(crate) type EdgeKey = ([u64; 3], [u64; 3]);
 
 /// A plane of the grid in input units, with a unit normal. Opposite
 /// planes give exactly opposite results.

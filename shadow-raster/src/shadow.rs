@@ -10,9 +10,9 @@ use std::time::Duration;
 
 use glam::DVec3;
 
+use crate::RasterError;
 use crate::hsr::{Frame, NONE, Visibility};
 use crate::scene::{RasterLight, SceneLight};
-use crate::RasterError;
 
 /// A shadow method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -146,16 +146,14 @@ impl ShadowOptions {
                 self.bias_constant, self.bias_slope
             )));
         }
-        if self.pcf == 0 || self.pcf > 15 || self.pcf % 2 == 0 {
+        if self.pcf == 0 || self.pcf > 15 || self.pcf.is_multiple_of(2) {
             return Err(RasterError::Option(format!(
                 "PCF kernel {}: it must be odd, between 1 and 15",
                 self.pcf
             )));
         }
         if self.planar_receivers == 0 {
-            return Err(RasterError::Option(
-                "planar receivers: at least one".into(),
-            ));
+            return Err(RasterError::Option("planar receivers: at least one".into()));
         }
         Ok(())
     }
@@ -219,11 +217,7 @@ pub(crate) fn facing_bits(frame: &Frame<'_>, lights: &[SceneLight]) -> Vec<u64> 
 /// The unit normal of the side of prim `i` the eye sees.
 #[inline]
 pub(crate) fn visible_normal(frame: &Frame<'_>, i: usize) -> DVec3 {
-    let n = frame.scene.plane[i].0;
-    match frame.vis_plane[i] {
-        Some(p) if p == *frame.scene.polys[i].support() => n,
-        _ => -n,
-    }
+    frame.vis_normal[i]
 }
 
 /// The world point of pixel `pix` (which has a visible prim).

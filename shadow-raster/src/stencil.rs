@@ -30,7 +30,7 @@ use glam::DVec3;
 
 use crate::hsr::{Frame, NONE, Visibility};
 use crate::raster::{Bins, for_bands, project_all, row_term};
-use crate::scene::{RasterLight, SceneLight};
+use crate::scene::{EdgeKey, RasterLight, SceneLight, point_key as key};
 use crate::shadow::{LitBuffer, ShadowFigures, facing_only};
 
 /// The polygons of a light's shadow volumes, in input units, with a
@@ -53,12 +53,15 @@ pub(crate) fn volumes(frame: &Frame<'_>, light: &SceneLight, caps: bool) -> Volu
         RasterLight::Point(l) => {
             let v = p - l;
             let len = v.length();
-            if len == 0.0 { p } else { l + v * ((len + reach) / len) }
+            if len == 0.0 {
+                p
+            } else {
+                l + v * ((len + reach) / len)
+            }
         }
         RasterLight::Sun(d) => p - d * reach,
     };
-    let key = |p: DVec3| p.to_array().map(|c| (c + 0.0).to_bits());
-    let mut edges: HashMap<([u64; 3], [u64; 3]), (DVec3, DVec3, i32)> = HashMap::new();
+    let mut edges: HashMap<EdgeKey, (DVec3, DVec3, i32)> = HashMap::new();
     let mut out = Volumes {
         polys: Vec::new(),
         weight: Vec::new(),
@@ -83,7 +86,8 @@ pub(crate) fn volumes(frame: &Frame<'_>, light: &SceneLight, caps: bool) -> Volu
             out.polys.push(pts.to_vec());
             out.weight.push(1);
             out.plane.push(Some(scene.plane[i]));
-            out.polys.push(pts.iter().rev().map(|&p| extrude(p)).collect());
+            out.polys
+                .push(pts.iter().rev().map(|&p| extrude(p)).collect());
             out.weight.push(1);
             out.plane.push(None);
         }

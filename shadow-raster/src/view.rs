@@ -80,9 +80,7 @@ impl Camera {
             ));
         };
         let Some(upn) = up.try_normalize() else {
-            return Err(RasterError::Camera(
-                "the up vector must not be zero".into(),
-            ));
+            return Err(RasterError::Camera("the up vector must not be zero".into()));
         };
         if f.cross(upn).length() <= MIN_UP_SINE {
             return Err(RasterError::Camera(
@@ -158,7 +156,7 @@ impl Camera {
         }
         let (x, y) = self.view.screen(c);
         let (w, h) = (self.view.width as f64, self.view.height as f64);
-        ((0.0..w).contains(&x) && (0.0..h).contains(&y)).then(|| (x as u32, y as u32))
+        ((0.0..w).contains(&x) && (0.0..h).contains(&y)).then_some((x as u32, y as u32))
     }
 
     /// The same camera with the near plane at distance `near` (set from
@@ -248,9 +246,7 @@ impl View {
             Kind::Perspective { .. } => self.origin + self.dir(xc, yc) / w,
             Kind::Orthographic { scale } => {
                 let (wd, h) = (self.width as f64, self.height as f64);
-                self.origin
-                    + (xc - 0.5 * wd) * scale * self.r
-                    + (0.5 * h - yc) * scale * self.u
+                self.origin + (xc - 0.5 * wd) * scale * self.r + (0.5 * h - yc) * scale * self.u
                     - w * self.f
             }
         }
@@ -368,8 +364,15 @@ mod tests {
 
     #[test]
     fn nearness_over_a_plane_is_affine_and_exact_for_negated_planes() {
-        let cam = Camera::look_at(DVec3::new(0.3, -6.0, 2.0), DVec3::ZERO, DVec3::Z, 60.0, 80, 60)
-            .unwrap();
+        let cam = Camera::look_at(
+            DVec3::new(0.3, -6.0, 2.0),
+            DVec3::ZERO,
+            DVec3::Z,
+            60.0,
+            80,
+            60,
+        )
+        .unwrap();
         let v = &cam.view;
         let (n, d) = (DVec3::new(0.2, 0.1, 1.0).normalize(), 0.4);
         let k = v.coeffs(n, d).unwrap();
@@ -401,11 +404,71 @@ mod tests {
     #[test]
     fn bad_cameras_are_errors() {
         let e = |r: Result<Camera, RasterError>| r.unwrap_err().to_string();
-        assert!(e(Camera::look_at(DVec3::ONE, DVec3::ONE, DVec3::Z, 50.0, 10, 10)).contains("coincide"));
-        assert!(e(Camera::look_at(DVec3::ZERO, DVec3::Z, DVec3::Z, 50.0, 10, 10)).contains("parallel"));
-        assert!(e(Camera::look_at(DVec3::ZERO, DVec3::X, DVec3::ZERO, 50.0, 10, 10)).contains("zero"));
-        assert!(e(Camera::look_at(DVec3::ZERO, DVec3::X, DVec3::Z, 180.0, 10, 10)).contains("180"));
-        assert!(e(Camera::look_at(DVec3::ZERO, DVec3::X, DVec3::Z, 50.0, 0, 10)).contains("0x10"));
-        assert!(e(Camera::look_at(DVec3::NAN, DVec3::X, DVec3::Z, 50.0, 10, 10)).contains("finite"));
+        assert!(
+            e(Camera::look_at(
+                DVec3::ONE,
+                DVec3::ONE,
+                DVec3::Z,
+                50.0,
+                10,
+                10
+            ))
+            .contains("coincide")
+        );
+        assert!(
+            e(Camera::look_at(
+                DVec3::ZERO,
+                DVec3::Z,
+                DVec3::Z,
+                50.0,
+                10,
+                10
+            ))
+            .contains("parallel")
+        );
+        assert!(
+            e(Camera::look_at(
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::ZERO,
+                50.0,
+                10,
+                10
+            ))
+            .contains("zero")
+        );
+        assert!(
+            e(Camera::look_at(
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::Z,
+                180.0,
+                10,
+                10
+            ))
+            .contains("180")
+        );
+        assert!(
+            e(Camera::look_at(
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::Z,
+                50.0,
+                0,
+                10
+            ))
+            .contains("0x10")
+        );
+        assert!(
+            e(Camera::look_at(
+                DVec3::NAN,
+                DVec3::X,
+                DVec3::Z,
+                50.0,
+                10,
+                10
+            ))
+            .contains("finite")
+        );
     }
 }

@@ -80,13 +80,20 @@ fn a_tiling_of_triangles_leaves_no_crack_and_no_double_cover() {
         }
     }
     let tiles = setup(&mesh(&faces), &[LightSpec::Sun(DVec3::Z)]);
-    let whole = setup(&mesh(&[vec![at(0, 0), at(n, 0), at(n, n), at(0, n)]]), &[LightSpec::Sun(DVec3::Z)]);
-    for (eye, fov) in [(DVec3::new(0.3, -4.0, 9.0), 60.0), (DVec3::new(0.0, 0.0, 10.0), 20.0)] {
+    let whole = setup(
+        &mesh(&[vec![at(0, 0), at(n, 0), at(n, n), at(0, n)]]),
+        &[LightSpec::Sun(DVec3::Z)],
+    );
+    for (eye, fov) in [
+        (DVec3::new(0.3, -4.0, 9.0), 60.0),
+        (DVec3::new(0.0, 0.0, 10.0), 20.0),
+    ] {
         let up = if eye.x == 0.0 { DVec3::Y } else { DVec3::Z };
         let cam = Camera::look_at(eye, DVec3::ZERO, up, fov, 200, 150).unwrap();
         let a = visible_surfaces(&tiles.scene, &cam, Hsr::ZBuffer, false).unwrap();
         let b = visible_surfaces(&whole.scene, &cam, Hsr::ZBuffer, false).unwrap();
-        let covered = |v: &shadow_raster::Visibility| v.prim.iter().map(|&p| p != NONE).collect::<Vec<_>>();
+        let covered =
+            |v: &shadow_raster::Visibility| v.prim.iter().map(|&p| p != NONE).collect::<Vec<_>>();
         assert_eq!(covered(&a), covered(&b));
         assert!(covered(&a).iter().filter(|&&c| c).count() > 5000);
     }

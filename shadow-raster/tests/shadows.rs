@@ -1,9 +1,7 @@
 //! Shadow methods against the exact shadows.
 
 use glam::DVec3;
-use shadow_raster::{
-    Camera, Hsr, Method, RenderOptions, ShadowOptions, render, render_fragments,
-};
+use shadow_raster::{Camera, Hsr, Method, RenderOptions, ShadowOptions, render, render_fragments};
 use svbsp::LightSpec;
 
 use crate::{bunny, cuboid, disagreement, mesh, room, room_camera, setup};
@@ -30,7 +28,10 @@ fn exact_and_raycast_agree_on_the_room_and_the_bunny() {
     let rays = mask_of(&b, &cam, with(Method::Raycast));
     let d = disagreement(&exact, &rays);
     assert!(d <= 0.001, "bunny: {:.4}% of pixels differ", 100.0 * d);
-    assert!(exact.iter().filter(|&&m| m == 128).count() > 2000, "the bunny casts a shadow");
+    assert!(
+        exact.iter().filter(|&&m| m == 128).count() > 2000,
+        "the bunny casts a shadow"
+    );
 }
 
 #[test]
@@ -38,15 +39,36 @@ fn stencil_zfail_is_right_where_zpass_fails() {
     // a roof over a floor, the eye under the roof in its shadow volume,
     // looking out at the lit floor
     let mut faces = cuboid(DVec3::new(-10.0, -10.0, -0.5), DVec3::new(10.0, 10.0, 0.0));
-    faces.extend(cuboid(DVec3::new(-2.0, -2.0, 3.0), DVec3::new(2.0, 2.0, 3.2)));
-    let s = setup(&mesh(&faces), &[LightSpec::Point(DVec3::new(0.0, 0.0, 8.0))]);
-    let cam = Camera::look_at(DVec3::new(0.0, -0.5, 1.5), DVec3::new(0.0, -8.0, 0.0), DVec3::Z, 70.0, 160, 120)
-        .unwrap();
+    faces.extend(cuboid(
+        DVec3::new(-2.0, -2.0, 3.0),
+        DVec3::new(2.0, 2.0, 3.2),
+    ));
+    let s = setup(
+        &mesh(&faces),
+        &[LightSpec::Point(DVec3::new(0.0, 0.0, 8.0))],
+    );
+    let cam = Camera::look_at(
+        DVec3::new(0.0, -0.5, 1.5),
+        DVec3::new(0.0, -8.0, 0.0),
+        DVec3::Z,
+        70.0,
+        160,
+        120,
+    )
+    .unwrap();
     let exact = mask_of(&s, &cam, with(Method::Exact));
     let zfail = mask_of(&s, &cam, with(Method::StencilZfail));
     let zpass = mask_of(&s, &cam, with(Method::StencilZpass));
-    assert!(disagreement(&exact, &zfail) < 0.002, "{}", disagreement(&exact, &zfail));
-    assert!(disagreement(&exact, &zpass) > 0.2, "{}", disagreement(&exact, &zpass));
+    assert!(
+        disagreement(&exact, &zfail) < 0.002,
+        "{}",
+        disagreement(&exact, &zfail)
+    );
+    assert!(
+        disagreement(&exact, &zpass) > 0.2,
+        "{}",
+        disagreement(&exact, &zpass)
+    );
     // from outside every volume both are right
     let out = room_camera(200, 112);
     let r = room();
@@ -62,7 +84,8 @@ fn shadow_map_bias_trades_acne_for_peter_panning() {
     let (b, cam) = bunny("bunny", 320, 180);
     let exact = mask_of(&b, &cam, with(Method::Exact));
     let map = |c: f64, k: f64, size: u32| {
-        let o = with(Method::ShadowMap).with_shadow(ShadowOptions::default().with_bias(c, k).with_map_size(size));
+        let o = with(Method::ShadowMap)
+            .with_shadow(ShadowOptions::default().with_bias(c, k).with_map_size(size));
         disagreement(&exact, &mask_of(&b, &cam, o))
     };
     let good = map(0.0, 1.5, 2048);
@@ -90,10 +113,27 @@ fn planar_clipping_removes_anti_and_false_shadows() {
         DVec3::new(10.0, 10.0, 0.0),
         DVec3::new(-10.0, 10.0, 0.0),
     ]];
-    faces.extend(cuboid(DVec3::new(1.0, -0.5, 0.0), DVec3::new(2.0, 0.5, 5.0)));
-    faces.extend(cuboid(DVec3::new(-4.0, -4.0, -3.0), DVec3::new(-2.0, -2.0, -1.0)));
-    let s = setup(&mesh(&faces), &[LightSpec::Point(DVec3::new(0.0, 0.0, 3.0))]);
-    let cam = Camera::look_at(DVec3::new(0.0, -14.0, 12.0), DVec3::ZERO, DVec3::Z, 60.0, 200, 150).unwrap();
+    faces.extend(cuboid(
+        DVec3::new(1.0, -0.5, 0.0),
+        DVec3::new(2.0, 0.5, 5.0),
+    ));
+    faces.extend(cuboid(
+        DVec3::new(-4.0, -4.0, -3.0),
+        DVec3::new(-2.0, -2.0, -1.0),
+    ));
+    let s = setup(
+        &mesh(&faces),
+        &[LightSpec::Point(DVec3::new(0.0, 0.0, 3.0))],
+    );
+    let cam = Camera::look_at(
+        DVec3::new(0.0, -14.0, 12.0),
+        DVec3::ZERO,
+        DVec3::Z,
+        60.0,
+        200,
+        150,
+    )
+    .unwrap();
     let exact = mask_of(&s, &cam, with(Method::Exact));
     let planar = |clip: bool| {
         let o = with(Method::Planar).with_shadow(ShadowOptions::default().with_planar_clip(clip));
@@ -108,28 +148,58 @@ fn planar_clipping_removes_anti_and_false_shadows() {
 fn the_shadow_texture_misses_self_shadows() {
     // one closed, non-convex object: an L whose upper arm shades its foot
     let p = |x: f64, z: f64, y: f64| DVec3::new(x, y, z);
-    let l = [(0.0, 0.0), (4.0, 0.0), (4.0, 1.0), (1.0, 1.0), (1.0, 4.0), (0.0, 4.0)];
+    let l = [
+        (0.0, 0.0),
+        (4.0, 0.0),
+        (4.0, 1.0),
+        (1.0, 1.0),
+        (1.0, 4.0),
+        (0.0, 4.0),
+    ];
     let mut faces = vec![
         l.iter().map(|&(x, z)| p(x, z, 0.0)).collect::<Vec<_>>(),
         l.iter().rev().map(|&(x, z)| p(x, z, 2.0)).collect(),
     ];
     for k in 0..l.len() {
         let (a, b) = (l[k], l[(k + 1) % l.len()]);
-        faces.push(vec![p(a.0, a.1, 0.0), p(a.0, a.1, 2.0), p(b.0, b.1, 2.0), p(b.0, b.1, 0.0)]);
+        faces.push(vec![
+            p(a.0, a.1, 0.0),
+            p(a.0, a.1, 2.0),
+            p(b.0, b.1, 2.0),
+            p(b.0, b.1, 0.0),
+        ]);
     }
     // the L's front faces -y: reverse everything if it came out inside-out
     let m = mesh(&faces);
     let m = if m.signed_volume() < 0.0 {
-        mesh(&faces.iter().map(|f| f.iter().rev().copied().collect()).collect::<Vec<_>>())
+        mesh(
+            &faces
+                .iter()
+                .map(|f| f.iter().rev().copied().collect())
+                .collect::<Vec<_>>(),
+        )
     } else {
         m
     };
     let s = setup(&m, &[LightSpec::Sun(DVec3::new(-1.0, 0.3, 1.2))]);
-    let cam = Camera::look_at(DVec3::new(8.0, 7.0, 6.0), DVec3::new(2.0, 1.0, 1.0), DVec3::Z, 50.0, 160, 120).unwrap();
+    let cam = Camera::look_at(
+        DVec3::new(8.0, 7.0, 6.0),
+        DVec3::new(2.0, 1.0, 1.0),
+        DVec3::Z,
+        50.0,
+        160,
+        120,
+    )
+    .unwrap();
     let exact = mask_of(&s, &cam, with(Method::Exact));
     let tex = mask_of(&s, &cam, with(Method::Texture));
     let shadowed = |m: &[u8]| m.iter().filter(|&&v| v == 128).count();
-    assert!(shadowed(&tex) < shadowed(&exact), "{} vs {}", shadowed(&tex), shadowed(&exact));
+    assert!(
+        shadowed(&tex) < shadowed(&exact),
+        "{} vs {}",
+        shadowed(&tex),
+        shadowed(&exact)
+    );
     assert!(disagreement(&exact, &tex) > 0.01);
 }
 
@@ -156,7 +226,11 @@ fn images_do_not_depend_on_the_thread_count() {
                 .num_threads(n)
                 .build()
                 .unwrap()
-                .install(|| render(&s.scene, &s.lights, &cam, &[], &with(m)).unwrap().image)
+                .install(|| {
+                    render(&s.scene, &s.lights, &cam, &[], &with(m))
+                        .unwrap()
+                        .image
+                })
         };
         assert_eq!(run(1), run(3), "{}", m.name());
     }
@@ -186,9 +260,15 @@ fn bad_options_are_errors() {
         ShadowOptions::default().with_bias(-1.0, 0.0),
         ShadowOptions::default().with_bias(f64::NAN, 0.0),
     ] {
-        let e = render(&s.scene, &s.lights, &cam, &[], &with(Method::ShadowMap).with_shadow(o))
-            .unwrap_err()
-            .to_string();
+        let e = render(
+            &s.scene,
+            &s.lights,
+            &cam,
+            &[],
+            &with(Method::ShadowMap).with_shadow(o),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(!e.is_empty());
     }
 }
