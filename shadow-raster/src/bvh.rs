@@ -2,9 +2,10 @@
 //! the visibility ray caster and the shadow rays.
 //!
 //! Axis-aligned boxes split at the median centroid along the longest axis
-//! of the centroids' box, up to [`LEAF`] prims per leaf (the same simple
-//! build as the ray-pass baseline of the `svbsp` benches). Each prim is kept
-//! as the fan of its triangles for Möller–Trumbore tests in `f64`.
+//! of the centroids' box, up to [`LEAF`] items per leaf. A prim is tested
+//! as the fan of its triangles, by Möller–Trumbore in `f64`. The same
+//! hierarchy over plain triangles ([`TriangleBvh`]) is the ray-pass
+//! baseline of the `svbsp` benches.
 
 use glam::DVec3;
 
@@ -23,7 +24,8 @@ struct Node {
     count: u32,
 }
 
-/// The hierarchy; items are prim indices.
+/// The hierarchy over items given by their boxes; leaves list item
+/// indices.
 pub(crate) struct Bvh {
     nodes: Vec<Node>,
     items: Vec<u32>,
@@ -32,19 +34,22 @@ pub(crate) struct Bvh {
 impl Bvh {
     /// Builds the hierarchy over every prim of `scene`.
     pub(crate) fn new(scene: &RasterScene) -> Bvh {
-        let n = scene.len();
-        let mut lo = Vec::with_capacity(n);
-        let mut hi = Vec::with_capacity(n);
-        for i in 0..n {
-            let pts = scene.prim(i);
-            let (l, h) = pts
-                .iter()
-                .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), p| {
-                    (l.min(*p), h.max(*p))
-                });
-            lo.push(l);
-            hi.push(h);
-        }
+        let (lo, hi): (Vec<DVec3>, Vec<DVec3>) = (0..scene.len())
+            .map(|i| {
+                scene
+                    .prim(i)
+                    .iter()
+                    .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), p| {
+                        (l.min(*p), h.max(*p))
+                    })
+            })
+            .unzip();
+        Bvh::from_boxes(&lo, &hi)
+    }
+
+    /// Builds the hierarchy over items with boxes `lo[i]..hi[i]`.
+    fn from_boxes(lo: &[DVec3], hi: &[DVec3]) -> Bvh {
+        let n = lo.len();
         let cen: Vec<DVec3> = (0..n).map(|i| (lo[i] + hi[i]) * 0.5).collect();
         let mut idx: Vec<u32> = (0..n as u32).collect();
         let empty = Node {
@@ -93,6 +98,37 @@ impl Bvh {
             stack.push((left + 1, mid, b));
         }
         Bvh { nodes, items: idx }
+    }
+
+    /// `true` if `hit(item)` holds for an item of a leaf whose box the
+    /// ray `o + t d`, `t` in `(tmin, tmax)`, meets (any hit: boxes in no
+    /// particular order).
+    fn any(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64, mut hit: impl FnMut(u32) -> bool) -> bool {
+        let inv = d.recip();
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            let t1 = (node.lo - o) * inv;
+            let t2 = (node.hi - o) * inv;
+            let tn = t1.min(t2).max_element().max(tmin);
+            let tf = t1.max(t2).min_element().min(tmax);
+            if tn > tf {
+                continue;
+            }
+            if node.count == 0 {
+                stack[top] = node.start;
+                stack[top + 1] = node.start + 1;
+                top += 2;
+                continue;
+            }
+            let s = node.start as usize;
+            if self.items[s..s + node.count as usize].iter().any(|&i| hit(i)) {
+                return true;
+            }
+        }
+        false
     }
 
     /// Visits the leaves the ray `o + t d` may reach for `t` in
@@ -160,23 +196,56 @@ impl Bvh {
         tmax: f64,
         skip: u32,
     ) -> bool {
-        let mut hit = false;
-        self.walk(
-            o,
-            d,
-            tmax,
-            |_| 0.0,
-            |items| {
-                for &i in items {
-                    if i != skip && prim_hit(scene.prim(i as usize), o, d, tmin, tmax) {
-                        hit = true;
-                        return -1.0;
-                    }
-                }
-                tmax
-            },
-        );
-        hit
+        self.any(o, d, tmin, tmax, |i| {
+            i != skip && prim_hit(scene.prim(i as usize), o, d, tmin, tmax)
+        })
+    }
+}
+
+/// A BVH over triangles for any-hit shadow rays: the renderer's
+/// alternative to exact shadows, also the baseline of the `svbsp` benches.
+///
+/// ```
+/// use glam::DVec3;
+/// use shadow_raster::TriangleBvh;
+/// let roof = [DVec3::new(-1.0, -1.0, 1.0), DVec3::new(1.0, -1.0, 1.0), DVec3::new(0.0, 1.0, 1.0)];
+/// let bvh = TriangleBvh::build(&[roof]);
+/// assert!(bvh.occluded(DVec3::ZERO, DVec3::Z, 0.0, 2.0));
+/// assert!(!bvh.occluded(DVec3::ZERO, DVec3::Z, 0.0, 0.5));
+/// ```
+pub struct TriangleBvh {
+    bvh: Bvh,
+    tris: Vec<[DVec3; 3]>,
+}
+
+impl TriangleBvh {
+    /// Median-split hierarchy over `tris`.
+    pub fn build(tris: &[[DVec3; 3]]) -> TriangleBvh {
+        let lo: Vec<DVec3> = tris.iter().map(|t| t[0].min(t[1]).min(t[2])).collect();
+        let hi: Vec<DVec3> = tris.iter().map(|t| t[0].max(t[1]).max(t[2])).collect();
+        TriangleBvh {
+            bvh: Bvh::from_boxes(&lo, &hi),
+            tris: tris.to_vec(),
+        }
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.bvh.nodes.len()
+    }
+
+    /// `true` if the hierarchy has no triangle.
+    pub fn is_empty(&self) -> bool {
+        self.tris.is_empty()
+    }
+
+    /// `true` if some triangle meets the ray `o + t d` for `t` in
+    /// `(tmin, tmax)` (edges included; any hit, no ordering).
+    pub fn occluded(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> bool {
+        self.bvh.any(o, d, tmin, tmax, |i| {
+            let [a, b, c] = self.tris[i as usize];
+            tri_hit(a, b, c, o, d, tmin, tmax)
+        })
     }
 }
 

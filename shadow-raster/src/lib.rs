@@ -74,6 +74,7 @@ use glam::DVec3;
 
 pub use compare::{Comparison, MethodReport, compare};
 pub use error::RasterError;
+pub use bvh::TriangleBvh;
 pub use hsr::{Hsr, NONE, Visibility, visible_surfaces};
 pub use image::{BACKGROUND, Image, composite, encode_pgm, mask, write_pgm};
 pub use lines::{HiddenLines, LINE_EPSILON, LineCheck, hidden_lines};
