@@ -103,7 +103,14 @@ impl Bvh {
     /// `true` if `hit(item)` holds for an item of a leaf whose box the
     /// ray `o + t d`, `t` in `(tmin, tmax)`, meets (any hit: boxes in no
     /// particular order).
-    fn any(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64, mut hit: impl FnMut(u32) -> bool) -> bool {
+    fn any(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        tmin: f64,
+        tmax: f64,
+        mut hit: impl FnMut(u32) -> bool,
+    ) -> bool {
         let inv = d.recip();
         let mut stack = [0u32; 64];
         let mut top = 1;
@@ -124,7 +131,10 @@ impl Bvh {
                 continue;
             }
             let s = node.start as usize;
-            if self.items[s..s + node.count as usize].iter().any(|&i| hit(i)) {
+            if self.items[s..s + node.count as usize]
+                .iter()
+                .any(|&i| hit(i))
+            {
                 return true;
             }
         }

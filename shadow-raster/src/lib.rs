@@ -72,9 +72,9 @@ use std::time::{Duration, Instant};
 
 use glam::DVec3;
 
+pub use bvh::TriangleBvh;
 pub use compare::{Comparison, MethodReport, compare};
 pub use error::RasterError;
-pub use bvh::TriangleBvh;
 pub use hsr::{Hsr, NONE, Visibility, visible_surfaces};
 pub use image::{BACKGROUND, Image, composite, encode_pgm, mask, write_pgm};
 pub use lines::{HiddenLines, LINE_EPSILON, LineCheck, hidden_lines};
@@ -183,16 +183,37 @@ pub fn render(
     let visibility = hsr::visibility(&frame, opts.hsr);
     let visibility_time = t.elapsed();
     let (lit, figures) = shadow::shadows(&frame, &visibility, lights, opts.method, &opts.shadow)?;
+    Ok(shaded(
+        &frame,
+        visibility,
+        visibility_time,
+        lit,
+        figures,
+        lights,
+        colors,
+    ))
+}
+
+/// Shades a frame's visibility and lit amounts into a [`Rendered`].
+fn shaded(
+    frame: &hsr::Frame<'_>,
+    visibility: Visibility,
+    visibility_time: Duration,
+    lit: LitBuffer,
+    figures: ShadowFigures,
+    lights: &[SceneLight],
+    colors: &[DVec3],
+) -> Rendered {
     let t = Instant::now();
-    let image = image::shade(&frame, &visibility, &lit, lights, colors);
-    Ok(Rendered {
+    let image = image::shade(frame, &visibility, &lit, lights, colors);
+    Rendered {
         visibility,
         lit,
         image,
         figures,
         visibility_time,
         shading_time: t.elapsed(),
-    })
+    }
 }
 
 /// Renders `scene` with the exact fragments of `batch` (from
@@ -217,14 +238,13 @@ pub fn render_fragments(
     let t = Instant::now();
     let (lit, mut figures) = exact::draw_fragments(&frame, &visibility, lights.len(), batch);
     figures.time = t.elapsed();
-    let t = Instant::now();
-    let image = image::shade(&frame, &visibility, &lit, lights, colors);
-    Ok(Rendered {
+    Ok(shaded(
+        &frame,
         visibility,
-        lit,
-        image,
-        figures,
         visibility_time,
-        shading_time: t.elapsed(),
-    })
+        lit,
+        figures,
+        lights,
+        colors,
+    ))
 }

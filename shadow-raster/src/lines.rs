@@ -363,39 +363,13 @@ fn polyhedra(scene: &RasterScene) -> (Vec<u32>, usize) {
             uses.entry(e).or_default().push((i, fwd));
         }
     }
-    let mut parent: Vec<usize> = (0..scene.len()).collect();
-    fn find(p: &mut [usize], mut x: usize) -> usize {
-        while p[x] != x {
-            p[x] = p[p[x]];
-            x = p[x];
-        }
-        x
-    }
     let mut pairs: Vec<(usize, usize)> = uses
         .values()
         .filter(|u| u.len() == 2 && u[0].1 != u[1].1)
         .map(|u| (u[0].0.min(u[1].0), u[0].0.max(u[1].0)))
         .collect();
     pairs.sort_unstable();
-    for (a, b) in pairs {
-        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-        if ra != rb {
-            parent[ra.max(rb)] = ra.min(rb);
-        }
-    }
-    let mut id = vec![u32::MAX; scene.len()];
-    let mut count = 0u32;
-    let obj = (0..scene.len())
-        .map(|i| {
-            let r = find(&mut parent, i);
-            if id[r] == u32::MAX {
-                id[r] = count;
-                count += 1;
-            }
-            id[r]
-        })
-        .collect();
-    (obj, count as usize)
+    crate::scene::components(scene.len(), pairs)
 }
 
 /// The `t`-range of edge `qa → qb` hidden by solid `s`: the projection on

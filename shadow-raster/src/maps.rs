@@ -24,7 +24,9 @@ use rayon::prelude::*;
 use crate::hsr::{Frame, NONE, Visibility};
 use crate::raster::{Bins, for_bands, project_all, row_term};
 use crate::scene::{RasterLight, RasterScene, SceneLight};
-use crate::shadow::{LitBuffer, ShadowFigures, ShadowOptions, pixel_point, visible_normal};
+use crate::shadow::{
+    LitBuffer, ShadowFigures, ShadowOptions, pixel_point, set_amounts, visible_normal,
+};
 use crate::view::{Kind, View};
 
 /// The views of a light's map: six cube faces (`+x, −x, +y, −y, +z, −z`)
@@ -242,43 +244,30 @@ pub(crate) fn shadow_map(
             },
         );
         fig.primitives += texels;
-        lit.amount
-            .par_chunks_mut(n * 256)
-            .enumerate()
-            .for_each(|(c, chunk)| {
-                for (k, cell) in chunk.chunks_mut(n).enumerate() {
-                    let pix = c * 256 + k;
-                    let prim = vis.prim[pix];
-                    if prim == NONE || facing[prim as usize] >> j & 1 == 0 {
-                        continue;
-                    }
-                    let p = pixel_point(frame, vis, pix);
-                    let Some((f, x, y, cf)) = map.texel(l.world, p) else {
-                        continue;
-                    };
-                    let view = &map.views[f];
-                    let data = map.data[f].as_ref().expect("needed faces are drawn");
-                    let z = cf.z;
-                    let cos = visible_normal(frame, prim as usize)
-                        .dot(l.world.toward(p))
-                        .clamp(0.02, 1.0);
-                    let tan = (1.0 - cos * cos).sqrt() / cos;
-                    let bias = opts.bias_constant + opts.bias_slope * view.pixel_size(z) * tan;
-                    let size = view.width as i64;
-                    let mut pass = 0.0f32;
-                    for dy in -half..=half {
-                        for dx in -half..=half {
-                            let (tx, ty) =
-                                ((x + dx).clamp(0, size - 1), (y + dy).clamp(0, size - 1));
-                            let wm = data[(ty * size + tx) as usize];
-                            let lit_here =
-                                wm == f32::NEG_INFINITY || z - bias <= view.depth(wm as f64);
-                            pass += lit_here as u8 as f32;
-                        }
-                    }
-                    cell[j] = pass / taps;
+        set_amounts(frame, vis, &mut lit, j, facing, |_, prim, p| {
+            let Some((f, x, y, cf)) = map.texel(l.world, p) else {
+                return 0.0;
+            };
+            let view = &map.views[f];
+            let data = map.data[f].as_ref().expect("needed faces are drawn");
+            let z = cf.z;
+            let cos = visible_normal(frame, prim as usize)
+                .dot(l.world.toward(p))
+                .clamp(0.02, 1.0);
+            let tan = (1.0 - cos * cos).sqrt() / cos;
+            let bias = opts.bias_constant + opts.bias_slope * view.pixel_size(z) * tan;
+            let size = view.width as i64;
+            let mut pass = 0.0f32;
+            for dy in -half..=half {
+                for dx in -half..=half {
+                    let (tx, ty) = ((x + dx).clamp(0, size - 1), (y + dy).clamp(0, size - 1));
+                    let wm = data[(ty * size + tx) as usize];
+                    let lit_here = wm == f32::NEG_INFINITY || z - bias <= view.depth(wm as f64);
+                    pass += lit_here as u8 as f32;
                 }
-            });
+            }
+            pass / taps
+        });
     }
     (lit, fig)
 }
@@ -287,38 +276,14 @@ pub(crate) fn shadow_map(
 /// each prim's object.
 pub(crate) fn objects(scene: &RasterScene) -> (Vec<u32>, usize) {
     use std::collections::HashMap;
-    let n = scene.len();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn find(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            parent[x as usize] = parent[parent[x as usize] as usize];
-            x = parent[x as usize];
-        }
-        x
-    }
-    let mut first: HashMap<[u64; 3], u32> = HashMap::with_capacity(scene.pts.len());
-    for i in 0..n {
+    let mut first: HashMap<[u64; 3], usize> = HashMap::with_capacity(scene.pts.len());
+    let mut pairs = Vec::with_capacity(scene.pts.len());
+    for i in 0..scene.len() {
         for p in scene.prim(i) {
-            let key = crate::scene::point_key(*p);
-            let other = *first.entry(key).or_insert(i as u32);
-            let (a, b) = (find(&mut parent, i as u32), find(&mut parent, other));
-            if a != b {
-                parent[a.max(b) as usize] = a.min(b);
-            }
+            pairs.push((i, *first.entry(crate::scene::point_key(*p)).or_insert(i)));
         }
     }
-    let mut id = vec![NONE; n];
-    let mut count = 0;
-    let mut obj = Vec::with_capacity(n);
-    for i in 0..n {
-        let r = find(&mut parent, i as u32) as usize;
-        if id[r] == NONE {
-            id[r] = count;
-            count += 1;
-        }
-        obj.push(id[r]);
-    }
-    (obj, count as usize)
+    crate::scene::components(scene.len(), pairs)
 }
 
 /// The shadow texture.
@@ -366,25 +331,14 @@ pub(crate) fn texture(
             },
         );
         fig.primitives += texels;
-        lit.amount
-            .par_chunks_mut(n * 256)
-            .enumerate()
-            .for_each(|(c, chunk)| {
-                for (k, cell) in chunk.chunks_mut(n).enumerate() {
-                    let pix = c * 256 + k;
-                    let prim = vis.prim[pix];
-                    if prim == NONE || facing[prim as usize] >> j & 1 == 0 {
-                        continue;
-                    }
-                    let p = pixel_point(frame, vis, pix);
-                    let Some((f, x, y, _)) = map.texel(l.world, p) else {
-                        continue;
-                    };
-                    let data = map.data[f].as_ref().expect("needed faces are drawn");
-                    let first = data[(y * map.views[f].width as i64 + x) as usize];
-                    cell[j] = (first >= prim_rank[prim as usize]) as u8 as f32;
-                }
-            });
+        set_amounts(frame, vis, &mut lit, j, facing, |_, prim, p| {
+            let Some((f, x, y, _)) = map.texel(l.world, p) else {
+                return 1.0;
+            };
+            let data = map.data[f].as_ref().expect("needed faces are drawn");
+            let first = data[(y * map.views[f].width as i64 + x) as usize];
+            (first >= prim_rank[prim as usize]) as u8 as f32
+        });
     }
     (lit, fig)
 }

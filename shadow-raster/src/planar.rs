@@ -51,17 +51,7 @@ fn apply(m: &[DVec4; 4], v: DVec3) -> DVec4 {
 /// Keeps the part of a polygon with `n · p + d >= 0`.
 fn clip(poly: &[DVec3], n: DVec3, d: f64) -> Vec<DVec3> {
     let mut out = Vec::with_capacity(poly.len() + 1);
-    let k = poly.len();
-    for i in 0..k {
-        let (a, b) = (poly[i], poly[(i + 1) % k]);
-        let (da, db) = (n.dot(a) + d, n.dot(b) + d);
-        if da >= 0.0 {
-            out.push(a);
-        }
-        if (da >= 0.0) != (db >= 0.0) {
-            out.push(a + (b - a) * (da / (da - db)));
-        }
-    }
+    crate::raster::clip_ring(poly, (n, d), &mut out);
     out
 }
 

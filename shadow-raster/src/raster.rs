@@ -342,7 +342,7 @@ fn cut(a: DVec3, b: DVec3, da: f64, db: f64) -> DVec3 {
 }
 
 /// Sutherland–Hodgman clip of a ring (frame coordinates) to `n · c + d >= 0`.
-fn clip_ring(ring: &[DVec3], (n, d): ClipPlane, out: &mut Vec<DVec3>) {
+pub(crate) fn clip_ring(ring: &[DVec3], (n, d): ClipPlane, out: &mut Vec<DVec3>) {
     out.clear();
     let k = ring.len();
     for i in 0..k {

@@ -183,6 +183,41 @@ pub(crate) fn point_key(p: DVec3) -> [u64; 3] {
     p.to_array().map(|c| (c + 0.0).to_bits())
 }
 
+/// The connected components of `n` items joined by `pairs`, numbered in
+/// the order of their first item: each item's component, and the count.
+pub(crate) fn components(
+    n: usize,
+    pairs: impl IntoIterator<Item = (usize, usize)>,
+) -> (Vec<u32>, usize) {
+    fn find(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    let mut parent: Vec<usize> = (0..n).collect();
+    for (a, b) in pairs {
+        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+        if ra != rb {
+            parent[ra.max(rb)] = ra.min(rb);
+        }
+    }
+    let mut id = vec![u32::MAX; n];
+    let mut count = 0u32;
+    let out = (0..n)
+        .map(|i| {
+            let r = find(&mut parent, i);
+            if id[r] == u32::MAX {
+                id[r] = count;
+                count += 1;
+            }
+            id[r]
+        })
+        .collect();
+    (out, count as usize)
+}
+
 /// An edge by its two endpoints' keys.
 pub(crate) type EdgeKey = ([u64; 3], [u64; 3]);
 

@@ -274,18 +274,18 @@ pub(crate) fn facing_only(vis: &Visibility, lights: usize, facing: &[u64]) -> Li
 /// shadow-map bias).
 pub const RAY_EPSILON: f64 = 1e-7;
 
-fn raycast(
+/// Sets the amount of light `j` at every pixel whose visible side faces
+/// it to `amount(pixel, prim, point)`, in parallel.
+pub(crate) fn set_amounts(
     frame: &Frame<'_>,
     vis: &Visibility,
-    lights: &[SceneLight],
+    lit: &mut LitBuffer,
+    j: usize,
     facing: &[u64],
-) -> (LitBuffer, ShadowFigures) {
+    amount: impl Fn(usize, u32, DVec3) -> f32 + Sync,
+) {
     use rayon::prelude::*;
-    let scene = frame.scene;
-    let bvh = crate::bvh::Bvh::new(scene);
-    let eps = RAY_EPSILON * scene.diagonal();
-    let n = lights.len();
-    let mut lit = LitBuffer::new(vis.prim.len(), n);
+    let n = lit.lights;
     lit.amount
         .par_chunks_mut(n * 256)
         .enumerate()
@@ -293,24 +293,32 @@ fn raycast(
             for (k, cell) in chunk.chunks_mut(n).enumerate() {
                 let pix = c * 256 + k;
                 let prim = vis.prim[pix];
-                if prim == NONE {
-                    continue;
-                }
-                let p = pixel_point(frame, vis, pix);
-                for (j, l) in lights.iter().enumerate() {
-                    if facing[prim as usize] >> j & 1 == 0 {
-                        continue;
-                    }
-                    let (d, tmax) = match l.world {
-                        RasterLight::Point(lp) => (lp - p, 1.0),
-                        RasterLight::Sun(dir) => (dir, f64::INFINITY),
-                    };
-                    let tmin = eps / d.length();
-                    if !bvh.occluded(scene, p, d, tmin, tmax, prim) {
-                        cell[j] = 1.0;
-                    }
+                if prim != NONE && facing[prim as usize] >> j & 1 == 1 {
+                    cell[j] = amount(pix, prim, pixel_point(frame, vis, pix));
                 }
             }
         });
+}
+
+fn raycast(
+    frame: &Frame<'_>,
+    vis: &Visibility,
+    lights: &[SceneLight],
+    facing: &[u64],
+) -> (LitBuffer, ShadowFigures) {
+    let scene = frame.scene;
+    let bvh = crate::bvh::Bvh::new(scene);
+    let eps = RAY_EPSILON * scene.diagonal();
+    let mut lit = LitBuffer::new(vis.prim.len(), lights.len());
+    for (j, l) in lights.iter().enumerate() {
+        set_amounts(frame, vis, &mut lit, j, facing, |_, prim, p| {
+            let (d, tmax) = match l.world {
+                RasterLight::Point(lp) => (lp - p, 1.0),
+                RasterLight::Sun(dir) => (dir, f64::INFINITY),
+            };
+            let tmin = eps / d.length();
+            (!bvh.occluded(scene, p, d, tmin, tmax, prim)) as u8 as f32
+        });
+    }
     (lit, ShadowFigures::default())
 }
