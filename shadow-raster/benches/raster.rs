@@ -3,7 +3,8 @@
 //! most 30 ms), with the phases apart, and the same frame at 960×540.
 //!
 //! A frame is visibility, shadows and shading, the scene already loaded;
-//! the PNG encoding is timed apart. The camera and light are the defaults
+//! the PNG encoding is timed apart. The baseline in the same run is the
+//! frame with one shadow ray per pixel (the `raycast` method). The camera and light are the defaults
 //! of `shadow render --scene bunny-99k`.
 
 use std::hint::black_box;
@@ -58,6 +59,14 @@ fn frames(cr: &mut Criterion) {
         g.bench_function(format!("{w}x{h}/visibility zbuffer"), |b| {
             b.iter(|| black_box(visible_surfaces(&point.scene, &cam, Hsr::ZBuffer, false).unwrap()))
         });
+        // the per-pixel reference, as a baseline in the same run
+        let rays = RenderOptions::default().with_method(Method::Raycast);
+        g.bench_function(
+            format!("{w}x{h}/frame zbuffer + shadow rays, point light"),
+            |b| {
+                b.iter(|| black_box(render(&point.scene, &point.lights, &cam, &[], &rays).unwrap()))
+            },
+        );
         for (what, s) in [("point light", &point), ("sun", &sun)] {
             let opts = RenderOptions::default()
                 .with_method(Method::ShadowMap)
