@@ -41,7 +41,14 @@ pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
         }
         Ok(n)
     };
-    Ok((side(w, "width")?, side(h, "height")?))
+    let (w, h) = (side(w, "width")?, side(h, "height")?);
+    if w as u64 * h as u64 > shadow_raster::MAX_PIXELS {
+        return Err(format!(
+            "`{s}`: at most {} pixels in all",
+            shadow_raster::MAX_PIXELS
+        ));
+    }
+    Ok((w, h))
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {
@@ -125,7 +132,7 @@ pub(crate) struct SceneArgs {
 pub(crate) struct MethodArgs {
     /// Shadow-map (and shadow-texture) size: texels on a side of a sun's
     /// map or of each cube face of a point light.
-    #[arg(long, value_name = "N", default_value_t = 2048, value_parser = clap::value_parser!(u32).range(16..=16384))]
+    #[arg(long, value_name = "N", default_value_t = 2048, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub(crate) map_size: u32,
     /// Shadow-map bias: C (input units) or C,S (S texel footprints times
     /// the tangent of the light's angle) [default: 0,1.5].
@@ -511,6 +518,11 @@ mod tests {
                 .contains("not a whole number")
         );
         assert!(parse_size("99999x2").unwrap_err().contains("width"));
+        assert!(
+            parse_size("16384x16384")
+                .unwrap_err()
+                .contains("pixels in all")
+        );
     }
 
     #[test]

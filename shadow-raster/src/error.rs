@@ -4,7 +4,8 @@
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum RasterError {
-    /// The image size is zero or larger than [`crate::MAX_SIZE`] on a side.
+    /// The image size is zero, larger than [`crate::MAX_SIZE`] on a side
+    /// or than [`crate::MAX_PIXELS`] in all.
     Size {
         /// Width asked for.
         width: u32,
@@ -37,8 +38,10 @@ impl std::fmt::Display for RasterError {
         match self {
             RasterError::Size { width, height } => write!(
                 f,
-                "image size {width}x{height}: each side must be between 1 and {}",
-                crate::MAX_SIZE
+                "image size {width}x{height}: each side must be between 1 and {} pixels, and the \
+                 image at most {} pixels",
+                crate::MAX_SIZE,
+                crate::MAX_PIXELS
             ),
             RasterError::Camera(m) | RasterError::Option(m) => f.write_str(m),
             RasterError::EmptyScene => f.write_str("nothing to draw: the scene has no faces"),

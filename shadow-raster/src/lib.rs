@@ -81,7 +81,7 @@ pub use lines::{HiddenLines, LINE_EPSILON, LineCheck, hidden_lines};
 pub use planar::{PLANAR_MARGIN, planar_matrix};
 pub use scene::{RasterLight, RasterScene, SceneLight};
 pub use shadow::{LitBuffer, Method, RAY_EPSILON, ShadowFigures, ShadowOptions};
-pub use view::{Camera, MAX_SIZE};
+pub use view::{Camera, MAX_PIXELS, MAX_SIZE};
 
 /// Options of [`render`].
 #[derive(Clone, Debug, PartialEq)]

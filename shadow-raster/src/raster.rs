@@ -317,7 +317,10 @@ fn fill(edges: &mut [Edge], rows: Range<i64>, width: i64, span: &mut impl FnMut(
 /// nearest (without a library call: this runs for every vertex).
 #[inline]
 fn to_fixed(v: f64) -> i32 {
-    let s = v * SUB as f64;
+    // clipping keeps |v| within the guard band; the clamp only tames
+    // non-finite input (NaN becomes 0)
+    const LIMIT: f64 = (1u64 << 30) as f64;
+    let s = (v * SUB as f64).clamp(-LIMIT, LIMIT);
     let i = s as i64;
     let f = s - i as f64;
     (if f >= 0.5 {

@@ -131,9 +131,9 @@ impl ShadowOptions {
 
     /// Checks the ranges.
     pub fn validate(&self) -> Result<(), RasterError> {
-        if !(16..=16384).contains(&self.map_size) {
+        if !(16..=8192).contains(&self.map_size) {
             return Err(RasterError::Option(format!(
-                "map size {}: it must lie between 16 and 16384 texels",
+                "map size {}: it must lie between 16 and 8192 texels",
                 self.map_size
             )));
         }

@@ -22,6 +22,9 @@ pub(crate) const GUARD: f64 = 8192.0;
 /// Largest image side in pixels (so that the guard band stays in range).
 pub const MAX_SIZE: u32 = 16384;
 
+/// Most pixels in an image (about 25 bytes each are kept while drawing).
+pub const MAX_PIXELS: u64 = 1 << 26;
+
 /// A perspective camera, the crate's contract for reproducing a pixel.
 ///
 /// Right-handed look-at: `f = normalize(target − eye)`,
@@ -170,7 +173,12 @@ impl Camera {
 
 /// Checks an image size.
 pub(crate) fn check_size(width: u32, height: u32) -> Result<(), RasterError> {
-    if width == 0 || height == 0 || width > MAX_SIZE || height > MAX_SIZE {
+    if width == 0
+        || height == 0
+        || width > MAX_SIZE
+        || height > MAX_SIZE
+        || width as u64 * height as u64 > MAX_PIXELS
+    {
         return Err(RasterError::Size { width, height });
     }
     Ok(())

@@ -272,3 +272,45 @@ fn bad_options_are_errors() {
         assert!(!e.is_empty());
     }
 }
+
+#[test]
+fn odd_cameras_and_lights_never_panic() {
+    let s = room();
+    let eyes = [
+        (DVec3::new(1e9, -2e9, 5e8), DVec3::ZERO, 50.0), // very far
+        (DVec3::new(0.0, 0.0, 0.01), DVec3::new(1.0, 0.0, 0.01), 50.0), // on the floor
+        (DVec3::new(-3.5, 0.0, 1.0), DVec3::new(3.0, 0.0, 1.0), 50.0), // in a wall's plane
+        (DVec3::new(1.0, 2.45, 1.0), DVec3::new(1.0, 0.0, 1.0), 0.01), // in the bookshelf, tiny fov
+        (DVec3::new(0.0, -1.0, 1.5), DVec3::new(0.0, 1.0, 1.5), 179.0), // very wide
+    ];
+    for (eye, target, fov) in eyes {
+        let cam = Camera::look_at(eye, target, DVec3::Z, fov, 40, 24).unwrap();
+        for m in Method::ALL {
+            for h in [Hsr::ZBuffer, Hsr::Warnock] {
+                let o = with(m)
+                    .with_hsr(h)
+                    .with_shadow(ShadowOptions::default().with_map_size(64));
+                let out = render(&s.scene, &s.lights, &cam, &[], &o).unwrap();
+                assert_eq!(out.mask().len(), 40 * 24);
+            }
+        }
+        let _ = shadow_raster::hidden_lines(&s.scene, &cam);
+    }
+    // no light at all, and a grazing sun
+    let cam = room_camera(40, 24);
+    for m in Method::ALL {
+        let out = render(&s.scene, &[], &cam, &[], &with(m)).unwrap();
+        assert!(out.mask().iter().all(|&v| v != 255));
+    }
+    let grazing = setup(
+        &shadow_scene::room(),
+        &[LightSpec::Sun(DVec3::new(1.0, 0.2, 0.0))],
+    );
+    for m in Method::ALL {
+        render(&grazing.scene, &grazing.lights, &cam, &[], &with(m)).unwrap();
+    }
+    // sizes
+    for (w, h) in [(0, 10), (20000, 10), (16384, 16384)] {
+        assert!(Camera::look_at(DVec3::ONE, DVec3::ZERO, DVec3::Z, 50.0, w, h).is_err());
+    }
+}
