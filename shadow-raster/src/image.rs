@@ -9,7 +9,7 @@ use glam::DVec3;
 use crate::RasterError;
 use crate::hsr::{Frame, NONE, Visibility};
 use crate::scene::SceneLight;
-use crate::shadow::{LitBuffer, pixel_point, visible_normal};
+use crate::shadow::{LitBuffer, visible_normal};
 
 /// An 8-bit RGB image, row-major from the top-left corner.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -134,9 +134,11 @@ pub fn write_pgm(path: &Path, width: u32, height: u32, mask: &[u8]) -> Result<()
     write_file(path, &encode_pgm(width, height, mask))
 }
 
-/// Lambert shading: the face's colour times ambient light (more on
-/// surfaces facing the viewer) plus each light's cosine times the amount
-/// of it that reaches the pixel.
+/// Lambert shading, as the SVG views: the face's colour times ambient
+/// light (more on surfaces facing the viewer) plus each light's cosine
+/// times the amount of it that reaches the pixel, the cosines taken at
+/// each prim's centre (so a face's lit parts share one shade and only the
+/// shadow boundaries show).
 pub(crate) fn shade(
     frame: &Frame<'_>,
     vis: &Visibility,
@@ -148,39 +150,51 @@ pub(crate) fn shade(
     let (w, h) = (vis.width, vis.height);
     let mut img = Image::new(w, h, BACKGROUND);
     let scene = frame.scene;
-    let view = frame.view();
+    let eye = frame.camera.eye();
     let weight = DIFFUSE / lights.len().max(1) as f64;
     let grey = DVec3::splat(0.7);
+    let nl = lights.len();
+    // per prim: colour, ambient, and each light's weighted cosine
+    let per: Vec<(DVec3, f64)> = (0..scene.len())
+        .into_par_iter()
+        .map(|i| {
+            let pts = scene.prim(i);
+            let centre = pts.iter().sum::<DVec3>() / pts.len() as f64;
+            let n = visible_normal(frame, i);
+            let to_eye = (eye - centre).normalize_or_zero();
+            let c = colors.get(scene.face[i] as usize).copied().unwrap_or(grey);
+            (c, AMBIENT + AMBIENT_FACING * n.dot(to_eye).max(0.0))
+        })
+        .collect();
+    let cosines: Vec<f64> = (0..scene.len() * nl)
+        .into_par_iter()
+        .map(|k| {
+            let (i, j) = (k / nl, k % nl);
+            let pts = scene.prim(i);
+            let centre = pts.iter().sum::<DVec3>() / pts.len() as f64;
+            weight
+                * visible_normal(frame, i)
+                    .dot(lights[j].world.toward(centre))
+                    .max(0.0)
+        })
+        .collect();
     img.rgb
         .par_chunks_mut(3 * w as usize)
         .enumerate()
         .for_each(|(y, row)| {
             for x in 0..w as usize {
                 let pix = y * w as usize + x;
-                let prim = vis.prim[pix];
-                if prim == NONE {
+                let prim = vis.prim[pix] as usize;
+                if prim == NONE as usize {
                     continue;
                 }
-                let n = visible_normal(frame, prim as usize);
-                let p = pixel_point(frame, vis, pix);
-                let dir = view.dir(x as f64 + 0.5, y as f64 + 0.5).normalize();
-                let mut b = AMBIENT + AMBIENT_FACING * (-n.dot(dir)).max(0.0);
-                for (j, l) in lights.iter().enumerate() {
-                    let a = lit.amount[pix * lit.lights + j] as f64;
-                    if a > 0.0 {
-                        b += weight * a * n.dot(l.world.toward(p)).max(0.0);
-                    }
+                let (c, mut b) = per[prim];
+                for j in 0..nl {
+                    b += lit.amount[pix * nl + j] as f64 * cosines[prim * nl + j];
                 }
-                let c = colors
-                    .get(scene.face[prim as usize] as usize)
-                    .copied()
-                    .unwrap_or(grey);
-                let v = (c * b).clamp(DVec3::ZERO, DVec3::ONE) * 255.0;
-                row[3 * x..3 * x + 3].copy_from_slice(&[
-                    v.x.round() as u8,
-                    v.y.round() as u8,
-                    v.z.round() as u8,
-                ]);
+                // in [0.5, 255.5]: truncation rounds (no library call)
+                let v = (c * b).clamp(DVec3::ZERO, DVec3::ONE) * 255.0 + 0.5;
+                row[3 * x..3 * x + 3].copy_from_slice(&[v.x as u8, v.y as u8, v.z as u8]);
             }
         });
     img

@@ -59,7 +59,9 @@ fn light_views(scene: &RasterScene, light: RasterLight, size: u32) -> Vec<View> 
                 width: size,
                 height: size,
                 near,
+                scale: (0.0, 0.0),
             }
+            .ready()
         })
         .collect(),
         RasterLight::Sun(d) => {
@@ -67,18 +69,22 @@ fn light_views(scene: &RasterScene, light: RasterLight, size: u32) -> Vec<View> 
             let radius = 0.5 * scene.diagonal();
             let f = -d;
             let (r, u) = frame_of(f);
-            vec![View {
-                kind: Kind::Orthographic {
-                    scale: 2.0 * radius / size as f64,
-                },
-                origin: centre + d * (2.0 * radius),
-                r,
-                u,
-                f,
-                width: size,
-                height: size,
-                near: 0.0,
-            }]
+            vec![
+                View {
+                    kind: Kind::Orthographic {
+                        scale: 2.0 * radius / size as f64,
+                    },
+                    origin: centre + d * (2.0 * radius),
+                    r,
+                    u,
+                    f,
+                    width: size,
+                    height: size,
+                    near: 0.0,
+                    scale: (0.0, 0.0),
+                }
+                .ready(),
+            ]
         }
     }
 }
@@ -161,6 +167,13 @@ fn draw_map<T: Copy + Send + Sync>(
     buf
 }
 
+/// `⌊v⌋` without a library call (this runs for every pixel).
+#[inline]
+fn floor(v: f64) -> i64 {
+    let i = v as i64;
+    if (i as f64) > v { i - 1 } else { i }
+}
+
 /// A rendered light map: per view its texels (`None` for faces not drawn).
 struct LightMap<T> {
     views: Vec<View>,
@@ -179,10 +192,7 @@ impl<T: Copy> LightMap<T> {
         }
         let (x, y) = view.screen(c);
         let n = view.width as i64;
-        let (x, y) = (
-            (x.floor() as i64).clamp(0, n - 1),
-            (y.floor() as i64).clamp(0, n - 1),
-        );
+        let (x, y) = (floor(x).clamp(0, n - 1), floor(y).clamp(0, n - 1));
         Some((f, x, y, c))
     }
 }
@@ -251,18 +261,25 @@ pub(crate) fn shadow_map(
             let view = &map.views[f];
             let data = map.data[f].as_ref().expect("needed faces are drawn");
             let z = cf.z;
-            let cos = visible_normal(frame, prim as usize)
-                .dot(l.world.toward(p))
-                .clamp(0.02, 1.0);
-            let tan = (1.0 - cos * cos).sqrt() / cos;
+            // tan θ from the normal and the (unnormalized) way to the light
+            let v = match l.world {
+                RasterLight::Point(lp) => lp - p,
+                RasterLight::Sun(d) => d,
+            };
+            let nv = visible_normal(frame, prim as usize).dot(v);
+            let vv = v.length_squared();
+            let tan = ((vv - nv * nv).max(0.0).sqrt() / nv).clamp(0.0, 50.0);
             let bias = opts.bias_constant + opts.bias_slope * view.pixel_size(z) * tan;
+            let (t, persp) = (z - bias, matches!(view.kind, Kind::Perspective { .. }));
             let size = view.width as i64;
             let mut pass = 0.0f32;
             for dy in -half..=half {
                 for dx in -half..=half {
                     let (tx, ty) = ((x + dx).clamp(0, size - 1), (y + dy).clamp(0, size - 1));
-                    let wm = data[(ty * size + tx) as usize];
-                    let lit_here = wm == f32::NEG_INFINITY || z - bias <= view.depth(wm as f64);
+                    let wm = data[(ty * size + tx) as usize] as f64;
+                    // t <= z_map, with z_map = 1/wm (perspective) or −wm
+                    let lit_here =
+                        wm == f64::NEG_INFINITY || if persp { wm * t <= 1.0 } else { t <= -wm };
                     pass += lit_here as u8 as f32;
                 }
             }

@@ -104,7 +104,9 @@ impl Camera {
                 width,
                 height,
                 near: 0.0,
-            },
+                scale: (0.0, 0.0),
+            }
+            .ready(),
             fov_deg,
         })
     }
@@ -206,12 +208,25 @@ pub(crate) struct View {
     pub(crate) height: u32,
     /// Near plane distance (perspective views only).
     pub(crate) near: f64,
+    /// The projection's scales, set by [`View::ready`]: perspective
+    /// `(W/2/kx, H/2/ky)`, orthographic `(1/scale, 1/scale)`.
+    pub(crate) scale: (f64, f64),
 }
 
 /// A plane `a · c + d >= 0` in frame coordinates.
 pub(crate) type ClipPlane = (DVec3, f64);
 
 impl View {
+    /// The view with its projection's scales computed.
+    pub(crate) fn ready(mut self) -> View {
+        let (w, h) = (self.width as f64, self.height as f64);
+        self.scale = match self.kind {
+            Kind::Perspective { kx, ky } => (0.5 * w / kx, 0.5 * h / ky),
+            Kind::Orthographic { scale } => (1.0 / scale, 1.0 / scale),
+        };
+        self
+    }
+
     /// Frame coordinates of a world point.
     #[inline]
     pub(crate) fn frame(&self, p: DVec3) -> DVec3 {
@@ -223,13 +238,14 @@ impl View {
     /// perspective view's eye).
     #[inline]
     pub(crate) fn screen(&self, c: DVec3) -> (f64, f64) {
-        let (w, h) = (self.width as f64, self.height as f64);
+        let (hw, hh) = (0.5 * self.width as f64, 0.5 * self.height as f64);
+        let (sx, sy) = self.scale;
         match self.kind {
-            Kind::Perspective { kx, ky } => (
-                0.5 * w * (1.0 + c.x / (c.z * kx)),
-                0.5 * h * (1.0 - c.y / (c.z * ky)),
-            ),
-            Kind::Orthographic { scale } => (c.x / scale + 0.5 * w, 0.5 * h - c.y / scale),
+            Kind::Perspective { .. } => {
+                let iz = 1.0 / c.z;
+                (hw + c.x * iz * sx, hh - c.y * iz * sy)
+            }
+            Kind::Orthographic { .. } => (hw + c.x * sx, hh - c.y * sy),
         }
     }
 
@@ -257,15 +273,6 @@ impl View {
                 self.origin + (xc - 0.5 * wd) * scale * self.r + (0.5 * h - yc) * scale * self.u
                     - w * self.f
             }
-        }
-    }
-
-    /// Depth `z` along `f` of a nearness value.
-    #[inline]
-    pub(crate) fn depth(&self, w: f64) -> f64 {
-        match self.kind {
-            Kind::Perspective { .. } => 1.0 / w,
-            Kind::Orthographic { .. } => -w,
         }
     }
 
@@ -400,7 +407,9 @@ mod tests {
             width: 32,
             height: 32,
             near: 0.0,
-        };
+            scale: (0.0, 0.0),
+        }
+        .ready();
         let k = o.coeffs(n, d).unwrap();
         let w = k[0] * 3.5 + (k[1] * 9.5 + k[2]);
         let p = o.point(3.5, 9.5, w);
