@@ -9,6 +9,10 @@
 //! shadow stats   [INPUT | --scene NAME]
 //! shadow demo    [-o room.svg]
 //! shadow csg     union|intersection|difference A B -o OUT [--weld] [--stats]
+//! shadow render  [INPUT | --scene NAME] [lights] [camera] [--method M] [--hsr H]
+//!                [--mask MASK.pgm] -o OUT.png
+//! shadow compare [INPUT | --scene NAME] [lights] [camera] -o OUT.png [--report OUT.csv]
+//! shadow lines   [INPUT | --scene NAME] [camera] [--hidden] -o OUT.svg
 //! ```
 //!
 //! Every command loads a mesh (OBJ or STL) or a built-in scene, snaps it
@@ -18,7 +22,9 @@
 //! the painter's algorithm in the tree's exact back-to-front order,
 //! `stats` reports the tree's figures, `demo` renders the built-in room,
 //! `csg` computes an exact Boolean operation of two closed meshes and
-//! writes the watertight result (OBJ or binary STL).
+//! writes the watertight result (OBJ or binary STL); `render`, `compare`
+//! and `lines` draw PNG images and hidden-line SVG with `shadow-raster`
+//! (see `docs/raster.md`).
 //! Errors go to stderr as `error: ...` with exit code 1.
 
 use std::path::{Path, PathBuf};

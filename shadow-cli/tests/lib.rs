@@ -33,7 +33,7 @@ fn scratch(name: &str) -> PathBuf {
     p
 }
 
-pub(crate) fn assert_failed_with(o: &Output, needles: &[&str]) {
+fn assert_failed_with(o: &Output, needles: &[&str]) {
     assert_eq!(o.status.code(), Some(1), "stderr: {}", stderr(o));
     let err = stderr(o);
     assert!(err.starts_with("error: "), "{err}");
