@@ -273,7 +273,9 @@ pub fn composite(panels: &[(String, Image)], columns: usize) -> Image {
         let (c, r) = ((k % columns) as u32, (k / columns) as u32);
         let x = gap + c * (pw + gap);
         let y = gap + r * (ph + bar + gap);
-        out.text(label, x + 4, y + 4, 2, [0xf0, 0xf0, 0xf0]);
+        // twice the glyph size when the label fits the panel
+        let scale = if 12 * label.chars().count() as u32 + 8 <= pw { 2 } else { 1 };
+        out.text(label, x + 4, y + 4 + 4 * (2 - scale), scale, [0xf0, 0xf0, 0xf0]);
         out.blit(img, x, y + bar);
     }
     out
