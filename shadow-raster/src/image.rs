@@ -274,8 +274,18 @@ pub fn composite(panels: &[(String, Image)], columns: usize) -> Image {
         let x = gap + c * (pw + gap);
         let y = gap + r * (ph + bar + gap);
         // twice the glyph size when the label fits the panel
-        let scale = if 12 * label.chars().count() as u32 + 16 <= pw { 2 } else { 1 };
-        out.text(label, x + 4, y + 4 + 4 * (2 - scale), scale, [0xf0, 0xf0, 0xf0]);
+        let scale = if 12 * label.chars().count() as u32 + 16 <= pw {
+            2
+        } else {
+            1
+        };
+        out.text(
+            label,
+            x + 4,
+            y + 4 + 4 * (2 - scale),
+            scale,
+            [0xf0, 0xf0, 0xf0],
+        );
         out.blit(img, x, y + bar);
     }
     out

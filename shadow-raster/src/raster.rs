@@ -636,6 +636,77 @@ mod tests {
     }
 
     #[test]
+    fn random_fans_and_strips_tile_exactly() {
+        // random convex polygons (vertices on random sub-pixel positions,
+        // a third of them exactly on pixel centres or corners) cut into a
+        // fan around a random inner point and into a strip of quads: the
+        // pieces cover exactly the pixels the polygon covers, each once
+        let mut rng = bsp_core::SplitMix(0x7011_1e57);
+        let mut coord = |rng: &mut bsp_core::SplitMix| {
+            let base = rng.below(24 * 256) as i32;
+            match rng.below(3) {
+                0 => base / 256 * 256 + 128,
+                1 => base / 256 * 256,
+                _ => base,
+            }
+        };
+        for k in 0..300 {
+            // a convex polygon around a centre on a pixel centre, a pixel
+            // corner or anywhere, its vertices at random sub-pixel places
+            let centre = [coord(&mut rng), coord(&mut rng)].map(|v| v % 256 + 12 * 256);
+            let n = 3 + rng.below(6);
+            let mut angles: Vec<f64> = (0..n)
+                .map(|_| rng.below(3600) as f64 / 3600.0 * std::f64::consts::TAU)
+                .collect();
+            angles.sort_by(f64::total_cmp);
+            angles.dedup();
+            let gap = angles
+                .windows(2)
+                .map(|w| w[1] - w[0])
+                .chain([angles[0] + std::f64::consts::TAU - angles[angles.len() - 1]])
+                .fold(0.0, f64::max);
+            if angles.len() < 3 || gap > 0.9 * std::f64::consts::PI {
+                continue; // the centre must be inside
+            }
+            let r = 2000.0 + rng.below(800) as f64;
+            let ring: Vec<[i32; 2]> = angles
+                .iter()
+                .map(|a| {
+                    [
+                        centre[0] + (r * a.cos()) as i32,
+                        centre[1] + (r * a.sin()) as i32,
+                    ]
+                })
+                .collect();
+            let whole = coverage(std::slice::from_ref(&ring), 24, 24);
+            let fan: Vec<Vec<[i32; 2]>> = (0..ring.len())
+                .map(|k| vec![centre, ring[k], ring[(k + 1) % ring.len()]])
+                .collect();
+            assert_eq!(
+                coverage(&fan, 24, 24),
+                whole,
+                "case {k}: fan of {ring:?} around {centre:?}"
+            );
+        }
+        // a strip of quads sharing random cut lines
+        for _ in 0..100 {
+            let xs: Vec<i32> = {
+                let mut v: Vec<i32> = (0..6).map(|_| coord(&mut rng)).collect();
+                v.sort_unstable();
+                v.dedup();
+                v
+            };
+            let (y0, y1) = (coord(&mut rng).min(2000), coord(&mut rng).max(3000));
+            let quads: Vec<Vec<[i32; 2]>> = xs
+                .windows(2)
+                .map(|w| vec![[w[0], y0], [w[1], y0 + 300], [w[1], y1], [w[0], y1 - 200]])
+                .collect();
+            let cov = coverage(&quads, 24, 24);
+            assert!(cov.iter().all(|&c| c <= 1), "overlap in {quads:?}");
+        }
+    }
+
+    #[test]
     fn top_left_rule() {
         // a square whose sides run through pixel centres: the top and left
         // sides are in, the bottom and right ones out
