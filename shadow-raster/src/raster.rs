@@ -642,7 +642,7 @@ mod tests {
         // fan around a random inner point and into a strip of quads: the
         // pieces cover exactly the pixels the polygon covers, each once
         let mut rng = bsp_core::SplitMix(0x7011_1e57);
-        let mut coord = |rng: &mut bsp_core::SplitMix| {
+        let coord = |rng: &mut bsp_core::SplitMix| {
             let base = rng.below(24 * 256) as i32;
             match rng.below(3) {
                 0 => base / 256 * 256 + 128,
