@@ -140,7 +140,7 @@ impl<'a> Frame<'a> {
         let view = &camera.view;
         let screen = project_all(view, scene.len(), |i, proj, out, sc| {
             let Some(p) = vis_plane[i] else { return };
-            if cull && p != *scene.polys[i].support() {
+            if cull && p != scene.support[i] {
                 return;
             }
             let (n, d) = scene.plane[i];
@@ -154,7 +154,7 @@ impl<'a> Frame<'a> {
         }
         let vis_normal = (0..scene.len())
             .map(|i| match vis_plane[i] {
-                Some(p) if p == *scene.polys[i].support() => scene.plane[i].0,
+                Some(p) if p == scene.support[i] => scene.plane[i].0,
                 _ => -scene.plane[i].0,
             })
             .collect();

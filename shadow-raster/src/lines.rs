@@ -203,16 +203,12 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
                     describe()
                 )));
             };
-            if ka < kb
-                && !scene.polys[i]
-                    .support()
-                    .is_coincident(scene.polys[j].support())
-            {
+            if ka < kb && !scene.support[i].is_coincident(&scene.support[j]) {
                 edges.push((o, a, b, i, j));
             }
         }
         // convex when every vertex is behind or on every face plane
-        let mut planes: Vec<Plane> = prims.iter().map(|&i| *scene.polys[i].support()).collect();
+        let mut planes: Vec<Plane> = prims.iter().map(|&i| scene.support[i]).collect();
         planes.sort_by_key(|p| (p.normal(), p.offset()));
         planes.dedup();
         let convex = planes.iter().all(|p| {

@@ -64,7 +64,7 @@ pub(crate) fn receivers(frame: &Frame<'_>, max: usize) -> Vec<Plane> {
     for i in 0..scene.len() {
         let a = svbsp::polygon_area(scene.prim(i));
         total += a;
-        *area.entry(*scene.polys[i].support()).or_insert(0.0) += a;
+        *area.entry(scene.support[i]).or_insert(0.0) += a;
     }
     let mut planes: Vec<(Plane, f64)> = area
         .into_iter()
@@ -109,7 +109,7 @@ pub(crate) fn planar(
             };
             let m = planar_matrix(nw, dw, lh);
             let shadows: Vec<Vec<DVec3>> = (0..scene.len())
-                .filter(|&i| !scene.polys[i].support().is_coincident(plane))
+                .filter(|&i| !scene.support[i].is_coincident(plane))
                 .filter_map(|i| {
                     let mut poly = scene.prim(i).to_vec();
                     if opts.planar_clip {

@@ -67,6 +67,9 @@ pub struct RasterScene {
     pub(crate) start: Vec<u32>,
     pub(crate) pts: Vec<DVec3>,
     pub(crate) face: Vec<u32>,
+    /// Each prim's exact support plane (kept apart from the polygons for
+    /// a compact per-frame pass).
+    pub(crate) support: Vec<Plane>,
     /// Unit normal and offset in input units: `n · p + d = 0`.
     pub(crate) plane: Vec<(DVec3, f64)>,
     pub(crate) lo: DVec3,
@@ -84,6 +87,7 @@ impl RasterScene {
         let mut pts = Vec::with_capacity(polys.len() * 4);
         let mut face = Vec::with_capacity(polys.len());
         let mut plane = Vec::with_capacity(polys.len());
+        let mut support = Vec::with_capacity(polys.len());
         let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
         start.push(0);
         for p in &polys {
@@ -95,6 +99,7 @@ impl RasterScene {
             }
             start.push(pts.len() as u32);
             face.push(p.tag());
+            support.push(*p.support());
             plane.push(world_plane(grid, p.support()));
         }
         if !(lo.is_finite() && hi.is_finite()) {
@@ -108,6 +113,7 @@ impl RasterScene {
             start,
             pts,
             face,
+            support,
             plane,
             lo,
             hi,
@@ -159,7 +165,7 @@ impl RasterScene {
         world: DVec3,
     ) -> Side {
         match eye {
-            Some(vp) => self.polys[i].support().classify_viewpoint(vp),
+            Some(vp) => self.support[i].classify_viewpoint(vp),
             None => {
                 let (n, d) = self.plane[i];
                 let s = n.dot(world) + d;
@@ -241,8 +247,8 @@ pub(crate) fn visible_planes(scene: &RasterScene, eye: DVec3) -> Vec<Option<Plan
     (0..scene.len())
         .into_par_iter()
         .map(|i| match scene.eye_side(i, vp, eye) {
-            Side::Front => Some(*scene.polys[i].support()),
-            Side::Back => Some(scene.polys[i].support().flip()),
+            Side::Front => Some(scene.support[i]),
+            Side::Back => Some(scene.support[i].flip()),
             Side::On => None,
         })
         .collect()

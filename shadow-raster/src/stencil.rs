@@ -68,7 +68,7 @@ pub(crate) fn volumes(frame: &Frame<'_>, light: &SceneLight, caps: bool) -> Volu
         plane: Vec::new(),
     };
     for i in 0..scene.len() {
-        if !light.exact.faces(scene.polys[i].support()) {
+        if !light.exact.faces(&scene.support[i]) {
             continue;
         }
         let pts = scene.prim(i);

@@ -289,9 +289,12 @@ impl View {
                 if s == 0.0 || !s.is_finite() {
                     return None;
                 }
-                let a = -((2.0 * kx / w) * nr) / s;
-                let b = ((2.0 * ky / h) * nu) / s;
-                let c = -(nf - kx * nr + ky * nu) / s;
+                // 1/(−s) = −(1/s) exactly: a plane and its negation still
+                // give the same bits
+                let is = 1.0 / s;
+                let a = -((2.0 * kx / w) * nr) * is;
+                let b = ((2.0 * ky / h) * nu) * is;
+                let c = -(nf - kx * nr + ky * nu) * is;
                 Some([a, b, c])
             }
             Kind::Orthographic { scale } => {
