@@ -252,3 +252,17 @@ fn bad_runs_are_clear_errors() {
         &["out.png"],
     );
 }
+
+#[test]
+fn lines_need_closed_polyhedra() {
+    let teapot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/meshes/teapot.obj");
+    let o = shadow(&[
+        "lines",
+        teapot.to_str().unwrap(),
+        "--eye",
+        "12,9,14",
+        "-o",
+        scratch("teapot_lines.svg").to_str().unwrap(),
+    ]);
+    crate::assert_failed_with(&o, &["polyhedron 0", "not closed", "closed polyhedra"]);
+}

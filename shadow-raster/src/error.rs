@@ -21,7 +21,7 @@ pub enum RasterError {
     Option(String),
     /// The exact shadows could not be computed.
     Shadows(String),
-    /// Roberts' algorithm needs convex polyhedra; the message names the
+    /// Roberts' algorithm needs closed polyhedra; the message names the
     /// part that is not one.
     NotConvex(String),
     /// Writing a file failed.

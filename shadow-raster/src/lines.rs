@@ -188,8 +188,8 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
                 let (a, b) = (pts[k], pts[(k + 1) % pts.len()]);
                 if directed.insert((key(a), key(b)), (i, a, b)).is_some() {
                     return Err(RasterError::NotConvex(format!(
-                        "{}: an edge is used twice the same way; Roberts' algorithm needs closed \
-                         convex polyhedra",
+                        "{}: an edge is used twice the same way; Roberts' hidden lines need closed, \
+                         consistently oriented polyhedra",
                         describe()
                     )));
                 }
@@ -198,7 +198,7 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
         for (&(ka, kb), &(i, a, b)) in &directed {
             let Some(&(j, _, _)) = directed.get(&(kb, ka)) else {
                 return Err(RasterError::NotConvex(format!(
-                    "{}: it is not closed (a border edge); Roberts' algorithm needs closed convex \
+                    "{}: it is not closed (a border edge); Roberts' hidden lines need closed \
                      polyhedra",
                     describe()
                 )));
