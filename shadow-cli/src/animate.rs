@@ -39,6 +39,9 @@ pub(crate) enum FrameFormat {
     Svg,
     /// The fragments, in the schema of `shadow shadows` (`frame_0000.json`).
     Json,
+    /// An image of the shaded frame (`frame_0000.png`), rasterized from the
+    /// exact fragments.
+    Png,
     /// Nothing: for timing.
     None,
 }
@@ -281,10 +284,10 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
     if degrees == 0.0 && step == DVec3::ZERO && args.frames > 1 {
         note("note: no motion given (--spin, --step): every frame is the same");
     }
-    if args.format != FrameFormat::Svg
+    if !matches!(args.format, FrameFormat::Svg | FrameFormat::Png)
         && (args.eye.is_some() || args.target.is_some() || args.up.is_some())
     {
-        note("note: --eye, --target and --up only apply to SVG frames");
+        note("note: --eye, --target and --up only apply to SVG and PNG frames");
     }
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("could not create {}", args.output.display()))?;
@@ -323,7 +326,10 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
     let start = Instant::now();
     let d = Dynamic::new(&statics, &moving, grid, &kernel, opts).map_err(|e| anyhow!("{e}"))?;
     let t_pre = start.elapsed();
-    let view = (args.format == FrameFormat::Svg).then(|| frame_view(args, &s));
+    let view =
+        matches!(args.format, FrameFormat::Svg | FrameFormat::Png).then(|| frame_view(args, &s));
+    // one colour per face, static faces then the moving object's
+    let colors = crate::color::face_colors(&frame_mesh(&s, &d, &DMat4::IDENTITY));
     let mut report = match &args.report {
         Some(p) => {
             let mut o = Output::create(p)?;
@@ -380,6 +386,11 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
                     o.commit()?;
                 }
             }
+            if args.format == FrameFormat::Png {
+                let path = stem.with_extension("png");
+                let view = view.as_ref().expect("PNG frames have a view");
+                frame_png(&d, &frame, &colors, &placed, view, &path)?;
+            }
             if args.format == FrameFormat::Json {
                 let path = stem.with_extension("json");
                 let mut o = Output::create(&path)?;
@@ -431,24 +442,31 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
     crate::csg::emit(&out)
 }
 
-/// The camera for SVG frames.
+/// The camera for SVG and PNG frames.
 fn frame_view(args: &AnimateArgs, s: &Setup) -> View {
     let (lo, hi) = s.statics.bounds().expect("the static scene has faces");
-    let c = (lo + hi) * 0.5;
-    let size = (hi - lo).length().max(1e-9);
-    let (eye, target) = match (args.eye, s.is_room) {
-        (Some(e), _) => (e, args.target),
-        (None, true) => (DEMO_EYE, Some(args.target.unwrap_or(DEMO_TARGET))),
-        // in front of the scene and above it, whichever axis is up
-        (None, false) => (
-            c + DVec3::new(0.35, -0.9, 0.6) * size + DVec3::new(0.0, 0.5, 0.0) * size,
+    let (c, half) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
+    let bunny = s.name.starts_with("scene bunny");
+    let (eye, target, up) = match (args.eye, s.is_room, bunny) {
+        (Some(e), _, _) => (e, args.target, args.up),
+        (None, true, _) => (DEMO_EYE, Some(args.target.unwrap_or(DEMO_TARGET)), args.up),
+        // the bunny stands along +y: from above, in front and to the side
+        (None, _, true) => (
+            c + DVec3::new(0.75 * half, 0.6 * half, 1.7 * half),
+            Some(args.target.unwrap_or(c - DVec3::Y * 0.25 * half)),
+            Some(args.up.unwrap_or(DVec3::Y)),
+        ),
+        // in front of the scene and above it
+        (None, false, false) => (
+            c + DVec3::new(0.7, -1.8, 1.2) * half,
             Some(args.target.unwrap_or(c)),
+            args.up,
         ),
     };
     View {
         eye,
         target,
-        up: args.up,
+        up,
         width: args.image.width,
         height: args.image.height,
         fov_deg: args.image.fov,
@@ -533,6 +551,61 @@ fn frame_json(
     out.write_all(text.get(1..).unwrap_or_default())?;
     json_footer(out, &areas)?;
     Ok(())
+}
+
+/// Rasterizes the frame's exact fragments to a PNG (`shadow-raster`).
+fn frame_png(
+    d: &Dynamic,
+    frame: &tiling::Frame,
+    colors: &[glam::DVec3],
+    lights: &[PlacedLight],
+    view: &View,
+    path: &std::path::Path,
+) -> Result<()> {
+    let grid = d.grid();
+    let mut polys: Vec<Polygon> = d.static_polygons().to_vec();
+    polys.extend(frame.moved.iter().cloned());
+    let scene = shadow_raster::RasterScene::new(grid, polys)?;
+    let (lo, hi) = bounds_of(d);
+    let target = view.target.unwrap_or((lo + hi) * 0.5);
+    let forward = (target - view.eye).normalize_or_zero();
+    let up = view.up.unwrap_or_else(|| {
+        [DVec3::Z, DVec3::Y, DVec3::X]
+            .into_iter()
+            .find(|u| forward.cross(*u).length() > 1e-3)
+            .unwrap_or(DVec3::X)
+    });
+    let camera = shadow_raster::Camera::look_at(
+        view.eye,
+        target,
+        up,
+        view.fov_deg,
+        view.width,
+        view.height,
+    )?;
+    let lights: Vec<_> = lights
+        .iter()
+        .map(shadow_raster::SceneLight::from_placed)
+        .collect();
+    let batch = d.fragments(frame);
+    let out = shadow_raster::render_fragments(&scene, &batch, &lights, &camera, colors)?;
+    let mut o = Output::create(path)?;
+    o.write_all(&out.image.encode_png())
+        .with_context(|| format!("could not write {}", path.display()))?;
+    o.commit()
+}
+
+/// The static scene's bounding box in input units.
+fn bounds_of(d: &Dynamic) -> (DVec3, DVec3) {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for p in d.static_polygons() {
+        for v in p.vertices_f64() {
+            let w = d.grid().to_world(v);
+            lo = lo.min(w);
+            hi = hi.max(w);
+        }
+    }
+    (lo, hi)
 }
 
 /// Draws the frame: a BSP tree of the frame's polygons gives the painter's

@@ -11,8 +11,12 @@
 //! shadow csg     union|intersection|difference A B -o OUT [--weld] [--stats]
 //! shadow animate (--scene room | STATIC --dynamic DYNAMIC) [--light X,Y,Z]... [--sun X,Y,Z]...
 //!                [--frames N] [--spin AX,AY,AZ:DEG] [--spin-center X,Y,Z] [--step DX,DY,DZ]
-//!                -o DIR [--format svg|json|none] [--report FILE.csv] [--export-scene]
+//!                -o DIR [--format svg|png|json|none] [--report FILE.csv] [--export-scene]
 //!                [--strategy paper|fast] [--tiles N]
+//! shadow render  [INPUT | --scene NAME] [lights] [camera] [--method M] [--hsr H]
+//!                [--mask MASK.pgm] -o OUT.png
+//! shadow compare [INPUT | --scene NAME] [lights] [camera] -o OUT.png [--report OUT.csv]
+//! shadow lines   [INPUT | --scene NAME] [camera] [--hidden] -o OUT.svg
 //! ```
 //!
 //! Every command loads a mesh (OBJ or STL) or a built-in scene, snaps it
@@ -23,7 +27,9 @@
 //! `stats` reports the tree's figures, `demo` renders the built-in room,
 //! `csg` computes an exact Boolean operation of two closed meshes and
 //! writes the watertight result (OBJ or binary STL), `animate` runs the
-//! core paper's real-time pipeline on a moving object (see `tiling`).
+//! core paper's real-time pipeline on a moving object (see `tiling`);
+//! `render`, `compare` and `lines` draw PNG images and hidden-line SVG
+//! with `shadow-raster` (see `docs/raster.md`).
 //! Errors go to stderr as `error: ...` with exit code 1.
 
 use std::path::{Path, PathBuf};
@@ -39,6 +45,7 @@ mod csg;
 mod lights;
 mod pipeline;
 mod progress;
+mod raster_cmd;
 mod render;
 mod shadows;
 
@@ -73,6 +80,14 @@ enum Command {
     /// The core paper's real-time pipeline: a moving object's exact
     /// shadows in a static scene, frame by frame, with Table 2's figures.
     Animate(Box<animate::AnimateArgs>),
+    /// Render a scene and its shadows to PNG by the exact method or a
+    /// classic image-space one (shadow map, stencil volumes, ...).
+    Render(Box<raster_cmd::RenderArgs>),
+    /// Every shadow method side by side, with the share of pixels where
+    /// each disagrees with the exact shadows.
+    Compare(Box<raster_cmd::CompareArgs>),
+    /// Hidden-line drawing of convex polyhedra (Roberts' algorithm) to SVG.
+    Lines(Box<raster_cmd::LinesArgs>),
 }
 
 /// Where the mesh comes from: a file or a built-in scene (exactly one).
@@ -311,6 +326,9 @@ fn main() -> ExitCode {
         Command::Demo(a) => demo(a),
         Command::Csg(a) => csg::run(a),
         Command::Animate(a) => animate::run(a),
+        Command::Render(a) => raster_cmd::run_render(a),
+        Command::Compare(a) => raster_cmd::run_compare(a),
+        Command::Lines(a) => raster_cmd::run_lines(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -180,6 +180,33 @@ fn both_strategies_agree_and_none_writes_no_frames() {
 }
 
 #[test]
+fn png_frames_are_rasterized() {
+    let out = dir("anim_png");
+    run(&[
+        "animate",
+        "--scene",
+        "room",
+        "--frames",
+        "2",
+        "--format",
+        "png",
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    for k in 0..2 {
+        let png = std::fs::read(out.join(format!("frame_{k:04}.png"))).unwrap();
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+        // width and height in the IHDR chunk
+        assert_eq!(u32::from_be_bytes(png[16..20].try_into().unwrap()), 160);
+        assert_eq!(u32::from_be_bytes(png[20..24].try_into().unwrap()), 120);
+    }
+}
+
+#[test]
 fn svg_frames_are_drawn() {
     let out = dir("anim_svg");
     run(&[

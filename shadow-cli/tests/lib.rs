@@ -4,6 +4,7 @@
 mod animate;
 mod cli;
 mod csg;
+mod raster;
 mod shadows;
 
 use std::path::{Path, PathBuf};

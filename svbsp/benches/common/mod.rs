@@ -7,10 +7,10 @@
 //! imported with `import_faces`.
 //!
 //! The baseline is what a renderer does instead of exact shadows: a
-//! median-split BVH over the scene's triangles (in `f64` grid units) and
-//! one any-hit shadow ray per sample point toward each light, with a
-//! Möller–Trumbore test; the points are spread over the faces by area, as
-//! the pixels of an image would be.
+//! median-split BVH over the scene's triangles (in `f64` grid units,
+//! `shadow_raster::TriangleBvh`) and one any-hit shadow ray per sample
+//! point toward each light, with a Möller–Trumbore test; the points are
+//! spread over the faces by area, as the pixels of an image would be.
 
 #![allow(dead_code, unreachable_pub, missing_docs)]
 
@@ -380,164 +380,10 @@ pub fn triangles(polys: &[Polygon]) -> Vec<[DVec3; 3]> {
 }
 
 // ---------------------------------------------------------------------------
-// The baseline: a median-split BVH and any-hit shadow rays.
+// The baseline: a median-split BVH and any-hit shadow rays (the hierarchy
+// is `shadow-raster`'s, the renderer's own).
 
-/// Triangles per leaf at most.
-const LEAF: usize = 4;
-
-#[derive(Clone, Copy, Debug)]
-struct BvhNode {
-    lo: DVec3,
-    hi: DVec3,
-    /// Leaf: first triangle; inner node: left child (right is `start + 1`).
-    start: u32,
-    /// Leaf: triangle count; inner node: 0.
-    count: u32,
-}
-
-/// A triangle ready for Möller–Trumbore: a vertex and two edges.
-#[derive(Clone, Copy, Debug)]
-struct Tri {
-    v0: DVec3,
-    e1: DVec3,
-    e2: DVec3,
-}
-
-/// A straightforward bounding-volume hierarchy: axis-aligned boxes, split
-/// at the median centroid along the longest axis of the centroids' box,
-/// up to [`LEAF`] triangles per leaf.
-pub struct Bvh {
-    nodes: Vec<BvhNode>,
-    tris: Vec<Tri>,
-}
-
-impl Bvh {
-    pub fn build(tris: &[[DVec3; 3]]) -> Bvh {
-        let n = tris.len();
-        let lo: Vec<DVec3> = tris.iter().map(|t| t[0].min(t[1]).min(t[2])).collect();
-        let hi: Vec<DVec3> = tris.iter().map(|t| t[0].max(t[1]).max(t[2])).collect();
-        let cen: Vec<DVec3> = (0..n).map(|i| (lo[i] + hi[i]) * 0.5).collect();
-        let mut idx: Vec<u32> = (0..n as u32).collect();
-        let mut nodes = vec![BvhNode {
-            lo: DVec3::ZERO,
-            hi: DVec3::ZERO,
-            start: 0,
-            count: 0,
-        }];
-        let mut stack = vec![(0usize, 0usize, n)];
-        while let Some((ni, a, b)) = stack.pop() {
-            let (mut bl, mut bh) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-            let (mut cl, mut ch) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-            for &i in &idx[a..b] {
-                let i = i as usize;
-                bl = bl.min(lo[i]);
-                bh = bh.max(hi[i]);
-                cl = cl.min(cen[i]);
-                ch = ch.max(cen[i]);
-            }
-            nodes[ni].lo = bl;
-            nodes[ni].hi = bh;
-            if b - a <= LEAF {
-                nodes[ni].start = a as u32;
-                nodes[ni].count = (b - a) as u32;
-                continue;
-            }
-            let ext = ch - cl;
-            let axis = if ext.x >= ext.y && ext.x >= ext.z {
-                0
-            } else if ext.y >= ext.z {
-                1
-            } else {
-                2
-            };
-            let mid = (a + b) / 2;
-            idx[a..b].select_nth_unstable_by(mid - a, |&i, &j| {
-                cen[i as usize][axis].total_cmp(&cen[j as usize][axis])
-            });
-            let left = nodes.len();
-            let empty = nodes[ni];
-            nodes.push(empty);
-            nodes.push(empty);
-            nodes[ni].start = left as u32;
-            nodes[ni].count = 0;
-            stack.push((left, a, mid));
-            stack.push((left + 1, mid, b));
-        }
-        let tris = idx
-            .iter()
-            .map(|&i| {
-                let t = &tris[i as usize];
-                Tri {
-                    v0: t[0],
-                    e1: t[1] - t[0],
-                    e2: t[2] - t[0],
-                }
-            })
-            .collect();
-        Bvh { nodes, tris }
-    }
-
-    /// Number of nodes.
-    pub fn len(&self) -> usize {
-        self.nodes.len()
-    }
-
-    /// `true` if some triangle meets the ray `o + t d` for `t` in
-    /// `(tmin, tmax)` (any hit, no ordering).
-    pub fn occluded(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> bool {
-        let inv = d.recip();
-        let mut stack = [0u32; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let node = &self.nodes[stack[top] as usize];
-            let t1 = (node.lo - o) * inv;
-            let t2 = (node.hi - o) * inv;
-            let tn = t1.min(t2).max_element().max(tmin);
-            let tf = t1.max(t2).min_element().min(tmax);
-            if tn > tf {
-                continue;
-            }
-            if node.count == 0 {
-                stack[top] = node.start;
-                stack[top + 1] = node.start + 1;
-                top += 2;
-                continue;
-            }
-            let s = node.start as usize;
-            for t in &self.tris[s..s + node.count as usize] {
-                if hit(t, o, d, tmin, tmax) {
-                    return true;
-                }
-            }
-        }
-        false
-    }
-}
-
-/// Möller–Trumbore in `f64`: does the ray meet the triangle (edges
-/// included) at a parameter in `(tmin, tmax)`?
-#[inline]
-fn hit(t: &Tri, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> bool {
-    let p = d.cross(t.e2);
-    let det = t.e1.dot(p);
-    if det == 0.0 {
-        return false;
-    }
-    let inv = 1.0 / det;
-    let s = o - t.v0;
-    let u = s.dot(p) * inv;
-    if !(0.0..=1.0).contains(&u) {
-        return false;
-    }
-    let qv = s.cross(t.e1);
-    let v = d.dot(qv) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return false;
-    }
-    let tt = t.e2.dot(qv) * inv;
-    tt > tmin && tt < tmax
-}
+pub use shadow_raster::TriangleBvh as Bvh;
 
 /// `n` sample points spread over the triangles by area (as an image's
 /// pixels land on the surfaces), each with its triangle's normal.

@@ -1,0 +1,543 @@
+//! `shadow render`, `shadow compare` and `shadow lines`: PNG images of a
+//! scene and its shadows by the exact method or a classic image-space one,
+//! every method side by side against the exact shadows, and Roberts'
+//! hidden-line drawing. The work is `shadow-raster`'s; this module parses
+//! the flags, prepares the scene and reports.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use bsp_core::import_faces_par;
+use clap::Args;
+use glam::DVec3;
+use shadow_raster::{
+    Camera, Hsr, Method, RasterScene, RenderOptions, SceneLight, ShadowOptions, compare,
+    hidden_lines, render, write_pgm,
+};
+use svbsp::LightSpec;
+
+use crate::color::face_colors;
+use crate::csg::emit;
+use crate::lights::{describe, place_lights, shared_grid};
+use crate::shadows::ROOM_LIGHT;
+use crate::{DEMO_EYE, DEMO_TARGET, SourceArgs, load_source_quiet, parse_vec3};
+
+/// `WxH`, each side between 1 and [`shadow_raster::MAX_SIZE`].
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{s}` is not a size: expected WxH, such as 1280x720"))?;
+    let side = |v: &str, what: &str| -> Result<u32, String> {
+        let n: u32 = v
+            .trim()
+            .parse()
+            .map_err(|_| format!("`{s}`: the {what} `{v}` is not a whole number (expected WxH)"))?;
+        if n == 0 || n > shadow_raster::MAX_SIZE {
+            return Err(format!(
+                "`{s}`: the {what} must lie between 1 and {} pixels",
+                shadow_raster::MAX_SIZE
+            ));
+        }
+        Ok(n)
+    };
+    let (w, h) = (side(w, "width")?, side(h, "height")?);
+    if w as u64 * h as u64 > shadow_raster::MAX_PIXELS {
+        return Err(format!(
+            "`{s}`: at most {} pixels in all",
+            shadow_raster::MAX_PIXELS
+        ));
+    }
+    Ok((w, h))
+}
+
+fn parse_method(s: &str) -> Result<Method, String> {
+    let s = s.trim();
+    Method::from_name(s).ok_or_else(|| {
+        format!(
+            "unknown method `{s}` (available: {})",
+            Method::ALL.map(Method::name).join(", ")
+        )
+    })
+}
+
+fn parse_hsr(s: &str) -> Result<Hsr, String> {
+    Hsr::from_name(s).ok_or_else(|| {
+        format!(
+            "unknown visibility method `{s}` (available: {})",
+            Hsr::ALL.map(Hsr::name).join(", ")
+        )
+    })
+}
+
+/// `C` or `C,S`: constant and slope-scaled bias, not negative.
+fn parse_bias(s: &str) -> Result<(f64, f64), String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let num = |v: &str| -> Result<f64, String> {
+        let x: f64 = v
+            .parse()
+            .map_err(|_| format!("`{v}` is not a number (expected C or C,S)"))?;
+        if !x.is_finite() || x < 0.0 {
+            return Err(format!("`{v}`: a bias must be finite and not negative"));
+        }
+        Ok(x)
+    };
+    match parts.as_slice() {
+        [c] => Ok((num(c)?, ShadowOptions::default().bias_slope)),
+        [c, k] => Ok((num(c)?, num(k)?)),
+        _ => Err(format!("`{s}`: expected C or C,S")),
+    }
+}
+
+/// Where the scene, lights and camera come from.
+#[derive(Args, Debug)]
+pub(crate) struct SceneArgs {
+    #[command(flatten)]
+    pub(crate) source: SourceArgs,
+    /// A point light at X,Y,Z (input units); repeatable. Lights are
+    /// numbered all --light first, then all --sun; the mask is the first's
+    /// [default for --scene room: 0.9,0.3,2.45; for the bunnies a key light
+    /// above].
+    #[arg(long = "light", value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) lights: Vec<DVec3>,
+    /// A light at infinity in the direction X,Y,Z from the scene toward
+    /// it; repeatable.
+    #[arg(long = "sun", value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) suns: Vec<DVec3>,
+    /// Eye position [default for the built-in room and bunnies: a view of
+    /// the whole scene; required otherwise].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) eye: Option<DVec3>,
+    /// Point looked at [default: the centre of the scene's bounding box].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) target: Option<DVec3>,
+    /// Up direction [default: +Z (+Y for the bunnies), or another axis when
+    /// looking along it].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) up: Option<DVec3>,
+    /// Vertical field of view in degrees.
+    #[arg(long, value_name = "DEG", default_value_t = 50.0, value_parser = crate::parse_fov)]
+    pub(crate) fov: f64,
+    /// Worker threads [default: one per core]; the image is the same for
+    /// every count.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) threads: Option<u32>,
+    /// No notes on stderr (errors still go there).
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
+/// Options of the image-space shadow methods.
+#[derive(Args, Debug)]
+pub(crate) struct MethodArgs {
+    /// Shadow-map (and shadow-texture) size: texels on a side of a sun's
+    /// map or of each cube face of a point light.
+    #[arg(long, value_name = "N", default_value_t = 2048, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    pub(crate) map_size: u32,
+    /// Shadow-map bias: C (input units) or C,S (S texel footprints times
+    /// the tangent of the light's angle) [default: 0,1.5].
+    #[arg(long, value_name = "C[,S]", value_parser = parse_bias, allow_hyphen_values = true)]
+    pub(crate) bias: Option<(f64, f64)>,
+    /// Percentage-closer filtering over K×K texels (odd K; 1: off).
+    #[arg(long, value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=15))]
+    pub(crate) pcf: u32,
+    /// Planar shadows: project occluders without clipping them to the slab
+    /// between the receiving plane and the light (shows anti-shadows and
+    /// false shadows).
+    #[arg(long)]
+    pub(crate) no_clip: bool,
+    /// Planar shadows: the number of receiving planes (the largest).
+    #[arg(long, value_name = "N", default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub(crate) receivers: u32,
+}
+
+impl MethodArgs {
+    fn options(&self) -> Result<ShadowOptions> {
+        if self.pcf.is_multiple_of(2) {
+            bail!("--pcf {}: the kernel must be odd (1, 3, 5, ...)", self.pcf);
+        }
+        let d = ShadowOptions::default();
+        let (c, s) = self.bias.unwrap_or((d.bias_constant, d.bias_slope));
+        Ok(ShadowOptions::default()
+            .with_map_size(self.map_size)
+            .with_bias(c, s)
+            .with_pcf(self.pcf)
+            .with_planar_clip(!self.no_clip)
+            .with_planar_receivers(self.receivers as usize))
+    }
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct RenderArgs {
+    #[command(flatten)]
+    pub(crate) scene: SceneArgs,
+    /// Image size.
+    #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
+    pub(crate) size: (u32, u32),
+    /// Shadow method: exact, raycast, shadow-map, stencil-zpass,
+    /// stencil-zfail, planar or texture.
+    #[arg(long, value_name = "M", default_value = "exact", value_parser = parse_method)]
+    pub(crate) method: Method,
+    /// Visible-surface method: zbuffer, scanline, warnock, raycast or bsp
+    /// (all give the same image).
+    #[arg(long, value_name = "H", default_value = "zbuffer", value_parser = parse_hsr)]
+    pub(crate) hsr: Hsr,
+    /// Back-face culling: leave out faces whose back faces the eye.
+    #[arg(long)]
+    pub(crate) cull: bool,
+    #[command(flatten)]
+    pub(crate) opts: MethodArgs,
+    /// Also write the first light's mask as binary PGM: 0 nothing seen,
+    /// 255 lit, 128 not lit.
+    #[arg(long, value_name = "MASK.pgm")]
+    pub(crate) mask: Option<PathBuf>,
+    /// Output PNG.
+    #[arg(short, long, value_name = "OUT.png")]
+    pub(crate) output: PathBuf,
+    /// Print the time of each phase.
+    #[arg(long)]
+    pub(crate) stats: bool,
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct CompareArgs {
+    #[command(flatten)]
+    pub(crate) scene: SceneArgs,
+    /// Size of each panel.
+    #[arg(long, value_name = "WxH", default_value = "640x360", value_parser = parse_size)]
+    pub(crate) size: (u32, u32),
+    /// The methods to compare with exact, comma-separated [default: all].
+    #[arg(long, value_name = "M,M...", value_delimiter = ',', value_parser = parse_method)]
+    pub(crate) methods: Vec<Method>,
+    #[command(flatten)]
+    pub(crate) opts: MethodArgs,
+    /// Panels per row.
+    #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub(crate) columns: u32,
+    /// Tint the pixels that disagree with exact.
+    #[arg(long)]
+    pub(crate) highlight: bool,
+    /// Output PNG: the panels side by side.
+    #[arg(short, long, value_name = "OUT.png")]
+    pub(crate) output: PathBuf,
+    /// Also write the report as CSV.
+    #[arg(long, value_name = "OUT.csv")]
+    pub(crate) report: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct LinesArgs {
+    #[command(flatten)]
+    pub(crate) scene: SceneArgs,
+    /// Image size.
+    #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
+    pub(crate) size: (u32, u32),
+    /// Also draw the hidden lines, dashed.
+    #[arg(long)]
+    pub(crate) hidden: bool,
+    /// Output SVG.
+    #[arg(short, long, value_name = "OUT.svg")]
+    pub(crate) output: PathBuf,
+}
+
+/// A scene ready to render.
+pub(crate) struct Prepared {
+    pub(crate) name: String,
+    pub(crate) faces: usize,
+    pub(crate) scene: RasterScene,
+    pub(crate) lights: Vec<SceneLight>,
+    pub(crate) light_notes: Vec<String>,
+    pub(crate) camera: Camera,
+    pub(crate) colors: Vec<DVec3>,
+    pub(crate) load_time: Duration,
+}
+
+/// The built-in bunnies stand along +y: their default view and light.
+fn is_bunny(src: &SourceArgs) -> bool {
+    src.input.is_none() && src.scene.as_deref().is_some_and(|s| s.starts_with("bunny"))
+}
+
+fn is_room(src: &SourceArgs) -> bool {
+    src.input.is_none() && src.scene.as_deref() == Some("room")
+}
+
+fn check_ext(path: &std::path::Path, ext: &str, flag: &str) -> Result<()> {
+    let ok = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext));
+    if !ok {
+        bail!("{}: {flag} must name a .{ext} file", path.display());
+    }
+    Ok(())
+}
+
+/// Loads the scene, places the lights and sets up the camera.
+pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> Result<Prepared> {
+    let start = Instant::now();
+    let (mesh, name) = load_source_quiet(&args.source, args.quiet)?;
+    let bunny = is_bunny(&args.source);
+    let room = is_room(&args.source);
+    let (lo, hi) = mesh.bounds().context("the mesh has no vertices")?;
+    let (centre, half) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
+    let mut specs: Vec<LightSpec> = args.lights.iter().map(|&p| LightSpec::Point(p)).collect();
+    specs.extend(args.suns.iter().map(|&d| LightSpec::Sun(d)));
+    if specs.is_empty() && need_lights {
+        if room {
+            specs.push(LightSpec::Point(ROOM_LIGHT));
+        } else if bunny {
+            // the key light of the shadow benches
+            specs.push(LightSpec::Point(
+                centre + DVec3::Y * 1.6 * half + DVec3::X * 0.4 * half + DVec3::Z * 0.6 * half,
+            ));
+        } else {
+            bail!(
+                "no light: give at least one --light X,Y,Z (a point light) or --sun X,Y,Z (a light \
+                 at infinity)"
+            );
+        }
+    }
+    let (eye, default_target) = match (args.eye, room, bunny) {
+        (Some(e), _, _) => (e, centre),
+        (None, true, _) => (DEMO_EYE, DEMO_TARGET),
+        (None, _, true) => (
+            centre + DVec3::new(0.75 * half, 0.6 * half, 1.7 * half),
+            centre - DVec3::Y * 0.25 * half,
+        ),
+        (None, false, false) => bail!(
+            "no viewpoint: give --eye X,Y,Z (only the built-in room and bunnies have a default)"
+        ),
+    };
+    let target = args.target.unwrap_or(default_target);
+    let forward = target - eye;
+    let up = match args.up {
+        Some(u) => u,
+        None => {
+            let pref = if bunny { DVec3::Y } else { DVec3::Z };
+            [pref, DVec3::Y, DVec3::X]
+                .into_iter()
+                .find(|u| forward.normalize_or_zero().cross(*u).length() > 1e-3)
+                .unwrap_or(DVec3::X)
+        }
+    };
+    let camera = Camera::look_at(eye, target, up, args.fov, size.0, size.1)?;
+    let grid = shared_grid(&mesh.positions, &specs).with_context(|| name.clone())?;
+    let placed = place_lights(&grid, &specs)?;
+    let loops = mesh.face_loops();
+    let (polys, report) = import_faces_par(&grid, &loops)
+        .with_context(|| format!("{name}: cannot import the faces"))?;
+    let summary = report.summary();
+    if !summary.is_empty() && !args.quiet {
+        eprintln!("note: {name}: {}", summary.trim_end());
+    }
+    if polys.is_empty() {
+        bail!("{name}: nothing to draw: no face has an area");
+    }
+    let scene = RasterScene::new(&grid, polys)?;
+    Ok(Prepared {
+        faces: mesh.faces.len(),
+        colors: face_colors(&mesh),
+        name,
+        scene,
+        lights: placed.iter().map(SceneLight::from_placed).collect(),
+        light_notes: placed.iter().map(describe).collect(),
+        camera,
+        load_time: start.elapsed(),
+    })
+}
+
+fn with_threads(threads: Option<u32>, f: impl FnOnce() -> Result<()> + Send) -> Result<()> {
+    match threads {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build()
+            .context("cannot start the worker threads")?
+            .install(f),
+        None => f(),
+    }
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// `shadow render`.
+pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
+    check_ext(&args.output, "png", "-o")?;
+    if let Some(m) = &args.mask {
+        check_ext(m, "pgm", "--mask")?;
+    }
+    let shadow = args.opts.options()?;
+    with_threads(args.scene.threads, || {
+        let total = Instant::now();
+        let p = prepare(&args.scene, args.size, true)?;
+        let opts = RenderOptions::default()
+            .with_hsr(args.hsr)
+            .with_culling(args.cull)
+            .with_method(args.method)
+            .with_shadow(shadow);
+        let out = render(&p.scene, &p.lights, &p.camera, &p.colors, &opts)?;
+        let t = Instant::now();
+        out.image.write_png(&args.output)?;
+        let mask = out.mask();
+        if let Some(path) = &args.mask {
+            write_pgm(path, args.size.0, args.size.1, &mask)?;
+        }
+        let write = t.elapsed();
+        let seen = mask.iter().filter(|&&m| m != 0).count();
+        let lit = mask.iter().filter(|&&m| m == 255).count();
+        let mut text = format!(
+            "wrote {}: {}x{} of {} ({} faces), {} shadows, {} visibility; {:.1}% of the visible \
+             pixels lit by light 0\n",
+            args.output.display(),
+            args.size.0,
+            args.size.1,
+            p.name,
+            p.faces,
+            args.method.name(),
+            args.hsr.name(),
+            100.0 * lit as f64 / seen.max(1) as f64
+        );
+        if let Some(m) = &args.mask {
+            text += &format!("wrote {}: the mask of light 0\n", m.display());
+        }
+        if args.stats {
+            for (i, n) in p.light_notes.iter().enumerate() {
+                text += &format!("light {i}:        {n}\n");
+            }
+            text += &format!("load/import:    {:.1} ms\n", ms(p.load_time));
+            text += &format!("visibility:     {:.1} ms\n", ms(out.visibility_time));
+            text += &format!(
+                "shadows:        {:.1} ms ({} primitives{})\n",
+                ms(out.figures.time),
+                out.figures.primitives,
+                if out.figures.fallback_pixels > 0 {
+                    format!(
+                        ", {} pixels settled by a point test",
+                        out.figures.fallback_pixels
+                    )
+                } else {
+                    String::new()
+                }
+            );
+            text += &format!("shading:        {:.1} ms\n", ms(out.shading_time));
+            text += &format!("write:          {:.1} ms\n", ms(write));
+            text += &format!("total:          {:.1} ms\n", ms(total.elapsed()));
+        }
+        emit(&text)
+    })
+}
+
+/// `shadow compare`.
+pub(crate) fn run_compare(args: &CompareArgs) -> Result<()> {
+    check_ext(&args.output, "png", "-o")?;
+    if let Some(r) = &args.report {
+        check_ext(r, "csv", "--report")?;
+    }
+    let shadow = args.opts.options()?;
+    with_threads(args.scene.threads, || {
+        let p = prepare(&args.scene, args.size, true)?;
+        let methods = if args.methods.is_empty() {
+            Method::ALL.to_vec()
+        } else {
+            args.methods.clone()
+        };
+        let cmp = compare(&p.scene, &p.lights, &p.camera, &p.colors, &shadow, &methods)?;
+        cmp.image(args.columns as usize, args.highlight)
+            .write_png(&args.output)?;
+        let csv = cmp.csv();
+        if let Some(r) = &args.report {
+            std::fs::write(r, &csv).with_context(|| format!("could not write {}", r.display()))?;
+        }
+        let mut text = format!(
+            "wrote {}: {} methods on {} ({} faces), {}x{} each; visibility {:.1} ms\n",
+            args.output.display(),
+            cmp.reports.len(),
+            p.name,
+            p.faces,
+            args.size.0,
+            args.size.1,
+            ms(cmp.visibility_time)
+        );
+        text += &format!("{:<15} {:>12} {:>10}\n", "method", "disagree", "time");
+        for r in &cmp.reports {
+            text += &format!(
+                "{:<15} {:>11.3}% {:>7.1} ms\n",
+                r.method.name(),
+                r.disagree_percent(),
+                ms(r.time)
+            );
+        }
+        if let Some(r) = &args.report {
+            text += &format!("wrote {}\n", r.display());
+        }
+        emit(&text)
+    })
+}
+
+/// `shadow lines`.
+pub(crate) fn run_lines(args: &LinesArgs) -> Result<()> {
+    check_ext(&args.output, "svg", "-o")?;
+    with_threads(args.scene.threads, || {
+        let p = prepare(&args.scene, args.size, false)?;
+        let lines = hidden_lines(&p.scene, &p.camera)?;
+        std::fs::write(&args.output, lines.svg(args.hidden))
+            .with_context(|| format!("could not write {}", args.output.display()))?;
+        emit(&format!(
+            "wrote {}: {} polyhedra ({} convex), {} edges, {} visible and {} hidden parts; \
+             z-buffer check: {} of {} points agree\n",
+            args.output.display(),
+            lines.polyhedra,
+            lines.convex,
+            lines.edges,
+            lines.visible.len(),
+            lines.hidden.len(),
+            lines.check.agree,
+            lines.check.checked
+        ))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_with_clear_errors() {
+        assert_eq!(parse_size("1920x1080"), Ok((1920, 1080)));
+        assert_eq!(parse_size("64X48"), Ok((64, 48)));
+        assert!(parse_size("1920").unwrap_err().contains("expected WxH"));
+        assert!(
+            parse_size("0x10")
+                .unwrap_err()
+                .contains("between 1 and 16384")
+        );
+        assert!(
+            parse_size("axb")
+                .unwrap_err()
+                .contains("not a whole number")
+        );
+        assert!(parse_size("99999x2").unwrap_err().contains("width"));
+        assert!(
+            parse_size("16384x16384")
+                .unwrap_err()
+                .contains("pixels in all")
+        );
+    }
+
+    #[test]
+    fn methods_and_biases_parse() {
+        assert_eq!(parse_method("shadow-map"), Ok(Method::ShadowMap));
+        assert!(
+            parse_method("phong")
+                .unwrap_err()
+                .contains("available: exact, raycast")
+        );
+        assert_eq!(parse_hsr("warnock"), Ok(Hsr::Warnock));
+        assert!(parse_hsr("painter").is_err());
+        assert_eq!(parse_bias("0.01"), Ok((0.01, 1.5)));
+        assert_eq!(parse_bias("0,2"), Ok((0.0, 2.0)));
+        assert!(parse_bias("-1").is_err());
+        assert!(parse_bias("1,2,3").is_err());
+    }
+}

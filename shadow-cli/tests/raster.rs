@@ -1,0 +1,268 @@
+//! `render`, `compare` and `lines`.
+
+use crate::{scratch, shadow, stderr, stdout};
+
+/// Checks a PNG's signature and size.
+fn png_size(path: &std::path::Path) -> (u32, u32) {
+    let b = std::fs::read(path).unwrap();
+    assert_eq!(&b[..8], b"\x89PNG\r\n\x1a\n");
+    let be = |i: usize| u32::from_be_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+    (be(16), be(20))
+}
+
+/// A usage error: exit code 1, `error: ` and a clear message, no panic.
+fn assert_usage_error(o: &std::process::Output, needles: &[&str]) {
+    crate::assert_failed_with(o, needles);
+}
+
+#[test]
+fn render_the_room_with_a_mask() {
+    let (out, mask) = (scratch("room.png"), scratch("room.pgm"));
+    let o = shadow(&[
+        "render",
+        "--scene",
+        "room",
+        "--size",
+        "160x90",
+        "-o",
+        out.to_str().unwrap(),
+        "--mask",
+        mask.to_str().unwrap(),
+        "--stats",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("exact shadows"), "{}", stdout(&o));
+    assert!(stdout(&o).contains("visibility:"), "{}", stdout(&o));
+    assert_eq!(png_size(&out), (160, 90));
+    let pgm = std::fs::read(&mask).unwrap();
+    let header = b"P5\n160 90\n255\n";
+    assert_eq!(&pgm[..header.len()], header);
+    let body = &pgm[header.len()..];
+    assert_eq!(body.len(), 160 * 90);
+    assert!(body.iter().all(|&v| v == 0 || v == 128 || v == 255));
+    assert!(body.contains(&0) && body.contains(&128) && body.contains(&255));
+}
+
+#[test]
+fn every_method_renders() {
+    for m in [
+        "raycast",
+        "shadow-map",
+        "stencil-zpass",
+        "stencil-zfail",
+        "planar",
+        "texture",
+    ] {
+        let out = scratch(&format!("room_{m}.png"));
+        let o = shadow(&[
+            "render",
+            "--scene",
+            "room",
+            "--size",
+            "96x54",
+            "--method",
+            m,
+            "--hsr",
+            "scanline",
+            "--map-size",
+            "256",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{m}: {}", stderr(&o));
+        assert_eq!(png_size(&out), (96, 54));
+    }
+}
+
+#[test]
+fn compare_writes_the_panels_and_the_report() {
+    let (out, csv) = (scratch("cmp.png"), scratch("cmp.csv"));
+    let o = shadow(&[
+        "compare",
+        "--scene",
+        "room",
+        "--size",
+        "96x54",
+        "--map-size",
+        "512",
+        "-o",
+        out.to_str().unwrap(),
+        "--report",
+        csv.to_str().unwrap(),
+        "--highlight",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = report.lines().collect();
+    assert_eq!(
+        lines[0],
+        "method,disagree_pixels,visible_pixels,disagree_percent,ms"
+    );
+    assert_eq!(lines.len(), 8, "{report}");
+    assert!(lines[1].starts_with("exact,0,"), "{report}");
+    let (w, h) = png_size(&out);
+    assert!(w > 4 * 96 && h > 2 * 54, "{w}x{h}");
+    // a subset, and a wrong name
+    let o = shadow(&[
+        "compare",
+        "--scene",
+        "room",
+        "--size",
+        "64x36",
+        "--methods",
+        "raycast,planar",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("planar") && !stdout(&o).contains("texture"));
+    let o = shadow(&[
+        "compare",
+        "--scene",
+        "room",
+        "--methods",
+        "raycast,phong",
+        "-o",
+        "x.png",
+    ]);
+    assert_usage_error(&o, &["unknown method `phong`", "available: exact, raycast"]);
+}
+
+#[test]
+fn lines_of_the_chair() {
+    let out = scratch("chair_lines.svg");
+    let o = shadow(&[
+        "lines",
+        "--scene",
+        "chair",
+        "--eye",
+        "2,-3,2",
+        "--size",
+        "320x240",
+        "--hidden",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.contains("polyhedra"), "{text}");
+    // the cross-check: "N of N points agree"
+    let check = text.split("check: ").nth(1).unwrap();
+    let nums: Vec<usize> = check
+        .split_whitespace()
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    assert_eq!(nums[0], nums[1], "{text}");
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert!(svg.starts_with("<?xml") && svg.contains("stroke-dasharray"));
+}
+
+#[test]
+fn bad_sizes_and_methods_are_clear_errors() {
+    let o = shadow(&["render", "--scene", "room", "--size", "1280", "-o", "x.png"]);
+    assert_usage_error(&o, &["--size", "expected WxH"]);
+    let o = shadow(&["render", "--scene", "room", "--size", "0x10", "-o", "x.png"]);
+    assert_usage_error(&o, &["between 1 and 16384"]);
+    let o = shadow(&["render", "--scene", "room", "--size", "wide", "-o", "x.png"]);
+    assert_usage_error(&o, &["expected WxH"]);
+    let o = shadow(&[
+        "render", "--scene", "room", "--method", "phong", "-o", "x.png",
+    ]);
+    assert_usage_error(&o, &["unknown method `phong`", "shadow-map"]);
+    let o = shadow(&[
+        "render", "--scene", "room", "--hsr", "painter", "-o", "x.png",
+    ]);
+    assert_usage_error(&o, &["unknown visibility method", "warnock"]);
+    let o = shadow(&["render", "--scene", "room", "--bias", "-1", "-o", "x.png"]);
+    assert_usage_error(&o, &["not negative"]);
+    let o = shadow(&["render", "--scene", "room", "--fov", "190", "-o", "x.png"]);
+    assert_usage_error(&o, &["170"]);
+}
+
+#[test]
+fn bad_runs_are_clear_errors() {
+    let fail = |args: &[&str], needles: &[&str]| {
+        let o = shadow(args);
+        crate::assert_failed_with(&o, needles);
+    };
+    fail(
+        &["render", "--scene", "room", "-o", "x.jpg"],
+        &["x.jpg", ".png"],
+    );
+    fail(
+        &[
+            "render", "--scene", "room", "--mask", "m.png", "-o", "x.png",
+        ],
+        &["--mask", ".pgm"],
+    );
+    fail(
+        &["render", "--scene", "room", "--pcf", "4", "-o", "x.png"],
+        &["--pcf 4", "odd"],
+    );
+    fail(
+        &[
+            "render",
+            "--scene",
+            "room",
+            "--eye",
+            "0.9,0.3,2.45",
+            "--target",
+            "0.9,0.3,2.45",
+            "-o",
+            "x.png",
+        ],
+        &["coincide"],
+    );
+    fail(
+        &[
+            "render", "--scene", "room", "--eye", "0,0,9", "--up", "0,0,1", "--target", "0,0,0",
+            "-o", "x.png",
+        ],
+        &["parallel"],
+    );
+    let teapot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/meshes/teapot.obj");
+    let teapot = teapot.to_str().unwrap();
+    fail(
+        &["render", teapot, "--light", "0,10,0", "-o", "x.png"],
+        &["--eye"],
+    );
+    fail(
+        &["render", teapot, "--eye", "12,9,14", "-o", "x.png"],
+        &["no light"],
+    );
+    fail(
+        &["render", "--scene", "room", "--sun", "0,0,0", "-o", "x.png"],
+        &["sun direction is zero"],
+    );
+    fail(
+        &["render", "--scene", "nowhere", "-o", "x.png"],
+        &["unknown scene `nowhere`"],
+    );
+    let missing = scratch("no_such_dir").join("out.png");
+    fail(
+        &[
+            "render",
+            "--scene",
+            "room",
+            "--size",
+            "32x18",
+            "-o",
+            missing.to_str().unwrap(),
+        ],
+        &["out.png"],
+    );
+}
+
+#[test]
+fn lines_need_closed_polyhedra() {
+    let teapot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/meshes/teapot.obj");
+    let o = shadow(&[
+        "lines",
+        teapot.to_str().unwrap(),
+        "--eye",
+        "12,9,14",
+        "-o",
+        scratch("teapot_lines.svg").to_str().unwrap(),
+    ]);
+    crate::assert_failed_with(&o, &["polyhedron 0", "not closed", "closed polyhedra"]);
+}

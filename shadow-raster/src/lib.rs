@@ -1,0 +1,250 @@
+//! A software rasterizer for the exact BSP shadow toolkit: PNG images of a
+//! scene and its shadows, and the classic image-space shadow and
+//! visibility methods measured against the exact shadows of `svbsp`.
+//!
+//! - [`Camera`]: the perspective camera contract (right-handed look-at,
+//!   pixel rays from the top-left corner).
+//! - [`RasterScene`]: the scene's exact convex polygons, in input units.
+//! - [`visible_surfaces`]: the visible polygon of every pixel by z-buffer,
+//!   scan-line, Warnock, ray casting or BSP traversal ([`Hsr`]), all
+//!   agreeing pixel for pixel (one coverage rule, the top-left rule in
+//!   fixed point, and one tie rule).
+//! - [`render`]: visibility, then shadows by one [`Method`] — the exact
+//!   fragments, shadow rays, shadow maps, stencil shadow volumes (z-pass and
+//!   z-fail), planar projection or a shadow texture — then Lambert shading
+//!   into an [`Image`] (PNG) and a mask of the first light (PGM).
+//! - [`render_fragments`]: the same image from exact fragments computed
+//!   elsewhere (a [`svbsp::Batch`]), e.g. one frame of an animation.
+//! - [`compare`]: every method on one camera, with the share of pixels
+//!   where each disagrees with `exact`, and its time.
+//! - [`hidden_lines`]: Roberts' hidden-line algorithm for convex polyhedra.
+//!
+//! Everything here is `f64` image-space arithmetic on the exact geometry;
+//! its tolerances (the shadow rays' self-intersection margin
+//! [`RAY_EPSILON`], the shadow map's bias, Roberts' [`LINE_EPSILON`]) are
+//! named and documented. Parallel work is split by bands of rows (rayon)
+//! and never changes a pixel.
+//!
+//! # Example
+//!
+//! ```
+//! use glam::DVec3;
+//! use shadow_raster::{Camera, Method, RasterScene, RenderOptions, SceneLight, render};
+//! use svbsp::{LightSpec, place_lights};
+//!
+//! // a floor and a floating square, a light above
+//! let faces = vec![
+//!     vec![DVec3::new(-4.0, -4.0, 0.0), DVec3::new(4.0, -4.0, 0.0), DVec3::new(4.0, 4.0, 0.0), DVec3::new(-4.0, 4.0, 0.0)],
+//!     vec![DVec3::new(-1.0, -1.0, 2.0), DVec3::new(1.0, -1.0, 2.0), DVec3::new(1.0, 1.0, 2.0), DVec3::new(-1.0, 1.0, 2.0)],
+//! ];
+//! let specs = [LightSpec::Point(DVec3::new(0.0, 0.0, 5.0))];
+//! let grid = svbsp::shared_grid(&faces.concat(), &specs).unwrap();
+//! let lights: Vec<SceneLight> = place_lights(&grid, &specs).unwrap().iter().map(SceneLight::from_placed).collect();
+//! let (polys, _) = bsp_core::import_faces(&grid, faces.iter().map(Vec::as_slice)).unwrap();
+//! let scene = RasterScene::new(&grid, polys)?;
+//! let cam = Camera::look_at(DVec3::new(0.0, -8.0, 6.0), DVec3::ZERO, DVec3::Z, 50.0, 64, 48)?;
+//! let out = render(&scene, &lights, &cam, &[], &RenderOptions::default().with_method(Method::Exact))?;
+//! let mask = out.mask();
+//! assert!(mask.contains(&255) && mask.contains(&128)); // lit floor, and its shadow
+//! # Ok::<(), shadow_raster::RasterError>(())
+//! ```
+//!
+//! # Feature flags
+//!
+//! None.
+
+mod bvh;
+mod compare;
+mod error;
+mod exact;
+mod hsr;
+mod image;
+mod lines;
+mod maps;
+mod planar;
+mod raster;
+mod scene;
+mod shadow;
+mod stencil;
+mod view;
+
+use std::time::{Duration, Instant};
+
+use glam::DVec3;
+
+pub use bvh::TriangleBvh;
+pub use compare::{Comparison, MethodReport, compare};
+pub use error::RasterError;
+pub use hsr::{Hsr, NONE, Visibility, visible_surfaces};
+pub use image::{BACKGROUND, Image, composite, encode_pgm, mask, write_pgm};
+pub use lines::{HiddenLines, LINE_EPSILON, LineCheck, hidden_lines};
+pub use planar::{PLANAR_MARGIN, planar_matrix};
+pub use scene::{RasterLight, RasterScene, SceneLight};
+pub use shadow::{LitBuffer, Method, RAY_EPSILON, ShadowFigures, ShadowOptions};
+pub use view::{Camera, MAX_PIXELS, MAX_SIZE};
+
+/// Options of [`render`].
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct RenderOptions {
+    /// The visible-surface method.
+    pub hsr: Hsr,
+    /// Leave out prims whose back faces the eye.
+    pub cull_back_faces: bool,
+    /// The shadow method.
+    pub method: Method,
+    /// Options of the image-space shadow methods.
+    pub shadow: ShadowOptions,
+}
+
+impl Default for RenderOptions {
+    fn default() -> RenderOptions {
+        RenderOptions {
+            hsr: Hsr::ZBuffer,
+            cull_back_faces: false,
+            method: Method::Exact,
+            shadow: ShadowOptions::default(),
+        }
+    }
+}
+
+impl RenderOptions {
+    /// Sets [`RenderOptions::hsr`].
+    pub fn with_hsr(mut self, hsr: Hsr) -> Self {
+        self.hsr = hsr;
+        self
+    }
+    /// Sets [`RenderOptions::cull_back_faces`].
+    pub fn with_culling(mut self, cull: bool) -> Self {
+        self.cull_back_faces = cull;
+        self
+    }
+    /// Sets [`RenderOptions::method`].
+    pub fn with_method(mut self, m: Method) -> Self {
+        self.method = m;
+        self
+    }
+    /// Sets [`RenderOptions::shadow`].
+    pub fn with_shadow(mut self, s: ShadowOptions) -> Self {
+        self.shadow = s;
+        self
+    }
+}
+
+/// A rendered image and what it was made of.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    /// The visible prim of every pixel.
+    pub visibility: Visibility,
+    /// How much of each light reaches every pixel.
+    pub lit: LitBuffer,
+    /// The shaded image.
+    pub image: Image,
+    /// Figures of the shadow method.
+    pub figures: ShadowFigures,
+    /// Time of the visibility pass.
+    pub visibility_time: Duration,
+    /// Time of the shading pass.
+    pub shading_time: Duration,
+}
+
+impl Rendered {
+    /// The mask of the first light (see [`mask`]).
+    pub fn mask(&self) -> Vec<u8> {
+        mask(&self.visibility, &self.lit)
+    }
+}
+
+fn check_lights(lights: &[SceneLight]) -> Result<(), RasterError> {
+    if lights.len() > svbsp::MAX_LIGHTS {
+        return Err(RasterError::Option(format!(
+            "{} lights: at most {} are supported",
+            lights.len(),
+            svbsp::MAX_LIGHTS
+        )));
+    }
+    Ok(())
+}
+
+/// Renders `scene` from `camera` with `lights`: visibility, shadows and
+/// Lambert shading. `colors` gives each face's base colour (RGB in
+/// `[0, 1]`, by face index; faces beyond it are grey).
+pub fn render(
+    scene: &RasterScene,
+    lights: &[SceneLight],
+    camera: &Camera,
+    colors: &[DVec3],
+    opts: &RenderOptions,
+) -> Result<Rendered, RasterError> {
+    check_lights(lights)?;
+    opts.shadow.validate()?;
+    let t = Instant::now();
+    let frame = hsr::Frame::new(scene, camera, opts.cull_back_faces)?;
+    let visibility = hsr::visibility(&frame, opts.hsr);
+    let visibility_time = t.elapsed();
+    let (lit, figures) = shadow::shadows(&frame, &visibility, lights, opts.method, &opts.shadow)?;
+    Ok(shaded(
+        &frame,
+        visibility,
+        visibility_time,
+        lit,
+        figures,
+        lights,
+        colors,
+    ))
+}
+
+/// Shades a frame's visibility and lit amounts into a [`Rendered`].
+fn shaded(
+    frame: &hsr::Frame<'_>,
+    visibility: Visibility,
+    visibility_time: Duration,
+    lit: LitBuffer,
+    figures: ShadowFigures,
+    lights: &[SceneLight],
+    colors: &[DVec3],
+) -> Rendered {
+    let t = Instant::now();
+    let image = image::shade(frame, &visibility, &lit, lights, colors);
+    Rendered {
+        visibility,
+        lit,
+        image,
+        figures,
+        visibility_time,
+        shading_time: t.elapsed(),
+    }
+}
+
+/// Renders `scene` with the exact fragments of `batch` (from
+/// [`svbsp::Shadows`] over the same polygons, every face a receiver with
+/// its front side; a face seen from the back is drawn in attached shadow
+/// unless the batch has fragments for its flipped plane). The hook for
+/// animations: one frame's polygons and fragments in, one image out.
+///
+/// `lights` are the batch's lights, in order.
+pub fn render_fragments(
+    scene: &RasterScene,
+    batch: &svbsp::Batch,
+    lights: &[SceneLight],
+    camera: &Camera,
+    colors: &[DVec3],
+) -> Result<Rendered, RasterError> {
+    check_lights(lights)?;
+    let t = Instant::now();
+    let frame = hsr::Frame::new(scene, camera, false)?;
+    let visibility = hsr::visibility(&frame, Hsr::ZBuffer);
+    let visibility_time = t.elapsed();
+    let t = Instant::now();
+    let (lit, mut figures) = exact::draw_fragments(&frame, &visibility, lights.len(), batch);
+    figures.time = t.elapsed();
+    Ok(shaded(
+        &frame,
+        visibility,
+        visibility_time,
+        lit,
+        figures,
+        lights,
+        colors,
+    ))
+}

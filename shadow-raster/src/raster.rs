@@ -1,0 +1,779 @@
+//! Scan conversion: polygons (any number of rings) clipped in a view's
+//! frame, projected to fixed-point pixel coordinates and filled with the
+//! top-left rule.
+//!
+//! **Fixed point.** Screen coordinates are rounded to `1/256` pixel
+//! ([`SUB`]) and every coverage decision after that is exact integer
+//! arithmetic, as in GPU rasterizers. A pixel is covered when its centre
+//! is inside by the *half-open* rule: an edge crosses the rows whose centre
+//! `y` satisfies `y0 <= y < y1` (so horizontal edges never count, a top
+//! edge's row is in and a bottom edge's row is out), and on a row a pixel
+//! whose centre lies exactly on a crossing belongs to the span to its right.
+//! That is the top-left rule. Each crossing is computed from the edge's
+//! endpoints in a canonical order (upper endpoint first), so two polygons
+//! that share an edge compute the same crossings: no crack and no pixel
+//! covered twice. Spans are filled even-odd, so rings may be holes.
+//!
+//! **Clipping.** Before projection, polygons are clipped (Sutherland–
+//! Hodgman) to the near plane and to the image widened by a guard band, in
+//! frame coordinates. A cut edge's new vertex is computed from the edge's
+//! endpoints in a canonical order, so polygons sharing an edge get the
+//! same point.
+//!
+//! **Bands.** The image is cut into bands of rows; polygons are binned by
+//! the rows they reach and the bands are filled in parallel. Every result
+//! depends only on each pixel's candidates, never on the order of work.
+
+use std::ops::Range;
+
+use glam::DVec3;
+use rayon::prelude::*;
+use smallvec_lite::Small;
+
+use crate::view::{ClipPlane, View};
+
+/// Fixed-point units per pixel.
+pub(crate) const SUB: i64 = 256;
+const HALF: i64 = SUB / 2;
+
+/// Rows per band of parallel work.
+pub(crate) const BAND: usize = 16;
+
+/// A tiny inline vector, enough for the crossings of one row.
+mod smallvec_lite {
+    /// Up to 16 values inline, more on the heap.
+    pub(crate) enum Small<T: Copy + Default> {
+        Inline([T; 16], usize),
+        Heap(Vec<T>),
+    }
+
+    impl<T: Copy + Default> Small<T> {
+        pub(crate) fn new() -> Self {
+            Small::Inline([T::default(); 16], 0)
+        }
+        pub(crate) fn push(&mut self, v: T) {
+            match self {
+                Small::Inline(a, n) if *n < 16 => {
+                    a[*n] = v;
+                    *n += 1;
+                }
+                Small::Inline(a, n) => {
+                    let mut h = a[..*n].to_vec();
+                    h.push(v);
+                    *self = Small::Heap(h);
+                }
+                Small::Heap(h) => h.push(v),
+            }
+        }
+        pub(crate) fn as_mut_slice(&mut self) -> &mut [T] {
+            match self {
+                Small::Inline(a, n) => &mut a[..*n],
+                Small::Heap(h) => h,
+            }
+        }
+        pub(crate) fn clear(&mut self) {
+            match self {
+                Small::Inline(_, n) => *n = 0,
+                Small::Heap(h) => h.clear(),
+            }
+        }
+    }
+}
+
+/// `ceil(a / b)` for `b > 0`.
+#[inline]
+fn ceil_div(a: i64, b: i64) -> i64 {
+    let q = a.div_euclid(b);
+    if a.rem_euclid(b) == 0 { q } else { q + 1 }
+}
+
+/// The first row whose centre is at or below fixed-point `y`.
+#[inline]
+fn first_row(y: i64) -> i64 {
+    ceil_div(y - HALF, SUB)
+}
+
+/// One edge, upper endpoint first (`y0 < y1`), with the exact crossing of
+/// the row it was last used on, stepped from row to row without division.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Edge {
+    x0: i64,
+    y0: i64,
+    dx: i64,
+    dy: i64,
+    /// Rows whose centre it crosses.
+    rows: (i64, i64),
+    /// The row `q`, `r` are for (`i64::MIN`: none yet).
+    next: i64,
+    /// `N = q·D + r`, `0 <= r < D`, with `N` the numerator of the crossing
+    /// at row `next` and `D = SUB · dy`.
+    q: i64,
+    r: i64,
+    /// One row's step of `N`, `SUB · dx = sq·D + sr` (`sq = i64::MIN`: not
+    /// computed yet).
+    sq: i64,
+    sr: i64,
+}
+
+impl Edge {
+    /// The edge between two fixed-point points; `None` if horizontal.
+    #[inline]
+    fn new(a: [i32; 2], b: [i32; 2]) -> Option<Edge> {
+        let (a, b) = if (a[1], a[0]) <= (b[1], b[0]) {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        let (x0, y0, x1, y1) = (a[0] as i64, a[1] as i64, b[0] as i64, b[1] as i64);
+        if y0 == y1 {
+            return None;
+        }
+        Some(Edge {
+            x0,
+            y0,
+            dx: x1 - x0,
+            dy: y1 - y0,
+            rows: (first_row(y0), first_row(y1)),
+            next: i64::MIN,
+            q: 0,
+            r: 0,
+            sq: i64::MIN,
+            sr: 0,
+        })
+    }
+
+    /// The first pixel of row `y` whose centre is at or right of the
+    /// crossing: `ceil(N / D)` with `N = x0·dy + dx·(yc − y0) − dy·SUB/2`
+    /// (`yc` the row's centre in fixed point), exactly. Rows asked in
+    /// increasing order cost no division after the second.
+    #[inline]
+    fn crossing(&mut self, y: i64) -> i64 {
+        let d = SUB * self.dy;
+        if self.next != y {
+            let py = y * SUB + HALF;
+            let n = self.x0 * self.dy + self.dx * (py - self.y0) - HALF * self.dy;
+            self.q = n.div_euclid(d);
+            self.r = n.rem_euclid(d);
+        }
+        let x = self.q + (self.r > 0) as i64;
+        if y + 1 < self.rows.1 {
+            if self.sq == i64::MIN {
+                self.sq = (SUB * self.dx).div_euclid(d);
+                self.sr = (SUB * self.dx).rem_euclid(d);
+            }
+            self.q += self.sq;
+            self.r += self.sr;
+            if self.r >= d {
+                self.q += 1;
+                self.r -= d;
+            }
+            self.next = y + 1;
+        }
+        x
+    }
+}
+
+/// Polygons in screen space: fixed-point rings, the rows they reach, and
+/// per polygon its nearness coefficients and an id.
+#[derive(Default)]
+pub(crate) struct Screen {
+    pub(crate) pts: Vec<[i32; 2]>,
+    /// Ring `k` is `pts[ring_start[k]..ring_start[k + 1]]`.
+    ring_start: Vec<u32>,
+    /// Polygon `i` is rings `poly_ring[i]..poly_ring[i + 1]`.
+    poly_ring: Vec<u32>,
+    pub(crate) rows: Vec<(i32, i32)>,
+    pub(crate) cols: Vec<(i32, i32)>,
+    pub(crate) coeffs: Vec<[f64; 3]>,
+    pub(crate) id: Vec<u32>,
+}
+
+impl Screen {
+    fn new() -> Screen {
+        Screen {
+            ring_start: vec![0],
+            poly_ring: vec![0],
+            ..Screen::default()
+        }
+    }
+
+    pub(crate) fn len(&self) -> usize {
+        self.id.len()
+    }
+
+    fn rings(&self, i: usize) -> impl Iterator<Item = &[[i32; 2]]> + '_ {
+        (self.poly_ring[i] as usize..self.poly_ring[i + 1] as usize)
+            .map(move |k| &self.pts[self.ring_start[k] as usize..self.ring_start[k + 1] as usize])
+    }
+
+    fn append(&mut self, o: Screen) {
+        let p0 = self.pts.len() as u32;
+        let r0 = (self.ring_start.len() - 1) as u32;
+        self.pts.extend_from_slice(&o.pts);
+        self.ring_start
+            .extend(o.ring_start[1..].iter().map(|s| s + p0));
+        self.poly_ring
+            .extend(o.poly_ring[1..].iter().map(|s| s + r0));
+        self.rows.extend_from_slice(&o.rows);
+        self.cols.extend_from_slice(&o.cols);
+        self.coeffs.extend_from_slice(&o.coeffs);
+        self.id.extend_from_slice(&o.id);
+    }
+
+    /// The edges of polygon `i`.
+    pub(crate) fn edges(&self, i: usize, out: &mut Vec<Edge>) {
+        out.clear();
+        for ring in self.rings(i) {
+            let n = ring.len();
+            for k in 0..n {
+                if let Some(e) = Edge::new(ring[k], ring[(k + 1) % n]) {
+                    out.push(e);
+                }
+            }
+        }
+    }
+
+    /// Calls `span(y, x0..x1)` for every run of covered pixels of polygon
+    /// `i` on the rows `rows` (clamped to the image width `width`).
+    pub(crate) fn spans(
+        &self,
+        i: usize,
+        rows: Range<i64>,
+        width: i64,
+        edges: &mut Vec<Edge>,
+        mut span: impl FnMut(i64, Range<i64>),
+    ) {
+        let (r0, r1) = self.rows[i];
+        let (y0, y1) = (rows.start.max(r0 as i64), rows.end.min(r1 as i64));
+        if y0 >= y1 {
+            return;
+        }
+        self.edges(i, edges);
+        fill(edges, y0..y1, width, &mut span);
+    }
+
+    /// `true` if polygon `i` covers pixel `(x, y)`.
+    pub(crate) fn covers(&self, i: usize, x: i64, y: i64, edges: &mut Vec<Edge>) -> bool {
+        let (r0, r1) = self.rows[i];
+        let (c0, c1) = self.cols[i];
+        if y < r0 as i64 || y >= r1 as i64 || x < c0 as i64 || x >= c1 as i64 {
+            return false;
+        }
+        let mut hit = false;
+        self.spans(i, y..y + 1, x + 1, edges, |_, s| hit |= s.contains(&x));
+        hit
+    }
+
+    /// Nearness of polygon `i` at pixel `(x, y)`.
+    #[inline]
+    pub(crate) fn nearness(&self, i: usize, x: i64, y: i64) -> f64 {
+        nearness(&self.coeffs[i], x, y)
+    }
+}
+
+/// The nearness `a·xc + (b·yc + c)` at the centre of pixel `(x, y)`: the one
+/// formula every method uses, so that equal inputs give equal bits.
+#[inline]
+pub(crate) fn nearness(k: &[f64; 3], x: i64, y: i64) -> f64 {
+    k[0] * (x as f64 + 0.5) + row_term(k, y)
+}
+
+/// The row part `b·yc + c` of [`nearness`].
+#[inline]
+pub(crate) fn row_term(k: &[f64; 3], y: i64) -> f64 {
+    k[1] * (y as f64 + 0.5) + k[2]
+}
+
+/// Even-odd fill of `edges` on rows `rows`.
+fn fill(edges: &mut [Edge], rows: Range<i64>, width: i64, span: &mut impl FnMut(i64, Range<i64>)) {
+    let mut xs: Small<i64> = Small::new();
+    for y in rows {
+        xs.clear();
+        for e in edges.iter_mut() {
+            if e.rows.0 <= y && y < e.rows.1 {
+                xs.push(e.crossing(y));
+            }
+        }
+        let xs = xs.as_mut_slice();
+        if xs.len() == 2 {
+            let (a, b) = (xs[0].min(xs[1]), xs[0].max(xs[1]));
+            let (a, b) = (a.max(0), b.min(width));
+            if a < b {
+                span(y, a..b);
+            }
+            continue;
+        }
+        xs.sort_unstable();
+        for pair in xs.chunks_exact(2) {
+            let (a, b) = (pair[0].max(0), pair[1].min(width));
+            if a < b {
+                span(y, a..b);
+            }
+        }
+    }
+}
+
+/// A pixel coordinate (within the guard band) in fixed point, rounded to
+/// nearest (without a library call: this runs for every vertex).
+#[inline]
+fn to_fixed(v: f64) -> i32 {
+    // clipping keeps |v| within the guard band; the clamp only tames
+    // non-finite input (NaN becomes 0)
+    const LIMIT: f64 = (1u64 << 30) as f64;
+    let s = (v * SUB as f64).clamp(-LIMIT, LIMIT);
+    let i = s as i64;
+    let f = s - i as f64;
+    (if f >= 0.5 {
+        i + 1
+    } else if f < -0.5 {
+        i - 1
+    } else {
+        i
+    }) as i32
+}
+
+/// Canonical intersection of segment `ab` with a plane, given the plane's
+/// values at both ends (of opposite signs).
+#[inline]
+fn cut(a: DVec3, b: DVec3, da: f64, db: f64) -> DVec3 {
+    let (a, b, da, db) = if a.to_array() <= b.to_array() {
+        (a, b, da, db)
+    } else {
+        (b, a, db, da)
+    };
+    a + (b - a) * (da / (da - db))
+}
+
+/// Sutherland–Hodgman clip of a ring (frame coordinates) to `n · c + d >= 0`.
+pub(crate) fn clip_ring(ring: &[DVec3], (n, d): ClipPlane, out: &mut Vec<DVec3>) {
+    out.clear();
+    let k = ring.len();
+    for i in 0..k {
+        let (a, b) = (ring[i], ring[(i + 1) % k]);
+        let (da, db) = (n.dot(a) + d, n.dot(b) + d);
+        if da >= 0.0 {
+            out.push(a);
+        }
+        if (da >= 0.0) != (db >= 0.0) {
+            out.push(cut(a, b, da, db));
+        }
+    }
+}
+
+/// Projects polygons into a view. Each polygon is given as rings of world
+/// points (`ring_pts(i, k)`), with its plane `n · p + d = 0` for the
+/// nearness and an id.
+pub(crate) struct Projector<'a> {
+    view: &'a View,
+    planes: [ClipPlane; 5],
+}
+
+impl<'a> Projector<'a> {
+    pub(crate) fn new(view: &'a View) -> Projector<'a> {
+        Projector {
+            view,
+            planes: view.clip_planes(),
+        }
+    }
+
+    #[inline]
+    fn fixed(&self, c: DVec3) -> [i32; 2] {
+        let (x, y) = self.view.screen(c);
+        [to_fixed(x), to_fixed(y)]
+    }
+
+    /// Adds one polygon (its rings in world coordinates) to `out`; nothing
+    /// if it is out of view or seen edge-on. `coeffs` is its nearness (see
+    /// [`View::coeffs`]).
+    pub(crate) fn add<'r>(
+        &self,
+        rings: impl IntoIterator<Item = &'r [DVec3]>,
+        coeffs: [f64; 3],
+        id: u32,
+        out: &mut Screen,
+        scratch: &mut (Vec<DVec3>, Vec<DVec3>),
+    ) {
+        let start_pts = out.pts.len();
+        let start_rings = out.ring_start.len();
+        let (mut ymin, mut ymax, mut xmin, mut xmax) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
+        for ring in rings {
+            let (a, b) = scratch;
+            a.clear();
+            a.extend(ring.iter().map(|&p| self.view.frame(p)));
+            let inside = |c: &DVec3| self.planes.iter().all(|(n, d)| n.dot(*c) + d >= 0.0);
+            if !a.iter().all(inside) {
+                for pl in self.planes {
+                    if a.len() < 3 {
+                        break;
+                    }
+                    clip_ring(a, pl, b);
+                    std::mem::swap(a, b);
+                }
+            }
+            if a.len() < 3 {
+                continue;
+            }
+            for c in a.iter() {
+                let p = self.fixed(*c);
+                ymin = ymin.min(p[1]);
+                ymax = ymax.max(p[1]);
+                xmin = xmin.min(p[0]);
+                xmax = xmax.max(p[0]);
+                out.pts.push(p);
+            }
+            out.ring_start.push(out.pts.len() as u32);
+        }
+        let rows = (
+            first_row(ymin as i64).max(0),
+            first_row(ymax as i64).min(self.view.height as i64),
+        );
+        let cols = (
+            first_row(xmin as i64).max(0),
+            (first_row(xmax as i64) + 1).min(self.view.width as i64),
+        );
+        if out.ring_start.len() == start_rings || rows.0 >= rows.1 || cols.0 >= cols.1 {
+            out.pts.truncate(start_pts);
+            out.ring_start.truncate(start_rings);
+            return;
+        }
+        out.poly_ring.push((out.ring_start.len() - 1) as u32);
+        out.rows.push((rows.0 as i32, rows.1 as i32));
+        out.cols.push((cols.0 as i32, cols.1 as i32));
+        out.coeffs.push(coeffs);
+        out.id.push(id);
+    }
+}
+
+/// Projects `count` polygons in parallel: `make(i, projector, out, scratch)`
+/// adds polygon `i`. The result keeps the order of `i`.
+pub(crate) fn project_all(
+    view: &View,
+    count: usize,
+    make: impl Fn(usize, &Projector<'_>, &mut Screen, &mut (Vec<DVec3>, Vec<DVec3>)) + Sync,
+) -> Screen {
+    const CHUNK: usize = 4096;
+    let proj = Projector::new(view);
+    let parts: Vec<Screen> = (0..count.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            let mut out = Screen::new();
+            let mut scratch = (Vec::new(), Vec::new());
+            for i in c * CHUNK..((c + 1) * CHUNK).min(count) {
+                make(i, &proj, &mut out, &mut scratch);
+            }
+            out
+        })
+        .collect();
+    let mut all = Screen::new();
+    for p in parts {
+        all.append(p);
+    }
+    all
+}
+
+/// The polygons of `screen` reaching each band of [`BAND`] rows, in
+/// polygon order: band `b` is `list[start[b]..start[b + 1]]`.
+pub(crate) struct Bins {
+    start: Vec<u32>,
+    list: Vec<u32>,
+}
+
+impl Bins {
+    pub(crate) fn new(screen: &Screen, height: u32) -> Bins {
+        let bands = (height as usize).div_ceil(BAND);
+        let mut count = vec![0u32; bands + 1];
+        let band_range = |&(r0, r1): &(i32, i32)| {
+            let b0 = r0 as usize / BAND;
+            let b1 = (r1 as usize - 1) / BAND + 1;
+            b0..b1
+        };
+        for r in &screen.rows {
+            for b in band_range(r) {
+                count[b + 1] += 1;
+            }
+        }
+        for b in 0..bands {
+            count[b + 1] += count[b];
+        }
+        let mut fill = count.clone();
+        let mut list = vec![0u32; count[bands] as usize];
+        for (i, r) in screen.rows.iter().enumerate() {
+            for b in band_range(r) {
+                list[fill[b] as usize] = i as u32;
+                fill[b] += 1;
+            }
+        }
+        Bins { start: count, list }
+    }
+
+    pub(crate) fn band(&self, b: usize) -> &[u32] {
+        &self.list[self.start[b] as usize..self.start[b + 1] as usize]
+    }
+}
+
+/// Runs `f(rows, polygons, pixels)` on every band of `buf` (a `width ×
+/// height` image, row-major) in parallel.
+pub(crate) fn for_bands<T: Send>(
+    buf: &mut [T],
+    width: u32,
+    bins: &Bins,
+    f: impl Fn(Range<i64>, &[u32], &mut [T]) + Sync,
+) {
+    let w = width as usize;
+    buf.par_chunks_mut(BAND * w)
+        .enumerate()
+        .for_each(|(b, chunk)| {
+            let y0 = (b * BAND) as i64;
+            let rows = y0..y0 + (chunk.len() / w) as i64;
+            f(rows, bins.band(b), chunk);
+        });
+}
+
+/// A vector of `n` copies of `v`, written in parallel: every page is first
+/// touched by a write on the thread that fills it (a zeroed allocation
+/// written later faults twice, copy-on-write, with TLB shootdowns).
+pub(crate) fn filled<T: Copy + Send + Sync>(n: usize, v: T) -> Vec<T> {
+    let mut out = Vec::with_capacity(n);
+    out.par_extend(rayon::iter::repeat_n(v, n));
+    out
+}
+
+/// [`for_bands`] over two images at once.
+pub(crate) fn for_bands2<T: Send, U: Send>(
+    a: &mut [T],
+    b: &mut [U],
+    width: u32,
+    bins: &Bins,
+    f: impl Fn(Range<i64>, &[u32], &mut [T], &mut [U]) + Sync,
+) {
+    let w = width as usize;
+    a.par_chunks_mut(BAND * w)
+        .zip(b.par_chunks_mut(BAND * w))
+        .enumerate()
+        .for_each(|(k, (ca, cb))| {
+            let y0 = (k * BAND) as i64;
+            let rows = y0..y0 + (ca.len() / w) as i64;
+            f(rows, bins.band(k), ca, cb);
+        });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Camera;
+
+    fn fx(x: f64, y: f64) -> [i32; 2] {
+        [(x * 256.0) as i32, (y * 256.0) as i32]
+    }
+
+    /// Coverage count of a set of fixed-point polygons over a small image.
+    fn coverage(polys: &[Vec<[i32; 2]>], w: i64, h: i64) -> Vec<u32> {
+        let mut cov = vec![0u32; (w * h) as usize];
+        let mut edges = Vec::new();
+        for p in polys {
+            edges.clear();
+            for k in 0..p.len() {
+                if let Some(e) = Edge::new(p[k], p[(k + 1) % p.len()]) {
+                    edges.push(e);
+                }
+            }
+            fill(&mut edges, 0..h, w, &mut |y, xs| {
+                for x in xs {
+                    cov[(y * w + x) as usize] += 1;
+                }
+            });
+        }
+        cov
+    }
+
+    #[test]
+    fn shared_edges_leave_no_crack_and_no_overlap() {
+        // a fan of triangles around a centre on a pixel corner and one on a
+        // pixel centre, and a grid of squares whose corners fall on pixel
+        // centres: every pixel of the covered square is covered exactly once
+        for centre in [(8.0, 8.0), (8.5, 8.5), (7.3, 8.61)] {
+            let c = fx(centre.0, centre.1);
+            let ring: Vec<[i32; 2]> = [
+                (2.0, 2.0),
+                (8.5, 1.5),
+                (14.0, 2.0),
+                (14.5, 8.5),
+                (14.0, 14.0),
+                (8.5, 14.5),
+                (2.0, 14.0),
+                (1.5, 8.5),
+            ]
+            .iter()
+            .map(|&(x, y)| fx(x, y))
+            .collect();
+            let fan: Vec<Vec<[i32; 2]>> = (0..ring.len())
+                .map(|k| vec![c, ring[k], ring[(k + 1) % ring.len()]])
+                .collect();
+            let whole = coverage(std::slice::from_ref(&ring), 16, 16);
+            let parts = coverage(&fan, 16, 16);
+            assert_eq!(whole, parts, "centre {centre:?}");
+            assert!(parts.iter().all(|&c| c <= 1));
+        }
+        let mut squares = Vec::new();
+        for i in 0..4 {
+            for j in 0..4 {
+                let (x, y) = (1.5 + 3.0 * i as f64, 0.5 + 3.0 * j as f64);
+                squares.push(vec![
+                    fx(x, y),
+                    fx(x + 3.0, y),
+                    fx(x + 3.0, y + 3.0),
+                    fx(x, y + 3.0),
+                ]);
+            }
+        }
+        let cov = coverage(&squares, 16, 16);
+        for y in 0..16 {
+            for x in 0..16 {
+                let inside = (1..13).contains(&x) && (0..12).contains(&y);
+                assert_eq!(cov[y * 16 + x], inside as u32, "({x}, {y})");
+            }
+        }
+    }
+
+    #[test]
+    fn random_fans_and_strips_tile_exactly() {
+        // random convex polygons (vertices on random sub-pixel positions,
+        // a third of them exactly on pixel centres or corners) cut into a
+        // fan around a random inner point and into a strip of quads: the
+        // pieces cover exactly the pixels the polygon covers, each once
+        let mut rng = bsp_core::SplitMix(0x7011_1e57);
+        let coord = |rng: &mut bsp_core::SplitMix| {
+            let base = rng.below(24 * 256) as i32;
+            match rng.below(3) {
+                0 => base / 256 * 256 + 128,
+                1 => base / 256 * 256,
+                _ => base,
+            }
+        };
+        for k in 0..300 {
+            // a convex polygon around a centre on a pixel centre, a pixel
+            // corner or anywhere, its vertices at random sub-pixel places
+            let centre = [coord(&mut rng), coord(&mut rng)].map(|v| v % 256 + 12 * 256);
+            let n = 3 + rng.below(6);
+            let mut angles: Vec<f64> = (0..n)
+                .map(|_| rng.below(3600) as f64 / 3600.0 * std::f64::consts::TAU)
+                .collect();
+            angles.sort_by(f64::total_cmp);
+            angles.dedup();
+            let gap = angles
+                .windows(2)
+                .map(|w| w[1] - w[0])
+                .chain([angles[0] + std::f64::consts::TAU - angles[angles.len() - 1]])
+                .fold(0.0, f64::max);
+            if angles.len() < 3 || gap > 0.9 * std::f64::consts::PI {
+                continue; // the centre must be inside
+            }
+            let r = 2000.0 + rng.below(800) as f64;
+            let ring: Vec<[i32; 2]> = angles
+                .iter()
+                .map(|a| {
+                    [
+                        centre[0] + (r * a.cos()) as i32,
+                        centre[1] + (r * a.sin()) as i32,
+                    ]
+                })
+                .collect();
+            let whole = coverage(std::slice::from_ref(&ring), 24, 24);
+            let fan: Vec<Vec<[i32; 2]>> = (0..ring.len())
+                .map(|k| vec![centre, ring[k], ring[(k + 1) % ring.len()]])
+                .collect();
+            assert_eq!(
+                coverage(&fan, 24, 24),
+                whole,
+                "case {k}: fan of {ring:?} around {centre:?}"
+            );
+        }
+        // a strip of quads sharing random cut lines
+        for _ in 0..100 {
+            let xs: Vec<i32> = {
+                let mut v: Vec<i32> = (0..6).map(|_| coord(&mut rng)).collect();
+                v.sort_unstable();
+                v.dedup();
+                v
+            };
+            let (y0, y1) = (coord(&mut rng).min(2000), coord(&mut rng).max(3000));
+            let quads: Vec<Vec<[i32; 2]>> = xs
+                .windows(2)
+                .map(|w| vec![[w[0], y0], [w[1], y0 + 300], [w[1], y1], [w[0], y1 - 200]])
+                .collect();
+            let cov = coverage(&quads, 24, 24);
+            assert!(cov.iter().all(|&c| c <= 1), "overlap in {quads:?}");
+        }
+    }
+
+    #[test]
+    fn top_left_rule() {
+        // a square whose sides run through pixel centres: the top and left
+        // sides are in, the bottom and right ones out
+        let sq = vec![fx(2.5, 2.5), fx(5.5, 2.5), fx(5.5, 5.5), fx(2.5, 5.5)];
+        let cov = coverage(std::slice::from_ref(&sq), 8, 8);
+        let covered: Vec<(usize, usize)> = (0..64)
+            .filter(|&i| cov[i] == 1)
+            .map(|i| (i % 8, i / 8))
+            .collect();
+        let want: Vec<(usize, usize)> = (2..5).flat_map(|y| (2..5).map(move |x| (x, y))).collect();
+        assert_eq!(covered, want);
+        // the same square the other way round covers the same pixels
+        let rev: Vec<[i32; 2]> = sq.into_iter().rev().collect();
+        assert_eq!(coverage(&[rev], 8, 8), cov);
+    }
+
+    #[test]
+    fn holes_are_left_out() {
+        let outer = vec![fx(0.0, 0.0), fx(10.0, 0.0), fx(10.0, 10.0), fx(0.0, 10.0)];
+        let hole = vec![fx(3.0, 3.0), fx(3.0, 7.0), fx(7.0, 7.0), fx(7.0, 3.0)];
+        let mut edges = Vec::new();
+        for p in [&outer, &hole] {
+            for k in 0..p.len() {
+                if let Some(e) = Edge::new(p[k], p[(k + 1) % p.len()]) {
+                    edges.push(e);
+                }
+            }
+        }
+        let mut n = 0;
+        fill(&mut edges, 0..10, 10, &mut |_, xs| n += xs.end - xs.start);
+        assert_eq!(n, 100 - 16);
+    }
+
+    #[test]
+    fn clipping_shares_cut_points() {
+        // two triangles sharing an edge that crosses the near plane: their
+        // clipped, projected edges coincide and they tile without overlap
+        let cam = Camera::look_at(
+            DVec3::new(0.0, -1.0, 0.3),
+            DVec3::new(0.0, 5.0, 0.0),
+            DVec3::Z,
+            70.0,
+            32,
+            32,
+        )
+        .unwrap()
+        .with_near(0.5);
+        let (a, b) = (DVec3::new(-0.2, -3.0, 0.0), DVec3::new(0.3, 6.0, 0.0));
+        let t1 = [a, b, DVec3::new(-4.0, 2.0, 0.0)];
+        let t2 = [b, a, DVec3::new(4.0, 1.0, 0.0)];
+        let quad_cov = {
+            let s = project_all(&cam.view, 2, |i, p, out, sc| {
+                let t: &[DVec3] = if i == 0 { &t1 } else { &t2 };
+                p.add([t], [0.0; 3], i as u32, out, sc);
+            });
+            let mut cov = vec![0u32; 32 * 32];
+            let mut e = Vec::new();
+            for i in 0..s.len() {
+                s.spans(i, 0..32, 32, &mut e, |y, xs| {
+                    for x in xs {
+                        cov[(y * 32 + x) as usize] += 1;
+                    }
+                });
+            }
+            cov
+        };
+        assert!(quad_cov.iter().all(|&c| c <= 1));
+        assert!(quad_cov.iter().filter(|&&c| c == 1).count() > 100);
+    }
+}

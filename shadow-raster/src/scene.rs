@@ -1,0 +1,273 @@
+//! The scene as the rasterizer sees it: convex polygons ("prims") in
+//! input units with their exact support planes, and the lights.
+
+use bsp_core::{Grid, Plane, Polygon, Side};
+use glam::DVec3;
+use svbsp::{Light, PlacedLight};
+
+use crate::RasterError;
+
+/// A light in input units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RasterLight {
+    /// A point light at this position.
+    Point(DVec3),
+    /// A light at infinity: the unit direction from the scene toward it.
+    Sun(DVec3),
+}
+
+impl RasterLight {
+    /// The unit direction from `p` toward the light.
+    #[inline]
+    pub fn toward(&self, p: DVec3) -> DVec3 {
+        match *self {
+            RasterLight::Point(l) => (l - p).normalize_or_zero(),
+            RasterLight::Sun(d) => d,
+        }
+    }
+}
+
+/// One light of a scene: its exact form (on the scene's grid) and its
+/// form in input units.
+#[derive(Clone, Copy, Debug)]
+pub struct SceneLight {
+    /// On the grid, as the exact shadows use it.
+    pub exact: Light,
+    /// In input units, as the image-space methods use it.
+    pub world: RasterLight,
+}
+
+impl SceneLight {
+    /// From a light placed on the scene's grid by [`svbsp::place_lights`].
+    pub fn from_placed(l: &PlacedLight) -> SceneLight {
+        let world = match l.light {
+            Light::Point(_) => RasterLight::Point(l.world),
+            Light::Directional(_) => RasterLight::Sun(l.world.normalize()),
+        };
+        SceneLight {
+            exact: l.light,
+            world,
+        }
+    }
+}
+
+/// The polygons of a scene ready to be drawn: each imported convex
+/// polygon ("prim") with its vertices in input units, its face, its exact
+/// support plane and that plane in input units (unit normal).
+///
+/// Built from the exact polygons of [`bsp_core::import_faces`] (or any
+/// polygons on the grid, such as a frame of a moving scene); the exact
+/// shadows of those polygons ([`svbsp::Shadows`]) are drawn by
+/// [`crate::render_fragments`].
+#[derive(Clone, Debug)]
+pub struct RasterScene {
+    pub(crate) grid: Grid,
+    pub(crate) polys: Vec<Polygon>,
+    /// Prim `i`'s vertices: `pts[start[i]..start[i + 1]]`.
+    pub(crate) start: Vec<u32>,
+    pub(crate) pts: Vec<DVec3>,
+    pub(crate) face: Vec<u32>,
+    /// Each prim's exact support plane (kept apart from the polygons for
+    /// a compact per-frame pass).
+    pub(crate) support: Vec<Plane>,
+    /// Unit normal and offset in input units: `n · p + d = 0`.
+    pub(crate) plane: Vec<(DVec3, f64)>,
+    pub(crate) lo: DVec3,
+    pub(crate) hi: DVec3,
+}
+
+impl RasterScene {
+    /// The scene of `polys` (imported on `grid`, each tagged with its
+    /// face).
+    pub fn new(grid: &Grid, polys: Vec<Polygon>) -> Result<RasterScene, RasterError> {
+        if polys.is_empty() {
+            return Err(RasterError::EmptyScene);
+        }
+        let mut start = Vec::with_capacity(polys.len() + 1);
+        let mut pts = Vec::with_capacity(polys.len() * 4);
+        let mut face = Vec::with_capacity(polys.len());
+        let mut plane = Vec::with_capacity(polys.len());
+        let mut support = Vec::with_capacity(polys.len());
+        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        start.push(0);
+        for p in &polys {
+            for g in p.vertices_f64() {
+                let w = grid.to_world(g);
+                lo = lo.min(w);
+                hi = hi.max(w);
+                pts.push(w);
+            }
+            start.push(pts.len() as u32);
+            face.push(p.tag());
+            support.push(*p.support());
+            plane.push(world_plane(grid, p.support()));
+        }
+        if !(lo.is_finite() && hi.is_finite()) {
+            return Err(RasterError::Camera(
+                "a vertex is not finite in input units".into(),
+            ));
+        }
+        Ok(RasterScene {
+            grid: *grid,
+            polys,
+            start,
+            pts,
+            face,
+            support,
+            plane,
+            lo,
+            hi,
+        })
+    }
+
+    /// Number of prims.
+    pub fn len(&self) -> usize {
+        self.face.len()
+    }
+
+    /// `true` if there is nothing to draw.
+    pub fn is_empty(&self) -> bool {
+        self.face.is_empty()
+    }
+
+    /// The grid of the exact polygons.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The exact polygons.
+    pub fn polygons(&self) -> &[Polygon] {
+        &self.polys
+    }
+
+    /// The bounding box of every vertex, in input units.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        (self.lo, self.hi)
+    }
+
+    /// Prim `i`'s vertices in input units.
+    #[inline]
+    pub(crate) fn prim(&self, i: usize) -> &[DVec3] {
+        &self.pts[self.start[i] as usize..self.start[i + 1] as usize]
+    }
+
+    /// Length of the bounding box's diagonal (at least 1e-300).
+    pub(crate) fn diagonal(&self) -> f64 {
+        (self.hi - self.lo).length().max(1e-300)
+    }
+
+    /// The side of prim `i`'s exact plane the point `eye` (input units)
+    /// is on: the eye is snapped to the grid for an exact answer.
+    pub(crate) fn eye_side(
+        &self,
+        i: usize,
+        eye: Option<bsp_core::ViewPoint>,
+        world: DVec3,
+    ) -> Side {
+        match eye {
+            Some(vp) => self.support[i].classify_viewpoint(vp),
+            None => {
+                let (n, d) = self.plane[i];
+                let s = n.dot(world) + d;
+                if s > 0.0 {
+                    Side::Front
+                } else if s < 0.0 {
+                    Side::Back
+                } else {
+                    Side::On
+                }
+            }
+        }
+    }
+}
+
+/// The bits of a point's coordinates (`-0.0` read as `0.0`): equal points,
+/// equal keys. Vertices shared by prims are equal bit for bit (each is one
+/// exact vertex rounded once).
+#[inline]
+pub(crate) fn point_key(p: DVec3) -> [u64; 3] {
+    p.to_array().map(|c| (c + 0.0).to_bits())
+}
+
+/// The connected components of `n` items joined by `pairs`, numbered in
+/// the order of their first item: each item's component, and the count.
+pub(crate) fn components(
+    n: usize,
+    pairs: impl IntoIterator<Item = (usize, usize)>,
+) -> (Vec<u32>, usize) {
+    fn find(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    let mut parent: Vec<usize> = (0..n).collect();
+    for (a, b) in pairs {
+        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+        if ra != rb {
+            parent[ra.max(rb)] = ra.min(rb);
+        }
+    }
+    let mut id = vec![u32::MAX; n];
+    let mut count = 0u32;
+    let out = (0..n)
+        .map(|i| {
+            let r = find(&mut parent, i);
+            if id[r] == u32::MAX {
+                id[r] = count;
+                count += 1;
+            }
+            id[r]
+        })
+        .collect();
+    (out, count as usize)
+}
+
+/// An edge by its two endpoints' keys.
+pub(crate) type EdgeKey = ([u64; 3], [u64; 3]);
+
+/// A plane of the grid in input units, with a unit normal. Opposite
+/// planes give exactly opposite results.
+pub(crate) fn world_plane(grid: &Grid, p: &Plane) -> (DVec3, f64) {
+    let [a, b, c, d] = p.approx();
+    let n = DVec3::new(a, b, c);
+    // n · g + d = 0 with g = (w - origin) * scale
+    // n · (w − origin) · scale + d = 0, divided by scale and |n|
+    let len = n.length();
+    let dw = d / grid.scale() - n.dot(grid.origin());
+    (n / len, dw / len)
+}
+
+/// Prims grouped by the plane of the side the eye sees, for each prim the
+/// visible side's exact plane (`None` when seen edge-on).
+pub(crate) fn visible_planes(scene: &RasterScene, eye: DVec3) -> Vec<Option<Plane>> {
+    use rayon::prelude::*;
+    let vp = scene.grid.snap_viewpoint(eye).ok();
+    (0..scene.len())
+        .into_par_iter()
+        .map(|i| match scene.eye_side(i, vp, eye) {
+            Side::Front => Some(scene.support[i]),
+            Side::Back => Some(scene.support[i].flip()),
+            Side::On => None,
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn world_planes_contain_the_vertices() {
+        let grid = Grid::new(DVec3::new(0.5, -1.0, 2.0), 10).unwrap();
+        let p = Polygon::from_grid_points(&[[0, 0, 7], [1000, 0, 9], [0, 900, 1]], 3).unwrap();
+        let (n, d) = world_plane(&grid, p.support());
+        for g in p.vertices_f64() {
+            let w = grid.to_world(g);
+            assert!((n.dot(w) + d).abs() < 1e-12, "{}", n.dot(w) + d);
+        }
+        let (nf, df) = world_plane(&grid, &p.support().flip());
+        assert_eq!((nf, df), (-n, -d));
+    }
+}
