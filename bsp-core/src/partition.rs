@@ -216,13 +216,35 @@ impl Partition<Cell> {
     /// planes, polygons and cells, with each node's sub-hyperplane computed
     /// by clipping its plane's box section by the ancestors' half-spaces.
     pub fn from_tree(tree: &BspTree) -> Partition<Cell> {
-        let mut out = Partition {
+        Partition::from_tree_with(tree, &[], |c| c)
+    }
+}
+
+impl Partition<u32> {
+    /// The partition of a BSP tree within a convex region: every
+    /// sub-hyperplane is clipped to the back of each plane of `walls` (the
+    /// region's faces, interior behind), and leaves are numbered `0..n` in
+    /// the order they are made, for labels found later (returned with
+    /// `n`). Every node's polygons must lie inside the region.
+    pub fn from_tree_in(tree: &BspTree, walls: &[Plane]) -> (Partition<u32>, u32) {
+        let mut n = 0;
+        let p = Partition::from_tree_with(tree, walls, |_| {
+            n += 1;
+            n - 1
+        });
+        (p, n)
+    }
+}
+
+impl<L: Copy> Partition<L> {
+    fn from_tree_with(
+        tree: &BspTree,
+        walls: &[Plane],
+        mut leaf: impl FnMut(Cell) -> L,
+    ) -> Partition<L> {
+        let mut out: Partition<L> = Partition {
             nodes: Vec::with_capacity(tree.nodes().len()),
-            root: PLink::Leaf(Cell::Out),
-        };
-        let conv = |l: Link| match l {
-            Link::Cell(c) => PLink::Leaf(c),
-            Link::Node(_) => PLink::Leaf(Cell::Out), // patched below
+            root: PLink::Node(0),
         };
         // (tree link, depth, edge to parent, slot to patch)
         let mut path: Vec<(Plane, Side)> = Vec::new();
@@ -234,15 +256,17 @@ impl Partition<Cell> {
                 path.push(e);
             }
             let v = match link {
-                Link::Cell(c) => PLink::Leaf(c),
+                Link::Cell(c) => PLink::Leaf(leaf(c)),
                 Link::Node(id) => {
                     let n = tree.node(id);
                     let mut shp =
                         box_section(&n.plane).expect("a plane through grid points meets the box");
                     // nearest ancestors first: they cut the box section
-                    // down early, and the far ones then rarely split it
-                    for (p, s) in path.iter().rev() {
-                        let kept = shp.clip(p, *s);
+                    // down early, and the far ones then rarely split it;
+                    // the region's walls last
+                    let ancestors = path.iter().rev().map(|(p, s)| (p, *s));
+                    for (p, s) in ancestors.chain(walls.iter().map(|w| (w, Side::Back))) {
+                        let kept = shp.clip(p, s);
                         assert!(
                             kept,
                             "a node's plane meets its region (its polygons lie there)"
@@ -253,8 +277,8 @@ impl Partition<Cell> {
                         plane: n.plane,
                         shp,
                         polygons: n.polygons.clone(),
-                        front: conv(n.front),
-                        back: conv(n.back),
+                        front: PLink::Node(u32::MAX), // patched below
+                        back: PLink::Node(u32::MAX),
                     });
                     let d = path.len();
                     stack.push((
@@ -280,7 +304,9 @@ impl Partition<Cell> {
         }
         out
     }
+}
 
+impl Partition<Cell> {
     /// Exact point membership (see [`BspTree::classify_point`]).
     pub fn classify_point(&self, p: &Point) -> Membership {
         let labels = self.locate(p);

@@ -1,0 +1,126 @@
+//! A uniform grid of face boxes: the faces overlapping a box, and the
+//! faces a ray along `+x` may cross.
+
+use bsp_core::{Point, Polygon};
+
+/// An integer box: inclusive grid coordinate ranges per axis.
+pub(crate) type IBox = ([i64; 3], [i64; 3]);
+
+/// The box of grid points that holds a polygon: exact for grid vertices,
+/// the floor and ceiling of the correctly rounded coordinates widened by
+/// one step for implicit ones.
+pub(crate) fn polygon_box(p: &Polygon) -> IBox {
+    let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
+    for v in p.vertices() {
+        match v {
+            Point::Grid(g) => {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(g[k] as i64);
+                    hi[k] = hi[k].max(g[k] as i64);
+                }
+            }
+            Point::Implicit(_) => {
+                let r = v.to_f64();
+                for k in 0..3 {
+                    lo[k] = lo[k].min(r[k].floor() as i64 - 1);
+                    hi[k] = hi[k].max(r[k].ceil() as i64 + 1);
+                }
+            }
+        }
+    }
+    (lo, hi)
+}
+
+pub(crate) fn overlaps(a: &IBox, b: &IBox) -> bool {
+    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
+}
+
+pub(crate) fn intersect(a: &IBox, b: &IBox) -> Option<IBox> {
+    let lo = [0, 1, 2].map(|k| a.0[k].max(b.0[k]));
+    let hi = [0, 1, 2].map(|k| a.1[k].min(b.1[k]));
+    (0..3).all(|k| lo[k] <= hi[k]).then_some((lo, hi))
+}
+
+pub(crate) fn union(a: &IBox, b: &IBox) -> IBox {
+    (
+        [0, 1, 2].map(|k| a.0[k].min(b.0[k])),
+        [0, 1, 2].map(|k| a.1[k].max(b.1[k])),
+    )
+}
+
+/// Face ids bucketed by the grid cells their boxes overlap. Boxes beyond
+/// the grid fall in its border cells, so every query stays conservative.
+#[derive(Clone, Debug)]
+pub(crate) struct FaceIndex {
+    lo: [i64; 3],
+    size: [i64; 3],
+    dims: [usize; 3],
+    cells: Vec<Vec<u32>>,
+}
+
+impl FaceIndex {
+    /// An index over `bounds` sized for about `count` faces.
+    pub(crate) fn new(bounds: IBox, count: usize) -> FaceIndex {
+        let ext = [0, 1, 2].map(|k| (bounds.1[k] - bounds.0[k] + 1).max(1) as f64);
+        let target = (count as f64 / 2.0).max(1.0);
+        let scale = (target / (ext[0] * ext[1] * ext[2])).cbrt();
+        let dims = [0, 1, 2].map(|k| ((ext[k] * scale).ceil() as usize).clamp(1, 256));
+        let size = [0, 1, 2].map(|k| ((ext[k] / dims[k] as f64).ceil() as i64).max(1));
+        FaceIndex {
+            lo: bounds.0,
+            size,
+            dims,
+            cells: vec![Vec::new(); dims[0] * dims[1] * dims[2]],
+        }
+    }
+
+    fn coord(&self, k: usize, x: i64) -> usize {
+        ((x - self.lo[k]).div_euclid(self.size[k])).clamp(0, self.dims[k] as i64 - 1) as usize
+    }
+
+    fn at(&self, c: [usize; 3]) -> usize {
+        (c[0] * self.dims[1] + c[1]) * self.dims[2] + c[2]
+    }
+
+    fn cells_of(&self, b: &IBox) -> impl Iterator<Item = usize> + '_ {
+        let lo = [0, 1, 2].map(|k| self.coord(k, b.0[k]));
+        let hi = [0, 1, 2].map(|k| self.coord(k, b.1[k]));
+        (lo[0]..=hi[0]).flat_map(move |x| {
+            (lo[1]..=hi[1]).flat_map(move |y| (lo[2]..=hi[2]).map(move |z| self.at([x, y, z])))
+        })
+    }
+
+    pub(crate) fn insert(&mut self, id: u32, b: &IBox) {
+        let cells: Vec<usize> = self.cells_of(b).collect();
+        for c in cells {
+            self.cells[c].push(id);
+        }
+    }
+
+    pub(crate) fn remove(&mut self, id: u32, b: &IBox) {
+        let cells: Vec<usize> = self.cells_of(b).collect();
+        for c in cells {
+            let list = &mut self.cells[c];
+            if let Some(i) = list.iter().position(|&x| x == id) {
+                list.swap_remove(i);
+            }
+        }
+    }
+
+    /// The ids in the cells `b` overlaps (with repeats), into `out`.
+    pub(crate) fn near(&self, b: &IBox, out: &mut Vec<u32>) {
+        for c in self.cells_of(b) {
+            out.extend_from_slice(&self.cells[c]);
+        }
+    }
+
+    /// The ids in the cells a ray from `q` along `+x` passes (with
+    /// repeats): the column of cells at `q`'s `y` and `z`, from `q`'s
+    /// cell on.
+    pub(crate) fn along_x(&self, q: [i64; 3], out: &mut Vec<u32>) {
+        let (y, z) = (self.coord(1, q[1]), self.coord(2, q[2]));
+        for x in self.coord(0, q[0])..self.dims[0] {
+            out.extend_from_slice(&self.cells[self.at([x, y, z])]);
+        }
+    }
+}

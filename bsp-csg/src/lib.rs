@@ -1,0 +1,743 @@
+//! Exact Boolean operations on closed meshes: local BSP trees in an
+//! adaptive octree.
+//!
+//! A [`Solid`] is the boundary of a closed, outward-oriented polyhedron as
+//! plane-based convex polygons on `bsp-core`'s grid, with a spatial index.
+//! [`Solid::apply`] computes `self ∘ other` for `∘` ∈ {∪, ∩, −}:
+//!
+//! 1. Faces outside the other solid's box are outside it: left as they
+//!    are (or dropped, for ∩), at no cost.
+//! 2. Over the box both solids share, an adaptive octree splits the cells
+//!    that hold faces of both until they hold few
+//!    ([`octree`](crate::octree): cell walls lie half a grid step off the
+//!    grid, so no vertex or face of either solid is ever on one).
+//! 3. In each cell that holds faces of both, the faces are clipped to the
+//!    cell, each operand's pieces make a small BSP partition whose leaves
+//!    are labelled exactly by the faces that cover their common boundaries
+//!    ([`local`](crate::local)), and the two partitions are merged with
+//!    `bsp-core`'s set operations: the result's boundary in the cell,
+//!    coplanar and touching faces included. Cells run in parallel.
+//! 4. Every other face lies in cells the other surface does not enter: it
+//!    is wholly inside or outside the other solid. Those cells form
+//!    connected regions of space free of the other surface (adjacent cells
+//!    share their label); each region's label is one exact winding number
+//!    ([`Solid::winding`]: a ray along `+x` with simulation of simplicity),
+//!    and a face keeps or loses its pieces by it.
+//!
+//! Everything is exact: the planes are `bsp-core`'s input tier (planes of
+//! the input faces, their edges, and the octree walls), vertices are
+//! intersections of three of them, and the result is again such a solid —
+//! the next operation takes it as it is ([`Solid::apply`] works in place
+//! and touches only the faces near the other operand, so a sequence of
+//! small operations on a large part never rebuilds anything global).
+//!
+//! # Example
+//!
+//! ```
+//! use bsp_core::{BoolOp, Grid, Membership};
+//! use bsp_csg::{MeshIn, mesh_boolean};
+//! use glam::DVec3;
+//!
+//! fn cube(lo: f64, hi: f64) -> (Vec<DVec3>, Vec<Vec<u32>>) {
+//!     let p = |i: u32| DVec3::new(
+//!         if i & 1 == 0 { lo } else { hi },
+//!         if i & 2 == 0 { lo } else { hi },
+//!         if i & 4 == 0 { lo } else { hi },
+//!     );
+//!     let faces = vec![vec![0, 2, 3, 1], vec![4, 5, 7, 6], vec![0, 1, 5, 4],
+//!                      vec![2, 6, 7, 3], vec![0, 4, 6, 2], vec![1, 3, 7, 5]];
+//!     ((0..8).map(p).collect(), faces)
+//! }
+//! let (pa, fa) = cube(0.0, 2.0);
+//! let (pb, fb) = cube(1.0, 3.0);
+//! let r = mesh_boolean(&MeshIn::new(&pa, &fa), &MeshIn::new(&pb, &fb), BoolOp::Union).unwrap();
+//! // 8 + 8 − 1 cubic units, exactly
+//! assert_eq!(r.volume(), 15.0);
+//! let inside = r.grid.snap(DVec3::splat(2.5)).unwrap();
+//! assert_eq!(r.solid.classify_point(inside), Membership::Inside);
+//! ```
+//!
+//! # Feature flags
+//!
+//! None.
+
+mod index;
+mod local;
+mod octree;
+mod winding;
+
+use std::collections::HashMap;
+
+use bsp_core::{
+    BoolOp, Grid, GridPoint, ImportReport, Membership, Polygon, Side, TopologyError, TriMesh,
+    check_closed_manifold, import_faces_par,
+};
+use glam::DVec3;
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
+use smallvec::SmallVec;
+
+use crate::index::{FaceIndex, IBox, intersect, overlaps, polygon_box, union};
+use crate::octree::{Leaf, walls};
+
+/// Faces a leaf of the octree may hold before it is split (when it holds
+/// faces of both operands), by default.
+pub const LEAF_SIZE: usize = 24;
+
+/// Options of [`Solid::apply_with`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct Options {
+    /// Faces an octree cell holding faces of both operands may have before
+    /// it is split; smaller cells make smaller local trees, and more cells.
+    pub leaf_size: usize,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            leaf_size: LEAF_SIZE,
+        }
+    }
+}
+
+impl Options {
+    /// Sets [`Options::leaf_size`] (at least 1).
+    pub fn with_leaf_size(mut self, n: usize) -> Options {
+        self.leaf_size = n.max(1);
+        self
+    }
+}
+
+/// Why an operation cannot be done.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum CsgError {
+    /// Operand `operand` (0 for the first) is not a closed, consistently
+    /// oriented 2-manifold.
+    Topology {
+        /// The operand.
+        operand: usize,
+        /// What is wrong, with face and edge.
+        error: TopologyError,
+    },
+    /// Operand `operand`'s faces face inward: the solid they bound is
+    /// unbounded.
+    Inward {
+        /// The operand.
+        operand: usize,
+    },
+    /// A coordinate does not fit the grid (or is not finite).
+    Grid(bsp_core::Error),
+    /// Operand `operand` is closed and oriented as a mesh, but its snapped
+    /// surface does not bound a solid (it crosses itself).
+    NotASolid,
+    /// The result is not watertight: a bug, not a problem of the input.
+    Internal(String),
+}
+
+impl std::fmt::Display for CsgError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CsgError::Topology { operand, error } => write!(f, "operand {operand}: {error}"),
+            CsgError::Inward { operand } => write!(
+                f,
+                "operand {operand}: the faces are oriented inward (clockwise seen from outside): \
+                 the solid they bound is unbounded; reverse every face's vertex order"
+            ),
+            CsgError::Grid(e) => write!(f, "{e}"),
+            CsgError::NotASolid => f.write_str(
+                "a surface crosses itself (after snapping to the grid) and bounds no solid",
+            ),
+            CsgError::Internal(e) => write!(f, "internal error: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for CsgError {}
+
+#[derive(Clone, Debug)]
+struct Face {
+    poly: Polygon,
+    bx: IBox,
+}
+
+/// The boundary of a closed, outward-oriented polyhedron: plane-based
+/// convex polygons on the grid, with a spatial index of their boxes (see
+/// the crate docs).
+#[derive(Clone, Debug)]
+pub struct Solid {
+    faces: Vec<Option<Face>>,
+    free: Vec<u32>,
+    index: FaceIndex,
+    /// The index's design size, to know when to rebuild it.
+    indexed: usize,
+    bounds: Option<IBox>,
+    live: usize,
+}
+
+/// An indexed mesh in input units: positions and faces (vertex index
+/// loops, counter-clockwise seen from outside).
+#[derive(Clone, Copy, Debug)]
+pub struct MeshIn<'a> {
+    /// The positions.
+    pub positions: &'a [DVec3],
+    /// The faces.
+    pub faces: &'a [Vec<u32>],
+}
+
+impl<'a> MeshIn<'a> {
+    /// A mesh from its parts.
+    pub fn new(positions: &'a [DVec3], faces: &'a [Vec<u32>]) -> MeshIn<'a> {
+        MeshIn { positions, faces }
+    }
+}
+
+/// The result of [`mesh_boolean`].
+#[derive(Clone, Debug)]
+pub struct Boolean {
+    /// The watertight result in grid units (`grid.to_world` for input
+    /// units).
+    pub mesh: TriMesh,
+    /// The grid every operand was snapped to.
+    pub grid: Grid,
+    /// The result as a solid, ready for further operations.
+    pub solid: Solid,
+    /// What snapping did to each operand's faces.
+    pub reports: Vec<ImportReport>,
+}
+
+impl Boolean {
+    /// The result's volume in input units (`f64`, from the exact mesh).
+    pub fn volume(&self) -> f64 {
+        self.mesh.volume_f64() / self.grid.scale().powi(3)
+    }
+}
+
+impl Solid {
+    /// The solid bounded by `polys`, which must tile the boundary of a
+    /// closed, outward-oriented polyhedron (not checked; see
+    /// [`mesh_boolean`] for checked input).
+    pub fn from_polygons(polys: Vec<Polygon>) -> Solid {
+        let faces: Vec<Option<Face>> = polys
+            .into_par_iter()
+            .map(|p| {
+                let bx = polygon_box(&p);
+                Some(Face {
+                    poly: p.with_tag(0),
+                    bx,
+                })
+            })
+            .collect();
+        let mut s = Solid {
+            faces,
+            free: Vec::new(),
+            index: FaceIndex::new(([0; 3], [0; 3]), 1),
+            indexed: 0,
+            bounds: None,
+            live: 0,
+        };
+        s.live = s.faces.len();
+        s.reindex();
+        s
+    }
+
+    /// An empty solid.
+    pub fn empty() -> Solid {
+        Solid::from_polygons(Vec::new())
+    }
+
+    fn reindex(&mut self) {
+        let mut bounds: Option<IBox> = None;
+        for f in self.faces.iter().flatten() {
+            bounds = Some(bounds.map_or(f.bx, |b| union(&b, &f.bx)));
+        }
+        self.bounds = bounds;
+        self.indexed = self.live.max(1);
+        self.index = FaceIndex::new(bounds.unwrap_or(([0; 3], [0; 3])), self.indexed);
+        for (i, f) in self.faces.iter().enumerate() {
+            if let Some(f) = f {
+                self.index.insert(i as u32, &f.bx);
+            }
+        }
+    }
+
+    /// Number of faces.
+    pub fn len(&self) -> usize {
+        self.live
+    }
+
+    /// `true` if the solid has no face (it is empty).
+    pub fn is_empty(&self) -> bool {
+        self.live == 0
+    }
+
+    /// The faces.
+    pub fn polygons(&self) -> impl Iterator<Item = &Polygon> + '_ {
+        self.faces.iter().flatten().map(|f| &f.poly)
+    }
+
+    fn face(&self, i: u32) -> &Face {
+        self.faces[i as usize].as_ref().expect("a live face")
+    }
+
+    fn add(&mut self, p: Polygon) {
+        let bx = polygon_box(&p);
+        let id = match self.free.pop() {
+            Some(i) => i,
+            None => {
+                self.faces.push(None);
+                (self.faces.len() - 1) as u32
+            }
+        };
+        self.index.insert(id, &bx);
+        self.bounds = Some(self.bounds.map_or(bx, |b| union(&b, &bx)));
+        self.faces[id as usize] = Some(Face {
+            poly: p.with_tag(0),
+            bx,
+        });
+        self.live += 1;
+    }
+
+    fn remove(&mut self, id: u32) {
+        if let Some(f) = self.faces[id as usize].take() {
+            self.index.remove(id, &f.bx);
+            self.free.push(id);
+            self.live -= 1;
+        }
+    }
+
+    /// The live faces whose box overlaps `b`.
+    fn faces_near(&self, b: &IBox) -> Vec<u32> {
+        let mut ids = Vec::new();
+        self.index.near(b, &mut ids);
+        ids.sort_unstable();
+        ids.dedup();
+        ids.retain(|&i| {
+            self.faces[i as usize]
+                .as_ref()
+                .is_some_and(|f| overlaps(&f.bx, b))
+        });
+        ids
+    }
+
+    /// The winding number of the grid point `q` displaced by
+    /// `(ε³, ε, ε²)` (see the crate docs): 1 inside, 0 outside; exact, and
+    /// for a point not on the surface its own winding number.
+    pub fn winding(&self, q: GridPoint) -> i32 {
+        let q = q.map(i64::from);
+        let mut ids = Vec::new();
+        self.index.along_x(q, &mut ids);
+        ids.sort_unstable();
+        ids.dedup();
+        ids.iter()
+            .filter_map(|&i| self.faces[i as usize].as_ref())
+            .filter(|f| {
+                f.bx.1[0] >= q[0]
+                    && f.bx.0[1] <= q[1]
+                    && q[1] <= f.bx.1[1]
+                    && f.bx.0[2] <= q[2]
+                    && q[2] <= f.bx.1[2]
+            })
+            .map(|f| winding::crossing(q, &f.poly))
+            .sum()
+    }
+
+    /// Exact membership of a grid point.
+    pub fn classify_point(&self, q: GridPoint) -> Membership {
+        let p = q.map(i64::from);
+        for i in self.faces_near(&(p, p)) {
+            let f = &self.face(i).poly;
+            if f.support().classify_grid(q) == Side::On
+                && f.edge_planes()
+                    .iter()
+                    .all(|e| e.classify_grid(q) != Side::Front)
+            {
+                return Membership::Boundary;
+            }
+        }
+        if self.winding(q) == 0 {
+            Membership::Outside
+        } else {
+            Membership::Inside
+        }
+    }
+
+    /// The watertight triangle mesh of the boundary (see
+    /// [`TriMesh::from_polygons`]).
+    pub fn to_mesh(&self) -> TriMesh {
+        let polys: Vec<Polygon> = self.polygons().cloned().collect();
+        TriMesh::from_polygons(&polys)
+    }
+
+    /// `self op other`, as a new solid.
+    pub fn boolean(&self, other: &Solid, op: BoolOp) -> Result<Solid, CsgError> {
+        let mut s = self.clone();
+        s.apply(other, op)?;
+        Ok(s)
+    }
+
+    /// `self op other` for solids whose faces cannot meet.
+    fn apart(&mut self, other: &Solid, op: BoolOp) -> Result<(), CsgError> {
+        match op {
+            BoolOp::Union => other.polygons().for_each(|p| self.add(p.clone())),
+            BoolOp::Intersection => *self = Solid::empty(),
+            BoolOp::Difference => {}
+        }
+        Ok(())
+    }
+
+    /// `self ← self op other`, touching only the faces near `other`.
+    pub fn apply(&mut self, other: &Solid, op: BoolOp) -> Result<(), CsgError> {
+        self.apply_with(other, op, &Options::default())
+    }
+
+    /// [`Solid::apply`] with options.
+    pub fn apply_with(
+        &mut self,
+        other: &Solid,
+        op: BoolOp,
+        opts: &Options,
+    ) -> Result<(), CsgError> {
+        let keep_a = |inside_b: bool| match op {
+            BoolOp::Union | BoolOp::Difference => !inside_b,
+            BoolOp::Intersection => inside_b,
+        };
+        let keep_b = |inside_a: bool| match op {
+            BoolOp::Union => !inside_a,
+            BoolOp::Intersection | BoolOp::Difference => inside_a,
+        };
+        let flip_b = op == BoolOp::Difference;
+        let domain = match (self.bounds, other.bounds) {
+            (Some(a), Some(b)) => intersect(&a, &b),
+            _ => None,
+        };
+        let Some(domain) = domain else {
+            return self.apart(other, op);
+        };
+        // the faces that may meet the other surface, and every face of
+        // either in the box they span: the octree's cells must know all
+        // the faces in them to tell which cells are free of a surface
+        let a_near = self.faces_near(&domain);
+        let b_near = other.faces_near(&domain);
+        let Some(root) = a_near
+            .iter()
+            .map(|&f| self.face(f).bx)
+            .chain(b_near.iter().map(|&f| other.face(f).bx))
+            .reduce(|x, y| union(&x, &y))
+        else {
+            return self.apart(other, op);
+        };
+        let a_c = self.faces_near(&root);
+        let b_c = other.faces_near(&root);
+        let leaves = octree::build(
+            root,
+            a_c.clone(),
+            b_c.clone(),
+            &|f| self.face(f).bx,
+            &|f| other.face(f).bx,
+            opts.leaf_size,
+        );
+        // each face's leaves
+        let mut a_leaves: FxHashMap<u32, SmallVec<[u32; 4]>> = FxHashMap::default();
+        let mut b_leaves: FxHashMap<u32, SmallVec<[u32; 4]>> = FxHashMap::default();
+        for (li, l) in leaves.iter().enumerate() {
+            for &f in &l.a {
+                a_leaves.entry(f).or_default().push(li as u32);
+            }
+            for &f in &l.b {
+                b_leaves.entry(f).or_default().push(li as u32);
+            }
+        }
+        let adjacent = octree::adjacent(&leaves);
+        // the regions free of each surface, and their labels
+        let inside_b = Regions::new(&leaves, &adjacent, |l| l.b.is_empty(), other);
+        let inside_a = Regions::new(&leaves, &adjacent, |l| l.a.is_empty(), self);
+
+        // the faces wholly in free cells, and the pieces of the others
+        let root_walls = walls(&root);
+        let (whole_a, pieces_a, local_a) = sort_faces(
+            &a_c,
+            &a_leaves,
+            &leaves,
+            &root_walls,
+            |f| &self.face(f).poly,
+            |l| l.b.is_empty(),
+        );
+        let (whole_b, pieces_b, local_b) = sort_faces(
+            &b_c,
+            &b_leaves,
+            &leaves,
+            &root_walls,
+            |f| &other.face(f).poly,
+            |l| l.a.is_empty(),
+        );
+        // the mixed cells, in parallel
+        let mixed: Vec<u32> = (0..leaves.len() as u32)
+            .filter(|&l| leaves[l as usize].mixed())
+            .collect();
+        let mut local_a = local_a;
+        let mut local_b = local_b;
+        let jobs: Vec<(u32, Vec<Polygon>, Vec<Polygon>)> = mixed
+            .iter()
+            .map(|&l| {
+                (
+                    l,
+                    local_a.remove(&l).unwrap_or_default(),
+                    local_b.remove(&l).unwrap_or_default(),
+                )
+            })
+            .collect();
+        let made: Vec<Vec<Polygon>> = jobs
+            .into_par_iter()
+            .map(|(l, pa, pb)| {
+                let bx = leaves[l as usize].bx;
+                let r = bx.0.map(|c| c as i32);
+                local::boolean(&bx, pa, pb, op, || self.winding(r), || other.winding(r))
+            })
+            .collect::<Result<_, _>>()?;
+
+        // the changes, now that everything is known
+        let mut add: Vec<Polygon> = made.into_iter().flatten().collect();
+        let mut remove: Vec<u32> = Vec::new();
+        for &f in &whole_a {
+            let l = a_leaves[&f][0];
+            if !keep_a(inside_b.inside(l)) {
+                remove.push(f);
+            }
+        }
+        // a piece beyond the octree's box is beyond the other solid's box
+        for (f, pieces) in pieces_a {
+            remove.push(f);
+            for (l, p) in pieces {
+                if keep_a(l.is_some_and(|l| inside_b.inside(l))) {
+                    add.push(p);
+                }
+            }
+        }
+        let b_out = |p: &Polygon| if flip_b { p.flipped() } else { p.clone() };
+        for &f in &whole_b {
+            let l = b_leaves[&f][0];
+            if keep_b(inside_a.inside(l)) {
+                add.push(b_out(&other.face(f).poly));
+            }
+        }
+        for (_, pieces) in pieces_b {
+            for (l, p) in pieces {
+                if keep_b(l.is_some_and(|l| inside_a.inside(l))) {
+                    add.push(b_out(&p));
+                }
+            }
+        }
+        // the faces away from the shared box: outside the other solid
+        if op == BoolOp::Union {
+            let near: std::collections::HashSet<u32> = b_c.iter().copied().collect();
+            for (i, f) in other.faces.iter().enumerate() {
+                if let Some(f) = f
+                    && !near.contains(&(i as u32))
+                {
+                    add.push(f.poly.clone());
+                }
+            }
+        }
+        if op == BoolOp::Intersection {
+            let near: std::collections::HashSet<u32> = a_c.iter().copied().collect();
+            for i in 0..self.faces.len() as u32 {
+                if self.faces[i as usize].is_some() && !near.contains(&i) {
+                    remove.push(i);
+                }
+            }
+        }
+        for f in remove {
+            self.remove(f);
+        }
+        for p in add {
+            self.add(p);
+        }
+        if self.live > 4 * self.indexed + 1024 {
+            self.reindex();
+        }
+        Ok(())
+    }
+}
+
+/// Faces wholly in cells free of the other surface; per other face its
+/// pieces in such cells (with the cell, or `None` beyond the octree's
+/// box); per mixed cell the pieces in it.
+type Sorted = (
+    Vec<u32>,
+    Vec<(u32, Vec<(Option<u32>, Polygon)>)>,
+    HashMap<u32, Vec<Polygon>>,
+);
+
+fn sort_faces<'p>(
+    faces: &[u32],
+    leaves_of: &FxHashMap<u32, SmallVec<[u32; 4]>>,
+    leaves: &[Leaf],
+    root: &[bsp_core::Plane; 6],
+    poly: impl Fn(u32) -> &'p Polygon + Sync,
+    free: impl Fn(&Leaf) -> bool + Sync,
+) -> Sorted {
+    let mut whole = Vec::new();
+    let mut split = Vec::new();
+    for &f in faces {
+        let ls = &leaves_of[&f];
+        if ls.iter().all(|&l| free(&leaves[l as usize])) {
+            whole.push(f);
+        } else {
+            split.push(f);
+        }
+    }
+    // clip the others into their cells, in parallel
+    type Piece = (Option<u32>, Polygon, bool);
+    let clipped: Vec<(u32, Vec<Piece>)> = split
+        .par_iter()
+        .map(|&f| {
+            let p = poly(f);
+            let mut pieces: Vec<Piece> = leaves_of[&f]
+                .iter()
+                .filter_map(|&l| {
+                    let leaf = &leaves[l as usize];
+                    local::clip_to(p, &walls(&leaf.bx)).map(|q| (Some(l), q, free(leaf)))
+                })
+                .collect();
+            pieces.extend(local::outside(p, root).into_iter().map(|q| (None, q, true)));
+            (f, pieces)
+        })
+        .collect();
+    let mut pieces = Vec::with_capacity(clipped.len());
+    let mut local: HashMap<u32, Vec<Polygon>> = HashMap::new();
+    for (f, list) in clipped {
+        let mut free_pieces = Vec::new();
+        for (l, q, is_free) in list {
+            match (l, is_free) {
+                (Some(l), false) => local.entry(l).or_default().push(q),
+                _ => free_pieces.push((l, q)),
+            }
+        }
+        pieces.push((f, free_pieces));
+    }
+    (whole, pieces, local)
+}
+
+/// Connected regions of octree cells free of one surface, each wholly
+/// inside or outside that surface's solid.
+struct Regions {
+    root: Vec<u32>,
+    inside: FxHashMap<u32, bool>,
+}
+
+impl Regions {
+    fn new(
+        leaves: &[Leaf],
+        adjacent: &[(u32, u32)],
+        free: impl Fn(&Leaf) -> bool,
+        solid: &Solid,
+    ) -> Regions {
+        let n = leaves.len();
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        fn find(p: &mut [u32], mut x: u32) -> u32 {
+            while p[x as usize] != x {
+                p[x as usize] = p[p[x as usize] as usize];
+                x = p[x as usize];
+            }
+            x
+        }
+        for &(a, b) in adjacent {
+            if free(&leaves[a as usize]) && free(&leaves[b as usize]) {
+                let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+                if ra != rb {
+                    parent[ra.max(rb) as usize] = ra.min(rb);
+                }
+            }
+        }
+        let root: Vec<u32> = (0..n as u32).map(|x| find(&mut parent, x)).collect();
+        // one winding number per region that holds faces to label
+        let mut wanted: Vec<u32> = (0..n)
+            .filter(|&l| free(&leaves[l]) && !(leaves[l].a.is_empty() && leaves[l].b.is_empty()))
+            .map(|l| root[l])
+            .collect();
+        wanted.sort_unstable();
+        wanted.dedup();
+        let inside: FxHashMap<u32, bool> = wanted
+            .par_iter()
+            .map(|&r| {
+                let q = leaves[r as usize].bx.0.map(|c| c as i32);
+                (r, solid.winding(q) != 0)
+            })
+            .collect();
+        Regions { root, inside }
+    }
+
+    fn inside(&self, leaf: u32) -> bool {
+        self.inside[&self.root[leaf as usize]]
+    }
+}
+
+/// Snaps both meshes to one grid, checks them, and computes `a op b`.
+pub fn mesh_boolean(a: &MeshIn<'_>, b: &MeshIn<'_>, op: BoolOp) -> Result<Boolean, CsgError> {
+    mesh_sequence(a, &[(op, *b)])
+}
+
+/// `((first op₁ m₁) op₂ m₂) ...` on one grid: every operand is snapped and
+/// checked once, and each operation works on the previous result in
+/// place.
+pub fn mesh_sequence(
+    first: &MeshIn<'_>,
+    ops: &[(BoolOp, MeshIn<'_>)],
+) -> Result<Boolean, CsgError> {
+    let all: Vec<&MeshIn<'_>> = std::iter::once(first)
+        .chain(ops.iter().map(|(_, m)| m))
+        .collect();
+    for (i, m) in all.iter().enumerate() {
+        check_closed_manifold(m.faces.iter().map(Vec::as_slice))
+            .map_err(|error| CsgError::Topology { operand: i, error })?;
+        if signed_volume(m) < 0.0 {
+            return Err(CsgError::Inward { operand: i });
+        }
+    }
+    let grid =
+        Grid::fit_points(all.iter().flat_map(|m| m.positions.iter())).map_err(CsgError::Grid)?;
+    let mut reports = Vec::with_capacity(all.len());
+    let mut solids = Vec::with_capacity(all.len());
+    for m in &all {
+        let loops: Vec<Vec<DVec3>> = m
+            .faces
+            .iter()
+            .map(|f| f.iter().map(|&v| m.positions[v as usize]).collect())
+            .collect();
+        let (polys, report) = import_faces_par(&grid, &loops).map_err(CsgError::Grid)?;
+        reports.push(report);
+        solids.push(Solid::from_polygons(polys));
+    }
+    let mut it = solids.into_iter();
+    let mut solid = it.next().expect("at least the first operand");
+    for (s, (op, _)) in it.zip(ops) {
+        solid.apply(&s, *op)?;
+    }
+    let mesh = solid.to_mesh();
+    mesh.check_watertight().map_err(CsgError::Internal)?;
+    Ok(Boolean {
+        mesh,
+        grid,
+        solid,
+        reports,
+    })
+}
+
+/// The signed volume of a mesh in input units (`f64`), positive for
+/// outward faces.
+fn signed_volume(m: &MeshIn<'_>) -> f64 {
+    let mut v = 0.0;
+    for f in m.faces {
+        if f.len() < 3 {
+            continue;
+        }
+        let p0 = m.positions[f[0] as usize];
+        for w in f[1..].windows(2) {
+            let (p1, p2) = (m.positions[w[0] as usize], m.positions[w[1] as usize]);
+            v += p0.dot(p1.cross(p2));
+        }
+    }
+    v / 6.0
+}

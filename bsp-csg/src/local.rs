@@ -1,0 +1,168 @@
+//! The boolean inside one octree cell where both surfaces are: a BSP
+//! partition of each operand's faces within the cell, labelled exactly,
+//! merged.
+//!
+//! **Labels.** A partition of one operand's face pieces (an
+//! autopartition: every face lies on a node plane) has leaves that no face
+//! crosses, so each leaf is all inside or all outside the operand. Two
+//! leaves that meet across a piece `σ` of a node's sub-hyperplane differ by
+//! the surface on `σ`: `w(back) − w(front)` is 1 where the node's polygons
+//! facing the node plane's front (outward, so inside behind) cover `σ`,
+//! minus 1 where those facing back do. The surface covers a piece all over
+//! or not at all (the two leaves have one label each), so one exact
+//! overlap test with one face decides it. A covered piece fixes both labels (the
+//! winding numbers of a solid are 0 and 1); the others carry them across.
+//! Only a cell whose pieces cover nothing with a net orientation needs a
+//! reference: the winding number of a grid point in it, by a ray.
+
+use bsp_core::{
+    BoolOp, BspTree, BuildOptions, Cell, PLink, Partition, Plane, Polygon, Side,
+    merge_smaller_into_larger,
+};
+
+use crate::CsgError;
+use crate::index::IBox;
+use crate::octree::walls;
+
+/// `true` if `piece` and `face` (in the same plane) overlap with an area.
+fn overlap(piece: &Polygon, face: &Polygon) -> bool {
+    let mut p = piece.clone();
+    face.edge_planes().iter().all(|e| p.clip(e, Side::Back))
+}
+
+/// The solid partition of `pieces` (faces of one operand clipped to the
+/// cell `bx`); `reference` gives the operand's winding number at a point
+/// of the cell when no piece decides it.
+pub(crate) fn solid(
+    bx: &IBox,
+    pieces: Vec<Polygon>,
+    reference: impl FnOnce() -> i32,
+) -> Result<Partition<Cell>, CsgError> {
+    let w = walls(bx);
+    let tree = BspTree::build(pieces, &BuildOptions::default());
+    let (part, leaves) = Partition::from_tree_in(&tree, &w);
+    // w(back) − w(front) across every piece of every sub-hyperplane
+    let mut links: Vec<(u32, u32, i32)> = Vec::new();
+    for n in part.nodes() {
+        for (pf, lf) in part.push_down(n.shp.clone(), n.front) {
+            for (pb, lb) in part.push_down(pf, n.back) {
+                // the surface on the node's plane covers the piece all
+                // over or not at all (it may be cut into several faces):
+                // one overlapping face of each orientation tells
+                let (mut up, mut down) = (false, false);
+                for g in &n.polygons {
+                    let same = g.support() == &n.plane;
+                    if (same && up) || (!same && down) {
+                        continue;
+                    }
+                    if overlap(&pb, g) {
+                        if same {
+                            up = true;
+                        } else {
+                            down = true;
+                        }
+                    }
+                }
+                let cov = up as i32 - down as i32;
+                links.push((lf, lb, cov));
+            }
+        }
+    }
+    let mut w: Vec<Option<i32>> = vec![None; leaves as usize];
+    let mut adj: Vec<Vec<(u32, i32)>> = vec![Vec::new(); leaves as usize];
+    for &(f, b, c) in &links {
+        adj[f as usize].push((b, c));
+        adj[b as usize].push((f, -c));
+        match c {
+            0 => {}
+            1 | -1 => {
+                let (wf, wb) = if c == 1 { (0, 1) } else { (1, 0) };
+                for (leaf, v) in [(f, wf), (b, wb)] {
+                    match w[leaf as usize] {
+                        None => w[leaf as usize] = Some(v),
+                        Some(x) if x == v => {}
+                        Some(_) => return Err(CsgError::NotASolid),
+                    }
+                }
+            }
+            _ => return Err(CsgError::NotASolid),
+        }
+    }
+    let mut queue: Vec<u32> = (0..leaves).filter(|&l| w[l as usize].is_some()).collect();
+    if queue.is_empty() {
+        // no piece decides: the whole cell is on one side
+        let r = reference();
+        w.iter_mut().for_each(|x| *x = Some(r));
+        queue.clear();
+    }
+    while let Some(l) = queue.pop() {
+        let v = w[l as usize].expect("queued leaves are labelled");
+        for &(m, c) in &adj[l as usize] {
+            let want = v + c;
+            match w[m as usize] {
+                None => {
+                    w[m as usize] = Some(want);
+                    queue.push(m);
+                }
+                Some(x) if x == want => {}
+                Some(_) => return Err(CsgError::NotASolid),
+            }
+        }
+    }
+    let mut cells = Vec::with_capacity(w.len());
+    for v in w {
+        cells.push(match v {
+            Some(0) => Cell::Out,
+            Some(1) => Cell::In,
+            _ => return Err(CsgError::NotASolid),
+        });
+    }
+    Ok(part.map_labels(|l| cells[l as usize]))
+}
+
+/// The boundary of `a op b` inside the cell `bx`, from the two operands'
+/// pieces in it.
+pub(crate) fn boolean(
+    bx: &IBox,
+    a: Vec<Polygon>,
+    b: Vec<Polygon>,
+    op: BoolOp,
+    ref_a: impl FnOnce() -> i32,
+    ref_b: impl FnOnce() -> i32,
+) -> Result<Vec<Polygon>, CsgError> {
+    let pa = solid(bx, a, ref_a)?;
+    let pb = solid(bx, b, ref_b)?;
+    let r = merge_smaller_into_larger(&pa, &pb, &op);
+    Ok(match r.root() {
+        PLink::Leaf(_) => Vec::new(),
+        PLink::Node(_) => r.boundary(),
+    })
+}
+
+/// The six walls of `bx`, for clipping faces into it.
+pub(crate) fn clip_to(face: &Polygon, w: &[Plane; 6]) -> Option<Polygon> {
+    let mut p = face.clone();
+    for wall in w {
+        if !p.clip(wall, Side::Back) {
+            return None;
+        }
+    }
+    Some(p)
+}
+
+/// The parts of `face` outside the box whose walls are `w`: convex
+/// pieces, one per wall it crosses.
+pub(crate) fn outside(face: &Polygon, w: &[Plane; 6]) -> Vec<Polygon> {
+    let mut out = Vec::new();
+    let mut rest = face.clone();
+    for wall in w {
+        let mut beyond = rest.clone();
+        if beyond.clip(wall, Side::Front) {
+            out.push(beyond);
+        }
+        if !rest.clip(wall, Side::Back) {
+            break;
+        }
+    }
+    out
+}
