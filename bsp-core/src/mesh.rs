@@ -447,6 +447,81 @@ impl TriMesh {
         BigRational::new_raw(num, den * BigInt::from(6))
     }
 
+    /// The exact signed volume in grid units³, correctly rounded to `f64`
+    /// (multiply by `scale⁻³`, a power of two, for input units), without
+    /// building the exact fraction.
+    ///
+    /// Triangles with grid vertices only are summed exactly in `i128`; the
+    /// others are grouped by their common denominator (exact integer sums
+    /// per group), and each group's quotient is taken in fixed point with
+    /// `F` fraction bits, so the sum is known within `groups · 2^−F`. When
+    /// both ends of that interval round to the same `f64`, so does the true
+    /// value (rounding is monotonic); otherwise `F` grows, and past 4096
+    /// bits the exact fraction decides ([`TriMesh::six_volume`]).
+    pub fn volume_rounded(&self) -> f64 {
+        use num_traits::{ToPrimitive, Zero};
+        let mut grid_sum: i128 = 0;
+        let mut hom: HashMap<u32, [BigInt; 4]> = HashMap::new();
+        let mut groups: HashMap<BigInt, BigInt> = HashMap::new();
+        for t in &self.triangles {
+            let p = t.map(|i| &self.vertices[i as usize]);
+            if let [Some(a), Some(b), Some(c)] = p.map(|v| v.as_grid()) {
+                let [a, b, c] = [a, b, c].map(|v| v.map(i128::from));
+                grid_sum += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0]);
+                continue;
+            }
+            for &i in t {
+                hom.entry(i).or_insert_with(|| {
+                    self.vertices[i as usize]
+                        .homogeneous()
+                        .map(|c| to_bigint(&c))
+                });
+            }
+            let [a, b, c] = t.map(|i| &hom[&i]);
+            let det = &a[0] * (&b[1] * &c[2] - &b[2] * &c[1])
+                - &a[1] * (&b[0] * &c[2] - &b[2] * &c[0])
+                + &a[2] * (&b[0] * &c[1] - &b[1] * &c[0]);
+            *groups.entry(&a[3] * &b[3] * &c[3]).or_default() += det;
+        }
+        let mut terms: Vec<(BigInt, BigInt)> = groups
+            .into_iter()
+            .filter(|(_, n)| !n.is_zero())
+            .map(|(d, n)| {
+                if d.sign() == num_bigint::Sign::Minus {
+                    (-n, -d)
+                } else {
+                    (n, d)
+                }
+            })
+            .collect();
+        terms.sort_by(|x, y| x.1.cmp(&y.1));
+        let to_f64 = |num: BigInt, shift: u32| {
+            BigRational::new(num, BigInt::from(6) << shift)
+                .to_f64()
+                .unwrap_or(f64::NAN)
+        };
+        if terms.is_empty() {
+            return to_f64(BigInt::from(grid_sum), 0);
+        }
+        let k = BigInt::from(terms.len());
+        for f in [64u32, 256, 1024, 4096] {
+            // truncated quotients: each within one unit of 2^−f
+            let mut s = BigInt::from(grid_sum) << f;
+            for (n, d) in &terms {
+                s += (n << f) / d;
+            }
+            let (lo, hi) = (to_f64(&s - &k, f), to_f64(&s + &k, f));
+            if lo == hi {
+                return lo;
+            }
+        }
+        let (num, den) = self.six_volume();
+        BigRational::new(num, den * BigInt::from(6))
+            .to_f64()
+            .unwrap_or(f64::NAN)
+    }
+
     /// Six times the exact volume as `(numerator, denominator)`,
     /// denominator positive and not reduced.
     pub fn six_volume(&self) -> (BigInt, BigInt) {

@@ -78,6 +78,7 @@ use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
 use crate::index::{FaceIndex, IBox, intersect, overlaps, polygon_box, union};
+use crate::local::{CellResult, Fate};
 use crate::octree::{Leaf, walls};
 
 /// Faces a leaf of the octree may hold before it is split (when it holds
@@ -107,6 +108,23 @@ impl Options {
         self.leaf_size = n.max(1);
         self
     }
+}
+
+/// What one [`Solid::apply`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Cells of the octree over the shared box.
+    pub cells: usize,
+    /// Cells that hold faces of both operands (a local boolean each).
+    pub mixed_cells: usize,
+    /// Mixed cells where faces of the two operands share a plane, merged
+    /// as whole partitions.
+    pub merged_cells: usize,
+    /// Faces of either operand that the other surface cuts, so that only
+    /// part of them stays (outside merged cells).
+    pub cut_faces: usize,
+    /// The pieces they left.
+    pub pieces: usize,
 }
 
 /// Why an operation cannot be done.
@@ -208,9 +226,11 @@ pub struct Boolean {
 }
 
 impl Boolean {
-    /// The result's volume in input units (`f64`, from the exact mesh).
+    /// The result's exact volume in input units, correctly rounded to
+    /// `f64` ([`TriMesh::volume_rounded`]; the grid's scale is a power of
+    /// two).
     pub fn volume(&self) -> f64 {
-        self.mesh.volume_f64() / self.grid.scale().powi(3)
+        self.mesh.volume_rounded() / self.grid.scale().powi(3)
     }
 }
 
@@ -378,17 +398,17 @@ impl Solid {
     }
 
     /// `self op other` for solids whose faces cannot meet.
-    fn apart(&mut self, other: &Solid, op: BoolOp) -> Result<(), CsgError> {
+    fn apart(&mut self, other: &Solid, op: BoolOp) -> Result<Stats, CsgError> {
         match op {
             BoolOp::Union => other.polygons().for_each(|p| self.add(p.clone())),
             BoolOp::Intersection => *self = Solid::empty(),
             BoolOp::Difference => {}
         }
-        Ok(())
+        Ok(Stats::default())
     }
 
     /// `self ← self op other`, touching only the faces near `other`.
-    pub fn apply(&mut self, other: &Solid, op: BoolOp) -> Result<(), CsgError> {
+    pub fn apply(&mut self, other: &Solid, op: BoolOp) -> Result<Stats, CsgError> {
         self.apply_with(other, op, &Options::default())
     }
 
@@ -398,7 +418,7 @@ impl Solid {
         other: &Solid,
         op: BoolOp,
         opts: &Options,
-    ) -> Result<(), CsgError> {
+    ) -> Result<Stats, CsgError> {
         let keep_a = |inside_b: bool| match op {
             BoolOp::Union | BoolOp::Difference => !inside_b,
             BoolOp::Intersection => inside_b,
@@ -434,8 +454,14 @@ impl Solid {
             root,
             a_c.clone(),
             b_c.clone(),
-            &|f| self.face(f).bx,
-            &|f| other.face(f).bx,
+            &|f, c| {
+                let face = self.face(f);
+                overlaps(&face.bx, c) && octree::plane_meets(face.poly.support(), c)
+            },
+            &|f, c| {
+                let face = other.face(f);
+                overlaps(&face.bx, c) && octree::plane_meets(face.poly.support(), c)
+            },
             opts.leaf_size,
         );
         // each face's leaves
@@ -476,6 +502,8 @@ impl Solid {
         let mixed: Vec<u32> = (0..leaves.len() as u32)
             .filter(|&l| leaves[l as usize].mixed())
             .collect();
+        let local_pieces_a = local_a.clone();
+        let local_pieces_b = local_b.clone();
         let mut local_a = local_a;
         let mut local_b = local_b;
         let jobs: Vec<(u32, Vec<Polygon>, Vec<Polygon>)> = mixed
@@ -488,45 +516,120 @@ impl Solid {
                 )
             })
             .collect();
-        let made: Vec<Vec<Polygon>> = jobs
+        let made: Vec<(u32, CellResult)> = jobs
             .into_par_iter()
             .map(|(l, pa, pb)| {
                 let bx = leaves[l as usize].bx;
                 let r = bx.0.map(|c| c as i32);
-                local::boolean(&bx, pa, pb, op, || self.winding(r), || other.winding(r))
+                local::boolean_pieces(
+                    &bx,
+                    pa,
+                    pb,
+                    op,
+                    (keep_a, keep_b),
+                    || self.winding(r),
+                    || other.winding(r),
+                )
+                .map(|c| (l, c))
             })
             .collect::<Result<_, _>>()?;
+        let mut stats = Stats {
+            cells: leaves.len(),
+            mixed_cells: mixed.len(),
+            ..Stats::default()
+        };
+        let mut add: Vec<Polygon> = Vec::new();
+        let mut fates_a: FxHashMap<u32, Vec<Fate>> = FxHashMap::default();
+        let mut fates_b: FxHashMap<u32, Vec<Fate>> = FxHashMap::default();
+        for (l, c) in made {
+            match c {
+                CellResult::Merged(ps) => {
+                    stats.merged_cells += 1;
+                    add.extend(ps)
+                }
+                CellResult::Pieces(fa, fb) => {
+                    fates_a.insert(l, fa);
+                    fates_b.insert(l, fb);
+                }
+            }
+        }
 
         // the changes, now that everything is known
-        let mut add: Vec<Polygon> = made.into_iter().flatten().collect();
         let mut remove: Vec<u32> = Vec::new();
         for &f in &whole_a {
-            let l = a_leaves[&f][0];
-            if !keep_a(inside_b.inside(l)) {
+            let inside = a_leaves.get(&f).is_some_and(|l| inside_b.inside(l[0]));
+            if !keep_a(inside) {
                 remove.push(f);
             }
         }
         // a piece beyond the octree's box is beyond the other solid's box
         for (f, pieces) in pieces_a {
-            remove.push(f);
-            for (l, p) in pieces {
-                if keep_a(l.is_some_and(|l| inside_b.inside(l))) {
-                    add.push(p);
+            let fate = |p: &Piece| match p {
+                Piece::Free(l, _) => {
+                    if keep_a(l.is_some_and(|l| inside_b.inside(l))) {
+                        Some(&Fate::Keep)
+                    } else {
+                        Some(&Fate::Drop)
+                    }
                 }
+                Piece::Mixed(l, i) => fates_a.get(l).map(|v| &v[*i as usize]),
+            };
+            if pieces.iter().all(|p| matches!(fate(p), Some(Fate::Keep))) {
+                continue; // the face stays whole
+            }
+            let n0 = add.len();
+            remove.push(f);
+            for p in &pieces {
+                match (fate(p), p) {
+                    (Some(Fate::Keep), Piece::Free(_, q)) => add.push(q.clone()),
+                    (Some(Fate::Keep), Piece::Mixed(l, i)) => {
+                        add.push(local_pieces_a[l][*i as usize].clone())
+                    }
+                    (Some(Fate::Cut(frags)), _) => add.extend(frags.iter().cloned()),
+                    _ => {}
+                }
+            }
+            if add.len() > n0 {
+                stats.cut_faces += 1;
+                stats.pieces += add.len() - n0;
             }
         }
         let b_out = |p: &Polygon| if flip_b { p.flipped() } else { p.clone() };
         for &f in &whole_b {
-            let l = b_leaves[&f][0];
-            if keep_b(inside_a.inside(l)) {
+            let inside = b_leaves.get(&f).is_some_and(|l| inside_a.inside(l[0]));
+            if keep_b(inside) {
                 add.push(b_out(&other.face(f).poly));
             }
         }
-        for (_, pieces) in pieces_b {
-            for (l, p) in pieces {
-                if keep_b(l.is_some_and(|l| inside_a.inside(l))) {
-                    add.push(b_out(&p));
+        for (f, pieces) in pieces_b {
+            let fate = |p: &Piece| match p {
+                Piece::Free(l, _) => {
+                    if keep_b(l.is_some_and(|l| inside_a.inside(l))) {
+                        Some(&Fate::Keep)
+                    } else {
+                        Some(&Fate::Drop)
+                    }
                 }
+                Piece::Mixed(l, i) => fates_b.get(l).map(|v| &v[*i as usize]),
+            };
+            if pieces.iter().all(|p| matches!(fate(p), Some(Fate::Keep))) {
+                add.push(b_out(&other.face(f).poly));
+                continue;
+            }
+            let n0 = add.len();
+            for p in &pieces {
+                match (fate(p), p) {
+                    (Some(Fate::Keep), Piece::Free(_, q)) => add.push(b_out(q)),
+                    (Some(Fate::Keep), Piece::Mixed(l, i)) => {
+                        add.push(b_out(&local_pieces_b[l][*i as usize]))
+                    }
+                    (Some(Fate::Cut(frags)), _) => add.extend(frags.iter().map(b_out)),
+                    _ => {}
+                }
+            }
+            if add.len() > n0 {
+                stats.cut_faces += 1;
+                stats.pieces += add.len() - n0;
             }
         }
         // the faces away from the shared box: outside the other solid
@@ -557,18 +660,22 @@ impl Solid {
         if self.live > 4 * self.indexed + 1024 {
             self.reindex();
         }
-        Ok(())
+        Ok(stats)
     }
 }
 
-/// Faces wholly in cells free of the other surface; per other face its
-/// pieces in such cells (with the cell, or `None` beyond the octree's
-/// box); per mixed cell the pieces in it.
-type Sorted = (
-    Vec<u32>,
-    Vec<(u32, Vec<(Option<u32>, Polygon)>)>,
-    HashMap<u32, Vec<Polygon>>,
-);
+/// A piece of a face cut by octree walls: in a cell free of the other
+/// surface (or `None`: beyond the octree's box), or the `i`-th piece in a
+/// mixed cell's list.
+#[allow(clippy::large_enum_variant)] // one per piece, held briefly; a box would cost an allocation each
+enum Piece {
+    Free(Option<u32>, Polygon),
+    Mixed(u32, u32),
+}
+
+/// Faces wholly in cells free of the other surface; the pieces of every
+/// other face; per mixed cell the pieces in it.
+type Sorted = (Vec<u32>, Vec<(u32, Vec<Piece>)>, HashMap<u32, Vec<Polygon>>);
 
 fn sort_faces<'p>(
     faces: &[u32],
@@ -581,7 +688,8 @@ fn sort_faces<'p>(
     let mut whole = Vec::new();
     let mut split = Vec::new();
     for &f in faces {
-        let ls = &leaves_of[&f];
+        // a face in no cell lies beyond the octree's box
+        let ls = leaves_of.get(&f).map_or(&[][..], |l| &l[..]);
         if ls.iter().all(|&l| free(&leaves[l as usize])) {
             whole.push(f);
         } else {
@@ -589,12 +697,12 @@ fn sort_faces<'p>(
         }
     }
     // clip the others into their cells, in parallel
-    type Piece = (Option<u32>, Polygon, bool);
-    let clipped: Vec<(u32, Vec<Piece>)> = split
+    type Clipped = (Option<u32>, Polygon, bool);
+    let clipped: Vec<(u32, Vec<Clipped>)> = split
         .par_iter()
         .map(|&f| {
             let p = poly(f);
-            let mut pieces: Vec<Piece> = leaves_of[&f]
+            let mut pieces: Vec<Clipped> = leaves_of[&f]
                 .iter()
                 .filter_map(|&l| {
                     let leaf = &leaves[l as usize];
@@ -608,14 +716,18 @@ fn sort_faces<'p>(
     let mut pieces = Vec::with_capacity(clipped.len());
     let mut local: HashMap<u32, Vec<Polygon>> = HashMap::new();
     for (f, list) in clipped {
-        let mut free_pieces = Vec::new();
+        let mut mine = Vec::with_capacity(list.len());
         for (l, q, is_free) in list {
             match (l, is_free) {
-                (Some(l), false) => local.entry(l).or_default().push(q),
-                _ => free_pieces.push((l, q)),
+                (Some(l), false) => {
+                    let v = local.entry(l).or_default();
+                    mine.push(Piece::Mixed(l, v.len() as u32));
+                    v.push(q);
+                }
+                _ => mine.push(Piece::Free(l, q)),
             }
         }
-        pieces.push((f, free_pieces));
+        pieces.push((f, mine));
     }
     (whole, pieces, local)
 }
@@ -679,6 +791,53 @@ pub fn mesh_boolean(a: &MeshIn<'_>, b: &MeshIn<'_>, op: BoolOp) -> Result<Boolea
     mesh_sequence(a, &[(op, *b)])
 }
 
+/// Checks that operand `operand` is a closed, consistently oriented
+/// 2-manifold ([`check_closed_manifold`]).
+pub fn check_mesh(m: &MeshIn<'_>, operand: usize) -> Result<(), CsgError> {
+    check_closed_manifold(m.faces.iter().map(Vec::as_slice))
+        .map_err(|error| CsgError::Topology { operand, error })
+}
+
+/// The snapped operands: one grid for all, and per mesh its solid and what
+/// snapping did to its faces.
+#[derive(Clone, Debug)]
+pub struct Snapped {
+    /// The grid every operand is snapped to.
+    pub grid: Grid,
+    /// The solids, in the order of the meshes.
+    pub solids: Vec<Solid>,
+    /// What snapping did to each mesh's faces.
+    pub reports: Vec<ImportReport>,
+}
+
+/// Snaps `meshes` (already checked with [`check_mesh`]) to one grid and
+/// makes their solids. Fails with [`CsgError::Inward`] for a mesh whose
+/// snapped faces bound a negative volume (exact).
+pub fn snap(meshes: &[MeshIn<'_>]) -> Result<Snapped, CsgError> {
+    let grid =
+        Grid::fit_points(meshes.iter().flat_map(|m| m.positions.iter())).map_err(CsgError::Grid)?;
+    let mut reports = Vec::with_capacity(meshes.len());
+    let mut solids = Vec::with_capacity(meshes.len());
+    for (i, m) in meshes.iter().enumerate() {
+        let loops: Vec<Vec<DVec3>> = m
+            .faces
+            .iter()
+            .map(|f| f.iter().map(|&v| m.positions[v as usize]).collect())
+            .collect();
+        let (polys, report) = import_faces_par(&grid, &loops).map_err(CsgError::Grid)?;
+        if six_volume_sign(&polys) < 0 {
+            return Err(CsgError::Inward { operand: i });
+        }
+        reports.push(report);
+        solids.push(Solid::from_polygons(polys));
+    }
+    Ok(Snapped {
+        grid,
+        solids,
+        reports,
+    })
+}
+
 /// `((first op₁ m₁) op₂ m₂) ...` on one grid: every operand is snapped and
 /// checked once, and each operation works on the previous result in
 /// place.
@@ -686,30 +845,17 @@ pub fn mesh_sequence(
     first: &MeshIn<'_>,
     ops: &[(BoolOp, MeshIn<'_>)],
 ) -> Result<Boolean, CsgError> {
-    let all: Vec<&MeshIn<'_>> = std::iter::once(first)
-        .chain(ops.iter().map(|(_, m)| m))
+    let all: Vec<MeshIn<'_>> = std::iter::once(*first)
+        .chain(ops.iter().map(|(_, m)| *m))
         .collect();
     for (i, m) in all.iter().enumerate() {
-        check_closed_manifold(m.faces.iter().map(Vec::as_slice))
-            .map_err(|error| CsgError::Topology { operand: i, error })?;
-        if signed_volume(m) < 0.0 {
-            return Err(CsgError::Inward { operand: i });
-        }
+        check_mesh(m, i)?;
     }
-    let grid =
-        Grid::fit_points(all.iter().flat_map(|m| m.positions.iter())).map_err(CsgError::Grid)?;
-    let mut reports = Vec::with_capacity(all.len());
-    let mut solids = Vec::with_capacity(all.len());
-    for m in &all {
-        let loops: Vec<Vec<DVec3>> = m
-            .faces
-            .iter()
-            .map(|f| f.iter().map(|&v| m.positions[v as usize]).collect())
-            .collect();
-        let (polys, report) = import_faces_par(&grid, &loops).map_err(CsgError::Grid)?;
-        reports.push(report);
-        solids.push(Solid::from_polygons(polys));
-    }
+    let Snapped {
+        grid,
+        solids,
+        reports,
+    } = snap(&all)?;
     let mut it = solids.into_iter();
     let mut solid = it.next().expect("at least the first operand");
     for (s, (op, _)) in it.zip(ops) {
@@ -725,19 +871,24 @@ pub fn mesh_sequence(
     })
 }
 
-/// The signed volume of a mesh in input units (`f64`), positive for
-/// outward faces.
-fn signed_volume(m: &MeshIn<'_>) -> f64 {
-    let mut v = 0.0;
-    for f in m.faces {
-        if f.len() < 3 {
-            continue;
-        }
-        let p0 = m.positions[f[0] as usize];
-        for w in f[1..].windows(2) {
-            let (p1, p2) = (m.positions[w[0] as usize], m.positions[w[1] as usize]);
-            v += p0.dot(p1.cross(p2));
+/// The exact sign of the volume the polygons bound (fans of grid
+/// vertices, summed in `i128`: coordinates below 2^26 keep each term below
+/// 2^81). Polygons with implicit vertices do not come from an import and
+/// are skipped.
+fn six_volume_sign(polys: &[Polygon]) -> i32 {
+    let mut v: i128 = 0;
+    for p in polys {
+        let g: Option<Vec<[i128; 3]>> = p
+            .vertices()
+            .iter()
+            .map(|q| q.as_grid().map(|c| c.map(i128::from)))
+            .collect();
+        let Some(g) = g else { continue };
+        for w in g[1..].windows(2) {
+            let (a, b, c) = (g[0], w[0], w[1]);
+            v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]);
         }
     }
-    v / 6.0
+    v.signum() as i32
 }

@@ -139,6 +139,73 @@ pub(crate) fn boolean(
     })
 }
 
+/// What becomes of one face piece in a mixed cell.
+#[derive(Clone, Debug)]
+pub(crate) enum Fate {
+    /// The piece lies wholly on the kept side of the other surface.
+    Keep,
+    /// The piece lies wholly on the dropped side.
+    Drop,
+    /// The other surface crosses the piece: its kept fragments.
+    Cut(Vec<Polygon>),
+}
+
+/// The result of one mixed cell: a fate per piece of each operand, or —
+/// where faces of the two operands share a plane, so the pieces alone
+/// cannot tell which copy of a shared area stays — the merged boundary of
+/// the whole cell.
+pub(crate) enum CellResult {
+    Pieces(Vec<Fate>, Vec<Fate>),
+    Merged(Vec<Polygon>),
+}
+
+/// The fate of `piece` against the labelled partition `other` of the
+/// other operand in the cell: a piece shares no plane with `other`'s
+/// faces, so every fragment lies strictly inside one leaf.
+fn fate(piece: &Polygon, other: &Partition<Cell>, keep: impl Fn(bool) -> bool) -> Fate {
+    let frags = other.push_down(piece.clone(), other.root());
+    let kept = |c: Cell| keep(c == Cell::In);
+    if frags.iter().all(|&(_, c)| kept(c)) {
+        Fate::Keep
+    } else if frags.iter().all(|&(_, c)| !kept(c)) {
+        Fate::Drop
+    } else {
+        Fate::Cut(
+            frags
+                .into_iter()
+                .filter(|&(_, c)| kept(c))
+                .map(|(p, _)| p)
+                .collect(),
+        )
+    }
+}
+
+/// The boolean inside the cell `bx` piece by piece: each operand's pieces
+/// are sorted against the other's labelled partition, so a piece no
+/// surface crosses stays whole and its face can be put back together.
+/// `keep_a(inside_b)` and `keep_b(inside_a)` say which pieces stay.
+pub(crate) fn boolean_pieces(
+    bx: &IBox,
+    a: Vec<Polygon>,
+    b: Vec<Polygon>,
+    op: BoolOp,
+    keep: (impl Fn(bool) -> bool, impl Fn(bool) -> bool),
+    ref_a: impl FnOnce() -> i32,
+    ref_b: impl FnOnce() -> i32,
+) -> Result<CellResult, CsgError> {
+    let shared = a
+        .iter()
+        .any(|p| b.iter().any(|q| p.support().is_coincident(q.support())));
+    if shared {
+        return boolean(bx, a, b, op, ref_a, ref_b).map(CellResult::Merged);
+    }
+    let pa = solid(bx, a.clone(), ref_a)?;
+    let pb = solid(bx, b.clone(), ref_b)?;
+    let fa = a.iter().map(|p| fate(p, &pb, &keep.0)).collect();
+    let fb = b.iter().map(|p| fate(p, &pa, &keep.1)).collect();
+    Ok(CellResult::Pieces(fa, fb))
+}
+
 /// The six walls of `bx`, for clipping faces into it.
 pub(crate) fn clip_to(face: &Polygon, w: &[Plane; 6]) -> Option<Polygon> {
     let mut p = face.clone();

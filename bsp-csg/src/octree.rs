@@ -10,7 +10,7 @@
 
 use bsp_core::Plane;
 
-use crate::index::{IBox, overlaps};
+use crate::index::IBox;
 
 /// A leaf of the octree: its box and the faces of each operand whose box
 /// overlaps it.
@@ -47,22 +47,51 @@ pub(crate) fn walls(bx: &IBox) -> [Plane; 6] {
     ]
 }
 
-/// The leaves of the octree over `domain` for the faces of `a` and `b`
-/// (ids with their boxes), in a fixed order.
+/// Whether the plane meets the closed box of a cell, walls included: the
+/// exact signs of the plane at the box's extreme corners (half-integers,
+/// so everything is doubled; the products stay within `i128`).
+pub(crate) fn plane_meets(pl: &Plane, bx: &IBox) -> bool {
+    let n = pl.normal();
+    let (mut lo, mut hi) = (2 * pl.offset(), 2 * pl.offset());
+    for ((&n, &l), &h) in n.iter().zip(&bx.0).zip(&bx.1) {
+        let (a, b) = (
+            n as i128 * (2 * l as i128 - 1),
+            n as i128 * (2 * h as i128 + 1),
+        );
+        lo += a.min(b);
+        hi += a.max(b);
+    }
+    lo <= 0 && 0 <= hi
+}
+
+/// The leaves of the octree over `domain` for the faces of `a` and `b`, in
+/// a fixed order. `meets_a(f, cell)` must hold whenever face `f` of `a`
+/// meets the cell (it may hold more often); likewise `meets_b`.
+///
+/// A cell holding faces of both operands is split while it holds more
+/// than `leaf_size` faces, can be split, and the last split made progress:
+/// a split after which some child holds every face of its parent gains
+/// nothing when faces pile up at one point (a vertex of high degree on the
+/// other surface), so the depth stays bounded there.
 pub(crate) fn build(
     domain: IBox,
     a: Vec<u32>,
     b: Vec<u32>,
-    box_a: &impl Fn(u32) -> IBox,
-    box_b: &impl Fn(u32) -> IBox,
+    meets_a: &(impl Fn(u32, &IBox) -> bool + Sync),
+    meets_b: &(impl Fn(u32, &IBox) -> bool + Sync),
     leaf_size: usize,
 ) -> Vec<Leaf> {
     let mut leaves = Vec::new();
-    let mut stack = vec![Leaf { bx: domain, a, b }];
-    while let Some(cell) = stack.pop() {
+    // cells with the number of splits in a row that made no progress
+    let mut stack = vec![(Leaf { bx: domain, a, b }, 0u8)];
+    while let Some((cell, stalled)) = stack.pop() {
         let (lo, hi) = cell.bx;
         let split: Vec<usize> = (0..3).filter(|&k| hi[k] > lo[k]).collect();
-        if !cell.mixed() || cell.a.len() + cell.b.len() <= leaf_size || split.is_empty() {
+        if !cell.mixed()
+            || cell.a.len() + cell.b.len() <= leaf_size
+            || split.is_empty()
+            || stalled >= MAX_STALLED
+        {
             leaves.push(cell);
             continue;
         }
@@ -79,61 +108,95 @@ pub(crate) fn build(
                 })
                 .collect();
         }
+        let n = cell.a.len() + cell.b.len();
+        let kids: Vec<Leaf> = children
+            .into_iter()
+            .map(|bx| {
+                let a = cell
+                    .a
+                    .iter()
+                    .copied()
+                    .filter(|&f| meets_a(f, &bx))
+                    .collect();
+                let b = cell
+                    .b
+                    .iter()
+                    .copied()
+                    .filter(|&f| meets_b(f, &bx))
+                    .collect();
+                Leaf { bx, a, b }
+            })
+            .collect();
+        // faces larger than the cell land in several children each: the
+        // split cuts them without sorting them apart
+        let total: usize = kids.iter().map(|k| k.a.len() + k.b.len()).sum();
+        let stuck = total >= STALL_SHARE * n || kids.iter().any(|k| k.a.len() + k.b.len() == n);
+        let stalled = if stuck { stalled + 1 } else { 0 };
         // children pushed in reverse so that they come out in order
-        for bx in children.into_iter().rev() {
-            let a = cell
-                .a
-                .iter()
-                .copied()
-                .filter(|&f| overlaps(&box_a(f), &bx))
-                .collect();
-            let b = cell
-                .b
-                .iter()
-                .copied()
-                .filter(|&f| overlaps(&box_b(f), &bx))
-                .collect();
-            stack.push(Leaf { bx, a, b });
+        for k in kids.into_iter().rev() {
+            stack.push((k, stalled));
         }
     }
     leaves
 }
 
+/// Splits in a row after which a child still holds all its parent's faces
+/// before a cell is left as it is.
+const MAX_STALLED: u8 = 2;
+
+/// A split after which the children hold this many times their parent's
+/// faces in all made no progress.
+const STALL_SHARE: usize = 3;
+
 /// Pairs of leaves that share a piece of wall with an area: their boxes
 /// touch along one axis (`hi + 1 == lo`) and their ranges overlap along the
-/// two others.
+/// two others. The leaves tile space without overlap, so for each wall
+/// coordinate a sweep finds the pairs in `O(n log n)` plus their number.
 pub(crate) fn adjacent(leaves: &[Leaf]) -> Vec<(u32, u32)> {
+    use std::collections::BTreeMap;
     let mut out = Vec::new();
     for k in 0..3 {
         let (u, v) = ((k + 1) % 3, (k + 2) % 3);
-        // leaves by the coordinate of their upper and of their lower wall
-        let mut upper: Vec<(i64, u32)> = leaves
-            .iter()
-            .enumerate()
-            .map(|(i, l)| (l.bx.1[k], i as u32))
-            .collect();
-        let mut lower: Vec<(i64, u32)> = leaves
-            .iter()
-            .enumerate()
-            .map(|(i, l)| (l.bx.0[k] - 1, i as u32))
-            .collect();
-        upper.sort_unstable();
-        lower.sort_unstable();
-        let (mut i, mut j) = (0, 0);
-        while i < upper.len() && j < lower.len() {
-            let c = upper[i].0.min(lower[j].0);
-            let i1 = i + upper[i..].iter().take_while(|x| x.0 == c).count();
-            let j1 = j + lower[j..].iter().take_while(|x| x.0 == c).count();
-            for &(_, p) in &upper[i..i1] {
-                for &(_, q) in &lower[j..j1] {
-                    let (bp, bq) = (&leaves[p as usize].bx, &leaves[q as usize].bx);
-                    let meet = |a: usize| bp.0[a] <= bq.1[a] && bq.0[a] <= bp.1[a];
-                    if meet(u) && meet(v) {
-                        out.push((p, q));
-                    }
-                }
+        // (wall coordinate, side, leaf): side 0 below the wall, 1 above
+        let mut by_wall: Vec<(i64, u8, u32)> = Vec::with_capacity(2 * leaves.len());
+        for (i, l) in leaves.iter().enumerate() {
+            by_wall.push((l.bx.1[k], 0, i as u32));
+            by_wall.push((l.bx.0[k] - 1, 1, i as u32));
+        }
+        by_wall.sort_unstable();
+        let mut events: Vec<(i64, u8, u8, u32)> = Vec::new();
+        for group in by_wall.chunk_by(|x, y| x.0 == y.0) {
+            if group.first().map(|g| g.1) == group.last().map(|g| g.1) {
+                continue; // leaves on one side of this wall only
             }
-            (i, j) = (i1, j1);
+            // sweep along u: removals (0) before insertions (1) at a coordinate
+            events.clear();
+            for &(_, side, i) in group {
+                let b = &leaves[i as usize].bx;
+                events.push((b.0[u], 1, side, i));
+                events.push((b.1[u] + 1, 0, side, i));
+            }
+            events.sort_unstable();
+            // the leaves of each side the sweep line crosses, by their lower
+            // v; their v ranges are disjoint
+            let mut active: [BTreeMap<i64, u32>; 2] = [BTreeMap::new(), BTreeMap::new()];
+            for &(_, kind, side, i) in &events {
+                let b = &leaves[i as usize].bx;
+                let s = side as usize;
+                if kind == 0 {
+                    active[s].remove(&b.0[v]);
+                    continue;
+                }
+                let other = &active[1 - s];
+                let before = other
+                    .range(..b.0[v])
+                    .next_back()
+                    .filter(|(_, j)| leaves[**j as usize].bx.1[v] >= b.0[v]);
+                for (_, &j) in before.into_iter().chain(other.range(b.0[v]..=b.1[v])) {
+                    out.push(if s == 0 { (i, j) } else { (j, i) });
+                }
+                active[s].insert(b.0[v], i);
+            }
         }
     }
     out
@@ -172,8 +235,8 @@ mod tests {
             ([0, 0, 0], [15, 15, 15]),
             (0..8).collect(),
             (0..8).collect(),
-            &bx,
-            &bx,
+            &|f, c| crate::index::overlaps(&bx(f), c),
+            &|f, c| crate::index::overlaps(&bx(f), c),
             4,
         );
         let volume: i64 = leaves

@@ -1,11 +1,13 @@
 //! `shadow csg`: exact Boolean operations (∪ ∩ −) on closed meshes.
 //!
-//! Load both operands → validate each as a closed, consistently oriented
-//! 2-manifold → snap both to one grid → build a solid BSP partition of
-//! each → merge → boundary as a watertight triangle mesh → write. Every
-//! decision after snapping is exact; the only roundings are the input
-//! snap and the final conversion of exact vertices to `f64` (and to `f32`
-//! for STL).
+//! Load the operands → validate each as a closed, consistently oriented
+//! 2-manifold → snap all to one grid → `bsp-csg` applies each operation in
+//! turn to the first operand (local BSPs in an adaptive octree) →
+//! boundary as a watertight triangle mesh → write. Every decision after
+//! snapping is exact; the only roundings are the input snap and the final
+//! conversion of exact vertices to `f64` (and to `f32` for STL). This
+//! module is the front end: loading, messages that point into the files,
+//! and the report; the work is the library's.
 
 use std::io::Write;
 use std::panic;
@@ -13,14 +15,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, anyhow, bail};
-use bsp_core::{
-    BoolOp, Grid, ImportReport, MAX_COORD, Membership, Partition, Point, TopologyError, TriMesh,
-    check_closed_manifold, import_faces,
-};
+use anyhow::{Context, Result, anyhow};
+use bsp_core::{BoolOp, Grid, ImportReport, TopologyError, TriMesh};
+use bsp_csg::{CsgError, MeshIn, Snapped};
 use clap::{Args, ValueEnum};
-use num_rational::BigRational;
-use num_traits::ToPrimitive;
 use shadow_scene::{Face, Mesh, MeshFormat};
 
 /// A Boolean operation as named on the command line.
@@ -54,13 +52,14 @@ impl Operation {
 
 #[derive(Args, Debug)]
 pub(crate) struct CsgArgs {
-    /// The operation (difference is A minus B).
+    /// The operation, applied in turn: `difference PART TOOL...` subtracts
+    /// every tool from the part; union and intersection combine all.
     #[arg(value_enum)]
     pub(crate) op: Operation,
-    /// First operand (.obj or .stl): a closed, consistently oriented mesh.
-    pub(crate) a: PathBuf,
-    /// Second operand (.obj or .stl).
-    pub(crate) b: PathBuf,
+    /// The operands (.obj or .stl), two or more: closed, consistently
+    /// oriented meshes.
+    #[arg(value_name = "MESH", num_args = 2.., required = true)]
+    pub(crate) operands: Vec<PathBuf>,
     /// Output file: .obj, or .stl for binary STL.
     #[arg(short, long, value_name = "OUT")]
     pub(crate) output: PathBuf,
@@ -74,6 +73,7 @@ pub(crate) struct CsgArgs {
 }
 
 /// One input mesh with what messages need to point into its file.
+#[derive(Clone)]
 struct Operand {
     /// The file, as given.
     name: String,
@@ -123,11 +123,19 @@ impl Operand {
         (in_file + 1).to_string()
     }
 
+    fn loops(&self) -> Vec<Vec<u32>> {
+        self.mesh.faces.iter().map(|f| f.vertices.clone()).collect()
+    }
+
     /// Checks that the faces form a closed, consistently oriented
     /// 2-manifold; the error names the file, line, face and edge.
     fn validate(&self) -> Result<()> {
-        check_closed_manifold(self.mesh.faces.iter().map(|f| f.vertices.as_slice()))
-            .map_err(|e| anyhow!(self.topology_message(&e)))
+        let loops = self.loops();
+        match bsp_csg::check_mesh(&MeshIn::new(&self.mesh.positions, &loops), 0) {
+            Err(CsgError::Topology { error, .. }) => Err(anyhow!(self.topology_message(&error))),
+            Err(e) => Err(anyhow!("{}: {e}", self.name)),
+            Ok(()) => Ok(()),
+        }
     }
 
     fn topology_message(&self, e: &TopologyError) -> String {
@@ -235,26 +243,36 @@ struct Outcome {
     /// The exact result (grid units).
     exact: TriMesh,
     grid: Grid,
-    reports: [ImportReport; 2],
-    /// BSP nodes of A, B and the result.
-    nodes: [usize; 3],
+    reports: Vec<ImportReport>,
+    /// What each operation did.
+    stats: Vec<bsp_csg::Stats>,
 }
 
-/// Snaps both operands to one grid, builds their solids, merges them and
-/// extracts the watertight boundary. Prints import summaries to stderr.
-fn compute(a: &Operand, b: &Operand, op: Operation, phases: &mut Phases) -> Result<Outcome> {
-    let (grid, [(polys_a, report_a), (polys_b, report_b)]) =
-        phases.run("snap/import", || -> Result<_> {
-            let grid = Grid::fit_points(a.mesh.positions.iter().chain(&b.mesh.positions))
-                .context("cannot fit a grid to the two meshes")?;
-            let import = |o: &Operand| {
-                let loops = o.mesh.face_loops();
-                import_faces(&grid, loops.iter().map(Vec::as_slice))
-                    .with_context(|| format!("{}: cannot snap the faces to the grid", o.name))
-            };
-            Ok((grid, [import(a)?, import(b)?]))
-        })?;
-    for (o, report) in [(a, &report_a), (b, &report_b)] {
+/// Snaps the operands to one grid and applies the operation to the first
+/// with each of the others in turn, then extracts the watertight
+/// boundary. Prints import summaries to stderr.
+fn compute(operands: &[Operand], op: Operation, phases: &mut Phases) -> Result<Outcome> {
+    let loops: Vec<Vec<Vec<u32>>> = operands.iter().map(Operand::loops).collect();
+    let meshes: Vec<MeshIn<'_>> = operands
+        .iter()
+        .zip(&loops)
+        .map(|(o, l)| MeshIn::new(&o.mesh.positions, l))
+        .collect();
+    let snapped = phases.run("snap/import", || bsp_csg::snap(&meshes));
+    let Snapped {
+        grid,
+        solids,
+        reports,
+    } = snapped.map_err(|e| match e {
+        CsgError::Inward { operand } => anyhow!(
+            "{}: the faces are oriented inward (clockwise seen from outside): the solid they \
+             bound is unbounded; reverse every face's vertex order",
+            operands[operand].name
+        ),
+        CsgError::Grid(e) => anyhow!(e).context("cannot snap the faces to one grid"),
+        e => anyhow!(e),
+    })?;
+    for (o, report) in operands.iter().zip(&reports) {
         let summary = report.summary();
         if !summary.is_empty() {
             eprint!("{}: {summary}", o.name);
@@ -269,13 +287,26 @@ fn compute(a: &Operand, b: &Operand, op: Operation, phases: &mut Phases) -> Resu
             );
         }
     }
-    let pa = phases.run("build A", || Partition::solid(polys_a));
-    bounded(&pa, a, &report_a)?;
-    let pb = phases.run("build B", || Partition::solid(polys_b));
-    bounded(&pb, b, &report_b)?;
-    let result = phases.run("merge", || pa.boolean(&pb, op.kernel()));
+    let mut it = solids.into_iter();
+    let mut solid = it.next().expect("at least two operands");
+    let stats = phases.run("boolean", || -> Result<Vec<bsp_csg::Stats>> {
+        let mut stats = Vec::new();
+        for (i, s) in it.enumerate() {
+            let st = solid.apply(&s, op.kernel()).map_err(|e| match e {
+                CsgError::NotASolid => anyhow!(
+                    "{} or the result before it: a surface crosses itself after snapping to the \
+                     grid (step 2^{}) and bounds no solid",
+                    operands[i + 1].name,
+                    -grid.scale().log2()
+                ),
+                e => anyhow!(e),
+            })?;
+            stats.push(st);
+        }
+        Ok(stats)
+    })?;
     let (exact, mesh) = phases.run("boundary+mesh", || {
-        let exact = result.to_mesh();
+        let exact = solid.to_mesh();
         let mesh = Mesh {
             positions: exact
                 .vertices_f64()
@@ -298,54 +329,28 @@ fn compute(a: &Operand, b: &Operand, op: Operation, phases: &mut Phases) -> Resu
     phases
         .run("check", || exact.check_watertight())
         .map_err(|e| {
+            let names: Vec<&str> = operands.iter().map(|o| o.name.as_str()).collect();
             anyhow!(
-                "internal error: the {} of {} and {} is not watertight ({e}); this is a bug in the \
-                 exact kernel, not a problem with the input, and nothing was written — please report \
-                 it with both input files",
+                "internal error: the {} of {} is not watertight ({e}); this is a bug in the \
+                 exact kernel, not a problem with the input, and nothing was written — please \
+                 report it with the input files",
                 op.name(),
-                a.name,
-                b.name
+                names.join(", ")
             )
         })?;
     Ok(Outcome {
         mesh,
         exact,
         grid,
-        reports: [report_a, report_b],
-        nodes: [pa.nodes().len(), pb.nodes().len(), result.nodes().len()],
+        reports,
+        stats,
     })
-}
-
-/// Fails if the solid of `o` contains a point far outside every input:
-/// its faces then face inward and bound the unbounded complement.
-fn bounded(p: &Partition<bsp_core::Cell>, o: &Operand, report: &ImportReport) -> Result<()> {
-    // the grid is fitted so that the inputs use at most half its range
-    if p.classify_point(&Point::Grid([MAX_COORD; 3])) == Membership::Inside {
-        bail!(
-            "{}: the faces are oriented inward (clockwise seen from outside){}: the solid they bound \
-             is unbounded; reverse every face's vertex order",
-            o.name,
-            if report.dropped.is_empty() {
-                ""
-            } else {
-                ", or faces dropped on the grid left it open"
-            }
-        );
-    }
-    Ok(())
 }
 
 /// The exact volume in input units, rounded once to `f64`.
 fn exact_volume(mesh: &TriMesh, grid: &Grid) -> f64 {
-    let (num, den) = mesh.six_volume();
-    // scale = 2^k exactly, so volume / scale^3 is a power-of-two shift
-    let k = 3 * grid.scale().log2() as i64;
-    let (num, den) = if k >= 0 {
-        (num, (den * 6) << k as usize)
-    } else {
-        (num << k.unsigned_abs() as usize, den * 6)
-    };
-    BigRational::new_raw(num, den).to_f64().unwrap_or(f64::NAN)
+    // the scale is a power of two: the division is exact
+    mesh.volume_rounded() / grid.scale().powi(3)
 }
 
 /// Runs `f`, turning a panic into an error that says it is a bug (the
@@ -388,27 +393,32 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
     // fail on a bad output name before doing any work
     MeshFormat::from_path(&args.output)?;
     let mut phases = Phases::default();
-    let (a, b) = phases.run("load", || -> Result<_> {
-        Ok((
-            Operand::load(&args.a, args.weld)?,
-            Operand::load(&args.b, args.weld)?,
-        ))
+    let operands = phases.run("load", || -> Result<Vec<Operand>> {
+        args.operands
+            .iter()
+            .map(|p| Operand::load(p, args.weld))
+            .collect()
     })?;
     phases.run("validate", || -> Result<()> {
-        a.validate()?;
-        b.validate()
+        operands.iter().try_for_each(Operand::validate)
     })?;
-    let out = guarded("both input files", || compute(&a, &b, args.op, &mut phases))?;
+    let out = guarded("the input files", || {
+        compute(&operands, args.op, &mut phases)
+    })?;
     phases.run("write", || shadow_scene::save(&args.output, &out.mesh))?;
     let total = total.elapsed();
 
     let (tris, verts) = (out.mesh.faces.len(), out.mesh.positions.len());
+    let names: Vec<&str> = operands.iter().map(|o| o.name.as_str()).collect();
+    let of = match names.as_slice() {
+        [a, b] => format!("{a} and {b}"),
+        [first, rest @ ..] => format!("{first} and {} more", rest.len()),
+        [] => String::new(),
+    };
     let mut report = format!(
-        "wrote {}: {} of {} and {}, {tris} triangles, {verts} vertices\n",
+        "wrote {}: {} of {of}, {tris} triangles, {verts} vertices\n",
         args.output.display(),
         args.op.name(),
-        a.name,
-        b.name
     );
     if tris == 0 {
         eprintln!("note: the {} is empty", args.op.name());
@@ -430,7 +440,7 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
         }
     }
     if args.stats {
-        report += &stats_text(args.op, [&a, &b], &out, &phases, total);
+        report += &stats_text(args.op, &operands, &out, &phases, total);
     }
     emit(&report)
 }
@@ -454,22 +464,29 @@ pub(crate) fn emit(text: &str) -> Result<()> {
 /// own (after "total", as only `--stats` pays for it).
 fn stats_text(
     op: Operation,
-    operands: [&Operand; 2],
+    operands: &[Operand],
     out: &Outcome,
     phases: &Phases,
     total: Duration,
 ) -> String {
     let mut s = format!("operation:      {}\n", op.name());
-    for ((label, o), r) in ["A", "B"].iter().zip(operands).zip(&out.reports) {
+    for (i, (o, r)) in operands.iter().zip(&out.reports).enumerate() {
+        let label = match i {
+            0 => "A".to_string(),
+            1 if operands.len() == 2 => "B".to_string(),
+            i => format!("{}", i + 1),
+        };
         s += &format!(
-            "input {label}:        {}: {} triangles ({} faces), {} polygons after import \
+            "input {label}:{:pad$}{}: {} triangles ({} faces), {} polygons after import \
              ({} faces triangulated, {} dropped)\n",
+            "",
             o.name,
             o.mesh.triangle_count(),
             o.mesh.faces.len(),
             r.polygons,
             r.triangulated.len(),
-            r.dropped.len()
+            r.dropped.len(),
+            pad = 9usize.saturating_sub(label.len())
         );
     }
     s += &format!(
@@ -477,9 +494,20 @@ fn stats_text(
         -out.grid.scale().log2(),
         out.grid.step()
     );
+    let sum = out
+        .stats
+        .iter()
+        .fold(bsp_csg::Stats::default(), |a, b| bsp_csg::Stats {
+            cells: a.cells + b.cells,
+            mixed_cells: a.mixed_cells + b.mixed_cells,
+            merged_cells: a.merged_cells + b.merged_cells,
+            cut_faces: a.cut_faces + b.cut_faces,
+            pieces: a.pieces + b.pieces,
+        });
     s += &format!(
-        "bsp nodes:      A {}, B {}, result {}\n",
-        out.nodes[0], out.nodes[1], out.nodes[2]
+        "octree:         {} cells, {} with both surfaces ({} with shared planes); {} faces cut \
+         into {} pieces\n",
+        sum.cells, sum.mixed_cells, sum.merged_cells, sum.cut_faces, sum.pieces
     );
     s += &format!(
         "output:         {} triangles, {} vertices\n",
@@ -508,7 +536,8 @@ fn stats_text(
 mod tests {
     use super::*;
     use num_bigint::BigInt;
-    use num_traits::{One, Zero};
+    use num_rational::BigRational;
+    use num_traits::{One, ToPrimitive, Zero};
     use shadow_scene::parse_obj;
 
     const CUBE: &str = "\
@@ -681,29 +710,19 @@ f 4 1 5 8
             (Operation::Difference, 56.0),
         ] {
             let mut phases = Phases::default();
-            let out = compute(&a, &b, op, &mut phases).unwrap();
+            let out = compute(&[a.clone(), b.clone()], op, &mut phases).unwrap();
             assert_eq!(exact_volume(&out.exact, &out.grid), vol, "{op:?}");
             assert_eq!(out.mesh.signed_volume(), vol, "{op:?}");
             assert!(out.mesh.is_closed_oriented());
             assert_eq!(out.mesh.groups, vec![op.name()]);
             let names: Vec<&str> = phases.0.iter().map(|p| p.0).collect();
-            assert_eq!(
-                names,
-                [
-                    "snap/import",
-                    "build A",
-                    "build B",
-                    "merge",
-                    "boundary+mesh",
-                    "check"
-                ]
-            );
+            assert_eq!(names, ["snap/import", "boolean", "boundary+mesh", "check"]);
         }
         // disjoint: empty intersection
         let far = operand(&cube(1.0, [10.0; 3]), "far.obj", false);
-        let out = compute(&a, &far, Operation::Intersection, &mut Phases::default()).unwrap();
+        let out = compute(&[a, far], Operation::Intersection, &mut Phases::default()).unwrap();
         assert!(out.mesh.faces.is_empty());
-        assert_eq!(out.nodes[2], 0);
+        assert_eq!(out.stats[0].cells, 0);
     }
 
     #[test]
@@ -712,7 +731,7 @@ f 4 1 5 8
         // exact volume is divided by a power of two
         let a = operand(&cube(0.75, [0.125; 3]), "a.obj", false);
         let b = operand(&cube(0.75, [0.5; 3]), "b.obj", false);
-        let out = compute(&a, &b, Operation::Union, &mut Phases::default()).unwrap();
+        let out = compute(&[a, b], Operation::Union, &mut Phases::default()).unwrap();
         assert!(out.grid.scale() > 1.0);
         assert_eq!(
             exact_volume(&out.exact, &out.grid),
@@ -721,7 +740,7 @@ f 4 1 5 8
         // a coarse grid (scale < 1) multiplies instead
         let a = operand(&cube(4e9, [0.0; 3]), "a.obj", false);
         let b = operand(&cube(4e9, [2e9; 3]), "b.obj", false);
-        let out = compute(&a, &b, Operation::Intersection, &mut Phases::default()).unwrap();
+        let out = compute(&[a, b], Operation::Intersection, &mut Phases::default()).unwrap();
         assert!(out.grid.scale() < 1.0);
         assert_eq!(exact_volume(&out.exact, &out.grid), 8e27);
     }
@@ -753,11 +772,21 @@ f 4 1 5 8
             (&a, &c, Operation::Difference),
             (&c, &b, Operation::Union),
         ] {
-            let out = compute(x, y, op, &mut Phases::default()).unwrap();
+            let out = compute(&[x.clone(), y.clone()], op, &mut Phases::default()).unwrap();
             assert!(out.exact.vertices.iter().any(|p| p.as_grid().is_none()));
-            let (num, den) = out.exact.six_volume();
-            let kernel = out.exact.volume_exact() * BigRational::from_integer(6.into());
-            assert_eq!(num * kernel.denom(), kernel.numer() * den, "{op:?}");
+            // the cheap rounding is the exact fraction's, rounded once
+            let exact = out.exact.volume_exact();
+            let k = out.grid.scale().log2() as i32;
+            let scaled = if k >= 0 {
+                exact / BigRational::from_integer(BigInt::one() << (3 * k) as usize)
+            } else {
+                exact * BigRational::from_integer(BigInt::one() << (-3 * k) as usize)
+            };
+            assert_eq!(
+                exact_volume(&out.exact, &out.grid),
+                scaled.to_f64().unwrap(),
+                "{op:?}"
+            );
             assert!(exact_volume(&out.exact, &out.grid) > 0.0);
         }
         assert_eq!(
@@ -782,7 +811,7 @@ f 4 1 5 8
         let a = operand(&inside_out, "inv.obj", false);
         a.validate().unwrap();
         let b = operand(CUBE, "b.obj", false);
-        let e = compute(&a, &b, Operation::Union, &mut Phases::default())
+        let e = compute(&[a, b], Operation::Union, &mut Phases::default())
             .err()
             .unwrap();
         assert!(

@@ -113,10 +113,11 @@ fn stats_report_counts_volume_and_phases() {
         stat(&s, "volume:"),
         "120 (exact, rounded once); 120 (f64 sum)"
     );
-    let nodes = stat(&s, "bsp nodes:");
-    assert!(
-        nodes.starts_with("A ") && nodes.contains(", result "),
-        "{nodes}"
+    // one cell holds both cubes' faces: three faces of each are cut by
+    // the other surface
+    assert_eq!(
+        stat(&s, "octree:"),
+        "1 cells, 1 with both surfaces (0 with shared planes); 6 faces cut into 12 pieces"
     );
     let m = closed_result(&out);
     assert_eq!(
@@ -131,10 +132,9 @@ fn stats_report_counts_volume_and_phases() {
         "load",
         "validate",
         "snap/import",
-        "build A",
-        "build B",
-        "merge",
+        "boolean",
         "boundary+mesh",
+        "check",
         "write",
         "total",
     ] {
@@ -356,7 +356,7 @@ fn argument_and_file_errors() {
     );
     assert_failed_with(&o, &["out.obj"]);
     let o = shadow(&["csg", "union", a.to_str().unwrap()]);
-    assert_failed_with(&o, &["<B>"]);
+    assert_failed_with(&o, &["2 values required", "<MESH>"]);
     assert!(!out.exists());
 }
 
@@ -395,4 +395,52 @@ fn dropped_faces_are_reported() {
     assert!(err.contains("the solid may not be closed"), "{err}");
     assert!(stat(&stdout(&o), "input A:").ends_with("(0 faces triangulated, 1 dropped)"));
     assert_eq!(closed_result(&out).signed_volume(), 2.0 - 0.125);
+}
+
+#[test]
+fn several_tools_in_turn() {
+    // a 4-cube; unit cubes bite into two of its corners, a third one
+    // overlaps the second by half, and a fourth lies apart
+    let part = write("part.obj", &cube_obj([0.0; 3], 4.0));
+    let t1 = write("tool1.obj", &cube_obj([-0.5; 3], 1.0));
+    let t2 = write("tool2.obj", &cube_obj([3.5, 3.5, -0.5], 1.0));
+    let t3 = write("tool3.obj", &cube_obj([3.0, 3.5, -0.5], 1.0));
+    let t4 = write("tool4.obj", &cube_obj([9.0; 3], 1.0));
+    let out = scratch("part_minus_tools.obj");
+    let paths = [&part, &t1, &t2, &t3, &t4];
+    let run = |op: &str, paths: &[&PathBuf], out: &Path| {
+        let mut args = vec!["csg", op];
+        args.extend(paths.iter().map(|p| p.to_str().unwrap()));
+        args.extend(["-o", out.to_str().unwrap(), "--stats"]);
+        let o = shadow(&args);
+        assert_ok(&o);
+        o
+    };
+    // each corner bite is 1/8; the third tool bites 1/4, half of it
+    // already taken by the second
+    let o = run("difference", &paths, &out);
+    assert_eq!(
+        closed_result(&out).signed_volume(),
+        64.0 - 0.125 - 0.125 - 0.125
+    );
+    let s = stdout(&o);
+    assert!(
+        s.contains("difference of ") && s.contains(" and 4 more"),
+        "{s}"
+    );
+    assert!(
+        stat(&s, "input 5:").contains("12 triangles (6 faces)"),
+        "{s}"
+    );
+    assert_eq!(stat(&s, "volume:").split(' ').next(), Some("63.625"));
+    // the union of the tools; their intersection is the second and third's
+    // overlap, and nothing once the part-free fourth joins
+    let u = scratch("tools_union.obj");
+    run("union", &[&t1, &t2, &t3, &t4], &u);
+    assert_eq!(closed_result(&u).signed_volume(), 4.0 - 0.5);
+    let i = scratch("tools_intersection.obj");
+    run("intersection", &[&part, &t2, &t3], &i);
+    assert_eq!(closed_result(&i).signed_volume(), 0.125);
+    run("intersection", &[&part, &t2, &t3, &t4], &i);
+    assert!(closed_result(&i).faces.is_empty());
 }

@@ -1,0 +1,101 @@
+//! Times the union of two UV spheres of about N triangles each (the inputs
+//! of `scripts/manifold_compare.py`): snap and import, the Boolean, and the
+//! output mesh.
+//!
+//! ```sh
+//! cargo run --release -p bsp-csg --example spheres [N] [union|intersection|difference]
+//! ```
+
+use std::time::Instant;
+
+use bsp_core::{BoolOp, Grid, import_faces_par};
+use bsp_csg::Solid;
+use glam::{DMat3, DVec3};
+
+fn uv_sphere(n: usize) -> (Vec<DVec3>, Vec<Vec<u32>>) {
+    let s = (((n as f64 / 4.0).sqrt() + 0.5).floor() as usize).max(3);
+    let m = 2 * s;
+    let mut v = vec![DVec3::Z];
+    for i in 1..s {
+        let th = std::f64::consts::PI * i as f64 / s as f64;
+        for j in 0..m {
+            let ph = std::f64::consts::TAU * j as f64 / m as f64;
+            v.push(DVec3::new(
+                th.sin() * ph.cos(),
+                th.sin() * ph.sin(),
+                th.cos(),
+            ));
+        }
+    }
+    v.push(-DVec3::Z);
+    let south = (v.len() - 1) as u32;
+    let ring = |i: usize, j: usize| (1 + (i - 1) * m + j % m) as u32;
+    let mut t = Vec::new();
+    for j in 0..m {
+        t.push(vec![0, ring(1, j), ring(1, j + 1)]);
+    }
+    for i in 1..s - 1 {
+        for j in 0..m {
+            let (a, b, c, d) = (
+                ring(i, j),
+                ring(i, j + 1),
+                ring(i + 1, j + 1),
+                ring(i + 1, j),
+            );
+            t.push(vec![a, d, c]);
+            t.push(vec![a, c, b]);
+        }
+    }
+    for j in 0..m {
+        t.push(vec![ring(s - 1, j), south, ring(s - 1, j + 1)]);
+    }
+    (v, t)
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let n: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(100_000);
+    let op = match args.next().as_deref() {
+        Some("intersection") => BoolOp::Intersection,
+        Some("difference") => BoolOp::Difference,
+        _ => BoolOp::Union,
+    };
+    let (va, fa) = uv_sphere(n);
+    let rot = DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 5f64.to_radians());
+    let vb: Vec<DVec3> = va
+        .iter()
+        .map(|&p| rot * p + DVec3::new(0.3, 0.1, 0.05))
+        .collect();
+    let t = Instant::now();
+    let grid = Grid::fit_points(va.iter().chain(&vb)).unwrap();
+    let loops = |v: &[DVec3], f: &[Vec<u32>]| -> Vec<Vec<DVec3>> {
+        f.iter()
+            .map(|f| f.iter().map(|&i| v[i as usize]).collect())
+            .collect()
+    };
+    let (pa, _) = import_faces_par(&grid, &loops(&va, &fa)).unwrap();
+    let (pb, _) = import_faces_par(&grid, &loops(&vb, &fa)).unwrap();
+    let t_import = t.elapsed();
+    let t = Instant::now();
+    let mut a = Solid::from_polygons(pa);
+    let b = Solid::from_polygons(pb);
+    let t_solid = t.elapsed();
+    let t = Instant::now();
+    a.apply(&b, op).unwrap();
+    let t_op = t.elapsed();
+    let t = Instant::now();
+    let mesh = a.to_mesh();
+    let t_mesh = t.elapsed();
+    println!(
+        "{} triangles each, {op:?}: import {:.0} ms, solids {:.0} ms, boolean {:.0} ms, mesh {:.0} ms; \
+         {} faces, {} triangles out",
+        fa.len(),
+        t_import.as_secs_f64() * 1e3,
+        t_solid.as_secs_f64() * 1e3,
+        t_op.as_secs_f64() * 1e3,
+        t_mesh.as_secs_f64() * 1e3,
+        a.len(),
+        mesh.triangles.len()
+    );
+    mesh.check_watertight().unwrap();
+}
