@@ -13,6 +13,7 @@ use bnum::cast::As;
 use bnum::types::I512;
 use num_bigint::BigInt;
 use num_rational::BigRational;
+use rayon::prelude::*;
 use smallvec::SmallVec;
 
 use crate::Side;
@@ -80,7 +81,7 @@ fn cmp_axis(p: &Point, q: &Point, k: usize) -> Ordering {
 
 struct Welder {
     vertices: Vec<Point>,
-    by_key: HashMap<[u64; 3], SmallVec<[u32; 1]>>,
+    by_key: rustc_hash::FxHashMap<[u64; 3], SmallVec<[u32; 1]>>,
 }
 
 impl Welder {
@@ -103,61 +104,78 @@ impl TriMesh {
     pub fn from_polygons(polys: &[Polygon]) -> TriMesh {
         let mut w = Welder {
             vertices: Vec::new(),
-            by_key: HashMap::new(),
+            by_key: rustc_hash::FxHashMap::default(),
         };
         let corners: Vec<Vec<u32>> = polys
             .iter()
             .map(|p| p.vertices().iter().map(|v| w.id(v)).collect())
             .collect();
         let vertices = w.vertices;
-        // vertices sorted by rounded x, for candidate look-up
-        let coords: Vec<[f64; 3]> = vertices.iter().map(Point::to_f64).collect();
-        let mut by_x: Vec<u32> = (0..vertices.len() as u32).collect();
-        by_x.sort_by(|&a, &b| coords[a as usize][0].total_cmp(&coords[b as usize][0]));
-        let xs: Vec<f64> = by_x.iter().map(|&i| coords[i as usize][0]).collect();
+        let coords: Vec<[f64; 3]> = vertices.par_iter().map(Point::to_f64).collect();
+        let near = Candidates::new(&coords, &corners);
 
-        let mut triangles = Vec::new();
-        let mut planes = Vec::new();
-        for (poly, cs) in polys.iter().zip(&corners) {
-            let k = cs.len();
-            // boundary loop: (vertex, edge ids it lies on)
-            let mut ring: Vec<(u32, SmallVec<[u32; 3]>)> = Vec::with_capacity(k);
-            for i in 0..k {
-                let (a, b) = (cs[i], cs[(i + 1) % k]);
-                ring.push((
-                    a,
-                    SmallVec::from_slice(&[((i + k - 1) % k) as u32, i as u32]),
-                ));
-                let mut on_edge = edge_points(poly, i, a, b, &vertices, &coords, &by_x, &xs);
-                if on_edge.len() > 1 {
-                    let (pa, pb) = (&vertices[a as usize], &vertices[b as usize]);
-                    let axis = (0..3)
-                        .max_by(|&x, &y| {
-                            let d =
-                                |c: usize| (coords[b as usize][c] - coords[a as usize][c]).abs();
-                            d(x).total_cmp(&d(y))
-                        })
-                        .filter(|&ax| cmp_axis(pa, pb, ax) != Ordering::Equal)
-                        .or_else(|| (0..3).find(|&ax| cmp_axis(pa, pb, ax) != Ordering::Equal))
-                        .expect("edge endpoints are distinct points");
-                    let rising = cmp_axis(pa, pb, axis) == Ordering::Less;
-                    on_edge.sort_by(|&x, &y| {
-                        let o = cmp_axis(&vertices[x as usize], &vertices[y as usize], axis);
-                        if rising { o } else { o.reverse() }
-                    });
+        // each polygon's triangles on its own, in parallel; chunks keep
+        // the order of the polygons
+        let chunks: Vec<(Vec<[u32; 3]>, Vec<Plane>)> = polys
+            .par_chunks(512)
+            .zip(corners.par_chunks(512))
+            .map(|(polys, corners)| {
+                let mut triangles = Vec::new();
+                let mut planes = Vec::new();
+                for (poly, cs) in polys.iter().zip(corners) {
+                    let k = cs.len();
+                    // boundary loop: (vertex, edge ids it lies on)
+                    let mut ring: Vec<(u32, SmallVec<[u32; 3]>)> = Vec::with_capacity(k);
+                    for i in 0..k {
+                        let (a, b) = (cs[i], cs[(i + 1) % k]);
+                        ring.push((
+                            a,
+                            SmallVec::from_slice(&[((i + k - 1) % k) as u32, i as u32]),
+                        ));
+                        let mut on_edge = edge_points(poly, i, a, b, &vertices, &coords, &near);
+                        if on_edge.len() > 1 {
+                            let (pa, pb) = (&vertices[a as usize], &vertices[b as usize]);
+                            let axis = (0..3)
+                                .max_by(|&x, &y| {
+                                    let d = |c: usize| {
+                                        (coords[b as usize][c] - coords[a as usize][c]).abs()
+                                    };
+                                    d(x).total_cmp(&d(y))
+                                })
+                                .filter(|&ax| cmp_axis(pa, pb, ax) != Ordering::Equal)
+                                .or_else(|| {
+                                    (0..3).find(|&ax| cmp_axis(pa, pb, ax) != Ordering::Equal)
+                                })
+                                .expect("edge endpoints are distinct points");
+                            let rising = cmp_axis(pa, pb, axis) == Ordering::Less;
+                            on_edge.sort_by(|&x, &y| {
+                                let o =
+                                    cmp_axis(&vertices[x as usize], &vertices[y as usize], axis);
+                                if rising { o } else { o.reverse() }
+                            });
+                        }
+                        ring.extend(
+                            on_edge
+                                .into_iter()
+                                .map(|v| (v, SmallVec::from_slice(&[i as u32]))),
+                        );
+                    }
+                    let before = triangles.len();
+                    clip_ears(ring, k as u32, &mut triangles);
+                    planes.extend(std::iter::repeat_n(
+                        *poly.support(),
+                        triangles.len() - before,
+                    ));
                 }
-                ring.extend(
-                    on_edge
-                        .into_iter()
-                        .map(|v| (v, SmallVec::from_slice(&[i as u32]))),
-                );
-            }
-            let before = triangles.len();
-            clip_ears(ring, k as u32, &mut triangles);
-            planes.extend(std::iter::repeat_n(
-                *poly.support(),
-                triangles.len() - before,
-            ));
+                (triangles, planes)
+            })
+            .collect();
+        let n: usize = chunks.iter().map(|c| c.0.len()).sum();
+        let mut triangles = Vec::with_capacity(n);
+        let mut planes = Vec::with_capacity(n);
+        for (t, p) in chunks {
+            triangles.extend(t);
+            planes.extend(p);
         }
         let mut mesh = TriMesh {
             vertices,
@@ -390,7 +408,11 @@ impl TriMesh {
     /// (closed, consistently oriented, no T-junctions), and that no
     /// triangle repeats a vertex. Names the first bad edge.
     pub fn check_watertight(&self) -> Result<(), String> {
-        let mut count: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut count: rustc_hash::FxHashMap<(u32, u32), u32> =
+            rustc_hash::FxHashMap::with_capacity_and_hasher(
+                3 * self.triangles.len(),
+                Default::default(),
+            );
         for (t, tri) in self.triangles.iter().enumerate() {
             if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
                 return Err(format!("triangle {t} repeats a vertex: {tri:?}"));
@@ -580,27 +602,24 @@ fn edge_points(
     b: u32,
     vertices: &[Point],
     coords: &[[f64; 3]],
-    by_x: &[u32],
-    xs: &[f64],
+    near: &Candidates,
 ) -> Vec<u32> {
     let k = poly.len();
     let (ca, cb) = (coords[a as usize], coords[b as usize]);
     let lo = [ca[0].min(cb[0]), ca[1].min(cb[1]), ca[2].min(cb[2])];
     let hi = [ca[0].max(cb[0]), ca[1].max(cb[1]), ca[2].max(cb[2])];
-    let start = xs.partition_point(|&x| x < lo[0]);
-    let end = xs.partition_point(|&x| x <= hi[0]);
     let edges = poly.edge_planes();
     let (e, prev, next) = (&edges[i], &edges[(i + k - 1) % k], &edges[(i + 1) % k]);
     let mut out = Vec::new();
-    for &v in &by_x[start..end] {
+    near.each(lo, hi, |v| {
         if v == a || v == b {
-            continue;
+            return;
         }
         let c = coords[v as usize];
         // rounding is monotone, so a point on the segment has its rounded
         // coordinates inside the rounded box: a conservative filter
-        if (1..3).any(|j| c[j] < lo[j] || c[j] > hi[j]) {
-            continue;
+        if (0..3).any(|j| c[j] < lo[j] || c[j] > hi[j]) {
+            return;
         }
         let p = &vertices[v as usize];
         if p.classify(poly.support()) == Side::On
@@ -610,8 +629,82 @@ fn edge_points(
         {
             out.push(v);
         }
-    }
+    });
+    // the same order whatever the index visited first
+    out.sort_unstable();
     out
+}
+
+/// The vertices whose rounded coordinates may lie in a box: a sparse
+/// uniform grid of cells about as large as a typical edge, and for boxes
+/// spanning many cells the vertices sorted by `x`.
+struct Candidates {
+    h: f64,
+    cells: rustc_hash::FxHashMap<[i64; 3], Vec<u32>>,
+    by_x: Vec<u32>,
+    xs: Vec<f64>,
+}
+
+impl Candidates {
+    /// Boxes spanning more cells than this scan the `x` slab instead.
+    const MAX_CELLS: i64 = 64;
+
+    fn new(coords: &[[f64; 3]], corners: &[Vec<u32>]) -> Candidates {
+        let mut by_x: Vec<u32> = (0..coords.len() as u32).collect();
+        by_x.sort_by(|&a, &b| coords[a as usize][0].total_cmp(&coords[b as usize][0]));
+        let xs: Vec<f64> = by_x.iter().map(|&i| coords[i as usize][0]).collect();
+        // the median longest extent of the polygons' first edges
+        let mut ext: Vec<f64> = corners
+            .iter()
+            .filter(|c| c.len() > 1)
+            .map(|c| {
+                let (p, q) = (coords[c[0] as usize], coords[c[1] as usize]);
+                (0..3).map(|j| (p[j] - q[j]).abs()).fold(0.0, f64::max)
+            })
+            .collect();
+        let h = if ext.is_empty() {
+            1.0
+        } else {
+            let m = ext.len() / 2;
+            *ext.select_nth_unstable_by(m, f64::total_cmp).1
+        };
+        let h = if h.is_finite() && h > 0.0 { h } else { 1.0 };
+        let mut cells: rustc_hash::FxHashMap<[i64; 3], Vec<u32>> = Default::default();
+        for (i, c) in coords.iter().enumerate() {
+            cells
+                .entry(c.map(|x| (x / h).floor() as i64))
+                .or_default()
+                .push(i as u32);
+        }
+        Candidates { h, cells, by_x, xs }
+    }
+
+    /// Calls `f` with every vertex whose rounded coordinates may lie in
+    /// `[lo, hi]` (and possibly others).
+    fn each(&self, lo: [f64; 3], hi: [f64; 3], mut f: impl FnMut(u32)) {
+        let (l, u) = (
+            lo.map(|x| (x / self.h).floor() as i64),
+            hi.map(|x| (x / self.h).floor() as i64),
+        );
+        let span = (0..3).fold(1i64, |acc, j| {
+            acc.saturating_mul(u[j].saturating_sub(l[j]).saturating_add(1).max(1))
+        });
+        if span <= Self::MAX_CELLS {
+            for x in l[0]..=u[0] {
+                for y in l[1]..=u[1] {
+                    for z in l[2]..=u[2] {
+                        if let Some(vs) = self.cells.get(&[x, y, z]) {
+                            vs.iter().for_each(|&v| f(v));
+                        }
+                    }
+                }
+            }
+        } else {
+            let start = self.xs.partition_point(|&x| x < lo[0]);
+            let end = self.xs.partition_point(|&x| x <= hi[0]);
+            self.by_x[start..end].iter().for_each(|&v| f(v));
+        }
+    }
 }
 
 /// Triangulates a convex loop whose points may be collinear along edges.

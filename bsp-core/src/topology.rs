@@ -1,7 +1,7 @@
 //! Combinatorial checks of indexed meshes: closed, consistently oriented
 //! 2-manifolds.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 /// Why an indexed mesh is not a closed, consistently oriented 2-manifold.
 /// Faces are 0-based indices into the list given; edges are vertex indices.
@@ -96,11 +96,14 @@ pub fn check_closed_manifold<'a>(
 ) -> Result<(), TopologyError> {
     let faces: Vec<&[u32]> = faces.into_iter().collect();
     // directed edge -> first face using it
-    let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
-    let mut undirected: HashMap<(u32, u32), (usize, usize)> = HashMap::new();
+    let edges: usize = faces.iter().map(|f| f.len()).sum();
+    let mut directed: HashMap<(u32, u32), usize> =
+        HashMap::with_capacity_and_hasher(edges, Default::default());
+    let mut undirected: HashMap<(u32, u32), (usize, usize)> =
+        HashMap::with_capacity_and_hasher(edges / 2 + 1, Default::default());
     for (fi, f) in faces.iter().enumerate() {
         let k = f.len();
-        let mut sorted = f.to_vec();
+        let mut sorted: smallvec::SmallVec<[u32; 8]> = f.iter().copied().collect();
         sorted.sort_unstable();
         sorted.dedup();
         if k < 3 || sorted.len() != k {
@@ -139,8 +142,8 @@ pub fn check_closed_manifold<'a>(
     }
     // vertex links: around each vertex v, face f with ... u -> v -> w ...
     // maps u to w; a single fan means one cycle covering all incident faces
-    let mut next: HashMap<(u32, u32), u32> = HashMap::new();
-    let mut incident: HashMap<u32, usize> = HashMap::new();
+    let mut next: HashMap<(u32, u32), u32> = HashMap::default();
+    let mut incident: HashMap<u32, usize> = HashMap::default();
     for f in &faces {
         let k = f.len();
         for i in 0..k {
@@ -149,7 +152,7 @@ pub fn check_closed_manifold<'a>(
             *incident.entry(v).or_default() += 1;
         }
     }
-    let mut start_of: HashMap<u32, u32> = HashMap::new();
+    let mut start_of: HashMap<u32, u32> = HashMap::default();
     for &(v, u) in next.keys() {
         start_of.entry(v).or_insert(u);
     }

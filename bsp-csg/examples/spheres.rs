@@ -10,47 +10,8 @@ use std::time::Instant;
 
 use bsp_core::{BoolOp, Grid, import_faces_par};
 use bsp_csg::Solid;
+use bsp_csg::shapes::uv_sphere;
 use glam::{DMat3, DVec3};
-
-fn uv_sphere(n: usize) -> (Vec<DVec3>, Vec<Vec<u32>>) {
-    let s = (((n as f64 / 4.0).sqrt() + 0.5).floor() as usize).max(3);
-    let m = 2 * s;
-    let mut v = vec![DVec3::Z];
-    for i in 1..s {
-        let th = std::f64::consts::PI * i as f64 / s as f64;
-        for j in 0..m {
-            let ph = std::f64::consts::TAU * j as f64 / m as f64;
-            v.push(DVec3::new(
-                th.sin() * ph.cos(),
-                th.sin() * ph.sin(),
-                th.cos(),
-            ));
-        }
-    }
-    v.push(-DVec3::Z);
-    let south = (v.len() - 1) as u32;
-    let ring = |i: usize, j: usize| (1 + (i - 1) * m + j % m) as u32;
-    let mut t = Vec::new();
-    for j in 0..m {
-        t.push(vec![0, ring(1, j), ring(1, j + 1)]);
-    }
-    for i in 1..s - 1 {
-        for j in 0..m {
-            let (a, b, c, d) = (
-                ring(i, j),
-                ring(i, j + 1),
-                ring(i + 1, j + 1),
-                ring(i + 1, j),
-            );
-            t.push(vec![a, d, c]);
-            t.push(vec![a, c, b]);
-        }
-    }
-    for j in 0..m {
-        t.push(vec![ring(s - 1, j), south, ring(s - 1, j + 1)]);
-    }
-    (v, t)
-}
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -81,7 +42,12 @@ fn main() {
     let b = Solid::from_polygons(pb);
     let t_solid = t.elapsed();
     let t = Instant::now();
-    a.apply(&b, op).unwrap();
+    let leaf = std::env::var("LEAF_SIZE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(bsp_csg::LEAF_SIZE);
+    a.apply_with(&b, op, &bsp_csg::Options::default().with_leaf_size(leaf))
+        .unwrap();
     let t_op = t.elapsed();
     let t = Instant::now();
     let mesh = a.to_mesh();

@@ -64,6 +64,7 @@
 mod index;
 mod local;
 mod octree;
+pub mod shapes;
 mod winding;
 
 use std::collections::HashMap;
@@ -486,16 +487,18 @@ impl Solid {
             &a_c,
             &a_leaves,
             &leaves,
-            &root_walls,
+            &root,
             |f| &self.face(f).poly,
+            |f| self.face(f).bx,
             |l| l.b.is_empty(),
         );
         let (whole_b, pieces_b, local_b) = sort_faces(
             &b_c,
             &b_leaves,
             &leaves,
-            &root_walls,
+            &root,
             |f| &other.face(f).poly,
+            |f| other.face(f).bx,
             |l| l.a.is_empty(),
         );
         // the mixed cells, in parallel
@@ -565,7 +568,7 @@ impl Solid {
         // a piece beyond the octree's box is beyond the other solid's box
         for (f, pieces) in pieces_a {
             let fate = |p: &Piece| match p {
-                Piece::Free(l, _) => {
+                Piece::Free(l) => {
                     if keep_a(l.is_some_and(|l| inside_b.inside(l))) {
                         Some(&Fate::Keep)
                     } else {
@@ -581,7 +584,11 @@ impl Solid {
             remove.push(f);
             for p in &pieces {
                 match (fate(p), p) {
-                    (Some(Fate::Keep), Piece::Free(_, q)) => add.push(q.clone()),
+                    (Some(Fate::Keep), Piece::Free(l)) => add.extend(free_pieces(
+                        &self.face(f).poly,
+                        l.map(|l| &leaves[l as usize]),
+                        &root_walls,
+                    )),
                     (Some(Fate::Keep), Piece::Mixed(l, i)) => {
                         add.push(local_pieces_a[l][*i as usize].clone())
                     }
@@ -603,7 +610,7 @@ impl Solid {
         }
         for (f, pieces) in pieces_b {
             let fate = |p: &Piece| match p {
-                Piece::Free(l, _) => {
+                Piece::Free(l) => {
                     if keep_b(l.is_some_and(|l| inside_a.inside(l))) {
                         Some(&Fate::Keep)
                     } else {
@@ -619,7 +626,15 @@ impl Solid {
             let n0 = add.len();
             for p in &pieces {
                 match (fate(p), p) {
-                    (Some(Fate::Keep), Piece::Free(_, q)) => add.push(b_out(q)),
+                    (Some(Fate::Keep), Piece::Free(l)) => add.extend(
+                        free_pieces(
+                            &other.face(f).poly,
+                            l.map(|l| &leaves[l as usize]),
+                            &root_walls,
+                        )
+                        .iter()
+                        .map(b_out),
+                    ),
                     (Some(Fate::Keep), Piece::Mixed(l, i)) => {
                         add.push(b_out(&local_pieces_b[l][*i as usize]))
                     }
@@ -665,11 +680,10 @@ impl Solid {
 }
 
 /// A piece of a face cut by octree walls: in a cell free of the other
-/// surface (or `None`: beyond the octree's box), or the `i`-th piece in a
-/// mixed cell's list.
-#[allow(clippy::large_enum_variant)] // one per piece, held briefly; a box would cost an allocation each
+/// surface (or `None`: beyond the octree's box), not clipped until it is
+/// needed, or the `i`-th piece in a mixed cell's list.
 enum Piece {
-    Free(Option<u32>, Polygon),
+    Free(Option<u32>),
     Mixed(u32, u32),
 }
 
@@ -677,12 +691,14 @@ enum Piece {
 /// other face; per mixed cell the pieces in it.
 type Sorted = (Vec<u32>, Vec<(u32, Vec<Piece>)>, HashMap<u32, Vec<Polygon>>);
 
+#[allow(clippy::too_many_arguments)]
 fn sort_faces<'p>(
     faces: &[u32],
     leaves_of: &FxHashMap<u32, SmallVec<[u32; 4]>>,
     leaves: &[Leaf],
-    root: &[bsp_core::Plane; 6],
+    root: &IBox,
     poly: impl Fn(u32) -> &'p Polygon + Sync,
+    bx: impl Fn(u32) -> IBox + Sync,
     free: impl Fn(&Leaf) -> bool + Sync,
 ) -> Sorted {
     let mut whole = Vec::new();
@@ -696,20 +712,27 @@ fn sort_faces<'p>(
             split.push(f);
         }
     }
-    // clip the others into their cells, in parallel
-    type Clipped = (Option<u32>, Polygon, bool);
-    let clipped: Vec<(u32, Vec<Clipped>)> = split
+    // clip the others into their mixed cells, in parallel
+    type Clipped = Vec<(Piece, Option<Polygon>)>;
+    let clipped: Vec<(u32, Clipped)> = split
         .par_iter()
         .map(|&f| {
             let p = poly(f);
-            let mut pieces: Vec<Clipped> = leaves_of[&f]
+            let mut pieces: Clipped = leaves_of[&f]
                 .iter()
                 .filter_map(|&l| {
                     let leaf = &leaves[l as usize];
-                    local::clip_to(p, &walls(&leaf.bx)).map(|q| (Some(l), q, free(leaf)))
+                    if free(leaf) {
+                        Some((Piece::Free(Some(l)), None))
+                    } else {
+                        local::clip_to(p, &walls(&leaf.bx)).map(|q| (Piece::Mixed(l, 0), Some(q)))
+                    }
                 })
                 .collect();
-            pieces.extend(local::outside(p, root).into_iter().map(|q| (None, q, true)));
+            let fb = bx(f);
+            if (0..3).any(|k| fb.0[k] < root.0[k] || fb.1[k] > root.1[k]) {
+                pieces.push((Piece::Free(None), None));
+            }
             (f, pieces)
         })
         .collect();
@@ -717,19 +740,28 @@ fn sort_faces<'p>(
     let mut local: HashMap<u32, Vec<Polygon>> = HashMap::new();
     for (f, list) in clipped {
         let mut mine = Vec::with_capacity(list.len());
-        for (l, q, is_free) in list {
-            match (l, is_free) {
-                (Some(l), false) => {
+        for (piece, q) in list {
+            match (piece, q) {
+                (Piece::Mixed(l, _), Some(q)) => {
                     let v = local.entry(l).or_default();
                     mine.push(Piece::Mixed(l, v.len() as u32));
                     v.push(q);
                 }
-                _ => mine.push(Piece::Free(l, q)),
+                (piece, _) => mine.push(piece),
             }
         }
         pieces.push((f, mine));
     }
     (whole, pieces, local)
+}
+
+/// The pieces of `p` in the free cell `leaf` (`None`: beyond the octree's
+/// box, whose walls are `root`).
+fn free_pieces(p: &Polygon, leaf: Option<&Leaf>, root: &[bsp_core::Plane; 6]) -> Vec<Polygon> {
+    match leaf {
+        Some(l) => local::clip_to(p, &walls(&l.bx)).into_iter().collect(),
+        None => local::outside(p, root),
+    }
 }
 
 /// Connected regions of octree cells free of one surface, each wholly

@@ -1,0 +1,79 @@
+//! Mesh Booleans by local BSPs in an adaptive octree (`bsp-csg`).
+//!
+//! * `octree_csg/union/sphere N`: a unit UV sphere of about N triangles (1k,
+//!   10k, 100k) united with a copy rotated 5° about (1, 2, 3) and shifted by
+//!   (0.3, 0.1, 0.05) — the inputs of `scripts/manifold_compare.py`. End to
+//!   end from the meshes: snap to one grid and make both solids, the union,
+//!   the output triangle mesh and its watertightness check.
+//! * `octree_csg/drill/N`: N successive subtractions of 1k-triangle spheres
+//!   (radius 0.05, centred on the surface along a Fibonacci spiral) from a
+//!   10k-triangle sphere, on snapped solids (the `drill` example runs the
+//!   1000-tool case of the docs).
+
+use bsp_core::BoolOp;
+use bsp_csg::shapes::uv_sphere;
+use bsp_csg::{MeshIn, Snapped, snap};
+use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
+use glam::{DMat3, DVec3};
+
+fn union(c: &mut Criterion) {
+    let mut g = c.benchmark_group("octree_csg/union");
+    g.sample_size(10);
+    for n in [1_000, 10_000, 100_000] {
+        let (va, f) = uv_sphere(n);
+        let rot = DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 5f64.to_radians());
+        let vb: Vec<DVec3> = va
+            .iter()
+            .map(|&p| rot * p + DVec3::new(0.3, 0.1, 0.05))
+            .collect();
+        g.bench_with_input(BenchmarkId::new("sphere", f.len()), &(), |bch, _| {
+            bch.iter(|| {
+                let r = bsp_csg::mesh_boolean(
+                    &MeshIn::new(&va, &f),
+                    &MeshIn::new(&vb, &f),
+                    BoolOp::Union,
+                )
+                .unwrap();
+                r.mesh.triangles.len()
+            })
+        });
+    }
+    g.finish();
+}
+
+fn drill(c: &mut Criterion) {
+    let mut g = c.benchmark_group("octree_csg/drill");
+    g.sample_size(10);
+    let (pv, pf) = uv_sphere(10_000);
+    let (tv, tf) = uv_sphere(1_000);
+    let tools = 20;
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let placed: Vec<Vec<DVec3>> = (0..tools)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / tools as f64;
+            let r = (1.0 - z * z).sqrt();
+            let a = golden * i as f64;
+            let c = DVec3::new(r * a.cos(), r * a.sin(), z);
+            tv.iter().map(|&p| c + 0.05 * p).collect()
+        })
+        .collect();
+    let mut meshes = vec![MeshIn::new(&pv, &pf)];
+    meshes.extend(placed.iter().map(|v| MeshIn::new(v, &tf)));
+    let Snapped { solids, .. } = snap(&meshes).unwrap();
+    g.bench_with_input(BenchmarkId::from_parameter(tools), &(), |bch, _| {
+        bch.iter_batched(
+            || solids[0].clone(),
+            |mut part| {
+                for tool in &solids[1..] {
+                    part.apply(tool, BoolOp::Difference).unwrap();
+                }
+                part.len()
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    g.finish();
+}
+
+criterion_group!(benches, union, drill);
+criterion_main!(benches);

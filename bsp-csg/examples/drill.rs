@@ -1,0 +1,67 @@
+//! Iterated CSG: subtracts `TOOLS` small spheres (about `TOOL_TRIS`
+//! triangles each) from a sphere of about `PART_TRIS` triangles, one after
+//! the other, on one grid; each tool is centred on the part's surface, on
+//! a Fibonacci spiral. Prints the time of the snap, of the subtractions
+//! and of the final mesh, and checks that the result is watertight.
+//!
+//! ```sh
+//! cargo run --release -p bsp-csg --example drill [TOOLS] [PART_TRIS] [TOOL_TRIS]
+//! ```
+
+use std::time::Instant;
+
+use bsp_core::BoolOp;
+use bsp_csg::shapes::uv_sphere;
+use bsp_csg::{MeshIn, Snapped, snap};
+use glam::DVec3;
+
+fn main() {
+    let mut args = std::env::args().skip(1).map(|a| a.parse::<usize>().ok());
+    let tools = args.next().flatten().unwrap_or(1000);
+    let part_tris = args.next().flatten().unwrap_or(100_000);
+    let tool_tris = args.next().flatten().unwrap_or(1000);
+    let (pv, pf) = uv_sphere(part_tris);
+    let (tv, tf) = uv_sphere(tool_tris);
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let tool_meshes: Vec<Vec<DVec3>> = (0..tools)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / tools as f64;
+            let r = (1.0 - z * z).sqrt();
+            let c = DVec3::new(
+                r * (golden * i as f64).cos(),
+                r * (golden * i as f64).sin(),
+                z,
+            );
+            tv.iter().map(|&p| c + 0.05 * p).collect()
+        })
+        .collect();
+    let mut meshes = vec![MeshIn::new(&pv, &pf)];
+    meshes.extend(tool_meshes.iter().map(|v| MeshIn::new(v, &tf)));
+    let t = Instant::now();
+    let Snapped { solids, .. } = snap(&meshes).unwrap();
+    let t_snap = t.elapsed();
+    let mut it = solids.into_iter();
+    let mut part = it.next().unwrap();
+    let t = Instant::now();
+    let mut cut = 0;
+    for tool in it {
+        cut += part.apply(&tool, BoolOp::Difference).unwrap().cut_faces;
+    }
+    let t_ops = t.elapsed();
+    let t = Instant::now();
+    let mesh = part.to_mesh();
+    mesh.check_watertight().unwrap();
+    let t_mesh = t.elapsed();
+    println!(
+        "{} - {tools} x {} triangles: snap {:.0} ms, subtractions {:.0} ms ({:.2} ms each, \
+         {cut} faces cut), mesh+check {:.0} ms; {} faces, {} triangles out",
+        pf.len(),
+        tf.len(),
+        t_snap.as_secs_f64() * 1e3,
+        t_ops.as_secs_f64() * 1e3,
+        t_ops.as_secs_f64() * 1e3 / tools as f64,
+        t_mesh.as_secs_f64() * 1e3,
+        part.len(),
+        mesh.triangles.len()
+    );
+}

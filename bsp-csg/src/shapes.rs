@@ -1,0 +1,67 @@
+//! Test shapes as closed, outward-oriented meshes (positions and faces),
+//! for examples, benches and tests.
+
+use glam::DVec3;
+
+/// The unit UV sphere of about `n` triangles: `s` stacks (at least 3) of
+/// `2s` slices, the poles as fans; `4s(s − 1)` triangles.
+pub fn uv_sphere(n: usize) -> (Vec<DVec3>, Vec<Vec<u32>>) {
+    let s = (((n as f64 / 4.0).sqrt() + 0.5).floor() as usize).max(3);
+    let m = 2 * s;
+    let mut v = vec![DVec3::Z];
+    for i in 1..s {
+        let th = std::f64::consts::PI * i as f64 / s as f64;
+        for j in 0..m {
+            let ph = std::f64::consts::TAU * j as f64 / m as f64;
+            v.push(DVec3::new(
+                th.sin() * ph.cos(),
+                th.sin() * ph.sin(),
+                th.cos(),
+            ));
+        }
+    }
+    v.push(-DVec3::Z);
+    let south = (v.len() - 1) as u32;
+    let ring = |i: usize, j: usize| (1 + (i - 1) * m + j % m) as u32;
+    let mut t = Vec::new();
+    for j in 0..m {
+        t.push(vec![0, ring(1, j), ring(1, j + 1)]);
+    }
+    for i in 1..s - 1 {
+        for j in 0..m {
+            let (a, b, c, d) = (
+                ring(i, j),
+                ring(i, j + 1),
+                ring(i + 1, j + 1),
+                ring(i + 1, j),
+            );
+            t.push(vec![a, d, c]);
+            t.push(vec![a, c, b]);
+        }
+    }
+    for j in 0..m {
+        t.push(vec![ring(s - 1, j), south, ring(s - 1, j + 1)]);
+    }
+    (v, t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uv_sphere_is_closed_and_outward() {
+        for n in [1, 100, 1000] {
+            let (v, f) = uv_sphere(n);
+            bsp_core::check_closed_manifold(f.iter().map(Vec::as_slice)).unwrap();
+            let s = ((n as f64 / 4.0).sqrt() + 0.5).floor().max(3.0) as usize;
+            assert_eq!(f.len(), 4 * s * (s - 1));
+            let vol: f64 = f
+                .iter()
+                .map(|t| v[t[0] as usize].dot(v[t[1] as usize].cross(v[t[2] as usize])))
+                .sum::<f64>()
+                / 6.0;
+            assert!(vol > 0.0 && vol < 4.0 / 3.0 * std::f64::consts::PI, "{vol}");
+        }
+    }
+}
