@@ -95,6 +95,81 @@ pub fn check_closed_manifold<'a>(
     faces: impl IntoIterator<Item = &'a [u32]>,
 ) -> Result<(), TopologyError> {
     let faces: Vec<&[u32]> = faces.into_iter().collect();
+    if is_closed_manifold(&faces) {
+        return Ok(());
+    }
+    first_defect(&faces)
+}
+
+/// The verdict of [`check_closed_manifold`] by parallel sorts, without
+/// naming a defect: no face repeats a vertex, every directed edge is used
+/// once and its reverse once (the sorted edges equal the sorted reversed
+/// edges, without repeats), and around every vertex the corners
+/// `u → v → w` form one cycle.
+fn is_closed_manifold(faces: &[&[u32]]) -> bool {
+    use rayon::prelude::*;
+    let ok_faces = faces.par_iter().all(|f| {
+        let mut v: smallvec::SmallVec<[u32; 8]> = f.iter().copied().collect();
+        v.sort_unstable();
+        f.len() >= 3 && v.windows(2).all(|w| w[0] != w[1])
+    });
+    if !ok_faces {
+        return false;
+    }
+    let key = |a: u32, b: u32| (a as u64) << 32 | b as u64;
+    let corners = |f: &&[u32]| {
+        let k = f.len();
+        (0..k)
+            .map(|i| (f[(i + k - 1) % k], f[i], f[(i + 1) % k]))
+            .collect::<Vec<_>>()
+    };
+    let mut fwd: Vec<u64> = faces
+        .par_iter()
+        .flat_map_iter(|f| {
+            let k = f.len();
+            (0..k).map(move |i| key(f[i], f[(i + 1) % k]))
+        })
+        .collect();
+    let mut rev: Vec<u64> = fwd.par_iter().map(|e| e.rotate_left(32)).collect();
+    fwd.par_sort_unstable();
+    rev.par_sort_unstable();
+    if fwd.par_windows(2).any(|w| w[0] == w[1]) || fwd != rev {
+        return false;
+    }
+    drop((fwd, rev));
+    // vertex links: (v, u) → w, sorted; each vertex's group is one cycle
+    let mut link: Vec<(u64, u32)> = faces
+        .par_iter()
+        .flat_map_iter(|f| corners(f).into_iter().map(|(u, v, w)| (key(v, u), w)))
+        .collect();
+    link.par_sort_unstable();
+    let groups: Vec<&[(u64, u32)]> = link.chunk_by(|x, y| x.0 >> 32 == y.0 >> 32).collect();
+    groups.par_iter().all(|g| {
+        let v = g[0].0 >> 32;
+        let next = |u: u32| {
+            g.binary_search_by(|e| e.0.cmp(&(v << 32 | u as u64)))
+                .ok()
+                .map(|i| g[i].1)
+        };
+        let start = g[0].0 as u32;
+        let mut u = start;
+        let mut steps = 0usize;
+        loop {
+            match next(u) {
+                Some(w) => u = w,
+                None => return false,
+            }
+            steps += 1;
+            if u == start || steps > g.len() {
+                break;
+            }
+        }
+        steps == g.len()
+    })
+}
+
+/// [`check_closed_manifold`] face by face, naming the first defect.
+fn first_defect(faces: &[&[u32]]) -> Result<(), TopologyError> {
     // directed edge -> first face using it
     let edges: usize = faces.iter().map(|f| f.len()).sum();
     let mut directed: HashMap<(u32, u32), usize> =
@@ -144,7 +219,7 @@ pub fn check_closed_manifold<'a>(
     // maps u to w; a single fan means one cycle covering all incident faces
     let mut next: HashMap<(u32, u32), u32> = HashMap::default();
     let mut incident: HashMap<u32, usize> = HashMap::default();
-    for f in &faces {
+    for f in faces {
         let k = f.len();
         for i in 0..k {
             let (u, v, w) = (f[(i + k - 1) % k], f[i], f[(i + 1) % k]);
