@@ -85,8 +85,9 @@ struct Welder {
 }
 
 impl Welder {
-    fn id(&mut self, p: &Point) -> u32 {
-        let bucket = self.by_key.entry(key(p)).or_default();
+    /// The id of `p`, whose [`key`] is `k`.
+    fn id(&mut self, p: &Point, k: [u64; 3]) -> u32 {
+        let bucket = self.by_key.entry(k).or_default();
         for &i in bucket.iter() {
             if self.vertices[i as usize].same_point(p) {
                 return i;
@@ -106,10 +107,18 @@ impl TriMesh {
             vertices: Vec::new(),
             by_key: rustc_hash::FxHashMap::default(),
         };
+        // the keys (correctly rounded coordinates) in parallel, the ids in
+        // order
+        let keys: Vec<Vec<[u64; 3]>> = polys
+            .par_iter()
+            .map(|p| p.vertices().iter().map(key).collect())
+            .collect();
         let corners: Vec<Vec<u32>> = polys
             .iter()
-            .map(|p| p.vertices().iter().map(|v| w.id(v)).collect())
+            .zip(&keys)
+            .map(|(p, k)| p.vertices().iter().zip(k).map(|(v, &k)| w.id(v, k)).collect())
             .collect();
+        drop(keys);
         let vertices = w.vertices;
         let coords: Vec<[f64; 3]> = vertices.par_iter().map(Point::to_f64).collect();
         let near = Candidates::new(&coords, &corners);
