@@ -116,7 +116,13 @@ impl TriMesh {
         let corners: Vec<Vec<u32>> = polys
             .iter()
             .zip(&keys)
-            .map(|(p, k)| p.vertices().iter().zip(k).map(|(v, &k)| w.id(v, k)).collect())
+            .map(|(p, k)| {
+                p.vertices()
+                    .iter()
+                    .zip(k)
+                    .map(|(v, &k)| w.id(v, k))
+                    .collect()
+            })
             .collect();
         drop(keys);
         let vertices = w.vertices;

@@ -14,15 +14,21 @@
 //! 3. In each cell that holds faces of both, the faces are clipped to the
 //!    cell, each operand's pieces make a small BSP partition whose leaves
 //!    are labelled exactly by the faces that cover their common boundaries
-//!    ([`local`](crate::local)), and the two partitions are merged with
-//!    `bsp-core`'s set operations: the result's boundary in the cell,
-//!    coplanar and touching faces included. Cells run in parallel.
+//!    ([`local`](crate::local)), and each piece of one operand is sorted
+//!    against the other's labelled partition: kept whole, dropped whole, or
+//!    cut by the other surface into kept fragments. Where faces of the two
+//!    operands share a plane, the cell's two partitions are merged with
+//!    `bsp-core`'s set operations instead (coplanar and touching faces
+//!    included). Cells run in parallel.
 //! 4. Every other face lies in cells the other surface does not enter: it
 //!    is wholly inside or outside the other solid. Those cells form
 //!    connected regions of space free of the other surface (adjacent cells
 //!    share their label); each region's label is one exact winding number
 //!    ([`Solid::winding`]: a ray along `+x` with simulation of simplicity),
 //!    and a face keeps or loses its pieces by it.
+//! 5. A face none of whose pieces the other surface cuts stays exactly as
+//!    it was, however many cells it spans; only cut faces are replaced by
+//!    pieces ([`Stats`]).
 //!
 //! Everything is exact: the planes are `bsp-core`'s input tier (planes of
 //! the input faces, their edges, and the octree walls), vertices are
