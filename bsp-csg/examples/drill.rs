@@ -7,6 +7,8 @@
 //! ```sh
 //! cargo run --release -p bsp-csg --example drill [TOOLS] [PART_TRIS] [TOOL_TRIS]
 //! ```
+//!
+//! `LEAF_SIZE=N` sets the octree's leaf size.
 
 use std::time::Instant;
 
@@ -43,9 +45,17 @@ fn main() {
     let mut it = solids.into_iter();
     let mut part = it.next().unwrap();
     let t = Instant::now();
-    let mut cut = 0;
+    let (mut cut, mut mixed, mut cells) = (0, 0, 0);
+    let leaf = std::env::var("LEAF_SIZE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(bsp_csg::LEAF_SIZE);
+    let opts = bsp_csg::Options::default().with_leaf_size(leaf);
     for tool in it {
-        cut += part.apply(&tool, BoolOp::Difference).unwrap().cut_faces;
+        let s = part.apply_with(&tool, BoolOp::Difference, &opts).unwrap();
+        cut += s.cut_faces;
+        mixed += s.mixed_cells;
+        cells += s.cells;
     }
     let t_ops = t.elapsed();
     let t = Instant::now();
@@ -54,7 +64,7 @@ fn main() {
     let t_mesh = t.elapsed();
     println!(
         "{} - {tools} x {} triangles: snap {:.0} ms, subtractions {:.0} ms ({:.2} ms each, \
-         {cut} faces cut), mesh+check {:.0} ms; {} faces, {} triangles out",
+         {cut} faces cut, {cells} cells, {mixed} mixed), mesh+check {:.0} ms; {} faces, {} triangles out",
         pf.len(),
         tf.len(),
         t_snap.as_secs_f64() * 1e3,
