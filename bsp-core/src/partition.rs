@@ -190,6 +190,45 @@ pub fn box_section(plane: &Plane) -> Option<Polygon> {
     Some(poly)
 }
 
+/// `plane` ∩ an axis-aligned box given by its six faces in the order
+/// `−x, +x, −y, +y, −z, +z` (interior behind each), built like
+/// [`box_section`] from the box's own faces rather than clipped down from
+/// the grid's box: fewer intersection points to construct. `None` if
+/// `walls` is not such a box or the plane misses it.
+fn section_in(plane: &Plane, walls: &[Plane]) -> Option<Polygon> {
+    let aligned = walls.len() == 6
+        && walls.iter().enumerate().all(|(i, w)| {
+            let (k, up) = (i / 2, i % 2 == 1);
+            let n = w.normal();
+            (0..3).all(|j| {
+                if j == k {
+                    (n[j] > 0) == up && n[j] != 0
+                } else {
+                    n[j] == 0
+                }
+            })
+        });
+    if !aligned {
+        return None;
+    }
+    let k = plane.dominant_axis();
+    let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+    let w = |axis: usize, up: bool| walls[2 * axis + up as usize];
+    let mut edges = vec![w(b, false), w(a, true), w(b, true), w(a, false)];
+    if plane.normal()[k] < 0 {
+        edges.reverse();
+    }
+    let mut poly = Polygon::from_planes(*plane, &edges, 0)?;
+    for up in [true, false] {
+        poly = match poly.split(&w(k, up)) {
+            Split::Back(p) => p,
+            Split::Spanning { back, .. } => back,
+            Split::Front(_) | Split::Coplanar { .. } => return None,
+        };
+    }
+    Some(poly)
+}
+
 /// Options of [`Partition::solid`]: the BSP build with balance cuts every
 /// 64 polygons, which keeps convex meshes from turning into chains.
 pub fn solid_build_options() -> BuildOptions {
@@ -259,13 +298,21 @@ impl<L: Copy> Partition<L> {
                 Link::Cell(c) => PLink::Leaf(leaf(c)),
                 Link::Node(id) => {
                     let n = tree.node(id);
-                    let mut shp =
-                        box_section(&n.plane).expect("a plane through grid points meets the box");
+                    // an axis-aligned region's section directly, else the
+                    // grid box's section clipped to the walls
+                    let (mut shp, rest) = match section_in(&n.plane, walls) {
+                        Some(p) => (p, &[][..]),
+                        None => (
+                            box_section(&n.plane)
+                                .expect("a plane through grid points meets the box"),
+                            walls,
+                        ),
+                    };
                     // nearest ancestors first: they cut the box section
                     // down early, and the far ones then rarely split it;
                     // the region's walls last
                     let ancestors = path.iter().rev().map(|(p, s)| (p, *s));
-                    for (p, s) in ancestors.chain(walls.iter().map(|w| (w, Side::Back))) {
+                    for (p, s) in ancestors.chain(rest.iter().map(|w| (w, Side::Back))) {
                         let kept = shp.clip(p, s);
                         assert!(
                             kept,
@@ -1100,6 +1147,63 @@ mod tests {
             d.volume_exact(),
             num_rational::BigRational::from_integer(8.into())
         );
+    }
+
+    #[test]
+    fn section_in_a_box_is_the_clipped_grid_section() {
+        // walls of [lo, hi] half a step out, as bsp-csg's octree makes them
+        let walls = |lo: [i64; 3], hi: [i64; 3]| -> Vec<Plane> {
+            let mut w = Vec::new();
+            for k in 0..3 {
+                for (sign, c) in [(-1i64, lo[k]), (1, hi[k])] {
+                    let mut n = [0i64; 3];
+                    n[k] = 2 * sign;
+                    w.push(
+                        Plane::new(n, -(sign as i128) * (2 * c as i128 + sign as i128)).unwrap(),
+                    );
+                }
+            }
+            w
+        };
+        let planes = [
+            Plane::through([0, 0, 0], [1, 0, 1], [0, 1, 3]).unwrap(),
+            Plane::through([2, 1, 0], [0, 3, 1], [1, 1, 4]).unwrap(),
+            Plane::through([0, 0, 2], [5, 0, 2], [0, 5, 2]).unwrap(),
+            Plane::through([1, 1, 1], [2, 3, 1], [1, 1, 7])
+                .unwrap()
+                .flip(),
+        ];
+        let mut met = 0;
+        for pl in &planes {
+            for (lo, hi) in [
+                ([0, 0, 0], [3, 3, 3]),
+                ([-2, 1, 0], [4, 2, 5]),
+                ([1, 1, 1], [1, 1, 1]),
+            ] {
+                let w = walls(lo, hi);
+                let mut clipped = box_section(pl);
+                for wall in &w {
+                    clipped = clipped.and_then(|mut c| c.clip(wall, Side::Back).then_some(c));
+                }
+                let direct = section_in(pl, &w);
+                match (clipped, direct) {
+                    (None, None) => {}
+                    (Some(c), Some(d)) => {
+                        met += 1;
+                        d.sanity_check().unwrap();
+                        assert_eq!(d.support(), pl);
+                        assert_eq!(c.len(), d.len(), "{pl:?} {lo:?} {hi:?}");
+                        for v in d.vertices() {
+                            assert!(c.vertices().iter().any(|u| u.same_point(v)));
+                        }
+                    }
+                    (c, d) => panic!("{pl:?} {lo:?} {hi:?}: {c:?} vs {d:?}"),
+                }
+            }
+        }
+        assert!(met >= 6, "{met}");
+        // not an axis-aligned box: no shortcut
+        assert!(section_in(&planes[0], &walls([0; 3], [1; 3])[..5]).is_none());
     }
 
     #[test]
