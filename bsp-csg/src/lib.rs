@@ -511,8 +511,6 @@ impl Solid {
         let mixed: Vec<u32> = (0..leaves.len() as u32)
             .filter(|&l| leaves[l as usize].mixed())
             .collect();
-        let local_pieces_a = local_a.clone();
-        let local_pieces_b = local_b.clone();
         let mut local_a = local_a;
         let mut local_b = local_b;
         let jobs: Vec<(u32, Vec<Polygon>, Vec<Polygon>)> = mixed
@@ -549,6 +547,8 @@ impl Solid {
         };
         let mut add: Vec<Polygon> = Vec::new();
         let mut fates_a: FxHashMap<u32, Vec<Fate>> = FxHashMap::default();
+        let mut local_pieces_a: FxHashMap<u32, Vec<Polygon>> = FxHashMap::default();
+        let mut local_pieces_b: FxHashMap<u32, Vec<Polygon>> = FxHashMap::default();
         let mut fates_b: FxHashMap<u32, Vec<Fate>> = FxHashMap::default();
         for (l, c) in made {
             match c {
@@ -556,9 +556,11 @@ impl Solid {
                     stats.merged_cells += 1;
                     add.extend(ps)
                 }
-                CellResult::Pieces(fa, fb) => {
+                CellResult::Pieces(fa, fb, pa, pb) => {
                     fates_a.insert(l, fa);
                     fates_b.insert(l, fb);
+                    local_pieces_a.insert(l, pa);
+                    local_pieces_b.insert(l, pb);
                 }
             }
         }

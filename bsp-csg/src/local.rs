@@ -155,7 +155,8 @@ pub(crate) enum Fate {
 /// cannot tell which copy of a shared area stays — the merged boundary of
 /// the whole cell.
 pub(crate) enum CellResult {
-    Pieces(Vec<Fate>, Vec<Fate>),
+    /// The fates, with the pieces given back (`a`'s, then `b`'s).
+    Pieces(Vec<Fate>, Vec<Fate>, Vec<Polygon>, Vec<Polygon>),
     Merged(Vec<Polygon>),
 }
 
@@ -203,7 +204,7 @@ pub(crate) fn boolean_pieces(
     let pb = solid(bx, b.clone(), ref_b)?;
     let fa = a.iter().map(|p| fate(p, &pb, &keep.0)).collect();
     let fb = b.iter().map(|p| fate(p, &pa, &keep.1)).collect();
-    Ok(CellResult::Pieces(fa, fb))
+    Ok(CellResult::Pieces(fa, fb, a, b))
 }
 
 /// The six walls of `bx`, for clipping faces into it.
