@@ -102,7 +102,8 @@ impl Welder {
 
 impl TriMesh {
     /// The conforming triangulation of `polys` (see the module docs).
-    pub fn from_polygons(polys: &[Polygon]) -> TriMesh {
+    /// Takes the polygons or references to them (no copy needed).
+    pub fn from_polygons<P: std::borrow::Borrow<Polygon> + Sync>(polys: &[P]) -> TriMesh {
         let mut w = Welder {
             vertices: Vec::new(),
             by_key: rustc_hash::FxHashMap::default(),
@@ -111,13 +112,14 @@ impl TriMesh {
         // order
         let keys: Vec<Vec<[u64; 3]>> = polys
             .par_iter()
-            .map(|p| p.vertices().iter().map(key).collect())
+            .map(|p| p.borrow().vertices().iter().map(key).collect())
             .collect();
         let corners: Vec<Vec<u32>> = polys
             .iter()
             .zip(&keys)
             .map(|(p, k)| {
-                p.vertices()
+                p.borrow()
+                    .vertices()
                     .iter()
                     .zip(k)
                     .map(|(v, &k)| w.id(v, k))
@@ -138,6 +140,7 @@ impl TriMesh {
                 let mut triangles = Vec::new();
                 let mut planes = Vec::new();
                 for (poly, cs) in polys.iter().zip(corners) {
+                    let poly: &Polygon = poly.borrow();
                     let k = cs.len();
                     // boundary loop: (vertex, edge ids it lies on)
                     let mut ring: Vec<(u32, SmallVec<[u32; 3]>)> = Vec::with_capacity(k);

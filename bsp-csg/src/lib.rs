@@ -393,7 +393,7 @@ impl Solid {
     /// The watertight triangle mesh of the boundary (see
     /// [`TriMesh::from_polygons`]).
     pub fn to_mesh(&self) -> TriMesh {
-        let polys: Vec<Polygon> = self.polygons().cloned().collect();
+        let polys: Vec<&Polygon> = self.polygons().collect();
         TriMesh::from_polygons(&polys)
     }
 

@@ -259,6 +259,9 @@ fn compute(operands: &[Operand], op: Operation, phases: &mut Phases) -> Result<O
         .map(|(o, l)| MeshIn::new(&o.mesh.positions, l))
         .collect();
     let snapped = phases.run("snap/import", || bsp_csg::snap(&meshes));
+    // the copies of the face lists are not needed any more
+    drop(meshes);
+    drop(loops);
     let Snapped {
         grid,
         solids,
