@@ -38,46 +38,11 @@ const SHIFT: DVec3 = DVec3::new(0.3, 0.1, 0.05);
 type Faces = Vec<Vec<DVec3>>;
 
 /// Unit UV sphere of `4 s (s - 1)` triangles, `s = floor(sqrt(n/4) + 0.5)`
-/// stacks and `2 s` slices, oriented outwards.
+/// stacks and `2 s` slices, oriented outwards ([`bsp_core::shapes::uv_sphere`]).
 fn uv_sphere(n: usize) -> Faces {
-    let s = (((n as f64 / 4.0).sqrt() + 0.5).floor() as usize).max(3);
-    let m = 2 * s;
-    let mut v = vec![DVec3::Z];
-    for i in 1..s {
-        let th = std::f64::consts::PI * i as f64 / s as f64;
-        for j in 0..m {
-            let ph = std::f64::consts::TAU * j as f64 / m as f64;
-            v.push(DVec3::new(
-                th.sin() * ph.cos(),
-                th.sin() * ph.sin(),
-                th.cos(),
-            ));
-        }
-    }
-    v.push(-DVec3::Z);
-    let south = v.len() - 1;
-    let ring = |i: usize, j: usize| 1 + (i - 1) * m + j % m;
-    let mut t = Vec::new();
-    for j in 0..m {
-        t.push([0, ring(1, j), ring(1, j + 1)]);
-    }
-    for i in 1..s - 1 {
-        for j in 0..m {
-            let (a, b, c, d) = (
-                ring(i, j),
-                ring(i, j + 1),
-                ring(i + 1, j + 1),
-                ring(i + 1, j),
-            );
-            t.push([a, d, c]);
-            t.push([a, c, b]);
-        }
-    }
-    for j in 0..m {
-        t.push([ring(s - 1, j), south, ring(s - 1, j + 1)]);
-    }
-    t.iter()
-        .map(|f| f.iter().map(|&k| v[k]).collect())
+    let (v, f) = bsp_core::shapes::uv_sphere(n);
+    f.iter()
+        .map(|t| t.iter().map(|&i| v[i as usize]).collect())
         .collect()
 }
 

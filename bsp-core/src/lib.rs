@@ -47,6 +47,7 @@ mod point;
 mod polygon;
 mod regions;
 mod sanity;
+pub mod shapes;
 mod topology;
 mod tree;
 

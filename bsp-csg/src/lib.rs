@@ -70,7 +70,8 @@
 mod index;
 mod local;
 mod octree;
-pub mod shapes;
+/// Test shapes (re-exported from `bsp-core`).
+pub use bsp_core::shapes;
 mod winding;
 
 use std::collections::HashMap;
@@ -574,39 +575,32 @@ impl Solid {
             }
         }
         // a piece beyond the octree's box is beyond the other solid's box
+        let settle_with = |poly: &Polygon,
+                           pieces: &[Piece],
+                           keep: &dyn Fn(bool) -> bool,
+                           other_side: &Regions,
+                           fates: &FxHashMap<u32, Vec<Fate>>,
+                           local: &FxHashMap<u32, Vec<Polygon>>| {
+            settle(
+                poly,
+                pieces,
+                &|l| keep(l.is_some_and(|l| other_side.inside(l))),
+                fates,
+                local,
+                &leaves,
+                &root_walls,
+            )
+        };
         for (f, pieces) in pieces_a {
-            let fate = |p: &Piece| match p {
-                Piece::Free(l) => {
-                    if keep_a(l.is_some_and(|l| inside_b.inside(l))) {
-                        Some(&Fate::Keep)
-                    } else {
-                        Some(&Fate::Drop)
-                    }
+            let poly = &self.face(f).poly;
+            let outcome = settle_with(poly, &pieces, &keep_a, &inside_b, &fates_a, &local_pieces_a);
+            if let Some(kept) = outcome {
+                remove.push(f);
+                if !kept.is_empty() {
+                    stats.cut_faces += 1;
+                    stats.pieces += kept.len();
                 }
-                Piece::Mixed(l, i) => fates_a.get(l).map(|v| &v[*i as usize]),
-            };
-            if pieces.iter().all(|p| matches!(fate(p), Some(Fate::Keep))) {
-                continue; // the face stays whole
-            }
-            let n0 = add.len();
-            remove.push(f);
-            for p in &pieces {
-                match (fate(p), p) {
-                    (Some(Fate::Keep), Piece::Free(l)) => add.extend(free_pieces(
-                        &self.face(f).poly,
-                        l.map(|l| &leaves[l as usize]),
-                        &root_walls,
-                    )),
-                    (Some(Fate::Keep), Piece::Mixed(l, i)) => {
-                        add.push(local_pieces_a[l][*i as usize].clone())
-                    }
-                    (Some(Fate::Cut(frags)), _) => add.extend(frags.iter().cloned()),
-                    _ => {}
-                }
-            }
-            if add.len() > n0 {
-                stats.cut_faces += 1;
-                stats.pieces += add.len() - n0;
+                add.extend(kept);
             }
         }
         let b_out = |p: &Polygon| if flip_b { p.flipped() } else { p.clone() };
@@ -617,42 +611,16 @@ impl Solid {
             }
         }
         for (f, pieces) in pieces_b {
-            let fate = |p: &Piece| match p {
-                Piece::Free(l) => {
-                    if keep_b(l.is_some_and(|l| inside_a.inside(l))) {
-                        Some(&Fate::Keep)
-                    } else {
-                        Some(&Fate::Drop)
+            let poly = &other.face(f).poly;
+            match settle_with(poly, &pieces, &keep_b, &inside_a, &fates_b, &local_pieces_b) {
+                None => add.push(b_out(poly)),
+                Some(kept) => {
+                    if !kept.is_empty() {
+                        stats.cut_faces += 1;
+                        stats.pieces += kept.len();
                     }
+                    add.extend(kept.iter().map(b_out));
                 }
-                Piece::Mixed(l, i) => fates_b.get(l).map(|v| &v[*i as usize]),
-            };
-            if pieces.iter().all(|p| matches!(fate(p), Some(Fate::Keep))) {
-                add.push(b_out(&other.face(f).poly));
-                continue;
-            }
-            let n0 = add.len();
-            for p in &pieces {
-                match (fate(p), p) {
-                    (Some(Fate::Keep), Piece::Free(l)) => add.extend(
-                        free_pieces(
-                            &other.face(f).poly,
-                            l.map(|l| &leaves[l as usize]),
-                            &root_walls,
-                        )
-                        .iter()
-                        .map(b_out),
-                    ),
-                    (Some(Fate::Keep), Piece::Mixed(l, i)) => {
-                        add.push(b_out(&local_pieces_b[l][*i as usize]))
-                    }
-                    (Some(Fate::Cut(frags)), _) => add.extend(frags.iter().map(b_out)),
-                    _ => {}
-                }
-            }
-            if add.len() > n0 {
-                stats.cut_faces += 1;
-                stats.pieces += add.len() - n0;
             }
         }
         // the faces away from the shared box: outside the other solid
@@ -761,6 +729,42 @@ fn sort_faces<'p>(
         pieces.push((f, mine));
     }
     (whole, pieces, local)
+}
+
+/// What stays of a face cut into `pieces`: `None` if every piece stays
+/// (the face stays as it is), else the kept pieces and fragments.
+/// `keep_free(cell)` says whether a piece in a free cell (`None`: beyond
+/// the octree's box) stays; `fates` and `local` are the mixed cells'.
+fn settle(
+    poly: &Polygon,
+    pieces: &[Piece],
+    keep_free: &dyn Fn(Option<u32>) -> bool,
+    fates: &FxHashMap<u32, Vec<Fate>>,
+    local: &FxHashMap<u32, Vec<Polygon>>,
+    leaves: &[Leaf],
+    root: &[bsp_core::Plane; 6],
+) -> Option<Vec<Polygon>> {
+    let fate = |p: &Piece| match p {
+        Piece::Free(l) if keep_free(*l) => Some(&Fate::Keep),
+        Piece::Free(_) => Some(&Fate::Drop),
+        // a piece of a merged cell is in the cell's output
+        Piece::Mixed(l, i) => fates.get(l).map(|v| &v[*i as usize]),
+    };
+    if pieces.iter().all(|p| matches!(fate(p), Some(Fate::Keep))) {
+        return None;
+    }
+    let mut kept = Vec::new();
+    for p in pieces {
+        match (fate(p), p) {
+            (Some(Fate::Keep), Piece::Free(l)) => {
+                kept.extend(free_pieces(poly, l.map(|l| &leaves[l as usize]), root))
+            }
+            (Some(Fate::Keep), Piece::Mixed(l, i)) => kept.push(local[l][*i as usize].clone()),
+            (Some(Fate::Cut(frags)), _) => kept.extend(frags.iter().cloned()),
+            _ => {}
+        }
+    }
+    Some(kept)
 }
 
 /// The pieces of `p` in the free cell `leaf` (`None`: beyond the octree's

@@ -292,10 +292,19 @@ proptest! {
         let mut l3 = l3;
         let k = l3.len();
         prop_assume!(k >= 4, "a triangle stays planar");
-        let n = crate::strategies::cross(
-            crate::strategies::sub(wide(l3[1]), wide(l3[0])),
-            crate::strategies::sub(wide(l3[2]), wide(l3[0])),
-        );
+        // the loop's normal from its first non-collinear corners (the first
+        // three may be collinear: lifting along an axis the normal lacks
+        // would keep the loop planar)
+        let n = (1..k)
+            .flat_map(|a| (a + 1..k).map(move |b| (a, b)))
+            .map(|(a, b)| {
+                crate::strategies::cross(
+                    crate::strategies::sub(wide(l3[a]), wide(l3[0])),
+                    crate::strategies::sub(wide(l3[b]), wide(l3[0])),
+                )
+            })
+            .find(|n| n.iter().any(|&c| c != 0))
+            .expect("a placed loop has an area");
         let axis = (0..3).max_by_key(|&a| n[a].abs()).expect("3 axes");
         let mut moved = wide(l3[i % k]);
         moved[axis] += if moved[axis] > 0 { -lift } else { lift };

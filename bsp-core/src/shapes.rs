@@ -53,7 +53,7 @@ mod tests {
     fn uv_sphere_is_closed_and_outward() {
         for n in [1, 100, 1000] {
             let (v, f) = uv_sphere(n);
-            bsp_core::check_closed_manifold(f.iter().map(Vec::as_slice)).unwrap();
+            crate::check_closed_manifold(f.iter().map(Vec::as_slice)).unwrap();
             let s = ((n as f64 / 4.0).sqrt() + 0.5).floor().max(3.0) as usize;
             assert_eq!(f.len(), 4 * s * (s - 1));
             let vol: f64 = f
