@@ -14,7 +14,7 @@
 
 use std::collections::HashMap;
 
-use bsp_core::Plane;
+use bsp_core::{Plane, Side};
 use glam::{DVec2, DVec3};
 use svbsp::{Batch, ShadeOptions, Shadows};
 
@@ -38,11 +38,11 @@ pub(crate) fn visible_side_fragments(
     let receivers: Vec<bsp_core::Polygon> = scene
         .polys
         .iter()
-        .zip(&frame.vis_plane)
+        .zip(&frame.side)
         .filter_map(|(p, v)| match v {
-            Some(v) if v == p.support() => Some(p.clone()),
-            Some(_) => Some(p.flipped()),
-            None => None,
+            Side::Front => Some(p.clone()),
+            Side::Back => Some(p.flipped()),
+            Side::On => None,
         })
         .collect();
     Ok(shadows.shade_all(&receivers, &ShadeOptions::default().with_pieces(false)))
@@ -79,7 +79,7 @@ pub(crate) fn draw_fragments(
     // a group: one face seen from one side
     let mut groups: HashMap<(u32, Plane), u32> = HashMap::new();
     let prim_group: Vec<u32> = (0..scene.len())
-        .map(|i| match frame.vis_plane[i] {
+        .map(|i| match frame.vis_plane(i) {
             Some(p) => {
                 let next = groups.len() as u32;
                 *groups.entry((scene.face[i], p)).or_insert(next)

@@ -26,12 +26,12 @@
 //! Back-face culling (prims whose back faces the eye are left out) is an
 //! option of all five.
 
-use bsp_core::{BspTree, BuildOptions, Order, Plane};
+use bsp_core::{BspTree, BuildOptions, Order, Plane, Side};
 use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
-use crate::raster::{Bins, Screen, for_bands2, nearness, project_all, row_term};
+use crate::raster::{Bins, Screen, for_bands2, nearness, project_all_into, row_term};
 use crate::scene::RasterScene;
 use crate::view::View;
 use crate::{Camera, RasterError};
@@ -113,14 +113,27 @@ impl Visibility {
 pub(crate) struct Frame<'a> {
     pub(crate) scene: &'a RasterScene,
     pub(crate) camera: Camera,
-    /// The exact plane of the side the eye sees of each prim.
-    pub(crate) vis_plane: Vec<Option<Plane>>,
-    /// The unit normal (input units) of the side the eye sees of each prim.
-    pub(crate) vis_normal: Vec<DVec3>,
+    /// The side of each prim's exact support plane the eye is on.
+    pub(crate) side: Vec<Side>,
     /// The drawn prims (ids are prim indices).
     pub(crate) screen: Screen,
     /// For each prim, its index in `screen`, or [`NONE`].
     pub(crate) slot: Vec<u32>,
+    /// The drawn prims by bands of rows.
+    pub(crate) bins: Bins,
+    /// Spare per-chunk screens of the projection.
+    parts: Vec<Screen>,
+}
+
+/// The buffers of a [`Frame`], kept from frame to frame by a
+/// [`crate::Renderer`].
+#[derive(Default)]
+pub(crate) struct FrameBuffers {
+    side: Vec<Side>,
+    screen: Screen,
+    slot: Vec<u32>,
+    bins: Bins,
+    parts: Vec<Screen>,
 }
 
 impl<'a> Frame<'a> {
@@ -129,43 +142,94 @@ impl<'a> Frame<'a> {
         camera: &Camera,
         cull: bool,
     ) -> Result<Frame<'a>, RasterError> {
+        Frame::with_buffers(scene, camera, cull, FrameBuffers::default())
+    }
+
+    /// [`Frame::new`] in the buffers of an earlier frame.
+    pub(crate) fn with_buffers(
+        scene: &'a RasterScene,
+        camera: &Camera,
+        cull: bool,
+        bufs: FrameBuffers,
+    ) -> Result<Frame<'a>, RasterError> {
         if scene.is_empty() {
             return Err(RasterError::EmptyScene);
         }
+        let FrameBuffers {
+            mut side,
+            mut screen,
+            mut slot,
+            mut bins,
+            mut parts,
+        } = bufs;
         let eye = camera.eye();
         let centre = (scene.lo + scene.hi) * 0.5;
         let near = 1e-6 * scene.diagonal().max((eye - centre).length());
         let camera = camera.with_near(near);
-        let vis_plane = crate::scene::visible_planes(scene, eye);
+        crate::scene::eye_sides(scene, eye, &mut side);
         let view = &camera.view;
-        let screen = project_all(view, scene.len(), |i, proj, out, sc| {
-            let Some(p) = vis_plane[i] else { return };
-            if cull && p != scene.support[i] {
-                return;
-            }
-            let (n, d) = scene.plane[i];
-            if let Some(k) = view.coeffs(n, d) {
-                proj.add([scene.prim(i)], k, i as u32, out, sc);
-            }
-        });
-        let mut slot = vec![NONE; scene.len()];
+        project_all_into(
+            view,
+            scene.len(),
+            |i, proj, out, sc| {
+                let s = side[i];
+                if s == Side::On || (cull && s == Side::Back) {
+                    return;
+                }
+                let (n, d) = scene.plane[i];
+                if let Some(k) = view.coeffs(n, d) {
+                    proj.add([scene.prim(i)], k, i as u32, out, sc);
+                }
+            },
+            &mut parts,
+            &mut screen,
+        );
+        slot.clear();
+        slot.resize(scene.len(), NONE);
         for (s, &id) in screen.id.iter().enumerate() {
             slot[id as usize] = s as u32;
         }
-        let vis_normal = (0..scene.len())
-            .map(|i| match vis_plane[i] {
-                Some(p) if p == scene.support[i] => scene.plane[i].0,
-                _ => -scene.plane[i].0,
-            })
-            .collect();
+        bins.rebuild(&screen, camera.height());
         Ok(Frame {
             scene,
             camera,
-            vis_plane,
-            vis_normal,
+            side,
             screen,
             slot,
+            bins,
+            parts,
         })
+    }
+
+    /// The buffers, for the next frame.
+    pub(crate) fn into_buffers(self) -> FrameBuffers {
+        FrameBuffers {
+            side: self.side,
+            screen: self.screen,
+            slot: self.slot,
+            bins: self.bins,
+            parts: self.parts,
+        }
+    }
+
+    /// The exact plane of the side of prim `i` the eye sees (`None` when
+    /// the eye is in its plane).
+    #[inline]
+    pub(crate) fn vis_plane(&self, i: usize) -> Option<Plane> {
+        match self.side[i] {
+            Side::Front => Some(self.scene.support[i]),
+            Side::Back => Some(self.scene.support[i].flip()),
+            Side::On => None,
+        }
+    }
+
+    /// The unit normal (input units) of the side of prim `i` the eye sees.
+    #[inline]
+    pub(crate) fn vis_normal(&self, i: usize) -> DVec3 {
+        match self.side[i] {
+            Side::Front => self.scene.plane[i].0,
+            _ => -self.scene.plane[i].0,
+        }
     }
 
     pub(crate) fn view(&self) -> &View {
@@ -200,8 +264,17 @@ const EMPTY: (f64, u32) = (f64::NEG_INFINITY, NONE);
 
 /// Computes the visibility of `frame` by `method`.
 pub(crate) fn visibility(frame: &Frame<'_>, method: Hsr) -> Visibility {
+    visibility_in(frame, method, None)
+}
+
+/// [`visibility`], the z-buffer in the buffers of an earlier visibility.
+pub(crate) fn visibility_in(
+    frame: &Frame<'_>,
+    method: Hsr,
+    spare: Option<Visibility>,
+) -> Visibility {
     match method {
-        Hsr::ZBuffer => zbuffer(frame),
+        Hsr::ZBuffer => zbuffer(frame, spare),
         Hsr::Scanline => scanline(frame),
         Hsr::Warnock => warnock(frame),
         Hsr::Raycast => raycast(frame),
@@ -209,18 +282,18 @@ pub(crate) fn visibility(frame: &Frame<'_>, method: Hsr) -> Visibility {
     }
 }
 
-fn zbuffer(frame: &Frame<'_>) -> Visibility {
+fn zbuffer(frame: &Frame<'_>, spare: Option<Visibility>) -> Visibility {
     let (w, h) = frame.size();
     let s = &frame.screen;
-    let bins = Bins::new(s, h as u32);
+    let (mut near, mut prim) = spare.map(|v| (v.w, v.prim)).unwrap_or_default();
     // nearness is positive in front of the eye: 0 is "nothing"
-    let mut near = crate::raster::filled(w * h, 0.0f64);
-    let mut prim = crate::raster::filled(w * h, NONE);
+    crate::raster::refill(&mut near, w * h, 0.0f64);
+    crate::raster::refill(&mut prim, w * h, NONE);
     for_bands2(
         &mut near,
         &mut prim,
         w as u32,
-        &bins,
+        &frame.bins,
         |rows, polys, nb, pb| {
             let mut edges = Vec::new();
             for &i in polys {

@@ -134,6 +134,17 @@ pub fn write_pgm(path: &Path, width: u32, height: u32, mask: &[u8]) -> Result<()
     write_file(path, &encode_pgm(width, height, mask))
 }
 
+/// Per-prim shading terms kept from frame to frame by a
+/// [`crate::Renderer`].
+#[derive(Default)]
+pub(crate) struct ShadeBuffers {
+    /// Per drawn prim (by its slot in the frame's screen): colour and
+    /// ambient light.
+    base: Vec<(DVec3, f64)>,
+    /// Per drawn prim and light: the weighted cosine.
+    cosines: Vec<f64>,
+}
+
 /// Lambert shading, as the SVG views: the face's colour times ambient
 /// light (more on surfaces facing the viewer) plus each light's cosine
 /// times the amount of it that reaches the pixel, the cosines taken at
@@ -146,58 +157,93 @@ pub(crate) fn shade(
     lights: &[SceneLight],
     colors: &[DVec3],
 ) -> Image {
+    shade_in(
+        frame,
+        vis,
+        lit,
+        lights,
+        colors,
+        None,
+        &mut ShadeBuffers::default(),
+    )
+}
+
+/// [`shade`] into the memory of `spare` and `bufs`.
+pub(crate) fn shade_in(
+    frame: &Frame<'_>,
+    vis: &Visibility,
+    lit: &LitBuffer,
+    lights: &[SceneLight],
+    colors: &[DVec3],
+    spare: Option<Image>,
+    bufs: &mut ShadeBuffers,
+) -> Image {
     use rayon::prelude::*;
     let (w, h) = (vis.width, vis.height);
-    let mut img = Image::new(w, h, BACKGROUND);
+    let n = w as usize * h as usize;
+    let mut rgb = spare.map(|i| i.rgb).unwrap_or_default();
+    if rgb.len() != 3 * n {
+        rgb = crate::raster::filled(3 * n, 0u8);
+    }
     let scene = frame.scene;
     let eye = frame.camera.eye();
     let weight = DIFFUSE / lights.len().max(1) as f64;
     let grey = DVec3::splat(0.7);
     let nl = lights.len();
-    // per prim: colour, ambient, and each light's weighted cosine
-    let per: Vec<(DVec3, f64)> = (0..scene.len())
-        .into_par_iter()
-        .map(|i| {
+    // per drawn prim: colour, ambient, and each light's weighted cosine
+    let drawn = &frame.screen.id;
+    bufs.base.clear();
+    bufs.base
+        .par_extend(drawn.par_iter().with_min_len(1024).map(|&i| {
+            let i = i as usize;
             let pts = scene.prim(i);
             let centre = pts.iter().sum::<DVec3>() / pts.len() as f64;
             let n = visible_normal(frame, i);
             let to_eye = (eye - centre).normalize_or_zero();
             let c = colors.get(scene.face[i] as usize).copied().unwrap_or(grey);
             (c, AMBIENT + AMBIENT_FACING * n.dot(to_eye).max(0.0))
-        })
-        .collect();
-    let cosines: Vec<f64> = (0..scene.len() * nl)
-        .into_par_iter()
-        .map(|k| {
-            let (i, j) = (k / nl, k % nl);
-            let pts = scene.prim(i);
-            let centre = pts.iter().sum::<DVec3>() / pts.len() as f64;
-            weight
-                * visible_normal(frame, i)
-                    .dot(lights[j].world.toward(centre))
-                    .max(0.0)
-        })
-        .collect();
-    img.rgb
-        .par_chunks_mut(3 * w as usize)
+        }));
+    bufs.cosines.clear();
+    bufs.cosines.par_extend(
+        (0..drawn.len() * nl)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|k| {
+                let (i, j) = (drawn[k / nl] as usize, k % nl);
+                let pts = scene.prim(i);
+                let centre = pts.iter().sum::<DVec3>() / pts.len() as f64;
+                weight
+                    * visible_normal(frame, i)
+                        .dot(lights[j].world.toward(centre))
+                        .max(0.0)
+            }),
+    );
+    let (base, cosines) = (&bufs.base, &bufs.cosines);
+    rgb.par_chunks_mut(3 * w as usize)
         .enumerate()
         .for_each(|(y, row)| {
-            for x in 0..w as usize {
+            for (x, out) in row.chunks_exact_mut(3).enumerate() {
                 let pix = y * w as usize + x;
-                let prim = vis.prim[pix] as usize;
-                if prim == NONE as usize {
+                let prim = vis.prim[pix];
+                if prim == NONE {
+                    out.copy_from_slice(&BACKGROUND);
                     continue;
                 }
-                let (c, mut b) = per[prim];
+                let s = frame.slot[prim as usize] as usize;
+                let (c, mut b) = base[s];
                 for j in 0..nl {
-                    b += lit.amount[pix * nl + j] as f64 * cosines[prim * nl + j];
+                    b += lit.amount[pix * nl + j] as f64 * cosines[s * nl + j];
                 }
                 // in [0.5, 255.5]: truncation rounds (no library call)
                 let v = (c * b).clamp(DVec3::ZERO, DVec3::ONE) * 255.0 + 0.5;
-                row[3 * x..3 * x + 3].copy_from_slice(&[v.x as u8, v.y as u8, v.z as u8]);
+                out.copy_from_slice(&[v.x as u8, v.y as u8, v.z as u8]);
             }
         });
-    img
+    Image {
+        width: w,
+        height: h,
+        rgb,
+    }
 }
 
 /// A 5×7 glyph: seven rows of five bits, most significant bit left.

@@ -169,6 +169,9 @@ fn check_lights(lights: &[SceneLight]) -> Result<(), RasterError> {
 /// Renders `scene` from `camera` with `lights`: visibility, shadows and
 /// Lambert shading. `colors` gives each face's base colour (RGB in
 /// `[0, 1]`, by face index; faces beyond it are grey).
+///
+/// Each call allocates its buffers; a [`Renderer`] keeps them from frame
+/// to frame.
 pub fn render(
     scene: &RasterScene,
     lights: &[SceneLight],
@@ -176,44 +179,9 @@ pub fn render(
     colors: &[DVec3],
     opts: &RenderOptions,
 ) -> Result<Rendered, RasterError> {
-    check_lights(lights)?;
-    opts.shadow.validate()?;
-    let t = Instant::now();
-    let frame = hsr::Frame::new(scene, camera, opts.cull_back_faces)?;
-    let visibility = hsr::visibility(&frame, opts.hsr);
-    let visibility_time = t.elapsed();
-    let (lit, figures) = shadow::shadows(&frame, &visibility, lights, opts.method, &opts.shadow)?;
-    Ok(shaded(
-        &frame,
-        visibility,
-        visibility_time,
-        lit,
-        figures,
-        lights,
-        colors,
-    ))
-}
-
-/// Shades a frame's visibility and lit amounts into a [`Rendered`].
-fn shaded(
-    frame: &hsr::Frame<'_>,
-    visibility: Visibility,
-    visibility_time: Duration,
-    lit: LitBuffer,
-    figures: ShadowFigures,
-    lights: &[SceneLight],
-    colors: &[DVec3],
-) -> Rendered {
-    let t = Instant::now();
-    let image = image::shade(frame, &visibility, &lit, lights, colors);
-    Rendered {
-        visibility,
-        lit,
-        image,
-        figures,
-        visibility_time,
-        shading_time: t.elapsed(),
-    }
+    let mut r = Renderer::new();
+    r.render(scene, lights, camera, colors, opts)?;
+    Ok(r.into_rendered().expect("a frame was rendered"))
 }
 
 /// Renders `scene` with the exact fragments of `batch` (from
@@ -230,21 +198,184 @@ pub fn render_fragments(
     camera: &Camera,
     colors: &[DVec3],
 ) -> Result<Rendered, RasterError> {
-    check_lights(lights)?;
-    let t = Instant::now();
-    let frame = hsr::Frame::new(scene, camera, false)?;
-    let visibility = hsr::visibility(&frame, Hsr::ZBuffer);
-    let visibility_time = t.elapsed();
-    let t = Instant::now();
-    let (lit, mut figures) = exact::draw_fragments(&frame, &visibility, lights.len(), batch);
-    figures.time = t.elapsed();
-    Ok(shaded(
-        &frame,
-        visibility,
-        visibility_time,
-        lit,
-        figures,
-        lights,
-        colors,
-    ))
+    let mut r = Renderer::new();
+    r.render_fragments(scene, batch, lights, camera, colors)?;
+    Ok(r.into_rendered().expect("a frame was rendered"))
+}
+
+/// A renderer that keeps its buffers from frame to frame: the depth and
+/// prim buffers, the prims' projection, the light maps' texels, the lit
+/// amounts and the image. An animation or a bench keeps one and calls
+/// [`Renderer::render`] for every frame; the result is the same as
+/// [`render`]'s, bit for bit, without the cost of fresh memory (a fresh
+/// buffer's pages fault on first write, in every phase).
+///
+/// ```
+/// use glam::DVec3;
+/// use shadow_raster::{Camera, Method, RasterScene, RenderOptions, Renderer};
+/// let grid = bsp_core::Grid::new(DVec3::ZERO, 0).unwrap();
+/// let quad = bsp_core::Polygon::from_grid_points(&[[-4, -4, 0], [4, -4, 0], [4, 4, 0], [-4, 4, 0]], 0).unwrap();
+/// let scene = RasterScene::new(&grid, vec![quad])?;
+/// let mut renderer = Renderer::new();
+/// for k in 0..3 {
+///     let eye = DVec3::new(k as f64, -6.0, 6.0);
+///     let cam = Camera::look_at(eye, DVec3::ZERO, DVec3::Z, 50.0, 32, 24)?;
+///     let opts = RenderOptions::default().with_method(Method::ShadowMap);
+///     let frame = renderer.render(&scene, &[], &cam, &[], &opts)?;
+///     assert_eq!(frame.visibility.prim[12 * 32 + 16], 0);
+/// }
+/// # Ok::<(), shadow_raster::RasterError>(())
+/// ```
+#[derive(Default)]
+pub struct Renderer {
+    frame: hsr::FrameBuffers,
+    shadow: shadow::ShadowBuffers,
+    shade: image::ShadeBuffers,
+    last: Option<Rendered>,
+}
+
+impl std::fmt::Debug for Renderer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Renderer")
+            .field(
+                "last",
+                &self.last.as_ref().map(|r| (r.image.width, r.image.height)),
+            )
+            .finish_non_exhaustive()
+    }
+}
+
+impl Renderer {
+    /// A renderer with no buffers yet.
+    pub fn new() -> Renderer {
+        Renderer::default()
+    }
+
+    /// [`render`] in this renderer's buffers: the frame is the renderer's
+    /// until the next call.
+    pub fn render(
+        &mut self,
+        scene: &RasterScene,
+        lights: &[SceneLight],
+        camera: &Camera,
+        colors: &[DVec3],
+        opts: &RenderOptions,
+    ) -> Result<&Rendered, RasterError> {
+        check_lights(lights)?;
+        opts.shadow.validate()?;
+        let t = Instant::now();
+        let last = self.last.take();
+        let frame = hsr::Frame::with_buffers(
+            scene,
+            camera,
+            opts.cull_back_faces,
+            std::mem::take(&mut self.frame),
+        )?;
+        let (spare_vis, spare_img) = match last {
+            Some(r) => {
+                self.shadow.lit = Some(r.lit);
+                (Some(r.visibility), Some(r.image))
+            }
+            None => (None, None),
+        };
+        let visibility = hsr::visibility_in(&frame, opts.hsr, spare_vis);
+        let visibility_time = t.elapsed();
+        let (lit, figures) = shadow::shadows_in(
+            &frame,
+            &visibility,
+            lights,
+            opts.method,
+            &opts.shadow,
+            &mut self.shadow,
+        )?;
+        let out = self.shaded(
+            &frame,
+            (visibility, visibility_time),
+            lit,
+            figures,
+            lights,
+            colors,
+            spare_img,
+        );
+        self.frame = frame.into_buffers();
+        Ok(self.last.insert(out))
+    }
+
+    /// [`render_fragments`] in this renderer's buffers.
+    pub fn render_fragments(
+        &mut self,
+        scene: &RasterScene,
+        batch: &svbsp::Batch,
+        lights: &[SceneLight],
+        camera: &Camera,
+        colors: &[DVec3],
+    ) -> Result<&Rendered, RasterError> {
+        check_lights(lights)?;
+        let t = Instant::now();
+        let last = self.last.take();
+        let frame =
+            hsr::Frame::with_buffers(scene, camera, false, std::mem::take(&mut self.frame))?;
+        let (spare_vis, spare_img) = match last {
+            Some(r) => (Some(r.visibility), Some(r.image)),
+            None => (None, None),
+        };
+        let visibility = hsr::visibility_in(&frame, Hsr::ZBuffer, spare_vis);
+        let visibility_time = t.elapsed();
+        let t = Instant::now();
+        let (lit, mut figures) = exact::draw_fragments(&frame, &visibility, lights.len(), batch);
+        figures.time = t.elapsed();
+        let out = self.shaded(
+            &frame,
+            (visibility, visibility_time),
+            lit,
+            figures,
+            lights,
+            colors,
+            spare_img,
+        );
+        self.frame = frame.into_buffers();
+        Ok(self.last.insert(out))
+    }
+
+    /// The last frame rendered, if any.
+    pub fn rendered(&self) -> Option<&Rendered> {
+        self.last.as_ref()
+    }
+
+    /// The last frame rendered, the buffers given up.
+    pub fn into_rendered(self) -> Option<Rendered> {
+        self.last
+    }
+
+    /// Shades a frame's visibility and lit amounts into a [`Rendered`].
+    #[allow(clippy::too_many_arguments)]
+    fn shaded(
+        &mut self,
+        frame: &hsr::Frame<'_>,
+        (visibility, visibility_time): (Visibility, Duration),
+        lit: LitBuffer,
+        figures: ShadowFigures,
+        lights: &[SceneLight],
+        colors: &[DVec3],
+        spare: Option<Image>,
+    ) -> Rendered {
+        let t = Instant::now();
+        let image = image::shade_in(
+            frame,
+            &visibility,
+            &lit,
+            lights,
+            colors,
+            spare,
+            &mut self.shade,
+        );
+        Rendered {
+            visibility,
+            lit,
+            image,
+            figures,
+            visibility_time,
+            shading_time: t.elapsed(),
+        }
+    }
 }

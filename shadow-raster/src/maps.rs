@@ -22,12 +22,10 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::hsr::{Frame, NONE, Visibility};
-use crate::raster::{Bins, for_bands, project_all, row_term};
+use crate::raster::{Bins, Screen, for_bands, project_all_into, row_term};
 use crate::scene::{RasterLight, RasterScene, SceneLight};
-use crate::shadow::{
-    LitBuffer, ShadowFigures, ShadowOptions, pixel_point, set_amounts, visible_normal,
-};
-use crate::view::{Kind, View};
+use crate::shadow::{LitBuffer, ShadowFigures, ShadowOptions, set_amounts, visible_normal};
+use crate::view::{Kind, Rays, View};
 
 /// The views of a light's map: six cube faces (`+x, −x, +y, −y, +z, −z`)
 /// for a point light, one orthographic view for a sun.
@@ -117,14 +115,29 @@ fn needed_faces(
     facing: &[u64],
 ) -> [bool; 6] {
     let w = vis.width as usize;
+    let faces = |prim: u32| prim != NONE && facing[prim as usize] >> j & 1 == 1;
+    if matches!(light, RasterLight::Sun(_)) {
+        // one view
+        return [
+            vis.prim.par_iter().any(|&p| faces(p)),
+            false,
+            false,
+            false,
+            false,
+            false,
+        ];
+    }
+    let rays = Rays::new(frame.view());
     vis.prim
         .par_chunks(w)
         .enumerate()
         .map(|(y, row)| {
             let mut need = [false; 6];
+            let rt = rays.row(y);
             for (x, &prim) in row.iter().enumerate() {
-                if prim != NONE && facing[prim as usize] >> j & 1 == 1 {
-                    need[face_of(light, pixel_point(frame, vis, y * w + x))] = true;
+                if faces(prim) {
+                    let p = rays.point(x, y, rt, vis.w[y * w + x]);
+                    need[face_of(light, p)] = true;
                 }
             }
             need
@@ -132,25 +145,56 @@ fn needed_faces(
         .reduce(|| [false; 6], |a, b| std::array::from_fn(|k| a[k] || b[k]))
 }
 
-/// Draws every prim into a `size²` map of view `view`: `update(texel,
-/// nearness, prim)` for each covered texel, bands in parallel.
+/// Projected polygons and their bins, kept from frame to frame.
+#[derive(Default)]
+pub(crate) struct Projected {
+    parts: Vec<Screen>,
+    screen: Screen,
+    bins: Bins,
+}
+
+/// The buffers of the shadow maps kept from frame to frame: the texels of
+/// each view, and the projected prims.
+#[derive(Default)]
+pub(crate) struct MapBuffers {
+    texels: Vec<Vec<f32>>,
+    proj: Projected,
+}
+
+/// Draws every prim into `buf`, a `size²` map of view `view`:
+/// `update(texel, nearness, prim)` for each covered texel, bands in
+/// parallel.
 fn draw_map<T: Copy + Send + Sync>(
     scene: &RasterScene,
     view: &View,
     init: T,
     update: impl Fn(&mut T, f64, u32) + Sync,
-) -> Vec<T> {
+    buf: &mut Vec<T>,
+    proj: &mut Projected,
+) {
     let size = view.width;
-    let screen = project_all(view, scene.len(), |i, proj, out, sc| {
-        let (n, d) = scene.plane[i];
-        if let Some(k) = view.coeffs(n, d) {
-            proj.add([scene.prim(i)], k, i as u32, out, sc);
-        }
-    });
-    let bins = Bins::new(&screen, size);
-    let mut buf = crate::raster::filled(size as usize * size as usize, init);
+    let Projected {
+        parts,
+        screen,
+        bins,
+    } = proj;
+    project_all_into(
+        view,
+        scene.len(),
+        |i, proj, out, sc| {
+            let (n, d) = scene.plane[i];
+            if let Some(k) = view.coeffs(n, d) {
+                proj.add([scene.prim(i)], k, i as u32, out, sc);
+            }
+        },
+        parts,
+        screen,
+    );
+    bins.rebuild(screen, size);
+    crate::raster::refill(buf, size as usize * size as usize, init);
     let w = size as usize;
-    for_bands(&mut buf, size, &bins, |rows, polys, px| {
+    let screen = &*screen;
+    for_bands(buf, size, bins, |rows, polys, px| {
         let mut edges = Vec::new();
         for &s in polys {
             let s = s as usize;
@@ -164,7 +208,6 @@ fn draw_map<T: Copy + Send + Sync>(
             });
         }
     });
-    buf
 }
 
 /// `⌊v⌋` without a library call (this runs for every pixel).
@@ -175,12 +218,12 @@ fn floor(v: f64) -> i64 {
 }
 
 /// A rendered light map: per view its texels (`None` for faces not drawn).
-struct LightMap<T> {
+struct LightMap<'m, T> {
     views: Vec<View>,
-    data: Vec<Option<Vec<T>>>,
+    data: Vec<Option<&'m [T]>>,
 }
 
-impl<T: Copy> LightMap<T> {
+impl<T: Copy> LightMap<'_, T> {
     /// The texel (clamped into the map) of `p`, and `p`'s frame coordinates.
     #[inline]
     fn texel(&self, light: RasterLight, p: DVec3) -> Option<(usize, i64, i64, DVec3)> {
@@ -197,6 +240,9 @@ impl<T: Copy> LightMap<T> {
     }
 }
 
+/// Draws the views of light `j`'s map that some pixel looks up into
+/// `store` (one buffer per view): the views, which were drawn, and the
+/// number of texels drawn.
 #[allow(clippy::too_many_arguments)]
 fn build_map<T: Copy + Send + Sync>(
     frame: &Frame<'_>,
@@ -207,21 +253,31 @@ fn build_map<T: Copy + Send + Sync>(
     size: u32,
     init: T,
     update: impl Fn(&mut T, f64, u32) + Sync,
-) -> (LightMap<T>, usize) {
+    store: &mut Vec<Vec<T>>,
+    proj: &mut Projected,
+) -> (Vec<View>, [bool; 6], usize) {
     let views = light_views(frame.scene, light, size);
     let need = needed_faces(frame, vis, light, j, facing);
+    store.resize_with(views.len(), Vec::new);
     let mut texels = 0;
-    let data = views
-        .iter()
-        .enumerate()
-        .map(|(f, v)| {
-            need[f].then(|| {
-                texels += (size as usize).pow(2);
-                draw_map(frame.scene, v, init, &update)
-            })
-        })
-        .collect();
-    (LightMap { views, data }, texels)
+    for (f, v) in views.iter().enumerate() {
+        if need[f] {
+            texels += (size as usize).pow(2);
+            draw_map(frame.scene, v, init, &update, &mut store[f], proj);
+        }
+    }
+    (views, need, texels)
+}
+
+impl<'m, T> LightMap<'m, T> {
+    fn new(views: Vec<View>, need: [bool; 6], store: &'m [Vec<T>]) -> LightMap<'m, T> {
+        let data = store
+            .iter()
+            .zip(need)
+            .map(|(t, n)| n.then_some(t.as_slice()))
+            .collect();
+        LightMap { views, data }
+    }
 }
 
 /// Williams' shadow map.
@@ -231,14 +287,16 @@ pub(crate) fn shadow_map(
     lights: &[SceneLight],
     facing: &[u64],
     opts: &ShadowOptions,
+    spare: Option<LitBuffer>,
+    bufs: &mut MapBuffers,
 ) -> (LitBuffer, ShadowFigures) {
     let n = lights.len();
-    let mut lit = LitBuffer::new(vis.prim.len(), n);
+    let mut lit = LitBuffer::reuse(spare, vis.prim.len(), n);
     let mut fig = ShadowFigures::default();
     let half = (opts.pcf / 2) as i64;
     let taps = (opts.pcf * opts.pcf) as f32;
     for (j, l) in lights.iter().enumerate() {
-        let (map, texels) = build_map(
+        let (views, need, texels) = build_map(
             frame,
             vis,
             l.world,
@@ -252,14 +310,17 @@ pub(crate) fn shadow_map(
                     *t = w;
                 }
             },
+            &mut bufs.texels,
+            &mut bufs.proj,
         );
+        let map = LightMap::new(views, need, &bufs.texels);
         fig.primitives += texels;
         set_amounts(frame, vis, &mut lit, j, facing, |_, prim, p| {
             let Some((f, x, y, cf)) = map.texel(l.world, p) else {
                 return 0.0;
             };
             let view = &map.views[f];
-            let data = map.data[f].as_ref().expect("needed faces are drawn");
+            let data = map.data[f].expect("needed faces are drawn");
             let z = cf.z;
             // tan θ from the normal and the (unnormalized) way to the light
             let v = match l.world {
@@ -310,11 +371,13 @@ pub(crate) fn texture(
     lights: &[SceneLight],
     facing: &[u64],
     opts: &ShadowOptions,
+    spare: Option<LitBuffer>,
 ) -> (LitBuffer, ShadowFigures) {
     let scene = frame.scene;
     let (obj, count) = objects(scene);
     let n = lights.len();
-    let mut lit = LitBuffer::new(vis.prim.len(), n);
+    let mut lit = LitBuffer::reuse(spare, vis.prim.len(), n);
+    let (mut store, mut proj) = (Vec::new(), Projected::default());
     let mut fig = ShadowFigures::default();
     for (j, l) in lights.iter().enumerate() {
         // objects in the light's order, by their nearest vertex
@@ -335,7 +398,7 @@ pub(crate) fn texture(
             rank[o as usize] = r as u32;
         }
         let prim_rank: Vec<u32> = obj.iter().map(|&o| rank[o as usize]).collect();
-        let (map, texels) = build_map(
+        let (views, need, texels) = build_map(
             frame,
             vis,
             l.world,
@@ -346,13 +409,16 @@ pub(crate) fn texture(
             |t, _, prim| {
                 *t = (*t).min(prim_rank[prim as usize]);
             },
+            &mut store,
+            &mut proj,
         );
+        let map = LightMap::new(views, need, &store);
         fig.primitives += texels;
         set_amounts(frame, vis, &mut lit, j, facing, |_, prim, p| {
             let Some((f, x, y, _)) = map.texel(l.world, p) else {
                 return 1.0;
             };
-            let data = map.data[f].as_ref().expect("needed faces are drawn");
+            let data = map.data[f].expect("needed faces are drawn");
             let first = data[(y * map.views[f].width as i64 + x) as usize];
             (first >= prim_rank[prim as usize]) as u8 as f32
         });

@@ -98,7 +98,9 @@ pub(crate) fn planar(
                 continue; // the plane faces away: attached shadow already
             }
             // the prims of this receiver that the eye sees from the front
-            let on: Vec<bool> = frame.vis_plane.iter().map(|p| *p == Some(*plane)).collect();
+            let on: Vec<bool> = (0..scene.len())
+                .map(|i| frame.vis_plane(i) == Some(*plane))
+                .collect();
             if !vis.prim.iter().any(|&p| p != NONE && on[p as usize]) {
                 continue;
             }

@@ -206,7 +206,20 @@ impl Screen {
             .map(move |k| &self.pts[self.ring_start[k] as usize..self.ring_start[k + 1] as usize])
     }
 
-    fn append(&mut self, o: Screen) {
+    /// Empties the screen, keeping its buffers.
+    fn clear(&mut self) {
+        self.pts.clear();
+        self.ring_start.clear();
+        self.ring_start.push(0);
+        self.poly_ring.clear();
+        self.poly_ring.push(0);
+        self.rows.clear();
+        self.cols.clear();
+        self.coeffs.clear();
+        self.id.clear();
+    }
+
+    fn append(&mut self, o: &Screen) {
         let p0 = self.pts.len() as u32;
         let r0 = (self.ring_start.len() - 1) as u32;
         self.pts.extend_from_slice(&o.pts);
@@ -451,28 +464,39 @@ pub(crate) fn project_all(
     count: usize,
     make: impl Fn(usize, &Projector<'_>, &mut Screen, &mut (Vec<DVec3>, Vec<DVec3>)) + Sync,
 ) -> Screen {
+    let mut all = Screen::new();
+    project_all_into(view, count, make, &mut Vec::new(), &mut all);
+    all
+}
+
+/// [`project_all`] into `all`, in the buffers of an earlier call (`parts`
+/// keeps the per-chunk screens).
+pub(crate) fn project_all_into(
+    view: &View,
+    count: usize,
+    make: impl Fn(usize, &Projector<'_>, &mut Screen, &mut (Vec<DVec3>, Vec<DVec3>)) + Sync,
+    parts: &mut Vec<Screen>,
+    all: &mut Screen,
+) {
     const CHUNK: usize = 4096;
     let proj = Projector::new(view);
-    let parts: Vec<Screen> = (0..count.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|c| {
-            let mut out = Screen::new();
-            let mut scratch = (Vec::new(), Vec::new());
-            for i in c * CHUNK..((c + 1) * CHUNK).min(count) {
-                make(i, &proj, &mut out, &mut scratch);
-            }
-            out
-        })
-        .collect();
-    let mut all = Screen::new();
-    for p in parts {
+    parts.resize_with(count.div_ceil(CHUNK), Screen::new);
+    parts.par_iter_mut().enumerate().for_each(|(c, out)| {
+        out.clear();
+        let mut scratch = (Vec::new(), Vec::new());
+        for i in c * CHUNK..((c + 1) * CHUNK).min(count) {
+            make(i, &proj, out, &mut scratch);
+        }
+    });
+    all.clear();
+    for p in parts.iter() {
         all.append(p);
     }
-    all
 }
 
 /// The polygons of `screen` reaching each band of [`BAND`] rows, in
 /// polygon order: band `b` is `list[start[b]..start[b + 1]]`.
+#[derive(Default)]
 pub(crate) struct Bins {
     start: Vec<u32>,
     list: Vec<u32>,
@@ -480,8 +504,20 @@ pub(crate) struct Bins {
 
 impl Bins {
     pub(crate) fn new(screen: &Screen, height: u32) -> Bins {
+        let mut b = Bins {
+            start: Vec::new(),
+            list: Vec::new(),
+        };
+        b.rebuild(screen, height);
+        b
+    }
+
+    /// The bins of `screen`, in the buffers of earlier ones.
+    pub(crate) fn rebuild(&mut self, screen: &Screen, height: u32) {
         let bands = (height as usize).div_ceil(BAND);
-        let mut count = vec![0u32; bands + 1];
+        let count = &mut self.start;
+        count.clear();
+        count.resize(bands + 1, 0);
         let band_range = |&(r0, r1): &(i32, i32)| {
             let b0 = r0 as usize / BAND;
             let b1 = (r1 as usize - 1) / BAND + 1;
@@ -496,14 +532,14 @@ impl Bins {
             count[b + 1] += count[b];
         }
         let mut fill = count.clone();
-        let mut list = vec![0u32; count[bands] as usize];
+        self.list.clear();
+        self.list.resize(count[bands] as usize, 0);
         for (i, r) in screen.rows.iter().enumerate() {
             for b in band_range(r) {
-                list[fill[b] as usize] = i as u32;
+                self.list[fill[b] as usize] = i as u32;
                 fill[b] += 1;
             }
         }
-        Bins { start: count, list }
     }
 
     pub(crate) fn band(&self, b: usize) -> &[u32] {
@@ -536,6 +572,16 @@ pub(crate) fn filled<T: Copy + Send + Sync>(n: usize, v: T) -> Vec<T> {
     let mut out = Vec::with_capacity(n);
     out.par_extend(rayon::iter::repeat_n(v, n));
     out
+}
+
+/// `buf` made `n` copies of `v`: in place and in parallel when it already
+/// holds `n` values (a kept buffer), else as [`filled`].
+pub(crate) fn refill<T: Copy + Send + Sync>(buf: &mut Vec<T>, n: usize, v: T) {
+    if buf.len() == n {
+        buf.par_chunks_mut(1 << 14).for_each(|c| c.fill(v));
+    } else {
+        *buf = filled(n, v);
+    }
 }
 
 /// [`for_bands`] over two images at once.

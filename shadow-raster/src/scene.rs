@@ -239,19 +239,18 @@ pub(crate) fn world_plane(grid: &Grid, p: &Plane) -> (DVec3, f64) {
     (n / len, dw / len)
 }
 
-/// Prims grouped by the plane of the side the eye sees, for each prim the
-/// visible side's exact plane (`None` when seen edge-on).
-pub(crate) fn visible_planes(scene: &RasterScene, eye: DVec3) -> Vec<Option<Plane>> {
+/// The side of each prim's exact plane the point `eye` (input units) is
+/// on, into `out`.
+pub(crate) fn eye_sides(scene: &RasterScene, eye: DVec3, out: &mut Vec<Side>) {
     use rayon::prelude::*;
     let vp = scene.grid.snap_viewpoint(eye).ok();
-    (0..scene.len())
-        .into_par_iter()
-        .map(|i| match scene.eye_side(i, vp, eye) {
-            Side::Front => Some(scene.support[i]),
-            Side::Back => Some(scene.support[i].flip()),
-            Side::On => None,
-        })
-        .collect()
+    out.clear();
+    out.par_extend(
+        (0..scene.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|i| scene.eye_side(i, vp, eye)),
+    );
 }
 
 #[cfg(test)]

@@ -13,6 +13,7 @@ use glam::DVec3;
 use crate::RasterError;
 use crate::hsr::{Frame, NONE, Visibility};
 use crate::scene::{RasterLight, SceneLight};
+use crate::view::Rays;
 
 /// A shadow method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -177,6 +178,19 @@ impl LitBuffer {
         }
     }
 
+    /// A buffer for `pixels × lights` amounts in the memory of `spare`,
+    /// its values left as they were: for methods that write every cell
+    /// (through [`set_amounts`]).
+    pub(crate) fn reuse(spare: Option<LitBuffer>, pixels: usize, lights: usize) -> LitBuffer {
+        match spare {
+            Some(l) if l.amount.len() == pixels * lights => LitBuffer {
+                lights,
+                amount: l.amount,
+            },
+            _ => LitBuffer::new(pixels, lights),
+        }
+    }
+
     /// `true` if light `j` reaches pixel `p` (at least half of it, with
     /// PCF).
     #[inline]
@@ -201,15 +215,16 @@ pub struct ShadowFigures {
 /// Per prim, bit `j` set when light `j` lies strictly on the side of the
 /// prim's exact plane that the eye sees.
 pub(crate) fn facing_bits(frame: &Frame<'_>, lights: &[SceneLight]) -> Vec<u64> {
-    frame
-        .vis_plane
-        .iter()
-        .map(|p| match p {
+    use rayon::prelude::*;
+    (0..frame.scene.len())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|i| match frame.vis_plane(i) {
             None => 0,
             Some(p) => lights
                 .iter()
                 .enumerate()
-                .fold(0u64, |m, (j, l)| m | (l.exact.faces(p) as u64) << j),
+                .fold(0u64, |m, (j, l)| m | (l.exact.faces(&p) as u64) << j),
         })
         .collect()
 }
@@ -217,7 +232,7 @@ pub(crate) fn facing_bits(frame: &Frame<'_>, lights: &[SceneLight]) -> Vec<u64> 
 /// The unit normal of the side of prim `i` the eye sees.
 #[inline]
 pub(crate) fn visible_normal(frame: &Frame<'_>, i: usize) -> DVec3 {
-    frame.vis_normal[i]
+    frame.vis_normal(i)
 }
 
 /// The world point of pixel `pix` (which has a visible prim).
@@ -228,6 +243,16 @@ pub(crate) fn pixel_point(frame: &Frame<'_>, vis: &Visibility, pix: usize) -> DV
     frame.view().point(x, y, vis.w[pix])
 }
 
+/// Buffers of the shadow methods kept from frame to frame by a
+/// [`crate::Renderer`].
+#[derive(Default)]
+pub(crate) struct ShadowBuffers {
+    /// The lit buffer of an earlier frame.
+    pub(crate) lit: Option<LitBuffer>,
+    /// Light maps.
+    pub(crate) maps: crate::maps::MapBuffers,
+}
+
 /// Computes the lit buffer of `method`.
 pub(crate) fn shadows(
     frame: &Frame<'_>,
@@ -236,14 +261,36 @@ pub(crate) fn shadows(
     method: Method,
     opts: &ShadowOptions,
 ) -> Result<(LitBuffer, ShadowFigures), RasterError> {
+    shadows_in(
+        frame,
+        vis,
+        lights,
+        method,
+        opts,
+        &mut ShadowBuffers::default(),
+    )
+}
+
+/// [`shadows`] in the buffers of earlier frames.
+pub(crate) fn shadows_in(
+    frame: &Frame<'_>,
+    vis: &Visibility,
+    lights: &[SceneLight],
+    method: Method,
+    opts: &ShadowOptions,
+    bufs: &mut ShadowBuffers,
+) -> Result<(LitBuffer, ShadowFigures), RasterError> {
     opts.validate()?;
     let start = std::time::Instant::now();
     let facing = facing_bits(frame, lights);
+    let spare = bufs.lit.take();
     let (lit, mut fig) = match method {
         Method::Exact => crate::exact::exact(frame, vis, lights, None, &facing)?,
-        Method::Raycast => raycast(frame, vis, lights, &facing),
-        Method::ShadowMap => crate::maps::shadow_map(frame, vis, lights, &facing, opts),
-        Method::Texture => crate::maps::texture(frame, vis, lights, &facing, opts),
+        Method::Raycast => raycast(frame, vis, lights, &facing, spare),
+        Method::ShadowMap => {
+            crate::maps::shadow_map(frame, vis, lights, &facing, opts, spare, &mut bufs.maps)
+        }
+        Method::Texture => crate::maps::texture(frame, vis, lights, &facing, opts, spare),
         Method::StencilZpass => crate::stencil::stencil(frame, vis, lights, &facing, false),
         Method::StencilZfail => crate::stencil::stencil(frame, vis, lights, &facing, true),
         Method::Planar => crate::planar::planar(frame, vis, lights, &facing, opts),
@@ -275,7 +322,8 @@ pub(crate) fn facing_only(vis: &Visibility, lights: usize, facing: &[u64]) -> Li
 pub const RAY_EPSILON: f64 = 1e-7;
 
 /// Sets the amount of light `j` at every pixel whose visible side faces
-/// it to `amount(pixel, prim, point)`, in parallel.
+/// it to `amount(pixel, prim, point)`, and at every other pixel to 0, in
+/// parallel by rows.
 pub(crate) fn set_amounts(
     frame: &Frame<'_>,
     vis: &Visibility,
@@ -285,17 +333,21 @@ pub(crate) fn set_amounts(
     amount: impl Fn(usize, u32, DVec3) -> f32 + Sync,
 ) {
     use rayon::prelude::*;
-    let n = lit.lights;
+    let (n, w) = (lit.lights, vis.width as usize);
+    let rays = Rays::new(frame.view());
     lit.amount
-        .par_chunks_mut(n * 256)
+        .par_chunks_mut(n * w)
         .enumerate()
-        .for_each(|(c, chunk)| {
-            for (k, cell) in chunk.chunks_mut(n).enumerate() {
-                let pix = c * 256 + k;
+        .for_each(|(y, cells)| {
+            let row = rays.row(y);
+            for (x, cell) in cells.chunks_mut(n).enumerate() {
+                let pix = y * w + x;
                 let prim = vis.prim[pix];
-                if prim != NONE && facing[prim as usize] >> j & 1 == 1 {
-                    cell[j] = amount(pix, prim, pixel_point(frame, vis, pix));
-                }
+                cell[j] = if prim != NONE && facing[prim as usize] >> j & 1 == 1 {
+                    amount(pix, prim, rays.point(x, y, row, vis.w[pix]))
+                } else {
+                    0.0
+                };
             }
         });
 }
@@ -305,11 +357,12 @@ fn raycast(
     vis: &Visibility,
     lights: &[SceneLight],
     facing: &[u64],
+    spare: Option<LitBuffer>,
 ) -> (LitBuffer, ShadowFigures) {
     let scene = frame.scene;
     let bvh = crate::bvh::Bvh::new(scene);
     let eps = RAY_EPSILON * scene.diagonal();
-    let mut lit = LitBuffer::new(vis.prim.len(), lights.len());
+    let mut lit = LitBuffer::reuse(spare, vis.prim.len(), lights.len());
     for (j, l) in lights.iter().enumerate() {
         set_amounts(frame, vis, &mut lit, j, facing, |_, prim, p| {
             let (d, tmax) = match l.world {

@@ -213,6 +213,54 @@ pub(crate) struct View {
     pub(crate) scale: (f64, f64),
 }
 
+/// The rays of a view's pixel centres, split into a part per column and a
+/// part per row, so that a pass over the pixels finds each pixel's point
+/// without a division by the image size: [`Rays::point`] gives
+/// [`View::point`]'s bits.
+pub(crate) struct Rays<'a> {
+    view: &'a View,
+    /// Perspective: `((2·xc/W) − 1)·kx·r` per column (empty otherwise).
+    col: Vec<DVec3>,
+}
+
+impl<'a> Rays<'a> {
+    pub(crate) fn new(view: &'a View) -> Rays<'a> {
+        let col = match view.kind {
+            Kind::Perspective { kx, .. } => {
+                let w = view.width as f64;
+                (0..view.width)
+                    .map(|x| ((2.0 * (x as f64 + 0.5) / w) - 1.0) * kx * view.r)
+                    .collect()
+            }
+            Kind::Orthographic { .. } => Vec::new(),
+        };
+        Rays { view, col }
+    }
+
+    /// The part of row `y`.
+    #[inline]
+    pub(crate) fn row(&self, y: usize) -> DVec3 {
+        match self.view.kind {
+            Kind::Perspective { ky, .. } => {
+                let h = self.view.height as f64;
+                (1.0 - 2.0 * (y as f64 + 0.5) / h) * ky * self.view.u
+            }
+            Kind::Orthographic { .. } => DVec3::ZERO,
+        }
+    }
+
+    /// The world point at the centre of pixel `(x, y)` with nearness `w`,
+    /// `row` being [`Rays::row`]`(y)`.
+    #[inline]
+    pub(crate) fn point(&self, x: usize, y: usize, row: DVec3, w: f64) -> DVec3 {
+        match self.col.get(x) {
+            // the order of View::dir's sums
+            Some(&c) => self.view.origin + (self.view.f + c + row) / w,
+            None => self.view.point(x as f64 + 0.5, y as f64 + 0.5, w),
+        }
+    }
+}
+
 /// A plane `a · c + d >= 0` in frame coordinates.
 pub(crate) type ClipPlane = (DVec3, f64);
 

@@ -1,0 +1,79 @@
+//! Renders the bench's frames (`bunny-99k`, default point light and a
+//! sun) and writes their images, masks and lit amounts to a folder, for a
+//! byte-for-byte comparison of two builds; `--repeat N` renders the
+//! point-light shadow-map frame N more times (for `perf record`).
+//!
+//! ```sh
+//! cargo run --release -p shadow-raster --example frame_dump -- OUT_DIR [--repeat N]
+//! ```
+
+use glam::DVec3;
+use shadow_raster::{Camera, Method, RasterScene, RenderOptions, Renderer, SceneLight, render};
+use svbsp::{LightSpec, place_lights, shared_grid};
+
+fn setup(sun: bool) -> (RasterScene, Vec<SceneLight>, Camera) {
+    let mesh = shadow_scene::scene("bunny-99k").expect("a built-in scene");
+    let (lo, hi) = mesh.bounds().unwrap();
+    let (c, half) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
+    let spec = if sun {
+        LightSpec::Sun(DVec3::new(3.0, 10.0, 2.0))
+    } else {
+        LightSpec::Point(c + DVec3::Y * 1.6 * half + DVec3::X * 0.4 * half + DVec3::Z * 0.6 * half)
+    };
+    let grid = shared_grid(&mesh.positions, &[spec]).unwrap();
+    let lights = place_lights(&grid, &[spec])
+        .unwrap()
+        .iter()
+        .map(SceneLight::from_placed)
+        .collect();
+    let (polys, _) = bsp_core::import_faces_par(&grid, &mesh.face_loops()).unwrap();
+    let eye = c + DVec3::new(0.75 * half, 0.6 * half, 1.7 * half);
+    let cam = Camera::look_at(eye, c - DVec3::Y * 0.25 * half, DVec3::Y, 50.0, 1920, 1080).unwrap();
+    (RasterScene::new(&grid, polys).unwrap(), lights, cam)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let out = std::path::PathBuf::from(args.get(1).expect("an output folder"));
+    let repeat: usize = match args.get(2).map(String::as_str) {
+        Some("--repeat") => args[3].parse().unwrap(),
+        _ => 0,
+    };
+    std::fs::create_dir_all(&out).unwrap();
+    for (name, sun) in [("point", false), ("sun", true)] {
+        let (scene, lights, cam) = setup(sun);
+        for m in [Method::ShadowMap, Method::Raycast] {
+            let o = RenderOptions::default().with_method(m);
+            let r = render(&scene, &lights, &cam, &[], &o).unwrap();
+            let stem = format!("{name}-{}", m.name());
+            std::fs::write(out.join(format!("{stem}.rgb")), &r.image.rgb).unwrap();
+            std::fs::write(out.join(format!("{stem}.mask")), r.mask()).unwrap();
+            let lit: Vec<u8> = r.lit.amount.iter().flat_map(|a| a.to_le_bytes()).collect();
+            std::fs::write(out.join(format!("{stem}.lit")), lit).unwrap();
+            let prim: Vec<u8> = r
+                .visibility
+                .prim
+                .iter()
+                .flat_map(|a| a.to_le_bytes())
+                .collect();
+            std::fs::write(out.join(format!("{stem}.prim")), prim).unwrap();
+        }
+        if !sun && repeat > 0 {
+            let o = RenderOptions::default().with_method(Method::ShadowMap);
+            let mut r = Renderer::new();
+            let t = std::time::Instant::now();
+            for _ in 0..repeat {
+                std::hint::black_box(r.render(&scene, &lights, &cam, &[], &o).unwrap());
+            }
+            eprintln!(
+                "{:.1} ms a frame",
+                t.elapsed().as_secs_f64() * 1e3 / repeat as f64
+            );
+            let once = render(&scene, &lights, &cam, &[], &o).unwrap();
+            assert!(
+                r.rendered().unwrap().image == once.image,
+                "kept buffers change the image"
+            );
+        }
+    }
+}
