@@ -2,7 +2,8 @@
 //! (the goal: a frame with z-buffer and a 2048² shadow map in at
 //! most 30 ms), with the phases apart, and the same frame at 960×540.
 //!
-//! A frame is visibility, shadows and shading, the scene already loaded;
+//! A frame is visibility, shadows and shading, the scene already loaded
+//! (also frame after frame in one `Renderer`, which keeps its buffers);
 //! the PNG encoding is timed apart. The baseline in the same run is the
 //! frame with one shadow ray per pixel (the `raycast` method). The camera and light are the defaults
 //! of `shadow render --scene bunny-99k`.
@@ -13,7 +14,7 @@ use std::time::Duration;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DVec3;
 use shadow_raster::{
-    Camera, Hsr, Method, RasterScene, RenderOptions, SceneLight, ShadowOptions, render,
+    Camera, Hsr, Method, RasterScene, RenderOptions, Renderer, SceneLight, ShadowOptions, render,
     visible_surfaces,
 };
 use svbsp::{LightSpec, place_lights, shared_grid};
@@ -74,6 +75,23 @@ fn frames(cr: &mut Criterion) {
             g.bench_function(
                 format!("{w}x{h}/frame zbuffer + shadow map 2048, {what}"),
                 |b| b.iter(|| black_box(render(&s.scene, &s.lights, &cam, &[], &opts).unwrap())),
+            );
+            // frame after frame in one Renderer (an animation): its buffers
+            // are kept from the previous frame
+            let mut renderer = Renderer::new();
+            g.bench_function(
+                format!("{w}x{h}/frame zbuffer + shadow map 2048, {what}, kept Renderer"),
+                |b| {
+                    b.iter(|| {
+                        black_box(
+                            renderer
+                                .render(&s.scene, &s.lights, &cam, &[], &opts)
+                                .unwrap()
+                                .image
+                                .width,
+                        )
+                    })
+                },
             );
         }
     }
