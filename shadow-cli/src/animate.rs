@@ -342,6 +342,9 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
     let mut times: Vec<Duration> = Vec::with_capacity(args.frames as usize);
     let mut related = 0usize;
     let mut last = FrameStats::default();
+    // PNG frames are drawn one after the other in one renderer, which
+    // keeps its buffers from frame to frame
+    let mut renderer = shadow_raster::Renderer::new();
     let loop_start = Instant::now();
     let in_flight = args.in_flight.max(1);
     let mut k0 = 0;
@@ -389,7 +392,7 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
             if args.format == FrameFormat::Png {
                 let path = stem.with_extension("png");
                 let view = view.as_ref().expect("PNG frames have a view");
-                frame_png(&d, &frame, &colors, &placed, view, &path)?;
+                frame_png(&mut renderer, &d, &frame, &colors, &placed, view, &path)?;
             }
             if args.format == FrameFormat::Json {
                 let path = stem.with_extension("json");
@@ -555,6 +558,7 @@ fn frame_json(
 
 /// Rasterizes the frame's exact fragments to a PNG (`shadow-raster`).
 fn frame_png(
+    renderer: &mut shadow_raster::Renderer,
     d: &Dynamic,
     frame: &tiling::Frame,
     colors: &[glam::DVec3],
@@ -588,7 +592,7 @@ fn frame_png(
         .map(shadow_raster::SceneLight::from_placed)
         .collect();
     let batch = d.fragments(frame);
-    let out = shadow_raster::render_fragments(&scene, &batch, &lights, &camera, colors)?;
+    let out = renderer.render_fragments(&scene, &batch, &lights, &camera, colors)?;
     let mut o = Output::create(path)?;
     o.write_all(&out.image.encode_png())
         .with_context(|| format!("could not write {}", path.display()))?;
