@@ -8,7 +8,8 @@
 //! both operands, more than `leaf_size` faces in all, and can be split.
 //! Faces are sent to every child their box overlaps.
 
-use bsp_core::Plane;
+use bsp_core::{Plane, Polygon};
+use smallvec::SmallVec;
 
 use crate::index::IBox;
 
@@ -62,6 +63,55 @@ pub(crate) fn plane_meets(pl: &Plane, bx: &IBox) -> bool {
         hi += a.max(b);
     }
     lo <= 0 && 0 <= hi
+}
+
+/// Whether the polygon meets the closed box of a cell (walls included).
+/// Exact for polygons with grid vertices (separating axes: the box's, the
+/// polygon's normal, and its edges crossed with the box's axes, all in
+/// doubled integer coordinates); for others the support plane's test
+/// ([`plane_meets`]), which may say yes where the polygon does not reach.
+pub(crate) fn polygon_meets(poly: &Polygon, bx: &IBox) -> bool {
+    if !plane_meets(poly.support(), bx) {
+        return false;
+    }
+    let g: Option<SmallVec<[[i128; 3]; 8]>> = poly
+        .vertices()
+        .iter()
+        .map(|v| v.as_grid().map(|c| c.map(|x| 2 * x as i128)))
+        .collect();
+    let Some(g) = g else {
+        return true;
+    };
+    // the box in doubled coordinates: centre lo + hi, half extent hi − lo + 1
+    let c = [0, 1, 2].map(|k| (bx.0[k] + bx.1[k]) as i128);
+    let h = [0, 1, 2].map(|k| (bx.1[k] - bx.0[k] + 1) as i128);
+    let dot = |l: &[i128; 3], p: &[i128; 3]| l[0] * p[0] + l[1] * p[1] + l[2] * p[2];
+    for (i, &p) in g.iter().enumerate() {
+        let q = g[(i + 1) % g.len()];
+        let e = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+        for k in 0..3 {
+            // e × unit axis k
+            let mut l = [0i128; 3];
+            let (u, v) = ((k + 1) % 3, (k + 2) % 3);
+            l[u] = e[v];
+            l[v] = -e[u];
+            if l == [0; 3] {
+                continue;
+            }
+            let (mut lo, mut hi) = (i128::MAX, i128::MIN);
+            for w in &g {
+                let d = dot(&l, w);
+                lo = lo.min(d);
+                hi = hi.max(d);
+            }
+            let mid = dot(&l, &c);
+            let r = l[0].abs() * h[0] + l[1].abs() * h[1] + l[2].abs() * h[2];
+            if hi < mid - r || lo > mid + r {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// The leaves of the octree over `domain` for the faces of `a` and `b`, in

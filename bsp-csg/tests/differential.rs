@@ -120,11 +120,13 @@ proptest! {
         b in shape(),
         op in op(),
         leaf in prop::sample::select(vec![1usize, 2, 3, 24]),
+        exact in any::<bool>(),
     ) {
         let (pa, pb) = (polys(&a), polys(&b));
         let mut octree = Solid::from_polygons(pa.clone());
+        let opts = Options::default().with_leaf_size(leaf).with_exact_cells(exact);
         octree
-            .apply_with(&Solid::from_polygons(pb.clone()), op, &Options::default().with_leaf_size(leaf))
+            .apply_with(&Solid::from_polygons(pb.clone()), op, &opts)
             .unwrap();
         let global = Partition::solid(pa).boolean(&Partition::solid(pb), op);
         same(&octree, &global)?;
@@ -135,8 +137,9 @@ proptest! {
         first in shape(),
         rest in prop::collection::vec((shape(), op()), 1..5),
         leaf in prop::sample::select(vec![1usize, 2, 5, 24]),
+        exact in any::<bool>(),
     ) {
-        let opts = Options::default().with_leaf_size(leaf);
+        let opts = Options::default().with_leaf_size(leaf).with_exact_cells(exact);
         let mut octree = Solid::from_polygons(polys(&first));
         let mut global = Partition::solid(polys(&first));
         for (s, op) in &rest {
