@@ -45,9 +45,31 @@ pub fn uv_sphere(n: usize) -> (Vec<DVec3>, Vec<Vec<u32>>) {
     (v, t)
 }
 
+/// `n` points spread evenly over the unit sphere (a Fibonacci spiral from
+/// the north pole to the south pole).
+pub fn fibonacci_sphere(n: usize) -> Vec<DVec3> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let a = golden * i as f64;
+            DVec3::new(r * a.cos(), r * a.sin(), z)
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fibonacci_points_are_on_the_sphere_from_pole_to_pole() {
+        let p = fibonacci_sphere(50);
+        assert_eq!(p.len(), 50);
+        assert!(p.iter().all(|q| (q.length() - 1.0).abs() < 1e-12));
+        assert!(p[0].z > 0.95 && p[49].z < -0.95);
+    }
 
     #[test]
     fn uv_sphere_is_closed_and_outward() {

@@ -11,7 +11,7 @@
 //!   1000-tool case of the docs).
 
 use bsp_core::BoolOp;
-use bsp_csg::shapes::uv_sphere;
+use bsp_csg::shapes::{fibonacci_sphere, uv_sphere};
 use bsp_csg::{MeshIn, Snapped, snap};
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 use glam::{DMat3, DVec3};
@@ -47,15 +47,9 @@ fn drill(c: &mut Criterion) {
     let (pv, pf) = uv_sphere(10_000);
     let (tv, tf) = uv_sphere(1_000);
     let tools = 20;
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    let placed: Vec<Vec<DVec3>> = (0..tools)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f64 + 0.5) / tools as f64;
-            let r = (1.0 - z * z).sqrt();
-            let a = golden * i as f64;
-            let c = DVec3::new(r * a.cos(), r * a.sin(), z);
-            tv.iter().map(|&p| c + 0.05 * p).collect()
-        })
+    let placed: Vec<Vec<DVec3>> = fibonacci_sphere(tools)
+        .into_iter()
+        .map(|c| tv.iter().map(|&p| c + 0.05 * p).collect())
         .collect();
     let mut meshes = vec![MeshIn::new(&pv, &pf)];
     meshes.extend(placed.iter().map(|v| MeshIn::new(v, &tf)));

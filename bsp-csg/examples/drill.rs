@@ -13,7 +13,7 @@
 use std::time::Instant;
 
 use bsp_core::BoolOp;
-use bsp_csg::shapes::uv_sphere;
+use bsp_csg::shapes::{fibonacci_sphere, uv_sphere};
 use bsp_csg::{MeshIn, Snapped, snap};
 use glam::DVec3;
 
@@ -24,18 +24,9 @@ fn main() {
     let tool_tris = args.next().flatten().unwrap_or(1000);
     let (pv, pf) = uv_sphere(part_tris);
     let (tv, tf) = uv_sphere(tool_tris);
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    let tool_meshes: Vec<Vec<DVec3>> = (0..tools)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f64 + 0.5) / tools as f64;
-            let r = (1.0 - z * z).sqrt();
-            let c = DVec3::new(
-                r * (golden * i as f64).cos(),
-                r * (golden * i as f64).sin(),
-                z,
-            );
-            tv.iter().map(|&p| c + 0.05 * p).collect()
-        })
+    let tool_meshes: Vec<Vec<DVec3>> = fibonacci_sphere(tools)
+        .into_iter()
+        .map(|c| tv.iter().map(|&p| c + 0.05 * p).collect())
         .collect();
     let mut meshes = vec![MeshIn::new(&pv, &pf)];
     meshes.extend(tool_meshes.iter().map(|v| MeshIn::new(v, &tf)));

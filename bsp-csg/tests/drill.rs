@@ -9,22 +9,16 @@
 //! left holes (the 2 000-triangle part minus 20 tools, from step 2 on).
 
 use bsp_core::BoolOp;
-use bsp_csg::shapes::uv_sphere;
+use bsp_csg::shapes::{fibonacci_sphere, uv_sphere};
 use bsp_csg::{MeshIn, Options, Snapped, snap};
 use glam::DVec3;
 
 fn drill(tools: usize, opts: &Options) -> (f64, usize) {
     let (pv, pf) = uv_sphere(2000);
     let (tv, tf) = uv_sphere(1000);
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    let placed: Vec<Vec<DVec3>> = (0..tools)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f64 + 0.5) / tools as f64;
-            let r = (1.0 - z * z).sqrt();
-            let a = golden * i as f64;
-            let c = DVec3::new(r * a.cos(), r * a.sin(), z);
-            tv.iter().map(|&p| c + 0.05 * p).collect()
-        })
+    let placed: Vec<Vec<DVec3>> = fibonacci_sphere(tools)
+        .into_iter()
+        .map(|c| tv.iter().map(|&p| c + 0.05 * p).collect())
         .collect();
     let mut meshes = vec![MeshIn::new(&pv, &pf)];
     meshes.extend(placed.iter().map(|v| MeshIn::new(v, &tf)));
