@@ -923,8 +923,14 @@ fn signed_area_sign(points: &Points<'_>, l: &[u32], u: usize, v: usize) -> i32 {
         s += x - y;
         t += x.abs() + y.abs();
     }
-    // each coordinate is within half an ulp of the exact value, each term
-    // carries a few roundings and the sum m more
+    // A certified filter, not a tolerance: each coordinate is within half
+    // an ulp (ε/2 relative) of the exact value, so each product is within
+    // about 3ε/2 of the exact product, the difference adds ε/2 and the
+    // running sum at most (m − 1)ε of `t`; `(m + 8)ε·t` bounds |s − exact|
+    // with room for the second-order terms. Nothing underflows: nonzero
+    // coordinates are at least 2^−200 or so (rationals of in-budget
+    // planes), products far above the subnormal range. Within the bound
+    // the exact rationals below decide.
     let bound = t * (m as f64 + 8.0) * f64::EPSILON;
     if s > bound {
         return 1;

@@ -67,8 +67,11 @@ mod tests {
     fn fibonacci_points_are_on_the_sphere_from_pole_to_pole() {
         let p = fibonacci_sphere(50);
         assert_eq!(p.len(), 50);
-        assert!(p.iter().all(|q| (q.length() - 1.0).abs() < 1e-12));
-        assert!(p[0].z > 0.95 && p[49].z < -0.95);
+        // heights 1 − (2i + 1)/n, strictly falling from pole to pole
+        for (i, q) in p.iter().enumerate() {
+            assert_eq!(q.z, 1.0 - 2.0 * (i as f64 + 0.5) / 50.0);
+        }
+        assert!(p.windows(2).all(|w| w[0].z > w[1].z));
     }
 
     #[test]

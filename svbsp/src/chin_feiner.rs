@@ -352,9 +352,10 @@ impl CfFragments {
         base: &CfFragments,
         base_of: impl Fn(u32) -> Option<&'b [u32]>,
     ) -> CfFragments {
-        // boxes around the exact fragments, from their correctly rounded
-        // vertices widened by far more than the rounding: fragments whose
-        // boxes are apart do not overlap, and are not cut against each other
+        // boxes around the exact fragments: a correctly rounded coordinate
+        // is within half an ulp of the exact one, so the neighbouring
+        // doubles bound it on both sides; fragments whose boxes are apart
+        // do not overlap, and are not cut against each other
         let bounds = |pts: &mut dyn Iterator<Item = [f64; 3]>| {
             let mut b = [
                 f64::INFINITY,
@@ -366,9 +367,8 @@ impl CfFragments {
             ];
             for p in pts {
                 for k in 0..3 {
-                    let m = p[k].abs() * 1e-15;
-                    b[k] = b[k].min(p[k] - m);
-                    b[k + 3] = b[k + 3].max(p[k] + m);
+                    b[k] = b[k].min(p[k].next_down());
+                    b[k + 3] = b[k + 3].max(p[k].next_up());
                 }
             }
             b
