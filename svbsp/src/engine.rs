@@ -478,34 +478,7 @@ impl<'a> ShadowSet<'a> {
             }
             s.cur.clear();
             s.cur.push((copy, now));
-            for &(sv, j) in &self.trees {
-                let bit = 1u64 << j;
-                if cut & bit == 0 {
-                    continue;
-                }
-                s.next.clear();
-                for (piece, flags) in s.cur.drain(..) {
-                    if flags & bit == 0 {
-                        s.next.push((piece, flags));
-                        continue;
-                    }
-                    s.out.clear();
-                    filter(
-                        sv,
-                        &mut s.arena,
-                        s.support,
-                        piece,
-                        &mut s.out,
-                        &mut s.stack,
-                        &mut s.links,
-                        &mut s.sides,
-                    );
-                    for (p, lit) in s.out.drain(..) {
-                        s.next.push((p, flags & !bit | (lit as u64) << j));
-                    }
-                }
-                std::mem::swap(&mut s.cur, &mut s.next);
-            }
+            self.pass_lights(s, cut);
             if s.cur.len() == 1 {
                 let f = s.cur[0].1;
                 if f != *flags {
@@ -566,12 +539,22 @@ impl<'a> ShadowSet<'a> {
                 s.whole = s.arena.add_polygon(&polys[0]);
             }
         }
+        // lights the face turns its back to: attached shadow, the flag
+        // stays 0
         let facing = self.facing(&support);
+        self.pass_lights(s, facing)
+    }
+
+    /// Filters every cell of `s.cur` through the tree of each light in
+    /// `mask` for which the cell's flag is set, light after light; a cell
+    /// may come back cut, or shadowed for that light. Returns whether a
+    /// cell was cut or lost a light.
+    fn pass_lights(&self, s: &mut Scratch, mask: u64) -> bool {
         let mut changed = false;
         for &(sv, j) in &self.trees {
             let bit = 1u64 << j;
-            if facing & bit == 0 {
-                continue; // attached shadow: the flag stays 0
+            if mask & bit == 0 {
+                continue;
             }
             s.next.clear();
             for (piece, flags) in s.cur.drain(..) {
