@@ -263,42 +263,15 @@ impl Renderer {
     ) -> Result<&Rendered, RasterError> {
         check_lights(lights)?;
         opts.shadow.validate()?;
-        let t = Instant::now();
-        let last = self.last.take();
-        let frame = hsr::Frame::with_buffers(
+        let (method, shadow) = (opts.method, &opts.shadow);
+        self.frame_with(
             scene,
             camera,
-            opts.cull_back_faces,
-            std::mem::take(&mut self.frame),
-        )?;
-        let (spare_vis, spare_img) = match last {
-            Some(r) => {
-                self.shadow.lit = Some(r.lit);
-                (Some(r.visibility), Some(r.image))
-            }
-            None => (None, None),
-        };
-        let visibility = hsr::visibility_in(&frame, opts.hsr, spare_vis);
-        let visibility_time = t.elapsed();
-        let (lit, figures) = shadow::shadows_in(
-            &frame,
-            &visibility,
-            lights,
-            opts.method,
-            &opts.shadow,
-            &mut self.shadow,
-        )?;
-        let out = self.shaded(
-            &frame,
-            (visibility, visibility_time),
-            lit,
-            figures,
+            (opts.cull_back_faces, opts.hsr),
             lights,
             colors,
-            spare_img,
-        );
-        self.frame = frame.into_buffers();
-        Ok(self.last.insert(out))
+            |frame, vis, bufs| shadow::shadows_in(frame, vis, lights, method, shadow, bufs),
+        )
     }
 
     /// [`render_fragments`] in this renderer's buffers.
@@ -310,20 +283,51 @@ impl Renderer {
         camera: &Camera,
         colors: &[DVec3],
     ) -> Result<&Rendered, RasterError> {
+        self.frame_with(
+            scene,
+            camera,
+            (false, Hsr::ZBuffer),
+            lights,
+            colors,
+            |frame, vis, _| {
+                let t = Instant::now();
+                let (lit, mut figures) = exact::draw_fragments(frame, vis, lights.len(), batch);
+                figures.time = t.elapsed();
+                Ok((lit, figures))
+            },
+        )
+    }
+
+    /// One frame in this renderer's buffers: visibility by `hsr` (back
+    /// faces culled with `cull`), the lit amounts by `shadows`, shading.
+    /// The previous frame's buffers are handed on for reuse.
+    fn frame_with(
+        &mut self,
+        scene: &RasterScene,
+        camera: &Camera,
+        (cull, hsr): (bool, Hsr),
+        lights: &[SceneLight],
+        colors: &[DVec3],
+        shadows: impl FnOnce(
+            &hsr::Frame<'_>,
+            &hsr::Visibility,
+            &mut shadow::ShadowBuffers,
+        ) -> Result<(LitBuffer, ShadowFigures), RasterError>,
+    ) -> Result<&Rendered, RasterError> {
         check_lights(lights)?;
         let t = Instant::now();
         let last = self.last.take();
-        let frame =
-            hsr::Frame::with_buffers(scene, camera, false, std::mem::take(&mut self.frame))?;
+        let frame = hsr::Frame::with_buffers(scene, camera, cull, std::mem::take(&mut self.frame))?;
         let (spare_vis, spare_img) = match last {
-            Some(r) => (Some(r.visibility), Some(r.image)),
+            Some(r) => {
+                self.shadow.lit = Some(r.lit);
+                (Some(r.visibility), Some(r.image))
+            }
             None => (None, None),
         };
-        let visibility = hsr::visibility_in(&frame, Hsr::ZBuffer, spare_vis);
+        let visibility = hsr::visibility_in(&frame, hsr, spare_vis);
         let visibility_time = t.elapsed();
-        let t = Instant::now();
-        let (lit, mut figures) = exact::draw_fragments(&frame, &visibility, lights.len(), batch);
-        figures.time = t.elapsed();
+        let (lit, figures) = shadows(&frame, &visibility, &mut self.shadow)?;
         let out = self.shaded(
             &frame,
             (visibility, visibility_time),
