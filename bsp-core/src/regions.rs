@@ -463,22 +463,21 @@ struct Built<'a> {
     cell_lines: Vec<SmallVec<[u32; 6]>>,
 }
 
-fn build<'a>(arena: &PieceArena, support: &Plane, cells: &[Piece], f: &Frame) -> Built<'a> {
-    let mut points = Points {
-        base: &[],
-        base_bits: None,
-        extra: Vec::new(),
-        extra_bits: FxHashMap::default(),
-    };
+/// The points of `cells`' corners, each arena vertex added to `points`
+/// once (its exact coordinates and their rounding computed once).
+fn add_points(
+    points: &mut Points<'_>,
+    arena: &PieceArena,
+    cells: &[Piece],
+) -> Vec<SmallVec<[u32; 6]>> {
     let mut seen: FxHashMap<u32, u32> = FxHashMap::default();
-    let cell_points: Vec<SmallVec<[u32; 6]>> = cells
+    cells
         .iter()
         .map(|c| {
             c.verts
                 .iter()
                 .map(|&v| {
                     *seen.entry(v).or_insert_with(|| {
-                        // each vertex's exact coordinates once
                         let vert = arena.vertex(v).to_owned();
                         let r = vert.to_f64();
                         points.add(vert, r, v)
@@ -486,7 +485,17 @@ fn build<'a>(arena: &PieceArena, support: &Plane, cells: &[Piece], f: &Frame) ->
                 })
                 .collect()
         })
-        .collect();
+        .collect()
+}
+
+fn build<'a>(arena: &PieceArena, support: &Plane, cells: &[Piece], f: &Frame) -> Built<'a> {
+    let mut points = Points {
+        base: &[],
+        base_bits: None,
+        extra: Vec::new(),
+        extra_bits: FxHashMap::default(),
+    };
+    let cell_points = add_points(&mut points, arena, cells);
     let mut lines: Vec<MLine> = Vec::new();
     let mut line_of: FxHashMap<LineKey, u32> = FxHashMap::default();
     let mut cell_lines: Vec<SmallVec<[u32; 6]>> = Vec::with_capacity(cells.len());
@@ -753,22 +762,7 @@ impl MergeCache {
         }
         labels.extend_from_slice(piece_labels);
         // the new pieces' points and lines
-        let mut seen: FxHashMap<u32, u32> = FxHashMap::default();
-        let piece_points: Vec<SmallVec<[u32; 6]>> = pieces
-            .iter()
-            .map(|c| {
-                c.verts
-                    .iter()
-                    .map(|&v| {
-                        *seen.entry(v).or_insert_with(|| {
-                            let vert = arena.vertex(v).to_owned();
-                            let r = vert.to_f64();
-                            points.add(vert, r, v)
-                        })
-                    })
-                    .collect()
-            })
-            .collect();
+        let piece_points = add_points(&mut points, arena, pieces);
         // touched lines: copies of the cached ones, and new ones
         let mut touched: FxHashMap<u32, MLine> = FxHashMap::default();
         let mut fresh: Vec<MLine> = Vec::new();
