@@ -35,6 +35,7 @@
 //!
 //! None.
 
+mod embedded;
 mod exact;
 mod flat;
 mod grid;
@@ -51,6 +52,7 @@ pub mod shapes;
 mod topology;
 mod tree;
 
+pub use embedded::{SolidBoundary, SurfaceDefect, certify_solid_boundary};
 pub use exact::{
     FILTER_REL, Homogeneous, approx, filter_side, filter_side_err, ratio_to_f64_exact,
 };

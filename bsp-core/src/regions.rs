@@ -23,7 +23,7 @@ use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
 use crate::I256;
-use crate::pieces::{Piece, PieceArena, Vertex};
+use crate::pieces::{EdgeRef, Piece, PieceArena, Vertex};
 use crate::plane::Plane;
 
 /// A maximal connected region of equally labelled cells.
@@ -65,6 +65,19 @@ fn gcd(mut a: u128, mut b: u128) -> u128 {
 fn axes(support: &Plane) -> (usize, usize, usize) {
     let k = support.dominant_axis();
     ((k + 1) % 3, (k + 2) % 3, k)
+}
+
+/// [`line_key`] of the arena's edge plane `e`, computed once a plane
+/// (the key does not depend on the plane's orientation).
+fn line_key_cached(
+    keys: &mut FxHashMap<u32, LineKey>,
+    support: &Plane,
+    arena: &PieceArena,
+    e: EdgeRef,
+) -> LineKey {
+    *keys
+        .entry(e.index())
+        .or_insert_with(|| line_key(support, &arena.plane(e)))
 }
 
 fn line_key(support: &Plane, e: &Plane) -> LineKey {
@@ -499,13 +512,14 @@ fn build<'a>(arena: &PieceArena, support: &Plane, cells: &[Piece], f: &Frame) ->
     let mut lines: Vec<MLine> = Vec::new();
     let mut line_of: FxHashMap<LineKey, u32> = FxHashMap::default();
     let mut cell_lines: Vec<SmallVec<[u32; 6]>> = Vec::with_capacity(cells.len());
+    let mut keys = FxHashMap::default();
     for (ci, c) in cells.iter().enumerate() {
         let pts = &cell_points[ci];
         let k = pts.len();
         let mut ls = SmallVec::new();
         for j in 0..k {
             let (a, b) = (pts[j], pts[(j + 1) % k]);
-            let key = line_key(support, &arena.plane(c.edges[j]));
+            let key = line_key_cached(&mut keys, support, arena, c.edges[j]);
             let id = *line_of.entry(key).or_insert_with(|| {
                 lines.push(new_line(&key, f));
                 (lines.len() - 1) as u32
@@ -777,11 +791,12 @@ impl MergeCache {
             }
         }
         let nl = self.lines.len() as u32;
+        let mut keys = FxHashMap::default();
         for (k, (c, pts)) in pieces.iter().zip(&piece_points).enumerate() {
             let m = pts.len();
             for j in 0..m {
                 let (a, b) = (pts[j], pts[(j + 1) % m]);
-                let key = line_key(&self.support, &arena.plane(c.edges[j]));
+                let key = line_key_cached(&mut keys, &self.support, arena, c.edges[j]);
                 let line = match self.line_of.get(&key) {
                     Some(&l) => touched.entry(l).or_insert_with(|| {
                         let mut line = self.lines[l as usize].clone();

@@ -120,6 +120,21 @@ impl Light {
         self.eval(p) > 0
     }
 
+    /// `true` if, among occluders certified to bound solids
+    /// ([`bsp_core::certify_solid_boundary`]), those this light does not
+    /// face ([`Light::faces`]) may be left out of its shadow volumes: the
+    /// light is a sun, or a point outside the solids' box, so its winding
+    /// number is 0. The others' volumes then cover theirs, except where a
+    /// segment to the light only grazes the surface: a set of no area on
+    /// every receiver not edge-on to the light, so every lit area stays the
+    /// same exactly.
+    pub fn culls_back_faces(&self, solid: &bsp_core::SolidBoundary) -> bool {
+        match self {
+            Light::Point(c) => solid.outside(*c),
+            Light::Directional(_) => true,
+        }
+    }
+
     /// The shadow plane of the edge `a → b` of a polygon with grid
     /// vertices: the plane through the light and the edge (for a sun, the
     /// plane through the edge parallel to the direction), oriented so that

@@ -247,6 +247,11 @@ pub struct FrameStats {
     /// block light on its way to the object), rather than through one tree
     /// of the object and those polygons.
     pub layered: bool,
+    /// Fast strategy: the lights for which the object's faces turned away
+    /// were left out of the shadow trees (its snapped surface certified to
+    /// bound solids, see [`bsp_core::certify_solid_boundary`], and the
+    /// light outside them).
+    pub culled: usize,
     /// Time of the tiling queries.
     pub t_tiling: Duration,
     /// Time of the merge: `Bsp2` replayed, `Bsp3` built and merged (paper);
@@ -617,6 +622,17 @@ impl Dynamic {
                 // few of them: one tree of the object and those; many: a
                 // tree of the object alone, and for the object's own faces
                 // the static trees too (a point is lit where neither blocks)
+                // the object's faces turned away from a light hide nothing
+                // more when its snapped surface is certified to bound
+                // solids and the light is outside them
+                let solid = bsp_core::certify_solid_boundary(&moved);
+                let solid = solid.ok();
+                let culls: Vec<bool> = self
+                    .lights
+                    .iter()
+                    .map(|l| solid.as_ref().is_some_and(|s| l.culls_back_faces(s)))
+                    .collect();
+                stats.culled = culls.iter().filter(|&&c| c).count();
                 let layered = blockers.iter().map(Vec::len).sum::<usize>() * 4
                     > moved.len() * self.lights.len();
                 stats.layered = layered;
@@ -624,11 +640,13 @@ impl Dynamic {
                     .lights
                     .iter()
                     .zip(&blockers)
-                    .map(|(l, b)| {
+                    .zip(&culls)
+                    .map(|((l, b), &cull)| {
+                        let own = moved.iter().filter(|p| !cull || l.faces(p.support()));
                         let occ: Vec<&Polygon> = if layered {
-                            moved.iter().collect()
+                            own.collect()
                         } else {
-                            moved.iter().chain(b.iter().copied()).collect()
+                            own.chain(b.iter().copied()).collect()
                         };
                         ShadowVolumes::build(*l, &occ)
                     })

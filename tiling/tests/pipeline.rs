@@ -477,3 +477,59 @@ fn frames_do_not_depend_on_what_came_before() {
     }
     assert_eq!(counts.len(), dy.len());
 }
+
+#[test]
+fn faces_turned_away_are_left_out_only_where_that_is_exact() {
+    // the object's faces turned away from the light are left out of its
+    // shadow tree when its snapped surface is certified to bound solids
+    // and the light is outside them; every other case keeps them, and
+    // each frame must still match the computation from scratch
+    let ground = vec![vec![
+        DVec3::new(-6.0, -6.0, 0.0),
+        DVec3::new(6.0, -6.0, 0.0),
+        DVec3::new(6.0, 6.0, 0.0),
+        DVec3::new(-6.0, 6.0, 0.0),
+    ]];
+    let light = [LightSpec::Point(DVec3::new(0.2, 0.1, 8.0))];
+    let turn = Motion {
+        axis: DVec3::new(0.3, 1.0, 0.2),
+        degrees: 25.0,
+        centre: DVec3::new(0.5, 0.5, 2.0),
+        step: DVec3::new(0.1, 0.05, 0.02),
+    };
+    let culled = |dy: &[Vec<DVec3>], lights: &[LightSpec]| -> Vec<usize> {
+        check_motion(&ground, dy, lights, &turn, 3, Strategy::Fast, None)
+            .iter()
+            .map(|f| f.culled)
+            .collect()
+    };
+    let cube = cuboid(DVec3::new(0.0, 0.0, 1.5), DVec3::new(1.0, 1.0, 2.5));
+    // a closed outward box: left out, for the point light and a sun
+    assert_eq!(culled(&cube, &light), vec![1; 3]);
+    let both = [light[0], LightSpec::Sun(DVec3::new(0.3, -0.2, 1.0))];
+    assert_eq!(culled(&cube, &both), vec![2; 3]);
+    // turned inside out: its bottom faces the light and is shadowed by
+    // its top, which faces away (leaving the top out would light it)
+    let inside_out: Vec<Vec<DVec3>> = cube
+        .iter()
+        .map(|f| f.iter().rev().copied().collect())
+        .collect();
+    assert_eq!(culled(&inside_out, &light), vec![0; 3]);
+    // two boxes through each other, and a box with its top missing
+    let mut crossing = cube.clone();
+    crossing.extend(cuboid(DVec3::new(0.5, 0.2, 1.2), DVec3::new(1.6, 0.8, 2.0)));
+    assert_eq!(culled(&crossing, &light), vec![0; 3]);
+    let open: Vec<Vec<DVec3>> = cube[..5].to_vec();
+    assert_eq!(culled(&open, &light), vec![0; 3]);
+    // the light inside the box: every face turns away from it, and the
+    // box hides everything
+    let around = cuboid(DVec3::new(-0.5, -0.5, 7.0), DVec3::new(1.0, 1.0, 9.0));
+    let still = Motion {
+        axis: DVec3::Z,
+        degrees: 0.0,
+        centre: DVec3::ZERO,
+        step: DVec3::ZERO,
+    };
+    let f = check_motion(&ground, &around, &light, &still, 1, Strategy::Fast, None);
+    assert_eq!(f[0].culled, 0);
+}

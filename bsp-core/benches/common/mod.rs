@@ -133,3 +133,10 @@ pub fn import(faces: &[[DVec3; 3]]) -> Vec<Polygon> {
 pub fn build(polys: Vec<Polygon>) -> BspTree {
     BspTree::build(polys, &BuildOptions::default())
 }
+
+#[allow(dead_code)]
+pub fn import_loops(faces: &[Vec<DVec3>]) -> Vec<Polygon> {
+    let (polys, _report) =
+        import_faces(&grid(), faces.iter().map(|f| &f[..])).expect("faces inside the grid");
+    polys
+}

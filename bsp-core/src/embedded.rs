@@ -1,0 +1,874 @@
+//! An exact certificate that polygons with grid vertices bound solids:
+//! closed, consistently oriented, embedded, every part turned outward.
+//!
+//! What it buys: the winding number `w` of such a surface is `0` outside
+//! its bounding box and `≥ 0` everywhere, and it rises by one across each
+//! polygon from its front side to its back. A segment from a point `L`
+//! with `w(L) = 0` to a point `p` with `w(p) ≥ 0` that crosses the surface
+//! at all therefore crosses it through a polygon facing `L` (the crossings
+//! sum to `w(p) − w(L) ≥ 0`, so entries are at least as many as exits):
+//! polygons turned away from a light outside the box hide nothing that
+//! the others do not hide already, up to segments that only graze the
+//! surface (a set of zero area on any receiver not edge-on to the light).
+//! This is what lets shadow computations leave those polygons out.
+//!
+//! The test, all on 64- and 128-bit integers (grid coordinates are below
+//! `2^26`, so edge vectors are below `2^27`):
+//!
+//! 1. **Closed and oriented.** At every vertex the corners' outgoing edges
+//!    `v → next` and incoming edges `prev → v` pair up one to one: every
+//!    edge is used once each way and by nothing else (edge-manifold). The
+//!    pairing orders the corners around the vertex.
+//! 2. **Embedded.** Around a vertex whose corners form one cycle, the
+//!    star is certified when, seen along the sum `d` of the corners'
+//!    normals, every corner's wedge turns counter-clockwise by less than a
+//!    half turn and the wedges go around exactly once: the star is then a
+//!    graph over the plane across `d`, and convex polygons meeting at the
+//!    vertex meet nowhere else but their shared edges. Every other pair of
+//!    polygons with overlapping boxes is tested on its fan triangles:
+//!    without a shared vertex, an axis among the normals, the edge cross
+//!    products and the in-plane edge normals must separate them strictly;
+//!    with one shared vertex `v`, the two cones at `v` must be strictly
+//!    separated by a plane through `v` (the sum of every candidate normal
+//!    `g_i × g_j`, `n × g_i` of the generators that separates weakly is
+//!    checked to separate strictly: it lies inside the dual cone whenever
+//!    that has an interior); with a shared edge, the triangles must not
+//!    be coplanar on the same side of it. The test is conservative: it
+//!    may refuse surfaces that are fine (touching, or a vertex lying on
+//!    another edge), never accept one that is not.
+//! 3. **Outward.** Each edge-connected part encloses a positive volume (the
+//!    sum of its fan triangles' determinants, exact in `i128`). An embedded
+//!    connected closed surface (pinched at vertices or not) contributes
+//!    `±1` inside and `0` outside, with the sign of its volume, so every
+//!    part positive gives `w ≥ 0`.
+
+use rustc_hash::FxHashMap;
+use smallvec::SmallVec;
+
+use crate::{GridPoint, Polygon};
+
+/// Why polygons are not certified as the boundary of solids (the first
+/// reason found; polygons are indices into the list given).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum SurfaceDefect {
+    /// A vertex of `polygon` is not a grid point.
+    NotGrid {
+        /// The polygon.
+        polygon: usize,
+    },
+    /// An edge of `polygon` is not met by exactly one reverse edge: the
+    /// surface is open, misoriented or not a manifold there.
+    Open {
+        /// The polygon.
+        polygon: usize,
+    },
+    /// Two polygons meet other than in shared vertices and edges, or touch
+    /// in a way the test does not settle.
+    Intersecting {
+        /// The two polygons.
+        polygons: [usize; 2],
+    },
+    /// An edge-connected part of the surface, holding `polygon`, encloses
+    /// no positive volume (it is turned inward, or flat).
+    Inward {
+        /// A polygon of the part.
+        polygon: usize,
+    },
+}
+
+impl std::fmt::Display for SurfaceDefect {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SurfaceDefect::NotGrid { polygon } => {
+                write!(f, "polygon {polygon} has a vertex off the grid")
+            }
+            SurfaceDefect::Open { polygon } => write!(
+                f,
+                "an edge of polygon {polygon} is not met by exactly one reverse edge"
+            ),
+            SurfaceDefect::Intersecting { polygons: [a, b] } => {
+                write!(f, "polygons {a} and {b} meet other than at shared corners")
+            }
+            SurfaceDefect::Inward { polygon } => write!(
+                f,
+                "the part holding polygon {polygon} encloses no positive volume"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for SurfaceDefect {}
+
+/// Polygons certified to bound solids (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SolidBoundary {
+    /// The corners of the surface's bounding box, `lo[k] <= hi[k]`.
+    pub lo: GridPoint,
+    /// See `lo`.
+    pub hi: GridPoint,
+    /// Number of edge-connected parts.
+    pub parts: usize,
+}
+
+impl SolidBoundary {
+    /// `true` if `p` lies strictly outside the bounding box, where the
+    /// winding number is `0`.
+    pub fn outside(&self, p: GridPoint) -> bool {
+        (0..3).any(|k| p[k] < self.lo[k] || p[k] > self.hi[k])
+    }
+}
+
+type V = [i64; 3];
+
+#[inline]
+fn sub(a: GridPoint, b: GridPoint) -> V {
+    [0, 1, 2].map(|k| a[k] as i64 - b[k] as i64)
+}
+
+/// `|u|, |v| < 2^27` per component gives components below `2^55`.
+#[inline]
+fn cross(u: V, v: V) -> V {
+    [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ]
+}
+
+#[inline]
+fn dot(u: V, v: V) -> i128 {
+    (0..3).map(|k| u[k] as i128 * v[k] as i128).sum()
+}
+
+type W = [i128; 3];
+
+#[inline]
+fn wide(u: V) -> W {
+    u.map(|c| c as i128)
+}
+
+/// `n × g` with `|n| < 2^56`, `|g| < 2^28`: components below `2^85`.
+#[inline]
+fn cross_wide(n: V, g: V) -> W {
+    cross_w(wide(n), wide(g))
+}
+
+#[inline]
+fn cross_w(u: W, v: W) -> W {
+    [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ]
+}
+
+/// `w · p` for `|w| < 2^89`, `|p| < 2^28` (below `2^119`).
+#[inline]
+fn dot_w(w: W, p: V) -> i128 {
+    (0..3).map(|k| w[k] * p[k] as i128).sum()
+}
+
+#[derive(Clone, Copy)]
+struct Tri {
+    v: [GridPoint; 3],
+    /// The corners' vertex numbers (equal numbers: equal points).
+    id: [u32; 3],
+    poly: u32,
+    lo: GridPoint,
+    hi: GridPoint,
+}
+
+/// Certifies that `polys` bound solids (see the module docs), or says why
+/// not. `O(n log n)` in the number of polygons plus the pairs of fan
+/// triangles whose boxes overlap.
+pub fn certify_solid_boundary(polys: &[Polygon]) -> Result<SolidBoundary, SurfaceDefect> {
+    certify(polys, true)
+}
+
+/// [`certify_solid_boundary`]; without `stars`, every pair of triangles
+/// with overlapping boxes is tested on its own (the reference the star
+/// tests are checked against).
+fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefect> {
+    // the loops as grid points, each numbered by its first occurrence
+    let mut start = Vec::with_capacity(polys.len() + 1);
+    let mut pts: Vec<GridPoint> = Vec::with_capacity(polys.len() * 3);
+    for (i, p) in polys.iter().enumerate() {
+        start.push(pts.len() as u32);
+        for v in p.vertices() {
+            pts.push(v.as_grid().ok_or(SurfaceDefect::NotGrid { polygon: i })?);
+        }
+    }
+    start.push(pts.len() as u32);
+    let lo = pts
+        .iter()
+        .fold([i32::MAX; 3], |m, p| [0, 1, 2].map(|k| m[k].min(p[k])));
+    let hi = pts
+        .iter()
+        .fold([i32::MIN; 3], |m, p| [0, 1, 2].map(|k| m[k].max(p[k])));
+    let mut number: FxHashMap<GridPoint, u32> = FxHashMap::default();
+    number.reserve(pts.len() / 2);
+    let ids: Vec<u32> = pts
+        .iter()
+        .map(|p| {
+            let next = number.len() as u32;
+            *number.entry(*p).or_insert(next)
+        })
+        .collect();
+    drop(number);
+    let loop_of = |i: usize| start[i] as usize..start[i + 1] as usize;
+
+    let n_ids = ids.iter().max().map_or(0, |&m| m as usize + 1);
+
+    // 1. closed and oriented, vertex by vertex: at each vertex the corners'
+    // outgoing edges `v → next` and incoming edges `prev → v` pair up one
+    // to one (an edge used once each way, by nothing else), which orders
+    // the corners around the vertex: a corner's successor is the corner
+    // across its outgoing edge
+    let mut corner_poly = vec![0u32; pts.len()];
+    for i in 0..polys.len() {
+        corner_poly[loop_of(i)].fill(i as u32);
+    }
+    let next_of = |g: usize| {
+        let r = loop_of(corner_poly[g] as usize);
+        if g + 1 == r.end { r.start } else { g + 1 }
+    };
+    let prev_of = |g: usize| {
+        let r = loop_of(corner_poly[g] as usize);
+        if g == r.start { r.end - 1 } else { g - 1 }
+    };
+    let mut first = vec![0u32; n_ids + 1];
+    for &v in &ids {
+        first[v as usize + 1] += 1;
+    }
+    for k in 1..first.len() {
+        first[k] += first[k - 1];
+    }
+    let mut fill = first.clone();
+    let mut corners = vec![0u32; pts.len()];
+    for (g, &v) in ids.iter().enumerate() {
+        corners[fill[v as usize] as usize] = g as u32;
+        fill[v as usize] += 1;
+    }
+    drop(fill);
+    let mut parent: Vec<u32> = (0..polys.len() as u32).collect();
+    let find = |parent: &mut Vec<u32>, mut x: u32| {
+        while parent[x as usize] != x {
+            let up = parent[parent[x as usize] as usize];
+            parent[x as usize] = up;
+            x = up;
+        }
+        x
+    };
+    // per vertex: its star certified embedded (see `star_embedded`)
+    let mut certified = vec![false; n_ids];
+    let mut around: Vec<(u32, u32, u32)> = Vec::new();
+    let mut order: Vec<u32> = Vec::new();
+    for v in 0..n_ids {
+        let star = &corners[first[v] as usize..first[v + 1] as usize];
+        // (prev, next, corner), sorted by prev
+        around.clear();
+        for &g in star {
+            let g = g as usize;
+            let (n, p) = (ids[next_of(g)], ids[prev_of(g)]);
+            if n == v as u32 || p == v as u32 {
+                return Err(SurfaceDefect::Open {
+                    polygon: corner_poly[g] as usize,
+                });
+            }
+            around.push((p, n, g as u32));
+        }
+        around.sort_unstable();
+        let mut nexts: SmallVec<[u32; 8]> = around.iter().map(|c| c.1).collect();
+        nexts.sort_unstable();
+        let bad = around.windows(2).any(|w| w[0].0 == w[1].0)
+            || nexts.windows(2).any(|w| w[0] == w[1])
+            || nexts.iter().zip(&around).any(|(n, c)| *n != c.0);
+        if bad {
+            return Err(SurfaceDefect::Open {
+                polygon: corner_poly[star[0] as usize] as usize,
+            });
+        }
+        // successor: the corner whose prev is this corner's next; the
+        // polygons across each edge are one part
+        let succ = |c: &(u32, u32, u32)| around.binary_search_by_key(&c.1, |d| d.0).unwrap_or(0);
+        for c in &around {
+            let d = &around[succ(c)];
+            let (rp, rq) = (
+                find(&mut parent, corner_poly[c.2 as usize]),
+                find(&mut parent, corner_poly[d.2 as usize]),
+            );
+            if rp != rq {
+                parent[rp.max(rq) as usize] = rp.min(rq);
+            }
+        }
+        // one cycle around the vertex: its corners in order
+        order.clear();
+        let mut c = 0;
+        loop {
+            order.push(around[c].2);
+            c = succ(&around[c]);
+            if c == 0 || order.len() > around.len() {
+                break;
+            }
+        }
+        if stars && order.len() == around.len() {
+            certified[v] = star_embedded(pts[order[0] as usize], &order, |g| {
+                (pts[next_of(g as usize)], pts[prev_of(g as usize)])
+            });
+        }
+    }
+    drop(corners);
+
+    // 3. each part encloses a positive volume (6 × the signed volume)
+    let mut volume = vec![0i128; polys.len()];
+    let mut tris: Vec<Tri> = Vec::with_capacity(pts.len());
+    for i in 0..polys.len() {
+        let r = loop_of(i);
+        let (l, id) = (&pts[r.clone()], &ids[r]);
+        let root = find(&mut parent, i as u32) as usize;
+        for j in 1..l.len() - 1 {
+            let t = [l[0], l[j], l[j + 1]];
+            let (a, b, c) = (sub(t[0], [0; 3]), sub(t[1], [0; 3]), sub(t[2], [0; 3]));
+            // |a|, |b|, |c| < 2^26: the determinant is below 2^80
+            volume[root] += dot(a, cross(b, c));
+            if cross(sub(t[1], t[0]), sub(t[2], t[0])) == [0; 3] {
+                continue; // no area: covered by the next triangle's edge
+            }
+            tris.push(Tri {
+                v: t,
+                id: [id[0], id[j], id[j + 1]],
+                poly: i as u32,
+                lo: [0, 1, 2].map(|k| t[0][k].min(t[1][k]).min(t[2][k])),
+                hi: [0, 1, 2].map(|k| t[0][k].max(t[1][k]).max(t[2][k])),
+            });
+        }
+    }
+    let mut parts = 0;
+    for i in 0..polys.len() {
+        if parent[i] == i as u32 {
+            parts += 1;
+            if volume[i] <= 0 {
+                return Err(SurfaceDefect::Inward { polygon: i });
+            }
+        }
+    }
+
+    // 2. embedded: the pairs of triangles whose boxes overlap
+    // (pairs with a certified shared vertex are settled by its star)
+    let settled = |s: &Tri, t: &Tri| {
+        s.id.iter()
+            .any(|&a| certified[a as usize] && t.id.contains(&a))
+    };
+    if let Some((a, b)) = overlapping_pairs(&tris, lo, hi, |s, t| {
+        s.poly == t.poly || settled(s, t) || apart(s, t)
+    }) {
+        return Err(SurfaceDefect::Intersecting {
+            polygons: [a as usize, b as usize],
+        });
+    }
+    Ok(SolidBoundary { lo, hi, parts })
+}
+
+/// `true` if the corners `order` around the vertex `v` (each corner's
+/// wedge from its next vertex to its previous one, counter-clockwise about
+/// its polygon's normal, successive corners sharing a ray) are certified
+/// to meet only along their shared rays: seen along `d`, the sum of the
+/// wedges' normals, every wedge turns counter-clockwise by less than a
+/// half turn, and the wedges go around exactly once. The star is then a
+/// graph over the plane across `d`, so the polygons at `v` meet only in
+/// the edges and vertex they share (each is convex, so two of them meet
+/// elsewhere only if their wedges at `v` do). Stars of more than 512
+/// corners, or with a ray seen along the first one's, are not certified.
+fn star_embedded(
+    v: GridPoint,
+    order: &[u32],
+    ends: impl Fn(u32) -> (GridPoint, GridPoint),
+) -> bool {
+    let k = order.len();
+    if !(3..=512).contains(&k) {
+        return false;
+    }
+    let mut rays: SmallVec<[V; 8]> = SmallVec::with_capacity(k);
+    let mut normals: SmallVec<[V; 8]> = SmallVec::with_capacity(k);
+    // |n| < 2^55 each, so |d| < 2^64
+    let mut d: W = [0; 3];
+    for &g in order {
+        let (next, prev) = ends(g);
+        let (e, p) = (sub(next, v), sub(prev, v));
+        let n = cross(e, p);
+        for k in 0..3 {
+            d[k] += n[k] as i128;
+        }
+        rays.push(e);
+        normals.push(n);
+    }
+    // |n · d| < 3 · 2^119
+    let along = |n: V| dot_w(d, n);
+    if normals.iter().any(|&n| along(n) <= 0) {
+        return false;
+    }
+    // wedge i runs from ray i to ray i - 1 (ray -1: the last); seen along
+    // d, count those whose half-open [start, end) holds ray 0: wedge 0
+    // does, wedge 1 ends there, no other may
+    let e0 = rays[0];
+    let orient = |x: V, y: V| along(cross(x, y));
+    let side: SmallVec<[i128; 8]> = rays.iter().map(|&e| orient(e, e0)).collect();
+    if side[1..].contains(&0) {
+        return false;
+    }
+    (2..k).all(|i| !(side[i] > 0 && side[i - 1] < 0))
+}
+
+/// Visits each pair of triangles whose closed boxes overlap once, until
+/// `fine` refuses one; returns the refused pair's polygons (smaller first).
+/// The pairs come from a uniform grid of cubic cells (each triangle listed
+/// in the cells its box meets, a pair visited in the cell holding the low
+/// corner of the boxes' common part), of a typical triangle's size.
+fn overlapping_pairs(
+    tris: &[Tri],
+    lo: GridPoint,
+    hi: GridPoint,
+    mut fine: impl FnMut(&Tri, &Tri) -> bool,
+) -> Option<(u32, u32)> {
+    if tris.len() < 2 {
+        return None;
+    }
+    // cells of the median of the triangles' largest box extents, grown
+    // until there are at most 8 cells a triangle
+    let mut ext: Vec<i64> = tris
+        .iter()
+        .map(|t| {
+            (0..3)
+                .map(|k| t.hi[k] as i64 - t.lo[k] as i64)
+                .max()
+                .unwrap_or(0)
+        })
+        .collect();
+    let mid = ext.len() / 2;
+    let mut size = (*ext.select_nth_unstable(mid).1).max(1);
+    let span = [0, 1, 2].map(|k| hi[k] as i64 - lo[k] as i64);
+    let dims = |size: i64| span.map(|s| (s / size + 1) as usize);
+    while dims(size).iter().product::<usize>() > 8 * tris.len() {
+        size *= 2;
+    }
+    let [nx, ny, _] = dims(size);
+    let cell = |p: GridPoint| [0, 1, 2].map(|k| ((p[k] as i64 - lo[k] as i64) / size) as usize);
+    let key = |c: [usize; 3]| (c[2] * ny + c[1]) * nx + c[0];
+    // the triangles of each cell, by a counting sort
+    let cells: Vec<([usize; 3], [usize; 3])> =
+        tris.iter().map(|t| (cell(t.lo), cell(t.hi))).collect();
+    let each = |(a, b): &([usize; 3], [usize; 3]), f: &mut dyn FnMut(usize)| {
+        for z in a[2]..=b[2] {
+            for y in a[1]..=b[1] {
+                for x in a[0]..=b[0] {
+                    f(key([x, y, z]));
+                }
+            }
+        }
+    };
+    let mut first = vec![0u32; dims(size).iter().product::<usize>() + 1];
+    for c in &cells {
+        each(c, &mut |k| first[k + 1] += 1);
+    }
+    for k in 1..first.len() {
+        first[k] += first[k - 1];
+    }
+    let mut fill = first.clone();
+    let mut listed = vec![0u32; *first.last().unwrap_or(&0) as usize];
+    for (i, c) in cells.iter().enumerate() {
+        each(c, &mut |k| {
+            listed[fill[k] as usize] = i as u32;
+            fill[k] += 1;
+        });
+    }
+    drop(fill);
+    let boxes: Vec<[i32; 6]> = tris
+        .iter()
+        .map(|t| [t.lo[0], t.lo[1], t.lo[2], t.hi[0], t.hi[1], t.hi[2]])
+        .collect();
+    for k in 0..first.len() - 1 {
+        let here = &listed[first[k] as usize..first[k + 1] as usize];
+        for (i, &si) in here.iter().enumerate() {
+            let si = si as usize;
+            let bs = boxes[si];
+            for &ti in &here[i + 1..] {
+                let ti = ti as usize;
+                let bt = boxes[ti];
+                // without branches: most pairs are near misses
+                let mut miss = false;
+                for k in 0..3 {
+                    miss |= (bt[k] > bs[k + 3]) | (bs[k] > bt[k + 3]);
+                }
+                if miss {
+                    continue;
+                }
+                // the cell of the common part's low corner: the larger of
+                // the two low cells
+                let (cs, ct) = (cells[si].0, cells[ti].0);
+                let (s, t) = (&tris[si], &tris[ti]);
+                if key([0, 1, 2].map(|k| cs[k].max(ct[k]))) != k || fine(s, t) {
+                    continue;
+                }
+                return Some((s.poly.min(t.poly), s.poly.max(t.poly)));
+            }
+        }
+    }
+    None
+}
+
+/// `true` if the closed triangles `s` and `t` (each with area) meet at
+/// most in the vertices and the edge they share; `false` when they meet
+/// elsewhere or the test cannot tell.
+fn apart(s: &Tri, t: &Tri) -> bool {
+    let mut shared = [(0usize, 0usize); 3];
+    let mut n = 0;
+    for i in 0..3 {
+        for j in 0..3 {
+            if s.id[i] == t.id[j] {
+                shared[n] = (i, j);
+                n += 1;
+            }
+        }
+    }
+    let (s, t) = (&s.v, &t.v);
+    match n {
+        0 => disjoint(s, t),
+        1 => {
+            let (i, j) = shared[0];
+            let v = s[i];
+            let g = [
+                sub(s[(i + 1) % 3], v),
+                sub(s[(i + 2) % 3], v),
+                sub(t[(j + 1) % 3], v),
+                sub(t[(j + 2) % 3], v),
+            ];
+            cones_apart(g)
+        }
+        2 => {
+            let (a, b) = (s[shared[0].0], s[shared[1].0]);
+            let c = s[3 - shared[0].0 - shared[1].0];
+            let d = t[3 - shared[0].1 - shared[1].1];
+            let e = sub(b, a);
+            let n = cross(e, sub(c, a));
+            // not coplanar, or coplanar on opposite sides of the edge
+            dot(n, sub(d, a)) != 0 || dot(n, cross(e, sub(d, a))) < 0
+        }
+        _ => false,
+    }
+}
+
+/// Strict separation of two triangles without a shared vertex, by the
+/// separating-axis test over every candidate axis.
+fn disjoint(s: &[GridPoint; 3], t: &[GridPoint; 3]) -> bool {
+    let ps = s.map(|p| sub(p, [0; 3]));
+    let pt = t.map(|p| sub(p, [0; 3]));
+    let es = [0, 1, 2].map(|k| sub(s[(k + 1) % 3], s[k]));
+    let et = [0, 1, 2].map(|k| sub(t[(k + 1) % 3], t[k]));
+    let ns = cross(es[0], es[1]);
+    let nt = cross(et[0], et[1]);
+    let separates = |w: W| {
+        let (mut a0, mut a1) = (i128::MAX, i128::MIN);
+        let (mut b0, mut b1) = (i128::MAX, i128::MIN);
+        for k in 0..3 {
+            let x = dot_w(w, ps[k]);
+            a0 = a0.min(x);
+            a1 = a1.max(x);
+            let y = dot_w(w, pt[k]);
+            b0 = b0.min(y);
+            b1 = b1.max(y);
+        }
+        a1 < b0 || b1 < a0
+    };
+    // the planes first, in 64 × 64-bit products: they settle most pairs
+    let off = |n: V, p: &[V; 3], q: &[V; 3]| {
+        let d = dot(n, p[0]);
+        let x = q.map(|q| dot(n, q) - d);
+        x.iter().all(|&x| x > 0) || x.iter().all(|&x| x < 0)
+    };
+    if off(ns, &ps, &pt) || off(nt, &pt, &ps) {
+        return true;
+    }
+    for a in es {
+        for b in et {
+            let w = cross(a, b);
+            if w != [0; 3] && separates(wide(w)) {
+                return true;
+            }
+        }
+    }
+    es.iter().any(|&e| separates(cross_wide(ns, e)))
+        || et.iter().any(|&e| separates(cross_wide(nt, e)))
+}
+
+/// `true` if the cones `{α g0 + β g1}` and `{γ g2 + δ g3}` (α, β, γ, δ ≥ 0)
+/// meet only at the origin, certified by a plane strictly between them.
+fn cones_apart(g: [V; 4]) -> bool {
+    let sign = [1i128, 1, -1, -1];
+    let valid = |w: W, strict: bool| {
+        (0..4).all(|i| {
+            let x = sign[i] * dot_w(w, g[i]);
+            if strict { x > 0 } else { x >= 0 }
+        })
+    };
+    let n0 = cross(g[0], g[1]);
+    let n1 = cross(g[2], g[3]);
+    // each triangle's plane first: the other strictly on one side
+    let quick = |n: V, a: V, b: V| {
+        let (x, y) = (dot(n, a), dot(n, b));
+        (x > 0 && y > 0) || (x < 0 && y < 0)
+    };
+    if quick(n0, g[2], g[3]) || quick(n1, g[0], g[1]) {
+        return true;
+    }
+    // the sum of every weakly separating candidate
+    let mut sum: W = [0; 3];
+    let mut add = |w: W| {
+        for s in [1, -1] {
+            let w = w.map(|c| c * s);
+            if valid(w, false) {
+                for k in 0..3 {
+                    sum[k] += w[k];
+                }
+            }
+        }
+    };
+    for i in 0..4 {
+        for j in i + 1..4 {
+            add(wide(cross(g[i], g[j])));
+        }
+    }
+    for (n, a, b) in [(n0, g[0], g[1]), (n1, g[2], g[3])] {
+        add(cross_wide(n, a));
+        add(cross_wide(n, b));
+    }
+    valid(sum, true)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn poly(p: &[GridPoint]) -> Polygon {
+        Polygon::from_grid_points(p, 0).unwrap()
+    }
+
+    /// A box's six faces, outward (or inward when `flip`).
+    fn cube(lo: GridPoint, hi: GridPoint, flip: bool) -> Vec<Polygon> {
+        let c = |m: u32| [0, 1, 2].map(|k| if m >> k & 1 == 1 { hi[k] } else { lo[k] });
+        let faces: [[u32; 4]; 6] = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        faces
+            .iter()
+            .map(|f| {
+                let mut l: Vec<GridPoint> = f.iter().map(|&m| c(m)).collect();
+                if flip {
+                    l.reverse();
+                }
+                poly(&l)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_box_is_certified_and_an_inverted_one_is_not() {
+        let b = certify_solid_boundary(&cube([0; 3], [4, 5, 6], false)).unwrap();
+        assert_eq!((b.lo, b.hi, b.parts), ([0; 3], [4, 5, 6], 1));
+        assert!(b.outside([5, 0, 0]) && !b.outside([4, 5, 6]));
+        assert_eq!(
+            certify_solid_boundary(&cube([0; 3], [4, 5, 6], true)),
+            Err(SurfaceDefect::Inward { polygon: 0 })
+        );
+    }
+
+    #[test]
+    fn open_surfaces_are_refused() {
+        let mut c = cube([0; 3], [4, 4, 4], false);
+        c.pop();
+        assert!(matches!(
+            certify_solid_boundary(&c),
+            Err(SurfaceDefect::Open { .. })
+        ));
+    }
+
+    #[test]
+    fn nested_and_separate_boxes_pass_crossing_ones_do_not() {
+        // a box in a box, both outward: w = 2 inside the inner one
+        let mut c = cube([0; 3], [10, 10, 10], false);
+        c.extend(cube([2; 3], [5; 3], false));
+        assert_eq!(certify_solid_boundary(&c).unwrap().parts, 2);
+        // a cavity (inner box inward) is an inward part: refused
+        let mut c = cube([0; 3], [10, 10, 10], false);
+        c.extend(cube([2; 3], [5; 3], true));
+        assert_eq!(
+            certify_solid_boundary(&c),
+            Err(SurfaceDefect::Inward { polygon: 6 })
+        );
+        // two boxes through each other
+        let mut c = cube([0; 3], [4, 4, 4], false);
+        c.extend(cube([2, 1, 1], [6, 3, 3], false));
+        assert!(matches!(
+            certify_solid_boundary(&c),
+            Err(SurfaceDefect::Intersecting { .. })
+        ));
+        // boxes touching along a face: refused (the test is conservative)
+        let mut c = cube([0; 3], [4, 4, 4], false);
+        c.extend(cube([4, 0, 0], [8, 4, 4], false));
+        assert!(certify_solid_boundary(&c).is_err());
+        // boxes sharing only a corner point: certified
+        let mut c = cube([0; 3], [4, 4, 4], false);
+        c.extend(cube([4; 3], [8; 3], false));
+        assert_eq!(certify_solid_boundary(&c).unwrap().parts, 2);
+    }
+
+    #[test]
+    fn a_fold_is_refused() {
+        // an octahedron whose top vertex is pushed below the bottom one:
+        // the part turns inside out
+        let o = |top: i32| -> Vec<Polygon> {
+            let (e, n, w, s) = ([4, 0, 0], [0, 4, 0], [-4, 0, 0], [0, -4, 0]);
+            let (t, b) = ([1, 1, top], [0, 0, -4]);
+            let ring = [e, n, w, s];
+            let mut out = Vec::new();
+            for k in 0..4 {
+                let (p, q) = (ring[k], ring[(k + 1) % 4]);
+                out.push(poly(&[p, q, t]));
+                out.push(poly(&[q, p, b]));
+            }
+            out
+        };
+        assert!(certify_solid_boundary(&o(4)).is_ok());
+        assert!(certify_solid_boundary(&o(-7)).is_err());
+    }
+
+    #[test]
+    fn cones_meeting_only_at_the_apex() {
+        let x = [1, 0, 0];
+        let y = [0, 1, 0];
+        let z = [0, 0, 1];
+        let m = |v: V| v.map(|c| -c);
+        // coplanar wedges on both sides of a line: apart
+        assert!(cones_apart([x, y, m(x), m([1, 1, 0])]));
+        assert!(cones_apart([x, [1, 1, 0], m(x), m(y)]));
+        // overlapping coplanar wedges
+        assert!(!cones_apart([x, y, [1, 1, 0], [2, 1, 0]]));
+        // touching along a ray: not apart
+        assert!(!cones_apart([x, y, x, z]));
+        // crossing wedges in different planes
+        assert!(!cones_apart([[1, -1, 0], [1, 1, 0], [1, 0, -1], [1, 0, 1]]));
+        // saddle: a wedge above and one below through the other's plane
+        assert!(cones_apart([
+            [1, -1, 1],
+            [1, 1, 1],
+            [-1, 0, -1],
+            [-1, 1, 1]
+        ]));
+    }
+
+    /// Two triangles with their corners numbered (equal points, equal
+    /// numbers).
+    fn tris(s: [GridPoint; 3], t: [GridPoint; 3]) -> (Tri, Tri) {
+        let mut seen: Vec<GridPoint> = Vec::new();
+        let mut id = |p: GridPoint| match seen.iter().position(|&q| q == p) {
+            Some(i) => i as u32,
+            None => {
+                seen.push(p);
+                seen.len() as u32 - 1
+            }
+        };
+        let (is, it) = (s.map(&mut id), t.map(&mut id));
+        let mk = |v, id| Tri {
+            v,
+            id,
+            poly: 0,
+            lo: [0; 3],
+            hi: [0; 3],
+        };
+        (mk(s, is), mk(t, it))
+    }
+
+    #[test]
+    fn triangle_pairs() {
+        let apart = |s: &[GridPoint; 3], t: &[GridPoint; 3]| {
+            let (s, t) = tris(*s, *t);
+            apart(&s, &t)
+        };
+        let t = [[0, 0, 0], [4, 0, 0], [0, 4, 0]];
+        // one shared corner: piercing through the other's cone, or beside it
+        assert!(!apart(&t, &[[0, 0, 0], [1, 1, -2], [1, 1, 2]]));
+        assert!(apart(&t, &[[0, 0, 0], [-1, -1, -2], [-1, -1, 2]]));
+        // a shared edge: folded onto the same side, or opened flat
+        assert!(!apart(&t, &[[4, 0, 0], [0, 0, 0], [1, 2, 0]]));
+        assert!(apart(&t, &[[4, 0, 0], [0, 0, 0], [1, -2, 0]]));
+        assert!(apart(&t, &[[4, 0, 0], [0, 0, 0], [1, 2, 1]]));
+        // nothing shared: crossing, touching, near
+        assert!(!disjoint(&t, &[[1, 1, -1], [1, 1, 1], [5, 5, 0]]));
+        assert!(!disjoint(&t, &[[2, 2, 0], [2, 2, 3], [5, 5, 3]]));
+        assert!(disjoint(&t, &[[3, 3, 0], [3, 3, 3], [5, 5, 3]]));
+        assert!(disjoint(&t, &[[1, 1, 1], [2, 1, 1], [1, 2, 1]]));
+        // coplanar, overlapping or beside
+        assert!(!disjoint(&t, &[[1, 1, 0], [5, 1, 0], [1, 5, 0]]));
+        assert!(disjoint(&t, &[[3, 3, 0], [7, 3, 0], [3, 7, 0]]));
+        // the coordinate budget: the largest grid coordinates
+        let m = crate::MAX_COORD;
+        let big = [[-m, -m, -m], [m, -m, -m], [-m, m, -m]];
+        assert!(disjoint(&big, &[[-m, -m, m], [m, -m, m], [-m, m, m]]));
+        assert!(!disjoint(
+            &big,
+            &[[-m + 1, -m + 1, m], [-m + 1, -m + 1, -m], [m, m, m]]
+        ));
+        assert!(apart(&big, &[[-m, -m, -m], [m, m, m], [-m, m, m]]));
+    }
+
+    /// Closed meshes on a coarse grid: a UV sphere of radius 8 with every
+    /// vertex moved at random by up to `jitter`, so that faces fold over
+    /// and pass through each other often.
+    fn jittered_sphere(jitter: i32, seed: u64) -> Vec<Polygon> {
+        let (v, f) = crate::shapes::uv_sphere(48);
+        let mut rng = crate::SplitMix(seed);
+        let pts: Vec<GridPoint> = v
+            .iter()
+            .map(|p| {
+                let mut j = || (rng.next_u64() % (2 * jitter as u64 + 1)) as i32 - jitter;
+                [
+                    (p.x * 8.0).round() as i32 + j(),
+                    (p.y * 8.0).round() as i32 + j(),
+                    (p.z * 8.0).round() as i32 + j(),
+                ]
+            })
+            .collect();
+        f.iter()
+            .filter_map(|t| {
+                let l: Vec<GridPoint> = t.iter().map(|&i| pts[i as usize]).collect();
+                Polygon::from_grid_points(&l, 0).ok()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn stars_agree_with_pairwise_tests() {
+        let (mut ok, mut refused) = (0, 0);
+        for seed in 0..800u64 {
+            let jitter = 1 + (seed % 4) as i32;
+            let polys = jittered_sphere(jitter, seed);
+            let (a, b) = (certify(&polys, true), certify(&polys, false));
+            assert_eq!(a.is_ok(), b.is_ok(), "seed {seed}: {a:?} vs {b:?}");
+            match a {
+                Ok(_) => ok += 1,
+                Err(SurfaceDefect::Intersecting { .. }) => refused += 1,
+                Err(_) => {}
+            }
+        }
+        // both outcomes are exercised
+        assert!(
+            ok > 50 && refused > 50,
+            "{ok} certified, {refused} intersecting"
+        );
+    }
+}
