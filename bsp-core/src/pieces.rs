@@ -131,7 +131,7 @@ impl EdgeRef {
 /// share.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Piece {
-    /// Vertex indices into [`PieceArena::vertices`].
+    /// Vertex indices into [`PieceArena::vertex`].
     pub verts: SmallVec<[u32; 6]>,
     /// Edge planes (edge `i` runs from vertex `i` to vertex `i + 1`).
     pub edges: SmallVec<[EdgeRef; 6]>,
