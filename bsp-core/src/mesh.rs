@@ -129,7 +129,7 @@ impl TriMesh {
         drop(keys);
         let vertices = w.vertices;
         let coords: Vec<[f64; 3]> = vertices.par_iter().map(Point::to_f64).collect();
-        let near = Candidates::new(&coords, &corners);
+        let near = Candidates::new(&coords);
 
         // each polygon's triangles on its own, in parallel; chunks keep
         // the order of the polygons
@@ -672,74 +672,80 @@ fn edge_points(
     out
 }
 
-/// The vertices whose rounded coordinates may lie in a box: a sparse
-/// uniform grid of cells about as large as a typical edge, and for boxes
-/// spanning many cells the vertices sorted by `x`.
+/// The vertices whose rounded coordinates may lie in a box: an implicit
+/// k-d tree over them (a permutation split at the median along the axis
+/// of largest extent, recursively), so that a box query costs about the
+/// vertices in the box plus a logarithm however unevenly they are spread
+/// (a UV sphere's poles gather hundreds of vertices in a few edge
+/// lengths, which made a uniform grid's cells crowded).
 struct Candidates {
-    h: f64,
-    cells: rustc_hash::FxHashMap<[i64; 3], Vec<u32>>,
-    by_x: Vec<u32>,
-    xs: Vec<f64>,
+    /// The vertices' rounded coordinates, in tree order, with their ids.
+    pts: Vec<([f64; 3], u32)>,
+    /// The split axis of the node whose median sits at each position.
+    axis: Vec<u8>,
 }
 
 impl Candidates {
-    /// Boxes spanning more cells than this scan the `x` slab instead.
-    const MAX_CELLS: i64 = 64;
+    /// Ranges at most this long are leaves.
+    const LEAF: usize = 8;
 
-    fn new(coords: &[[f64; 3]], corners: &[Vec<u32>]) -> Candidates {
-        let mut by_x: Vec<u32> = (0..coords.len() as u32).collect();
-        by_x.sort_by(|&a, &b| coords[a as usize][0].total_cmp(&coords[b as usize][0]));
-        let xs: Vec<f64> = by_x.iter().map(|&i| coords[i as usize][0]).collect();
-        // the median longest extent of the polygons' first edges
-        let mut ext: Vec<f64> = corners
-            .iter()
-            .filter(|c| c.len() > 1)
-            .map(|c| {
-                let (p, q) = (coords[c[0] as usize], coords[c[1] as usize]);
-                (0..3).map(|j| (p[j] - q[j]).abs()).fold(0.0, f64::max)
-            })
-            .collect();
-        let h = if ext.is_empty() {
-            1.0
-        } else {
-            let m = ext.len() / 2;
-            *ext.select_nth_unstable_by(m, f64::total_cmp).1
-        };
-        let h = if h.is_finite() && h > 0.0 { h } else { 1.0 };
-        let mut cells: rustc_hash::FxHashMap<[i64; 3], Vec<u32>> = Default::default();
-        for (i, c) in coords.iter().enumerate() {
-            cells
-                .entry(c.map(|x| (x / h).floor() as i64))
-                .or_default()
-                .push(i as u32);
+    fn new(coords: &[[f64; 3]]) -> Candidates {
+        let mut pts: Vec<([f64; 3], u32)> =
+            coords.iter().enumerate().map(|(i, c)| (*c, i as u32)).collect();
+        let mut axis = vec![0u8; pts.len()];
+        let mut stack = vec![(0usize, pts.len())];
+        while let Some((lo, hi)) = stack.pop() {
+            if hi - lo <= Self::LEAF {
+                continue;
+            }
+            let part = &mut pts[lo..hi];
+            let mut best = (0usize, f64::NEG_INFINITY);
+            for j in 0..3 {
+                let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
+                for p in part.iter() {
+                    a = a.min(p.0[j]);
+                    b = b.max(p.0[j]);
+                }
+                if b - a > best.1 {
+                    best = (j, b - a);
+                }
+            }
+            let j = best.0;
+            let mid = part.len() / 2;
+            part.select_nth_unstable_by(mid, |p, q| p.0[j].total_cmp(&q.0[j]));
+            axis[lo + mid] = j as u8;
+            stack.push((lo + mid + 1, hi));
+            stack.push((lo, lo + mid));
         }
-        Candidates { h, cells, by_x, xs }
+        Candidates { pts, axis }
     }
 
     /// Calls `f` with every vertex whose rounded coordinates may lie in
     /// `[lo, hi]` (and possibly others).
     fn each(&self, lo: [f64; 3], hi: [f64; 3], mut f: impl FnMut(u32)) {
-        let (l, u) = (
-            lo.map(|x| (x / self.h).floor() as i64),
-            hi.map(|x| (x / self.h).floor() as i64),
-        );
-        let span = (0..3).fold(1i64, |acc, j| {
-            acc.saturating_mul(u[j].saturating_sub(l[j]).saturating_add(1).max(1))
-        });
-        if span <= Self::MAX_CELLS {
-            for x in l[0]..=u[0] {
-                for y in l[1]..=u[1] {
-                    for z in l[2]..=u[2] {
-                        if let Some(vs) = self.cells.get(&[x, y, z]) {
-                            vs.iter().for_each(|&v| f(v));
-                        }
-                    }
+        let mut stack: SmallVec<[(usize, usize); 32]> = SmallVec::new();
+        stack.push((0, self.pts.len()));
+        while let Some((a, b)) = stack.pop() {
+            if b - a <= Self::LEAF {
+                for p in &self.pts[a..b] {
+                    f(p.1);
                 }
+                continue;
             }
-        } else {
-            let start = self.xs.partition_point(|&x| x < lo[0]);
-            let end = self.xs.partition_point(|&x| x <= hi[0]);
-            self.by_x[start..end].iter().for_each(|&v| f(v));
+            let mid = a + (b - a) / 2;
+            let j = self.axis[mid] as usize;
+            let split = self.pts[mid].0[j];
+            // the left part has coordinates <= split, the right >= split
+            let (left, right) = (lo[j] <= split, hi[j] >= split);
+            if left && right {
+                f(self.pts[mid].1);
+            }
+            if right {
+                stack.push((mid + 1, b));
+            }
+            if left {
+                stack.push((a, mid));
+            }
         }
     }
 }
