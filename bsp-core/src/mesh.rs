@@ -690,8 +690,11 @@ impl Candidates {
     const LEAF: usize = 8;
 
     fn new(coords: &[[f64; 3]]) -> Candidates {
-        let mut pts: Vec<([f64; 3], u32)> =
-            coords.iter().enumerate().map(|(i, c)| (*c, i as u32)).collect();
+        let mut pts: Vec<([f64; 3], u32)> = coords
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (*c, i as u32))
+            .collect();
         let mut axis = vec![0u8; pts.len()];
         let mut stack = vec![(0usize, pts.len())];
         while let Some((lo, hi)) = stack.pop() {
