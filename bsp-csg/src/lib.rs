@@ -419,13 +419,22 @@ impl Solid {
     }
 
     /// `self op other` for solids whose faces cannot meet.
-    fn apart(&mut self, other: &Solid, op: BoolOp) -> Result<Stats, CsgError> {
+    fn apart(&mut self, other: &Solid, op: BoolOp) -> Result<(Stats, Plan), CsgError> {
+        let mut plan = Plan {
+            add: Vec::new(),
+            flip: false,
+        };
         match op {
-            BoolOp::Union => other.polygons().for_each(|p| self.add(p.clone())),
+            BoolOp::Union => {
+                plan.add = (0..other.faces.len() as u32)
+                    .filter(|&i| other.faces[i as usize].is_some())
+                    .map(Added::Whole)
+                    .collect()
+            }
             BoolOp::Intersection => *self = Solid::empty(),
             BoolOp::Difference => {}
         }
-        Ok(Stats::default())
+        Ok((Stats::default(), plan))
     }
 
     /// `self ← self op other`, touching only the faces near `other`.
@@ -440,6 +449,40 @@ impl Solid {
         op: BoolOp,
         opts: &Options,
     ) -> Result<Stats, CsgError> {
+        let (stats, plan) = self.plan(other, op, opts)?;
+        self.carry_out(plan, |f| other.face(f).poly.clone());
+        Ok(stats)
+    }
+
+    /// [`Solid::apply`], taking the other solid: the faces it keeps whole
+    /// move over instead of being copied, so that the two are not held
+    /// at once (the same result).
+    pub fn apply_owned(&mut self, other: Solid, op: BoolOp) -> Result<Stats, CsgError> {
+        self.apply_owned_with(other, op, &Options::default())
+    }
+
+    /// [`Solid::apply_owned`] with options.
+    pub fn apply_owned_with(
+        &mut self,
+        mut other: Solid,
+        op: BoolOp,
+        opts: &Options,
+    ) -> Result<Stats, CsgError> {
+        let (stats, plan) = self.plan(&other, op, opts)?;
+        self.carry_out(plan, |f| {
+            other.faces[f as usize].take().expect("a live face").poly
+        });
+        Ok(stats)
+    }
+
+    /// Everything an operation decides, before the first solid changes
+    /// (its faces to remove are removed).
+    fn plan(
+        &mut self,
+        other: &Solid,
+        op: BoolOp,
+        opts: &Options,
+    ) -> Result<(Stats, Plan), CsgError> {
         let keep_a = |inside_b: bool| match op {
             BoolOp::Union | BoolOp::Difference => !inside_b,
             BoolOp::Intersection => inside_b,
@@ -567,7 +610,7 @@ impl Solid {
             mixed_cells: mixed.len(),
             ..Stats::default()
         };
-        let mut add: Vec<Polygon> = Vec::new();
+        let mut add: Vec<Added> = Vec::new();
         let mut fates_a: FxHashMap<u32, Vec<Fate>> = FxHashMap::default();
         let mut local_pieces_a: FxHashMap<u32, Vec<Polygon>> = FxHashMap::default();
         let mut local_pieces_b: FxHashMap<u32, Vec<Polygon>> = FxHashMap::default();
@@ -576,7 +619,7 @@ impl Solid {
             match c {
                 CellResult::Merged(ps) => {
                     stats.merged_cells += 1;
-                    add.extend(ps)
+                    add.extend(ps.into_iter().map(|p| Added::New(Box::new(p))))
                 }
                 CellResult::Pieces(fa, fb, pa, pb) => {
                     fates_a.insert(l, fa);
@@ -624,29 +667,33 @@ impl Solid {
                     stats.cut_faces += 1;
                     stats.pieces += kept.len();
                 }
-                add.extend(kept);
+                add.extend(kept.into_iter().map(|p| Added::New(Box::new(p))));
             }
         }
-        let b_out = |p: &Polygon| if flip_b { p.flipped() } else { p.clone() };
+        // the other solid's faces kept whole are listed, to be copied or
+        // moved over (flipped for a difference)
         for &f in &whole_b {
             let inside = b_leaves
                 .get(&f)
                 .and_then(|ls| meeting_leaf(&other.face(f).poly, ls, &leaves))
                 .is_some_and(|l| inside_a.inside(l));
             if keep_b(inside) {
-                add.push(b_out(&other.face(f).poly));
+                add.push(Added::Whole(f));
             }
         }
         for (f, pieces) in pieces_b {
             let poly = &other.face(f).poly;
             match settle_with(poly, &pieces, &keep_b, &inside_a, &fates_b, &local_pieces_b) {
-                None => add.push(b_out(poly)),
+                None => add.push(Added::Whole(f)),
                 Some(kept) => {
                     if !kept.is_empty() {
                         stats.cut_faces += 1;
                         stats.pieces += kept.len();
                     }
-                    add.extend(kept.iter().map(b_out));
+                    add.extend(
+                        kept.into_iter()
+                            .map(|p| Added::New(Box::new(if flip_b { p.flipped() } else { p }))),
+                    );
                 }
             }
         }
@@ -654,10 +701,8 @@ impl Solid {
         if op == BoolOp::Union {
             let near: std::collections::HashSet<u32> = b_c.iter().copied().collect();
             for (i, f) in other.faces.iter().enumerate() {
-                if let Some(f) = f
-                    && !near.contains(&(i as u32))
-                {
-                    add.push(f.poly.clone());
+                if f.is_some() && !near.contains(&(i as u32)) {
+                    add.push(Added::Whole(i as u32));
                 }
             }
         }
@@ -672,14 +717,43 @@ impl Solid {
         for f in remove {
             self.remove(f);
         }
-        for p in add {
-            self.add(p);
+        Ok((stats, Plan { add, flip: flip_b }))
+    }
+
+    /// Carries a plan out: its new faces, then the other solid's faces it
+    /// keeps whole, each taken by `take`.
+    fn carry_out(&mut self, plan: Plan, mut take: impl FnMut(u32) -> Polygon) {
+        // room for the new faces at once: growing by doubling would hold
+        // the old and a twice larger array of faces at the same time
+        self.faces
+            .reserve_exact(plan.add.len().saturating_sub(self.free.len()));
+        for a in plan.add {
+            match a {
+                Added::New(p) => self.add(*p),
+                Added::Whole(f) => {
+                    let p = take(f);
+                    self.add(if plan.flip { p.flipped() } else { p });
+                }
+            }
         }
         if self.live > 4 * self.indexed + 1024 {
             self.reindex();
         }
-        Ok(stats)
     }
+}
+
+/// What an operation adds to the first solid, in order: new faces, and
+/// the other solid's faces kept whole (flipped if `flip`).
+struct Plan {
+    add: Vec<Added>,
+    flip: bool,
+}
+
+/// A new face, or (`Whole`) the other solid's face kept whole; new faces
+/// are boxed so that the many whole ones cost a few bytes each.
+enum Added {
+    New(Box<Polygon>),
+    Whole(u32),
 }
 
 /// A piece of a face cut by octree walls: in a cell free of the other
@@ -953,7 +1027,7 @@ pub fn mesh_sequence(
     let mut it = solids.into_iter();
     let mut solid = it.next().expect("at least the first operand");
     for (s, (op, _)) in it.zip(ops) {
-        solid.apply(&s, *op)?;
+        solid.apply_owned(s, *op)?;
     }
     let mesh = solid.to_mesh();
     mesh.check_watertight().map_err(CsgError::Internal)?;

@@ -81,9 +81,21 @@ struct Operand {
     /// The faces' vertex loops as in the file, kept when `--weld` renumbered
     /// them, so that messages quote the file's indices.
     file_loops: Option<Vec<Vec<u32>>>,
+    /// Triangles and faces as read (the mesh itself is let go once
+    /// snapped).
+    counts: (usize, usize),
 }
 
 impl Operand {
+    fn new(name: String, mesh: Mesh, file_loops: Option<Vec<Vec<u32>>>) -> Operand {
+        Operand {
+            name,
+            counts: (mesh.triangle_count(), mesh.faces.len()),
+            mesh,
+            file_loops,
+        }
+    }
+
     fn load(path: &Path, weld: bool) -> Result<Operand> {
         let mut mesh = crate::load_mesh(path, false)?;
         let file_loops = weld.then(|| {
@@ -91,11 +103,7 @@ impl Operand {
             mesh.weld();
             loops
         });
-        Ok(Operand {
-            name: path.display().to_string(),
-            mesh,
-            file_loops,
-        })
+        Ok(Operand::new(path.display().to_string(), mesh, file_loops))
     }
 
     /// `file:line` of face `face` for text formats, else `file`.
@@ -251,7 +259,7 @@ struct Outcome {
 /// Snaps the operands to one grid and applies the operation to the first
 /// with each of the others in turn, then extracts the watertight
 /// boundary. Prints import summaries to stderr.
-fn compute(operands: &[Operand], op: Operation, phases: &mut Phases) -> Result<Outcome> {
+fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Result<Outcome> {
     let loops: Vec<Vec<Vec<u32>>> = operands.iter().map(Operand::loops).collect();
     let meshes: Vec<MeshIn<'_>> = operands
         .iter()
@@ -259,9 +267,14 @@ fn compute(operands: &[Operand], op: Operation, phases: &mut Phases) -> Result<O
         .map(|(o, l)| MeshIn::new(&o.mesh.positions, l))
         .collect();
     let snapped = phases.run("snap/import", || bsp_csg::snap(&meshes));
-    // the copies of the face lists are not needed any more
+    // the copies of the face lists are not needed any more, nor the
+    // meshes as read (messages from here on name the files only)
     drop(meshes);
     drop(loops);
+    for o in operands.iter_mut() {
+        o.mesh = Mesh::default();
+        o.file_loops = None;
+    }
     let Snapped {
         grid,
         solids,
@@ -295,7 +308,7 @@ fn compute(operands: &[Operand], op: Operation, phases: &mut Phases) -> Result<O
     let stats = phases.run("boolean", || -> Result<Vec<bsp_csg::Stats>> {
         let mut stats = Vec::new();
         for (i, s) in it.enumerate() {
-            let st = solid.apply(&s, op.kernel()).map_err(|e| match e {
+            let st = solid.apply_owned(s, op.kernel()).map_err(|e| match e {
                 CsgError::NotASolid => anyhow!(
                     "{} or the result before it: a surface crosses itself after snapping to the \
                      grid (step 2^{}) and bounds no solid",
@@ -396,7 +409,7 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
     // fail on a bad output name before doing any work
     MeshFormat::from_path(&args.output)?;
     let mut phases = Phases::default();
-    let operands = phases.run("load", || -> Result<Vec<Operand>> {
+    let mut operands = phases.run("load", || -> Result<Vec<Operand>> {
         args.operands
             .iter()
             .map(|p| Operand::load(p, args.weld))
@@ -406,7 +419,7 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
         operands.iter().try_for_each(Operand::validate)
     })?;
     let out = guarded("the input files", || {
-        compute(&operands, args.op, &mut phases)
+        compute(&mut operands, args.op, &mut phases)
     })?;
     phases.run("write", || shadow_scene::save(&args.output, &out.mesh))?;
     let total = total.elapsed();
@@ -484,8 +497,8 @@ fn stats_text(
              ({} faces triangulated, {} dropped)\n",
             "",
             o.name,
-            o.mesh.triangle_count(),
-            o.mesh.faces.len(),
+            o.counts.0,
+            o.counts.1,
             r.polygons,
             r.triangulated.len(),
             r.dropped.len(),
@@ -567,11 +580,7 @@ f 4 1 5 8
             mesh.weld();
             l
         });
-        Operand {
-            name: name.to_string(),
-            mesh,
-            file_loops,
-        }
+        Operand::new(name.to_string(), mesh, file_loops)
     }
 
     /// The cube scaled by `s` and moved by `d`, as OBJ text with relative
@@ -681,22 +690,14 @@ f 4 1 5 8
             f.line = 0;
         }
         mesh.faces.remove(1);
-        let o = Operand {
-            name: "open.stl".into(),
-            mesh,
-            file_loops: None,
-        };
+        let o = Operand::new("open.stl".into(), mesh, None);
         assert_eq!(
             o.validate().unwrap_err().to_string(),
             "open.stl: edge (1, 0, 1)-(0, 0, 1) of face 1 is a boundary edge (the mesh is not closed)"
         );
         let mut mesh = o.mesh;
         mesh.faces[0].vertices = vec![0, 3, 0];
-        let o = Operand {
-            name: "sliver.stl".into(),
-            mesh,
-            file_loops: None,
-        };
+        let o = Operand::new("sliver.stl".into(), mesh, None);
         assert_eq!(
             o.validate().unwrap_err().to_string(),
             "sliver.stl: face 0 (0, 0, 0) (0, 1, 0) (0, 0, 0) repeats a vertex"
@@ -713,7 +714,7 @@ f 4 1 5 8
             (Operation::Difference, 56.0),
         ] {
             let mut phases = Phases::default();
-            let out = compute(&[a.clone(), b.clone()], op, &mut phases).unwrap();
+            let out = compute(&mut [a.clone(), b.clone()], op, &mut phases).unwrap();
             assert_eq!(exact_volume(&out.exact, &out.grid), vol, "{op:?}");
             assert_eq!(out.mesh.signed_volume(), vol, "{op:?}");
             assert!(out.mesh.is_closed_oriented());
@@ -723,7 +724,12 @@ f 4 1 5 8
         }
         // disjoint: empty intersection
         let far = operand(&cube(1.0, [10.0; 3]), "far.obj", false);
-        let out = compute(&[a, far], Operation::Intersection, &mut Phases::default()).unwrap();
+        let out = compute(
+            &mut [a, far],
+            Operation::Intersection,
+            &mut Phases::default(),
+        )
+        .unwrap();
         assert!(out.mesh.faces.is_empty());
         assert_eq!(out.stats[0].cells, 0);
     }
@@ -734,7 +740,7 @@ f 4 1 5 8
         // exact volume is divided by a power of two
         let a = operand(&cube(0.75, [0.125; 3]), "a.obj", false);
         let b = operand(&cube(0.75, [0.5; 3]), "b.obj", false);
-        let out = compute(&[a, b], Operation::Union, &mut Phases::default()).unwrap();
+        let out = compute(&mut [a, b], Operation::Union, &mut Phases::default()).unwrap();
         assert!(out.grid.scale() > 1.0);
         assert_eq!(
             exact_volume(&out.exact, &out.grid),
@@ -743,7 +749,7 @@ f 4 1 5 8
         // a coarse grid (scale < 1) multiplies instead
         let a = operand(&cube(4e9, [0.0; 3]), "a.obj", false);
         let b = operand(&cube(4e9, [2e9; 3]), "b.obj", false);
-        let out = compute(&[a, b], Operation::Intersection, &mut Phases::default()).unwrap();
+        let out = compute(&mut [a, b], Operation::Intersection, &mut Phases::default()).unwrap();
         assert!(out.grid.scale() < 1.0);
         assert_eq!(exact_volume(&out.exact, &out.grid), 8e27);
     }
@@ -775,7 +781,7 @@ f 4 1 5 8
             (&a, &c, Operation::Difference),
             (&c, &b, Operation::Union),
         ] {
-            let out = compute(&[x.clone(), y.clone()], op, &mut Phases::default()).unwrap();
+            let out = compute(&mut [x.clone(), y.clone()], op, &mut Phases::default()).unwrap();
             assert!(out.exact.vertices.iter().any(|p| p.as_grid().is_none()));
             // the cheap rounding is the exact fraction's, rounded once
             let exact = out.exact.volume_exact();
@@ -814,7 +820,7 @@ f 4 1 5 8
         let a = operand(&inside_out, "inv.obj", false);
         a.validate().unwrap();
         let b = operand(CUBE, "b.obj", false);
-        let e = compute(&[a, b], Operation::Union, &mut Phases::default())
+        let e = compute(&mut [a, b], Operation::Union, &mut Phases::default())
             .err()
             .unwrap();
         assert!(
