@@ -826,37 +826,13 @@ mod tests {
         assert!(apart(&big, &[[-m, -m, -m], [m, m, m], [-m, m, m]]));
     }
 
-    /// Closed meshes on a coarse grid: a UV sphere of radius 8 with every
-    /// vertex moved at random by up to `jitter`, so that faces fold over
-    /// and pass through each other often.
-    fn jittered_sphere(jitter: i32, seed: u64) -> Vec<Polygon> {
-        let (v, f) = crate::shapes::uv_sphere(48);
-        let mut rng = crate::SplitMix(seed);
-        let pts: Vec<GridPoint> = v
-            .iter()
-            .map(|p| {
-                let mut j = || (rng.next_u64() % (2 * jitter as u64 + 1)) as i32 - jitter;
-                [
-                    (p.x * 8.0).round() as i32 + j(),
-                    (p.y * 8.0).round() as i32 + j(),
-                    (p.z * 8.0).round() as i32 + j(),
-                ]
-            })
-            .collect();
-        f.iter()
-            .filter_map(|t| {
-                let l: Vec<GridPoint> = t.iter().map(|&i| pts[i as usize]).collect();
-                Polygon::from_grid_points(&l, 0).ok()
-            })
-            .collect()
-    }
-
     #[test]
     fn stars_agree_with_pairwise_tests() {
         let (mut ok, mut refused) = (0, 0);
         for seed in 0..800u64 {
             let jitter = 1 + (seed % 4) as i32;
-            let polys = jittered_sphere(jitter, seed);
+            let polys =
+                crate::shapes::jittered_uv_sphere(48, 8.0, jitter, &mut crate::SplitMix(seed));
             let (a, b) = (certify(&polys, true), certify(&polys, false));
             assert_eq!(a.is_ok(), b.is_ok(), "seed {seed}: {a:?} vs {b:?}");
             match a {

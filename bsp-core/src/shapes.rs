@@ -59,6 +59,38 @@ pub fn fibonacci_sphere(n: usize) -> Vec<DVec3> {
         .collect()
 }
 
+/// The UV sphere of about `n` triangles ([`uv_sphere`]) scaled by `radius`
+/// on the integer grid, every vertex moved by a random amount in
+/// `-jitter..=jitter` on each axis, and the faces that keep an area as
+/// polygons: a closed surface that often folds over, passes through
+/// itself or turns a part inside out, for tests of what is certified
+/// about surfaces.
+pub fn jittered_uv_sphere(
+    n: usize,
+    radius: f64,
+    jitter: i32,
+    rng: &mut crate::SplitMix,
+) -> Vec<crate::Polygon> {
+    let (v, f) = uv_sphere(n);
+    let pts: Vec<crate::GridPoint> = v
+        .iter()
+        .map(|p| {
+            let mut j = || (rng.next_u64() % (2 * jitter as u64 + 1)) as i32 - jitter;
+            [
+                (p.x * radius).round() as i32 + j(),
+                (p.y * radius).round() as i32 + j(),
+                (p.z * radius).round() as i32 + j(),
+            ]
+        })
+        .collect();
+    f.iter()
+        .filter_map(|t| {
+            let l: Vec<crate::GridPoint> = t.iter().map(|&i| pts[i as usize]).collect();
+            crate::Polygon::from_grid_points(&l, 0).ok()
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

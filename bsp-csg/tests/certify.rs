@@ -8,38 +8,17 @@
 use bsp_core::{GridPoint, Polygon, SplitMix, certify_solid_boundary, shapes};
 use bsp_csg::Solid;
 
-fn jittered_sphere(n: usize, radius: f64, jitter: i32, rng: &mut SplitMix) -> Vec<Polygon> {
-    let (v, f) = shapes::uv_sphere(n);
-    let pts: Vec<GridPoint> = v
-        .iter()
-        .map(|p| {
-            let mut j = || (rng.next_u64() % (2 * jitter as u64 + 1)) as i32 - jitter;
-            [
-                (p.x * radius).round() as i32 + j(),
-                (p.y * radius).round() as i32 + j(),
-                (p.z * radius).round() as i32 + j(),
-            ]
-        })
-        .collect();
-    f.iter()
-        .filter_map(|t| {
-            let l: Vec<GridPoint> = t.iter().map(|&i| pts[i as usize]).collect();
-            Polygon::from_grid_points(&l, 0).ok()
-        })
-        .collect()
-}
-
 #[test]
 fn certified_surfaces_have_no_negative_winding() {
     let mut rng = SplitMix(0xce27);
     let (mut certified, mut refused_negative) = (0, 0);
     for case in 0..200 {
         let jitter = 1 + case % 4;
-        let mut polys = jittered_sphere(48, 7.0, jitter, &mut rng);
+        let mut polys = shapes::jittered_uv_sphere(48, 7.0, jitter, &mut rng);
         if case % 4 == 3 {
             // a second sphere, apart, overlapping or inside
             let off = (rng.next_u64() % 20) as i32 - 4;
-            let other = jittered_sphere(24, 3.0, 1, &mut rng);
+            let other = shapes::jittered_uv_sphere(24, 3.0, 1, &mut rng);
             polys.extend(other.iter().map(|p| {
                 let l: Vec<GridPoint> = p
                     .vertices()
