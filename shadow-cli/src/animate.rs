@@ -341,6 +341,8 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
     progress.phase("frames", args.frames as u64);
     let mut times: Vec<Duration> = Vec::with_capacity(args.frames as usize);
     let mut related = 0usize;
+    // frames in which a light left out the object's faces turned away
+    let mut culled = 0u32;
     let mut last = FrameStats::default();
     // PNG frames are drawn one after the other in one renderer, which
     // keeps its buffers from frame to frame
@@ -367,6 +369,7 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
             let m = motion.matrix(k);
             times.push(frame.stats.t_frame);
             related += frame.stats.related;
+            culled += (frame.stats.culled > 0) as u32;
             if let Some(r) = &mut report {
                 writeln!(r, "{}", report_row(k, &frame.stats))?;
             }
@@ -422,7 +425,8 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
         "{} frames of {}: {} static faces, {} moving; {:?} strategy, {} light(s); frame time \
          median {:.2} ms, mean {:.2} ms, max {:.2} ms; wall time a frame {:.2} ms ({} in \
          flight); {:.0} related static polygons a frame; {} fragments in the last frame; \
-         preprocessing {:.1} ms, total {:.2} s",
+         faces turned away from a light left out in {} of the frames; preprocessing {:.1} ms, \
+         total {:.2} s",
         args.frames,
         s.name,
         s.statics.faces.len(),
@@ -436,6 +440,7 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
         in_flight,
         related as f64 / args.frames as f64,
         last.total_drawn,
+        culled,
         ms(t_pre),
         total.elapsed().as_secs_f64()
     );

@@ -294,6 +294,12 @@ fn files_need_a_moving_object_a_light_and_a_good_spin() {
         o,
     ]);
     assert!(text.starts_with("4 frames of "), "{text}");
+    // a closed outward tetrahedron under the light: every frame leaves
+    // out its faces turned away from it
+    assert!(
+        text.contains("faces turned away from a light left out in 4 of the frames"),
+        "{text}"
+    );
     let last = json(&out.join("frame_0003.json"));
     // the tetrahedron's shadow is a hole in the quad's lit fragment
     let quad: Vec<&Value> = last["fragments"]
