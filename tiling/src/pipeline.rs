@@ -619,20 +619,19 @@ impl Dynamic {
                             .collect()
                     })
                     .collect();
-                // few of them: one tree of the object and those; many: a
-                // tree of the object alone, and for the object's own faces
-                // the static trees too (a point is lit where neither blocks)
                 // the object's faces turned away from a light hide nothing
                 // more when its snapped surface is certified to bound
                 // solids and the light is outside them
-                let solid = bsp_core::certify_solid_boundary(&moved);
-                let solid = solid.ok();
+                let solid = bsp_core::certify_solid_boundary(&moved).ok();
                 let culls: Vec<bool> = self
                     .lights
                     .iter()
                     .map(|l| solid.as_ref().is_some_and(|s| l.culls_back_faces(s)))
                     .collect();
                 stats.culled = culls.iter().filter(|&&c| c).count();
+                // few of them: one tree of the object and those; many: a
+                // tree of the object alone, and for the object's own faces
+                // the static trees too (a point is lit where neither blocks)
                 let layered = blockers.iter().map(Vec::len).sum::<usize>() * 4
                     > moved.len() * self.lights.len();
                 stats.layered = layered;
