@@ -67,7 +67,7 @@ fn axes(support: &Plane) -> (usize, usize, usize) {
     ((k + 1) % 3, (k + 2) % 3, k)
 }
 
-/// [`line_key`] of the arena's edge plane `e`, computed once a plane
+/// [`line_key`] of the arena's edge plane `e`, computed once per plane
 /// (the key does not depend on the plane's orientation).
 fn line_key_cached(
     keys: &mut FxHashMap<u32, LineKey>,

@@ -475,8 +475,9 @@ impl Solid {
         Ok(stats)
     }
 
-    /// Everything an operation decides, before the first solid changes
-    /// (its faces to remove are removed).
+    /// Everything an operation decides; of the changes to this solid it
+    /// makes the removals (and empties it for an intersection with a
+    /// solid apart), and leaves the additions to [`Solid::carry_out`].
     fn plan(
         &mut self,
         other: &Solid,
