@@ -9,12 +9,12 @@
 //!    are (or dropped, for ∩), at no cost.
 //! 2. Over the box both solids share, an adaptive octree splits the cells
 //!    that hold faces of both until they hold few
-//!    ([`octree`](crate::octree): cell walls lie half a grid step off the
+//!    (module `octree`: cell walls lie half a grid step off the
 //!    grid, so no vertex or face of either solid is ever on one).
 //! 3. In each cell that holds faces of both, the faces are clipped to the
 //!    cell, each operand's pieces make a small BSP partition whose leaves
 //!    are labelled exactly by the faces that cover their common boundaries
-//!    ([`local`](crate::local)), and each piece of one operand is sorted
+//!    (module `local`), and each piece of one operand is sorted
 //!    against the other's labelled partition: kept whole, dropped whole, or
 //!    cut by the other surface into kept fragments. Where faces of the two
 //!    operands share a plane, the cell's two partitions are merged with
