@@ -59,6 +59,34 @@ pub fn fibonacci_sphere(n: usize) -> Vec<DVec3> {
         .collect()
 }
 
+/// The CSG benches' pair: the unit UV sphere of about `n` triangles
+/// ([`uv_sphere`]) and a copy of it rotated 5° about `(1, 2, 3)` and moved
+/// by `(0.3, 0.1, 0.05)` (the inputs of `scripts/manifold_compare.py`).
+/// Returns both vertex lists and their shared faces.
+pub fn sphere_pair(n: usize) -> (Vec<DVec3>, Vec<DVec3>, Vec<Vec<u32>>) {
+    let (a, f) = uv_sphere(n);
+    let rot =
+        glam::DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 5f64.to_radians());
+    let b = a
+        .iter()
+        .map(|&p| rot * p + DVec3::new(0.3, 0.1, 0.05))
+        .collect();
+    (a, b, f)
+}
+
+/// The iterated-CSG benches' tools: `count` UV spheres of about `n`
+/// triangles and radius 0.05, centred on the unit sphere along a
+/// Fibonacci spiral ([`fibonacci_sphere`]). Returns each tool's vertices
+/// and their shared faces.
+pub fn drill_tools(count: usize, n: usize) -> (Vec<Vec<DVec3>>, Vec<Vec<u32>>) {
+    let (v, f) = uv_sphere(n);
+    let tools = fibonacci_sphere(count)
+        .into_iter()
+        .map(|c| v.iter().map(|&p| c + 0.05 * p).collect())
+        .collect();
+    (tools, f)
+}
+
 /// The UV sphere of about `n` triangles ([`uv_sphere`]) scaled by `radius`
 /// on the integer grid, every vertex moved by a random amount in
 /// `-jitter..=jitter` on each axis, and the faces that keep an area as

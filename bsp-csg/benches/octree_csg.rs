@@ -11,21 +11,15 @@
 //!   1000-tool case of the docs).
 
 use bsp_core::BoolOp;
-use bsp_csg::shapes::{fibonacci_sphere, uv_sphere};
+use bsp_csg::shapes::{drill_tools, sphere_pair, uv_sphere};
 use bsp_csg::{MeshIn, Snapped, snap};
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
-use glam::{DMat3, DVec3};
 
 fn union(c: &mut Criterion) {
     let mut g = c.benchmark_group("octree_csg/union");
     g.sample_size(10);
     for n in [1_000, 10_000, 100_000] {
-        let (va, f) = uv_sphere(n);
-        let rot = DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 5f64.to_radians());
-        let vb: Vec<DVec3> = va
-            .iter()
-            .map(|&p| rot * p + DVec3::new(0.3, 0.1, 0.05))
-            .collect();
+        let (va, vb, f) = sphere_pair(n);
         g.bench_with_input(BenchmarkId::new("sphere", f.len()), &(), |bch, _| {
             bch.iter(|| {
                 let r = bsp_csg::mesh_boolean(
@@ -45,12 +39,8 @@ fn drill(c: &mut Criterion) {
     let mut g = c.benchmark_group("octree_csg/drill");
     g.sample_size(10);
     let (pv, pf) = uv_sphere(10_000);
-    let (tv, tf) = uv_sphere(1_000);
     let tools = 20;
-    let placed: Vec<Vec<DVec3>> = fibonacci_sphere(tools)
-        .into_iter()
-        .map(|c| tv.iter().map(|&p| c + 0.05 * p).collect())
-        .collect();
+    let (placed, tf) = drill_tools(tools, 1_000);
     let mut meshes = vec![MeshIn::new(&pv, &pf)];
     meshes.extend(placed.iter().map(|v| MeshIn::new(v, &tf)));
     let Snapped { solids, .. } = snap(&meshes).unwrap();

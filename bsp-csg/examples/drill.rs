@@ -13,9 +13,8 @@
 use std::time::Instant;
 
 use bsp_core::BoolOp;
-use bsp_csg::shapes::{fibonacci_sphere, uv_sphere};
+use bsp_csg::shapes::{drill_tools, uv_sphere};
 use bsp_csg::{MeshIn, Snapped, snap};
-use glam::DVec3;
 
 fn main() {
     let mut args = std::env::args().skip(1).map(|a| a.parse::<usize>().ok());
@@ -23,11 +22,7 @@ fn main() {
     let part_tris = args.next().flatten().unwrap_or(100_000);
     let tool_tris = args.next().flatten().unwrap_or(1000);
     let (pv, pf) = uv_sphere(part_tris);
-    let (tv, tf) = uv_sphere(tool_tris);
-    let tool_meshes: Vec<Vec<DVec3>> = fibonacci_sphere(tools)
-        .into_iter()
-        .map(|c| tv.iter().map(|&p| c + 0.05 * p).collect())
-        .collect();
+    let (tool_meshes, tf) = drill_tools(tools, tool_tris);
     let mut meshes = vec![MeshIn::new(&pv, &pf)];
     meshes.extend(tool_meshes.iter().map(|v| MeshIn::new(v, &tf)));
     let t = Instant::now();

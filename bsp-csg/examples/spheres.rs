@@ -10,8 +10,8 @@ use std::time::Instant;
 
 use bsp_core::{BoolOp, Grid, import_faces_par};
 use bsp_csg::Solid;
-use bsp_csg::shapes::uv_sphere;
-use glam::{DMat3, DVec3};
+use bsp_csg::shapes::sphere_pair;
+use glam::DVec3;
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -21,12 +21,7 @@ fn main() {
         Some("difference") => BoolOp::Difference,
         _ => BoolOp::Union,
     };
-    let (va, fa) = uv_sphere(n);
-    let rot = DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 5f64.to_radians());
-    let vb: Vec<DVec3> = va
-        .iter()
-        .map(|&p| rot * p + DVec3::new(0.3, 0.1, 0.05))
-        .collect();
+    let (va, vb, fa) = sphere_pair(n);
     let t = Instant::now();
     let grid = Grid::fit_points(va.iter().chain(&vb)).unwrap();
     let loops = |v: &[DVec3], f: &[Vec<u32>]| -> Vec<Vec<DVec3>> {

@@ -9,17 +9,12 @@
 //! left holes (the 2 000-triangle part minus 20 tools, from step 2 on).
 
 use bsp_core::BoolOp;
-use bsp_csg::shapes::{fibonacci_sphere, uv_sphere};
+use bsp_csg::shapes::{drill_tools, uv_sphere};
 use bsp_csg::{MeshIn, Options, Snapped, snap};
-use glam::DVec3;
 
 fn drill(tools: usize, opts: &Options) -> (f64, usize) {
     let (pv, pf) = uv_sphere(2000);
-    let (tv, tf) = uv_sphere(1000);
-    let placed: Vec<Vec<DVec3>> = fibonacci_sphere(tools)
-        .into_iter()
-        .map(|c| tv.iter().map(|&p| c + 0.05 * p).collect())
-        .collect();
+    let (placed, tf) = drill_tools(tools, 1000);
     let mut meshes = vec![MeshIn::new(&pv, &pf)];
     meshes.extend(placed.iter().map(|v| MeshIn::new(v, &tf)));
     let Snapped { solids, .. } = snap(&meshes).unwrap();
