@@ -9,27 +9,14 @@
 
 use glam::DVec3;
 use shadow_raster::{Camera, Method, RasterScene, RenderOptions, Renderer, SceneLight, render};
-use svbsp::{LightSpec, place_lights, shared_grid};
+
+#[path = "../benches/common/mod.rs"]
+mod common;
 
 fn setup(sun: bool) -> (RasterScene, Vec<SceneLight>, Camera) {
-    let mesh = shadow_scene::scene("bunny-99k").expect("a built-in scene");
-    let (lo, hi) = mesh.bounds().unwrap();
-    let (c, half) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
-    let spec = if sun {
-        LightSpec::Sun(DVec3::new(3.0, 10.0, 2.0))
-    } else {
-        LightSpec::Point(c + DVec3::Y * 1.6 * half + DVec3::X * 0.4 * half + DVec3::Z * 0.6 * half)
-    };
-    let grid = shared_grid(&mesh.positions, &[spec]).unwrap();
-    let lights = place_lights(&grid, &[spec])
-        .unwrap()
-        .iter()
-        .map(SceneLight::from_placed)
-        .collect();
-    let (polys, _) = bsp_core::import_faces_par(&grid, &mesh.face_loops()).unwrap();
-    let eye = c + DVec3::new(0.75 * half, 0.6 * half, 1.7 * half);
-    let cam = Camera::look_at(eye, c - DVec3::Y * 0.25 * half, DVec3::Y, 50.0, 1920, 1080).unwrap();
-    (RasterScene::new(&grid, polys).unwrap(), lights, cam)
+    let s = common::bunny("bunny-99k", sun);
+    let cam = Camera::look_at(s.eye, s.target, DVec3::Y, 50.0, 1920, 1080).unwrap();
+    (s.scene, s.lights, cam)
 }
 
 fn main() {
