@@ -81,6 +81,43 @@ pub fn filter_side_err(plane: &[f64; 4], point: &[f64; 4], err: &[f64; 4]) -> Op
     sign_beyond(v, m * FILTER_REL + e * 1.0625)
 }
 
+/// The sign of twice the signed area of a ring, `Σ (x_i y_(i+1) −
+/// x_(i+1) y_i)`, when its `f64` evaluation certifies it; `None` when the
+/// value is too close to zero to tell (the caller then decides exactly).
+///
+/// Every coordinate must be its exact value correctly rounded (relative
+/// error at most `u = 2^-53`). Each product then carries a relative error
+/// of at most `γ3` (`γn = nu / (1 − nu)`), each difference one more
+/// rounding and the running sum of `m` terms `m − 1` more, so the computed
+/// sum is within `γ(m+3) · T` of the exact one, `T` the exact sum of the
+/// products' magnitudes; the computed `t` is at least `T (1 − γ(m+4))`.
+/// For `m < 2^26` the bound used, `(m + 4) u · t` (one more rounding),
+/// exceeds `γ(m+3) T` by at least `u t / 2`. That margin also covers the
+/// products that underflow (each off by at most `2^-1075`) as long as
+/// `t >= 2^-968`; smaller, infinite or longer sums answer `None`.
+pub(crate) fn filter_ring_area(ring: impl Iterator<Item = [f64; 2]> + Clone) -> Option<i32> {
+    let mut pts = ring.clone().chain(ring.take(1));
+    let Some(mut a) = pts.next() else {
+        return Some(0);
+    };
+    let (mut s, mut t, mut m) = (0.0f64, 0.0f64, 0u64);
+    for b in pts {
+        let (x, y) = (a[0] * b[1], b[0] * a[1]);
+        s += x - y;
+        t += x.abs() + y.abs();
+        m += 1;
+        a = b;
+    }
+    if m >= 1 << 26 || !t.is_finite() || t < pow2(-968) {
+        return None;
+    }
+    let bound = t * (m + 4) as f64 * pow2(-53);
+    match sign_beyond(s, bound)? {
+        Side::Front => Some(1),
+        _ => Some(-1),
+    }
+}
+
 /// `2^e` as an `f64`, for `-1022 <= e <= 1023`.
 #[inline]
 fn pow2(e: i32) -> f64 {
@@ -412,5 +449,52 @@ mod tests {
         let w =
             Homogeneous::<8>::new([I512::from(5), I512::ONE, I512::ONE, I512::from(-10)]).unwrap();
         assert_eq!(w.round_with::<17>(), [-0.5, -0.1, -0.1]);
+    }
+
+    #[test]
+    fn ring_area_filter_is_never_wrong() {
+        let square = [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]];
+        assert_eq!(filter_ring_area(square.iter().copied()), Some(1));
+        assert_eq!(filter_ring_area(square.iter().rev().copied()), Some(-1));
+        // no area: the filter cannot certify a sign, the caller decides
+        let flat = [[0.0, 0.0], [1.0, 1.0], [3.0, 3.0]];
+        assert_eq!(filter_ring_area(flat.iter().copied()), None);
+        // below the underflow guard
+        let tiny = square.map(|p| p.map(|c| c * pow2(-1000)));
+        assert_eq!(filter_ring_area(tiny.iter().copied()), None);
+        // near-degenerate rings of large integers (exact in f64): a
+        // certified sign is the exact one
+        let mut rng = crate::SplitMix(0x51de);
+        let mut certified = 0;
+        for _ in 0..20_000 {
+            // offsets from 2^10 to 2^50: far ones leave the small area
+            // below the filter's bound, near ones not
+            let big = 1i64 << (10 + rng.next_u64() % 41);
+            let a = [0, 1].map(|_| (rng.next_u64() % (2 * big as u64)) as i64 - big);
+            let d = [0, 1].map(|_| (rng.next_u64() % 1000) as i64 + 1);
+            // three nearly collinear points and a fourth off the line
+            let k = (rng.next_u64() % 7) as i64 - 3;
+            let ring = [
+                a,
+                [a[0] + d[0], a[1] + d[1]],
+                [a[0] + 2 * d[0] + k, a[1] + 2 * d[1]],
+                [
+                    a[0] + 3 * d[0],
+                    a[1] + 3 * d[1] + (rng.next_u64() % 3) as i64 - 1,
+                ],
+            ];
+            let exact: i128 = (0..4)
+                .map(|i| {
+                    let (p, q) = (ring[i], ring[(i + 1) % 4]);
+                    p[0] as i128 * q[1] as i128 - q[0] as i128 * p[1] as i128
+                })
+                .sum();
+            let f = filter_ring_area(ring.iter().map(|p| [p[0] as f64, p[1] as f64]));
+            if let Some(sign) = f {
+                certified += 1;
+                assert_eq!(sign as i128, exact.signum(), "{ring:?}");
+            }
+        }
+        assert!(certified > 1000 && certified < 20_000, "{certified}");
     }
 }

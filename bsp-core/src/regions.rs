@@ -921,31 +921,17 @@ fn cmp_clockwise(r: [i128; 2], a: [i128; 2], b: [i128; 2], sigma: i32) -> Orderi
 }
 
 /// The sign of a loop's signed area in `(u, v)` coordinates: the `f64`
-/// shoelace sum when its error bound certifies it, else exact rationals.
+/// shoelace sum when the kernel's filter certifies it
+/// ([`crate::exact::filter_ring_area`]: the points' coordinates are
+/// correctly rounded), else exact rationals.
 fn signed_area_sign(points: &Points<'_>, l: &[u32], u: usize, v: usize) -> i32 {
     let m = l.len();
-    let p = |i: usize| points.get(l[i % m]).rounded;
-    let (mut s, mut t) = (0.0f64, 0.0f64);
-    for i in 0..m {
-        let (a, b) = (p(i), p(i + 1));
-        let (x, y) = (a[u] * b[v], b[u] * a[v]);
-        s += x - y;
-        t += x.abs() + y.abs();
-    }
-    // A certified filter, not a tolerance: each coordinate is within half
-    // an ulp (ε/2 relative) of the exact value, so each product is within
-    // about 3ε/2 of the exact product, the difference adds ε/2 and the
-    // running sum at most (m − 1)ε of `t`; `(m + 8)ε·t` bounds |s − exact|
-    // with room for the second-order terms. Nothing underflows: nonzero
-    // coordinates are at least 2^−200 or so (rationals of in-budget
-    // planes), products far above the subnormal range. Within the bound
-    // the exact rationals below decide.
-    let bound = t * (m as f64 + 8.0) * f64::EPSILON;
-    if s > bound {
-        return 1;
-    }
-    if s < -bound {
-        return -1;
+    let ring = l.iter().map(|&i| {
+        let r = points.get(i).rounded;
+        [r[u], r[v]]
+    });
+    if let Some(sign) = crate::exact::filter_ring_area(ring) {
+        return sign;
     }
     let q = |i: usize| -> [BigRational; 2] {
         match &points.get(l[i % m]).vertex {
