@@ -292,13 +292,16 @@ mod tests {
             quantize_direction(DVec3::new(-2.0, 1.0, 0.0)),
             Some([-m, (m + 1) / 2, 0])
         );
-        // tiny and huge directions scale alike
+        // subnormal and huge directions scale alike (the scaling divides
+        // by the largest component, which is exact)
+        let subnormal = f64::MIN_POSITIVE * 2f64.powi(-40);
         assert_eq!(
-            quantize_direction(DVec3::new(3e-320, 0.0, -3e-320)),
+            quantize_direction(DVec3::new(subnormal, 0.0, -subnormal)),
             Some([m, 0, -m])
         );
+        let huge = f64::MAX / 4.0;
         assert_eq!(
-            quantize_direction(DVec3::new(1e300, 1e300, 0.0)),
+            quantize_direction(DVec3::new(huge, huge, 0.0)),
             Some([m, m, 0])
         );
         assert_eq!(quantize_direction(DVec3::ZERO), None);
@@ -317,7 +320,11 @@ mod tests {
         let q = quantize_direction(DVec3::new(1.0, 2.0, 3.0)).unwrap();
         assert_eq!(q, [22369621, 44739242, MAX_COORD]);
         assert_eq!(angle_between(DVec3::X, DVec3::X * 7.0), 0.0);
-        assert!((angle_between(DVec3::X, DVec3::Y) - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+        // atan2(1, 0): π/2 correctly rounded
+        assert_eq!(
+            angle_between(DVec3::X, DVec3::Y),
+            std::f64::consts::FRAC_PI_2
+        );
     }
 
     #[test]
