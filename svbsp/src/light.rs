@@ -129,8 +129,15 @@ impl Light {
     /// every receiver not edge-on to the light, so every lit area stays the
     /// same exactly.
     pub fn culls_back_faces(&self, solid: &bsp_core::SolidBoundary) -> bool {
+        self.outside_box(solid.lo, solid.hi)
+    }
+
+    /// `true` for a sun, or a point light strictly outside the box `[lo,
+    /// hi]`: where [`Light::culls_back_faces`] may answer `true` for
+    /// solids with that box (so a caller can skip certifying them).
+    pub fn outside_box(&self, lo: GridPoint, hi: GridPoint) -> bool {
         match self {
-            Light::Point(c) => solid.outside(*c),
+            Light::Point(c) => (0..3).any(|k| c[k] < lo[k] || c[k] > hi[k]),
             Light::Directional(_) => true,
         }
     }

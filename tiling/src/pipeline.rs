@@ -621,8 +621,14 @@ impl Dynamic {
                     .collect();
                 // the object's faces turned away from a light hide nothing
                 // more when its snapped surface is certified to bound
-                // solids and the light is outside them
-                let solid = bsp_core::certify_solid_boundary(&moved).ok();
+                // solids and the light is outside them (not certified
+                // when no light could use it)
+                let solid = self
+                    .lights
+                    .iter()
+                    .any(|l| l.outside_box(lo, hi))
+                    .then(|| bsp_core::certify_solid_boundary(&moved).ok())
+                    .flatten();
                 let culls: Vec<bool> = self
                     .lights
                     .iter()
