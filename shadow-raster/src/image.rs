@@ -136,13 +136,27 @@ pub fn write_pgm(path: &Path, width: u32, height: u32, mask: &[u8]) -> Result<()
 
 /// Per-prim shading terms kept from frame to frame by a
 /// [`crate::Renderer`].
-#[derive(Default)]
 pub(crate) struct ShadeBuffers {
     /// Per drawn prim (by its slot in the frame's screen): colour and
     /// ambient light.
     base: Vec<(DVec3, f64)>,
     /// Per drawn prim and light: the weighted cosine.
     cosines: Vec<f64>,
+    /// With one light, per drawn prim: its colour unlit and lit.
+    two: Vec<[[u8; 3]; 2]>,
+    /// Use `two` (tests turn it off).
+    table: bool,
+}
+
+impl Default for ShadeBuffers {
+    fn default() -> ShadeBuffers {
+        ShadeBuffers {
+            base: Vec::new(),
+            cosines: Vec::new(),
+            two: Vec::new(),
+            table: true,
+        }
+    }
 }
 
 /// Lambert shading, as the SVG views: the face's colour times ambient
@@ -219,6 +233,29 @@ pub(crate) fn shade_in(
             }),
     );
     let (base, cosines) = (&bufs.base, &bufs.cosines);
+    // the colour of drawn prim `s` with the lit amounts `amount`
+    let color = |s: usize, amount: &[f32]| {
+        let (c, mut b) = base[s];
+        for (j, &a) in amount.iter().enumerate() {
+            b += a as f64 * cosines[s * nl + j];
+        }
+        // in [0.5, 255.5]: truncation rounds (no library call)
+        let v = (c * b).clamp(DVec3::ZERO, DVec3::ONE) * 255.0 + 0.5;
+        [v.x as u8, v.y as u8, v.z as u8]
+    };
+    // one light: each drawn prim's colour in its shadow and in its light,
+    // the same bits as `color` with an amount of 0 or 1
+    bufs.two.clear();
+    let table = nl == 1 && bufs.table;
+    if table {
+        bufs.two.par_extend(
+            (0..drawn.len())
+                .into_par_iter()
+                .with_min_len(1024)
+                .map(|s| [color(s, &[0.0]), color(s, &[1.0])]),
+        );
+    }
+    let two = &bufs.two;
     rgb.par_chunks_mut(3 * w as usize)
         .enumerate()
         .for_each(|(y, row)| {
@@ -230,13 +267,12 @@ pub(crate) fn shade_in(
                     continue;
                 }
                 let s = frame.slot[prim as usize] as usize;
-                let (c, mut b) = base[s];
-                for j in 0..nl {
-                    b += lit.amount[pix * nl + j] as f64 * cosines[s * nl + j];
-                }
-                // in [0.5, 255.5]: truncation rounds (no library call)
-                let v = (c * b).clamp(DVec3::ZERO, DVec3::ONE) * 255.0 + 0.5;
-                out.copy_from_slice(&[v.x as u8, v.y as u8, v.z as u8]);
+                let amount = &lit.amount[pix * nl..(pix + 1) * nl];
+                let v = match amount.first() {
+                    Some(&a) if table && (a == 0.0 || a == 1.0) => two[s][(a == 1.0) as usize],
+                    _ => color(s, amount),
+                };
+                out.copy_from_slice(&v);
             }
         });
     Image {
@@ -340,6 +376,44 @@ pub fn composite(panels: &[(String, Image)], columns: usize) -> Image {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn one_light_colours_from_the_table_are_those_of_the_formula() {
+        // every pixel of a one-light frame shaded through the unlit and
+        // lit colours of its prim, and by the formula, with amounts of 0
+        // and 1 only and with PCF fractions
+        let mut shaded = 0;
+        for (scene, lights, cams) in crate::testing::scenes() {
+            for cam in &cams {
+                let frame = crate::hsr::Frame::new(&scene, cam, false).unwrap();
+                let vis = crate::hsr::visibility(&frame, crate::Hsr::ZBuffer);
+                for pcf in [1, 5] {
+                    let opts = crate::ShadowOptions::default()
+                        .with_pcf(pcf)
+                        .with_map_size(128);
+                    let (lit, _) = crate::shadow::shadows(
+                        &frame,
+                        &vis,
+                        &lights,
+                        crate::Method::ShadowMap,
+                        &opts,
+                    )
+                    .unwrap();
+                    let colors = [DVec3::new(0.9, 0.5, 0.2), DVec3::new(0.1, 0.8, 0.6)];
+                    let mut plain = ShadeBuffers {
+                        table: false,
+                        ..ShadeBuffers::default()
+                    };
+                    let a = shade(&frame, &vis, &lit, &lights, &colors);
+                    let b = shade_in(&frame, &vis, &lit, &lights, &colors, None, &mut plain);
+                    assert_eq!(a, b, "pcf {pcf}");
+                    assert!(plain.two.is_empty());
+                    shaded += vis.prim.iter().filter(|&&p| p != NONE).count();
+                }
+            }
+        }
+        assert!(shaded > 10_000, "{shaded}");
+    }
 
     #[test]
     fn png_and_pgm_headers() {

@@ -66,6 +66,8 @@ mod raster;
 mod scene;
 mod shadow;
 mod stencil;
+#[cfg(test)]
+mod testing;
 mod view;
 
 use std::time::{Duration, Instant};

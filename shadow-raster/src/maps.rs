@@ -159,6 +159,7 @@ pub(crate) struct Projected {
 pub(crate) struct MapBuffers {
     texels: Vec<Vec<f32>>,
     proj: Projected,
+    look: Lookups,
 }
 
 /// Draws every prim into `buf`, a `size²` map of view `view`:
@@ -167,6 +168,7 @@ pub(crate) struct MapBuffers {
 fn draw_map<T: Copy + Send + Sync>(
     scene: &RasterScene,
     view: &View,
+    region: Region,
     init: T,
     update: impl Fn(&mut T, f64, u32) + Sync,
     buf: &mut Vec<T>,
@@ -191,18 +193,32 @@ fn draw_map<T: Copy + Send + Sync>(
         screen,
     );
     bins.rebuild(screen, size);
-    crate::raster::refill(buf, size as usize * size as usize, init);
     let w = size as usize;
+    let Region { x0, y0, x1, y1 } = region;
+    crate::raster::reserve_len(buf, w * w, init);
+    buf[y0 as usize * w..y1 as usize * w]
+        .par_chunks_mut(1 << 14)
+        .for_each(|c| c.fill(init));
     let screen = &*screen;
+    let (x0, x1) = (x0 as i64, x1 as i64);
     for_bands(buf, size, bins, |rows, polys, px| {
+        let rows = rows.start.max(y0 as i64)..rows.end.min(y1 as i64);
+        if rows.is_empty() {
+            return;
+        }
+        let band = rows.start as usize / crate::raster::BAND * crate::raster::BAND;
         let mut edges = Vec::new();
         for &s in polys {
             let s = s as usize;
+            let (c0, c1) = screen.cols[s];
+            if c1 as i64 <= x0 || c0 as i64 >= x1 {
+                continue;
+            }
             let (k, id) = (screen.coeffs[s], screen.id[s]);
-            screen.spans(s, rows.clone(), w as i64, &mut edges, |y, xs| {
-                let row = &mut px[(y - rows.start) as usize * w..];
+            screen.spans(s, rows.clone(), x1, &mut edges, |y, xs| {
+                let row = &mut px[(y as usize - band) * w..];
                 let rt = row_term(&k, y);
-                for x in xs {
+                for x in xs.start.max(x0)..xs.end {
                     update(&mut row[x as usize], k[0] * (x as f64 + 0.5) + rt, id);
                 }
             });
@@ -214,7 +230,7 @@ fn draw_map<T: Copy + Send + Sync>(
 #[inline]
 fn floor(v: f64) -> i64 {
     let i = v as i64;
-    if (i as f64) > v { i - 1 } else { i }
+    i - ((i as f64) > v) as i64
 }
 
 /// A rendered light map: per view its texels (`None` for faces not drawn).
@@ -240,33 +256,80 @@ impl<T: Copy> LightMap<'_, T> {
     }
 }
 
-/// Draws the views of light `j`'s map that some pixel looks up into
-/// `store` (one buffer per view): the views, which were drawn, and the
-/// number of texels drawn.
-#[allow(clippy::too_many_arguments)]
+/// A rectangle of texels, `x0..x1` by `y0..y1` (empty when `x0 >= x1`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Region {
+    x0: u32,
+    y0: u32,
+    x1: u32,
+    y1: u32,
+}
+
+impl Region {
+    const EMPTY: Region = Region {
+        x0: u32::MAX,
+        y0: u32::MAX,
+        x1: 0,
+        y1: 0,
+    };
+
+    fn whole(size: u32) -> Region {
+        Region {
+            x0: 0,
+            y0: 0,
+            x1: size,
+            y1: size,
+        }
+    }
+
+    fn is_empty(self) -> bool {
+        self.x0 >= self.x1 || self.y0 >= self.y1
+    }
+
+    /// The smallest rectangle holding both.
+    fn union(self, o: Region) -> Region {
+        Region {
+            x0: self.x0.min(o.x0),
+            y0: self.y0.min(o.y0),
+            x1: self.x1.max(o.x1),
+            y1: self.y1.max(o.y1),
+        }
+    }
+
+    /// Widened by `k` texels on every side, within a `size²` map.
+    fn grown(self, k: u32, size: u32) -> Region {
+        Region {
+            x0: self.x0.saturating_sub(k),
+            y0: self.y0.saturating_sub(k),
+            x1: (self.x1 + k).min(size),
+            y1: (self.y1 + k).min(size),
+        }
+    }
+}
+
+/// Draws the views of a light's map that some pixel looks up into `store`
+/// (one buffer per view), each only over the texels some pixel looks up
+/// (`need`, empty for a view not drawn; the other texels are left as
+/// they were): the number of texels drawn.
 fn build_map<T: Copy + Send + Sync>(
-    frame: &Frame<'_>,
-    vis: &Visibility,
-    light: RasterLight,
-    j: usize,
-    facing: &[u64],
-    size: u32,
+    scene: &RasterScene,
+    views: &[View],
+    need: [Region; 6],
     init: T,
     update: impl Fn(&mut T, f64, u32) + Sync,
     store: &mut Vec<Vec<T>>,
     proj: &mut Projected,
-) -> (Vec<View>, [bool; 6], usize) {
-    let views = light_views(frame.scene, light, size);
-    let need = needed_faces(frame, vis, light, j, facing);
+) -> usize {
     store.resize_with(views.len(), Vec::new);
     let mut texels = 0;
     for (f, v) in views.iter().enumerate() {
-        if need[f] {
-            texels += (size as usize).pow(2);
-            draw_map(frame.scene, v, init, &update, &mut store[f], proj);
+        let r = need[f];
+        if !r.is_empty() {
+            texels += (r.x1 - r.x0) as usize * (r.y1 - r.y0) as usize;
+            draw_map(scene, v, r, init, &update, &mut store[f], proj);
         }
     }
-    (views, need, texels)
+    texels
 }
 
 impl<'m, T> LightMap<'m, T> {
@@ -280,6 +343,99 @@ impl<'m, T> LightMap<'m, T> {
     }
 }
 
+/// A pixel that looks nothing up (its visible side does not face the
+/// light, or it lies at a point light): its amount is 0.
+const NO_LOOKUP: u32 = u32::MAX;
+
+/// Bits of a texel coordinate in a [`Lookups`] entry (map sizes are at most
+/// 8192 = 2^13).
+const TEXEL_BITS: u32 = 13;
+
+/// Where each pixel looks a light's map up, found in one pass before the
+/// map is drawn (which also tells which cube faces to draw), and read
+/// back after it: the view and texel (`face << 26 | y << 13 | x`, or
+/// [`NO_LOOKUP`]) and the biased depth `z − bias` to test.
+#[derive(Default)]
+struct Lookups {
+    at: Vec<u32>,
+    depth: Vec<f64>,
+}
+
+/// Fills `look` for light `j`: per pixel whose visible side faces the
+/// light, the view and texel its point falls in (clamped into the map)
+/// and its depth there less the bias. Returns per view the texels some
+/// pixel looks up.
+fn locate(
+    frame: &Frame<'_>,
+    vis: &Visibility,
+    (light, j): (RasterLight, usize),
+    facing: &[u64],
+    views: &[View],
+    opts: &ShadowOptions,
+    look: &mut Lookups,
+) -> [Region; 6] {
+    let (w, n) = (vis.width as usize, vis.prim.len());
+    let Lookups { at, depth } = look;
+    crate::raster::reserve_len(at, n, NO_LOOKUP);
+    crate::raster::reserve_len(depth, n, 0.0);
+    let rays = Rays::new(frame.view());
+    // the slope-scaled bias per unit of tan θ and of depth: a texel's
+    // footprint (`View::pixel_size`) is `z · k` at depth `z` for a
+    // perspective view, `k` for an orthographic one
+    let slope: Vec<f64> = views
+        .iter()
+        .map(|v| opts.bias_slope * v.pixel_size(1.0))
+        .collect();
+    at.par_chunks_mut(w)
+        .zip(depth.par_chunks_mut(w))
+        .enumerate()
+        .map(|(y, (at, depth))| {
+            let mut need = [Region::EMPTY; 6];
+            let rt = rays.row(y);
+            for x in 0..w {
+                let pix = y * w + x;
+                let prim = vis.prim[pix];
+                at[x] = NO_LOOKUP;
+                if prim == NONE || facing[prim as usize] >> j & 1 == 0 {
+                    continue;
+                }
+                let p = rays.point_fast(x, y, rt, vis.w[pix]);
+                let f = face_of(light, p);
+                let view = &views[f];
+                let c = view.frame(p);
+                let persp = matches!(view.kind, Kind::Perspective { .. });
+                if persp && c.z <= 0.0 {
+                    continue;
+                }
+                let (sx, sy) = view.screen(c);
+                let size = view.width as i64;
+                let (tx, ty) = (floor(sx).clamp(0, size - 1), floor(sy).clamp(0, size - 1));
+                // tan θ from the normal and the (unnormalized) way to the light
+                let v = match light {
+                    RasterLight::Point(lp) => lp - p,
+                    RasterLight::Sun(d) => d,
+                };
+                let nv = visible_normal(frame, prim as usize).dot(v);
+                let vv = v.length_squared();
+                let tan = ((vv - nv * nv).max(0.0).sqrt() / nv).clamp(0.0, 50.0);
+                let bias = opts.bias_constant + slope[f] * if persp { c.z } else { 1.0 } * tan;
+                at[x] = (f as u32) << (2 * TEXEL_BITS) | (ty as u32) << TEXEL_BITS | tx as u32;
+                depth[x] = c.z - bias;
+                let (tx, ty) = (tx as u32, ty as u32);
+                let r = &mut need[f];
+                r.x0 = r.x0.min(tx);
+                r.y0 = r.y0.min(ty);
+                r.x1 = r.x1.max(tx + 1);
+                r.y1 = r.y1.max(ty + 1);
+            }
+            need
+        })
+        .reduce(
+            || [Region::EMPTY; 6],
+            |a, b| std::array::from_fn(|k| a[k].union(b[k])),
+        )
+}
+
 /// Williams' shadow map.
 pub(crate) fn shadow_map(
     frame: &Frame<'_>,
@@ -290,19 +446,51 @@ pub(crate) fn shadow_map(
     spare: Option<LitBuffer>,
     bufs: &mut MapBuffers,
 ) -> (LitBuffer, ShadowFigures) {
+    shadow_map_in(frame, vis, (lights, facing), opts, spare, bufs, true)
+}
+
+/// [`shadow_map`], each view drawn only over the texels some pixel looks
+/// up (`scissor`) or whole.
+fn shadow_map_in(
+    frame: &Frame<'_>,
+    vis: &Visibility,
+    (lights, facing): (&[SceneLight], &[u64]),
+    opts: &ShadowOptions,
+    spare: Option<LitBuffer>,
+    bufs: &mut MapBuffers,
+    scissor: bool,
+) -> (LitBuffer, ShadowFigures) {
     let n = lights.len();
     let mut lit = LitBuffer::reuse(spare, vis.prim.len(), n);
     let mut fig = ShadowFigures::default();
     let half = (opts.pcf / 2) as i64;
     let taps = (opts.pcf * opts.pcf) as f32;
+    let w = vis.width as usize;
     for (j, l) in lights.iter().enumerate() {
-        let (views, need, texels) = build_map(
+        let views = light_views(frame.scene, l.world, opts.map_size);
+        let need = locate(
             frame,
             vis,
-            l.world,
-            j,
+            (l.world, j),
             facing,
-            opts.map_size,
+            &views,
+            opts,
+            &mut bufs.look,
+        )
+        .map(|r| {
+            if r.is_empty() {
+                r
+            } else if scissor {
+                // the texels of the lookups and of their PCF kernels
+                r.grown(half as u32, opts.map_size)
+            } else {
+                Region::whole(opts.map_size)
+            }
+        });
+        fig.primitives += build_map(
+            frame.scene,
+            &views,
+            need,
             f32::NEG_INFINITY,
             |t, w, _| {
                 let w = w as f32;
@@ -313,39 +501,47 @@ pub(crate) fn shadow_map(
             &mut bufs.texels,
             &mut bufs.proj,
         );
-        let map = LightMap::new(views, need, &bufs.texels);
-        fig.primitives += texels;
-        set_amounts(frame, vis, &mut lit, j, facing, |_, prim, p| {
-            let Some((f, x, y, cf)) = map.texel(l.world, p) else {
-                return 0.0;
-            };
-            let view = &map.views[f];
-            let data = map.data[f].expect("needed faces are drawn");
-            let z = cf.z;
-            // tan θ from the normal and the (unnormalized) way to the light
-            let v = match l.world {
-                RasterLight::Point(lp) => lp - p,
-                RasterLight::Sun(d) => d,
-            };
-            let nv = visible_normal(frame, prim as usize).dot(v);
-            let vv = v.length_squared();
-            let tan = ((vv - nv * nv).max(0.0).sqrt() / nv).clamp(0.0, 50.0);
-            let bias = opts.bias_constant + opts.bias_slope * view.pixel_size(z) * tan;
-            let (t, persp) = (z - bias, matches!(view.kind, Kind::Perspective { .. }));
-            let size = view.width as i64;
-            let mut pass = 0.0f32;
-            for dy in -half..=half {
-                for dx in -half..=half {
-                    let (tx, ty) = ((x + dx).clamp(0, size - 1), (y + dy).clamp(0, size - 1));
-                    let wm = data[(ty * size + tx) as usize] as f64;
-                    // t <= z_map, with z_map = 1/wm (perspective) or −wm
-                    let lit_here =
-                        wm == f64::NEG_INFINITY || if persp { wm * t <= 1.0 } else { t <= -wm };
-                    pass += lit_here as u8 as f32;
+        let persp = matches!(l.world, RasterLight::Point(_));
+        let size = opts.map_size as i64;
+        let data: Vec<&[f32]> = bufs.texels.iter().map(Vec::as_slice).collect();
+        let (at, depth) = (&bufs.look.at, &bufs.look.depth);
+        // lit when z − bias <= z_map, with z_map = 1/wm (perspective) or
+        // −wm, and nothing drawn (wm = −∞) lit
+        let passes = |wm: f64, t: f64| {
+            wm == f64::NEG_INFINITY || if persp { wm * t <= 1.0 } else { t <= -wm }
+        };
+        lit.amount
+            .par_chunks_mut(n * w)
+            .zip(at.par_chunks(w).zip(depth.par_chunks(w)))
+            .for_each(|(cells, (at, depth))| {
+                for (x, cell) in cells.chunks_mut(n).enumerate() {
+                    let a = at[x];
+                    cell[j] = if a == NO_LOOKUP {
+                        0.0
+                    } else {
+                        let texels = data[(a >> (2 * TEXEL_BITS)) as usize];
+                        let mask = (1 << TEXEL_BITS) - 1;
+                        let (tx, ty) = ((a & mask) as i64, (a >> TEXEL_BITS & mask) as i64);
+                        let t = depth[x];
+                        if half == 0 {
+                            passes(texels[(ty * size + tx) as usize] as f64, t) as u8 as f32
+                        } else {
+                            let mut pass = 0.0f32;
+                            for dy in -half..=half {
+                                for dx in -half..=half {
+                                    let (sx, sy) = (
+                                        (tx + dx).clamp(0, size - 1),
+                                        (ty + dy).clamp(0, size - 1),
+                                    );
+                                    let wm = texels[(sy * size + sx) as usize] as f64;
+                                    pass += passes(wm, t) as u8 as f32;
+                                }
+                            }
+                            pass / taps
+                        }
+                    };
                 }
-            }
-            pass / taps
-        });
+            });
     }
     (lit, fig)
 }
@@ -398,13 +594,19 @@ pub(crate) fn texture(
             rank[o as usize] = r as u32;
         }
         let prim_rank: Vec<u32> = obj.iter().map(|&o| rank[o as usize]).collect();
-        let (views, need, texels) = build_map(
-            frame,
-            vis,
-            l.world,
-            j,
-            facing,
-            opts.map_size,
+        let views = light_views(scene, l.world, opts.map_size);
+        let need = needed_faces(frame, vis, l.world, j, facing);
+        let whole = need.map(|n| {
+            if n {
+                Region::whole(opts.map_size)
+            } else {
+                Region::EMPTY
+            }
+        });
+        let texels = build_map(
+            scene,
+            &views,
+            whole,
             NONE,
             |t, _, prim| {
                 *t = (*t).min(prim_rank[prim as usize]);
@@ -424,4 +626,43 @@ pub(crate) fn texture(
         });
     }
     (lit, fig)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::scenes;
+
+    #[test]
+    fn maps_drawn_only_where_looked_up_give_the_same_shadows() {
+        // the scissored views against whole ones, frame after frame in the
+        // same buffers (texels outside the lookups are left from earlier
+        // frames and must never be read), with and without PCF
+        let mut bufs = MapBuffers::default();
+        let mut drawn = (0, 0);
+        for (scene, lights, cams) in scenes() {
+            for cam in &cams {
+                let frame = Frame::new(&scene, cam, false).unwrap();
+                let vis = crate::hsr::visibility(&frame, crate::Hsr::ZBuffer);
+                let facing = crate::shadow::facing_bits(&frame, &lights);
+                for (pcf, size) in [(1, 256), (3, 64), (1, 16)] {
+                    let opts = ShadowOptions::default().with_pcf(pcf).with_map_size(size);
+                    let args = (lights.as_slice(), facing.as_slice());
+                    let (part, pf) =
+                        shadow_map_in(&frame, &vis, args, &opts, None, &mut bufs, true);
+                    let mut fresh = MapBuffers::default();
+                    let (whole, wf) =
+                        shadow_map_in(&frame, &vis, args, &opts, None, &mut fresh, false);
+                    assert_eq!(part, whole, "pcf {pcf}, map {size}");
+                    assert!(pf.primitives <= wf.primitives);
+                    drawn.0 += pf.primitives;
+                    drawn.1 += wf.primitives;
+                    assert!(part.amount.contains(&1.0));
+                    assert!(part.amount.contains(&0.0));
+                }
+            }
+        }
+        // the scissor saves texels
+        assert!(drawn.0 < drawn.1, "{drawn:?}");
+    }
 }

@@ -30,7 +30,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use smallvec_lite::Small;
 
-use crate::view::{ClipPlane, View};
+use crate::view::{ClipPlane, Kind, View};
 
 /// Fixed-point units per pixel.
 pub(crate) const SUB: i64 = 256;
@@ -163,10 +163,11 @@ impl Edge {
             }
             self.q += self.sq;
             self.r += self.sr;
-            if self.r >= d {
-                self.q += 1;
-                self.r -= d;
-            }
+            // carry without a branch: it is a coin toss on most edges
+            // carry without a branch: it is a coin toss on most edges
+            let carry = (self.r >= d) as i64;
+            self.q += carry;
+            self.r -= carry * d;
             self.next = y + 1;
         }
         x
@@ -239,7 +240,7 @@ impl Screen {
         for ring in self.rings(i) {
             let n = ring.len();
             for k in 0..n {
-                if let Some(e) = Edge::new(ring[k], ring[(k + 1) % n]) {
+                if let Some(e) = Edge::new(ring[k], ring[if k + 1 == n { 0 } else { k + 1 }]) {
                     out.push(e);
                 }
             }
@@ -327,22 +328,17 @@ fn fill(edges: &mut [Edge], rows: Range<i64>, width: i64, span: &mut impl FnMut(
 }
 
 /// A pixel coordinate (within the guard band) in fixed point, rounded to
-/// nearest (without a library call: this runs for every vertex).
+/// nearest, halves up: `⌊v·SUB + 1/2⌋` (exact: `|v·SUB| < 2^31`, so adding
+/// a half does not round). Branch-free and without a library call, since
+/// this runs for every vertex and the rounding direction is a coin toss.
 #[inline]
 fn to_fixed(v: f64) -> i32 {
     // clipping keeps |v| within the guard band; the clamp only tames
     // non-finite input (NaN becomes 0)
     const LIMIT: f64 = (1u64 << 30) as f64;
-    let s = (v * SUB as f64).clamp(-LIMIT, LIMIT);
+    let s = (v * SUB as f64).clamp(-LIMIT, LIMIT) + 0.5;
     let i = s as i64;
-    let f = s - i as f64;
-    (if f >= 0.5 {
-        i + 1
-    } else if f < -0.5 {
-        i - 1
-    } else {
-        i
-    }) as i32
+    (i - ((i as f64) > s) as i64) as i32
 }
 
 /// Canonical intersection of segment `ab` with a plane, given the plane's
@@ -379,13 +375,61 @@ pub(crate) fn clip_ring(ring: &[DVec3], (n, d): ClipPlane, out: &mut Vec<DVec3>)
 pub(crate) struct Projector<'a> {
     view: &'a View,
     planes: [ClipPlane; 5],
+    /// The same planes as bounds: perspective `z >= near`,
+    /// `|x| <= gx·z`, `|y| <= gy·z`; orthographic `|x| <= gx`, `|y| <= gy`.
+    bounds: Bounds,
+}
+
+/// [`View::clip_planes`] as the bounds of a box or a pyramid, tested with
+/// the same arithmetic as the planes' `n · c + d >= 0` (each plane has one
+/// or two non-zero coefficients, ±1 and a bound), so the decisions agree.
+#[derive(Clone, Copy)]
+enum Bounds {
+    Pyramid { near: f64, gx: f64, gy: f64 },
+    Box { hx: f64, hy: f64 },
+}
+
+impl Bounds {
+    fn of(view: &View, planes: &[ClipPlane; 5]) -> Bounds {
+        match view.kind {
+            Kind::Perspective { .. } => Bounds::Pyramid {
+                near: -planes[0].1,
+                gx: planes[1].0.z,
+                gy: planes[3].0.z,
+            },
+            Kind::Orthographic { .. } => Bounds::Box {
+                hx: planes[1].1,
+                hy: planes[3].1,
+            },
+        }
+    }
+
+    /// `true` if `c` is inside every clip plane.
+    #[inline]
+    fn inside(self, c: DVec3) -> bool {
+        match self {
+            Bounds::Pyramid { near, gx, gy } => {
+                let (x, y) = (gx * c.z, gy * c.z);
+                (c.z - near >= 0.0)
+                    & (c.x + x >= 0.0)
+                    & (x - c.x >= 0.0)
+                    & (y - c.y >= 0.0)
+                    & (c.y + y >= 0.0)
+            }
+            Bounds::Box { hx, hy } => {
+                (c.x + hx >= 0.0) & (hx - c.x >= 0.0) & (c.y + hy >= 0.0) & (hy - c.y >= 0.0)
+            }
+        }
+    }
 }
 
 impl<'a> Projector<'a> {
     pub(crate) fn new(view: &'a View) -> Projector<'a> {
+        let planes = view.clip_planes();
         Projector {
             view,
-            planes: view.clip_planes(),
+            planes,
+            bounds: Bounds::of(view, &planes),
         }
     }
 
@@ -413,8 +457,8 @@ impl<'a> Projector<'a> {
             let (a, b) = scratch;
             a.clear();
             a.extend(ring.iter().map(|&p| self.view.frame(p)));
-            let inside = |c: &DVec3| self.planes.iter().all(|(n, d)| n.dot(*c) + d >= 0.0);
-            if !a.iter().all(inside) {
+            let bounds = self.bounds;
+            if !a.iter().fold(true, |all, c| all & bounds.inside(*c)) {
                 for pl in self.planes {
                     if a.len() < 3 {
                         break;
@@ -584,6 +628,14 @@ pub(crate) fn refill<T: Copy + Send + Sync>(buf: &mut Vec<T>, n: usize, v: T) {
     }
 }
 
+/// `buf` made `n` long, its values left as they were when it already is
+/// (for passes that write every cell), else `n` copies of `v`.
+pub(crate) fn reserve_len<T: Copy + Send + Sync>(buf: &mut Vec<T>, n: usize, v: T) {
+    if buf.len() != n {
+        *buf = filled(n, v);
+    }
+}
+
 /// [`for_bands`] over two images at once.
 pub(crate) fn for_bands2<T: Send, U: Send>(
     a: &mut [T],
@@ -749,6 +801,100 @@ mod tests {
                 .collect();
             let cov = coverage(&quads, 24, 24);
             assert!(cov.iter().all(|&c| c <= 1), "overlap in {quads:?}");
+        }
+    }
+
+    #[test]
+    fn fixed_point_rounding_is_to_nearest_halves_up() {
+        // the branch-free rounding against the rounding it replaced
+        let old = |v: f64| -> i32 {
+            const LIMIT: f64 = (1u64 << 30) as f64;
+            let s = (v * SUB as f64).clamp(-LIMIT, LIMIT);
+            let i = s as i64;
+            let f = s - i as f64;
+            (if f >= 0.5 {
+                i + 1
+            } else if f < -0.5 {
+                i - 1
+            } else {
+                i
+            }) as i32
+        };
+        let mut rng = bsp_core::SplitMix(0xf1_0a7);
+        let mut vals = vec![
+            0.0,
+            -0.0,
+            1.5 / 256.0,
+            -1.5 / 256.0,
+            2.5 / 256.0,
+            -2.5 / 256.0,
+        ];
+        vals.extend([f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300, -1e300]);
+        for _ in 0..100_000 {
+            let k = rng.below(1 << 24) as f64 - (1 << 23) as f64;
+            // on and near halves, and anywhere
+            vals.push((k + 0.5) / 256.0);
+            vals.push((k + 0.5 + (rng.below(3) as f64 - 1.0) * 1e-9) / 256.0);
+            vals.push((rng.below(1 << 40) as f64 - (1u64 << 39) as f64) * 1e-5);
+        }
+        for v in vals {
+            assert_eq!(to_fixed(v), old(v), "{v:e}");
+        }
+        assert_eq!(to_fixed(2.5 / 256.0), 3);
+        assert_eq!(to_fixed(-2.5 / 256.0), -2);
+    }
+
+    #[test]
+    fn clip_bounds_agree_with_the_clip_planes() {
+        // the bounds' tests against n · c + d >= 0, on points on, near and
+        // off every plane of a perspective and an orthographic view
+        let cam = Camera::look_at(
+            DVec3::new(1.0, -5.0, 2.0),
+            DVec3::ZERO,
+            DVec3::Z,
+            50.0,
+            64,
+            40,
+        )
+        .unwrap()
+        .with_near(0.25);
+        let mut ortho = cam.view.clone();
+        ortho.kind = Kind::Orthographic { scale: 0.01 };
+        let ortho = ortho.ready();
+        let mut rng = bsp_core::SplitMix(0xb0_0d5);
+        for view in [&cam.view, &ortho] {
+            let planes = view.clip_planes();
+            let bounds = Bounds::of(view, &planes);
+            let mut tested = [0usize; 2];
+            for _ in 0..50_000 {
+                let r = |rng: &mut bsp_core::SplitMix| {
+                    (rng.below(1 << 20) as f64 - (1 << 19) as f64) / 1024.0
+                };
+                let mut c = DVec3::new(r(&mut rng), r(&mut rng), r(&mut rng));
+                // move some points exactly onto a plane
+                match rng.below(4) {
+                    0 => c.z = 0.25,
+                    1 => {
+                        if let Bounds::Pyramid { gx, .. } = bounds {
+                            c.x = gx * c.z
+                        } else if let Bounds::Box { hx, .. } = bounds {
+                            c.x = -hx
+                        }
+                    }
+                    2 => {
+                        if let Bounds::Pyramid { gy, .. } = bounds {
+                            c.y = -(gy * c.z)
+                        } else if let Bounds::Box { hy, .. } = bounds {
+                            c.y = hy
+                        }
+                    }
+                    _ => {}
+                }
+                let want = planes.iter().all(|(n, d)| n.dot(c) + d >= 0.0);
+                assert_eq!(bounds.inside(c), want, "{c:?}");
+                tested[want as usize] += 1;
+            }
+            assert!(tested[0] > 1000 && tested[1] > 1000, "{tested:?}");
         }
     }
 
