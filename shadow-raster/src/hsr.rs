@@ -31,7 +31,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
-use crate::raster::{Bins, Screen, for_bands2, nearness, project_all_into, row_term};
+use crate::raster::{
+    Bins, Corners, Projector, Screen, for_bands2, nearness, project_all_into, row_term,
+};
 use crate::scene::RasterScene;
 use crate::view::View;
 use crate::{Camera, RasterError};
@@ -123,6 +125,8 @@ pub(crate) struct Frame<'a> {
     pub(crate) bins: Bins,
     /// Spare per-chunk screens of the projection.
     parts: Vec<Screen>,
+    /// The screen points of the scene's shared vertices.
+    corners: Corners,
 }
 
 /// The buffers of a [`Frame`], kept from frame to frame by a
@@ -134,6 +138,7 @@ pub(crate) struct FrameBuffers {
     slot: Vec<u32>,
     bins: Bins,
     parts: Vec<Screen>,
+    corners: Corners,
 }
 
 impl<'a> Frame<'a> {
@@ -161,6 +166,7 @@ impl<'a> Frame<'a> {
             mut slot,
             mut bins,
             mut parts,
+            mut corners,
         } = bufs;
         let eye = camera.eye();
         let centre = (scene.lo + scene.hi) * 0.5;
@@ -168,6 +174,7 @@ impl<'a> Frame<'a> {
         let camera = camera.with_near(near);
         crate::scene::eye_sides(scene, eye, &mut side);
         let view = &camera.view;
+        corners.compute(scene, &Projector::new(view));
         project_all_into(
             view,
             scene.len(),
@@ -178,7 +185,7 @@ impl<'a> Frame<'a> {
                 }
                 let (n, d) = scene.plane[i];
                 if let Some(k) = view.coeffs(n, d) {
-                    proj.add([scene.prim(i)], k, i as u32, out, sc);
+                    proj.add_prim(scene, i, &corners, k, out, sc);
                 }
             },
             &mut parts,
@@ -198,6 +205,7 @@ impl<'a> Frame<'a> {
             slot,
             bins,
             parts,
+            corners,
         })
     }
 
@@ -209,6 +217,7 @@ impl<'a> Frame<'a> {
             slot: self.slot,
             bins: self.bins,
             parts: self.parts,
+            corners: self.corners,
         }
     }
 

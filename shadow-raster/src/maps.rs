@@ -22,7 +22,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::hsr::{Frame, NONE, Visibility};
-use crate::raster::{Bins, Screen, for_bands, project_all_into, row_term};
+use crate::raster::{Bins, Corners, Projector, Screen, for_bands, project_all_into, row_term};
 use crate::scene::{RasterLight, RasterScene, SceneLight};
 use crate::shadow::{LitBuffer, ShadowFigures, ShadowOptions, set_amounts, visible_normal};
 use crate::view::{Kind, Rays, View};
@@ -151,6 +151,7 @@ pub(crate) struct Projected {
     parts: Vec<Screen>,
     screen: Screen,
     bins: Bins,
+    corners: Corners,
 }
 
 /// The buffers of the shadow maps kept from frame to frame: the texels of
@@ -179,14 +180,17 @@ fn draw_map<T: Copy + Send + Sync>(
         parts,
         screen,
         bins,
+        corners,
     } = proj;
+    corners.compute(scene, &Projector::new(view));
+    let corners = &*corners;
     project_all_into(
         view,
         scene.len(),
         |i, proj, out, sc| {
             let (n, d) = scene.plane[i];
             if let Some(k) = view.coeffs(n, d) {
-                proj.add([scene.prim(i)], k, i as u32, out, sc);
+                proj.add_prim(scene, i, corners, k, out, sc);
             }
         },
         parts,

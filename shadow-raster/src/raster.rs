@@ -30,6 +30,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use smallvec_lite::Small;
 
+use crate::scene::RasterScene;
 use crate::view::{ClipPlane, Kind, View};
 
 /// Fixed-point units per pixel.
@@ -163,7 +164,6 @@ impl Edge {
             }
             self.q += self.sq;
             self.r += self.sr;
-            // carry without a branch: it is a coin toss on most edges
             // carry without a branch: it is a coin toss on most edges
             let carry = (self.r >= d) as i64;
             self.q += carry;
@@ -480,6 +480,61 @@ impl<'a> Projector<'a> {
             }
             out.ring_start.push(out.pts.len() as u32);
         }
+        self.close(
+            out,
+            (start_pts, start_rings),
+            [xmin, ymin, xmax, ymax],
+            coeffs,
+            id,
+        );
+    }
+
+    /// Adds polygon `i` of `scene` as [`Projector::add`] does, from its
+    /// corners' screen points in `corners` when they are all inside the
+    /// clip planes (the same points, computed once per shared vertex).
+    #[inline]
+    pub(crate) fn add_prim(
+        &self,
+        scene: &RasterScene,
+        i: usize,
+        corners: &Corners,
+        coeffs: [f64; 3],
+        out: &mut Screen,
+        scratch: &mut (Vec<DVec3>, Vec<DVec3>),
+    ) {
+        let range = scene.start[i] as usize..scene.start[i + 1] as usize;
+        let verts = &scene.corner[range];
+        if !verts.iter().all(|&v| corners.fixed[v as usize].is_some()) {
+            self.add([scene.prim(i)], coeffs, i as u32, out, scratch);
+            return;
+        }
+        let start = (out.pts.len(), out.ring_start.len());
+        let (mut ymin, mut ymax, mut xmin, mut xmax) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
+        for &v in verts {
+            let p = corners.fixed[v as usize].expect("checked above");
+            ymin = ymin.min(p[1]);
+            ymax = ymax.max(p[1]);
+            xmin = xmin.min(p[0]);
+            xmax = xmax.max(p[0]);
+            out.pts.push(p);
+        }
+        out.ring_start.push(out.pts.len() as u32);
+        self.close(out, start, [xmin, ymin, xmax, ymax], coeffs, i as u32);
+    }
+
+    /// Ends the polygon whose points and rings `out` has from `start` on,
+    /// with their bounds `[xmin, ymin, xmax, ymax]`: kept with its rows,
+    /// columns, nearness and id if it has a ring and reaches a pixel
+    /// centre, else taken back.
+    #[inline]
+    fn close(
+        &self,
+        out: &mut Screen,
+        (start_pts, start_rings): (usize, usize),
+        [xmin, ymin, xmax, ymax]: [i32; 4],
+        coeffs: [f64; 3],
+        id: u32,
+    ) {
         let rows = (
             first_row(ymin as i64).max(0),
             first_row(ymax as i64).min(self.view.height as i64),
@@ -498,6 +553,27 @@ impl<'a> Projector<'a> {
         out.cols.push((cols.0 as i32, cols.1 as i32));
         out.coeffs.push(coeffs);
         out.id.push(id);
+    }
+}
+
+/// The screen point of each of a scene's shared vertices in one view, or
+/// `None` where the vertex is outside a clip plane (its polygons are then
+/// clipped point by point).
+#[derive(Default)]
+pub(crate) struct Corners {
+    fixed: Vec<Option<[i32; 2]>>,
+}
+
+impl Corners {
+    /// The corners of `scene` in `proj`'s view, in the buffers of earlier
+    /// ones.
+    pub(crate) fn compute(&mut self, scene: &RasterScene, proj: &Projector<'_>) {
+        self.fixed.clear();
+        self.fixed
+            .par_extend(scene.verts.par_iter().with_min_len(4096).map(|&p| {
+                let c = proj.view.frame(p);
+                proj.bounds.inside(c).then(|| proj.fixed(c))
+            }));
     }
 }
 
@@ -896,6 +972,58 @@ mod tests {
             }
             assert!(tested[0] > 1000 && tested[1] > 1000, "{tested:?}");
         }
+    }
+
+    #[test]
+    fn shared_vertices_project_as_each_corner_does() {
+        // a polygon projected from its shared vertices' points, against
+        // projected corner by corner, in perspective views from outside
+        // and from inside the scene (polygons cut by the near plane and
+        // the guard band) and in a sun's orthographic view
+        let mut compared = 0;
+        for (scene, _, cams) in crate::testing::scenes() {
+            let mut views: Vec<View> = cams.iter().map(|c| c.view.clone()).collect();
+            let inside = Camera::look_at(
+                DVec3::new(0.0, -0.5, 1.0),
+                DVec3::new(3.0, 1.0, 0.5),
+                DVec3::Z,
+                120.0,
+                80,
+                60,
+            )
+            .unwrap()
+            .with_near(0.3);
+            views.push(inside.view.clone());
+            let mut ortho = inside.view.clone();
+            ortho.kind = Kind::Orthographic { scale: 0.05 };
+            views.push(ortho.ready());
+            for view in &views {
+                let proj = Projector::new(view);
+                let mut corners = Corners::default();
+                corners.compute(&scene, &proj);
+                let (mut a, mut b) = (Screen::new(), Screen::new());
+                let mut sc = (Vec::new(), Vec::new());
+                for i in 0..scene.len() {
+                    let (n, d) = scene.plane[i];
+                    if let Some(k) = view.coeffs(n, d) {
+                        proj.add_prim(&scene, i, &corners, k, &mut a, &mut sc);
+                        proj.add([scene.prim(i)], k, i as u32, &mut b, &mut sc);
+                    }
+                }
+                assert_eq!(
+                    (&a.pts, &a.ring_start, &a.poly_ring, &a.rows, &a.cols, &a.id),
+                    (&b.pts, &b.ring_start, &b.poly_ring, &b.rows, &b.cols, &b.id)
+                );
+                compared += a.len();
+                assert!(corners.fixed.iter().any(Option::is_some));
+            }
+            assert!(views.iter().any(|v| {
+                let mut c = Corners::default();
+                c.compute(&scene, &Projector::new(v));
+                c.fixed.iter().any(Option::is_none)
+            }));
+        }
+        assert!(compared > 100, "{compared}");
     }
 
     #[test]

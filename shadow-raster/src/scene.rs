@@ -66,6 +66,10 @@ pub struct RasterScene {
     /// Prim `i`'s vertices: `pts[start[i]..start[i + 1]]`.
     pub(crate) start: Vec<u32>,
     pub(crate) pts: Vec<DVec3>,
+    /// Prim `i`'s vertices as indices into `verts`, the distinct points
+    /// (bit for bit) of `pts`: `corner[start[i]..start[i + 1]]`.
+    pub(crate) corner: Vec<u32>,
+    pub(crate) verts: Vec<DVec3>,
     pub(crate) face: Vec<u32>,
     /// Each prim's exact support plane (kept apart from the polygons for
     /// a compact per-frame pass).
@@ -107,11 +111,14 @@ impl RasterScene {
                 "a vertex is not finite in input units".into(),
             ));
         }
+        let (corner, verts) = shared_vertices(&pts);
         Ok(RasterScene {
             grid: *grid,
             polys,
             start,
             pts,
+            corner,
+            verts,
             face,
             support,
             plane,
@@ -179,6 +186,37 @@ impl RasterScene {
             }
         }
     }
+}
+
+/// The distinct points of `pts`, bit for bit, and each point's index
+/// among them (numbered in the order of their first use).
+fn shared_vertices(pts: &[DVec3]) -> (Vec<u32>, Vec<DVec3>) {
+    use rayon::prelude::*;
+    let bits = |p: DVec3| p.to_array().map(f64::to_bits);
+    let mut order: Vec<u32> = (0..pts.len() as u32).collect();
+    order.par_sort_unstable_by_key(|&k| (bits(pts[k as usize]), k));
+    // each point's first use, through its run of equal points
+    let mut first = vec![0u32; pts.len()];
+    let mut k = 0;
+    while k < order.len() {
+        let key = bits(pts[order[k] as usize]);
+        let mut e = k;
+        while e < order.len() && bits(pts[order[e] as usize]) == key {
+            first[order[e] as usize] = order[k];
+            e += 1;
+        }
+        k = e;
+    }
+    let (mut corner, mut verts) = (vec![0u32; pts.len()], Vec::new());
+    for (c, &f) in first.iter().enumerate() {
+        corner[c] = if f as usize == c {
+            verts.push(pts[c]);
+            (verts.len() - 1) as u32
+        } else {
+            corner[f as usize]
+        };
+    }
+    (corner, verts)
 }
 
 /// The bits of a point's coordinates (`-0.0` read as `0.0`): equal points,
@@ -256,6 +294,31 @@ pub(crate) fn eye_sides(scene: &RasterScene, eye: DVec3, out: &mut Vec<Side>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn shared_vertices_are_the_distinct_points() {
+        let mut rng = bsp_core::SplitMix(0x5_4a7e);
+        let pool: Vec<DVec3> = (0..50)
+            .map(|_| DVec3::new(rng.below(4) as f64, rng.below(3) as f64 - 1.0, 0.5))
+            .chain([DVec3::new(0.0, 0.0, 0.5), DVec3::new(-0.0, 0.0, 0.5)])
+            .collect();
+        let pts: Vec<DVec3> = (0..2000).map(|_| pool[rng.below(pool.len())]).collect();
+        let (corner, verts) = shared_vertices(&pts);
+        let bits = |p: DVec3| p.to_array().map(f64::to_bits);
+        for (c, p) in pts.iter().enumerate() {
+            assert_eq!(bits(verts[corner[c] as usize]), bits(*p));
+        }
+        let mut keys: Vec<_> = verts.iter().map(|&p| bits(p)).collect();
+        keys.sort_unstable();
+        keys.dedup();
+        assert_eq!(keys.len(), verts.len(), "distinct");
+        // numbered by first use
+        let mut seen = 0;
+        for &c in &corner {
+            assert!(c as usize <= seen);
+            seen = seen.max(c as usize + 1);
+        }
+    }
 
     #[test]
     fn world_planes_contain_the_vertices() {
