@@ -220,18 +220,37 @@ impl Screen {
         self.id.clear();
     }
 
-    fn append(&mut self, o: &Screen) {
-        let p0 = self.pts.len() as u32;
-        let r0 = (self.ring_start.len() - 1) as u32;
-        self.pts.extend_from_slice(&o.pts);
-        self.ring_start
-            .extend(o.ring_start[1..].iter().map(|s| s + p0));
-        self.poly_ring
-            .extend(o.poly_ring[1..].iter().map(|s| s + r0));
-        self.rows.extend_from_slice(&o.rows);
-        self.cols.extend_from_slice(&o.cols);
-        self.coeffs.extend_from_slice(&o.coeffs);
-        self.id.extend_from_slice(&o.id);
+    /// The polygons of `parts`, one part after the other, in this
+    /// screen's buffers, copied in parallel.
+    fn concat(&mut self, parts: &[Screen]) {
+        // each part's first point and ring in the whole
+        let (mut p0, mut r0) = (
+            Vec::with_capacity(parts.len()),
+            Vec::with_capacity(parts.len()),
+        );
+        let (mut p, mut r) = (0u32, 0u32);
+        for part in parts {
+            p0.push(p);
+            r0.push(r);
+            p += part.pts.len() as u32;
+            r += (part.ring_start.len() - 1) as u32;
+        }
+        let pts: Vec<&[[i32; 2]]> = parts.iter().map(|s| s.pts.as_slice()).collect();
+        par_concat(&mut self.pts, 0, &pts, |_, v| v);
+        let rings: Vec<&[u32]> = parts.iter().map(|s| &s.ring_start[1..]).collect();
+        par_concat(&mut self.ring_start, 1, &rings, |k, v| v + p0[k]);
+        self.ring_start[0] = 0;
+        let polys: Vec<&[u32]> = parts.iter().map(|s| &s.poly_ring[1..]).collect();
+        par_concat(&mut self.poly_ring, 1, &polys, |k, v| v + r0[k]);
+        self.poly_ring[0] = 0;
+        let rows: Vec<&[(i32, i32)]> = parts.iter().map(|s| s.rows.as_slice()).collect();
+        par_concat(&mut self.rows, 0, &rows, |_, v| v);
+        let cols: Vec<&[(i32, i32)]> = parts.iter().map(|s| s.cols.as_slice()).collect();
+        par_concat(&mut self.cols, 0, &cols, |_, v| v);
+        let coeffs: Vec<&[[f64; 3]]> = parts.iter().map(|s| s.coeffs.as_slice()).collect();
+        par_concat(&mut self.coeffs, 0, &coeffs, |_, v| v);
+        let id: Vec<&[u32]> = parts.iter().map(|s| s.id.as_slice()).collect();
+        par_concat(&mut self.id, 0, &id, |_, v| v);
     }
 
     /// The edges of polygon `i`.
@@ -608,10 +627,38 @@ pub(crate) fn project_all_into(
             make(i, &proj, out, &mut scratch);
         }
     });
-    all.clear();
-    for p in parts.iter() {
-        all.append(p);
+    all.concat(parts);
+}
+
+/// `srcs` one after the other into `dst[lead..]`, `adjust(k, v)` applied
+/// to each value `v` of `srcs[k]`, copied in parallel (`dst` keeps its
+/// first `lead` values).
+fn par_concat<T: Copy + Default + Send + Sync>(
+    dst: &mut Vec<T>,
+    lead: usize,
+    srcs: &[&[T]],
+    adjust: impl Fn(usize, T) -> T + Sync,
+) {
+    let total = lead + srcs.iter().map(|s| s.len()).sum::<usize>();
+    if dst.len() != total {
+        dst.resize(total, T::default());
     }
+    let mut pieces = Vec::with_capacity(srcs.len());
+    let mut rest = &mut dst[lead..];
+    for s in srcs {
+        let (piece, tail) = rest.split_at_mut(s.len());
+        pieces.push(piece);
+        rest = tail;
+    }
+    pieces
+        .into_par_iter()
+        .zip(srcs.par_iter())
+        .enumerate()
+        .for_each(|(k, (piece, src))| {
+            for (d, &v) in piece.iter_mut().zip(src.iter()) {
+                *d = adjust(k, v);
+            }
+        });
 }
 
 /// The polygons of `screen` reaching each band of [`BAND`] rows, in
@@ -1024,6 +1071,53 @@ mod tests {
             }));
         }
         assert!(compared > 100, "{compared}");
+    }
+
+    #[test]
+    fn concatenated_parts_are_the_whole() {
+        // a scene's polygons projected into one screen, and into parts
+        // (one of them empty) put together again
+        let (scene, _, cams) = crate::testing::scenes().swap_remove(0);
+        let view = &cams[0].view;
+        let proj = Projector::new(view);
+        let mut sc = (Vec::new(), Vec::new());
+        let add = |i: usize, out: &mut Screen, sc: &mut (Vec<DVec3>, Vec<DVec3>)| {
+            let (n, d) = scene.plane[i];
+            if let Some(k) = view.coeffs(n, d) {
+                proj.add([scene.prim(i)], k, i as u32, out, sc);
+            }
+        };
+        let mut whole = Screen::new();
+        for i in 0..scene.len() {
+            add(i, &mut whole, &mut sc);
+        }
+        let mut parts = vec![Screen::new(), Screen::new(), Screen::new(), Screen::new()];
+        let cut = [0, 5, 5, 11, scene.len()];
+        for (k, part) in parts.iter_mut().enumerate() {
+            for i in cut[k]..cut[k + 1] {
+                add(i, part, &mut sc);
+            }
+        }
+        // into buffers of another size, and into the same ones again
+        let mut joined = Screen::new();
+        joined.pts = vec![[7, 7]; 3];
+        for _ in 0..2 {
+            joined.concat(&parts);
+            assert_eq!(
+                (
+                    &joined.pts,
+                    &joined.ring_start,
+                    &joined.poly_ring,
+                    &joined.rows
+                ),
+                (&whole.pts, &whole.ring_start, &whole.poly_ring, &whole.rows)
+            );
+            assert_eq!(
+                (&joined.cols, &joined.coeffs, &joined.id),
+                (&whole.cols, &whole.coeffs, &whole.id)
+            );
+        }
+        assert!(whole.len() > 10);
     }
 
     #[test]
