@@ -311,13 +311,18 @@ fn zbuffer(frame: &Frame<'_>, spare: Option<Visibility>) -> Visibility {
                 s.spans(i, rows.clone(), w as i64, &mut edges, |y, xs| {
                     let base = (y - rows.start) as usize * w;
                     let rt = row_term(&k, y);
-                    for x in xs {
+                    let cells = base + xs.start as usize..base + xs.end as usize;
+                    // `x as f64` through i32: the same value, and a
+                    // conversion the compiler can do two at a time
+                    for ((n, p), x) in nb[cells.clone()]
+                        .iter_mut()
+                        .zip(&mut pb[cells])
+                        .zip(xs.start as i32..)
+                    {
                         let wv = k[0] * (x as f64 + 0.5) + rt;
-                        let c = base + x as usize;
-                        if better(wv, id, (nb[c], pb[c])) {
-                            nb[c] = wv;
-                            pb[c] = id;
-                        }
+                        let take = better(wv, id, (*n, *p));
+                        *n = if take { wv } else { *n };
+                        *p = if take { id } else { *p };
                     }
                 });
             }

@@ -220,10 +220,14 @@ fn draw_map<T: Copy + Send + Sync>(
             }
             let (k, id) = (screen.coeffs[s], screen.id[s]);
             screen.spans(s, rows.clone(), x1, &mut edges, |y, xs| {
-                let row = &mut px[(y as usize - band) * w..];
+                let row = (y as usize - band) * w;
                 let rt = row_term(&k, y);
-                for x in xs.start.max(x0)..xs.end {
-                    update(&mut row[x as usize], k[0] * (x as f64 + 0.5) + rt, id);
+                let start = xs.start.max(x0);
+                let texels = &mut px[row + start as usize..row + xs.end.max(start) as usize];
+                // `x as f64` through i32: the same value, and a conversion
+                // the compiler can do two at a time
+                for (t, x) in texels.iter_mut().zip(start as i32..) {
+                    update(t, k[0] * (x as f64 + 0.5) + rt, id);
                 }
             });
         }
@@ -498,9 +502,7 @@ fn shadow_map_in(
             f32::NEG_INFINITY,
             |t, w, _| {
                 let w = w as f32;
-                if w > *t {
-                    *t = w;
-                }
+                *t = if w > *t { w } else { *t };
             },
             &mut bufs.texels,
             &mut bufs.proj,
