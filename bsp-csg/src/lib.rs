@@ -198,7 +198,28 @@ impl std::error::Error for CsgError {}
 #[derive(Clone, Debug)]
 struct Face {
     poly: Polygon,
-    bx: IBox,
+    /// The polygon's box, in 32 bits (rounded outward where a coordinate
+    /// does not fit): a face slot is most of a solid's memory.
+    small_box: ([i32; 3], [i32; 3]),
+}
+
+impl Face {
+    fn new(poly: Polygon, bx: &IBox) -> Face {
+        let narrow = |v: i64| v.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+        Face {
+            poly,
+            small_box: (bx.0.map(narrow), bx.1.map(narrow)),
+        }
+    }
+
+    /// A box holding the polygon.
+    #[inline]
+    fn bx(&self) -> IBox {
+        (
+            self.small_box.0.map(i64::from),
+            self.small_box.1.map(i64::from),
+        )
+    }
 }
 
 /// The boundary of a closed, outward-oriented polyhedron: plane-based
@@ -264,10 +285,7 @@ impl Solid {
             .into_par_iter()
             .map(|p| {
                 let bx = polygon_box(&p);
-                Some(Face {
-                    poly: p.with_tag(0),
-                    bx,
-                })
+                Some(Face::new(p.with_tag(0), &bx))
             })
             .collect();
         let mut s = Solid {
@@ -291,14 +309,14 @@ impl Solid {
     fn reindex(&mut self) {
         let mut bounds: Option<IBox> = None;
         for f in self.faces.iter().flatten() {
-            bounds = Some(bounds.map_or(f.bx, |b| union(&b, &f.bx)));
+            bounds = Some(bounds.map_or(f.bx(), |b| union(&b, &f.bx())));
         }
         self.bounds = bounds;
         self.indexed = self.live.max(1);
         self.index = FaceIndex::new(bounds.unwrap_or(([0; 3], [0; 3])), self.indexed);
         for (i, f) in self.faces.iter().enumerate() {
             if let Some(f) = f {
-                self.index.insert(i as u32, &f.bx);
+                self.index.insert(i as u32, &f.bx());
             }
         }
     }
@@ -333,16 +351,13 @@ impl Solid {
         };
         self.index.insert(id, &bx);
         self.bounds = Some(self.bounds.map_or(bx, |b| union(&b, &bx)));
-        self.faces[id as usize] = Some(Face {
-            poly: p.with_tag(0),
-            bx,
-        });
+        self.faces[id as usize] = Some(Face::new(p.with_tag(0), &bx));
         self.live += 1;
     }
 
     fn remove(&mut self, id: u32) {
         if let Some(f) = self.faces[id as usize].take() {
-            self.index.remove(id, &f.bx);
+            self.index.remove(id, &f.bx());
             self.free.push(id);
             self.live -= 1;
         }
@@ -357,8 +372,11 @@ impl Solid {
         ids.retain(|&i| {
             self.faces[i as usize]
                 .as_ref()
-                .is_some_and(|f| overlaps(&f.bx, b))
+                .is_some_and(|f| overlaps(&f.bx(), b))
         });
+        // the ids came with repeats: the lists of a large box are kept
+        // while an operation runs
+        ids.shrink_to_fit();
         ids
     }
 
@@ -374,11 +392,12 @@ impl Solid {
         ids.iter()
             .filter_map(|&i| self.faces[i as usize].as_ref())
             .filter(|f| {
-                f.bx.1[0] >= q[0]
-                    && f.bx.0[1] <= q[1]
-                    && q[1] <= f.bx.1[1]
-                    && f.bx.0[2] <= q[2]
-                    && q[2] <= f.bx.1[2]
+                let bx = f.bx();
+                bx.1[0] >= q[0]
+                    && bx.0[1] <= q[1]
+                    && q[1] <= bx.1[1]
+                    && bx.0[2] <= q[2]
+                    && q[2] <= bx.1[2]
             })
             .map(|f| winding::crossing(q, &f.poly))
             .sum()
@@ -507,8 +526,8 @@ impl Solid {
         let b_near = other.faces_near(&domain);
         let Some(root) = a_near
             .iter()
-            .map(|&f| self.face(f).bx)
-            .chain(b_near.iter().map(|&f| other.face(f).bx))
+            .map(|&f| self.face(f).bx())
+            .chain(b_near.iter().map(|&f| other.face(f).bx()))
             .reduce(|x, y| union(&x, &y))
         else {
             return self.apart(other, op);
@@ -521,11 +540,11 @@ impl Solid {
             b_c.clone(),
             &|f, c| {
                 let face = self.face(f);
-                overlaps(&face.bx, c) && octree::plane_meets(face.poly.support(), c)
+                overlaps(&face.bx(), c) && octree::plane_meets(face.poly.support(), c)
             },
             &|f, c| {
                 let face = other.face(f);
-                overlaps(&face.bx, c) && octree::plane_meets(face.poly.support(), c)
+                overlaps(&face.bx(), c) && octree::plane_meets(face.poly.support(), c)
             },
             opts.leaf_size,
         );
@@ -555,44 +574,45 @@ impl Solid {
 
         // the faces wholly in free cells, and the pieces of the others
         let root_walls = walls(&root);
-        let (whole_a, pieces_a, local_a) = sort_faces(
+        let (whole_a, pieces_a, mut cand_a) = sort_faces(
             &a_c,
             &a_leaves,
             &leaves,
             &root,
-            |f| &self.face(f).poly,
-            |f| self.face(f).bx,
+            |f| self.face(f).bx(),
             |l| l.b.is_empty(),
         );
-        let (whole_b, pieces_b, local_b) = sort_faces(
+        let (whole_b, pieces_b, mut cand_b) = sort_faces(
             &b_c,
             &b_leaves,
             &leaves,
             &root,
-            |f| &other.face(f).poly,
-            |f| other.face(f).bx,
+            |f| other.face(f).bx(),
             |l| l.a.is_empty(),
         );
         // the mixed cells, in parallel
         let mixed: Vec<u32> = (0..leaves.len() as u32)
             .filter(|&l| leaves[l as usize].mixed())
             .collect();
-        let mut local_a = local_a;
-        let mut local_b = local_b;
-        let jobs: Vec<(u32, Vec<Polygon>, Vec<Polygon>)> = mixed
+        let jobs: Vec<(u32, Vec<u32>, Vec<u32>)> = mixed
             .iter()
             .map(|&l| {
                 (
                     l,
-                    local_a.remove(&l).unwrap_or_default(),
-                    local_b.remove(&l).unwrap_or_default(),
+                    cand_a.remove(&l).unwrap_or_default(),
+                    cand_b.remove(&l).unwrap_or_default(),
                 )
             })
             .collect();
-        let made: Vec<(u32, CellResult)> = jobs
+        // each cell clips its faces to its walls itself, so that only the
+        // cells at work hold their pieces, and gives back what stays
+        let made: Vec<(u32, Made)> = jobs
             .into_par_iter()
-            .map(|(l, pa, pb)| {
+            .map(|(l, fa, fb)| {
                 let bx = leaves[l as usize].bx;
+                let w = walls(&bx);
+                let (pa, ia) = clip_all(&fa, |f| &self.face(f).poly, &w);
+                let (pb, ib) = clip_all(&fb, |f| &other.face(f).poly, &w);
                 let r = bx.0.map(|c| c as i32);
                 local::boolean_pieces(
                     &bx,
@@ -603,7 +623,7 @@ impl Solid {
                     || self.winding(r),
                     || other.winding(r),
                 )
-                .map(|c| (l, c))
+                .map(|c| (l, Made::of(c, &ia, &ib)))
             })
             .collect::<Result<_, _>>()?;
         let mut stats = Stats {
@@ -612,21 +632,17 @@ impl Solid {
             ..Stats::default()
         };
         let mut add: Vec<Added> = Vec::new();
-        let mut fates_a: FxHashMap<u32, Vec<Fate>> = FxHashMap::default();
-        let mut local_pieces_a: FxHashMap<u32, Vec<Polygon>> = FxHashMap::default();
-        let mut local_pieces_b: FxHashMap<u32, Vec<Polygon>> = FxHashMap::default();
-        let mut fates_b: FxHashMap<u32, Vec<Fate>> = FxHashMap::default();
+        let mut fates_a: FxHashMap<u32, Vec<PieceFate>> = FxHashMap::default();
+        let mut fates_b: FxHashMap<u32, Vec<PieceFate>> = FxHashMap::default();
         for (l, c) in made {
             match c {
-                CellResult::Merged(ps) => {
+                Made::Merged(ps) => {
                     stats.merged_cells += 1;
                     add.extend(ps.into_iter().map(|p| Added::New(Box::new(p))))
                 }
-                CellResult::Pieces(fa, fb, pa, pb) => {
+                Made::Fates(fa, fb) => {
                     fates_a.insert(l, fa);
                     fates_b.insert(l, fb);
-                    local_pieces_a.insert(l, pa);
-                    local_pieces_b.insert(l, pb);
                 }
             }
         }
@@ -647,21 +663,19 @@ impl Solid {
                            pieces: &[Piece],
                            keep: &dyn Fn(bool) -> bool,
                            other_side: &Regions,
-                           fates: &FxHashMap<u32, Vec<Fate>>,
-                           local: &FxHashMap<u32, Vec<Polygon>>| {
+                           fates: &mut FxHashMap<u32, Vec<PieceFate>>| {
             settle(
                 poly,
                 pieces,
                 &|l| keep(l.is_some_and(|l| other_side.inside(l))),
                 fates,
-                local,
                 &leaves,
                 &root_walls,
             )
         };
         for (f, pieces) in pieces_a {
             let poly = &self.face(f).poly;
-            let outcome = settle_with(poly, &pieces, &keep_a, &inside_b, &fates_a, &local_pieces_a);
+            let outcome = settle_with(poly, &pieces, &keep_a, &inside_b, &mut fates_a);
             if let Some(kept) = outcome {
                 remove.push(f);
                 if !kept.is_empty() {
@@ -684,7 +698,7 @@ impl Solid {
         }
         for (f, pieces) in pieces_b {
             let poly = &other.face(f).poly;
-            match settle_with(poly, &pieces, &keep_b, &inside_a, &fates_b, &local_pieces_b) {
+            match settle_with(poly, &pieces, &keep_b, &inside_a, &mut fates_b) {
                 None => add.push(Added::Whole(f)),
                 Some(kept) => {
                     if !kept.is_empty() {
@@ -758,79 +772,117 @@ enum Added {
 }
 
 /// A piece of a face cut by octree walls: in a cell free of the other
-/// surface (or `None`: beyond the octree's box), not clipped until it is
-/// needed, or the `i`-th piece in a mixed cell's list.
+/// surface (or `None`: beyond the octree's box), or in a mixed cell as
+/// the `i`-th face of the cell's list; neither is clipped until needed.
 enum Piece {
     Free(Option<u32>),
     Mixed(u32, u32),
 }
 
 /// Faces wholly in cells free of the other surface; the pieces of every
-/// other face; per mixed cell the pieces in it.
-type Sorted = (Vec<u32>, Vec<(u32, Vec<Piece>)>, HashMap<u32, Vec<Polygon>>);
+/// other face; per mixed cell the faces in it, in order.
+type Sorted = (Vec<u32>, Vec<(u32, Vec<Piece>)>, HashMap<u32, Vec<u32>>);
 
-#[allow(clippy::too_many_arguments)]
-fn sort_faces<'p>(
+/// What becomes of a face listed in a mixed cell.
+enum PieceFate {
+    /// Clipped to the cell, nothing is left of it.
+    Missing,
+    /// Its piece in the cell stays whole.
+    Keep(Box<Polygon>),
+    /// Its piece goes.
+    Drop,
+    /// The other surface cuts its piece: the fragments that stay.
+    Cut(Vec<Polygon>),
+}
+
+/// A mixed cell's outcome, per listed face of each operand, or the
+/// cell's merged boundary.
+enum Made {
+    Fates(Vec<PieceFate>, Vec<PieceFate>),
+    Merged(Vec<Polygon>),
+}
+
+impl Made {
+    /// The outcome of a cell's result for its listed faces, `ia` and `ib`
+    /// giving each listed face's piece among the result's.
+    fn of(c: CellResult, ia: &[Option<u32>], ib: &[Option<u32>]) -> Made {
+        let fates = |fates: Vec<Fate>, pieces: Vec<Polygon>, index: &[Option<u32>]| {
+            let mut all: Vec<Option<(Fate, Polygon)>> =
+                fates.into_iter().zip(pieces).map(Some).collect();
+            index
+                .iter()
+                .map(|i| match i.and_then(|i| all[i as usize].take()) {
+                    None => PieceFate::Missing,
+                    Some((Fate::Keep, p)) => PieceFate::Keep(Box::new(p)),
+                    Some((Fate::Drop, _)) => PieceFate::Drop,
+                    Some((Fate::Cut(frags), _)) => PieceFate::Cut(frags),
+                })
+                .collect()
+        };
+        match c {
+            CellResult::Merged(ps) => Made::Merged(ps),
+            CellResult::Pieces(fa, fb, pa, pb) => Made::Fates(fates(fa, pa, ia), fates(fb, pb, ib)),
+        }
+    }
+}
+
+/// The faces `fs` clipped to the walls `w`: the non-empty pieces, in
+/// order, and each face's piece among them.
+fn clip_all<'p>(
+    fs: &[u32],
+    poly: impl Fn(u32) -> &'p Polygon,
+    w: &[bsp_core::Plane; 6],
+) -> (Vec<Polygon>, Vec<Option<u32>>) {
+    let mut pieces = Vec::with_capacity(fs.len());
+    let index = fs
+        .iter()
+        .map(|&f| {
+            local::clip_to(poly(f), w).map(|q| {
+                pieces.push(q);
+                (pieces.len() - 1) as u32
+            })
+        })
+        .collect();
+    (pieces, index)
+}
+
+fn sort_faces(
     faces: &[u32],
     leaves_of: &FxHashMap<u32, SmallVec<[u32; 4]>>,
     leaves: &[Leaf],
     root: &IBox,
-    poly: impl Fn(u32) -> &'p Polygon + Sync,
-    bx: impl Fn(u32) -> IBox + Sync,
-    free: impl Fn(&Leaf) -> bool + Sync,
+    bx: impl Fn(u32) -> IBox,
+    free: impl Fn(&Leaf) -> bool,
 ) -> Sorted {
     let mut whole = Vec::new();
-    let mut split = Vec::new();
+    let mut pieces = Vec::new();
+    let mut listed: HashMap<u32, Vec<u32>> = HashMap::new();
     for &f in faces {
         // a face in no cell lies beyond the octree's box
         let ls = leaves_of.get(&f).map_or(&[][..], |l| &l[..]);
         if ls.iter().all(|&l| free(&leaves[l as usize])) {
             whole.push(f);
-        } else {
-            split.push(f);
+            continue;
         }
-    }
-    // clip the others into their mixed cells, in parallel
-    type Clipped = Vec<(Piece, Option<Polygon>)>;
-    let clipped: Vec<(u32, Clipped)> = split
-        .par_iter()
-        .map(|&f| {
-            let p = poly(f);
-            let mut pieces: Clipped = leaves_of[&f]
-                .iter()
-                .filter_map(|&l| {
-                    let leaf = &leaves[l as usize];
-                    if free(leaf) {
-                        Some((Piece::Free(Some(l)), None))
-                    } else {
-                        local::clip_to(p, &walls(&leaf.bx)).map(|q| (Piece::Mixed(l, 0), Some(q)))
-                    }
-                })
-                .collect();
-            let fb = bx(f);
-            if (0..3).any(|k| fb.0[k] < root.0[k] || fb.1[k] > root.1[k]) {
-                pieces.push((Piece::Free(None), None));
-            }
-            (f, pieces)
-        })
-        .collect();
-    let mut pieces = Vec::with_capacity(clipped.len());
-    let mut local: HashMap<u32, Vec<Polygon>> = HashMap::new();
-    for (f, list) in clipped {
-        let mut mine = Vec::with_capacity(list.len());
-        for (piece, q) in list {
-            match (piece, q) {
-                (Piece::Mixed(l, _), Some(q)) => {
-                    let v = local.entry(l).or_default();
-                    mine.push(Piece::Mixed(l, v.len() as u32));
-                    v.push(q);
+        let mut mine: Vec<Piece> = ls
+            .iter()
+            .map(|&l| {
+                if free(&leaves[l as usize]) {
+                    Piece::Free(Some(l))
+                } else {
+                    let v = listed.entry(l).or_default();
+                    v.push(f);
+                    Piece::Mixed(l, (v.len() - 1) as u32)
                 }
-                (piece, _) => mine.push(piece),
-            }
+            })
+            .collect();
+        let fb = bx(f);
+        if (0..3).any(|k| fb.0[k] < root.0[k] || fb.1[k] > root.1[k]) {
+            mine.push(Piece::Free(None));
         }
         pieces.push((f, mine));
     }
-    (whole, pieces, local)
+    (whole, pieces, listed)
 }
 
 /// A leaf among `ls` (the leaves a face's box and plane tests put it in)
@@ -859,34 +911,43 @@ fn meeting_leaf(poly: &Polygon, ls: &[u32], leaves: &[Leaf]) -> Option<u32> {
 /// What stays of a face cut into `pieces`: `None` if every piece stays
 /// (the face stays as it is), else the kept pieces and fragments.
 /// `keep_free(cell)` says whether a piece in a free cell (`None`: beyond
-/// the octree's box) stays; `fates` and `local` are the mixed cells'.
+/// the octree's box) stays; `fates` are the mixed cells' (the pieces kept are moved out).
 fn settle(
     poly: &Polygon,
     pieces: &[Piece],
     keep_free: &dyn Fn(Option<u32>) -> bool,
-    fates: &FxHashMap<u32, Vec<Fate>>,
-    local: &FxHashMap<u32, Vec<Polygon>>,
+    fates: &mut FxHashMap<u32, Vec<PieceFate>>,
     leaves: &[Leaf],
     root: &[bsp_core::Plane; 6],
 ) -> Option<Vec<Polygon>> {
+    // `None`: the piece is in a merged cell's output
     let fate = |p: &Piece| match p {
-        Piece::Free(l) if keep_free(*l) => Some(&Fate::Keep),
-        Piece::Free(_) => Some(&Fate::Drop),
-        // a piece of a merged cell is in the cell's output
-        Piece::Mixed(l, i) => fates.get(l).map(|v| &v[*i as usize]),
+        Piece::Free(l) if keep_free(*l) => Some(Ok(())),
+        Piece::Free(_) => Some(Err(())),
+        Piece::Mixed(l, i) => fates.get(l).map(|v| match &v[*i as usize] {
+            PieceFate::Missing | PieceFate::Keep(_) => Ok(()),
+            PieceFate::Drop | PieceFate::Cut(_) => Err(()),
+        }),
     };
-    if pieces.iter().all(|p| matches!(fate(p), Some(Fate::Keep))) {
+    if pieces.iter().all(|p| fate(p) == Some(Ok(()))) {
         return None;
     }
     let mut kept = Vec::new();
     for p in pieces {
-        match (fate(p), p) {
-            (Some(Fate::Keep), Piece::Free(l)) => {
+        match p {
+            Piece::Free(l) if keep_free(*l) => {
                 kept.extend(free_pieces(poly, l.map(|l| &leaves[l as usize]), root))
             }
-            (Some(Fate::Keep), Piece::Mixed(l, i)) => kept.push(local[l][*i as usize].clone()),
-            (Some(Fate::Cut(frags)), _) => kept.extend(frags.iter().cloned()),
-            _ => {}
+            Piece::Free(_) => {}
+            // each piece is one face's: it is moved out, not copied
+            Piece::Mixed(l, i) => match fates
+                .get_mut(l)
+                .map(|v| std::mem::replace(&mut v[*i as usize], PieceFate::Drop))
+            {
+                Some(PieceFate::Keep(q)) => kept.push(*q),
+                Some(PieceFate::Cut(frags)) => kept.extend(frags),
+                _ => {}
+            },
         }
     }
     Some(kept)

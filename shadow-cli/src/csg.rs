@@ -260,20 +260,29 @@ struct Outcome {
 /// with each of the others in turn, then extracts the watertight
 /// boundary. Prints import summaries to stderr.
 fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Result<Outcome> {
-    let loops: Vec<Vec<Vec<u32>>> = operands.iter().map(Operand::loops).collect();
+    // the meshes are checked: their face lists are moved out (not copied)
+    // for the snap, and messages from here on name the files only
+    let loops: Vec<Vec<Vec<u32>>> = operands
+        .iter_mut()
+        .map(|o| {
+            o.file_loops = None;
+            std::mem::take(&mut o.mesh.faces)
+                .into_iter()
+                .map(|f| f.vertices)
+                .collect()
+        })
+        .collect();
     let meshes: Vec<MeshIn<'_>> = operands
         .iter()
         .zip(&loops)
         .map(|(o, l)| MeshIn::new(&o.mesh.positions, l))
         .collect();
     let snapped = phases.run("snap/import", || bsp_csg::snap(&meshes));
-    // the copies of the face lists are not needed any more, nor the
-    // meshes as read (messages from here on name the files only)
+    // the face lists are not needed any more, nor the meshes as read
     drop(meshes);
     drop(loops);
     for o in operands.iter_mut() {
         o.mesh = Mesh::default();
-        o.file_loops = None;
     }
     let Snapped {
         grid,
