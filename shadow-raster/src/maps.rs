@@ -397,39 +397,85 @@ fn locate(
     at.par_chunks_mut(w)
         .zip(depth.par_chunks_mut(w))
         .enumerate()
-        .map(|(y, (at, depth))| {
+        .map_init(Row::default, |row, (y, (at, depth))| {
+            // the row in simple passes over its facing pixels (each pass
+            // many independent iterations: the divisions and the square
+            // root of neighbouring pixels overlap), the same arithmetic as
+            // one pixel at a time
             let mut need = [Region::EMPTY; 6];
             let rt = rays.row(y);
-            for x in 0..w {
-                let pix = y * w + x;
-                let prim = vis.prim[pix];
-                at[x] = NO_LOOKUP;
-                if prim == NONE || facing[prim as usize] >> j & 1 == 0 {
-                    continue;
+            let base = y * w;
+            row.clear();
+            for (x, a) in at.iter_mut().enumerate() {
+                *a = NO_LOOKUP;
+                let prim = vis.prim[base + x];
+                if prim != NONE && facing[prim as usize] >> j & 1 == 1 {
+                    row.x.push(x as u32);
+                    row.prim.push(prim);
                 }
-                let p = rays.point_fast(x, y, rt, vis.w[pix]);
-                let f = face_of(light, p);
-                let view = &views[f];
-                let c = view.frame(p);
-                let persp = matches!(view.kind, Kind::Perspective { .. });
+            }
+            row.p.extend(
+                row.x
+                    .iter()
+                    .map(|&x| rays.point_fast(x as usize, y, rt, vis.w[base + x as usize])),
+            );
+            match light {
+                RasterLight::Point(l) => {
+                    // the cube faces share their origin, the light
+                    row.fc.extend(row.p.iter().map(|&p| {
+                        let f = face_of(light, p);
+                        let (v, view) = (p - l, &views[f]);
+                        (
+                            f as u8,
+                            DVec3::new(v.dot(view.r), v.dot(view.u), v.dot(view.f)),
+                        )
+                    }));
+                }
+                RasterLight::Sun(_) => {
+                    row.fc.extend(row.p.iter().map(|&p| (0, views[0].frame(p))));
+                }
+            }
+            let view = &views[row.fc.first().map_or(0, |fc| fc.0 as usize)];
+            let persp = matches!(view.kind, Kind::Perspective { .. });
+            let size = view.width as i64;
+            // every view of a light has the same size and projection
+            row.texel.extend(row.fc.iter().map(|&(_, c)| {
                 if persp && c.z <= 0.0 {
-                    continue;
+                    return None;
                 }
                 let (sx, sy) = view.screen(c);
-                let size = view.width as i64;
-                let (tx, ty) = (floor(sx).clamp(0, size - 1), floor(sy).clamp(0, size - 1));
-                // tan θ from the normal and the (unnormalized) way to the light
-                let v = match light {
-                    RasterLight::Point(lp) => lp - p,
-                    RasterLight::Sun(d) => d,
+                Some((
+                    floor(sx).clamp(0, size - 1) as u32,
+                    floor(sy).clamp(0, size - 1) as u32,
+                ))
+            }));
+            row.depth
+                .extend(
+                    row.p
+                        .iter()
+                        .zip(&row.fc)
+                        .zip(&row.prim)
+                        .map(|((&p, &(f, c)), &prim)| {
+                            // tan θ from the normal and the (unnormalized) way to the light
+                            let v = match light {
+                                RasterLight::Point(lp) => lp - p,
+                                RasterLight::Sun(d) => d,
+                            };
+                            let nv = visible_normal(frame, prim as usize).dot(v);
+                            let vv = v.length_squared();
+                            let tan = ((vv - nv * nv).max(0.0).sqrt() / nv).clamp(0.0, 50.0);
+                            let bias = opts.bias_constant
+                                + slope[f as usize] * if persp { c.z } else { 1.0 } * tan;
+                            c.z - bias
+                        }),
+                );
+            for k in 0..row.x.len() {
+                let Some((tx, ty)) = row.texel[k] else {
+                    continue;
                 };
-                let nv = visible_normal(frame, prim as usize).dot(v);
-                let vv = v.length_squared();
-                let tan = ((vv - nv * nv).max(0.0).sqrt() / nv).clamp(0.0, 50.0);
-                let bias = opts.bias_constant + slope[f] * if persp { c.z } else { 1.0 } * tan;
-                at[x] = (f as u32) << (2 * TEXEL_BITS) | (ty as u32) << TEXEL_BITS | tx as u32;
-                depth[x] = c.z - bias;
-                let (tx, ty) = (tx as u32, ty as u32);
+                let (x, f) = (row.x[k] as usize, row.fc[k].0 as usize);
+                at[x] = (f as u32) << (2 * TEXEL_BITS) | ty << TEXEL_BITS | tx;
+                depth[x] = row.depth[k];
                 let r = &mut need[f];
                 r.x0 = r.x0.min(tx);
                 r.y0 = r.y0.min(ty);
@@ -442,6 +488,32 @@ fn locate(
             || [Region::EMPTY; 6],
             |a, b| std::array::from_fn(|k| a[k].union(b[k])),
         )
+}
+
+/// One row's facing pixels in [`locate`], pass by pass.
+#[derive(Default)]
+struct Row {
+    x: Vec<u32>,
+    prim: Vec<u32>,
+    /// World points.
+    p: Vec<DVec3>,
+    /// View and frame coordinates in it.
+    fc: Vec<(u8, DVec3)>,
+    /// Texel, `None` at a point light.
+    texel: Vec<Option<(u32, u32)>>,
+    /// Depth less the bias.
+    depth: Vec<f64>,
+}
+
+impl Row {
+    fn clear(&mut self) {
+        self.x.clear();
+        self.prim.clear();
+        self.p.clear();
+        self.fc.clear();
+        self.texel.clear();
+        self.depth.clear();
+    }
 }
 
 /// Williams' shadow map.

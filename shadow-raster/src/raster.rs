@@ -81,17 +81,14 @@ mod smallvec_lite {
     }
 }
 
-/// `ceil(a / b)` for `b > 0`.
-#[inline]
-fn ceil_div(a: i64, b: i64) -> i64 {
-    let q = a.div_euclid(b);
-    if a.rem_euclid(b) == 0 { q } else { q + 1 }
-}
-
-/// The first row whose centre is at or below fixed-point `y`.
+/// The first row whose centre is at or below fixed-point `y`:
+/// `⌈(y − HALF) / SUB⌉ = ⌊(y − HALF + SUB − 1) / SUB⌋`, the floor by an
+/// arithmetic shift (`SUB` is a power of two).
 #[inline]
 fn first_row(y: i64) -> i64 {
-    ceil_div(y - HALF, SUB)
+    const SHIFT: u32 = SUB.trailing_zeros();
+    const _: () = assert!(1 << SHIFT == SUB);
+    (y - HALF + SUB - 1) >> SHIFT
 }
 
 /// One edge, upper endpoint first (`y0 < y1`), with the exact crossing of
@@ -1118,6 +1115,14 @@ mod tests {
             );
         }
         assert!(whole.len() > 10);
+    }
+
+    #[test]
+    fn first_rows_by_shifting() {
+        let ceil_div = |a: i64, b: i64| a.div_euclid(b) + (a.rem_euclid(b) != 0) as i64;
+        for y in (-3000..3000).chain([i32::MIN as i64, i32::MAX as i64, -(1 << 40), 1 << 40]) {
+            assert_eq!(first_row(y), ceil_div(y - HALF, SUB), "{y}");
+        }
     }
 
     #[test]
