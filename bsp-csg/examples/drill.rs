@@ -1,8 +1,10 @@
 //! Iterated CSG: subtracts `TOOLS` small spheres (about `TOOL_TRIS`
 //! triangles each) from a sphere of about `PART_TRIS` triangles, one after
 //! the other, on one grid; each tool is centred on the part's surface, on
-//! a Fibonacci spiral. Prints the time of the snap, of the subtractions
-//! and of the final mesh, and checks that the result is watertight.
+//! a Fibonacci spiral. Each tool is snapped when its turn comes (the grid
+//! is fitted to every mesh first), so that only the part and one tool are
+//! solids at a time. Prints the time of the snaps, of the subtractions and
+//! of the final mesh, and checks that the result is watertight.
 //!
 //! ```sh
 //! cargo run --release -p bsp-csg --example drill [TOOLS] [PART_TRIS] [TOOL_TRIS]
@@ -14,7 +16,7 @@ use std::time::Instant;
 
 use bsp_core::BoolOp;
 use bsp_csg::shapes::{drill_tools, uv_sphere};
-use bsp_csg::{MeshIn, Snapped, snap};
+use bsp_csg::{MeshIn, fit_grid, snap_one};
 
 fn main() {
     let mut args = std::env::args().skip(1).map(|a| a.parse::<usize>().ok());
@@ -26,24 +28,29 @@ fn main() {
     let mut meshes = vec![MeshIn::new(&pv, &pf)];
     meshes.extend(tool_meshes.iter().map(|v| MeshIn::new(v, &tf)));
     let t = Instant::now();
-    let Snapped { solids, .. } = snap(&meshes).unwrap();
-    let t_snap = t.elapsed();
-    let mut it = solids.into_iter();
-    let mut part = it.next().unwrap();
-    let t = Instant::now();
+    let grid = fit_grid(&meshes).unwrap();
+    let mut part = snap_one(&grid, &meshes[0], 0).unwrap().0;
+    let mut t_snap = t.elapsed();
     let (mut cut, mut mixed, mut cells) = (0, 0, 0);
     let leaf = std::env::var("LEAF_SIZE")
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(bsp_csg::LEAF_SIZE);
     let opts = bsp_csg::Options::default().with_leaf_size(leaf);
-    for tool in it {
-        let s = part.apply_with(&tool, BoolOp::Difference, &opts).unwrap();
+    let mut t_ops = std::time::Duration::ZERO;
+    for (i, m) in meshes.iter().enumerate().skip(1) {
+        let t = Instant::now();
+        let tool = snap_one(&grid, m, i).unwrap().0;
+        t_snap += t.elapsed();
+        let t = Instant::now();
+        let s = part
+            .apply_owned_with(tool, BoolOp::Difference, &opts)
+            .unwrap();
+        t_ops += t.elapsed();
         cut += s.cut_faces;
         mixed += s.mixed_cells;
         cells += s.cells;
     }
-    let t_ops = t.elapsed();
     let t = Instant::now();
     let mesh = part.to_mesh();
     mesh.check_watertight().unwrap();

@@ -1043,23 +1043,18 @@ pub struct Snapped {
 /// Snaps `meshes` (already checked with [`check_mesh`]) to one grid and
 /// makes their solids. Fails with [`CsgError::Inward`] for a mesh whose
 /// snapped faces bound a negative volume (exact).
+///
+/// For a long sequence of operands, [`fit_grid`] and [`snap_one`] make
+/// each solid only when it is needed, so that the solids of operands not
+/// yet used do not take memory.
 pub fn snap(meshes: &[MeshIn<'_>]) -> Result<Snapped, CsgError> {
-    let grid =
-        Grid::fit_points(meshes.iter().flat_map(|m| m.positions.iter())).map_err(CsgError::Grid)?;
+    let grid = fit_grid(meshes)?;
     let mut reports = Vec::with_capacity(meshes.len());
     let mut solids = Vec::with_capacity(meshes.len());
     for (i, m) in meshes.iter().enumerate() {
-        let loops: Vec<Vec<DVec3>> = m
-            .faces
-            .iter()
-            .map(|f| f.iter().map(|&v| m.positions[v as usize]).collect())
-            .collect();
-        let (polys, report) = import_faces_par(&grid, &loops).map_err(CsgError::Grid)?;
-        if six_volume_sign(&polys) < 0 {
-            return Err(CsgError::Inward { operand: i });
-        }
+        let (solid, report) = snap_one(&grid, m, i)?;
         reports.push(report);
-        solids.push(Solid::from_polygons(polys));
+        solids.push(solid);
     }
     Ok(Snapped {
         grid,
@@ -1068,9 +1063,38 @@ pub fn snap(meshes: &[MeshIn<'_>]) -> Result<Snapped, CsgError> {
     })
 }
 
-/// `((first op₁ m₁) op₂ m₂) ...` on one grid: every operand is snapped and
-/// checked once, and each operation works on the previous result in
-/// place.
+/// The grid [`snap`] puts `meshes` on: one that holds every position of
+/// every mesh.
+pub fn fit_grid(meshes: &[MeshIn<'_>]) -> Result<Grid, CsgError> {
+    Grid::fit_points(meshes.iter().flat_map(|m| m.positions.iter())).map_err(CsgError::Grid)
+}
+
+/// The solid of one mesh (already checked with [`check_mesh`]) on `grid`
+/// (from [`fit_grid`] over every mesh of the computation), and what
+/// snapping did to its faces; `operand` is its position, for
+/// [`CsgError::Inward`].
+pub fn snap_one(
+    grid: &Grid,
+    mesh: &MeshIn<'_>,
+    operand: usize,
+) -> Result<(Solid, ImportReport), CsgError> {
+    let loops: Vec<Vec<DVec3>> = mesh
+        .faces
+        .iter()
+        .map(|f| f.iter().map(|&v| mesh.positions[v as usize]).collect())
+        .collect();
+    let (polys, report) = import_faces_par(grid, &loops).map_err(CsgError::Grid)?;
+    drop(loops);
+    if six_volume_sign(&polys) < 0 {
+        return Err(CsgError::Inward { operand });
+    }
+    Ok((Solid::from_polygons(polys), report))
+}
+
+/// `((first op₁ m₁) op₂ m₂) ...` on one grid: every operand is checked
+/// and snapped once, its solid made only when its turn comes, and each
+/// operation works on the previous result in place (so a long sequence
+/// holds the result and one operand's solid at a time).
 pub fn mesh_sequence(
     first: &MeshIn<'_>,
     ops: &[(BoolOp, MeshIn<'_>)],
@@ -1081,15 +1105,14 @@ pub fn mesh_sequence(
     for (i, m) in all.iter().enumerate() {
         check_mesh(m, i)?;
     }
-    let Snapped {
-        grid,
-        solids,
-        reports,
-    } = snap(&all)?;
-    let mut it = solids.into_iter();
-    let mut solid = it.next().expect("at least the first operand");
-    for (s, (op, _)) in it.zip(ops) {
-        solid.apply_owned(s, *op)?;
+    // each operand's solid is made when its turn comes
+    let grid = fit_grid(&all)?;
+    let (mut solid, report) = snap_one(&grid, first, 0)?;
+    let mut reports = vec![report];
+    for (i, (op, m)) in ops.iter().enumerate() {
+        let (other, report) = snap_one(&grid, m, i + 1)?;
+        reports.push(report);
+        solid.apply_owned(other, *op)?;
     }
     let mesh = solid.to_mesh();
     mesh.check_watertight().map_err(CsgError::Internal)?;

@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow};
 use bsp_core::{BoolOp, Grid, ImportReport, TopologyError, TriMesh};
-use bsp_csg::{CsgError, MeshIn, Snapped};
+use bsp_csg::{CsgError, MeshIn, Solid};
 use clap::{Args, ValueEnum};
 use shadow_scene::{Face, Mesh, MeshFormat};
 
@@ -235,10 +235,16 @@ impl Operand {
 pub(crate) struct Phases(pub(crate) Vec<(&'static str, Duration)>);
 
 impl Phases {
+    /// Runs `f`, its time added to phase `name` (a new phase the first
+    /// time).
     pub(crate) fn run<T>(&mut self, name: &'static str, f: impl FnOnce() -> T) -> T {
         let start = Instant::now();
         let out = f();
-        self.0.push((name, start.elapsed()));
+        let t = start.elapsed();
+        match self.0.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, d)) => *d += t,
+            None => self.0.push((name, t)),
+        }
         out
     }
 }
@@ -260,44 +266,42 @@ struct Outcome {
 /// with each of the others in turn, then extracts the watertight
 /// boundary. Prints import summaries to stderr.
 fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Result<Outcome> {
-    // the meshes are checked: their face lists are moved out (not copied)
-    // for the snap, and messages from here on name the files only
-    let loops: Vec<Vec<Vec<u32>>> = operands
-        .iter_mut()
-        .map(|o| {
-            o.file_loops = None;
-            std::mem::take(&mut o.mesh.faces)
-                .into_iter()
-                .map(|f| f.vertices)
-                .collect()
-        })
-        .collect();
-    let meshes: Vec<MeshIn<'_>> = operands
-        .iter()
-        .zip(&loops)
-        .map(|(o, l)| MeshIn::new(&o.mesh.positions, l))
-        .collect();
-    let snapped = phases.run("snap/import", || bsp_csg::snap(&meshes));
-    // the face lists are not needed any more, nor the meshes as read
-    drop(meshes);
-    drop(loops);
-    for o in operands.iter_mut() {
+    // the meshes are checked, and messages from here on name the files
+    // only; one grid holds every operand, and each operand's solid is made
+    // when its turn comes, so that a long sequence holds the result and
+    // one operand's solid at a time
+    let grid = {
+        let meshes: Vec<MeshIn<'_>> = operands
+            .iter()
+            .map(|o| MeshIn::new(&o.mesh.positions, &[]))
+            .collect();
+        bsp_csg::fit_grid(&meshes)
+            .map_err(|e| anyhow!(e).context("cannot snap the faces to one grid"))?
+    };
+    let mut solid: Option<Solid> = None;
+    let mut reports = Vec::with_capacity(operands.len());
+    let mut stats = Vec::new();
+    for (i, o) in operands.iter_mut().enumerate() {
+        // the face lists are moved out of the mesh as read, not copied
+        o.file_loops = None;
+        let loops: Vec<Vec<u32>> = std::mem::take(&mut o.mesh.faces)
+            .into_iter()
+            .map(|f| f.vertices)
+            .collect();
+        let snapped = phases.run("snap/import", || {
+            bsp_csg::snap_one(&grid, &MeshIn::new(&o.mesh.positions, &loops), i)
+        });
+        drop(loops);
         o.mesh = Mesh::default();
-    }
-    let Snapped {
-        grid,
-        solids,
-        reports,
-    } = snapped.map_err(|e| match e {
-        CsgError::Inward { operand } => anyhow!(
-            "{}: the faces are oriented inward (clockwise seen from outside): the solid they \
-             bound is unbounded; reverse every face's vertex order",
-            operands[operand].name
-        ),
-        CsgError::Grid(e) => anyhow!(e).context("cannot snap the faces to one grid"),
-        e => anyhow!(e),
-    })?;
-    for (o, report) in operands.iter().zip(&reports) {
+        let (next, report) = snapped.map_err(|e| match e {
+            CsgError::Inward { .. } => anyhow!(
+                "{}: the faces are oriented inward (clockwise seen from outside): the solid they \
+                 bound is unbounded; reverse every face's vertex order",
+                o.name
+            ),
+            CsgError::Grid(e) => anyhow!(e).context("cannot snap the faces to one grid"),
+            e => anyhow!(e),
+        })?;
         let summary = report.summary();
         if !summary.is_empty() {
             eprint!("{}: {summary}", o.name);
@@ -311,25 +315,25 @@ fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Resu
                 -grid.scale().log2()
             );
         }
-    }
-    let mut it = solids.into_iter();
-    let mut solid = it.next().expect("at least two operands");
-    let stats = phases.run("boolean", || -> Result<Vec<bsp_csg::Stats>> {
-        let mut stats = Vec::new();
-        for (i, s) in it.enumerate() {
-            let st = solid.apply_owned(s, op.kernel()).map_err(|e| match e {
+        reports.push(report);
+        let Some(acc) = solid.as_mut() else {
+            solid = Some(next);
+            continue;
+        };
+        let st = phases
+            .run("boolean", || acc.apply_owned(next, op.kernel()))
+            .map_err(|e| match e {
                 CsgError::NotASolid => anyhow!(
                     "{} or the result before it: a surface crosses itself after snapping to the \
                      grid (step 2^{}) and bounds no solid",
-                    operands[i + 1].name,
+                    o.name,
                     -grid.scale().log2()
                 ),
                 e => anyhow!(e),
             })?;
-            stats.push(st);
-        }
-        Ok(stats)
-    })?;
+        stats.push(st);
+    }
+    let solid = solid.expect("at least two operands");
     let (exact, mesh) = phases.run("boundary+mesh", || {
         let exact = solid.to_mesh();
         let mesh = Mesh {
