@@ -8,9 +8,14 @@ use serde_json::Value;
 use crate::{assert_failed_with, scratch, shadow, stderr, stdout};
 
 /// A 2 × 2 floor at z = 0 (face 0, facing up) and a 0.5 × 0.5 occluder
-/// at z = 1 (face 1, facing up) over `[0.5, 1]²`.
+/// at z = 1 (face 1, facing up) over `[0.5, 1]²`, in a file of its own
+/// for each caller (tests run at once: one must not read the file while
+/// another rewrites it).
 fn floor_and_occluder() -> PathBuf {
-    let path = scratch("floor_and_occluder.obj");
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static CALLS: AtomicUsize = AtomicUsize::new(0);
+    let n = CALLS.fetch_add(1, Ordering::Relaxed);
+    let path = scratch(&format!("floor_and_occluder_{n}.obj"));
     std::fs::write(
         &path,
         "v 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\n\
