@@ -37,6 +37,11 @@
 //! and touches only the faces near the other operand, so a sequence of
 //! small operations on a large part never rebuilds anything global).
 //!
+//! From meshes: [`mesh_boolean`] and [`mesh_sequence`] check, snap, operate
+//! and mesh in one call; [`snap`] makes every operand's solid on one grid
+//! at once, and [`fit_grid`] with [`snap_one`] makes each when its turn
+//! comes, so that a long sequence holds only the result and one operand.
+//!
 //! # Example
 //!
 //! ```
