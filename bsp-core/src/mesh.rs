@@ -108,25 +108,46 @@ impl TriMesh {
             vertices: Vec::new(),
             by_key: rustc_hash::FxHashMap::default(),
         };
-        // the keys (correctly rounded coordinates) in parallel, the ids in
-        // order
-        let keys: Vec<Vec<[u64; 3]>> = polys
-            .par_iter()
-            .map(|p| p.borrow().vertices().iter().map(key).collect())
-            .collect();
-        let corners: Vec<Vec<u32>> = polys
-            .iter()
-            .zip(&keys)
-            .map(|(p, k)| {
+        // polygon `i`'s corners are `corners[start[i]..start[i + 1]]`, in
+        // flat arrays (a list per polygon costs an allocation each)
+        let mut start = Vec::with_capacity(polys.len() + 1);
+        start.push(0usize);
+        for p in polys {
+            start.push(start[start.len() - 1] + p.borrow().vertices().len());
+        }
+        // the keys (correctly rounded coordinates) in parallel, by runs of
+        // polygons, the ids in order
+        const RUN: usize = 512;
+        let mut keys = vec![[0u64; 3]; start[polys.len()]];
+        {
+            let mut pieces = Vec::with_capacity(polys.len().div_ceil(RUN));
+            let mut rest = &mut keys[..];
+            for c in (0..polys.len()).step_by(RUN) {
+                let end = (c + RUN).min(polys.len());
+                let (piece, tail) = rest.split_at_mut(start[end] - start[c]);
+                pieces.push((c..end, piece));
+                rest = tail;
+            }
+            pieces.into_par_iter().for_each(|(range, piece)| {
+                let vs = range.flat_map(|i| polys[i].borrow().vertices().iter());
+                for (k, v) in piece.iter_mut().zip(vs) {
+                    *k = key(v);
+                }
+            });
+        }
+        let mut corners = Vec::with_capacity(keys.len());
+        for (p, ks) in polys.iter().zip(start.windows(2)) {
+            let ks = &keys[ks[0]..ks[1]];
+            corners.extend(
                 p.borrow()
                     .vertices()
                     .iter()
-                    .zip(k)
-                    .map(|(v, &k)| w.id(v, k))
-                    .collect()
-            })
-            .collect();
+                    .zip(ks)
+                    .map(|(v, &k)| w.id(v, k)),
+            );
+        }
         drop(keys);
+        drop(std::mem::take(&mut w.by_key));
         let vertices = w.vertices;
         let coords: Vec<[f64; 3]> = vertices.par_iter().map(Point::to_f64).collect();
         let near = Candidates::new(&coords);
@@ -134,12 +155,15 @@ impl TriMesh {
         // each polygon's triangles on its own, in parallel; chunks keep
         // the order of the polygons
         let chunks: Vec<(Vec<[u32; 3]>, Vec<Plane>)> = polys
-            .par_chunks(512)
-            .zip(corners.par_chunks(512))
-            .map(|(polys, corners)| {
+            .par_chunks(RUN)
+            .enumerate()
+            .map(|(c, polys)| {
                 let mut triangles = Vec::new();
                 let mut planes = Vec::new();
-                for (poly, cs) in polys.iter().zip(corners) {
+                let first = c * RUN;
+                let cs_of = |i: usize| &corners[start[first + i]..start[first + i + 1]];
+                for (i, poly) in polys.iter().enumerate() {
+                    let cs = cs_of(i);
                     let poly: &Polygon = poly.borrow();
                     let k = cs.len();
                     // boundary loop: (vertex, edge ids it lies on)
@@ -433,15 +457,23 @@ impl TriMesh {
             .par_iter()
             .all(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
         if distinct {
-            let mut fwd: Vec<u64> = self
-                .triangles
-                .par_iter()
-                .flat_map_iter(|t| (0..3).map(move |i| key(t[i], t[(i + 1) % 3])))
+            // the directed edges, sorted (an exact-size array: the mesh's
+            // largest allocation here); each used once and its reverse
+            // present means every edge is used once each way
+            let tris = &self.triangles;
+            let mut fwd: Vec<u64> = (0..3 * tris.len())
+                .into_par_iter()
+                .map(|e| {
+                    let (t, i) = (&tris[e / 3], e % 3);
+                    key(t[i], t[(i + 1) % 3])
+                })
                 .collect();
-            let mut rev: Vec<u64> = fwd.par_iter().map(|e| e.rotate_left(32)).collect();
             fwd.par_sort_unstable();
-            rev.par_sort_unstable();
-            if !fwd.par_windows(2).any(|w| w[0] == w[1]) && fwd == rev {
+            if !fwd.par_windows(2).any(|w| w[0] == w[1])
+                && fwd
+                    .par_iter()
+                    .all(|e| fwd.binary_search(&e.rotate_left(32)).is_ok())
+            {
                 return Ok(());
             }
         }
@@ -796,6 +828,48 @@ fn clip_ears(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn watertightness_is_checked_edge_by_edge() {
+        // a tetrahedron, then the defects the fast check must not let by
+        let tet = vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
+        let mesh = |triangles: Vec<[u32; 3]>| TriMesh {
+            vertices: (0..5).map(|i| Point::Grid([i, 0, 0])).collect(),
+            planes: Vec::new(),
+            triangles,
+        };
+        assert_eq!(mesh(tet.clone()).check_watertight(), Ok(()));
+        let mut open = tet.clone();
+        open.pop();
+        assert!(mesh(open).check_watertight().is_err(), "a missing face");
+        let mut flipped = tet.clone();
+        flipped[2] = [1, 3, 2];
+        assert!(mesh(flipped).check_watertight().is_err(), "a flipped face");
+        let mut twice = tet.clone();
+        twice.extend(tet.iter().map(|t| [t[0], t[2], t[1]]));
+        assert!(
+            mesh(twice).check_watertight().is_err(),
+            "every edge used twice each way"
+        );
+        let mut repeated = tet.clone();
+        repeated[0] = [0, 0, 1];
+        assert!(
+            mesh(repeated).check_watertight().is_err(),
+            "a repeated vertex"
+        );
+        // two tetrahedra sharing only a vertex are still watertight
+        let mut two = tet.clone();
+        two.extend(
+            tet.iter()
+                .map(|t| t.map(|v| if v == 0 { 0 } else { v + 3 })),
+        );
+        let m = TriMesh {
+            vertices: (0..8).map(|i| Point::Grid([i, 0, 0])).collect(),
+            planes: Vec::new(),
+            triangles: two,
+        };
+        assert_eq!(m.check_watertight(), Ok(()));
+    }
 
     #[test]
     fn t_junction_is_resolved() {

@@ -117,31 +117,22 @@ fn is_closed_manifold(faces: &[&[u32]]) -> bool {
         return false;
     }
     let key = |a: u32, b: u32| (a as u64) << 32 | b as u64;
-    let corners = |f: &&[u32]| {
-        let k = f.len();
-        (0..k)
-            .map(|i| (f[(i + k - 1) % k], f[i], f[(i + 1) % k]))
-            .collect::<Vec<_>>()
-    };
-    let mut fwd: Vec<u64> = faces
-        .par_iter()
-        .flat_map_iter(|f| {
-            let k = f.len();
-            (0..k).map(move |i| key(f[i], f[(i + 1) % k]))
-        })
-        .collect();
-    let mut rev: Vec<u64> = fwd.par_iter().map(|e| e.rotate_left(32)).collect();
+    // every directed edge, sorted: each used once and its reverse present
+    let mut fwd: Vec<u64> = per_corner(faces, |f, i| key(f[i], f[(i + 1) % f.len()]));
     fwd.par_sort_unstable();
-    rev.par_sort_unstable();
-    if fwd.par_windows(2).any(|w| w[0] == w[1]) || fwd != rev {
+    if fwd.par_windows(2).any(|w| w[0] == w[1])
+        || !fwd
+            .par_iter()
+            .all(|e| fwd.binary_search(&e.rotate_left(32)).is_ok())
+    {
         return false;
     }
-    drop((fwd, rev));
+    drop(fwd);
     // vertex links: (v, u) → w, sorted; each vertex's group is one cycle
-    let mut link: Vec<(u64, u32)> = faces
-        .par_iter()
-        .flat_map_iter(|f| corners(f).into_iter().map(|(u, v, w)| (key(v, u), w)))
-        .collect();
+    let mut link: Vec<(u64, u32)> = per_corner(faces, |f, i| {
+        let k = f.len();
+        (key(f[i], f[(i + k - 1) % k]), f[(i + 1) % k])
+    });
     link.par_sort_unstable();
     let groups: Vec<&[(u64, u32)]> = link.chunk_by(|x, y| x.0 >> 32 == y.0 >> 32).collect();
     groups.par_iter().all(|g| {
@@ -166,6 +157,43 @@ fn is_closed_manifold(faces: &[&[u32]]) -> bool {
         }
         steps == g.len()
     })
+}
+
+/// `item(face, i)` for every corner `i` of every face, in order, in an
+/// array of exactly that size (filled in parallel, by runs of faces).
+fn per_corner<T: Copy + Default + Send + Sync>(
+    faces: &[&[u32]],
+    item: impl Fn(&[u32], usize) -> T + Sync,
+) -> Vec<T> {
+    use rayon::prelude::*;
+    const RUN: usize = 4096;
+    let mut start = Vec::with_capacity(faces.len() / RUN + 2);
+    let mut total = 0;
+    for (k, f) in faces.iter().enumerate() {
+        if k % RUN == 0 {
+            start.push(total);
+        }
+        total += f.len();
+    }
+    let mut out = vec![T::default(); total];
+    let mut pieces = Vec::with_capacity(start.len());
+    let mut rest = &mut out[..];
+    for (r, &s) in start.iter().enumerate() {
+        let end = start.get(r + 1).copied().unwrap_or(total);
+        let (piece, tail) = rest.split_at_mut(end - s);
+        pieces.push(piece);
+        rest = tail;
+    }
+    pieces
+        .into_par_iter()
+        .zip(faces.par_chunks(RUN))
+        .for_each(|(piece, fs)| {
+            let items = fs.iter().flat_map(|f| (0..f.len()).map(|i| item(f, i)));
+            for (o, v) in piece.iter_mut().zip(items) {
+                *o = v;
+            }
+        });
+    out
 }
 
 /// [`check_closed_manifold`] face by face, naming the first defect.
