@@ -59,6 +59,28 @@ pub fn fibonacci_sphere(n: usize) -> Vec<DVec3> {
         .collect()
 }
 
+/// An axis-aligned box from `lo` to `hi` as six quads, counter-clockwise
+/// seen from outside (bottom, top, then the sides at `y = lo`, `y = hi`,
+/// `x = lo`, `x = hi`).
+pub fn cuboid(lo: DVec3, hi: DVec3) -> Vec<Vec<DVec3>> {
+    let c = |x: bool, y: bool, z: bool| {
+        DVec3::new(
+            if x { hi.x } else { lo.x },
+            if y { hi.y } else { lo.y },
+            if z { hi.z } else { lo.z },
+        )
+    };
+    let (f, t) = (false, true);
+    vec![
+        vec![c(f, f, f), c(f, t, f), c(t, t, f), c(t, f, f)],
+        vec![c(f, f, t), c(t, f, t), c(t, t, t), c(f, t, t)],
+        vec![c(f, f, f), c(t, f, f), c(t, f, t), c(f, f, t)],
+        vec![c(f, t, f), c(f, t, t), c(t, t, t), c(t, t, f)],
+        vec![c(f, f, f), c(f, f, t), c(f, t, t), c(f, t, f)],
+        vec![c(t, f, f), c(t, t, f), c(t, t, t), c(t, f, t)],
+    ]
+}
+
 /// The CSG benches' pair: the unit UV sphere of about `n` triangles
 /// ([`uv_sphere`]) and a copy of it rotated 5° about `(1, 2, 3)` and moved
 /// by `(0.3, 0.1, 0.05)` (the inputs of `scripts/manifold_compare.py`).

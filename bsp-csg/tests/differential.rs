@@ -11,23 +11,18 @@ use proptest::prelude::*;
 
 type Face = Vec<GridPoint>;
 
+/// `bsp_core::shapes::cuboid` on grid points (small integers, exact in
+/// `f64` both ways).
 fn cuboid(lo: GridPoint, hi: GridPoint) -> Vec<Face> {
-    let c = |x: bool, y: bool, z: bool| {
-        [
-            if x { hi[0] } else { lo[0] },
-            if y { hi[1] } else { lo[1] },
-            if z { hi[2] } else { lo[2] },
-        ]
-    };
-    let (f, t) = (false, true);
-    vec![
-        vec![c(f, f, f), c(f, t, f), c(t, t, f), c(t, f, f)],
-        vec![c(f, f, t), c(t, f, t), c(t, t, t), c(f, t, t)],
-        vec![c(f, f, f), c(t, f, f), c(t, f, t), c(f, f, t)],
-        vec![c(f, t, f), c(f, t, t), c(t, t, t), c(t, t, f)],
-        vec![c(f, f, f), c(f, f, t), c(f, t, t), c(f, t, f)],
-        vec![c(t, f, f), c(t, t, f), c(t, t, t), c(t, f, t)],
-    ]
+    let v = |p: GridPoint| glam::DVec3::from_array(p.map(f64::from));
+    bsp_core::shapes::cuboid(v(lo), v(hi))
+        .into_iter()
+        .map(|f| {
+            f.into_iter()
+                .map(|q| q.to_array().map(|c| c as i32))
+                .collect()
+        })
+        .collect()
 }
 
 fn det(a: GridPoint, b: GridPoint, c: GridPoint, d: GridPoint) -> i64 {

@@ -468,13 +468,13 @@ impl<'a> Projector<'a> {
     ) {
         let start_pts = out.pts.len();
         let start_rings = out.ring_start.len();
-        let (mut ymin, mut ymax, mut xmin, mut xmax) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
+        let mut bounds = NO_BOUNDS;
         for ring in rings {
             let (a, b) = scratch;
             a.clear();
             a.extend(ring.iter().map(|&p| self.view.frame(p)));
-            let bounds = self.bounds;
-            if !a.iter().fold(true, |all, c| all & bounds.inside(*c)) {
+            let clip = self.bounds;
+            if !a.iter().fold(true, |all, c| all & clip.inside(*c)) {
                 for pl in self.planes {
                     if a.len() < 3 {
                         break;
@@ -487,22 +487,11 @@ impl<'a> Projector<'a> {
                 continue;
             }
             for c in a.iter() {
-                let p = self.fixed(*c);
-                ymin = ymin.min(p[1]);
-                ymax = ymax.max(p[1]);
-                xmin = xmin.min(p[0]);
-                xmax = xmax.max(p[0]);
-                out.pts.push(p);
+                push_point(out, self.fixed(*c), &mut bounds);
             }
             out.ring_start.push(out.pts.len() as u32);
         }
-        self.close(
-            out,
-            (start_pts, start_rings),
-            [xmin, ymin, xmax, ymax],
-            coeffs,
-            id,
-        );
+        self.close(out, (start_pts, start_rings), bounds, coeffs, id);
     }
 
     /// Adds polygon `i` of `scene` as [`Projector::add`] does, from its
@@ -525,17 +514,16 @@ impl<'a> Projector<'a> {
             return;
         }
         let start = (out.pts.len(), out.ring_start.len());
-        let (mut ymin, mut ymax, mut xmin, mut xmax) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
+        let mut bounds = NO_BOUNDS;
         for &v in verts {
-            let p = corners.fixed[v as usize].expect("checked above");
-            ymin = ymin.min(p[1]);
-            ymax = ymax.max(p[1]);
-            xmin = xmin.min(p[0]);
-            xmax = xmax.max(p[0]);
-            out.pts.push(p);
+            push_point(
+                out,
+                corners.fixed[v as usize].expect("checked above"),
+                &mut bounds,
+            );
         }
         out.ring_start.push(out.pts.len() as u32);
-        self.close(out, start, [xmin, ymin, xmax, ymax], coeffs, i as u32);
+        self.close(out, start, bounds, coeffs, i as u32);
     }
 
     /// Ends the polygon whose points and rings `out` has from `start` on,
@@ -570,6 +558,19 @@ impl<'a> Projector<'a> {
         out.coeffs.push(coeffs);
         out.id.push(id);
     }
+}
+
+/// Bounds `[xmin, ymin, xmax, ymax]` of no point yet.
+const NO_BOUNDS: [i32; 4] = [i32::MAX, i32::MAX, i32::MIN, i32::MIN];
+
+/// Adds fixed-point `p` to the current ring of `out`, growing `bounds`.
+#[inline]
+fn push_point(out: &mut Screen, p: [i32; 2], bounds: &mut [i32; 4]) {
+    bounds[0] = bounds[0].min(p[0]);
+    bounds[1] = bounds[1].min(p[1]);
+    bounds[2] = bounds[2].max(p[0]);
+    bounds[3] = bounds[3].max(p[1]);
+    out.pts.push(p);
 }
 
 /// The screen point of each of a scene's shared vertices in one view, or

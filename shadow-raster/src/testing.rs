@@ -8,24 +8,7 @@ use crate::{Camera, RasterScene, SceneLight};
 /// Boxes standing on a ground, seen from a few places, lit by a point
 /// light and a sun.
 pub(crate) fn scenes() -> Vec<(RasterScene, Vec<SceneLight>, Vec<Camera>)> {
-    let cuboid = |lo: DVec3, hi: DVec3| -> Vec<Vec<DVec3>> {
-        let c = |x: bool, y: bool, z: bool| {
-            DVec3::new(
-                if x { hi.x } else { lo.x },
-                if y { hi.y } else { lo.y },
-                if z { hi.z } else { lo.z },
-            )
-        };
-        let (f, t) = (false, true);
-        vec![
-            vec![c(f, f, f), c(f, t, f), c(t, t, f), c(t, f, f)],
-            vec![c(f, f, t), c(t, f, t), c(t, t, t), c(f, t, t)],
-            vec![c(f, f, f), c(t, f, f), c(t, f, t), c(f, f, t)],
-            vec![c(f, t, f), c(f, t, t), c(t, t, t), c(t, t, f)],
-            vec![c(f, f, f), c(f, f, t), c(f, t, t), c(f, t, f)],
-            vec![c(t, f, f), c(t, t, f), c(t, t, t), c(t, f, t)],
-        ]
-    };
+    use bsp_core::shapes::cuboid;
     let mut faces = vec![vec![
         DVec3::new(-8.0, -8.0, 0.0),
         DVec3::new(8.0, -8.0, 0.0),

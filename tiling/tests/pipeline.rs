@@ -309,25 +309,7 @@ fn room_axis_stands_on_the_floor() {
     }
 }
 
-/// An axis-aligned box as six quads.
-fn cuboid(lo: DVec3, hi: DVec3) -> Vec<Vec<DVec3>> {
-    let c = |x: bool, y: bool, z: bool| {
-        DVec3::new(
-            if x { hi.x } else { lo.x },
-            if y { hi.y } else { lo.y },
-            if z { hi.z } else { lo.z },
-        )
-    };
-    let (f, t) = (false, true);
-    vec![
-        vec![c(f, f, f), c(f, t, f), c(t, t, f), c(t, f, f)],
-        vec![c(f, f, t), c(t, f, t), c(t, t, t), c(f, t, t)],
-        vec![c(f, f, f), c(t, f, f), c(t, f, t), c(f, f, t)],
-        vec![c(f, t, f), c(f, t, t), c(t, t, t), c(t, t, f)],
-        vec![c(f, f, f), c(f, f, t), c(f, t, t), c(f, t, f)],
-        vec![c(t, f, f), c(t, t, f), c(t, t, t), c(t, f, t)],
-    ]
-}
+use bsp_core::shapes::cuboid;
 
 fn tetra(at: DVec3, s: f64) -> Vec<Vec<DVec3>> {
     let v = [
