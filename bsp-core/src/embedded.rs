@@ -45,6 +45,7 @@
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
+use crate::plane::{cross, cross_wide};
 use crate::{GridPoint, Polygon};
 
 /// Why polygons are not certified as the boundary of solids (the first
@@ -126,16 +127,6 @@ fn sub(a: GridPoint, b: GridPoint) -> V {
     [0, 1, 2].map(|k| a[k] as i64 - b[k] as i64)
 }
 
-/// `|u|, |v| < 2^27` per component gives components below `2^55`.
-#[inline]
-fn cross(u: V, v: V) -> V {
-    [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ]
-}
-
 #[inline]
 fn dot(u: V, v: V) -> i128 {
     (0..3).map(|k| u[k] as i128 * v[k] as i128).sum()
@@ -146,21 +137,6 @@ type W = [i128; 3];
 #[inline]
 fn wide(u: V) -> W {
     u.map(|c| c as i128)
-}
-
-/// `n × g` with `|n| < 2^56`, `|g| < 2^28`: components below `2^85`.
-#[inline]
-fn cross_wide(n: V, g: V) -> W {
-    cross_w(wide(n), wide(g))
-}
-
-#[inline]
-fn cross_w(u: W, v: W) -> W {
-    [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ]
 }
 
 /// `w · p` for `|w| < 2^89`, `|p| < 2^28` (below `2^119`).
@@ -597,6 +573,7 @@ fn disjoint(s: &[GridPoint; 3], t: &[GridPoint; 3]) -> bool {
             }
         }
     }
+    // a normal (`< 2^56`) across an edge (`< 2^28`): below `2^85`
     es.iter().any(|&e| separates(cross_wide(ns, e)))
         || et.iter().any(|&e| separates(cross_wide(nt, e)))
 }
@@ -638,6 +615,7 @@ fn cones_apart(g: [V; 4]) -> bool {
             add(wide(cross(g[i], g[j])));
         }
     }
+    // normals (`< 2^56`) across edges (`< 2^28`): below `2^85`
     for (n, a, b) in [(n0, g[0], g[1]), (n1, g[2], g[3])] {
         add(cross_wide(n, a));
         add(cross_wide(n, b));
@@ -653,21 +631,15 @@ mod tests {
         Polygon::from_grid_points(p, 0).unwrap()
     }
 
-    /// A box's six faces, outward (or inward when `flip`).
+    /// A box's six faces ([`crate::shapes::cuboid`]), outward (or inward
+    /// when `flip`).
     fn cube(lo: GridPoint, hi: GridPoint, flip: bool) -> Vec<Polygon> {
-        let c = |m: u32| [0, 1, 2].map(|k| if m >> k & 1 == 1 { hi[k] } else { lo[k] });
-        let faces: [[u32; 4]; 6] = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        faces
-            .iter()
+        let v = |p: GridPoint| glam::DVec3::from_array(p.map(f64::from));
+        crate::shapes::cuboid(v(lo), v(hi))
+            .into_iter()
             .map(|f| {
-                let mut l: Vec<GridPoint> = f.iter().map(|&m| c(m)).collect();
+                let mut l: Vec<GridPoint> =
+                    f.iter().map(|q| q.to_array().map(|c| c as i32)).collect();
                 if flip {
                     l.reverse();
                 }

@@ -238,6 +238,17 @@ pub(crate) fn cross(u: [i64; 3], v: [i64; 3]) -> [i64; 3] {
     ]
 }
 
+/// Cross product of `i64` vectors in `i128` (exact for components below
+/// `2^63`: each product is below `2^126`, each difference below `2^127`).
+pub(crate) fn cross_wide(a: [i64; 3], b: [i64; 3]) -> [i128; 3] {
+    let m = |x: i64, y: i64| x as i128 * y as i128;
+    [
+        m(a[1], b[2]) - m(a[2], b[1]),
+        m(a[2], b[0]) - m(a[0], b[2]),
+        m(a[0], b[1]) - m(a[1], b[0]),
+    ]
+}
+
 fn dot_wide(n: [i64; 3], p: GridPoint) -> i128 {
     n[0] as i128 * p[0] as i128 + n[1] as i128 * p[1] as i128 + n[2] as i128 * p[2] as i128
 }
