@@ -17,7 +17,7 @@ use rayon::prelude::*;
 use smallvec::SmallVec;
 
 use crate::Side;
-use crate::plane::Plane;
+use crate::plane::{Plane, cross_wide};
 use crate::point::Point;
 use crate::polygon::Polygon;
 
@@ -46,15 +46,6 @@ pub(crate) fn to_bigint(x: &crate::I256) -> BigInt {
 
 fn key(p: &Point) -> [u64; 3] {
     p.to_f64().map(|c| (c + 0.0).to_bits())
-}
-
-fn cross_wide(a: [i64; 3], b: [i64; 3]) -> [i128; 3] {
-    let m = |x: i64, y: i64| x as i128 * y as i128;
-    [
-        m(a[1], b[2]) - m(a[2], b[1]),
-        m(a[2], b[0]) - m(a[0], b[2]),
-        m(a[0], b[1]) - m(a[1], b[0]),
-    ]
 }
 
 fn cross3(a: &[crate::I256; 3], b: &[crate::I256; 3]) -> [crate::I256; 3] {
@@ -115,26 +106,13 @@ impl TriMesh {
         for p in polys {
             start.push(start[start.len() - 1] + p.borrow().vertices().len());
         }
-        // the keys (correctly rounded coordinates) in parallel, by runs of
-        // polygons, the ids in order
-        const RUN: usize = 512;
-        let mut keys = vec![[0u64; 3]; start[polys.len()]];
-        {
-            let mut pieces = Vec::with_capacity(polys.len().div_ceil(RUN));
-            let mut rest = &mut keys[..];
-            for c in (0..polys.len()).step_by(RUN) {
-                let end = (c + RUN).min(polys.len());
-                let (piece, tail) = rest.split_at_mut(start[end] - start[c]);
-                pieces.push((c..end, piece));
-                rest = tail;
-            }
-            pieces.into_par_iter().for_each(|(range, piece)| {
-                let vs = range.flat_map(|i| polys[i].borrow().vertices().iter());
-                for (k, v) in piece.iter_mut().zip(vs) {
-                    *k = key(v);
-                }
-            });
-        }
+        // the keys (correctly rounded coordinates) in parallel, the ids in
+        // order
+        let keys = crate::topology::per_corner(
+            polys,
+            |p| p.borrow().vertices().len(),
+            |p, i| key(&p.borrow().vertices()[i]),
+        );
         let mut corners = Vec::with_capacity(keys.len());
         for (p, ks) in polys.iter().zip(start.windows(2)) {
             let ks = &keys[ks[0]..ks[1]];
@@ -154,6 +132,7 @@ impl TriMesh {
 
         // each polygon's triangles on its own, in parallel; chunks keep
         // the order of the polygons
+        const RUN: usize = 512;
         let chunks: Vec<(Vec<[u32; 3]>, Vec<Plane>)> = polys
             .par_chunks(RUN)
             .enumerate()

@@ -118,7 +118,7 @@ fn is_closed_manifold(faces: &[&[u32]]) -> bool {
     }
     let key = |a: u32, b: u32| (a as u64) << 32 | b as u64;
     // every directed edge, sorted: each used once and its reverse present
-    let mut fwd: Vec<u64> = per_corner(faces, |f, i| key(f[i], f[(i + 1) % f.len()]));
+    let mut fwd: Vec<u64> = per_corner(faces, |f| f.len(), |f, i| key(f[i], f[(i + 1) % f.len()]));
     fwd.par_sort_unstable();
     if fwd.par_windows(2).any(|w| w[0] == w[1])
         || !fwd
@@ -129,10 +129,14 @@ fn is_closed_manifold(faces: &[&[u32]]) -> bool {
     }
     drop(fwd);
     // vertex links: (v, u) → w, sorted; each vertex's group is one cycle
-    let mut link: Vec<(u64, u32)> = per_corner(faces, |f, i| {
-        let k = f.len();
-        (key(f[i], f[(i + k - 1) % k]), f[(i + 1) % k])
-    });
+    let mut link: Vec<(u64, u32)> = per_corner(
+        faces,
+        |f| f.len(),
+        |f, i| {
+            let k = f.len();
+            (key(f[i], f[(i + k - 1) % k]), f[(i + 1) % k])
+        },
+    );
     link.par_sort_unstable();
     let groups: Vec<&[(u64, u32)]> = link.chunk_by(|x, y| x.0 >> 32 == y.0 >> 32).collect();
     groups.par_iter().all(|g| {
@@ -159,21 +163,23 @@ fn is_closed_manifold(faces: &[&[u32]]) -> bool {
     })
 }
 
-/// `item(face, i)` for every corner `i` of every face, in order, in an
-/// array of exactly that size (filled in parallel, by runs of faces).
-fn per_corner<T: Copy + Default + Send + Sync>(
-    faces: &[&[u32]],
-    item: impl Fn(&[u32], usize) -> T + Sync,
+/// `item(face, i)` for every corner `i` of every face (`corners(face)` of
+/// them), in order, in an array of exactly that size, filled in parallel
+/// by runs of faces: no list per face, no growing.
+pub(crate) fn per_corner<F: Sync, T: Copy + Default + Send + Sync>(
+    faces: &[F],
+    corners: impl Fn(&F) -> usize + Sync,
+    item: impl Fn(&F, usize) -> T + Sync,
 ) -> Vec<T> {
     use rayon::prelude::*;
-    const RUN: usize = 4096;
+    const RUN: usize = 1024;
     let mut start = Vec::with_capacity(faces.len() / RUN + 2);
     let mut total = 0;
     for (k, f) in faces.iter().enumerate() {
         if k % RUN == 0 {
             start.push(total);
         }
-        total += f.len();
+        total += corners(f);
     }
     let mut out = vec![T::default(); total];
     let mut pieces = Vec::with_capacity(start.len());
@@ -188,9 +194,11 @@ fn per_corner<T: Copy + Default + Send + Sync>(
         .into_par_iter()
         .zip(faces.par_chunks(RUN))
         .for_each(|(piece, fs)| {
-            let items = fs.iter().flat_map(|f| (0..f.len()).map(|i| item(f, i)));
-            for (o, v) in piece.iter_mut().zip(items) {
-                *o = v;
+            let mut o = piece.iter_mut();
+            for f in fs {
+                for (i, slot) in o.by_ref().take(corners(f)).enumerate() {
+                    *slot = item(f, i);
+                }
             }
         });
     out
