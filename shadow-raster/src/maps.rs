@@ -92,17 +92,20 @@ fn light_views(scene: &RasterScene, light: RasterLight, size: u32) -> Vec<View> 
 fn face_of(light: RasterLight, p: DVec3) -> usize {
     match light {
         RasterLight::Sun(_) => 0,
-        RasterLight::Point(l) => {
-            let v = p - l;
-            let a = v.abs();
-            if a.x >= a.y && a.x >= a.z {
-                (v.x < 0.0) as usize
-            } else if a.y >= a.z {
-                2 + (v.y < 0.0) as usize
-            } else {
-                4 + (v.z < 0.0) as usize
-            }
-        }
+        RasterLight::Point(l) => cube_face(p - l),
+    }
+}
+
+/// The cube face the direction `v` from a point light falls in.
+#[inline]
+fn cube_face(v: DVec3) -> usize {
+    let a = v.abs();
+    if a.x >= a.y && a.x >= a.z {
+        (v.x < 0.0) as usize
+    } else if a.y >= a.z {
+        2 + (v.y < 0.0) as usize
+    } else {
+        4 + (v.z < 0.0) as usize
     }
 }
 
@@ -417,14 +420,15 @@ fn locate(
             row.p.extend(
                 row.x
                     .iter()
-                    .map(|&x| rays.point_fast(x as usize, y, rt, vis.w[base + x as usize])),
+                    .map(|&x| rays.point(x as usize, y, rt, vis.w[base + x as usize])),
             );
             match light {
                 RasterLight::Point(l) => {
                     // the cube faces share their origin, the light
                     row.fc.extend(row.p.iter().map(|&p| {
-                        let f = face_of(light, p);
-                        let (v, view) = (p - l, &views[f]);
+                        let v = p - l;
+                        let f = cube_face(v);
+                        let view = &views[f];
                         (
                             f as u8,
                             DVec3::new(v.dot(view.r), v.dot(view.u), v.dot(view.f)),

@@ -249,17 +249,6 @@ impl<'a> Rays<'a> {
         }
     }
 
-    /// [`Rays::point`] by one division instead of three: within a few
-    /// ulps of it, for passes whose answer is approximate anyway (the
-    /// shadow map's lookups).
-    #[inline]
-    pub(crate) fn point_fast(&self, x: usize, y: usize, row: DVec3, w: f64) -> DVec3 {
-        match self.col.get(x) {
-            Some(&c) => self.view.origin + (self.view.f + c + row) * (1.0 / w),
-            None => self.view.point(x as f64 + 0.5, y as f64 + 0.5, w),
-        }
-    }
-
     /// The world point at the centre of pixel `(x, y)` with nearness `w`,
     /// `row` being [`Rays::row`]`(y)`.
     #[inline]
