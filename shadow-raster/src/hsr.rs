@@ -295,15 +295,18 @@ fn zbuffer(frame: &Frame<'_>, spare: Option<Visibility>) -> Visibility {
     let (w, h) = frame.size();
     let s = &frame.screen;
     let (mut near, mut prim) = spare.map(|v| (v.w, v.prim)).unwrap_or_default();
-    // nearness is positive in front of the eye: 0 is "nothing"
-    crate::raster::refill(&mut near, w * h, 0.0f64);
-    crate::raster::refill(&mut prim, w * h, NONE);
+    // nearness is positive in front of the eye: 0 is "nothing"; each
+    // band is cleared by the job that draws it (then it is in cache)
+    crate::raster::reserve_len(&mut near, w * h, 0.0f64);
+    crate::raster::reserve_len(&mut prim, w * h, NONE);
     for_bands2(
         &mut near,
         &mut prim,
         w as u32,
         &frame.bins,
         |rows, polys, nb, pb| {
+            nb.fill(0.0);
+            pb.fill(NONE);
             let mut edges = Vec::new();
             for &i in polys {
                 let i = i as usize;

@@ -203,17 +203,17 @@ fn draw_map<T: Copy + Send + Sync>(
     let w = size as usize;
     let Region { x0, y0, x1, y1 } = region;
     crate::raster::reserve_len(buf, w * w, init);
-    buf[y0 as usize * w..y1 as usize * w]
-        .par_chunks_mut(1 << 14)
-        .for_each(|c| c.fill(init));
     let screen = &*screen;
     let (x0, x1) = (x0 as i64, x1 as i64);
     for_bands(buf, size, bins, |rows, polys, px| {
+        let band = rows.start as usize;
         let rows = rows.start.max(y0 as i64)..rows.end.min(y1 as i64);
         if rows.is_empty() {
             return;
         }
-        let band = rows.start as usize / crate::raster::BAND * crate::raster::BAND;
+        // the region's rows, cleared by the job that draws them (then
+        // they are in cache when drawn)
+        px[(rows.start as usize - band) * w..(rows.end as usize - band) * w].fill(init);
         let mut edges = Vec::new();
         for &s in polys {
             let s = s as usize;

@@ -739,16 +739,6 @@ pub(crate) fn filled<T: Copy + Send + Sync>(n: usize, v: T) -> Vec<T> {
     out
 }
 
-/// `buf` made `n` copies of `v`: in place and in parallel when it already
-/// holds `n` values (a kept buffer), else as [`filled`].
-pub(crate) fn refill<T: Copy + Send + Sync>(buf: &mut Vec<T>, n: usize, v: T) {
-    if buf.len() == n {
-        buf.par_chunks_mut(1 << 14).for_each(|c| c.fill(v));
-    } else {
-        *buf = filled(n, v);
-    }
-}
-
 /// `buf` made `n` long, its values left as they were when it already is
 /// (for passes that write every cell), else `n` copies of `v`.
 pub(crate) fn reserve_len<T: Copy + Send + Sync>(buf: &mut Vec<T>, n: usize, v: T) {

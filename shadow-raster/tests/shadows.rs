@@ -237,6 +237,44 @@ fn images_do_not_depend_on_the_thread_count() {
 }
 
 #[test]
+fn a_kept_renderer_draws_every_frame_as_a_fresh_one() {
+    // one Renderer frame after frame (its buffers are not cleared between
+    // frames: each pass must write or clear every cell it reads), the
+    // camera and the light moving and the size changing, against fresh
+    // renders
+    let setups = [
+        room(),
+        setup(
+            &shadow_scene::room(),
+            &[LightSpec::Point(DVec3::new(-1.2, 0.8, 1.9))],
+        ),
+    ];
+    let mut r = shadow_raster::Renderer::new();
+    let eyes = [
+        DVec3::new(3.3, -7.4, 4.3),
+        DVec3::new(-4.0, 5.0, 1.2),
+        DVec3::new(0.2, 0.4, 9.0),
+        DVec3::new(3.3, -7.4, 4.3),
+    ];
+    let mut frames = 0;
+    for (k, eye) in eyes.into_iter().enumerate() {
+        let s = &setups[k % 2];
+        let (w, h) = if k == 2 { (96, 96) } else { (160, 90) };
+        let cam = Camera::look_at(eye, DVec3::new(-0.15, 0.3, 0.45), DVec3::Z, 50.0, w, h).unwrap();
+        for m in [Method::ShadowMap, Method::Raycast, Method::Exact] {
+            let o = with(m);
+            let fresh = render(&s.scene, &s.lights, &cam, &[], &o).unwrap();
+            let kept = r.render(&s.scene, &s.lights, &cam, &[], &o).unwrap();
+            assert!(kept.image == fresh.image, "{} at eye {eye}", m.name());
+            assert_eq!(kept.visibility.prim, fresh.visibility.prim);
+            assert_eq!(kept.mask(), fresh.mask());
+            frames += 1;
+        }
+    }
+    assert_eq!(frames, 12);
+}
+
+#[test]
 fn fragments_from_elsewhere_draw_the_same_image() {
     // the animation hook: fragments of every face's front side
     let s = room();
