@@ -159,6 +159,19 @@ impl Default for ShadeBuffers {
     }
 }
 
+/// The colour `c · b` of a prim with colour and ambient `(c, b)`, with
+/// the lit amounts `amount` of the lights whose weighted cosines are
+/// `cosines` (at least as many).
+#[inline]
+fn mix((c, mut b): (DVec3, f64), amount: &[f32], cosines: &[f64]) -> [u8; 3] {
+    for (&a, &cos) in amount.iter().zip(cosines) {
+        b += a as f64 * cos;
+    }
+    // in [0.5, 255.5]: truncation rounds (no library call)
+    let v = (c * b).clamp(DVec3::ZERO, DVec3::ONE) * 255.0 + 0.5;
+    [v.x as u8, v.y as u8, v.z as u8]
+}
+
 /// Lambert shading, as the SVG views: the face's colour times ambient
 /// light (more on surfaces facing the viewer) plus each light's cosine
 /// times the amount of it that reaches the pixel, the cosines taken at
@@ -204,57 +217,51 @@ pub(crate) fn shade_in(
     let weight = DIFFUSE / lights.len().max(1) as f64;
     let grey = DVec3::splat(0.7);
     let nl = lights.len();
-    // per drawn prim: colour, ambient, and each light's weighted cosine
+    // per drawn prim, in one pass: colour, ambient, each light's weighted
+    // cosine, and with one light its colours in shadow and in light (the
+    // same bits as `color` below with an amount of 0 or 1)
     let drawn = &frame.screen.id;
-    bufs.base.clear();
-    bufs.base
-        .par_extend(drawn.par_iter().with_min_len(1024).map(|&i| {
-            let i = i as usize;
-            let pts = scene.prim(i);
-            let centre = pts.iter().sum::<DVec3>() / pts.len() as f64;
-            let n = visible_normal(frame, i);
-            let to_eye = (eye - centre).normalize_or_zero();
-            let c = colors.get(scene.face[i] as usize).copied().unwrap_or(grey);
-            (c, AMBIENT + AMBIENT_FACING * n.dot(to_eye).max(0.0))
-        }));
-    bufs.cosines.clear();
-    bufs.cosines.par_extend(
-        (0..drawn.len() * nl)
-            .into_par_iter()
+    let table = nl == 1 && bufs.table;
+    // (a spare cosine when there is no light: chunks are not empty)
+    let per = nl.max(1);
+    bufs.base.resize(drawn.len(), (DVec3::ZERO, 0.0));
+    bufs.cosines.resize(drawn.len() * per, 0.0);
+    bufs.two
+        .resize(if table { drawn.len() } else { 0 }, [[0; 3]; 2]);
+    let prim = |s: usize, base: &mut (DVec3, f64), cos: &mut [f64]| {
+        let i = drawn[s] as usize;
+        let pts = scene.prim(i);
+        let centre = pts.iter().sum::<DVec3>() / pts.len() as f64;
+        let n = visible_normal(frame, i);
+        let to_eye = (eye - centre).normalize_or_zero();
+        let c = colors.get(scene.face[i] as usize).copied().unwrap_or(grey);
+        *base = (c, AMBIENT + AMBIENT_FACING * n.dot(to_eye).max(0.0));
+        for (cos, l) in cos.iter_mut().zip(lights) {
+            *cos = weight * n.dot(l.world.toward(centre)).max(0.0);
+        }
+    };
+    let per_prim = bufs
+        .base
+        .par_iter_mut()
+        .zip(bufs.cosines.par_chunks_mut(per));
+    if table {
+        per_prim
+            .zip(bufs.two.par_iter_mut())
+            .enumerate()
             .with_min_len(1024)
-            .map(|k| {
-                let (i, j) = (drawn[k / nl] as usize, k % nl);
-                let pts = scene.prim(i);
-                let centre = pts.iter().sum::<DVec3>() / pts.len() as f64;
-                weight
-                    * visible_normal(frame, i)
-                        .dot(lights[j].world.toward(centre))
-                        .max(0.0)
-            }),
-    );
+            .for_each(|(s, ((base, cos), two))| {
+                prim(s, base, cos);
+                *two = [mix(*base, &[0.0], cos), mix(*base, &[1.0], cos)];
+            });
+    } else {
+        per_prim
+            .enumerate()
+            .with_min_len(1024)
+            .for_each(|(s, (base, cos))| prim(s, base, cos));
+    }
     let (base, cosines) = (&bufs.base, &bufs.cosines);
     // the colour of drawn prim `s` with the lit amounts `amount`
-    let color = |s: usize, amount: &[f32]| {
-        let (c, mut b) = base[s];
-        for (j, &a) in amount.iter().enumerate() {
-            b += a as f64 * cosines[s * nl + j];
-        }
-        // in [0.5, 255.5]: truncation rounds (no library call)
-        let v = (c * b).clamp(DVec3::ZERO, DVec3::ONE) * 255.0 + 0.5;
-        [v.x as u8, v.y as u8, v.z as u8]
-    };
-    // one light: each drawn prim's colour in its shadow and in its light,
-    // the same bits as `color` with an amount of 0 or 1
-    bufs.two.clear();
-    let table = nl == 1 && bufs.table;
-    if table {
-        bufs.two.par_extend(
-            (0..drawn.len())
-                .into_par_iter()
-                .with_min_len(1024)
-                .map(|s| [color(s, &[0.0]), color(s, &[1.0])]),
-        );
-    }
+    let color = |s: usize, amount: &[f32]| mix(base[s], amount, &cosines[s * per..]);
     let two = &bufs.two;
     rgb.par_chunks_mut(3 * w as usize)
         .enumerate()
