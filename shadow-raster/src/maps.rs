@@ -441,17 +441,18 @@ fn locate(
             }
             let view = &views[row.fc.first().map_or(0, |fc| fc.0 as usize)];
             let persp = matches!(view.kind, Kind::Perspective { .. });
-            let size = view.width as i64;
-            // every view of a light has the same size and projection
+            let top = (view.width - 1) as f64;
+            // every view of a light has the same size and projection;
+            // `⌊s⌋` clamped into the map is `s` clamped, then truncated
+            // (`as` saturates, and NaN, behind the light, is 0)
             row.texel.extend(row.fc.iter().map(|&(_, c)| {
-                if persp && c.z <= 0.0 {
-                    return None;
-                }
                 let (sx, sy) = view.screen(c);
-                Some((
-                    floor(sx).clamp(0, size - 1) as u32,
-                    floor(sy).clamp(0, size - 1) as u32,
-                ))
+                let (tx, ty) = (sx.clamp(0.0, top) as u32, sy.clamp(0.0, top) as u32);
+                if persp && c.z <= 0.0 {
+                    NO_LOOKUP
+                } else {
+                    ty << TEXEL_BITS | tx
+                }
             }));
             row.depth
                 .extend(
@@ -473,19 +474,29 @@ fn locate(
                             c.z - bias
                         }),
                 );
+            // the region of the current run of one view in locals (in
+            // `need[f]` every update waited on the one before through
+            // memory), merged into `need` where the view changes
+            let (mut cur, mut r) = (0, Region::EMPTY);
             for k in 0..row.x.len() {
-                let Some((tx, ty)) = row.texel[k] else {
+                let t = row.texel[k];
+                if t == NO_LOOKUP {
                     continue;
-                };
+                }
+                let (tx, ty) = (t & ((1 << TEXEL_BITS) - 1), t >> TEXEL_BITS);
                 let (x, f) = (row.x[k] as usize, row.fc[k].0 as usize);
-                at[x] = (f as u32) << (2 * TEXEL_BITS) | ty << TEXEL_BITS | tx;
+                at[x] = (f as u32) << (2 * TEXEL_BITS) | t;
                 depth[x] = row.depth[k];
-                let r = &mut need[f];
+                if f != cur {
+                    need[cur] = need[cur].union(r);
+                    (cur, r) = (f, Region::EMPTY);
+                }
                 r.x0 = r.x0.min(tx);
                 r.y0 = r.y0.min(ty);
                 r.x1 = r.x1.max(tx + 1);
                 r.y1 = r.y1.max(ty + 1);
             }
+            need[cur] = need[cur].union(r);
             need
         })
         .reduce(
@@ -503,8 +514,9 @@ struct Row {
     p: Vec<DVec3>,
     /// View and frame coordinates in it.
     fc: Vec<(u8, DVec3)>,
-    /// Texel, `None` at a point light.
-    texel: Vec<Option<(u32, u32)>>,
+    /// Texel, `y << TEXEL_BITS | x`, or [`NO_LOOKUP`] behind a point
+    /// light.
+    texel: Vec<u32>,
     /// Depth less the bias.
     depth: Vec<f64>,
 }
