@@ -660,35 +660,35 @@ fn par_concat<T: Copy + Default + Send + Sync>(
 }
 
 /// The polygons of `screen` reaching each band of [`BAND`] rows, in
-/// polygon order: band `b` is `list[start[b]..start[b + 1]]`.
+/// polygon order, binned in parallel by runs of [`BIN_RUN`] polygons:
+/// a band's polygons are its lists in every run, one run after the other.
 #[derive(Default)]
 pub(crate) struct Bins {
+    runs: Vec<BinRun>,
+}
+
+/// Polygons binned per run in [`Bins`].
+const BIN_RUN: usize = 16384;
+
+/// One run's bins: band `b` is `list[start[b]..start[b + 1]]`.
+#[derive(Default)]
+struct BinRun {
     start: Vec<u32>,
     list: Vec<u32>,
 }
 
-impl Bins {
-    pub(crate) fn new(screen: &Screen, height: u32) -> Bins {
-        let mut b = Bins {
-            start: Vec::new(),
-            list: Vec::new(),
-        };
-        b.rebuild(screen, height);
-        b
-    }
-
-    /// The bins of `screen`, in the buffers of earlier ones.
-    pub(crate) fn rebuild(&mut self, screen: &Screen, height: u32) {
-        let bands = (height as usize).div_ceil(BAND);
-        let count = &mut self.start;
-        count.clear();
-        count.resize(bands + 1, 0);
+impl BinRun {
+    /// Bins polygons `first..` whose rows are `rows`.
+    fn rebuild(&mut self, first: usize, rows: &[(i32, i32)], bands: usize) {
         let band_range = |&(r0, r1): &(i32, i32)| {
             let b0 = r0 as usize / BAND;
             let b1 = (r1 as usize - 1) / BAND + 1;
             b0..b1
         };
-        for r in &screen.rows {
+        let count = &mut self.start;
+        count.clear();
+        count.resize(bands + 1, 0);
+        for r in rows {
             for b in band_range(r) {
                 count[b + 1] += 1;
             }
@@ -699,16 +699,58 @@ impl Bins {
         let mut fill = count.clone();
         self.list.clear();
         self.list.resize(count[bands] as usize, 0);
-        for (i, r) in screen.rows.iter().enumerate() {
+        for (i, r) in rows.iter().enumerate() {
             for b in band_range(r) {
-                self.list[fill[b] as usize] = i as u32;
+                self.list[fill[b] as usize] = (first + i) as u32;
                 fill[b] += 1;
             }
         }
     }
 
-    pub(crate) fn band(&self, b: usize) -> &[u32] {
+    fn band(&self, b: usize) -> &[u32] {
         &self.list[self.start[b] as usize..self.start[b + 1] as usize]
+    }
+}
+
+impl Bins {
+    pub(crate) fn new(screen: &Screen, height: u32) -> Bins {
+        let mut b = Bins::default();
+        b.rebuild(screen, height);
+        b
+    }
+
+    /// The bins of `screen`, in the buffers of earlier ones.
+    pub(crate) fn rebuild(&mut self, screen: &Screen, height: u32) {
+        self.rebuild_by(screen, height, BIN_RUN);
+    }
+
+    /// [`Bins::rebuild`] by runs of `run` polygons.
+    fn rebuild_by(&mut self, screen: &Screen, height: u32, run: usize) {
+        let bands = (height as usize).div_ceil(BAND);
+        let rows = &screen.rows;
+        self.runs
+            .resize_with(rows.len().div_ceil(run), BinRun::default);
+        self.runs
+            .par_iter_mut()
+            .zip(rows.par_chunks(run))
+            .enumerate()
+            .for_each(|(k, (bins, rows))| bins.rebuild(k * run, rows, bands));
+    }
+
+    /// The polygons reaching band `b`, in polygon order (gathered into
+    /// `buf` when there are several runs).
+    pub(crate) fn band<'a>(&'a self, b: usize, buf: &'a mut Vec<u32>) -> &'a [u32] {
+        match self.runs.as_slice() {
+            [] => &[],
+            [one] => one.band(b),
+            runs => {
+                buf.clear();
+                for r in runs {
+                    buf.extend_from_slice(r.band(b));
+                }
+                buf
+            }
+        }
     }
 }
 
@@ -723,10 +765,10 @@ pub(crate) fn for_bands<T: Send>(
     let w = width as usize;
     buf.par_chunks_mut(BAND * w)
         .enumerate()
-        .for_each(|(b, chunk)| {
+        .for_each_init(Vec::new, |polys, (b, chunk)| {
             let y0 = (b * BAND) as i64;
             let rows = y0..y0 + (chunk.len() / w) as i64;
-            f(rows, bins.band(b), chunk);
+            f(rows, bins.band(b, polys), chunk);
         });
 }
 
@@ -759,10 +801,10 @@ pub(crate) fn for_bands2<T: Send, U: Send>(
     a.par_chunks_mut(BAND * w)
         .zip(b.par_chunks_mut(BAND * w))
         .enumerate()
-        .for_each(|(k, (ca, cb))| {
+        .for_each_init(Vec::new, |polys, (k, (ca, cb))| {
             let y0 = (k * BAND) as i64;
             let rows = y0..y0 + (ca.len() / w) as i64;
-            f(rows, bins.band(k), ca, cb);
+            f(rows, bins.band(k, polys), ca, cb);
         });
 }
 
@@ -1106,6 +1148,47 @@ mod tests {
             );
         }
         assert!(whole.len() > 10);
+    }
+
+    #[test]
+    fn bins_by_runs_list_each_band_in_polygon_order() {
+        // random row ranges binned by runs of a few polygons (and by one
+        // run) against a direct count: every band lists exactly the
+        // polygons reaching it, in polygon order
+        let mut rng = bsp_core::SplitMix(0xb1_25);
+        let height = 100u32;
+        let mut s = Screen::new();
+        for _ in 0..500 {
+            let r0 = rng.below(height as usize) as i32;
+            let r1 = r0 + 1 + rng.below((height as i32 - r0) as usize) as i32;
+            s.rows.push((r0, r1));
+        }
+        let bands = (height as usize).div_ceil(BAND);
+        let mut bins = Bins::default();
+        let mut buf = Vec::new();
+        for run in [7, 64, 499, 500, BIN_RUN] {
+            bins.rebuild_by(&s, height, run);
+            assert_eq!(bins.runs.len(), 500usize.div_ceil(run));
+            for b in 0..bands {
+                let want: Vec<u32> = (0..500u32)
+                    .filter(|&i| {
+                        let (r0, r1) = s.rows[i as usize];
+                        (r0 as usize) < (b + 1) * BAND && r1 as usize > b * BAND
+                    })
+                    .collect();
+                assert!(!want.is_empty());
+                assert_eq!(bins.band(b, &mut buf), want, "run {run}, band {b}");
+            }
+        }
+        // fewer polygons in the same buffers: no run is left from before
+        s.rows.truncate(3);
+        bins.rebuild_by(&s, height, 7);
+        let all: usize = (0..bands).map(|b| bins.band(b, &mut buf).len()).sum();
+        let direct: usize = s.rows[..3]
+            .iter()
+            .map(|&(r0, r1)| (r1 as usize - 1) / BAND + 1 - r0 as usize / BAND)
+            .sum();
+        assert_eq!(all, direct);
     }
 
     #[test]
