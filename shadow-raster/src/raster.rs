@@ -232,22 +232,42 @@ impl Screen {
             p += part.pts.len() as u32;
             r += (part.ring_start.len() - 1) as u32;
         }
-        let pts: Vec<&[[i32; 2]]> = parts.iter().map(|s| s.pts.as_slice()).collect();
-        par_concat(&mut self.pts, 0, &pts, |_, v| v);
-        let rings: Vec<&[u32]> = parts.iter().map(|s| &s.ring_start[1..]).collect();
-        par_concat(&mut self.ring_start, 1, &rings, |k, v| v + p0[k]);
+        // every array of a part copied by one job (one fork-join for all)
+        let lens = |f: fn(&Screen) -> usize| parts.iter().map(f).collect::<Vec<_>>();
+        let pts = pieces(&mut self.pts, 0, &lens(|s| s.pts.len()));
+        let rings = pieces(&mut self.ring_start, 1, &lens(|s| s.ring_start.len() - 1));
+        let polys = pieces(&mut self.poly_ring, 1, &lens(|s| s.poly_ring.len() - 1));
+        let rows = pieces(&mut self.rows, 0, &lens(|s| s.rows.len()));
+        let cols = pieces(&mut self.cols, 0, &lens(|s| s.cols.len()));
+        let coeffs = pieces(&mut self.coeffs, 0, &lens(|s| s.coeffs.len()));
+        let id = pieces(&mut self.id, 0, &lens(|s| s.id.len()));
+        let jobs: Vec<_> = pts
+            .into_iter()
+            .zip(rings)
+            .zip(polys)
+            .zip(rows.into_iter().zip(cols))
+            .zip(coeffs.into_iter().zip(id))
+            .collect();
+        jobs.into_par_iter()
+            .zip(parts.par_iter())
+            .enumerate()
+            .for_each(
+                |(k, (((((pts, rings), polys), (rows, cols)), (coeffs, id)), s))| {
+                    pts.copy_from_slice(&s.pts);
+                    for (d, &v) in rings.iter_mut().zip(&s.ring_start[1..]) {
+                        *d = v + p0[k];
+                    }
+                    for (d, &v) in polys.iter_mut().zip(&s.poly_ring[1..]) {
+                        *d = v + r0[k];
+                    }
+                    rows.copy_from_slice(&s.rows);
+                    cols.copy_from_slice(&s.cols);
+                    coeffs.copy_from_slice(&s.coeffs);
+                    id.copy_from_slice(&s.id);
+                },
+            );
         self.ring_start[0] = 0;
-        let polys: Vec<&[u32]> = parts.iter().map(|s| &s.poly_ring[1..]).collect();
-        par_concat(&mut self.poly_ring, 1, &polys, |k, v| v + r0[k]);
         self.poly_ring[0] = 0;
-        let rows: Vec<&[(i32, i32)]> = parts.iter().map(|s| s.rows.as_slice()).collect();
-        par_concat(&mut self.rows, 0, &rows, |_, v| v);
-        let cols: Vec<&[(i32, i32)]> = parts.iter().map(|s| s.cols.as_slice()).collect();
-        par_concat(&mut self.cols, 0, &cols, |_, v| v);
-        let coeffs: Vec<&[[f64; 3]]> = parts.iter().map(|s| s.coeffs.as_slice()).collect();
-        par_concat(&mut self.coeffs, 0, &coeffs, |_, v| v);
-        let id: Vec<&[u32]> = parts.iter().map(|s| s.id.as_slice()).collect();
-        par_concat(&mut self.id, 0, &id, |_, v| v);
     }
 
     /// The edges of polygon `i`.
@@ -628,35 +648,26 @@ pub(crate) fn project_all_into(
     all.concat(parts);
 }
 
-/// `srcs` one after the other into `dst[lead..]`, `adjust(k, v)` applied
-/// to each value `v` of `srcs[k]`, copied in parallel (`dst` keeps its
-/// first `lead` values).
-fn par_concat<T: Copy + Default + Send + Sync>(
-    dst: &mut Vec<T>,
+/// `dst` made `lead` values followed by pieces of lengths `lens`, one
+/// after the other: the pieces (`dst` keeps its first `lead` values, and
+/// the pieces' values are left to be written).
+fn pieces<'a, T: Copy + Default>(
+    dst: &'a mut Vec<T>,
     lead: usize,
-    srcs: &[&[T]],
-    adjust: impl Fn(usize, T) -> T + Sync,
-) {
-    let total = lead + srcs.iter().map(|s| s.len()).sum::<usize>();
+    lens: &[usize],
+) -> Vec<&'a mut [T]> {
+    let total = lead + lens.iter().sum::<usize>();
     if dst.len() != total {
         dst.resize(total, T::default());
     }
-    let mut pieces = Vec::with_capacity(srcs.len());
+    let mut out = Vec::with_capacity(lens.len());
     let mut rest = &mut dst[lead..];
-    for s in srcs {
-        let (piece, tail) = rest.split_at_mut(s.len());
-        pieces.push(piece);
+    for &n in lens {
+        let (piece, tail) = rest.split_at_mut(n);
+        out.push(piece);
         rest = tail;
     }
-    pieces
-        .into_par_iter()
-        .zip(srcs.par_iter())
-        .enumerate()
-        .for_each(|(k, (piece, src))| {
-            for (d, &v) in piece.iter_mut().zip(src.iter()) {
-                *d = adjust(k, v);
-            }
-        });
+    out
 }
 
 /// The polygons of `screen` reaching each band of [`BAND`] rows, in
