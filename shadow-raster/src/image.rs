@@ -266,8 +266,28 @@ pub(crate) fn shade_in(
     rgb.par_chunks_mut(3 * w as usize)
         .enumerate()
         .for_each(|(y, row)| {
+            let w = w as usize;
+            let prims = &vis.prim[y * w..(y + 1) * w];
+            if table {
+                // one light, a plain loop over the row
+                let amounts = &lit.amount[y * w..(y + 1) * w];
+                for ((out, &prim), &a) in row.chunks_exact_mut(3).zip(prims).zip(amounts) {
+                    let v = if prim == NONE {
+                        BACKGROUND
+                    } else {
+                        let s = frame.slot[prim as usize] as usize;
+                        if a == 0.0 || a == 1.0 {
+                            two[s][(a == 1.0) as usize]
+                        } else {
+                            color(s, &[a])
+                        }
+                    };
+                    out.copy_from_slice(&v);
+                }
+                return;
+            }
             for (x, out) in row.chunks_exact_mut(3).enumerate() {
-                let pix = y * w as usize + x;
+                let pix = y * w + x;
                 let prim = vis.prim[pix];
                 if prim == NONE {
                     out.copy_from_slice(&BACKGROUND);
