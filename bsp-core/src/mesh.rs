@@ -44,8 +44,11 @@ pub(crate) fn to_bigint(x: &crate::I256) -> BigInt {
     if neg { -m } else { m }
 }
 
-fn key(p: &Point) -> [u64; 3] {
-    p.to_f64().map(|c| (c + 0.0).to_bits())
+/// A hash of the point's correctly rounded coordinates: exactly equal
+/// points get equal keys; unequal points rarely do (the welder compares
+/// them exactly).
+fn key(p: &Point) -> u64 {
+    crate::polygon::coords_key(p.to_f64())
 }
 
 fn cross3(a: &[crate::I256; 3], b: &[crate::I256; 3]) -> [crate::I256; 3] {
@@ -70,24 +73,33 @@ fn cmp_axis(p: &Point, q: &Point, k: usize) -> Ordering {
     (big(a[k]) * big(b[3])).cmp(&(big(b[k]) * big(a[3])))
 }
 
+/// Distinct vertices by key: the map holds the last vertex of each key,
+/// and `next` chains the vertices of one key (a list per key cost 40
+/// bytes an entry; this costs 12, and 4 per vertex).
 struct Welder {
     vertices: Vec<Point>,
-    by_key: rustc_hash::FxHashMap<[u64; 3], SmallVec<[u32; 1]>>,
+    by_key: rustc_hash::FxHashMap<u64, u32>,
+    next: Vec<u32>,
 }
 
 impl Welder {
+    const END: u32 = u32::MAX;
+
     /// The id of `p`, whose [`key`] is `k`.
-    fn id(&mut self, p: &Point, k: [u64; 3]) -> u32 {
-        let bucket = self.by_key.entry(k).or_default();
-        for &i in bucket.iter() {
+    fn id(&mut self, p: &Point, k: u64) -> u32 {
+        let head = self.by_key.entry(k).or_insert(Self::END);
+        let mut i = *head;
+        while i != Self::END {
             if self.vertices[i as usize].same_point(p) {
                 return i;
             }
+            i = self.next[i as usize];
         }
-        let i = self.vertices.len() as u32;
+        let id = self.vertices.len() as u32;
         self.vertices.push(p.clone());
-        bucket.push(i);
-        i
+        self.next.push(*head);
+        *head = id;
+        id
     }
 }
 
@@ -95,9 +107,51 @@ impl TriMesh {
     /// The conforming triangulation of `polys` (see the module docs).
     /// Takes the polygons or references to them (no copy needed).
     pub fn from_polygons<P: std::borrow::Borrow<Polygon> + Sync>(polys: &[P]) -> TriMesh {
+        let (vertices, triangles, of) = Self::triangulate(polys);
+        let planes = of
+            .par_iter()
+            .map(|&i| *polys[i as usize].borrow().support())
+            .collect();
+        drop(of);
+        let mut mesh = TriMesh {
+            vertices,
+            triangles,
+            planes,
+        };
+        mesh.split_non_manifold();
+        mesh
+    }
+
+    /// [`TriMesh::from_polygons`], letting the polygons go as soon as the
+    /// triangles are made: only their support planes are kept, so a large
+    /// mesh is not made while all of its polygons are held.
+    pub fn from_polygons_owned(polys: Vec<Polygon>) -> TriMesh {
+        let (vertices, triangles, of) = Self::triangulate(&polys);
+        // in place: each polygon is dropped as its plane is taken
+        let mut supports: Vec<Plane> = polys.into_iter().map(|p| *p.support()).collect();
+        supports.shrink_to_fit();
+        let planes = of.par_iter().map(|&i| supports[i as usize]).collect();
+        drop(of);
+        drop(supports);
+        let mut mesh = TriMesh {
+            vertices,
+            triangles,
+            planes,
+        };
+        mesh.split_non_manifold();
+        mesh
+    }
+
+    /// The welded vertices, the triangles, and the polygon each triangle
+    /// comes from.
+    #[allow(clippy::type_complexity)]
+    fn triangulate<P: std::borrow::Borrow<Polygon> + Sync>(
+        polys: &[P],
+    ) -> (Vec<Point>, Vec<[u32; 3]>, Vec<u32>) {
         let mut w = Welder {
             vertices: Vec::new(),
             by_key: rustc_hash::FxHashMap::default(),
+            next: Vec::new(),
         };
         // polygon `i`'s corners are `corners[start[i]..start[i + 1]]`, in
         // flat arrays (a list per polygon costs an allocation each)
@@ -106,39 +160,41 @@ impl TriMesh {
         for p in polys {
             start.push(start[start.len() - 1] + p.borrow().vertices().len());
         }
-        // the keys (correctly rounded coordinates) in parallel, the ids in
-        // order
-        let keys = crate::topology::per_corner(
-            polys,
-            |p| p.borrow().vertices().len(),
-            |p, i| key(&p.borrow().vertices()[i]),
-        );
-        let mut corners = Vec::with_capacity(keys.len());
-        for (p, ks) in polys.iter().zip(start.windows(2)) {
-            let ks = &keys[ks[0]..ks[1]];
-            corners.extend(
-                p.borrow()
-                    .vertices()
-                    .iter()
-                    .zip(ks)
-                    .map(|(v, &k)| w.id(v, k)),
+        // the keys (hashes of the correctly rounded coordinates) in
+        // parallel, the ids in order; run by run, so that the keys of all
+        // corners are never held at once
+        const WELD_RUN: usize = 1 << 14;
+        let mut corners = Vec::with_capacity(start[polys.len()]);
+        for run in polys.chunks(WELD_RUN) {
+            let keys = crate::topology::per_corner(
+                run,
+                |p| p.borrow().vertices().len(),
+                |p, i| key(&p.borrow().vertices()[i]),
             );
+            let vs = run.iter().flat_map(|p| p.borrow().vertices());
+            corners.extend(vs.zip(&keys).map(|(v, &k)| w.id(v, k)));
         }
-        drop(keys);
-        drop(std::mem::take(&mut w.by_key));
+        drop(w.by_key);
+        drop(w.next);
         let vertices = w.vertices;
-        let coords: Vec<[f64; 3]> = vertices.par_iter().map(Point::to_f64).collect();
+        // rounded once more to `f32` for the search of vertices on edges:
+        // both roundings are monotone, so a point on a segment still has
+        // its rounded coordinates in the segment's rounded box
+        let coords: Vec<[f32; 3]> = vertices
+            .par_iter()
+            .map(|v| v.to_f64().map(|c| c as f32))
+            .collect();
         let near = Candidates::new(&coords);
 
         // each polygon's triangles on its own, in parallel; chunks keep
         // the order of the polygons
         const RUN: usize = 512;
-        let chunks: Vec<(Vec<[u32; 3]>, Vec<Plane>)> = polys
+        let chunks: Vec<(Vec<[u32; 3]>, Vec<u32>)> = polys
             .par_chunks(RUN)
             .enumerate()
             .map(|(c, polys)| {
                 let mut triangles = Vec::new();
-                let mut planes = Vec::new();
+                let mut of = Vec::new();
                 let first = c * RUN;
                 let cs_of = |i: usize| &corners[start[first + i]..start[first + i + 1]];
                 for (i, poly) in polys.iter().enumerate() {
@@ -183,28 +239,23 @@ impl TriMesh {
                     }
                     let before = triangles.len();
                     clip_ears(ring, k as u32, &mut triangles);
-                    planes.extend(std::iter::repeat_n(
-                        *poly.support(),
+                    of.extend(std::iter::repeat_n(
+                        (first + i) as u32,
                         triangles.len() - before,
                     ));
                 }
-                (triangles, planes)
+                (triangles, of)
             })
             .collect();
+        drop((near, coords, corners, start));
         let n: usize = chunks.iter().map(|c| c.0.len()).sum();
         let mut triangles = Vec::with_capacity(n);
-        let mut planes = Vec::with_capacity(n);
+        let mut of = Vec::with_capacity(n);
         for (t, p) in chunks {
             triangles.extend(t);
-            planes.extend(p);
+            of.extend(p);
         }
-        let mut mesh = TriMesh {
-            vertices,
-            triangles,
-            planes,
-        };
-        mesh.split_non_manifold();
-        mesh
+        (vertices, triangles, of)
     }
 
     /// Makes the mesh a 2-manifold where the solid touches itself along an
@@ -649,7 +700,7 @@ fn edge_points(
     a: u32,
     b: u32,
     vertices: &[Point],
-    coords: &[[f64; 3]],
+    coords: &[[f32; 3]],
     near: &Candidates,
 ) -> Vec<u32> {
     let k = poly.len();
@@ -691,7 +742,7 @@ fn edge_points(
 /// lengths, which made a uniform grid's cells crowded).
 struct Candidates {
     /// The vertices' rounded coordinates, in tree order, with their ids.
-    pts: Vec<([f64; 3], u32)>,
+    pts: Vec<([f32; 3], u32)>,
     /// The split axis of the node whose median sits at each position.
     axis: Vec<u8>,
 }
@@ -700,8 +751,8 @@ impl Candidates {
     /// Ranges at most this long are leaves.
     const LEAF: usize = 8;
 
-    fn new(coords: &[[f64; 3]]) -> Candidates {
-        let mut pts: Vec<([f64; 3], u32)> = coords
+    fn new(coords: &[[f32; 3]]) -> Candidates {
+        let mut pts: Vec<([f32; 3], u32)> = coords
             .iter()
             .enumerate()
             .map(|(i, c)| (*c, i as u32))
@@ -713,9 +764,9 @@ impl Candidates {
                 continue;
             }
             let part = &mut pts[lo..hi];
-            let mut best = (0usize, f64::NEG_INFINITY);
+            let mut best = (0usize, f32::NEG_INFINITY);
             for j in 0..3 {
-                let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
+                let (mut a, mut b) = (f32::INFINITY, f32::NEG_INFINITY);
                 for p in part.iter() {
                     a = a.min(p.0[j]);
                     b = b.max(p.0[j]);
@@ -736,7 +787,7 @@ impl Candidates {
 
     /// Calls `f` with every vertex whose rounded coordinates may lie in
     /// `[lo, hi]` (and possibly others).
-    fn each(&self, lo: [f64; 3], hi: [f64; 3], mut f: impl FnMut(u32)) {
+    fn each(&self, lo: [f32; 3], hi: [f32; 3], mut f: impl FnMut(u32)) {
         let mut stack: SmallVec<[(usize, usize); 32]> = SmallVec::new();
         stack.push((0, self.pts.len()));
         while let Some((a, b)) = stack.pop() {
@@ -807,6 +858,42 @@ fn clip_ears(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_owned_mesh_is_the_borrowed_mesh() {
+        // a box cut by an oblique plane: implicit vertices, T-junctions
+        let cube = crate::shapes::cuboid(glam::DVec3::ZERO, glam::DVec3::splat(6.0));
+        let cut = Plane::new([1, 2, 3], -17).unwrap();
+        let mut polys = Vec::new();
+        for f in &cube {
+            let g: Vec<crate::GridPoint> =
+                f.iter().map(|v| v.to_array().map(|c| c as i32)).collect();
+            match Polygon::from_grid_points(&g, 0).unwrap().split(&cut) {
+                crate::Split::Spanning { front, back } => polys.extend([front, back]),
+                crate::Split::Front(p) | crate::Split::Back(p) => polys.push(p),
+                crate::Split::Coplanar { polygon, .. } => polys.push(polygon),
+            }
+        }
+        let borrowed = TriMesh::from_polygons(&polys);
+        let owned = TriMesh::from_polygons_owned(polys);
+        assert_eq!(borrowed.triangles, owned.triangles);
+        assert_eq!(borrowed.planes, owned.planes);
+        assert_eq!(borrowed.planes.len(), borrowed.triangles.len());
+        assert!(
+            borrowed
+                .vertices
+                .iter()
+                .zip(&owned.vertices)
+                .all(|(p, q)| p.same_point(q))
+        );
+        assert!(
+            owned
+                .vertices
+                .iter()
+                .any(|v| matches!(v, Point::Implicit(_)))
+        );
+        owned.check_watertight().unwrap();
+    }
 
     #[test]
     fn watertightness_is_checked_edge_by_edge() {

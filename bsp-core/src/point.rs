@@ -205,7 +205,7 @@ impl Point {
     pub fn same_point(&self, o: &Point) -> bool {
         match (self, o) {
             (Point::Grid(a), Point::Grid(b)) => a == b,
-            (Point::Implicit(a), Point::Implicit(b)) => a.same_point(b),
+            (Point::Implicit(a), Point::Implicit(b)) => Arc::ptr_eq(a, b) || a.same_point(b),
             (Point::Grid(g), Point::Implicit(i)) | (Point::Implicit(i), Point::Grid(g)) => {
                 let h = i.coords();
                 (0..3).all(|k| h[k] == wide(g[k] as i128) * h[3])

@@ -4,7 +4,9 @@ use smallvec::SmallVec;
 
 use crate::grid::GridPoint;
 use crate::plane::{Plane, cross, sub};
-use crate::point::Point;
+use std::sync::Arc;
+
+use crate::point::{Implicit, Point};
 use crate::sanity::{ConvexParts, SanityError, check_convex};
 
 /// Exact side of a point relative to a plane.
@@ -572,9 +574,129 @@ impl Builder {
     }
 }
 
+/// Makes equal implicit vertices one shared allocation.
+///
+/// Two pieces cut at the same time along a shared edge compute the same
+/// new vertex each for itself: the point is exact and equal, but held
+/// twice (an implicit point takes about 190 bytes). Passing the new
+/// polygons of an operation through one pool leaves one copy of each
+/// point. Points are compared exactly, so no vertex moves.
+#[derive(Debug, Default)]
+pub struct PointPool {
+    by_key: rustc_hash::FxHashMap<u64, SmallVec<[Arc<Implicit>; 1]>>,
+}
+
+impl PointPool {
+    /// An empty pool.
+    pub fn new() -> PointPool {
+        PointPool::default()
+    }
+
+    /// Replaces every implicit vertex of `polys` equal to one the pool has
+    /// seen (in this call or an earlier one) by that one. The keys (the
+    /// correctly rounded coordinates) are found in parallel.
+    pub fn share(&mut self, polys: &mut [&mut Polygon]) {
+        use rayon::prelude::*;
+        let keys: Vec<SmallVec<[u64; 6]>> = polys
+            .par_iter()
+            .map(|p| {
+                p.verts
+                    .iter()
+                    .filter_map(|v| match v {
+                        Point::Implicit(i) => Some(point_key(i)),
+                        Point::Grid(_) => None,
+                    })
+                    .collect()
+            })
+            .collect();
+        for (p, ks) in polys.iter_mut().zip(keys) {
+            let implicit = p.verts.iter_mut().filter_map(|v| match v {
+                Point::Implicit(i) => Some(i),
+                Point::Grid(_) => None,
+            });
+            for (i, k) in implicit.zip(ks) {
+                let bucket = self.by_key.entry(k).or_default();
+                match bucket.iter().find(|b| Arc::ptr_eq(b, i) || b.same_point(i)) {
+                    Some(b) => *i = b.clone(),
+                    None => bucket.push(i.clone()),
+                }
+            }
+        }
+    }
+}
+
+/// A hash of an implicit point's correctly rounded coordinates: equal
+/// points have equal keys.
+fn point_key(i: &Implicit) -> u64 {
+    coords_key(i.to_f64())
+}
+
+/// A hash of correctly rounded coordinates (`-0.0` and `0.0` alike).
+pub(crate) fn coords_key(c: [f64; 3]) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = rustc_hash::FxHasher::default();
+    c.map(|c| (c + 0.0).to_bits()).hash(&mut h);
+    h.finish()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_point_pool_shares_equal_new_vertices_and_moves_none() {
+        use std::sync::Arc;
+        // two squares sharing the edge x = 4, z = 0, cut by 2y + z = 3:
+        // each cut makes the point (4, 1.5, 0) for itself
+        let floor =
+            Polygon::from_grid_points(&[[0, 0, 0], [4, 0, 0], [4, 4, 0], [0, 4, 0]], 0).unwrap();
+        let wall =
+            Polygon::from_grid_points(&[[4, 0, 0], [4, 4, 0], [4, 4, 4], [4, 0, 4]], 0).unwrap();
+        let cut = Plane::new([0, 2, 1], -3).unwrap();
+        let mut pieces = Vec::new();
+        for p in [floor, wall] {
+            match p.split(&cut) {
+                Split::Spanning { front, back } => pieces.extend([front, back]),
+                _ => panic!("the plane crosses both squares"),
+            }
+        }
+        let implicit = |ps: &[Polygon]| -> Vec<Arc<Implicit>> {
+            ps.iter()
+                .flat_map(|p| p.vertices())
+                .filter_map(|v| match v {
+                    Point::Implicit(i) => Some(i.clone()),
+                    Point::Grid(_) => None,
+                })
+                .collect()
+        };
+        let distinct_allocations = |is: &[Arc<Implicit>]| {
+            let mut ptrs: Vec<usize> = is.iter().map(|i| Arc::as_ptr(i) as usize).collect();
+            ptrs.sort_unstable();
+            ptrs.dedup();
+            ptrs.len()
+        };
+        let distinct_points = |is: &[Arc<Implicit>]| {
+            let mut seen: Vec<&Arc<Implicit>> = Vec::new();
+            for i in is {
+                if !seen.iter().any(|s| s.same_point(i)) {
+                    seen.push(i);
+                }
+            }
+            seen.len()
+        };
+        let before = implicit(&pieces);
+        assert!(distinct_allocations(&before) > distinct_points(&before));
+        let originals: Vec<Vec<Point>> = pieces.iter().map(|p| p.vertices().to_vec()).collect();
+        let mut refs: Vec<&mut Polygon> = pieces.iter_mut().collect();
+        PointPool::new().share(&mut refs);
+        let after = implicit(&pieces);
+        assert_eq!(distinct_allocations(&after), distinct_points(&after));
+        assert_eq!(distinct_points(&after), distinct_points(&before));
+        for (p, o) in pieces.iter().zip(&originals) {
+            assert_eq!(p.vertices().len(), o.len());
+            assert!(p.vertices().iter().zip(o).all(|(v, w)| v.same_point(w)));
+        }
+    }
     use crate::Side;
 
     fn square() -> Polygon {

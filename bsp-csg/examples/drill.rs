@@ -52,7 +52,8 @@ fn main() {
         cells += s.cells;
     }
     let t = Instant::now();
-    let mesh = part.to_mesh();
+    let faces_out = part.len();
+    let mesh = part.into_mesh();
     mesh.check_watertight().unwrap();
     let t_mesh = t.elapsed();
     println!(
@@ -64,7 +65,7 @@ fn main() {
         t_ops.as_secs_f64() * 1e3,
         t_ops.as_secs_f64() * 1e3 / tools as f64,
         t_mesh.as_secs_f64() * 1e3,
-        part.len(),
+        faces_out,
         mesh.triangles.len()
     );
 }

@@ -82,8 +82,8 @@ mod winding;
 use std::collections::HashMap;
 
 use bsp_core::{
-    BoolOp, Grid, GridPoint, ImportReport, Membership, Polygon, Side, TopologyError, TriMesh,
-    check_closed_manifold, import_faces_par,
+    BoolOp, Grid, GridPoint, ImportReport, Membership, PointPool, Polygon, Side, TopologyError,
+    TriMesh, check_closed_manifold, import_faces_par,
 };
 use glam::DVec3;
 use rayon::prelude::*;
@@ -435,6 +435,19 @@ impl Solid {
         TriMesh::from_polygons(&polys)
     }
 
+    /// [`Solid::to_mesh`] for a solid no longer needed: its faces go as
+    /// soon as the triangles are made, so the mesh of a large result is
+    /// not finished while the whole solid is held (the same mesh).
+    pub fn into_mesh(self) -> TriMesh {
+        let Solid { faces, .. } = self;
+        // in place: a polygon takes no more room than a face slot
+        let polys: Vec<Polygon> = faces
+            .into_iter()
+            .filter_map(|f| f.map(|f| f.poly))
+            .collect();
+        TriMesh::from_polygons_owned(polys)
+    }
+
     /// `self op other`, as a new solid.
     pub fn boolean(&self, other: &Solid, op: BoolOp) -> Result<Solid, CsgError> {
         let mut s = self.clone();
@@ -742,7 +755,19 @@ impl Solid {
 
     /// Carries a plan out: its new faces, then the other solid's faces it
     /// keeps whole, each taken by `take`.
-    fn carry_out(&mut self, plan: Plan, mut take: impl FnMut(u32) -> Polygon) {
+    fn carry_out(&mut self, mut plan: Plan, mut take: impl FnMut(u32) -> Polygon) {
+        // the new faces' equal new vertices become one each (pieces cut
+        // along a shared edge computed them each for itself)
+        let mut new: Vec<&mut Polygon> = plan
+            .add
+            .iter_mut()
+            .filter_map(|a| match a {
+                Added::New(p) => Some(&mut **p),
+                Added::Whole(_) => None,
+            })
+            .collect();
+        PointPool::new().share(&mut new);
+        drop(new);
         // room for the new faces at once: growing by doubling would hold
         // the old and a twice larger array of faces at the same time
         self.faces

@@ -38,3 +38,55 @@ fn twenty_tools_through_a_pole_fan() {
     assert_eq!(box_lists, exact_lists, "the exact volume (grid units)");
     assert!(box_lists > 0.0);
 }
+
+/// After one operation on imported solids (grid vertices only), every
+/// implicit vertex was made by that operation: equal ones must be one
+/// shared allocation (`PointPool`), and `into_mesh` must give exactly the
+/// mesh `to_mesh` gives.
+#[test]
+fn new_vertices_are_shared_and_into_mesh_is_to_mesh() {
+    use bsp_core::Point;
+    use std::collections::HashMap;
+    let (va, vb, f) = bsp_csg::shapes::sphere_pair(2000);
+    let Snapped { solids, .. } = snap(&[MeshIn::new(&va, &f), MeshIn::new(&vb, &f)]).unwrap();
+    let mut it = solids.into_iter();
+    let (mut a, b) = (it.next().unwrap(), it.next().unwrap());
+    a.apply(&b, BoolOp::Union).unwrap();
+    let mut by_coords: HashMap<[u64; 3], Vec<std::sync::Arc<bsp_core::Implicit>>> = HashMap::new();
+    let mut corners = 0;
+    for p in a.polygons() {
+        for v in p.vertices() {
+            if let Point::Implicit(i) = v {
+                corners += 1;
+                let k = i.to_f64().map(|c| (c + 0.0).to_bits());
+                let same = by_coords.entry(k).or_default();
+                if let Some(s) = same.iter().find(|s| s.same_point(i)) {
+                    assert!(
+                        std::sync::Arc::ptr_eq(s, i),
+                        "an equal implicit vertex held twice"
+                    );
+                } else {
+                    same.push(i.clone());
+                }
+            }
+        }
+    }
+    let distinct: usize = by_coords.values().map(Vec::len).sum();
+    assert!(
+        corners > 2 * distinct && distinct > 100,
+        "the union cuts faces: {corners} implicit corners, {distinct} points"
+    );
+
+    let kept = a.to_mesh();
+    let owned = a.into_mesh();
+    assert_eq!(kept.triangles, owned.triangles);
+    assert_eq!(kept.planes, owned.planes);
+    assert_eq!(kept.vertices.len(), owned.vertices.len());
+    assert!(
+        kept.vertices
+            .iter()
+            .zip(&owned.vertices)
+            .all(|(p, q)| p.same_point(q))
+    );
+    owned.check_watertight().unwrap();
+}

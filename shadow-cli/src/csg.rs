@@ -335,7 +335,7 @@ fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Resu
     }
     let solid = solid.expect("at least two operands");
     let (exact, mesh) = phases.run("boundary+mesh", || {
-        let exact = solid.to_mesh();
+        let exact = solid.into_mesh();
         let mesh = Mesh {
             positions: exact
                 .vertices_f64()
