@@ -574,61 +574,102 @@ impl Builder {
     }
 }
 
-/// Makes equal implicit vertices one shared allocation.
+/// Makes equal implicit vertices of `polys` one shared allocation: each
+/// is replaced by the first equal one (in the order of the polygons and
+/// their vertices), but for rare pairs whose approximate keys differ (see
+/// `point_key`).
 ///
 /// Two pieces cut at the same time along a shared edge compute the same
 /// new vertex each for itself: the point is exact and equal, but held
-/// twice (an implicit point takes about 190 bytes). Passing the new
-/// polygons of an operation through one pool leaves one copy of each
-/// point. Points are compared exactly, so no vertex moves.
-#[derive(Debug, Default)]
-pub struct PointPool {
-    by_key: rustc_hash::FxHashMap<u64, SmallVec<[Arc<Implicit>; 1]>>,
-}
-
-impl PointPool {
-    /// An empty pool.
-    pub fn new() -> PointPool {
-        PointPool::default()
-    }
-
-    /// Replaces every implicit vertex of `polys` equal to one the pool has
-    /// seen (in this call or an earlier one) by that one. The keys (the
-    /// correctly rounded coordinates) are found in parallel.
-    pub fn share(&mut self, polys: &mut [&mut Polygon]) {
-        use rayon::prelude::*;
-        let keys: Vec<SmallVec<[u64; 6]>> = polys
-            .par_iter()
-            .map(|p| {
-                p.verts
-                    .iter()
-                    .filter_map(|v| match v {
-                        Point::Implicit(i) => Some(point_key(i)),
-                        Point::Grid(_) => None,
-                    })
-                    .collect()
-            })
-            .collect();
-        for (p, ks) in polys.iter_mut().zip(keys) {
-            let implicit = p.verts.iter_mut().filter_map(|v| match v {
-                Point::Implicit(i) => Some(i),
-                Point::Grid(_) => None,
-            });
-            for (i, k) in implicit.zip(ks) {
-                let bucket = self.by_key.entry(k).or_default();
-                match bucket.iter().find(|b| Arc::ptr_eq(b, i) || b.same_point(i)) {
-                    Some(b) => *i = b.clone(),
-                    None => bucket.push(i.clone()),
+/// twice (an implicit point takes about 190 bytes). Points are compared
+/// exactly, so no vertex moves. The work is parallel: the corners are
+/// sharded by key.
+pub fn share_points(polys: &mut [&mut Polygon]) {
+    use rayon::prelude::*;
+    let keys: Vec<SmallVec<[(u64, u8); 6]>> = polys
+        .par_iter()
+        .map(|p| {
+            p.verts
+                .iter()
+                .enumerate()
+                .filter_map(|(v, pt)| match pt {
+                    Point::Implicit(i) => Some((point_key(i), v as u8)),
+                    Point::Grid(_) => None,
+                })
+                .collect()
+        })
+        .collect();
+    let corners: Vec<(u64, u32, u8)> = keys
+        .iter()
+        .enumerate()
+        .flat_map(|(p, ks)| ks.iter().map(move |&(k, v)| (k, p as u32, v)))
+        .collect();
+    drop(keys);
+    let shards = 4 * rayon::current_num_threads().max(1);
+    let shard = |k: u64| (k >> 40) as usize % shards;
+    let view: &[&mut Polygon] = polys;
+    // (corner, the first equal corner), shard by shard
+    let moves: Vec<Vec<(u32, u8, u32, u8)>> = (0..shards)
+        .into_par_iter()
+        .map(|s| {
+            let mut firsts: rustc_hash::FxHashMap<u64, SmallVec<[(u32, u8); 1]>> =
+                Default::default();
+            let mut moves = Vec::new();
+            for &(k, p, v) in corners.iter().filter(|c| shard(c.0) == s) {
+                let Some(i) = implicit_at(view, p, v) else {
+                    continue;
+                };
+                let bucket = firsts.entry(k).or_default();
+                let first = bucket.iter().copied().find(|&(q, w)| {
+                    implicit_at(view, q, w).is_some_and(|j| Arc::ptr_eq(j, i) || j.same_point(i))
+                });
+                match first {
+                    Some((q, w)) => {
+                        if implicit_at(view, q, w).is_some_and(|j| !Arc::ptr_eq(j, i)) {
+                            moves.push((p, v, q, w));
+                        }
+                    }
+                    None => bucket.push((p, v)),
                 }
             }
+            moves
+        })
+        .collect();
+    // a first corner is never moved, so the order does not matter
+    for (p, v, q, w) in moves.into_iter().flatten() {
+        let first = implicit_at(polys, q, w).cloned();
+        if let (Some(first), Some(Point::Implicit(i))) =
+            (first, polys[p as usize].verts.get_mut(v as usize))
+        {
+            *i = first;
         }
     }
 }
 
-/// A hash of an implicit point's correctly rounded coordinates: equal
-/// points have equal keys.
+/// The implicit vertex `v` of polygon `p`, if it is one.
+fn implicit_at<'a>(polys: &'a [&mut Polygon], p: u32, v: u8) -> Option<&'a Arc<Implicit>> {
+    match polys.get(p as usize)?.verts.get(v as usize)? {
+        Point::Implicit(i) => Some(i),
+        Point::Grid(_) => None,
+    }
+}
+
+/// A hash of an implicit point's approximate coordinates, each mantissa
+/// rounded to its top 36 bits. Equal points computed from different
+/// planes differ by a few ulps there, so they nearly always get equal
+/// keys (rounding, not truncation: a coordinate on a cell wall is a
+/// round number, which truncation would split between two keys); a rare
+/// pair that straddles a boundary is simply not shared. A share is only
+/// ever decided by the exact comparison. The correctly
+/// rounded coordinates would be canonical, but cost an exact division
+/// per coordinate (5% of an iterated subtraction).
 fn point_key(i: &Implicit) -> u64 {
-    coords_key(i.to_f64())
+    use std::hash::{Hash, Hasher};
+    let mut h = rustc_hash::FxHasher::default();
+    i.approx_f64()
+        .map(|c| ((c + 0.0).to_bits() + 0x8000) & !0xffff)
+        .hash(&mut h);
+    h.finish()
 }
 
 /// A hash of correctly rounded coordinates (`-0.0` and `0.0` alike).
@@ -644,7 +685,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_point_pool_shares_equal_new_vertices_and_moves_none() {
+    fn equal_new_vertices_are_shared_and_none_moves() {
         use std::sync::Arc;
         // two squares sharing the edge x = 4, z = 0, cut by 2y + z = 3:
         // each cut makes the point (4, 1.5, 0) for itself
@@ -688,7 +729,7 @@ mod tests {
         assert!(distinct_allocations(&before) > distinct_points(&before));
         let originals: Vec<Vec<Point>> = pieces.iter().map(|p| p.vertices().to_vec()).collect();
         let mut refs: Vec<&mut Polygon> = pieces.iter_mut().collect();
-        PointPool::new().share(&mut refs);
+        share_points(&mut refs);
         let after = implicit(&pieces);
         assert_eq!(distinct_allocations(&after), distinct_points(&after));
         assert_eq!(distinct_points(&after), distinct_points(&before));

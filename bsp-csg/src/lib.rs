@@ -82,8 +82,8 @@ mod winding;
 use std::collections::HashMap;
 
 use bsp_core::{
-    BoolOp, Grid, GridPoint, ImportReport, Membership, PointPool, Polygon, Side, TopologyError,
-    TriMesh, check_closed_manifold, import_faces_par,
+    BoolOp, Grid, GridPoint, ImportReport, Membership, Polygon, Side, TopologyError, TriMesh,
+    check_closed_manifold, import_faces_par, share_points,
 };
 use glam::DVec3;
 use rayon::prelude::*;
@@ -766,7 +766,7 @@ impl Solid {
                 Added::Whole(_) => None,
             })
             .collect();
-        PointPool::new().share(&mut new);
+        share_points(&mut new);
         drop(new);
         // room for the new faces at once: growing by doubling would hold
         // the old and a twice larger array of faces at the same time
