@@ -7,8 +7,8 @@ use bsp_core::{Point, Polygon};
 pub(crate) type IBox = ([i64; 3], [i64; 3]);
 
 /// The box of grid points that holds a polygon: exact for grid vertices,
-/// the floor and ceiling of the correctly rounded coordinates widened by
-/// one step for implicit ones.
+/// the floor and ceiling of the approximate coordinates widened by one
+/// step for implicit ones.
 pub(crate) fn polygon_box(p: &Polygon) -> IBox {
     let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
     for v in p.vertices() {
@@ -19,8 +19,17 @@ pub(crate) fn polygon_box(p: &Polygon) -> IBox {
                     hi[k] = hi[k].max(g[k] as i64);
                 }
             }
-            Point::Implicit(_) => {
-                let r = v.to_f64();
+            Point::Implicit(i) => {
+                // the cached approximation is within a few ulps, far
+                // below the margin of 1 for any coordinate under 2^40;
+                // beyond that, the correctly rounded value (an exact
+                // division) is used
+                let a = i.approx_f64();
+                let r = if a.iter().all(|c| c.abs() < (1u64 << 40) as f64) {
+                    a
+                } else {
+                    v.to_f64()
+                };
                 for k in 0..3 {
                     lo[k] = lo[k].min(r[k].floor() as i64 - 1);
                     hi[k] = hi[k].max(r[k].ceil() as i64 + 1);
