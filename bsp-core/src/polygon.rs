@@ -586,20 +586,20 @@ impl Builder {
 /// sharded by key.
 pub fn share_points(polys: &mut [&mut Polygon]) {
     use rayon::prelude::*;
-    let keys: Vec<SmallVec<[(u64, u8); 6]>> = polys
+    let keys: Vec<SmallVec<[(u64, u32); 6]>> = polys
         .par_iter()
         .map(|p| {
             p.verts
                 .iter()
                 .enumerate()
                 .filter_map(|(v, pt)| match pt {
-                    Point::Implicit(i) => Some((point_key(i), v as u8)),
+                    Point::Implicit(i) => Some((point_key(i), v as u32)),
                     Point::Grid(_) => None,
                 })
                 .collect()
         })
         .collect();
-    let corners: Vec<(u64, u32, u8)> = keys
+    let corners: Vec<(u64, u32, u32)> = keys
         .iter()
         .enumerate()
         .flat_map(|(p, ks)| ks.iter().map(move |&(k, v)| (k, p as u32, v)))
@@ -609,10 +609,10 @@ pub fn share_points(polys: &mut [&mut Polygon]) {
     let shard = |k: u64| (k >> 40) as usize % shards;
     let view: &[&mut Polygon] = polys;
     // (corner, the first equal corner), shard by shard
-    let moves: Vec<Vec<(u32, u8, u32, u8)>> = (0..shards)
+    let moves: Vec<Vec<(u32, u32, u32, u32)>> = (0..shards)
         .into_par_iter()
         .map(|s| {
-            let mut firsts: rustc_hash::FxHashMap<u64, SmallVec<[(u32, u8); 1]>> =
+            let mut firsts: rustc_hash::FxHashMap<u64, SmallVec<[(u32, u32); 1]>> =
                 Default::default();
             let mut moves = Vec::new();
             for &(k, p, v) in corners.iter().filter(|c| shard(c.0) == s) {
@@ -647,7 +647,7 @@ pub fn share_points(polys: &mut [&mut Polygon]) {
 }
 
 /// The implicit vertex `v` of polygon `p`, if it is one.
-fn implicit_at<'a>(polys: &'a [&mut Polygon], p: u32, v: u8) -> Option<&'a Arc<Implicit>> {
+fn implicit_at<'a>(polys: &'a [&mut Polygon], p: u32, v: u32) -> Option<&'a Arc<Implicit>> {
     match polys.get(p as usize)?.verts.get(v as usize)? {
         Point::Implicit(i) => Some(i),
         Point::Grid(_) => None,
