@@ -108,18 +108,9 @@ impl TriMesh {
     /// Takes the polygons or references to them (no copy needed).
     pub fn from_polygons<P: std::borrow::Borrow<Polygon> + Sync>(polys: &[P]) -> TriMesh {
         let (vertices, triangles, of) = Self::triangulate(polys);
-        let planes = of
-            .par_iter()
-            .map(|&i| *polys[i as usize].borrow().support())
-            .collect();
-        drop(of);
-        let mut mesh = TriMesh {
-            vertices,
-            triangles,
-            planes,
-        };
-        mesh.split_non_manifold();
-        mesh
+        Self::assemble(vertices, triangles, of, |i| {
+            *polys[i as usize].borrow().support()
+        })
     }
 
     /// [`TriMesh::from_polygons`], letting the polygons go as soon as the
@@ -130,9 +121,19 @@ impl TriMesh {
         // in place: each polygon is dropped as its plane is taken
         let mut supports: Vec<Plane> = polys.into_iter().map(|p| *p.support()).collect();
         supports.shrink_to_fit();
-        let planes = of.par_iter().map(|&i| supports[i as usize]).collect();
+        Self::assemble(vertices, triangles, of, |i| supports[i as usize])
+    }
+
+    /// The mesh from [`TriMesh::triangulate`]'s parts, each triangle's
+    /// plane that of its polygon `i` (`support(i)`), made a 2-manifold.
+    fn assemble(
+        vertices: Vec<Point>,
+        triangles: Vec<[u32; 3]>,
+        of: Vec<u32>,
+        support: impl Fn(u32) -> Plane + Sync,
+    ) -> TriMesh {
+        let planes = of.par_iter().map(|&i| support(i)).collect();
         drop(of);
-        drop(supports);
         let mut mesh = TriMesh {
             vertices,
             triangles,
