@@ -861,6 +861,38 @@ mod tests {
     use super::*;
 
     #[test]
+    fn welding_across_runs_finds_every_shared_corner() {
+        // a cube of side 60 with each face cut into 60 x 60 squares:
+        // 21 600 polygons, more than one run of the welder, and
+        // 6 * 60^2 + 2 distinct corners
+        let n = 60;
+        let cube = crate::shapes::cuboid(glam::DVec3::ZERO, glam::DVec3::splat(n as f64));
+        let mut polys = Vec::new();
+        for q in &cube {
+            let at = |u: i32, v: i32| {
+                let p = q[0]
+                    + (q[1] - q[0]) * (u as f64 / n as f64)
+                    + (q[3] - q[0]) * (v as f64 / n as f64);
+                p.to_array().map(|c| c.round() as i32)
+            };
+            for i in 0..n {
+                for j in 0..n {
+                    let g = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+                    polys.push(Polygon::from_grid_points(&g, 0).unwrap());
+                }
+            }
+        }
+        assert!(polys.len() > 1 << 14);
+        let mesh = TriMesh::from_polygons(&polys);
+        assert_eq!(mesh.vertices.len(), 6 * 60 * 60 + 2);
+        assert_eq!(mesh.triangles.len(), 2 * polys.len());
+        mesh.check_watertight().unwrap();
+        // numbered in the order of first appearance
+        let first: Vec<u32> = mesh.triangles[..2].iter().flatten().copied().collect();
+        assert_eq!(first.iter().max(), Some(&3));
+    }
+
+    #[test]
     fn the_owned_mesh_is_the_borrowed_mesh() {
         // a box cut by an oblique plane: implicit vertices, T-junctions
         let cube = crate::shapes::cuboid(glam::DVec3::ZERO, glam::DVec3::splat(6.0));
