@@ -48,7 +48,7 @@ pub(crate) fn to_bigint(x: &crate::I256) -> BigInt {
 /// points get equal keys; unequal points rarely do (the welder compares
 /// them exactly).
 fn key(p: &Point) -> u64 {
-    crate::polygon::coords_key(p.to_f64())
+    crate::polygon::hash_bits(p.to_f64().map(|c| (c + 0.0).to_bits()))
 }
 
 fn cross3(a: &[crate::I256; 3], b: &[crate::I256; 3]) -> [crate::I256; 3] {

@@ -128,9 +128,10 @@ impl Homogeneous<4> {
         self.round_with::<9>()
     }
 
-    /// Exact equality of the represented points.
+    /// Exact equality of the represented points (at once for the same
+    /// allocation: equal new vertices are shared, see `share_points`).
     pub fn same_point(&self, o: &Implicit) -> bool {
-        self.same_with::<8>(o)
+        std::ptr::eq(self, o) || self.same_with::<8>(o)
     }
 
     /// Exact comparison of coordinate `k` with another point's.
@@ -205,7 +206,7 @@ impl Point {
     pub fn same_point(&self, o: &Point) -> bool {
         match (self, o) {
             (Point::Grid(a), Point::Grid(b)) => a == b,
-            (Point::Implicit(a), Point::Implicit(b)) => Arc::ptr_eq(a, b) || a.same_point(b),
+            (Point::Implicit(a), Point::Implicit(b)) => a.same_point(b),
             (Point::Grid(g), Point::Implicit(i)) | (Point::Implicit(i), Point::Grid(g)) => {
                 let h = i.coords();
                 (0..3).all(|k| h[k] == wide(g[k] as i128) * h[3])

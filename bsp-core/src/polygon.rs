@@ -599,33 +599,36 @@ pub fn share_points(polys: &mut [&mut Polygon]) {
                 .collect()
         })
         .collect();
-    let corners: Vec<(u64, u32, u32)> = keys
-        .iter()
-        .enumerate()
-        .flat_map(|(p, ks)| ks.iter().map(move |&(k, v)| (k, p as u32, v)))
-        .collect();
-    drop(keys);
+    // the corners by shard of their keys, each shard in order
     let shards = 4 * rayon::current_num_threads().max(1);
-    let shard = |k: u64| (k >> 40) as usize % shards;
+    let mut by_shard: Vec<Vec<(u64, u32, u32)>> = vec![Vec::new(); shards];
+    for (p, ks) in keys.iter().enumerate() {
+        for &(k, v) in ks {
+            by_shard[(k >> 40) as usize % shards].push((k, p as u32, v));
+        }
+    }
+    drop(keys);
     let view: &[&mut Polygon] = polys;
     // (corner, the first equal corner), shard by shard
-    let moves: Vec<Vec<(u32, u32, u32, u32)>> = (0..shards)
-        .into_par_iter()
-        .map(|s| {
+    let moves: Vec<Vec<(u32, u32, u32, u32)>> = by_shard
+        .par_iter()
+        .map(|corners| {
             let mut firsts: rustc_hash::FxHashMap<u64, SmallVec<[(u32, u32); 1]>> =
                 Default::default();
             let mut moves = Vec::new();
-            for &(k, p, v) in corners.iter().filter(|c| shard(c.0) == s) {
+            for &(k, p, v) in corners {
                 let Some(i) = implicit_at(view, p, v) else {
                     continue;
                 };
                 let bucket = firsts.entry(k).or_default();
-                let first = bucket.iter().copied().find(|&(q, w)| {
-                    implicit_at(view, q, w).is_some_and(|j| Arc::ptr_eq(j, i) || j.same_point(i))
+                let first = bucket.iter().find_map(|&(q, w)| {
+                    implicit_at(view, q, w)
+                        .filter(|j| j.same_point(i))
+                        .map(|j| (q, w, j))
                 });
                 match first {
-                    Some((q, w)) => {
-                        if implicit_at(view, q, w).is_some_and(|j| !Arc::ptr_eq(j, i)) {
+                    Some((q, w, j)) => {
+                        if !Arc::ptr_eq(j, i) {
                             moves.push((p, v, q, w));
                         }
                     }
@@ -664,19 +667,17 @@ fn implicit_at<'a>(polys: &'a [&mut Polygon], p: u32, v: u32) -> Option<&'a Arc<
 /// rounded coordinates would be canonical, but cost an exact division
 /// per coordinate (5% of an iterated subtraction).
 fn point_key(i: &Implicit) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut h = rustc_hash::FxHasher::default();
-    i.approx_f64()
-        .map(|c| ((c + 0.0).to_bits() + 0x8000) & !0xffff)
-        .hash(&mut h);
-    h.finish()
+    hash_bits(
+        i.approx_f64()
+            .map(|c| ((c + 0.0).to_bits() + 0x8000) & !0xffff),
+    )
 }
 
-/// A hash of correctly rounded coordinates (`-0.0` and `0.0` alike).
-pub(crate) fn coords_key(c: [f64; 3]) -> u64 {
+/// A hash of three coordinates' bits.
+pub(crate) fn hash_bits(bits: [u64; 3]) -> u64 {
     use std::hash::{Hash, Hasher};
     let mut h = rustc_hash::FxHasher::default();
-    c.map(|c| (c + 0.0).to_bits()).hash(&mut h);
+    bits.hash(&mut h);
     h.finish()
 }
 
