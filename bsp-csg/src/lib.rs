@@ -439,7 +439,9 @@ impl Solid {
     /// soon as the triangles are made, so the mesh of a large result is
     /// not finished while the whole solid is held (the same mesh).
     pub fn into_mesh(self) -> TriMesh {
-        let Solid { faces, .. } = self;
+        // the index goes now (`..` would keep it to the end)
+        let Solid { faces, index, .. } = self;
+        drop(index);
         // in place: a polygon takes no more room than a face slot
         let polys: Vec<Polygon> = faces
             .into_iter()
