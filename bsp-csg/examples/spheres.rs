@@ -41,7 +41,8 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(bsp_csg::LEAF_SIZE);
-    a.apply_with(&b, op, &bsp_csg::Options::default().with_leaf_size(leaf))
+    let stats = a
+        .apply_with(&b, op, &bsp_csg::Options::default().with_leaf_size(leaf))
         .unwrap();
     let t_op = t.elapsed();
     let t = Instant::now();
@@ -57,6 +58,15 @@ fn main() {
         t_mesh.as_secs_f64() * 1e3,
         a.len(),
         mesh.triangles.len()
+    );
+    println!(
+        "cells {}, mixed {} (easy {}, merged {}), cut faces {} into {} pieces",
+        stats.cells,
+        stats.mixed_cells,
+        stats.easy_cells,
+        stats.merged_cells,
+        stats.cut_faces,
+        stats.pieces
     );
     mesh.check_watertight().unwrap();
 }

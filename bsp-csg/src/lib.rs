@@ -111,6 +111,11 @@ pub struct Options {
     /// the tests. Off by default (slower on the benchmarks); the result is
     /// the same either way.
     pub exact_cells: bool,
+    /// Let a mixed cell whose two surfaces do not meet label its pieces
+    /// along their faces from the cells around instead of building local
+    /// trees (on by default; off, every mixed cell builds them). The
+    /// result is the same either way.
+    pub easy_cells: bool,
 }
 
 impl Default for Options {
@@ -118,6 +123,7 @@ impl Default for Options {
         Options {
             leaf_size: LEAF_SIZE,
             exact_cells: false,
+            easy_cells: true,
         }
     }
 }
@@ -126,6 +132,12 @@ impl Options {
     /// Sets [`Options::exact_cells`].
     pub fn with_exact_cells(mut self, on: bool) -> Options {
         self.exact_cells = on;
+        self
+    }
+
+    /// Sets [`Options::easy_cells`].
+    pub fn with_easy_cells(mut self, on: bool) -> Options {
+        self.easy_cells = on;
         self
     }
 
@@ -151,6 +163,10 @@ pub struct Stats {
     pub cut_faces: usize,
     /// The pieces they left.
     pub pieces: usize,
+    /// Mixed cells where the two surfaces do not meet: their pieces were
+    /// labelled along their faces from the cells around, without local
+    /// trees.
+    pub easy_cells: usize,
 }
 
 /// Why an operation cannot be done.
@@ -554,20 +570,33 @@ impl Solid {
         };
         let a_c = self.faces_near(&root);
         let b_c = other.faces_near(&root);
+        // the faces' boxes and planes side by side, by their place in
+        // `a_c` and `b_c` (a face slot is large: the build reads these often)
+        let geometry = |s: &Solid, fs: &[u32]| -> (Vec<IBox>, Vec<bsp_core::Plane>) {
+            fs.par_iter()
+                .map(|&f| (s.face(f).bx(), *s.face(f).poly.support()))
+                .unzip()
+        };
+        let (boxes_a, planes_a) = geometry(self, &a_c);
+        let (boxes_b, planes_b) = geometry(other, &b_c);
         let mut leaves = octree::build(
             root,
-            a_c.clone(),
-            b_c.clone(),
-            &|f, c| {
-                let face = self.face(f);
-                overlaps(&face.bx(), c) && octree::plane_meets(face.poly.support(), c)
+            &octree::Faces {
+                boxes: &boxes_a,
+                plane_meets: |f: u32, c: &IBox| octree::plane_meets(&planes_a[f as usize], c),
             },
-            &|f, c| {
-                let face = other.face(f);
-                overlaps(&face.bx(), c) && octree::plane_meets(face.poly.support(), c)
+            &octree::Faces {
+                boxes: &boxes_b,
+                plane_meets: |f: u32, c: &IBox| octree::plane_meets(&planes_b[f as usize], c),
             },
             opts.leaf_size,
         );
+        drop((boxes_a, planes_a, boxes_b, planes_b));
+        // the leaves' lists by face id
+        leaves.par_iter_mut().for_each(|l| {
+            l.a.iter_mut().for_each(|f| *f = a_c[*f as usize]);
+            l.b.iter_mut().for_each(|f| *f = b_c[*f as usize]);
+        });
         if opts.exact_cells {
             // the lists of the leaves holding both, by the exact test
             leaves.par_iter_mut().filter(|l| l.mixed()).for_each(|l| {
@@ -624,27 +653,50 @@ impl Solid {
                 )
             })
             .collect();
-        // each cell clips its faces to its walls itself, so that only the
-        // cells at work hold their pieces, and gives back what stays
-        let made: Vec<(u32, Made)> = jobs
+        // Each cell clips its faces to its walls itself, so that only the
+        // cells at work hold their pieces, and finds the pieces that meet
+        // no piece of the other surface (isolated). A cell whose pieces are
+        // all isolated ("easy") builds nothing: its pieces' labels are
+        // carried along their faces from the neighbouring cells
+        // (`label_easy`). The others build their partitions and give
+        // back what stays.
+        let run = |l: u32, fa: &[u32], fb: &[u32], allow_easy: bool| -> Result<First, CsgError> {
+            let bx = leaves[l as usize].bx;
+            let w = walls(&bx);
+            let (pa, ia) = clip_all(fa, |f| &self.face(f).poly, &w);
+            let (pb, ib) = clip_all(fb, |f| &other.face(f).poly, &w);
+            let (isa, isb) = local::isolated(&pa, &pb);
+            let masks = |pieces: &[Polygon], iso: &[bool], index: &[Option<u32>]| {
+                index
+                    .iter()
+                    .map(|i| {
+                        i.filter(|&i| iso[i as usize])
+                            .map(|i| local::wall_edges(&pieces[i as usize], &w))
+                    })
+                    .collect::<Vec<Option<u8>>>()
+            };
+            let (ma, mb) = (masks(&pa, &isa, &ia), masks(&pb, &isb, &ib));
+            if allow_easy && isa.iter().chain(&isb).all(|&x| x) {
+                return Ok(First::Easy(
+                    Listed::new(ma, &pa, &ia),
+                    Listed::new(mb, &pb, &ib),
+                ));
+            }
+            let r = bx.0.map(|c| c as i32);
+            let c = local::boolean_pieces(
+                &bx,
+                pa,
+                pb,
+                op,
+                (keep_a, keep_b),
+                || self.winding(r),
+                || other.winding(r),
+            )?;
+            Ok(First::Done(Made::of(c, &ia, &ib), ma, mb))
+        };
+        let first: Vec<(u32, Vec<u32>, Vec<u32>, First)> = jobs
             .into_par_iter()
-            .map(|(l, fa, fb)| {
-                let bx = leaves[l as usize].bx;
-                let w = walls(&bx);
-                let (pa, ia) = clip_all(&fa, |f| &self.face(f).poly, &w);
-                let (pb, ib) = clip_all(&fb, |f| &other.face(f).poly, &w);
-                let r = bx.0.map(|c| c as i32);
-                local::boolean_pieces(
-                    &bx,
-                    pa,
-                    pb,
-                    op,
-                    (keep_a, keep_b),
-                    || self.winding(r),
-                    || other.winding(r),
-                )
-                .map(|c| (l, Made::of(c, &ia, &ib)))
-            })
+            .map(|(l, fa, fb)| run(l, &fa, &fb, opts.easy_cells).map(|r| (l, fa, fb, r)))
             .collect::<Result<_, _>>()?;
         let mut stats = Stats {
             cells: leaves.len(),
@@ -654,16 +706,112 @@ impl Solid {
         let mut add: Vec<Added> = Vec::new();
         let mut fates_a: FxHashMap<u32, Vec<PieceFate>> = FxHashMap::default();
         let mut fates_b: FxHashMap<u32, Vec<PieceFate>> = FxHashMap::default();
-        for (l, c) in made {
-            match c {
-                Made::Merged(ps) => {
+        let mut masks_a: FxHashMap<u32, Vec<Option<u8>>> = FxHashMap::default();
+        let mut masks_b: FxHashMap<u32, Vec<Option<u8>>> = FxHashMap::default();
+        let mut easy: Vec<(u32, Vec<u32>, Vec<u32>)> = Vec::new();
+        let mut listed_a: FxHashMap<u32, Listed> = FxHashMap::default();
+        let mut listed_b: FxHashMap<u32, Listed> = FxHashMap::default();
+        for (l, fa, fb, r) in first {
+            match r {
+                First::Easy(la, lb) => {
+                    easy.push((l, fa, fb));
+                    masks_a.insert(l, la.masks.clone());
+                    masks_b.insert(l, lb.masks.clone());
+                    listed_a.insert(l, la);
+                    listed_b.insert(l, lb);
+                }
+                First::Done(Made::Merged(ps), _, _) => {
                     stats.merged_cells += 1;
                     add.extend(ps.into_iter().map(|p| Added::New(Box::new(p))))
                 }
-                Made::Fates(fa, fb) => {
+                First::Done(Made::Fates(fa, fb), ma, mb) => {
+                    fates_a.insert(l, fa);
+                    fates_b.insert(l, fb);
+                    masks_a.insert(l, ma);
+                    masks_b.insert(l, mb);
+                }
+            }
+        }
+        // the easy cells' labels
+        // a piece kept whole is inside when pieces inside are kept
+        fn label_of(
+            fates: &FxHashMap<u32, Vec<PieceFate>>,
+            keep_inside: bool,
+        ) -> impl Fn(u32, u32) -> Option<bool> + Sync + '_ {
+            move |l: u32, i: u32| match fates.get(&l).map(|v| &v[i as usize]) {
+                Some(PieceFate::Keep(_) | PieceFate::KeepClip) => Some(keep_inside),
+                Some(PieceFate::Drop) => Some(!keep_inside),
+                _ => None,
+            }
+        }
+        let mut labels_a = label_easy(
+            &pieces_a,
+            |f| &self.face(f).poly,
+            &leaves,
+            &masks_a,
+            &listed_a,
+            &label_of(&fates_a, keep_a(true)),
+            &|l| inside_b.inside(l),
+            &|g| other.winding(g) != 0,
+        )?;
+        let mut labels_b = label_easy(
+            &pieces_b,
+            |f| &other.face(f).poly,
+            &leaves,
+            &masks_b,
+            &listed_b,
+            &label_of(&fates_b, keep_b(true)),
+            &|l| inside_a.inside(l),
+            &|g| self.winding(g) != 0,
+        )?;
+        drop((listed_a, listed_b));
+        // an easy cell with a piece no label reached does the full work
+        let mut again: Vec<(u32, Vec<u32>, Vec<u32>)> = Vec::new();
+        for (l, fa, fb) in easy {
+            let la = labels_a.remove(&l).expect("an easy cell");
+            let lb = labels_b.remove(&l).expect("an easy cell");
+            let settled =
+                |masks: &[Option<u8>], labels: &[Option<bool>], keep: &dyn Fn(bool) -> bool| {
+                    masks
+                        .iter()
+                        .zip(labels)
+                        .map(|(m, lab)| match (m, lab) {
+                            (None, _) => Some(PieceFate::Missing),
+                            (Some(_), Some(inside)) => Some(if keep(*inside) {
+                                PieceFate::KeepClip
+                            } else {
+                                PieceFate::Drop
+                            }),
+                            (Some(_), None) => None,
+                        })
+                        .collect::<Option<Vec<PieceFate>>>()
+                };
+            let sa = settled(&masks_a[&l], &la, &keep_a);
+            let sb = settled(&masks_b[&l], &lb, &keep_b);
+            match (sa, sb) {
+                (Some(sa), Some(sb)) => {
+                    stats.easy_cells += 1;
+                    fates_a.insert(l, sa);
+                    fates_b.insert(l, sb);
+                }
+                _ => again.push((l, fa, fb)),
+            }
+        }
+        let done: Vec<(u32, First)> = again
+            .into_par_iter()
+            .map(|(l, fa, fb)| run(l, &fa, &fb, false).map(|r| (l, r)))
+            .collect::<Result<_, _>>()?;
+        for (l, r) in done {
+            match r {
+                First::Done(Made::Merged(ps), _, _) => {
+                    stats.merged_cells += 1;
+                    add.extend(ps.into_iter().map(|p| Added::New(Box::new(p))))
+                }
+                First::Done(Made::Fates(fa, fb), _, _) => {
                     fates_a.insert(l, fa);
                     fates_b.insert(l, fb);
                 }
+                First::Easy(..) => unreachable!("a second run does the full work"),
             }
         }
 
@@ -821,10 +969,21 @@ enum PieceFate {
     Missing,
     /// Its piece in the cell stays whole.
     Keep(Box<Polygon>),
+    /// Its piece in the cell stays whole, and is clipped again when
+    /// needed (an easy cell keeps no pieces).
+    KeepClip,
     /// Its piece goes.
     Drop,
     /// The other surface cuts its piece: the fragments that stay.
     Cut(Vec<Polygon>),
+}
+
+/// A mixed cell's first run: done (with, per listed face of each operand,
+/// the walls an isolated piece crosses, [`local::wall_edges`]), or easy:
+/// every piece isolated, the labels to come from the cells around.
+enum First {
+    Done(Made, Vec<Option<u8>>, Vec<Option<u8>>),
+    Easy(Listed, Listed),
 }
 
 /// A mixed cell's outcome, per listed face of each operand, or the
@@ -957,7 +1116,7 @@ fn settle(
         Piece::Free(l) if keep_free(*l) => Some(Ok(())),
         Piece::Free(_) => Some(Err(())),
         Piece::Mixed(l, i) => fates.get(l).map(|v| match &v[*i as usize] {
-            PieceFate::Missing | PieceFate::Keep(_) => Ok(()),
+            PieceFate::Missing | PieceFate::Keep(_) | PieceFate::KeepClip => Ok(()),
             PieceFate::Drop | PieceFate::Cut(_) => Err(()),
         }),
     };
@@ -977,6 +1136,9 @@ fn settle(
                 .map(|v| std::mem::replace(&mut v[*i as usize], PieceFate::Drop))
             {
                 Some(PieceFate::Keep(q)) => kept.push(*q),
+                Some(PieceFate::KeepClip) => {
+                    kept.extend(local::clip_to(poly, &walls(&leaves[*l as usize].bx)))
+                }
                 Some(PieceFate::Cut(frags)) => kept.extend(frags),
                 _ => {}
             },
@@ -992,6 +1154,244 @@ fn free_pieces(p: &Polygon, leaf: Option<&Leaf>, root: &[bsp_core::Plane; 6]) ->
         Some(l) => local::clip_to(p, &walls(&l.bx)).into_iter().collect(),
         None => local::outside(p, root),
     }
+}
+
+/// The wall of the cell `s` that faces the cell `l`, if they are
+/// neighbours across it and the wall's rectangle of `s` lies within `l`'s
+/// (index into [`walls`]).
+fn facing(s: &IBox, l: &IBox) -> Option<usize> {
+    for k in 0..3 {
+        let wall = if s.1[k] + 1 == l.0[k] {
+            2 * k + 1
+        } else if l.1[k] + 1 == s.0[k] {
+            2 * k
+        } else {
+            continue;
+        };
+        let within = (0..3)
+            .filter(|&j| j != k)
+            .all(|j| l.0[j] <= s.0[j] && s.1[j] <= l.1[j]);
+        return within.then_some(wall);
+    }
+    None
+}
+
+/// One operand's listed faces in an easy cell: the walls each piece
+/// crosses ([`local::wall_edges`]; `None`: no piece), a grid vertex of
+/// each piece, and the pairs of pieces sharing a grid vertex.
+struct Listed {
+    masks: Vec<Option<u8>>,
+    grid: Vec<Option<GridPoint>>,
+    touch: Vec<(u32, u32)>,
+}
+
+impl Listed {
+    fn new(masks: Vec<Option<u8>>, pieces: &[Polygon], index: &[Option<u32>]) -> Listed {
+        let grid_of = |p: &Polygon| -> SmallVec<[GridPoint; 4]> {
+            p.vertices()
+                .iter()
+                .filter_map(|v| match v {
+                    bsp_core::Point::Grid(g) => Some(*g),
+                    _ => None,
+                })
+                .collect()
+        };
+        let verts: Vec<SmallVec<[GridPoint; 4]>> = index
+            .iter()
+            .map(|i| i.map_or_else(SmallVec::new, |i| grid_of(&pieces[i as usize])))
+            .collect();
+        let mut touch = Vec::new();
+        for i in 0..verts.len() {
+            for j in i + 1..verts.len() {
+                if verts[i].iter().any(|g| verts[j].contains(g)) {
+                    touch.push((i as u32, j as u32));
+                }
+            }
+        }
+        Listed {
+            masks,
+            grid: verts.iter().map(|v| v.first().copied()).collect(),
+            touch,
+        }
+    }
+}
+
+/// Labels (inside the other solid or not) for one operand's pieces in
+/// the easy cells (`listed`), per cell and listed face; `None` where no
+/// label reached a piece.
+///
+/// A piece meeting no piece of the other surface in its cell (isolated)
+/// has one label: the other surface does not meet its inside, which lies
+/// in the open cell. Pieces with the same label are joined, and the
+/// groups take their label from a member whose label is known:
+///
+/// - Two pieces of one face in neighbouring cells `s` and `l`, when `s`'s
+///   piece crosses the wall into `l` ([`local::wall_edges`]: an edge on
+///   `s`'s wall facing `l`, with a point `y` inside the wall's rectangle,
+///   which lies within `l`'s) and each is isolated or in a cell free of
+///   the other surface. A face of the other surface through `y` would have
+///   a piece in `s` or `l` (no face lies in a wall) meeting one of them,
+///   so a small disc of the face around `y` is free of it and joins the
+///   two pieces.
+/// - Two isolated pieces of one cell sharing a grid vertex: a small ball
+///   around it is free of the other surface.
+///
+/// Known labels: a face's piece in a free cell (its region's winding
+/// number), an isolated piece of a cell that built its partitions
+/// (`known`), and, for a group no known label reaches, the winding number
+/// `inside` of a grid vertex of one of its pieces.
+#[allow(clippy::too_many_arguments)]
+fn label_easy<'p>(
+    faces: &[(u32, Vec<Piece>)],
+    poly: impl Fn(u32) -> &'p Polygon + Sync,
+    leaves: &[Leaf],
+    masks: &FxHashMap<u32, Vec<Option<u8>>>,
+    listed: &FxHashMap<u32, Listed>,
+    known: &(dyn Fn(u32, u32) -> Option<bool> + Sync),
+    free_inside: &(dyn Fn(u32) -> bool + Sync),
+    inside: &(dyn Fn(GridPoint) -> bool + Sync),
+) -> Result<FxHashMap<u32, Vec<Option<bool>>>, CsgError> {
+    // nodes: 0 and 1 stand for the labels outside and inside, then the
+    // listed faces of each easy cell from its base
+    let mut base: FxHashMap<u32, u32> = FxHashMap::default();
+    let mut cells: Vec<u32> = listed.keys().copied().collect();
+    cells.sort_unstable();
+    let mut n = 2u32;
+    for &l in &cells {
+        base.insert(l, n);
+        n += listed[&l].masks.len() as u32;
+    }
+    // the node of a face's piece in a mixed cell, if it has one
+    let node = |l: u32, i: u32| -> Option<u32> {
+        masks.get(&l).and_then(|v| v[i as usize])?;
+        match base.get(&l) {
+            Some(b) => Some(b + i),
+            None => known(l, i).map(u32::from),
+        }
+    };
+    struct End {
+        cell: u32,
+        node: u32,
+        /// The walls the piece crosses; for a free cell, found when asked.
+        mask: Option<u8>,
+    }
+    let mut joins: Vec<(u32, u32)> = faces
+        .par_iter()
+        .filter(|(_, ps)| {
+            ps.iter()
+                .any(|p| matches!(p, Piece::Mixed(l, _) if base.contains_key(l)))
+        })
+        .flat_map_iter(|(f, ps)| {
+            let mut ends: SmallVec<[End; 8]> = SmallVec::new();
+            for p in ps {
+                match *p {
+                    Piece::Free(Some(l)) => ends.push(End {
+                        cell: l,
+                        node: free_inside(l) as u32,
+                        mask: None,
+                    }),
+                    Piece::Free(None) => {}
+                    Piece::Mixed(l, i) => {
+                        if let Some(node) = node(l, i) {
+                            let mask = masks[&l][i as usize];
+                            ends.push(End {
+                                cell: l,
+                                node,
+                                mask,
+                            });
+                        }
+                    }
+                }
+            }
+            let mask = |e: &mut End| -> u8 {
+                *e.mask.get_or_insert_with(|| {
+                    let w = walls(&leaves[e.cell as usize].bx);
+                    local::clip_to(poly(*f), &w).map_or(0, |q| local::wall_edges(&q, &w))
+                })
+            };
+            let mut out = Vec::new();
+            for j in 0..ends.len() {
+                for k in j + 1..ends.len() {
+                    if ends[j].node < 2 && ends[k].node < 2 {
+                        continue;
+                    }
+                    let (bj, bk) = (
+                        &leaves[ends[j].cell as usize].bx,
+                        &leaves[ends[k].cell as usize].bx,
+                    );
+                    let linked = if let Some(w) = facing(bj, bk) {
+                        mask(&mut ends[j]) & (1 << w) != 0
+                    } else if let Some(w) = facing(bk, bj) {
+                        mask(&mut ends[k]) & (1 << w) != 0
+                    } else {
+                        false
+                    };
+                    if linked {
+                        out.push((ends[j].node, ends[k].node));
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    for &l in &cells {
+        let b = base[&l];
+        joins.extend(listed[&l].touch.iter().map(|&(i, j)| (b + i, b + j)));
+    }
+    let mut parent: Vec<u32> = (0..n).collect();
+    fn find(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            p[x as usize] = p[p[x as usize] as usize];
+            x = p[x as usize];
+        }
+        x
+    }
+    fn join(p: &mut [u32], a: u32, b: u32) {
+        let (ra, rb) = (find(p, a), find(p, b));
+        if ra != rb {
+            // the labels 0 and 1 stay roots
+            p[ra.max(rb) as usize] = ra.min(rb);
+        }
+    }
+    for (a, b) in joins {
+        join(&mut parent, a, b);
+    }
+    let disagree = || CsgError::Internal("an easy cell's pieces got both labels".into());
+    if find(&mut parent, 1) == 0 {
+        return Err(disagree());
+    }
+    // groups no known label reached: the winding number at a grid vertex
+    let mut asked: FxHashMap<u32, GridPoint> = FxHashMap::default();
+    for &l in &cells {
+        let b = base[&l];
+        for (i, g) in listed[&l].grid.iter().enumerate() {
+            if let Some(g) = g {
+                let r = find(&mut parent, b + i as u32);
+                if r >= 2 {
+                    asked.entry(r).or_insert(*g);
+                }
+            }
+        }
+    }
+    let mut asked: Vec<(u32, GridPoint)> = asked.into_iter().collect();
+    asked.sort_unstable();
+    let answers: Vec<(u32, bool)> = asked.par_iter().map(|&(r, g)| (r, inside(g))).collect();
+    for (r, x) in answers {
+        join(&mut parent, r, x as u32);
+    }
+    let mut out = FxHashMap::default();
+    for &l in &cells {
+        let b = base[&l];
+        let labels = (0..listed[&l].masks.len() as u32)
+            .map(|i| match find(&mut parent, b + i) {
+                0 => Some(false),
+                1 => Some(true),
+                _ => None,
+            })
+            .collect();
+        out.insert(l, labels);
+    }
+    Ok(out)
 }
 
 /// Connected regions of octree cells free of one surface, each wholly

@@ -207,6 +207,63 @@ pub(crate) fn boolean_pieces(
     Ok(CellResult::Pieces(fa, fb, a, b))
 }
 
+/// `true` if every vertex of `p` lies strictly on one side of `plane`.
+fn strictly_one_side(p: &Polygon, plane: &Plane) -> bool {
+    let mut sides = p.vertices().iter().map(|v| v.classify(plane));
+    let first = sides.next().unwrap_or(Side::On);
+    first != Side::On && sides.all(|s| s == first)
+}
+
+/// `true` if the closed polygons `p` and `q` are apart by a support plane:
+/// one lies strictly on one side of the other's. Polygons that meet are
+/// never apart; some that do not meet are not found apart (a sufficient
+/// test only).
+pub(crate) fn apart(p: &Polygon, q: &Polygon) -> bool {
+    strictly_one_side(q, p.support()) || strictly_one_side(p, q.support())
+}
+
+/// For each piece of `a`, whether it is apart from every piece of `b`
+/// ([`apart`]), and the same for `b`'s pieces: an isolated piece meets
+/// no piece of the other surface in the cell, closed sets as they are.
+pub(crate) fn isolated(a: &[Polygon], b: &[Polygon]) -> (Vec<bool>, Vec<bool>) {
+    let mut ia = vec![true; a.len()];
+    let mut ib = vec![true; b.len()];
+    for (i, p) in a.iter().enumerate() {
+        for (j, q) in b.iter().enumerate() {
+            if !apart(p, q) {
+                ia[i] = false;
+                ib[j] = false;
+            }
+        }
+    }
+    (ia, ib)
+}
+
+/// The walls `w[k]` of its cell that the piece `p` (a face clipped to the
+/// cell) crosses into the next cell, as bits `1 << k`: the piece has an
+/// edge on the wall, and that edge does not lie along a border of the
+/// wall (both ends on one perpendicular wall), so every point inside the
+/// edge lies inside the wall's rectangle, where the face goes on into the
+/// cells beyond.
+pub(crate) fn wall_edges(p: &Polygon, w: &[Plane; 6]) -> u8 {
+    let (edges, verts) = (p.edge_planes(), p.vertices());
+    let n = verts.len();
+    let mut mask = 0u8;
+    for (k, wall) in w.iter().enumerate() {
+        let Some(e) = edges.iter().position(|e| e == wall) else {
+            continue;
+        };
+        let (v0, v1) = (&verts[e], &verts[(e + 1) % n]);
+        let along_border = w.iter().enumerate().any(|(j, other)| {
+            j / 2 != k / 2 && v0.classify(other) == Side::On && v1.classify(other) == Side::On
+        });
+        if !along_border {
+            mask |= 1 << k;
+        }
+    }
+    mask
+}
+
 /// The six walls of `bx`, for clipping faces into it.
 pub(crate) fn clip_to(face: &Polygon, w: &[Plane; 6]) -> Option<Polygon> {
     let mut p = face.clone();

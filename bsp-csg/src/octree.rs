@@ -9,6 +9,7 @@
 //! Faces are sent to every child their box overlaps.
 
 use bsp_core::{Plane, Polygon};
+use rayon::prelude::*;
 use smallvec::SmallVec;
 
 use crate::index::IBox;
@@ -114,80 +115,170 @@ pub(crate) fn polygon_meets(poly: &Polygon, bx: &IBox) -> bool {
     true
 }
 
-/// The leaves of the octree over `domain` for the faces of `a` and `b`, in
-/// a fixed order. `meets_a(f, cell)` must hold whenever face `f` of `a`
-/// meets the cell (it may hold more often); likewise `meets_b`.
+/// One operand's faces for [`build`]: each face's box, and a test of its
+/// plane against a cell (`true` whenever the face meets the cell; it may
+/// be `true` more often).
+pub(crate) struct Faces<'a, P> {
+    pub(crate) boxes: &'a [IBox],
+    pub(crate) plane_meets: P,
+}
+
+/// The leaves of the octree over `domain` for the faces `0..` of `a` and
+/// of `b` (by their index in each), in a fixed order. A face goes to each
+/// child of a cell that its box overlaps and whose box its plane meets.
 ///
 /// A cell holding faces of both operands is split while it holds more
 /// than `leaf_size` faces, can be split, and the last split made progress:
 /// a split after which some child holds every face of its parent gains
 /// nothing when faces pile up at one point (a vertex of high degree on the
-/// other surface), so the depth stays bounded there.
-pub(crate) fn build(
+/// other surface), so the depth stays bounded there. Large cells' subtrees
+/// are built in parallel (the same leaves, in the same order).
+pub(crate) fn build<P, Q>(
     domain: IBox,
-    a: Vec<u32>,
-    b: Vec<u32>,
-    meets_a: &(impl Fn(u32, &IBox) -> bool + Sync),
-    meets_b: &(impl Fn(u32, &IBox) -> bool + Sync),
+    a: &Faces<'_, P>,
+    b: &Faces<'_, Q>,
     leaf_size: usize,
-) -> Vec<Leaf> {
+) -> Vec<Leaf>
+where
+    P: Fn(u32, &IBox) -> bool + Sync,
+    Q: Fn(u32, &IBox) -> bool + Sync,
+{
+    let root = Leaf {
+        bx: domain,
+        a: (0..a.boxes.len() as u32).collect(),
+        b: (0..b.boxes.len() as u32).collect(),
+    };
+    grow(root, 0, a, b, leaf_size)
+}
+
+/// Cells with more faces than this build their children's subtrees in
+/// parallel.
+const PARALLEL_FACES: usize = 2048;
+
+/// The leaves under `cell`, in order; `stalled` counts the splits in a row
+/// that made no progress.
+fn grow<P, Q>(
+    cell: Leaf,
+    stalled: u8,
+    a: &Faces<'_, P>,
+    b: &Faces<'_, Q>,
+    leaf_size: usize,
+) -> Vec<Leaf>
+where
+    P: Fn(u32, &IBox) -> bool + Sync,
+    Q: Fn(u32, &IBox) -> bool + Sync,
+{
     let mut leaves = Vec::new();
-    // cells with the number of splits in a row that made no progress
-    let mut stack = vec![(Leaf { bx: domain, a, b }, 0u8)];
+    let mut stack = vec![(cell, stalled)];
     while let Some((cell, stalled)) = stack.pop() {
-        let (lo, hi) = cell.bx;
-        let split: Vec<usize> = (0..3).filter(|&k| hi[k] > lo[k]).collect();
-        if !cell.mixed()
-            || cell.a.len() + cell.b.len() <= leaf_size
-            || split.is_empty()
-            || stalled >= MAX_STALLED
-        {
+        let Some((kids, stalled)) = split(&cell, stalled, a, b, leaf_size) else {
             leaves.push(cell);
             continue;
-        }
-        let mid = [0, 1, 2].map(|k| lo[k] + (hi[k] - lo[k]) / 2);
-        let mut children: Vec<IBox> = vec![(lo, hi)];
-        for &k in &split {
-            children = children
-                .into_iter()
-                .flat_map(|(l, h)| {
-                    let (mut h1, mut l2) = (h, l);
-                    h1[k] = mid[k];
-                    l2[k] = mid[k] + 1;
-                    [(l, h1), (l2, h)]
-                })
+        };
+        if cell.a.len() + cell.b.len() > PARALLEL_FACES {
+            let parts: Vec<Vec<Leaf>> = kids
+                .into_par_iter()
+                .map(|k| grow(k, stalled, a, b, leaf_size))
                 .collect();
-        }
-        let n = cell.a.len() + cell.b.len();
-        let kids: Vec<Leaf> = children
-            .into_iter()
-            .map(|bx| {
-                let a = cell
-                    .a
-                    .iter()
-                    .copied()
-                    .filter(|&f| meets_a(f, &bx))
-                    .collect();
-                let b = cell
-                    .b
-                    .iter()
-                    .copied()
-                    .filter(|&f| meets_b(f, &bx))
-                    .collect();
-                Leaf { bx, a, b }
-            })
-            .collect();
-        // faces larger than the cell land in several children each: the
-        // split cuts them without sorting them apart
-        let total: usize = kids.iter().map(|k| k.a.len() + k.b.len()).sum();
-        let stuck = total >= STALL_SHARE * n || kids.iter().any(|k| k.a.len() + k.b.len() == n);
-        let stalled = if stuck { stalled + 1 } else { 0 };
-        // children pushed in reverse so that they come out in order
-        for k in kids.into_iter().rev() {
-            stack.push((k, stalled));
+            leaves.extend(parts.into_iter().flatten());
+        } else {
+            // children pushed in reverse so that they come out in order
+            for k in kids.into_iter().rev() {
+                stack.push((k, stalled));
+            }
         }
     }
     leaves
+}
+
+/// The children of `cell` with their faces, and their count of stalled
+/// splits; `None` if the cell is a leaf.
+fn split<P, Q>(
+    cell: &Leaf,
+    stalled: u8,
+    a: &Faces<'_, P>,
+    b: &Faces<'_, Q>,
+    leaf_size: usize,
+) -> Option<(Vec<Leaf>, u8)>
+where
+    P: Fn(u32, &IBox) -> bool + Sync,
+    Q: Fn(u32, &IBox) -> bool + Sync,
+{
+    let (lo, hi) = cell.bx;
+    let axes: SmallVec<[usize; 3]> = (0..3).filter(|&k| hi[k] > lo[k]).collect();
+    if !cell.mixed()
+        || cell.a.len() + cell.b.len() <= leaf_size
+        || axes.is_empty()
+        || stalled >= MAX_STALLED
+    {
+        return None;
+    }
+    let mid = [0, 1, 2].map(|k| lo[k] + (hi[k] - lo[k]) / 2);
+    // child `c` lies on the upper side of axis `axes[j]` when bit
+    // `axes.len() - 1 - j` of `c` is set (the first axis varies slowest)
+    let m = axes.len();
+    let boxes: SmallVec<[IBox; 8]> = (0..1usize << m)
+        .map(|c| {
+            let (mut l, mut h) = (lo, hi);
+            for (j, &k) in axes.iter().enumerate() {
+                if c >> (m - 1 - j) & 1 == 0 {
+                    h[k] = mid[k];
+                } else {
+                    l[k] = mid[k] + 1;
+                }
+            }
+            (l, h)
+        })
+        .collect();
+    let mut kids: Vec<Leaf> = boxes
+        .iter()
+        .map(|&bx| Leaf {
+            bx,
+            a: Vec::new(),
+            b: Vec::new(),
+        })
+        .collect();
+    // a face's box overlaps the cell, so along each split axis it
+    // overlaps the lower child if it starts at or below the middle, the
+    // upper if it ends above it
+    let deal = |fs: &[u32],
+                bxs: &[IBox],
+                meets: &dyn Fn(u32, &IBox) -> bool,
+                kids: &mut Vec<Leaf>,
+                upper: bool| {
+        for &f in fs {
+            let (fl, fh) = bxs[f as usize];
+            let (mut any, mut all) = (0usize, 0usize);
+            for (j, &k) in axes.iter().enumerate() {
+                let bit = 1 << (m - 1 - j);
+                let (low, high) = (fl[k] <= mid[k], fh[k] > mid[k]);
+                if high {
+                    any |= bit;
+                    if !low {
+                        all |= bit;
+                    }
+                }
+            }
+            // the children c with all ⊆ c ⊆ any
+            for (c, kid) in kids.iter_mut().enumerate() {
+                if c & !any == 0 && c & all == all && meets(f, &boxes[c]) {
+                    if upper {
+                        kid.b.push(f);
+                    } else {
+                        kid.a.push(f);
+                    }
+                }
+            }
+        }
+    };
+    deal(&cell.a, a.boxes, &a.plane_meets, &mut kids, false);
+    deal(&cell.b, b.boxes, &b.plane_meets, &mut kids, true);
+    // faces larger than the cell land in several children each: the
+    // split cuts them without sorting them apart
+    let n = cell.a.len() + cell.b.len();
+    let total: usize = kids.iter().map(|k| k.a.len() + k.b.len()).sum();
+    let stuck = total >= STALL_SHARE * n || kids.iter().any(|k| k.a.len() + k.b.len() == n);
+    Some((kids, if stuck { stalled + 1 } else { 0 }))
 }
 
 /// Splits in a row after which a child still holds all its parent's faces
@@ -280,15 +371,11 @@ mod tests {
     fn leaves_tile_the_domain_and_adjacency_is_found() {
         // eight faces of each operand packed in one corner: the cell splits
         let boxes: Vec<IBox> = (0..8).map(|i| ([i, 0, 0], [i, 1, 1])).collect();
-        let bx = |f: u32| boxes[f as usize];
-        let leaves = build(
-            ([0, 0, 0], [15, 15, 15]),
-            (0..8).collect(),
-            (0..8).collect(),
-            &|f, c| crate::index::overlaps(&bx(f), c),
-            &|f, c| crate::index::overlaps(&bx(f), c),
-            4,
-        );
+        let faces = Faces {
+            boxes: &boxes,
+            plane_meets: |_, _: &IBox| true,
+        };
+        let leaves = build(([0, 0, 0], [15, 15, 15]), &faces, &faces, 4);
         let volume: i64 = leaves
             .iter()
             .map(|l| (0..3).map(|k| l.bx.1[k] - l.bx.0[k] + 1).product::<i64>())

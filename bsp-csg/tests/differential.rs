@@ -74,6 +74,17 @@ fn op() -> impl Strategy<Value = BoolOp> {
     ])
 }
 
+/// The same mesh, vertex for vertex and triangle for triangle.
+fn identical(a: &Solid, b: &Solid) -> Result<(), TestCaseError> {
+    let (ma, mb) = (a.to_mesh(), b.to_mesh());
+    prop_assert_eq!(ma.vertices.len(), mb.vertices.len(), "vertices");
+    for (p, q) in ma.vertices.iter().zip(&mb.vertices) {
+        prop_assert!(p.same_point(q), "vertex {:?} against {:?}", p, q);
+    }
+    prop_assert_eq!(&ma.triangles, &mb.triangles, "triangles");
+    Ok(())
+}
+
 /// Checks the octree result against the global merge of the same inputs.
 fn same(octree: &Solid, global: &Partition<bsp_core::Cell>) -> Result<(), TestCaseError> {
     let mesh = octree.to_mesh();
@@ -123,8 +134,14 @@ proptest! {
         octree
             .apply_with(&Solid::from_polygons(pb.clone()), op, &opts)
             .unwrap();
-        let global = Partition::solid(pa).boolean(&Partition::solid(pb), op);
+        let global = Partition::solid(pa.clone()).boolean(&Partition::solid(pb.clone()), op);
         same(&octree, &global)?;
+        // labelling the cells where the surfaces do not meet along the
+        // faces gives what their local trees give
+        let mut full = Solid::from_polygons(pa);
+        full.apply_with(&Solid::from_polygons(pb), op, &opts.with_easy_cells(false))
+            .unwrap();
+        identical(&octree, &full)?;
     }
 
     #[test]
@@ -135,12 +152,16 @@ proptest! {
         exact in any::<bool>(),
     ) {
         let opts = Options::default().with_leaf_size(leaf).with_exact_cells(exact);
+        let full_opts = opts.clone().with_easy_cells(false);
         let mut octree = Solid::from_polygons(polys(&first));
+        let mut full = octree.clone();
         let mut global = Partition::solid(polys(&first));
         for (s, op) in &rest {
             octree.apply_with(&Solid::from_polygons(polys(s)), *op, &opts).unwrap();
+            full.apply_with(&Solid::from_polygons(polys(s)), *op, &full_opts).unwrap();
             global = global.boolean(&Partition::solid(polys(s)), *op);
             same(&octree, &global)?;
+            identical(&octree, &full)?;
         }
     }
 }

@@ -532,11 +532,12 @@ fn stats_text(
             merged_cells: a.merged_cells + b.merged_cells,
             cut_faces: a.cut_faces + b.cut_faces,
             pieces: a.pieces + b.pieces,
+            easy_cells: a.easy_cells + b.easy_cells,
         });
     s += &format!(
-        "octree:         {} cells, {} with both surfaces ({} with shared planes); {} faces cut \
-         into {} pieces\n",
-        sum.cells, sum.mixed_cells, sum.merged_cells, sum.cut_faces, sum.pieces
+        "octree:         {} cells, {} with both surfaces ({} with shared planes, {} where \
+         they do not meet); {} faces cut into {} pieces\n",
+        sum.cells, sum.mixed_cells, sum.merged_cells, sum.easy_cells, sum.cut_faces, sum.pieces
     );
     s += &format!(
         "output:         {} triangles, {} vertices\n",
