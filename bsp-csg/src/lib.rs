@@ -96,7 +96,7 @@ use crate::octree::{Leaf, walls};
 
 /// Faces a leaf of the octree may hold before it is split (when it holds
 /// faces of both operands), by default.
-pub const LEAF_SIZE: usize = 24;
+pub const LEAF_SIZE: usize = 32;
 
 /// Options of [`Solid::apply_with`].
 #[derive(Clone, Debug, PartialEq, Eq)]
