@@ -121,7 +121,9 @@ fn import_from<'a>(
     faces: impl IntoIterator<Item = &'a [DVec3]>,
     first: usize,
 ) -> Result<(Vec<Polygon>, ImportReport), Error> {
-    let mut out = Vec::new();
+    let faces = faces.into_iter();
+    // one polygon a face, as a rule: no regrowth (a polygon is large)
+    let mut out = Vec::with_capacity(faces.size_hint().0);
     let mut report = ImportReport::default();
     let mut pts: Vec<GridPoint> = Vec::new();
     for (fi, face) in faces.into_iter().enumerate() {

@@ -99,21 +99,30 @@ impl FaceIndex {
         })
     }
 
-    pub(crate) fn insert(&mut self, id: u32, b: &IBox) {
-        let cells: Vec<usize> = self.cells_of(b).collect();
-        for c in cells {
-            self.cells[c].push(id);
+    /// Calls `f` with each cell's list that `b` overlaps.
+    fn each_list(&mut self, b: &IBox, mut f: impl FnMut(&mut Vec<u32>)) {
+        let lo = [0, 1, 2].map(|k| self.coord(k, b.0[k]));
+        let hi = [0, 1, 2].map(|k| self.coord(k, b.1[k]));
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    let c = self.at([x, y, z]);
+                    f(&mut self.cells[c]);
+                }
+            }
         }
     }
 
+    pub(crate) fn insert(&mut self, id: u32, b: &IBox) {
+        self.each_list(b, |list| list.push(id));
+    }
+
     pub(crate) fn remove(&mut self, id: u32, b: &IBox) {
-        let cells: Vec<usize> = self.cells_of(b).collect();
-        for c in cells {
-            let list = &mut self.cells[c];
+        self.each_list(b, |list| {
             if let Some(i) = list.iter().position(|&x| x == id) {
                 list.swap_remove(i);
             }
-        }
+        });
     }
 
     /// The ids in the cells `b` overlaps (with repeats), into `out`.

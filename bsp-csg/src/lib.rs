@@ -361,8 +361,8 @@ impl Solid {
         self.faces[i as usize].as_ref().expect("a live face")
     }
 
-    fn add(&mut self, p: Polygon) {
-        let bx = polygon_box(&p);
+    /// Adds the polygon `p`, whose box is `bx` ([`polygon_box`]).
+    fn add(&mut self, p: Polygon, bx: IBox) {
         let id = match self.free.pop() {
             Some(i) => i,
             None => {
@@ -505,7 +505,10 @@ impl Solid {
         opts: &Options,
     ) -> Result<Stats, CsgError> {
         let (stats, plan) = self.plan(other, op, opts)?;
-        self.carry_out(plan, |f| other.face(f).poly.clone());
+        self.carry_out(plan, |f| {
+            let face = other.face(f);
+            (face.poly.clone(), face.bx())
+        });
         Ok(stats)
     }
 
@@ -525,7 +528,9 @@ impl Solid {
     ) -> Result<Stats, CsgError> {
         let (stats, plan) = self.plan(&other, op, opts)?;
         self.carry_out(plan, |f| {
-            other.faces[f as usize].take().expect("a live face").poly
+            let face = other.faces[f as usize].take().expect("a live face");
+            let bx = face.bx();
+            (face.poly, bx)
         });
         Ok(stats)
     }
@@ -816,34 +821,42 @@ impl Solid {
         }
 
         // the changes, now that everything is known
-        let mut remove: Vec<u32> = Vec::new();
-        for &f in &whole_a {
-            let inside = a_leaves
-                .get(&f)
-                .and_then(|ls| meeting_leaf(&self.face(f).poly, ls, &leaves))
-                .is_some_and(|l| inside_b.inside(l));
-            if !keep_a(inside) {
-                remove.push(f);
-            }
-        }
+        // (decided in parallel, applied in order)
+        let mut remove: Vec<u32> = whole_a
+            .par_iter()
+            .copied()
+            .filter(|&f| {
+                let inside = a_leaves
+                    .get(&f)
+                    .and_then(|ls| meeting_leaf(&self.face(f).poly, ls, &leaves))
+                    .is_some_and(|l| inside_b.inside(l));
+                !keep_a(inside)
+            })
+            .collect();
         // a piece beyond the octree's box is beyond the other solid's box
-        let settle_with = |poly: &Polygon,
-                           pieces: &[Piece],
-                           keep: &dyn Fn(bool) -> bool,
-                           other_side: &Regions,
-                           fates: &mut FxHashMap<u32, Vec<PieceFate>>| {
-            settle(
-                poly,
-                pieces,
-                &|l| keep(l.is_some_and(|l| other_side.inside(l))),
-                fates,
-                &leaves,
-                &root_walls,
-            )
+        let settle_all = |pieces: &[(u32, Vec<Piece>)],
+                          solid: &Solid,
+                          keep: &(dyn Fn(bool) -> bool + Sync),
+                          other_side: &Regions,
+                          fates: &FxHashMap<u32, Vec<PieceFate>>| {
+            pieces
+                .par_iter()
+                .map(|(f, pieces)| {
+                    let kept = settle(
+                        &solid.face(*f).poly,
+                        pieces,
+                        &|l| keep(l.is_some_and(|l| other_side.inside(l))),
+                        fates,
+                        &leaves,
+                        &root_walls,
+                    );
+                    (*f, kept)
+                })
+                .collect::<Vec<_>>()
         };
-        for (f, pieces) in pieces_a {
-            let poly = &self.face(f).poly;
-            let outcome = settle_with(poly, &pieces, &keep_a, &inside_b, &mut fates_a);
+        let settled_a = settle_all(&pieces_a, self, &keep_a, &inside_b, &fates_a);
+        drop((pieces_a, fates_a));
+        for (f, outcome) in settled_a {
             if let Some(kept) = outcome {
                 remove.push(f);
                 if !kept.is_empty() {
@@ -855,18 +868,22 @@ impl Solid {
         }
         // the other solid's faces kept whole are listed, to be copied or
         // moved over (flipped for a difference)
-        for &f in &whole_b {
-            let inside = b_leaves
-                .get(&f)
-                .and_then(|ls| meeting_leaf(&other.face(f).poly, ls, &leaves))
-                .is_some_and(|l| inside_a.inside(l));
-            if keep_b(inside) {
-                add.push(Added::Whole(f));
-            }
-        }
-        for (f, pieces) in pieces_b {
-            let poly = &other.face(f).poly;
-            match settle_with(poly, &pieces, &keep_b, &inside_a, &mut fates_b) {
+        let kept_b: Vec<u32> = whole_b
+            .par_iter()
+            .copied()
+            .filter(|&f| {
+                let inside = b_leaves
+                    .get(&f)
+                    .and_then(|ls| meeting_leaf(&other.face(f).poly, ls, &leaves))
+                    .is_some_and(|l| inside_a.inside(l));
+                keep_b(inside)
+            })
+            .collect();
+        add.extend(kept_b.into_iter().map(Added::Whole));
+        let settled_b = settle_all(&pieces_b, other, &keep_b, &inside_a, &fates_b);
+        drop((pieces_b, fates_b));
+        for (f, outcome) in settled_b {
+            match outcome {
                 None => add.push(Added::Whole(f)),
                 Some(kept) => {
                     if !kept.is_empty() {
@@ -904,8 +921,8 @@ impl Solid {
     }
 
     /// Carries a plan out: its new faces, then the other solid's faces it
-    /// keeps whole, each taken by `take`.
-    fn carry_out(&mut self, mut plan: Plan, mut take: impl FnMut(u32) -> Polygon) {
+    /// keeps whole, each taken by `take` with its box.
+    fn carry_out(&mut self, mut plan: Plan, mut take: impl FnMut(u32) -> (Polygon, IBox)) {
         // the new faces' equal new vertices become one each (pieces cut
         // along a shared edge computed them each for itself)
         let mut new: Vec<&mut Polygon> = plan
@@ -917,6 +934,12 @@ impl Solid {
             })
             .collect();
         share_points(&mut new);
+        // the new faces' boxes, in parallel
+        let mut boxes = new
+            .par_iter()
+            .map(|p| polygon_box(p))
+            .collect::<Vec<_>>()
+            .into_iter();
         drop(new);
         // room for the new faces at once: growing by doubling would hold
         // the old and a twice larger array of faces at the same time
@@ -924,10 +947,11 @@ impl Solid {
             .reserve_exact(plan.add.len().saturating_sub(self.free.len()));
         for a in plan.add {
             match a {
-                Added::New(p) => self.add(*p),
+                Added::New(p) => self.add(*p, boxes.next().expect("a box a new face")),
                 Added::Whole(f) => {
-                    let p = take(f);
-                    self.add(if plan.flip { p.flipped() } else { p });
+                    // flipping keeps the box
+                    let (p, bx) = take(f);
+                    self.add(if plan.flip { p.flipped() } else { p }, bx);
                 }
             }
         }
@@ -1102,12 +1126,13 @@ fn meeting_leaf(poly: &Polygon, ls: &[u32], leaves: &[Leaf]) -> Option<u32> {
 /// What stays of a face cut into `pieces`: `None` if every piece stays
 /// (the face stays as it is), else the kept pieces and fragments.
 /// `keep_free(cell)` says whether a piece in a free cell (`None`: beyond
-/// the octree's box) stays; `fates` are the mixed cells' (the pieces kept are moved out).
+/// the octree's box) stays; `fates` are the mixed cells' (the pieces kept
+/// are copied: faces settle in parallel).
 fn settle(
     poly: &Polygon,
     pieces: &[Piece],
     keep_free: &dyn Fn(Option<u32>) -> bool,
-    fates: &mut FxHashMap<u32, Vec<PieceFate>>,
+    fates: &FxHashMap<u32, Vec<PieceFate>>,
     leaves: &[Leaf],
     root: &[bsp_core::Plane; 6],
 ) -> Option<Vec<Polygon>> {
@@ -1130,16 +1155,12 @@ fn settle(
                 kept.extend(free_pieces(poly, l.map(|l| &leaves[l as usize]), root))
             }
             Piece::Free(_) => {}
-            // each piece is one face's: it is moved out, not copied
-            Piece::Mixed(l, i) => match fates
-                .get_mut(l)
-                .map(|v| std::mem::replace(&mut v[*i as usize], PieceFate::Drop))
-            {
-                Some(PieceFate::Keep(q)) => kept.push(*q),
+            Piece::Mixed(l, i) => match fates.get(l).map(|v| &v[*i as usize]) {
+                Some(PieceFate::Keep(q)) => kept.push((**q).clone()),
                 Some(PieceFate::KeepClip) => {
                     kept.extend(local::clip_to(poly, &walls(&leaves[*l as usize].bx)))
                 }
-                Some(PieceFate::Cut(frags)) => kept.extend(frags),
+                Some(PieceFate::Cut(frags)) => kept.extend(frags.iter().cloned()),
                 _ => {}
             },
         }
@@ -1319,12 +1340,16 @@ fn label_easy<'p>(
                         &leaves[ends[j].cell as usize].bx,
                         &leaves[ends[k].cell as usize].bx,
                     );
-                    let linked = if let Some(w) = facing(bj, bk) {
-                        mask(&mut ends[j]) & (1 << w) != 0
-                    } else if let Some(w) = facing(bk, bj) {
-                        mask(&mut ends[k]) & (1 << w) != 0
-                    } else {
-                        false
+                    // either piece's edge on the wall will do when the
+                    // cells' walls are the same: rather one already known
+                    // than one of a free cell, which must be clipped
+                    let linked = match (facing(bj, bk), facing(bk, bj)) {
+                        (Some(w), Some(_)) if ends[j].mask.is_some() || ends[k].mask.is_none() => {
+                            mask(&mut ends[j]) & (1 << w) != 0
+                        }
+                        (_, Some(w)) => mask(&mut ends[k]) & (1 << w) != 0,
+                        (Some(w), None) => mask(&mut ends[j]) & (1 << w) != 0,
+                        (None, None) => false,
                     };
                     if linked {
                         out.push((ends[j].node, ends[k].node));
