@@ -79,8 +79,6 @@ mod octree;
 pub use bsp_core::shapes;
 mod winding;
 
-use std::collections::HashMap;
-
 use bsp_core::{
     BoolOp, Grid, GridPoint, ImportReport, Membership, Polygon, Side, TopologyError, TriMesh,
     check_closed_manifold, import_faces_par, share_points,
@@ -388,13 +386,21 @@ impl Solid {
     fn faces_near(&self, b: &IBox) -> Vec<u32> {
         let mut ids = Vec::new();
         self.index.near(b, &mut ids);
-        ids.sort_unstable();
-        ids.dedup();
-        ids.retain(|&i| {
+        let meets = |&i: &u32| {
             self.faces[i as usize]
                 .as_ref()
                 .is_some_and(|f| overlaps(&f.bx(), b))
-        });
+        };
+        // many ids (a large box): in parallel
+        const MANY: usize = 1 << 15;
+        if ids.len() > MANY {
+            ids.par_sort_unstable();
+            ids.dedup();
+            return ids.into_par_iter().filter(meets).collect();
+        }
+        ids.sort_unstable();
+        ids.dedup();
+        ids.retain(meets);
         // the ids came with repeats: the lists of a large box are kept
         // while an operation runs
         ids.shrink_to_fit();
@@ -597,30 +603,30 @@ impl Solid {
             opts.leaf_size,
         );
         drop((boxes_a, planes_a, boxes_b, planes_b));
+        if opts.exact_cells {
+            // the lists of the leaves holding both, by the exact test
+            leaves.par_iter_mut().filter(|l| l.mixed()).for_each(|l| {
+                let bx = l.bx;
+                l.a.retain(|&f| octree::polygon_meets(&self.face(a_c[f as usize]).poly, &bx));
+                l.b.retain(|&f| octree::polygon_meets(&other.face(b_c[f as usize]).poly, &bx));
+            });
+        }
+        // each face's leaves, by its place in `a_c` and `b_c`
+        let mut a_leaves: Vec<SmallVec<[u32; 4]>> = vec![SmallVec::new(); a_c.len()];
+        let mut b_leaves: Vec<SmallVec<[u32; 4]>> = vec![SmallVec::new(); b_c.len()];
+        for (li, l) in leaves.iter().enumerate() {
+            for &f in &l.a {
+                a_leaves[f as usize].push(li as u32);
+            }
+            for &f in &l.b {
+                b_leaves[f as usize].push(li as u32);
+            }
+        }
         // the leaves' lists by face id
         leaves.par_iter_mut().for_each(|l| {
             l.a.iter_mut().for_each(|f| *f = a_c[*f as usize]);
             l.b.iter_mut().for_each(|f| *f = b_c[*f as usize]);
         });
-        if opts.exact_cells {
-            // the lists of the leaves holding both, by the exact test
-            leaves.par_iter_mut().filter(|l| l.mixed()).for_each(|l| {
-                let bx = l.bx;
-                l.a.retain(|&f| octree::polygon_meets(&self.face(f).poly, &bx));
-                l.b.retain(|&f| octree::polygon_meets(&other.face(f).poly, &bx));
-            });
-        }
-        // each face's leaves
-        let mut a_leaves: FxHashMap<u32, SmallVec<[u32; 4]>> = FxHashMap::default();
-        let mut b_leaves: FxHashMap<u32, SmallVec<[u32; 4]>> = FxHashMap::default();
-        for (li, l) in leaves.iter().enumerate() {
-            for &f in &l.a {
-                a_leaves.entry(f).or_default().push(li as u32);
-            }
-            for &f in &l.b {
-                b_leaves.entry(f).or_default().push(li as u32);
-            }
-        }
         let adjacent = octree::adjacent(&leaves);
         // the regions free of each surface, and their labels
         let inside_b = Regions::new(&leaves, &adjacent, |l| l.b.is_empty(), other);
@@ -653,8 +659,8 @@ impl Solid {
             .map(|&l| {
                 (
                     l,
-                    cand_a.remove(&l).unwrap_or_default(),
-                    cand_b.remove(&l).unwrap_or_default(),
+                    std::mem::take(&mut cand_a[l as usize]),
+                    std::mem::take(&mut cand_b[l as usize]),
                 )
             })
             .collect();
@@ -824,14 +830,16 @@ impl Solid {
         // (decided in parallel, applied in order)
         let mut remove: Vec<u32> = whole_a
             .par_iter()
-            .copied()
-            .filter(|&f| {
-                let inside = a_leaves
-                    .get(&f)
-                    .and_then(|ls| meeting_leaf(&self.face(f).poly, ls, &leaves))
-                    .is_some_and(|l| inside_b.inside(l));
+            .filter(|&&i| {
+                let inside = meeting_leaf(
+                    &self.face(a_c[i as usize]).poly,
+                    &a_leaves[i as usize],
+                    &leaves,
+                )
+                .is_some_and(|l| inside_b.inside(l));
                 !keep_a(inside)
             })
+            .map(|&i| a_c[i as usize])
             .collect();
         // a piece beyond the octree's box is beyond the other solid's box
         let settle_all = |pieces: &[(u32, Vec<Piece>)],
@@ -870,14 +878,16 @@ impl Solid {
         // moved over (flipped for a difference)
         let kept_b: Vec<u32> = whole_b
             .par_iter()
-            .copied()
-            .filter(|&f| {
-                let inside = b_leaves
-                    .get(&f)
-                    .and_then(|ls| meeting_leaf(&other.face(f).poly, ls, &leaves))
-                    .is_some_and(|l| inside_a.inside(l));
+            .filter(|&&i| {
+                let inside = meeting_leaf(
+                    &other.face(b_c[i as usize]).poly,
+                    &b_leaves[i as usize],
+                    &leaves,
+                )
+                .is_some_and(|l| inside_a.inside(l));
                 keep_b(inside)
             })
+            .map(|&i| b_c[i as usize])
             .collect();
         add.extend(kept_b.into_iter().map(Added::Whole));
         let settled_b = settle_all(&pieces_b, other, &keep_b, &inside_a, &fates_b);
@@ -899,17 +909,19 @@ impl Solid {
         }
         // the faces away from the shared box: outside the other solid
         if op == BoolOp::Union {
-            let near: std::collections::HashSet<u32> = b_c.iter().copied().collect();
+            let mut near = vec![false; other.faces.len()];
+            b_c.iter().for_each(|&f| near[f as usize] = true);
             for (i, f) in other.faces.iter().enumerate() {
-                if f.is_some() && !near.contains(&(i as u32)) {
+                if f.is_some() && !near[i] {
                     add.push(Added::Whole(i as u32));
                 }
             }
         }
         if op == BoolOp::Intersection {
-            let near: std::collections::HashSet<u32> = a_c.iter().copied().collect();
+            let mut near = vec![false; self.faces.len()];
+            a_c.iter().for_each(|&f| near[f as usize] = true);
             for i in 0..self.faces.len() as u32 {
-                if self.faces[i as usize].is_some() && !near.contains(&i) {
+                if self.faces[i as usize].is_some() && !near[i as usize] {
                     remove.push(i);
                 }
             }
@@ -983,9 +995,10 @@ enum Piece {
     Mixed(u32, u32),
 }
 
-/// Faces wholly in cells free of the other surface; the pieces of every
-/// other face; per mixed cell the faces in it, in order.
-type Sorted = (Vec<u32>, Vec<(u32, Vec<Piece>)>, HashMap<u32, Vec<u32>>);
+/// Faces wholly in cells free of the other surface (by their place in the
+/// list sorted); the pieces of every other face (by id); per leaf, the
+/// faces in it if it is mixed, in order.
+type Sorted = (Vec<u32>, Vec<(u32, Vec<Piece>)>, Vec<Vec<u32>>);
 
 /// What becomes of a face listed in a mixed cell.
 enum PieceFate {
@@ -1061,9 +1074,11 @@ fn clip_all<'p>(
     (pieces, index)
 }
 
+/// Sorts `faces` (their leaves `leaves_of`, by place) into those in free
+/// cells only and those with pieces in mixed cells.
 fn sort_faces(
     faces: &[u32],
-    leaves_of: &FxHashMap<u32, SmallVec<[u32; 4]>>,
+    leaves_of: &[SmallVec<[u32; 4]>],
     leaves: &[Leaf],
     root: &IBox,
     bx: impl Fn(u32) -> IBox,
@@ -1071,12 +1086,11 @@ fn sort_faces(
 ) -> Sorted {
     let mut whole = Vec::new();
     let mut pieces = Vec::new();
-    let mut listed: HashMap<u32, Vec<u32>> = HashMap::new();
-    for &f in faces {
+    let mut listed: Vec<Vec<u32>> = vec![Vec::new(); leaves.len()];
+    for (i, (&f, ls)) in faces.iter().zip(leaves_of).enumerate() {
         // a face in no cell lies beyond the octree's box
-        let ls = leaves_of.get(&f).map_or(&[][..], |l| &l[..]);
         if ls.iter().all(|&l| free(&leaves[l as usize])) {
-            whole.push(f);
+            whole.push(i as u32);
             continue;
         }
         let mut mine: Vec<Piece> = ls
@@ -1085,7 +1099,7 @@ fn sort_faces(
                 if free(&leaves[l as usize]) {
                     Piece::Free(Some(l))
                 } else {
-                    let v = listed.entry(l).or_default();
+                    let v = &mut listed[l as usize];
                     v.push(f);
                     Piece::Mixed(l, (v.len() - 1) as u32)
                 }

@@ -295,52 +295,57 @@ const STALL_SHARE: usize = 3;
 /// coordinate a sweep finds the pairs in `O(n log n)` plus their number.
 pub(crate) fn adjacent(leaves: &[Leaf]) -> Vec<(u32, u32)> {
     use std::collections::BTreeMap;
-    let mut out = Vec::new();
-    for k in 0..3 {
-        let (u, v) = ((k + 1) % 3, (k + 2) % 3);
-        // (wall coordinate, side, leaf): side 0 below the wall, 1 above
-        let mut by_wall: Vec<(i64, u8, u32)> = Vec::with_capacity(2 * leaves.len());
-        for (i, l) in leaves.iter().enumerate() {
-            by_wall.push((l.bx.1[k], 0, i as u32));
-            by_wall.push((l.bx.0[k] - 1, 1, i as u32));
-        }
-        by_wall.sort_unstable();
-        let mut events: Vec<(i64, u8, u8, u32)> = Vec::new();
-        for group in by_wall.chunk_by(|x, y| x.0 == y.0) {
-            if group.first().map(|g| g.1) == group.last().map(|g| g.1) {
-                continue; // leaves on one side of this wall only
+    // the three axes in parallel, joined in order
+    let per_axis: Vec<Vec<(u32, u32)>> = (0..3usize)
+        .into_par_iter()
+        .map(|k| {
+            let mut out = Vec::new();
+            let (u, v) = ((k + 1) % 3, (k + 2) % 3);
+            // (wall coordinate, side, leaf): side 0 below the wall, 1 above
+            let mut by_wall: Vec<(i64, u8, u32)> = Vec::with_capacity(2 * leaves.len());
+            for (i, l) in leaves.iter().enumerate() {
+                by_wall.push((l.bx.1[k], 0, i as u32));
+                by_wall.push((l.bx.0[k] - 1, 1, i as u32));
             }
-            // sweep along u: removals (0) before insertions (1) at a coordinate
-            events.clear();
-            for &(_, side, i) in group {
-                let b = &leaves[i as usize].bx;
-                events.push((b.0[u], 1, side, i));
-                events.push((b.1[u] + 1, 0, side, i));
-            }
-            events.sort_unstable();
-            // the leaves of each side the sweep line crosses, by their lower
-            // v; their v ranges are disjoint
-            let mut active: [BTreeMap<i64, u32>; 2] = [BTreeMap::new(), BTreeMap::new()];
-            for &(_, kind, side, i) in &events {
-                let b = &leaves[i as usize].bx;
-                let s = side as usize;
-                if kind == 0 {
-                    active[s].remove(&b.0[v]);
-                    continue;
+            by_wall.sort_unstable();
+            let mut events: Vec<(i64, u8, u8, u32)> = Vec::new();
+            for group in by_wall.chunk_by(|x, y| x.0 == y.0) {
+                if group.first().map(|g| g.1) == group.last().map(|g| g.1) {
+                    continue; // leaves on one side of this wall only
                 }
-                let other = &active[1 - s];
-                let before = other
-                    .range(..b.0[v])
-                    .next_back()
-                    .filter(|(_, j)| leaves[**j as usize].bx.1[v] >= b.0[v]);
-                for (_, &j) in before.into_iter().chain(other.range(b.0[v]..=b.1[v])) {
-                    out.push(if s == 0 { (i, j) } else { (j, i) });
+                // sweep along u: removals (0) before insertions (1) at a coordinate
+                events.clear();
+                for &(_, side, i) in group {
+                    let b = &leaves[i as usize].bx;
+                    events.push((b.0[u], 1, side, i));
+                    events.push((b.1[u] + 1, 0, side, i));
                 }
-                active[s].insert(b.0[v], i);
+                events.sort_unstable();
+                // the leaves of each side the sweep line crosses, by their lower
+                // v; their v ranges are disjoint
+                let mut active: [BTreeMap<i64, u32>; 2] = [BTreeMap::new(), BTreeMap::new()];
+                for &(_, kind, side, i) in &events {
+                    let b = &leaves[i as usize].bx;
+                    let s = side as usize;
+                    if kind == 0 {
+                        active[s].remove(&b.0[v]);
+                        continue;
+                    }
+                    let other = &active[1 - s];
+                    let before = other
+                        .range(..b.0[v])
+                        .next_back()
+                        .filter(|(_, j)| leaves[**j as usize].bx.1[v] >= b.0[v]);
+                    for (_, &j) in before.into_iter().chain(other.range(b.0[v]..=b.1[v])) {
+                        out.push(if s == 0 { (i, j) } else { (j, i) });
+                    }
+                    active[s].insert(b.0[v], i);
+                }
             }
-        }
-    }
-    out
+            out
+        })
+        .collect();
+    per_axis.concat()
 }
 
 #[cfg(test)]
