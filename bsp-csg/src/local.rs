@@ -24,10 +24,18 @@ use crate::CsgError;
 use crate::index::IBox;
 use crate::octree::walls;
 
-/// `true` if `piece` and `face` (in the same plane) overlap with an area.
+/// `true` if `piece` and `face` (convex, in the same plane) overlap with
+/// an area: no edge line of either has the other wholly on its outer side
+/// (separating axes; nothing is built).
 fn overlap(piece: &Polygon, face: &Polygon) -> bool {
-    let mut p = piece.clone();
-    face.edge_planes().iter().all(|e| p.clip(e, Side::Back))
+    let separates = |e: &Plane, other: &Polygon| {
+        other
+            .vertices()
+            .iter()
+            .all(|v| v.classify(e) != Side::Back)
+    };
+    !face.edge_planes().iter().any(|e| separates(e, piece))
+        && !piece.edge_planes().iter().any(|e| separates(e, face))
 }
 
 /// The solid partition of `pieces` (faces of one operand clipped to the
