@@ -107,12 +107,76 @@ pub fn import_faces_par(
     for part in parts {
         let (polys, r) = part?;
         out.extend(polys);
-        report.faces += r.faces;
-        report.polygons += r.polygons;
-        report.triangulated.extend(r.triangulated);
-        report.dropped.extend(r.dropped);
+        report.add(r);
     }
     Ok((out, report))
+}
+
+/// [`import_faces`] of an indexed mesh (positions and vertex-index
+/// loops), in parallel (rayon): the polygons come in runs, in face order
+/// (the faces of one run imported together), so that a caller can move
+/// them on in parallel without gathering them first; the same polygons,
+/// tags and report as [`import_faces`] of the loops.
+///
+/// ```
+/// use bsp_core::{Grid, import_indexed_par};
+/// use glam::DVec3;
+/// let p = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+/// let grid = Grid::fit_points(&p).unwrap();
+/// let (runs, report) = import_indexed_par(&grid, &p, &[vec![0, 1, 2], vec![0, 2, 1]]).unwrap();
+/// let polys: Vec<_> = runs.into_iter().flatten().collect();
+/// assert_eq!((polys.len(), report.polygons), (2, 2));
+/// assert_eq!(polys[1].tag(), 1);
+/// assert!(import_indexed_par(&grid, &p, &[vec![0, 1, 7]]).is_err());
+/// ```
+pub fn import_indexed_par(
+    grid: &Grid,
+    positions: &[DVec3],
+    faces: &[Vec<u32>],
+) -> Result<(Vec<Vec<Polygon>>, ImportReport), Error> {
+    use rayon::prelude::*;
+    const CHUNK: usize = 4096;
+    let parts: Vec<Result<(Vec<Polygon>, ImportReport), Error>> = faces
+        .par_chunks(CHUNK)
+        .enumerate()
+        .map(|(c, chunk)| {
+            let mut run = Importer::new(chunk.len());
+            let mut loop_ = Vec::new();
+            for (i, face) in chunk.iter().enumerate() {
+                let fi = c * CHUNK + i;
+                loop_.clear();
+                for (vertex, &v) in face.iter().enumerate() {
+                    let p = positions.get(v as usize).ok_or(Error::VertexIndex {
+                        face: fi,
+                        vertex,
+                        index: v,
+                    })?;
+                    loop_.push(*p);
+                }
+                run.face(grid, &loop_, fi)?;
+            }
+            Ok(run.finish())
+        })
+        .collect();
+    let mut runs = Vec::with_capacity(parts.len());
+    let mut report = ImportReport::default();
+    // the first error in face order, as the sequential import gives
+    for part in parts {
+        let (polys, r) = part?;
+        runs.push(polys);
+        report.add(r);
+    }
+    Ok((runs, report))
+}
+
+impl ImportReport {
+    /// Adds the report of the faces after these.
+    fn add(&mut self, r: ImportReport) {
+        self.faces += r.faces;
+        self.polygons += r.polygons;
+        self.triangulated.extend(r.triangulated);
+        self.dropped.extend(r.dropped);
+    }
 }
 
 /// [`import_faces`], numbering the faces from `first`.
@@ -122,12 +186,34 @@ fn import_from<'a>(
     first: usize,
 ) -> Result<(Vec<Polygon>, ImportReport), Error> {
     let faces = faces.into_iter();
-    // one polygon a face, as a rule: no regrowth (a polygon is large)
-    let mut out = Vec::with_capacity(faces.size_hint().0);
-    let mut report = ImportReport::default();
-    let mut pts: Vec<GridPoint> = Vec::new();
-    for (fi, face) in faces.into_iter().enumerate() {
-        let fi = fi + first;
+    let mut run = Importer::new(faces.size_hint().0);
+    for (fi, face) in faces.enumerate() {
+        run.face(grid, face, fi + first)?;
+    }
+    Ok(run.finish())
+}
+
+/// Faces imported one after the other.
+struct Importer {
+    out: Vec<Polygon>,
+    report: ImportReport,
+    pts: Vec<GridPoint>,
+}
+
+impl Importer {
+    /// Room for about `faces` polygons: one a face as a rule, so that the
+    /// output (large polygons) is not regrown.
+    fn new(faces: usize) -> Importer {
+        Importer {
+            out: Vec::with_capacity(faces),
+            report: ImportReport::default(),
+            pts: Vec::new(),
+        }
+    }
+
+    /// Imports face `fi`.
+    fn face(&mut self, grid: &Grid, face: &[DVec3], fi: usize) -> Result<(), Error> {
+        let (out, report, pts) = (&mut self.out, &mut self.report, &mut self.pts);
         report.faces += 1;
         pts.clear();
         for (vi, p) in face.iter().enumerate() {
@@ -140,10 +226,10 @@ fn import_from<'a>(
             pts.push(g);
         }
         let tag = fi as u32;
-        match Polygon::from_grid_points(&pts, tag) {
+        match Polygon::from_grid_points(pts, tag) {
             Ok(p) => out.push(p),
             Err(defect @ (FaceDefect::NonConvex | FaceDefect::NonPlanar)) => {
-                let tris = triangulate(&pts, defect);
+                let tris = triangulate(pts, defect);
                 let before = out.len();
                 out.extend(
                     tris.iter()
@@ -157,9 +243,13 @@ fn import_from<'a>(
             }
             Err(defect) => report.dropped.push((fi, defect)),
         }
+        Ok(())
     }
-    report.polygons = out.len();
-    Ok((out, report))
+
+    fn finish(mut self) -> (Vec<Polygon>, ImportReport) {
+        self.report.polygons = self.out.len();
+        (self.out, self.report)
+    }
 }
 
 /// Triangles covering the loop: exact ear clipping for planar loops, a fan
@@ -253,6 +343,62 @@ mod tests {
         let f: Vec<DVec3> = face.iter().map(|p| DVec3::from_array(*p)).collect();
         let grid = Grid::new(DVec3::ZERO, 0).unwrap();
         import_faces(&grid, [&f[..]]).unwrap()
+    }
+
+    #[test]
+    fn indexed_import_matches_the_loops() {
+        // many faces (several runs): triangles, a quad, an L (ear-clipped),
+        // a non-planar quad (fanned) and a degenerate one (dropped)
+        let mut positions = Vec::new();
+        let mut faces: Vec<Vec<u32>> = Vec::new();
+        for i in 0..10_000 {
+            let b = positions.len() as u32;
+            let x = (i % 100) as f64 * 3.0;
+            let y = (i / 100) as f64 * 3.0;
+            let shape: &[[f64; 3]] = match i % 5 {
+                0 => &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]],
+                1 => &[[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]],
+                2 => &[
+                    [0., 0., 0.],
+                    [2., 0., 0.],
+                    [2., 1., 0.],
+                    [1., 1., 0.],
+                    [1., 2., 0.],
+                    [0., 2., 0.],
+                ],
+                3 => &[[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 1.]],
+                _ => &[[0., 0., 0.], [1., 1., 1.], [2., 2., 2.]],
+            };
+            positions.extend(shape.iter().map(|p| DVec3::new(p[0] + x, p[1] + y, p[2])));
+            faces.push((b..b + shape.len() as u32).collect());
+        }
+        let grid = Grid::fit_points(&positions).unwrap();
+        let loops: Vec<Vec<DVec3>> = faces
+            .iter()
+            .map(|f| f.iter().map(|&v| positions[v as usize]).collect())
+            .collect();
+        let (want, want_report) = import_faces(&grid, loops.iter().map(|f| &f[..])).unwrap();
+        let (runs, report) = import_indexed_par(&grid, &positions, &faces).unwrap();
+        assert!(runs.len() > 1);
+        let got: Vec<Polygon> = runs.into_iter().flatten().collect();
+        assert_eq!(report, want_report);
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            assert_eq!(g.tag(), w.tag());
+            assert_eq!(g.support(), w.support());
+            assert_eq!(g.vertices_f64(), w.vertices_f64());
+        }
+        // a face naming a vertex the mesh does not have is an error, not
+        // a panic
+        faces[7_000].push(positions.len() as u32);
+        assert_eq!(
+            import_indexed_par(&grid, &positions, &faces).unwrap_err(),
+            Error::VertexIndex {
+                face: 7_000,
+                vertex: 3,
+                index: positions.len() as u32
+            }
+        );
     }
 
     #[test]

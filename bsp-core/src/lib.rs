@@ -58,7 +58,7 @@ pub use exact::{
 };
 pub use flat::FlatBsp;
 pub use grid::{GRID_BITS, Grid, GridPoint, MAX_COORD, MAX_VIEW_COORD, SnapError, ViewPoint};
-pub use import::{ImportReport, all_planar, import_faces, import_faces_par};
+pub use import::{ImportReport, all_planar, import_faces, import_faces_par, import_indexed_par};
 pub use mesh::TriMesh;
 pub use partition::{
     BOX_HALF, BoolOp, CellOp, Overlay, PLink, PNode, Partition, box_section, merge,
@@ -96,6 +96,15 @@ pub enum Error {
     },
     /// Grid parameters are unusable.
     InvalidGrid(&'static str),
+    /// A face names a vertex the mesh does not have.
+    VertexIndex {
+        /// Index of the face.
+        face: usize,
+        /// Position of the index within the face.
+        vertex: usize,
+        /// The index.
+        index: u32,
+    },
 }
 
 impl std::fmt::Display for Error {
@@ -108,6 +117,11 @@ impl std::fmt::Display for Error {
                 reason,
             } => write!(f, "face {face}, vertex {vertex} {value:?}: {reason}"),
             Error::InvalidGrid(why) => write!(f, "invalid grid: {why}"),
+            Error::VertexIndex {
+                face,
+                vertex,
+                index,
+            } => write!(f, "face {face}, vertex {vertex}: no vertex {index}"),
         }
     }
 }

@@ -99,6 +99,33 @@ impl FaceIndex {
         })
     }
 
+    /// The index over `bounds` sized for about `count` faces, holding the
+    /// faces `(id, box)` of `faces` (built in parallel: the same lists as
+    /// inserting them in order of id).
+    pub(crate) fn filled(
+        bounds: IBox,
+        count: usize,
+        faces: impl rayon::iter::IndexedParallelIterator<Item = Option<IBox>>,
+    ) -> FaceIndex {
+        use rayon::prelude::*;
+        let mut ix = FaceIndex::new(bounds, count);
+        let this = &ix;
+        let mut pairs: Vec<(u32, u32)> = faces
+            .enumerate()
+            .flat_map_iter(|(i, b)| {
+                let cells: smallvec::SmallVec<[(u32, u32); 8]> = b
+                    .map(|b| this.cells_of(&b).map(|c| (c as u32, i as u32)).collect())
+                    .unwrap_or_default();
+                cells
+            })
+            .collect();
+        pairs.par_sort_unstable();
+        for run in pairs.chunk_by(|x, y| x.0 == y.0) {
+            ix.cells[run[0].0 as usize] = run.iter().map(|&(_, i)| i).collect();
+        }
+        ix
+    }
+
     /// Calls `f` with each cell's list that `b` overlaps.
     fn each_list(&mut self, b: &IBox, mut f: impl FnMut(&mut Vec<u32>)) {
         let lo = [0, 1, 2].map(|k| self.coord(k, b.0[k]));

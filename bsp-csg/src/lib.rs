@@ -81,7 +81,7 @@ mod winding;
 
 use bsp_core::{
     BoolOp, Grid, GridPoint, ImportReport, Membership, Polygon, Side, TopologyError, TriMesh,
-    check_closed_manifold, import_faces_par, share_points,
+    check_closed_manifold, import_indexed_par, share_points,
 };
 use glam::DVec3;
 use rayon::prelude::*;
@@ -307,6 +307,11 @@ impl Solid {
                 Some(Face::new(p.with_tag(0), &bx))
             })
             .collect();
+        Solid::from_faces(faces)
+    }
+
+    /// The solid of these face slots, indexed.
+    fn from_faces(faces: Vec<Option<Face>>) -> Solid {
         let mut s = Solid {
             faces,
             free: Vec::new(),
@@ -320,24 +325,47 @@ impl Solid {
         s
     }
 
+    /// [`Solid::from_polygons`] of runs of polygons (as
+    /// [`bsp_core::import_indexed_par`] gives them), each run moved into
+    /// its place in parallel.
+    pub fn from_runs(runs: Vec<Vec<Polygon>>) -> Solid {
+        let n: usize = runs.iter().map(Vec::len).sum();
+        let mut faces: Vec<Option<Face>> = Vec::with_capacity(n);
+        faces.par_extend((0..n).into_par_iter().map(|_| None));
+        let mut slots: Vec<&mut [Option<Face>]> = Vec::with_capacity(runs.len());
+        let mut rest = &mut faces[..];
+        for r in &runs {
+            let (here, after) = rest.split_at_mut(r.len());
+            slots.push(here);
+            rest = after;
+        }
+        slots.into_par_iter().zip(runs).for_each(|(slots, run)| {
+            for (slot, p) in slots.iter_mut().zip(run) {
+                let bx = polygon_box(&p);
+                *slot = Some(Face::new(p.with_tag(0), &bx));
+            }
+        });
+        Solid::from_faces(faces)
+    }
+
     /// An empty solid.
     pub fn empty() -> Solid {
         Solid::from_polygons(Vec::new())
     }
 
     fn reindex(&mut self) {
-        let mut bounds: Option<IBox> = None;
-        for f in self.faces.iter().flatten() {
-            bounds = Some(bounds.map_or(f.bx(), |b| union(&b, &f.bx())));
-        }
+        let bounds = self
+            .faces
+            .par_iter()
+            .filter_map(|f| f.as_ref().map(Face::bx))
+            .reduce_with(|a, b| union(&a, &b));
         self.bounds = bounds;
         self.indexed = self.live.max(1);
-        self.index = FaceIndex::new(bounds.unwrap_or(([0; 3], [0; 3])), self.indexed);
-        for (i, f) in self.faces.iter().enumerate() {
-            if let Some(f) = f {
-                self.index.insert(i as u32, &f.bx());
-            }
-        }
+        self.index = FaceIndex::filled(
+            bounds.unwrap_or(([0; 3], [0; 3])),
+            self.indexed,
+            self.faces.par_iter().map(|f| f.as_ref().map(Face::bx)),
+        );
     }
 
     /// Number of faces.
@@ -1549,17 +1577,13 @@ pub fn snap_one(
     mesh: &MeshIn<'_>,
     operand: usize,
 ) -> Result<(Solid, ImportReport), CsgError> {
-    let loops: Vec<Vec<DVec3>> = mesh
-        .faces
-        .iter()
-        .map(|f| f.iter().map(|&v| mesh.positions[v as usize]).collect())
-        .collect();
-    let (polys, report) = import_faces_par(grid, &loops).map_err(CsgError::Grid)?;
-    drop(loops);
-    if six_volume_sign(&polys) < 0 {
+    let (runs, report) =
+        import_indexed_par(grid, mesh.positions, mesh.faces).map_err(CsgError::Grid)?;
+    let sign: i128 = runs.par_iter().map(|r| six_volume(r)).sum();
+    if sign < 0 {
         return Err(CsgError::Inward { operand });
     }
-    Ok((Solid::from_polygons(polys), report))
+    Ok((Solid::from_runs(runs), report))
 }
 
 /// `((first op₁ m₁) op₂ m₂) ...` on one grid: every operand is checked
@@ -1595,17 +1619,20 @@ pub fn mesh_sequence(
     })
 }
 
-/// The exact sign of the volume the polygons bound (fans of grid
-/// vertices, summed in `i128`: coordinates below 2^26 keep each term below
-/// 2^81). Polygons with implicit vertices do not come from an import and
-/// are skipped.
-fn six_volume_sign(polys: &[Polygon]) -> i32 {
+/// Six times the exact volume the polygons bound (fans of grid vertices,
+/// summed in `i128`: coordinates below 2^26 keep each term below 2^81).
+/// Polygons with implicit vertices do not come from an import and are
+/// skipped.
+fn six_volume(polys: &[Polygon]) -> i128 {
     let mut v: i128 = 0;
     for p in polys {
-        let g: Option<Vec<[i128; 3]>> = p
+        let g: Option<SmallVec<[[i128; 3]; 4]>> = p
             .vertices()
             .iter()
-            .map(|q| q.as_grid().map(|c| c.map(i128::from)))
+            .map(|q| match q {
+                bsp_core::Point::Grid(c) => Some(c.map(i128::from)),
+                bsp_core::Point::Implicit(_) => None,
+            })
             .collect();
         let Some(g) = g else { continue };
         for w in g[1..].windows(2) {
@@ -1614,5 +1641,5 @@ fn six_volume_sign(polys: &[Polygon]) -> i32 {
                 + a[2] * (b[0] * c[1] - b[1] * c[0]);
         }
     }
-    v.signum() as i32
+    v
 }

@@ -28,12 +28,8 @@ use crate::octree::walls;
 /// an area: no edge line of either has the other wholly on its outer side
 /// (separating axes; nothing is built).
 fn overlap(piece: &Polygon, face: &Polygon) -> bool {
-    let separates = |e: &Plane, other: &Polygon| {
-        other
-            .vertices()
-            .iter()
-            .all(|v| v.classify(e) != Side::Back)
-    };
+    let separates =
+        |e: &Plane, other: &Polygon| other.vertices().iter().all(|v| v.classify(e) != Side::Back);
     !face.edge_planes().iter().any(|e| separates(e, piece))
         && !piece.edge_planes().iter().any(|e| separates(e, face))
 }

@@ -33,10 +33,14 @@ fn drill(tools: usize, opts: &Options) -> (f64, usize) {
 
 #[test]
 fn twenty_tools_through_a_pole_fan() {
-    let (box_lists, _) = drill(20, &Options::default());
+    let (box_lists, tris) = drill(20, &Options::default());
     let (exact_lists, _) = drill(20, &Options::default().with_exact_cells(true));
     assert_eq!(box_lists, exact_lists, "the exact volume (grid units)");
     assert!(box_lists > 0.0);
+    // the cells whose surfaces do not meet, labelled along the faces,
+    // leave what their local trees leave
+    let full = drill(20, &Options::default().with_easy_cells(false));
+    assert_eq!((box_lists, tris), full);
 }
 
 /// After one operation on imported solids (grid vertices only), every
