@@ -2,7 +2,8 @@
 //!
 //! [`TriMesh::from_polygons`] welds exactly equal vertices, inserts into
 //! every polygon edge each vertex that lies exactly on it (so that no
-//! T-junction remains), and triangulates each polygon without new vertices.
+//! T-junction remains; an edge used once each way is closed already and
+//! skips the search), and triangulates each polygon without new vertices.
 //! When the polygons tile the boundary of a solid, every edge of the result
 //! is shared by exactly two triangles with opposite directions.
 
@@ -186,6 +187,7 @@ impl TriMesh {
             .map(|v| v.to_f64().map(|c| c as f32))
             .collect();
         let near = Candidates::new(&coords);
+        let twinned = twinned_edges(&corners, &start);
 
         // each polygon's triangles on its own, in parallel; chunks keep
         // the order of the polygons
@@ -198,7 +200,8 @@ impl TriMesh {
                 let mut of = Vec::new();
                 let first = c * RUN;
                 let cs_of = |i: usize| &corners[start[first + i]..start[first + i + 1]];
-                for (i, poly) in polys.iter().enumerate() {
+                for (pi, poly) in polys.iter().enumerate() {
+                    let i = pi;
                     let cs = cs_of(i);
                     let poly: &Polygon = poly.borrow();
                     let k = cs.len();
@@ -210,7 +213,13 @@ impl TriMesh {
                             a,
                             SmallVec::from_slice(&[((i + k - 1) % k) as u32, i as u32]),
                         ));
-                        let mut on_edge = edge_points(poly, i, a, b, &vertices, &coords, &near);
+                        // an edge used once each way needs no search
+                        // (`twinned_edges`)
+                        let mut on_edge = if twinned[start[first + pi] + i] {
+                            Vec::new()
+                        } else {
+                            edge_points(poly, i, a, b, &vertices, &coords, &near)
+                        };
                         if on_edge.len() > 1 {
                             let (pa, pb) = (&vertices[a as usize], &vertices[b as usize]);
                             let axis = (0..3)
@@ -248,7 +257,7 @@ impl TriMesh {
                 (triangles, of)
             })
             .collect();
-        drop((near, coords, corners, start));
+        drop((near, coords, corners, start, twinned));
         let n: usize = chunks.iter().map(|c| c.0.len()).sum();
         let mut triangles = Vec::with_capacity(n);
         let mut of = Vec::with_capacity(n);
@@ -472,9 +481,10 @@ impl TriMesh {
         out
     }
 
-    /// Vertex coordinates (grid units), correctly rounded.
+    /// Vertex coordinates (grid units), correctly rounded (in parallel:
+    /// an implicit vertex's rounding is an exact division).
     pub fn vertices_f64(&self) -> Vec<[f64; 3]> {
-        self.vertices.iter().map(Point::to_f64).collect()
+        self.vertices.par_iter().map(Point::to_f64).collect()
     }
 
     /// Checks that every directed edge appears once and its reverse once
@@ -693,6 +703,47 @@ impl TriMesh {
     }
 }
 
+/// For every polygon edge (by its first corner's place in `corners`,
+/// polygon `p`'s corners being `corners[start[p]..start[p + 1]]`): whether
+/// it is used exactly once and its reverse exactly once. No vertex needs
+/// to be inserted into such an edge: where the polygons bound a solid, a
+/// vertex strictly inside it could only be a point where the surface
+/// touches itself (a vertex of other polygons, whose own edges along the
+/// line, if any, come in pairs of their own), and the edge's two uses
+/// already close it.
+fn twinned_edges(corners: &[u32], start: &[usize]) -> Vec<bool> {
+    if corners.len() >= 1 << 31 {
+        return vec![false; corners.len()]; // places do not fit: search all
+    }
+    // (undirected edge, place << 1 | direction), sorted
+    let mut keys: Vec<(u64, u32)> = (0..start.len() - 1)
+        .into_par_iter()
+        .flat_map_iter(|p| {
+            let cs = &corners[start[p]..start[p + 1]];
+            let k = cs.len();
+            (0..k).map(move |i| {
+                let (a, b) = (cs[i], cs[(i + 1) % k]);
+                let (lo, hi, dir) = if a < b { (a, b, 0) } else { (b, a, 1) };
+                (
+                    (lo as u64) << 32 | hi as u64,
+                    ((start[p] + i) as u32) << 1 | dir,
+                )
+            })
+        })
+        .collect();
+    keys.par_sort_unstable();
+    let mut twinned = vec![false; corners.len()];
+    for group in keys.chunk_by(|x, y| x.0 == y.0) {
+        if let [(_, e), (_, f)] = group
+            && (e ^ f) & 1 == 1
+        {
+            twinned[(e >> 1) as usize] = true;
+            twinned[(f >> 1) as usize] = true;
+        }
+    }
+    twinned
+}
+
 /// Welded vertices lying strictly inside edge `i` (from `a` to `b`) of `poly`.
 #[allow(clippy::too_many_arguments)]
 fn edge_points(
@@ -859,6 +910,21 @@ fn clip_ears(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_edge_is_twinned_when_used_once_each_way() {
+        // polygons by corner ids: 0-1 once each way; 4-5 twice one way
+        let polys: [&[u32]; 5] = [&[0, 1, 2], &[1, 0, 3], &[4, 5, 6], &[5, 4, 7], &[4, 5, 8]];
+        let corners: Vec<u32> = polys.concat();
+        let mut start = vec![0];
+        for p in polys {
+            start.push(start.last().unwrap() + p.len());
+        }
+        let t = twinned_edges(&corners, &start);
+        // the edge from each corner to the next of its polygon
+        let twinned: Vec<usize> = (0..t.len()).filter(|&e| t[e]).collect();
+        assert_eq!(twinned, [0, 3]);
+    }
 
     #[test]
     fn welding_across_runs_finds_every_shared_corner() {

@@ -9,6 +9,7 @@
 //! module is the front end: loading, messages that point into the files,
 //! and the report; the work is the library's.
 
+use rayon::prelude::*;
 use std::io::Write;
 use std::panic;
 use std::path::{Path, PathBuf};
@@ -339,12 +340,12 @@ fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Resu
         let mesh = Mesh {
             positions: exact
                 .vertices_f64()
-                .into_iter()
+                .into_par_iter()
                 .map(|v| grid.to_world(v))
                 .collect(),
             faces: exact
                 .triangles
-                .iter()
+                .par_iter()
                 .map(|t| Face {
                     vertices: t.to_vec(),
                     line: 0,
