@@ -101,15 +101,28 @@ pub fn import_faces_par(
         .enumerate()
         .map(|(i, chunk)| import_from(grid, chunk.iter().map(|f| &f[..]), i * CHUNK))
         .collect();
+    let (runs, report) = gather(parts)?;
     let mut out = Vec::with_capacity(faces.len());
-    let mut report = ImportReport::default();
-    // the first error in face order, as the sequential import gives
-    for part in parts {
-        let (polys, r) = part?;
-        out.extend(polys);
-        report.add(r);
+    for run in runs {
+        out.extend(run);
     }
     Ok((out, report))
+}
+
+/// The runs of a parallel import in face order, with their report joined;
+/// the first error in face order, as the sequential import gives.
+#[allow(clippy::type_complexity)]
+fn gather(
+    parts: Vec<Result<(Vec<Polygon>, ImportReport), Error>>,
+) -> Result<(Vec<Vec<Polygon>>, ImportReport), Error> {
+    let mut runs = Vec::with_capacity(parts.len());
+    let mut report = ImportReport::default();
+    for part in parts {
+        let (polys, r) = part?;
+        runs.push(polys);
+        report.add(r);
+    }
+    Ok((runs, report))
 }
 
 /// [`import_faces`] of an indexed mesh (positions and vertex-index
@@ -158,15 +171,7 @@ pub fn import_indexed_par(
             Ok(run.finish())
         })
         .collect();
-    let mut runs = Vec::with_capacity(parts.len());
-    let mut report = ImportReport::default();
-    // the first error in face order, as the sequential import gives
-    for part in parts {
-        let (polys, r) = part?;
-        runs.push(polys);
-        report.add(r);
-    }
-    Ok((runs, report))
+    gather(parts)
 }
 
 impl ImportReport {
@@ -358,14 +363,7 @@ mod tests {
             let shape: &[[f64; 3]] = match i % 5 {
                 0 => &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]],
                 1 => &[[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]],
-                2 => &[
-                    [0., 0., 0.],
-                    [2., 0., 0.],
-                    [2., 1., 0.],
-                    [1., 1., 0.],
-                    [1., 2., 0.],
-                    [0., 2., 0.],
-                ],
+                2 => L_SHAPE,
                 3 => &[[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 1.]],
                 _ => &[[0., 0., 0.], [1., 1., 1.], [2., 2., 2.]],
             };
@@ -401,16 +399,19 @@ mod tests {
         );
     }
 
+    /// A non-convex planar face.
+    const L_SHAPE: &[[f64; 3]] = &[
+        [0., 0., 0.],
+        [2., 0., 0.],
+        [2., 1., 0.],
+        [1., 1., 0.],
+        [1., 2., 0.],
+        [0., 2., 0.],
+    ];
+
     #[test]
     fn l_shape_is_ear_clipped() {
-        let (p, r) = import(&[
-            [0., 0., 0.],
-            [2., 0., 0.],
-            [2., 1., 0.],
-            [1., 1., 0.],
-            [1., 2., 0.],
-            [0., 2., 0.],
-        ]);
+        let (p, r) = import(L_SHAPE);
         assert_eq!(p.len(), 4);
         assert_eq!(r.triangulated, vec![(0, FaceDefect::NonConvex)]);
         assert!(p.iter().all(|q| q.support().normal() == [0, 0, 1]));

@@ -115,6 +115,11 @@ pub(crate) fn polygon_meets(poly: &Polygon, bx: &IBox) -> bool {
     true
 }
 
+/// A test of a face's plane against a cell, for [`Faces`].
+pub(crate) trait PlaneTest: Fn(u32, &IBox) -> bool + Sync {}
+
+impl<T: Fn(u32, &IBox) -> bool + Sync> PlaneTest for T {}
+
 /// One operand's faces for [`build`]: each face's box, and a test of its
 /// plane against a cell (`true` whenever the face meets the cell; it may
 /// be `true` more often).
@@ -133,22 +138,25 @@ pub(crate) struct Faces<'a, P> {
 /// nothing when faces pile up at one point (a vertex of high degree on the
 /// other surface), so the depth stays bounded there. Large cells' subtrees
 /// are built in parallel (the same leaves, in the same order).
-pub(crate) fn build<P, Q>(
+pub(crate) fn build<P: PlaneTest, Q: PlaneTest>(
     domain: IBox,
     a: &Faces<'_, P>,
     b: &Faces<'_, Q>,
     leaf_size: usize,
-) -> Vec<Leaf>
-where
-    P: Fn(u32, &IBox) -> bool + Sync,
-    Q: Fn(u32, &IBox) -> bool + Sync,
-{
+) -> Vec<Leaf> {
     let root = Leaf {
         bx: domain,
         a: (0..a.boxes.len() as u32).collect(),
         b: (0..b.boxes.len() as u32).collect(),
     };
-    grow(root, 0, a, b, leaf_size)
+    grow(root, 0, &Octree { a, b, leaf_size })
+}
+
+/// What the build works from.
+struct Octree<'f, 'a, P, Q> {
+    a: &'f Faces<'a, P>,
+    b: &'f Faces<'a, Q>,
+    leaf_size: usize,
 }
 
 /// Cells with more faces than this build their children's subtrees in
@@ -157,29 +165,20 @@ const PARALLEL_FACES: usize = 2048;
 
 /// The leaves under `cell`, in order; `stalled` counts the splits in a row
 /// that made no progress.
-fn grow<P, Q>(
+fn grow<P: PlaneTest, Q: PlaneTest>(
     cell: Leaf,
     stalled: u8,
-    a: &Faces<'_, P>,
-    b: &Faces<'_, Q>,
-    leaf_size: usize,
-) -> Vec<Leaf>
-where
-    P: Fn(u32, &IBox) -> bool + Sync,
-    Q: Fn(u32, &IBox) -> bool + Sync,
-{
+    o: &Octree<'_, '_, P, Q>,
+) -> Vec<Leaf> {
     let mut leaves = Vec::new();
     let mut stack = vec![(cell, stalled)];
     while let Some((cell, stalled)) = stack.pop() {
-        let Some((kids, stalled)) = split(&cell, stalled, a, b, leaf_size) else {
+        let Some((kids, stalled)) = split(&cell, stalled, o) else {
             leaves.push(cell);
             continue;
         };
         if cell.a.len() + cell.b.len() > PARALLEL_FACES {
-            let parts: Vec<Vec<Leaf>> = kids
-                .into_par_iter()
-                .map(|k| grow(k, stalled, a, b, leaf_size))
-                .collect();
+            let parts: Vec<Vec<Leaf>> = kids.into_par_iter().map(|k| grow(k, stalled, o)).collect();
             leaves.extend(parts.into_iter().flatten());
         } else {
             // children pushed in reverse so that they come out in order
@@ -193,17 +192,12 @@ where
 
 /// The children of `cell` with their faces, and their count of stalled
 /// splits; `None` if the cell is a leaf.
-fn split<P, Q>(
+fn split<P: PlaneTest, Q: PlaneTest>(
     cell: &Leaf,
     stalled: u8,
-    a: &Faces<'_, P>,
-    b: &Faces<'_, Q>,
-    leaf_size: usize,
-) -> Option<(Vec<Leaf>, u8)>
-where
-    P: Fn(u32, &IBox) -> bool + Sync,
-    Q: Fn(u32, &IBox) -> bool + Sync,
-{
+    o: &Octree<'_, '_, P, Q>,
+) -> Option<(Vec<Leaf>, u8)> {
+    let (a, b, leaf_size) = (o.a, o.b, o.leaf_size);
     let (lo, hi) = cell.bx;
     let axes: SmallVec<[usize; 3]> = (0..3).filter(|&k| hi[k] > lo[k]).collect();
     if !cell.mixed()
