@@ -784,9 +784,10 @@ impl Solid {
             }
         }
         let mut labels_a = label_easy(
-            &pieces_a,
+            true,
             |f| &self.face(f).poly,
             &leaves,
+            &adjacent,
             &masks_a,
             &listed_a,
             &label_of(&fates_a, keep_a(true)),
@@ -794,9 +795,10 @@ impl Solid {
             &|g| other.winding(g) != 0,
         )?;
         let mut labels_b = label_easy(
-            &pieces_b,
+            false,
             |f| &other.face(f).poly,
             &leaves,
+            &adjacent,
             &masks_b,
             &listed_b,
             &label_of(&fates_b, keep_b(true)),
@@ -1305,15 +1307,30 @@ impl Listed {
 /// `inside` of a grid vertex of one of its pieces.
 #[allow(clippy::too_many_arguments)]
 fn label_easy<'p>(
-    faces: &[(u32, Vec<Piece>)],
+    side_a: bool,
     poly: impl Fn(u32) -> &'p Polygon + Sync,
     leaves: &[Leaf],
+    adjacent: &[(u32, u32)],
     masks: &FxHashMap<u32, Vec<Option<u8>>>,
     listed: &FxHashMap<u32, Listed>,
     known: &(dyn Fn(u32, u32) -> Option<bool> + Sync),
     free_inside: &(dyn Fn(u32) -> bool + Sync),
     inside: &(dyn Fn(GridPoint) -> bool + Sync),
 ) -> Result<FxHashMap<u32, Vec<Option<bool>>>, CsgError> {
+    // a leaf's faces of this operand (ascending ids; in a mixed leaf, in
+    // the order of its listed faces), and whether it is free of the other
+    let list = |l: u32| -> &[u32] {
+        let leaf = &leaves[l as usize];
+        if side_a { &leaf.a } else { &leaf.b }
+    };
+    let free = |l: u32| {
+        let leaf = &leaves[l as usize];
+        if side_a {
+            leaf.b.is_empty()
+        } else {
+            leaf.a.is_empty()
+        }
+    };
     // nodes: 0 and 1 stand for the labels outside and inside, then the
     // listed faces of each easy cell from its base
     let mut base: FxHashMap<u32, u32> = FxHashMap::default();
@@ -1324,7 +1341,7 @@ fn label_easy<'p>(
         base.insert(l, n);
         n += listed[&l].masks.len() as u32;
     }
-    // the node of a face's piece in a mixed cell, if it has one
+    // the node of the `i`-th listed face of a mixed cell, if it has one
     let node = |l: u32, i: u32| -> Option<u32> {
         masks.get(&l).and_then(|v| v[i as usize])?;
         match base.get(&l) {
@@ -1332,69 +1349,59 @@ fn label_easy<'p>(
             None => known(l, i).map(u32::from),
         }
     };
-    struct End {
-        cell: u32,
-        node: u32,
-        /// The walls the piece crosses; for a free cell, found when asked.
-        mask: Option<u8>,
-    }
-    let mut joins: Vec<(u32, u32)> = faces
-        .par_iter()
-        .filter(|(_, ps)| {
-            ps.iter()
-                .any(|p| matches!(p, Piece::Mixed(l, _) if base.contains_key(l)))
-        })
-        .flat_map_iter(|(f, ps)| {
-            let mut ends: SmallVec<[End; 8]> = SmallVec::new();
-            for p in ps {
-                match *p {
-                    Piece::Free(Some(l)) => ends.push(End {
-                        cell: l,
-                        node: free_inside(l) as u32,
-                        mask: None,
-                    }),
-                    Piece::Free(None) => {}
-                    Piece::Mixed(l, i) => {
-                        if let Some(node) = node(l, i) {
-                            let mask = masks[&l][i as usize];
-                            ends.push(End {
-                                cell: l,
-                                node,
-                                mask,
-                            });
-                        }
-                    }
-                }
+    // the easy cells' neighbours
+    let mut around: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+    for &(x, y) in adjacent {
+        for (p, q) in [(x, y), (y, x)] {
+            if base.contains_key(&p) {
+                around.entry(p).or_default().push(q);
             }
-            let mask = |e: &mut End| -> u8 {
-                *e.mask.get_or_insert_with(|| {
-                    let w = walls(&leaves[e.cell as usize].bx);
-                    local::clip_to(poly(*f), &w).map_or(0, |q| local::wall_edges(&q, &w))
-                })
-            };
+        }
+    }
+    // each easy cell's pieces joined with the same face's pieces in the
+    // cells around, across the walls the smaller of the two crosses
+    let mut joins: Vec<(u32, u32)> = cells
+        .par_iter()
+        .flat_map_iter(|&l| {
+            let (b, fs) = (base[&l], list(l));
+            let ml = &masks[&l];
             let mut out = Vec::new();
-            for j in 0..ends.len() {
-                for k in j + 1..ends.len() {
-                    if ends[j].node < 2 && ends[k].node < 2 {
+            for &m in around.get(&l).map_or(&[][..], |v| &v[..]) {
+                let (bl, bm) = (&leaves[l as usize].bx, &leaves[m as usize].bx);
+                let (here, there) = (facing(bl, bm), facing(bm, bl));
+                if here.is_none() && there.is_none() {
+                    continue;
+                }
+                let others = list(m);
+                for (i, &f) in fs.iter().enumerate() {
+                    let Some(mask) = ml[i] else { continue };
+                    let Ok(j) = others.binary_search(&f) else {
                         continue;
-                    }
-                    let (bj, bk) = (
-                        &leaves[ends[j].cell as usize].bx,
-                        &leaves[ends[k].cell as usize].bx,
-                    );
-                    // either piece's edge on the wall will do when the
-                    // cells' walls are the same: rather one already known
-                    // than one of a free cell, which must be clipped
-                    let linked = match (facing(bj, bk), facing(bk, bj)) {
-                        (Some(w), Some(_)) if ends[j].mask.is_some() || ends[k].mask.is_none() => {
-                            mask(&mut ends[j]) & (1 << w) != 0
+                    };
+                    // the face's piece in `m`: its node, and the walls it
+                    // crosses (a free cell's piece is clipped when needed)
+                    let (other, other_mask) = if free(m) {
+                        (free_inside(m) as u32, None)
+                    } else {
+                        let Some(node) = node(m, j as u32) else {
+                            continue;
+                        };
+                        (node, masks[&m][j])
+                    };
+                    let linked = match (here, there) {
+                        (Some(w), _) => mask & (1 << w) != 0,
+                        (None, Some(w)) => {
+                            let mm = other_mask.unwrap_or_else(|| {
+                                let wm = walls(bm);
+                                local::clip_to(poly(f), &wm)
+                                    .map_or(0, |q| local::wall_edges(&q, &wm))
+                            });
+                            mm & (1 << w) != 0
                         }
-                        (_, Some(w)) => mask(&mut ends[k]) & (1 << w) != 0,
-                        (Some(w), None) => mask(&mut ends[j]) & (1 << w) != 0,
                         (None, None) => false,
                     };
                     if linked {
-                        out.push((ends[j].node, ends[k].node));
+                        out.push((b + i as u32, other));
                     }
                 }
             }

@@ -99,3 +99,32 @@ fn new_vertices_are_shared_and_into_mesh_is_to_mesh() {
     );
     owned.check_watertight().unwrap();
 }
+
+/// A box whose large faces run through many cells along the sphere: each
+/// of them has pieces in easy cells, labelled from the cells around.
+#[test]
+fn a_box_through_a_sphere_with_and_without_easy_cells() {
+    use glam::DVec3;
+    let (sv, sf) = uv_sphere(4000);
+    let quads = bsp_csg::shapes::cuboid(DVec3::splat(-0.4), DVec3::splat(1.7));
+    let bv: Vec<DVec3> = quads.concat();
+    let bf: Vec<Vec<u32>> = (0..quads.len() as u32)
+        .map(|q| (4 * q..4 * q + 4).collect())
+        .collect();
+    let meshes = [MeshIn::new(&sv, &sf), MeshIn::new(&bv, &bf)];
+    let Snapped { solids, .. } = snap(&meshes).unwrap();
+    for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
+        let run = |opts: &Options| {
+            let mut s = solids[0].clone();
+            let stats = s.apply_with(&solids[1], op, opts).unwrap();
+            let mesh = s.to_mesh();
+            mesh.check_watertight().unwrap();
+            (mesh, stats)
+        };
+        let (easy, stats) = run(&Options::default().with_leaf_size(8));
+        assert!(stats.easy_cells > 0, "{op:?}: {stats:?}");
+        let (full, _) = run(&Options::default().with_leaf_size(8).with_easy_cells(false));
+        assert_eq!(easy.triangles, full.triangles, "{op:?}");
+        assert_eq!(easy.volume_rounded(), full.volume_rounded(), "{op:?}");
+    }
+}
