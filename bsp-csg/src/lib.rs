@@ -19,7 +19,11 @@
 //!    cut by the other surface into kept fragments. Where faces of the two
 //!    operands share a plane, the cell's two partitions are merged with
 //!    `bsp-core`'s set operations instead (coplanar and touching faces
-//!    included). Cells run in parallel.
+//!    included). Cells run in parallel. A cell where the two surfaces come
+//!    near without meeting (each piece strictly on one side of the other
+//!    surface's pieces' planes, or they of its) builds nothing: its pieces
+//!    take their labels along their faces from the cells around
+//!    ([`Options::easy_cells`]).
 //! 4. Every other face lies in cells the other surface does not enter: it
 //!    is wholly inside or outside the other solid. Those cells form
 //!    connected regions of space free of the other surface (adjacent cells
