@@ -666,35 +666,26 @@ impl Solid {
 
         // the faces wholly in free cells, and the pieces of the others
         let root_walls = walls(&root);
-        let (whole_a, pieces_a, mut cand_a) = sort_faces(
+        let (whole_a, pieces_a) = sort_faces(
             &a_c,
             &a_leaves,
             &leaves,
             &root,
             |f| self.face(f).bx(),
-            |l| l.b.is_empty(),
+            |l| (&l.a, l.b.is_empty()),
         );
-        let (whole_b, pieces_b, mut cand_b) = sort_faces(
+        let (whole_b, pieces_b) = sort_faces(
             &b_c,
             &b_leaves,
             &leaves,
             &root,
             |f| other.face(f).bx(),
-            |l| l.a.is_empty(),
+            |l| (&l.b, l.a.is_empty()),
         );
-        // the mixed cells, in parallel
+        // the mixed cells, in parallel; a mixed leaf's lists are its
+        // listed faces (`Piece::Mixed` indexes them)
         let mixed: Vec<u32> = (0..leaves.len() as u32)
             .filter(|&l| leaves[l as usize].mixed())
-            .collect();
-        let jobs: Vec<(u32, Vec<u32>, Vec<u32>)> = mixed
-            .iter()
-            .map(|&l| {
-                (
-                    l,
-                    std::mem::take(&mut cand_a[l as usize]),
-                    std::mem::take(&mut cand_b[l as usize]),
-                )
-            })
             .collect();
         // Each cell clips its faces to its walls itself, so that only the
         // cells at work hold their pieces, and finds the pieces that meet
@@ -703,11 +694,11 @@ impl Solid {
         // carried along their faces from the neighbouring cells
         // (`label_easy`). The others build their partitions and give
         // back what stays.
-        let run = |l: u32, fa: &[u32], fb: &[u32], allow_easy: bool| -> Result<First, CsgError> {
-            let bx = leaves[l as usize].bx;
-            let w = walls(&bx);
-            let (pa, ia) = clip_all(fa, |f| &self.face(f).poly, &w);
-            let (pb, ib) = clip_all(fb, |f| &other.face(f).poly, &w);
+        let run = |l: u32, allow_easy: bool| -> Result<First, CsgError> {
+            let leaf = &leaves[l as usize];
+            let (bx, w) = (leaf.bx, walls(&leaf.bx));
+            let (pa, ia) = clip_all(&leaf.a, |f| &self.face(f).poly, &w);
+            let (pb, ib) = clip_all(&leaf.b, |f| &other.face(f).poly, &w);
             let (isa, isb) = local::isolated(&pa, &pb);
             let masks = |pieces: &[Polygon], iso: &[bool], index: &[Option<u32>]| {
                 index
@@ -721,8 +712,8 @@ impl Solid {
             let (ma, mb) = (masks(&pa, &isa, &ia), masks(&pb, &isb, &ib));
             if allow_easy && isa.iter().chain(&isb).all(|&x| x) {
                 return Ok(First::Easy(
-                    Listed::new(ma, &pa, &ia),
-                    Listed::new(mb, &pb, &ib),
+                    (ma, Listed::new(&pa, &ia)),
+                    (mb, Listed::new(&pb, &ib)),
                 ));
             }
             let r = bx.0.map(|c| c as i32);
@@ -737,9 +728,9 @@ impl Solid {
             )?;
             Ok(First::Done(Made::of(c, &ia, &ib), ma, mb))
         };
-        let first: Vec<(u32, Vec<u32>, Vec<u32>, First)> = jobs
-            .into_par_iter()
-            .map(|(l, fa, fb)| run(l, &fa, &fb, opts.easy_cells).map(|r| (l, fa, fb, r)))
+        let first: Vec<(u32, First)> = mixed
+            .par_iter()
+            .map(|&l| run(l, opts.easy_cells).map(|r| (l, r)))
             .collect::<Result<_, _>>()?;
         let mut stats = Stats {
             cells: leaves.len(),
@@ -751,27 +742,38 @@ impl Solid {
         let mut fates_b: FxHashMap<u32, Vec<PieceFate>> = FxHashMap::default();
         let mut masks_a: FxHashMap<u32, Vec<Option<u8>>> = FxHashMap::default();
         let mut masks_b: FxHashMap<u32, Vec<Option<u8>>> = FxHashMap::default();
-        let mut easy: Vec<(u32, Vec<u32>, Vec<u32>)> = Vec::new();
+        let mut easy: Vec<u32> = Vec::new();
         let mut listed_a: FxHashMap<u32, Listed> = FxHashMap::default();
         let mut listed_b: FxHashMap<u32, Listed> = FxHashMap::default();
-        for (l, fa, fb, r) in first {
+        // a cell done: its boundary (merged) or its fates
+        let mut done = |l: u32,
+                        made: Made,
+                        fates_a: &mut FxHashMap<_, _>,
+                        fates_b: &mut FxHashMap<_, _>| match made {
+            Made::Merged(ps) => {
+                stats.merged_cells += 1;
+                add.extend(ps.into_iter().map(|p| Added::New(Box::new(p))))
+            }
+            Made::Fates(fa, fb) => {
+                fates_a.insert(l, fa);
+                fates_b.insert(l, fb);
+            }
+        };
+        for (l, r) in first {
             match r {
-                First::Easy(la, lb) => {
-                    easy.push((l, fa, fb));
-                    masks_a.insert(l, la.masks.clone());
-                    masks_b.insert(l, lb.masks.clone());
+                First::Easy((ma, la), (mb, lb)) => {
+                    easy.push(l);
+                    masks_a.insert(l, ma);
+                    masks_b.insert(l, mb);
                     listed_a.insert(l, la);
                     listed_b.insert(l, lb);
                 }
-                First::Done(Made::Merged(ps), _, _) => {
-                    stats.merged_cells += 1;
-                    add.extend(ps.into_iter().map(|p| Added::New(Box::new(p))))
-                }
-                First::Done(Made::Fates(fa, fb), ma, mb) => {
-                    fates_a.insert(l, fa);
-                    fates_b.insert(l, fb);
-                    masks_a.insert(l, ma);
-                    masks_b.insert(l, mb);
+                First::Done(made, ma, mb) => {
+                    if matches!(made, Made::Fates(..)) {
+                        masks_a.insert(l, ma);
+                        masks_b.insert(l, mb);
+                    }
+                    done(l, made, &mut fates_a, &mut fates_b);
                 }
             }
         }
@@ -811,8 +813,8 @@ impl Solid {
         )?;
         drop((listed_a, listed_b));
         // an easy cell with a piece no label reached does the full work
-        let mut again: Vec<(u32, Vec<u32>, Vec<u32>)> = Vec::new();
-        for (l, fa, fb) in easy {
+        let mut again: Vec<u32> = Vec::new();
+        for l in easy {
             let la = labels_a.remove(&l).expect("an easy cell");
             let lb = labels_b.remove(&l).expect("an easy cell");
             let settled =
@@ -839,23 +841,16 @@ impl Solid {
                     fates_a.insert(l, sa);
                     fates_b.insert(l, sb);
                 }
-                _ => again.push((l, fa, fb)),
+                _ => again.push(l),
             }
         }
-        let done: Vec<(u32, First)> = again
+        let redone: Vec<(u32, First)> = again
             .into_par_iter()
-            .map(|(l, fa, fb)| run(l, &fa, &fb, false).map(|r| (l, r)))
+            .map(|l| run(l, false).map(|r| (l, r)))
             .collect::<Result<_, _>>()?;
-        for (l, r) in done {
+        for (l, r) in redone {
             match r {
-                First::Done(Made::Merged(ps), _, _) => {
-                    stats.merged_cells += 1;
-                    add.extend(ps.into_iter().map(|p| Added::New(Box::new(p))))
-                }
-                First::Done(Made::Fates(fa, fb), _, _) => {
-                    fates_a.insert(l, fa);
-                    fates_b.insert(l, fb);
-                }
+                First::Done(made, _, _) => done(l, made, &mut fates_a, &mut fates_b),
                 First::Easy(..) => unreachable!("a second run does the full work"),
             }
         }
@@ -1030,9 +1025,8 @@ enum Piece {
 }
 
 /// Faces wholly in cells free of the other surface (by their place in the
-/// list sorted); the pieces of every other face (by id); per leaf, the
-/// faces in it if it is mixed, in order.
-type Sorted = (Vec<u32>, Vec<(u32, Vec<Piece>)>, Vec<Vec<u32>>);
+/// list sorted), and the pieces of every other face (by id).
+type Sorted = (Vec<u32>, Vec<(u32, Vec<Piece>)>);
 
 /// What becomes of a face listed in a mixed cell.
 enum PieceFate {
@@ -1049,12 +1043,13 @@ enum PieceFate {
     Cut(Vec<Polygon>),
 }
 
-/// A mixed cell's first run: done (with, per listed face of each operand,
-/// the walls an isolated piece crosses, [`local::wall_edges`]), or easy:
-/// every piece isolated, the labels to come from the cells around.
+/// A mixed cell's first run: done, or easy (every piece isolated, the
+/// labels to come from the cells around); either way with, per listed
+/// face of each operand, the walls an isolated piece crosses
+/// ([`local::wall_edges`]).
 enum First {
     Done(Made, Vec<Option<u8>>, Vec<Option<u8>>),
-    Easy(Listed, Listed),
+    Easy((Vec<Option<u8>>, Listed), (Vec<Option<u8>>, Listed)),
 }
 
 /// A mixed cell's outcome, per listed face of each operand, or the
@@ -1109,33 +1104,39 @@ fn clip_all<'p>(
 }
 
 /// Sorts `faces` (their leaves `leaves_of`, by place) into those in free
-/// cells only and those with pieces in mixed cells.
-fn sort_faces(
+/// cells only and those with pieces in mixed cells. `side(leaf)` gives the
+/// leaf's list of this operand's faces and whether it is free of the
+/// other surface; a face's piece in a mixed leaf is named by its place in
+/// that list (the leaves list the faces in the order of `faces`).
+fn sort_faces<'l>(
     faces: &[u32],
     leaves_of: &[SmallVec<[u32; 4]>],
-    leaves: &[Leaf],
+    leaves: &'l [Leaf],
     root: &IBox,
     bx: impl Fn(u32) -> IBox,
-    free: impl Fn(&Leaf) -> bool,
+    side: impl Fn(&'l Leaf) -> (&'l Vec<u32>, bool),
 ) -> Sorted {
     let mut whole = Vec::new();
     let mut pieces = Vec::new();
-    let mut listed: Vec<Vec<u32>> = vec![Vec::new(); leaves.len()];
+    // per leaf, the faces met so far
+    let mut seen: Vec<u32> = vec![0; leaves.len()];
+    let free = |l: u32| side(&leaves[l as usize]).1;
     for (i, (&f, ls)) in faces.iter().zip(leaves_of).enumerate() {
         // a face in no cell lies beyond the octree's box
-        if ls.iter().all(|&l| free(&leaves[l as usize])) {
+        if ls.iter().all(|&l| free(l)) {
             whole.push(i as u32);
             continue;
         }
         let mut mine: Vec<Piece> = ls
             .iter()
             .map(|&l| {
-                if free(&leaves[l as usize]) {
+                if free(l) {
                     Piece::Free(Some(l))
                 } else {
-                    let v = &mut listed[l as usize];
-                    v.push(f);
-                    Piece::Mixed(l, (v.len() - 1) as u32)
+                    let at = seen[l as usize];
+                    seen[l as usize] += 1;
+                    debug_assert_eq!(side(&leaves[l as usize]).0[at as usize], f);
+                    Piece::Mixed(l, at)
                 }
             })
             .collect();
@@ -1145,7 +1146,7 @@ fn sort_faces(
         }
         pieces.push((f, mine));
     }
-    (whole, pieces, listed)
+    (whole, pieces)
 }
 
 /// A leaf among `ls` (the leaves a face's box and plane tests put it in)
@@ -1245,17 +1246,15 @@ fn facing(s: &IBox, l: &IBox) -> Option<usize> {
     None
 }
 
-/// One operand's listed faces in an easy cell: the walls each piece
-/// crosses ([`local::wall_edges`]; `None`: no piece), a grid vertex of
-/// each piece, and the pairs of pieces sharing a grid vertex.
+/// One operand's listed faces in an easy cell: a grid vertex of each
+/// piece, and the pairs of pieces sharing a grid vertex.
 struct Listed {
-    masks: Vec<Option<u8>>,
     grid: Vec<Option<GridPoint>>,
     touch: Vec<(u32, u32)>,
 }
 
 impl Listed {
-    fn new(masks: Vec<Option<u8>>, pieces: &[Polygon], index: &[Option<u32>]) -> Listed {
+    fn new(pieces: &[Polygon], index: &[Option<u32>]) -> Listed {
         let grid_of = |p: &Polygon| -> SmallVec<[GridPoint; 4]> {
             p.vertices()
                 .iter()
@@ -1278,7 +1277,6 @@ impl Listed {
             }
         }
         Listed {
-            masks,
             grid: verts.iter().map(|v| v.first().copied()).collect(),
             touch,
         }
@@ -1343,7 +1341,7 @@ fn label_easy<'p>(
     let mut n = 2u32;
     for &l in &cells {
         base.insert(l, n);
-        n += listed[&l].masks.len() as u32;
+        n += listed[&l].grid.len() as u32;
     }
     // the node of the `i`-th listed face of a mixed cell, if it has one
     let node = |l: u32, i: u32| -> Option<u32> {
@@ -1460,7 +1458,7 @@ fn label_easy<'p>(
     let mut out = FxHashMap::default();
     for &l in &cells {
         let b = base[&l];
-        let labels = (0..listed[&l].masks.len() as u32)
+        let labels = (0..listed[&l].grid.len() as u32)
             .map(|i| match find(&mut parent, b + i) {
                 0 => Some(false),
                 1 => Some(true),
