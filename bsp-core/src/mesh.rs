@@ -200,9 +200,10 @@ impl TriMesh {
                 let mut of = Vec::new();
                 let first = c * RUN;
                 let cs_of = |i: usize| &corners[start[first + i]..start[first + i + 1]];
-                for (pi, poly) in polys.iter().enumerate() {
-                    let i = pi;
+                for (i, poly) in polys.iter().enumerate() {
                     let cs = cs_of(i);
+                    // the place of the polygon's first edge in `twinned`
+                    let edge0 = start[first + i];
                     let poly: &Polygon = poly.borrow();
                     let k = cs.len();
                     // boundary loop: (vertex, edge ids it lies on)
@@ -215,7 +216,7 @@ impl TriMesh {
                         ));
                         // an edge used once each way needs no search
                         // (`twinned_edges`)
-                        let mut on_edge = if twinned[start[first + pi] + i] {
+                        let mut on_edge = if twinned[edge0 + i] {
                             Vec::new()
                         } else {
                             edge_points(poly, i, a, b, &vertices, &coords, &near)
