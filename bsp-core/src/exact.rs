@@ -120,7 +120,7 @@ pub(crate) fn filter_ring_area(ring: impl Iterator<Item = [f64; 2]> + Clone) -> 
 
 /// `2^e` as an `f64`, for `-1022 <= e <= 1023`.
 #[inline]
-fn pow2(e: i32) -> f64 {
+pub(crate) fn pow2(e: i32) -> f64 {
     debug_assert!((-1022..=1023).contains(&e));
     f64::from_bits(((1023 + e) as u64) << 52)
 }
@@ -278,6 +278,14 @@ impl<const N: usize> Homogeneous<N> {
             approx: [approx(&h[0]), approx(&h[1]), approx(&h[2]), approx(&h[3])],
             h,
         })
+    }
+
+    /// The point from coordinates with `w > 0` and their approximations
+    /// as [`approx`] gives them (for a caller that has them cheaper).
+    pub(crate) fn with_approx(h: [BInt<N>; 4], approx: [f64; 4]) -> Self {
+        debug_assert!(h[3].is_positive());
+        debug_assert!((0..4).all(|i| approx[i] == self::approx(&h[i])));
+        Homogeneous { h, approx }
     }
 
     /// The homogeneous coordinates `(x, y, z, w)`, `w > 0`.

@@ -327,9 +327,10 @@ fn exact_det(p1: &Plane, p2: &Plane, p3: &Plane) -> crate::I256 {
         m(n2[2], n3[0]) - m(n2[0], n3[2]),
         m(n2[0], n3[1]) - m(n2[1], n3[0]),
     ];
+    use crate::point::Wide;
     (0..3)
-        .map(|i| crate::point::mul_wide(n1[i] as i128, c[i]))
-        .fold(crate::I256::ZERO, |s, t| s + t)
+        .fold(Wide::ZERO, |s, i| s.add(Wide::product(n1[i] as i128, c[i])))
+        .to_i256()
 }
 
 /// A vertex of a [`PieceArena`], borrowed.

@@ -36,21 +36,107 @@ fn wide(x: i128) -> I256 {
 }
 
 /// The exact product of two `i128`s with magnitudes below `2^127`, as a
-/// 256-bit integer: four 64 × 64-bit products (a general 256-bit
-/// multiplication takes sixteen).
-#[inline]
-pub(crate) fn mul_wide(a: i128, b: i128) -> I256 {
-    const M: u128 = u64::MAX as u128;
-    let (ua, ub) = (a.unsigned_abs(), b.unsigned_abs());
-    let (a0, a1) = (ua & M, ua >> 64);
-    let (b0, b1) = (ub & M, ub >> 64);
-    let (p00, p01, p10, p11) = (a0 * b0, a0 * b1, a1 * b0, a1 * b1);
-    let t1 = (p00 >> 64) + (p01 & M) + (p10 & M);
-    let t2 = (t1 >> 64) + (p01 >> 64) + (p10 >> 64) + (p11 & M);
-    let t3 = (t2 >> 64) + (p11 >> 64);
-    let u = bnum::types::U256::from_digits([p00 as u64, t1 as u64, t2 as u64, t3 as u64]);
-    let v = u.as_::<I256>();
-    if (a < 0) != (b < 0) { -v } else { v }
+/// 256-bit integer ([`Wide::product`]).
+#[cfg(test)]
+fn mul_wide(a: i128, b: i128) -> I256 {
+    Wide::product(a, b).to_i256()
+}
+
+/// A 256-bit two's complement integer in two `u128` halves, for sums of
+/// products of `i128`s: the products and sums run on native 128-bit
+/// operations (four 64 × 64-bit products each) instead of the general
+/// 256-bit arithmetic. Sums wrap modulo `2^256`, so a sum whose true
+/// value has fewer than 256 bits is exact whatever the order.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Wide {
+    lo: u128,
+    hi: u128,
+}
+
+impl Wide {
+    pub(crate) const ZERO: Wide = Wide { lo: 0, hi: 0 };
+
+    /// `a · b`, exactly (`|a|, |b| ≤ 2^127`: the magnitude is below
+    /// `2^254`).
+    #[inline]
+    pub(crate) fn product(a: i128, b: i128) -> Wide {
+        const M: u128 = u64::MAX as u128;
+        let (ua, ub) = (a.unsigned_abs(), b.unsigned_abs());
+        let (a0, a1) = (ua & M, ua >> 64);
+        let (b0, b1) = (ub & M, ub >> 64);
+        let (p00, p01, p10, p11) = (a0 * b0, a0 * b1, a1 * b0, a1 * b1);
+        // the middle products' sum has up to 129 bits: its carry is 2^192
+        let (mid, c_mid) = p01.overflowing_add(p10);
+        let (lo, c_lo) = p00.overflowing_add(mid << 64);
+        let hi = p11
+            .wrapping_add(mid >> 64)
+            .wrapping_add((c_mid as u128) << 64)
+            .wrapping_add(c_lo as u128);
+        let u = Wide { lo, hi };
+        if (a < 0) != (b < 0) { u.neg() } else { u }
+    }
+
+    /// `self + o` (modulo `2^256`).
+    #[inline]
+    pub(crate) fn add(self, o: Wide) -> Wide {
+        let (lo, c) = self.lo.overflowing_add(o.lo);
+        Wide {
+            lo,
+            hi: self.hi.wrapping_add(o.hi).wrapping_add(c as u128),
+        }
+    }
+
+    /// `-self` (modulo `2^256`).
+    #[inline]
+    pub(crate) fn neg(self) -> Wide {
+        let (lo, c) = (!self.lo).overflowing_add(1);
+        Wide {
+            lo,
+            hi: (!self.hi).wrapping_add(c as u128),
+        }
+    }
+
+    #[inline]
+    pub(crate) fn is_zero(self) -> bool {
+        self.lo == 0 && self.hi == 0
+    }
+
+    #[inline]
+    pub(crate) fn is_negative(self) -> bool {
+        (self.hi as i128) < 0
+    }
+
+    /// [`crate::exact::approx`] of the same value, from the halves.
+    #[inline]
+    pub(crate) fn approx(self) -> f64 {
+        use crate::exact::pow2;
+        let neg = self.is_negative();
+        let u = if neg { self.neg() } else { self };
+        let d = [
+            u.lo as u64,
+            (u.lo >> 64) as u64,
+            u.hi as u64,
+            (u.hi >> 64) as u64,
+        ];
+        let v = match d.iter().rposition(|&x| x != 0) {
+            None => return 0.0,
+            Some(0) => d[0] as f64,
+            Some(i) => (d[i] as f64 * pow2(64) + d[i - 1] as f64) * pow2(64 * (i as i32 - 1)),
+        };
+        if neg { -v } else { v }
+    }
+
+    /// The same value as a [`I256`].
+    #[inline]
+    pub(crate) fn to_i256(self) -> I256 {
+        let digits = [
+            self.lo as u64,
+            (self.lo >> 64) as u64,
+            self.hi as u64,
+            (self.hi >> 64) as u64,
+        ];
+        I256::from_bits(bnum::types::U256::from_digits(digits))
+    }
 }
 
 fn cross_wide(a: [i64; 3], b: [i64; 3]) -> [i128; 3] {
@@ -71,21 +157,28 @@ impl Homogeneous<4> {
         let c31 = cross_wide(n3, n1);
         let c12 = cross_wide(n1, n2);
         // |c| < 2^111; det = n1 · c23, |det| < 2^168
-        let mut w = I256::ZERO;
-        for i in 0..3 {
-            w += mul_wide(n1[i] as i128, c23[i]);
-        }
+        let w = (0..3).fold(Wide::ZERO, |s, i| {
+            s.add(Wide::product(n1[i] as i128, c23[i]))
+        });
         if w.is_zero() {
             return None;
         }
         let (d1, d2, d3) = (p1.offset(), p2.offset(), p3.offset());
-        // x · det = -(c23 d1 + c31 d2 + c12 d3); |x| < 3 · 2^111 · 2^83 < 2^196
-        let mut h = [I256::ZERO; 4];
+        // x · det = -(c23 d1 + c31 d2 + c12 d3); |x| < 3 · 2^111 · 2^83 < 2^196;
+        // all four negated at once where det < 0, for w > 0
+        let flip = w.is_negative();
+        let mut h = [Wide::ZERO; 4];
         for i in 0..3 {
-            h[i] = -(mul_wide(c23[i], d1) + mul_wide(c31[i], d2) + mul_wide(c12[i], d3));
+            let s = Wide::product(c23[i], d1)
+                .add(Wide::product(c31[i], d2))
+                .add(Wide::product(c12[i], d3));
+            h[i] = if flip { s } else { s.neg() };
         }
-        h[3] = w;
-        Homogeneous::new(h)
+        h[3] = if flip { w.neg() } else { w };
+        Some(Homogeneous::with_approx(
+            h.map(Wide::to_i256),
+            h.map(Wide::approx),
+        ))
     }
 
     /// The homogeneous coordinates `(x, y, z, w)` with `w > 0`.
@@ -271,6 +364,55 @@ mod tests {
         for (a, b) in cases {
             assert_eq!(mul_wide(a, b), I256::from(a) * I256::from(b), "{a} * {b}");
             assert_eq!(mul_wide(b, -a), I256::from(b) * I256::from(-a));
+        }
+    }
+
+    proptest::proptest! {
+        /// Sums of signed products in the native 128-bit halves equal the
+        /// general 256-bit arithmetic, signs and carries included.
+        #[test]
+        fn wide_sums_match_general_arithmetic(
+            terms in proptest::collection::vec(
+                (-(1i128 << 126)..(1i128 << 126), proptest::num::i128::ANY), 1..4),
+        ) {
+            let mut fast = Wide::ZERO;
+            let mut slow = I256::ZERO;
+            for &(a, b) in &terms {
+                let b = b >> 1;
+                fast = fast.add(Wide::product(a, b));
+                slow += I256::from(a) * I256::from(b);
+                proptest::prop_assert_eq!(Wide::product(a, b).neg().to_i256(), -(I256::from(a) * I256::from(b)));
+            }
+            proptest::prop_assert_eq!(fast.to_i256(), slow);
+            proptest::prop_assert_eq!(fast.is_negative(), slow.is_negative());
+            proptest::prop_assert_eq!(fast.is_zero(), slow.is_zero());
+            proptest::prop_assert_eq!(fast.approx(), crate::exact::approx(&slow));
+        }
+
+        /// The intersection of three planes with large coefficients is the
+        /// solution of the system, checked in the general arithmetic: the
+        /// point lies on each plane and `w > 0`.
+        #[test]
+        fn implicit_points_lie_on_their_planes(
+            n in proptest::collection::vec(-(1i64 << 40)..(1i64 << 40), 9),
+            d in proptest::collection::vec(-(1i128 << 70)..(1i128 << 70), 3),
+        ) {
+            let planes: Vec<Plane> = (0..3)
+                .filter_map(|k| Plane::new([n[3 * k], n[3 * k + 1], n[3 * k + 2]], d[k]))
+                .collect();
+            proptest::prop_assume!(planes.len() == 3);
+            if let Some(p) = Implicit::from_planes(&planes[0], &planes[1], &planes[2]) {
+                let h = p.coords();
+                proptest::prop_assert!(h[3].is_positive());
+                for q in &planes {
+                    let m = q.normal();
+                    let v = I256::from(m[0]) * h[0]
+                        + I256::from(m[1]) * h[1]
+                        + I256::from(m[2]) * h[2]
+                        + I256::from(q.offset()) * h[3];
+                    proptest::prop_assert!(v.is_zero());
+                }
+            }
         }
     }
 
