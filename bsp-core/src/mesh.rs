@@ -492,30 +492,23 @@ impl TriMesh {
     /// (closed, consistently oriented, no T-junctions), and that no
     /// triangle repeats a vertex. Names the first bad edge.
     pub fn check_watertight(&self) -> Result<(), String> {
-        // the common verdict by parallel sorts; a defect is named below
-        let key = |a: u32, b: u32| (a as u64) << 32 | b as u64;
+        // the common verdict by a parallel sort; a defect is named below
         let distinct = self
             .triangles
             .par_iter()
             .all(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
         if distinct {
-            // the directed edges, sorted (an exact-size array: the mesh's
-            // largest allocation here); each used once and its reverse
-            // present means every edge is used once each way
+            // every edge used once each way (an exact-size array: the
+            // mesh's largest allocation here)
             let tris = &self.triangles;
-            let mut fwd: Vec<u64> = (0..3 * tris.len())
+            let edges: Vec<u128> = (0..3 * tris.len())
                 .into_par_iter()
                 .map(|e| {
                     let (t, i) = (&tris[e / 3], e % 3);
-                    key(t[i], t[(i + 1) % 3])
+                    crate::topology::edge_key(t[i], t[(i + 1) % 3])
                 })
                 .collect();
-            fwd.par_sort_unstable();
-            if !fwd.par_windows(2).any(|w| w[0] == w[1])
-                && fwd
-                    .par_iter()
-                    .all(|e| fwd.binary_search(&e.rotate_left(32)).is_ok())
-            {
+            if crate::topology::edges_pair_up(edges) {
                 return Ok(());
             }
         }

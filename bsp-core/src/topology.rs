@@ -117,17 +117,15 @@ fn is_closed_manifold(faces: &[&[u32]]) -> bool {
         return false;
     }
     let key = |a: u32, b: u32| (a as u64) << 32 | b as u64;
-    // every directed edge, sorted: each used once and its reverse present
-    let mut fwd: Vec<u64> = per_corner(faces, |f| f.len(), |f, i| key(f[i], f[(i + 1) % f.len()]));
-    fwd.par_sort_unstable();
-    if fwd.par_windows(2).any(|w| w[0] == w[1])
-        || !fwd
-            .par_iter()
-            .all(|e| fwd.binary_search(&e.rotate_left(32)).is_ok())
-    {
+    // every directed edge used once and its reverse once
+    let edges = per_corner(
+        faces,
+        |f| f.len(),
+        |f, i| edge_key(f[i], f[(i + 1) % f.len()]),
+    );
+    if !edges_pair_up(edges) {
         return false;
     }
-    drop(fwd);
     // vertex links: (v, u) → w, sorted; each vertex's group is one cycle
     let mut link: Vec<(u64, u32)> = per_corner(
         faces,
@@ -161,6 +159,32 @@ fn is_closed_manifold(faces: &[&[u32]]) -> bool {
         }
         steps == g.len()
     })
+}
+
+/// The directed edge `a → b` (`a ≠ b`) as a sort key for
+/// [`edges_pair_up`]: its undirected edge, then its direction.
+#[inline]
+pub(crate) fn edge_key(a: u32, b: u32) -> u128 {
+    let (lo, hi, dir) = if a < b { (a, b, 0) } else { (b, a, 1) };
+    (lo as u128) << 64 | (hi as u128) << 1 | dir
+}
+
+/// `true` if every directed edge of `edges` ([`edge_key`]s) is used once
+/// and its reverse once: sorted, the keys come in pairs, both directions
+/// of one edge, and no edge has a second pair. One parallel sort and one
+/// scan.
+pub(crate) fn edges_pair_up(mut edges: Vec<u128>) -> bool {
+    use rayon::prelude::*;
+    edges.par_sort_unstable();
+    let n = edges.len();
+    n.is_multiple_of(2)
+        && (0..n / 2).into_par_iter().all(|i| {
+            let (x, y) = (edges[2 * i], edges[2 * i + 1]);
+            x >> 1 == y >> 1
+                && x & 1 == 0
+                && y & 1 == 1
+                && edges.get(2 * i + 2).is_none_or(|z| z >> 1 != y >> 1)
+        })
 }
 
 /// `item(face, i)` for every corner `i` of every face (`corners(face)` of
@@ -293,6 +317,24 @@ mod tests {
 
     fn check(f: &[&[u32]]) -> Result<(), TopologyError> {
         check_closed_manifold(f.iter().copied())
+    }
+
+    #[test]
+    fn edges_pair_up_only_once_each_way() {
+        let keys = |e: &[(u32, u32)]| e.iter().map(|&(a, b)| edge_key(a, b)).collect();
+        assert!(edges_pair_up(keys(&[(0, 1), (1, 0), (2, 1), (1, 2)])));
+        assert!(edges_pair_up(Vec::new()));
+        assert!(!edges_pair_up(keys(&[(0, 1)])), "one way only");
+        assert!(!edges_pair_up(keys(&[(0, 1), (0, 1)])), "twice one way");
+        assert!(
+            !edges_pair_up(keys(&[(0, 1), (1, 0), (0, 1), (1, 0)])),
+            "twice each way"
+        );
+        assert!(!edges_pair_up(keys(&[(0, 1), (1, 2)])), "two one-way edges");
+        // the largest ids keep their direction bit apart
+        let m = u32::MAX;
+        assert!(edges_pair_up(keys(&[(m, m - 1), (m - 1, m)])));
+        assert!(!edges_pair_up(keys(&[(m, m - 1), (m, m - 1)])));
     }
 
     #[test]
