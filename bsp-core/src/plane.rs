@@ -50,11 +50,11 @@ fn gcd64(a: u64, b: u64) -> u64 {
     let shift = (a | b).trailing_zeros();
     let (mut a, mut b) = (a >> a.trailing_zeros(), b);
     loop {
+        // a odd; min and max compile to conditional moves
         b >>= b.trailing_zeros();
-        if a > b {
-            std::mem::swap(&mut a, &mut b);
-        }
-        b -= a;
+        let (lo, hi) = (a.min(b), a.max(b));
+        a = lo;
+        b = hi - lo;
         if b == 0 {
             return a << shift;
         }
@@ -86,10 +86,10 @@ impl Plane {
         }
         // the normal's gcd first (binary, in 64 bits): usually 1, and then
         // the offset need not be looked at
-        let mut g = gcd64(
-            gcd64(n[0].unsigned_abs(), n[1].unsigned_abs()),
-            n[2].unsigned_abs(),
-        );
+        let mut g = gcd64(n[0].unsigned_abs(), n[1].unsigned_abs());
+        if g != 1 {
+            g = gcd64(g, n[2].unsigned_abs());
+        }
         if g > 1 {
             g = gcd(g as u128, d.unsigned_abs() % g as u128) as u64;
         }
@@ -284,6 +284,22 @@ mod tests {
         ] {
             assert_eq!(gcd64(a, b) as u128, gcd(a as u128, b as u128), "{a} {b}");
         }
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..10_000 {
+            // xorshift pairs, and pairs with a large common factor
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let (a, b) = (x >> (x % 40), x.rotate_left(17) >> (x % 23));
+            assert_eq!(gcd64(a, b) as u128, gcd(a as u128, b as u128), "{a} {b}");
+            let (a, b) = ((a >> 40) * 1_000_003, (b >> 40) * 1_000_003);
+            assert_eq!(gcd64(a, b) as u128, gcd(a as u128, b as u128), "{a} {b}");
+        }
+        // the third component counts when the first two share a factor
+        let p = Plane::new([6, 10, 15], 30).unwrap();
+        assert_eq!((p.normal(), p.offset()), ([6, 10, 15], 30));
+        let p = Plane::new([6, 10, 14], 30).unwrap();
+        assert_eq!((p.normal(), p.offset()), ([3, 5, 7], 15));
         // the offset takes part in the reduction
         let p = Plane::new([6, 12, 18], 9).unwrap();
         assert_eq!((p.normal(), p.offset()), ([2, 4, 6], 3));
