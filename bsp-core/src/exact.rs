@@ -255,11 +255,14 @@ fn round_ratio<const N: usize, const M: usize>(num: &BInt<N>, den: &BInt<N>, gue
 }
 
 /// An exact point in homogeneous integer coordinates `(x, y, z, w)` with
-/// `w > 0`, of `64 N` bits each, and their `f64` approximations.
+/// `w > 0`, of `64 N` bits each, and their `f64` approximations; its
+/// correctly rounded Cartesian coordinates are kept once computed (a
+/// mesh's vertex is asked for them by each of its corners).
 #[derive(Clone, Debug)]
 pub struct Homogeneous<const N: usize> {
     h: [BInt<N>; 4],
     approx: [f64; 4],
+    rounded: std::sync::OnceLock<[f64; 3]>,
 }
 
 impl<const N: usize> Homogeneous<N> {
@@ -277,6 +280,7 @@ impl<const N: usize> Homogeneous<N> {
         Some(Homogeneous {
             approx: [approx(&h[0]), approx(&h[1]), approx(&h[2]), approx(&h[3])],
             h,
+            rounded: std::sync::OnceLock::new(),
         })
     }
 
@@ -285,7 +289,17 @@ impl<const N: usize> Homogeneous<N> {
     pub(crate) fn with_approx(h: [BInt<N>; 4], approx: [f64; 4]) -> Self {
         debug_assert!(h[3].is_positive());
         debug_assert!((0..4).all(|i| approx[i] == self::approx(&h[i])));
-        Homogeneous { h, approx }
+        Homogeneous {
+            h,
+            approx,
+            rounded: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// The correctly rounded coordinates, once computed.
+    #[inline]
+    pub(crate) fn rounded(&self) -> &std::sync::OnceLock<[f64; 3]> {
+        &self.rounded
     }
 
     /// The homogeneous coordinates `(x, y, z, w)`, `w > 0`.

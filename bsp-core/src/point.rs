@@ -216,9 +216,9 @@ impl Homogeneous<4> {
     }
 
     /// The correctly rounded Cartesian coordinates (see
-    /// [`Homogeneous::round_with`]).
+    /// [`Homogeneous::round_with`]), computed once.
     pub fn to_f64(&self) -> [f64; 3] {
-        self.round_with::<9>()
+        *self.rounded().get_or_init(|| self.round_with::<9>())
     }
 
     /// Exact equality of the represented points (at once for the same
