@@ -113,8 +113,11 @@ pub struct Polygon {
     tag: u32,
 }
 
-fn dedupe_cyclic(points: &[GridPoint]) -> Vec<GridPoint> {
-    let mut v: Vec<GridPoint> = Vec::with_capacity(points.len());
+/// A face's loop of grid points, on the stack for up to eight corners.
+type GridLoop = SmallVec<[GridPoint; 8]>;
+
+fn dedupe_cyclic(points: &[GridPoint]) -> GridLoop {
+    let mut v = GridLoop::with_capacity(points.len());
     for p in points {
         if v.last() != Some(p) {
             v.push(*p);
@@ -128,7 +131,7 @@ fn dedupe_cyclic(points: &[GridPoint]) -> Vec<GridPoint> {
 
 /// Removes vertices whose two edges are collinear (straight-through points
 /// and zero-area spikes); they do not change the enclosed region.
-fn remove_collinear(v: &mut Vec<GridPoint>) {
+fn remove_collinear(v: &mut GridLoop) {
     let mut changed = true;
     while changed && v.len() >= 3 {
         changed = false;
