@@ -391,21 +391,6 @@ impl Solid {
         self.faces[i as usize].as_ref().expect("a live face")
     }
 
-    /// Adds the polygon `p`, whose box is `bx` ([`polygon_box`]).
-    fn add(&mut self, p: Polygon, bx: IBox) {
-        let id = match self.free.pop() {
-            Some(i) => i,
-            None => {
-                self.faces.push(None);
-                (self.faces.len() - 1) as u32
-            }
-        };
-        self.index.insert(id, &bx);
-        self.bounds = Some(self.bounds.map_or(bx, |b| union(&b, &bx)));
-        self.faces[id as usize] = Some(Face::new(p.with_tag(0), &bx));
-        self.live += 1;
-    }
-
     fn remove(&mut self, id: u32) {
         if let Some(f) = self.faces[id as usize].take() {
             self.index.remove(id, &f.bx());
@@ -543,10 +528,7 @@ impl Solid {
         opts: &Options,
     ) -> Result<Stats, CsgError> {
         let (stats, plan) = self.plan(other, op, opts)?;
-        self.carry_out(plan, |f| {
-            let face = other.face(f);
-            (face.poly.clone(), face.bx())
-        });
+        self.carry_out(plan, Other::Borrowed(other));
         Ok(stats)
     }
 
@@ -565,11 +547,7 @@ impl Solid {
         opts: &Options,
     ) -> Result<Stats, CsgError> {
         let (stats, plan) = self.plan(&other, op, opts)?;
-        self.carry_out(plan, |f| {
-            let face = other.faces[f as usize].take().expect("a live face");
-            let bx = face.bx();
-            (face.poly, bx)
-        });
+        self.carry_out(plan, Other::Owned(&mut other));
         Ok(stats)
     }
 
@@ -962,8 +940,12 @@ impl Solid {
     }
 
     /// Carries a plan out: its new faces, then the other solid's faces it
-    /// keeps whole, each taken by `take` with its box.
-    fn carry_out(&mut self, mut plan: Plan, mut take: impl FnMut(u32) -> (Polygon, IBox)) {
+    /// keeps whole, from `other`.
+    ///
+    /// The faces are made in parallel and written straight into their
+    /// slots (freed slots first, in order, then the end of the array),
+    /// each moved or copied once; the index takes them after.
+    fn carry_out(&mut self, mut plan: Plan, other: Other<'_>) {
         // the new faces' equal new vertices become one each (pieces cut
         // along a shared edge computed them each for itself)
         let mut new: Vec<&mut Polygon> = plan
@@ -975,31 +957,97 @@ impl Solid {
             })
             .collect();
         share_points(&mut new);
-        // the new faces' boxes, in parallel
-        let mut boxes = new
-            .par_iter()
-            .map(|p| polygon_box(p))
-            .collect::<Vec<_>>()
-            .into_iter();
         drop(new);
-        // room for the new faces at once: growing by doubling would hold
-        // the old and a twice larger array of faces at the same time
-        self.faces
-            .reserve_exact(plan.add.len().saturating_sub(self.free.len()));
-        for a in plan.add {
-            match a {
-                Added::New(p) => self.add(*p, boxes.next().expect("a box a new face")),
-                Added::Whole(f) => {
-                    // flipping keeps the box
-                    let (p, bx) = take(f);
-                    self.add(if plan.flip { p.flipped() } else { p }, bx);
-                }
-            }
+        // where each face comes from: a kept face of an owned solid is
+        // taken from its slot (distinct slots: one borrow each)
+        enum From<'s> {
+            New(Box<Polygon>),
+            Slot(&'s mut Option<Face>),
+            Copy(&'s Face),
         }
+        let (mut slots, borrowed): (Vec<Option<&mut Option<Face>>>, Option<&Solid>) = match other {
+            Other::Owned(o) => (o.faces.iter_mut().map(Some).collect(), None),
+            Other::Borrowed(o) => (Vec::new(), Some(o)),
+        };
+        let from: Vec<From<'_>> = plan
+            .add
+            .into_iter()
+            .map(|a| match a {
+                Added::New(p) => From::New(p),
+                Added::Whole(f) => match borrowed {
+                    Some(o) => From::Copy(o.face(f)),
+                    None => From::Slot(slots[f as usize].take().expect("a face kept once")),
+                },
+            })
+            .collect();
+        drop(slots);
+        let flip = plan.flip;
+        let make = |f: From<'_>| -> Face {
+            match f {
+                From::New(p) => {
+                    let bx = polygon_box(&p);
+                    Face::new(p.with_tag(0), &bx)
+                }
+                From::Slot(slot) => {
+                    let face = slot.take().expect("a live face");
+                    if flip {
+                        // flipping keeps the box
+                        Face {
+                            poly: face.poly.flipped(),
+                            small_box: face.small_box,
+                        }
+                    } else {
+                        face
+                    }
+                }
+                From::Copy(face) => Face {
+                    poly: if flip {
+                        face.poly.flipped()
+                    } else {
+                        face.poly.clone()
+                    },
+                    small_box: face.small_box,
+                },
+            }
+        };
+        let n = from.len();
+        let mut from = from.into_iter();
+        // freed slots first, in the order they are popped
+        let reused: Vec<u32> = (0..n.min(self.free.len()))
+            .map(|_| self.free.pop().expect("a free slot"))
+            .collect();
+        for &id in &reused {
+            self.faces[id as usize] = Some(make(from.next().expect("a face per slot")));
+        }
+        // then the end of the array, in place: room for all at once (growing
+        // by doubling would hold the old and a twice larger array)
+        let first_new = self.faces.len();
+        self.faces.reserve_exact(from.len());
+        let rest: Vec<From<'_>> = from.collect();
+        self.faces
+            .par_extend(rest.into_par_iter().map(|f| Some(make(f))));
+        // the index and the bounds
+        let ids = reused
+            .into_iter()
+            .chain(first_new as u32..self.faces.len() as u32);
+        for id in ids {
+            let bx = self.face(id).bx();
+            self.index.insert(id, &bx);
+            self.bounds = Some(self.bounds.map_or(bx, |b| union(&b, &bx)));
+        }
+        self.live += n;
         if self.live > 4 * self.indexed + 1024 {
             self.reindex();
         }
     }
+}
+
+/// The solid an operation takes kept faces from.
+enum Other<'s> {
+    /// Its faces are copied.
+    Borrowed(&'s Solid),
+    /// Its faces move over.
+    Owned(&'s mut Solid),
 }
 
 /// What an operation adds to the first solid, in order: new faces, and
