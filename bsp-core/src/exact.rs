@@ -341,17 +341,27 @@ impl<const N: usize> Homogeneous<N> {
     /// computing in `M >= 2N` limbs when the `f64` approximations cannot
     /// tell.
     pub fn cmp_axis_with<const M: usize>(&self, o: &Self, k: usize) -> Ordering {
+        if let Some(ord) = self.cmp_axis_filtered(o, k) {
+            return ord;
+        }
+        let w = |x: &BInt<N>| (*x).as_::<BInt<M>>();
+        (w(&self.h[k]) * w(&o.h[3])).cmp(&(w(&o.h[k]) * w(&self.h[3])))
+    }
+
+    /// [`Homogeneous::cmp_axis_with`] by the `f64` approximations alone:
+    /// `None` when they cannot tell.
+    #[inline]
+    pub(crate) fn cmp_axis_filtered(&self, o: &Self, k: usize) -> Option<Ordering> {
         let (p, q) = (self.approx[k] / self.approx[3], o.approx[k] / o.approx[3]);
         // each quotient is within 8u of the exact value (3u + 3u + u)
         let tol = (p.abs() + q.abs()) * (16.0 / (1u64 << 53) as f64);
         if p - q > tol {
-            return Ordering::Greater;
+            Some(Ordering::Greater)
+        } else if q - p > tol {
+            Some(Ordering::Less)
+        } else {
+            None
         }
-        if q - p > tol {
-            return Ordering::Less;
-        }
-        let w = |x: &BInt<N>| (*x).as_::<BInt<M>>();
-        (w(&self.h[k]) * w(&o.h[3])).cmp(&(w(&o.h[k]) * w(&self.h[3])))
     }
 
     /// Exact equality of the represented points, in `M >= 2N` limbs.

@@ -224,12 +224,28 @@ impl Homogeneous<4> {
     /// Exact equality of the represented points (at once for the same
     /// allocation: equal new vertices are shared, see `share_points`).
     pub fn same_point(&self, o: &Implicit) -> bool {
-        std::ptr::eq(self, o) || self.same_with::<8>(o)
+        std::ptr::eq(self, o) || (0..3).all(|k| self.cmp_axis(o, k) == std::cmp::Ordering::Equal)
     }
 
-    /// Exact comparison of coordinate `k` with another point's.
+    /// Exact comparison of coordinate `k` with another point's (the same
+    /// as [`Homogeneous::cmp_axis_with`]): `x / w` against `x' / w'` is
+    /// `x w'` against `x' w` (`w, w' > 0`), compared by sign and then by
+    /// the magnitudes' full 512-bit products (sixteen 64-bit products
+    /// each, where a general 512-bit multiplication takes sixty-four).
     pub fn cmp_axis(&self, o: &Implicit, k: usize) -> std::cmp::Ordering {
-        self.cmp_axis_with::<8>(o, k)
+        if let Some(ord) = self.cmp_axis_filtered(o, k) {
+            return ord;
+        }
+        let (h, g) = (self.coords(), o.coords());
+        let sign = |x: &I256| (!x.is_zero() as i8) * if x.is_negative() { -1 } else { 1 };
+        let (sa, sb) = (sign(&h[k]), sign(&g[k]));
+        if sa != sb || sa == 0 {
+            return sa.cmp(&sb);
+        }
+        let (lo, hi) = h[k].unsigned_abs().widening_mul(g[3].unsigned_abs());
+        let (lo2, hi2) = g[k].unsigned_abs().widening_mul(h[3].unsigned_abs());
+        let by_size = (hi, lo).cmp(&(hi2, lo2));
+        if sa > 0 { by_size } else { by_size.reverse() }
     }
 }
 
@@ -387,6 +403,42 @@ mod tests {
             proptest::prop_assert_eq!(fast.is_negative(), slow.is_negative());
             proptest::prop_assert_eq!(fast.is_zero(), slow.is_zero());
             proptest::prop_assert_eq!(fast.approx(), crate::exact::approx(&slow));
+        }
+
+        /// Comparing coordinates by sign and 512-bit magnitudes agrees with
+        /// the general arithmetic, equal points included.
+        #[test]
+        fn coordinate_order_matches_general_arithmetic(
+            n in proptest::collection::vec(-(1i64 << 40)..(1i64 << 40), 12),
+            d in proptest::collection::vec(-(1i128 << 70)..(1i128 << 70), 4),
+            same in proptest::bool::ANY,
+        ) {
+            let plane = |k: usize| Plane::new([n[3 * k], n[3 * k + 1], n[3 * k + 2]], d[k]);
+            let planes: Vec<Plane> = (0..4).filter_map(plane).collect();
+            proptest::prop_assume!(planes.len() == 4);
+            let p = Implicit::from_planes(&planes[0], &planes[1], &planes[2]);
+            // the same point from the planes in another order, or another point
+            let q = if same {
+                Implicit::from_planes(&planes[2], &planes[0], &planes[1])
+            } else {
+                Implicit::from_planes(&planes[0], &planes[1], &planes[3])
+            };
+            if let (Some(p), Some(q)) = (p, q) {
+                for k in 0..3 {
+                    proptest::prop_assert_eq!(p.cmp_axis(&q, k), p.cmp_axis_with::<8>(&q, k));
+                    proptest::prop_assert_eq!(q.cmp_axis(&p, k), q.cmp_axis_with::<8>(&p, k));
+                }
+                proptest::prop_assert_eq!(p.same_point(&q), p.same_with::<8>(&q));
+                if same {
+                    proptest::prop_assert!(p.same_point(&q));
+                }
+                // the same point written with other coordinates
+                let scaled = Implicit::new(p.coords().map(|c| c * I256::from(-3))).unwrap();
+                proptest::prop_assert!(p.same_point(&scaled) && scaled.same_point(&p));
+                for k in 0..3 {
+                    proptest::prop_assert_eq!(scaled.cmp_axis(&q, k), p.cmp_axis_with::<8>(&q, k));
+                }
+            }
         }
 
         /// The intersection of three planes with large coefficients is the
