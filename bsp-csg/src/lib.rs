@@ -408,8 +408,17 @@ impl Solid {
                 .as_ref()
                 .is_some_and(|f| overlaps(&f.bx(), b))
         };
-        // many ids (a large box): in parallel
+        // many ids (a large box): in parallel; as many as half the slots
+        // (each face is listed in several index cells): a scan of the
+        // slots in order gives them sorted, without repeats
         const MANY: usize = 1 << 15;
+        if ids.len() > MANY && ids.len() > self.faces.len() / 2 {
+            drop(ids);
+            return (0..self.faces.len() as u32)
+                .into_par_iter()
+                .filter(meets)
+                .collect();
+        }
         if ids.len() > MANY {
             ids.par_sort_unstable();
             ids.dedup();
