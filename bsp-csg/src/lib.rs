@@ -969,7 +969,7 @@ impl Solid {
         drop(new);
         // where each face comes from: a kept face of an owned solid is
         // taken from its slot (distinct slots: one borrow each)
-        enum From<'s> {
+        enum Source<'s> {
             New(Box<Polygon>),
             Slot(&'s mut Option<Face>),
             Copy(&'s Face),
@@ -978,26 +978,26 @@ impl Solid {
             Other::Owned(o) => (o.faces.iter_mut().map(Some).collect(), None),
             Other::Borrowed(o) => (Vec::new(), Some(o)),
         };
-        let from: Vec<From<'_>> = plan
+        let from: Vec<Source<'_>> = plan
             .add
             .into_iter()
             .map(|a| match a {
-                Added::New(p) => From::New(p),
+                Added::New(p) => Source::New(p),
                 Added::Whole(f) => match borrowed {
-                    Some(o) => From::Copy(o.face(f)),
-                    None => From::Slot(slots[f as usize].take().expect("a face kept once")),
+                    Some(o) => Source::Copy(o.face(f)),
+                    None => Source::Slot(slots[f as usize].take().expect("a face kept once")),
                 },
             })
             .collect();
         drop(slots);
         let flip = plan.flip;
-        let make = |f: From<'_>| -> Face {
+        let make = |f: Source<'_>| -> Face {
             match f {
-                From::New(p) => {
+                Source::New(p) => {
                     let bx = polygon_box(&p);
                     Face::new(p.with_tag(0), &bx)
                 }
-                From::Slot(slot) => {
+                Source::Slot(slot) => {
                     let face = slot.take().expect("a live face");
                     if flip {
                         // flipping keeps the box
@@ -1009,7 +1009,7 @@ impl Solid {
                         face
                     }
                 }
-                From::Copy(face) => Face {
+                Source::Copy(face) => Face {
                     poly: if flip {
                         face.poly.flipped()
                     } else {
@@ -1032,7 +1032,7 @@ impl Solid {
         // by doubling would hold the old and a twice larger array)
         let first_new = self.faces.len();
         self.faces.reserve_exact(from.len());
-        let rest: Vec<From<'_>> = from.collect();
+        let rest: Vec<Source<'_>> = from.collect();
         self.faces
             .par_extend(rest.into_par_iter().map(|f| Some(make(f))));
         // the index and the bounds
