@@ -709,31 +709,37 @@ fn twinned_edges(corners: &[u32], start: &[usize]) -> Vec<bool> {
     if corners.len() >= 1 << 31 {
         return vec![false; corners.len()]; // places do not fit: search all
     }
-    // (undirected edge, place << 1 | direction), sorted
-    let mut keys: Vec<(u64, u32)> = (0..start.len() - 1)
-        .into_par_iter()
-        .flat_map_iter(|p| {
+    // (undirected edge, place << 1 | direction), sorted; in an array of
+    // exactly that size, filled in parallel polygon by polygon
+    let polys: Vec<usize> = (0..start.len() - 1).collect();
+    let mut keys: Vec<(u64, u32)> = crate::topology::per_corner(
+        &polys,
+        |&p| start[p + 1] - start[p],
+        |&p, i| {
             let cs = &corners[start[p]..start[p + 1]];
-            let k = cs.len();
-            (0..k).map(move |i| {
-                let (a, b) = (cs[i], cs[(i + 1) % k]);
-                let (lo, hi, dir) = if a < b { (a, b, 0) } else { (b, a, 1) };
-                (
-                    (lo as u64) << 32 | hi as u64,
-                    ((start[p] + i) as u32) << 1 | dir,
-                )
-            })
+            let (a, b) = (cs[i], cs[(i + 1) % cs.len()]);
+            let (lo, hi, dir) = if a < b { (a, b, 0) } else { (b, a, 1) };
+            (
+                (lo as u64) << 32 | hi as u64,
+                ((start[p] + i) as u32) << 1 | dir,
+            )
+        },
+    );
+    drop(polys);
+    keys.par_sort_unstable();
+    // the edges used once each way, found in parallel
+    let pairs: Vec<(u32, u32)> = keys
+        .par_chunk_by(|x, y| x.0 == y.0)
+        .filter_map(|group| match group {
+            [(_, e), (_, f)] if (e ^ f) & 1 == 1 => Some((e >> 1, f >> 1)),
+            _ => None,
         })
         .collect();
-    keys.par_sort_unstable();
+    drop(keys);
     let mut twinned = vec![false; corners.len()];
-    for group in keys.chunk_by(|x, y| x.0 == y.0) {
-        if let [(_, e), (_, f)] = group
-            && (e ^ f) & 1 == 1
-        {
-            twinned[(e >> 1) as usize] = true;
-            twinned[(f >> 1) as usize] = true;
-        }
+    for (e, f) in pairs {
+        twinned[e as usize] = true;
+        twinned[f as usize] = true;
     }
     twinned
 }
@@ -799,36 +805,50 @@ impl Candidates {
 
     fn new(coords: &[[f32; 3]]) -> Candidates {
         let mut pts: Vec<([f32; 3], u32)> = coords
-            .iter()
+            .par_iter()
             .enumerate()
             .map(|(i, c)| (*c, i as u32))
             .collect();
         let mut axis = vec![0u8; pts.len()];
-        let mut stack = vec![(0usize, pts.len())];
-        while let Some((lo, hi)) = stack.pop() {
-            if hi - lo <= Self::LEAF {
-                continue;
-            }
-            let part = &mut pts[lo..hi];
-            let mut best = (0usize, f32::NEG_INFINITY);
-            for j in 0..3 {
-                let (mut a, mut b) = (f32::INFINITY, f32::NEG_INFINITY);
-                for p in part.iter() {
-                    a = a.min(p.0[j]);
-                    b = b.max(p.0[j]);
-                }
-                if b - a > best.1 {
-                    best = (j, b - a);
-                }
-            }
-            let j = best.0;
-            let mid = part.len() / 2;
-            part.select_nth_unstable_by(mid, |p, q| p.0[j].total_cmp(&q.0[j]));
-            axis[lo + mid] = j as u8;
-            stack.push((lo + mid + 1, hi));
-            stack.push((lo, lo + mid));
-        }
+        Self::split(&mut pts, &mut axis);
         Candidates { pts, axis }
+    }
+
+    /// Builds the tree of `pts` in place: the median along the widest
+    /// axis in the middle (its axis in `axis`), the two halves likewise;
+    /// large halves in parallel (the same tree: the halves are apart).
+    fn split(pts: &mut [([f32; 3], u32)], axis: &mut [u8]) {
+        if pts.len() <= Self::LEAF {
+            return;
+        }
+        let mut best = (0usize, f32::NEG_INFINITY);
+        for j in 0..3 {
+            let (mut a, mut b) = (f32::INFINITY, f32::NEG_INFINITY);
+            for p in pts.iter() {
+                a = a.min(p.0[j]);
+                b = b.max(p.0[j]);
+            }
+            if b - a > best.1 {
+                best = (j, b - a);
+            }
+        }
+        let j = best.0;
+        let mid = pts.len() / 2;
+        pts.select_nth_unstable_by(mid, |p, q| p.0[j].total_cmp(&q.0[j]));
+        axis[mid] = j as u8;
+        let (low, high) = pts.split_at_mut(mid);
+        let (low_axis, high_axis) = axis.split_at_mut(mid);
+        let (high, high_axis) = (&mut high[1..], &mut high_axis[1..]);
+        const PARALLEL: usize = 1 << 14;
+        if low.len() > PARALLEL {
+            rayon::join(
+                || Self::split(low, low_axis),
+                || Self::split(high, high_axis),
+            );
+        } else {
+            Self::split(low, low_axis);
+            Self::split(high, high_axis);
+        }
     }
 
     /// Calls `f` with every vertex whose rounded coordinates may lie in
