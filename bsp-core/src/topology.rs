@@ -136,8 +136,7 @@ fn is_closed_manifold(faces: &[&[u32]]) -> bool {
         },
     );
     link.par_sort_unstable();
-    let groups: Vec<&[(u64, u32)]> = link.chunk_by(|x, y| x.0 >> 32 == y.0 >> 32).collect();
-    groups.par_iter().all(|g| {
+    link.par_chunk_by(|x, y| x.0 >> 32 == y.0 >> 32).all(|g| {
         let v = g[0].0 >> 32;
         let next = |u: u32| {
             g.binary_search_by(|e| e.0.cmp(&(v << 32 | u as u64)))
