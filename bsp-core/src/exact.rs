@@ -337,9 +337,34 @@ impl<const N: usize> Homogeneous<N> {
         [0, 1, 2].map(|k| round_ratio::<N, M>(&self.h[k], &self.h[3], g[k]))
     }
 
-    /// Exact comparison of coordinate `k` (0, 1 or 2) with another point's,
-    /// computing in `M >= 2N` limbs when the `f64` approximations cannot
-    /// tell.
+    /// Exact comparison of coordinate `k` (0, 1 or 2) with another point's:
+    /// `x / w` against `x' / w'` is `x w'` against `x' w` (`w, w' > 0`).
+    /// By the `f64` approximations when they tell; else by sign, then by
+    /// the magnitudes' full products from widening multiplications of
+    /// the `N`-limb values (a quarter of the limb products of a general
+    /// multiplication in `2N` limbs).
+    pub fn cmp_axis(&self, o: &Self, k: usize) -> Ordering {
+        if let Some(ord) = self.cmp_axis_filtered(o, k) {
+            return ord;
+        }
+        let sign = |x: &BInt<N>| (!x.is_zero() as i8) * if x.is_negative() { -1 } else { 1 };
+        let (sa, sb) = (sign(&self.h[k]), sign(&o.h[k]));
+        if sa != sb || sa == 0 {
+            return sa.cmp(&sb);
+        }
+        let (lo, hi) = self.h[k].unsigned_abs().widening_mul(o.h[3].unsigned_abs());
+        let (lo2, hi2) = o.h[k].unsigned_abs().widening_mul(self.h[3].unsigned_abs());
+        let by_size = (hi, lo).cmp(&(hi2, lo2));
+        if sa > 0 { by_size } else { by_size.reverse() }
+    }
+
+    /// Exact equality of the represented points ([`Homogeneous::cmp_axis`]).
+    pub fn same(&self, o: &Self) -> bool {
+        (0..3).all(|k| self.cmp_axis(o, k) == Ordering::Equal)
+    }
+
+    /// [`Homogeneous::cmp_axis`] in the general arithmetic of `M >= 2N`
+    /// limbs (the reference the tests check it against).
     pub fn cmp_axis_with<const M: usize>(&self, o: &Self, k: usize) -> Ordering {
         if let Some(ord) = self.cmp_axis_filtered(o, k) {
             return ord;
@@ -348,7 +373,7 @@ impl<const N: usize> Homogeneous<N> {
         (w(&self.h[k]) * w(&o.h[3])).cmp(&(w(&o.h[k]) * w(&self.h[3])))
     }
 
-    /// [`Homogeneous::cmp_axis_with`] by the `f64` approximations alone:
+    /// [`Homogeneous::cmp_axis`] by the `f64` approximations alone:
     /// `None` when they cannot tell.
     #[inline]
     pub(crate) fn cmp_axis_filtered(&self, o: &Self, k: usize) -> Option<Ordering> {
@@ -364,7 +389,7 @@ impl<const N: usize> Homogeneous<N> {
         }
     }
 
-    /// Exact equality of the represented points, in `M >= 2N` limbs.
+    /// [`Homogeneous::same`] in the general arithmetic of `M >= 2N` limbs.
     pub fn same_with<const M: usize>(&self, o: &Self) -> bool {
         (0..3).all(|k| self.cmp_axis_with::<M>(o, k) == Ordering::Equal)
     }

@@ -35,13 +35,6 @@ fn wide(x: i128) -> I256 {
     I256::from(x)
 }
 
-/// The exact product of two `i128`s with magnitudes below `2^127`, as a
-/// 256-bit integer ([`Wide::product`]).
-#[cfg(test)]
-fn mul_wide(a: i128, b: i128) -> I256 {
-    Wide::product(a, b).to_i256()
-}
-
 /// A 256-bit two's complement integer in two `u128` halves, for sums of
 /// products of `i128`s: the products and sums run on native 128-bit
 /// operations (four 64 × 64-bit products each) instead of the general
@@ -224,28 +217,7 @@ impl Homogeneous<4> {
     /// Exact equality of the represented points (at once for the same
     /// allocation: equal new vertices are shared, see `share_points`).
     pub fn same_point(&self, o: &Implicit) -> bool {
-        std::ptr::eq(self, o) || (0..3).all(|k| self.cmp_axis(o, k) == std::cmp::Ordering::Equal)
-    }
-
-    /// Exact comparison of coordinate `k` with another point's (the same
-    /// as [`Homogeneous::cmp_axis_with`]): `x / w` against `x' / w'` is
-    /// `x w'` against `x' w` (`w, w' > 0`), compared by sign and then by
-    /// the magnitudes' full 512-bit products (sixteen 64-bit products
-    /// each, where a general 512-bit multiplication takes sixty-four).
-    pub fn cmp_axis(&self, o: &Implicit, k: usize) -> std::cmp::Ordering {
-        if let Some(ord) = self.cmp_axis_filtered(o, k) {
-            return ord;
-        }
-        let (h, g) = (self.coords(), o.coords());
-        let sign = |x: &I256| (!x.is_zero() as i8) * if x.is_negative() { -1 } else { 1 };
-        let (sa, sb) = (sign(&h[k]), sign(&g[k]));
-        if sa != sb || sa == 0 {
-            return sa.cmp(&sb);
-        }
-        let (lo, hi) = h[k].unsigned_abs().widening_mul(g[3].unsigned_abs());
-        let (lo2, hi2) = g[k].unsigned_abs().widening_mul(h[3].unsigned_abs());
-        let by_size = (hi, lo).cmp(&(hi2, lo2));
-        if sa > 0 { by_size } else { by_size.reverse() }
+        std::ptr::eq(self, o) || self.same(o)
     }
 }
 
@@ -351,6 +323,12 @@ pub fn rational_to_f64(num: I512, den: I512) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The exact product of two `i128`s ([`Wide::product`]) as a 256-bit
+    /// integer.
+    fn mul_wide(a: i128, b: i128) -> I256 {
+        Wide::product(a, b).to_i256()
+    }
 
     #[test]
     fn ratio_rounds_correctly() {

@@ -299,7 +299,7 @@ impl WPoint {
 
     /// Exact equality of the represented points.
     pub fn same_point(&self, o: &WPoint) -> bool {
-        self.h.same_with::<16>(&o.h)
+        self.h.same(&o.h)
     }
 }
 
