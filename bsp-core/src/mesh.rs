@@ -718,7 +718,7 @@ fn twinned_edges(corners: &[u32], start: &[usize]) -> Vec<bool> {
         |&p, i| {
             let cs = &corners[start[p]..start[p + 1]];
             let (a, b) = (cs[i], cs[(i + 1) % cs.len()]);
-            let (lo, hi, dir) = if a < b { (a, b, 0) } else { (b, a, 1) };
+            let (lo, hi, dir) = crate::topology::undirected(a, b);
             (
                 (lo as u64) << 32 | hi as u64,
                 ((start[p] + i) as u32) << 1 | dir,

@@ -164,8 +164,15 @@ fn is_closed_manifold(faces: &[&[u32]]) -> bool {
 /// [`edges_pair_up`]: its undirected edge, then its direction.
 #[inline]
 pub(crate) fn edge_key(a: u32, b: u32) -> u128 {
-    let (lo, hi, dir) = if a < b { (a, b, 0) } else { (b, a, 1) };
-    (lo as u128) << 64 | (hi as u128) << 1 | dir
+    let (lo, hi, dir) = undirected(a, b);
+    (lo as u128) << 64 | (hi as u128) << 1 | dir as u128
+}
+
+/// The edge `a → b` as its two ends in order and its direction (0 when
+/// `a < b`).
+#[inline]
+pub(crate) fn undirected(a: u32, b: u32) -> (u32, u32, u32) {
+    if a < b { (a, b, 0) } else { (b, a, 1) }
 }
 
 /// `true` if every directed edge of `edges` ([`edge_key`]s) is used once

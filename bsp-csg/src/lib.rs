@@ -978,7 +978,7 @@ impl Solid {
             Other::Owned(o) => (o.faces.iter_mut().map(Some).collect(), None),
             Other::Borrowed(o) => (Vec::new(), Some(o)),
         };
-        let from: Vec<Source<'_>> = plan
+        let mut from: Vec<Source<'_>> = plan
             .add
             .into_iter()
             .map(|a| match a {
@@ -991,6 +991,11 @@ impl Solid {
             .collect();
         drop(slots);
         let flip = plan.flip;
+        // flipping keeps the box
+        let flipped = |face: &Face| Face {
+            poly: face.poly.flipped(),
+            small_box: face.small_box,
+        };
         let make = |f: Source<'_>| -> Face {
             match f {
                 Source::New(p) => {
@@ -999,40 +1004,27 @@ impl Solid {
                 }
                 Source::Slot(slot) => {
                     let face = slot.take().expect("a live face");
-                    if flip {
-                        // flipping keeps the box
-                        Face {
-                            poly: face.poly.flipped(),
-                            small_box: face.small_box,
-                        }
-                    } else {
-                        face
-                    }
+                    if flip { flipped(&face) } else { face }
                 }
-                Source::Copy(face) => Face {
-                    poly: if flip {
-                        face.poly.flipped()
-                    } else {
-                        face.poly.clone()
-                    },
-                    small_box: face.small_box,
-                },
+                Source::Copy(face) if flip => flipped(face),
+                Source::Copy(face) => face.clone(),
             }
         };
-        let n = from.len();
-        let mut from = from.into_iter();
-        // freed slots first, in the order they are popped
-        let reused: Vec<u32> = (0..n.min(self.free.len()))
-            .map(|_| self.free.pop().expect("a free slot"))
+        // freed slots first, in the order they are popped, then the end of
+        // the array, in place: room for all at once (growing by doubling
+        // would hold the old and a twice larger array)
+        let rest = from.split_off(from.len().min(self.free.len()));
+        let n = from.len() + rest.len();
+        let reused: Vec<u32> = from
+            .into_iter()
+            .map(|f| {
+                let id = self.free.pop().expect("a free slot");
+                self.faces[id as usize] = Some(make(f));
+                id
+            })
             .collect();
-        for &id in &reused {
-            self.faces[id as usize] = Some(make(from.next().expect("a face per slot")));
-        }
-        // then the end of the array, in place: room for all at once (growing
-        // by doubling would hold the old and a twice larger array)
         let first_new = self.faces.len();
-        self.faces.reserve_exact(from.len());
-        let rest: Vec<Source<'_>> = from.collect();
+        self.faces.reserve_exact(rest.len());
         self.faces
             .par_extend(rest.into_par_iter().map(|f| Some(make(f))));
         // the index and the bounds
