@@ -650,6 +650,45 @@ impl BspTree {
         }
     }
 
+    /// Splits `poly` down the tree by the node planes: the pieces, each with
+    /// the cell it lands in. A piece lying in a node's plane goes to the
+    /// front (as [`crate::Partition::push_down`]).
+    pub fn push_down(&self, poly: Polygon) -> Vec<(Polygon, Cell)> {
+        let mut out = Vec::new();
+        let mut stack = vec![(poly, self.root)];
+        while let Some((p, link)) = stack.pop() {
+            match link {
+                Link::Cell(c) => out.push((p, c)),
+                Link::Node(id) => {
+                    let n = &self.nodes[id as usize];
+                    match p.split(&n.plane) {
+                        Split::Front(q) | Split::Coplanar { polygon: q, .. } => {
+                            stack.push((q, n.front))
+                        }
+                        Split::Back(q) => stack.push((q, n.back)),
+                        Split::Spanning { front, back } => {
+                            stack.push((front, n.front));
+                            stack.push((back, n.back));
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// `true` if every node's polygons face the way of its plane (none is
+    /// coplanar with the opposite orientation). Then, for the faces of a
+    /// solid, each empty leaf of an autopartition lies on one side of a
+    /// face of its parent node, across nothing else: the leaves that
+    /// [`BspTree::build`] makes are labelled as the solid is (a front leaf
+    /// outside, a back leaf inside) without any other test.
+    pub fn faces_agree(&self) -> bool {
+        self.nodes
+            .iter()
+            .all(|n| !n.polygons.is_empty() && n.polygons.iter().all(|p| p.support() == &n.plane))
+    }
+
     /// Checks the tree invariants exactly: the links form a tree reaching
     /// every node once; every stored polygon is valid and lies in its
     /// node's plane; every polygon of a subtree lies on that subtree's
@@ -750,6 +789,44 @@ mod tests {
         assert_eq!(m([4, 4, 4]), Membership::Boundary);
         assert_eq!(m([4, 5, 4]), Membership::Outside);
         assert_eq!(t.stats().nodes, 6);
+    }
+
+    #[test]
+    fn push_down_splits_by_the_cube_and_labels_the_pieces() {
+        let t = BspTree::build(cube(0, 4), &BuildOptions::default());
+        assert!(t.faces_agree());
+        // a square in z = 2 from -2 to 6 each way: its middle (0..4)² is
+        // inside, the rest outside
+        let sq = Polygon::from_grid_points(&[[-2, -2, 2], [6, -2, 2], [6, 6, 2], [-2, 6, 2]], 9)
+            .unwrap();
+        let parts = t.push_down(sq);
+        let area = |p: &Polygon| -> f64 {
+            let v: Vec<[f64; 3]> = p.vertices().iter().map(|q| q.approx_f64()).collect();
+            (0..v.len())
+                .map(|i| {
+                    let (a, b) = (v[i], v[(i + 1) % v.len()]);
+                    a[0] * b[1] - b[0] * a[1]
+                })
+                .sum::<f64>()
+                / 2.0
+        };
+        let inside: f64 = parts
+            .iter()
+            .filter(|(_, c)| *c == Cell::In)
+            .map(|(p, _)| area(p))
+            .sum();
+        let outside: f64 = parts
+            .iter()
+            .filter(|(_, c)| *c == Cell::Out)
+            .map(|(p, _)| area(p))
+            .sum();
+        assert_eq!(inside, 16.0);
+        assert_eq!(outside, 64.0 - 16.0);
+        // a cube's face coplanar with the opposite orientation breaks the
+        // agreement
+        let mut faces = cube(0, 4);
+        faces.push(faces[0].flipped());
+        assert!(!BspTree::build(faces, &BuildOptions::default()).faces_agree());
     }
 
     #[test]

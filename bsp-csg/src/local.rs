@@ -14,6 +14,18 @@
 //! winding numbers of a solid are 0 and 1); the others carry them across.
 //! Only a cell whose pieces cover nothing with a net orientation needs a
 //! reference: the winding number of a grid point in it, by a ray.
+//!
+//! **Labels without regions.** Where every node's pieces face its plane's
+//! way (no two coplanar pieces face opposite ways), each leaf is the
+//! child of a node with a piece on the leaf's side of it and nothing
+//! between: the labels [`BspTree::build`] gives (front leaves outside,
+//! back leaves inside) are the winding numbers, and sorting the other
+//! operand's pieces needs only the tree ([`Labelled`]). The regions and
+//! their links are built where pieces face both ways (a solid touching
+//! itself in a plane), and for the merged cells. A surface that crosses
+//! itself is caught by the link labelling only: in the cells that label
+//! by the tree it goes unnoticed, as it does in the cells no other surface
+//! reaches.
 
 use bsp_core::{
     BoolOp, BspTree, BuildOptions, Cell, PLink, Partition, Plane, Polygon, Side,
@@ -42,9 +54,21 @@ pub(crate) fn solid(
     pieces: Vec<Polygon>,
     reference: impl FnOnce() -> i32,
 ) -> Result<Partition<Cell>, CsgError> {
+    solid_of(
+        bx,
+        &BspTree::build(pieces, &BuildOptions::default()),
+        reference,
+    )
+}
+
+/// [`solid`] from the autopartition `tree` of the pieces.
+fn solid_of(
+    bx: &IBox,
+    tree: &BspTree,
+    reference: impl FnOnce() -> i32,
+) -> Result<Partition<Cell>, CsgError> {
     let w = walls(bx);
-    let tree = BspTree::build(pieces, &BuildOptions::default());
-    let (part, leaves) = Partition::from_tree_in(&tree, &w);
+    let (part, leaves) = Partition::from_tree_in(tree, &w);
     // w(back) − w(front) across every piece of every sub-hyperplane
     let mut links: Vec<(u32, u32, i32)> = Vec::new();
     for n in part.nodes() {
@@ -164,11 +188,54 @@ pub(crate) enum CellResult {
     Merged(Vec<Polygon>),
 }
 
-/// The fate of `piece` against the labelled partition `other` of the
-/// other operand in the cell: a piece shares no plane with `other`'s
-/// faces, so every fragment lies strictly inside one leaf.
-fn fate(piece: &Polygon, other: &Partition<Cell>, keep: impl Fn(bool) -> bool) -> Fate {
-    let frags = other.push_down(piece.clone(), other.root());
+/// One operand's pieces in a cell with every region labelled, to sort the
+/// other operand's pieces by.
+pub(crate) enum Labelled {
+    /// The autopartition as built, when every node's pieces face its
+    /// plane's way ([`BspTree::faces_agree`]): each leaf then lies beside
+    /// a piece of its parent node, on that piece's outer side (a front
+    /// leaf) or inner side (a back leaf), and no piece crosses the leaf's
+    /// part of the cell, so the built labels are the winding numbers and
+    /// no region needs to be made.
+    Tree(BspTree),
+    /// The labelled partition ([`solid`]): where coplanar pieces face
+    /// both ways (a solid touching itself), or there are no pieces.
+    Partition(Partition<Cell>),
+}
+
+impl Labelled {
+    /// The labelled regions of `pieces` (faces of one operand clipped to
+    /// the cell `bx`), `reference` as for [`solid`].
+    pub(crate) fn new(
+        bx: &IBox,
+        pieces: Vec<Polygon>,
+        reference: impl FnOnce() -> i32,
+    ) -> Result<Labelled, CsgError> {
+        if pieces.is_empty() {
+            return solid(bx, pieces, reference).map(Labelled::Partition);
+        }
+        let tree = BspTree::build(pieces, &BuildOptions::default());
+        if tree.faces_agree() {
+            Ok(Labelled::Tree(tree))
+        } else {
+            solid_of(bx, &tree, reference).map(Labelled::Partition)
+        }
+    }
+
+    /// `poly` split by the regions, each fragment with its region's label.
+    fn push_down(&self, poly: Polygon) -> Vec<(Polygon, Cell)> {
+        match self {
+            Labelled::Tree(t) => t.push_down(poly),
+            Labelled::Partition(p) => p.push_down(poly, p.root()),
+        }
+    }
+}
+
+/// The fate of `piece` against the labelled regions `other` of the other
+/// operand in the cell: a piece shares no plane with `other`'s faces, so
+/// every fragment lies strictly inside one region.
+fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(bool) -> bool) -> Fate {
+    let frags = other.push_down(piece.clone());
     let kept = |c: Cell| keep(c == Cell::In);
     if frags.iter().all(|&(_, c)| kept(c)) {
         Fate::Keep
@@ -204,8 +271,8 @@ pub(crate) fn boolean_pieces(
     if shared {
         return boolean(bx, a, b, op, ref_a, ref_b).map(CellResult::Merged);
     }
-    let pa = solid(bx, a.clone(), ref_a)?;
-    let pb = solid(bx, b.clone(), ref_b)?;
+    let pa = Labelled::new(bx, a.clone(), ref_a)?;
+    let pb = Labelled::new(bx, b.clone(), ref_b)?;
     let fa = a.iter().map(|p| fate(p, &pb, &keep.0)).collect();
     let fb = b.iter().map(|p| fate(p, &pa, &keep.1)).collect();
     Ok(CellResult::Pieces(fa, fb, a, b))
@@ -294,4 +361,136 @@ pub(crate) fn outside(face: &Polygon, w: &[Plane; 6]) -> Vec<Polygon> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bsp_core::GridPoint;
+
+    /// The faces of the box `lo..hi` (grid corners), outward.
+    fn cuboid(lo: GridPoint, hi: GridPoint) -> Vec<Polygon> {
+        let v = |p: GridPoint| glam::DVec3::from_array(p.map(f64::from));
+        bsp_core::shapes::cuboid(v(lo), v(hi))
+            .into_iter()
+            .map(|f| {
+                let g: Vec<GridPoint> = f.iter().map(|q| q.to_array().map(|c| c as i32)).collect();
+                Polygon::from_grid_points(&g, 0).expect("a proper face")
+            })
+            .collect()
+    }
+
+    /// A tetrahedron's faces, outward (corners counter-clockwise from
+    /// outside for `a, b, c` seen against `d` behind).
+    fn tetra(a: GridPoint, b: GridPoint, c: GridPoint, d: GridPoint) -> Vec<Polygon> {
+        [[a, b, c], [a, d, b], [b, d, c], [a, c, d]]
+            .iter()
+            .map(|f| Polygon::from_grid_points(f, 1).expect("a proper face"))
+            .collect()
+    }
+
+    fn pieces(faces: &[Polygon], bx: &IBox) -> Vec<Polygon> {
+        faces
+            .iter()
+            .filter_map(|f| clip_to(f, &walls(bx)))
+            .collect()
+    }
+
+    /// The fragments and labels of `probe` in both labellings, which must
+    /// agree fragment for fragment.
+    fn agree(tree: &Labelled, part: &Partition<Cell>, probe: &Polygon) -> Vec<Cell> {
+        let t = tree.push_down(probe.clone());
+        let p = part.push_down(probe.clone(), part.root());
+        assert_eq!(t.len(), p.len(), "fragment count of {probe:?}");
+        for ((a, la), (b, lb)) in t.iter().zip(&p) {
+            assert_eq!(la, lb, "label of a fragment of {probe:?}");
+            assert_eq!(a.vertices().len(), b.vertices().len());
+            assert!(
+                a.vertices()
+                    .iter()
+                    .zip(b.vertices())
+                    .all(|(x, y)| x.same_point(y))
+            );
+        }
+        t.into_iter().map(|(_, c)| c).collect()
+    }
+
+    #[test]
+    fn the_built_labels_are_the_winding_numbers_when_faces_agree() {
+        // a box and a tetrahedron, cut by cells through them; probes are a
+        // slanted tetrahedron's faces (no plane in common with either)
+        let solids = [
+            cuboid([0, 0, 0], [6, 5, 4]),
+            tetra([0, 0, 0], [9, 1, 0], [2, 8, 1], [3, 2, 7]),
+        ];
+        let probes = tetra([-3, -2, -1], [11, 2, 3], [1, 12, -2], [4, 3, 13]);
+        let cells: [IBox; 4] = [
+            ([-5, -5, -5], [20, 20, 20]),
+            ([1, 1, 1], [3, 3, 9]),
+            ([-2, 2, -2], [4, 9, 2]),
+            ([3, -1, 2], [9, 9, 9]),
+        ];
+        let mut seen = [false; 2];
+        for s in &solids {
+            for bx in &cells {
+                let ps = pieces(s, bx);
+                if ps.is_empty() {
+                    continue;
+                }
+                let l = Labelled::new(bx, ps.clone(), || panic!("pieces decide")).unwrap();
+                assert!(matches!(l, Labelled::Tree(_)), "one solid's faces agree");
+                let part = solid(bx, ps, || panic!("pieces decide")).unwrap();
+                for probe in pieces(&probes, bx) {
+                    for c in agree(&l, &part, &probe) {
+                        seen[(c == Cell::In) as usize] = true;
+                    }
+                }
+            }
+        }
+        assert_eq!(seen, [true, true], "probes reach inside and outside");
+    }
+
+    #[test]
+    fn faces_of_both_orientations_in_one_plane_take_the_partition() {
+        // a block above z = 0 and another below it, side by side: the
+        // plane z = 0 holds a face facing down and one facing up
+        let mut faces = cuboid([0, 0, 0], [2, 2, 2]);
+        faces.extend(cuboid([4, 0, -2], [6, 2, 0]));
+        let bx: IBox = ([-1, -1, -1], [7, 3, 1]);
+        let ps = pieces(&faces, &bx);
+        let l = Labelled::new(&bx, ps.clone(), || panic!("pieces decide")).unwrap();
+        let Labelled::Partition(part) = &l else {
+            panic!("opposite faces in one plane need the regions");
+        };
+        // a horizontal probe just above z = 0 is inside the first block
+        // only, one just below inside the second only
+        let strip = |z2: i32| {
+            // the plane 2z = z2 (half-integer z) through a strip x ∈ [-1, 7]
+            let n = [0, 0, 2];
+            let support = bsp_core::Plane::new(n, -(z2 as i128)).unwrap();
+            let mut p = bsp_core::box_section(&support).unwrap();
+            for w in walls(&bx) {
+                assert!(p.clip(&w, Side::Back));
+            }
+            p
+        };
+        let inside = |p: &Polygon| -> Vec<(i64, Cell)> {
+            let mut v: Vec<(i64, Cell)> = part
+                .push_down(p.clone(), part.root())
+                .into_iter()
+                .map(|(q, c)| {
+                    let x = q.vertices().iter().map(|v| v.approx_f64()[0]).sum::<f64>()
+                        / q.vertices().len() as f64;
+                    (x.floor() as i64, c)
+                })
+                .filter(|&(_, c)| c == Cell::In)
+                .collect();
+            v.sort_unstable_by_key(|&(x, _)| x);
+            v
+        };
+        let above = inside(&strip(1));
+        let below = inside(&strip(-1));
+        assert!(!above.is_empty() && above.iter().all(|&(x, _)| (0..2).contains(&x)));
+        assert!(!below.is_empty() && below.iter().all(|&(x, _)| (4..6).contains(&x)));
+    }
 }
