@@ -73,6 +73,23 @@ pub enum Split {
     },
 }
 
+/// A polygon's parts on the two sides of a plane, the polygon itself kept
+/// ([`Polygon::parts`]).
+// By value on purpose, as [`Split`].
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug)]
+pub enum Parts {
+    /// Not cut: the polygon's side of the plane (never `Spanning`).
+    Whole(PolygonSide),
+    /// Cut into two convex pieces sharing the cut edge's two vertices.
+    Split {
+        /// The piece in front.
+        front: Polygon,
+        /// The piece behind.
+        back: Polygon,
+    },
+}
+
 /// Why an input face could not become one convex polygon.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum FaceDefect {
@@ -389,6 +406,23 @@ impl Polygon {
             },
             PolygonSide::Spanning => unreachable!("spanning handled above"),
         }
+    }
+
+    /// As [`Polygon::split`], keeping the polygon: its side of `plane`, or
+    /// the two pieces when it spans the plane.
+    pub fn parts(&self, plane: &Plane) -> Parts {
+        if let Some(c) = self.coplanar_with(plane) {
+            return Parts::Whole(c);
+        }
+        let sides: SmallVec<[crate::Side; 8]> =
+            self.verts.iter().map(|v| v.classify(plane)).collect();
+        let front = sides.contains(&crate::Side::Front);
+        let back = sides.contains(&crate::Side::Back);
+        if front && back {
+            let (front, back) = self.split_with_sides(plane, &sides);
+            return Parts::Split { front, back };
+        }
+        Parts::Whole(self.side_from(front, back, plane))
     }
 
     /// Keeps only the part on side `keep` (`Front` or `Back`) of `plane`,

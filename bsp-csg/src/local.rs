@@ -28,8 +28,8 @@
 //! reaches.
 
 use bsp_core::{
-    BoolOp, BspTree, BuildOptions, Cell, PLink, Partition, Plane, Polygon, Side,
-    merge_smaller_into_larger,
+    BoolOp, BspTree, BuildOptions, Cell, Link, PLink, Partition, Parts, Plane, Polygon,
+    PolygonSide, Side, merge_smaller_into_larger,
 };
 
 use crate::CsgError;
@@ -223,32 +223,156 @@ impl Labelled {
     }
 
     /// `poly` split by the regions, each fragment with its region's label.
+    #[cfg(test)]
     fn push_down(&self, poly: Polygon) -> Vec<(Polygon, Cell)> {
         match self {
             Labelled::Tree(t) => t.push_down(poly),
             Labelled::Partition(p) => p.push_down(poly, p.root()),
         }
     }
+
+    /// The root.
+    fn at_root(&self) -> At {
+        match self {
+            Labelled::Tree(t) => At::of_tree(t.root()),
+            Labelled::Partition(p) => At::of_partition(p.root()),
+        }
+    }
+
+    /// A node's plane and its front and back children.
+    fn node(&self, i: u32) -> (&Plane, At, At) {
+        match self {
+            Labelled::Tree(t) => {
+                let n = t.node(i);
+                (&n.plane, At::of_tree(n.front), At::of_tree(n.back))
+            }
+            Labelled::Partition(p) => {
+                let n = &p.nodes()[i as usize];
+                (
+                    &n.plane,
+                    At::of_partition(n.front),
+                    At::of_partition(n.back),
+                )
+            }
+        }
+    }
+}
+
+/// A place in a labelled tree: a node or a labelled leaf.
+#[derive(Clone, Copy)]
+enum At {
+    Node(u32),
+    Leaf(Cell),
+}
+
+impl At {
+    fn of_tree(l: Link) -> At {
+        match l {
+            Link::Node(i) => At::Node(i),
+            Link::Cell(c) => At::Leaf(c),
+        }
+    }
+
+    fn of_partition(l: PLink<Cell>) -> At {
+        match l {
+            PLink::Node(i) => At::Node(i),
+            PLink::Leaf(c) => At::Leaf(c),
+        }
+    }
 }
 
 /// The fate of `piece` against the labelled regions `other` of the other
 /// operand in the cell: a piece shares no plane with `other`'s faces, so
-/// every fragment lies strictly inside one region.
-fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(bool) -> bool) -> Fate {
-    let frags = other.push_down(piece.clone());
-    let kept = |c: Cell| keep(c == Cell::In);
-    if frags.iter().all(|&(_, c)| kept(c)) {
-        Fate::Keep
-    } else if frags.iter().all(|&(_, c)| !kept(c)) {
-        Fate::Drop
-    } else {
-        Fate::Cut(
-            frags
-                .into_iter()
-                .filter(|&(_, c)| kept(c))
-                .map(|(p, _)| p)
-                .collect(),
-        )
+/// every fragment lies strictly inside one region. `keep(c)` says whether
+/// a fragment in a region labelled `c` stays.
+///
+/// The piece is split down the tree; where both parts of a split stay
+/// whole, the part they were cut from stays instead (it is their union),
+/// so a kept fragment is cut only by planes with something dropped on
+/// one side. The mesh puts into its edges the vertices its neighbours
+/// have there.
+fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate {
+    #[derive(Clone, Copy, PartialEq)]
+    enum State {
+        Kept,
+        Dropped,
+        Mixed,
+    }
+    /// A part met on the way down: a fragment in a leaf, or a part that a
+    /// node's plane splits, with its two pieces' records.
+    struct Rec {
+        poly: Option<Polygon>,
+        pieces: Option<[u32; 2]>,
+        state: State,
+    }
+    /// A part on its way down: where it goes, and its parent's record
+    /// and side.
+    type Going = (Polygon, At, Option<(u32, usize)>);
+    let mut recs: Vec<Rec> = Vec::new();
+    let mut stack: Vec<Going> = vec![(piece.clone(), other.at_root(), None)];
+    while let Some((p, mut at, parent)) = stack.pop() {
+        let me = recs.len() as u32;
+        if let Some((r, k)) = parent {
+            recs[r as usize].pieces.as_mut().expect("a split record")[k] = me;
+        }
+        loop {
+            match at {
+                At::Leaf(c) => {
+                    let state = if keep(c) { State::Kept } else { State::Dropped };
+                    recs.push(Rec {
+                        poly: Some(p),
+                        pieces: None,
+                        state,
+                    });
+                    break;
+                }
+                At::Node(i) => {
+                    let (plane, front, back) = other.node(i);
+                    match p.parts(plane) {
+                        Parts::Whole(PolygonSide::Back) => at = back,
+                        Parts::Whole(_) => at = front,
+                        Parts::Split { front: f, back: b } => {
+                            recs.push(Rec {
+                                poly: Some(p),
+                                pieces: Some([u32::MAX; 2]),
+                                state: State::Mixed,
+                            });
+                            stack.push((b, back, Some((me, 1))));
+                            stack.push((f, front, Some((me, 0))));
+                            break;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // a split part's pieces are recorded after it
+    for j in (0..recs.len()).rev() {
+        if let Some([f, b]) = recs[j].pieces {
+            let (sf, sb) = (recs[f as usize].state, recs[b as usize].state);
+            recs[j].state = if sf == sb { sf } else { State::Mixed };
+        }
+    }
+    match recs[0].state {
+        State::Kept => Fate::Keep,
+        State::Dropped => Fate::Drop,
+        State::Mixed => {
+            let mut kept = Vec::new();
+            let mut todo = vec![0u32];
+            while let Some(j) = todo.pop() {
+                let r = &mut recs[j as usize];
+                match r.state {
+                    State::Kept => kept.push(r.poly.take().expect("each record once")),
+                    State::Dropped => {}
+                    State::Mixed => {
+                        let [f, b] = r.pieces.expect("a mixed record is split");
+                        todo.push(b);
+                        todo.push(f);
+                    }
+                }
+            }
+            Fate::Cut(kept)
+        }
     }
 }
 
@@ -273,8 +397,14 @@ pub(crate) fn boolean_pieces(
     }
     let pa = Labelled::new(bx, a.clone(), ref_a)?;
     let pb = Labelled::new(bx, b.clone(), ref_b)?;
-    let fa = a.iter().map(|p| fate(p, &pb, &keep.0)).collect();
-    let fb = b.iter().map(|p| fate(p, &pa, &keep.1)).collect();
+    let fa = a
+        .iter()
+        .map(|p| fate(p, &pb, |c| keep.0(c == Cell::In)))
+        .collect();
+    let fb = b
+        .iter()
+        .map(|p| fate(p, &pa, |c| keep.1(c == Cell::In)))
+        .collect();
     Ok(CellResult::Pieces(fa, fb, a, b))
 }
 
@@ -492,5 +622,59 @@ mod tests {
         let below = inside(&strip(-1));
         assert!(!above.is_empty() && above.iter().all(|&(x, _)| (0..2).contains(&x)));
         assert!(!below.is_empty() && below.iter().all(|&(x, _)| (4..6).contains(&x)));
+    }
+
+    fn area(p: &Polygon) -> f64 {
+        let v: Vec<[f64; 3]> = p.vertices().iter().map(|q| q.approx_f64()).collect();
+        let n = p.support().normal().map(|c| c as f64);
+        let mut a = [0.0; 3];
+        for i in 1..v.len() - 1 {
+            let (e, f) = (
+                [0, 1, 2].map(|k| v[i][k] - v[0][k]),
+                [0, 1, 2].map(|k| v[i + 1][k] - v[0][k]),
+            );
+            a[0] += e[1] * f[2] - e[2] * f[1];
+            a[1] += e[2] * f[0] - e[0] * f[2];
+            a[2] += e[0] * f[1] - e[1] * f[0];
+        }
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        (a[0] * n[0] + a[1] * n[1] + a[2] * n[2]) / len / 2.0
+    }
+
+    #[test]
+    fn kept_fragments_of_one_split_are_put_back_together() {
+        // two blocks as one operand, the second moved about; a square
+        // through the first at z = 1 (in no face's plane) and beside the
+        // second, of which the part outside the blocks stays: the planes of
+        // the second block's faces cut the square where nothing is dropped
+        let sq = Polygon::from_grid_points(&[[-4, -1, 1], [4, -1, 1], [4, 8, 1], [-4, 8, 1]], 7)
+            .unwrap();
+        let bx: IBox = ([-5, -5, -5], [13, 9, 7]);
+        let out = |c: Cell| c == Cell::Out;
+        let (mut fewer, mut cases) = (0, 0);
+        for dx in 5..8 {
+            for h in 3..7 {
+                for dz in [-1, 0] {
+                    let mut faces = cuboid([0, 0, 0], [2, 2, 2]);
+                    faces.extend(cuboid([dx, -1, dz], [dx + 2, h, dz + 3]));
+                    let l = Labelled::new(&bx, pieces(&faces, &bx), || panic!("pieces decide"))
+                        .unwrap();
+                    let Fate::Cut(kept) = fate(&sq, &l, out) else {
+                        panic!("the first block cuts the square");
+                    };
+                    let leaves = l.push_down(sq.clone());
+                    let kept_leaves = leaves.iter().filter(|(_, c)| out(*c)).count();
+                    let total: f64 = kept.iter().map(area).sum();
+                    assert_eq!(total, 8.0 * 9.0 - 4.0, "the kept area");
+                    assert!(kept.len() <= kept_leaves);
+                    fewer += (kept.len() < kept_leaves) as u32;
+                    cases += 1;
+                    // everything kept, or everything dropped: the piece
+                    assert!(matches!(fate(&sq, &l, |_| true), Fate::Keep));
+                    assert!(matches!(fate(&sq, &l, |_| false), Fate::Drop));
+                }
+            }
+        }
+        assert!(fewer > 0, "no split put back in {cases} cases");
     }
 }
