@@ -498,17 +498,8 @@ impl TriMesh {
             .par_iter()
             .all(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
         if distinct {
-            // every edge used once each way (an exact-size array: the
-            // mesh's largest allocation here)
-            let tris = &self.triangles;
-            let edges: Vec<u128> = (0..3 * tris.len())
-                .into_par_iter()
-                .map(|e| {
-                    let (t, i) = (&tris[e / 3], e % 3);
-                    crate::topology::edge_key(t[i], t[(i + 1) % 3])
-                })
-                .collect();
-            if crate::topology::edges_pair_up(edges) {
+            // every edge used once each way
+            if crate::topology::corners_close(&self.triangles, false) {
                 return Ok(());
             }
         }

@@ -101,11 +101,9 @@ pub fn check_closed_manifold<'a>(
     first_defect(&faces)
 }
 
-/// The verdict of [`check_closed_manifold`] by parallel sorts, without
-/// naming a defect: no face repeats a vertex, every directed edge is used
-/// once and its reverse once (the sorted edges equal the sorted reversed
-/// edges, without repeats), and around every vertex the corners
-/// `u → v → w` form one cycle.
+/// The verdict of [`check_closed_manifold`], without naming a defect: no
+/// face repeats a vertex, and the corners around every vertex close up
+/// ([`corners_close`], with the link cycles).
 fn is_closed_manifold(faces: &[&[u32]]) -> bool {
     use rayon::prelude::*;
     let ok_faces = faces.par_iter().all(|f| {
@@ -113,59 +111,99 @@ fn is_closed_manifold(faces: &[&[u32]]) -> bool {
         v.sort_unstable();
         f.len() >= 3 && v.windows(2).all(|w| w[0] != w[1])
     });
-    if !ok_faces {
-        return false;
-    }
-    let key = |a: u32, b: u32| (a as u64) << 32 | b as u64;
-    // every directed edge used once and its reverse once
-    let edges = per_corner(
-        faces,
-        |f| f.len(),
-        |f, i| edge_key(f[i], f[(i + 1) % f.len()]),
-    );
-    if !edges_pair_up(edges) {
-        return false;
-    }
-    // vertex links: (v, u) → w, sorted; each vertex's group is one cycle
-    let mut link: Vec<(u64, u32)> = per_corner(
-        faces,
-        |f| f.len(),
-        |f, i| {
-            let k = f.len();
-            (key(f[i], f[(i + k - 1) % k]), f[(i + 1) % k])
-        },
-    );
-    link.par_sort_unstable();
-    link.par_chunk_by(|x, y| x.0 >> 32 == y.0 >> 32).all(|g| {
-        let v = g[0].0 >> 32;
-        let next = |u: u32| {
-            g.binary_search_by(|e| e.0.cmp(&(v << 32 | u as u64)))
-                .ok()
-                .map(|i| g[i].1)
-        };
-        let start = g[0].0 as u32;
-        let mut u = start;
-        let mut steps = 0usize;
-        loop {
-            match next(u) {
-                Some(w) => u = w,
-                None => return false,
-            }
-            steps += 1;
-            if u == start || steps > g.len() {
-                break;
-            }
-        }
-        steps == g.len()
-    })
+    ok_faces && corners_close(faces, true)
 }
 
-/// The directed edge `a → b` (`a ≠ b`) as a sort key for
-/// [`edges_pair_up`]: its undirected edge, then its direction.
-#[inline]
-pub(crate) fn edge_key(a: u32, b: u32) -> u128 {
-    let (lo, hi, dir) = undirected(a, b);
-    (lo as u128) << 64 | (hi as u128) << 1 | dir as u128
+/// `true` if around every vertex `v` the corners `u → v → w` of the faces
+/// (no face repeating a vertex) close up: the `u`s are distinct and are
+/// the `w`s. That is every directed edge used once and its reverse once:
+/// `v → w` is used by one corner at `v` (the `w`s are distinct), and
+/// `w → v` by one (`w` is one of the distinct `u`s). With `cycles`, the
+/// corners also form one cycle `u ↦ w` (the vertex's link is one loop, so
+/// no two sheets of the surface meet there).
+///
+/// The corners are put in buckets by vertex (one count, one pass), and
+/// each vertex's few corners are checked on their own, in parallel: no
+/// sort of all edges.
+pub(crate) fn corners_close<F: AsRef<[u32]> + Sync>(faces: &[F], cycles: bool) -> bool {
+    use rayon::prelude::*;
+    let Some(last) = faces
+        .par_iter()
+        .filter_map(|f| f.as_ref().iter().max().copied())
+        .max()
+    else {
+        return true;
+    };
+    let corners: usize = faces.par_iter().map(|f| f.as_ref().len()).sum();
+    // ids far beyond the corner count are numbered densely first, so that
+    // the buckets stay as small as the faces
+    let (n, dense): (usize, Option<Vec<u32>>) = if last as usize > 4 * corners + 1024 {
+        let mut ids: Vec<u32> = faces
+            .iter()
+            .flat_map(|f| f.as_ref().iter().copied())
+            .collect();
+        ids.par_sort_unstable();
+        ids.dedup();
+        (ids.len(), Some(ids))
+    } else {
+        (last as usize + 1, None)
+    };
+    let id = |v: u32| match &dense {
+        Some(ids) => ids.binary_search(&v).expect("every id is listed"),
+        None => v as usize,
+    };
+    // the corners of vertex `v` are `link[start[v]..start[v + 1]]`
+    let mut start = vec![0usize; n + 1];
+    for f in faces {
+        for &v in f.as_ref() {
+            start[id(v) + 1] += 1;
+        }
+    }
+    for v in 0..n {
+        start[v + 1] += start[v];
+    }
+    let mut link = vec![(0u32, 0u32); start[n]];
+    let mut fill = start.clone();
+    for f in faces {
+        let f = f.as_ref();
+        let k = f.len();
+        for i in 0..k {
+            let at = &mut fill[id(f[i])];
+            link[*at] = (f[(i + k - 1) % k], f[(i + 1) % k]);
+            *at += 1;
+        }
+    }
+    drop(fill);
+    (0..n)
+        .into_par_iter()
+        .with_min_len(4096)
+        .all(|v| corners_close_at(&link[start[v]..start[v + 1]], cycles))
+}
+
+/// [`corners_close`] at one vertex, its corners `(u, w)`.
+fn corners_close_at(g: &[(u32, u32)], cycles: bool) -> bool {
+    let mut by_u: smallvec::SmallVec<[(u32, u32); 16]> = g.iter().copied().collect();
+    by_u.sort_unstable();
+    let mut ws: smallvec::SmallVec<[u32; 16]> = g.iter().map(|c| c.1).collect();
+    ws.sort_unstable();
+    if by_u.windows(2).any(|x| x[0].0 == x[1].0) || !by_u.iter().map(|c| c.0).eq(ws) {
+        return false;
+    }
+    if !cycles || by_u.is_empty() {
+        return true;
+    }
+    let first = by_u[0].0;
+    let mut u = first;
+    for step in 1..=by_u.len() {
+        match by_u.binary_search_by_key(&u, |c| c.0) {
+            Ok(i) => u = by_u[i].1,
+            Err(_) => return false,
+        }
+        if u == first {
+            return step == by_u.len();
+        }
+    }
+    false
 }
 
 /// The edge `a → b` as its two ends in order and its direction (0 when
@@ -173,24 +211,6 @@ pub(crate) fn edge_key(a: u32, b: u32) -> u128 {
 #[inline]
 pub(crate) fn undirected(a: u32, b: u32) -> (u32, u32, u32) {
     if a < b { (a, b, 0) } else { (b, a, 1) }
-}
-
-/// `true` if every directed edge of `edges` ([`edge_key`]s) is used once
-/// and its reverse once: sorted, the keys come in pairs, both directions
-/// of one edge, and no edge has a second pair. One parallel sort and one
-/// scan.
-pub(crate) fn edges_pair_up(mut edges: Vec<u128>) -> bool {
-    use rayon::prelude::*;
-    edges.par_sort_unstable();
-    let n = edges.len();
-    n.is_multiple_of(2)
-        && (0..n / 2).into_par_iter().all(|i| {
-            let (x, y) = (edges[2 * i], edges[2 * i + 1]);
-            x >> 1 == y >> 1
-                && x & 1 == 0
-                && y & 1 == 1
-                && edges.get(2 * i + 2).is_none_or(|z| z >> 1 != y >> 1)
-        })
 }
 
 /// `item(face, i)` for every corner `i` of every face (`corners(face)` of
@@ -326,21 +346,28 @@ mod tests {
     }
 
     #[test]
-    fn edges_pair_up_only_once_each_way() {
-        let keys = |e: &[(u32, u32)]| e.iter().map(|&(a, b)| edge_key(a, b)).collect();
-        assert!(edges_pair_up(keys(&[(0, 1), (1, 0), (2, 1), (1, 2)])));
-        assert!(edges_pair_up(Vec::new()));
-        assert!(!edges_pair_up(keys(&[(0, 1)])), "one way only");
-        assert!(!edges_pair_up(keys(&[(0, 1), (0, 1)])), "twice one way");
-        assert!(
-            !edges_pair_up(keys(&[(0, 1), (1, 0), (0, 1), (1, 0)])),
-            "twice each way"
-        );
-        assert!(!edges_pair_up(keys(&[(0, 1), (1, 2)])), "two one-way edges");
-        // the largest ids keep their direction bit apart
-        let m = u32::MAX;
-        assert!(edges_pair_up(keys(&[(m, m - 1), (m - 1, m)])));
-        assert!(!edges_pair_up(keys(&[(m, m - 1), (m, m - 1)])));
+    fn corners_close_only_once_each_way() {
+        let close = |f: &[[u32; 3]], cycles| corners_close(f, cycles);
+        let tet = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+        assert!(close(&tet, true));
+        assert!(close(&[] as &[[u32; 3]], true));
+        assert!(!close(&tet[..3], false), "one way only");
+        let mut twice = tet.to_vec();
+        twice.extend(tet);
+        assert!(!close(&twice, false), "twice each way");
+        let mut one_way = tet.to_vec();
+        one_way.push(tet[0]);
+        assert!(!close(&one_way, false), "a face twice");
+        // two tetrahedra sharing vertex 0: every edge pairs up, but the
+        // link of 0 is two loops
+        let mut pinch = tet.to_vec();
+        pinch.extend([[0, 5, 4], [0, 4, 6], [0, 6, 5], [4, 5, 6]]);
+        assert!(close(&pinch, false));
+        assert!(!close(&pinch, true));
+        // the largest ids
+        let m = u32::MAX - 1;
+        let big = tet.map(|t| t.map(|v| m - v));
+        assert!(close(&big, true));
     }
 
     #[test]
