@@ -700,37 +700,40 @@ fn twinned_edges(corners: &[u32], start: &[usize]) -> Vec<bool> {
     if corners.len() >= 1 << 31 {
         return vec![false; corners.len()]; // places do not fit: search all
     }
-    // (undirected edge, place << 1 | direction), sorted; in an array of
-    // exactly that size, filled in parallel polygon by polygon
-    let polys: Vec<usize> = (0..start.len() - 1).collect();
-    let mut keys: Vec<(u64, u32)> = crate::topology::per_corner(
-        &polys,
-        |&p| start[p + 1] - start[p],
-        |&p, i| {
+    // each edge under its lower end: (upper end, place << 1 | direction)
+    let n = corners.par_iter().max().map_or(0, |&v| v as usize + 1);
+    let (at, edges) = crate::topology::bucket(n, |emit| {
+        for p in 0..start.len() - 1 {
             let cs = &corners[start[p]..start[p + 1]];
-            let (a, b) = (cs[i], cs[(i + 1) % cs.len()]);
-            let (lo, hi, dir) = crate::topology::undirected(a, b);
-            (
-                (lo as u64) << 32 | hi as u64,
-                ((start[p] + i) as u32) << 1 | dir,
-            )
-        },
-    );
-    drop(polys);
-    keys.par_sort_unstable();
-    // the edges used once each way, found in parallel
-    let pairs: Vec<(u32, u32)> = keys
-        .par_chunk_by(|x, y| x.0 == y.0)
-        .filter_map(|group| match group {
-            [(_, e), (_, f)] if (e ^ f) & 1 == 1 => Some((e >> 1, f >> 1)),
-            _ => None,
+            for i in 0..cs.len() {
+                let (lo, hi, dir) = crate::topology::undirected(cs[i], cs[(i + 1) % cs.len()]);
+                emit(lo as usize, (hi, ((start[p] + i) as u32) << 1 | dir));
+            }
+        }
+    });
+    // the edges used once each way, vertex by vertex in parallel
+    let places: Vec<u32> = (0..n)
+        .into_par_iter()
+        .with_min_len(4096)
+        .flat_map_iter(|v| {
+            let mut g: SmallVec<[(u32, u32); 16]> =
+                edges[at[v]..at[v + 1]].iter().copied().collect();
+            g.sort_unstable();
+            let mut out: SmallVec<[u32; 16]> = SmallVec::new();
+            for run in g.chunk_by(|x, y| x.0 == y.0) {
+                if let [(_, e), (_, f)] = run
+                    && (e ^ f) & 1 == 1
+                {
+                    out.extend([e >> 1, f >> 1]);
+                }
+            }
+            out
         })
         .collect();
-    drop(keys);
+    drop(edges);
     let mut twinned = vec![false; corners.len()];
-    for (e, f) in pairs {
+    for e in places {
         twinned[e as usize] = true;
-        twinned[f as usize] = true;
     }
     twinned
 }

@@ -153,31 +153,41 @@ pub(crate) fn corners_close<F: AsRef<[u32]> + Sync>(faces: &[F], cycles: bool) -
         None => v as usize,
     };
     // the corners of vertex `v` are `link[start[v]..start[v + 1]]`
-    let mut start = vec![0usize; n + 1];
-    for f in faces {
-        for &v in f.as_ref() {
-            start[id(v) + 1] += 1;
+    let (start, link) = bucket(n, |emit| {
+        for f in faces {
+            let f = f.as_ref();
+            let k = f.len();
+            for i in 0..k {
+                emit(id(f[i]), (f[(i + k - 1) % k], f[(i + 1) % k]));
+            }
         }
-    }
-    for v in 0..n {
-        start[v + 1] += start[v];
-    }
-    let mut link = vec![(0u32, 0u32); start[n]];
-    let mut fill = start.clone();
-    for f in faces {
-        let f = f.as_ref();
-        let k = f.len();
-        for i in 0..k {
-            let at = &mut fill[id(f[i])];
-            link[*at] = (f[(i + k - 1) % k], f[(i + 1) % k]);
-            *at += 1;
-        }
-    }
-    drop(fill);
+    });
     (0..n)
         .into_par_iter()
         .with_min_len(4096)
         .all(|v| corners_close_at(&link[start[v]..start[v + 1]], cycles))
+}
+
+/// Items grouped by key: `each(emit)` calls `emit(key, item)` for every
+/// item (keys below `n`), twice, the same way each time; key `k`'s items
+/// come out in `items[start[k]..start[k + 1]]`, in the order emitted. One
+/// count and one pass: a counting sort, no comparison.
+pub(crate) fn bucket<T: Copy + Default>(
+    n: usize,
+    each: impl Fn(&mut dyn FnMut(usize, T)),
+) -> (Vec<usize>, Vec<T>) {
+    let mut start = vec![0usize; n + 1];
+    each(&mut |k, _| start[k + 1] += 1);
+    for k in 0..n {
+        start[k + 1] += start[k];
+    }
+    let mut items = vec![T::default(); start[n]];
+    let mut fill = start.clone();
+    each(&mut |k, t| {
+        items[fill[k]] = t;
+        fill[k] += 1;
+    });
+    (start, items)
 }
 
 /// [`corners_close`] at one vertex, its corners `(u, w)`.
