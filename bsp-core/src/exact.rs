@@ -359,8 +359,10 @@ impl<const N: usize> Homogeneous<N> {
     }
 
     /// Exact equality of the represented points ([`Homogeneous::cmp_axis`]).
+    /// Equal coordinates (a point made twice from the same planes) are
+    /// found without a product.
     pub fn same(&self, o: &Self) -> bool {
-        (0..3).all(|k| self.cmp_axis(o, k) == Ordering::Equal)
+        self.h == o.h || (0..3).all(|k| self.cmp_axis(o, k) == Ordering::Equal)
     }
 
     /// [`Homogeneous::cmp_axis`] in the general arithmetic of `M >= 2N`

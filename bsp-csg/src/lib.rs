@@ -684,8 +684,8 @@ impl Solid {
         let run = |l: u32, allow_easy: bool| -> Result<First, CsgError> {
             let leaf = &leaves[l as usize];
             let (bx, w) = (leaf.bx, walls(&leaf.bx));
-            let (pa, ia) = clip_all(&leaf.a, |f| &self.face(f).poly, &w);
-            let (pb, ib) = clip_all(&leaf.b, |f| &other.face(f).poly, &w);
+            let (pa, ia) = clip_all(&leaf.a, |f| self.face(f), &bx, &w);
+            let (pb, ib) = clip_all(&leaf.b, |f| other.face(f), &bx, &w);
             let (isa, isb) = local::isolated(&pa, &pb);
             let masks = |pieces: &[Polygon], iso: &[bool], index: &[Option<u32>]| {
                 index
@@ -867,7 +867,7 @@ impl Solid {
                 .par_iter()
                 .map(|(f, pieces)| {
                     let kept = settle(
-                        &solid.face(*f).poly,
+                        solid.face(*f),
                         pieces,
                         &|l| keep(l.is_some_and(|l| other_side.inside(l))),
                         fates,
@@ -1132,18 +1132,20 @@ impl Made {
     }
 }
 
-/// The faces `fs` clipped to the walls `w`: the non-empty pieces, in
-/// order, and each face's piece among them.
+/// The faces `fs` clipped to the cell `cell` (walls `w`): the non-empty
+/// pieces, in order, and each face's piece among them.
 fn clip_all<'p>(
     fs: &[u32],
-    poly: impl Fn(u32) -> &'p Polygon,
+    face: impl Fn(u32) -> &'p Face,
+    cell: &IBox,
     w: &[bsp_core::Plane; 6],
 ) -> (Vec<Polygon>, Vec<Option<u32>>) {
     let mut pieces = Vec::with_capacity(fs.len());
     let index = fs
         .iter()
         .map(|&f| {
-            local::clip_to(poly(f), w).map(|q| {
+            let face = face(f);
+            local::clip_in(&face.poly, &face.bx(), cell, w).map(|q| {
                 pieces.push(q);
                 (pieces.len() - 1) as u32
             })
@@ -1227,7 +1229,7 @@ fn meeting_leaf(poly: &Polygon, ls: &[u32], leaves: &[Leaf]) -> Option<u32> {
 /// the octree's box) stays; `fates` are the mixed cells' (the pieces kept
 /// are copied: faces settle in parallel).
 fn settle(
-    poly: &Polygon,
+    face: &Face,
     pieces: &[Piece],
     keep_free: &dyn Fn(Option<u32>) -> bool,
     fates: &FxHashMap<u32, Vec<PieceFate>>,
@@ -1246,33 +1248,26 @@ fn settle(
     if pieces.iter().all(|p| fate(p) == Some(Ok(()))) {
         return None;
     }
+    let (poly, fb) = (&face.poly, face.bx());
+    let in_leaf = |l: u32| {
+        let bx = &leaves[l as usize].bx;
+        local::clip_in(poly, &fb, bx, &walls(bx))
+    };
     let mut kept = Vec::new();
     for p in pieces {
         match p {
-            Piece::Free(l) if keep_free(*l) => {
-                kept.extend(free_pieces(poly, l.map(|l| &leaves[l as usize]), root))
-            }
+            Piece::Free(Some(l)) if keep_free(Some(*l)) => kept.extend(in_leaf(*l)),
+            Piece::Free(None) if keep_free(None) => kept.extend(local::outside(poly, root)),
             Piece::Free(_) => {}
             Piece::Mixed(l, i) => match fates.get(l).map(|v| &v[*i as usize]) {
                 Some(PieceFate::Keep(q)) => kept.push((**q).clone()),
-                Some(PieceFate::KeepClip) => {
-                    kept.extend(local::clip_to(poly, &walls(&leaves[*l as usize].bx)))
-                }
+                Some(PieceFate::KeepClip) => kept.extend(in_leaf(*l)),
                 Some(PieceFate::Cut(frags)) => kept.extend(frags.iter().cloned()),
                 _ => {}
             },
         }
     }
     Some(kept)
-}
-
-/// The pieces of `p` in the free cell `leaf` (`None`: beyond the octree's
-/// box, whose walls are `root`).
-fn free_pieces(p: &Polygon, leaf: Option<&Leaf>, root: &[bsp_core::Plane; 6]) -> Vec<Polygon> {
-    match leaf {
-        Some(l) => local::clip_to(p, &walls(&l.bx)).into_iter().collect(),
-        None => local::outside(p, root),
-    }
 }
 
 /// The wall of the cell `s` that faces the cell `l`, if they are
