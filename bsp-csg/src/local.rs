@@ -18,14 +18,16 @@
 //! **Labels without regions.** Where every node's pieces face its plane's
 //! way (no two coplanar pieces face opposite ways), each leaf is the
 //! child of a node with a piece on the leaf's side of it and nothing
-//! between: the labels [`BspTree::build`] gives (front leaves outside,
-//! back leaves inside) are the winding numbers, and sorting the other
-//! operand's pieces needs only the tree ([`Labelled`]). The regions and
-//! their links are built where pieces face both ways (a solid touching
-//! itself in a plane), and for the merged cells. A surface that crosses
-//! itself is caught by the link labelling only: in the cells that label
-//! by the tree it goes unnoticed, as it does in the cells no other surface
-//! reaches.
+//! between: for a solid, the labels [`BspTree::build`] gives (front leaves
+//! outside, back leaves inside) are the winding numbers, and sorting the
+//! other operand's pieces needs only the tree ([`Labelled`]). Each piece
+//! is checked against the leaves right in front of it and right behind it
+//! (`faces_bound`), which a surface crossing itself (two overlapping
+//! shells in one file) fails where a leaf lies against two of its pieces
+//! from opposite sides. The regions and their links are built where
+//! pieces face both ways (a solid touching itself in a plane), where that
+//! check fails (the links then find the crossing and fail the operation),
+//! and for the merged cells.
 
 use bsp_core::{
     BoolOp, BspTree, BuildOptions, Cell, Link, PLink, Partition, Parts, Plane, Polygon,
@@ -215,7 +217,7 @@ impl Labelled {
             return solid(bx, pieces, reference).map(Labelled::Partition);
         }
         let tree = BspTree::build(pieces, &BuildOptions::default());
-        if tree.faces_agree() {
+        if tree.faces_agree() && faces_bound(&tree) {
             Ok(Labelled::Tree(tree))
         } else {
             solid_of(bx, &tree, reference).map(Labelled::Partition)
@@ -256,6 +258,45 @@ impl Labelled {
             }
         }
     }
+}
+
+/// `true` if every piece of every node (all facing the node plane's way)
+/// has only outside leaves right in front of it and only inside leaves
+/// right behind it: each piece is pushed down the node's front subtree and
+/// its back subtree, and every leaf a part of it lands in must be labelled
+/// so. A solid's faces always pass (just in front of a face is outside,
+/// just behind it inside); a surface that crosses itself in the cell, two
+/// overlapping shells say, fails wherever a leaf lies against a piece of
+/// each shell from opposite sides, and the cell is then labelled through
+/// its regions, which finds it out.
+fn faces_bound(tree: &BspTree) -> bool {
+    use std::borrow::Cow;
+    let lands_in = |poly: &Polygon, start: Link, want: Cell| {
+        let mut stack: Vec<(Cow<'_, Polygon>, Link)> = vec![(Cow::Borrowed(poly), start)];
+        while let Some((p, link)) = stack.pop() {
+            match link {
+                Link::Cell(c) if c != want => return false,
+                Link::Cell(_) => {}
+                Link::Node(i) => {
+                    let n = tree.node(i);
+                    match p.parts(&n.plane) {
+                        Parts::Whole(PolygonSide::Back) => stack.push((p, n.back)),
+                        Parts::Whole(_) => stack.push((p, n.front)),
+                        Parts::Split { front, back } => {
+                            stack.push((Cow::Owned(front), n.front));
+                            stack.push((Cow::Owned(back), n.back));
+                        }
+                    }
+                }
+            }
+        }
+        true
+    };
+    tree.nodes().iter().all(|n| {
+        n.polygons
+            .iter()
+            .all(|g| lands_in(g, n.front, Cell::Out) && lands_in(g, n.back, Cell::In))
+    })
 }
 
 /// A place in a labelled tree: a node or a labelled leaf.
@@ -747,5 +788,26 @@ mod tests {
             }
         }
         assert!(some > 20 && some < same, "{some} pieces of {same}");
+    }
+
+    #[test]
+    fn overlapping_shells_are_not_a_solid() {
+        // two boxes overlapping in [1, 2]³ as one operand: inside both the
+        // winding number is 2; the pieces face their planes' ways, but a
+        // leaf lies in front of one box's face and behind the other's
+        let mut faces = cuboid([0, 0, 0], [2, 2, 2]);
+        faces.extend(cuboid([1, 1, 1], [3, 3, 3]));
+        let bx: IBox = ([-1, -1, -1], [4, 4, 4]);
+        let ps = pieces(&faces, &bx);
+        let tree = BspTree::build(ps.clone(), &BuildOptions::default());
+        assert!(tree.faces_agree());
+        assert!(!faces_bound(&tree));
+        assert!(matches!(
+            Labelled::new(&bx, ps, || panic!("pieces decide")),
+            Err(CsgError::NotASolid)
+        ));
+        // one box alone bounds
+        let one = BspTree::build(cuboid([0, 0, 0], [2, 2, 2]), &BuildOptions::default());
+        assert!(faces_bound(&one));
     }
 }

@@ -846,6 +846,27 @@ f 4 1 5 8
     }
 
     #[test]
+    fn overlapping_shells_in_one_file_are_rejected() {
+        // two closed cubes that overlap, in one file: each is a closed
+        // manifold, but together they bound no solid (winding number 2
+        // where they overlap); the other operand's surface crosses there
+        let shells = cube(4.0, [0.0; 3]) + &cube(4.0, [2.0; 3]);
+        let a = operand(&shells, "shells.obj", false);
+        a.validate().unwrap();
+        let b = operand(&cube(3.0, [2.5, -0.5, 1.5]), "b.obj", false);
+        for op in [
+            Operation::Union,
+            Operation::Intersection,
+            Operation::Difference,
+        ] {
+            let e = compute(&mut [a.clone(), b.clone()], op, &mut Phases::default())
+                .err()
+                .unwrap();
+            assert!(e.to_string().contains("crosses itself"), "{op:?}: {e}");
+        }
+    }
+
+    #[test]
     fn guarded_turns_a_panic_into_an_error() {
         let e = guarded("both input files", || -> Result<()> {
             panic!("inconsistent sub-hyperplanes")
