@@ -752,6 +752,33 @@ where
     out
 }
 
+/// Splits `poly` down a tree from `start`: `step(link)` gives a node's
+/// plane and its front and back links, or the leaf's label. The pieces,
+/// each with the label of the leaf it lands in; a piece lying in a node's
+/// plane goes to the front.
+pub(crate) fn push_down_by<'t, K: Copy, L>(
+    poly: Polygon,
+    start: K,
+    step: impl Fn(K) -> Result<(&'t Plane, K, K), L>,
+) -> Vec<(Polygon, L)> {
+    let mut out = Vec::new();
+    let mut stack = vec![(poly, start)];
+    while let Some((p, k)) = stack.pop() {
+        match step(k) {
+            Err(x) => out.push((p, x)),
+            Ok((plane, front, back)) => match p.split(plane) {
+                Split::Front(q) | Split::Coplanar { polygon: q, .. } => stack.push((q, front)),
+                Split::Back(q) => stack.push((q, back)),
+                Split::Spanning { front: f, back: b } => {
+                    stack.push((f, front));
+                    stack.push((b, back));
+                }
+            },
+        }
+    }
+    out
+}
+
 fn first_leaf<L: Copy>(p: &Partition<L>) -> L {
     let mut l = p.root;
     loop {
@@ -925,27 +952,13 @@ impl<L: Copy> Partition<L> {
     /// of the cell each lands in. A piece lying in a node's plane goes to
     /// the front.
     pub fn push_down(&self, poly: Polygon, link: PLink<L>) -> Vec<(Polygon, L)> {
-        let mut out = Vec::new();
-        let mut stack = vec![(poly, link)];
-        while let Some((p, l)) = stack.pop() {
-            match l {
-                PLink::Leaf(x) => out.push((p, x)),
-                PLink::Node(i) => {
-                    let n = &self.nodes[i as usize];
-                    match p.split(&n.plane) {
-                        Split::Front(q) | Split::Coplanar { polygon: q, .. } => {
-                            stack.push((q, n.front))
-                        }
-                        Split::Back(q) => stack.push((q, n.back)),
-                        Split::Spanning { front, back } => {
-                            stack.push((front, n.front));
-                            stack.push((back, n.back));
-                        }
-                    }
-                }
+        push_down_by(poly, link, |l| match l {
+            PLink::Leaf(x) => Err(x),
+            PLink::Node(i) => {
+                let n = &self.nodes[i as usize];
+                Ok((&n.plane, n.front, n.back))
             }
-        }
-        out
+        })
     }
 
     /// Collapses nodes whose children are leaves with equal labels, and

@@ -383,28 +383,15 @@ impl Polygon {
     /// cover it exactly, and share the same two exact vertices on the cut.
     /// Each vertex is classified once.
     pub fn split(self, plane: &Plane) -> Split {
-        let side = match self.coplanar_with(plane) {
-            Some(c) => c,
-            None => {
-                let sides: SmallVec<[crate::Side; 8]> =
-                    self.verts.iter().map(|v| v.classify(plane)).collect();
-                let front = sides.contains(&crate::Side::Front);
-                let back = sides.contains(&crate::Side::Back);
-                if front && back {
-                    let (front, back) = self.split_with_sides(plane, &sides);
-                    return Split::Spanning { front, back };
-                }
-                self.side_from(front, back, plane)
-            }
-        };
-        match side {
-            PolygonSide::Front => Split::Front(self),
-            PolygonSide::Back => Split::Back(self),
-            PolygonSide::Coplanar { same_orientation } => Split::Coplanar {
+        match self.parts(plane) {
+            Parts::Split { front, back } => Split::Spanning { front, back },
+            Parts::Whole(PolygonSide::Front) => Split::Front(self),
+            Parts::Whole(PolygonSide::Back) => Split::Back(self),
+            Parts::Whole(PolygonSide::Coplanar { same_orientation }) => Split::Coplanar {
                 polygon: self,
                 same_orientation,
             },
-            PolygonSide::Spanning => unreachable!("spanning handled above"),
+            Parts::Whole(PolygonSide::Spanning) => unreachable!("a spanning polygon is split"),
         }
     }
 

@@ -654,27 +654,13 @@ impl BspTree {
     /// the cell it lands in. A piece lying in a node's plane goes to the
     /// front (as [`crate::Partition::push_down`]).
     pub fn push_down(&self, poly: Polygon) -> Vec<(Polygon, Cell)> {
-        let mut out = Vec::new();
-        let mut stack = vec![(poly, self.root)];
-        while let Some((p, link)) = stack.pop() {
-            match link {
-                Link::Cell(c) => out.push((p, c)),
-                Link::Node(id) => {
-                    let n = &self.nodes[id as usize];
-                    match p.split(&n.plane) {
-                        Split::Front(q) | Split::Coplanar { polygon: q, .. } => {
-                            stack.push((q, n.front))
-                        }
-                        Split::Back(q) => stack.push((q, n.back)),
-                        Split::Spanning { front, back } => {
-                            stack.push((front, n.front));
-                            stack.push((back, n.back));
-                        }
-                    }
-                }
+        crate::partition::push_down_by(poly, self.root, |l| match l {
+            Link::Cell(c) => Err(c),
+            Link::Node(id) => {
+                let n = &self.nodes[id as usize];
+                Ok((&n.plane, n.front, n.back))
             }
-        }
-        out
+        })
     }
 
     /// `true` if every node's polygons face the way of its plane (none is
