@@ -778,7 +778,7 @@ impl Solid {
         }
         let mut labels_a = label_easy(
             true,
-            |f| &self.face(f).poly,
+            |f| self.face(f),
             &leaves,
             &adjacent,
             &masks_a,
@@ -789,7 +789,7 @@ impl Solid {
         )?;
         let mut labels_b = label_easy(
             false,
-            |f| &other.face(f).poly,
+            |f| other.face(f),
             &leaves,
             &adjacent,
             &masks_b,
@@ -847,12 +847,9 @@ impl Solid {
         let mut remove: Vec<u32> = whole_a
             .par_iter()
             .filter(|&&i| {
-                let inside = meeting_leaf(
-                    &self.face(a_c[i as usize]).poly,
-                    &a_leaves[i as usize],
-                    &leaves,
-                )
-                .is_some_and(|l| inside_b.inside(l));
+                let inside =
+                    meeting_leaf(self.face(a_c[i as usize]), &a_leaves[i as usize], &leaves)
+                        .is_some_and(|l| inside_b.inside(l));
                 !keep_a(inside)
             })
             .map(|&i| a_c[i as usize])
@@ -895,12 +892,9 @@ impl Solid {
         let kept_b: Vec<u32> = whole_b
             .par_iter()
             .filter(|&&i| {
-                let inside = meeting_leaf(
-                    &other.face(b_c[i as usize]).poly,
-                    &b_leaves[i as usize],
-                    &leaves,
-                )
-                .is_some_and(|l| inside_a.inside(l));
+                let inside =
+                    meeting_leaf(other.face(b_c[i as usize]), &b_leaves[i as usize], &leaves)
+                        .is_some_and(|l| inside_a.inside(l));
                 keep_b(inside)
             })
             .map(|&i| b_c[i as usize])
@@ -1201,12 +1195,13 @@ fn sort_faces<'l>(
 }
 
 /// A leaf among `ls` (the leaves a face's box and plane tests put it in)
-/// that the face `poly` really meets: the one holding a grid vertex of it,
+/// that the face really meets: the one holding a grid vertex of it,
 /// else the first one its clipping leaves something in. The lists may
 /// name leaves the face does not reach, whose region may lie on the other
 /// side of the other surface; `None` if it meets none (it lies beyond the
 /// octree's box, so beyond the other solid).
-fn meeting_leaf(poly: &Polygon, ls: &[u32], leaves: &[Leaf]) -> Option<u32> {
+fn meeting_leaf(face: &Face, ls: &[u32], leaves: &[Leaf]) -> Option<u32> {
+    let poly = &face.poly;
     let holds = |l: u32, g: GridPoint| {
         let (lo, hi) = leaves[l as usize].bx;
         (0..3).all(|k| lo[k] <= g[k] as i64 && g[k] as i64 <= hi[k])
@@ -1218,9 +1213,11 @@ fn meeting_leaf(poly: &Polygon, ls: &[u32], leaves: &[Leaf]) -> Option<u32> {
             return Some(l);
         }
     }
-    ls.iter()
-        .copied()
-        .find(|&l| local::clip_to(poly, &walls(&leaves[l as usize].bx)).is_some())
+    let fb = face.bx();
+    ls.iter().copied().find(|&l| {
+        let bx = &leaves[l as usize].bx;
+        local::clip_in(poly, &fb, bx, &walls(bx)).is_some()
+    })
 }
 
 /// What stays of a face cut into `pieces`: `None` if every piece stays
@@ -1354,7 +1351,7 @@ impl Listed {
 #[allow(clippy::too_many_arguments)]
 fn label_easy<'p>(
     side_a: bool,
-    poly: impl Fn(u32) -> &'p Polygon + Sync,
+    face: impl Fn(u32) -> &'p Face + Sync,
     leaves: &[Leaf],
     adjacent: &[(u32, u32)],
     masks: &FxHashMap<u32, Vec<Option<u8>>>,
@@ -1438,8 +1435,8 @@ fn label_easy<'p>(
                         (Some(w), _) => mask & (1 << w) != 0,
                         (None, Some(w)) => {
                             let mm = other_mask.unwrap_or_else(|| {
-                                let wm = walls(bm);
-                                local::clip_to(poly(f), &wm)
+                                let (wm, g) = (walls(bm), face(f));
+                                local::clip_in(&g.poly, &g.bx(), bm, &wm)
                                     .map_or(0, |q| local::wall_edges(&q, &wm))
                             });
                             mm & (1 << w) != 0

@@ -333,6 +333,7 @@ impl At {
 /// one side. The mesh puts into its edges the vertices its neighbours
 /// have there.
 fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate {
+    use std::borrow::Cow;
     #[derive(Clone, Copy, PartialEq)]
     enum State {
         Kept,
@@ -341,16 +342,17 @@ fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate 
     }
     /// A part met on the way down: a fragment in a leaf, or a part that a
     /// node's plane splits, with its two pieces' records.
-    struct Rec {
-        poly: Option<Polygon>,
+    struct Rec<'p> {
+        poly: Option<Cow<'p, Polygon>>,
         pieces: Option<[u32; 2]>,
         state: State,
     }
     /// A part on its way down: where it goes, and its parent's record
     /// and side.
-    type Going = (Polygon, At, Option<(u32, usize)>);
-    let mut recs: Vec<Rec> = Vec::new();
-    let mut stack: Vec<Going> = vec![(piece.clone(), other.at_root(), None)];
+    /// (The piece itself is only borrowed: most go down whole.)
+    type Going<'p> = (Cow<'p, Polygon>, At, Option<(u32, usize)>);
+    let mut recs: Vec<Rec<'_>> = Vec::new();
+    let mut stack: Vec<Going<'_>> = vec![(Cow::Borrowed(piece), other.at_root(), None)];
     while let Some((p, mut at, parent)) = stack.pop() {
         let me = recs.len() as u32;
         if let Some((r, k)) = parent {
@@ -378,8 +380,8 @@ fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate 
                                 pieces: Some([u32::MAX; 2]),
                                 state: State::Mixed,
                             });
-                            stack.push((b, back, Some((me, 1))));
-                            stack.push((f, front, Some((me, 0))));
+                            stack.push((Cow::Owned(b), back, Some((me, 1))));
+                            stack.push((Cow::Owned(f), front, Some((me, 0))));
                             break;
                         }
                     }
@@ -403,7 +405,7 @@ fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate 
             while let Some(j) = todo.pop() {
                 let r = &mut recs[j as usize];
                 match r.state {
-                    State::Kept => kept.push(r.poly.take().expect("each record once")),
+                    State::Kept => kept.push(r.poly.take().expect("each record once").into_owned()),
                     State::Dropped => {}
                     State::Mixed => {
                         let [f, b] = r.pieces.expect("a mixed record is split");
@@ -506,7 +508,9 @@ pub(crate) fn wall_edges(p: &Polygon, w: &[Plane; 6]) -> u8 {
     mask
 }
 
-/// The six walls of `bx`, for clipping faces into it.
+/// `face` clipped to the cell whose walls are `w`, by every wall: the
+/// reference [`clip_in`] is tested against.
+#[cfg(test)]
 pub(crate) fn clip_to(face: &Polygon, w: &[Plane; 6]) -> Option<Polygon> {
     let mut p = face.clone();
     for wall in w {
@@ -517,10 +521,11 @@ pub(crate) fn clip_to(face: &Polygon, w: &[Plane; 6]) -> Option<Polygon> {
     Some(p)
 }
 
-/// [`clip_to`] the cell `cell` (walls `w`) for a face whose box is `fb`
-/// (a box holding it): a wall the box lies behind is not tried, and a box
-/// apart from the cell gives nothing at once. The same piece as
-/// [`clip_to`], with fewer vertices classified.
+/// The piece of `face` in the cell `cell` (walls `w`, interior behind),
+/// `None` if no area is left; `fb` is a box holding the face. A wall the
+/// box lies behind is not tried, and a box apart from the cell gives
+/// nothing at once: the piece that clipping by all six walls gives, with
+/// fewer vertices classified.
 pub(crate) fn clip_in(face: &Polygon, fb: &IBox, cell: &IBox, w: &[Plane; 6]) -> Option<Polygon> {
     if (0..3).any(|k| fb.1[k] < cell.0[k] || fb.0[k] > cell.1[k]) {
         return None;
