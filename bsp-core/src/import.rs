@@ -154,19 +154,10 @@ pub fn import_indexed_par(
         .enumerate()
         .map(|(c, chunk)| {
             let mut run = Importer::new(chunk.len());
-            let mut loop_ = Vec::new();
             for (i, face) in chunk.iter().enumerate() {
-                let fi = c * CHUNK + i;
-                loop_.clear();
-                for (vertex, &v) in face.iter().enumerate() {
-                    let p = positions.get(v as usize).ok_or(Error::VertexIndex {
-                        face: fi,
-                        vertex,
-                        index: v,
-                    })?;
-                    loop_.push(*p);
-                }
-                run.face(grid, &loop_, fi)?;
+                let out = &mut run.out;
+                run.faces
+                    .indexed(grid, positions, face, c * CHUNK + i, |p| out.push(p))?;
             }
             Ok(run.finish())
         })
@@ -175,8 +166,9 @@ pub fn import_indexed_par(
 }
 
 impl ImportReport {
-    /// Adds the report of the faces after these.
-    fn add(&mut self, r: ImportReport) {
+    /// Adds the report of the faces after these (the reports of a
+    /// parallel import's runs, joined in face order).
+    pub fn add(&mut self, r: ImportReport) {
         self.faces += r.faces;
         self.polygons += r.polygons;
         self.triangulated.extend(r.triangulated);
@@ -193,16 +185,16 @@ fn import_from<'a>(
     let faces = faces.into_iter();
     let mut run = Importer::new(faces.size_hint().0);
     for (fi, face) in faces.enumerate() {
-        run.face(grid, face, fi + first)?;
+        let out = &mut run.out;
+        run.faces.face(grid, face, fi + first, |p| out.push(p))?;
     }
     Ok(run.finish())
 }
 
-/// Faces imported one after the other.
+/// Faces imported one after the other into a list.
 struct Importer {
     out: Vec<Polygon>,
-    report: ImportReport,
-    pts: Vec<GridPoint>,
+    faces: FaceImporter,
 }
 
 impl Importer {
@@ -211,14 +203,78 @@ impl Importer {
     fn new(faces: usize) -> Importer {
         Importer {
             out: Vec::with_capacity(faces),
-            report: ImportReport::default(),
-            pts: Vec::new(),
+            faces: FaceImporter::default(),
         }
     }
 
-    /// Imports face `fi`.
-    fn face(&mut self, grid: &Grid, face: &[DVec3], fi: usize) -> Result<(), Error> {
-        let (out, report, pts) = (&mut self.out, &mut self.report, &mut self.pts);
+    fn finish(self) -> (Vec<Polygon>, ImportReport) {
+        (self.out, self.faces.finish())
+    }
+}
+
+/// The import of one face at a time, each face's polygons handed to the
+/// caller as they are made (one as a rule; none for a dropped face,
+/// several for a triangulated one), so that a caller can put them
+/// straight where they are kept, with no list to gather and copy. The
+/// same polygons, tags and report as [`import_faces`].
+///
+/// ```
+/// use bsp_core::{FaceImporter, Grid};
+/// use glam::DVec3;
+/// let p = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)];
+/// let grid = Grid::fit_points(&p).unwrap();
+/// let mut imp = FaceImporter::default();
+/// let mut polys = Vec::new();
+/// imp.indexed(&grid, &p, &[0, 1, 3, 2], 0, |q| polys.push(q)).unwrap();
+/// imp.indexed(&grid, &p, &[0, 1, 0], 1, |q| polys.push(q)).unwrap(); // no area
+/// assert!(imp.indexed(&grid, &p, &[0, 1, 9], 2, |q| polys.push(q)).is_err());
+/// let report = imp.finish();
+/// assert_eq!((polys.len(), polys[0].len(), report.polygons), (1, 4, 1));
+/// assert_eq!(report.dropped.len(), 1);
+/// ```
+#[derive(Debug, Default)]
+pub struct FaceImporter {
+    report: ImportReport,
+    pts: Vec<GridPoint>,
+    loop_: Vec<DVec3>,
+}
+
+impl FaceImporter {
+    /// Imports face `fi` of an indexed mesh: the loop `face` of indices
+    /// into `positions`. An index out of range is an error naming the face
+    /// and the corner.
+    pub fn indexed(
+        &mut self,
+        grid: &Grid,
+        positions: &[DVec3],
+        face: &[u32],
+        fi: usize,
+        out: impl FnMut(Polygon),
+    ) -> Result<(), Error> {
+        let mut loop_ = std::mem::take(&mut self.loop_);
+        loop_.clear();
+        for (vertex, &v) in face.iter().enumerate() {
+            let p = positions.get(v as usize).ok_or(Error::VertexIndex {
+                face: fi,
+                vertex,
+                index: v,
+            })?;
+            loop_.push(*p);
+        }
+        let r = self.face(grid, &loop_, fi, out);
+        self.loop_ = loop_;
+        r
+    }
+
+    /// Imports face `fi`, the loop `face`.
+    pub fn face(
+        &mut self,
+        grid: &Grid,
+        face: &[DVec3],
+        fi: usize,
+        mut out: impl FnMut(Polygon),
+    ) -> Result<(), Error> {
+        let (report, pts) = (&mut self.report, &mut self.pts);
         report.faces += 1;
         pts.clear();
         for (vi, p) in face.iter().enumerate() {
@@ -232,15 +288,20 @@ impl Importer {
         }
         let tag = fi as u32;
         match Polygon::from_grid_points(pts, tag) {
-            Ok(p) => out.push(p),
+            Ok(p) => {
+                report.polygons += 1;
+                out(p);
+            }
             Err(defect @ (FaceDefect::NonConvex | FaceDefect::NonPlanar)) => {
                 let tris = triangulate(pts, defect);
-                let before = out.len();
-                out.extend(
-                    tris.iter()
-                        .filter_map(|t| Polygon::from_grid_points(t, tag).ok()),
-                );
-                if out.len() == before {
+                let before = report.polygons;
+                for t in tris.iter() {
+                    if let Ok(p) = Polygon::from_grid_points(t, tag) {
+                        report.polygons += 1;
+                        out(p);
+                    }
+                }
+                if report.polygons == before {
                     report.dropped.push((fi, defect));
                 } else {
                     report.triangulated.push((fi, defect));
@@ -251,9 +312,9 @@ impl Importer {
         Ok(())
     }
 
-    fn finish(mut self) -> (Vec<Polygon>, ImportReport) {
-        self.report.polygons = self.out.len();
-        (self.out, self.report)
+    /// What happened to the faces imported so far.
+    pub fn finish(self) -> ImportReport {
+        self.report
     }
 }
 

@@ -58,7 +58,9 @@ pub use exact::{
 };
 pub use flat::FlatBsp;
 pub use grid::{GRID_BITS, Grid, GridPoint, MAX_COORD, MAX_VIEW_COORD, SnapError, ViewPoint};
-pub use import::{ImportReport, all_planar, import_faces, import_faces_par, import_indexed_par};
+pub use import::{
+    FaceImporter, ImportReport, all_planar, import_faces, import_faces_par, import_indexed_par,
+};
 pub use mesh::TriMesh;
 pub use partition::{
     BOX_HALF, BoolOp, CellOp, Overlay, PLink, PNode, Partition, box_section, merge,

@@ -185,7 +185,8 @@ pub(crate) fn support_plane(v: &[GridPoint]) -> Result<Plane, FaceDefect> {
         }
     }
     let plane = plane.ok_or(FaceDefect::ZeroArea)?;
-    if v.iter().any(|p| plane.classify_grid(*p) != crate::Side::On) {
+    // the plane through three points holds them exactly
+    if k > 3 && v.iter().any(|p| plane.classify_grid(*p) != crate::Side::On) {
         return Err(FaceDefect::NonPlanar);
     }
     // orientation: twice the projected signed area along the dominant axis
@@ -228,9 +229,14 @@ impl Polygon {
             return Err(FaceDefect::TooFewVertices);
         }
         let support = support_plane(&v)?;
-        remove_collinear(&mut v);
-        if v.len() < 3 {
-            return Err(FaceDefect::ZeroArea);
+        // a triangle of nonzero area has no collinear corner and is
+        // convex: the checks are for larger loops
+        let triangle = v.len() == 3;
+        if !triangle {
+            remove_collinear(&mut v);
+            if v.len() < 3 {
+                return Err(FaceDefect::ZeroArea);
+            }
         }
         let k = v.len();
         let edges: SmallVec<[Plane; 4]> = (0..k)
@@ -239,12 +245,17 @@ impl Polygon {
                     .expect("edge plane of two distinct grid points fits the budget")
             })
             .collect();
-        for (i, e) in edges.iter().enumerate() {
-            for (j, p) in v.iter().enumerate() {
-                if j != i && j != (i + 1) % k && e.classify_grid(*p) != crate::Side::Back {
-                    return Err(FaceDefect::NonConvex);
-                }
-            }
+        let convex = || {
+            edges.iter().enumerate().all(|(i, e)| {
+                v.iter().enumerate().all(|(j, p)| {
+                    j == i || j == (i + 1) % k || e.classify_grid(*p) == crate::Side::Back
+                })
+            })
+        };
+        if triangle {
+            debug_assert!(convex(), "a triangle of nonzero area is convex");
+        } else if !convex() {
+            return Err(FaceDefect::NonConvex);
         }
         Ok(Polygon {
             support,

@@ -85,7 +85,7 @@ mod winding;
 
 use bsp_core::{
     BoolOp, Grid, GridPoint, ImportReport, Membership, Polygon, Side, TopologyError, TriMesh,
-    check_closed_manifold, import_indexed_par, share_points,
+    check_closed_manifold, share_points,
 };
 use glam::DVec3;
 use rayon::prelude::*;
@@ -311,45 +311,25 @@ impl Solid {
                 Some(Face::new(p.with_tag(0), &bx))
             })
             .collect();
-        Solid::from_faces(faces)
+        Solid::from_faces(faces, Vec::new())
     }
 
     /// The solid of these face slots, indexed.
-    fn from_faces(faces: Vec<Option<Face>>) -> Solid {
+    /// The solid of `faces`, whose empty slots are `free` (each once).
+    fn from_faces(faces: Vec<Option<Face>>, free: Vec<u32>) -> Solid {
+        debug_assert!(free.iter().all(|&f| faces[f as usize].is_none()));
+        let live = faces.len() - free.len();
         let mut s = Solid {
             faces,
-            free: Vec::new(),
+            free,
             index: FaceIndex::new(([0; 3], [0; 3]), 1),
             indexed: 0,
             bounds: None,
             live: 0,
         };
-        s.live = s.faces.len();
+        s.live = live;
         s.reindex();
         s
-    }
-
-    /// [`Solid::from_polygons`] of runs of polygons (as
-    /// [`bsp_core::import_indexed_par`] gives them), each run moved into
-    /// its place in parallel.
-    pub fn from_runs(runs: Vec<Vec<Polygon>>) -> Solid {
-        let n: usize = runs.iter().map(Vec::len).sum();
-        let mut faces: Vec<Option<Face>> = Vec::with_capacity(n);
-        faces.par_extend((0..n).into_par_iter().map(|_| None));
-        let mut slots: Vec<&mut [Option<Face>]> = Vec::with_capacity(runs.len());
-        let mut rest = &mut faces[..];
-        for r in &runs {
-            let (here, after) = rest.split_at_mut(r.len());
-            slots.push(here);
-            rest = after;
-        }
-        slots.into_par_iter().zip(runs).for_each(|(slots, run)| {
-            for (slot, p) in slots.iter_mut().zip(run) {
-                let bx = polygon_box(&p);
-                *slot = Some(Face::new(p.with_tag(0), &bx));
-            }
-        });
-        Solid::from_faces(faces)
     }
 
     /// An empty solid.
@@ -1627,13 +1607,58 @@ pub fn snap_one(
     mesh: &MeshIn<'_>,
     operand: usize,
 ) -> Result<(Solid, ImportReport), CsgError> {
-    let (runs, report) =
-        import_indexed_par(grid, mesh.positions, mesh.faces).map_err(CsgError::Grid)?;
-    let sign: i128 = runs.par_iter().map(|r| six_volume(r)).sum();
+    // each face's polygon goes straight into the face's slot, in
+    // parallel: a solid's faces are most of its memory, and a list of
+    // polygons moved into the slots after would be made and touched once
+    // more; the rare extra polygons of triangulated faces go after
+    const CHUNK: usize = 4096;
+    let n = mesh.faces.len();
+    let mut faces: Vec<Option<Face>> = Vec::with_capacity(n);
+    faces.par_extend((0..n).into_par_iter().map(|_| None));
+    type Run = (ImportReport, Vec<Face>, i128);
+    let runs: Vec<Result<Run, bsp_core::Error>> = faces
+        .par_chunks_mut(CHUNK)
+        .zip(mesh.faces.par_chunks(CHUNK))
+        .enumerate()
+        .map(|(c, (slots, loops))| {
+            let mut imp = bsp_core::FaceImporter::default();
+            let (mut extra, mut six) = (Vec::new(), 0i128);
+            for (i, (slot, face)) in slots.iter_mut().zip(loops).enumerate() {
+                imp.indexed(grid, mesh.positions, face, c * CHUNK + i, |p| {
+                    six += six_volume(std::slice::from_ref(&p));
+                    let bx = polygon_box(&p);
+                    let face = Face::new(p.with_tag(0), &bx);
+                    match slot {
+                        None => *slot = Some(face),
+                        Some(_) => extra.push(face),
+                    }
+                })?;
+            }
+            Ok((imp.finish(), extra, six))
+        })
+        .collect();
+    // the first error in face order, as a sequential import gives
+    let mut report = ImportReport::default();
+    let mut sign = 0i128;
+    let mut extra = Vec::new();
+    for run in runs {
+        let (r, e, six) = run.map_err(CsgError::Grid)?;
+        report.add(r);
+        extra.extend(e);
+        sign += six;
+    }
     if sign < 0 {
         return Err(CsgError::Inward { operand });
     }
-    Ok((Solid::from_runs(runs), report))
+    faces.extend(extra.into_iter().map(Some));
+    // a dropped face left its slot empty (the lowest is reused first)
+    let free = report
+        .dropped
+        .iter()
+        .rev()
+        .map(|&(f, _)| f as u32)
+        .collect();
+    Ok((Solid::from_faces(faces, free), report))
 }
 
 /// `((first op₁ m₁) op₂ m₂) ...` on one grid: every operand is checked
