@@ -493,6 +493,76 @@ impl Polygon {
         (f.finish(), b.finish())
     }
 
+    /// The union of two polygons on the same support plane that share an
+    /// edge (this one's edge `u → v` is `other`'s edge `v → u`, with exactly
+    /// equal endpoints), if it is convex; `None` if they share no edge or
+    /// their union is not convex. Where the two meet in a straight line
+    /// the shared endpoint is dropped (so the union is strictly convex
+    /// again) and the first's edge plane spans both edges. Exact: the
+    /// angles at the shared endpoints are read off by classifying the next
+    /// vertex of one against the edge plane of the other. The tag is this
+    /// polygon's.
+    ///
+    /// ```
+    /// use bsp_core::Polygon;
+    /// let a = Polygon::from_grid_points(&[[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0]], 1).unwrap();
+    /// let b = Polygon::from_grid_points(&[[2, 0, 0], [5, 0, 0], [5, 2, 0], [2, 2, 0]], 2).unwrap();
+    /// let m = a.merge(&b).unwrap();
+    /// assert_eq!(m.len(), 4); // (2, 0, 0) and (2, 2, 0) lie on straight lines
+    /// assert!(m.sanity_check().is_ok());
+    /// let c = Polygon::from_grid_points(&[[2, 0, 0], [5, 1, 0], [2, 2, 0]], 3).unwrap();
+    /// assert_eq!(a.merge(&c).unwrap().len(), 5);
+    /// let d = Polygon::from_grid_points(&[[2, 0, 0], [3, 0, 0], [3, 3, 0], [2, 2, 0]], 4).unwrap();
+    /// assert!(a.merge(&d).is_none()); // a reflex corner at (2, 2, 0)
+    /// ```
+    pub fn merge(&self, other: &Polygon) -> Option<Polygon> {
+        if self.support != other.support {
+            return None;
+        }
+        let (n, m) = (self.verts.len(), other.verts.len());
+        for i in 0..n {
+            let (u, v) = (&self.verts[i], &self.verts[(i + 1) % n]);
+            for j in 0..m {
+                if other.verts[j].same_point(v) && other.verts[(j + 1) % m].same_point(u) {
+                    return self.merge_at(other, i, j);
+                }
+            }
+        }
+        None
+    }
+
+    /// [`Polygon::merge`] along this polygon's edge `i` (`u → v`) and
+    /// `other`'s edge `j` (`v → u`).
+    fn merge_at(&self, other: &Polygon, i: usize, j: usize) -> Option<Polygon> {
+        use crate::Side::{Front, On};
+        let (n, m) = (self.verts.len(), other.verts.len());
+        // at u: this polygon's edge into u, against other's vertex after u
+        let at_u = other.verts[(j + 2) % m].classify(&self.edges[(i + n - 1) % n]);
+        // at v: other's edge into v, against this polygon's vertex after v
+        let at_v = self.verts[(i + 2) % n].classify(&other.edges[(j + m - 1) % m]);
+        if at_u == Front || at_v == Front {
+            return None;
+        }
+        let mut out = Builder::new(self.support, self.tag);
+        // this polygon from v round to u, then other from u round to v;
+        // each vertex with its outgoing edge plane
+        for t in 1..n {
+            let k = (i + t) % n;
+            if t == 1 && at_v == On {
+                continue; // v lies between two parts of one straight edge
+            }
+            out.push(self.verts[k].clone(), self.edges[k]);
+        }
+        if at_u != On {
+            out.push(self.verts[i].clone(), other.edges[(j + 1) % m]);
+        }
+        for t in 2..m {
+            let k = (j + t) % m;
+            out.push(other.verts[k].clone(), other.edges[k]);
+        }
+        Some(out.finish())
+    }
+
     /// Checks the representation invariants exactly: every vertex lies on
     /// the support plane and on its two edge planes, and strictly behind
     /// every other edge plane (strict convexity).
@@ -861,6 +931,79 @@ mod tests {
                 same_orientation: false
             }
         );
+    }
+
+    /// The same points in the same cyclic order.
+    fn same_loop(a: &Polygon, b: &Polygon) -> bool {
+        let (x, y) = (a.vertices(), b.vertices());
+        let n = x.len();
+        n == y.len() && (0..n).any(|r| (0..n).all(|i| x[i].same_point(&y[(i + r) % n])))
+    }
+
+    #[test]
+    fn the_two_parts_of_a_split_merge_back_into_the_polygon() {
+        let polys = [
+            Polygon::from_grid_points(&[[0, 0, 0], [9, 0, 0], [9, 7, 0], [0, 7, 0]], 5).unwrap(),
+            Polygon::from_grid_points(&[[1, 2, 3], [11, -4, 6], [5, 9, -2]], 5).unwrap(),
+            Polygon::from_grid_points(
+                &[[0, 0, 0], [6, 0, 6], [8, 5, 3], [3, 9, -6], [-2, 4, -6]],
+                5,
+            )
+            .unwrap(),
+        ];
+        let mut splits = 0;
+        for p in &polys {
+            for a in -3i64..=3 {
+                for b in -3i64..=3 {
+                    for c in [-1i64, 0, 2] {
+                        for d in (-20i128..=20).step_by(3) {
+                            let Some(plane) = Plane::new([a, b, c], d) else {
+                                continue;
+                            };
+                            let Parts::Split { front, back } = p.parts(&plane) else {
+                                continue;
+                            };
+                            splits += 1;
+                            for m in [front.merge(&back), back.merge(&front)] {
+                                let m = m.expect("the parts share the cut edge");
+                                assert!(m.sanity_check().is_ok());
+                                assert!(same_loop(&m, p), "{m:?} is not {p:?}");
+                                assert_eq!(m.edge_planes().len(), m.len());
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(splits > 500, "{splits} splits");
+    }
+
+    #[test]
+    fn merges_need_a_whole_shared_edge_a_convex_union_and_one_plane() {
+        let g = |p: &[GridPoint]| Polygon::from_grid_points(p, 0).unwrap();
+        let a = g(&[[0, 0, 0], [4, 0, 0], [4, 4, 0], [0, 4, 0]]);
+        // a convex corner at both ends: a pentagon, every vertex kept
+        let roof = g(&[[0, 4, 0], [4, 4, 0], [2, 6, 0]]);
+        let house = a.merge(&roof).unwrap();
+        assert_eq!(house.len(), 5);
+        assert!(house.sanity_check().is_ok());
+        // only part of the edge shared (a T-junction): not merged
+        let half = g(&[[0, 4, 0], [2, 4, 0], [1, 6, 0]]);
+        assert!(a.merge(&half).is_none());
+        // the same edge in the same direction: overlapping, not merged
+        let under = g(&[[4, 4, 0], [0, 4, 0], [2, 2, 0]]);
+        assert!(a.merge(&under).is_none());
+        // another plane through the shared edge: not merged
+        let fold = g(&[[0, 4, 0], [4, 4, 0], [2, 6, 1]]);
+        assert!(a.merge(&fold).is_none());
+        // a reflex corner at one end
+        let wing = g(&[[4, 0, 0], [8, -1, 0], [4, 4, 0]]);
+        assert!(a.merge(&wing).is_none());
+        // straight at one end only
+        let side = g(&[[4, 0, 0], [8, 0, 0], [4, 4, 0]]);
+        let m = a.merge(&side).unwrap();
+        assert_eq!(m.len(), 4);
+        assert!(m.sanity_check().is_ok());
     }
 
     #[test]

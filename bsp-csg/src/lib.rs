@@ -1244,7 +1244,79 @@ fn settle(
             },
         }
     }
-    Some(kept)
+    Some(rejoin(kept))
+}
+
+/// The kept pieces of one face put back together where two share a whole
+/// edge and their union is convex ([`Polygon::merge`]): the cells' walls
+/// cut a face into pieces that the other surface does not separate, and
+/// a piece per cell would be a polygon per cell in the result (more
+/// vertices to weld, more triangles). The same region, exactly; pieces
+/// whose edges meet partly (a T-junction) stay apart.
+fn rejoin(pieces: Vec<Polygon>) -> Vec<Polygon> {
+    if pieces.len() < 2 {
+        return pieces;
+    }
+    // an endpoint's key: its approximate coordinates rounded to 36 bits
+    // (equal points nearly always get equal keys; a pair that does not is
+    // only a merge missed, and a merge is decided exactly)
+    let key = |p: &bsp_core::Point| {
+        let a = p.approx_f64();
+        let mut h = rustc_hash::FxHasher::default();
+        for c in a {
+            std::hash::Hasher::write_u64(&mut h, ((c + 0.0).to_bits() + 0x8000) & !0xffff);
+        }
+        std::hash::Hasher::finish(&h)
+    };
+    let mut live: Vec<Option<Polygon>> = pieces.into_iter().map(Some).collect();
+    loop {
+        // each directed edge's polygons; a polygon merged in this round is
+        // not merged again until the next (its edges changed)
+        let mut edges: FxHashMap<(u64, u64), SmallVec<[u32; 2]>> = FxHashMap::default();
+        let keys: Vec<SmallVec<[u64; 8]>> = live
+            .iter()
+            .map(|p| {
+                p.iter()
+                    .flat_map(|p| p.vertices().iter().map(key))
+                    .collect()
+            })
+            .collect();
+        for (i, ks) in keys.iter().enumerate() {
+            for e in 0..ks.len() {
+                let b = ks[(e + 1) % ks.len()];
+                edges.entry((ks[e], b)).or_default().push(i as u32);
+            }
+        }
+        let mut touched = vec![false; live.len()];
+        let mut merged = false;
+        for i in 0..live.len() {
+            if touched[i] || live[i].is_none() {
+                continue;
+            }
+            let ks = &keys[i];
+            let partner = (0..ks.len()).find_map(|e| {
+                let twins = edges.get(&(ks[(e + 1) % ks.len()], ks[e]))?;
+                twins.iter().find_map(|&j| {
+                    let j = j as usize;
+                    if j == i || touched[j] {
+                        return None;
+                    }
+                    let (a, b) = (live[i].as_ref()?, live[j].as_ref()?);
+                    a.merge(b).map(|m| (j, m))
+                })
+            });
+            if let Some((j, m)) = partner {
+                live[i] = Some(m);
+                live[j] = None;
+                touched[i] = true;
+                touched[j] = true;
+                merged = true;
+            }
+        }
+        if !merged {
+            return live.into_iter().flatten().collect();
+        }
+    }
 }
 
 /// The wall of the cell `s` that faces the cell `l`, if they are
@@ -1717,4 +1789,179 @@ fn six_volume(polys: &[Polygon]) -> i128 {
         }
     }
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bsp_core::{Parts, Plane};
+
+    /// The same points in the same cyclic order.
+    fn same_loop(a: &Polygon, b: &Polygon) -> bool {
+        let (x, y) = (a.vertices(), b.vertices());
+        let n = x.len();
+        n == y.len() && (0..n).any(|r| (0..n).all(|i| x[i].same_point(&y[(i + r) % n])))
+    }
+
+    /// `p` cut by the walls `x = 4, 8, 12` and `y = 4, 8, 12`: up to 16
+    /// pieces, one per cell, as the cells' clipping leaves them.
+    fn cells_of(p: &Polygon) -> Vec<Polygon> {
+        let mut pieces = vec![p.clone()];
+        for k in 0..2 {
+            for w in [4i128, 8, 12] {
+                let mut n = [0; 3];
+                n[k] = 1;
+                let wall = Plane::new(n, -w).unwrap();
+                pieces = pieces
+                    .into_iter()
+                    .flat_map(|q| match q.parts(&wall) {
+                        Parts::Split { front, back } => vec![back, front],
+                        Parts::Whole(_) => vec![q],
+                    })
+                    .collect();
+            }
+        }
+        pieces
+    }
+
+    #[test]
+    fn triangulated_and_dropped_faces_keep_their_slots_straight() {
+        // an L-shaped prism (its top and bottom are non-convex hexagons,
+        // imported as triangles after the other faces), with a vertex 12
+        // on the edge 0-1 and a sliver face 0 12 1 without area (dropped,
+        // its slot left empty), united with a unit cube in its notch
+        let v = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        let mut positions = Vec::new();
+        for z in [0.0, 1.0] {
+            for (x, y) in [(0., 0.), (2., 0.), (2., 1.), (1., 1.), (1., 2.), (0., 2.)] {
+                positions.push(v(x, y, z));
+            }
+        }
+        positions.push(v(1.0, 0.0, 0.0));
+        let mut faces: Vec<Vec<u32>> = vec![vec![5, 4, 3, 2, 1, 0]];
+        faces.push(vec![6, 7, 8, 9, 10, 11]);
+        for i in 0..6u32 {
+            let j = (i + 1) % 6;
+            faces.push(if i == 0 {
+                vec![0, 12, 1, 7, 6]
+            } else {
+                vec![i, j, j + 6, i + 6]
+            });
+        }
+        faces.push(vec![0, 1, 12]);
+        let cube: Vec<DVec3> = (0..8)
+            .map(|i| {
+                v(
+                    1.0 + (i & 1) as f64,
+                    1.0 + (i >> 1 & 1) as f64,
+                    (i >> 2) as f64,
+                )
+            })
+            .collect();
+        let cube_faces: Vec<Vec<u32>> = vec![
+            vec![0, 2, 3, 1],
+            vec![4, 5, 7, 6],
+            vec![0, 1, 5, 4],
+            vec![2, 6, 7, 3],
+            vec![0, 4, 6, 2],
+            vec![1, 3, 7, 5],
+        ];
+        let r = mesh_boolean(
+            &MeshIn::new(&positions, &faces),
+            &MeshIn::new(&cube, &cube_faces),
+            BoolOp::Union,
+        )
+        .unwrap();
+        let rep = &r.reports[0];
+        assert_eq!(rep.faces, 9);
+        assert_eq!(
+            rep.triangulated.iter().map(|t| t.0).collect::<Vec<_>>(),
+            [0, 1]
+        );
+        assert_eq!(rep.dropped.iter().map(|t| t.0).collect::<Vec<_>>(), [8]);
+        // 8 faces' slots (one empty) and the triangles after them
+        assert_eq!(rep.polygons, 6 + 2 * 4);
+        assert_eq!(r.volume(), 4.0);
+        r.mesh.check_watertight().unwrap();
+        // the union's solid: the cube's faces took the empty slot and the
+        // end; a point in each part is inside
+        for q in [
+            [0.5, 0.5, 0.5],
+            [1.5, 0.5, 0.5],
+            [0.5, 1.5, 0.5],
+            [1.5, 1.5, 0.5],
+        ] {
+            let g = r.grid.snap(DVec3::from_array(q)).unwrap();
+            assert_eq!(r.solid.winding(g), 1, "{q:?}");
+        }
+    }
+
+    #[test]
+    fn a_face_cut_by_walls_and_one_plane_is_put_back_whole() {
+        let square =
+            Polygon::from_grid_points(&[[1, 1, 0], [15, 1, 0], [15, 15, 0], [1, 15, 0]], 0)
+                .unwrap();
+        // no cut: the square itself
+        let pieces = cells_of(&square);
+        assert_eq!(pieces.len(), 16);
+        let back = rejoin(pieces);
+        assert_eq!(back.len(), 1);
+        assert!(same_loop(&back[0], &square));
+        // a cut 2x + 3y = 41 across many cells: what is behind it, whole
+        let cut = Plane::new([2, 3, 0], -41).unwrap();
+        let kept: Vec<Polygon> = cells_of(&square)
+            .into_iter()
+            .filter_map(|mut q| q.clip(&cut, Side::Back).then_some(q))
+            .collect();
+        assert!(kept.len() > 6, "{} pieces", kept.len());
+        let mut whole = square.clone();
+        assert!(whole.clip(&cut, Side::Back));
+        let back = rejoin(kept);
+        assert_eq!(back.len(), 1);
+        assert!(back[0].sanity_check().is_ok());
+        assert!(same_loop(&back[0], &whole));
+    }
+
+    #[test]
+    fn pieces_a_bend_separates_stay_convex_and_fewer() {
+        // the kept part is behind two cuts meeting at a reflex corner: not
+        // convex, so it stays in several convex pieces, each valid
+        let square =
+            Polygon::from_grid_points(&[[1, 1, 0], [15, 1, 0], [15, 15, 0], [1, 15, 0]], 0)
+                .unwrap();
+        let (c1, c2) = (
+            Plane::new([1, 0, 0], -10).unwrap(),
+            Plane::new([0, 1, 0], -10).unwrap(),
+        );
+        // kept: x < 10 or y < 10 (an L)
+        let kept: Vec<Polygon> = cells_of(&square)
+            .into_iter()
+            .flat_map(|q| {
+                let mut a = q.clone();
+                let left = a.clip(&c1, Side::Back).then_some(a);
+                let mut b = q;
+                let right = b.clip(&c1, Side::Front) && b.clip(&c2, Side::Back);
+                left.into_iter().chain(right.then_some(b))
+            })
+            .collect();
+        let n = kept.len();
+        let back = rejoin(kept);
+        assert!(back.len() >= 2 && back.len() < n, "{} of {n}", back.len());
+        for p in &back {
+            assert!(p.sanity_check().is_ok());
+        }
+        // the same region: a point off every wall and cut is in one piece
+        // exactly when it is kept
+        let odd = [2, 3, 5, 6, 7, 9, 11, 13, 14];
+        for x in odd {
+            for y in odd {
+                let pt = bsp_core::Point::Grid([x, y, 0]);
+                let holding = back
+                    .iter()
+                    .filter(|p| p.edge_planes().iter().all(|e| pt.classify(e) == Side::Back))
+                    .count();
+                assert_eq!(holding, usize::from(x < 10 || y < 10), "({x}, {y})");
+            }
+        }
+    }
 }
