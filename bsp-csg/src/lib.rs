@@ -463,19 +463,20 @@ impl Solid {
         TriMesh::from_polygons(&polys)
     }
 
-    /// [`Solid::to_mesh`] for a solid no longer needed: its faces go as
-    /// soon as the triangles are made, so the mesh of a large result is
-    /// not finished while the whole solid is held (the same mesh).
+    /// [`Solid::to_mesh`] for a solid no longer needed: the index goes
+    /// first, and the faces go in parallel once the triangles are made
+    /// (the same mesh).
     pub fn into_mesh(self) -> TriMesh {
         // the index goes now (`..` would keep it to the end)
         let Solid { faces, index, .. } = self;
         drop(index);
-        // in place: a polygon takes no more room than a face slot
-        let polys: Vec<Polygon> = faces
-            .into_iter()
-            .filter_map(|f| f.map(|f| f.poly))
-            .collect();
-        TriMesh::from_polygons_owned(polys)
+        // the polygons are read where they are (moving them out of their
+        // slots into a list cost a pass over all of them)
+        let polys: Vec<&Polygon> = faces.iter().flatten().map(|f| &f.poly).collect();
+        let mesh = TriMesh::from_polygons(&polys);
+        drop(polys);
+        faces.into_par_iter().for_each(drop);
+        mesh
     }
 
     /// `self op other`, as a new solid.
