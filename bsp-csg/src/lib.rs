@@ -629,26 +629,34 @@ impl Solid {
         });
         let adjacent = octree::adjacent(&leaves);
         // the regions free of each surface, and their labels
-        let inside_b = Regions::new(&leaves, &adjacent, |l| l.b.is_empty(), other);
-        let inside_a = Regions::new(&leaves, &adjacent, |l| l.a.is_empty(), self);
+        let (inside_b, inside_a) = rayon::join(
+            || Regions::new(&leaves, &adjacent, |l| l.b.is_empty(), other),
+            || Regions::new(&leaves, &adjacent, |l| l.a.is_empty(), self),
+        );
 
         // the faces wholly in free cells, and the pieces of the others
         let root_walls = walls(&root);
-        let (whole_a, pieces_a) = sort_faces(
-            &a_c,
-            &a_leaves,
-            &leaves,
-            &root,
-            |f| self.face(f).bx(),
-            |l| (&l.a, l.b.is_empty()),
-        );
-        let (whole_b, pieces_b) = sort_faces(
-            &b_c,
-            &b_leaves,
-            &leaves,
-            &root,
-            |f| other.face(f).bx(),
-            |l| (&l.b, l.a.is_empty()),
+        let ((whole_a, pieces_a), (whole_b, pieces_b)) = rayon::join(
+            || {
+                sort_faces(
+                    &a_c,
+                    &a_leaves,
+                    &leaves,
+                    &root,
+                    |f| self.face(f).bx(),
+                    |l| (&l.a, l.b.is_empty()),
+                )
+            },
+            || {
+                sort_faces(
+                    &b_c,
+                    &b_leaves,
+                    &leaves,
+                    &root,
+                    |f| other.face(f).bx(),
+                    |l| (&l.b, l.a.is_empty()),
+                )
+            },
         );
         // the mixed cells, in parallel; a mixed leaf's lists are its
         // listed faces (`Piece::Mixed` indexes them)
@@ -757,28 +765,35 @@ impl Solid {
                 _ => None,
             }
         }
-        let mut labels_a = label_easy(
-            true,
-            |f| self.face(f),
-            &leaves,
-            &adjacent,
-            &masks_a,
-            &listed_a,
-            &label_of(&fates_a, keep_a(true)),
-            &|l| inside_b.inside(l),
-            &|g| other.winding(g) != 0,
-        )?;
-        let mut labels_b = label_easy(
-            false,
-            |f| other.face(f),
-            &leaves,
-            &adjacent,
-            &masks_b,
-            &listed_b,
-            &label_of(&fates_b, keep_b(true)),
-            &|l| inside_a.inside(l),
-            &|g| self.winding(g) != 0,
-        )?;
+        let (labels_a, labels_b) = rayon::join(
+            || {
+                label_easy(
+                    true,
+                    |f| self.face(f),
+                    &leaves,
+                    &adjacent,
+                    &masks_a,
+                    &listed_a,
+                    &label_of(&fates_a, keep_a(true)),
+                    &|l| inside_b.inside(l),
+                    &|g| other.winding(g) != 0,
+                )
+            },
+            || {
+                label_easy(
+                    false,
+                    |f| other.face(f),
+                    &leaves,
+                    &adjacent,
+                    &masks_b,
+                    &listed_b,
+                    &label_of(&fates_b, keep_b(true)),
+                    &|l| inside_a.inside(l),
+                    &|g| self.winding(g) != 0,
+                )
+            },
+        );
+        let (mut labels_a, mut labels_b) = (labels_a?, labels_b?);
         drop((listed_a, listed_b));
         // an easy cell with a piece no label reached does the full work
         let mut again: Vec<u32> = Vec::new();
@@ -856,8 +871,34 @@ impl Solid {
                 })
                 .collect::<Vec<_>>()
         };
-        let settled_a = settle_all(&pieces_a, self, &keep_a, &inside_b, &fates_a);
-        drop((pieces_a, fates_a));
+        // the two operands' faces at once (each in parallel, but each
+        // with sequential tails)
+        let (settled_a, (kept_b, settled_b)) = rayon::join(
+            || settle_all(&pieces_a, self, &keep_a, &inside_b, &fates_a),
+            || {
+                rayon::join(
+                    // the other solid's faces kept whole are listed, to be
+                    // copied or moved over (flipped for a difference)
+                    || -> Vec<u32> {
+                        whole_b
+                            .par_iter()
+                            .filter(|&&i| {
+                                let inside = meeting_leaf(
+                                    other.face(b_c[i as usize]),
+                                    &b_leaves[i as usize],
+                                    &leaves,
+                                )
+                                .is_some_and(|l| inside_a.inside(l));
+                                keep_b(inside)
+                            })
+                            .map(|&i| b_c[i as usize])
+                            .collect()
+                    },
+                    || settle_all(&pieces_b, other, &keep_b, &inside_a, &fates_b),
+                )
+            },
+        );
+        drop((pieces_a, fates_a, pieces_b, fates_b));
         for (f, outcome) in settled_a {
             if let Some(kept) = outcome {
                 remove.push(f);
@@ -868,21 +909,7 @@ impl Solid {
                 add.extend(kept.into_iter().map(|p| Added::New(Box::new(p))));
             }
         }
-        // the other solid's faces kept whole are listed, to be copied or
-        // moved over (flipped for a difference)
-        let kept_b: Vec<u32> = whole_b
-            .par_iter()
-            .filter(|&&i| {
-                let inside =
-                    meeting_leaf(other.face(b_c[i as usize]), &b_leaves[i as usize], &leaves)
-                        .is_some_and(|l| inside_a.inside(l));
-                keep_b(inside)
-            })
-            .map(|&i| b_c[i as usize])
-            .collect();
         add.extend(kept_b.into_iter().map(Added::Whole));
-        let settled_b = settle_all(&pieces_b, other, &keep_b, &inside_a, &fates_b);
-        drop((pieces_b, fates_b));
         for (f, outcome) in settled_b {
             match outcome {
                 None => add.push(Added::Whole(f)),
@@ -1269,55 +1296,42 @@ fn rejoin(pieces: Vec<Polygon>) -> Vec<Polygon> {
         }
         std::hash::Hasher::finish(&h)
     };
+    let keys_of = |p: &Polygon| -> SmallVec<[u64; 8]> { p.vertices().iter().map(key).collect() };
+    // each directed edge's latest polygon; an entry left by a polygon
+    // merged since only costs a merge that fails
+    let mut edges: FxHashMap<(u64, u64), u32> = FxHashMap::default();
+    let add_edges = |edges: &mut FxHashMap<(u64, u64), u32>, ks: &[u64], i: usize| {
+        for e in 0..ks.len() {
+            edges.insert((ks[e], ks[(e + 1) % ks.len()]), i as u32);
+        }
+    };
+    let mut keys: Vec<SmallVec<[u64; 8]>> = pieces.iter().map(keys_of).collect();
+    for (i, ks) in keys.iter().enumerate() {
+        add_edges(&mut edges, ks, i);
+    }
     let mut live: Vec<Option<Polygon>> = pieces.into_iter().map(Some).collect();
-    loop {
-        // each directed edge's polygons; a polygon merged in this round is
-        // not merged again until the next (its edges changed)
-        let mut edges: FxHashMap<(u64, u64), SmallVec<[u32; 2]>> = FxHashMap::default();
-        let keys: Vec<SmallVec<[u64; 8]>> = live
-            .iter()
-            .map(|p| {
-                p.iter()
-                    .flat_map(|p| p.vertices().iter().map(key))
-                    .collect()
-            })
-            .collect();
-        for (i, ks) in keys.iter().enumerate() {
-            for e in 0..ks.len() {
-                let b = ks[(e + 1) % ks.len()];
-                edges.entry((ks[e], b)).or_default().push(i as u32);
+    // each polygon looks for a partner across its edges; one that grew
+    // looks again
+    let mut work: Vec<usize> = (0..live.len()).rev().collect();
+    while let Some(i) = work.pop() {
+        let Some(p) = live[i].as_ref() else { continue };
+        let ks = &keys[i];
+        let partner = (0..ks.len()).find_map(|e| {
+            let j = *edges.get(&(ks[(e + 1) % ks.len()], ks[e]))? as usize;
+            if j == i {
+                return None;
             }
-        }
-        let mut touched = vec![false; live.len()];
-        let mut merged = false;
-        for i in 0..live.len() {
-            if touched[i] || live[i].is_none() {
-                continue;
-            }
-            let ks = &keys[i];
-            let partner = (0..ks.len()).find_map(|e| {
-                let twins = edges.get(&(ks[(e + 1) % ks.len()], ks[e]))?;
-                twins.iter().find_map(|&j| {
-                    let j = j as usize;
-                    if j == i || touched[j] {
-                        return None;
-                    }
-                    let (a, b) = (live[i].as_ref()?, live[j].as_ref()?);
-                    a.merge(b).map(|m| (j, m))
-                })
-            });
-            if let Some((j, m)) = partner {
-                live[i] = Some(m);
-                live[j] = None;
-                touched[i] = true;
-                touched[j] = true;
-                merged = true;
-            }
-        }
-        if !merged {
-            return live.into_iter().flatten().collect();
+            p.merge(live[j].as_ref()?).map(|m| (j, m))
+        });
+        if let Some((j, m)) = partner {
+            keys[i] = keys_of(&m);
+            add_edges(&mut edges, &keys[i], i);
+            live[i] = Some(m);
+            live[j] = None;
+            work.push(i);
         }
     }
+    live.into_iter().flatten().collect()
 }
 
 /// The wall of the cell `s` that faces the cell `l`, if they are
