@@ -74,34 +74,116 @@ fn cmp_axis(p: &Point, q: &Point, k: usize) -> Ordering {
     (big(a[k]) * big(b[3])).cmp(&(big(b[k]) * big(a[3])))
 }
 
-/// Distinct vertices by key: the map holds the last vertex of each key,
-/// and `next` chains the vertices of one key (a list per key cost 40
-/// bytes an entry; this costs 12, and 4 per vertex).
-struct Welder {
-    vertices: Vec<Point>,
-    by_key: rustc_hash::FxHashMap<u64, u32>,
-    next: Vec<u32>,
-}
-
-impl Welder {
-    const END: u32 = u32::MAX;
-
-    /// The id of `p`, whose [`key`] is `k`.
-    fn id(&mut self, p: &Point, k: u64) -> u32 {
-        let head = self.by_key.entry(k).or_insert(Self::END);
-        let mut i = *head;
-        while i != Self::END {
-            if self.vertices[i as usize].same_point(p) {
-                return i;
-            }
-            i = self.next[i as usize];
-        }
-        let id = self.vertices.len() as u32;
-        self.vertices.push(p.clone());
-        self.next.push(*head);
-        *head = id;
-        id
+/// The distinct points of the polygons' corners, in the order they first
+/// occur, and each corner's point (polygon `i`'s corners are
+/// `start[i]..start[i + 1]`). The corners are sorted by their [`key`]
+/// into a fixed number of shards, each welded on its own (in parallel,
+/// with a map a shard's size that stays in cache), and the points are
+/// numbered in the order of their first corners, as one pass in order
+/// would number them: the same result whatever the thread count.
+fn weld<P: std::borrow::Borrow<Polygon> + Sync>(
+    polys: &[P],
+    start: &[usize],
+) -> (Vec<Point>, Vec<u32>) {
+    use std::sync::Arc;
+    /// A corner's point as the shards read it: a grid point by value, an
+    /// implicit one by reference (no polygon is read again).
+    #[derive(Clone, Copy)]
+    enum Pt<'a> {
+        G(crate::GridPoint),
+        I(&'a Arc<crate::point::Implicit>),
     }
+    impl Default for Pt<'_> {
+        fn default() -> Self {
+            Pt::G([0; 3])
+        }
+    }
+    let same = |a: Pt<'_>, b: Pt<'_>| match (a, b) {
+        (Pt::G(x), Pt::G(y)) => x == y,
+        (Pt::I(x), Pt::I(y)) => x.same_point(y),
+        (Pt::G(g), Pt::I(i)) | (Pt::I(i), Pt::G(g)) => crate::point::grid_is(&g, i),
+    };
+    const SHARDS: usize = 16;
+    // each corner's point and key, in parallel
+    let corners_of = crate::topology::per_corner_at(polys, start, |p, i| {
+        let v = &p.borrow().vertices()[i];
+        let pt = match v {
+            Point::Grid(g) => Pt::G(*g),
+            Point::Implicit(a) => Pt::I(a),
+        };
+        (pt, key(v))
+    });
+    let shard = |k: u64| (k >> 60) as usize % SHARDS;
+    // the corners by shard, in order
+    let (at, items) = crate::topology::bucket_par(
+        SHARDS,
+        &corners_of,
+        |&(_, k)| shard(k),
+        |c, &(pt, k)| (pt, k, c as u32),
+    );
+    drop(corners_of);
+    // per shard: each item's point there, and the points with their first
+    // corners; a key's points are chained (`next`), the map holds the last
+    const END: u32 = u32::MAX;
+    let welded: Vec<(Vec<u32>, Vec<(Pt<'_>, u32)>)> = (0..SHARDS)
+        .into_par_iter()
+        .map(|s| {
+            let items = &items[at[s]..at[s + 1]];
+            let mut by_key: rustc_hash::FxHashMap<u64, u32> = Default::default();
+            let mut points: Vec<(Pt<'_>, u32)> = Vec::new();
+            let mut next: Vec<u32> = Vec::new();
+            let ids = items
+                .iter()
+                .map(|&(pt, k, c)| {
+                    let head = by_key.entry(k).or_insert(END);
+                    let mut i = *head;
+                    while i != END {
+                        if same(points[i as usize].0, pt) {
+                            return i;
+                        }
+                        i = next[i as usize];
+                    }
+                    let id = points.len() as u32;
+                    points.push((pt, c));
+                    next.push(*head);
+                    *head = id;
+                    id
+                })
+                .collect();
+            (ids, points)
+        })
+        .collect();
+    // the points numbered by their first corners
+    let mut order: Vec<(u32, u32, u32)> = welded
+        .iter()
+        .enumerate()
+        .flat_map(|(s, (_, pts))| {
+            pts.iter()
+                .enumerate()
+                .map(move |(i, &(_, c))| (c, s as u32, i as u32))
+        })
+        .collect();
+    order.par_sort_unstable();
+    let mut number: Vec<Vec<u32>> = welded.iter().map(|(_, pts)| vec![0; pts.len()]).collect();
+    let vertices: Vec<Point> = order
+        .iter()
+        .enumerate()
+        .map(|(g, &(_, s, i))| {
+            number[s as usize][i as usize] = g as u32;
+            match welded[s as usize].1[i as usize].0 {
+                Pt::G(g) => Point::Grid(g),
+                Pt::I(a) => Point::Implicit(a.clone()),
+            }
+        })
+        .collect();
+    drop(order);
+    let mut corners = vec![0u32; start[polys.len()]];
+    for (s, (ids, _)) in welded.iter().enumerate() {
+        for (&(_, _, c), &id) in items[at[s]..at[s + 1]].iter().zip(ids) {
+            corners[c as usize] = number[s][id as usize];
+        }
+    }
+    (vertices, corners)
 }
 
 impl TriMesh {
@@ -150,35 +232,19 @@ impl TriMesh {
     fn triangulate<P: std::borrow::Borrow<Polygon> + Sync>(
         polys: &[P],
     ) -> (Vec<Point>, Vec<[u32; 3]>, Vec<u32>) {
-        let mut w = Welder {
-            vertices: Vec::new(),
-            by_key: rustc_hash::FxHashMap::default(),
-            next: Vec::new(),
-        };
         // polygon `i`'s corners are `corners[start[i]..start[i + 1]]`, in
         // flat arrays (a list per polygon costs an allocation each)
+        // (the counts read in parallel: a polygon read is a cache miss)
+        let counts: Vec<usize> = polys
+            .par_iter()
+            .map(|p| p.borrow().vertices().len())
+            .collect();
         let mut start = Vec::with_capacity(polys.len() + 1);
         start.push(0usize);
-        for p in polys {
-            start.push(start[start.len() - 1] + p.borrow().vertices().len());
+        for n in counts {
+            start.push(start[start.len() - 1] + n);
         }
-        // the keys (hashes of the correctly rounded coordinates) in
-        // parallel, the ids in order; run by run, so that the keys of all
-        // corners are never held at once
-        const WELD_RUN: usize = 1 << 14;
-        let mut corners = Vec::with_capacity(start[polys.len()]);
-        for run in polys.chunks(WELD_RUN) {
-            let keys = crate::topology::per_corner(
-                run,
-                |p| p.borrow().vertices().len(),
-                |p, i| key(&p.borrow().vertices()[i]),
-            );
-            let vs = run.iter().flat_map(|p| p.borrow().vertices());
-            corners.extend(vs.zip(&keys).map(|(v, &k)| w.id(v, k)));
-        }
-        drop(w.by_key);
-        drop(w.next);
-        let vertices = w.vertices;
+        let (vertices, corners) = weld(polys, &start);
         // rounded once more to `f32` for the search of vertices on edges:
         // both roundings are monotone, so a point on a segment still has
         // its rounded coordinates in the segment's rounded box
@@ -918,6 +984,63 @@ fn clip_ears(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn welding_names_each_exact_point_once_in_first_order() {
+        // squares on a grid, each split by x = 2i + 1 (implicit points
+        // with integer coordinates, equal to the grid corners of the
+        // squares beside them) and by y = 1/2 (new points shared by the
+        // two pieces of each split)
+        let mut polys = Vec::new();
+        for i in 0..40i32 {
+            for j in 0..3i32 {
+                let (x, y) = (2 * i, 2 * j);
+                let sq = Polygon::from_grid_points(
+                    &[[x, y, 0], [x + 2, y, 0], [x + 2, y + 2, 0], [x, y + 2, 0]],
+                    0,
+                )
+                .unwrap();
+                let cut = Plane::new([1, 0, 0], -(x as i128 + 1)).unwrap();
+                let half = Plane::new([0, 2, 0], -(2 * y as i128 + 1)).unwrap();
+                match sq.parts(&cut) {
+                    crate::Parts::Split { front, back } => {
+                        for q in [front, back] {
+                            match q.parts(&half) {
+                                crate::Parts::Split { front, back } => polys.extend([front, back]),
+                                _ => polys.push(q),
+                            }
+                        }
+                    }
+                    _ => polys.push(sq),
+                }
+            }
+        }
+        let mut start = vec![0usize];
+        for p in &polys {
+            start.push(start[start.len() - 1] + p.len());
+        }
+        let (vertices, corners) = weld(&polys, &start);
+        // one vertex per exact point
+        for a in 0..vertices.len() {
+            for b in a + 1..vertices.len() {
+                assert!(!vertices[a].same_point(&vertices[b]), "{a} and {b}");
+            }
+        }
+        // each corner names its own point, and the points come in the
+        // order of their first corners
+        let mut seen = 0;
+        let flat: Vec<&Point> = polys.iter().flat_map(|p| p.vertices()).collect();
+        for (c, (&v, p)) in corners.iter().zip(&flat).enumerate() {
+            assert!(vertices[v as usize].same_point(p), "corner {c}");
+            assert!(v as usize <= seen);
+            if v as usize == seen {
+                seen += 1;
+            }
+        }
+        assert_eq!(seen, vertices.len());
+        // every point of x in 0..=80 and y in {0, 1/2, 2, 5/2, 4, 9/2, 6}
+        assert_eq!(vertices.len(), 81 * 7);
+    }
 
     #[test]
     fn an_edge_is_twinned_when_used_once_each_way() {

@@ -289,11 +289,16 @@ impl Point {
             (Point::Grid(a), Point::Grid(b)) => a == b,
             (Point::Implicit(a), Point::Implicit(b)) => a.same_point(b),
             (Point::Grid(g), Point::Implicit(i)) | (Point::Implicit(i), Point::Grid(g)) => {
-                let h = i.coords();
-                (0..3).all(|k| h[k] == wide(g[k] as i128) * h[3])
+                grid_is(g, i)
             }
         }
     }
+}
+
+/// Whether the grid point `g` is the implicit point `i`, exactly.
+pub(crate) fn grid_is(g: &crate::GridPoint, i: &Implicit) -> bool {
+    let h = i.coords();
+    (0..3).all(|k| h[k] == wide(g[k] as i128) * h[3])
 }
 
 /// The `f64` nearest to `num / den` (ties to even), `den > 0`.

@@ -190,6 +190,66 @@ pub(crate) fn bucket<T: Copy + Default>(
     (start, items)
 }
 
+/// `n` default items, written in parallel (a large array's pages are
+/// first touched by both threads).
+fn zeroed_par<T: Copy + Default + Send + Sync>(n: usize) -> Vec<T> {
+    use rayon::prelude::*;
+    let mut v = Vec::with_capacity(n);
+    v.par_extend(rayon::iter::repeat_n(T::default(), n));
+    v
+}
+
+/// [`bucket`] of the items `make(i, &src[i])` by `key(&src[i])` (below
+/// `n`), in parallel: each run of the source counts its items per key,
+/// and then fills its own ranges. The same result as [`bucket`].
+pub(crate) fn bucket_par<S: Sync, T: Copy + Default + Send + Sync>(
+    n: usize,
+    src: &[S],
+    key: impl Fn(&S) -> usize + Sync,
+    make: impl Fn(usize, &S) -> T + Sync,
+) -> (Vec<usize>, Vec<T>) {
+    use rayon::prelude::*;
+    const RUN: usize = 1 << 15;
+    let counts: Vec<Vec<usize>> = src
+        .par_chunks(RUN)
+        .map(|run| {
+            let mut c = vec![0usize; n];
+            for s in run {
+                c[key(s)] += 1;
+            }
+            c
+        })
+        .collect();
+    let mut start = vec![0usize; n + 1];
+    for k in 0..n {
+        start[k + 1] = start[k] + counts.iter().map(|c| c[k]).sum::<usize>();
+    }
+    let mut items = zeroed_par(start[n]);
+    // each run's range of each key, key by key, run by run
+    let mut ranges: Vec<Vec<&mut [T]>> = counts.iter().map(|_| Vec::with_capacity(n)).collect();
+    let mut rest = &mut items[..];
+    for k in 0..n {
+        for (r, c) in counts.iter().enumerate() {
+            let (here, tail) = std::mem::take(&mut rest).split_at_mut(c[k]);
+            ranges[r].push(here);
+            rest = tail;
+        }
+    }
+    ranges
+        .into_par_iter()
+        .zip(src.par_chunks(RUN))
+        .enumerate()
+        .for_each(|(r, (mut out, run))| {
+            let mut at = vec![0usize; n];
+            for (i, s) in run.iter().enumerate() {
+                let k = key(s);
+                out[k][at[k]] = make(r * RUN + i, s);
+                at[k] += 1;
+            }
+        });
+    (start, items)
+}
+
 /// [`corners_close`] at one vertex, its corners `(u, w)`.
 fn corners_close_at(g: &[(u32, u32)], cycles: bool) -> bool {
     let mut by_u: smallvec::SmallVec<[(u32, u32); 16]> = g.iter().copied().collect();
@@ -223,40 +283,34 @@ pub(crate) fn undirected(a: u32, b: u32) -> (u32, u32, u32) {
     if a < b { (a, b, 0) } else { (b, a, 1) }
 }
 
-/// `item(face, i)` for every corner `i` of every face (`corners(face)` of
-/// them), in order, in an array of exactly that size, filled in parallel
-/// by runs of faces: no list per face, no growing.
-pub(crate) fn per_corner<F: Sync, T: Copy + Default + Send + Sync>(
-    faces: &[F],
-    corners: impl Fn(&F) -> usize + Sync,
-    item: impl Fn(&F, usize) -> T + Sync,
+/// `item(face, i)` for every corner `i` of every face, face `f`'s corners
+/// being `start[f]..start[f + 1]`, in order, in an array of exactly that
+/// size, made and filled in parallel by runs of faces: no list per face,
+/// no growing.
+pub(crate) fn per_corner_at<'f, F: Sync, T: Copy + Default + Send + Sync>(
+    faces: &'f [F],
+    start: &[usize],
+    item: impl Fn(&'f F, usize) -> T + Sync,
 ) -> Vec<T> {
     use rayon::prelude::*;
     const RUN: usize = 1024;
-    let mut start = Vec::with_capacity(faces.len() / RUN + 2);
-    let mut total = 0;
-    for (k, f) in faces.iter().enumerate() {
-        if k % RUN == 0 {
-            start.push(total);
-        }
-        total += corners(f);
-    }
-    let mut out = vec![T::default(); total];
-    let mut pieces = Vec::with_capacity(start.len());
+    let mut out = zeroed_par(start[faces.len()]);
+    let mut pieces = Vec::with_capacity(faces.len() / RUN + 1);
     let mut rest = &mut out[..];
-    for (r, &s) in start.iter().enumerate() {
-        let end = start.get(r + 1).copied().unwrap_or(total);
-        let (piece, tail) = rest.split_at_mut(end - s);
-        pieces.push(piece);
+    for r in (0..faces.len()).step_by(RUN) {
+        let end = start[(r + RUN).min(faces.len())];
+        let (piece, tail) = std::mem::take(&mut rest).split_at_mut(end - start[r]);
+        pieces.push((r, piece));
         rest = tail;
     }
     pieces
         .into_par_iter()
         .zip(faces.par_chunks(RUN))
-        .for_each(|(piece, fs)| {
+        .for_each(|((r, piece), fs)| {
             let mut o = piece.iter_mut();
-            for f in fs {
-                for (i, slot) in o.by_ref().take(corners(f)).enumerate() {
+            for (j, f) in fs.iter().enumerate() {
+                let n = start[r + j + 1] - start[r + j];
+                for (i, slot) in o.by_ref().take(n).enumerate() {
                     *slot = item(f, i);
                 }
             }
