@@ -125,7 +125,10 @@ fn weld<P: std::borrow::Borrow<Polygon> + Sync>(
     // per shard: each item's point there, and the points with their first
     // corners; a key's points are chained (`next`), the map holds the last
     const END: u32 = u32::MAX;
-    let welded: Vec<(Vec<u32>, Vec<(Pt<'_>, u32)>)> = (0..SHARDS)
+    /// A shard's point of each item, and its points with their first
+    /// corners.
+    type Shard<'a> = (Vec<u32>, Vec<(Pt<'a>, u32)>);
+    let welded: Vec<Shard<'_>> = (0..SHARDS)
         .into_par_iter()
         .map(|s| {
             let items = &items[at[s]..at[s + 1]];
