@@ -152,6 +152,12 @@ impl FaceIndex {
         });
     }
 
+    /// How many ids [`FaceIndex::near`] would give (with repeats),
+    /// without listing them.
+    pub(crate) fn near_count(&self, b: &IBox) -> usize {
+        self.cells_of(b).map(|c| self.cells[c].len()).sum()
+    }
+
     /// The ids in the cells `b` overlaps (with repeats), into `out`.
     pub(crate) fn near(&self, b: &IBox, out: &mut Vec<u32>) {
         for c in self.cells_of(b) {

@@ -381,8 +381,6 @@ impl Solid {
 
     /// The live faces whose box overlaps `b`.
     fn faces_near(&self, b: &IBox) -> Vec<u32> {
-        let mut ids = Vec::new();
-        self.index.near(b, &mut ids);
         let meets = |&i: &u32| {
             self.faces[i as usize]
                 .as_ref()
@@ -390,15 +388,18 @@ impl Solid {
         };
         // many ids (a large box): in parallel; as many as half the slots
         // (each face is listed in several index cells): a scan of the
-        // slots in order gives them sorted, without repeats
+        // slots in order gives them sorted, without repeats, and the ids
+        // are not listed first
         const MANY: usize = 1 << 15;
-        if ids.len() > MANY && ids.len() > self.faces.len() / 2 {
-            drop(ids);
+        let listed = self.index.near_count(b);
+        if listed > MANY && listed > self.faces.len() / 2 {
             return (0..self.faces.len() as u32)
                 .into_par_iter()
                 .filter(meets)
                 .collect();
         }
+        let mut ids = Vec::with_capacity(listed);
+        self.index.near(b, &mut ids);
         if ids.len() > MANY {
             ids.par_sort_unstable();
             ids.dedup();
@@ -572,10 +573,10 @@ impl Solid {
         let a_near = self.faces_near(&domain);
         let b_near = other.faces_near(&domain);
         let Some(root) = a_near
-            .iter()
+            .par_iter()
             .map(|&f| self.face(f).bx())
-            .chain(b_near.iter().map(|&f| other.face(f).bx()))
-            .reduce(|x, y| union(&x, &y))
+            .chain(b_near.par_iter().map(|&f| other.face(f).bx()))
+            .reduce_with(|x, y| union(&x, &y))
         else {
             return self.apart(other, op);
         };

@@ -235,11 +235,10 @@ fn split<P: PlaneTest, Q: PlaneTest>(
     // a face's box overlaps the cell, so along each split axis it
     // overlaps the lower child if it starts at or below the middle, the
     // upper if it ends above it
-    let deal = |fs: &[u32],
-                bxs: &[IBox],
-                meets: &dyn Fn(u32, &IBox) -> bool,
-                kids: &mut Vec<Leaf>,
-                upper: bool| {
+    let deal_run = |fs: &[u32],
+                    bxs: &[IBox],
+                    meets: &(dyn Fn(u32, &IBox) -> bool + Sync),
+                    kids: &mut [Vec<u32>]| {
         for &f in fs {
             let (fl, fh) = bxs[f as usize];
             let (mut any, mut all) = (0usize, 0usize);
@@ -256,17 +255,47 @@ fn split<P: PlaneTest, Q: PlaneTest>(
             // the children c with all ⊆ c ⊆ any
             for (c, kid) in kids.iter_mut().enumerate() {
                 if c & !any == 0 && c & all == all && meets(f, &boxes[c]) {
-                    if upper {
-                        kid.b.push(f);
-                    } else {
-                        kid.a.push(f);
-                    }
+                    kid.push(f);
                 }
             }
         }
     };
-    deal(&cell.a, a.boxes, &a.plane_meets, &mut kids, false);
-    deal(&cell.b, b.boxes, &b.plane_meets, &mut kids, true);
+    // a large cell's faces are dealt in runs in parallel, each run's
+    // lists joined in order (the same lists)
+    let deal = |fs: &[u32], bxs: &[IBox], meets: &(dyn Fn(u32, &IBox) -> bool + Sync)| {
+        const RUN: usize = 1 << 13;
+        if fs.len() <= 2 * RUN {
+            let mut lists = vec![Vec::new(); boxes.len()];
+            deal_run(fs, bxs, meets, &mut lists);
+            return lists;
+        }
+        let runs: Vec<Vec<Vec<u32>>> = fs
+            .par_chunks(RUN)
+            .map(|run| {
+                let mut lists = vec![Vec::new(); boxes.len()];
+                deal_run(run, bxs, meets, &mut lists);
+                lists
+            })
+            .collect();
+        (0..boxes.len())
+            .map(|c| runs.iter().flat_map(|r| r[c].iter().copied()).collect())
+            .collect()
+    };
+    let (la, lb) = if cell.a.len() + cell.b.len() > PARALLEL_FACES {
+        rayon::join(
+            || deal(&cell.a, a.boxes, &a.plane_meets),
+            || deal(&cell.b, b.boxes, &b.plane_meets),
+        )
+    } else {
+        (
+            deal(&cell.a, a.boxes, &a.plane_meets),
+            deal(&cell.b, b.boxes, &b.plane_meets),
+        )
+    };
+    for ((kid, fa), fb) in kids.iter_mut().zip(la).zip(lb) {
+        kid.a = fa;
+        kid.b = fb;
+    }
     // faces larger than the cell land in several children each: the
     // split cuts them without sorting them apart
     let n = cell.a.len() + cell.b.len();
