@@ -260,6 +260,20 @@ impl Point {
         }
     }
 
+    /// A hash of the approximate coordinates ([`Point::approx_f64`]), each
+    /// mantissa rounded to its top 36 bits, for finding equal points
+    /// cheaply. Equal points computed from different planes differ by a
+    /// few ulps there, so they nearly always get equal keys (rounding, not
+    /// truncation: a coordinate on a cell wall is a round number, which
+    /// truncation would split between two keys); a rare pair straddling a
+    /// boundary gets two, so a key only proposes a match, and the exact
+    /// comparison decides. The correctly rounded coordinates
+    /// ([`Point::to_f64`]) would be canonical, but cost an exact division
+    /// per coordinate.
+    pub fn approx_key(&self) -> u64 {
+        crate::polygon::approx_key(self.approx_f64())
+    }
+
     /// Grid coordinates as `f64`, each the correctly rounded value of the
     /// exact rational coordinate. Equal points give equal results however
     /// they were constructed.

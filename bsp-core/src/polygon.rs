@@ -762,20 +762,15 @@ fn implicit_at<'a>(polys: &'a [&mut Polygon], p: u32, v: u32) -> Option<&'a Arc<
     }
 }
 
-/// A hash of an implicit point's approximate coordinates, each mantissa
-/// rounded to its top 36 bits. Equal points computed from different
-/// planes differ by a few ulps there, so they nearly always get equal
-/// keys (rounding, not truncation: a coordinate on a cell wall is a
-/// round number, which truncation would split between two keys); a rare
-/// pair that straddles a boundary is simply not shared. A share is only
-/// ever decided by the exact comparison. The correctly
-/// rounded coordinates would be canonical, but cost an exact division
-/// per coordinate (5% of an iterated subtraction).
+/// [`Point::approx_key`] of an implicit point.
 fn point_key(i: &Implicit) -> u64 {
-    hash_bits(
-        i.approx_f64()
-            .map(|c| ((c + 0.0).to_bits() + 0x8000) & !0xffff),
-    )
+    approx_key(i.approx_f64())
+}
+
+/// A hash of approximate coordinates, each mantissa rounded to its top 36
+/// bits (see [`Point::approx_key`]).
+pub(crate) fn approx_key(a: [f64; 3]) -> u64 {
+    hash_bits(a.map(|c| ((c + 0.0).to_bits() + 0x8000) & !0xffff))
 }
 
 /// A hash of three coordinates' bits.

@@ -201,7 +201,9 @@ fn zeroed_par<T: Copy + Default + Send + Sync>(n: usize) -> Vec<T> {
 
 /// [`bucket`] of the items `make(i, &src[i])` by `key(&src[i])` (below
 /// `n`), in parallel: each run of the source counts its items per key,
-/// and then fills its own ranges. The same result as [`bucket`].
+/// and then fills its own ranges. The same result as [`bucket`], for few
+/// keys (shards): each run holds a count per key, which for keys as many
+/// as the vertices would be larger than the items.
 pub(crate) fn bucket_par<S: Sync, T: Copy + Default + Send + Sync>(
     n: usize,
     src: &[S],

@@ -314,20 +314,18 @@ impl Solid {
         Solid::from_faces(faces, Vec::new())
     }
 
-    /// The solid of these face slots, indexed.
-    /// The solid of `faces`, whose empty slots are `free` (each once).
+    /// The solid of these face slots, indexed; the empty ones are `free`
+    /// (each once).
     fn from_faces(faces: Vec<Option<Face>>, free: Vec<u32>) -> Solid {
         debug_assert!(free.iter().all(|&f| faces[f as usize].is_none()));
-        let live = faces.len() - free.len();
         let mut s = Solid {
+            live: faces.len() - free.len(),
             faces,
             free,
             index: FaceIndex::new(([0; 3], [0; 3]), 1),
             indexed: 0,
             bounds: None,
-            live: 0,
         };
-        s.live = live;
         s.reindex();
         s
     }
@@ -1286,18 +1284,14 @@ fn rejoin(pieces: Vec<Polygon>) -> Vec<Polygon> {
     if pieces.len() < 2 {
         return pieces;
     }
-    // an endpoint's key: its approximate coordinates rounded to 36 bits
-    // (equal points nearly always get equal keys; a pair that does not is
-    // only a merge missed, and a merge is decided exactly)
-    let key = |p: &bsp_core::Point| {
-        let a = p.approx_f64();
-        let mut h = rustc_hash::FxHasher::default();
-        for c in a {
-            std::hash::Hasher::write_u64(&mut h, ((c + 0.0).to_bits() + 0x8000) & !0xffff);
-        }
-        std::hash::Hasher::finish(&h)
+    // the endpoints' approximate keys: a pair of equal points that gets
+    // two keys is only a merge missed, and a merge is decided exactly
+    let keys_of = |p: &Polygon| -> SmallVec<[u64; 8]> {
+        p.vertices()
+            .iter()
+            .map(bsp_core::Point::approx_key)
+            .collect()
     };
-    let keys_of = |p: &Polygon| -> SmallVec<[u64; 8]> { p.vertices().iter().map(key).collect() };
     // each directed edge's latest polygon; an entry left by a polygon
     // merged since only costs a merge that fails
     let mut edges: FxHashMap<(u64, u64), u32> = FxHashMap::default();
@@ -1713,7 +1707,7 @@ pub fn snap_one(
             let (mut extra, mut six) = (Vec::new(), 0i128);
             for (i, (slot, face)) in slots.iter_mut().zip(loops).enumerate() {
                 imp.indexed(grid, mesh.positions, face, c * CHUNK + i, |p| {
-                    six += six_volume(std::slice::from_ref(&p));
+                    six += six_volume(&p);
                     let bx = polygon_box(&p);
                     let face = Face::new(p.with_tag(0), &bx);
                     match slot {
@@ -1782,29 +1776,29 @@ pub fn mesh_sequence(
     })
 }
 
-/// Six times the exact volume the polygons bound (fans of grid vertices,
-/// summed in `i128`: coordinates below 2^26 keep each term below 2^81).
-/// Polygons with implicit vertices do not come from an import and are
-/// skipped.
-fn six_volume(polys: &[Polygon]) -> i128 {
-    let mut v: i128 = 0;
-    for p in polys {
-        let g: Option<SmallVec<[[i128; 3]; 4]>> = p
-            .vertices()
-            .iter()
-            .map(|q| match q {
-                bsp_core::Point::Grid(c) => Some(c.map(i128::from)),
-                bsp_core::Point::Implicit(_) => None,
-            })
-            .collect();
-        let Some(g) = g else { continue };
-        for w in g[1..].windows(2) {
+/// Six times the signed volume of the cone from the origin over the
+/// polygon (a fan of grid vertices, summed in `i128`: coordinates below
+/// 2^26 keep each term below 2^81); summed over a closed surface, six
+/// times the volume it bounds. A polygon with implicit vertices does not
+/// come from an import and gives 0.
+fn six_volume(p: &Polygon) -> i128 {
+    let g: Option<SmallVec<[[i128; 3]; 4]>> = p
+        .vertices()
+        .iter()
+        .map(|q| match q {
+            bsp_core::Point::Grid(c) => Some(c.map(i128::from)),
+            bsp_core::Point::Implicit(_) => None,
+        })
+        .collect();
+    let Some(g) = g else { return 0 };
+    g[1..]
+        .windows(2)
+        .map(|w| {
             let (a, b, c) = (g[0], w[0], w[1]);
-            v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-                + a[2] * (b[0] * c[1] - b[1] * c[0]);
-        }
-    }
-    v
+            a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0])
+        })
+        .sum()
 }
 
 #[cfg(test)]
