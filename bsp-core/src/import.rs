@@ -4,7 +4,7 @@ use glam::DVec3;
 
 use crate::grid::{Grid, GridPoint};
 use crate::plane::Plane;
-use crate::polygon::{FaceDefect, Polygon, support_plane};
+use crate::polygon::{FaceDefect, GridPolygon, Polygon, support_plane};
 use crate::{Error, Side};
 
 /// What happened to the input faces on the way to convex polygons.
@@ -249,7 +249,20 @@ impl FaceImporter {
         positions: &[DVec3],
         face: &[u32],
         fi: usize,
-        out: impl FnMut(Polygon),
+        mut out: impl FnMut(Polygon),
+    ) -> Result<(), Error> {
+        self.indexed_grid(grid, positions, face, fi, |g| out(g.to_polygon()))
+    }
+
+    /// [`FaceImporter::indexed`], giving the polygons without their edge
+    /// planes (see [`GridPolygon`]).
+    pub fn indexed_grid(
+        &mut self,
+        grid: &Grid,
+        positions: &[DVec3],
+        face: &[u32],
+        fi: usize,
+        out: impl FnMut(GridPolygon),
     ) -> Result<(), Error> {
         let mut loop_ = std::mem::take(&mut self.loop_);
         loop_.clear();
@@ -261,7 +274,7 @@ impl FaceImporter {
             })?;
             loop_.push(*p);
         }
-        let r = self.face(grid, &loop_, fi, out);
+        let r = self.face_grid(grid, &loop_, fi, out);
         self.loop_ = loop_;
         r
     }
@@ -273,6 +286,18 @@ impl FaceImporter {
         face: &[DVec3],
         fi: usize,
         mut out: impl FnMut(Polygon),
+    ) -> Result<(), Error> {
+        self.face_grid(grid, face, fi, |g| out(g.to_polygon()))
+    }
+
+    /// [`FaceImporter::face`], giving the polygons without their edge
+    /// planes (see [`GridPolygon`]).
+    pub fn face_grid(
+        &mut self,
+        grid: &Grid,
+        face: &[DVec3],
+        fi: usize,
+        mut out: impl FnMut(GridPolygon),
     ) -> Result<(), Error> {
         let (report, pts) = (&mut self.report, &mut self.pts);
         report.faces += 1;
@@ -287,7 +312,7 @@ impl FaceImporter {
             pts.push(g);
         }
         let tag = fi as u32;
-        match Polygon::from_grid_points(pts, tag) {
+        match GridPolygon::from_grid_points(pts, tag) {
             Ok(p) => {
                 report.polygons += 1;
                 out(p);
@@ -296,7 +321,7 @@ impl FaceImporter {
                 let tris = triangulate(pts, defect);
                 let before = report.polygons;
                 for t in tris.iter() {
-                    if let Ok(p) = Polygon::from_grid_points(t, tag) {
+                    if let Ok(p) = GridPolygon::from_grid_points(t, tag) {
                         report.polygons += 1;
                         out(p);
                     }

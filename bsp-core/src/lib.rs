@@ -68,8 +68,11 @@ pub use partition::{
 };
 pub use pieces::{ArenaMark, EdgeRef, Lazy, Piece, PieceArena, Sides, Vertex, VertexRef};
 pub use plane::{MAX_NORMAL_BITS, MAX_OFFSET_BITS, Plane};
-pub use point::{Implicit, Point, rational_to_f64};
-pub use polygon::{FaceDefect, Parts, Polygon, PolygonSide, Side, Split, share_points, split_loop};
+pub use point::{Implicit, Point, PointRef, rational_to_f64};
+pub use polygon::{
+    ConvexFace, FaceDefect, GridPolygon, Parts, Polygon, PolygonSide, Side, Split, share_points,
+    split_loop,
+};
 pub use regions::{MergeCache, MergedRegion, Region, Remerged, merge_cells, merge_cells_adjacent};
 pub use sanity::{ConvexParts, SanityError, check_convex};
 pub use topology::{TopologyError, check_closed_manifold};

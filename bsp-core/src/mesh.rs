@@ -19,8 +19,8 @@ use smallvec::SmallVec;
 
 use crate::Side;
 use crate::plane::{Plane, cross_wide};
-use crate::point::Point;
-use crate::polygon::Polygon;
+use crate::point::{Point, PointRef};
+use crate::polygon::{ConvexFace, Polygon};
 
 /// A triangle mesh over exact, welded vertices.
 #[derive(Clone, Debug, Default)]
@@ -48,7 +48,7 @@ pub(crate) fn to_bigint(x: &crate::I256) -> BigInt {
 /// A hash of the point's correctly rounded coordinates: exactly equal
 /// points get equal keys; unequal points rarely do (the welder compares
 /// them exactly).
-fn key(p: &Point) -> u64 {
+fn key(p: PointRef<'_>) -> u64 {
     crate::polygon::hash_bits(p.to_f64().map(|c| (c + 0.0).to_bits()))
 }
 
@@ -81,10 +81,7 @@ fn cmp_axis(p: &Point, q: &Point, k: usize) -> Ordering {
 /// with a map a shard's size that stays in cache), and the points are
 /// numbered in the order of their first corners, as one pass in order
 /// would number them: the same result whatever the thread count.
-fn weld<P: std::borrow::Borrow<Polygon> + Sync>(
-    polys: &[P],
-    start: &[usize],
-) -> (Vec<Point>, Vec<u32>) {
+fn weld<P: ConvexFace + Sync>(polys: &[P], start: &[usize]) -> (Vec<Point>, Vec<u32>) {
     use std::sync::Arc;
     /// A corner's point as the shards read it: a grid point by value, an
     /// implicit one by reference (no polygon is read again).
@@ -106,10 +103,10 @@ fn weld<P: std::borrow::Borrow<Polygon> + Sync>(
     const SHARDS: usize = 16;
     // each corner's point and key, in parallel
     let corners_of = crate::topology::per_corner_at(polys, start, |p, i| {
-        let v = &p.borrow().vertices()[i];
+        let v = p.corner(i);
         let pt = match v {
-            Point::Grid(g) => Pt::G(*g),
-            Point::Implicit(a) => Pt::I(a),
+            PointRef::Grid(g) => Pt::G(g),
+            PointRef::Implicit(a) => Pt::I(a),
         };
         (pt, key(v))
     });
@@ -192,11 +189,9 @@ fn weld<P: std::borrow::Borrow<Polygon> + Sync>(
 impl TriMesh {
     /// The conforming triangulation of `polys` (see the module docs).
     /// Takes the polygons or references to them (no copy needed).
-    pub fn from_polygons<P: std::borrow::Borrow<Polygon> + Sync>(polys: &[P]) -> TriMesh {
+    pub fn from_polygons<P: ConvexFace + Sync>(polys: &[P]) -> TriMesh {
         let (vertices, triangles, of) = Self::triangulate(polys);
-        Self::assemble(vertices, triangles, of, |i| {
-            *polys[i as usize].borrow().support()
-        })
+        Self::assemble(vertices, triangles, of, |i| *polys[i as usize].support())
     }
 
     /// [`TriMesh::from_polygons`], letting the polygons go as soon as the
@@ -232,16 +227,11 @@ impl TriMesh {
     /// The welded vertices, the triangles, and the polygon each triangle
     /// comes from.
     #[allow(clippy::type_complexity)]
-    fn triangulate<P: std::borrow::Borrow<Polygon> + Sync>(
-        polys: &[P],
-    ) -> (Vec<Point>, Vec<[u32; 3]>, Vec<u32>) {
+    fn triangulate<P: ConvexFace + Sync>(polys: &[P]) -> (Vec<Point>, Vec<[u32; 3]>, Vec<u32>) {
         // polygon `i`'s corners are `corners[start[i]..start[i + 1]]`, in
         // flat arrays (a list per polygon costs an allocation each)
         // (the counts read in parallel: a polygon read is a cache miss)
-        let counts: Vec<usize> = polys
-            .par_iter()
-            .map(|p| p.borrow().vertices().len())
-            .collect();
+        let counts: Vec<usize> = polys.par_iter().map(|p| p.corner_count()).collect();
         let mut start = Vec::with_capacity(polys.len() + 1);
         start.push(0usize);
         for n in counts {
@@ -273,7 +263,6 @@ impl TriMesh {
                     let cs = cs_of(i);
                     // the place of the polygon's first edge in `twinned`
                     let edge0 = start[first + i];
-                    let poly: &Polygon = poly.borrow();
                     let k = cs.len();
                     // boundary loop: (vertex, edge ids it lies on)
                     let mut ring: Vec<(u32, SmallVec<[u32; 3]>)> = Vec::with_capacity(k);
@@ -810,7 +799,7 @@ fn twinned_edges(corners: &[u32], start: &[usize]) -> Vec<bool> {
 /// Welded vertices lying strictly inside edge `i` (from `a` to `b`) of `poly`.
 #[allow(clippy::too_many_arguments)]
 fn edge_points(
-    poly: &Polygon,
+    poly: &impl ConvexFace,
     i: usize,
     a: u32,
     b: u32,
@@ -818,12 +807,15 @@ fn edge_points(
     coords: &[[f32; 3]],
     near: &Candidates,
 ) -> Vec<u32> {
-    let k = poly.len();
+    let k = poly.corner_count();
     let (ca, cb) = (coords[a as usize], coords[b as usize]);
     let lo = [ca[0].min(cb[0]), ca[1].min(cb[1]), ca[2].min(cb[2])];
     let hi = [ca[0].max(cb[0]), ca[1].max(cb[1]), ca[2].max(cb[2])];
-    let edges = poly.edge_planes();
-    let (e, prev, next) = (&edges[i], &edges[(i + k - 1) % k], &edges[(i + 1) % k]);
+    let (e, prev, next) = (
+        &poly.edge_plane(i),
+        &poly.edge_plane((i + k - 1) % k),
+        &poly.edge_plane((i + 1) % k),
+    );
     let mut out = Vec::new();
     near.each(lo, hi, |v| {
         if v == a || v == b {

@@ -221,7 +221,74 @@ impl Homogeneous<4> {
     }
 }
 
+/// A point read where it is stored: a grid point by value, an implicit
+/// one by reference (see [`ConvexFace::corner`](crate::ConvexFace)).
+#[derive(Clone, Copy, Debug)]
+pub enum PointRef<'a> {
+    /// An input vertex on the grid.
+    Grid(GridPoint),
+    /// The intersection of three planes.
+    Implicit(&'a Arc<Implicit>),
+}
+
+impl PointRef<'_> {
+    /// The point, owned (an implicit point's count goes up).
+    pub fn to_point(self) -> Point {
+        match self {
+            PointRef::Grid(g) => Point::Grid(g),
+            PointRef::Implicit(i) => Point::Implicit(i.clone()),
+        }
+    }
+
+    /// Exact side of `plane`.
+    #[inline]
+    pub fn classify(self, plane: &Plane) -> Side {
+        match self {
+            PointRef::Grid(g) => plane.classify_grid(g),
+            PointRef::Implicit(i) => i.classify(plane),
+        }
+    }
+
+    /// [`Point::to_f64`].
+    pub fn to_f64(self) -> [f64; 3] {
+        match self {
+            PointRef::Grid(g) => g.map(|c| c as f64),
+            PointRef::Implicit(i) => i.to_f64(),
+        }
+    }
+
+    /// [`Point::as_grid`].
+    pub fn as_grid(self) -> Option<GridPoint> {
+        match self {
+            PointRef::Grid(g) => Some(g),
+            PointRef::Implicit(i) => {
+                let c = i.as_integer()?;
+                c.iter()
+                    .all(|v| v.abs() <= crate::MAX_COORD as i64)
+                    .then(|| c.map(|v| v as i32))
+            }
+        }
+    }
+
+    /// The grid point, if it is stored as one.
+    pub fn grid(self) -> Option<GridPoint> {
+        match self {
+            PointRef::Grid(g) => Some(g),
+            PointRef::Implicit(_) => None,
+        }
+    }
+}
+
 impl Point {
+    /// The point as a [`PointRef`].
+    #[inline]
+    pub fn as_ref(&self) -> PointRef<'_> {
+        match self {
+            Point::Grid(g) => PointRef::Grid(*g),
+            Point::Implicit(i) => PointRef::Implicit(i),
+        }
+    }
+
     /// The intersection of three planes (see [`Implicit::from_planes`]).
     pub fn from_planes(p1: &Plane, p2: &Plane, p3: &Plane) -> Option<Point> {
         Implicit::from_planes(p1, p2, p3).map(|i| Point::Implicit(Arc::new(i)))
@@ -286,15 +353,7 @@ impl Point {
 
     /// `Some` grid point if this point has integer coordinates within the grid.
     pub fn as_grid(&self) -> Option<GridPoint> {
-        match self {
-            Point::Grid(g) => Some(*g),
-            Point::Implicit(i) => {
-                let c = i.as_integer()?;
-                c.iter()
-                    .all(|v| v.abs() <= crate::MAX_COORD as i64)
-                    .then(|| c.map(|v| v as i32))
-            }
-        }
+        self.as_ref().as_grid()
     }
 
     /// Exact equality of the represented points.

@@ -6,7 +6,7 @@ use crate::grid::GridPoint;
 use crate::plane::{Plane, cross, sub};
 use std::sync::Arc;
 
-use crate::point::{Implicit, Point};
+use crate::point::{Implicit, Point, PointRef};
 use crate::sanity::{ConvexParts, SanityError, check_convex};
 
 /// Exact side of a point relative to a plane.
@@ -209,6 +209,211 @@ pub(crate) fn support_plane(v: &[GridPoint]) -> Result<Plane, FaceDefect> {
     })
 }
 
+/// A convex polygon with grid vertices, stored without its edge planes:
+/// its support plane and its corners. Each edge plane is the one
+/// [`Polygon::from_grid_points`] gives (through the edge, containing the
+/// axis along which the support's normal is largest), computed when asked
+/// for, so the form takes about a third of a [`Polygon`]'s room: a large
+/// solid whose faces are mostly never cut keeps them in it.
+#[derive(Clone, Debug)]
+pub struct GridPolygon {
+    support: Plane,
+    verts: SmallVec<[GridPoint; 4]>,
+    tag: u32,
+}
+
+impl GridPolygon {
+    /// A polygon from grid points in counter-clockwise order, checked and
+    /// cleaned as [`Polygon::from_grid_points`] does.
+    pub fn from_grid_points(points: &[GridPoint], tag: u32) -> Result<GridPolygon, FaceDefect> {
+        let mut v = dedupe_cyclic(points);
+        if v.len() < 3 {
+            return Err(FaceDefect::TooFewVertices);
+        }
+        let support = support_plane(&v)?;
+        // a triangle of nonzero area has no collinear corner and is
+        // convex: the checks are for larger loops
+        let triangle = v.len() == 3;
+        if !triangle {
+            remove_collinear(&mut v);
+            if v.len() < 3 {
+                return Err(FaceDefect::ZeroArea);
+            }
+        }
+        let g = GridPolygon {
+            support,
+            verts: v.into_iter().collect(),
+            tag,
+        };
+        let convex = || {
+            let k = g.verts.len();
+            (0..k).all(|i| {
+                let e = g.edge_plane(i);
+                g.verts.iter().enumerate().all(|(j, p)| {
+                    j == i || j == (i + 1) % k || e.classify_grid(*p) == crate::Side::Back
+                })
+            })
+        };
+        if triangle {
+            debug_assert!(convex(), "a triangle of nonzero area is convex");
+        } else if !convex() {
+            return Err(FaceDefect::NonConvex);
+        }
+        Ok(g)
+    }
+
+    /// The support plane.
+    pub fn support(&self) -> &Plane {
+        &self.support
+    }
+
+    /// The corners, counter-clockwise.
+    pub fn vertices(&self) -> &[GridPoint] {
+        &self.verts
+    }
+
+    /// Number of corners.
+    pub fn len(&self) -> usize {
+        self.verts.len()
+    }
+
+    /// Always `false`: a polygon has at least three corners.
+    pub fn is_empty(&self) -> bool {
+        self.verts.is_empty()
+    }
+
+    /// The tag.
+    pub fn tag(&self) -> u32 {
+        self.tag
+    }
+
+    /// The same polygon with another tag.
+    pub fn with_tag(mut self, tag: u32) -> GridPolygon {
+        self.tag = tag;
+        self
+    }
+
+    /// Edge plane `i`, bounding the edge from corner `i` to `i + 1`
+    /// (interior behind): the plane [`GridPolygon::to_polygon`] stores.
+    #[inline]
+    pub fn edge_plane(&self, i: usize) -> Plane {
+        let k = self.verts.len();
+        Plane::edge(self.verts[i], self.verts[(i + 1) % k], &self.support)
+            .expect("edge plane of two distinct grid points fits the budget")
+    }
+
+    /// The same polygon seen from the other side: its edge planes are
+    /// those of [`Polygon::flipped`] of the polygon.
+    pub fn flipped(&self) -> GridPolygon {
+        GridPolygon {
+            support: self.support.flip(),
+            verts: self.verts.iter().rev().copied().collect(),
+            tag: self.tag,
+        }
+    }
+
+    /// The polygon with its edge planes.
+    pub fn to_polygon(&self) -> Polygon {
+        Polygon {
+            support: self.support,
+            edges: (0..self.verts.len()).map(|i| self.edge_plane(i)).collect(),
+            verts: self.verts.iter().map(|&g| Point::Grid(g)).collect(),
+            tag: self.tag,
+        }
+    }
+}
+
+/// A convex face as the mesh builder and the exact ray test read it: its
+/// support plane, its corners counter-clockwise, and its edge planes (edge
+/// `i` runs from corner `i` to `i + 1`, interior behind). [`Polygon`] and
+/// [`GridPolygon`] are faces, and so is a reference or box of one.
+pub trait ConvexFace {
+    /// The support plane.
+    fn support(&self) -> &Plane;
+    /// Number of corners.
+    fn corner_count(&self) -> usize;
+    /// Corner `i`.
+    fn corner(&self, i: usize) -> PointRef<'_>;
+    /// Edge plane `i`.
+    fn edge_plane(&self, i: usize) -> Plane;
+}
+
+impl ConvexFace for Polygon {
+    #[inline]
+    fn support(&self) -> &Plane {
+        &self.support
+    }
+    #[inline]
+    fn corner_count(&self) -> usize {
+        self.verts.len()
+    }
+    #[inline]
+    fn corner(&self, i: usize) -> PointRef<'_> {
+        self.verts[i].as_ref()
+    }
+    #[inline]
+    fn edge_plane(&self, i: usize) -> Plane {
+        self.edges[i]
+    }
+}
+
+impl ConvexFace for GridPolygon {
+    #[inline]
+    fn support(&self) -> &Plane {
+        &self.support
+    }
+    #[inline]
+    fn corner_count(&self) -> usize {
+        self.verts.len()
+    }
+    #[inline]
+    fn corner(&self, i: usize) -> PointRef<'_> {
+        PointRef::Grid(self.verts[i])
+    }
+    #[inline]
+    fn edge_plane(&self, i: usize) -> Plane {
+        GridPolygon::edge_plane(self, i)
+    }
+}
+
+impl<T: ConvexFace + ?Sized> ConvexFace for &T {
+    #[inline]
+    fn support(&self) -> &Plane {
+        (**self).support()
+    }
+    #[inline]
+    fn corner_count(&self) -> usize {
+        (**self).corner_count()
+    }
+    #[inline]
+    fn corner(&self, i: usize) -> PointRef<'_> {
+        (**self).corner(i)
+    }
+    #[inline]
+    fn edge_plane(&self, i: usize) -> Plane {
+        (**self).edge_plane(i)
+    }
+}
+
+impl<T: ConvexFace + ?Sized> ConvexFace for Box<T> {
+    #[inline]
+    fn support(&self) -> &Plane {
+        (**self).support()
+    }
+    #[inline]
+    fn corner_count(&self) -> usize {
+        (**self).corner_count()
+    }
+    #[inline]
+    fn corner(&self, i: usize) -> PointRef<'_> {
+        (**self).corner(i)
+    }
+    #[inline]
+    fn edge_plane(&self, i: usize) -> Plane {
+        (**self).edge_plane(i)
+    }
+}
+
 impl Polygon {
     /// A polygon from grid points in counter-clockwise order.
     ///
@@ -224,45 +429,7 @@ impl Polygon {
     /// assert!(bow.is_err());
     /// ```
     pub fn from_grid_points(points: &[GridPoint], tag: u32) -> Result<Polygon, FaceDefect> {
-        let mut v = dedupe_cyclic(points);
-        if v.len() < 3 {
-            return Err(FaceDefect::TooFewVertices);
-        }
-        let support = support_plane(&v)?;
-        // a triangle of nonzero area has no collinear corner and is
-        // convex: the checks are for larger loops
-        let triangle = v.len() == 3;
-        if !triangle {
-            remove_collinear(&mut v);
-            if v.len() < 3 {
-                return Err(FaceDefect::ZeroArea);
-            }
-        }
-        let k = v.len();
-        let edges: SmallVec<[Plane; 4]> = (0..k)
-            .map(|i| {
-                Plane::edge(v[i], v[(i + 1) % k], &support)
-                    .expect("edge plane of two distinct grid points fits the budget")
-            })
-            .collect();
-        let convex = || {
-            edges.iter().enumerate().all(|(i, e)| {
-                v.iter().enumerate().all(|(j, p)| {
-                    j == i || j == (i + 1) % k || e.classify_grid(*p) == crate::Side::Back
-                })
-            })
-        };
-        if triangle {
-            debug_assert!(convex(), "a triangle of nonzero area is convex");
-        } else if !convex() {
-            return Err(FaceDefect::NonConvex);
-        }
-        Ok(Polygon {
-            support,
-            edges,
-            verts: v.into_iter().map(Point::Grid).collect(),
-            tag,
-        })
+        GridPolygon::from_grid_points(points, tag).map(|g| g.to_polygon())
     }
 
     /// A polygon from its support plane and cycle of edge planes (edge
@@ -302,6 +469,11 @@ impl Polygon {
     pub fn with_tag(mut self, tag: u32) -> Polygon {
         self.tag = tag;
         self
+    }
+
+    /// Sets the tag in place.
+    pub fn set_tag(&mut self, tag: u32) {
+        self.tag = tag;
     }
 
     /// The support plane.
@@ -784,6 +956,88 @@ pub(crate) fn hash_bits(bits: [u64; 3]) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A grid polygon's computed edge planes are exact edge planes of it
+    /// (each holds its edge's ends, every other corner strictly behind),
+    /// the ones its full polygon stores, and flipping either form gives the
+    /// same polygon; the defects are the full form's.
+    #[test]
+    fn grid_polygons_compute_the_stored_edge_planes() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |m: i32| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % (2 * m as u64 + 1)) as i32 - m
+        };
+        let same = |p: &Polygon, q: &Polygon| {
+            p.support() == q.support()
+                && p.edge_planes() == q.edge_planes()
+                && p.vertices().len() == q.vertices().len()
+                && p.vertices()
+                    .iter()
+                    .zip(q.vertices())
+                    .all(|(a, b)| a.same_point(b))
+        };
+        let mut loops: Vec<Vec<GridPoint>> = Vec::new();
+        for _ in 0..400 {
+            let m = if loops.len().is_multiple_of(2) {
+                9
+            } else {
+                1 << 20
+            };
+            loops.push((0..3).map(|_| [next(m), next(m), next(m)]).collect());
+        }
+        // squares and pentagons in tilted planes, some with a collinear
+        // corner, and a bow tie
+        for t in 0..20 {
+            let (u, v) = ([1, 0, t], [0, 1, 2 - t]);
+            let at = |a: i32, b: i32| {
+                [
+                    a * u[0] + b * v[0],
+                    a * u[1] + b * v[1],
+                    a * u[2] + b * v[2],
+                ]
+            };
+            loops.push(vec![at(0, 0), at(3, 0), at(3, 3), at(0, 3)]);
+            loops.push(vec![at(0, 0), at(2, 0), at(4, 0), at(4, 4), at(0, 4)]);
+            loops.push(vec![at(0, 0), at(4, 0), at(5, 2), at(2, 5), at(0, 3)]);
+            loops.push(vec![at(0, 0), at(2, 2), at(2, 0), at(0, 2)]);
+        }
+        let mut made = 0;
+        for l in &loops {
+            let g = GridPolygon::from_grid_points(l, 3);
+            let p = Polygon::from_grid_points(l, 3);
+            let (g, p) = match (g, p) {
+                (Ok(g), Ok(p)) => (g, p),
+                (Err(a), Err(b)) => {
+                    assert_eq!(a, b);
+                    continue;
+                }
+                (g, p) => panic!("{l:?}: {:?} against {:?}", g.err(), p.err()),
+            };
+            made += 1;
+            let full = g.to_polygon();
+            assert!(same(&full, &p), "{l:?}");
+            assert!(full.sanity_check().is_ok());
+            let k = g.len();
+            for i in 0..k {
+                let e = g.edge_plane(i);
+                assert_eq!(e, ConvexFace::edge_plane(&p, i));
+                for (j, &c) in g.vertices().iter().enumerate() {
+                    let want = if j == i || j == (i + 1) % k {
+                        Side::On
+                    } else {
+                        Side::Back
+                    };
+                    assert_eq!(e.classify_grid(c), want, "{l:?} edge {i} corner {j}");
+                }
+            }
+            assert!(same(&g.flipped().to_polygon(), &p.flipped()), "{l:?}");
+            assert_eq!(g.tag(), 3);
+        }
+        assert!(made > 300, "only {made} polygons made");
+    }
 
     #[test]
     fn equal_new_vertices_are_shared_and_none_moves() {

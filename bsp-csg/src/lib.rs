@@ -84,13 +84,14 @@ pub use bsp_core::shapes;
 mod winding;
 
 use bsp_core::{
-    BoolOp, Grid, GridPoint, ImportReport, Membership, Polygon, Side, TopologyError, TriMesh,
-    check_closed_manifold, share_points,
+    BoolOp, ConvexFace, Grid, GridPoint, GridPolygon, ImportReport, Membership, Plane, PointRef,
+    Polygon, Side, TopologyError, TriMesh, check_closed_manifold, share_points,
 };
 use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
+use std::borrow::Cow;
 
 use crate::index::{FaceIndex, IBox, intersect, overlaps, polygon_box, union};
 use crate::local::{CellResult, Fate};
@@ -218,20 +219,70 @@ impl std::fmt::Display for CsgError {
 
 impl std::error::Error for CsgError {}
 
+/// A face's polygon. An imported face keeps its grid corners only, and
+/// its edge planes are computed when it is cut or tested: most faces of a
+/// large solid are never cut, and the edge planes are most of a
+/// polygon's room.
+#[derive(Clone, Debug)]
+enum Shape {
+    /// An imported face (or one kept whole from one).
+    Grid(GridPolygon),
+    /// A face an operation made, with its edge planes.
+    Made(Box<Polygon>),
+}
+
 #[derive(Clone, Debug)]
 struct Face {
-    poly: Polygon,
+    shape: Shape,
     /// The polygon's box, in 32 bits (rounded outward where a coordinate
     /// does not fit): a face slot is most of a solid's memory.
     small_box: ([i32; 3], [i32; 3]),
 }
 
 impl Face {
-    fn new(poly: Polygon, bx: &IBox) -> Face {
+    fn new(shape: Shape, bx: &IBox) -> Face {
         let narrow = |v: i64| v.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
         Face {
-            poly,
+            shape,
             small_box: (bx.0.map(narrow), bx.1.map(narrow)),
+        }
+    }
+
+    /// An imported face (tag 0).
+    fn grid(g: GridPolygon) -> Face {
+        let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
+        for p in g.vertices() {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k] as i64);
+                hi[k] = hi[k].max(p[k] as i64);
+            }
+        }
+        Face::new(Shape::Grid(g.with_tag(0)), &(lo, hi))
+    }
+
+    /// A face an operation made (tag 0).
+    fn made(mut p: Box<Polygon>) -> Face {
+        p.set_tag(0);
+        let bx = polygon_box(&p);
+        Face::new(Shape::Made(p), &bx)
+    }
+
+    /// The polygon, with its edge planes (made for an imported face).
+    fn polygon(&self) -> Cow<'_, Polygon> {
+        match &self.shape {
+            Shape::Grid(g) => Cow::Owned(g.to_polygon()),
+            Shape::Made(p) => Cow::Borrowed(p),
+        }
+    }
+
+    /// The same face seen from the other side (the same box).
+    fn flipped(&self) -> Face {
+        Face {
+            shape: match &self.shape {
+                Shape::Grid(g) => Shape::Grid(g.flipped()),
+                Shape::Made(p) => Shape::Made(Box::new(p.flipped())),
+            },
+            small_box: self.small_box,
         }
     }
 
@@ -242,6 +293,37 @@ impl Face {
             self.small_box.0.map(i64::from),
             self.small_box.1.map(i64::from),
         )
+    }
+}
+
+impl ConvexFace for Face {
+    #[inline]
+    fn support(&self) -> &Plane {
+        match &self.shape {
+            Shape::Grid(g) => g.support(),
+            Shape::Made(p) => p.support(),
+        }
+    }
+    #[inline]
+    fn corner_count(&self) -> usize {
+        match &self.shape {
+            Shape::Grid(g) => g.len(),
+            Shape::Made(p) => p.len(),
+        }
+    }
+    #[inline]
+    fn corner(&self, i: usize) -> PointRef<'_> {
+        match &self.shape {
+            Shape::Grid(g) => PointRef::Grid(g.vertices()[i]),
+            Shape::Made(p) => p.vertices()[i].as_ref(),
+        }
+    }
+    #[inline]
+    fn edge_plane(&self, i: usize) -> Plane {
+        match &self.shape {
+            Shape::Grid(g) => g.edge_plane(i),
+            Shape::Made(p) => p.edge_planes()[i],
+        }
     }
 }
 
@@ -306,10 +388,7 @@ impl Solid {
     pub fn from_polygons(polys: Vec<Polygon>) -> Solid {
         let faces: Vec<Option<Face>> = polys
             .into_par_iter()
-            .map(|p| {
-                let bx = polygon_box(&p);
-                Some(Face::new(p.with_tag(0), &bx))
-            })
+            .map(|p| Some(Face::made(Box::new(p))))
             .collect();
         Solid::from_faces(faces, Vec::new())
     }
@@ -360,9 +439,10 @@ impl Solid {
         self.live == 0
     }
 
-    /// The faces.
-    pub fn polygons(&self) -> impl Iterator<Item = &Polygon> + '_ {
-        self.faces.iter().flatten().map(|f| &f.poly)
+    /// The faces, each with its edge planes (made for a face kept as
+    /// imported, which does not store them).
+    pub fn polygons(&self) -> impl Iterator<Item = Cow<'_, Polygon>> + '_ {
+        self.faces.iter().flatten().map(Face::polygon)
     }
 
     fn face(&self, i: u32) -> &Face {
@@ -431,7 +511,7 @@ impl Solid {
                     && bx.0[2] <= q[2]
                     && q[2] <= bx.1[2]
             })
-            .map(|f| winding::crossing(q, &f.poly))
+            .map(|f| winding::crossing(q, f))
             .sum()
     }
 
@@ -439,11 +519,9 @@ impl Solid {
     pub fn classify_point(&self, q: GridPoint) -> Membership {
         let p = q.map(i64::from);
         for i in self.faces_near(&(p, p)) {
-            let f = &self.face(i).poly;
+            let f = self.face(i);
             if f.support().classify_grid(q) == Side::On
-                && f.edge_planes()
-                    .iter()
-                    .all(|e| e.classify_grid(q) != Side::Front)
+                && (0..f.corner_count()).all(|e| f.edge_plane(e).classify_grid(q) != Side::Front)
             {
                 return Membership::Boundary;
             }
@@ -458,8 +536,8 @@ impl Solid {
     /// The watertight triangle mesh of the boundary (see
     /// [`TriMesh::from_polygons`]).
     pub fn to_mesh(&self) -> TriMesh {
-        let polys: Vec<&Polygon> = self.polygons().collect();
-        TriMesh::from_polygons(&polys)
+        let faces: Vec<&Face> = self.faces.iter().flatten().collect();
+        TriMesh::from_polygons(&faces)
     }
 
     /// [`Solid::to_mesh`] for a solid no longer needed: the index goes
@@ -471,7 +549,7 @@ impl Solid {
         drop(index);
         // the polygons are read where they are (moving them out of their
         // slots into a list cost a pass over all of them)
-        let polys: Vec<&Polygon> = faces.iter().flatten().map(|f| &f.poly).collect();
+        let polys: Vec<&Face> = faces.iter().flatten().collect();
         let mesh = TriMesh::from_polygons(&polys);
         drop(polys);
         faces.into_par_iter().for_each(drop);
@@ -584,7 +662,7 @@ impl Solid {
         // `a_c` and `b_c` (a face slot is large: the build reads these often)
         let geometry = |s: &Solid, fs: &[u32]| -> (Vec<IBox>, Vec<bsp_core::Plane>) {
             fs.par_iter()
-                .map(|&f| (s.face(f).bx(), *s.face(f).poly.support()))
+                .map(|&f| (s.face(f).bx(), *s.face(f).support()))
                 .unzip()
         };
         let (boxes_a, planes_a) = geometry(self, &a_c);
@@ -606,8 +684,8 @@ impl Solid {
             // the lists of the leaves holding both, by the exact test
             leaves.par_iter_mut().filter(|l| l.mixed()).for_each(|l| {
                 let bx = l.bx;
-                l.a.retain(|&f| octree::polygon_meets(&self.face(a_c[f as usize]).poly, &bx));
-                l.b.retain(|&f| octree::polygon_meets(&other.face(b_c[f as usize]).poly, &bx));
+                l.a.retain(|&f| octree::polygon_meets(self.face(a_c[f as usize]), &bx));
+                l.b.retain(|&f| octree::polygon_meets(other.face(b_c[f as usize]), &bx));
             });
         }
         // each face's leaves, by its place in `a_c` and `b_c`
@@ -992,22 +1070,14 @@ impl Solid {
             .collect();
         drop(slots);
         let flip = plan.flip;
-        // flipping keeps the box
-        let flipped = |face: &Face| Face {
-            poly: face.poly.flipped(),
-            small_box: face.small_box,
-        };
         let make = |f: Source<'_>| -> Face {
             match f {
-                Source::New(p) => {
-                    let bx = polygon_box(&p);
-                    Face::new(p.with_tag(0), &bx)
-                }
+                Source::New(p) => Face::made(p),
                 Source::Slot(slot) => {
                     let face = slot.take().expect("a live face");
-                    if flip { flipped(&face) } else { face }
+                    if flip { face.flipped() } else { face }
                 }
-                Source::Copy(face) if flip => flipped(face),
+                Source::Copy(face) if flip => face.flipped(),
                 Source::Copy(face) => face.clone(),
             }
         };
@@ -1146,7 +1216,7 @@ fn clip_all<'p>(
         .iter()
         .map(|&f| {
             let face = face(f);
-            local::clip_in(&face.poly, &face.bx(), cell, w).map(|q| {
+            local::clip_face(face, cell, w).map(|q| {
                 pieces.push(q);
                 (pieces.len() - 1) as u32
             })
@@ -1208,22 +1278,22 @@ fn sort_faces<'l>(
 /// side of the other surface; `None` if it meets none (it lies beyond the
 /// octree's box, so beyond the other solid).
 fn meeting_leaf(face: &Face, ls: &[u32], leaves: &[Leaf]) -> Option<u32> {
-    let poly = &face.poly;
     let holds = |l: u32, g: GridPoint| {
         let (lo, hi) = leaves[l as usize].bx;
         (0..3).all(|k| lo[k] <= g[k] as i64 && g[k] as i64 <= hi[k])
     };
-    for v in poly.vertices() {
-        if let Some(g) = v.as_grid()
+    for i in 0..face.corner_count() {
+        if let Some(g) = face.corner(i).as_grid()
             && let Some(&l) = ls.iter().find(|&&l| holds(l, g))
         {
             return Some(l);
         }
     }
+    let poly = face.polygon();
     let fb = face.bx();
     ls.iter().copied().find(|&l| {
         let bx = &leaves[l as usize].bx;
-        local::clip_in(poly, &fb, bx, &walls(bx)).is_some()
+        local::clip_in(&poly, &fb, bx, &walls(bx)).is_some()
     })
 }
 
@@ -1252,16 +1322,16 @@ fn settle(
     if pieces.iter().all(|p| fate(p) == Some(Ok(()))) {
         return None;
     }
-    let (poly, fb) = (&face.poly, face.bx());
+    let (poly, fb) = (face.polygon(), face.bx());
     let in_leaf = |l: u32| {
         let bx = &leaves[l as usize].bx;
-        local::clip_in(poly, &fb, bx, &walls(bx))
+        local::clip_in(&poly, &fb, bx, &walls(bx))
     };
     let mut kept = Vec::new();
     for p in pieces {
         match p {
             Piece::Free(Some(l)) if keep_free(Some(*l)) => kept.extend(in_leaf(*l)),
-            Piece::Free(None) if keep_free(None) => kept.extend(local::outside(poly, root)),
+            Piece::Free(None) if keep_free(None) => kept.extend(local::outside(&poly, root)),
             Piece::Free(_) => {}
             Piece::Mixed(l, i) => match fates.get(l).map(|v| &v[*i as usize]) {
                 Some(PieceFate::Keep(q)) => kept.push((**q).clone()),
@@ -1498,7 +1568,7 @@ fn label_easy<'p>(
                         (None, Some(w)) => {
                             let mm = other_mask.unwrap_or_else(|| {
                                 let (wm, g) = (walls(bm), face(f));
-                                local::clip_in(&g.poly, &g.bx(), bm, &wm)
+                                local::clip_face(g, bm, &wm)
                                     .map_or(0, |q| local::wall_edges(&q, &wm))
                             });
                             mm & (1 << w) != 0
@@ -1706,10 +1776,9 @@ pub fn snap_one(
             let mut imp = bsp_core::FaceImporter::default();
             let (mut extra, mut six) = (Vec::new(), 0i128);
             for (i, (slot, face)) in slots.iter_mut().zip(loops).enumerate() {
-                imp.indexed(grid, mesh.positions, face, c * CHUNK + i, |p| {
+                imp.indexed_grid(grid, mesh.positions, face, c * CHUNK + i, |p| {
                     six += six_volume(&p);
-                    let bx = polygon_box(&p);
-                    let face = Face::new(p.with_tag(0), &bx);
+                    let face = Face::grid(p);
                     match slot {
                         None => *slot = Some(face),
                         Some(_) => extra.push(face),
@@ -1781,14 +1850,9 @@ pub fn mesh_sequence(
 /// 2^26 keep each term below 2^81); summed over a closed surface, six
 /// times the volume it bounds. A polygon with implicit vertices does not
 /// come from an import and gives 0.
-fn six_volume(p: &Polygon) -> i128 {
-    let g: Option<SmallVec<[[i128; 3]; 4]>> = p
-        .vertices()
-        .iter()
-        .map(|q| match q {
-            bsp_core::Point::Grid(c) => Some(c.map(i128::from)),
-            bsp_core::Point::Implicit(_) => None,
-        })
+fn six_volume(p: &impl ConvexFace) -> i128 {
+    let g: Option<SmallVec<[[i128; 3]; 4]>> = (0..p.corner_count())
+        .map(|i| p.corner(i).grid().map(|c| c.map(i128::from)))
         .collect();
     let Some(g) = g else { return 0 };
     g[1..]

@@ -545,6 +545,16 @@ pub(crate) fn clip_in(face: &Polygon, fb: &IBox, cell: &IBox, w: &[Plane; 6]) ->
     Some(p)
 }
 
+/// [`clip_in`] for a solid's face: its polygon is made (with its edge
+/// planes) only when its box meets the cell.
+pub(crate) fn clip_face(face: &crate::Face, cell: &IBox, w: &[Plane; 6]) -> Option<Polygon> {
+    let fb = face.bx();
+    if (0..3).any(|k| fb.1[k] < cell.0[k] || fb.0[k] > cell.1[k]) {
+        return None;
+    }
+    clip_in(&face.polygon(), &fb, cell, w)
+}
+
 /// The parts of `face` outside the box whose walls are `w`: convex
 /// pieces, one per wall it crosses.
 pub(crate) fn outside(face: &Polygon, w: &[Plane; 6]) -> Vec<Polygon> {

@@ -8,7 +8,7 @@
 //! both operands, more than `leaf_size` faces in all, and can be split.
 //! Faces are sent to every child their box overlaps.
 
-use bsp_core::{Plane, Polygon};
+use bsp_core::{ConvexFace, Plane};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
@@ -71,14 +71,12 @@ pub(crate) fn plane_meets(pl: &Plane, bx: &IBox) -> bool {
 /// polygon's normal, and its edges crossed with the box's axes, all in
 /// doubled integer coordinates); for others the support plane's test
 /// ([`plane_meets`]), which may say yes where the polygon does not reach.
-pub(crate) fn polygon_meets(poly: &Polygon, bx: &IBox) -> bool {
+pub(crate) fn polygon_meets(poly: &impl ConvexFace, bx: &IBox) -> bool {
     if !plane_meets(poly.support(), bx) {
         return false;
     }
-    let g: Option<SmallVec<[[i128; 3]; 8]>> = poly
-        .vertices()
-        .iter()
-        .map(|v| v.as_grid().map(|c| c.map(|x| 2 * x as i128)))
+    let g: Option<SmallVec<[[i128; 3]; 8]>> = (0..poly.corner_count())
+        .map(|i| poly.corner(i).as_grid().map(|c| c.map(|x| 2 * x as i128)))
         .collect();
     let Some(g) = g else {
         return true;

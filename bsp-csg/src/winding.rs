@@ -30,7 +30,7 @@
 //! winding number of a point inside a closed, outward-oriented surface is
 //! 1 and outside 0.
 
-use bsp_core::{I256, Plane, Polygon};
+use bsp_core::{ConvexFace, I256, Plane};
 
 /// The sign of the first non-zero value.
 fn first_sign(values: &[i128]) -> i32 {
@@ -49,7 +49,7 @@ fn eval(p: &Plane, q: [i64; 3]) -> i128 {
 }
 
 /// `+1`, `−1` or `0`: how the ray from `q_ε` along `+x` crosses `face`.
-pub(crate) fn crossing(q: [i64; 3], face: &Polygon) -> i32 {
+pub(crate) fn crossing(q: [i64; 3], face: &impl ConvexFace) -> i32 {
     let s = face.support();
     let n = s.normal();
     if n[0] == 0 {
@@ -61,7 +61,8 @@ pub(crate) fn crossing(q: [i64; 3], face: &Polygon) -> i32 {
     if side == nx {
         return 0; // the plane is behind the ray's start
     }
-    for e in face.edge_planes() {
+    for i in 0..face.corner_count() {
+        let e = &face.edge_plane(i);
         let m = e.normal();
         // n_x E(q) − e_x P(q), in 256 bits
         let c0 = I256::from(n[0]) * I256::from(eval(e, q)) - I256::from(m[0]) * I256::from(ps);
@@ -86,6 +87,7 @@ pub(crate) fn crossing(q: [i64; 3], face: &Polygon) -> i32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use bsp_core::Polygon;
 
     fn winding<'a>(q: [i64; 3], faces: impl IntoIterator<Item = &'a Polygon>) -> i32 {
         faces.into_iter().map(|f| crossing(q, f)).sum()
