@@ -530,7 +530,12 @@ pub(crate) fn clip_in(face: &Polygon, fb: &IBox, cell: &IBox, w: &[Plane; 6]) ->
     if (0..3).any(|k| fb.1[k] < cell.0[k] || fb.0[k] > cell.1[k]) {
         return None;
     }
-    let mut p = face.clone();
+    clip_owned(face.clone(), fb, cell, w)
+}
+
+/// [`clip_in`] of a polygon the caller gives up, whose box `fb` meets the
+/// cell.
+fn clip_owned(mut p: Polygon, fb: &IBox, cell: &IBox, w: &[Plane; 6]) -> Option<Polygon> {
     for (i, wall) in w.iter().enumerate() {
         let k = i / 2;
         let behind = if i % 2 == 0 {
@@ -552,7 +557,7 @@ pub(crate) fn clip_face(face: &crate::Face, cell: &IBox, w: &[Plane; 6]) -> Opti
     if (0..3).any(|k| fb.1[k] < cell.0[k] || fb.0[k] > cell.1[k]) {
         return None;
     }
-    clip_in(&face.polygon(), &fb, cell, w)
+    clip_owned(face.polygon().into_owned(), &fb, cell, w)
 }
 
 /// The parts of `face` outside the box whose walls are `w`: convex
