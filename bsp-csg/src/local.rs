@@ -56,11 +56,16 @@ pub(crate) fn solid(
     pieces: Vec<Polygon>,
     reference: impl FnOnce() -> i32,
 ) -> Result<Partition<Cell>, CsgError> {
-    solid_of(
-        bx,
-        &BspTree::build(pieces, &BuildOptions::default()),
-        reference,
-    )
+    solid_of(bx, &BspTree::build(pieces, &local_build()), reference)
+}
+
+/// How a cell's trees choose their planes: 4 candidate planes, each
+/// scored on 16 of the pieces (the defaults, 8 on 48, are for large
+/// trees). A cell holds a few dozen pieces a side, and choosing was a
+/// sixth of the time of 1 000 subtractions (the drill: 15% faster with
+/// these, for 1% more output triangles).
+fn local_build() -> BuildOptions {
+    BuildOptions::default().with_candidates(4).with_sample(16)
 }
 
 /// [`solid`] from the autopartition `tree` of the pieces.
@@ -216,7 +221,7 @@ impl Labelled {
         if pieces.is_empty() {
             return solid(bx, pieces, reference).map(Labelled::Partition);
         }
-        let tree = BspTree::build(pieces, &BuildOptions::default());
+        let tree = BspTree::build(pieces, &local_build());
         if tree.faces_agree() && faces_bound(&tree) {
             Ok(Labelled::Tree(tree))
         } else {
