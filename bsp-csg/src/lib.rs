@@ -32,7 +32,10 @@
 //!    and a face keeps or loses its pieces by it.
 //! 5. A face none of whose pieces the other surface cuts stays exactly as
 //!    it was, however many cells it spans; only cut faces are replaced by
-//!    pieces ([`Stats`]).
+//!    pieces ([`Stats`]). An imported face is kept as its grid corners
+//!    ([`bsp_core::GridPolygon`]), and its edge planes are computed only
+//!    when a cell clips it: most faces of a large solid never are, and the
+//!    edge planes were most of a face's memory.
 //!
 //! Everything is exact: the planes are `bsp-core`'s input tier (planes of
 //! the input faces, their edges, and the octree walls), vertices are
