@@ -326,7 +326,7 @@ impl GridPolygon {
 /// A convex face as the mesh builder and the exact ray test read it: its
 /// support plane, its corners counter-clockwise, and its edge planes (edge
 /// `i` runs from corner `i` to `i + 1`, interior behind). [`Polygon`] and
-/// [`GridPolygon`] are faces, and so is a reference or box of one.
+/// [`GridPolygon`] are faces, and so is a reference to one.
 pub trait ConvexFace {
     /// The support plane.
     fn support(&self) -> &Plane;
@@ -377,25 +377,6 @@ impl ConvexFace for GridPolygon {
 }
 
 impl<T: ConvexFace + ?Sized> ConvexFace for &T {
-    #[inline]
-    fn support(&self) -> &Plane {
-        (**self).support()
-    }
-    #[inline]
-    fn corner_count(&self) -> usize {
-        (**self).corner_count()
-    }
-    #[inline]
-    fn corner(&self, i: usize) -> PointRef<'_> {
-        (**self).corner(i)
-    }
-    #[inline]
-    fn edge_plane(&self, i: usize) -> Plane {
-        (**self).edge_plane(i)
-    }
-}
-
-impl<T: ConvexFace + ?Sized> ConvexFace for Box<T> {
     #[inline]
     fn support(&self) -> &Plane {
         (**self).support()

@@ -1,7 +1,7 @@
 //! A uniform grid of face boxes: the faces overlapping a box, and the
 //! faces a ray along `+x` may cross.
 
-use bsp_core::{Point, Polygon};
+use bsp_core::{ConvexFace, PointRef};
 
 /// An integer box: inclusive grid coordinate ranges per axis.
 pub(crate) type IBox = ([i64; 3], [i64; 3]);
@@ -9,17 +9,18 @@ pub(crate) type IBox = ([i64; 3], [i64; 3]);
 /// The box of grid points that holds a polygon: exact for grid vertices,
 /// the floor and ceiling of the approximate coordinates widened by one
 /// step for implicit ones.
-pub(crate) fn polygon_box(p: &Polygon) -> IBox {
+pub(crate) fn polygon_box(p: &impl ConvexFace) -> IBox {
     let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
-    for v in p.vertices() {
+    for i in 0..p.corner_count() {
+        let v = p.corner(i);
         match v {
-            Point::Grid(g) => {
+            PointRef::Grid(g) => {
                 for k in 0..3 {
                     lo[k] = lo[k].min(g[k] as i64);
                     hi[k] = hi[k].max(g[k] as i64);
                 }
             }
-            Point::Implicit(i) => {
+            PointRef::Implicit(i) => {
                 // the cached approximation is within a few ulps, far
                 // below the margin of 1 for any coordinate under 2^40;
                 // beyond that, the correctly rounded value (an exact

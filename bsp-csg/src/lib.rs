@@ -253,20 +253,14 @@ impl Face {
 
     /// An imported face (tag 0).
     fn grid(g: GridPolygon) -> Face {
-        let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
-        for p in g.vertices() {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k] as i64);
-                hi[k] = hi[k].max(p[k] as i64);
-            }
-        }
-        Face::new(Shape::Grid(g.with_tag(0)), &(lo, hi))
+        let bx = polygon_box(&g);
+        Face::new(Shape::Grid(g.with_tag(0)), &bx)
     }
 
     /// A face an operation made (tag 0).
     fn made(mut p: Box<Polygon>) -> Face {
         p.set_tag(0);
-        let bx = polygon_box(&p);
+        let bx = polygon_box(&*p);
         Face::new(Shape::Made(p), &bx)
     }
 
