@@ -250,11 +250,21 @@ fn split<P: PlaneTest, Q: PlaneTest>(
                     }
                 }
             }
-            // the children c with all ⊆ c ⊆ any
-            for (c, kid) in kids.iter_mut().enumerate() {
-                if c & !any == 0 && c & all == all && meets(f, &boxes[c]) {
-                    kid.push(f);
+            // the children c with all ⊆ c ⊆ any; a face whose box lies
+            // within the child's meets it, so its plane needs no test
+            let spread = any & !all;
+            let mut s = spread;
+            loop {
+                let c = all | s;
+                let (cl, ch) = &boxes[c];
+                let within = (0..3).all(|k| cl[k] <= fl[k] && fh[k] <= ch[k]);
+                if within || meets(f, &boxes[c]) {
+                    kids[c].push(f);
                 }
+                if s == 0 {
+                    break;
+                }
+                s = (s - 1) & spread;
             }
         }
     };
@@ -315,7 +325,6 @@ const STALL_SHARE: usize = 3;
 /// two others. The leaves tile space without overlap, so for each wall
 /// coordinate a sweep finds the pairs in `O(n log n)` plus their number.
 pub(crate) fn adjacent(leaves: &[Leaf]) -> Vec<(u32, u32)> {
-    use std::collections::BTreeMap;
     // the three axes in parallel, joined in order
     let per_axis: Vec<Vec<(u32, u32)>> = (0..3usize)
         .into_par_iter()
@@ -343,24 +352,30 @@ pub(crate) fn adjacent(leaves: &[Leaf]) -> Vec<(u32, u32)> {
                 }
                 events.sort_unstable();
                 // the leaves of each side the sweep line crosses, by their lower
-                // v; their v ranges are disjoint
-                let mut active: [BTreeMap<i64, u32>; 2] = [BTreeMap::new(), BTreeMap::new()];
+                // v; their v ranges are disjoint (few at a time: sorted lists)
+                let mut active: [Vec<(i64, u32)>; 2] = [Vec::new(), Vec::new()];
                 for &(_, kind, side, i) in &events {
                     let b = &leaves[i as usize].bx;
                     let s = side as usize;
+                    let at = active[s].partition_point(|x| x.0 < b.0[v]);
                     if kind == 0 {
-                        active[s].remove(&b.0[v]);
+                        active[s].remove(at);
                         continue;
                     }
                     let other = &active[1 - s];
-                    let before = other
-                        .range(..b.0[v])
-                        .next_back()
-                        .filter(|(_, j)| leaves[**j as usize].bx.1[v] >= b.0[v]);
-                    for (_, &j) in before.into_iter().chain(other.range(b.0[v]..=b.1[v])) {
+                    // the other side's leaves whose v range meets [lo, hi]:
+                    // the last starting below lo (if it reaches lo), then
+                    // those starting in [lo, hi]
+                    let from = other.partition_point(|x| x.0 < b.0[v]);
+                    let to = other.partition_point(|x| x.0 <= b.1[v]);
+                    let before = from
+                        .checked_sub(1)
+                        .filter(|&p| leaves[other[p].1 as usize].bx.1[v] >= b.0[v]);
+                    for p in before.into_iter().chain(from..to) {
+                        let j = other[p].1;
                         out.push(if s == 0 { (i, j) } else { (j, i) });
                     }
-                    active[s].insert(b.0[v], i);
+                    active[s].insert(at, (b.0[v], i));
                 }
             }
             out
