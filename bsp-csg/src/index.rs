@@ -153,6 +153,14 @@ impl FaceIndex {
         });
     }
 
+    /// Keeps the ids `keep` accepts (every list in parallel, in order).
+    pub(crate) fn retain(&mut self, keep: impl Fn(u32) -> bool + Sync) {
+        use rayon::prelude::*;
+        self.cells
+            .par_iter_mut()
+            .for_each(|list| list.retain(|&f| keep(f)));
+    }
+
     /// How many ids [`FaceIndex::near`] would give (with repeats),
     /// without listing them.
     pub(crate) fn near_count(&self, b: &IBox) -> usize {

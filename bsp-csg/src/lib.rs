@@ -104,6 +104,10 @@ use crate::octree::{Leaf, walls};
 /// faces of both operands), by default.
 pub const LEAF_SIZE: usize = 32;
 
+/// Faces removed or added at once from which the index is updated in
+/// parallel passes rather than face by face.
+const BULK: usize = 4096;
+
 /// Options of [`Solid::apply_with`].
 #[derive(Clone, Debug, PartialEq, Eq)]
 #[non_exhaustive]
@@ -454,6 +458,48 @@ impl Solid {
         }
     }
 
+    /// [`Solid::remove`] of each of `ids` in turn (the same free list);
+    /// many at once are taken out of the slots and the index in parallel
+    /// passes (the index's lists keep their other ids in order, which no
+    /// query depends on).
+    fn remove_all(&mut self, ids: &[u32]) {
+        if ids.len() < BULK.max(self.faces.len() / 16) {
+            ids.iter().for_each(|&f| self.remove(f));
+            return;
+        }
+        let mut gone = vec![false; self.faces.len()];
+        for &f in ids {
+            if self.faces[f as usize].is_some() && !gone[f as usize] {
+                gone[f as usize] = true;
+                self.free.push(f);
+                self.live -= 1;
+            }
+        }
+        self.faces
+            .par_iter_mut()
+            .zip(&gone)
+            .filter(|(_, g)| **g)
+            .for_each(|(f, _)| *f = None);
+        self.index.retain(|f| !gone[f as usize]);
+    }
+
+    /// Adds `ids` (live faces not yet indexed) to the index and the
+    /// bounds, in order; many at once read their boxes in parallel.
+    fn index_all(&mut self, ids: &[u32]) {
+        let boxes: Vec<IBox> = if ids.len() < BULK {
+            ids.iter().map(|&f| self.face(f).bx()).collect()
+        } else {
+            ids.par_iter().map(|&f| self.face(f).bx()).collect()
+        };
+        let Some(all) = boxes.iter().copied().reduce(|a, b| union(&a, &b)) else {
+            return;
+        };
+        self.bounds = Some(self.bounds.map_or(all, |b| union(&b, &all)));
+        for (&f, bx) in ids.iter().zip(&boxes) {
+            self.index.insert(f, bx);
+        }
+    }
+
     /// The live faces whose box overlaps `b`.
     fn faces_near(&self, b: &IBox) -> Vec<u32> {
         let meets = |&i: &u32| {
@@ -612,6 +658,7 @@ impl Solid {
     ) -> Result<Stats, CsgError> {
         let (stats, plan) = self.plan(&other, op, opts)?;
         self.carry_out(plan, Other::Owned(&mut other));
+        drop_aside(other);
         Ok(stats)
     }
 
@@ -686,16 +733,20 @@ impl Solid {
             });
         }
         // each face's leaves, by its place in `a_c` and `b_c`
-        let mut a_leaves: Vec<SmallVec<[u32; 4]>> = vec![SmallVec::new(); a_c.len()];
-        let mut b_leaves: Vec<SmallVec<[u32; 4]>> = vec![SmallVec::new(); b_c.len()];
-        for (li, l) in leaves.iter().enumerate() {
-            for &f in &l.a {
-                a_leaves[f as usize].push(li as u32);
+        // (each operand's on its own thread)
+        let leaves_of = |n: usize, list: fn(&Leaf) -> &Vec<u32>| {
+            let mut of: Vec<SmallVec<[u32; 4]>> = vec![SmallVec::new(); n];
+            for (li, l) in leaves.iter().enumerate() {
+                for &f in list(l) {
+                    of[f as usize].push(li as u32);
+                }
             }
-            for &f in &l.b {
-                b_leaves[f as usize].push(li as u32);
-            }
-        }
+            of
+        };
+        let (a_leaves, b_leaves) = rayon::join(
+            || leaves_of(a_c.len(), |l| &l.a),
+            || leaves_of(b_c.len(), |l| &l.b),
+        );
         // the leaves' lists by face id
         leaves.par_iter_mut().for_each(|l| {
             l.a.iter_mut().for_each(|f| *f = a_c[*f as usize]);
@@ -868,7 +919,7 @@ impl Solid {
             },
         );
         let (mut labels_a, mut labels_b) = (labels_a?, labels_b?);
-        drop((listed_a, listed_b));
+        drop_aside((listed_a, listed_b));
         // an easy cell with a piece no label reached does the full work
         let mut again: Vec<u32> = Vec::new();
         for l in easy {
@@ -972,7 +1023,7 @@ impl Solid {
                 )
             },
         );
-        drop((pieces_a, fates_a, pieces_b, fates_b));
+        drop_aside((pieces_a, fates_a, pieces_b, fates_b));
         for (f, outcome) in settled_a {
             if let Some(kept) = outcome {
                 remove.push(f);
@@ -1018,9 +1069,7 @@ impl Solid {
                 }
             }
         }
-        for f in remove {
-            self.remove(f);
-        }
+        self.remove_all(&remove);
         Ok((stats, Plan { add, flip: flip_b }))
     }
 
@@ -1096,14 +1145,11 @@ impl Solid {
         self.faces
             .par_extend(rest.into_par_iter().map(|f| Some(make(f))));
         // the index and the bounds
-        let ids = reused
+        let ids: Vec<u32> = reused
             .into_iter()
-            .chain(first_new as u32..self.faces.len() as u32);
-        for id in ids {
-            let bx = self.face(id).bx();
-            self.index.insert(id, &bx);
-            self.bounds = Some(self.bounds.map_or(bx, |b| union(&b, &bx)));
-        }
+            .chain(first_new as u32..self.faces.len() as u32)
+            .collect();
+        self.index_all(&ids);
         self.live += n;
         if self.live > 4 * self.indexed + 1024 {
             self.reindex();
@@ -1198,6 +1244,14 @@ impl Made {
             CellResult::Pieces(fa, fb, pa, pb) => Made::Fates(fates(fa, pa, ia), fates(fb, pb, ib)),
         }
     }
+}
+
+/// Frees `x` on the thread pool: large temporaries (a cell's fates, the
+/// other operand's remains) are many small allocations, and freeing them
+/// where they fall due would hold up the sequential steps after while the
+/// other threads idle.
+fn drop_aside<T: Send + 'static>(x: T) {
+    rayon::spawn(move || drop(x));
 }
 
 /// The faces `fs` clipped to the cell `cell` (walls `w`): the non-empty
@@ -2033,6 +2087,42 @@ mod tests {
                     .count();
                 assert_eq!(holding, usize::from(x < 10 || y < 10), "({x}, {y})");
             }
+        }
+    }
+
+    /// Many faces removed at once (slots and index in parallel passes)
+    /// leave the solid as removing them one by one does: the same free
+    /// list, slots, bounds of the remaining queries and index answers.
+    #[test]
+    fn removing_many_faces_at_once_is_removing_them_in_turn() {
+        let (pos, faces) = shapes::uv_sphere(12_000);
+        let snapped = snap(&[MeshIn::new(&pos, &faces)]).unwrap();
+        let solid = &snapped.solids[0];
+        let n = solid.faces.len() as u32;
+        // every other face, some named twice, ending with one already gone
+        let mut ids: Vec<u32> = (0..n).filter(|i| i % 2 == 0).rev().collect();
+        ids.extend([2, 4, 6]);
+        assert!(ids.len() >= BULK && ids.len() >= solid.faces.len() / 16);
+        let mut one = solid.clone();
+        let mut all = solid.clone();
+        one.remove(8);
+        all.remove(8);
+        ids.iter().for_each(|&f| one.remove(f));
+        all.remove_all(&ids);
+        assert_eq!(one.free, all.free);
+        assert_eq!(one.live, all.live);
+        assert_eq!(one.live, (n / 2) as usize);
+        let live = |s: &Solid| -> Vec<bool> { s.faces.iter().map(Option::is_some).collect() };
+        assert_eq!(live(&one), live(&all));
+        let (lo, hi) = solid.bounds.unwrap();
+        let mid = [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2);
+        for bx in [(lo, hi), (lo, mid), (mid, hi), (mid, mid)] {
+            let near = all.faces_near(&bx);
+            assert_eq!(one.faces_near(&bx), near);
+            assert!(near.iter().all(|&f| f % 2 == 1));
+        }
+        for q in [lo, mid].map(|p| p.map(|c| c as i32)) {
+            assert_eq!(one.winding(q), all.winding(q));
         }
     }
 }
