@@ -31,7 +31,7 @@ fn main() {
     let grid = fit_grid(&meshes).unwrap();
     let mut part = snap_one(&grid, &meshes[0], 0).unwrap().0;
     let mut t_snap = t.elapsed();
-    let (mut cut, mut mixed, mut easy, mut cells) = (0, 0, 0, 0);
+    let (mut cut, mut mixed, mut easy, mut clean, mut cells) = (0, 0, 0, 0, 0);
     let leaf = std::env::var("LEAF_SIZE")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -50,6 +50,7 @@ fn main() {
         cut += s.cut_faces;
         mixed += s.mixed_cells;
         easy += s.easy_cells;
+        clean += s.clean_cells;
         cells += s.cells;
     }
     let t = Instant::now();
@@ -59,7 +60,7 @@ fn main() {
     let t_mesh = t.elapsed();
     println!(
         "{} - {tools} x {} triangles: snap {:.0} ms, subtractions {:.0} ms ({:.2} ms each, \
-         {cut} faces cut, {cells} cells, {mixed} mixed, {easy} easy), mesh+check {:.0} ms; {} faces, {} triangles out",
+         {cut} faces cut, {cells} cells, {mixed} mixed, {clean} clean, {easy} easy), mesh+check {:.0} ms; {} faces, {} triangles out",
         pf.len(),
         tf.len(),
         t_snap.as_secs_f64() * 1e3,

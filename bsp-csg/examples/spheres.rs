@@ -60,9 +60,10 @@ fn main() {
         mesh.triangles.len()
     );
     println!(
-        "cells {}, mixed {} (easy {}, merged {}), cut faces {} into {} pieces",
+        "cells {}, mixed {} (clean {}, easy {}, merged {}), cut faces {} into {} pieces",
         stats.cells,
         stats.mixed_cells,
+        stats.clean_cells,
         stats.easy_cells,
         stats.merged_cells,
         stats.cut_faces,

@@ -123,7 +123,8 @@ pub struct Options {
     pub exact_cells: bool,
     /// Let a mixed cell whose two surfaces do not meet label its pieces
     /// along their faces from the cells around instead of building local
-    /// trees (on by default; off, every mixed cell builds them). The
+    /// trees, and one whose faces all lie apart from the other surface
+    /// do nothing (on by default; off, every mixed cell builds them). The
     /// result is the same either way.
     pub easy_cells: bool,
 }
@@ -177,6 +178,11 @@ pub struct Stats {
     /// labelled along their faces from the cells around, without local
     /// trees.
     pub easy_cells: usize,
+    /// Mixed cells whose faces all lie apart from the other surface's
+    /// (each whole face from each face of the other in every mixed cell
+    /// that lists both): nothing was clipped or built there, and those
+    /// faces were kept or dropped whole.
+    pub clean_cells: usize,
 }
 
 /// Why an operation cannot be done.
@@ -788,6 +794,20 @@ impl Solid {
         let mixed: Vec<u32> = (0..leaves.len() as u32)
             .filter(|&l| leaves[l as usize].mixed())
             .collect();
+        // The faces that may meet the other surface: those not apart from
+        // some face of it in some mixed cell (whole faces, by their
+        // support planes). Every other face meets the other surface
+        // nowhere (a common point would lie in a cell listing both), so it
+        // is kept or dropped whole by one label (`label_untouched`); a
+        // mixed cell all of whose faces are such ("clean") does nothing.
+        // (without easy cells every mixed cell builds its trees, and the
+        // untouched faces take their labels from them: the same result)
+        let (touched_a, touched_b, mut clean) = touched(&mixed, &leaves, self, other);
+        if !opts.easy_cells {
+            clean.iter_mut().for_each(|c| *c = false);
+        }
+        let untouched_a = |f: u32| touched_a.get(f as usize) == Some(&false);
+        let untouched_b = |f: u32| touched_b.get(f as usize) == Some(&false);
         // Each cell clips its faces to its walls itself, so that only the
         // cells at work hold their pieces, and finds the pieces that meet
         // no piece of the other surface (isolated). A cell whose pieces are
@@ -831,11 +851,13 @@ impl Solid {
         };
         let first: Vec<(u32, First)> = mixed
             .par_iter()
+            .filter(|&&l| !clean[l as usize])
             .map(|&l| run(l, opts.easy_cells).map(|r| (l, r)))
             .collect::<Result<_, _>>()?;
         let mut stats = Stats {
             cells: leaves.len(),
             mixed_cells: mixed.len(),
+            clean_cells: mixed.iter().filter(|&&l| clean[l as usize]).count(),
             ..Stats::default()
         };
         let mut add: Vec<Added> = Vec::new();
@@ -963,6 +985,32 @@ impl Solid {
             }
         }
 
+        // the untouched faces' labels
+        let (untouched_la, untouched_lb) = rayon::join(
+            || {
+                label_untouched(
+                    &pieces_a,
+                    &untouched_a,
+                    |f| self.face(f),
+                    &leaves,
+                    &label_of(&fates_a, keep_a(true)),
+                    &|l| inside_b.inside(l),
+                    &|g| other.winding(g) != 0,
+                )
+            },
+            || {
+                label_untouched(
+                    &pieces_b,
+                    &untouched_b,
+                    |f| other.face(f),
+                    &leaves,
+                    &label_of(&fates_b, keep_b(true)),
+                    &|l| inside_a.inside(l),
+                    &|g| self.winding(g) != 0,
+                )
+            },
+        );
+        let (untouched_la, untouched_lb) = (untouched_la?, untouched_lb?);
         // the changes, now that everything is known
         // (decided in parallel, applied in order)
         let mut remove: Vec<u32> = whole_a
@@ -976,14 +1024,30 @@ impl Solid {
             .map(|&i| a_c[i as usize])
             .collect();
         // a piece beyond the octree's box is beyond the other solid's box
+        // (an untouched face stays or goes whole by its label; a face the
+        // other surface may meet has no piece in a clean cell)
         let settle_all = |pieces: &[(u32, Vec<Piece>)],
                           solid: &Solid,
                           keep: &(dyn Fn(bool) -> bool + Sync),
                           other_side: &Regions,
-                          fates: &FxHashMap<u32, Vec<PieceFate>>| {
+                          fates: &FxHashMap<u32, Vec<PieceFate>>,
+                          labels: &[Option<bool>]|
+         -> Result<Settled, CsgError> {
             pieces
                 .par_iter()
-                .map(|(f, pieces)| {
+                .zip(labels)
+                .map(|((f, pieces), label)| {
+                    if let Some(inside) = label {
+                        return Ok((*f, (!keep(*inside)).then(Vec::new)));
+                    }
+                    if pieces
+                        .iter()
+                        .any(|p| matches!(p, Piece::Mixed(l, _) if clean[*l as usize]))
+                    {
+                        return Err(CsgError::Internal(
+                            "a face the other surface may meet has a piece in a clean cell".into(),
+                        ));
+                    }
                     let kept = settle(
                         solid.face(*f),
                         pieces,
@@ -992,14 +1056,14 @@ impl Solid {
                         &leaves,
                         &root_walls,
                     );
-                    (*f, kept)
+                    Ok((*f, kept))
                 })
-                .collect::<Vec<_>>()
+                .collect()
         };
         // the two operands' faces at once (each in parallel, but each
         // with sequential tails)
         let (settled_a, (kept_b, settled_b)) = rayon::join(
-            || settle_all(&pieces_a, self, &keep_a, &inside_b, &fates_a),
+            || settle_all(&pieces_a, self, &keep_a, &inside_b, &fates_a, &untouched_la),
             || {
                 rayon::join(
                     // the other solid's faces kept whole are listed, to be
@@ -1019,11 +1083,21 @@ impl Solid {
                             .map(|&i| b_c[i as usize])
                             .collect()
                     },
-                    || settle_all(&pieces_b, other, &keep_b, &inside_a, &fates_b),
+                    || {
+                        settle_all(
+                            &pieces_b,
+                            other,
+                            &keep_b,
+                            &inside_a,
+                            &fates_b,
+                            &untouched_lb,
+                        )
+                    },
                 )
             },
         );
         drop_aside((pieces_a, fates_a, pieces_b, fates_b));
+        let (settled_a, settled_b) = (settled_a?, settled_b?);
         for (f, outcome) in settled_a {
             if let Some(kept) = outcome {
                 remove.push(f);
@@ -1190,6 +1264,9 @@ enum Piece {
 /// Faces wholly in cells free of the other surface (by their place in the
 /// list sorted), and the pieces of every other face (by id).
 type Sorted = (Vec<u32>, Vec<(u32, Vec<Piece>)>);
+
+/// Faces with pieces, each with what stays of it ([`settle`]).
+type Settled = Vec<(u32, Option<Vec<Polygon>>)>;
 
 /// What becomes of a face listed in a mixed cell.
 enum PieceFate {
@@ -1692,6 +1769,189 @@ fn label_easy<'p>(
         out.insert(l, labels);
     }
     Ok(out)
+}
+
+/// For each face of `a` and of `b` (by id; `false` for faces in no
+/// mixed cell), whether it may meet the other surface: it is not apart
+/// ([`local::apart`], whole faces) from some face of the other in some
+/// mixed cell of `mixed`, or it has no grid corner (where its label could
+/// be asked), or it is listed in a mixed cell where faces of the two
+/// share a plane (which may be merged whole, pieces and all); and per
+/// leaf, whether it is a clean mixed cell: one whose faces all are
+/// untouched.
+///
+/// An untouched face meets the other surface nowhere: a common point
+/// would lie in some leaf's closed cell, whose lists hold every face
+/// meeting it (box and plane), so that leaf would be mixed and the two
+/// faces tested there, and faces with a common point are never apart.
+fn touched(
+    mixed: &[u32],
+    leaves: &[Leaf],
+    a: &Solid,
+    b: &Solid,
+) -> (Vec<bool>, Vec<bool>, Vec<bool>) {
+    let no_grid_corner = |f: &Face| (0..f.corner_count()).all(|i| f.corner(i).as_grid().is_none());
+    let per_cell: Vec<(Vec<u32>, Vec<u32>)> = mixed
+        .par_iter()
+        .map(|&l| {
+            let leaf = &leaves[l as usize];
+            let fa: Vec<&Face> = leaf.a.iter().map(|&f| a.face(f)).collect();
+            let fb: Vec<&Face> = leaf.b.iter().map(|&f| b.face(f)).collect();
+            // a cell where faces of the two share a plane may be merged
+            // as a whole (`local::boolean_pieces`): all its faces settle
+            // piece by piece
+            let shared = fa
+                .iter()
+                .any(|p| fb.iter().any(|q| p.support().is_coincident(q.support())));
+            if shared {
+                return (leaf.a.clone(), leaf.b.clone());
+            }
+            let mut ta: Vec<bool> = fa.iter().map(|f| no_grid_corner(f)).collect();
+            let mut tb: Vec<bool> = fb.iter().map(|f| no_grid_corner(f)).collect();
+            for (i, p) in fa.iter().enumerate() {
+                for (j, q) in fb.iter().enumerate() {
+                    if ta[i] && tb[j] {
+                        continue; // both known already
+                    }
+                    if !local::apart(*p, *q) {
+                        ta[i] = true;
+                        tb[j] = true;
+                    }
+                }
+            }
+            let pick = |fs: &[u32], t: &[bool]| -> Vec<u32> {
+                fs.iter()
+                    .zip(t)
+                    .filter(|(_, t)| **t)
+                    .map(|(f, _)| *f)
+                    .collect()
+            };
+            (pick(&leaf.a, &ta), pick(&leaf.b, &tb))
+        })
+        .collect();
+    let (mut ta, mut tb) = (vec![false; a.faces.len()], vec![false; b.faces.len()]);
+    for (xa, xb) in &per_cell {
+        xa.iter().for_each(|&f| ta[f as usize] = true);
+        xb.iter().for_each(|&f| tb[f as usize] = true);
+    }
+    let mut clean = vec![false; leaves.len()];
+    for &l in mixed {
+        let leaf = &leaves[l as usize];
+        clean[l as usize] =
+            leaf.a.iter().all(|&f| !ta[f as usize]) && leaf.b.iter().all(|&f| !tb[f as usize]);
+    }
+    (ta, tb, clean)
+}
+
+/// The labels (inside the other solid or not) of the untouched faces
+/// among `pieces` (by place; `None` for the others), each one label for
+/// the whole face, which meets the other surface nowhere:
+///
+/// - a grid corner of it in a free cell of its own: that cell's region's
+///   label;
+/// - a piece of it whose fate in a mixed cell is known (`known`);
+/// - another untouched face of this operand with a common grid corner
+///   (a small ball around the corner is free of the other surface);
+/// - for a group none of these reach, the winding number `inside` at a
+///   grid corner of its first face (every untouched face has one).
+#[allow(clippy::too_many_arguments)]
+fn label_untouched<'p>(
+    pieces: &[(u32, Vec<Piece>)],
+    untouched: &(dyn Fn(u32) -> bool + Sync),
+    face: impl Fn(u32) -> &'p Face + Sync,
+    leaves: &[Leaf],
+    known: &(dyn Fn(u32, u32) -> Option<bool> + Sync),
+    free_inside: &(dyn Fn(u32) -> bool + Sync),
+    inside: &(dyn Fn(GridPoint) -> bool + Sync),
+) -> Result<Vec<Option<bool>>, CsgError> {
+    let corners = |f: u32| -> SmallVec<[GridPoint; 4]> {
+        let face = face(f);
+        (0..face.corner_count())
+            .filter_map(|i| face.corner(i).as_grid())
+            .collect()
+    };
+    // `None`: touched; `Some(None)`: untouched, no label of its own yet
+    let own: Vec<Option<Option<bool>>> = pieces
+        .par_iter()
+        .map(|(f, ps)| {
+            if !untouched(*f) {
+                return None;
+            }
+            let cs = corners(*f);
+            let holds = |l: u32| {
+                let (lo, hi) = leaves[l as usize].bx;
+                cs.iter()
+                    .any(|g| (0..3).all(|k| lo[k] <= g[k] as i64 && g[k] as i64 <= hi[k]))
+            };
+            let label = ps.iter().find_map(|p| match *p {
+                Piece::Free(Some(l)) if holds(l) => Some(free_inside(l)),
+                Piece::Mixed(l, i) => known(l, i),
+                _ => None,
+            });
+            Some(label)
+        })
+        .collect();
+    if own.iter().all(|x| !matches!(x, Some(None))) {
+        return Ok(own.into_iter().map(Option::flatten).collect());
+    }
+    // nodes: 0 and 1 stand for the labels outside and inside, then the
+    // faces by place
+    let mut parent: Vec<u32> = (0..pieces.len() as u32 + 2).collect();
+    fn find(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            p[x as usize] = p[p[x as usize] as usize];
+            x = p[x as usize];
+        }
+        x
+    }
+    fn join(p: &mut [u32], a: u32, b: u32) {
+        let (ra, rb) = (find(p, a), find(p, b));
+        if ra != rb {
+            // the labels 0 and 1 stay roots
+            p[ra.max(rb) as usize] = ra.min(rb);
+        }
+    }
+    let mut first: FxHashMap<GridPoint, u32> = FxHashMap::default();
+    for (i, x) in own.iter().enumerate() {
+        let Some(label) = x else { continue };
+        let node = i as u32 + 2;
+        if let Some(inside) = label {
+            join(&mut parent, node, u32::from(*inside));
+        }
+        for g in corners(pieces[i].0) {
+            let at = *first.entry(g).or_insert(node);
+            join(&mut parent, node, at);
+        }
+    }
+    let disagree = || CsgError::Internal("an untouched face got both labels".into());
+    if find(&mut parent, 1) == 0 {
+        return Err(disagree());
+    }
+    // groups no label reached: the winding number at a grid corner
+    let mut asked: Vec<(u32, GridPoint)> = Vec::new();
+    let mut seen: rustc_hash::FxHashSet<u32> = Default::default();
+    for (i, x) in own.iter().enumerate() {
+        if x.is_some() {
+            let r = find(&mut parent, i as u32 + 2);
+            if r >= 2 && seen.insert(r) {
+                asked.push((r, corners(pieces[i].0)[0]));
+            }
+        }
+    }
+    let answers: Vec<(u32, bool)> = asked.par_iter().map(|&(r, g)| (r, inside(g))).collect();
+    for (r, x) in answers {
+        join(&mut parent, r, u32::from(x));
+    }
+    (0..pieces.len())
+        .map(|i| match own[i] {
+            None => Ok(None),
+            Some(_) => match find(&mut parent, i as u32 + 2) {
+                0 => Ok(Some(false)),
+                1 => Ok(Some(true)),
+                _ => Err(CsgError::Internal("an untouched face got no label".into())),
+            },
+        })
+        .collect()
 }
 
 /// Connected regions of octree cells free of one surface, each wholly

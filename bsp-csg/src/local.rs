@@ -30,7 +30,7 @@
 //! and for the merged cells.
 
 use bsp_core::{
-    BoolOp, BspTree, BuildOptions, Cell, Link, PLink, Partition, Parts, Plane, Polygon,
+    BoolOp, BspTree, BuildOptions, Cell, ConvexFace, Link, PLink, Partition, Parts, Plane, Polygon,
     PolygonSide, Side, merge_smaller_into_larger,
 };
 
@@ -457,8 +457,8 @@ pub(crate) fn boolean_pieces(
 }
 
 /// `true` if every vertex of `p` lies strictly on one side of `plane`.
-fn strictly_one_side(p: &Polygon, plane: &Plane) -> bool {
-    let mut sides = p.vertices().iter().map(|v| v.classify(plane));
+fn strictly_one_side(p: &impl ConvexFace, plane: &Plane) -> bool {
+    let mut sides = (0..p.corner_count()).map(|i| p.corner(i).classify(plane));
     let first = sides.next().unwrap_or(Side::On);
     first != Side::On && sides.all(|s| s == first)
 }
@@ -467,7 +467,7 @@ fn strictly_one_side(p: &Polygon, plane: &Plane) -> bool {
 /// one lies strictly on one side of the other's. Polygons that meet are
 /// never apart; some that do not meet are not found apart (a sufficient
 /// test only).
-pub(crate) fn apart(p: &Polygon, q: &Polygon) -> bool {
+pub(crate) fn apart(p: &impl ConvexFace, q: &impl ConvexFace) -> bool {
     strictly_one_side(q, p.support()) || strictly_one_side(p, q.support())
 }
 

@@ -128,3 +128,47 @@ fn a_box_through_a_sphere_with_and_without_easy_cells() {
         assert_eq!(easy.volume_rounded(), full.volume_rounded(), "{op:?}");
     }
 }
+
+/// Two offset spheres: most faces in cells holding both surfaces lie
+/// apart from the other surface, so many such cells are clean (nothing
+/// clipped or built, their faces kept or dropped whole); the result is
+/// the one every cell building its trees gives, triangle for triangle,
+/// and its exact volume.
+#[test]
+fn clean_cells_keep_faces_whole_as_local_trees_would() {
+    let (va, vb, f) = bsp_csg::shapes::sphere_pair(4000);
+    let meshes = [MeshIn::new(&va, &f), MeshIn::new(&vb, &f)];
+    let Snapped { solids, .. } = snap(&meshes).unwrap();
+    for leaf in [8, bsp_csg::LEAF_SIZE] {
+        for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
+            let run = |opts: &Options| {
+                let mut s = solids[0].clone();
+                let stats = s.apply_with(&solids[1], op, opts).unwrap();
+                let mesh = s.to_mesh();
+                mesh.check_watertight().unwrap();
+                (mesh, stats)
+            };
+            let (clean, stats) = run(&Options::default().with_leaf_size(leaf));
+            assert!(stats.clean_cells > 0, "{op:?}: {stats:?}");
+            let (full, full_stats) = run(&Options::default()
+                .with_leaf_size(leaf)
+                .with_easy_cells(false));
+            assert_eq!(full_stats.clean_cells, 0);
+            assert_eq!(clean.triangles, full.triangles, "{op:?} at {leaf}");
+            assert_eq!(clean.vertices.len(), full.vertices.len());
+            assert!(
+                clean
+                    .vertices
+                    .iter()
+                    .zip(&full.vertices)
+                    .all(|(p, q)| p.same_point(q)),
+                "{op:?} at {leaf}"
+            );
+            assert_eq!(
+                clean.volume_exact(),
+                full.volume_exact(),
+                "{op:?} at {leaf}"
+            );
+        }
+    }
+}

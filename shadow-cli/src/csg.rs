@@ -534,11 +534,20 @@ fn stats_text(
             cut_faces: a.cut_faces + b.cut_faces,
             pieces: a.pieces + b.pieces,
             easy_cells: a.easy_cells + b.easy_cells,
+            clean_cells: a.clean_cells + b.clean_cells,
         });
     s += &format!(
         "octree:         {} cells, {} with both surfaces ({} with shared planes, {} where \
-         they do not meet); {} faces cut into {} pieces\n",
-        sum.cells, sum.mixed_cells, sum.merged_cells, sum.easy_cells, sum.cut_faces, sum.pieces
+         they do not meet: {} with every face apart from the other surface, {} labelled from \
+         the cells around); {} faces cut into {} pieces\n",
+        sum.cells,
+        sum.mixed_cells,
+        sum.merged_cells,
+        sum.easy_cells + sum.clean_cells,
+        sum.clean_cells,
+        sum.easy_cells,
+        sum.cut_faces,
+        sum.pieces
     );
     s += &format!(
         "output:         {} triangles, {} vertices\n",
