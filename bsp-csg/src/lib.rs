@@ -818,9 +818,6 @@ impl Solid {
         let run = |l: u32, allow_easy: bool| -> Result<First, CsgError> {
             let leaf = &leaves[l as usize];
             let (bx, w) = (leaf.bx, walls(&leaf.bx));
-            let (pa, ia) = clip_all(&leaf.a, |f| self.face(f), &bx, &w);
-            let (pb, ib) = clip_all(&leaf.b, |f| other.face(f), &bx, &w);
-            let (isa, isb) = local::isolated(&pa, &pb);
             let masks = |pieces: &[Polygon], iso: &[bool], index: &[Option<u32>]| {
                 index
                     .iter()
@@ -830,13 +827,43 @@ impl Solid {
                     })
                     .collect::<Vec<Option<u8>>>()
             };
-            let (ma, mb) = (masks(&pa, &isa, &ia), masks(&pb, &isb, &ib));
-            if allow_easy && isa.iter().chain(&isb).all(|&x| x) {
-                return Ok(First::Easy(
-                    (ma, Listed::new(&pa, &ia)),
-                    (mb, Listed::new(&pb, &ib)),
-                ));
+            let touched_a = |f: u32| !untouched_a(f);
+            let touched_b = |f: u32| !untouched_b(f);
+            // Untouched faces are isolated, and their pieces need no
+            // labels of their own (their faces' are known): a cell tries
+            // to be easy with only the other faces clipped. Their pieces
+            // are the nodes of `label_easy`; an untouched face stands
+            // there by its grid corners in the cell, with its label.
+            let mut tried = None;
+            if allow_easy {
+                let (pa, ia) = clip_all(&leaf.a, |f| self.face(f), &bx, &w, &touched_a);
+                let (pb, ib) = clip_all(&leaf.b, |f| other.face(f), &bx, &w, &touched_b);
+                let (isa, isb) = local::isolated(&pa, &pb);
+                if isa.iter().chain(&isb).all(|&x| x) {
+                    let (ma, mb) = (masks(&pa, &isa, &ia), masks(&pb, &isb, &ib));
+                    let la = Listed::new(&leaf.a, |f| self.face(f), &pa, &ia, touched_a, &bx);
+                    let lb = Listed::new(&leaf.b, |f| other.face(f), &pb, &ib, touched_b, &bx);
+                    return Ok(First::Easy((ma, la), (mb, lb)));
+                }
+                tried = Some(((pa, ia), (pb, ib)));
             }
+            // every face's piece (those clipped already reused)
+            let (pa, ia, pb, ib) = match tried {
+                Some(((pa, ia), (pb, ib))) => {
+                    let (pa, ia) =
+                        clip_rest(&leaf.a, |f| self.face(f), &bx, &w, &touched_a, pa, &ia);
+                    let (pb, ib) =
+                        clip_rest(&leaf.b, |f| other.face(f), &bx, &w, &touched_b, pb, &ib);
+                    (pa, ia, pb, ib)
+                }
+                None => {
+                    let (pa, ia) = clip_all(&leaf.a, |f| self.face(f), &bx, &w, &|_| true);
+                    let (pb, ib) = clip_all(&leaf.b, |f| other.face(f), &bx, &w, &|_| true);
+                    (pa, ia, pb, ib)
+                }
+            };
+            let (isa, isb) = local::isolated(&pa, &pb);
+            let (ma, mb) = (masks(&pa, &isa, &ia), masks(&pb, &isb, &ib));
             let r = bx.0.map(|c| c as i32);
             let c = local::boolean_pieces(
                 &bx,
@@ -912,6 +939,43 @@ impl Solid {
                 _ => None,
             }
         }
+        // the untouched faces' labels
+        let (untouched_la, untouched_lb) = rayon::join(
+            || {
+                label_untouched(
+                    &pieces_a,
+                    &untouched_a,
+                    |f| self.face(f),
+                    &leaves,
+                    &label_of(&fates_a, keep_a(true)),
+                    &|l| inside_b.inside(l),
+                    &|g| other.winding(g) != 0,
+                )
+            },
+            || {
+                label_untouched(
+                    &pieces_b,
+                    &untouched_b,
+                    |f| other.face(f),
+                    &leaves,
+                    &label_of(&fates_b, keep_b(true)),
+                    &|l| inside_a.inside(l),
+                    &|g| self.winding(g) != 0,
+                )
+            },
+        );
+        let (untouched_la, untouched_lb) = (untouched_la?, untouched_lb?);
+        // (from the cells that built their trees, free cells, each other
+        // and winding numbers; by face id for `label_easy`)
+        let by_id = |pieces: &[(u32, Vec<Piece>)], labels: &[Option<bool>], n: usize| {
+            let mut v: Vec<Option<bool>> = vec![None; n];
+            for ((f, _), x) in pieces.iter().zip(labels) {
+                v[*f as usize] = *x;
+            }
+            v
+        };
+        let face_la = by_id(&pieces_a, &untouched_la, self.faces.len());
+        let face_lb = by_id(&pieces_b, &untouched_lb, other.faces.len());
         let (labels_a, labels_b) = rayon::join(
             || {
                 label_easy(
@@ -922,6 +986,7 @@ impl Solid {
                     &masks_a,
                     &listed_a,
                     &label_of(&fates_a, keep_a(true)),
+                    &|f| face_la[f as usize],
                     &|l| inside_b.inside(l),
                     &|g| other.winding(g) != 0,
                 )
@@ -935,6 +1000,7 @@ impl Solid {
                     &masks_b,
                     &listed_b,
                     &label_of(&fates_b, keep_b(true)),
+                    &|f| face_lb[f as usize],
                     &|l| inside_a.inside(l),
                     &|g| self.winding(g) != 0,
                 )
@@ -985,32 +1051,6 @@ impl Solid {
             }
         }
 
-        // the untouched faces' labels
-        let (untouched_la, untouched_lb) = rayon::join(
-            || {
-                label_untouched(
-                    &pieces_a,
-                    &untouched_a,
-                    |f| self.face(f),
-                    &leaves,
-                    &label_of(&fates_a, keep_a(true)),
-                    &|l| inside_b.inside(l),
-                    &|g| other.winding(g) != 0,
-                )
-            },
-            || {
-                label_untouched(
-                    &pieces_b,
-                    &untouched_b,
-                    |f| other.face(f),
-                    &leaves,
-                    &label_of(&fates_b, keep_b(true)),
-                    &|l| inside_a.inside(l),
-                    &|g| self.winding(g) != 0,
-                )
-            },
-        );
-        let (untouched_la, untouched_lb) = (untouched_la?, untouched_lb?);
         // the changes, now that everything is known
         // (decided in parallel, applied in order)
         let mut remove: Vec<u32> = whole_a
@@ -1286,7 +1326,8 @@ enum PieceFate {
 /// A mixed cell's first run: done, or easy (every piece isolated, the
 /// labels to come from the cells around); either way with, per listed
 /// face of each operand, the walls an isolated piece crosses
-/// ([`local::wall_edges`]).
+/// ([`local::wall_edges`]; `None` for an untouched face in an easy cell,
+/// which is not clipped).
 enum First {
     Done(Made, Vec<Option<u8>>, Vec<Option<u8>>),
     Easy((Vec<Option<u8>>, Listed), (Vec<Option<u8>>, Listed)),
@@ -1338,11 +1379,15 @@ fn clip_all<'p>(
     face: impl Fn(u32) -> &'p Face,
     cell: &IBox,
     w: &[bsp_core::Plane; 6],
+    which: &dyn Fn(u32) -> bool,
 ) -> (Vec<Polygon>, Vec<Option<u32>>) {
     let mut pieces = Vec::with_capacity(fs.len());
     let index = fs
         .iter()
         .map(|&f| {
+            if !which(f) {
+                return None;
+            }
             let face = face(f);
             local::clip_face(face, cell, w).map(|q| {
                 pieces.push(q);
@@ -1351,6 +1396,38 @@ fn clip_all<'p>(
         })
         .collect();
     (pieces, index)
+}
+
+/// [`clip_all`] of every face, given `pieces` and `index` from
+/// [`clip_all`] of the faces `done` accepts: those are taken over, the
+/// others clipped now (the same pieces, in the same order).
+fn clip_rest<'p>(
+    fs: &[u32],
+    face: impl Fn(u32) -> &'p Face,
+    cell: &IBox,
+    w: &[bsp_core::Plane; 6],
+    done: &dyn Fn(u32) -> bool,
+    pieces: Vec<Polygon>,
+    index: &[Option<u32>],
+) -> (Vec<Polygon>, Vec<Option<u32>>) {
+    let mut got: Vec<Option<Polygon>> = pieces.into_iter().map(Some).collect();
+    let mut out = Vec::with_capacity(fs.len());
+    let index = fs
+        .iter()
+        .zip(index)
+        .map(|(&f, i)| {
+            let piece = if done(f) {
+                i.and_then(|i| got[i as usize].take())
+            } else {
+                local::clip_face(face(f), cell, w)
+            };
+            piece.map(|q| {
+                out.push(q);
+                (out.len() - 1) as u32
+            })
+        })
+        .collect();
+    (out, index)
 }
 
 /// Sorts `faces` (their leaves `leaves_of`, by place) into those in free
@@ -1555,7 +1632,18 @@ struct Listed {
 }
 
 impl Listed {
-    fn new(pieces: &[Polygon], index: &[Option<u32>]) -> Listed {
+    /// From the grid vertices of each listed face's piece in the cell:
+    /// its clipped piece's (`index` into `pieces`), or for a face not
+    /// clipped, its grid corners in the cell's box `bx` (the same points:
+    /// the walls hold no grid point).
+    fn new<'p>(
+        fs: &[u32],
+        face: impl Fn(u32) -> &'p Face,
+        pieces: &[Polygon],
+        index: &[Option<u32>],
+        clipped: impl Fn(u32) -> bool,
+        bx: &IBox,
+    ) -> Listed {
         let grid_of = |p: &Polygon| -> SmallVec<[GridPoint; 4]> {
             p.vertices()
                 .iter()
@@ -1565,9 +1653,21 @@ impl Listed {
                 })
                 .collect()
         };
-        let verts: Vec<SmallVec<[GridPoint; 4]>> = index
+        let within =
+            |g: &GridPoint| (0..3).all(|k| bx.0[k] <= g[k] as i64 && g[k] as i64 <= bx.1[k]);
+        let verts: Vec<SmallVec<[GridPoint; 4]>> = fs
             .iter()
-            .map(|i| i.map_or_else(SmallVec::new, |i| grid_of(&pieces[i as usize])))
+            .zip(index)
+            .map(|(&f, i)| {
+                if clipped(f) {
+                    return i.map_or_else(SmallVec::new, |i| grid_of(&pieces[i as usize]));
+                }
+                let face = face(f);
+                (0..face.corner_count())
+                    .filter_map(|k| face.corner(k).as_grid())
+                    .filter(within)
+                    .collect()
+            })
             .collect();
         let mut touch = Vec::new();
         for i in 0..verts.len() {
@@ -1606,8 +1706,10 @@ impl Listed {
 ///
 /// Known labels: a face's piece in a free cell (its region's winding
 /// number), an isolated piece of a cell that built its partitions
-/// (`known`), and, for a group no known label reaches, the winding number
-/// `inside` of a grid vertex of one of its pieces.
+/// (`known`), a piece of a face labelled as a whole (`face_label`: an
+/// untouched face, which an easy cell does not clip), and, for a group no
+/// known label reaches, the winding number `inside` of a grid vertex of
+/// one of its pieces.
 #[allow(clippy::too_many_arguments)]
 fn label_easy<'p>(
     side_a: bool,
@@ -1617,6 +1719,7 @@ fn label_easy<'p>(
     masks: &FxHashMap<u32, Vec<Option<u8>>>,
     listed: &FxHashMap<u32, Listed>,
     known: &(dyn Fn(u32, u32) -> Option<bool> + Sync),
+    face_label: &(dyn Fn(u32) -> Option<bool> + Sync),
     free_inside: &(dyn Fn(u32) -> bool + Sync),
     inside: &(dyn Fn(GridPoint) -> bool + Sync),
 ) -> Result<FxHashMap<u32, Vec<Option<bool>>>, CsgError> {
@@ -1714,6 +1817,13 @@ fn label_easy<'p>(
     for &l in &cells {
         let b = base[&l];
         joins.extend(listed[&l].touch.iter().map(|&(i, j)| (b + i, b + j)));
+        // a face whose label is known as a whole (untouched)
+        joins.extend(
+            list(l)
+                .iter()
+                .enumerate()
+                .filter_map(|(i, &f)| face_label(f).map(|x| (b + i as u32, u32::from(x)))),
+        );
     }
     let mut parent: Vec<u32> = (0..n).collect();
     fn find(p: &mut [u32], mut x: u32) -> u32 {
