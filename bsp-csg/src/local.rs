@@ -338,7 +338,26 @@ impl At {
 /// one side. The mesh puts into its edges the vertices its neighbours
 /// have there.
 fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate {
-    use std::borrow::Cow;
+    /// A part: the piece itself (borrowed: most go down whole), or a
+    /// part cut from it (boxed, so that the records stay small).
+    enum Cow<'p> {
+        Borrowed(&'p Polygon),
+        Owned(Box<Polygon>),
+    }
+    impl Cow<'_> {
+        fn get(&self) -> &Polygon {
+            match self {
+                Cow::Borrowed(p) => p,
+                Cow::Owned(p) => p,
+            }
+        }
+        fn into_owned(self) -> Polygon {
+            match self {
+                Cow::Borrowed(p) => p.clone(),
+                Cow::Owned(p) => *p,
+            }
+        }
+    }
     #[derive(Clone, Copy, PartialEq)]
     enum State {
         Kept,
@@ -348,16 +367,18 @@ fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate 
     /// A part met on the way down: a fragment in a leaf, or a part that a
     /// node's plane splits, with its two pieces' records.
     struct Rec<'p> {
-        poly: Option<Cow<'p, Polygon>>,
+        poly: Option<Cow<'p>>,
         pieces: Option<[u32; 2]>,
         state: State,
     }
     /// A part on its way down: where it goes, and its parent's record
     /// and side.
     /// (The piece itself is only borrowed: most go down whole.)
-    type Going<'p> = (Cow<'p, Polygon>, At, Option<(u32, usize)>);
-    let mut recs: Vec<Rec<'_>> = Vec::new();
-    let mut stack: Vec<Going<'_>> = vec![(Cow::Borrowed(piece), other.at_root(), None)];
+    type Going<'p> = (Cow<'p>, At, Option<(u32, usize)>);
+    // (small records in place: most pieces make one, and no allocation)
+    let mut recs: smallvec::SmallVec<[Rec<'_>; 8]> = smallvec::SmallVec::new();
+    let mut stack: smallvec::SmallVec<[Going<'_>; 8]> =
+        smallvec::smallvec![(Cow::Borrowed(piece), other.at_root(), None)];
     while let Some((p, mut at, parent)) = stack.pop() {
         let me = recs.len() as u32;
         if let Some((r, k)) = parent {
@@ -376,7 +397,7 @@ fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate 
                 }
                 At::Node(i) => {
                     let (plane, front, back) = other.node(i);
-                    match p.parts(plane) {
+                    match p.get().parts(plane) {
                         Parts::Whole(PolygonSide::Back) => at = back,
                         Parts::Whole(_) => at = front,
                         Parts::Split { front: f, back: b } => {
@@ -385,8 +406,8 @@ fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate 
                                 pieces: Some([u32::MAX; 2]),
                                 state: State::Mixed,
                             });
-                            stack.push((Cow::Owned(b), back, Some((me, 1))));
-                            stack.push((Cow::Owned(f), front, Some((me, 0))));
+                            stack.push((Cow::Owned(Box::new(b)), back, Some((me, 1))));
+                            stack.push((Cow::Owned(Box::new(f)), front, Some((me, 0))));
                             break;
                         }
                     }
@@ -405,7 +426,8 @@ fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate 
         State::Kept => Fate::Keep,
         State::Dropped => Fate::Drop,
         State::Mixed => {
-            let mut kept = Vec::new();
+            // (room for every leaf record at once: a polygon is large)
+            let mut kept = Vec::with_capacity(recs.len().div_ceil(2));
             let mut todo = vec![0u32];
             while let Some(j) = todo.pop() {
                 let r = &mut recs[j as usize];
