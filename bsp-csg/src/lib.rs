@@ -23,7 +23,10 @@
 //!    near without meeting (each piece strictly on one side of the other
 //!    surface's pieces' planes, or they of its) builds nothing: its pieces
 //!    take their labels along their faces from the cells around
-//!    ([`Options::easy_cells`]).
+//!    ([`Options::easy_cells`]). A face apart from every face of the other
+//!    surface in every mixed cell listing both meets that surface nowhere:
+//!    it is kept or dropped whole by one label, without being clipped, and
+//!    a cell holding only such faces does nothing ([`Stats::clean_cells`]).
 //! 4. Every other face lies in cells the other surface does not enter: it
 //!    is wholly inside or outside the other solid. Those cells form
 //!    connected regions of space free of the other surface (adjacent cells
