@@ -1187,6 +1187,10 @@ impl Solid {
             }
         }
         self.remove_all(&remove);
+        // the octree and its lists go on the pool (freeing them here, as
+        // the function returns, held up carrying the plan out)
+        drop_aside((leaves, a_leaves, b_leaves, adjacent, a_c, b_c));
+        drop_aside((inside_a, inside_b, masks_a, masks_b, remove));
         Ok((stats, Plan { add, flip: flip_b }))
     }
 
