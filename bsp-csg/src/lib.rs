@@ -1832,27 +1832,14 @@ fn label_easy<'p>(
                 .filter_map(|(i, &f)| face_label(f).map(|x| (b + i as u32, u32::from(x)))),
         );
     }
-    let mut parent: Vec<u32> = (0..n).collect();
-    fn find(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            p[x as usize] = p[p[x as usize] as usize];
-            x = p[x as usize];
-        }
-        x
-    }
-    fn join(p: &mut [u32], a: u32, b: u32) {
-        let (ra, rb) = (find(p, a), find(p, b));
-        if ra != rb {
-            // the labels 0 and 1 stay roots
-            p[ra.max(rb) as usize] = ra.min(rb);
-        }
-    }
+    let mut groups = UnionFind::new(n as usize);
     for (a, b) in joins {
-        join(&mut parent, a, b);
+        groups.join(a, b);
     }
-    let disagree = || CsgError::Internal("an easy cell's pieces got both labels".into());
-    if find(&mut parent, 1) == 0 {
-        return Err(disagree());
+    if groups.find(1) == 0 {
+        return Err(CsgError::Internal(
+            "an easy cell's pieces got both labels".into(),
+        ));
     }
     // groups no known label reached: the winding number at a grid vertex
     let mut asked: FxHashMap<u32, GridPoint> = FxHashMap::default();
@@ -1860,7 +1847,7 @@ fn label_easy<'p>(
         let b = base[&l];
         for (i, g) in listed[&l].grid.iter().enumerate() {
             if let Some(g) = g {
-                let r = find(&mut parent, b + i as u32);
+                let r = groups.find(b + i as u32);
                 if r >= 2 {
                     asked.entry(r).or_insert(*g);
                 }
@@ -1869,19 +1856,12 @@ fn label_easy<'p>(
     }
     let mut asked: Vec<(u32, GridPoint)> = asked.into_iter().collect();
     asked.sort_unstable();
-    let answers: Vec<(u32, bool)> = asked.par_iter().map(|&(r, g)| (r, inside(g))).collect();
-    for (r, x) in answers {
-        join(&mut parent, r, x as u32);
-    }
+    groups.answer(&asked, inside);
     let mut out = FxHashMap::default();
     for &l in &cells {
         let b = base[&l];
         let labels = (0..listed[&l].grid.len() as u32)
-            .map(|i| match find(&mut parent, b + i) {
-                0 => Some(false),
-                1 => Some(true),
-                _ => None,
-            })
+            .map(|i| groups.label(b + i))
             .collect();
         out.insert(l, labels);
     }
@@ -2011,64 +1991,96 @@ fn label_untouched<'p>(
     if own.iter().all(|x| !matches!(x, Some(None))) {
         return Ok(own.into_iter().map(Option::flatten).collect());
     }
-    // nodes: 0 and 1 stand for the labels outside and inside, then the
-    // faces by place
-    let mut parent: Vec<u32> = (0..pieces.len() as u32 + 2).collect();
-    fn find(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            p[x as usize] = p[p[x as usize] as usize];
-            x = p[x as usize];
-        }
-        x
-    }
-    fn join(p: &mut [u32], a: u32, b: u32) {
-        let (ra, rb) = (find(p, a), find(p, b));
-        if ra != rb {
-            // the labels 0 and 1 stay roots
-            p[ra.max(rb) as usize] = ra.min(rb);
-        }
-    }
+    // nodes: the two labels, then the faces by place
+    let mut groups = UnionFind::new(pieces.len() + 2);
     let mut first: FxHashMap<GridPoint, u32> = FxHashMap::default();
     for (i, x) in own.iter().enumerate() {
         let Some(label) = x else { continue };
         let node = i as u32 + 2;
         if let Some(inside) = label {
-            join(&mut parent, node, u32::from(*inside));
+            groups.join(node, u32::from(*inside));
         }
         for g in corners(pieces[i].0) {
             let at = *first.entry(g).or_insert(node);
-            join(&mut parent, node, at);
+            groups.join(node, at);
         }
     }
-    let disagree = || CsgError::Internal("an untouched face got both labels".into());
-    if find(&mut parent, 1) == 0 {
-        return Err(disagree());
+    if groups.find(1) == 0 {
+        return Err(CsgError::Internal(
+            "an untouched face got both labels".into(),
+        ));
     }
     // groups no label reached: the winding number at a grid corner
     let mut asked: Vec<(u32, GridPoint)> = Vec::new();
     let mut seen: rustc_hash::FxHashSet<u32> = Default::default();
     for (i, x) in own.iter().enumerate() {
         if x.is_some() {
-            let r = find(&mut parent, i as u32 + 2);
+            let r = groups.find(i as u32 + 2);
             if r >= 2 && seen.insert(r) {
                 asked.push((r, corners(pieces[i].0)[0]));
             }
         }
     }
-    let answers: Vec<(u32, bool)> = asked.par_iter().map(|&(r, g)| (r, inside(g))).collect();
-    for (r, x) in answers {
-        join(&mut parent, r, u32::from(x));
-    }
+    groups.answer(&asked, inside);
     (0..pieces.len())
         .map(|i| match own[i] {
             None => Ok(None),
-            Some(_) => match find(&mut parent, i as u32 + 2) {
-                0 => Ok(Some(false)),
-                1 => Ok(Some(true)),
-                _ => Err(CsgError::Internal("an untouched face got no label".into())),
-            },
+            Some(_) => groups
+                .label(i as u32 + 2)
+                .map(Some)
+                .ok_or_else(|| CsgError::Internal("an untouched face got no label".into())),
         })
         .collect()
+}
+
+/// Groups of nodes `0..n` by union and find; a group's root is its
+/// smallest node, so where nodes 0 and 1 stand for the labels outside and
+/// inside, they stay roots and name their groups' label.
+struct UnionFind {
+    parent: Vec<u32>,
+}
+
+impl UnionFind {
+    fn new(n: usize) -> UnionFind {
+        UnionFind {
+            parent: (0..n as u32).collect(),
+        }
+    }
+
+    fn find(&mut self, mut x: u32) -> u32 {
+        let p = &mut self.parent;
+        while p[x as usize] != x {
+            p[x as usize] = p[p[x as usize] as usize];
+            x = p[x as usize];
+        }
+        x
+    }
+
+    fn join(&mut self, a: u32, b: u32) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            self.parent[ra.max(rb) as usize] = ra.min(rb);
+        }
+    }
+
+    /// Joins each group `(root, g)` of `asked` to the label `inside(g)`
+    /// (asked in parallel).
+    fn answer(&mut self, asked: &[(u32, GridPoint)], inside: &(dyn Fn(GridPoint) -> bool + Sync)) {
+        let answers: Vec<(u32, bool)> = asked.par_iter().map(|&(r, g)| (r, inside(g))).collect();
+        for (r, x) in answers {
+            self.join(r, u32::from(x));
+        }
+    }
+
+    /// The label of node `x`'s group: `Some(inside)`, or `None` if no
+    /// label reached it.
+    fn label(&mut self, x: u32) -> Option<bool> {
+        match self.find(x) {
+            0 => Some(false),
+            1 => Some(true),
+            _ => None,
+        }
+    }
 }
 
 /// Connected regions of octree cells free of one surface, each wholly
@@ -2086,23 +2098,13 @@ impl Regions {
         solid: &Solid,
     ) -> Regions {
         let n = leaves.len();
-        let mut parent: Vec<u32> = (0..n as u32).collect();
-        fn find(p: &mut [u32], mut x: u32) -> u32 {
-            while p[x as usize] != x {
-                p[x as usize] = p[p[x as usize] as usize];
-                x = p[x as usize];
-            }
-            x
-        }
+        let mut groups = UnionFind::new(n);
         for &(a, b) in adjacent {
             if free(&leaves[a as usize]) && free(&leaves[b as usize]) {
-                let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-                if ra != rb {
-                    parent[ra.max(rb) as usize] = ra.min(rb);
-                }
+                groups.join(a, b);
             }
         }
-        let root: Vec<u32> = (0..n as u32).map(|x| find(&mut parent, x)).collect();
+        let root: Vec<u32> = (0..n as u32).map(|x| groups.find(x)).collect();
         // one winding number per region that holds faces to label
         let mut wanted: Vec<u32> = (0..n)
             .filter(|&l| free(&leaves[l]) && !(leaves[l].a.is_empty() && leaves[l].b.is_empty()))

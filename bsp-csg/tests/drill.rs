@@ -8,9 +8,9 @@
 //! cell across the other surface. With exact cell lists the wrong label
 //! left holes (the 2 000-triangle part minus 20 tools, from step 2 on).
 
-use bsp_core::BoolOp;
+use bsp_core::{BoolOp, TriMesh};
 use bsp_csg::shapes::{drill_tools, uv_sphere};
-use bsp_csg::{MeshIn, Options, Snapped, snap};
+use bsp_csg::{MeshIn, Options, Snapped, Solid, Stats, snap};
 
 fn drill(tools: usize, opts: &Options) -> (f64, usize) {
     let (pv, pf) = uv_sphere(2000);
@@ -100,6 +100,16 @@ fn new_vertices_are_shared_and_into_mesh_is_to_mesh() {
     owned.check_watertight().unwrap();
 }
 
+/// `solids[0] op solids[1]` with `opts`: the result's mesh, checked
+/// watertight, and the operation's stats.
+fn apply_watertight(solids: &[Solid], op: BoolOp, opts: &Options) -> (TriMesh, Stats) {
+    let mut s = solids[0].clone();
+    let stats = s.apply_with(&solids[1], op, opts).unwrap();
+    let mesh = s.to_mesh();
+    mesh.check_watertight().unwrap();
+    (mesh, stats)
+}
+
 /// A box whose large faces run through many cells along the sphere: each
 /// of them has pieces in easy cells, labelled from the cells around.
 #[test]
@@ -114,13 +124,7 @@ fn a_box_through_a_sphere_with_and_without_easy_cells() {
     let meshes = [MeshIn::new(&sv, &sf), MeshIn::new(&bv, &bf)];
     let Snapped { solids, .. } = snap(&meshes).unwrap();
     for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
-        let run = |opts: &Options| {
-            let mut s = solids[0].clone();
-            let stats = s.apply_with(&solids[1], op, opts).unwrap();
-            let mesh = s.to_mesh();
-            mesh.check_watertight().unwrap();
-            (mesh, stats)
-        };
+        let run = |opts: &Options| apply_watertight(&solids, op, opts);
         let (easy, stats) = run(&Options::default().with_leaf_size(8));
         assert!(stats.easy_cells > 0, "{op:?}: {stats:?}");
         let (full, _) = run(&Options::default().with_leaf_size(8).with_easy_cells(false));
@@ -141,13 +145,7 @@ fn clean_cells_keep_faces_whole_as_local_trees_would() {
     let Snapped { solids, .. } = snap(&meshes).unwrap();
     for leaf in [8, bsp_csg::LEAF_SIZE] {
         for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
-            let run = |opts: &Options| {
-                let mut s = solids[0].clone();
-                let stats = s.apply_with(&solids[1], op, opts).unwrap();
-                let mesh = s.to_mesh();
-                mesh.check_watertight().unwrap();
-                (mesh, stats)
-            };
+            let run = |opts: &Options| apply_watertight(&solids, op, opts);
             let (clean, stats) = run(&Options::default().with_leaf_size(leaf));
             assert!(stats.clean_cells > 0, "{op:?}: {stats:?}");
             let (full, full_stats) = run(&Options::default()
