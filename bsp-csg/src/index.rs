@@ -41,6 +41,11 @@ pub(crate) fn polygon_box(p: &impl ConvexFace) -> IBox {
     (lo, hi)
 }
 
+/// Whether the box holds the grid point.
+pub(crate) fn holds(b: &IBox, g: &bsp_core::GridPoint) -> bool {
+    (0..3).all(|k| b.0[k] <= g[k] as i64 && g[k] as i64 <= b.1[k])
+}
+
 pub(crate) fn overlaps(a: &IBox, b: &IBox) -> bool {
     (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
 }

@@ -99,7 +99,7 @@ use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 use std::borrow::Cow;
 
-use crate::index::{FaceIndex, IBox, intersect, overlaps, polygon_box, union};
+use crate::index::{FaceIndex, IBox, holds, intersect, overlaps, polygon_box, union};
 use crate::local::{CellResult, Fate};
 use crate::octree::{Leaf, walls};
 
@@ -805,12 +805,14 @@ impl Solid {
         // mixed cell all of whose faces are such ("clean") does nothing.
         // (without easy cells every mixed cell builds its trees, and the
         // untouched faces take their labels from them: the same result)
-        let (touched_a, touched_b, mut clean) = touched(&mixed, &leaves, self, other);
+        let (meets_a, meets_b, mut clean) = touched(&mixed, &leaves, self, other);
         if !opts.easy_cells {
             clean.iter_mut().for_each(|c| *c = false);
         }
-        let untouched_a = |f: u32| touched_a.get(f as usize) == Some(&false);
-        let untouched_b = |f: u32| touched_b.get(f as usize) == Some(&false);
+        let touched_a = |f: u32| meets_a.get(f as usize) != Some(&false);
+        let touched_b = |f: u32| meets_b.get(f as usize) != Some(&false);
+        let untouched_a = |f: u32| !touched_a(f);
+        let untouched_b = |f: u32| !touched_b(f);
         // Each cell clips its faces to its walls itself, so that only the
         // cells at work hold their pieces, and finds the pieces that meet
         // no piece of the other surface (isolated). A cell whose pieces are
@@ -830,8 +832,6 @@ impl Solid {
                     })
                     .collect::<Vec<Option<u8>>>()
             };
-            let touched_a = |f: u32| !untouched_a(f);
-            let touched_b = |f: u32| !untouched_b(f);
             // Untouched faces are isolated, and their pieces need no
             // labels of their own (their faces' are known): a cell tries
             // to be easy with only the other faces clipped. Their pieces
@@ -947,6 +947,7 @@ impl Solid {
             || {
                 label_untouched(
                     &pieces_a,
+                    self.faces.len(),
                     &untouched_a,
                     |f| self.face(f),
                     &leaves,
@@ -958,6 +959,7 @@ impl Solid {
             || {
                 label_untouched(
                     &pieces_b,
+                    other.faces.len(),
                     &untouched_b,
                     |f| other.face(f),
                     &leaves,
@@ -967,18 +969,9 @@ impl Solid {
                 )
             },
         );
-        let (untouched_la, untouched_lb) = (untouched_la?, untouched_lb?);
         // (from the cells that built their trees, free cells, each other
-        // and winding numbers; by face id for `label_easy`)
-        let by_id = |pieces: &[(u32, Vec<Piece>)], labels: &[Option<bool>], n: usize| {
-            let mut v: Vec<Option<bool>> = vec![None; n];
-            for ((f, _), x) in pieces.iter().zip(labels) {
-                v[*f as usize] = *x;
-            }
-            v
-        };
-        let face_la = by_id(&pieces_a, &untouched_la, self.faces.len());
-        let face_lb = by_id(&pieces_b, &untouched_lb, other.faces.len());
+        // and winding numbers; by face id)
+        let (face_la, face_lb) = (untouched_la?, untouched_lb?);
         let (labels_a, labels_b) = rayon::join(
             || {
                 label_easy(
@@ -1078,10 +1071,9 @@ impl Solid {
          -> Result<Settled, CsgError> {
             pieces
                 .par_iter()
-                .zip(labels)
-                .map(|((f, pieces), label)| {
-                    if let Some(inside) = label {
-                        return Ok((*f, (!keep(*inside)).then(Vec::new)));
+                .map(|(f, pieces)| {
+                    if let Some(inside) = labels[*f as usize] {
+                        return Ok((*f, (!keep(inside)).then(Vec::new)));
                     }
                     if pieces
                         .iter()
@@ -1106,7 +1098,7 @@ impl Solid {
         // the two operands' faces at once (each in parallel, but each
         // with sequential tails)
         let (settled_a, (kept_b, settled_b)) = rayon::join(
-            || settle_all(&pieces_a, self, &keep_a, &inside_b, &fates_a, &untouched_la),
+            || settle_all(&pieces_a, self, &keep_a, &inside_b, &fates_a, &face_la),
             || {
                 rayon::join(
                     // the other solid's faces kept whole are listed, to be
@@ -1126,16 +1118,7 @@ impl Solid {
                             .map(|&i| b_c[i as usize])
                             .collect()
                     },
-                    || {
-                        settle_all(
-                            &pieces_b,
-                            other,
-                            &keep_b,
-                            &inside_a,
-                            &fates_b,
-                            &untouched_lb,
-                        )
-                    },
+                    || settle_all(&pieces_b, other, &keep_b, &inside_a, &fates_b, &face_lb),
                 )
             },
         );
@@ -1490,13 +1473,9 @@ fn sort_faces<'l>(
 /// side of the other surface; `None` if it meets none (it lies beyond the
 /// octree's box, so beyond the other solid).
 fn meeting_leaf(face: &Face, ls: &[u32], leaves: &[Leaf]) -> Option<u32> {
-    let holds = |l: u32, g: GridPoint| {
-        let (lo, hi) = leaves[l as usize].bx;
-        (0..3).all(|k| lo[k] <= g[k] as i64 && g[k] as i64 <= hi[k])
-    };
     for i in 0..face.corner_count() {
         if let Some(g) = face.corner(i).as_grid()
-            && let Some(&l) = ls.iter().find(|&&l| holds(l, g))
+            && let Some(&l) = ls.iter().find(|&&l| holds(&leaves[l as usize].bx, &g))
         {
             return Some(l);
         }
@@ -1660,8 +1639,6 @@ impl Listed {
                 })
                 .collect()
         };
-        let within =
-            |g: &GridPoint| (0..3).all(|k| bx.0[k] <= g[k] as i64 && g[k] as i64 <= bx.1[k]);
         let verts: Vec<SmallVec<[GridPoint; 4]>> = fs
             .iter()
             .zip(index)
@@ -1672,7 +1649,7 @@ impl Listed {
                 let face = face(f);
                 (0..face.corner_count())
                     .filter_map(|k| face.corner(k).as_grid())
-                    .filter(within)
+                    .filter(|g| holds(bx, g))
                     .collect()
             })
             .collect();
@@ -1941,8 +1918,8 @@ fn touched(
 }
 
 /// The labels (inside the other solid or not) of the untouched faces
-/// among `pieces` (by place; `None` for the others), each one label for
-/// the whole face, which meets the other surface nowhere:
+/// among `pieces`, by face id (`n` ids; `None` for the others), each one
+/// label for the whole face, which meets the other surface nowhere:
 ///
 /// - a grid corner of it in a free cell of its own: that cell's region's
 ///   label;
@@ -1954,6 +1931,7 @@ fn touched(
 #[allow(clippy::too_many_arguments)]
 fn label_untouched<'p>(
     pieces: &[(u32, Vec<Piece>)],
+    n: usize,
     untouched: &(dyn Fn(u32) -> bool + Sync),
     face: impl Fn(u32) -> &'p Face + Sync,
     leaves: &[Leaf],
@@ -1975,21 +1953,24 @@ fn label_untouched<'p>(
                 return None;
             }
             let cs = corners(*f);
-            let holds = |l: u32| {
-                let (lo, hi) = leaves[l as usize].bx;
-                cs.iter()
-                    .any(|g| (0..3).all(|k| lo[k] <= g[k] as i64 && g[k] as i64 <= hi[k]))
-            };
+            let corner_in = |l: u32| cs.iter().any(|g| holds(&leaves[l as usize].bx, g));
             let label = ps.iter().find_map(|p| match *p {
-                Piece::Free(Some(l)) if holds(l) => Some(free_inside(l)),
+                Piece::Free(Some(l)) if corner_in(l) => Some(free_inside(l)),
                 Piece::Mixed(l, i) => known(l, i),
                 _ => None,
             });
             Some(label)
         })
         .collect();
+    let by_id = |label: &dyn Fn(usize) -> Result<Option<bool>, CsgError>| {
+        let mut out: Vec<Option<bool>> = vec![None; n];
+        for (i, (f, _)) in pieces.iter().enumerate() {
+            out[*f as usize] = label(i)?;
+        }
+        Ok(out)
+    };
     if own.iter().all(|x| !matches!(x, Some(None))) {
-        return Ok(own.into_iter().map(Option::flatten).collect());
+        return by_id(&|i| Ok(own[i].flatten()));
     }
     // nodes: the two labels, then the faces by place
     let mut groups = UnionFind::new(pieces.len() + 2);
@@ -2022,15 +2003,15 @@ fn label_untouched<'p>(
         }
     }
     groups.answer(&asked, inside);
-    (0..pieces.len())
-        .map(|i| match own[i] {
-            None => Ok(None),
-            Some(_) => groups
-                .label(i as u32 + 2)
-                .map(Some)
-                .ok_or_else(|| CsgError::Internal("an untouched face got no label".into())),
-        })
-        .collect()
+    let labels: Vec<Option<bool>> = (0..pieces.len())
+        .map(|i| groups.label(i as u32 + 2))
+        .collect();
+    by_id(&|i| match own[i] {
+        None => Ok(None),
+        Some(_) => labels[i]
+            .map(Some)
+            .ok_or_else(|| CsgError::Internal("an untouched face got no label".into())),
+    })
 }
 
 /// Groups of nodes `0..n` by union and find; a group's root is its
