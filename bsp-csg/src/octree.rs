@@ -325,6 +325,16 @@ const STALL_SHARE: usize = 3;
 /// two others. The leaves tile space without overlap, so for each wall
 /// coordinate a sweep finds the pairs in `O(n log n)` plus their number.
 pub(crate) fn adjacent(leaves: &[Leaf]) -> Vec<(u32, u32)> {
+    // the boxes side by side (a leaf is large), read at random below
+    let boxes: Vec<IBox> = leaves.iter().map(|l| l.bx).collect();
+    // (coordinate, a small field, leaf) packed in one integer that sorts
+    // as the tuple would (the coordinate's sign bit flipped)
+    let key = |c: i64, small: u64, i: usize| -> u128 {
+        (((c as u64) ^ (1 << 63)) as u128) << 64 | (small << 32 | i as u64) as u128
+    };
+    let coordinate = |key: u128| (key >> 64) as u64;
+    let side = |key: u128| (key >> 32) as u8 & 1;
+    let leaf = |key: u128| key as u32;
     // the three axes in parallel, joined in order
     let per_axis: Vec<Vec<(u32, u32)>> = (0..3usize)
         .into_par_iter()
@@ -332,33 +342,38 @@ pub(crate) fn adjacent(leaves: &[Leaf]) -> Vec<(u32, u32)> {
             let mut out = Vec::new();
             let (u, v) = ((k + 1) % 3, (k + 2) % 3);
             // (wall coordinate, side, leaf): side 0 below the wall, 1 above
-            let mut by_wall: Vec<(i64, u8, u32)> = Vec::with_capacity(2 * leaves.len());
-            for (i, l) in leaves.iter().enumerate() {
-                by_wall.push((l.bx.1[k], 0, i as u32));
-                by_wall.push((l.bx.0[k] - 1, 1, i as u32));
+            let mut by_wall: Vec<u128> = Vec::with_capacity(2 * boxes.len());
+            for (i, b) in boxes.iter().enumerate() {
+                by_wall.push(key(b.1[k], 0, i));
+                by_wall.push(key(b.0[k] - 1, 1, i));
             }
             by_wall.sort_unstable();
-            let mut events: Vec<(i64, u8, u8, u32)> = Vec::new();
-            for group in by_wall.chunk_by(|x, y| x.0 == y.0) {
-                if group.first().map(|g| g.1) == group.last().map(|g| g.1) {
+            // (u coordinate, kind, side, leaf): removals (kind 0) before
+            // insertions (1) at a coordinate
+            let mut events: Vec<u128> = Vec::new();
+            // the leaves of each side the sweep line crosses, by their
+            // lower v: (lower v, upper v, leaf); their v ranges are
+            // disjoint (few at a time: sorted lists)
+            let mut active: [Vec<(i64, i64, u32)>; 2] = [Vec::new(), Vec::new()];
+            for group in by_wall.chunk_by(|x, y| coordinate(*x) == coordinate(*y)) {
+                if side(group[0]) == side(group[group.len() - 1]) {
                     continue; // leaves on one side of this wall only
                 }
-                // sweep along u: removals (0) before insertions (1) at a coordinate
+                // sweep along u
                 events.clear();
-                for &(_, side, i) in group {
-                    let b = &leaves[i as usize].bx;
-                    events.push((b.0[u], 1, side, i));
-                    events.push((b.1[u] + 1, 0, side, i));
+                for &g in group {
+                    let (i, s) = (leaf(g) as usize, side(g) as u64);
+                    let b = &boxes[i];
+                    events.push(key(b.0[u], 2 | s, i));
+                    events.push(key(b.1[u] + 1, s, i));
                 }
                 events.sort_unstable();
-                // the leaves of each side the sweep line crosses, by their lower
-                // v; their v ranges are disjoint (few at a time: sorted lists)
-                let mut active: [Vec<(i64, u32)>; 2] = [Vec::new(), Vec::new()];
-                for &(_, kind, side, i) in &events {
-                    let b = &leaves[i as usize].bx;
-                    let s = side as usize;
+                for &e in &events {
+                    let i = leaf(e);
+                    let b = &boxes[i as usize];
+                    let (s, insert) = (side(e) as usize, (e >> 33) & 1 == 1);
                     let at = active[s].partition_point(|x| x.0 < b.0[v]);
-                    if kind == 0 {
+                    if !insert {
                         active[s].remove(at);
                         continue;
                     }
@@ -367,15 +382,13 @@ pub(crate) fn adjacent(leaves: &[Leaf]) -> Vec<(u32, u32)> {
                     // the last starting below lo (if it reaches lo), then
                     // those starting in [lo, hi]
                     let from = other.partition_point(|x| x.0 < b.0[v]);
-                    let to = other.partition_point(|x| x.0 <= b.1[v]);
-                    let before = from
-                        .checked_sub(1)
-                        .filter(|&p| leaves[other[p].1 as usize].bx.1[v] >= b.0[v]);
+                    let to = from + other[from..].partition_point(|x| x.0 <= b.1[v]);
+                    let before = from.checked_sub(1).filter(|&p| other[p].1 >= b.0[v]);
                     for p in before.into_iter().chain(from..to) {
-                        let j = other[p].1;
+                        let j = other[p].2;
                         out.push(if s == 0 { (i, j) } else { (j, i) });
                     }
-                    active[s].insert(at, (b.0[v], i));
+                    active[s].insert(at, (b.0[v], b.1[v], i));
                 }
             }
             out
