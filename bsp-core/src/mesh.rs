@@ -191,7 +191,22 @@ impl TriMesh {
     /// Takes the polygons or references to them (no copy needed).
     pub fn from_polygons<P: ConvexFace + Sync>(polys: &[P]) -> TriMesh {
         let (vertices, triangles, of) = Self::triangulate(polys);
-        Self::assemble(vertices, triangles, of, |i| *polys[i as usize].support())
+        Self::assemble(vertices, triangles, of, |i| *polys[i as usize].support()).0
+    }
+
+    /// [`TriMesh::from_polygons`], checked with
+    /// [`TriMesh::check_watertight`] (its message on failure). The check
+    /// is made once: a mesh that comes out a closed 2-manifold, as the
+    /// boundary of a solid that does not touch itself does, passed it
+    /// while it was made.
+    pub fn from_polygons_watertight<P: ConvexFace + Sync>(polys: &[P]) -> Result<TriMesh, String> {
+        let (vertices, triangles, of) = Self::triangulate(polys);
+        let (mesh, closed) =
+            Self::assemble(vertices, triangles, of, |i| *polys[i as usize].support());
+        if !closed {
+            mesh.check_watertight()?;
+        }
+        Ok(mesh)
     }
 
     /// [`TriMesh::from_polygons`], letting the polygons go as soon as the
@@ -202,17 +217,19 @@ impl TriMesh {
         // the polygons are dropped in parallel as their planes are taken
         // (the planes take a seventh of the polygons' room)
         let supports: Vec<Plane> = polys.into_par_iter().map(|p| *p.support()).collect();
-        Self::assemble(vertices, triangles, of, |i| supports[i as usize])
+        Self::assemble(vertices, triangles, of, |i| supports[i as usize]).0
     }
 
     /// The mesh from [`TriMesh::triangulate`]'s parts, each triangle's
-    /// plane that of its polygon `i` (`support(i)`), made a 2-manifold.
+    /// plane that of its polygon `i` (`support(i)`), made a 2-manifold;
+    /// and whether it was one already (a closed 2-manifold: watertight,
+    /// [`TriMesh::check_watertight`]).
     fn assemble(
         vertices: Vec<Point>,
         triangles: Vec<[u32; 3]>,
         of: Vec<u32>,
         support: impl Fn(u32) -> Plane + Sync,
-    ) -> TriMesh {
+    ) -> (TriMesh, bool) {
         let planes = of.par_iter().map(|&i| support(i)).collect();
         drop(of);
         let mut mesh = TriMesh {
@@ -220,8 +237,8 @@ impl TriMesh {
             triangles,
             planes,
         };
-        mesh.split_non_manifold();
-        mesh
+        let closed = mesh.split_non_manifold();
+        (mesh, closed)
     }
 
     /// The welded vertices, the triangles, and the polygon each triangle
@@ -333,9 +350,10 @@ impl TriMesh {
     /// (exactly) and each is paired with its neighbour across the solid's
     /// interior; then every vertex gets one copy per fan of triangles
     /// connected through paired edges. The copies are the same exact point.
-    fn split_non_manifold(&mut self) {
+    /// `true` if the mesh was a closed 2-manifold already (nothing done).
+    fn split_non_manifold(&mut self) -> bool {
         if crate::topology::check_closed_manifold(self.triangles.iter().map(|t| &t[..])).is_ok() {
-            return; // the common case
+            return true; // the common case
         }
         let original = self.triangles.clone();
         let n_vertices = self.vertices.len();
@@ -386,6 +404,7 @@ impl TriMesh {
                 break;
             }
         }
+        false
     }
 
     /// One round of [`TriMesh::split_non_manifold`]: pairs the uses of every
@@ -1118,6 +1137,41 @@ mod tests {
                 .any(|v| matches!(v, Point::Implicit(_)))
         );
         owned.check_watertight().unwrap();
+    }
+
+    #[test]
+    fn the_checked_mesh_is_the_mesh_or_the_check_s_message() {
+        let cube = |lo: f64, d: glam::DVec3| -> Vec<Polygon> {
+            crate::shapes::cuboid(glam::DVec3::splat(lo) + d, glam::DVec3::splat(lo + 4.0) + d)
+                .iter()
+                .map(|f| {
+                    let g: Vec<crate::GridPoint> =
+                        f.iter().map(|v| v.to_array().map(|c| c as i32)).collect();
+                    Polygon::from_grid_points(&g, 0).unwrap()
+                })
+                .collect()
+        };
+        let same = |p: &[Polygon]| {
+            let m = TriMesh::from_polygons(p);
+            let c = TriMesh::from_polygons_watertight(p).unwrap();
+            assert_eq!(m.triangles, c.triangles);
+            assert_eq!(m.planes, c.planes);
+            assert_eq!(m.vertices.len(), c.vertices.len());
+        };
+        // closed: passes while it is made
+        let one = cube(0.0, glam::DVec3::ZERO);
+        same(&one);
+        // two cubes sharing an edge: mended, then checked
+        let mut two = one.clone();
+        two.extend(cube(4.0, glam::DVec3::new(0.0, 0.0, -4.0)));
+        let (v, t, of) = TriMesh::triangulate(&two);
+        let (_, closed) = TriMesh::assemble(v, t, of, |i| *two[i as usize].support());
+        assert!(!closed, "the shared edge is used four times");
+        same(&two);
+        // open: the check's own message
+        let open = &one[1..];
+        let e = TriMesh::from_polygons_watertight(open).unwrap_err();
+        assert_eq!(Err(e), TriMesh::from_polygons(open).check_watertight());
     }
 
     #[test]

@@ -107,6 +107,9 @@ use crate::octree::{Leaf, walls};
 /// faces of both operands), by default.
 pub const LEAF_SIZE: usize = 32;
 
+/// Face ids a query near a box handles in parallel.
+const MANY_NEAR: usize = 1 << 15;
+
 /// Faces removed or added at once from which the index is updated in
 /// parallel passes rather than face by face.
 const BULK: usize = 4096;
@@ -511,37 +514,66 @@ impl Solid {
 
     /// The live faces whose box overlaps `b`.
     fn faces_near(&self, b: &IBox) -> Vec<u32> {
-        let meets = |&i: &u32| {
-            self.faces[i as usize]
-                .as_ref()
-                .is_some_and(|f| overlaps(&f.bx(), b))
-        };
-        // many ids (a large box): in parallel; as many as half the slots
-        // (each face is listed in several index cells): a scan of the
-        // slots in order gives them sorted, without repeats, and the ids
-        // are not listed first
-        const MANY: usize = 1 << 15;
-        let listed = self.index.near_count(b);
-        if listed > MANY && listed > self.faces.len() / 2 {
-            return (0..self.faces.len() as u32)
+        match self.near_ids(b) {
+            None => (0..self.faces.len() as u32)
                 .into_par_iter()
-                .filter(meets)
-                .collect();
+                .filter(|&i| self.near_face(i, b).is_some())
+                .collect(),
+            Some(ids) if ids.len() > MANY_NEAR => ids
+                .into_par_iter()
+                .filter(|&i| self.near_face(i, b).is_some())
+                .collect(),
+            Some(mut ids) => {
+                ids.retain(|&i| self.near_face(i, b).is_some());
+                // the ids came with repeats: the lists of a large box are
+                // kept while an operation runs
+                ids.shrink_to_fit();
+                ids
+            }
+        }
+    }
+
+    /// The box spanned by the live faces whose box overlaps `b`.
+    fn near_span(&self, b: &IBox) -> Option<IBox> {
+        let bx = |i: u32| self.near_face(i, b).map(Face::bx);
+        match self.near_ids(b) {
+            None => (0..self.faces.len() as u32)
+                .into_par_iter()
+                .filter_map(bx)
+                .reduce_with(|x, y| union(&x, &y)),
+            Some(ids) => ids
+                .into_par_iter()
+                .filter_map(bx)
+                .reduce_with(|x, y| union(&x, &y)),
+        }
+    }
+
+    /// Face `i` if it is live and its box overlaps `b`.
+    #[inline]
+    fn near_face(&self, i: u32, b: &IBox) -> Option<&Face> {
+        self.faces[i as usize]
+            .as_ref()
+            .filter(|f| overlaps(&f.bx(), b))
+    }
+
+    /// The ids the index lists near `b`, sorted and without repeats;
+    /// `None` where a scan of the slots is cheaper: many ids, as many as
+    /// half the slots (each face is listed in several index cells), which
+    /// a scan in order gives sorted without listing them first.
+    fn near_ids(&self, b: &IBox) -> Option<Vec<u32>> {
+        let listed = self.index.near_count(b);
+        if listed > MANY_NEAR && listed > self.faces.len() / 2 {
+            return None;
         }
         let mut ids = Vec::with_capacity(listed);
         self.index.near(b, &mut ids);
-        if ids.len() > MANY {
+        if ids.len() > MANY_NEAR {
             ids.par_sort_unstable();
-            ids.dedup();
-            return ids.into_par_iter().filter(meets).collect();
+        } else {
+            ids.sort_unstable();
         }
-        ids.sort_unstable();
         ids.dedup();
-        ids.retain(meets);
-        // the ids came with repeats: the lists of a large box are kept
-        // while an operation runs
-        ids.shrink_to_fit();
-        ids
+        Some(ids)
     }
 
     /// The winding number of the grid point `q` displaced by
@@ -592,19 +624,44 @@ impl Solid {
         TriMesh::from_polygons(&faces)
     }
 
+    /// [`Solid::to_mesh`], checked watertight
+    /// ([`TriMesh::from_polygons_watertight`]: one check, most often made
+    /// while the mesh is made). A failure is a bug in this crate
+    /// ([`CsgError::Internal`]).
+    pub fn to_watertight_mesh(&self) -> Result<TriMesh, CsgError> {
+        let faces: Vec<&Face> = self.faces.iter().flatten().collect();
+        TriMesh::from_polygons_watertight(&faces).map_err(CsgError::Internal)
+    }
+
     /// [`Solid::to_mesh`] for a solid no longer needed: the index goes
-    /// first, and the faces go in parallel once the triangles are made
-    /// (the same mesh).
+    /// first, and the faces go on the thread pool once the triangles are
+    /// made (the same mesh).
     pub fn into_mesh(self) -> TriMesh {
+        self.into_mesh_with(|polys| Ok(TriMesh::from_polygons(polys)))
+            .expect("an unchecked mesh is made")
+    }
+
+    /// [`Solid::to_watertight_mesh`] for a solid no longer needed, as
+    /// [`Solid::into_mesh`] makes it.
+    pub fn into_watertight_mesh(self) -> Result<TriMesh, CsgError> {
+        self.into_mesh_with(|polys| {
+            TriMesh::from_polygons_watertight(polys).map_err(CsgError::Internal)
+        })
+    }
+
+    fn into_mesh_with(
+        self,
+        make: impl FnOnce(&[&Face]) -> Result<TriMesh, CsgError>,
+    ) -> Result<TriMesh, CsgError> {
         // the index goes now (`..` would keep it to the end)
         let Solid { faces, index, .. } = self;
-        drop(index);
+        drop_aside(index);
         // the polygons are read where they are (moving them out of their
         // slots into a list cost a pass over all of them)
         let polys: Vec<&Face> = faces.iter().flatten().collect();
-        let mesh = TriMesh::from_polygons(&polys);
+        let mesh = make(&polys);
         drop(polys);
-        faces.into_par_iter().for_each(drop);
+        drop_aside(faces);
         mesh
     }
 
@@ -699,15 +756,10 @@ impl Solid {
         // the faces that may meet the other surface, and every face of
         // either in the box they span: the octree's cells must know all
         // the faces in them to tell which cells are free of a surface
-        let a_near = self.faces_near(&domain);
-        let b_near = other.faces_near(&domain);
-        let Some(root) = a_near
-            .par_iter()
-            .map(|&f| self.face(f).bx())
-            .chain(b_near.par_iter().map(|&f| other.face(f).bx()))
-            .reduce_with(|x, y| union(&x, &y))
-        else {
-            return self.apart(other, op);
+        let root = match (self.near_span(&domain), other.near_span(&domain)) {
+            (Some(a), Some(b)) => union(&a, &b),
+            (Some(x), None) | (None, Some(x)) => x,
+            (None, None) => return self.apart(other, op),
         };
         let a_c = self.faces_near(&root);
         let b_c = other.faces_near(&root);
@@ -2246,8 +2298,7 @@ pub fn mesh_sequence(
         reports.push(report);
         solid.apply_owned(other, *op)?;
     }
-    let mesh = solid.to_mesh();
-    mesh.check_watertight().map_err(CsgError::Internal)?;
+    let mesh = solid.to_watertight_mesh()?;
     Ok(Boolean {
         mesh,
         grid,

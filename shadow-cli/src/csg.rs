@@ -335,8 +335,23 @@ fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Resu
         stats.push(st);
     }
     let solid = solid.expect("at least two operands");
-    let (exact, mesh) = phases.run("boundary+mesh", || {
-        let exact = solid.into_mesh();
+    // the mesh is checked watertight as it is made (one check, the one
+    // that tells whether it needs mending where the solid touches itself)
+    let (exact, mesh) = phases.run("boundary+mesh", || -> Result<(TriMesh, Mesh)> {
+        let exact = solid.into_watertight_mesh().map_err(|e| {
+            let names: Vec<&str> = operands.iter().map(|o| o.name.as_str()).collect();
+            let e = match e {
+                CsgError::Internal(why) => why,
+                e => e.to_string(),
+            };
+            anyhow!(
+                "internal error: the {} of {} is not watertight ({e}); this is a bug in the \
+                 exact kernel, not a problem with the input, and nothing was written — please \
+                 report it with the input files",
+                op.name(),
+                names.join(", ")
+            )
+        })?;
         let mesh = Mesh {
             positions: exact
                 .vertices_f64()
@@ -354,20 +369,8 @@ fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Resu
                 .collect(),
             groups: vec![op.name().to_string()],
         };
-        (exact, mesh)
-    });
-    phases
-        .run("check", || exact.check_watertight())
-        .map_err(|e| {
-            let names: Vec<&str> = operands.iter().map(|o| o.name.as_str()).collect();
-            anyhow!(
-                "internal error: the {} of {} is not watertight ({e}); this is a bug in the \
-                 exact kernel, not a problem with the input, and nothing was written — please \
-                 report it with the input files",
-                op.name(),
-                names.join(", ")
-            )
-        })?;
+        Ok((exact, mesh))
+    })?;
     Ok(Outcome {
         mesh,
         exact,
@@ -744,7 +747,7 @@ f 4 1 5 8
             assert!(out.mesh.is_closed_oriented());
             assert_eq!(out.mesh.groups, vec![op.name()]);
             let names: Vec<&str> = phases.0.iter().map(|p| p.0).collect();
-            assert_eq!(names, ["snap/import", "boolean", "boundary+mesh", "check"]);
+            assert_eq!(names, ["snap/import", "boolean", "boundary+mesh"]);
         }
         // disjoint: empty intersection
         let far = operand(&cube(1.0, [10.0; 3]), "far.obj", false);

@@ -136,7 +136,6 @@ fn stats_report_counts_volume_and_phases() {
         "snap/import",
         "boolean",
         "boundary+mesh",
-        "check",
         "write",
         "total",
     ] {
