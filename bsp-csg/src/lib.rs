@@ -497,18 +497,15 @@ impl Solid {
 
     /// Adds `ids` (live faces not yet indexed) to the index and the
     /// bounds, in order; many at once read their boxes in parallel.
-    fn index_all(&mut self, ids: &[u32]) {
-        let boxes: Vec<IBox> = if ids.len() < BULK {
-            ids.iter().map(|&f| self.face(f).bx()).collect()
-        } else {
-            ids.par_iter().map(|&f| self.face(f).bx()).collect()
-        };
+    /// Adds faces `ids` with their `boxes` to the index and the bounds,
+    /// in order.
+    fn index_boxes(index: &mut FaceIndex, bounds: &mut Option<IBox>, ids: &[u32], boxes: &[IBox]) {
         let Some(all) = boxes.iter().copied().reduce(|a, b| union(&a, &b)) else {
             return;
         };
-        self.bounds = Some(self.bounds.map_or(all, |b| union(&b, &all)));
-        for (&f, bx) in ids.iter().zip(&boxes) {
-            self.index.insert(f, bx);
+        *bounds = Some(bounds.map_or(all, |b| union(&b, &all)));
+        for (&f, bx) in ids.iter().zip(boxes) {
+            index.insert(f, bx);
         }
     }
 
@@ -1235,19 +1232,7 @@ impl Solid {
     /// The faces are made in parallel and written straight into their
     /// slots (freed slots first, in order, then the end of the array),
     /// each moved or copied once; the index takes them after.
-    fn carry_out(&mut self, mut plan: Plan, other: Other<'_>) {
-        // the new faces' equal new vertices become one each (pieces cut
-        // along a shared edge computed them each for itself)
-        let mut new: Vec<&mut Polygon> = plan
-            .add
-            .iter_mut()
-            .filter_map(|a| match a {
-                Added::New(p) => Some(&mut **p),
-                Added::Whole(_) => None,
-            })
-            .collect();
-        share_points(&mut new);
-        drop(new);
+    fn carry_out(&mut self, plan: Plan, other: Other<'_>) {
         // where each face comes from: a kept face of an owned solid is
         // taken from its slot (distinct slots: one borrow each)
         enum Source<'s> {
@@ -1272,40 +1257,68 @@ impl Solid {
             .collect();
         drop(slots);
         let flip = plan.flip;
-        let make = |f: Source<'_>| -> Face {
+        let make = |f: Source<'_>| -> (Face, bool) {
             match f {
-                Source::New(p) => Face::made(p),
+                Source::New(p) => (Face::made(p), true),
                 Source::Slot(slot) => {
                     let face = slot.take().expect("a live face");
-                    if flip { face.flipped() } else { face }
+                    (if flip { face.flipped() } else { face }, false)
                 }
-                Source::Copy(face) if flip => face.flipped(),
-                Source::Copy(face) => face.clone(),
+                Source::Copy(face) if flip => (face.flipped(), false),
+                Source::Copy(face) => (face.clone(), false),
             }
         };
         // freed slots first, in the order they are popped, then the end of
         // the array, in place: room for all at once (growing by doubling
         // would hold the old and a twice larger array)
-        let rest = from.split_off(from.len().min(self.free.len()));
-        let n = from.len() + rest.len();
+        let n = from.len();
+        let rest = from.split_off(n.min(self.free.len()));
+        let mut is_new = vec![false; self.faces.len() + rest.len()];
         let reused: Vec<u32> = from
             .into_iter()
             .map(|f| {
                 let id = self.free.pop().expect("a free slot");
-                self.faces[id as usize] = Some(make(f));
+                let (face, new) = make(f);
+                self.faces[id as usize] = Some(face);
+                is_new[id as usize] = new;
                 id
             })
             .collect();
         let first_new = self.faces.len();
+        for (flag, f) in is_new[first_new..].iter_mut().zip(&rest) {
+            *flag = matches!(f, Source::New(_));
+        }
         self.faces.reserve_exact(rest.len());
         self.faces
-            .par_extend(rest.into_par_iter().map(|f| Some(make(f))));
-        // the index and the bounds
+            .par_extend(rest.into_par_iter().map(|f| Some(make(f).0)));
+        // the index takes the faces while their equal new vertices become
+        // one each (pieces cut along a shared edge computed them each for
+        // itself); the boxes stay as they are
         let ids: Vec<u32> = reused
             .into_iter()
             .chain(first_new as u32..self.faces.len() as u32)
             .collect();
-        self.index_all(&ids);
+        let boxes: Vec<IBox> = ids.par_iter().map(|&f| self.face(f).bx()).collect();
+        let Solid {
+            faces,
+            index,
+            bounds,
+            ..
+        } = self;
+        rayon::join(
+            || {
+                let mut new: Vec<&mut Polygon> = faces
+                    .iter_mut()
+                    .zip(&is_new)
+                    .filter_map(|(f, &new)| match f.as_mut().map(|f| &mut f.shape) {
+                        Some(Shape::Made(p)) if new => Some(&mut **p),
+                        _ => None,
+                    })
+                    .collect();
+                share_points(&mut new);
+            },
+            || Solid::index_boxes(index, bounds, &ids, &boxes),
+        );
         self.live += n;
         if self.live > 4 * self.indexed + 1024 {
             self.reindex();
@@ -2307,22 +2320,24 @@ pub fn mesh_sequence(
     })
 }
 
-/// Six times the signed volume of the cone from the origin over the
-/// polygon (a fan of grid vertices, summed in `i128`: coordinates below
-/// 2^26 keep each term below 2^81); summed over a closed surface, six
-/// times the volume it bounds. A polygon with implicit vertices does not
-/// come from an import and gives 0.
-fn six_volume(p: &impl ConvexFace) -> i128 {
-    let g: Option<SmallVec<[[i128; 3]; 4]>> = (0..p.corner_count())
-        .map(|i| p.corner(i).grid().map(|c| c.map(i128::from)))
-        .collect();
-    let Some(g) = g else { return 0 };
+/// Six times the signed volume of the cone from the origin over an
+/// imported polygon (a fan of grid vertices); summed over a closed
+/// surface, six times the volume it bounds. Coordinates below 2^26 keep
+/// each cross product's coordinates below 2^53 (in `i64`) and each term
+/// below 2^81 (in `i128`).
+fn six_volume(p: &GridPolygon) -> i128 {
+    let g = p.vertices();
+    let a = g[0].map(i128::from);
     g[1..]
         .windows(2)
         .map(|w| {
-            let (a, b, c) = (g[0], w[0], w[1]);
-            a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-                + a[2] * (b[0] * c[1] - b[1] * c[0])
+            let (b, c) = (w[0].map(i64::from), w[1].map(i64::from));
+            let n = [
+                b[1] * c[2] - b[2] * c[1],
+                b[2] * c[0] - b[0] * c[2],
+                b[0] * c[1] - b[1] * c[0],
+            ];
+            a[0] * n[0] as i128 + a[1] * n[1] as i128 + a[2] * n[2] as i128
         })
         .sum()
 }
