@@ -297,10 +297,10 @@ impl FaceImporter {
         grid: &Grid,
         face: &[DVec3],
         fi: usize,
-        mut out: impl FnMut(GridPolygon),
+        out: impl FnMut(GridPolygon),
     ) -> Result<(), Error> {
-        let (report, pts) = (&mut self.report, &mut self.pts);
-        report.faces += 1;
+        self.report.faces += 1;
+        let mut pts = std::mem::take(&mut self.pts);
         pts.clear();
         for (vi, p) in face.iter().enumerate() {
             let g = grid.snap(*p).map_err(|e| Error::Snap {
@@ -311,6 +311,46 @@ impl FaceImporter {
             })?;
             pts.push(g);
         }
+        self.grid_loop(&pts, fi, out);
+        self.pts = pts;
+        Ok(())
+    }
+
+    /// [`FaceImporter::indexed_grid`] with the positions snapped already:
+    /// `snapped[v]` is `grid.snap(positions[v])` where that succeeds
+    /// ([`snap_positions`]). The same polygons, report and errors, without
+    /// snapping a vertex again for every face it is a corner of.
+    pub fn indexed_snapped(
+        &mut self,
+        grid: &Grid,
+        positions: &[DVec3],
+        snapped: &[Option<GridPoint>],
+        face: &[u32],
+        fi: usize,
+        out: impl FnMut(GridPolygon),
+    ) -> Result<(), Error> {
+        let mut pts = std::mem::take(&mut self.pts);
+        pts.clear();
+        for &v in face {
+            match snapped.get(v as usize) {
+                Some(&Some(g)) => pts.push(g),
+                // a bad index or a vertex off the grid: the error as
+                // the face's own import names it
+                _ => {
+                    self.pts = pts;
+                    return self.indexed_grid(grid, positions, face, fi, out);
+                }
+            }
+        }
+        self.report.faces += 1;
+        self.grid_loop(&pts, fi, out);
+        self.pts = pts;
+        Ok(())
+    }
+
+    /// The polygons of face `fi`, the loop of grid points `pts`.
+    fn grid_loop(&mut self, pts: &[GridPoint], fi: usize, mut out: impl FnMut(GridPolygon)) {
+        let report = &mut self.report;
         let tag = fi as u32;
         match GridPolygon::from_grid_points(pts, tag) {
             Ok(p) => {
@@ -334,13 +374,19 @@ impl FaceImporter {
             }
             Err(defect) => report.dropped.push((fi, defect)),
         }
-        Ok(())
     }
 
     /// What happened to the faces imported so far.
     pub fn finish(self) -> ImportReport {
         self.report
     }
+}
+
+/// Each position snapped to `grid` ([`Grid::snap`]), `None` where that
+/// fails, in parallel: for [`FaceImporter::indexed_snapped`].
+pub fn snap_positions(grid: &Grid, positions: &[DVec3]) -> Vec<Option<GridPoint>> {
+    use rayon::prelude::*;
+    positions.par_iter().map(|&p| grid.snap(p).ok()).collect()
 }
 
 /// Triangles covering the loop: exact ear clipping for planar loops, a fan
@@ -434,6 +480,57 @@ mod tests {
         let f: Vec<DVec3> = face.iter().map(|p| DVec3::from_array(*p)).collect();
         let grid = Grid::new(DVec3::ZERO, 0).unwrap();
         import_faces(&grid, [&f[..]]).unwrap()
+    }
+
+    #[test]
+    fn snapped_positions_import_as_the_positions_do() {
+        // triangles, an L (ear-clipped), a degenerate face, a bad index,
+        // and a vertex beyond the grid's range and one not finite
+        let grid = Grid::new(DVec3::ZERO, 0).unwrap();
+        let mut positions: Vec<DVec3> = (0..6)
+            .flat_map(|i| {
+                L_SHAPE
+                    .iter()
+                    .map(move |p| DVec3::from_array(*p) + i as f64)
+            })
+            .collect();
+        let far = positions.len() as u32;
+        positions.push(DVec3::new(1e9, 0.0, 0.0));
+        positions.push(DVec3::new(f64::NAN, 0.0, 0.0));
+        let n = L_SHAPE.len() as u32;
+        let mut faces: Vec<Vec<u32>> = (0..6).map(|i| (i * n..(i + 1) * n).collect()).collect();
+        faces.push(vec![0, 1, 2]);
+        faces.push(vec![0, 0, 1]);
+        faces.push(vec![0, 1, far]);
+        faces.push(vec![0, far + 1, 1]);
+        faces.push(vec![0, 1, far + 7]);
+        let snapped = snap_positions(&grid, &positions);
+        assert_eq!(snapped[far as usize], None);
+        let run = |pre: bool| {
+            let mut imp = FaceImporter::default();
+            let mut polys = Vec::new();
+            let results: Vec<Result<(), Error>> = faces
+                .iter()
+                .enumerate()
+                .map(|(fi, f)| {
+                    let out = |p: GridPolygon| polys.push((p.vertices().to_vec(), *p.support()));
+                    if pre {
+                        imp.indexed_snapped(&grid, &positions, &snapped, f, fi, out)
+                    } else {
+                        imp.indexed_grid(&grid, &positions, f, fi, out)
+                    }
+                })
+                .collect();
+            (results, polys, imp.finish())
+        };
+        let (r0, p0, rep0) = run(false);
+        let (r1, p1, rep1) = run(true);
+        // (as text: a NaN coordinate is not equal to itself)
+        assert_eq!(format!("{r0:?}"), format!("{r1:?}"));
+        assert_eq!(rep0, rep1);
+        assert_eq!(p0, p1);
+        assert!(r0.iter().filter(|r| r.is_err()).count() == 3, "{r0:?}");
+        assert!(!rep0.triangulated.is_empty() && !rep0.dropped.is_empty());
     }
 
     #[test]

@@ -60,6 +60,7 @@ pub use flat::FlatBsp;
 pub use grid::{GRID_BITS, Grid, GridPoint, MAX_COORD, MAX_VIEW_COORD, SnapError, ViewPoint};
 pub use import::{
     FaceImporter, ImportReport, all_planar, import_faces, import_faces_par, import_indexed_par,
+    snap_positions,
 };
 pub use mesh::TriMesh;
 pub use partition::{

@@ -106,8 +106,9 @@ impl FaceIndex {
     }
 
     /// The index over `bounds` sized for about `count` faces, holding the
-    /// faces `(id, box)` of `faces` (built in parallel: the same lists as
-    /// inserting them in order of id).
+    /// faces `(id, box)` of `faces` (the same lists as inserting them in
+    /// order of id): each face's range of cells is found in parallel,
+    /// then the lists are counted, made to size and filled in order.
     pub(crate) fn filled(
         bounds: IBox,
         count: usize,
@@ -116,19 +117,48 @@ impl FaceIndex {
         use rayon::prelude::*;
         let mut ix = FaceIndex::new(bounds, count);
         let this = &ix;
-        let mut pairs: Vec<(u32, u32)> = faces
-            .enumerate()
-            .flat_map_iter(|(i, b)| {
-                let cells: smallvec::SmallVec<[(u32, u32); 8]> = b
-                    .map(|b| this.cells_of(&b).map(|c| (c as u32, i as u32)).collect())
-                    .unwrap_or_default();
-                cells
+        // (cell coordinates are below 256)
+        let ranges: Vec<Option<[u8; 6]>> = faces
+            .map(|b| {
+                b.map(|b| {
+                    let c = |k: usize, x: i64| this.coord(k, x) as u8;
+                    [
+                        c(0, b.0[0]),
+                        c(1, b.0[1]),
+                        c(2, b.0[2]),
+                        c(0, b.1[0]),
+                        c(1, b.1[1]),
+                        c(2, b.1[2]),
+                    ]
+                })
             })
             .collect();
-        pairs.par_sort_unstable();
-        for run in pairs.chunk_by(|x, y| x.0 == y.0) {
-            ix.cells[run[0].0 as usize] = run.iter().map(|&(_, i)| i).collect();
+        let dims = ix.dims;
+        let cells_in = move |r: [u8; 6]| {
+            (r[0] as usize..=r[3] as usize).flat_map(move |x| {
+                (r[1] as usize..=r[4] as usize).flat_map(move |y| {
+                    (r[2] as usize..=r[5] as usize).map(move |z| (x * dims[1] + y) * dims[2] + z)
+                })
+            })
+        };
+        let mut counts = vec![0u32; ix.cells.len()];
+        for &r in ranges.iter().flatten() {
+            for c in cells_in(r) {
+                counts[c] += 1;
+            }
         }
+        let mut cells: Vec<Vec<u32>> = counts
+            .iter()
+            .map(|&n| Vec::with_capacity(n as usize))
+            .collect();
+        for (i, r) in ranges.iter().enumerate() {
+            if let &Some(r) = r {
+                for c in cells_in(r) {
+                    cells[c].push(i as u32);
+                }
+            }
+        }
+        ix.cells = cells;
         ix
     }
 
@@ -187,5 +217,44 @@ impl FaceIndex {
         for x in self.coord(0, q[0])..self.dims[0] {
             out.extend_from_slice(&self.cells[self.at([x, y, z])]);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_filled_index_is_the_faces_inserted_in_turn() {
+        use rayon::prelude::*;
+        let bounds = ([-50, 0, 10], [149, 99, 59]);
+        // small and large boxes, some beyond the bounds, some slots empty
+        let mut state = 7u64;
+        let mut next = |m: i64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) as i64 % m
+        };
+        let boxes: Vec<Option<IBox>> = (0..3000)
+            .map(|i| {
+                if i % 17 == 0 {
+                    return None;
+                }
+                let lo = [next(260) - 80, next(130) - 15, next(80)];
+                let size = if i % 5 == 0 { 60 } else { 4 };
+                Some((lo, [0, 1, 2].map(|k| lo[k] + next(size))))
+            })
+            .collect();
+        let filled = FaceIndex::filled(bounds, 2000, boxes.par_iter().copied());
+        let mut inserted = FaceIndex::new(bounds, 2000);
+        for (i, b) in boxes.iter().enumerate() {
+            if let Some(b) = b {
+                inserted.insert(i as u32, b);
+            }
+        }
+        assert_eq!(filled.dims, inserted.dims);
+        assert_eq!(filled.cells, inserted.cells);
+        assert!(filled.cells.iter().filter(|c| !c.is_empty()).count() > 100);
     }
 }

@@ -2243,6 +2243,8 @@ pub fn snap_one(
     let n = mesh.faces.len();
     let mut faces: Vec<Option<Face>> = Vec::with_capacity(n);
     faces.par_extend((0..n).into_par_iter().map(|_| None));
+    // each vertex snapped once, not once per face around it
+    let snapped = bsp_core::snap_positions(grid, mesh.positions);
     type Run = (ImportReport, Vec<Face>, i128);
     let runs: Vec<Result<Run, bsp_core::Error>> = faces
         .par_chunks_mut(CHUNK)
@@ -2252,7 +2254,7 @@ pub fn snap_one(
             let mut imp = bsp_core::FaceImporter::default();
             let (mut extra, mut six) = (Vec::new(), 0i128);
             for (i, (slot, face)) in slots.iter_mut().zip(loops).enumerate() {
-                imp.indexed_grid(grid, mesh.positions, face, c * CHUNK + i, |p| {
+                imp.indexed_snapped(grid, mesh.positions, &snapped, face, c * CHUNK + i, |p| {
                     six += six_volume(&p);
                     let face = Face::grid(p);
                     match slot {
@@ -2285,7 +2287,8 @@ pub fn snap_one(
         .rev()
         .map(|&(f, _)| f as u32)
         .collect();
-    Ok((Solid::from_faces(faces, free), report))
+    let s = Solid::from_faces(faces, free);
+    Ok((s, report))
 }
 
 /// `((first op₁ m₁) op₂ m₂) ...` on one grid: every operand is checked
