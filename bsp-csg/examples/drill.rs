@@ -55,8 +55,7 @@ fn main() {
     }
     let t = Instant::now();
     let faces_out = part.len();
-    let mesh = part.into_mesh();
-    mesh.check_watertight().unwrap();
+    let mesh = part.into_watertight_mesh().unwrap();
     let t_mesh = t.elapsed();
     println!(
         "{} - {tools} x {} triangles: snap {:.0} ms, subtractions {:.0} ms ({:.2} ms each, \

@@ -1273,21 +1273,27 @@ impl Solid {
         // would hold the old and a twice larger array)
         let n = from.len();
         let rest = from.split_off(n.min(self.free.len()));
-        let mut is_new = vec![false; self.faces.len() + rest.len()];
+        // the slots of the new faces
+        let mut new_slots: Vec<u32> = Vec::new();
         let reused: Vec<u32> = from
             .into_iter()
             .map(|f| {
                 let id = self.free.pop().expect("a free slot");
                 let (face, new) = make(f);
                 self.faces[id as usize] = Some(face);
-                is_new[id as usize] = new;
+                if new {
+                    new_slots.push(id);
+                }
                 id
             })
             .collect();
         let first_new = self.faces.len();
-        for (flag, f) in is_new[first_new..].iter_mut().zip(&rest) {
-            *flag = matches!(f, Source::New(_));
-        }
+        new_slots.extend(
+            (first_new as u32..)
+                .zip(&rest)
+                .filter(|(_, f)| matches!(f, Source::New(_)))
+                .map(|(id, _)| id),
+        );
         self.faces.reserve_exact(rest.len());
         self.faces
             .par_extend(rest.into_par_iter().map(|f| Some(make(f).0)));
@@ -1307,14 +1313,24 @@ impl Solid {
         } = self;
         rayon::join(
             || {
-                let mut new: Vec<&mut Polygon> = faces
-                    .iter_mut()
-                    .zip(&is_new)
-                    .filter_map(|(f, &new)| match f.as_mut().map(|f| &mut f.shape) {
-                        Some(Shape::Made(p)) if new => Some(&mut **p),
-                        _ => None,
-                    })
-                    .collect();
+                // one borrow each, by slot (not a pass over all slots: a
+                // long sequence of operations adds few faces to many)
+                new_slots.sort_unstable();
+                let mut new: Vec<&mut Polygon> = Vec::with_capacity(new_slots.len());
+                let (mut tail, mut at) = (&mut faces[..], 0);
+                for &id in &new_slots {
+                    let (slot, rest) = std::mem::take(&mut tail)[id as usize - at..]
+                        .split_first_mut()
+                        .expect("a new face's slot");
+                    (tail, at) = (rest, id as usize + 1);
+                    if let Some(Face {
+                        shape: Shape::Made(p),
+                        ..
+                    }) = slot
+                    {
+                        new.push(&mut **p);
+                    }
+                }
                 share_points(&mut new);
             },
             || Solid::index_boxes(index, bounds, &ids, &boxes),
