@@ -281,6 +281,13 @@ impl TriMesh {
                     // the place of the polygon's first edge in `twinned`
                     let edge0 = start[first + i];
                     let k = cs.len();
+                    // a triangle whose edges are all closed is itself (as
+                    // the ears below would give it), the common case
+                    if k == 3 && twinned[edge0..edge0 + 3].iter().all(|&t| t) {
+                        triangles.push([cs[0], cs[1], cs[2]]);
+                        of.push((first + i) as u32);
+                        continue;
+                    }
                     // boundary loop: (vertex, edge ids it lies on)
                     let mut ring: Vec<(u32, SmallVec<[u32; 3]>)> = Vec::with_capacity(k);
                     for i in 0..k {
