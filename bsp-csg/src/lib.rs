@@ -1273,27 +1273,28 @@ impl Solid {
         // would hold the old and a twice larger array)
         let n = from.len();
         let rest = from.split_off(n.min(self.free.len()));
-        // the slots of the new faces
-        let mut new_slots: Vec<u32> = Vec::new();
-        let reused: Vec<u32> = from
-            .into_iter()
-            .map(|f| {
-                let id = self.free.pop().expect("a free slot");
-                let (face, new) = make(f);
-                self.faces[id as usize] = Some(face);
-                if new {
-                    new_slots.push(id);
-                }
-                id
-            })
+        let reused: Vec<u32> = (0..from.len())
+            .map(|_| self.free.pop().expect("a free slot"))
             .collect();
         let first_new = self.faces.len();
-        new_slots.extend(
-            (first_new as u32..)
-                .zip(&rest)
-                .filter(|(_, f)| matches!(f, Source::New(_)))
-                .map(|(id, _)| id),
-        );
+        // the slots of the new faces
+        let mut new_slots: Vec<u32> = reused
+            .iter()
+            .copied()
+            .zip(&from)
+            .chain((first_new as u32..).zip(&rest))
+            .filter(|(_, f)| matches!(f, Source::New(_)))
+            .map(|(id, _)| id)
+            .collect();
+        // the freed slots filled in parallel, each borrowed once
+        let mut refill: Vec<(u32, Source<'_>)> = reused.iter().copied().zip(from).collect();
+        refill.sort_unstable_by_key(|r| r.0);
+        let (ids, sources): (Vec<u32>, Vec<Source<'_>>) = refill.into_iter().unzip();
+        borrow_sorted(&mut self.faces, &ids)
+            .into_par_iter()
+            .zip(sources)
+            .for_each(|(slot, f)| *slot = Some(make(f).0));
+        drop(ids);
         self.faces.reserve_exact(rest.len());
         self.faces
             .par_extend(rest.into_par_iter().map(|f| Some(make(f).0)));
@@ -1316,21 +1317,16 @@ impl Solid {
                 // one borrow each, by slot (not a pass over all slots: a
                 // long sequence of operations adds few faces to many)
                 new_slots.sort_unstable();
-                let mut new: Vec<&mut Polygon> = Vec::with_capacity(new_slots.len());
-                let (mut tail, mut at) = (&mut faces[..], 0);
-                for &id in &new_slots {
-                    let (slot, rest) = std::mem::take(&mut tail)[id as usize - at..]
-                        .split_first_mut()
-                        .expect("a new face's slot");
-                    (tail, at) = (rest, id as usize + 1);
-                    if let Some(Face {
-                        shape: Shape::Made(p),
-                        ..
-                    }) = slot
-                    {
-                        new.push(&mut **p);
-                    }
-                }
+                let mut new: Vec<&mut Polygon> = borrow_sorted(faces, &new_slots)
+                    .into_iter()
+                    .filter_map(|slot| match slot {
+                        Some(Face {
+                            shape: Shape::Made(p),
+                            ..
+                        }) => Some(&mut **p),
+                        _ => None,
+                    })
+                    .collect();
                 share_points(&mut new);
             },
             || Solid::index_boxes(index, bounds, &ids, &boxes),
@@ -1340,6 +1336,20 @@ impl Solid {
             self.reindex();
         }
     }
+}
+
+/// The items at `ids` (strictly increasing), each borrowed once.
+fn borrow_sorted<'a, T>(items: &'a mut [T], ids: &[u32]) -> Vec<&'a mut T> {
+    let mut out = Vec::with_capacity(ids.len());
+    let (mut tail, mut at) = (items, 0);
+    for &id in ids {
+        let (item, rest) = std::mem::take(&mut tail)[id as usize - at..]
+            .split_first_mut()
+            .expect("ids within the items, increasing");
+        out.push(item);
+        (tail, at) = (rest, id as usize + 1);
+    }
+    out
 }
 
 /// The solid an operation takes kept faces from.
