@@ -1231,7 +1231,8 @@ impl Solid {
     ///
     /// The faces are made in parallel and written straight into their
     /// slots (freed slots first, in order, then the end of the array),
-    /// each moved or copied once; the index takes them after.
+    /// each moved or copied once; the index takes them while the new
+    /// faces' equal new vertices are made one.
     fn carry_out(&mut self, plan: Plan, other: Other<'_>) {
         // where each face comes from: a kept face of an owned solid is
         // taken from its slot (distinct slots: one borrow each)
@@ -1257,15 +1258,15 @@ impl Solid {
             .collect();
         drop(slots);
         let flip = plan.flip;
-        let make = |f: Source<'_>| -> (Face, bool) {
+        let make = |f: Source<'_>| -> Face {
             match f {
-                Source::New(p) => (Face::made(p), true),
+                Source::New(p) => Face::made(p),
                 Source::Slot(slot) => {
                     let face = slot.take().expect("a live face");
-                    (if flip { face.flipped() } else { face }, false)
+                    if flip { face.flipped() } else { face }
                 }
-                Source::Copy(face) if flip => (face.flipped(), false),
-                Source::Copy(face) => (face.clone(), false),
+                Source::Copy(face) if flip => face.flipped(),
+                Source::Copy(face) => face.clone(),
             }
         };
         // freed slots first, in the order they are popped, then the end of
@@ -1289,15 +1290,14 @@ impl Solid {
         // the freed slots filled in parallel, each borrowed once
         let mut refill: Vec<(u32, Source<'_>)> = reused.iter().copied().zip(from).collect();
         refill.sort_unstable_by_key(|r| r.0);
-        let (ids, sources): (Vec<u32>, Vec<Source<'_>>) = refill.into_iter().unzip();
-        borrow_sorted(&mut self.faces, &ids)
+        let (slots, sources): (Vec<u32>, Vec<Source<'_>>) = refill.into_iter().unzip();
+        borrow_sorted(&mut self.faces, &slots)
             .into_par_iter()
             .zip(sources)
-            .for_each(|(slot, f)| *slot = Some(make(f).0));
-        drop(ids);
+            .for_each(|(slot, f)| *slot = Some(make(f)));
         self.faces.reserve_exact(rest.len());
         self.faces
-            .par_extend(rest.into_par_iter().map(|f| Some(make(f).0)));
+            .par_extend(rest.into_par_iter().map(|f| Some(make(f))));
         // the index takes the faces while their equal new vertices become
         // one each (pieces cut along a shared edge computed them each for
         // itself); the boxes stay as they are
@@ -2313,8 +2313,7 @@ pub fn snap_one(
         .rev()
         .map(|&(f, _)| f as u32)
         .collect();
-    let s = Solid::from_faces(faces, free);
-    Ok((s, report))
+    Ok((Solid::from_faces(faces, free), report))
 }
 
 /// `((first op₁ m₁) op₂ m₂) ...` on one grid: every operand is checked
