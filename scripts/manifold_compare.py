@@ -209,6 +209,8 @@ def main():
                 mc, mb, mt = run_theirs(op, a, b, args.reps)
                 build = ph.get("snap/import", 0)
                 merge = ph.get("boolean", 0)
+                # (the watertightness check is inside boundary+mesh since
+                # 363195e; older builds print it as a phase of its own)
                 mesh = ph.get("boundary+mesh", 0) + ph.get("check", 0)
                 ours = build + merge + mesh
                 print("%-14s %-12s %9.2f %9.2f %9.2f %9.2f %9.2f | %9.2f %9.2f | %7.2f %7.2f | %s / %s,%s"

@@ -117,7 +117,9 @@ impl FaceIndex {
         use rayon::prelude::*;
         let mut ix = FaceIndex::new(bounds, count);
         let this = &ix;
-        // (cell coordinates are below 256)
+        // (cell coordinates are below 256: `new` makes at most 256 cells
+        // along an axis)
+        debug_assert!(ix.dims.iter().all(|&d| d <= 256));
         let ranges: Vec<Option<[u8; 6]>> = faces
             .map(|b| {
                 b.map(|b| {
