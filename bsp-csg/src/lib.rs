@@ -762,9 +762,9 @@ impl Solid {
         let b_c = other.faces_near(&root);
         // the faces' boxes and planes side by side, by their place in
         // `a_c` and `b_c` (a face slot is large: the build reads these often)
-        let geometry = |s: &Solid, fs: &[u32]| -> (Vec<IBox>, Vec<bsp_core::Plane>) {
+        let geometry = |s: &Solid, fs: &[u32]| -> (Vec<octree::SmallBox>, Vec<bsp_core::Plane>) {
             fs.par_iter()
-                .map(|&f| (s.face(f).bx(), *s.face(f).support()))
+                .map(|&f| (s.face(f).small_box, *s.face(f).support()))
                 .unzip()
         };
         let (boxes_a, planes_a) = geometry(self, &a_c);

@@ -118,11 +118,15 @@ pub(crate) trait PlaneTest: Fn(u32, &IBox) -> bool + Sync {}
 
 impl<T: Fn(u32, &IBox) -> bool + Sync> PlaneTest for T {}
 
+/// A face's box in 32 bits (as a solid keeps it): the build reads one
+/// per face at every level, so half the room is half the traffic.
+pub(crate) type SmallBox = ([i32; 3], [i32; 3]);
+
 /// One operand's faces for [`build`]: each face's box, and a test of its
 /// plane against a cell (`true` whenever the face meets the cell; it may
 /// be `true` more often).
 pub(crate) struct Faces<'a, P> {
-    pub(crate) boxes: &'a [IBox],
+    pub(crate) boxes: &'a [SmallBox],
     pub(crate) plane_meets: P,
 }
 
@@ -234,11 +238,12 @@ fn split<P: PlaneTest, Q: PlaneTest>(
     // overlaps the lower child if it starts at or below the middle, the
     // upper if it ends above it
     let deal_run = |fs: &[u32],
-                    bxs: &[IBox],
+                    bxs: &[SmallBox],
                     meets: &(dyn Fn(u32, &IBox) -> bool + Sync),
                     kids: &mut [Vec<u32>]| {
         for &f in fs {
             let (fl, fh) = bxs[f as usize];
+            let (fl, fh) = (fl.map(i64::from), fh.map(i64::from));
             let (mut any, mut all) = (0usize, 0usize);
             for (j, &k) in axes.iter().enumerate() {
                 let bit = 1 << (m - 1 - j);
@@ -270,7 +275,7 @@ fn split<P: PlaneTest, Q: PlaneTest>(
     };
     // a large cell's faces are dealt in runs in parallel, each run's
     // lists joined in order (the same lists)
-    let deal = |fs: &[u32], bxs: &[IBox], meets: &(dyn Fn(u32, &IBox) -> bool + Sync)| {
+    let deal = |fs: &[u32], bxs: &[SmallBox], meets: &(dyn Fn(u32, &IBox) -> bool + Sync)| {
         const RUN: usize = 1 << 13;
         if fs.len() <= 2 * RUN {
             let mut lists = vec![Vec::new(); boxes.len()];
@@ -424,7 +429,7 @@ mod tests {
     #[test]
     fn leaves_tile_the_domain_and_adjacency_is_found() {
         // eight faces of each operand packed in one corner: the cell splits
-        let boxes: Vec<IBox> = (0..8).map(|i| ([i, 0, 0], [i, 1, 1])).collect();
+        let boxes: Vec<SmallBox> = (0..8).map(|i| ([i, 0, 0], [i, 1, 1])).collect();
         let faces = Faces {
             boxes: &boxes,
             plane_meets: |_, _: &IBox| true,
