@@ -634,8 +634,7 @@ impl Solid {
     /// first, and the faces go on the thread pool once the triangles are
     /// made (the same mesh).
     pub fn into_mesh(self) -> TriMesh {
-        self.into_mesh_with(|polys| Ok(TriMesh::from_polygons(polys)))
-            .expect("an unchecked mesh is made")
+        self.into_mesh_with(|polys| TriMesh::from_polygons(polys))
     }
 
     /// [`Solid::to_watertight_mesh`] for a solid no longer needed, as
@@ -646,10 +645,9 @@ impl Solid {
         })
     }
 
-    fn into_mesh_with(
-        self,
-        make: impl FnOnce(&[&Face]) -> Result<TriMesh, CsgError>,
-    ) -> Result<TriMesh, CsgError> {
+    /// `make` of the faces, the index and the faces let go as
+    /// [`Solid::into_mesh`] says.
+    fn into_mesh_with<T>(self, make: impl FnOnce(&[&Face]) -> T) -> T {
         // the index goes now (`..` would keep it to the end)
         let Solid { faces, index, .. } = self;
         drop_aside(index);
