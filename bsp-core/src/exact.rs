@@ -144,6 +144,19 @@ pub fn approx<const N: usize>(x: &BInt<N>) -> f64 {
     if neg { -v } else { v }
 }
 
+/// [`approx`] of an `i128`: the same value, without the wide integer.
+#[inline]
+pub(crate) fn approx_i128(x: i128) -> f64 {
+    let u = x.unsigned_abs();
+    let (hi, lo) = ((u >> 64) as u64, u as u64);
+    let v = if hi == 0 {
+        lo as f64
+    } else {
+        hi as f64 * pow2(64) + lo as f64
+    };
+    if x < 0 { -v } else { v }
+}
+
 /// `a / b` for unsigned `a`, `b > 0`, correctly rounded (ties to even) by
 /// long division: `None` if `a` or `b` has more than `64 M - 64` bits.
 fn ratio_by_division<const M: usize>(a: BUint<M>, b: BUint<M>) -> Option<f64> {

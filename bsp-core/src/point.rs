@@ -174,6 +174,32 @@ impl Homogeneous<4> {
         ))
     }
 
+    /// The point where the segment from the grid point `p` to `q` crosses
+    /// `plane`, which has them strictly on opposite sides: with
+    /// `s(x) = n · x + d`, the point `(s(q) p − s(p) q) / (s(q) − s(p))`.
+    /// The same point as [`Implicit::from_planes`] of the segment's line
+    /// and the plane gives, in smaller coordinates and a few native
+    /// products: for any `i32` coordinates and a plane within the budget,
+    /// `|s| < 2^88`, so `|w| < 2^89` and `|x|, |y|, |z| < 2^120` (in
+    /// `i128`, and within [`Implicit`]'s bounds).
+    pub fn on_segment(p: &GridPoint, q: &GridPoint, plane: &Plane) -> Implicit {
+        let n = plane.normal();
+        let s =
+            |g: &GridPoint| (0..3).fold(plane.offset(), |acc, k| acc + n[k] as i128 * g[k] as i128);
+        let (sp, sq) = (s(p), s(q));
+        debug_assert!(sp != 0 && sq != 0 && (sp < 0) != (sq < 0));
+        // w = s(q) − s(p) > 0 when p lies behind the plane; else all negated
+        let sign = if sq > sp { 1 } else { -1 };
+        let h = [0, 1, 2, 3].map(|k| {
+            sign * if k == 3 {
+                sq - sp
+            } else {
+                sq * p[k] as i128 - sp * q[k] as i128
+            }
+        });
+        Homogeneous::with_approx(h.map(I256::from), h.map(crate::exact::approx_i128))
+    }
+
     /// The homogeneous coordinates `(x, y, z, w)` with `w > 0`.
     pub fn homogeneous(&self) -> &[I256; 4] {
         self.coords()
@@ -292,6 +318,18 @@ impl Point {
     /// The intersection of three planes (see [`Implicit::from_planes`]).
     pub fn from_planes(p1: &Plane, p2: &Plane, p3: &Plane) -> Option<Point> {
         Implicit::from_planes(p1, p2, p3).map(|i| Point::Implicit(Arc::new(i)))
+    }
+
+    /// The point where the edge from `a` to `b`, on the planes `support`
+    /// and `edge`, crosses `plane`, which has `a` and `b` strictly on
+    /// opposite sides: from the segment when both ends are grid points
+    /// ([`Implicit::on_segment`]), else from the three planes.
+    pub fn crossing(a: &Point, b: &Point, support: &Plane, edge: &Plane, plane: &Plane) -> Point {
+        if let (Point::Grid(p), Point::Grid(q)) = (a, b) {
+            return Point::Implicit(Arc::new(Implicit::on_segment(p, q, plane)));
+        }
+        Point::from_planes(support, edge, plane)
+            .expect("a spanning edge meets the cutting plane in one point")
     }
 
     /// Exact side of `plane`.
@@ -494,6 +532,47 @@ mod tests {
                 for k in 0..3 {
                     proptest::prop_assert_eq!(scaled.cmp_axis(&q, k), p.cmp_axis_with::<8>(&q, k));
                 }
+            }
+        }
+
+        /// The crossing of a segment between grid points, at the ends of
+        /// the grid, with a plane through three other grid points is the
+        /// point the three planes give: the same point, on the plane,
+        /// `w > 0`, and the `f64` approximations the filter expects.
+        #[test]
+        fn a_segment_crosses_a_plane_where_the_planes_meet(
+            g in proptest::collection::vec(-crate::MAX_COORD..=crate::MAX_COORD, 18),
+        ) {
+            let pt = |k: usize| [g[3 * k], g[3 * k + 1], g[3 * k + 2]];
+            let (p, q, r) = (pt(0), pt(1), pt(2));
+            let Some(plane) = Plane::through(pt(3), pt(4), pt(5)) else {
+                return Ok(());
+            };
+            let (sp, sq) = (plane.classify_grid(p), plane.classify_grid(q));
+            proptest::prop_assume!(sp != Side::On && sq != Side::On && sp != sq);
+            let Some(support) = Plane::through(p, q, r) else {
+                return Ok(());
+            };
+            let edge = Plane::edge(p, q, &support).expect("a plane along the edge");
+            let via_planes = Implicit::from_planes(&support, &edge, &plane)
+                .expect("the edge crosses the plane");
+            let direct = Implicit::on_segment(&p, &q, &plane);
+            proptest::prop_assert!(direct.same_point(&via_planes));
+            proptest::prop_assert!(direct.coords()[3].is_positive());
+            for c in 0..4 {
+                proptest::prop_assert_eq!(
+                    direct.approx()[c],
+                    crate::exact::approx(&direct.coords()[c])
+                );
+            }
+            let (a, b) = (Point::Grid(p), Point::Grid(q));
+            for x in [
+                Point::crossing(&a, &b, &support, &edge, &plane),
+                Point::crossing(&b, &a, &support, &edge.flip(), &plane),
+            ] {
+                proptest::prop_assert_eq!(x.classify(&plane), Side::On);
+                proptest::prop_assert_eq!(x.classify(&support), Side::On);
+                proptest::prop_assert!(x.same_point(&Point::Implicit(Arc::new(via_planes.clone()))));
             }
         }
 

@@ -608,8 +608,9 @@ impl Polygon {
             plane.flip(),
             *plane,
             |i| {
-                Point::from_planes(&support, &edges[i], plane)
-                    .expect("a spanning edge meets the cutting plane in one point")
+                let verts = &self.verts;
+                let j = if i + 1 == verts.len() { 0 } else { i + 1 };
+                Point::crossing(&verts[i], &verts[j], &support, &edges[i], plane)
             },
             |v, e| {
                 if keep_front {
@@ -637,8 +638,14 @@ impl Polygon {
             plane.flip(),
             *plane,
             |i| {
-                Point::from_planes(&self.support, &self.edges[i], plane)
-                    .expect("a spanning edge meets the cutting plane in one point")
+                let j = if i + 1 == self.verts.len() { 0 } else { i + 1 };
+                Point::crossing(
+                    &self.verts[i],
+                    &self.verts[j],
+                    &self.support,
+                    &self.edges[i],
+                    plane,
+                )
             },
             |v, e| f.push(v, e),
             |v, e| b.push(v, e),
