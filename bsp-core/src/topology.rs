@@ -256,14 +256,20 @@ pub(crate) fn bucket_par<S: Sync, T: Copy + Default + Send + Sync>(
 fn corners_close_at(g: &[(u32, u32)], cycles: bool) -> bool {
     let mut by_u: smallvec::SmallVec<[(u32, u32); 16]> = g.iter().copied().collect();
     by_u.sort_unstable();
-    let mut ws: smallvec::SmallVec<[u32; 16]> = g.iter().map(|c| c.1).collect();
-    ws.sort_unstable();
-    if by_u.windows(2).any(|x| x[0].0 == x[1].0) || !by_u.iter().map(|c| c.0).eq(ws) {
+    if by_u.windows(2).any(|x| x[0].0 == x[1].0) {
         return false;
     }
-    if !cycles || by_u.is_empty() {
+    if !cycles {
+        let mut ws: smallvec::SmallVec<[u32; 16]> = g.iter().map(|c| c.1).collect();
+        ws.sort_unstable();
+        return by_u.iter().map(|c| c.0).eq(ws);
+    }
+    if by_u.is_empty() {
         return true;
     }
+    // the walk u ↦ w from the first u: with the u's distinct, it comes
+    // back to its start after exactly as many steps as there are corners
+    // only if it met every u once, so the w's are the u's
     let first = by_u[0].0;
     let mut u = first;
     for step in 1..=by_u.len() {
