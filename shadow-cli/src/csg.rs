@@ -12,7 +12,7 @@
 use rayon::prelude::*;
 use std::io::Write;
 use std::panic;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -97,14 +97,32 @@ impl Operand {
         }
     }
 
-    fn load(path: &Path, weld: bool) -> Result<Operand> {
-        let mut mesh = crate::load_mesh(path, false)?;
-        let file_loops = weld.then(|| {
-            let loops = mesh.faces.iter().map(|f| f.vertices.clone()).collect();
-            mesh.weld();
-            loops
-        });
-        Ok(Operand::new(path.display().to_string(), mesh, file_loops))
+    /// The operands from `paths`, read (and welded) in parallel; the
+    /// readers' notes are printed, and the first error returned, in the
+    /// order of the files, as reading them in turn would.
+    fn load_all(paths: &[PathBuf], weld: bool) -> Result<Vec<Operand>> {
+        let read: Vec<Result<(Mesh, Option<String>)>> =
+            paths.par_iter().map(|p| crate::read_mesh(p)).collect();
+        let mut meshes = Vec::with_capacity(paths.len());
+        for (path, r) in paths.iter().zip(read) {
+            let (mesh, note) = r?;
+            if let Some(m) = note {
+                eprintln!("note: {m}");
+            }
+            meshes.push(crate::with_faces(path, mesh)?);
+        }
+        Ok(meshes
+            .into_par_iter()
+            .zip(paths)
+            .map(|(mut mesh, path)| {
+                let file_loops = weld.then(|| {
+                    let loops = mesh.faces.iter().map(|f| f.vertices.clone()).collect();
+                    mesh.weld();
+                    loops
+                });
+                Operand::new(path.display().to_string(), mesh, file_loops)
+            })
+            .collect())
     }
 
     /// `file:line` of face `face` for text formats, else `file`.
@@ -132,19 +150,19 @@ impl Operand {
         (in_file + 1).to_string()
     }
 
-    fn loops(&self) -> Vec<Vec<u32>> {
-        self.mesh.faces.iter().map(|f| f.vertices.clone()).collect()
+    /// Checks that the faces form a closed, consistently oriented
+    /// 2-manifold; the error names the file, line, face and edge. (The
+    /// check of [`bsp_csg::check_mesh`], on the faces as they are.)
+    fn validate(&self) -> Result<()> {
+        bsp_core::check_closed_manifold(self.mesh.faces.iter().map(|f| f.vertices.as_slice()))
+            .map_err(|error| anyhow!(self.topology_message(&error)))
     }
 
-    /// Checks that the faces form a closed, consistently oriented
-    /// 2-manifold; the error names the file, line, face and edge.
-    fn validate(&self) -> Result<()> {
-        let loops = self.loops();
-        match bsp_csg::check_mesh(&MeshIn::new(&self.mesh.positions, &loops), 0) {
-            Err(CsgError::Topology { error, .. }) => Err(anyhow!(self.topology_message(&error))),
-            Err(e) => Err(anyhow!("{}: {e}", self.name)),
-            Ok(()) => Ok(()),
-        }
+    /// [`Operand::validate`] of each operand, in parallel; the first
+    /// error in their order.
+    fn validate_all(operands: &[Operand]) -> Result<()> {
+        let checked: Vec<Result<()>> = operands.par_iter().map(Operand::validate).collect();
+        checked.into_iter().collect()
     }
 
     fn topology_message(&self, e: &TopologyError) -> String {
@@ -426,15 +444,8 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
     // fail on a bad output name before doing any work
     MeshFormat::from_path(&args.output)?;
     let mut phases = Phases::default();
-    let mut operands = phases.run("load", || -> Result<Vec<Operand>> {
-        args.operands
-            .iter()
-            .map(|p| Operand::load(p, args.weld))
-            .collect()
-    })?;
-    phases.run("validate", || -> Result<()> {
-        operands.iter().try_for_each(Operand::validate)
-    })?;
+    let mut operands = phases.run("load", || Operand::load_all(&args.operands, args.weld))?;
+    phases.run("validate", || Operand::validate_all(&operands))?;
     let out = guarded("the input files", || {
         compute(&mut operands, args.op, &mut phases)
     })?;

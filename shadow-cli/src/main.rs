@@ -184,15 +184,26 @@ const DEMO_TARGET: DVec3 = DVec3::new(-0.15, 0.3, 0.45);
 /// Reads a mesh file: an error if it has no faces; a note on stderr
 /// (unless `quiet`) if the reader skipped unknown statements.
 fn load_mesh(path: &Path, quiet: bool) -> Result<shadow_scene::Mesh> {
-    let (mesh, notes) = shadow_scene::load_notes(path)?;
-    let name = path.display().to_string();
-    if let Some(m) = notes.message(&name)
+    let (mesh, note) = read_mesh(path)?;
+    if let Some(m) = note
         && !quiet
     {
         eprintln!("note: {m}");
     }
+    with_faces(path, mesh)
+}
+
+/// [`load_mesh`]'s reading, printing nothing: the mesh, faces or not, and
+/// the reader's note on what it skipped.
+fn read_mesh(path: &Path) -> Result<(shadow_scene::Mesh, Option<String>)> {
+    let (mesh, notes) = shadow_scene::load_notes(path)?;
+    Ok((mesh, notes.message(&path.display().to_string())))
+}
+
+/// `mesh` read from `path`, unless it has no faces.
+fn with_faces(path: &Path, mesh: shadow_scene::Mesh) -> Result<shadow_scene::Mesh> {
     if mesh.faces.is_empty() {
-        bail!("{name}: no faces");
+        bail!("{}: no faces", path.display());
     }
     Ok(mesh)
 }

@@ -314,3 +314,36 @@ fn unknown_statements_are_reported_once_with_the_first_line() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(stderr(&o), "");
 }
+
+#[test]
+fn csg_operands_read_in_parallel_report_in_the_order_of_the_files() {
+    // the files are read at once; their notes come out in order, and the
+    // error is the first file's in order (not the missing last one's)
+    let first = file(
+        "order_first.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nW 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n",
+    );
+    let second = file("order_second.obj", b"v 0 0 0\nQ 2\nQ 3\n");
+    let missing = scratch("order_missing.obj");
+    let missing = missing.to_str().unwrap();
+    let out = scratch("order_out.obj");
+    let o = shadow(&[
+        "csg",
+        "union",
+        &first,
+        &second,
+        missing,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert_eq!(
+        stderr(&o),
+        format!(
+            "note: {first}: skipped an unknown statement `W` on line 5\n\
+             note: {second}: skipped 2 unknown statements, the first `Q` on line 2\n\
+             error: {second}: no faces\n"
+        )
+    );
+    assert!(!out.exists());
+}

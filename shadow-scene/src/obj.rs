@@ -163,26 +163,35 @@ pub fn parse_obj_notes(
     let mut statement = String::new();
     while let Some((i, first)) = lines.next() {
         let line = i + 1;
-        statement.clear();
-        let mut current = first;
-        loop {
-            let trimmed = current.trim_end();
-            match trimmed.strip_suffix('\\') {
-                Some(head) => {
-                    statement.push_str(head);
-                    statement.push(' ');
-                    match lines.next() {
-                        Some((_, next)) => current = next,
-                        None => break,
+        // a line read as it is, unless it goes on to the next (copied then)
+        let mut current = first.trim_end();
+        let whole: &str = match current.strip_suffix('\\') {
+            None => current,
+            Some(_) => {
+                statement.clear();
+                loop {
+                    match current.strip_suffix('\\') {
+                        Some(head) => {
+                            statement.push_str(head);
+                            statement.push(' ');
+                            match lines.next() {
+                                Some((_, next)) => current = next.trim_end(),
+                                None => break,
+                            }
+                        }
+                        None => {
+                            statement.push_str(current);
+                            break;
+                        }
                     }
                 }
-                None => {
-                    statement.push_str(trimmed);
-                    break;
-                }
+                &statement
             }
-        }
-        let content = statement.split('#').next().unwrap_or("");
+        };
+        let content = match whole.find('#') {
+            Some(at) => &whole[..at],
+            None => whole,
+        };
         let mut tokens = content.split_whitespace();
         let Some(keyword) = tokens.next() else {
             continue;
@@ -229,23 +238,31 @@ fn parse_number(token: &str) -> Result<f64, String> {
 }
 
 fn parse_vertex<'a>(tokens: impl Iterator<Item = &'a str>) -> Result<DVec3, String> {
-    let tokens: Vec<&str> = tokens.collect();
-    let numbers = tokens
-        .iter()
-        .map(|t| parse_number(t))
-        .collect::<Result<Vec<f64>, String>>()?;
-    if !matches!(numbers.len(), 3 | 4 | 6 | 7) {
+    // (no list per line: the numbers are parsed as they come, and the
+    // messages are those of a check of all numbers, then their count,
+    // then the first three's finiteness)
+    let mut xyz = [0.0; 3];
+    let mut count = 0usize;
+    let mut not_finite: Option<&str> = None;
+    for t in tokens {
+        let x = parse_number(t)?;
+        if count < 3 {
+            xyz[count] = x;
+            if !x.is_finite() && not_finite.is_none() {
+                not_finite = Some(t);
+            }
+        }
+        count += 1;
+    }
+    if !matches!(count, 3 | 4 | 6 | 7) {
         return Err(format!(
-            "vertex has {} number(s); expected `v x y z [w]`, optionally followed by `r g b`",
-            numbers.len()
+            "vertex has {count} number(s); expected `v x y z [w]`, optionally followed by `r g b`"
         ));
     }
-    for (t, x) in tokens.iter().zip(&numbers).take(3) {
-        if !x.is_finite() {
-            return Err(format!("coordinate `{t}` is not finite"));
-        }
+    if let Some(t) = not_finite {
+        return Err(format!("coordinate `{t}` is not finite"));
     }
-    Ok(DVec3::new(numbers[0], numbers[1], numbers[2]))
+    Ok(DVec3::from_array(xyz))
 }
 
 fn parse_face<'a>(
@@ -256,11 +273,11 @@ fn parse_face<'a>(
     for token in tokens {
         let mut parts = token.split('/');
         let index = parts.next().unwrap_or("");
-        let rest: Vec<&str> = parts.collect();
-        if rest.len() > 2 {
+        let rest = [parts.next(), parts.next()];
+        if parts.next().is_some() {
             return Err(format!("malformed face vertex `{token}`"));
         }
-        for extra in rest.iter().filter(|s| !s.is_empty()) {
+        for extra in rest.into_iter().flatten().filter(|s| !s.is_empty()) {
             extra.parse::<i64>().map_err(|_| {
                 format!("could not parse `{extra}` as a texture or normal index in `{token}`")
             })?;
@@ -312,32 +329,65 @@ fn resolve_index(i: i64, n: usize) -> Result<u32, String> {
 /// assert_eq!(back.faces.len(), chair.faces.len());
 /// ```
 pub fn write_obj<W: Write>(mesh: &Mesh, mut out: W) -> std::io::Result<()> {
+    use rayon::prelude::*;
+    use std::fmt::Write as _;
     writeln!(
         out,
         "# shadow-scene: {} vertices, {} faces",
         mesh.positions.len(),
         mesh.faces.len()
     )?;
-    for p in &mesh.positions {
-        writeln!(out, "v {:?} {:?} {:?}", p.x, p.y, p.z)?;
+    // The lines are formatted in parallel, by runs, a window of runs at a
+    // time (so that only a window's text is held), and written in order.
+    const RUN: usize = 4096;
+    const WINDOW: usize = 32 * RUN;
+    const INFALLIBLE: &str = "writing to a String does not fail";
+    for window in mesh.positions.chunks(WINDOW) {
+        let texts: Vec<String> = window
+            .par_chunks(RUN)
+            .map(|run| {
+                let mut text = String::with_capacity(64 * run.len());
+                for p in run {
+                    writeln!(text, "v {:?} {:?} {:?}", p.x, p.y, p.z).expect(INFALLIBLE);
+                }
+                text
+            })
+            .collect();
+        texts.iter().try_for_each(|t| out.write_all(t.as_bytes()))?;
     }
-    let mut current = None;
-    for f in &mesh.faces {
-        if current != Some(f.group) {
-            current = Some(f.group);
-            let name = mesh
-                .groups
-                .get(f.group as usize)
-                .map(|s| s.split_whitespace().collect::<Vec<_>>().join(" "))
-                .filter(|s| !s.is_empty())
-                .unwrap_or_else(|| "default".to_string());
-            writeln!(out, "g {name}")?;
-        }
-        out.write_all(b"f")?;
-        for v in &f.vertices {
-            write!(out, " {}", v + 1)?;
-        }
-        out.write_all(b"\n")?;
+    // a `g` line where the group changes from the face before
+    let group_line = |g: u32| {
+        let name = mesh
+            .groups
+            .get(g as usize)
+            .map(|s| s.split_whitespace().collect::<Vec<_>>().join(" "))
+            .filter(|s| !s.is_empty())
+            .unwrap_or_else(|| "default".to_string());
+        format!("g {name}\n")
+    };
+    for (w, window) in mesh.faces.chunks(WINDOW).enumerate() {
+        let texts: Vec<String> = window
+            .par_chunks(RUN)
+            .enumerate()
+            .map(|(r, run)| {
+                let first = w * WINDOW + r * RUN;
+                let mut current = first.checked_sub(1).map(|i| mesh.faces[i].group);
+                let mut text = String::with_capacity(24 * run.len());
+                for f in run {
+                    if current != Some(f.group) {
+                        current = Some(f.group);
+                        text.push_str(&group_line(f.group));
+                    }
+                    text.push('f');
+                    for v in &f.vertices {
+                        write!(text, " {}", u64::from(*v) + 1).expect(INFALLIBLE);
+                    }
+                    text.push('\n');
+                }
+                text
+            })
+            .collect();
+        texts.iter().try_for_each(|t| out.write_all(t.as_bytes()))?;
     }
     out.flush()
 }
@@ -564,6 +614,54 @@ f 4 1 5 8
                 .collect::<Vec<_>>()
         };
         assert_eq!(loops(&back), loops(&m));
+    }
+
+    /// A mesh larger than the writer's runs and windows, with groups that
+    /// change within runs, at a run's first face and back, is written
+    /// line for line as one pass in order writes it.
+    #[test]
+    fn a_large_mesh_is_written_as_one_pass_in_order_writes_it() {
+        let mut m = Mesh::default();
+        for i in 0..300_000u32 {
+            let x = f64::from(i);
+            m.positions.push(DVec3::new(x / 7.0, -x * 1e-9, x.sqrt()));
+        }
+        let (a, b) = (m.add_group("a"), m.add_group("b  c"));
+        let faces = 200_000u32;
+        for i in 0..faces {
+            // a run of 4096 faces starts at 4096: group b there, then a
+            // run boundary inside a group, and a change at every 1000th face
+            let group = if i == 4096 || (i / 1000) % 2 == 1 {
+                b
+            } else {
+                a
+            };
+            m.faces.push(Face {
+                vertices: vec![i, i + 1, i + 2 + i % 5],
+                line: 0,
+                group,
+            });
+        }
+        let mut buf = Vec::new();
+        write_obj(&m, &mut buf).unwrap();
+        let mut expected = format!(
+            "# shadow-scene: {} vertices, {} faces\n",
+            m.positions.len(),
+            m.faces.len()
+        );
+        for p in &m.positions {
+            expected += &format!("v {:?} {:?} {:?}\n", p.x, p.y, p.z);
+        }
+        let mut current = None;
+        for f in &m.faces {
+            if current != Some(f.group) {
+                current = Some(f.group);
+                expected += if f.group == a { "g a\n" } else { "g b c\n" };
+            }
+            let [x, y, z] = [0, 1, 2].map(|k| f.vertices[k] + 1);
+            expected += &format!("f {x} {y} {z}\n");
+        }
+        assert!(String::from_utf8(buf).unwrap() == expected);
     }
 
     #[test]
