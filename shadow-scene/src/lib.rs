@@ -211,6 +211,19 @@ mod tests {
     }
 
     #[test]
+    fn bytes_that_are_not_utf8_are_replaced() {
+        // a Latin-1 comment and group name: the geometry reads as it is
+        let text = b"# caf\xe9\nv 0 0 0\nv 1 0 0\nv 0 1 0\ng t\xeate\nf 1 2 3\n";
+        let m = load(&temp("latin1.obj", text)).unwrap();
+        assert_eq!(m.positions.len(), 3);
+        assert_eq!(m.faces[0].vertices, vec![0, 1, 2]);
+        assert_eq!(m.group_name(0), "t\u{fffd}te");
+        // where a number is expected, the replaced byte is an error there
+        let e = load(&temp("latin1_bad.obj", b"v 0 0 0\nv 1 \xe9 0\n")).unwrap_err();
+        assert_eq!(e.line(), Some(2));
+    }
+
+    #[test]
     fn the_shipped_meshes_load() {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/meshes");
         let teapot = load(&dir.join("teapot.obj")).unwrap();

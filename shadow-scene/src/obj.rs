@@ -24,7 +24,10 @@ pub fn read_obj_notes(path: &Path) -> Result<(Mesh, ObjNotes), SceneError> {
         path: name.clone(),
         source,
     })?;
-    if let Some(at) = bytes.iter().position(|&b| b == 0) {
+    // (`contains` on bytes is a fast scan; the place only on a find)
+    if bytes.contains(&0)
+        && let Some(at) = bytes.iter().position(|&b| b == 0)
+    {
         let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
         return Err(SceneError::Parse {
             path: name,
@@ -32,7 +35,11 @@ pub fn read_obj_notes(path: &Path) -> Result<(Mesh, ObjNotes), SceneError> {
             message: format!("binary data (a NUL byte at byte {at}): not an OBJ file"),
         });
     }
-    parse_obj_notes(&String::from_utf8_lossy(&bytes), &name)
+    // valid UTF-8 is read as it is (the strict check is the fast one)
+    match std::str::from_utf8(&bytes) {
+        Ok(text) => parse_obj_notes(text, &name),
+        Err(_) => parse_obj_notes(&String::from_utf8_lossy(&bytes), &name),
+    }
 }
 
 /// Statements an OBJ reader skipped because it does not know them (a typo
