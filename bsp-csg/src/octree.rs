@@ -277,15 +277,22 @@ fn split<P: PlaneTest, Q: PlaneTest>(
     // lists joined in order (the same lists)
     let deal = |fs: &[u32], bxs: &[SmallBox], meets: &(dyn Fn(u32, &IBox) -> bool + Sync)| {
         const RUN: usize = 1 << 13;
+        // (each child's list starts with room for a share of the faces:
+        // a surface crosses about half the children of a cell)
+        let room = |n: usize| n.div_ceil(boxes.len()) * 2;
         if fs.len() <= 2 * RUN {
-            let mut lists = vec![Vec::new(); boxes.len()];
+            let mut lists: Vec<Vec<u32>> = (0..boxes.len())
+                .map(|_| Vec::with_capacity(room(fs.len())))
+                .collect();
             deal_run(fs, bxs, meets, &mut lists);
             return lists;
         }
         let runs: Vec<Vec<Vec<u32>>> = fs
             .par_chunks(RUN)
             .map(|run| {
-                let mut lists = vec![Vec::new(); boxes.len()];
+                let mut lists: Vec<Vec<u32>> = (0..boxes.len())
+                    .map(|_| Vec::with_capacity(room(run.len())))
+                    .collect();
                 deal_run(run, bxs, meets, &mut lists);
                 lists
             })
