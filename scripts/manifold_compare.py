@@ -19,6 +19,11 @@ end to end (snap+boolean+mesh vs construct+boolean; file reading, validation
 and writing excluded on both sides). `total` is the CLI's own wall time
 with loading, validation and writing.
 
+On a host whose speed drifts over minutes, the ratio of a block of our runs
+to a block of theirs moves with the drift; `--paired K` then runs K rounds
+of one run each, alternating, and prints the median and range of the
+per-round ratios.
+
     pip install manifold3d numpy
     cargo build --release -p shadow-cli
     python3 scripts/manifold_compare.py --sizes 1000 10000 --bunny
@@ -176,6 +181,36 @@ def run_theirs(op, a, b, reps):
     return statistics.median(cons), statistics.median(boo), ntri
 
 
+def ours_of(ph):
+    """The compared phases of one run of ours (see the table's `ours`)."""
+    return (ph.get("snap/import", 0) + ph.get("boolean", 0)
+            + ph.get("boundary+mesh", 0) + ph.get("check", 0))
+
+
+def run_paired(args, op, pa, pb, out, a, b):
+    """`args.paired` rounds of one run of ours and one of theirs, the
+    first of the pair alternating: (rounds, our median, their median,
+    median ratio, lowest, highest)."""
+    ours, theirs, ratios = [], [], []
+    for k in range(args.paired):
+        def one_ours():
+            return ours_of(run_ours(args.cli, op, pa, pb, out, 1, args.timeout)[0])
+
+        def one_theirs():
+            mc, mb, _ = run_theirs(op, a, b, 1)
+            return mc + mb
+
+        if k % 2 == 0:
+            o, t = one_ours(), one_theirs()
+        else:
+            t, o = one_theirs(), one_ours()
+        ours.append(o)
+        theirs.append(t)
+        ratios.append(o / t)
+    return (args.paired, statistics.median(ours), statistics.median(theirs),
+            statistics.median(ratios), min(ratios), max(ratios))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sizes", type=int, nargs="*", default=[1000, 10000])
@@ -186,6 +221,11 @@ def main():
     ap.add_argument("--cli", default=os.path.join(ROOT, "target/release/shadow"))
     ap.add_argument("--timeout", type=float, default=600)
     ap.add_argument("--keep", help="write the OBJ files here instead of a temp dir")
+    ap.add_argument("--paired", type=int, default=0, metavar="K",
+                    help="then K rounds of one run each, ours and theirs alternating "
+                         "(which goes first too): the median and range of the "
+                         "per-round ratios, which a host whose speed drifts over "
+                         "minutes moves less than the ratio of two blocks of runs")
     args = ap.parse_args()
 
     from importlib.metadata import version
@@ -195,6 +235,7 @@ def main():
               "r.b+m", "r.all", "octree / out tris ours,theirs"))
     print(hdr)
     print("-" * len(hdr))
+    paired = []
     with tempfile.TemporaryDirectory() as tmp:
         d = args.keep or tmp
         os.makedirs(d, exist_ok=True)
@@ -217,6 +258,14 @@ def main():
                       % (name, op, build, merge, mesh, ours, ph.get("total", 0), mc, mb,
                          (merge + mesh) / mb, ours / (mc + mb), nodes, tris, mt))
                 sys.stdout.flush()
+                if args.paired:
+                    paired.append((name, op) + run_paired(args, op, pa, pb, out, a, b))
+    if paired:
+        print("paired rounds (ours = snap+boolean+mesh, theirs = construct+boolean, one "
+              "run each per round, alternating):")
+        for name, op, k, o, t, med, lo, hi in paired:
+            print("%-14s %-12s %3d rounds: ours %8.2f ms, theirs %8.2f ms (medians); "
+                  "ratio median %.3f (%.3f-%.3f)" % (name, op, k, o, t, med, lo, hi))
     print("times in ms (medians); ours = snap/import + boolean + boundary+mesh+check "
           "(file IO and validation excluded); total = the CLI's whole run;")
     print("r.b+m = (boolean+mesh)/manifold boolean; r.all = ours/(manifold construct+boolean)")
