@@ -598,20 +598,14 @@ impl Polygon {
             (true, true) => {}
         }
         let out = std::cell::RefCell::new(Builder::new(self.support, self.tag));
-        let support = self.support;
-        let edges = &self.edges;
         let (keep_front, keep_back) = (keep == Front, keep == Back);
         split_loop(
             &self.verts,
-            edges,
+            &self.edges,
             &sides,
             plane.flip(),
             *plane,
-            |i| {
-                let verts = &self.verts;
-                let j = if i + 1 == verts.len() { 0 } else { i + 1 };
-                Point::crossing(&verts[i], &verts[j], &support, &edges[i], plane)
-            },
+            |i| self.crossing(i, plane),
             |v, e| {
                 if keep_front {
                     out.borrow_mut().push(v, e)
@@ -628,6 +622,19 @@ impl Polygon {
         true
     }
 
+    /// The new vertex where `plane` cuts edge `i`, whose ends it has
+    /// strictly on opposite sides ([`Point::crossing`]).
+    fn crossing(&self, i: usize, plane: &Plane) -> Point {
+        let j = if i + 1 == self.verts.len() { 0 } else { i + 1 };
+        Point::crossing(
+            &self.verts[i],
+            &self.verts[j],
+            &self.support,
+            &self.edges[i],
+            plane,
+        )
+    }
+
     fn split_with_sides(&self, plane: &Plane, sides: &[crate::Side]) -> (Polygon, Polygon) {
         let mut f = Builder::new(self.support, self.tag);
         let mut b = Builder::new(self.support, self.tag);
@@ -637,16 +644,7 @@ impl Polygon {
             sides,
             plane.flip(),
             *plane,
-            |i| {
-                let j = if i + 1 == self.verts.len() { 0 } else { i + 1 };
-                Point::crossing(
-                    &self.verts[i],
-                    &self.verts[j],
-                    &self.support,
-                    &self.edges[i],
-                    plane,
-                )
-            },
+            |i| self.crossing(i, plane),
             |v, e| f.push(v, e),
             |v, e| b.push(v, e),
         );

@@ -101,28 +101,29 @@ impl Operand {
     /// readers' notes are printed, and the first error returned, in the
     /// order of the files, as reading them in turn would.
     fn load_all(paths: &[PathBuf], weld: bool) -> Result<Vec<Operand>> {
-        let read: Vec<Result<(Mesh, Option<String>)>> =
-            paths.par_iter().map(|p| crate::read_mesh(p)).collect();
-        let mut meshes = Vec::with_capacity(paths.len());
-        for (path, r) in paths.iter().zip(read) {
-            let (mesh, note) = r?;
-            if let Some(m) = note {
-                eprintln!("note: {m}");
-            }
-            meshes.push(crate::with_faces(path, mesh)?);
-        }
-        Ok(meshes
-            .into_par_iter()
-            .zip(paths)
-            .map(|(mut mesh, path)| {
+        type Read = (Mesh, Option<Vec<Vec<u32>>>, Option<String>);
+        let read: Vec<Result<Read>> = paths
+            .par_iter()
+            .map(|p| {
+                let (mut mesh, note) = crate::read_mesh(p)?;
                 let file_loops = weld.then(|| {
                     let loops = mesh.faces.iter().map(|f| f.vertices.clone()).collect();
                     mesh.weld();
                     loops
                 });
-                Operand::new(path.display().to_string(), mesh, file_loops)
+                Ok((mesh, file_loops, note))
             })
-            .collect())
+            .collect();
+        let mut operands = Vec::with_capacity(paths.len());
+        for (path, r) in paths.iter().zip(read) {
+            let (mesh, file_loops, note) = r?;
+            if let Some(m) = note {
+                eprintln!("note: {m}");
+            }
+            let mesh = crate::with_faces(path, mesh)?;
+            operands.push(Operand::new(path.display().to_string(), mesh, file_loops));
+        }
+        Ok(operands)
     }
 
     /// `file:line` of face `face` for text formats, else `file`.

@@ -172,28 +172,23 @@ pub fn parse_obj_notes(
         let line = i + 1;
         // a line read as it is, unless it goes on to the next (copied then)
         let mut current = first.trim_end();
-        let whole: &str = match current.strip_suffix('\\') {
-            None => current,
-            Some(_) => {
-                statement.clear();
-                loop {
-                    match current.strip_suffix('\\') {
-                        Some(head) => {
-                            statement.push_str(head);
-                            statement.push(' ');
-                            match lines.next() {
-                                Some((_, next)) => current = next.trim_end(),
-                                None => break,
-                            }
-                        }
-                        None => {
-                            statement.push_str(current);
-                            break;
-                        }
+        let whole: &str = if current.ends_with('\\') {
+            statement.clear();
+            while let Some(head) = current.strip_suffix('\\') {
+                statement.push_str(head);
+                statement.push(' ');
+                match lines.next() {
+                    Some((_, next)) => current = next.trim_end(),
+                    None => {
+                        current = "";
+                        break;
                     }
                 }
-                &statement
             }
+            statement.push_str(current);
+            &statement
+        } else {
+            current
         };
         let content = match whole.find('#') {
             Some(at) => &whole[..at],
@@ -336,32 +331,19 @@ fn resolve_index(i: i64, n: usize) -> Result<u32, String> {
 /// assert_eq!(back.faces.len(), chair.faces.len());
 /// ```
 pub fn write_obj<W: Write>(mesh: &Mesh, mut out: W) -> std::io::Result<()> {
-    use rayon::prelude::*;
     use std::fmt::Write as _;
+    const INFALLIBLE: &str = "writing to a String does not fail";
     writeln!(
         out,
         "# shadow-scene: {} vertices, {} faces",
         mesh.positions.len(),
         mesh.faces.len()
     )?;
-    // The lines are formatted in parallel, by runs, a window of runs at a
-    // time (so that only a window's text is held), and written in order.
-    const RUN: usize = 4096;
-    const WINDOW: usize = 32 * RUN;
-    const INFALLIBLE: &str = "writing to a String does not fail";
-    for window in mesh.positions.chunks(WINDOW) {
-        let texts: Vec<String> = window
-            .par_chunks(RUN)
-            .map(|run| {
-                let mut text = String::with_capacity(64 * run.len());
-                for p in run {
-                    writeln!(text, "v {:?} {:?} {:?}", p.x, p.y, p.z).expect(INFALLIBLE);
-                }
-                text
-            })
-            .collect();
-        texts.iter().try_for_each(|t| out.write_all(t.as_bytes()))?;
-    }
+    write_in_runs(&mut out, &mesh.positions, 64, |text, _, run| {
+        for p in run {
+            writeln!(text, "v {:?} {:?} {:?}", p.x, p.y, p.z).expect(INFALLIBLE);
+        }
+    })?;
     // a `g` line where the group changes from the face before
     let group_line = |g: u32| {
         let name = mesh
@@ -372,31 +354,50 @@ pub fn write_obj<W: Write>(mesh: &Mesh, mut out: W) -> std::io::Result<()> {
             .unwrap_or_else(|| "default".to_string());
         format!("g {name}\n")
     };
-    for (w, window) in mesh.faces.chunks(WINDOW).enumerate() {
+    write_in_runs(&mut out, &mesh.faces, 24, |text, first, run| {
+        let mut current = first.checked_sub(1).map(|i| mesh.faces[i].group);
+        for f in run {
+            if current != Some(f.group) {
+                current = Some(f.group);
+                text.push_str(&group_line(f.group));
+            }
+            text.push('f');
+            for v in &f.vertices {
+                write!(text, " {}", u64::from(*v) + 1).expect(INFALLIBLE);
+            }
+            text.push('\n');
+        }
+    })?;
+    out.flush()
+}
+
+/// Writes the lines of `items` that `format(text, first, run)` appends for
+/// each run of them (`first`: the index of the run's first item), the runs
+/// formatted in parallel, a window of runs at a time (so that only a
+/// window's text is held), and written in order: the bytes one pass in
+/// order writes. `bytes` is a guess at an item's line length.
+fn write_in_runs<T: Sync, W: Write>(
+    out: &mut W,
+    items: &[T],
+    bytes: usize,
+    format: impl Fn(&mut String, usize, &[T]) + Sync,
+) -> std::io::Result<()> {
+    use rayon::prelude::*;
+    const RUN: usize = 4096;
+    const WINDOW: usize = 32 * RUN;
+    for (w, window) in items.chunks(WINDOW).enumerate() {
         let texts: Vec<String> = window
             .par_chunks(RUN)
             .enumerate()
             .map(|(r, run)| {
-                let first = w * WINDOW + r * RUN;
-                let mut current = first.checked_sub(1).map(|i| mesh.faces[i].group);
-                let mut text = String::with_capacity(24 * run.len());
-                for f in run {
-                    if current != Some(f.group) {
-                        current = Some(f.group);
-                        text.push_str(&group_line(f.group));
-                    }
-                    text.push('f');
-                    for v in &f.vertices {
-                        write!(text, " {}", u64::from(*v) + 1).expect(INFALLIBLE);
-                    }
-                    text.push('\n');
-                }
+                let mut text = String::with_capacity(bytes * run.len());
+                format(&mut text, w * WINDOW + r * RUN, run);
                 text
             })
             .collect();
         texts.iter().try_for_each(|t| out.write_all(t.as_bytes()))?;
     }
-    out.flush()
+    Ok(())
 }
 
 #[cfg(test)]
