@@ -672,6 +672,7 @@ impl Solid {
         let mut plan = Plan {
             add: Vec::new(),
             flip: false,
+            later: Vec::new(),
         };
         match op {
             BoolOp::Union => {
@@ -721,6 +722,21 @@ impl Solid {
         self.carry_out(plan, Other::Owned(&mut other));
         drop_aside(other);
         Ok(stats)
+    }
+
+    /// `self op other`, decided but not yet carried out: the result is
+    /// then made as a mesh ([`Planned::into_watertight_mesh`]) straight
+    /// from the two solids' faces, with no solid of its own (the last
+    /// operation of a sequence needs none), or as a solid
+    /// ([`Planned::into_solid`], what [`Solid::apply_owned`] gives).
+    pub fn plan_owned(mut self, other: Solid, op: BoolOp) -> Result<Planned, CsgError> {
+        let (stats, plan) = self.plan(&other, op, &Options::default())?;
+        Ok(Planned {
+            solid: self,
+            other,
+            plan,
+            stats,
+        })
     }
 
     /// Everything an operation decides; of the changes to this solid it
@@ -1169,7 +1185,7 @@ impl Solid {
                 )
             },
         );
-        drop_aside((pieces_a, fates_a, pieces_b, fates_b));
+        let mut later: Later = vec![Box::new((pieces_a, fates_a, pieces_b, fates_b))];
         let (settled_a, settled_b) = (settled_a?, settled_b?);
         for (f, outcome) in settled_a {
             if let Some(kept) = outcome {
@@ -1217,11 +1233,19 @@ impl Solid {
             }
         }
         self.remove_all(&remove);
-        // the octree and its lists go on the pool (freeing them here, as
-        // the function returns, held up carrying the plan out)
-        drop_aside((leaves, a_leaves, b_leaves, adjacent, a_c, b_c));
-        drop_aside((inside_a, inside_b, masks_a, masks_b, remove));
-        Ok((stats, Plan { add, flip: flip_b }))
+        // the octree and its lists are let go of with the pieces, once the
+        // result is made (freeing them here, as the function returns, held
+        // up what follows)
+        later.push(Box::new((leaves, a_leaves, b_leaves, adjacent, a_c, b_c)));
+        later.push(Box::new((inside_a, inside_b, masks_a, masks_b, remove)));
+        Ok((
+            stats,
+            Plan {
+                add,
+                flip: flip_b,
+                later,
+            },
+        ))
     }
 
     /// Carries a plan out: its new faces, then the other solid's faces it
@@ -1231,7 +1255,8 @@ impl Solid {
     /// slots (freed slots first, in order, then the end of the array),
     /// each moved or copied once; the index takes them while the new
     /// faces' equal new vertices are made one.
-    fn carry_out(&mut self, plan: Plan, other: Other<'_>) {
+    fn carry_out(&mut self, mut plan: Plan, other: Other<'_>) {
+        drop_aside(std::mem::take(&mut plan.later));
         // where each face comes from: a kept face of an owned solid is
         // taken from its slot (distinct slots: one borrow each)
         enum Source<'s> {
@@ -1336,6 +1361,118 @@ impl Solid {
     }
 }
 
+/// An operation on two solids, decided ([`Solid::plan_owned`]).
+pub struct Planned {
+    solid: Solid,
+    other: Solid,
+    plan: Plan,
+    stats: Stats,
+}
+
+impl Planned {
+    /// What the operation found.
+    pub fn stats(&self) -> &Stats {
+        &self.stats
+    }
+
+    /// The result as a solid, ready for further operations.
+    pub fn into_solid(self) -> Solid {
+        let Planned {
+            mut solid,
+            mut other,
+            plan,
+            ..
+        } = self;
+        solid.carry_out(plan, Other::Owned(&mut other));
+        drop_aside(other);
+        solid
+    }
+
+    /// The result's watertight mesh, the one [`Planned::into_solid`]'s
+    /// [`Solid::into_watertight_mesh`] gives (the same triangles in the
+    /// same order), made from the faces where they are: the result's
+    /// faces are not moved into one solid, and no index is made for them.
+    pub fn into_watertight_mesh(self) -> Result<TriMesh, CsgError> {
+        let Planned {
+            solid,
+            other,
+            mut plan,
+            ..
+        } = self;
+        let later = std::mem::take(&mut plan.later);
+        let Solid {
+            faces,
+            mut free,
+            index,
+            ..
+        } = solid;
+        let Solid {
+            faces: theirs,
+            index: their_index,
+            ..
+        } = other;
+        drop_aside((index, their_index));
+        // the faces the plan adds that are not read where they are: new
+        // ones, and the other solid's flipped for a difference
+        let flip = plan.flip;
+        enum Src {
+            New(u32),
+            Flipped(u32),
+            Theirs(u32),
+        }
+        let (mut news, mut flipped) = (Vec::new(), Vec::new());
+        let srcs: Vec<Src> = plan
+            .add
+            .into_iter()
+            .map(|a| match a {
+                Added::New(p) => {
+                    news.push(p);
+                    Src::New((news.len() - 1) as u32)
+                }
+                Added::Whole(f) if flip => {
+                    flipped.push(f);
+                    Src::Flipped((flipped.len() - 1) as u32)
+                }
+                Added::Whole(f) => Src::Theirs(f),
+            })
+            .collect();
+        let face = |f: u32| theirs[f as usize].as_ref().expect("a live face");
+        {
+            // equal new vertices made one, as `carry_out` makes them: the
+            // welder then knows them equal at once
+            let mut refs: Vec<&mut Polygon> = news.iter_mut().map(|p| &mut **p).collect();
+            share_points(&mut refs);
+        }
+        let (news, flipped): (Vec<Face>, Vec<Face>) = rayon::join(
+            || news.into_par_iter().map(Face::made).collect(),
+            || flipped.par_iter().map(|&f| face(f).flipped()).collect(),
+        );
+        let src = |s: &Src| -> &Face {
+            match *s {
+                Src::New(i) => &news[i as usize],
+                Src::Flipped(i) => &flipped[i as usize],
+                Src::Theirs(f) => face(f),
+            }
+        };
+        // in the order of the slots `carry_out` would put them in: the
+        // freed slots first, as popped, then the end of the array
+        let k = srcs.len().min(free.len());
+        let mut polys: Vec<Option<&Face>> = faces.iter().map(Option::as_ref).collect();
+        for s in &srcs[..k] {
+            polys[free.pop().expect("a free slot") as usize] = Some(src(s));
+        }
+        let polys: Vec<&Face> = polys
+            .into_iter()
+            .flatten()
+            .chain(srcs[k..].iter().map(src))
+            .collect();
+        let mesh = TriMesh::from_polygons_watertight(&polys).map_err(CsgError::Internal);
+        drop(polys);
+        drop_aside((faces, theirs, news, flipped, later));
+        mesh
+    }
+}
+
 /// The items at `ids` (strictly increasing), each borrowed once.
 fn borrow_sorted<'a, T>(items: &'a mut [T], ids: &[u32]) -> Vec<&'a mut T> {
     let mut out = Vec::with_capacity(ids.len());
@@ -1363,7 +1500,14 @@ enum Other<'s> {
 struct Plan {
     add: Vec<Added>,
     flip: bool,
+    /// What the decision was made with, to be let go of when it suits.
+    later: Later,
 }
+
+/// Things to be dropped later, on the thread pool: freeing the octree and
+/// the pieces of a large operation takes a few milliseconds, and is put
+/// off until the result is made.
+type Later = Vec<Box<dyn Send>>;
 
 /// A new face, or (`Whole`) the other solid's face kept whole; new faces
 /// are boxed so that the many whole ones cost a few bytes each.

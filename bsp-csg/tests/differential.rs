@@ -76,12 +76,17 @@ fn op() -> impl Strategy<Value = BoolOp> {
 
 /// The same mesh, vertex for vertex and triangle for triangle.
 fn identical(a: &Solid, b: &Solid) -> Result<(), TestCaseError> {
-    let (ma, mb) = (a.to_mesh(), b.to_mesh());
+    same_mesh(&a.to_mesh(), &b.to_mesh())
+}
+
+/// The same mesh, vertex for vertex and triangle for triangle.
+fn same_mesh(ma: &bsp_core::TriMesh, mb: &bsp_core::TriMesh) -> Result<(), TestCaseError> {
     prop_assert_eq!(ma.vertices.len(), mb.vertices.len(), "vertices");
     for (p, q) in ma.vertices.iter().zip(&mb.vertices) {
         prop_assert!(p.same_point(q), "vertex {:?} against {:?}", p, q);
     }
     prop_assert_eq!(&ma.triangles, &mb.triangles, "triangles");
+    prop_assert_eq!(&ma.planes, &mb.planes, "planes");
     Ok(())
 }
 
@@ -142,6 +147,33 @@ proptest! {
         full.apply_with(&Solid::from_polygons(pb), op, &opts.with_easy_cells(false))
             .unwrap();
         identical(&octree, &full)?;
+    }
+
+    #[test]
+    fn the_last_result_meshed_from_its_plan_is_the_solid_s_mesh(
+        first in shape(),
+        rest in prop::collection::vec((shape(), op()), 1..4),
+    ) {
+        // the operations before the last leave free slots in the first
+        // solid, which the last one's faces fill first
+        let mut acc = Solid::from_polygons(polys(&first));
+        let (last, op) = rest.last().unwrap();
+        for (s, op) in &rest[..rest.len() - 1] {
+            acc.apply(&Solid::from_polygons(polys(s)), *op).unwrap();
+        }
+        let other = Solid::from_polygons(polys(last));
+        let mut applied = acc.clone();
+        applied.apply(&other, *op).unwrap();
+        let solid = acc.clone().plan_owned(other.clone(), *op).unwrap().into_solid();
+        identical(&solid, &applied)?;
+        let planned = acc.plan_owned(other, *op).unwrap();
+        match (planned.into_watertight_mesh(), solid.into_watertight_mesh()) {
+            (Ok(direct), Ok(via_solid)) => same_mesh(&direct, &via_solid)?,
+            (direct, via_solid) => prop_assert_eq!(
+                direct.map(|m| m.triangles).map_err(|e| e.to_string()),
+                via_solid.map(|m| m.triangles).map_err(|e| e.to_string())
+            ),
+        }
     }
 
     #[test]

@@ -170,3 +170,43 @@ fn clean_cells_keep_faces_whole_as_local_trees_would() {
         }
     }
 }
+
+/// The last operation of a sequence, meshed straight from its plan
+/// (`Planned::into_watertight_mesh`), gives the mesh of the solid the
+/// operation makes: the same vertices and triangles in the same order,
+/// for every operation, after subtractions that left free slots for its
+/// new faces to fill.
+#[test]
+fn a_planned_result_meshes_as_its_solid() {
+    let (pv, pf) = uv_sphere(2000);
+    let (placed, tf) = drill_tools(6, 1000);
+    let mut meshes = vec![MeshIn::new(&pv, &pf)];
+    meshes.extend(placed.iter().map(|v| MeshIn::new(v, &tf)));
+    let Snapped { mut solids, .. } = snap(&meshes).unwrap();
+    let last = solids.pop().unwrap();
+    let mut it = solids.into_iter();
+    let mut part = it.next().unwrap();
+    for tool in it {
+        part.apply(&tool, BoolOp::Difference).unwrap();
+    }
+    for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
+        let mut solid = part.clone();
+        let stats = solid.apply_owned(last.clone(), op).unwrap();
+        let planned = part.clone().plan_owned(last.clone(), op).unwrap();
+        assert_eq!(*planned.stats(), stats);
+        assert!(stats.pieces > 0, "{op:?} cuts faces");
+        let direct = planned.into_watertight_mesh().unwrap();
+        let via_solid = solid.into_watertight_mesh().unwrap();
+        assert_eq!(direct.triangles, via_solid.triangles, "{op:?}");
+        assert_eq!(direct.planes, via_solid.planes, "{op:?}");
+        assert_eq!(direct.vertices.len(), via_solid.vertices.len(), "{op:?}");
+        assert!(
+            direct
+                .vertices
+                .iter()
+                .zip(&via_solid.vertices)
+                .all(|(p, q)| p.same_point(q)),
+            "{op:?}"
+        );
+    }
+}

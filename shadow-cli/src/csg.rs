@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow};
 use bsp_core::{BoolOp, Grid, ImportReport, TopologyError, TriMesh};
-use bsp_csg::{CsgError, MeshIn, Solid};
+use bsp_csg::{CsgError, MeshIn, Planned, Solid};
 use clap::{Args, ValueEnum};
 use shadow_scene::{Face, Mesh, MeshFormat};
 
@@ -298,7 +298,11 @@ fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Resu
         bsp_csg::fit_grid(&meshes)
             .map_err(|e| anyhow!(e).context("cannot snap the faces to one grid"))?
     };
+    // the result so far, and the last operation decided (its result is
+    // made as a mesh only, with no solid)
     let mut solid: Option<Solid> = None;
+    let mut last: Option<Planned> = None;
+    let n_operands = operands.len();
     let mut reports = Vec::with_capacity(operands.len());
     let mut stats = Vec::new();
     for (i, o) in operands.iter_mut().enumerate() {
@@ -336,12 +340,16 @@ fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Resu
             );
         }
         reports.push(report);
-        let Some(acc) = solid.as_mut() else {
+        let Some(acc) = solid.take() else {
             solid = Some(next);
             continue;
         };
-        let st = phases
-            .run("boolean", || acc.apply_owned(next, op.kernel()))
+        let planned = phases
+            .run("boolean", || -> Result<Planned, CsgError> {
+                let planned = acc.plan_owned(next, op.kernel())?;
+                stats.push(*planned.stats());
+                Ok(planned)
+            })
             .map_err(|e| match e {
                 CsgError::NotASolid => anyhow!(
                     "{} or the result before it: a surface crosses itself after snapping to the \
@@ -351,13 +359,19 @@ fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Resu
                 ),
                 e => anyhow!(e),
             })?;
-        stats.push(st);
+        // the last result is made as a mesh only, from the faces where
+        // they are (no solid of its own)
+        if i + 1 < n_operands {
+            solid = Some(phases.run("boolean", || planned.into_solid()));
+        } else {
+            last = Some(planned);
+        }
     }
-    let solid = solid.expect("at least two operands");
+    let last = last.expect("at least two operands");
     // the mesh is checked watertight as it is made (one check, the one
     // that tells whether it needs mending where the solid touches itself)
     let (exact, mesh) = phases.run("boundary+mesh", || -> Result<(TriMesh, Mesh)> {
-        let exact = solid.into_watertight_mesh().map_err(|e| {
+        let exact = last.into_watertight_mesh().map_err(|e| {
             let names: Vec<&str> = operands.iter().map(|o| o.name.as_str()).collect();
             let e = match e {
                 CsgError::Internal(why) => why,
