@@ -5,6 +5,10 @@
 //!   (0.3, 0.1, 0.05) — the inputs of `scripts/manifold_compare.py`. End to
 //!   end from the meshes: snap to one grid and make both solids, the union,
 //!   the output triangle mesh and its watertightness check.
+//! * `octree_csg/union_planned/sphere N`: the same, as the CLI makes it:
+//!   the union decided (`Solid::plan_owned`) and meshed straight from the
+//!   two solids' faces (`Planned::into_watertight_mesh`), with no solid for
+//!   the result.
 //! * `octree_csg/drill/N`: N successive subtractions of 1k-triangle spheres
 //!   (radius 0.05, centred on the surface along a Fibonacci spiral) from a
 //!   10k-triangle sphere, on snapped solids (the `drill` example runs the
@@ -12,7 +16,7 @@
 
 use bsp_core::BoolOp;
 use bsp_csg::shapes::{drill_tools, sphere_pair, uv_sphere};
-use bsp_csg::{MeshIn, Snapped, snap};
+use bsp_csg::{MeshIn, Snapped, fit_grid, snap, snap_one};
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 
 fn union(c: &mut Criterion) {
@@ -29,6 +33,22 @@ fn union(c: &mut Criterion) {
                 )
                 .unwrap();
                 r.mesh.triangles.len()
+            })
+        });
+    }
+    g.finish();
+    let mut g = c.benchmark_group("octree_csg/union_planned");
+    g.sample_size(10);
+    for n in [1_000, 10_000, 100_000] {
+        let (va, vb, f) = sphere_pair(n);
+        let (a, b) = (MeshIn::new(&va, &f), MeshIn::new(&vb, &f));
+        g.bench_with_input(BenchmarkId::new("sphere", f.len()), &(), |bch, _| {
+            bch.iter(|| {
+                let grid = fit_grid(&[a, b]).unwrap();
+                let (sa, _) = snap_one(&grid, &a, 0).unwrap();
+                let (sb, _) = snap_one(&grid, &b, 1).unwrap();
+                let planned = sa.plan_owned(sb, BoolOp::Union).unwrap();
+                planned.into_watertight_mesh().unwrap().triangles.len()
             })
         });
     }
