@@ -51,6 +51,10 @@
 //! and mesh in one call; [`snap`] makes every operand's solid on one grid
 //! at once, and [`fit_grid`] with [`snap_one`] makes each when its turn
 //! comes, so that a long sequence holds only the result and one operand.
+//! Where only the mesh of the last result is wanted, [`Solid::plan_owned`]
+//! decides the operation and [`Planned::into_watertight_mesh`] meshes the
+//! result straight from the two solids' faces, with no solid of its own
+//! (what the CLI does).
 //!
 //! # Example
 //!
@@ -729,6 +733,24 @@ impl Solid {
     /// from the two solids' faces, with no solid of its own (the last
     /// operation of a sequence needs none), or as a solid
     /// ([`Planned::into_solid`], what [`Solid::apply_owned`] gives).
+    ///
+    /// ```
+    /// use bsp_core::BoolOp;
+    /// use bsp_csg::{MeshIn, fit_grid, shapes::sphere_pair, snap_one};
+    ///
+    /// let (va, vb, faces) = sphere_pair(1000);
+    /// let (a, b) = (MeshIn::new(&va, &faces), MeshIn::new(&vb, &faces));
+    /// let grid = fit_grid(&[a, b]).unwrap();
+    /// let (sa, _) = snap_one(&grid, &a, 0).unwrap();
+    /// let (sb, _) = snap_one(&grid, &b, 1).unwrap();
+    /// let planned = sa.clone().plan_owned(sb.clone(), BoolOp::Union).unwrap();
+    /// assert!(planned.stats().cut_faces > 0);
+    /// let mesh = planned.into_watertight_mesh().unwrap();
+    /// // the mesh of the solid `apply_owned` makes, triangle for triangle
+    /// let mut solid = sa;
+    /// solid.apply_owned(sb, BoolOp::Union).unwrap();
+    /// assert_eq!(mesh.triangles, solid.into_watertight_mesh().unwrap().triangles);
+    /// ```
     pub fn plan_owned(mut self, other: Solid, op: BoolOp) -> Result<Planned, CsgError> {
         let (stats, plan) = self.plan(&other, op, &Options::default())?;
         Ok(Planned {
