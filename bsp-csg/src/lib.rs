@@ -1022,7 +1022,7 @@ impl Solid {
             keep_inside: bool,
         ) -> impl Fn(u32, u32) -> Option<bool> + Sync + '_ {
             move |l: u32, i: u32| match fates.get(&l).map(|v| &v[i as usize]) {
-                Some(PieceFate::Keep(_) | PieceFate::KeepClip) => Some(keep_inside),
+                Some(PieceFate::Keep) => Some(keep_inside),
                 Some(PieceFate::Drop) => Some(!keep_inside),
                 _ => None,
             }
@@ -1102,7 +1102,7 @@ impl Solid {
                         .map(|(m, lab)| match (m, lab) {
                             (None, _) => Some(PieceFate::Missing),
                             (Some(_), Some(inside)) => Some(if keep(*inside) {
-                                PieceFate::KeepClip
+                                PieceFate::Keep
                             } else {
                                 PieceFate::Drop
                             }),
@@ -1557,11 +1557,9 @@ type Settled = Vec<(u32, Option<Vec<Polygon>>)>;
 enum PieceFate {
     /// Clipped to the cell, nothing is left of it.
     Missing,
-    /// Its piece in the cell stays whole.
-    Keep(Box<Polygon>),
-    /// Its piece in the cell stays whole, and is clipped again when
-    /// needed (an easy cell keeps no pieces).
-    KeepClip,
+    /// Its piece in the cell stays whole (the face is clipped again, to
+    /// the cells it stays whole in joined, when it is settled).
+    Keep,
     /// Its piece goes.
     Drop,
     /// The other surface cuts its piece: the fragments that stay.
@@ -1596,7 +1594,7 @@ impl Made {
                 .iter()
                 .map(|i| match i.and_then(|i| all[i as usize].take()) {
                     None => PieceFate::Missing,
-                    Some((Fate::Keep, p)) => PieceFate::Keep(Box::new(p)),
+                    Some((Fate::Keep, _)) => PieceFate::Keep,
                     Some((Fate::Drop, _)) => PieceFate::Drop,
                     Some((Fate::Cut(frags), _)) => PieceFate::Cut(frags),
                 })
@@ -1746,8 +1744,9 @@ fn meeting_leaf(face: &Face, ls: &[u32], leaves: &[Leaf]) -> Option<u32> {
 /// What stays of a face cut into `pieces`: `None` if every piece stays
 /// (the face stays as it is), else the kept pieces and fragments.
 /// `keep_free(cell)` says whether a piece in a free cell (`None`: beyond
-/// the octree's box) stays; `fates` are the mixed cells' (the pieces kept
-/// are copied: faces settle in parallel).
+/// the octree's box) stays; `fates` are the mixed cells' (the fragments
+/// kept are copied: faces settle in parallel). The face is clipped anew
+/// to the cells whose piece stays whole, joined into larger boxes.
 fn settle(
     face: &Face,
     pieces: &[Piece],
@@ -1761,7 +1760,7 @@ fn settle(
         Piece::Free(l) if keep_free(*l) => Some(Ok(())),
         Piece::Free(_) => Some(Err(())),
         Piece::Mixed(l, i) => fates.get(l).map(|v| match &v[*i as usize] {
-            PieceFate::Missing | PieceFate::Keep(_) | PieceFate::KeepClip => Ok(()),
+            PieceFate::Missing | PieceFate::Keep => Ok(()),
             PieceFate::Drop | PieceFate::Cut(_) => Err(()),
         }),
     };
@@ -1769,25 +1768,61 @@ fn settle(
         return None;
     }
     let (poly, fb) = (face.polygon(), face.bx());
-    let in_leaf = |l: u32| {
-        let bx = &leaves[l as usize].bx;
-        local::clip_in(&poly, &fb, bx, &walls(bx))
-    };
+    // the cells whose piece stays whole (the face clipped to the cell),
+    // and the fragments of the cells that cut it
     let mut kept = Vec::new();
+    let mut whole: Vec<IBox> = Vec::new();
     for p in pieces {
         match p {
-            Piece::Free(Some(l)) if keep_free(Some(*l)) => kept.extend(in_leaf(*l)),
+            Piece::Free(Some(l)) if keep_free(Some(*l)) => whole.push(leaves[*l as usize].bx),
             Piece::Free(None) if keep_free(None) => kept.extend(local::outside(&poly, root)),
             Piece::Free(_) => {}
             Piece::Mixed(l, i) => match fates.get(l).map(|v| &v[*i as usize]) {
-                Some(PieceFate::Keep(q)) => kept.push((**q).clone()),
-                Some(PieceFate::KeepClip) => kept.extend(in_leaf(*l)),
+                Some(PieceFate::Keep) => whole.push(leaves[*l as usize].bx),
                 Some(PieceFate::Cut(frags)) => kept.extend(frags.iter().cloned()),
                 _ => {}
             },
         }
     }
+    // the face clipped to the boxes those cells join into: the same
+    // region in fewer pieces than a piece per cell (a face crossing many
+    // small cells has dozens), so fewer clips and fewer to put together
+    join_boxes(&mut whole);
+    kept.extend(
+        whole
+            .iter()
+            .filter_map(|bx| local::clip_in(&poly, &fb, bx, &walls(bx))),
+    );
     Some(rejoin(kept))
+}
+
+/// Joins boxes that tile space without overlap into fewer boxes covering
+/// the same points: two boxes join where they share a whole wall (the
+/// same extent along two axes, one just after the other along the
+/// third), axis after axis, until none do. The result does not depend on
+/// the boxes' order.
+fn join_boxes(boxes: &mut Vec<IBox>) {
+    loop {
+        let before = boxes.len();
+        for k in 0..3 {
+            let (u, v) = ((k + 1) % 3, (k + 2) % 3);
+            let rest = |b: &IBox| (b.0[u], b.1[u], b.0[v], b.1[v]);
+            boxes.sort_unstable_by_key(|b| (rest(b), b.0[k]));
+            let mut joined: Vec<IBox> = Vec::with_capacity(boxes.len());
+            for b in boxes.drain(..) {
+                match joined.last_mut() {
+                    Some(last) if rest(last) == rest(&b) && last.1[k] + 1 == b.0[k] => {
+                        last.1[k] = b.1[k]
+                    }
+                    _ => joined.push(b),
+                }
+            }
+            *boxes = joined;
+        }
+        if boxes.len() == before {
+            return;
+        }
+    }
 }
 
 /// The kept pieces of one face put back together where two share a whole
@@ -2706,6 +2741,52 @@ mod tests {
                 assert_eq!(holding, usize::from(x < 10 || y < 10), "({x}, {y})");
             }
         }
+    }
+
+    /// Joined boxes cover exactly the points of the boxes joined: an
+    /// octree cell's eight children become the cell, an L of three boxes
+    /// stays two, and the order they come in does not matter.
+    #[test]
+    fn joined_boxes_cover_the_same_points() {
+        let children: Vec<IBox> = (0..8)
+            .map(|c: i64| {
+                let lo = [0, 1, 2].map(|k| if c >> k & 1 == 0 { 0 } else { 4 });
+                (lo, lo.map(|x| x + 3))
+            })
+            .collect();
+        for turn in 0..8 {
+            let mut bs = children.clone();
+            bs.rotate_left(turn);
+            join_boxes(&mut bs);
+            assert_eq!(bs, vec![([0, 0, 0], [7, 7, 7])]);
+        }
+        // an L (and a box apart): a cell and two of its neighbours
+        let l_shape = vec![
+            ([0, 0, 0], [1, 1, 1]),
+            ([2, 0, 0], [3, 1, 1]),
+            ([0, 2, 0], [1, 3, 1]),
+            ([9, 9, 9], [9, 9, 9]),
+        ];
+        let mut bs = l_shape.clone();
+        join_boxes(&mut bs);
+        assert_eq!(bs.len(), 3);
+        let points = |bs: &[IBox]| -> Vec<[i64; 3]> {
+            let mut ps: Vec<[i64; 3]> = bs
+                .iter()
+                .flat_map(|b| {
+                    (b.0[0]..=b.1[0]).flat_map(move |x| {
+                        (b.0[1]..=b.1[1])
+                            .flat_map(move |y| (b.0[2]..=b.1[2]).map(move |z| [x, y, z]))
+                    })
+                })
+                .collect();
+            ps.sort_unstable();
+            ps
+        };
+        assert_eq!(points(&bs), points(&l_shape));
+        let mut reversed: Vec<IBox> = l_shape.into_iter().rev().collect();
+        join_boxes(&mut reversed);
+        assert_eq!(reversed, bs);
     }
 
     /// Many faces removed at once (slots and index in parallel passes)
