@@ -676,7 +676,6 @@ impl Solid {
         let mut plan = Plan {
             add: Vec::new(),
             flip: false,
-            later: Vec::new(),
         };
         match op {
             BoolOp::Union => {
@@ -1207,7 +1206,7 @@ impl Solid {
                 )
             },
         );
-        let mut later: Later = vec![Box::new((pieces_a, fates_a, pieces_b, fates_b))];
+        drop_aside((pieces_a, fates_a, pieces_b, fates_b));
         let (settled_a, settled_b) = (settled_a?, settled_b?);
         for (f, outcome) in settled_a {
             if let Some(kept) = outcome {
@@ -1255,19 +1254,11 @@ impl Solid {
             }
         }
         self.remove_all(&remove);
-        // the octree and its lists are let go of with the pieces, once the
-        // result is made (freeing them here, as the function returns, held
-        // up what follows)
-        later.push(Box::new((leaves, a_leaves, b_leaves, adjacent, a_c, b_c)));
-        later.push(Box::new((inside_a, inside_b, masks_a, masks_b, remove)));
-        Ok((
-            stats,
-            Plan {
-                add,
-                flip: flip_b,
-                later,
-            },
-        ))
+        // the octree and its lists go on the pool (freeing them here, as
+        // the function returns, held up what follows)
+        drop_aside((leaves, a_leaves, b_leaves, adjacent, a_c, b_c));
+        drop_aside((inside_a, inside_b, masks_a, masks_b, remove));
+        Ok((stats, Plan { add, flip: flip_b }))
     }
 
     /// Carries a plan out: its new faces, then the other solid's faces it
@@ -1277,8 +1268,7 @@ impl Solid {
     /// slots (freed slots first, in order, then the end of the array),
     /// each moved or copied once; the index takes them while the new
     /// faces' equal new vertices are made one.
-    fn carry_out(&mut self, mut plan: Plan, other: Other<'_>) {
-        drop_aside(std::mem::take(&mut plan.later));
+    fn carry_out(&mut self, plan: Plan, other: Other<'_>) {
         // where each face comes from: a kept face of an owned solid is
         // taken from its slot (distinct slots: one borrow each)
         enum Source<'s> {
@@ -1416,12 +1406,8 @@ impl Planned {
     /// faces are not moved into one solid, and no index is made for them.
     pub fn into_watertight_mesh(self) -> Result<TriMesh, CsgError> {
         let Planned {
-            solid,
-            other,
-            mut plan,
-            ..
+            solid, other, plan, ..
         } = self;
-        let later = std::mem::take(&mut plan.later);
         let Solid {
             faces,
             mut free,
@@ -1490,7 +1476,7 @@ impl Planned {
             .collect();
         let mesh = TriMesh::from_polygons_watertight(&polys).map_err(CsgError::Internal);
         drop(polys);
-        drop_aside((faces, theirs, news, flipped, later));
+        drop_aside((faces, theirs, news, flipped));
         mesh
     }
 }
@@ -1522,14 +1508,7 @@ enum Other<'s> {
 struct Plan {
     add: Vec<Added>,
     flip: bool,
-    /// What the decision was made with, to be let go of when it suits.
-    later: Later,
 }
-
-/// Things to be dropped later, on the thread pool: freeing the octree and
-/// the pieces of a large operation takes a few milliseconds, and is put
-/// off until the result is made.
-type Later = Vec<Box<dyn Send>>;
 
 /// A new face, or (`Whole`) the other solid's face kept whole; new faces
 /// are boxed so that the many whole ones cost a few bytes each.
