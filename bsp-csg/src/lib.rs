@@ -1308,10 +1308,8 @@ impl Solid {
         // the array, in place: room for all at once (growing by doubling
         // would hold the old and a twice larger array)
         let n = from.len();
-        let rest = from.split_off(n.min(self.free.len()));
-        let reused: Vec<u32> = (0..from.len())
-            .map(|_| self.free.pop().expect("a free slot"))
-            .collect();
+        let reused = reused_slots(&mut self.free, n);
+        let rest = from.split_off(reused.len());
         let first_new = self.faces.len();
         // the slots of the new faces
         let mut new_slots: Vec<u32> = reused
@@ -1463,11 +1461,12 @@ impl Planned {
             }
         };
         // in the order of the slots `carry_out` would put them in: the
-        // freed slots first, as popped, then the end of the array
-        let k = srcs.len().min(free.len());
+        // freed slots first, then the end of the array
+        let reused = reused_slots(&mut free, srcs.len());
+        let k = reused.len();
         let mut polys: Vec<Option<&Face>> = faces.iter().map(Option::as_ref).collect();
-        for s in &srcs[..k] {
-            polys[free.pop().expect("a free slot") as usize] = Some(src(s));
+        for (&slot, s) in reused.iter().zip(&srcs) {
+            polys[slot as usize] = Some(src(s));
         }
         let polys: Vec<&Face> = polys
             .into_iter()
@@ -1479,6 +1478,16 @@ impl Planned {
         drop_aside((faces, theirs, news, flipped));
         mesh
     }
+}
+
+/// The freed slots the first `n` faces an operation adds go to, in the
+/// order they take them (popped from the end of `free`); the rest go at
+/// the end of the array. One rule for [`Solid::carry_out`] and for
+/// [`Planned::into_watertight_mesh`], which meshes the faces in the
+/// order the slots would hold them.
+fn reused_slots(free: &mut Vec<u32>, n: usize) -> Vec<u32> {
+    let k = n.min(free.len());
+    free.drain(free.len() - k..).rev().collect()
 }
 
 /// The items at `ids` (strictly increasing), each borrowed once.

@@ -88,16 +88,22 @@ fn new_vertices_are_shared_and_into_mesh_is_to_mesh() {
 
     let kept = a.to_mesh();
     let owned = a.into_mesh();
-    assert_eq!(kept.triangles, owned.triangles);
+    same_mesh(&kept, &owned, "into_mesh");
     assert_eq!(kept.planes, owned.planes);
-    assert_eq!(kept.vertices.len(), owned.vertices.len());
-    assert!(
-        kept.vertices
-            .iter()
-            .zip(&owned.vertices)
-            .all(|(p, q)| p.same_point(q))
-    );
     owned.check_watertight().unwrap();
+}
+
+/// The same triangles over the same exact vertices, in the same order.
+fn same_mesh(a: &TriMesh, b: &TriMesh, what: &str) {
+    assert_eq!(a.triangles, b.triangles, "{what}");
+    assert_eq!(a.vertices.len(), b.vertices.len(), "{what}");
+    assert!(
+        a.vertices
+            .iter()
+            .zip(&b.vertices)
+            .all(|(p, q)| p.same_point(q)),
+        "{what}"
+    );
 }
 
 /// `solids[0] op solids[1]` with `opts`: the result's mesh, checked
@@ -152,16 +158,7 @@ fn clean_cells_keep_faces_whole_as_local_trees_would() {
                 .with_leaf_size(leaf)
                 .with_easy_cells(false));
             assert_eq!(full_stats.clean_cells, 0);
-            assert_eq!(clean.triangles, full.triangles, "{op:?} at {leaf}");
-            assert_eq!(clean.vertices.len(), full.vertices.len());
-            assert!(
-                clean
-                    .vertices
-                    .iter()
-                    .zip(&full.vertices)
-                    .all(|(p, q)| p.same_point(q)),
-                "{op:?} at {leaf}"
-            );
+            same_mesh(&clean, &full, &format!("{op:?} at {leaf}"));
             assert_eq!(
                 clean.volume_exact(),
                 full.volume_exact(),
@@ -197,16 +194,7 @@ fn a_planned_result_meshes_as_its_solid() {
         assert!(stats.pieces > 0, "{op:?} cuts faces");
         let direct = planned.into_watertight_mesh().unwrap();
         let via_solid = solid.into_watertight_mesh().unwrap();
-        assert_eq!(direct.triangles, via_solid.triangles, "{op:?}");
+        same_mesh(&direct, &via_solid, &format!("{op:?}"));
         assert_eq!(direct.planes, via_solid.planes, "{op:?}");
-        assert_eq!(direct.vertices.len(), via_solid.vertices.len(), "{op:?}");
-        assert!(
-            direct
-                .vertices
-                .iter()
-                .zip(&via_solid.vertices)
-                .all(|(p, q)| p.same_point(q)),
-            "{op:?}"
-        );
     }
 }
