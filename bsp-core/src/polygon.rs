@@ -226,6 +226,22 @@ impl GridPolygon {
     /// A polygon from grid points in counter-clockwise order, checked and
     /// cleaned as [`Polygon::from_grid_points`] does.
     pub fn from_grid_points(points: &[GridPoint], tag: u32) -> Result<GridPolygon, FaceDefect> {
+        // most faces are triangles of three distinct corners: what the
+        // general path gives them, without its copies (the plane through
+        // the corners in order is the one oriented by their winding, and
+        // a triangle of nonzero area is convex)
+        if let [a, b, c] = *points
+            && a != b
+            && b != c
+            && c != a
+        {
+            let support = Plane::through(a, b, c).ok_or(FaceDefect::ZeroArea)?;
+            return Ok(GridPolygon {
+                support,
+                verts: SmallVec::from_buf_and_len([a, b, c, [0; 3]], 3),
+                tag,
+            });
+        }
         let mut v = dedupe_cyclic(points);
         if v.len() < 3 {
             return Err(FaceDefect::TooFewVertices);
@@ -942,6 +958,33 @@ pub(crate) fn hash_bits(bits: [u64; 3]) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    proptest::proptest! {
+        /// A triangle of three distinct corners takes a short path; it
+        /// gives what the general path gives the same corners (reached
+        /// through a repeated corner, which the general path drops):
+        /// plane, orientation, corners, and the defect of a degenerate one.
+        #[test]
+        fn a_triangle_s_short_path_gives_the_general_result(
+            c in proptest::array::uniform9(-6i32..6),
+            big in proptest::prelude::any::<bool>(),
+        ) {
+            let k = if big { 1 << 25 } else { 1 };
+            let p = |i: usize| [c[i] * k, c[i + 1] * k + 1, c[i + 2] * k];
+            let (a, b, d) = (p(0), p(3), p(6));
+            let short = GridPolygon::from_grid_points(&[a, b, d], 7);
+            let general = GridPolygon::from_grid_points(&[a, b, d, d], 7);
+            match (&short, &general) {
+                (Ok(s), Ok(g)) => {
+                    proptest::prop_assert_eq!(s.support(), g.support());
+                    proptest::prop_assert_eq!(s.vertices(), g.vertices());
+                    proptest::prop_assert_eq!(s.tag(), g.tag());
+                }
+                (Err(s), Err(g)) => proptest::prop_assert_eq!(s, g),
+                _ => proptest::prop_assert!(false, "{:?} against {:?}", short, general),
+            }
+        }
+    }
 
     /// A grid polygon's computed edge planes are exact edge planes of it
     /// (each holds its edge's ends, every other corner strictly behind),
