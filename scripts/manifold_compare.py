@@ -12,12 +12,13 @@ files into a temp dir, and for each operation:
   timing) and times, median of `--reps`: Manifold construction of both
   operands, and the boolean forced by `to_mesh()` (manifold is lazy).
 
-Prints a table: ours (snap/import of both meshes into solids, the boolean,
-boundary+mesh with its watertightness check), manifold (construct,
-boolean+to_mesh), and the ratios ours/theirs for boolean+mesh vs boolean and
-end to end (snap+boolean+mesh vs construct+boolean; file reading, validation
-and writing excluded on both sides). `total` is the CLI's own wall time
-with loading, validation and writing.
+Prints a table: ours (validation of both meshes as closed, oriented
+2-manifolds, snap/import of both into solids, the boolean, boundary+mesh
+with its watertightness check), manifold (construct, which checks the
+meshes too, and boolean+to_mesh), and the ratios ours/theirs for
+boolean+mesh vs boolean and end to end (validate+snap+boolean+mesh vs
+construct+boolean; file reading and writing excluded on both sides).
+`total` is the CLI's own wall time with loading and writing.
 
 On a host whose speed drifts over minutes, the ratio of a block of our runs
 to a block of theirs moves with the drift; `--paired K` then runs K rounds
@@ -152,9 +153,17 @@ def run_ours(cli, op, pa, pb, out, reps, timeout):
     return med, nodes, tris
 
 
+def arrays_of(verts, tris):
+    """The input as manifold3d takes it: `float32` positions and `uint32`
+    triangles (made outside the timing: turning a Python list of 100k
+    tuples into an array takes about 17 ms, which is not manifold's work)."""
+    return (np.ascontiguousarray(verts, dtype=np.float32),
+            np.ascontiguousarray(tris, dtype=np.uint32))
+
+
 def manifold_of(verts, tris):
-    mesh = Mesh(vert_properties=np.asarray(verts, dtype=np.float32),
-                tri_verts=np.asarray(tris, dtype=np.uint32))
+    """A Manifold from the arrays of `arrays_of`."""
+    mesh = Mesh(vert_properties=verts, tri_verts=tris)
     m = Manifold(mesh)
     st = m.status()
     if str(st) not in ("Error.NoError", "NoError") and "NoError" not in str(st):
@@ -167,6 +176,7 @@ def run_theirs(op, a, b, reps):
           "intersection": lambda x, y: x ^ y,
           "difference": lambda x, y: x - y}[op]
     cons, boo, ntri = [], [], None
+    a, b = arrays_of(*a), arrays_of(*b)
     for _ in range(reps):
         t0 = time.perf_counter()
         ma, mb = manifold_of(*a), manifold_of(*b)
@@ -183,14 +193,14 @@ def run_theirs(op, a, b, reps):
 
 def ours_of(ph):
     """The compared phases of one run of ours (see the table's `ours`)."""
-    return (ph.get("snap/import", 0) + ph.get("boolean", 0)
+    return (ph.get("validate", 0) + ph.get("snap/import", 0) + ph.get("boolean", 0)
             + ph.get("boundary+mesh", 0) + ph.get("check", 0))
 
 
 def run_paired(args, op, pa, pb, out, a, b):
     """`args.paired` rounds of one run of ours and one of theirs, the
     first of the pair alternating: (rounds, our median, their median,
-    median ratio, lowest, highest)."""
+    median ratio, lowest, highest, rounds with a ratio below 1)."""
     ours, theirs, ratios = [], [], []
     for k in range(args.paired):
         def one_ours():
@@ -208,7 +218,14 @@ def run_paired(args, op, pa, pb, out, a, b):
         theirs.append(t)
         ratios.append(o / t)
     return (args.paired, statistics.median(ours), statistics.median(theirs),
-            statistics.median(ratios), min(ratios), max(ratios))
+            statistics.median(ratios), min(ratios), max(ratios),
+            sum(r < 1 for r in ratios))
+
+
+def sign_test(below, k):
+    """One-sided sign test: the chance of `below` or more of `k` rounds
+    below 1 if ours and theirs were equally fast (each round a coin)."""
+    return sum(math.comb(k, j) for j in range(below, k + 1)) / 2 ** k
 
 
 def main():
@@ -231,7 +248,7 @@ def main():
     from importlib.metadata import version
     print("manifold3d %s, numpy %s" % (version("manifold3d"), np.__version__))
     hdr = ("%-14s %-12s %9s %9s %9s %9s %9s | %9s %9s | %7s %7s | %s"
-           % ("case", "op", "snap", "boolean", "mesh", "ours", "total", "m.constr", "m.bool",
+           % ("case", "op", "val+snap", "boolean", "mesh", "ours", "total", "m.constr", "m.bool",
               "r.b+m", "r.all", "octree / out tris ours,theirs"))
     print(hdr)
     print("-" * len(hdr))
@@ -248,12 +265,12 @@ def main():
                 out = os.path.join(d, "%s_%s_out.obj" % (tag, op))
                 ph, nodes, tris = run_ours(args.cli, op, pa, pb, out, args.our_reps, args.timeout)
                 mc, mb, mt = run_theirs(op, a, b, args.reps)
-                build = ph.get("snap/import", 0)
+                build = ph.get("validate", 0) + ph.get("snap/import", 0)
                 merge = ph.get("boolean", 0)
                 # (the watertightness check is inside boundary+mesh since
                 # 363195e; older builds print it as a phase of its own)
                 mesh = ph.get("boundary+mesh", 0) + ph.get("check", 0)
-                ours = build + merge + mesh
+                ours = ours_of(ph)
                 print("%-14s %-12s %9.2f %9.2f %9.2f %9.2f %9.2f | %9.2f %9.2f | %7.2f %7.2f | %s / %s,%s"
                       % (name, op, build, merge, mesh, ours, ph.get("total", 0), mc, mb,
                          (merge + mesh) / mb, ours / (mc + mb), nodes, tris, mt))
@@ -261,13 +278,14 @@ def main():
                 if args.paired:
                     paired.append((name, op) + run_paired(args, op, pa, pb, out, a, b))
     if paired:
-        print("paired rounds (ours = snap+boolean+mesh, theirs = construct+boolean, one "
+        print("paired rounds (ours = validate+snap+boolean+mesh, theirs = construct+boolean, one "
               "run each per round, alternating):")
-        for name, op, k, o, t, med, lo, hi in paired:
+        for name, op, k, o, t, med, lo, hi, below in paired:
             print("%-14s %-12s %3d rounds: ours %8.2f ms, theirs %8.2f ms (medians); "
-                  "ratio median %.3f (%.3f-%.3f)" % (name, op, k, o, t, med, lo, hi))
-    print("times in ms (medians); ours = snap/import + boolean + boundary+mesh+check "
-          "(file IO and validation excluded); total = the CLI's whole run;")
+                  "ratio median %.3f (%.3f-%.3f); below 1 in %d (sign test p = %.2g)"
+                  % (name, op, k, o, t, med, lo, hi, below, sign_test(below, k)))
+    print("times in ms (medians); ours = validate + snap/import + boolean + boundary+mesh+check "
+          "(file IO excluded); total = the CLI's whole run;")
     print("r.b+m = (boolean+mesh)/manifold boolean; r.all = ours/(manifold construct+boolean)")
 
 
