@@ -9,6 +9,9 @@
 //!   the union decided (`Solid::plan_owned`) and meshed straight from the
 //!   two solids' faces (`Planned::into_watertight_mesh`), with no solid for
 //!   the result.
+//! * `octree_csg/snap/sphere N`: the first step of those alone: the grid
+//!   fitted to both meshes, and both snapped to it as solids (faces,
+//!   support planes and face index).
 //! * `octree_csg/drill/N`: N successive subtractions of 1k-triangle spheres
 //!   (radius 0.05, centred on the surface along a Fibonacci spiral) from a
 //!   10k-triangle sphere, on snapped solids (the `drill` example runs the
@@ -49,6 +52,21 @@ fn union(c: &mut Criterion) {
                 let (sb, _) = snap_one(&grid, &b, 1).unwrap();
                 let planned = sa.plan_owned(sb, BoolOp::Union).unwrap();
                 planned.into_watertight_mesh().unwrap().triangles.len()
+            })
+        });
+    }
+    g.finish();
+    let mut g = c.benchmark_group("octree_csg/snap");
+    g.sample_size(10);
+    for n in [10_000, 100_000] {
+        let (va, vb, f) = sphere_pair(n);
+        let (a, b) = (MeshIn::new(&va, &f), MeshIn::new(&vb, &f));
+        g.bench_with_input(BenchmarkId::new("sphere", f.len()), &(), |bch, _| {
+            bch.iter(|| {
+                let grid = fit_grid(&[a, b]).unwrap();
+                let (sa, _) = snap_one(&grid, &a, 0).unwrap();
+                let (sb, _) = snap_one(&grid, &b, 1).unwrap();
+                sa.len() + sb.len()
             })
         });
     }
