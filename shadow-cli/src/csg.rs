@@ -20,7 +20,8 @@ use anyhow::{Context, Result, anyhow};
 use bsp_core::{BoolOp, Grid, ImportReport, TopologyError, TriMesh};
 use bsp_csg::{CsgError, MeshIn, Planned, Solid};
 use clap::{Args, ValueEnum};
-use shadow_scene::{Face, Mesh, MeshFormat};
+use glam::DVec3;
+use shadow_scene::{Mesh, MeshFormat, MeshView, Triangles};
 
 /// A Boolean operation as named on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -271,15 +272,29 @@ impl Phases {
 
 /// A Boolean operation's result and the figures `--stats` prints.
 struct Outcome {
-    /// The result in input units: one triangle face per triangle, one
-    /// group named after the operation.
-    mesh: Mesh,
+    /// The result's vertices in input units (its triangles are `exact`'s).
+    positions: Vec<DVec3>,
+    /// The operation's name: the result's one group.
+    group: &'static str,
     /// The exact result (grid units).
     exact: TriMesh,
     grid: Grid,
     reports: Vec<ImportReport>,
     /// What each operation did.
     stats: Vec<bsp_csg::Stats>,
+}
+
+impl Outcome {
+    /// The result in input units, as written: its triangles beside their
+    /// positions (no list per triangle), one group named after the
+    /// operation.
+    fn mesh(&self) -> Triangles<'_> {
+        Triangles {
+            positions: &self.positions,
+            triangles: &self.exact.triangles,
+            group: self.group,
+        }
+    }
 }
 
 /// Snaps the operands to one grid and applies the operation to the first
@@ -370,7 +385,7 @@ fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Resu
     let last = last.expect("at least two operands");
     // the mesh is checked watertight as it is made (one check, the one
     // that tells whether it needs mending where the solid touches itself)
-    let (exact, mesh) = phases.run("boundary+mesh", || -> Result<(TriMesh, Mesh)> {
+    let (exact, positions) = phases.run("boundary+mesh", || -> Result<(TriMesh, Vec<DVec3>)> {
         let exact = last.into_watertight_mesh().map_err(|e| {
             let names: Vec<&str> = operands.iter().map(|o| o.name.as_str()).collect();
             let e = match e {
@@ -385,27 +400,16 @@ fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Resu
                 names.join(", ")
             )
         })?;
-        let mesh = Mesh {
-            positions: exact
-                .vertices_f64()
-                .into_par_iter()
-                .map(|v| grid.to_world(v))
-                .collect(),
-            faces: exact
-                .triangles
-                .par_iter()
-                .map(|t| Face {
-                    vertices: t.to_vec(),
-                    line: 0,
-                    group: 0,
-                })
-                .collect(),
-            groups: vec![op.name().to_string()],
-        };
-        Ok((exact, mesh))
+        let positions = exact
+            .vertices_f64()
+            .into_par_iter()
+            .map(|v| grid.to_world(v))
+            .collect();
+        Ok((exact, positions))
     })?;
     Ok(Outcome {
-        mesh,
+        positions,
+        group: op.name(),
         exact,
         grid,
         reports,
@@ -464,10 +468,10 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
     let out = guarded("the input files", || {
         compute(&mut operands, args.op, &mut phases)
     })?;
-    phases.run("write", || shadow_scene::save(&args.output, &out.mesh))?;
+    phases.run("write", || shadow_scene::save(&args.output, &out.mesh()))?;
     let total = total.elapsed();
 
-    let (tris, verts) = (out.mesh.faces.len(), out.mesh.positions.len());
+    let (tris, verts) = (out.exact.triangles.len(), out.positions.len());
     let names: Vec<&str> = operands.iter().map(|o| o.name.as_str()).collect();
     let of = match names.as_slice() {
         [a, b] => format!("{a} and {b}"),
@@ -482,7 +486,7 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
     if tris == 0 {
         eprintln!("note: the {} is empty", args.op.name());
     }
-    let coincide = out.mesh.repeated_positions();
+    let coincide = out.mesh().repeated_positions();
     if coincide > 0 {
         eprintln!(
             "warning: {coincide} distinct exact vertices coincide once rounded to f64 input units; \
@@ -490,7 +494,7 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
         );
     }
     if MeshFormat::from_path(&args.output)? == MeshFormat::Stl {
-        let merged = shadow_scene::stl_collisions(&out.mesh);
+        let merged = shadow_scene::stl_collisions(&out.mesh());
         if merged > 0 {
             eprintln!(
                 "warning: {merged} vertices coincide once rounded to f32 for STL; the file may \
@@ -580,8 +584,8 @@ fn stats_text(
     );
     s += &format!(
         "output:         {} triangles, {} vertices\n",
-        out.mesh.faces.len(),
-        out.mesh.positions.len()
+        out.exact.triangles.len(),
+        out.positions.len()
     );
     let start = Instant::now();
     let exact = exact_volume(&out.exact, &out.grid);
@@ -769,9 +773,10 @@ f 4 1 5 8
             let mut phases = Phases::default();
             let out = compute(&mut [a.clone(), b.clone()], op, &mut phases).unwrap();
             assert_eq!(exact_volume(&out.exact, &out.grid), vol, "{op:?}");
-            assert_eq!(out.mesh.signed_volume(), vol, "{op:?}");
-            assert!(out.mesh.is_closed_oriented());
-            assert_eq!(out.mesh.groups, vec![op.name()]);
+            let mesh = out.mesh().to_mesh();
+            assert_eq!(mesh.signed_volume(), vol, "{op:?}");
+            assert!(mesh.is_closed_oriented());
+            assert_eq!(mesh.groups, vec![op.name()]);
             let names: Vec<&str> = phases.0.iter().map(|p| p.0).collect();
             assert_eq!(names, ["snap/import", "boolean", "boundary+mesh"]);
         }
@@ -783,7 +788,7 @@ f 4 1 5 8
             &mut Phases::default(),
         )
         .unwrap();
-        assert!(out.mesh.faces.is_empty());
+        assert!(out.exact.triangles.is_empty() && out.positions.is_empty());
         assert_eq!(out.stats[0].cells, 0);
     }
 

@@ -54,7 +54,7 @@ mod stl;
 
 pub use animated::{ANIMATED_NAMES, Animated, BUNNY_LIGHT, ROOM_LIGHT, animated, torus};
 pub use error::SceneError;
-pub use mesh::{Face, Mesh};
+pub use mesh::{Face, Mesh, MeshView, Triangles};
 pub use obj::{ObjNotes, parse_obj, parse_obj_notes, read_obj, read_obj_notes, write_obj};
 pub use scan::{MAX_SUBDIVISIONS, bunny, sqrt3_subdivide};
 pub use scenes::{SCENE_NAMES, room, scene};
@@ -127,7 +127,7 @@ pub fn load_notes(path: &Path) -> Result<(Mesh, ObjNotes), SceneError> {
 /// let err = save(Path::new("cube.ply"), &cube).unwrap_err();
 /// assert!(matches!(err, SceneError::UnknownFormat { .. }));
 /// ```
-pub fn save(path: &Path, mesh: &Mesh) -> Result<(), SceneError> {
+pub fn save<M: MeshView + ?Sized>(path: &Path, mesh: &M) -> Result<(), SceneError> {
     let format = MeshFormat::from_path(path)?;
     let io = |source| SceneError::Io {
         path: path.display().to_string(),

@@ -29,6 +29,137 @@ pub struct Mesh {
     pub groups: Vec<String>,
 }
 
+/// What the writers ([`crate::write_obj`], [`crate::write_stl`],
+/// [`crate::save`]) read of a mesh: its positions and its faces, each a
+/// loop of vertex indices in a group. A [`Mesh`] is one; [`Triangles`], a
+/// triangle list beside its positions, is another that needs no list per
+/// face.
+pub trait MeshView: Sync {
+    /// Vertex positions.
+    fn positions(&self) -> &[DVec3];
+    /// Number of faces.
+    fn face_count(&self) -> usize;
+    /// Face `i`'s vertex loop (indices into [`MeshView::positions`]).
+    fn face(&self, i: usize) -> &[u32];
+    /// Face `i`'s group, named by [`MeshView::group_name`].
+    fn group(&self, i: usize) -> u32;
+    /// The name of group `g`, if it has one.
+    fn group_name(&self, g: u32) -> Option<&str>;
+
+    /// How many of the vertices used by faces repeat the position of
+    /// another used vertex (`-0.0` equals `0.0`): the number of vertices
+    /// [`Mesh::weld`] would merge away. Non-zero for files that store the
+    /// corners of every face separately.
+    ///
+    /// ```
+    /// use shadow_scene::{MeshView, parse_obj};
+    /// let soup = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 4 6 5\n", "s.obj").unwrap();
+    /// assert_eq!(soup.repeated_positions(), 2);
+    /// ```
+    fn repeated_positions(&self) -> usize {
+        let positions = self.positions();
+        let mut used = vec![false; positions.len()];
+        for i in 0..self.face_count() {
+            for &v in self.face(i) {
+                used[v as usize] = true;
+            }
+        }
+        let mut seen: HashSet<[u64; 3]> = HashSet::new();
+        let mut repeats = 0;
+        for (p, _) in positions.iter().zip(&used).filter(|(_, u)| **u) {
+            if !seen.insert(key(*p)) {
+                repeats += 1;
+            }
+        }
+        repeats
+    }
+}
+
+impl MeshView for Mesh {
+    fn positions(&self) -> &[DVec3] {
+        &self.positions
+    }
+
+    fn face_count(&self) -> usize {
+        self.faces.len()
+    }
+
+    fn face(&self, i: usize) -> &[u32] {
+        &self.faces[i].vertices
+    }
+
+    fn group(&self, i: usize) -> u32 {
+        self.faces[i].group
+    }
+
+    fn group_name(&self, g: u32) -> Option<&str> {
+        self.groups.get(g as usize).map(String::as_str)
+    }
+}
+
+/// Triangles beside their positions, all in one group: a mesh to write
+/// ([`MeshView`]) with no list per face, as a large result is made.
+///
+/// ```
+/// use glam::DVec3;
+/// use shadow_scene::{MeshView, Triangles};
+/// let positions = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+/// let triangles = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+/// let tet = Triangles { positions: &positions, triangles: &triangles, group: "tet" };
+/// assert_eq!(tet.face(3), &[1, 2, 3]);
+/// assert!(tet.to_mesh().is_closed_oriented());
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct Triangles<'a> {
+    /// Vertex positions.
+    pub positions: &'a [DVec3],
+    /// Counter-clockwise triangles (indices into `positions`).
+    pub triangles: &'a [[u32; 3]],
+    /// The one group's name.
+    pub group: &'a str,
+}
+
+impl Triangles<'_> {
+    /// The same faces as a [`Mesh`] (one [`Face`] per triangle).
+    pub fn to_mesh(&self) -> Mesh {
+        Mesh {
+            positions: self.positions.to_vec(),
+            faces: self
+                .triangles
+                .iter()
+                .map(|t| Face {
+                    vertices: t.to_vec(),
+                    line: 0,
+                    group: 0,
+                })
+                .collect(),
+            groups: vec![self.group.to_string()],
+        }
+    }
+}
+
+impl MeshView for Triangles<'_> {
+    fn positions(&self) -> &[DVec3] {
+        self.positions
+    }
+
+    fn face_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    fn face(&self, i: usize) -> &[u32] {
+        &self.triangles[i]
+    }
+
+    fn group(&self, _: usize) -> u32 {
+        0
+    }
+
+    fn group_name(&self, g: u32) -> Option<&str> {
+        (g == 0).then_some(self.group)
+    }
+}
+
 /// Bit pattern of a position, with `-0.0` read as `0.0`, so that equal
 /// values get equal keys.
 fn key(p: DVec3) -> [u64; 3] {
@@ -153,31 +284,6 @@ impl Mesh {
             }
         }
         self.positions = positions;
-    }
-
-    /// How many of the vertices used by faces repeat the position of
-    /// another used vertex (`-0.0` equals `0.0`): the number of vertices
-    /// [`Mesh::weld`] would merge away. Non-zero for files that store the
-    /// corners of every face separately.
-    ///
-    /// ```
-    /// use shadow_scene::parse_obj;
-    /// let soup = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 4 6 5\n", "s.obj").unwrap();
-    /// assert_eq!(soup.repeated_positions(), 2);
-    /// ```
-    pub fn repeated_positions(&self) -> usize {
-        let mut used = vec![false; self.positions.len()];
-        for v in self.faces.iter().flat_map(|f| &f.vertices) {
-            used[*v as usize] = true;
-        }
-        let mut seen: HashSet<[u64; 3]> = HashSet::new();
-        let mut repeats = 0;
-        for (p, _) in self.positions.iter().zip(&used).filter(|(_, u)| **u) {
-            if !seen.insert(key(*p)) {
-                repeats += 1;
-            }
-        }
-        repeats
     }
 
     /// `true` if every directed edge `a → b` of every face appears exactly
@@ -373,6 +479,48 @@ mod tests {
         assert_eq!(before - t.positions.len(), 3 + 1);
         assert_eq!(t.repeated_positions(), 0);
         assert!(t.is_closed_oriented());
+    }
+
+    /// A triangle list written through its view gives the bytes its
+    /// [`Mesh`] gives, OBJ and STL, and the same counts of repeats (a
+    /// soup of 3 000 triangles: more than one run of the OBJ writer).
+    #[test]
+    fn triangles_write_as_their_mesh() {
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for i in 0..3000u32 {
+            let x = f64::from(i % 97) * 0.25;
+            let y = f64::from(i / 97) * -0.5;
+            positions.extend([
+                DVec3::new(x, y, 0.0),
+                DVec3::new(x + 0.25, y, 0.125),
+                DVec3::new(x, y + 0.5, 0.0),
+            ]);
+            triangles.push([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        let view = Triangles {
+            positions: &positions,
+            triangles: &triangles,
+            group: "a group",
+        };
+        let mesh = view.to_mesh();
+        assert_eq!(mesh.faces.len(), 3000);
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        crate::write_obj(&view, &mut a).unwrap();
+        crate::write_obj(&mesh, &mut b).unwrap();
+        assert!(a == b, "OBJ bytes differ");
+        assert!(
+            String::from_utf8(a)
+                .unwrap()
+                .contains("\ng a group\nf 1 2 3\n")
+        );
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        crate::write_stl(&view, &mut a).unwrap();
+        crate::write_stl(&mesh, &mut b).unwrap();
+        assert!(a == b, "STL bytes differ");
+        assert_eq!(view.repeated_positions(), mesh.repeated_positions());
+        assert!(mesh.repeated_positions() > 0);
+        assert_eq!(crate::stl_collisions(&view), crate::stl_collisions(&mesh));
     }
 
     #[test]

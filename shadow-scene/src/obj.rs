@@ -6,7 +6,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use crate::{Face, Mesh, SceneError};
+use crate::{Face, Mesh, MeshView, SceneError};
 
 /// Reads a Wavefront OBJ file (see [`parse_obj`] for what is understood).
 ///
@@ -330,39 +330,40 @@ fn resolve_index(i: i64, n: usize) -> Result<u32, String> {
 /// assert_eq!(back.positions, chair.positions);
 /// assert_eq!(back.faces.len(), chair.faces.len());
 /// ```
-pub fn write_obj<W: Write>(mesh: &Mesh, mut out: W) -> std::io::Result<()> {
+pub fn write_obj<M: MeshView + ?Sized, W: Write>(mesh: &M, mut out: W) -> std::io::Result<()> {
     use std::fmt::Write as _;
     const INFALLIBLE: &str = "writing to a String does not fail";
+    let positions = mesh.positions();
     writeln!(
         out,
         "# shadow-scene: {} vertices, {} faces",
-        mesh.positions.len(),
-        mesh.faces.len()
+        positions.len(),
+        mesh.face_count()
     )?;
-    write_in_runs(&mut out, &mesh.positions, 64, |text, _, run| {
-        for p in run {
+    write_in_runs(&mut out, positions.len(), 64, |text, run| {
+        for p in &positions[run] {
             writeln!(text, "v {:?} {:?} {:?}", p.x, p.y, p.z).expect(INFALLIBLE);
         }
     })?;
     // a `g` line where the group changes from the face before
     let group_line = |g: u32| {
         let name = mesh
-            .groups
-            .get(g as usize)
+            .group_name(g)
             .map(|s| s.split_whitespace().collect::<Vec<_>>().join(" "))
             .filter(|s| !s.is_empty())
             .unwrap_or_else(|| "default".to_string());
         format!("g {name}\n")
     };
-    write_in_runs(&mut out, &mesh.faces, 24, |text, first, run| {
-        let mut current = first.checked_sub(1).map(|i| mesh.faces[i].group);
+    write_in_runs(&mut out, mesh.face_count(), 24, |text, run| {
+        let mut current = run.start.checked_sub(1).map(|i| mesh.group(i));
         for f in run {
-            if current != Some(f.group) {
-                current = Some(f.group);
-                text.push_str(&group_line(f.group));
+            let group = mesh.group(f);
+            if current != Some(group) {
+                current = Some(group);
+                text.push_str(&group_line(group));
             }
             text.push('f');
-            for v in &f.vertices {
+            for v in mesh.face(f) {
                 write!(text, " {}", u64::from(*v) + 1).expect(INFALLIBLE);
             }
             text.push('\n');
@@ -371,27 +372,29 @@ pub fn write_obj<W: Write>(mesh: &Mesh, mut out: W) -> std::io::Result<()> {
     out.flush()
 }
 
-/// Writes the lines of `items` that `format(text, first, run)` appends for
-/// each run of them (`first`: the index of the run's first item), the runs
-/// formatted in parallel, a window of runs at a time (so that only a
-/// window's text is held), and written in order: the bytes one pass in
-/// order writes. `bytes` is a guess at an item's line length.
-fn write_in_runs<T: Sync, W: Write>(
+/// Writes the lines that `format(text, run)` appends for each run of the
+/// items `0..n` (a range of indices), the runs formatted in parallel, a
+/// window of runs at a time (so that only a window's text is held), and
+/// written in order: the bytes one pass in order writes. `bytes` is a
+/// guess at an item's line length.
+fn write_in_runs<W: Write>(
     out: &mut W,
-    items: &[T],
+    n: usize,
     bytes: usize,
-    format: impl Fn(&mut String, usize, &[T]) + Sync,
+    format: impl Fn(&mut String, std::ops::Range<usize>) + Sync,
 ) -> std::io::Result<()> {
     use rayon::prelude::*;
     const RUN: usize = 4096;
     const WINDOW: usize = 32 * RUN;
-    for (w, window) in items.chunks(WINDOW).enumerate() {
-        let texts: Vec<String> = window
-            .par_chunks(RUN)
-            .enumerate()
-            .map(|(r, run)| {
+    for window in (0..n).step_by(WINDOW) {
+        let end = (window + WINDOW).min(n);
+        let texts: Vec<String> = (window..end)
+            .into_par_iter()
+            .step_by(RUN)
+            .map(|first| {
+                let run = first..(first + RUN).min(end);
                 let mut text = String::with_capacity(bytes * run.len());
-                format(&mut text, w * WINDOW + r * RUN, run);
+                format(&mut text, run);
                 text
             })
             .collect();

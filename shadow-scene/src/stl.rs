@@ -8,7 +8,7 @@ use std::collections::{HashMap, HashSet};
 
 use glam::DVec3;
 
-use crate::{Face, Mesh, SceneError};
+use crate::{Face, Mesh, MeshView, SceneError};
 
 /// Reads a binary or ASCII STL file; see [`parse_stl`].
 pub fn read_stl(path: &Path) -> Result<Mesh, SceneError> {
@@ -107,12 +107,16 @@ pub fn parse_stl(bytes: &[u8], path_for_messages: &str) -> Result<Mesh, SceneErr
 /// assert!(back.is_closed_oriented());
 /// assert_eq!(back.signed_volume(), cube.signed_volume());
 /// ```
-pub fn write_stl<W: Write>(mesh: &Mesh, mut out: W) -> std::io::Result<()> {
-    let mut triangles = Vec::with_capacity(mesh.triangle_count());
+pub fn write_stl<M: MeshView + ?Sized, W: Write>(mesh: &M, mut out: W) -> std::io::Result<()> {
+    let count = (0..mesh.face_count())
+        .map(|f| mesh.face(f).len().saturating_sub(2))
+        .sum();
+    let mut triangles = Vec::with_capacity(count);
     let to32 = |p: DVec3| stl_io::Vector::new([p.x as f32, p.y as f32, p.z as f32]);
-    for f in &mesh.faces {
-        let p = |i: usize| mesh.positions[f.vertices[i] as usize];
-        for i in 1..f.vertices.len().saturating_sub(1) {
+    let positions = mesh.positions();
+    for f in (0..mesh.face_count()).map(|f| mesh.face(f)) {
+        let p = |i: usize| positions[f[i] as usize];
+        for i in 1..f.len().saturating_sub(1) {
             let (a, b, c) = (p(0), p(i), p(i + 1));
             let n = (b - a).cross(c - a).normalize_or_zero();
             triangles.push(stl_io::Triangle {
@@ -146,9 +150,10 @@ pub fn write_stl<W: Write>(mesh: &Mesh, mut out: W) -> std::io::Result<()> {
 /// };
 /// assert_eq!(stl_collisions(&mesh), 1);
 /// ```
-pub fn stl_collisions(mesh: &Mesh) -> usize {
-    let mut used = vec![false; mesh.positions.len()];
-    for v in mesh.faces.iter().flat_map(|f| &f.vertices) {
+pub fn stl_collisions<M: MeshView + ?Sized>(mesh: &M) -> usize {
+    let positions = mesh.positions();
+    let mut used = vec![false; positions.len()];
+    for v in (0..mesh.face_count()).flat_map(|f| mesh.face(f)) {
         used[*v as usize] = true;
     }
     let key64 = |p: DVec3| [p.x, p.y, p.z].map(|c| (c + 0.0).to_bits());
@@ -156,7 +161,7 @@ pub fn stl_collisions(mesh: &Mesh) -> usize {
     let mut by32: HashMap<[u32; 3], [u64; 3]> = HashMap::new();
     let mut distinct64: HashSet<[u64; 3]> = HashSet::new();
     let mut collisions = 0;
-    for (p, _) in mesh.positions.iter().zip(&used).filter(|(_, u)| **u) {
+    for (p, _) in positions.iter().zip(&used).filter(|(_, u)| **u) {
         if !distinct64.insert(key64(*p)) {
             continue; // an exact repeat: merged by any reader, not by rounding
         }
