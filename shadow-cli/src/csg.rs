@@ -457,9 +457,34 @@ pub(crate) fn guarded<T>(inputs: &str, f: impl FnOnce() -> Result<T>) -> Result<
     })
 }
 
+/// Has glibc keep the large blocks a run frees, to be used again, instead
+/// of unmapping each one and faulting the next one in page by page.
+///
+/// glibc maps each allocation above a threshold (128 KiB at start) on its
+/// own, and unmaps it when it is freed; when such a block is freed, it
+/// raises the threshold to that block's size (up to 32 MiB) and from then
+/// on keeps up to twice that much free memory in its heaps (mallopt(3),
+/// "dynamic mmap threshold"). The phases of a mesh Boolean make and free
+/// buffers of megabytes one after the other, so the threshold would rise
+/// only after many of them had been faulted in and given back. Freeing one
+/// block of just under 32 MiB, never touched (no page of it is faulted in),
+/// raises it at once: the 99k-triangle union makes a fifth fewer page
+/// faults and runs about 7% faster, with the same peak. (Not for every
+/// command: `shadow shadows` on the 99k bunny ran no faster, with a
+/// quarter more peak memory.) Other allocators and C libraries see one
+/// allocation made and freed.
+fn keep_freed_blocks() {
+    // (two pages under 32 MiB: with glibc's header the mapped block is one
+    // page under, within the largest threshold glibc raises to)
+    let block: Vec<u8> = Vec::with_capacity((32 << 20) - 8192);
+    // (kept from being optimized away: the allocation is the point)
+    drop(std::hint::black_box(block));
+}
+
 /// `shadow csg`.
 pub(crate) fn run(args: &CsgArgs) -> Result<()> {
     let total = Instant::now();
+    keep_freed_blocks();
     // fail on a bad output name before doing any work
     MeshFormat::from_path(&args.output)?;
     let mut phases = Phases::default();
