@@ -19,8 +19,16 @@
 
 use bsp_core::BoolOp;
 use bsp_csg::shapes::{drill_tools, sphere_pair, uv_sphere};
-use bsp_csg::{MeshIn, Snapped, fit_grid, snap, snap_one};
+use bsp_csg::{MeshIn, Snapped, Solid, snap};
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
+
+/// Both meshes snapped to one grid, as solids (what a mesh boolean does
+/// first).
+fn snapped_pair(a: MeshIn<'_>, b: MeshIn<'_>) -> (Solid, Solid) {
+    let Snapped { solids, .. } = snap(&[a, b]).unwrap();
+    let [sa, sb]: [Solid; 2] = solids.try_into().expect("two solids");
+    (sa, sb)
+}
 
 fn union(c: &mut Criterion) {
     let mut g = c.benchmark_group("octree_csg/union");
@@ -47,9 +55,7 @@ fn union(c: &mut Criterion) {
         let (a, b) = (MeshIn::new(&va, &f), MeshIn::new(&vb, &f));
         g.bench_with_input(BenchmarkId::new("sphere", f.len()), &(), |bch, _| {
             bch.iter(|| {
-                let grid = fit_grid(&[a, b]).unwrap();
-                let (sa, _) = snap_one(&grid, &a, 0).unwrap();
-                let (sb, _) = snap_one(&grid, &b, 1).unwrap();
+                let (sa, sb) = snapped_pair(a, b);
                 let planned = sa.plan_owned(sb, BoolOp::Union).unwrap();
                 planned.into_watertight_mesh().unwrap().triangles.len()
             })
@@ -63,9 +69,7 @@ fn union(c: &mut Criterion) {
         let (a, b) = (MeshIn::new(&va, &f), MeshIn::new(&vb, &f));
         g.bench_with_input(BenchmarkId::new("sphere", f.len()), &(), |bch, _| {
             bch.iter(|| {
-                let grid = fit_grid(&[a, b]).unwrap();
-                let (sa, _) = snap_one(&grid, &a, 0).unwrap();
-                let (sb, _) = snap_one(&grid, &b, 1).unwrap();
+                let (sa, sb) = snapped_pair(a, b);
                 sa.len() + sb.len()
             })
         });
