@@ -57,22 +57,25 @@ pub trait MeshView: Sync {
     /// assert_eq!(soup.repeated_positions(), 2);
     /// ```
     fn repeated_positions(&self) -> usize {
-        let positions = self.positions();
-        let mut used = vec![false; positions.len()];
-        for i in 0..self.face_count() {
-            for &v in self.face(i) {
-                used[v as usize] = true;
-            }
-        }
         let mut seen: HashSet<[u64; 3]> = HashSet::new();
-        let mut repeats = 0;
-        for (p, _) in positions.iter().zip(&used).filter(|(_, u)| **u) {
-            if !seen.insert(key(*p)) {
-                repeats += 1;
-            }
-        }
-        repeats
+        used_positions(self)
+            .filter(|p| !seen.insert(key(**p)))
+            .count()
     }
+}
+
+/// The positions some face uses, in order (each once).
+pub(crate) fn used_positions<M: MeshView + ?Sized>(mesh: &M) -> impl Iterator<Item = &DVec3> {
+    let positions = mesh.positions();
+    let mut used = vec![false; positions.len()];
+    for v in (0..mesh.face_count()).flat_map(|f| mesh.face(f)) {
+        used[*v as usize] = true;
+    }
+    positions
+        .iter()
+        .zip(used)
+        .filter(|(_, u)| *u)
+        .map(|(p, _)| p)
 }
 
 impl MeshView for Mesh {
@@ -162,7 +165,7 @@ impl MeshView for Triangles<'_> {
 
 /// Bit pattern of a position, with `-0.0` read as `0.0`, so that equal
 /// values get equal keys.
-fn key(p: DVec3) -> [u64; 3] {
+pub(crate) fn key(p: DVec3) -> [u64; 3] {
     // adding +0.0 turns -0.0 into +0.0 and leaves every other value alone
     [p.x, p.y, p.z].map(|c| (c + 0.0).to_bits())
 }

@@ -151,17 +151,12 @@ pub fn write_stl<M: MeshView + ?Sized, W: Write>(mesh: &M, mut out: W) -> std::i
 /// assert_eq!(stl_collisions(&mesh), 1);
 /// ```
 pub fn stl_collisions<M: MeshView + ?Sized>(mesh: &M) -> usize {
-    let positions = mesh.positions();
-    let mut used = vec![false; positions.len()];
-    for v in (0..mesh.face_count()).flat_map(|f| mesh.face(f)) {
-        used[*v as usize] = true;
-    }
-    let key64 = |p: DVec3| [p.x, p.y, p.z].map(|c| (c + 0.0).to_bits());
+    let key64 = crate::mesh::key;
     let key32 = |p: DVec3| [p.x, p.y, p.z].map(|c| (c as f32 + 0.0).to_bits());
     let mut by32: HashMap<[u32; 3], [u64; 3]> = HashMap::new();
     let mut distinct64: HashSet<[u64; 3]> = HashSet::new();
     let mut collisions = 0;
-    for (p, _) in positions.iter().zip(&used).filter(|(_, u)| **u) {
+    for p in crate::mesh::used_positions(mesh) {
         if !distinct64.insert(key64(*p)) {
             continue; // an exact repeat: merged by any reader, not by rounding
         }
