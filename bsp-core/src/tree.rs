@@ -218,6 +218,48 @@ fn partition_list(
     (on, front, back)
 }
 
+/// [`partition_list`] of polygons whose sides of `plane` are known
+/// (`sides`, [`Polygon::classify`]'s): only the spanning ones are looked
+/// at again, to be split, and each list is made at its size.
+fn partition_known(
+    polys: Vec<Polygon>,
+    plane: &Plane,
+    sides: &[PolygonSide],
+) -> (Vec<Polygon>, Vec<Polygon>, Vec<Polygon>) {
+    let (mut n_on, mut n_front, mut n_back) = (0, 0, 0);
+    for s in sides {
+        match s {
+            PolygonSide::Front => n_front += 1,
+            PolygonSide::Back => n_back += 1,
+            PolygonSide::Coplanar { .. } => n_on += 1,
+            PolygonSide::Spanning => {
+                n_front += 1;
+                n_back += 1;
+            }
+        }
+    }
+    let (mut on, mut front, mut back) = (
+        Vec::with_capacity(n_on),
+        Vec::with_capacity(n_front),
+        Vec::with_capacity(n_back),
+    );
+    for (p, side) in polys.into_iter().zip(sides) {
+        match side {
+            PolygonSide::Front => front.push(p),
+            PolygonSide::Back => back.push(p),
+            PolygonSide::Coplanar { .. } => on.push(p),
+            PolygonSide::Spanning => match p.split(plane) {
+                Split::Spanning { front: f, back: b } => {
+                    front.push(f);
+                    back.push(b);
+                }
+                _ => unreachable!("a spanning polygon spans the plane"),
+            },
+        }
+    }
+    (on, front, back)
+}
+
 /// `true` if cutting by `plane` leaves each side with at most three
 /// quarters of the polygons (spanning ones count on both sides) and neither
 /// side empty. Decided before anything is split, so a rejected cut costs no
@@ -265,9 +307,21 @@ fn balance_cut(polys: &[Polygon]) -> Option<Plane> {
 }
 
 fn choose_plane(polys: &[Polygon], opts: &BuildOptions, rng: &mut SplitMix) -> Plane {
+    choose_plane_sides(polys, opts, rng, &mut Vec::new()).0
+}
+
+/// [`choose_plane`], and whether `sides` holds every polygon's side of
+/// the chosen plane ([`Polygon::classify`]): so when the sample is the
+/// whole list, which the scoring classified against each candidate.
+fn choose_plane_sides(
+    polys: &[Polygon],
+    opts: &BuildOptions,
+    rng: &mut SplitMix,
+    sides: &mut Vec<PolygonSide>,
+) -> (Plane, bool) {
     let n = polys.len();
     if n <= 2 {
-        return *polys[0].support();
+        return (*polys[0].support(), false);
     }
     let k = opts.candidates.min(n);
     let s = opts.sample.min(n);
@@ -276,28 +330,41 @@ fn choose_plane(polys: &[Polygon], opts: &BuildOptions, rng: &mut SplitMix) -> P
     } else {
         (0..s).map(|_| rng.below(n)).collect()
     };
+    // the best candidate's sides, and the current one's
+    let mut these: Vec<PolygonSide> = Vec::with_capacity(s);
+    sides.clear();
     let mut best = (u64::MAX, *polys[0].support());
+    let mut tried: smallvec::SmallVec<[Plane; 8]> = smallvec::SmallVec::new();
     for c in 0..k {
         let plane = if k == n {
             *polys[c].support()
         } else {
             *polys[rng.below(n)].support()
         };
+        // a plane drawn again scores as it did, which does not beat itself
+        if tried.contains(&plane) {
+            continue;
+        }
+        tried.push(plane);
         let (mut f, mut b, mut sp) = (0u64, 0u64, 0u64);
+        these.clear();
         for &i in &sample {
-            match polys[i].classify(&plane) {
+            let side = polys[i].classify(&plane);
+            match side {
                 PolygonSide::Front => f += 1,
                 PolygonSide::Back => b += 1,
                 PolygonSide::Spanning => sp += 1,
                 PolygonSide::Coplanar { .. } => {}
             }
+            these.push(side);
         }
         let score = opts.split_weight as u64 * sp + f.abs_diff(b);
         if score < best.0 {
             best = (score, plane);
+            std::mem::swap(sides, &mut these);
         }
     }
-    best.1
+    (best.1, s == n)
 }
 
 impl BspTree {
@@ -311,6 +378,7 @@ impl BspTree {
             root: Link::Cell(Cell::Out),
         };
         let mut rng = SplitMix(opts.seed);
+        let mut sides = Vec::new();
         let mut stack: Vec<(Vec<Polygon>, Slot)> = vec![(polygons, Slot::Root)];
         while let Some((polys, slot)) = stack.pop() {
             let link = if polys.is_empty() {
@@ -333,8 +401,12 @@ impl BspTree {
                 let (plane, on, front, back) = match parts {
                     Some(p) => p,
                     None => {
-                        let plane = choose_plane(&polys, opts, &mut rng);
-                        let (on, front, back) = partition_list(polys, &plane);
+                        let (plane, known) = choose_plane_sides(&polys, opts, &mut rng, &mut sides);
+                        let (on, front, back) = if known {
+                            partition_known(polys, &plane, &sides)
+                        } else {
+                            partition_list(polys, &plane)
+                        };
                         (plane, on, front, back)
                     }
                 };
@@ -836,5 +908,126 @@ mod tests {
         t.traverse(eye, Order::FrontToBack, |p| b.push(p.tag()));
         assert_eq!(a.len(), 2 * n as usize);
         assert_eq!(a, b);
+    }
+
+    /// The build as it was before the scoring's sides were kept: each
+    /// candidate scored afresh, each list split by classifying again.
+    fn reference_build(polygons: Vec<Polygon>, opts: &BuildOptions) -> BspTree {
+        fn choose(polys: &[Polygon], opts: &BuildOptions, rng: &mut SplitMix) -> Plane {
+            let n = polys.len();
+            if n <= 2 {
+                return *polys[0].support();
+            }
+            let (k, s) = (opts.candidates.min(n), opts.sample.min(n));
+            let sample: Vec<usize> = if s == n {
+                (0..n).collect()
+            } else {
+                (0..s).map(|_| rng.below(n)).collect()
+            };
+            let mut best = (u64::MAX, *polys[0].support());
+            for c in 0..k {
+                let plane = if k == n {
+                    *polys[c].support()
+                } else {
+                    *polys[rng.below(n)].support()
+                };
+                let (mut f, mut b, mut sp) = (0u64, 0u64, 0u64);
+                for &i in &sample {
+                    match polys[i].classify(&plane) {
+                        PolygonSide::Front => f += 1,
+                        PolygonSide::Back => b += 1,
+                        PolygonSide::Spanning => sp += 1,
+                        PolygonSide::Coplanar { .. } => {}
+                    }
+                }
+                let score = opts.split_weight as u64 * sp + f.abs_diff(b);
+                if score < best.0 {
+                    best = (score, plane);
+                }
+            }
+            best.1
+        }
+        let mut tree = BspTree {
+            nodes: Vec::new(),
+            root: Link::Cell(Cell::Out),
+        };
+        let mut rng = SplitMix(opts.seed);
+        let mut stack = vec![(polygons, Slot::Root)];
+        while let Some((polys, slot)) = stack.pop() {
+            let link = if polys.is_empty() {
+                Link::Cell(match slot {
+                    Slot::Back(_) => Cell::In,
+                    _ => Cell::Out,
+                })
+            } else {
+                let plane = choose(&polys, opts, &mut rng);
+                let (on, front, back) = partition_list(polys, &plane);
+                let id = tree.nodes.len() as NodeId;
+                tree.nodes.push(Node {
+                    plane,
+                    polygons: on,
+                    front: Link::Cell(Cell::Out),
+                    back: Link::Cell(Cell::In),
+                });
+                stack.push((back, Slot::Back(id)));
+                stack.push((front, Slot::Front(id)));
+                Link::Node(id)
+            };
+            match slot {
+                Slot::Root => tree.root = link,
+                Slot::Front(id) => tree.nodes[id as usize].front = link,
+                Slot::Back(id) => tree.nodes[id as usize].back = link,
+            }
+        }
+        tree
+    }
+
+    /// Keeping the scoring's sides for the split, and scoring a plane drawn
+    /// twice once, builds the same tree: the same planes, polygons (exact
+    /// corners, tags) and links, for small lists (every polygon sampled)
+    /// and large ones (a random sample), with many spanning polygons.
+    #[test]
+    fn kept_sides_build_the_same_tree() {
+        use crate::shapes::uv_sphere;
+        // two overlapping spheres' triangles and a few large random ones
+        let mut polys = Vec::new();
+        for (shift, n) in [(0i32, 300usize), (700, 120)] {
+            let (pos, faces) = uv_sphere(n);
+            let g = |i: u32| {
+                let p = pos[i as usize] * 1000.0;
+                [p.x as i32 + shift, p.y as i32, p.z as i32 - shift / 3]
+            };
+            for f in &faces {
+                let pts: Vec<crate::GridPoint> = f.iter().map(|&i| g(i)).collect();
+                if let Ok(p) = Polygon::from_grid_points(&pts, polys.len() as u32) {
+                    polys.push(p);
+                }
+            }
+        }
+        let mut rng = SplitMix(3);
+        for _ in 0..40 {
+            let mut c = || (rng.below(4000) as i32) - 2000;
+            let t = [[c(), c(), c()], [c(), c(), c()], [c(), c(), c()]];
+            if let Ok(p) = Polygon::from_grid_points(&t, polys.len() as u32) {
+                polys.push(p);
+            }
+        }
+        let shown = |t: &BspTree| format!("{:?} {:?}", t.root, t.nodes);
+        for opts in [
+            BuildOptions::default(),
+            BuildOptions::default().with_candidates(4).with_sample(16),
+            BuildOptions::default().with_candidates(3).with_sample(5000),
+        ] {
+            for part in [&polys[..25], &polys[300..340], &polys[..]] {
+                let built = BspTree::build(part.to_vec(), &opts);
+                assert_eq!(shown(&built), shown(&reference_build(part.to_vec(), &opts)));
+                if part.len() == polys.len() {
+                    assert!(
+                        built.stats().polygons > part.len(),
+                        "some polygons are split"
+                    );
+                }
+            }
+        }
     }
 }
