@@ -129,9 +129,14 @@ fn weld<P: ConvexFace + Sync>(polys: &[P], start: &[usize]) -> (Vec<Point>, Vec<
         .into_par_iter()
         .map(|s| {
             let items = &items[at[s]..at[s + 1]];
-            let mut by_key: rustc_hash::FxHashMap<u64, u32> = Default::default();
-            let mut points: Vec<(Pt<'_>, u32)> = Vec::new();
-            let mut next: Vec<u32> = Vec::new();
+            // room for the points a closed triangle mesh's corners have
+            // (about one in six corners starts a point), so the map is
+            // seldom grown
+            let room = items.len() / 5 + 16;
+            let mut by_key: rustc_hash::FxHashMap<u64, u32> =
+                rustc_hash::FxHashMap::with_capacity_and_hasher(room, Default::default());
+            let mut points: Vec<(Pt<'_>, u32)> = Vec::with_capacity(room);
+            let mut next: Vec<u32> = Vec::with_capacity(room);
             let ids = items
                 .iter()
                 .map(|&(pt, k, c)| {
@@ -902,15 +907,20 @@ impl Candidates {
         if pts.len() <= Self::LEAF {
             return;
         }
+        // the extent along each axis, in one pass (the coordinates are
+        // finite: plain comparisons, which compile to `minss`/`maxss`)
+        let (mut a, mut b) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for p in pts.iter() {
+            for j in 0..3 {
+                let c = p.0[j];
+                a[j] = if c < a[j] { c } else { a[j] };
+                b[j] = if c > b[j] { c } else { b[j] };
+            }
+        }
         let mut best = (0usize, f32::NEG_INFINITY);
         for j in 0..3 {
-            let (mut a, mut b) = (f32::INFINITY, f32::NEG_INFINITY);
-            for p in pts.iter() {
-                a = a.min(p.0[j]);
-                b = b.max(p.0[j]);
-            }
-            if b - a > best.1 {
-                best = (j, b - a);
+            if b[j] - a[j] > best.1 {
+                best = (j, b[j] - a[j]);
             }
         }
         let j = best.0;
