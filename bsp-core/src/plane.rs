@@ -90,19 +90,38 @@ impl Plane {
         if g != 1 {
             g = gcd64(g, n[2].unsigned_abs());
         }
+        // (the offset in 64 bits where it fits: `i128` division and
+        // conversion are library calls, several times slower)
+        let small = i64::try_from(d).ok();
         if g > 1 {
-            g = gcd(g as u128, d.unsigned_abs() % g as u128) as u64;
+            let rest = match small {
+                Some(d) => (d.unsigned_abs() % g) as u128,
+                None => d.unsigned_abs() % g as u128,
+            };
+            g = gcd(g as u128, rest) as u64;
         }
-        let (n, d) = if g > 1 {
-            (n.map(|c| c / g as i64), d / g as i128)
+        let (n, d, small) = if g > 1 {
+            // (a divisor of 2^63, from a normal of `i64::MIN`s and
+            // zeros, takes the wide path)
+            let small = small.filter(|_| g <= i64::MAX as u64).map(|d| d / g as i64);
+            let d = small.map_or(d / g as i128, i128::from);
+            // (2^63 divides only `i64::MIN`: dividing by it as an `i64`
+            // would turn the normal around)
+            let n = if g <= i64::MAX as u64 {
+                n.map(|c| c / g as i64)
+            } else {
+                n.map(|c| (c as i128 / g as i128) as i64)
+            };
+            (n, d, small)
         } else {
-            (n, d)
+            (n, d, small)
         };
         let fits = n.iter().all(|c| c.unsigned_abs() < 1u64 << MAX_NORMAL_BITS)
             && d.unsigned_abs() < 1u128 << MAX_OFFSET_BITS;
         fits.then_some(Plane {
             n,
-            d_approx: d as f64,
+            // (both conversions round to nearest: the same value)
+            d_approx: small.map_or(d as f64, |d| d as f64),
             d,
         })
     }
@@ -295,6 +314,37 @@ mod tests {
             let (a, b) = ((a >> 40) * 1_000_003, (b >> 40) * 1_000_003);
             assert_eq!(gcd64(a, b) as u128, gcd(a as u128, b as u128), "{a} {b}");
         }
+        // the offset's 64-bit path gives what the 128-bit one gives:
+        // random planes, small and large offsets, common factors
+        let wide = |n: [i64; 3], d: i128| -> Option<([i64; 3], i128, f64)> {
+            let g = n.iter().fold(d.unsigned_abs(), |g, c| gcd(g, c.unsigned_abs() as u128));
+            let (n, d) = (n.map(|c| (c as i128 / g as i128) as i64), d / g as i128);
+            let fits = n.iter().all(|c| c.unsigned_abs() < 1u64 << MAX_NORMAL_BITS)
+                && d.unsigned_abs() < 1u128 << MAX_OFFSET_BITS;
+            fits.then_some((n, d, d as f64))
+        };
+        for i in 0..20_000u64 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let f = [1i64, 2, 6, 1 << 20, 1_000_003][(i % 5) as usize];
+            let c = |s: u32| ((x.rotate_left(s) >> 44) as i64 - (1 << 19)) * f;
+            let n = [c(0), c(21), c(42)];
+            if n == [0; 3] {
+                continue;
+            }
+            let d = match i % 4 {
+                0 => c(7) as i128,
+                1 => (c(7) as i128) << 40,
+                2 => i64::MIN as i128 + (x % 7) as i128 * f as i128,
+                _ => (x as i128) * f as i128,
+            };
+            let got = Plane::new(n, d).map(|p| (p.normal(), p.offset(), p.approx()[3]));
+            let want = wide(n, d);
+            assert_eq!(got, want, "{n:?} {d}");
+        }
+        let p = Plane::new([i64::MIN, 0, 0], (i64::MIN as i128) * 3).unwrap();
+        assert_eq!((p.normal(), p.offset()), ([-1, 0, 0], -3));
         // the third component counts when the first two share a factor
         let p = Plane::new([6, 10, 15], 30).unwrap();
         assert_eq!((p.normal(), p.offset()), ([6, 10, 15], 30));
