@@ -317,7 +317,9 @@ mod tests {
         // the offset's 64-bit path gives what the 128-bit one gives:
         // random planes, small and large offsets, common factors
         let wide = |n: [i64; 3], d: i128| -> Option<([i64; 3], i128, f64)> {
-            let g = n.iter().fold(d.unsigned_abs(), |g, c| gcd(g, c.unsigned_abs() as u128));
+            let g = n
+                .iter()
+                .fold(d.unsigned_abs(), |g, c| gcd(g, c.unsigned_abs() as u128));
             let (n, d) = (n.map(|c| (c as i128 / g as i128) as i64), d / g as i128);
             let fits = n.iter().all(|c| c.unsigned_abs() < 1u64 << MAX_NORMAL_BITS)
                 && d.unsigned_abs() < 1u128 << MAX_OFFSET_BITS;

@@ -106,10 +106,14 @@ pub fn check_closed_manifold<'a>(
 /// ([`corners_close`], with the link cycles).
 fn is_closed_manifold(faces: &[&[u32]]) -> bool {
     use rayon::prelude::*;
-    let ok_faces = faces.par_iter().all(|f| {
-        let mut v: smallvec::SmallVec<[u32; 8]> = f.iter().copied().collect();
-        v.sort_unstable();
-        f.len() >= 3 && v.windows(2).all(|w| w[0] != w[1])
+    let ok_faces = faces.par_iter().all(|f| match **f {
+        // (most faces: three comparisons, no copy)
+        [a, b, c] => a != b && b != c && c != a,
+        _ => {
+            let mut v: smallvec::SmallVec<[u32; 8]> = f.iter().copied().collect();
+            v.sort_unstable();
+            f.len() >= 3 && v.windows(2).all(|w| w[0] != w[1])
+        }
     });
     ok_faces && corners_close(faces, true)
 }
@@ -254,6 +258,55 @@ pub(crate) fn bucket_par<S: Sync, T: Copy + Default + Send + Sync>(
 
 /// [`corners_close`] at one vertex, its corners `(u, w)`.
 fn corners_close_at(g: &[(u32, u32)], cycles: bool) -> bool {
+    if g.len() <= SMALL_LINK {
+        corners_close_small(g, cycles)
+    } else {
+        corners_close_sorted(g, cycles)
+    }
+}
+
+/// A vertex with at most this many corners (most of them: a closed
+/// triangle mesh has six on average) is checked by comparing its corners
+/// pairwise, with no copy and no sort.
+const SMALL_LINK: usize = 12;
+
+/// [`corners_close_at`] by pairwise comparisons: the `u`s distinct, and
+/// then either the walk `u ↦ w` from the first corner comes back to it
+/// after exactly as many steps as there are corners (`cycles`), or each
+/// `w` is the `u` of exactly one corner.
+fn corners_close_small(g: &[(u32, u32)], cycles: bool) -> bool {
+    for (i, a) in g.iter().enumerate() {
+        if g[i + 1..].iter().any(|b| b.0 == a.0) {
+            return false;
+        }
+    }
+    if !cycles {
+        // with the `u`s distinct, every `w` a `u` and the `w`s distinct
+        // make the `w`s the `u`s
+        return g
+            .iter()
+            .enumerate()
+            .all(|(i, a)| g.iter().any(|b| b.0 == a.1) && !g[i + 1..].iter().any(|b| b.1 == a.1));
+    }
+    let Some(&(first, mut u)) = g.first() else {
+        return true;
+    };
+    // (the walk as in `corners_close_sorted`, the next corner found by a
+    // scan)
+    for step in 1..=g.len() {
+        if u == first {
+            return step == g.len();
+        }
+        match g.iter().find(|c| c.0 == u) {
+            Some(c) => u = c.1,
+            None => return false,
+        }
+    }
+    false
+}
+
+/// [`corners_close_at`] by sorting the corners by `u`.
+fn corners_close_sorted(g: &[(u32, u32)], cycles: bool) -> bool {
     let mut by_u: smallvec::SmallVec<[(u32, u32); 16]> = g.iter().copied().collect();
     by_u.sort_unstable();
     if by_u.windows(2).any(|x| x[0].0 == x[1].0) {
@@ -440,6 +493,49 @@ mod tests {
         let m = u32::MAX - 1;
         let big = tet.map(|t| t.map(|v| m - v));
         assert!(close(&big, true));
+    }
+
+    /// The pairwise check of a vertex's corners says what the sorting
+    /// one says: random small links, closed (one loop or several),
+    /// broken, and with repeats.
+    #[test]
+    fn small_links_are_checked_as_sorted_ones() {
+        let mut rng = crate::tree::SplitMix(9);
+        let mut seen = [0usize; 2];
+        for _ in 0..20_000 {
+            let k = 1 + rng.below(SMALL_LINK);
+            // a permutation of k ids as the link's loop(s) ...
+            let mut ids: Vec<u32> = (0..k as u32).map(|i| i * 3 + 1).collect();
+            for i in (1..k).rev() {
+                ids.swap(i, rng.below(i + 1));
+            }
+            let split = rng.below(k + 1);
+            let mut g: Vec<(u32, u32)> = Vec::new();
+            for part in [&ids[..split], &ids[split..]] {
+                for (i, &u) in part.iter().enumerate() {
+                    g.push((u, part[(i + 1) % part.len()]));
+                }
+            }
+            // ... broken now and then
+            match rng.below(4) {
+                0 => {
+                    let i = rng.below(k);
+                    g[i].1 = ids[rng.below(k)];
+                }
+                1 => {
+                    let i = rng.below(k);
+                    g[i].0 = ids[rng.below(k)];
+                }
+                2 => g.swap(0, k - 1),
+                _ => {}
+            }
+            for cycles in [false, true] {
+                let want = corners_close_sorted(&g, cycles);
+                assert_eq!(corners_close_small(&g, cycles), want, "{g:?} {cycles}");
+                seen[want as usize] += 1;
+            }
+        }
+        assert!(seen[0] > 1000 && seen[1] > 1000, "{seen:?}");
     }
 
     #[test]
