@@ -56,12 +56,21 @@ pub(crate) fn plane_meets(pl: &Plane, bx: &IBox) -> bool {
     let n = pl.normal();
     let (mut lo, mut hi) = (2 * pl.offset(), 2 * pl.offset());
     for ((&n, &l), &h) in n.iter().zip(&bx.0).zip(&bx.1) {
+        // (a cell's coordinates are grid coordinates, far inside `i64`:
+        // each product is one 64 × 64 → 128-bit multiplication)
+        debug_assert!(l.unsigned_abs() < 1 << 61 && h.unsigned_abs() < 1 << 61);
         let (a, b) = (
-            n as i128 * (2 * l as i128 - 1),
-            n as i128 * (2 * h as i128 + 1),
+            n as i128 * (2 * l - 1) as i128,
+            n as i128 * (2 * h + 1) as i128,
         );
-        lo += a.min(b);
-        hi += a.max(b);
+        // the lower end is at the low wall where the normal is positive
+        if n >= 0 {
+            lo += a;
+            hi += b;
+        } else {
+            lo += b;
+            hi += a;
+        }
     }
     lo <= 0 && 0 <= hi
 }
@@ -431,6 +440,53 @@ mod tests {
                 .iter()
                 .any(|w| w.classify_grid([3, 0, 5]) == Side::Front)
         );
+    }
+
+    /// The plane meets the closed box exactly when its value at the
+    /// box's eight corners (half a step outside the grid points, doubled
+    /// here) is not of one strict sign: random planes near and through
+    /// random boxes, large coefficients, both orientations.
+    #[test]
+    fn plane_meets_the_box_as_its_corners_say() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move |m: i64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 2) as i64 % m
+        };
+        let mut seen = [0usize; 2];
+        for i in 0..20_000 {
+            let lo = [0, 1, 2].map(|_| next(1 << 30) - (1 << 29));
+            let hi = [0, 1, 2].map(|k| lo[k] + next(1 << (4 + i % 20)));
+            let scale = 1i64 << (i % 30);
+            let n = [0, 1, 2].map(|_| (next(2001) - 1000) * scale);
+            if n == [0; 3] {
+                continue;
+            }
+            // through a point near the box, moved off by a little
+            let p = [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2 + next(1 << (4 + i % 20)));
+            let d = -(0..3).map(|k| n[k] as i128 * p[k] as i128).sum::<i128>()
+                + next(3) as i128 - 1;
+            let Some(pl) = Plane::new(n, d) else {
+                continue;
+            };
+            let (pn, pd) = (pl.normal(), pl.offset());
+            let values = (0..8).map(|c: usize| {
+                let v = |k: usize| {
+                    if c >> k & 1 == 0 {
+                        2 * lo[k] as i128 - 1
+                    } else {
+                        2 * hi[k] as i128 + 1
+                    }
+                };
+                2 * pd + (0..3).map(|k| pn[k] as i128 * v(k)).sum::<i128>()
+            });
+            let want = values.clone().any(|v| v <= 0) && values.clone().any(|v| v >= 0);
+            assert_eq!(plane_meets(&pl, &(lo, hi)), want, "{pl:?} {lo:?} {hi:?}");
+            seen[want as usize] += 1;
+        }
+        assert!(seen[0] > 1000 && seen[1] > 1000, "{seen:?}");
     }
 
     #[test]
