@@ -466,8 +466,8 @@ mod tests {
             }
             // through a point near the box, moved off by a little
             let p = [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2 + next(1 << (4 + i % 20)));
-            let d = -(0..3).map(|k| n[k] as i128 * p[k] as i128).sum::<i128>()
-                + next(3) as i128 - 1;
+            let d =
+                -(0..3).map(|k| n[k] as i128 * p[k] as i128).sum::<i128>() + next(3) as i128 - 1;
             let Some(pl) = Plane::new(n, d) else {
                 continue;
             };
