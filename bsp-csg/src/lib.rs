@@ -248,47 +248,46 @@ impl std::error::Error for CsgError {}
 /// polygon's room.
 #[derive(Clone, Debug)]
 enum Shape {
-    /// An imported face (or one kept whole from one).
+    /// An imported face (or one kept whole from one); its box is read off
+    /// its corners.
     Grid(GridPolygon),
-    /// A face an operation made, with its edge planes.
-    Made(Box<Polygon>),
+    /// A face an operation made, with its edge planes, and its box in 32
+    /// bits (rounded outward where a coordinate does not fit).
+    Made(Box<Polygon>, octree::SmallBox),
 }
 
+/// A face slot's content (a face slot is most of a solid's memory: an
+/// imported triangle takes 120 bytes, and a box stored beside its
+/// corners would take 24 more).
 #[derive(Clone, Debug)]
 struct Face {
     shape: Shape,
-    /// The polygon's box, in 32 bits (rounded outward where a coordinate
-    /// does not fit): a face slot is most of a solid's memory.
-    small_box: ([i32; 3], [i32; 3]),
 }
 
 impl Face {
-    fn new(shape: Shape, bx: &IBox) -> Face {
-        let narrow = |v: i64| v.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
-        Face {
-            shape,
-            small_box: (bx.0.map(narrow), bx.1.map(narrow)),
-        }
-    }
-
     /// An imported face (tag 0).
     fn grid(g: GridPolygon) -> Face {
-        let bx = polygon_box(&g);
-        Face::new(Shape::Grid(g.with_tag(0)), &bx)
+        Face {
+            shape: Shape::Grid(g.with_tag(0)),
+        }
     }
 
     /// A face an operation made (tag 0).
     fn made(mut p: Box<Polygon>) -> Face {
         p.set_tag(0);
         let bx = polygon_box(&*p);
-        Face::new(Shape::Made(p), &bx)
+        let narrow = |v: i64| v.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+        let small = (bx.0.map(narrow), bx.1.map(narrow));
+        Face {
+            shape: Shape::Made(p, small),
+        }
     }
 
     /// The polygon, with its edge planes (made for an imported face).
     fn polygon(&self) -> Cow<'_, Polygon> {
         match &self.shape {
             Shape::Grid(g) => Cow::Owned(g.to_polygon()),
-            Shape::Made(p) => Cow::Borrowed(p),
+            Shape::Made(p, _) => Cow::Borrowed(p),
         }
     }
 
@@ -297,19 +296,42 @@ impl Face {
         Face {
             shape: match &self.shape {
                 Shape::Grid(g) => Shape::Grid(g.flipped()),
-                Shape::Made(p) => Shape::Made(Box::new(p.flipped())),
+                Shape::Made(p, b) => Shape::Made(Box::new(p.flipped()), *b),
             },
-            small_box: self.small_box,
+        }
+    }
+
+    /// A box holding the polygon, in 32 bits: an imported face's corners'
+    /// (exact), a made face's stored one.
+    #[inline]
+    fn small_box(&self) -> octree::SmallBox {
+        match &self.shape {
+            Shape::Grid(g) => match *g.vertices() {
+                // (most imported faces)
+                [a, b, c] => (
+                    [0, 1, 2].map(|k| a[k].min(b[k]).min(c[k])),
+                    [0, 1, 2].map(|k| a[k].max(b[k]).max(c[k])),
+                ),
+                ref v => {
+                    let (mut lo, mut hi) = (v[0], v[0]);
+                    for p in &v[1..] {
+                        for k in 0..3 {
+                            lo[k] = lo[k].min(p[k]);
+                            hi[k] = hi[k].max(p[k]);
+                        }
+                    }
+                    (lo, hi)
+                }
+            },
+            Shape::Made(_, b) => *b,
         }
     }
 
     /// A box holding the polygon.
     #[inline]
     fn bx(&self) -> IBox {
-        (
-            self.small_box.0.map(i64::from),
-            self.small_box.1.map(i64::from),
-        )
+        let (lo, hi) = self.small_box();
+        (lo.map(i64::from), hi.map(i64::from))
     }
 }
 
@@ -318,28 +340,28 @@ impl ConvexFace for Face {
     fn support(&self) -> &Plane {
         match &self.shape {
             Shape::Grid(g) => g.support(),
-            Shape::Made(p) => p.support(),
+            Shape::Made(p, _) => p.support(),
         }
     }
     #[inline]
     fn corner_count(&self) -> usize {
         match &self.shape {
             Shape::Grid(g) => g.len(),
-            Shape::Made(p) => p.len(),
+            Shape::Made(p, _) => p.len(),
         }
     }
     #[inline]
     fn corner(&self, i: usize) -> PointRef<'_> {
         match &self.shape {
             Shape::Grid(g) => PointRef::Grid(g.vertices()[i]),
-            Shape::Made(p) => p.vertices()[i].as_ref(),
+            Shape::Made(p, _) => p.vertices()[i].as_ref(),
         }
     }
     #[inline]
     fn edge_plane(&self, i: usize) -> Plane {
         match &self.shape {
             Shape::Grid(g) => g.edge_plane(i),
-            Shape::Made(p) => p.edge_planes()[i],
+            Shape::Made(p, _) => p.edge_planes()[i],
         }
     }
 }
@@ -799,7 +821,7 @@ impl Solid {
         // `a_c` and `b_c` (a face slot is large: the build reads these often)
         let geometry = |s: &Solid, fs: &[u32]| -> (Vec<octree::SmallBox>, Vec<bsp_core::Plane>) {
             fs.par_iter()
-                .map(|&f| (s.face(f).small_box, *s.face(f).support()))
+                .map(|&f| (s.face(f).small_box(), *s.face(f).support()))
                 .unzip()
         };
         let (boxes_a, planes_a) = geometry(self, &a_c);
@@ -1354,8 +1376,7 @@ impl Solid {
                     .into_iter()
                     .filter_map(|slot| match slot {
                         Some(Face {
-                            shape: Shape::Made(p),
-                            ..
+                            shape: Shape::Made(p, _),
                         }) => Some(&mut **p),
                         _ => None,
                     })
@@ -2588,6 +2609,22 @@ mod tests {
             }
         }
         pieces
+    }
+
+    /// A face slot stays small (it is most of a solid's memory), and an
+    /// imported face's box read off its corners is the box of its
+    /// polygon, as a made face's stored one is.
+    #[test]
+    fn face_slots_are_small_and_know_their_boxes() {
+        assert!(std::mem::size_of::<Face>() <= 120);
+        let g = GridPolygon::from_grid_points(&[[5, -7, 1], [9, 2, -3], [-4, 0, 8]], 3).unwrap();
+        let want = polygon_box(&g);
+        let grid = Face::grid(g.clone());
+        assert_eq!(grid.bx(), want);
+        assert_eq!(grid.flipped().bx(), want);
+        let made = Face::made(Box::new(g.to_polygon()));
+        assert_eq!(made.bx(), want);
+        assert_eq!(made.flipped().bx(), want);
     }
 
     #[test]
