@@ -101,24 +101,24 @@ fn weld<P: ConvexFace + Sync>(polys: &[P], start: &[usize]) -> (Vec<Point>, Vec<
         (Pt::G(g), Pt::I(i)) | (Pt::I(i), Pt::G(g)) => crate::point::grid_is(&g, i),
     };
     const SHARDS: usize = 16;
-    // each corner's point and key, in parallel
-    let corners_of = crate::topology::per_corner_at(polys, start, |p, i| {
-        let v = p.corner(i);
-        let pt = match v {
-            PointRef::Grid(g) => Pt::G(g),
-            PointRef::Implicit(a) => Pt::I(a),
-        };
-        (pt, key(v))
-    });
     let shard = |k: u64| (k >> 60) as usize % SHARDS;
-    // the corners by shard, in order
-    let (at, items) = crate::topology::bucket_par(
+    // the corners by shard, in order, with their points and keys, in
+    // parallel (a key is computed twice: cheaper than a list of them, at
+    // the peak of a large mesh's memory)
+    let (at, items) = crate::topology::bucket_par_corners(
         SHARDS,
-        &corners_of,
-        |&(_, k)| shard(k),
-        |c, &(pt, k)| (pt, k, c as u32),
+        polys,
+        start,
+        |p, i| shard(key(p.corner(i))),
+        |c, p, i| {
+            let v = p.corner(i);
+            let pt = match v {
+                PointRef::Grid(g) => Pt::G(g),
+                PointRef::Implicit(a) => Pt::I(a),
+            };
+            (pt, key(v), c as u32)
+        },
     );
-    drop(corners_of);
     // per shard: each item's point there, and the points with their first
     // corners; a key's points are chained (`next`), the map holds the last
     const END: u32 = u32::MAX;

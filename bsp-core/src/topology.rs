@@ -203,34 +203,41 @@ fn zeroed_par<T: Copy + Default + Send + Sync>(n: usize) -> Vec<T> {
     v
 }
 
-/// [`bucket`] of the items `make(i, &src[i])` by `key(&src[i])` (below
-/// `n`), in parallel: each run of the source counts its items per key,
-/// and then fills its own ranges. The same result as [`bucket`], for few
-/// keys (shards): each run holds a count per key, which for keys as many
-/// as the vertices would be larger than the items.
-pub(crate) fn bucket_par<S: Sync, T: Copy + Default + Send + Sync>(
+/// [`bucket`] of every corner `i` of every face `f` (face `f`'s corners
+/// being `start[f]..start[f + 1]`), item `make(c, f, i)` for corner number
+/// `c` under key `key(f, i)` (below `n`; called twice per corner), in
+/// parallel, for few keys (shards): each run of faces counts its corners
+/// per key, then fills its own ranges (a count per key per run, which for
+/// keys as many as the vertices would be larger than the items). No list
+/// of the corners is made first.
+pub(crate) fn bucket_par_corners<'f, F: Sync, T: Copy + Default + Send + Sync>(
     n: usize,
-    src: &[S],
-    key: impl Fn(&S) -> usize + Sync,
-    make: impl Fn(usize, &S) -> T + Sync,
+    faces: &'f [F],
+    start: &[usize],
+    key: impl Fn(&'f F, usize) -> usize + Sync,
+    make: impl Fn(usize, &'f F, usize) -> T + Sync,
 ) -> (Vec<usize>, Vec<T>) {
     use rayon::prelude::*;
-    const RUN: usize = 1 << 15;
-    let counts: Vec<Vec<usize>> = src
+    const RUN: usize = 4096;
+    let corners = |r: usize, j: usize| start[r * RUN + j]..start[r * RUN + j + 1];
+    let counts: Vec<Vec<usize>> = faces
         .par_chunks(RUN)
-        .map(|run| {
+        .enumerate()
+        .map(|(r, run)| {
             let mut c = vec![0usize; n];
-            for s in run {
-                c[key(s)] += 1;
+            for (j, f) in run.iter().enumerate() {
+                for i in 0..corners(r, j).len() {
+                    c[key(f, i)] += 1;
+                }
             }
             c
         })
         .collect();
-    let mut start = vec![0usize; n + 1];
+    let mut at = vec![0usize; n + 1];
     for k in 0..n {
-        start[k + 1] = start[k] + counts.iter().map(|c| c[k]).sum::<usize>();
+        at[k + 1] = at[k] + counts.iter().map(|c| c[k]).sum::<usize>();
     }
-    let mut items = zeroed_par(start[n]);
+    let mut items = zeroed_par(at[n]);
     // each run's range of each key, key by key, run by run
     let mut ranges: Vec<Vec<&mut [T]>> = counts.iter().map(|_| Vec::with_capacity(n)).collect();
     let mut rest = &mut items[..];
@@ -243,17 +250,19 @@ pub(crate) fn bucket_par<S: Sync, T: Copy + Default + Send + Sync>(
     }
     ranges
         .into_par_iter()
-        .zip(src.par_chunks(RUN))
+        .zip(faces.par_chunks(RUN))
         .enumerate()
         .for_each(|(r, (mut out, run))| {
-            let mut at = vec![0usize; n];
-            for (i, s) in run.iter().enumerate() {
-                let k = key(s);
-                out[k][at[k]] = make(r * RUN + i, s);
-                at[k] += 1;
+            let mut fill = vec![0usize; n];
+            for (j, f) in run.iter().enumerate() {
+                for (i, c) in corners(r, j).enumerate() {
+                    let k = key(f, i);
+                    out[k][fill[k]] = make(c, f, i);
+                    fill[k] += 1;
+                }
             }
         });
-    (start, items)
+    (at, items)
 }
 
 /// [`corners_close`] at one vertex, its corners `(u, w)`.
@@ -342,41 +351,6 @@ fn corners_close_sorted(g: &[(u32, u32)], cycles: bool) -> bool {
 #[inline]
 pub(crate) fn undirected(a: u32, b: u32) -> (u32, u32, u32) {
     if a < b { (a, b, 0) } else { (b, a, 1) }
-}
-
-/// `item(face, i)` for every corner `i` of every face, face `f`'s corners
-/// being `start[f]..start[f + 1]`, in order, in an array of exactly that
-/// size, made and filled in parallel by runs of faces: no list per face,
-/// no growing.
-pub(crate) fn per_corner_at<'f, F: Sync, T: Copy + Default + Send + Sync>(
-    faces: &'f [F],
-    start: &[usize],
-    item: impl Fn(&'f F, usize) -> T + Sync,
-) -> Vec<T> {
-    use rayon::prelude::*;
-    const RUN: usize = 1024;
-    let mut out = zeroed_par(start[faces.len()]);
-    let mut pieces = Vec::with_capacity(faces.len() / RUN + 1);
-    let mut rest = &mut out[..];
-    for r in (0..faces.len()).step_by(RUN) {
-        let end = start[(r + RUN).min(faces.len())];
-        let (piece, tail) = std::mem::take(&mut rest).split_at_mut(end - start[r]);
-        pieces.push((r, piece));
-        rest = tail;
-    }
-    pieces
-        .into_par_iter()
-        .zip(faces.par_chunks(RUN))
-        .for_each(|((r, piece), fs)| {
-            let mut o = piece.iter_mut();
-            for (j, f) in fs.iter().enumerate() {
-                let n = start[r + j + 1] - start[r + j];
-                for (i, slot) in o.by_ref().take(n).enumerate() {
-                    *slot = item(f, i);
-                }
-            }
-        });
-    out
 }
 
 /// [`check_closed_manifold`] face by face, naming the first defect.
@@ -536,6 +510,34 @@ mod tests {
             }
         }
         assert!(seen[0] > 1000 && seen[1] > 1000, "{seen:?}");
+    }
+
+    /// The parallel bucketing of corners gives what one pass in order
+    /// gives: faces of 3 to 7 corners, enough for several runs.
+    #[test]
+    fn corners_bucket_in_parallel_as_in_order() {
+        let mut rng = crate::tree::SplitMix(5);
+        let faces: Vec<Vec<u32>> = (0..20_000)
+            .map(|_| {
+                (0..3 + rng.below(5))
+                    .map(|_| rng.below(1 << 20) as u32)
+                    .collect()
+            })
+            .collect();
+        let mut start = vec![0usize];
+        for f in &faces {
+            start.push(start[start.len() - 1] + f.len());
+        }
+        let key = |f: &Vec<u32>, i: usize| (f[i] % 13) as usize;
+        let got = bucket_par_corners(13, &faces, &start, key, |c, f, i| (c as u32, f[i]));
+        let want = bucket(13, |emit| {
+            for (fi, f) in faces.iter().enumerate() {
+                for i in 0..f.len() {
+                    emit(key(f, i), ((start[fi] + i) as u32, f[i]));
+                }
+            }
+        });
+        assert_eq!(got, want);
     }
 
     #[test]
