@@ -102,8 +102,8 @@ fn weld<P: ConvexFace + Sync>(polys: &[P], start: &[usize]) -> (Vec<Point>, Vec<
     };
     const SHARDS: usize = 16;
     let shard = |k: u64| (k >> 60) as usize % SHARDS;
-    // the corners by shard, in order, with their points and keys, in
-    // parallel (a key is computed twice: cheaper than a list of them, at
+    // the corners by shard, in order, with their points, in parallel (a
+    // key is computed where it is needed: cheaper than lists of them, at
     // the peak of a large mesh's memory)
     let (at, items) = crate::topology::bucket_par_corners(
         SHARDS,
@@ -116,9 +116,15 @@ fn weld<P: ConvexFace + Sync>(polys: &[P], start: &[usize]) -> (Vec<Point>, Vec<
                 PointRef::Grid(g) => Pt::G(g),
                 PointRef::Implicit(a) => Pt::I(a),
             };
-            (pt, key(v), c as u32)
+            (pt, c as u32)
         },
     );
+    // (the key again where the shard reads it: an item without it is a
+    // quarter smaller, at the peak of a large mesh's memory)
+    let key_of = |pt: Pt<'_>| match pt {
+        Pt::G(g) => key(PointRef::Grid(g)),
+        Pt::I(a) => key(PointRef::Implicit(a)),
+    };
     // per shard: each item's point there, and the points with their first
     // corners; a key's points are chained (`next`), the map holds the last
     const END: u32 = u32::MAX;
@@ -139,8 +145,8 @@ fn weld<P: ConvexFace + Sync>(polys: &[P], start: &[usize]) -> (Vec<Point>, Vec<
             let mut next: Vec<u32> = Vec::with_capacity(room);
             let ids = items
                 .iter()
-                .map(|&(pt, k, c)| {
-                    let head = by_key.entry(k).or_insert(END);
+                .map(|&(pt, c)| {
+                    let head = by_key.entry(key_of(pt)).or_insert(END);
                     let mut i = *head;
                     while i != END {
                         if same(points[i as usize].0, pt) {
@@ -184,7 +190,7 @@ fn weld<P: ConvexFace + Sync>(polys: &[P], start: &[usize]) -> (Vec<Point>, Vec<
     drop(order);
     let mut corners = vec![0u32; start[polys.len()]];
     for (s, (ids, _)) in welded.iter().enumerate() {
-        for (&(_, _, c), &id) in items[at[s]..at[s + 1]].iter().zip(ids) {
+        for (&(_, c), &id) in items[at[s]..at[s + 1]].iter().zip(ids) {
             corners[c as usize] = number[s][id as usize];
         }
     }
