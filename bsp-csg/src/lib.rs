@@ -1434,20 +1434,20 @@ impl Planned {
             ..
         } = solid;
         let Solid {
-            faces: theirs,
+            faces: mut theirs,
             index: their_index,
             ..
         } = other;
         drop_aside((index, their_index));
         // the faces the plan adds that are not read where they are: new
-        // ones, and the other solid's flipped for a difference
+        // ones (the other solid's kept whole are read in its slots,
+        // turned around there for a difference)
         let flip = plan.flip;
         enum Src {
             New(u32),
-            Flipped(u32),
             Theirs(u32),
         }
-        let (mut news, mut flipped) = (Vec::new(), Vec::new());
+        let (mut news, mut turned) = (Vec::new(), Vec::new());
         let srcs: Vec<Src> = plan
             .add
             .into_iter()
@@ -1456,13 +1456,23 @@ impl Planned {
                     news.push(p);
                     Src::New((news.len() - 1) as u32)
                 }
-                Added::Whole(f) if flip => {
-                    flipped.push(f);
-                    Src::Flipped((flipped.len() - 1) as u32)
+                Added::Whole(f) => {
+                    if flip {
+                        turned.push(f);
+                    }
+                    Src::Theirs(f)
                 }
-                Added::Whole(f) => Src::Theirs(f),
             })
             .collect();
+        // (in place, in parallel: no second copy of the faces kept)
+        turned.sort_unstable();
+        turned.dedup();
+        borrow_sorted(&mut theirs, &turned)
+            .into_par_iter()
+            .for_each(|slot| {
+                let f = slot.as_mut().expect("a live face");
+                *f = f.flipped();
+            });
         let face = |f: u32| theirs[f as usize].as_ref().expect("a live face");
         {
             // equal new vertices made one, as `carry_out` makes them: the
@@ -1470,14 +1480,10 @@ impl Planned {
             let mut refs: Vec<&mut Polygon> = news.iter_mut().map(|p| &mut **p).collect();
             share_points(&mut refs);
         }
-        let (news, flipped): (Vec<Face>, Vec<Face>) = rayon::join(
-            || news.into_par_iter().map(Face::made).collect(),
-            || flipped.par_iter().map(|&f| face(f).flipped()).collect(),
-        );
+        let news: Vec<Face> = news.into_par_iter().map(Face::made).collect();
         let src = |s: &Src| -> &Face {
             match *s {
                 Src::New(i) => &news[i as usize],
-                Src::Flipped(i) => &flipped[i as usize],
                 Src::Theirs(f) => face(f),
             }
         };
@@ -1496,7 +1502,7 @@ impl Planned {
             .collect();
         let mesh = TriMesh::from_polygons_watertight(&polys).map_err(CsgError::Internal);
         drop(polys);
-        drop_aside((faces, theirs, news, flipped));
+        drop_aside((faces, theirs, news));
         mesh
     }
 }
