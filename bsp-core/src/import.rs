@@ -251,7 +251,7 @@ impl FaceImporter {
         fi: usize,
         mut out: impl FnMut(Polygon),
     ) -> Result<(), Error> {
-        self.indexed_grid(grid, positions, face, fi, |g| out(g.to_polygon()))
+        self.indexed_grid(grid, positions, face, fi, |g| out(g.to_polygon(fi as u32)))
     }
 
     /// [`FaceImporter::indexed`], giving the polygons without their edge
@@ -287,7 +287,7 @@ impl FaceImporter {
         fi: usize,
         mut out: impl FnMut(Polygon),
     ) -> Result<(), Error> {
-        self.face_grid(grid, face, fi, |g| out(g.to_polygon()))
+        self.face_grid(grid, face, fi, |g| out(g.to_polygon(fi as u32)))
     }
 
     /// [`FaceImporter::face`], giving the polygons without their edge
@@ -351,8 +351,7 @@ impl FaceImporter {
     /// The polygons of face `fi`, the loop of grid points `pts`.
     fn grid_loop(&mut self, pts: &[GridPoint], fi: usize, mut out: impl FnMut(GridPolygon)) {
         let report = &mut self.report;
-        let tag = fi as u32;
-        match GridPolygon::from_grid_points(pts, tag) {
+        match GridPolygon::from_grid_points(pts) {
             Ok(p) => {
                 report.polygons += 1;
                 out(p);
@@ -361,7 +360,7 @@ impl FaceImporter {
                 let tris = triangulate(pts, defect);
                 let before = report.polygons;
                 for t in tris.iter() {
-                    if let Ok(p) = GridPolygon::from_grid_points(t, tag) {
+                    if let Ok(p) = GridPolygon::from_grid_points(t) {
                         report.polygons += 1;
                         out(p);
                     }

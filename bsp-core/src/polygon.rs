@@ -214,18 +214,19 @@ pub(crate) fn support_plane(v: &[GridPoint]) -> Result<Plane, FaceDefect> {
 /// [`Polygon::from_grid_points`] gives (through the edge, containing the
 /// axis along which the support's normal is largest), computed when asked
 /// for, so the form takes about a third of a [`Polygon`]'s room: a large
-/// solid whose faces are mostly never cut keeps them in it.
+/// solid whose faces are mostly never cut keeps them in it. It carries no
+/// tag (a caller who tags its polygons tags the [`Polygon`] it makes of
+/// one): four bytes more on every face of a large solid.
 #[derive(Clone, Debug)]
 pub struct GridPolygon {
     support: Plane,
     verts: SmallVec<[GridPoint; 4]>,
-    tag: u32,
 }
 
 impl GridPolygon {
     /// A polygon from grid points in counter-clockwise order, checked and
     /// cleaned as [`Polygon::from_grid_points`] does.
-    pub fn from_grid_points(points: &[GridPoint], tag: u32) -> Result<GridPolygon, FaceDefect> {
+    pub fn from_grid_points(points: &[GridPoint]) -> Result<GridPolygon, FaceDefect> {
         // most faces are triangles of three distinct corners: what the
         // general path gives them, without its copies (the plane through
         // the corners in order is the one oriented by their winding, and
@@ -239,7 +240,6 @@ impl GridPolygon {
             return Ok(GridPolygon {
                 support,
                 verts: SmallVec::from_buf_and_len([a, b, c, [0; 3]], 3),
-                tag,
             });
         }
         let mut v = dedupe_cyclic(points);
@@ -259,7 +259,6 @@ impl GridPolygon {
         let g = GridPolygon {
             support,
             verts: v.into_iter().collect(),
-            tag,
         };
         let convex = || {
             let k = g.verts.len();
@@ -298,17 +297,6 @@ impl GridPolygon {
         self.verts.is_empty()
     }
 
-    /// The tag.
-    pub fn tag(&self) -> u32 {
-        self.tag
-    }
-
-    /// The same polygon with another tag.
-    pub fn with_tag(mut self, tag: u32) -> GridPolygon {
-        self.tag = tag;
-        self
-    }
-
     /// Edge plane `i`, bounding the edge from corner `i` to `i + 1`
     /// (interior behind): the plane [`GridPolygon::to_polygon`] stores.
     #[inline]
@@ -324,17 +312,16 @@ impl GridPolygon {
         GridPolygon {
             support: self.support.flip(),
             verts: self.verts.iter().rev().copied().collect(),
-            tag: self.tag,
         }
     }
 
-    /// The polygon with its edge planes.
-    pub fn to_polygon(&self) -> Polygon {
+    /// The polygon with its edge planes, tagged `tag`.
+    pub fn to_polygon(&self, tag: u32) -> Polygon {
         Polygon {
             support: self.support,
             edges: (0..self.verts.len()).map(|i| self.edge_plane(i)).collect(),
             verts: self.verts.iter().map(|&g| Point::Grid(g)).collect(),
-            tag: self.tag,
+            tag,
         }
     }
 }
@@ -426,7 +413,7 @@ impl Polygon {
     /// assert!(bow.is_err());
     /// ```
     pub fn from_grid_points(points: &[GridPoint], tag: u32) -> Result<Polygon, FaceDefect> {
-        GridPolygon::from_grid_points(points, tag).map(|g| g.to_polygon())
+        GridPolygon::from_grid_points(points).map(|g| g.to_polygon(tag))
     }
 
     /// A polygon from its support plane and cycle of edge planes (edge
@@ -972,13 +959,12 @@ mod tests {
             let k = if big { 1 << 25 } else { 1 };
             let p = |i: usize| [c[i] * k, c[i + 1] * k + 1, c[i + 2] * k];
             let (a, b, d) = (p(0), p(3), p(6));
-            let short = GridPolygon::from_grid_points(&[a, b, d], 7);
-            let general = GridPolygon::from_grid_points(&[a, b, d, d], 7);
+            let short = GridPolygon::from_grid_points(&[a, b, d]);
+            let general = GridPolygon::from_grid_points(&[a, b, d, d]);
             match (&short, &general) {
                 (Ok(s), Ok(g)) => {
                     proptest::prop_assert_eq!(s.support(), g.support());
                     proptest::prop_assert_eq!(s.vertices(), g.vertices());
-                    proptest::prop_assert_eq!(s.tag(), g.tag());
                 }
                 (Err(s), Err(g)) => proptest::prop_assert_eq!(s, g),
                 _ => proptest::prop_assert!(false, "{:?} against {:?}", short, general),
@@ -1035,7 +1021,7 @@ mod tests {
         }
         let mut made = 0;
         for l in &loops {
-            let g = GridPolygon::from_grid_points(l, 3);
+            let g = GridPolygon::from_grid_points(l);
             let p = Polygon::from_grid_points(l, 3);
             let (g, p) = match (g, p) {
                 (Ok(g), Ok(p)) => (g, p),
@@ -1046,7 +1032,7 @@ mod tests {
                 (g, p) => panic!("{l:?}: {:?} against {:?}", g.err(), p.err()),
             };
             made += 1;
-            let full = g.to_polygon();
+            let full = g.to_polygon(3);
             assert!(same(&full, &p), "{l:?}");
             assert!(full.sanity_check().is_ok());
             let k = g.len();
@@ -1062,8 +1048,8 @@ mod tests {
                     assert_eq!(e.classify_grid(c), want, "{l:?} edge {i} corner {j}");
                 }
             }
-            assert!(same(&g.flipped().to_polygon(), &p.flipped()), "{l:?}");
-            assert_eq!(g.tag(), 3);
+            assert!(same(&g.flipped().to_polygon(3), &p.flipped()), "{l:?}");
+            assert_eq!(full.tag(), 3);
         }
         assert!(made > 300, "only {made} polygons made");
     }
