@@ -367,67 +367,80 @@ fn choose_plane_sides(
     (best.1, s == n)
 }
 
+/// A node's cut: its plane, the polygons in the plane, and the lists in
+/// front of it and behind it.
+type Cut = (Plane, Vec<Polygon>, Vec<Polygon>, Vec<Polygon>);
+
+/// The tree `split` grows from `polygons`: a non-empty list becomes a node
+/// by the cut `split` makes of it (given what the caller keeps with the
+/// list, `at`, and giving that of the front and back lists); an empty one
+/// is a leaf, inside behind its parent's plane and outside elsewhere.
+/// Nodes are numbered in the order they are made, front subtree first;
+/// an explicit stack, so any depth is fine.
+fn grow<A>(
+    polygons: Vec<Polygon>,
+    at: A,
+    mut split: impl FnMut(Vec<Polygon>, A) -> (Cut, A, A),
+) -> BspTree {
+    let mut tree = BspTree {
+        nodes: Vec::new(),
+        root: Link::Cell(Cell::Out),
+    };
+    let mut stack: Vec<(Vec<Polygon>, A, Slot)> = vec![(polygons, at, Slot::Root)];
+    while let Some((polys, at, slot)) = stack.pop() {
+        let link = if polys.is_empty() {
+            Link::Cell(match slot {
+                Slot::Back(_) => Cell::In,
+                Slot::Front(_) | Slot::Root => Cell::Out,
+            })
+        } else {
+            let ((plane, on, front, back), at_front, at_back) = split(polys, at);
+            let id = tree.nodes.len() as NodeId;
+            tree.nodes.push(Node {
+                plane,
+                polygons: on,
+                front: Link::Cell(Cell::Out),
+                back: Link::Cell(Cell::In),
+            });
+            stack.push((back, at_back, Slot::Back(id)));
+            stack.push((front, at_front, Slot::Front(id)));
+            Link::Node(id)
+        };
+        match slot {
+            Slot::Root => tree.root = link,
+            Slot::Front(id) => tree.nodes[id as usize].front = link,
+            Slot::Back(id) => tree.nodes[id as usize].back = link,
+        }
+    }
+    tree
+}
+
 impl BspTree {
     /// An autopartition of `polygons`: every partitioning plane is the
     /// support plane of an input polygon; coplanar polygons of both
     /// orientations stay at their node. Uses an explicit stack, so any
     /// depth is fine.
     pub fn build(polygons: Vec<Polygon>, opts: &BuildOptions) -> BspTree {
-        let mut tree = BspTree {
-            nodes: Vec::new(),
-            root: Link::Cell(Cell::Out),
-        };
         let mut rng = SplitMix(opts.seed);
         let mut sides = Vec::new();
-        let mut stack: Vec<(Vec<Polygon>, Slot)> = vec![(polygons, Slot::Root)];
-        while let Some((polys, slot)) = stack.pop() {
-            let link = if polys.is_empty() {
-                Link::Cell(match slot {
-                    Slot::Back(_) => Cell::In,
-                    Slot::Front(_) | Slot::Root => Cell::Out,
-                })
+        grow(polygons, (), |polys, ()| {
+            let cut = if opts.cut_threshold > 0 && polys.len() > opts.cut_threshold {
+                balance_cut(&polys)
             } else {
-                let cut = if opts.cut_threshold > 0 && polys.len() > opts.cut_threshold {
-                    balance_cut(&polys)
-                } else {
-                    None
-                };
-                let (mut polys, mut parts) = (polys, None);
-                if let Some(plane) = cut.filter(|c| cut_balances(&polys, c)) {
-                    let (on, front, back) = partition_list(polys, &plane);
-                    parts = Some((plane, on, front, back));
-                    polys = Vec::new();
-                }
-                let (plane, on, front, back) = match parts {
-                    Some(p) => p,
-                    None => {
-                        let (plane, known) = choose_plane_sides(&polys, opts, &mut rng, &mut sides);
-                        let (on, front, back) = if known {
-                            partition_known(polys, &plane, &sides)
-                        } else {
-                            partition_list(polys, &plane)
-                        };
-                        (plane, on, front, back)
-                    }
-                };
-                let id = tree.nodes.len() as NodeId;
-                tree.nodes.push(Node {
-                    plane,
-                    polygons: on,
-                    front: Link::Cell(Cell::Out),
-                    back: Link::Cell(Cell::In),
-                });
-                stack.push((back, Slot::Back(id)));
-                stack.push((front, Slot::Front(id)));
-                Link::Node(id)
+                None
             };
-            match slot {
-                Slot::Root => tree.root = link,
-                Slot::Front(id) => tree.nodes[id as usize].front = link,
-                Slot::Back(id) => tree.nodes[id as usize].back = link,
+            if let Some(plane) = cut.filter(|c| cut_balances(&polys, c)) {
+                let (on, front, back) = partition_list(polys, &plane);
+                return ((plane, on, front, back), (), ());
             }
-        }
-        tree
+            let (plane, known) = choose_plane_sides(&polys, opts, &mut rng, &mut sides);
+            let (on, front, back) = if known {
+                partition_known(polys, &plane, &sides)
+            } else {
+                partition_list(polys, &plane)
+            };
+            ((plane, on, front, back), (), ())
+        })
     }
 
     /// A tree from its nodes and root (indices into `nodes`; every node
@@ -446,52 +459,24 @@ impl BspTree {
     /// tree wherever the new coordinates keep every polygon on the same
     /// side of every plane, and a valid autopartition in any case.
     pub fn replay(&self, polygons: Vec<Polygon>, fallback: &BuildOptions) -> BspTree {
-        let mut tree = BspTree {
-            nodes: Vec::new(),
-            root: Link::Cell(Cell::Out),
-        };
         let mut rng = SplitMix(fallback.seed);
-        // (the polygons, the node of this tree they stand at, the slot)
-        let mut stack: Vec<(Vec<Polygon>, Option<NodeId>, Slot)> =
-            vec![(polygons, self.root_id(), Slot::Root)];
-        while let Some((polys, at, slot)) = stack.pop() {
-            let link = if polys.is_empty() {
-                Link::Cell(match slot {
-                    Slot::Back(_) => Cell::In,
-                    Slot::Front(_) | Slot::Root => Cell::Out,
-                })
-            } else {
-                let old = at.map(|i| &self.nodes[i as usize]);
-                // the face whose plane this tree chose here
-                let chosen = old.and_then(|n| {
-                    let t = n.polygons.iter().find(|p| p.support() == &n.plane)?.tag();
-                    polys.iter().find(|p| p.tag() == t).map(|p| *p.support())
-                });
-                let plane = chosen.unwrap_or_else(|| choose_plane(&polys, fallback, &mut rng));
-                let (on, front, back) = partition_list(polys, &plane);
-                let id = tree.nodes.len() as NodeId;
-                tree.nodes.push(Node {
-                    plane,
-                    polygons: on,
-                    front: Link::Cell(Cell::Out),
-                    back: Link::Cell(Cell::In),
-                });
-                let child = |l: Link| match l {
-                    Link::Node(j) => Some(j),
-                    Link::Cell(_) => None,
-                };
-                let (f, b) = old.map_or((None, None), |n| (child(n.front), child(n.back)));
-                stack.push((back, b, Slot::Back(id)));
-                stack.push((front, f, Slot::Front(id)));
-                Link::Node(id)
+        // each list with the node of this tree it stands at
+        grow(polygons, self.root_id(), |polys, at| {
+            let old = at.map(|i| &self.nodes[i as usize]);
+            // the face whose plane this tree chose here
+            let chosen = old.and_then(|n| {
+                let t = n.polygons.iter().find(|p| p.support() == &n.plane)?.tag();
+                polys.iter().find(|p| p.tag() == t).map(|p| *p.support())
+            });
+            let plane = chosen.unwrap_or_else(|| choose_plane(&polys, fallback, &mut rng));
+            let (on, front, back) = partition_list(polys, &plane);
+            let child = |l: Link| match l {
+                Link::Node(j) => Some(j),
+                Link::Cell(_) => None,
             };
-            match slot {
-                Slot::Root => tree.root = link,
-                Slot::Front(id) => tree.nodes[id as usize].front = link,
-                Slot::Back(id) => tree.nodes[id as usize].back = link,
-            }
-        }
-        tree
+            let (f, b) = old.map_or((None, None), |n| (child(n.front), child(n.back)));
+            ((plane, on, front, back), f, b)
+        })
     }
 
     fn root_id(&self) -> Option<NodeId> {
@@ -947,39 +932,12 @@ mod tests {
             }
             best.1
         }
-        let mut tree = BspTree {
-            nodes: Vec::new(),
-            root: Link::Cell(Cell::Out),
-        };
         let mut rng = SplitMix(opts.seed);
-        let mut stack = vec![(polygons, Slot::Root)];
-        while let Some((polys, slot)) = stack.pop() {
-            let link = if polys.is_empty() {
-                Link::Cell(match slot {
-                    Slot::Back(_) => Cell::In,
-                    _ => Cell::Out,
-                })
-            } else {
-                let plane = choose(&polys, opts, &mut rng);
-                let (on, front, back) = partition_list(polys, &plane);
-                let id = tree.nodes.len() as NodeId;
-                tree.nodes.push(Node {
-                    plane,
-                    polygons: on,
-                    front: Link::Cell(Cell::Out),
-                    back: Link::Cell(Cell::In),
-                });
-                stack.push((back, Slot::Back(id)));
-                stack.push((front, Slot::Front(id)));
-                Link::Node(id)
-            };
-            match slot {
-                Slot::Root => tree.root = link,
-                Slot::Front(id) => tree.nodes[id as usize].front = link,
-                Slot::Back(id) => tree.nodes[id as usize].back = link,
-            }
-        }
-        tree
+        grow(polygons, (), |polys, ()| {
+            let plane = choose(&polys, opts, &mut rng);
+            let (on, front, back) = partition_list(polys, &plane);
+            ((plane, on, front, back), (), ())
+        })
     }
 
     /// Keeping the scoring's sides for the split, and scoring a plane drawn
