@@ -312,15 +312,10 @@ impl Face {
                     [0, 1, 2].map(|k| a[k].min(b[k]).min(c[k])),
                     [0, 1, 2].map(|k| a[k].max(b[k]).max(c[k])),
                 ),
-                ref v => {
-                    let (mut lo, mut hi) = (v[0], v[0]);
-                    for p in &v[1..] {
-                        for k in 0..3 {
-                            lo[k] = lo[k].min(p[k]);
-                            hi[k] = hi[k].max(p[k]);
-                        }
-                    }
-                    (lo, hi)
+                // (a grid polygon's box is its corners' own: it fits)
+                _ => {
+                    let (lo, hi) = polygon_box(g);
+                    (lo.map(|v| v as i32), hi.map(|v| v as i32))
                 }
             },
             Shape::Made(_, b) => *b,
