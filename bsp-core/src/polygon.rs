@@ -215,8 +215,8 @@ pub(crate) fn support_plane(v: &[GridPoint]) -> Result<Plane, FaceDefect> {
 /// axis along which the support's normal is largest), computed when asked
 /// for, so the form takes about a third of a [`Polygon`]'s room: a large
 /// solid whose faces are mostly never cut keeps them in it. It carries no
-/// tag (a caller who tags its polygons tags the [`Polygon`] it makes of
-/// one): four bytes more on every face of a large solid.
+/// tag, which would cost eight bytes on every face of a large solid: a
+/// caller who tags its polygons tags the [`Polygon`] it makes of one.
 #[derive(Clone, Debug)]
 pub struct GridPolygon {
     support: Plane,
