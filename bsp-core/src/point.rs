@@ -8,7 +8,7 @@ use bnum::types::{I256, I512};
 use crate::Side;
 use crate::exact::Homogeneous;
 use crate::grid::GridPoint;
-use crate::plane::Plane;
+use crate::plane::{Plane, cross_wide};
 
 /// An exact point: either an input grid point or the intersection of three
 /// planes of the input budget, held in homogeneous integer coordinates.
@@ -132,46 +132,87 @@ impl Wide {
     }
 }
 
-fn cross_wide(a: [i64; 3], b: [i64; 3]) -> [i128; 3] {
-    let m = |x: i64, y: i64| x as i128 * y as i128;
-    [
-        m(a[1], b[2]) - m(a[2], b[1]),
-        m(a[2], b[0]) - m(a[0], b[2]),
-        m(a[0], b[1]) - m(a[1], b[0]),
-    ]
+/// [`Implicit::from_planes`]'s coordinates `(x, y, z, w)` (`w ≥ 0`;
+/// zero where the planes do not meet in one point) computed in `i128`,
+/// where every product of them has at most 124 bits: then each sum of
+/// three is below `2^126`, and the coordinates are exactly those of the
+/// 256-bit evaluation. `None` where some product could be larger. A cell
+/// wall (an axis-aligned plane with small coefficients) and an edge plane
+/// with a support plane always fit: the cuts of a face by the walls of its
+/// cell take this path.
+fn from_planes_native(n1: [i64; 3], c: [[i128; 3]; 3], d: [i128; 3]) -> Option<[i128; 4]> {
+    let bits = |x: i128| 128 - x.unsigned_abs().leading_zeros();
+    let most = |v: &[i128; 3]| v.iter().map(|&x| bits(x)).max().unwrap_or(0);
+    let n_bits = n1
+        .iter()
+        .map(|&x| 64 - x.unsigned_abs().leading_zeros())
+        .max();
+    let c_bits = c.map(|v| most(&v));
+    let fits =
+        (0..3).all(|j| c_bits[j] + bits(d[j]) <= 124) && n_bits.unwrap_or(0) + c_bits[0] <= 124;
+    if !fits {
+        return None;
+    }
+    let [c23, c31, c12] = c;
+    let w: i128 = (0..3).map(|i| n1[i] as i128 * c23[i]).sum();
+    // x · det = -(c23 d1 + c31 d2 + c12 d3), all four negated where
+    // det < 0, for w > 0 (as the wide evaluation does)
+    let sign = if w < 0 { 1 } else { -1 };
+    let mut h = [0i128; 4];
+    for i in 0..3 {
+        h[i] = sign * (c23[i] * d[0] + c31[i] * d[1] + c12[i] * d[2]);
+    }
+    h[3] = -sign * w;
+    Some(h)
+}
+
+/// [`Implicit::from_planes`] in 256-bit sums, for any planes within the
+/// budget: with `c = [n2 × n3, n3 × n1, n1 × n2]` (`|c| < 2^111`) and the
+/// offsets `d`, `det = n1 · c[0]` (`|det| < 2^168`) and
+/// `x · det = -(c[0] d1 + c[1] d2 + c[2] d3)` (`|x| < 3 · 2^111 · 2^83 <
+/// 2^196`), all four negated at once where `det < 0`, for `w > 0`.
+fn from_planes_wide(n1: [i64; 3], c: [[i128; 3]; 3], d: [i128; 3]) -> Option<Implicit> {
+    let [c23, c31, c12] = c;
+    let w = (0..3).fold(Wide::ZERO, |s, i| {
+        s.add(Wide::product(n1[i] as i128, c23[i]))
+    });
+    if w.is_zero() {
+        return None;
+    }
+    let flip = w.is_negative();
+    let mut h = [Wide::ZERO; 4];
+    for i in 0..3 {
+        let s = Wide::product(c23[i], d[0])
+            .add(Wide::product(c31[i], d[1]))
+            .add(Wide::product(c12[i], d[2]));
+        h[i] = if flip { s } else { s.neg() };
+    }
+    h[3] = if flip { w.neg() } else { w };
+    Some(Homogeneous::with_approx(
+        h.map(Wide::to_i256),
+        h.map(Wide::approx),
+    ))
 }
 
 impl Homogeneous<4> {
     /// The intersection of three planes, or `None` if they do not meet in a
     /// single point.
     pub fn from_planes(p1: &Plane, p2: &Plane, p3: &Plane) -> Option<Implicit> {
-        let (n1, n2, n3) = (p1.normal(), p2.normal(), p3.normal());
-        let c23 = cross_wide(n2, n3);
-        let c31 = cross_wide(n3, n1);
-        let c12 = cross_wide(n1, n2);
-        // |c| < 2^111; det = n1 · c23, |det| < 2^168
-        let w = (0..3).fold(Wide::ZERO, |s, i| {
-            s.add(Wide::product(n1[i] as i128, c23[i]))
-        });
-        if w.is_zero() {
-            return None;
+        let n1 = p1.normal();
+        let c = [
+            cross_wide(p2.normal(), p3.normal()),
+            cross_wide(p3.normal(), n1),
+            cross_wide(n1, p2.normal()),
+        ];
+        let d = [p1.offset(), p2.offset(), p3.offset()];
+        match from_planes_native(n1, c, d) {
+            Some(h) if h[3] == 0 => None,
+            Some(h) => Some(Homogeneous::with_approx(
+                h.map(I256::from),
+                h.map(crate::exact::approx_i128),
+            )),
+            None => from_planes_wide(n1, c, d),
         }
-        let (d1, d2, d3) = (p1.offset(), p2.offset(), p3.offset());
-        // x · det = -(c23 d1 + c31 d2 + c12 d3); |x| < 3 · 2^111 · 2^83 < 2^196;
-        // all four negated at once where det < 0, for w > 0
-        let flip = w.is_negative();
-        let mut h = [Wide::ZERO; 4];
-        for i in 0..3 {
-            let s = Wide::product(c23[i], d1)
-                .add(Wide::product(c31[i], d2))
-                .add(Wide::product(c12[i], d3));
-            h[i] = if flip { s } else { s.neg() };
-        }
-        h[3] = if flip { w.neg() } else { w };
-        Some(Homogeneous::with_approx(
-            h.map(Wide::to_i256),
-            h.map(Wide::approx),
-        ))
     }
 
     /// The point where the segment from the grid point `p` to `q` crosses
@@ -616,5 +657,85 @@ mod tests {
         let q = Plane::new([1, 1, 1], -5).unwrap();
         assert_eq!(p.classify(&q), Side::On);
         assert!(Point::from_planes(&x, &x.flip(), &z).is_none());
+    }
+
+    #[test]
+    fn native_plane_meets_give_the_wide_coordinates() {
+        // plane triples of every size the kernel makes: cell walls (axis
+        // planes at half steps), edge planes (one zero, |n| < 2^27),
+        // supports (|n| < 2^55, |d| < 2^83), and planes of random size;
+        // where the native path takes them, its coordinates are the wide
+        // path's bit for bit (and `None` for `None`)
+        fn next(state: &mut u64) -> u64 {
+            *state ^= *state << 13;
+            *state ^= *state >> 7;
+            *state ^= *state << 17;
+            *state
+        }
+        // a random integer of at most `bits` bits, either sign
+        fn int(state: &mut u64, bits: u32) -> i128 {
+            let v = ((next(state) as u128) << 64 | next(state) as u128) >> (128 - bits);
+            if next(state) & 1 == 0 {
+                v as i128
+            } else {
+                -(v as i128)
+            }
+        }
+        fn plane(s: &mut u64, kind: u64) -> Option<Plane> {
+            let axis = |s: &mut u64| (next(s) % 3) as usize;
+            match kind % 4 {
+                0 => {
+                    let mut n = [0i64; 3];
+                    n[axis(s)] = if next(s) & 1 == 0 { -2 } else { 2 };
+                    Plane::new(n, 2 * int(s, 27) + 1)
+                }
+                1 => {
+                    let mut n = [0; 3].map(|_| int(s, 27) as i64);
+                    n[axis(s)] = 0;
+                    Plane::new(n, int(s, 54))
+                }
+                2 => Plane::new([0; 3].map(|_| int(s, 55) as i64), int(s, 83)),
+                _ => {
+                    let b = 1 + (next(s) % 55) as u32;
+                    let n = [0; 3].map(|_| int(s, b) as i64);
+                    let bd = 1 + (next(s) % 83) as u32;
+                    Plane::new(n, int(s, bd))
+                }
+            }
+        }
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let (mut native, mut wide) = (0, 0);
+        for i in 0..30_000u64 {
+            let p: Option<Vec<Plane>> = [i, i / 4, i / 16]
+                .into_iter()
+                .map(|k| plane(&mut state, k))
+                .collect();
+            let Some(p) = p else {
+                continue;
+            };
+            let n1 = p[0].normal();
+            let c = [
+                cross_wide(p[1].normal(), p[2].normal()),
+                cross_wide(p[2].normal(), n1),
+                cross_wide(n1, p[1].normal()),
+            ];
+            let d = [p[0].offset(), p[1].offset(), p[2].offset()];
+            let reference = from_planes_wide(n1, c, d);
+            let Some(h) = from_planes_native(n1, c, d) else {
+                wide += 1;
+                continue;
+            };
+            native += 1;
+            match &reference {
+                None => assert_eq!(h[3], 0, "{p:?}"),
+                Some(r) => assert_eq!(r.coords(), &h.map(I256::from), "{p:?}"),
+            }
+            let via = Implicit::from_planes(&p[0], &p[1], &p[2]);
+            assert_eq!(via.map(|v| *v.coords()), reference.map(|r| *r.coords()));
+        }
+        assert!(
+            native > 5_000 && wide > 5_000,
+            "native {native}, wide {wide}"
+        );
     }
 }
