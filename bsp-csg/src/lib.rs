@@ -283,6 +283,14 @@ impl Face {
         }
     }
 
+    /// An imported face's grid polygon.
+    fn as_grid(&self) -> Option<&GridPolygon> {
+        match &self.shape {
+            Shape::Grid(g) => Some(g),
+            Shape::Made(..) => None,
+        }
+    }
+
     /// The polygon, with its edge planes (made for an imported face).
     fn polygon(&self) -> Cow<'_, Polygon> {
         match &self.shape {
@@ -1777,7 +1785,6 @@ fn settle(
     if pieces.iter().all(|p| fate(p) == Some(Ok(()))) {
         return None;
     }
-    let (poly, fb) = (face.polygon(), face.bx());
     // the cells whose piece stays whole (the face clipped to the cell),
     // and the fragments of the cells that cut it
     let mut kept = Vec::new();
@@ -1785,7 +1792,9 @@ fn settle(
     for p in pieces {
         match p {
             Piece::Free(Some(l)) if keep_free(Some(*l)) => whole.push(leaves[*l as usize].bx),
-            Piece::Free(None) if keep_free(None) => kept.extend(local::outside(&poly, root)),
+            Piece::Free(None) if keep_free(None) => {
+                kept.extend(local::outside(&face.polygon(), root))
+            }
             Piece::Free(_) => {}
             Piece::Mixed(l, i) => match fates.get(l).map(|v| &v[*i as usize]) {
                 Some(PieceFate::Keep) => whole.push(leaves[*l as usize].bx),
@@ -1801,7 +1810,7 @@ fn settle(
     kept.extend(
         whole
             .iter()
-            .filter_map(|bx| local::clip_in(&poly, &fb, bx, &walls(bx))),
+            .filter_map(|bx| local::clip_face(face, bx, &walls(bx))),
     );
     Some(rejoin(kept))
 }

@@ -563,28 +563,41 @@ pub(crate) fn clip_in(face: &Polygon, fb: &IBox, cell: &IBox, w: &[Plane; 6]) ->
 /// [`clip_in`] of a polygon the caller gives up, whose box `fb` meets the
 /// cell.
 fn clip_owned(mut p: Polygon, fb: &IBox, cell: &IBox, w: &[Plane; 6]) -> Option<Polygon> {
-    for (i, wall) in w.iter().enumerate() {
-        let k = i / 2;
-        let behind = if i % 2 == 0 {
-            fb.0[k] >= cell.0[k]
-        } else {
-            fb.1[k] <= cell.1[k]
-        };
-        if !behind && !p.clip(wall, Side::Back) {
+    for wall in walls_crossed(fb, cell, w) {
+        if !p.clip(wall, Side::Back) {
             return None;
         }
     }
     Some(p)
 }
 
-/// [`clip_in`] for a solid's face: its polygon is made (with its edge
-/// planes) only when its box meets the cell.
+/// The walls `w` of the cell `cell` that a face whose box is `fb` may
+/// reach beyond (those its box does not lie behind), in order.
+fn walls_crossed<'w>(fb: &IBox, cell: &IBox, w: &'w [Plane; 6]) -> impl Iterator<Item = &'w Plane> {
+    let (fb, cell) = (*fb, *cell);
+    w.iter().enumerate().filter_map(move |(i, wall)| {
+        let k = i / 2;
+        let behind = if i % 2 == 0 {
+            fb.0[k] >= cell.0[k]
+        } else {
+            fb.1[k] <= cell.1[k]
+        };
+        (!behind).then_some(wall)
+    })
+}
+
+/// [`clip_in`] for a solid's face: an imported face is clipped from its
+/// grid corners ([`GridPolygon::clipped`](bsp_core::GridPolygon::clipped):
+/// the same piece, made more cheaply), only when its box meets the cell.
 pub(crate) fn clip_face(face: &crate::Face, cell: &IBox, w: &[Plane; 6]) -> Option<Polygon> {
     let fb = face.bx();
     if !overlaps(&fb, cell) {
         return None;
     }
-    clip_owned(face.polygon().into_owned(), &fb, cell, w)
+    match face.as_grid() {
+        Some(g) => g.clipped(walls_crossed(&fb, cell, w), 0),
+        None => clip_owned(face.polygon().into_owned(), &fb, cell, w),
+    }
 }
 
 /// The parts of `face` outside the box whose walls are `w`: convex
