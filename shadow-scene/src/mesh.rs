@@ -57,7 +57,7 @@ pub trait MeshView: Sync {
     /// assert_eq!(soup.repeated_positions(), 2);
     /// ```
     fn repeated_positions(&self) -> usize {
-        let mut seen: HashSet<[u64; 3]> = HashSet::new();
+        let mut seen: rustc_hash::FxHashSet<[u64; 3]> = Default::default();
         used_positions(self)
             .filter(|p| !seen.insert(key(**p)))
             .count()
@@ -270,7 +270,7 @@ impl Mesh {
     /// assert_eq!(m.faces[1].vertices, vec![1, 3, 2]);
     /// ```
     pub fn weld(&mut self) {
-        let mut index: HashMap<[u64; 3], u32> = HashMap::new();
+        let mut index: rustc_hash::FxHashMap<[u64; 3], u32> = Default::default();
         let mut positions = Vec::new();
         let mut map = vec![u32::MAX; self.positions.len()];
         for f in &mut self.faces {

@@ -4,7 +4,6 @@ use std::borrow::Cow;
 use std::io::{Cursor, Write};
 use std::path::Path;
 
-use std::collections::{HashMap, HashSet};
 
 use glam::DVec3;
 
@@ -153,8 +152,8 @@ pub fn write_stl<M: MeshView + ?Sized, W: Write>(mesh: &M, mut out: W) -> std::i
 pub fn stl_collisions<M: MeshView + ?Sized>(mesh: &M) -> usize {
     let key64 = crate::mesh::key;
     let key32 = |p: DVec3| [p.x, p.y, p.z].map(|c| (c as f32 + 0.0).to_bits());
-    let mut by32: HashMap<[u32; 3], [u64; 3]> = HashMap::new();
-    let mut distinct64: HashSet<[u64; 3]> = HashSet::new();
+    let mut by32: rustc_hash::FxHashMap<[u32; 3], [u64; 3]> = Default::default();
+    let mut distinct64: rustc_hash::FxHashSet<[u64; 3]> = Default::default();
     let mut collisions = 0;
     for p in crate::mesh::used_positions(mesh) {
         if !distinct64.insert(key64(*p)) {
