@@ -166,7 +166,7 @@ pub fn parse_obj_notes(
         ..Mesh::default()
     };
     let mut group = 0u32;
-    let mut lines = text.lines().enumerate();
+    let mut lines = Lines(text).enumerate();
     let mut statement = String::new();
     while let Some((i, first)) = lines.next() {
         let line = i + 1;
@@ -190,11 +190,7 @@ pub fn parse_obj_notes(
         } else {
             current
         };
-        let content = match whole.find('#') {
-            Some(at) => &whole[..at],
-            None => whole,
-        };
-        let mut tokens = content.split_whitespace();
+        let mut tokens = Tokens::of(whole);
         let Some(keyword) = tokens.next() else {
             continue;
         };
@@ -231,6 +227,84 @@ pub fn parse_obj_notes(
         }
     }
     Ok((mesh, notes))
+}
+
+/// The lines of a text, as [`str::lines`] gives them but for a carriage
+/// return before the newline, which is left on the line (the parser
+/// trims it with the other trailing whitespace): the newline is found by
+/// a plain scan of the bytes, where `str::lines` sets up a search for
+/// each line, slow for the short lines of a mesh file.
+struct Lines<'a>(&'a str);
+
+impl<'a> Iterator for Lines<'a> {
+    type Item = &'a str;
+
+    fn next(&mut self) -> Option<&'a str> {
+        if self.0.is_empty() {
+            return None;
+        }
+        let end = self.0.bytes().position(|c| c == b'\n');
+        let (line, rest) = match end {
+            Some(at) => (&self.0[..at], &self.0[at + 1..]),
+            None => (self.0, ""),
+        };
+        self.0 = rest;
+        Some(line)
+    }
+}
+
+/// The whitespace-separated words of a line before any `#`, as
+/// [`str::split_whitespace`] gives them; a line of ASCII (nearly every
+/// line of every file) is split by its bytes, without decoding
+/// characters.
+enum Tokens<'a> {
+    Ascii(&'a str),
+    Any(std::str::SplitWhitespace<'a>),
+}
+
+impl<'a> Tokens<'a> {
+    fn of(line: &'a str) -> Tokens<'a> {
+        if line.is_ascii() {
+            let end = line.bytes().position(|c| c == b'#').unwrap_or(line.len());
+            return Tokens::Ascii(&line[..end]);
+        }
+        let content = match line.find('#') {
+            Some(at) => &line[..at],
+            None => line,
+        };
+        Tokens::Any(content.split_whitespace())
+    }
+}
+
+impl<'a> Iterator for Tokens<'a> {
+    type Item = &'a str;
+
+    fn next(&mut self) -> Option<&'a str> {
+        match self {
+            Tokens::Any(words) => words.next(),
+            Tokens::Ascii(rest) => {
+                // the ASCII characters `char::is_whitespace` accepts:
+                // space, and tab through carriage return
+                let space = |c: u8| matches!(c, b' ' | b'\t'..=b'\r');
+                let b = rest.as_bytes();
+                let mut start = 0;
+                while start < b.len() && space(b[start]) {
+                    start += 1;
+                }
+                if start == b.len() {
+                    *rest = "";
+                    return None;
+                }
+                let mut end = start + 1;
+                while end < b.len() && !space(b[end]) {
+                    end += 1;
+                }
+                let word = &rest[start..end];
+                *rest = &rest[end..];
+                Some(word)
+            }
+        }
+    }
 }
 
 fn parse_number(token: &str) -> Result<f64, String> {
@@ -273,12 +347,18 @@ fn parse_face<'a>(
 ) -> Result<Vec<u32>, String> {
     let mut out = Vec::new();
     for token in tokens {
-        let mut parts = token.split('/');
-        let index = parts.next().unwrap_or("");
-        let rest = [parts.next(), parts.next()];
-        if parts.next().is_some() {
-            return Err(format!("malformed face vertex `{token}`"));
-        }
+        // (most tokens are a bare index: no search set up for the slashes)
+        let (index, rest) = match token.bytes().position(|c| c == b'/') {
+            None => (token, [None, None]),
+            Some(at) => {
+                let mut parts = token[at + 1..].split('/');
+                let rest = [parts.next(), parts.next()];
+                if parts.next().is_some() {
+                    return Err(format!("malformed face vertex `{token}`"));
+                }
+                (&token[..at], rest)
+            }
+        };
         for extra in rest.into_iter().flatten().filter(|s| !s.is_empty()) {
             extra.parse::<i64>().map_err(|_| {
                 format!("could not parse `{extra}` as a texture or normal index in `{token}`")
@@ -406,6 +486,58 @@ fn write_in_runs<W: Write>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The lines are `str::lines`' once trailing whitespace is trimmed
+    /// (the parser trims every line), with or without a final newline,
+    /// with `\r\n` endings, empty lines and lone carriage returns.
+    #[test]
+    fn lines_are_split_as_str_lines_splits_them() {
+        let mut seed = 0x6a09_e667_f3bc_c909u64;
+        let mut next = |m: u64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed % m
+        };
+        let pieces = ["\n", "\r\n", "\r", "v 1 2 3", " ", "f 1 2 3", "é"];
+        for _ in 0..5_000 {
+            let text: String = (0..next(12))
+                .map(|_| pieces[next(pieces.len() as u64) as usize])
+                .collect();
+            let want: Vec<&str> = text.lines().map(str::trim_end).collect();
+            let got: Vec<&str> = Lines(&text).map(str::trim_end).collect();
+            assert_eq!(got, want, "{text:?}");
+        }
+    }
+
+    /// A line's words are `split_whitespace`'s of the text before its
+    /// first `#`, whatever characters separate them: every ASCII
+    /// character, and a few others (no-break space, next line, an
+    /// em space, letters beyond ASCII).
+    #[test]
+    fn words_are_split_as_split_whitespace_splits_them() {
+        let mut seed = 0x853c_49e6_748f_ea9bu64;
+        let mut next = |m: u64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed % m
+        };
+        let others = ['\u{a0}', '\u{85}', '\u{2003}', 'é', '\u{1680}'];
+        for round in 0..20_000 {
+            let line: String = (0..next(24))
+                .map(|_| match next(4) {
+                    0 if round % 3 == 0 => others[next(others.len() as u64) as usize],
+                    0 | 1 => char::from(next(128) as u8),
+                    _ => char::from(b'0' + next(10) as u8),
+                })
+                .collect();
+            let content = line.find('#').map_or(line.as_str(), |at| &line[..at]);
+            let want: Vec<&str> = content.split_whitespace().collect();
+            let got: Vec<&str> = Tokens::of(&line).collect();
+            assert_eq!(got, want, "{line:?}");
+        }
+    }
 
     fn parse(text: &str) -> Result<Mesh, SceneError> {
         parse_obj(text, "test.obj")

@@ -4,7 +4,6 @@ use std::borrow::Cow;
 use std::io::{Cursor, Write};
 use std::path::Path;
 
-
 use glam::DVec3;
 
 use crate::{Face, Mesh, MeshView, SceneError};
