@@ -102,6 +102,8 @@ use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 use std::borrow::Cow;
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 use crate::index::{FaceIndex, IBox, holds, intersect, overlaps, polygon_box, union};
 use crate::local::{CellResult, Fate};
@@ -376,9 +378,17 @@ impl ConvexFace for Face {
 pub struct Solid {
     faces: Vec<Option<Face>>,
     free: Vec<u32>,
-    index: FaceIndex,
+    /// The spatial index of the faces' boxes, once made: by an operation
+    /// carried out on the solid (a solid changed in place is likely to
+    /// be changed again), or by a solid's queries once it has been asked
+    /// [`SCANS_BEFORE_INDEX`] times; until then a query reads every face
+    /// (an operation on two new solids asks each a few times, and making
+    /// the index costs more than those reads).
+    index: OnceLock<FaceIndex>,
     /// The index's design size, to know when to rebuild it.
     indexed: usize,
+    /// Queries answered by reading every face.
+    scans: Scans,
     bounds: Option<IBox>,
     live: usize,
 }
@@ -439,16 +449,26 @@ impl Solid {
     /// (each once).
     fn from_faces(faces: Vec<Option<Face>>, free: Vec<u32>) -> Solid {
         debug_assert!(free.iter().all(|&f| faces[f as usize].is_none()));
+        let live = faces.len() - free.len();
         let mut s = Solid {
-            live: faces.len() - free.len(),
+            live,
             faces,
             free,
-            index: FaceIndex::new(([0; 3], [0; 3]), 1),
-            indexed: 0,
+            index: OnceLock::new(),
+            indexed: live.max(1),
+            scans: Scans::default(),
             bounds: None,
         };
-        s.reindex();
+        s.bounds = s.faces_bounds();
         s
+    }
+
+    /// The box of the live faces' boxes.
+    fn faces_bounds(&self) -> Option<IBox> {
+        self.faces
+            .par_iter()
+            .filter_map(|f| f.as_ref().map(Face::bx))
+            .reduce_with(|a, b| union(&a, &b))
     }
 
     /// An empty solid.
@@ -456,19 +476,45 @@ impl Solid {
         Solid::from_polygons(Vec::new())
     }
 
+    /// The bounds found again and the index made anew, sized for the
+    /// live faces.
     fn reindex(&mut self) {
-        let bounds = self
-            .faces
-            .par_iter()
-            .filter_map(|f| f.as_ref().map(Face::bx))
-            .reduce_with(|a, b| union(&a, &b));
-        self.bounds = bounds;
+        self.bounds = self.faces_bounds();
         self.indexed = self.live.max(1);
-        self.index = FaceIndex::filled(
-            bounds.unwrap_or(([0; 3], [0; 3])),
+        self.make_index();
+    }
+
+    /// The index of the faces over the bounds, sized for `indexed`, made
+    /// now (in parallel).
+    fn make_index(&mut self) {
+        self.index = OnceLock::from(FaceIndex::filled(
+            self.bounds.unwrap_or(([0; 3], [0; 3])),
             self.indexed,
             self.faces.par_iter().map(|f| f.as_ref().map(Face::bx)),
-        );
+        ));
+    }
+
+    /// The index for a query: `None` while the solid has been asked fewer
+    /// than [`SCANS_BEFORE_INDEX`] times without one (the query reads
+    /// every face), then made. (Made on one thread: a query may run on
+    /// the thread pool, and a thread making it with the pool's help could
+    /// be handed another query that waits for it.)
+    fn query_index(&self) -> Option<&FaceIndex> {
+        if let Some(index) = self.index.get() {
+            return Some(index);
+        }
+        if self.scans.0.fetch_add(1, Ordering::Relaxed) < SCANS_BEFORE_INDEX {
+            return None;
+        }
+        Some(self.index.get_or_init(|| {
+            let mut index = FaceIndex::new(self.bounds.unwrap_or(([0; 3], [0; 3])), self.indexed);
+            for (i, f) in self.faces.iter().enumerate() {
+                if let Some(f) = f {
+                    index.insert(i as u32, &f.bx());
+                }
+            }
+            index
+        }))
     }
 
     /// Number of faces.
@@ -493,7 +539,9 @@ impl Solid {
 
     fn remove(&mut self, id: u32) {
         if let Some(f) = self.faces[id as usize].take() {
-            self.index.remove(id, &f.bx());
+            if let Some(index) = self.index.get_mut() {
+                index.remove(id, &f.bx());
+            }
             self.free.push(id);
             self.live -= 1;
         }
@@ -521,20 +569,29 @@ impl Solid {
             .zip(&gone)
             .filter(|(_, g)| **g)
             .for_each(|(f, _)| *f = None);
-        self.index.retain(|f| !gone[f as usize]);
+        if let Some(index) = self.index.get_mut() {
+            index.retain(|f| !gone[f as usize]);
+        }
     }
 
     /// Adds `ids` (live faces not yet indexed) to the index and the
     /// bounds, in order; many at once read their boxes in parallel.
     /// Adds faces `ids` with their `boxes` to the index and the bounds,
     /// in order.
-    fn index_boxes(index: &mut FaceIndex, bounds: &mut Option<IBox>, ids: &[u32], boxes: &[IBox]) {
+    fn index_boxes(
+        index: Option<&mut FaceIndex>,
+        bounds: &mut Option<IBox>,
+        ids: &[u32],
+        boxes: &[IBox],
+    ) {
         let Some(all) = boxes.iter().copied().reduce(|a, b| union(&a, &b)) else {
             return;
         };
         *bounds = Some(bounds.map_or(all, |b| union(&b, &all)));
-        for (&f, bx) in ids.iter().zip(boxes) {
-            index.insert(f, bx);
+        if let Some(index) = index {
+            for (&f, bx) in ids.iter().zip(boxes) {
+                index.insert(f, bx);
+            }
         }
     }
 
@@ -587,12 +644,13 @@ impl Solid {
     /// half the slots (each face is listed in several index cells), which
     /// a scan in order gives sorted without listing them first.
     fn near_ids(&self, b: &IBox) -> Option<Vec<u32>> {
-        let listed = self.index.near_count(b);
+        let index = self.query_index()?;
+        let listed = index.near_count(b);
         if listed > MANY_NEAR && listed > self.faces.len() / 2 {
             return None;
         }
         let mut ids = Vec::with_capacity(listed);
-        self.index.near(b, &mut ids);
+        index.near(b, &mut ids);
         if ids.len() > MANY_NEAR {
             ids.par_sort_unstable();
         } else {
@@ -607,22 +665,48 @@ impl Solid {
     /// for a point not on the surface its own winding number.
     pub fn winding(&self, q: GridPoint) -> i32 {
         let q = q.map(i64::from);
+        let Some(index) = self.query_index() else {
+            return self
+                .faces
+                .par_iter()
+                .filter_map(Option::as_ref)
+                .map(|f| ray_crossing(q, f))
+                .sum();
+        };
         let mut ids = Vec::new();
-        self.index.along_x(q, &mut ids);
+        index.along_x(q, &mut ids);
         ids.sort_unstable();
         ids.dedup();
         ids.iter()
             .filter_map(|&i| self.faces[i as usize].as_ref())
-            .filter(|f| {
-                let bx = f.bx();
-                bx.1[0] >= q[0]
-                    && bx.0[1] <= q[1]
-                    && q[1] <= bx.1[1]
-                    && bx.0[2] <= q[2]
-                    && q[2] <= bx.1[2]
-            })
-            .map(|f| winding::crossing(q, f))
+            .map(|f| ray_crossing(q, f))
             .sum()
+    }
+
+    /// [`Solid::winding`] of each of `qs`: for a few points and no index,
+    /// in one pass over the faces.
+    fn windings(&self, qs: &[GridPoint]) -> Vec<i32> {
+        if self.index.get().is_some() || qs.len() > FEW_WINDINGS {
+            return qs.par_iter().map(|&q| self.winding(q)).collect();
+        }
+        let qs: Vec<[i64; 3]> = qs.iter().map(|q| q.map(i64::from)).collect();
+        let zero = || vec![0i32; qs.len()];
+        self.faces
+            .par_iter()
+            .filter_map(Option::as_ref)
+            .fold(zero, |mut sums, f| {
+                let bx = f.bx();
+                for (s, &q) in sums.iter_mut().zip(&qs) {
+                    if ray_reaches(q, &bx) {
+                        *s += winding::crossing(q, f);
+                    }
+                }
+                sums
+            })
+            .reduce(zero, |mut a, b| {
+                a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+                a
+            })
     }
 
     /// Exact membership of a grid point.
@@ -1386,11 +1470,14 @@ impl Solid {
                     .collect();
                 share_points(&mut new);
             },
-            || Solid::index_boxes(index, bounds, &ids, &boxes),
+            || Solid::index_boxes(index.get_mut(), bounds, &ids, &boxes),
         );
         self.live += n;
         if self.live > 4 * self.indexed + 1024 {
             self.reindex();
+        } else if self.index.get().is_none() {
+            // a solid changed in place is likely to be changed again
+            self.make_index();
         }
     }
 }
@@ -1622,6 +1709,42 @@ impl Made {
             CellResult::Merged(ps) => Made::Merged(ps),
             CellResult::Pieces(fa, fb, pa, pb) => Made::Fates(fates(fa, pa, ia), fates(fb, pb, ib)),
         }
+    }
+}
+
+/// The crossing number of the ray from `q` along `+x` (displaced as
+/// [`Solid::winding`] says) with the face `f`: 0 where the face's box is
+/// beyond the ray's reach.
+fn ray_crossing(q: [i64; 3], f: &Face) -> i32 {
+    if ray_reaches(q, &f.bx()) {
+        winding::crossing(q, f)
+    } else {
+        0
+    }
+}
+
+/// Whether the ray from `q` along `+x` may meet a face in the box `bx`.
+#[inline]
+fn ray_reaches(q: [i64; 3], bx: &IBox) -> bool {
+    bx.1[0] >= q[0] && bx.0[1] <= q[1] && q[1] <= bx.1[1] && bx.0[2] <= q[2] && q[2] <= bx.1[2]
+}
+
+/// Queries a solid answers by reading every face before it makes its
+/// index ([`Solid::query_index`]).
+const SCANS_BEFORE_INDEX: u32 = 8;
+
+/// At most this many winding numbers are found in one pass over a
+/// solid's faces that has no index ([`Solid::windings`]).
+const FEW_WINDINGS: usize = 64;
+
+/// A count of queries, shared by the threads asking (a copy starts with
+/// the count so far).
+#[derive(Debug, Default)]
+struct Scans(AtomicU32);
+
+impl Clone for Scans {
+    fn clone(&self) -> Scans {
+        Scans(AtomicU32::new(self.0.load(Ordering::Relaxed)))
     }
 }
 
@@ -2402,12 +2525,14 @@ impl Regions {
             .collect();
         wanted.sort_unstable();
         wanted.dedup();
+        let qs: Vec<GridPoint> = wanted
+            .iter()
+            .map(|&r| leaves[r as usize].bx.0.map(|c| c as i32))
+            .collect();
         let inside: FxHashMap<u32, bool> = wanted
-            .par_iter()
-            .map(|&r| {
-                let q = leaves[r as usize].bx.0.map(|c| c as i32);
-                (r, solid.winding(q) != 0)
-            })
+            .iter()
+            .zip(solid.windings(&qs))
+            .map(|(&r, w)| (r, w != 0))
             .collect();
         Regions { root, inside }
     }
@@ -2831,7 +2956,15 @@ mod tests {
     fn removing_many_faces_at_once_is_removing_them_in_turn() {
         let (pos, faces) = shapes::uv_sphere(12_000);
         let snapped = snap(&[MeshIn::new(&pos, &faces)]).unwrap();
-        let solid = &snapped.solids[0];
+        // with the index made (it is updated) and without (a new solid's)
+        let mut indexed = snapped.solids[0].clone();
+        indexed.reindex();
+        for solid in [&snapped.solids[0], &indexed] {
+            removing_many_at_once(solid);
+        }
+    }
+
+    fn removing_many_at_once(solid: &Solid) {
         let n = solid.faces.len() as u32;
         // every other face, some named twice, ending with one already gone
         let mut ids: Vec<u32> = (0..n).filter(|i| i % 2 == 0).rev().collect();
@@ -2858,5 +2991,61 @@ mod tests {
         for q in [lo, mid].map(|p| p.map(|c| c as i32)) {
             assert_eq!(one.winding(q), all.winding(q));
         }
+    }
+
+    /// A solid answers its queries the same before it has an index (by
+    /// reading every face), while the index is made after a few queries,
+    /// and with it: the faces near boxes, winding numbers one by one and
+    /// in one pass, and membership. A solid an operation changed in place
+    /// has its index.
+    #[test]
+    fn queries_agree_with_and_without_the_index() {
+        let (pos, faces) = shapes::uv_sphere(6_000);
+        let snapped = snap(&[MeshIn::new(&pos, &faces)]).unwrap();
+        let fresh = snapped.solids[0].clone();
+        assert!(fresh.index.get().is_none());
+        let mut indexed = fresh.clone();
+        indexed.reindex();
+        let (lo, hi) = fresh.bounds.unwrap();
+        let at = |t: [i64; 3]| [0, 1, 2].map(|k| (lo[k] + (hi[k] - lo[k]) * t[k] / 8) as i32);
+        let points: Vec<GridPoint> = (0..9 * 9 * 9)
+            .map(|i| at([i % 9, i / 9 % 9, i / 81]))
+            .collect();
+        let boxes: Vec<IBox> = points
+            .iter()
+            .zip(points.iter().rev())
+            .map(|(p, q)| {
+                let lo = [0, 1, 2].map(|k| p[k].min(q[k]) as i64);
+                let hi = [0, 1, 2].map(|k| p[k].max(q[k]) as i64);
+                (lo, hi)
+            })
+            .step_by(37)
+            .collect();
+        // one pass, then point by point (which makes the index as it goes)
+        let lazy = fresh.clone();
+        let few: Vec<GridPoint> = points.iter().copied().step_by(12).collect();
+        assert!(few.len() <= FEW_WINDINGS);
+        let want = indexed.windings(&few);
+        assert!(want.iter().any(|&w| w != 0) && want.contains(&0));
+        assert_eq!(lazy.windings(&few), want);
+        let mut inside = 0;
+        for &q in &points {
+            let w = indexed.winding(q);
+            assert_eq!(lazy.winding(q), w, "{q:?}");
+            assert_eq!(fresh.clone().classify_point(q), indexed.classify_point(q));
+            inside += (w != 0) as usize;
+        }
+        assert!(inside > 50 && inside < points.len() - 50, "{inside}");
+        assert!(lazy.index.get().is_some());
+        for bx in &boxes {
+            assert_eq!(fresh.clone().faces_near(bx), indexed.faces_near(bx));
+            assert_eq!(fresh.clone().near_span(bx), indexed.near_span(bx));
+        }
+        // an operation carried out leaves an index
+        let mut a = fresh.clone();
+        let mut b = fresh.clone();
+        b.apply(&a.clone(), BoolOp::Union).unwrap();
+        a.apply(&indexed, BoolOp::Intersection).unwrap();
+        assert!(a.index.get().is_some() && b.index.get().is_some());
     }
 }
