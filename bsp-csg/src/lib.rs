@@ -2,7 +2,9 @@
 //! adaptive octree.
 //!
 //! A [`Solid`] is the boundary of a closed, outward-oriented polyhedron as
-//! plane-based convex polygons on `bsp-core`'s grid, with a spatial index.
+//! plane-based convex polygons on `bsp-core`'s grid, with a spatial index
+//! of their boxes made once it pays (by the first operation carried out on
+//! the solid, or after a few queries).
 //! [`Solid::apply`] computes `self ∘ other` for `∘` ∈ {∪, ∩, −}:
 //!
 //! 1. Faces outside the other solid's box are outside it: left as they
