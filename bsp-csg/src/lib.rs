@@ -576,10 +576,8 @@ impl Solid {
         }
     }
 
-    /// Adds `ids` (live faces not yet indexed) to the index and the
-    /// bounds, in order; many at once read their boxes in parallel.
-    /// Adds faces `ids` with their `boxes` to the index and the bounds,
-    /// in order.
+    /// Adds the faces `ids` (live, not yet indexed) with their `boxes` to
+    /// the bounds, and to the index if there is one, in order.
     fn index_boxes(
         index: Option<&mut FaceIndex>,
         bounds: &mut Option<IBox>,
