@@ -465,12 +465,7 @@ mod tests {
     fn rounding_matches_division() {
         // a deterministic sweep of awkward quotients
         let mut s = 0x1234_5678_9abc_def0u64;
-        let mut next = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
+        let mut next = || crate::xorshift(&mut s);
         for _ in 0..20_000 {
             let shift = next() % 150;
             let num = (I256::from(next() as i64) * I256::from((next() >> 3) as i64))

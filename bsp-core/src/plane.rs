@@ -352,9 +352,7 @@ mod tests {
         let mut x = 0x9e37_79b9_7f4a_7c15u64;
         for _ in 0..10_000 {
             // xorshift pairs, and pairs with a large common factor
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            crate::xorshift(&mut x);
             let (a, b) = (x >> (x % 40), x.rotate_left(17) >> (x % 23));
             assert_eq!(gcd64(a, b) as u128, gcd(a as u128, b as u128), "{a} {b}");
             let (a, b) = ((a >> 40) * 1_000_003, (b >> 40) * 1_000_003);
@@ -372,9 +370,7 @@ mod tests {
             fits.then_some((n, d, d as f64))
         };
         for i in 0..20_000u64 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            crate::xorshift(&mut x);
             let f = [1i64, 2, 6, 1 << 20, 1_000_003][(i % 5) as usize];
             let c = |s: u32| ((x.rotate_left(s) >> 44) as i64 - (1 << 19)) * f;
             let n = [c(0), c(21), c(42)];

@@ -666,12 +666,7 @@ mod tests {
         // supports (|n| < 2^55, |d| < 2^83), and planes of random size;
         // where the native path takes them, its coordinates are the wide
         // path's bit for bit (and `None` for `None`)
-        fn next(state: &mut u64) -> u64 {
-            *state ^= *state << 13;
-            *state ^= *state >> 7;
-            *state ^= *state << 17;
-            *state
-        }
+        use crate::xorshift as next;
         // a random integer of at most `bits` bits, either sign
         fn int(state: &mut u64, bits: u32) -> i128 {
             let v = ((next(state) as u128) << 64 | next(state) as u128) >> (128 - bits);

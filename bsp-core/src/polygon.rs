@@ -1067,12 +1067,7 @@ mod tests {
     #[test]
     fn clipping_from_the_corners_gives_the_clipped_polygon() {
         let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = |m: i32| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 33) as i32 % m
-        };
+        let mut next = |m: i32| (crate::xorshift(&mut seed) >> 33) as i32 % m;
         let (mut kept, mut gone, mut cut) = (0, 0, 0);
         for round in 0..8000 {
             let k = if round % 2 == 0 { 1 } else { 1 << 20 };
@@ -1153,12 +1148,7 @@ mod tests {
     #[test]
     fn grid_polygons_compute_the_stored_edge_planes() {
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = |m: i32| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed % (2 * m as u64 + 1)) as i32 - m
-        };
+        let mut next = |m: i32| (crate::xorshift(&mut seed) % (2 * m as u64 + 1)) as i32 - m;
         let same = |p: &Polygon, q: &Polygon| {
             p.support() == q.support()
                 && p.edge_planes() == q.edge_planes()

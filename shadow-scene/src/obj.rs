@@ -493,18 +493,22 @@ fn write_in_runs<W: Write>(
 mod tests {
     use super::*;
 
+    /// One step of the xorshift generator (13, 7, 17) the tests draw
+    /// their cases from: the new state, which is also the number drawn.
+    fn xorshift(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
     /// The lines are `str::lines`' once trailing whitespace is trimmed
     /// (the parser trims every line), with or without a final newline,
     /// with `\r\n` endings, empty lines and lone carriage returns.
     #[test]
     fn lines_are_split_as_str_lines_splits_them() {
         let mut seed = 0x6a09_e667_f3bc_c909u64;
-        let mut next = |m: u64| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed % m
-        };
+        let mut next = |m: u64| xorshift(&mut seed) % m;
         let pieces = ["\n", "\r\n", "\r", "v 1 2 3", " ", "f 1 2 3", "é"];
         for _ in 0..5_000 {
             let text: String = (0..next(12))
@@ -523,12 +527,7 @@ mod tests {
     #[test]
     fn words_are_split_as_split_whitespace_splits_them() {
         let mut seed = 0x853c_49e6_748f_ea9bu64;
-        let mut next = |m: u64| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed % m
-        };
+        let mut next = |m: u64| xorshift(&mut seed) % m;
         let others = ['\u{a0}', '\u{85}', '\u{2003}', 'é', '\u{1680}'];
         for round in 0..20_000 {
             let line: String = (0..next(24))
@@ -828,9 +827,7 @@ f 4 1 5 8
         while m.positions.len() < 30_000 {
             let mut c = [0.0; 3];
             for x in &mut c {
-                seed ^= seed << 13;
-                seed ^= seed >> 7;
-                seed ^= seed << 17;
+                xorshift(&mut seed);
                 *x = match seed % 4 {
                     0 => f64::from_bits(seed >> 12),
                     1 => -0.0,
