@@ -32,7 +32,10 @@
 //!    separated by a plane through `v` (the sum of every candidate normal
 //!    `g_i × g_j`, `n × g_i` of the generators that separates weakly is
 //!    checked to separate strictly: it lies inside the dual cone whenever
-//!    that has an interior); with a shared edge, the triangles must not
+//!    that has an interior); with two shared vertices, these must be the
+//!    ends of an edge of both polygons (not a diagonal of either: two
+//!    polygons can cross along a shared diagonal while every pair of
+//!    their fan triangles meets only there), and the triangles must not
 //!    be coplanar on the same side of it. The test is conservative: it
 //!    may refuse surfaces that are fine (touching, or a vertex lying on
 //!    another edge), never accept one that is not.
@@ -150,6 +153,10 @@ struct Tri {
     v: [GridPoint; 3],
     /// The corners' vertex numbers (equal numbers: equal points).
     id: [u32; 3],
+    /// Bit `k` set: the edge from corner `k` to corner `k + 1` is one edge
+    /// of the polygon (two consecutive corners of its loop), not a
+    /// diagonal of its fan nor a run of collinear edges.
+    edges: u8,
     poly: u32,
     lo: GridPoint,
     hi: GridPoint,
@@ -311,9 +318,13 @@ fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefec
             if cross(sub(t[1], t[0]), sub(t[2], t[0])) == [0; 3] {
                 continue; // no area: covered by the next triangle's edge
             }
+            // the fan triangle's edges: `l0 → lj` is an edge of the loop
+            // only for j = 1, `lj → lj+1` always, `lj+1 → l0` only last
+            let edges = u8::from(j == 1) | 2 | (u8::from(j + 2 == l.len()) << 2);
             tris.push(Tri {
                 v: t,
                 id: [id[0], id[j], id[j + 1]],
+                edges,
                 poly: i as u32,
                 lo: [0, 1, 2].map(|k| t[0][k].min(t[1][k]).min(t[2][k])),
                 hi: [0, 1, 2].map(|k| t[0][k].max(t[1][k]).max(t[2][k])),
@@ -507,10 +518,10 @@ fn apart(s: &Tri, t: &Tri) -> bool {
             }
         }
     }
-    let (s, t) = (&s.v, &t.v);
     match n {
-        0 => disjoint(s, t),
+        0 => disjoint(&s.v, &t.v),
         1 => {
+            let (s, t) = (&s.v, &t.v);
             let (i, j) = shared[0];
             let v = s[i];
             let g = [
@@ -522,6 +533,19 @@ fn apart(s: &Tri, t: &Tri) -> bool {
             cones_apart(g)
         }
         2 => {
+            // the shared pair must be an edge of both polygons: a diagonal
+            // (or a run of collinear edges) lies inside its polygon, or
+            // along a line other polygons share, where two polygons can
+            // cross along `ab` with every pair of triangles touching only
+            // there (and the stars at a and b refused)
+            let edge = |tri: &Tri, i: usize, j: usize| {
+                let k = if (i + 1) % 3 == j { i } else { j };
+                tri.edges & (1 << k) != 0
+            };
+            if !edge(s, shared[0].0, shared[1].0) || !edge(t, shared[0].1, shared[1].1) {
+                return false;
+            }
+            let (s, t) = (&s.v, &t.v);
             let (a, b) = (s[shared[0].0], s[shared[1].0]);
             let c = s[3 - shared[0].0 - shared[1].0];
             let d = t[3 - shared[0].1 - shared[1].1];
@@ -758,6 +782,7 @@ mod tests {
         let mk = |v, id| Tri {
             v,
             id,
+            edges: 7,
             poly: 0,
             lo: [0; 3],
             hi: [0; 3],
@@ -796,6 +821,55 @@ mod tests {
             &[[-m + 1, -m + 1, m], [-m + 1, -m + 1, -m], [m, m, m]]
         ));
         assert!(apart(&big, &[[-m, -m, -m], [m, m, m], [-m, m, m]]));
+    }
+
+    /// The review's counterexample: two tetrahedra touching along `ab`,
+    /// their faces through `ab` merged into two convex quads that cross
+    /// along it (a diagonal of both). Closed, one part, positive volume,
+    /// winding number `-1` at `(-1, 0, 0)`.
+    #[test]
+    fn regress_quads_crossing_along_a_shared_diagonal() {
+        let (a, b) = ([0, 0, -3], [0, 0, 3]);
+        let g = [[-2, -1, 0], [-2, 1, 0], [4, -2, 0], [4, 2, 0]];
+        let faces = [
+            poly(&[a, g[1], g[0]]),
+            poly(&[b, g[0], g[1]]),
+            poly(&[a, g[2], b, g[1]]),
+            poly(&[a, g[3], g[2]]),
+            poly(&[b, g[2], g[3]]),
+            poly(&[a, g[0], b, g[3]]),
+        ];
+        assert_eq!(
+            certify_solid_boundary(&faces),
+            Err(SurfaceDefect::Intersecting { polygons: [2, 5] })
+        );
+        assert!(certify(&faces, false).is_err());
+    }
+
+    #[test]
+    fn crossings_along_diagonals_are_refused() {
+        for seed in 0..400u64 {
+            let c = crate::shapes::crossing_along_diagonal(&mut crate::SplitMix(seed));
+            for stars in [true, false] {
+                assert!(
+                    matches!(
+                        certify(&c.surface, stars),
+                        Err(SurfaceDefect::Intersecting { .. })
+                    ),
+                    "seed {seed}, stars {stars}: {:?}",
+                    certify(&c.surface, stars)
+                );
+            }
+            // each solid on its own is a valid boundary: the merged faces
+            // and the pentagons and larger faces are not refused as such
+            for s in &c.solids {
+                assert_eq!(
+                    certify_solid_boundary(s).map(|b| b.parts),
+                    Ok(1),
+                    "seed {seed}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -141,6 +141,190 @@ pub fn jittered_uv_sphere(
         .collect()
 }
 
+/// A closed surface that crosses itself along a segment `ab` which is a
+/// diagonal of two of its faces, with its two solids on their own and
+/// points of known winding number (see [`crossing_along_diagonal`]).
+#[derive(Clone, Debug)]
+pub struct DiagonalCrossing {
+    /// The surface: one edge-connected part, every edge used once each
+    /// way, positive volume, yet winding number `-1` at `negative`.
+    pub surface: Vec<crate::Polygon>,
+    /// The two convex solids it is made of, each on its own and outward.
+    pub solids: [Vec<crate::Polygon>; 2],
+    /// A point inside the inverted solid: winding number `-1`.
+    pub negative: crate::GridPoint,
+    /// A point inside the other solid: winding number `+1`.
+    pub positive: crate::GridPoint,
+}
+
+/// Two convex solids lying in opposite dihedral wedges about a segment
+/// `ab`, so that they touch only along it; the small one turned inside
+/// out, and each solid's two faces through `ab` merged with the other's
+/// into one convex polygon (of 4 to 10 corners) with `ab` as a diagonal.
+/// The two merged polygons cross along `ab`. Every edge is used once each
+/// way and the volume is positive, so only a test of how the faces meet
+/// along `ab` can tell that the winding number is `-1` inside the small
+/// solid. Drawn at random: the wedges, the solids' profiles (1 to 3
+/// corners a side) and an orientation-preserving integer map with a
+/// translation.
+pub fn crossing_along_diagonal(rng: &mut crate::SplitMix) -> DiagonalCrossing {
+    type P = [i64; 3];
+    let mut pick = |lo: i64, hi: i64| lo + (rng.next_u64() % (hi - lo + 1) as u64) as i64;
+    // two wedge directions across the z axis, not parallel
+    let (u, v) = loop {
+        let u = [pick(-4, 4), pick(-4, 4), 0];
+        let v = [pick(-4, 4), pick(-4, 4), 0];
+        if u[0] * v[1] - u[1] * v[0] != 0 {
+            break (u, v);
+        }
+    };
+    let h = 12 * pick(1, 2);
+    // a strictly concave profile of `k` radii at equal heights
+    let profile = |pick: &mut dyn FnMut(i64, i64) -> i64, r: i64| -> Vec<(i64, i64)> {
+        let k = pick(1, 3);
+        let radii = match k {
+            1 => vec![r],
+            2 => vec![r, r],
+            _ => {
+                let d = pick(1, r - 1);
+                vec![r, r + d, r]
+            }
+        };
+        (1..=k)
+            .zip(radii)
+            .map(|(i, r)| (i * h / (k + 1), r))
+            .collect()
+    };
+    // the small solid's radii stay below 2r, the large one's start at 4r:
+    // the large one holds more than twice the volume
+    let r = pick(2, 3);
+    let small = profile(&mut pick, r);
+    let big = pick(4 * r, 4 * r + 3);
+    let large = profile(&mut pick, big);
+    let at = |w: P, s: i64, (z, r): (i64, i64)| [s * r * w[0], s * r * w[1], z];
+    let (a, b): (P, P) = ([0; 3], [0, 0, h]);
+    // the small solid in the wedge of +u and +v, the large one in -u, -v
+    let chain = |prof: &[(i64, i64)], w: P, s: i64| -> Vec<P> {
+        std::iter::once(a)
+            .chain(prof.iter().map(|&q| at(w, s, q)))
+            .chain(std::iter::once(b))
+            .collect()
+    };
+    let (sp, sq) = (chain(&small, u, 1), chain(&small, v, 1));
+    let (lp, lq) = (chain(&large, u, -1), chain(&large, v, -1));
+    // each solid: the strips between its two chains, and its two faces
+    // through `ab` (one in the plane of u, one in the plane of v)
+    let strips = |p: &[P], q: &[P]| -> Vec<Vec<P>> {
+        (0..p.len() - 1)
+            .map(|i| {
+                let mut f = vec![p[i], p[i + 1], q[i + 1], q[i]];
+                f.dedup();
+                if f.first() == f.last() {
+                    f.pop();
+                }
+                f
+            })
+            .collect()
+    };
+    let inner = |c: &[P]| c[1..c.len() - 1].to_vec();
+    let centroid = |c: &[&[P]]| {
+        let pts: Vec<P> = c.iter().flat_map(|c| inner(c)).chain([a, b]).collect();
+        (
+            pts.iter()
+                .fold([0; 3], |s, p| [0, 1, 2].map(|k| s[k] + p[k])),
+            pts.len() as i64,
+        )
+    };
+    let (cs, ns) = centroid(&[&sp, &sq]);
+    let (cl, nl) = centroid(&[&lp, &lq]);
+    // everything scaled by ns · nl: both centroids become grid points
+    let scale = ns * nl;
+    let sub = |p: P, q: P| [0, 1, 2].map(|k| p[k] - q[k]);
+    // a face turned so that its normal points away from `c / n` (or
+    // towards it when `inward`)
+    let orient = |mut f: Vec<P>, (c, n): (P, i64), inward: bool| -> Vec<P> {
+        let (e, g) = (sub(f[1], f[0]), sub(f[2], f[0]));
+        let nrm = [
+            e[1] * g[2] - e[2] * g[1],
+            e[2] * g[0] - e[0] * g[2],
+            e[0] * g[1] - e[1] * g[0],
+        ];
+        let to_c = sub(c, f[0].map(|x| x * n));
+        let towards = (0..3).map(|k| nrm[k] * to_c[k]).sum::<i64>() > 0;
+        if towards != inward {
+            f.reverse();
+        }
+        f
+    };
+    let solid = |p: &[P], q: &[P], c: (P, i64), inward: bool| -> Vec<Vec<P>> {
+        strips(p, q)
+            .into_iter()
+            .chain([p.to_vec(), q.to_vec()])
+            .map(|f| orient(f, c, inward))
+            .collect()
+    };
+    // the merged faces: a, one side's chain, b, the other side's back
+    let merged = |s: &[P], l: &[P]| -> Vec<P> {
+        s.iter()
+            .copied()
+            .chain(l[1..l.len() - 1].iter().rev().copied())
+            .collect()
+    };
+    let mut surface: Vec<Vec<P>> = strips(&sp, &sq)
+        .into_iter()
+        .map(|f| orient(f, (cs, ns), true))
+        .chain(
+            strips(&lp, &lq)
+                .into_iter()
+                .map(|f| orient(f, (cl, nl), false)),
+        )
+        .collect();
+    // each merged face starts at `a` or `b`, so that `ab` is a diagonal
+    // of its triangle fan too (a certificate that works on fan triangles
+    // sees the crossing only as two triangles sharing `ab`)
+    for (s, l) in [(&sp, &lp), (&sq, &lq)] {
+        let mut f = orient(merged(s, l), (cl, nl), false);
+        let end = if pick(0, 1) == 0 { a } else { b };
+        let at = f.iter().position(|&p| p == end).expect("a corner");
+        f.rotate_left(at);
+        surface.push(f);
+    }
+    let solids = [
+        solid(&sp, &sq, (cs, ns), false),
+        solid(&lp, &lq, (cl, nl), false),
+    ];
+    // an integer map of positive determinant and a translation
+    let m = loop {
+        let m: [[i64; 3]; 3] = [(); 3].map(|_| [(); 3].map(|_| pick(-2, 2)));
+        let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        if det > 0 {
+            break m;
+        }
+    };
+    let t = [(); 3].map(|_| pick(-1000, 1000));
+    let map = |p: P, s: i64| -> crate::GridPoint {
+        [0, 1, 2].map(|r| ((0..3).map(|k| m[r][k] * p[k]).sum::<i64>() * s + t[r] * scale) as i32)
+    };
+    let polys = |faces: Vec<Vec<P>>| -> Vec<crate::Polygon> {
+        faces
+            .iter()
+            .map(|f| {
+                let l: Vec<crate::GridPoint> = f.iter().map(|&p| map(p, scale)).collect();
+                crate::Polygon::from_grid_points(&l, 0).expect("a convex face")
+            })
+            .collect()
+    };
+    let [s0, s1] = solids;
+    DiagonalCrossing {
+        surface: polys(surface),
+        solids: [polys(s0), polys(s1)],
+        negative: map(cs, nl),
+        positive: map(cl, ns),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -62,3 +62,20 @@ fn certified_surfaces_have_no_negative_winding() {
         "{refused_negative} refused with negative winding"
     );
 }
+
+/// Surfaces that cross themselves along a diagonal of two faces
+/// (`shapes::crossing_along_diagonal`): the winding number is `-1` inside
+/// the inverted solid, and the certificate refuses them.
+#[test]
+fn crossings_along_diagonals_have_negative_winding_and_are_refused() {
+    for seed in 0..60u64 {
+        let c = shapes::crossing_along_diagonal(&mut SplitMix(seed));
+        assert!(certify_solid_boundary(&c.surface).is_err(), "seed {seed}");
+        let solid = Solid::from_polygons(c.surface.clone());
+        assert_eq!(solid.winding(c.negative), -1, "seed {seed}");
+        assert_eq!(solid.winding(c.positive), 1, "seed {seed}");
+        for s in c.solids {
+            assert_eq!(certify_solid_boundary(&s).map(|b| b.parts), Ok(1));
+        }
+    }
+}

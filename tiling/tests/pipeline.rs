@@ -515,3 +515,43 @@ fn faces_turned_away_are_left_out_only_where_that_is_exact() {
     let f = check_motion(&ground, &around, &light, &still, 1, Strategy::Fast, None);
     assert_eq!(f[0].culled, 0);
 }
+
+/// The review's counterexample to the culling certificate: two tetrahedra
+/// touching along `ab`, their faces through `ab` merged into two quads
+/// that cross along it. Accepted, the object's faces turned away from the
+/// light were left out and about 45% of the shadowed area of face
+/// `(a, g2, b, g1)` came out lit. It must keep every face.
+#[test]
+fn regress_quads_crossing_along_a_diagonal_keep_every_face() {
+    let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    let (a, b) = (p(0.0, 0.0, -3.0), p(0.0, 0.0, 3.0));
+    let g = [
+        p(-2.0, -1.0, 0.0),
+        p(-2.0, 1.0, 0.0),
+        p(4.0, -2.0, 0.0),
+        p(4.0, 2.0, 0.0),
+    ];
+    let object = vec![
+        vec![a, g[1], g[0]],
+        vec![b, g[0], g[1]],
+        vec![a, g[2], b, g[1]],
+        vec![a, g[3], g[2]],
+        vec![b, g[2], g[3]],
+        vec![a, g[0], b, g[3]],
+    ];
+    let wall = vec![vec![
+        p(20.0, -30.0, -30.0),
+        p(20.0, -30.0, 30.0),
+        p(20.0, 30.0, 30.0),
+        p(20.0, 30.0, -30.0),
+    ]];
+    let light = [LightSpec::Point(p(-40.0, 1.0, 1.0))];
+    let still = Motion {
+        axis: DVec3::Z,
+        degrees: 0.0,
+        centre: DVec3::ZERO,
+        step: DVec3::ZERO,
+    };
+    let f = check_motion(&wall, &object, &light, &still, 1, Strategy::Fast, None);
+    assert_eq!(f[0].culled, 0);
+}
