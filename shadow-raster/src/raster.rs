@@ -378,10 +378,19 @@ fn to_fixed(v: f64) -> i32 {
 }
 
 /// Canonical intersection of segment `ab` with a plane, given the plane's
-/// values at both ends (of opposite signs).
+/// values at both ends (of opposite signs): interpolated from the end
+/// inside the plane (`value >= 0`), so that an edge shared by two polygons
+/// is cut at the same point whichever way each one runs along it.
+///
+/// The order is chosen from the values, not from the points' coordinates:
+/// comparing coordinates here read single lanes of the corner carried
+/// from one iteration of [`clip_ring`]'s loop to the next, and LLVM 22's
+/// x86 register allocator then kept that corner's `y` in the spill slot
+/// of its `x` (8 bytes, reloaded with `y = 0`) in the fat-LTO release
+/// build: `docs/llvm-clip-miscompile/README.md`.
 #[inline]
 fn cut(a: DVec3, b: DVec3, da: f64, db: f64) -> DVec3 {
-    let (a, b, da, db) = if a.to_array() <= b.to_array() {
+    let (a, b, da, db) = if da >= 0.0 {
         (a, b, da, db)
     } else {
         (b, a, db, da)
@@ -846,6 +855,57 @@ mod tests {
             });
         }
         cov
+    }
+
+    /// `clip_ring` against the plane taken corner by corner: the corners
+    /// inside are kept in order from the first, each edge that crosses
+    /// the plane adds one point on it and on the edge, and an edge cut
+    /// from either end gives the same point. (The fat-LTO miscompile of
+    /// `docs/llvm-clip-miscompile` zeroed the first kept corner's `y`.)
+    #[test]
+    fn clip_ring_keeps_inside_corners_and_cuts_each_crossing_edge_once() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 * 20.0 - 10.0
+        };
+        let (mut out, mut back) = (Vec::new(), Vec::new());
+        let mut cuts = 0;
+        for _ in 0..4000 {
+            let k = 3 + (rnd().abs() as usize) % 6;
+            let ring: Vec<DVec3> = (0..k).map(|_| DVec3::new(rnd(), rnd(), rnd())).collect();
+            let plane = (DVec3::new(rnd(), rnd(), rnd()), rnd());
+            let value = |c: DVec3| plane.0.dot(c) + plane.1;
+            clip_ring(&ring, plane, &mut out);
+            let mut want = Vec::new();
+            for i in 0..k {
+                let (a, b) = (ring[i], ring[(i + 1) % k]);
+                if value(a) >= 0.0 {
+                    want.push(Some(a));
+                }
+                if (value(a) >= 0.0) != (value(b) >= 0.0) {
+                    want.push(None);
+                }
+            }
+            assert_eq!(out.len(), want.len(), "{ring:?} {plane:?}");
+            let reversed: Vec<DVec3> = ring.iter().rev().copied().collect();
+            clip_ring(&reversed, plane, &mut back);
+            for (i, (got, w)) in out.iter().zip(&want).enumerate() {
+                match w {
+                    Some(c) => assert_eq!(got, c, "corner {i} of {ring:?}"),
+                    None => {
+                        cuts += 1;
+                        let scale = plane.0.length() * 20.0 + plane.1.abs();
+                        assert!(value(*got).abs() <= 1e-12 * scale, "{got} off the plane");
+                        // the same point when the ring runs the other way
+                        assert!(back.contains(got), "{got} not in {back:?}");
+                    }
+                }
+            }
+        }
+        assert!(cuts > 1000, "{cuts} crossing edges");
     }
 
     #[test]
