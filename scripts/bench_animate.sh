@@ -20,8 +20,8 @@ RUNS=${RUNS:-3}
 OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
 
-cargo build --release -q -p shadow-cli
-BIN=target/release/shadow
+cargo build --profile dist -q -p shadow-cli
+BIN=target/dist/shadow
 
 echo "machine: $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg), $(date -u +%F)"
 

@@ -18,10 +18,10 @@ RUNS=${RUNS:-5}
 OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
 
-cargo build --release -q -p shadow-cli
-cargo build --release -q -p svbsp --example shade
-BIN=target/release/shadow
-SHADE=target/release/examples/shade
+cargo build --profile dist -q -p shadow-cli
+cargo build --profile dist -q -p svbsp --example shade
+BIN=target/dist/shadow
+SHADE=target/dist/examples/shade
 
 echo "machine: $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg), $(date -u +%F)"
 

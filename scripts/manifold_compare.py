@@ -6,7 +6,7 @@ Outside CI. Generates the inputs of `bsp-core/benches/csg.rs` (UV spheres of
 0.3 radius; data/meshes/bunny.obj against a shifted copy), writes them as OBJ
 files into a temp dir, and for each operation:
 
-* runs `target/release/shadow csg OP A.obj B.obj -o out.obj --stats`
+* runs `target/dist/shadow csg OP A.obj B.obj -o out.obj --stats`
   `--our-reps` times and takes the median of each phase it prints;
 * loads the same OBJ vertex/triangle arrays into manifold3d (outside the
   timing) and times, median of `--reps`: Manifold construction of both
@@ -26,7 +26,7 @@ of one run each, alternating, and prints the median and range of the
 per-round ratios.
 
     pip install manifold3d numpy
-    cargo build --release -p shadow-cli
+    cargo build --profile dist -p shadow-cli
     python3 scripts/manifold_compare.py --sizes 1000 10000 --bunny
 """
 import argparse
@@ -235,7 +235,7 @@ def main():
     ap.add_argument("--ops", nargs="*", default=["union", "intersection", "difference"])
     ap.add_argument("--reps", type=int, default=5, help="manifold3d repetitions (median)")
     ap.add_argument("--our-reps", type=int, default=3, help="shadow csg runs (median)")
-    ap.add_argument("--cli", default=os.path.join(ROOT, "target/release/shadow"))
+    ap.add_argument("--cli", default=os.path.join(ROOT, "target/dist/shadow"))
     ap.add_argument("--timeout", type=float, default=600)
     ap.add_argument("--keep", help="write the OBJ files here instead of a temp dir")
     ap.add_argument("--paired", type=int, default=0, metavar="K",

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# Regenerates the pictures of docs/raster.md (release build of `shadow`).
+# Regenerates the pictures of docs/raster.md (the `dist` build of `shadow`, whose pictures `scripts/check-release.sh dist` checks).
 # Each picture is `shadow compare` of exact against one method on one
 # camera; the PNGs are then recompressed (zlib level 9) to keep the
 # repository small.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --release -p shadow-cli
-S=target/release/shadow
+cargo build --profile dist -p shadow-cli
+S=target/dist/shadow
 D=docs/img
 mkdir -p "$D"
 B="--scene bunny --size 400x225 --columns 2"

@@ -10,8 +10,18 @@ mod shadows;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+/// The binary under test: this build's, or the one `SHADOW_BIN` names
+/// (`.ci/run` runs the suite again against the release binary, the one
+/// the README's first command builds).
+fn shadow_bin() -> PathBuf {
+    std::env::var_os("SHADOW_BIN").map_or_else(
+        || PathBuf::from(env!("CARGO_BIN_EXE_shadow")),
+        PathBuf::from,
+    )
+}
+
 fn shadow(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_shadow"))
+    Command::new(shadow_bin())
         .args(args)
         .output()
         .expect("the shadow binary runs")

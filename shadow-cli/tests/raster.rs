@@ -128,6 +128,84 @@ fn compare_writes_the_panels_and_the_report() {
     assert_usage_error(&o, &["unknown method `phong`", "available: exact, raycast"]);
 }
 
+/// `compare`'s disagreeing pixels per method, from its report.
+fn compare_counts(scene: &str, size: &str) -> Vec<(String, u64)> {
+    let (out, csv) = (
+        scratch(&format!("figures_{scene}.png")),
+        scratch(&format!("figures_{scene}.csv")),
+    );
+    let o = shadow(&[
+        "compare",
+        "--scene",
+        scene,
+        "--size",
+        size,
+        "-o",
+        out.to_str().unwrap(),
+        "--report",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::read_to_string(&csv)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[0].to_string(), f[1].parse().unwrap())
+        })
+        .collect()
+}
+
+/// The figures docs/raster.md quotes, as bounds on the pixels each method
+/// gets wrong: a build whose image-space methods break (the fat-LTO
+/// miscompile of `clip_ring` drew wedges of false shadow: 2,041 to 8,345
+/// pixels on the room) fails here.
+#[test]
+fn compare_keeps_the_documented_figures() {
+    let check = |scene: &str, size: &str, most: &[(&str, u64)]| {
+        let got = compare_counts(scene, size);
+        assert_eq!(got.len(), most.len(), "{scene}: {got:?}");
+        for ((name, n), (want, bound)) in got.iter().zip(most) {
+            assert_eq!(name, want);
+            assert!(
+                n <= bound,
+                "{scene}, {name}: {n} pixels disagree, documented {bound}"
+            );
+        }
+    };
+    // docs/raster.md: 0%, 0.005%, 0.026%, 0.005%, 0.005%, 0.92%, 2.39% of
+    // 19,255 visible pixels
+    check(
+        "room",
+        "320x180",
+        &[
+            ("exact", 0),
+            ("raycast", 1),
+            ("shadow-map", 5),
+            ("stencil-zpass", 1),
+            ("stencil-zfail", 1),
+            ("planar", 177),
+            ("texture", 460),
+        ],
+    );
+    // docs/raster.md: exact, raycast and both stencils on every pixel;
+    // shadow-map 0.20%, planar 1.08%, texture 1.11% of 206,838
+    check(
+        "bunny-99k",
+        "960x540",
+        &[
+            ("exact", 0),
+            ("raycast", 0),
+            ("shadow-map", 412),
+            ("stencil-zpass", 0),
+            ("stencil-zfail", 0),
+            ("planar", 2242),
+            ("texture", 2290),
+        ],
+    );
+}
+
 #[test]
 fn lines_of_the_chair() {
     let out = scratch("chair_lines.svg");
