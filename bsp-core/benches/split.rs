@@ -39,7 +39,8 @@ fn spanning_plane(rng: &mut Rng, poly: &Polygon) -> Option<Plane> {
         c,
         [0, 1, 2].map(|k| c[k] + d1[k]),
         [0, 1, 2].map(|k| c[k] + d2[k]),
-    )?;
+    )
+    .ok()?;
     (poly.classify(&plane) == PolygonSide::Spanning).then_some(plane)
 }
 

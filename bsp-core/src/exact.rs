@@ -91,10 +91,14 @@ pub fn filter_side_err(plane: &[f64; 4], point: &[f64; 4], err: &[f64; 4]) -> Op
 /// rounding and the running sum of `m` terms `m − 1` more, so the computed
 /// sum is within `γ(m+3) · T` of the exact one, `T` the exact sum of the
 /// products' magnitudes; the computed `t` is at least `T (1 − γ(m+4))`.
-/// For `m < 2^26` the bound used, `(m + 4) u · t` (one more rounding),
-/// exceeds `γ(m+3) T` by at least `u t / 2`. That margin also covers the
-/// products that underflow (each off by at most `2^-1075`) as long as
-/// `t >= 2^-968`; smaller, infinite or longer sums answer `None`.
+/// The bound used, `(m + 4) u · t`, is rounded once more (the factor
+/// `2^-53` is exact), so it is at least `(m + 4) u (1 − u) (1 − γ(m+4)) T`.
+/// Its excess over `γ(m+3) T` is about `u T (1 − 2 (m + 4)² u)`: it is
+/// gone near `m = 2^26`. For `m < 2^24`, evaluated exactly at the worst
+/// case `m = 2^24 − 1`, the excess is above `0.937 u T`. That margin also
+/// covers the products that underflow (at most `2m`, each off by at most
+/// `2^-1075`: below `2^-1050` in all) as long as `t >= 2^-968`. Longer
+/// rings, smaller, infinite or NaN sums answer `None`.
 pub(crate) fn filter_ring_area(ring: impl Iterator<Item = [f64; 2]> + Clone) -> Option<i32> {
     let mut pts = ring.clone().chain(ring.take(1));
     let Some(mut a) = pts.next() else {
@@ -108,7 +112,7 @@ pub(crate) fn filter_ring_area(ring: impl Iterator<Item = [f64; 2]> + Clone) -> 
         m += 1;
         a = b;
     }
-    if m >= 1 << 26 || !t.is_finite() || t < pow2(-968) {
+    if m >= 1 << 24 || !t.is_finite() || t < pow2(-968) {
         return None;
     }
     let bound = t * (m + 4) as f64 * pow2(-53);
@@ -563,5 +567,16 @@ mod tests {
             }
         }
         assert!(certified > 1000 && certified < 20_000, "{certified}");
+    }
+
+    #[test]
+    fn ring_area_filter_declines_rings_of_2_24_corners_or_more() {
+        // a convex ring (corners on the parabola y = x², counter-clockwise)
+        // with a large area: certified up to 2^24 − 1 corners, left to
+        // the exact path from 2^24 on, where the proof of the bound ends
+        let ring = |n: u64| (0..n).map(|i| [i as f64, (i * i) as f64]);
+        assert_eq!(filter_ring_area(ring(1000)), Some(1));
+        assert_eq!(filter_ring_area(ring((1 << 24) - 1)), Some(1));
+        assert_eq!(filter_ring_area(ring(1 << 24)), None);
     }
 }

@@ -3,6 +3,34 @@
 use crate::Side;
 use crate::grid::{GridPoint, ViewPoint};
 
+/// Why an input face could not become one convex polygon.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FaceDefect {
+    /// Fewer than three distinct vertices.
+    TooFewVertices,
+    /// All vertices on one line, or zero enclosed area.
+    ZeroArea,
+    /// Not all vertices lie in one plane (after snapping).
+    NonPlanar,
+    /// Planar but not convex (or not simple).
+    NonConvex,
+    /// A coordinate beyond `±MAX_COORD`, the range the exact arithmetic
+    /// is proved for (snap input with a [`Grid`](crate::Grid) first).
+    OutOfRange,
+}
+
+impl std::fmt::Display for FaceDefect {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            FaceDefect::TooFewVertices => "fewer than three distinct vertices",
+            FaceDefect::ZeroArea => "zero area (collinear vertices)",
+            FaceDefect::NonPlanar => "vertices not in one plane",
+            FaceDefect::NonConvex => "not convex",
+            FaceDefect::OutOfRange => "a grid coordinate beyond ±MAX_COORD (2^26 - 1)",
+        })
+    }
+}
+
 /// Exclusive bound on the absolute value of a normal component: `2^55`.
 pub const MAX_NORMAL_BITS: u32 = 55;
 /// Exclusive bound on the absolute value of an offset: `2^83`.
@@ -146,15 +174,30 @@ impl Plane {
 
     /// The plane through three grid points, oriented so that `a, b, c` run
     /// counter-clockwise seen from the front (right-hand normal).
-    /// `None` if they are collinear.
+    /// [`FaceDefect::ZeroArea`] if they are collinear,
+    /// [`FaceDefect::OutOfRange`] if a coordinate exceeds
+    /// [`MAX_COORD`](crate::MAX_COORD) (the arithmetic's budget: beyond
+    /// it the normal could overflow).
     ///
     /// ```
-    /// use bsp_core::{Plane, Side};
+    /// use bsp_core::{FaceDefect, MAX_COORD, Plane, Side};
     /// let p = Plane::through([0, 0, 0], [1, 0, 0], [0, 1, 0]).unwrap();
     /// assert_eq!(p.classify_grid([5, 5, 1]), Side::Front);
     /// assert_eq!(p.classify_grid([5, 5, 0]), Side::On);
+    /// let far = [MAX_COORD + 1, 0, 0];
+    /// assert_eq!(Plane::through([0, 0, 0], far, [0, 1, 0]), Err(FaceDefect::OutOfRange));
     /// ```
-    pub fn through(a: GridPoint, b: GridPoint, c: GridPoint) -> Option<Plane> {
+    pub fn through(a: GridPoint, b: GridPoint, c: GridPoint) -> Result<Plane, FaceDefect> {
+        if !in_range(&[a, b, c]) {
+            return Err(FaceDefect::OutOfRange);
+        }
+        Plane::through_in_range(a, b, c).ok_or(FaceDefect::ZeroArea)
+    }
+
+    /// [`Plane::through`] for points the caller knows to be within
+    /// [`MAX_COORD`](crate::MAX_COORD); `None` if they are collinear.
+    pub(crate) fn through_in_range(a: GridPoint, b: GridPoint, c: GridPoint) -> Option<Plane> {
+        debug_assert!(in_range(&[a, b, c]), "{a:?} {b:?} {c:?}");
         let u = sub(b, a);
         let v = sub(c, a);
         let n = cross(u, v);
@@ -268,6 +311,12 @@ pub(crate) fn sub(a: GridPoint, b: GridPoint) -> [i64; 3] {
 }
 
 /// Cross product of grid differences (`|u_i|, |v_i| < 2^27`): `< 2^55`.
+/// `true` if every coordinate is within `±MAX_COORD`.
+pub(crate) fn in_range(points: &[GridPoint]) -> bool {
+    let m = crate::MAX_COORD;
+    points.iter().flatten().all(|c| (-m..=m).contains(c))
+}
+
 pub(crate) fn cross(u: [i64; 3], v: [i64; 3]) -> [i64; 3] {
     [
         u[1] * v[2] - u[2] * v[1],
@@ -295,6 +344,35 @@ fn dot_wide(n: [i64; 3], p: GridPoint) -> i128 {
 mod tests {
     use super::*;
     use crate::MAX_COORD;
+
+    /// Near `2^31` the normal's cross product overflows `i64` (a panic in
+    /// the test build, a wrong plane in a release build): points beyond
+    /// `MAX_COORD` are refused where a library caller hands them in.
+    #[test]
+    fn regress_grid_range_is_checked_at_the_api() {
+        let m = MAX_COORD;
+        let big = [i32::MAX, i32::MIN + 1, i32::MAX];
+        assert_eq!(
+            Plane::through([0, 0, 0], big, [i32::MIN + 1, i32::MAX, 5]),
+            Err(FaceDefect::OutOfRange)
+        );
+        assert_eq!(
+            Plane::through([m + 1, 0, 0], [0, 1, 0], [0, 0, 1]),
+            Err(FaceDefect::OutOfRange)
+        );
+        assert!(Plane::through([m, 0, 0], [0, -m, 0], [0, 0, m]).is_ok());
+        for poly in [
+            vec![[0, 0, 0], [m + 1, 0, 0], [0, 1, 0]],
+            vec![[0, 0, -m - 1], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
+            vec![[0, 0, 0], big, [1, 1, 1]],
+        ] {
+            assert_eq!(
+                crate::Polygon::from_grid_points(&poly, 0).unwrap_err(),
+                FaceDefect::OutOfRange
+            );
+        }
+        assert!(crate::Polygon::from_grid_points(&[[-m, -m, 0], [m, -m, 0], [m, m, 0]], 0).is_ok());
+    }
 
     #[test]
     fn extreme_grid_points_stay_in_budget() {
@@ -409,6 +487,6 @@ mod tests {
         let b = Plane::through([5, 5, 0], [1, 7, 0], [9, 9, 0]).unwrap();
         assert!(a.is_coincident(&b));
         assert_eq!(a.flip().flip(), a);
-        assert!(Plane::through([0, 0, 0], [1, 1, 1], [2, 2, 2]).is_none());
+        assert_eq!(Plane::through([0, 0, 0], [1, 1, 1], [2, 2, 2]), Err(FaceDefect::ZeroArea));
     }
 }

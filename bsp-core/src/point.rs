@@ -586,12 +586,12 @@ mod tests {
         ) {
             let pt = |k: usize| [g[3 * k], g[3 * k + 1], g[3 * k + 2]];
             let (p, q, r) = (pt(0), pt(1), pt(2));
-            let Some(plane) = Plane::through(pt(3), pt(4), pt(5)) else {
+            let Ok(plane) = Plane::through(pt(3), pt(4), pt(5)) else {
                 return Ok(());
             };
             let (sp, sq) = (plane.classify_grid(p), plane.classify_grid(q));
             proptest::prop_assume!(sp != Side::On && sq != Side::On && sp != sq);
-            let Some(support) = Plane::through(p, q, r) else {
+            let Ok(support) = Plane::through(p, q, r) else {
                 return Ok(());
             };
             let edge = Plane::edge(p, q, &support).expect("a plane along the edge");

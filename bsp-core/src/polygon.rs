@@ -3,7 +3,8 @@
 use smallvec::SmallVec;
 
 use crate::grid::GridPoint;
-use crate::plane::{Plane, cross, sub};
+pub use crate::plane::FaceDefect;
+use crate::plane::{Plane, cross, in_range, sub};
 use std::sync::Arc;
 
 use crate::point::{Implicit, Point, PointRef};
@@ -90,30 +91,6 @@ pub enum Parts {
     },
 }
 
-/// Why an input face could not become one convex polygon.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum FaceDefect {
-    /// Fewer than three distinct vertices.
-    TooFewVertices,
-    /// All vertices on one line, or zero enclosed area.
-    ZeroArea,
-    /// Not all vertices lie in one plane (after snapping).
-    NonPlanar,
-    /// Planar but not convex (or not simple).
-    NonConvex,
-}
-
-impl std::fmt::Display for FaceDefect {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            FaceDefect::TooFewVertices => "fewer than three distinct vertices",
-            FaceDefect::ZeroArea => "zero area (collinear vertices)",
-            FaceDefect::NonPlanar => "vertices not in one plane",
-            FaceDefect::NonConvex => "not convex",
-        })
-    }
-}
-
 /// A convex polygon: a support plane and a cycle of edge planes.
 ///
 /// Vertex `i` is the intersection of the support plane with edge planes
@@ -178,7 +155,7 @@ pub(crate) fn support_plane(v: &[GridPoint]) -> Result<Plane, FaceDefect> {
     let mut plane = None;
     'outer: for i in 1..k {
         for j in i + 1..k {
-            if let Some(p) = Plane::through(v[0], v[i], v[j]) {
+            if let Some(p) = Plane::through_in_range(v[0], v[i], v[j]) {
                 plane = Some(p);
                 break 'outer;
             }
@@ -227,6 +204,9 @@ impl GridPolygon {
     /// A polygon from grid points in counter-clockwise order, checked and
     /// cleaned as [`Polygon::from_grid_points`] does.
     pub fn from_grid_points(points: &[GridPoint]) -> Result<GridPolygon, FaceDefect> {
+        if !in_range(points) {
+            return Err(FaceDefect::OutOfRange);
+        }
         // most faces are triangles of three distinct corners: what the
         // general path gives them, without its copies (the plane through
         // the corners in order is the one oriented by their winding, and
@@ -236,7 +216,7 @@ impl GridPolygon {
             && b != c
             && c != a
         {
-            let support = Plane::through(a, b, c).ok_or(FaceDefect::ZeroArea)?;
+            let support = Plane::through_in_range(a, b, c).ok_or(FaceDefect::ZeroArea)?;
             return Ok(GridPolygon {
                 support,
                 verts: SmallVec::from_buf_and_len([a, b, c, [0; 3]], 3),
@@ -489,7 +469,8 @@ impl Polygon {
     /// A polygon from grid points in counter-clockwise order.
     ///
     /// Repeated and collinear vertices are removed first; the rest must be
-    /// planar and strictly convex.
+    /// planar and strictly convex, with every coordinate within
+    /// `±`[`MAX_COORD`](crate::MAX_COORD) ([`FaceDefect::OutOfRange`]).
     ///
     /// ```
     /// use bsp_core::{Polygon, FaceDefect};

@@ -153,7 +153,7 @@ impl Light {
     /// `|n_i| < 2^54`, `|d| < 2^82` (see `docs/architecture.md`).
     pub fn edge_plane(&self, a: GridPoint, b: GridPoint, inside: GridPoint) -> Option<Plane> {
         let p = match self {
-            Light::Point(l) => Plane::through(*l, a, b)?,
+            Light::Point(l) => Plane::through(*l, a, b).ok()?,
             Light::Directional(d) => {
                 let n = cross(sub(b, a), d.map(i64::from));
                 let off = -(0..3).map(|k| n[k] as i128 * a[k] as i128).sum::<i128>();

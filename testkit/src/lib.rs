@@ -541,7 +541,7 @@ impl SplitInput {
             if c.iter().flatten().any(|c| c.abs() > MAX_COORD) {
                 continue;
             }
-            let Some(plane) = Plane::through(c[0], c[1], c[2]) else {
+            let Ok(plane) = Plane::through(c[0], c[1], c[2]) else {
                 continue;
             };
             let mut next = Vec::with_capacity(2 * pieces.len());

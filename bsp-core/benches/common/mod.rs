@@ -54,7 +54,7 @@ impl Rng {
 /// (coefficients near the budget).
 pub fn random_plane(rng: &mut Rng, m: i32) -> Plane {
     loop {
-        if let Some(p) = Plane::through(rng.grid_point(m), rng.grid_point(m), rng.grid_point(m)) {
+        if let Ok(p) = Plane::through(rng.grid_point(m), rng.grid_point(m), rng.grid_point(m)) {
             return p;
         }
     }

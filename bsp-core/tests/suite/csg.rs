@@ -156,7 +156,7 @@ fn hull(points: &[GridPoint]) -> Option<Shape> {
     for i in 0..pts.len() {
         for j in i + 1..pts.len() {
             for k in j + 1..pts.len() {
-                let Some(pl) = Plane::through(pts[i], pts[j], pts[k]) else {
+                let Ok(pl) = Plane::through(pts[i], pts[j], pts[k]) else {
                     continue;
                 };
                 let sides: Vec<Side> = pts.iter().map(|p| pl.classify_grid(*p)).collect();

@@ -236,8 +236,8 @@ pub(crate) fn plane_triple() -> BoxedStrategy<[Plane; 3]> {
             "degenerate",
             |(t, e, p3)| {
                 let c2 = to_grid(add(wide(t[2]), e))?;
-                let p1 = Plane::through(t[0], t[1], t[2])?;
-                let p2 = Plane::through(t[0], t[1], c2)?;
+                let p1 = Plane::through(t[0], t[1], t[2]).ok()?;
+                let p2 = Plane::through(t[0], t[1], c2).ok()?;
                 Some([p1, p2, p3])
             }
         ),
@@ -247,7 +247,7 @@ pub(crate) fn plane_triple() -> BoxedStrategy<[Plane; 3]> {
                 // planes through g parallel to the given triangles' planes
                 let mut out = Vec::new();
                 for t in ts {
-                    let p = Plane::through(t[0], t[1], t[2])?;
+                    let p = Plane::through(t[0], t[1], t[2]).ok()?;
                     let n = p.normal();
                     let d = -(0..3).map(|k| n[k] as i128 * g[k] as i128).sum::<i128>();
                     out.push(Plane::new(n, d)?);
@@ -469,11 +469,11 @@ pub(crate) fn make_cut(cut: &Cut, verts: &[GridPoint]) -> Option<Plane> {
     let b = |f| box_point(lo, hi, f);
     let v = |i: usize| verts[i % verts.len()];
     match cut {
-        Cut::Points([p, q, r]) => Plane::through(b(*p), b(*q), b(*r)),
-        Cut::Vertex(i, [p, q]) => Plane::through(v(*i), b(*p), b(*q)),
-        Cut::TwoVertices(i, j, p) => Plane::through(v(*i), v(*j), b(*p)),
+        Cut::Points([p, q, r]) => Plane::through(b(*p), b(*q), b(*r)).ok(),
+        Cut::Vertex(i, [p, q]) => Plane::through(v(*i), b(*p), b(*q)).ok(),
+        Cut::TwoVertices(i, j, p) => Plane::through(v(*i), v(*j), b(*p)).ok(),
         Cut::Nudged(i, [p, q], d) => {
-            let pl = Plane::through(v(*i), b(*p), b(*q))?;
+            let pl = Plane::through(v(*i), b(*p), b(*q)).ok()?;
             Plane::new(pl.normal(), pl.offset() + *d as i128)
         }
         Cut::Raw(p) => Some(*p),
