@@ -42,7 +42,9 @@ run demo -o demo.svg
 run csg union "$SPHERE" moved_sphere.obj -o union.obj
 run csg intersection "$SPHERE" moved_sphere.obj -o inter.stl
 run csg difference "$SPHERE" moved_sphere.obj -o diff.obj
-run render --scene room --size 320x180 -o render_exact.png
+run render --scene room --size 320x180 -o render_exact.png --mask render_exact.pgm
+run render --scene bunny --size 320x180 --sun 1,2,3 --light 4,20.6,5.9 -o render_bunny.png \
+  --mask render_bunny.pgm
 for m in shadow-map stencil-zpass stencil-zfail planar texture raycast; do
   run render --scene room --size 320x180 --method "$m" -o "render_$m.png"
 done
@@ -54,12 +56,21 @@ run animate --scene room --frames 3 --format png --width 320 --height 180 -o ani
 run animate --scene room --frames 2 --format json -o anim_json --strategy paper
 run animate --scene room --frames 2 --format svg -o anim_svg
 if [[ $SCALE == full ]]; then
+  # the benches' scenes
   run shadows --scene bunny-99k --light 4,20.6,5.9 -o bunny99k.json
+  run shadows --scene bunny-99k --light 4,20.6,5.9 --light -10.9,16.7,2 \
+    --light 17.8,9.8,-8.9 --sun 3,10,2 -o bunny99k_four.obj
+  awk '$1 == "v" { printf "v %.17g %.17g %.17g\n", $2 + 0.01, $3 + 0.02, $4 + 0.005; next } { print }' \
+    "$ROOT/data/meshes/bunny.obj" > moved_bunny.obj
+  run csg union "$ROOT/data/meshes/bunny.obj" moved_bunny.obj -o bunny_union.obj
+  run csg difference "$ROOT/data/meshes/bunny.obj" moved_bunny.obj -o bunny_diff.stl
+  run animate --scene bunny-11k --frames 4 --format png --width 320 --height 180 \
+    -o anim_bunny --report anim_bunny.csv
   run compare --scene bunny-99k --size 960x540 -o cmp_b99k.png --report cmp_b99k.csv
 fi
 
 # (compare's panels print each method's time: its report stands for it)
-for f in $(find . -type f ! -name moved_sphere.obj ! -name 'cmp_*.png' | sort); do
+for f in $(find . -type f ! -name 'moved_*.obj' ! -name 'cmp_*.png' | sort); do
   case $f in
     *.csv) echo "$(untimed "$f" | sha256sum | cut -c1-16)  ${f#./}" ;;
     *) echo "$(sha256sum < "$f" | cut -c1-16)  ${f#./}" ;;
