@@ -38,9 +38,9 @@ const SHIFT: DVec3 = DVec3::new(0.3, 0.1, 0.05);
 type Faces = Vec<Vec<DVec3>>;
 
 /// Unit UV sphere of `4 s (s - 1)` triangles, `s = floor(sqrt(n/4) + 0.5)`
-/// stacks and `2 s` slices, oriented outwards ([`bsp_core::shapes::uv_sphere`]).
+/// stacks and `2 s` slices, oriented outwards ([`bsp_fixtures::uv_sphere`]).
 fn uv_sphere(n: usize) -> Faces {
-    let (v, f) = bsp_core::shapes::uv_sphere(n);
+    let (v, f) = bsp_fixtures::uv_sphere(n);
     f.iter()
         .map(|t| t.iter().map(|&i| v[i as usize]).collect())
         .collect()

@@ -3,7 +3,8 @@
 
 use std::hint::black_box;
 
-use bsp_core::{certify_solid_boundary, shapes};
+use bsp_core::certify_solid_boundary;
+use bsp_fixtures as shapes;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
 

@@ -655,15 +655,17 @@ mod tests {
         Polygon::from_grid_points(p, 0).unwrap()
     }
 
-    /// A box's six faces ([`crate::shapes::cuboid`]), outward (or inward
-    /// when `flip`).
+    /// Loops of grid points as polygons.
+    fn polys(loops: &[Vec<GridPoint>]) -> Vec<Polygon> {
+        loops.iter().map(|l| poly(l)).collect()
+    }
+
+    /// A box's six faces ([`bsp_fixtures::grid_cuboid`]), outward (or
+    /// inward when `flip`).
     fn cube(lo: GridPoint, hi: GridPoint, flip: bool) -> Vec<Polygon> {
-        let v = |p: GridPoint| glam::DVec3::from_array(p.map(f64::from));
-        crate::shapes::cuboid(v(lo), v(hi))
+        bsp_fixtures::grid_cuboid(lo, hi)
             .into_iter()
-            .map(|f| {
-                let mut l: Vec<GridPoint> =
-                    f.iter().map(|q| q.to_array().map(|c| c as i32)).collect();
+            .map(|mut l| {
                 if flip {
                     l.reverse();
                 }
@@ -849,20 +851,21 @@ mod tests {
     #[test]
     fn crossings_along_diagonals_are_refused() {
         for seed in 0..400u64 {
-            let c = crate::shapes::crossing_along_diagonal(&mut crate::SplitMix(seed));
+            let c = bsp_fixtures::crossing_along_diagonal(&mut bsp_fixtures::Rng(seed));
+            let (surface, solids) = (polys(&c.surface), c.solids.map(|s| polys(&s)));
             for stars in [true, false] {
                 assert!(
                     matches!(
-                        certify(&c.surface, stars),
+                        certify(&surface, stars),
                         Err(SurfaceDefect::Intersecting { .. })
                     ),
                     "seed {seed}, stars {stars}: {:?}",
-                    certify(&c.surface, stars)
+                    certify(&surface, stars)
                 );
             }
             // each solid on its own is a valid boundary: the merged faces
             // and the pentagons and larger faces are not refused as such
-            for s in &c.solids {
+            for s in &solids {
                 assert_eq!(
                     certify_solid_boundary(s).map(|b| b.parts),
                     Ok(1),
@@ -877,8 +880,12 @@ mod tests {
         let (mut ok, mut refused) = (0, 0);
         for seed in 0..800u64 {
             let jitter = 1 + (seed % 4) as i32;
-            let polys =
-                crate::shapes::jittered_uv_sphere(48, 8.0, jitter, &mut crate::SplitMix(seed));
+            let polys = polys(&bsp_fixtures::jittered_uv_sphere(
+                48,
+                8.0,
+                jitter,
+                &mut bsp_fixtures::Rng(seed),
+            ));
             let (a, b) = (certify(&polys, true), certify(&polys, false));
             assert_eq!(a.is_ok(), b.is_ok(), "seed {seed}: {a:?} vs {b:?}");
             match a {

@@ -48,7 +48,6 @@ mod point;
 mod polygon;
 mod regions;
 mod sanity;
-pub mod shapes;
 mod topology;
 mod tree;
 

@@ -1100,7 +1100,7 @@ mod tests {
         // 21 600 polygons, more than one run of the welder, and
         // 6 * 60^2 + 2 distinct corners
         let n = 60;
-        let cube = crate::shapes::cuboid(glam::DVec3::ZERO, glam::DVec3::splat(n as f64));
+        let cube = bsp_fixtures::cuboid(glam::DVec3::ZERO, glam::DVec3::splat(n as f64));
         let mut polys = Vec::new();
         for q in &cube {
             let at = |u: i32, v: i32| {
@@ -1129,7 +1129,7 @@ mod tests {
     #[test]
     fn the_owned_mesh_is_the_borrowed_mesh() {
         // a box cut by an oblique plane: implicit vertices, T-junctions
-        let cube = crate::shapes::cuboid(glam::DVec3::ZERO, glam::DVec3::splat(6.0));
+        let cube = bsp_fixtures::cuboid(glam::DVec3::ZERO, glam::DVec3::splat(6.0));
         let cut = Plane::new([1, 2, 3], -17).unwrap();
         let mut polys = Vec::new();
         for f in &cube {
@@ -1165,7 +1165,7 @@ mod tests {
     #[test]
     fn the_checked_mesh_is_the_mesh_or_the_check_s_message() {
         let cube = |lo: f64, d: glam::DVec3| -> Vec<Polygon> {
-            crate::shapes::cuboid(glam::DVec3::splat(lo) + d, glam::DVec3::splat(lo + 4.0) + d)
+            bsp_fixtures::cuboid(glam::DVec3::splat(lo) + d, glam::DVec3::splat(lo + 4.0) + d)
                 .iter()
                 .map(|f| {
                     let g: Vec<crate::GridPoint> =

@@ -487,6 +487,9 @@ mod tests {
         let b = Plane::through([5, 5, 0], [1, 7, 0], [9, 9, 0]).unwrap();
         assert!(a.is_coincident(&b));
         assert_eq!(a.flip().flip(), a);
-        assert_eq!(Plane::through([0, 0, 0], [1, 1, 1], [2, 2, 2]), Err(FaceDefect::ZeroArea));
+        assert_eq!(
+            Plane::through([0, 0, 0], [1, 1, 1], [2, 2, 2]),
+            Err(FaceDefect::ZeroArea)
+        );
     }
 }

@@ -946,7 +946,7 @@ mod tests {
     /// and large ones (a random sample), with many spanning polygons.
     #[test]
     fn kept_sides_build_the_same_tree() {
-        use crate::shapes::uv_sphere;
+        use bsp_fixtures::uv_sphere;
         // two overlapping spheres' triangles and a few large random ones
         let mut polys = Vec::new();
         for (shift, n) in [(0i32, 300usize), (700, 120)] {

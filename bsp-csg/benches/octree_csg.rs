@@ -18,8 +18,8 @@
 //!   1000-tool case of the docs).
 
 use bsp_core::BoolOp;
-use bsp_csg::shapes::{drill_tools, sphere_pair, uv_sphere};
 use bsp_csg::{MeshIn, Snapped, Solid, snap};
+use bsp_fixtures::{drill_tools, sphere_pair, uv_sphere};
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 
 /// Both meshes snapped to one grid, as solids (what a mesh boolean does

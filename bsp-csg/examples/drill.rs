@@ -15,8 +15,8 @@
 use std::time::Instant;
 
 use bsp_core::BoolOp;
-use bsp_csg::shapes::{drill_tools, uv_sphere};
 use bsp_csg::{MeshIn, fit_grid, snap_one};
+use bsp_fixtures::{drill_tools, uv_sphere};
 
 fn main() {
     let mut args = std::env::args().skip(1).map(|a| a.parse::<usize>().ok());

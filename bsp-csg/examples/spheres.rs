@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use bsp_core::{BoolOp, Grid, import_faces_par};
 use bsp_csg::Solid;
-use bsp_csg::shapes::sphere_pair;
+use bsp_fixtures::sphere_pair;
 use glam::DVec3;
 
 fn main() {

@@ -91,8 +91,6 @@
 mod index;
 mod local;
 mod octree;
-/// Test shapes (re-exported from `bsp-core`).
-pub use bsp_core::shapes;
 mod winding;
 
 use bsp_core::{
@@ -844,7 +842,8 @@ impl Solid {
     ///
     /// ```
     /// use bsp_core::BoolOp;
-    /// use bsp_csg::{MeshIn, fit_grid, shapes::sphere_pair, snap_one};
+    /// use bsp_csg::{MeshIn, fit_grid, snap_one};
+    /// use bsp_fixtures::sphere_pair;
     ///
     /// let (va, vb, faces) = sphere_pair(1000);
     /// let (a, b) = (MeshIn::new(&va, &faces), MeshIn::new(&vb, &faces));
@@ -2954,7 +2953,7 @@ mod tests {
     /// list, slots, bounds of the remaining queries and index answers.
     #[test]
     fn removing_many_faces_at_once_is_removing_them_in_turn() {
-        let (pos, faces) = shapes::uv_sphere(12_000);
+        let (pos, faces) = bsp_fixtures::uv_sphere(12_000);
         let snapped = snap(&[MeshIn::new(&pos, &faces)]).unwrap();
         // with the index made (it is updated) and without (a new solid's)
         let mut indexed = snapped.solids[0].clone();
@@ -3000,7 +2999,7 @@ mod tests {
     /// has its index.
     #[test]
     fn queries_agree_with_and_without_the_index() {
-        let (pos, faces) = shapes::uv_sphere(6_000);
+        let (pos, faces) = bsp_fixtures::uv_sphere(6_000);
         let snapped = snap(&[MeshIn::new(&pos, &faces)]).unwrap();
         let fresh = snapped.solids[0].clone();
         assert!(fresh.index.get().is_none());

@@ -624,13 +624,9 @@ mod tests {
 
     /// The faces of the box `lo..hi` (grid corners), outward.
     fn cuboid(lo: GridPoint, hi: GridPoint) -> Vec<Polygon> {
-        let v = |p: GridPoint| glam::DVec3::from_array(p.map(f64::from));
-        bsp_core::shapes::cuboid(v(lo), v(hi))
-            .into_iter()
-            .map(|f| {
-                let g: Vec<GridPoint> = f.iter().map(|q| q.to_array().map(|c| c as i32)).collect();
-                Polygon::from_grid_points(&g, 0).expect("a proper face")
-            })
+        bsp_fixtures::grid_cuboid(lo, hi)
+            .iter()
+            .map(|g| Polygon::from_grid_points(g, 0).expect("a proper face"))
             .collect()
     }
 

@@ -5,8 +5,17 @@
 //! on a coarse grid with every vertex moved at random, so that faces fold
 //! over, pass through each other and turn inside out often.
 
-use bsp_core::{GridPoint, Polygon, SplitMix, certify_solid_boundary, shapes};
+use bsp_core::{Polygon, certify_solid_boundary};
 use bsp_csg::Solid;
+use bsp_fixtures::{self as shapes, GridPoint, Rng as SplitMix};
+
+/// Loops of grid points as polygons.
+fn polys(loops: &[Vec<GridPoint>]) -> Vec<Polygon> {
+    loops
+        .iter()
+        .map(|l| Polygon::from_grid_points(l, 0).unwrap())
+        .collect()
+}
 
 #[test]
 fn certified_surfaces_have_no_negative_winding() {
@@ -14,20 +23,13 @@ fn certified_surfaces_have_no_negative_winding() {
     let (mut certified, mut refused_negative) = (0, 0);
     for case in 0..200 {
         let jitter = 1 + case % 4;
-        let mut polys = shapes::jittered_uv_sphere(48, 7.0, jitter, &mut rng);
+        let mut polys = polys(&shapes::jittered_uv_sphere(48, 7.0, jitter, &mut rng));
         if case % 4 == 3 {
             // a second sphere, apart, overlapping or inside
             let off = (rng.next_u64() % 20) as i32 - 4;
             let other = shapes::jittered_uv_sphere(24, 3.0, 1, &mut rng);
             polys.extend(other.iter().map(|p| {
-                let l: Vec<GridPoint> = p
-                    .vertices()
-                    .iter()
-                    .map(|v| {
-                        let g = v.as_grid().unwrap();
-                        [g[0] + off, g[1], g[2]]
-                    })
-                    .collect();
+                let l: Vec<GridPoint> = p.iter().map(|g| [g[0] + off, g[1], g[2]]).collect();
                 Polygon::from_grid_points(&l, 0).unwrap()
             }));
         }
@@ -70,11 +72,12 @@ fn certified_surfaces_have_no_negative_winding() {
 fn crossings_along_diagonals_have_negative_winding_and_are_refused() {
     for seed in 0..60u64 {
         let c = shapes::crossing_along_diagonal(&mut SplitMix(seed));
-        assert!(certify_solid_boundary(&c.surface).is_err(), "seed {seed}");
-        let solid = Solid::from_polygons(c.surface.clone());
+        let (surface, solids) = (polys(&c.surface), c.solids.map(|s| polys(&s)));
+        assert!(certify_solid_boundary(&surface).is_err(), "seed {seed}");
+        let solid = Solid::from_polygons(surface);
         assert_eq!(solid.winding(c.negative), -1, "seed {seed}");
         assert_eq!(solid.winding(c.positive), 1, "seed {seed}");
-        for s in c.solids {
+        for s in solids {
             assert_eq!(certify_solid_boundary(&s).map(|b| b.parts), Ok(1));
         }
     }

@@ -11,19 +11,7 @@ use proptest::prelude::*;
 
 type Face = Vec<GridPoint>;
 
-/// `bsp_core::shapes::cuboid` on grid points (small integers, exact in
-/// `f64` both ways).
-fn cuboid(lo: GridPoint, hi: GridPoint) -> Vec<Face> {
-    let v = |p: GridPoint| glam::DVec3::from_array(p.map(f64::from));
-    bsp_core::shapes::cuboid(v(lo), v(hi))
-        .into_iter()
-        .map(|f| {
-            f.into_iter()
-                .map(|q| q.to_array().map(|c| c as i32))
-                .collect()
-        })
-        .collect()
-}
+use bsp_fixtures::grid_cuboid as cuboid;
 
 fn det(a: GridPoint, b: GridPoint, c: GridPoint, d: GridPoint) -> i64 {
     let s = |p: GridPoint, q: GridPoint| [0, 1, 2].map(|k| (p[k] - q[k]) as i64);

@@ -9,8 +9,8 @@
 //! left holes (the 2 000-triangle part minus 20 tools, from step 2 on).
 
 use bsp_core::{BoolOp, TriMesh};
-use bsp_csg::shapes::{drill_tools, uv_sphere};
 use bsp_csg::{MeshIn, Options, Snapped, Solid, Stats, snap};
+use bsp_fixtures::{drill_tools, uv_sphere};
 
 fn drill(tools: usize, opts: &Options) -> (f64, usize) {
     let (pv, pf) = uv_sphere(2000);
@@ -51,7 +51,7 @@ fn twenty_tools_through_a_pole_fan() {
 fn new_vertices_are_shared_and_into_mesh_is_to_mesh() {
     use bsp_core::Point;
     use std::collections::HashMap;
-    let (va, vb, f) = bsp_csg::shapes::sphere_pair(2000);
+    let (va, vb, f) = bsp_fixtures::sphere_pair(2000);
     let Snapped { solids, .. } = snap(&[MeshIn::new(&va, &f), MeshIn::new(&vb, &f)]).unwrap();
     let mut it = solids.into_iter();
     let (mut a, b) = (it.next().unwrap(), it.next().unwrap());
@@ -122,7 +122,7 @@ fn apply_watertight(solids: &[Solid], op: BoolOp, opts: &Options) -> (TriMesh, S
 fn a_box_through_a_sphere_with_and_without_easy_cells() {
     use glam::DVec3;
     let (sv, sf) = uv_sphere(4000);
-    let quads = bsp_csg::shapes::cuboid(DVec3::splat(-0.4), DVec3::splat(1.7));
+    let quads = bsp_fixtures::cuboid(DVec3::splat(-0.4), DVec3::splat(1.7));
     let bv: Vec<DVec3> = quads.concat();
     let bf: Vec<Vec<u32>> = (0..quads.len() as u32)
         .map(|q| (4 * q..4 * q + 4).collect())
@@ -146,7 +146,7 @@ fn a_box_through_a_sphere_with_and_without_easy_cells() {
 /// and its exact volume.
 #[test]
 fn clean_cells_keep_faces_whole_as_local_trees_would() {
-    let (va, vb, f) = bsp_csg::shapes::sphere_pair(4000);
+    let (va, vb, f) = bsp_fixtures::sphere_pair(4000);
     let meshes = [MeshIn::new(&va, &f), MeshIn::new(&vb, &f)];
     let Snapped { solids, .. } = snap(&meshes).unwrap();
     for leaf in [8, bsp_csg::LEAF_SIZE] {

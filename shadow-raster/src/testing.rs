@@ -8,7 +8,7 @@ use crate::{Camera, RasterScene, SceneLight};
 /// Boxes standing on a ground, seen from a few places, lit by a point
 /// light and a sun.
 pub(crate) fn scenes() -> Vec<(RasterScene, Vec<SceneLight>, Vec<Camera>)> {
-    use bsp_core::shapes::cuboid;
+    use bsp_fixtures::cuboid;
     let mut faces = vec![vec![
         DVec3::new(-8.0, -8.0, 0.0),
         DVec3::new(8.0, -8.0, 0.0),

@@ -309,7 +309,7 @@ fn room_axis_stands_on_the_floor() {
     }
 }
 
-use bsp_core::shapes::cuboid;
+use bsp_fixtures::cuboid;
 
 fn tetra(at: DVec3, s: f64) -> Vec<Vec<DVec3>> {
     let v = [

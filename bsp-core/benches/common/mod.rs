@@ -3,52 +3,11 @@
 
 #![allow(dead_code, unreachable_pub)]
 
-use bsp_core::{BspTree, BuildOptions, Grid, GridPoint, Plane, Polygon, import_faces};
+use bsp_core::{BspTree, BuildOptions, Grid, Plane, Polygon, import_faces};
 use glam::DVec3;
 
-/// `SplitMix64`: a small deterministic generator.
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Rng {
-        Rng(seed)
-    }
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `[0, 1)`.
-    pub fn f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Uniform in `[lo, hi)`.
-    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.f64()
-    }
-    /// Uniform integer in `[-m, m]`.
-    pub fn coord(&mut self, m: i32) -> i32 {
-        (self.next_u64() % (2 * m as u64 + 1)) as i64 as i32 - m
-    }
-    pub fn grid_point(&mut self, m: i32) -> GridPoint {
-        [self.coord(m), self.coord(m), self.coord(m)]
-    }
-    pub fn unit_vector(&mut self) -> DVec3 {
-        loop {
-            let v = DVec3::new(
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            );
-            let l = v.length();
-            if l > 0.1 && l <= 1.0 {
-                return v / l;
-            }
-        }
-    }
-}
+/// The generator every bench draws from.
+pub use bsp_fixtures::Rng;
 
 /// A generic plane through three random grid points of the full range
 /// (coefficients near the budget).
