@@ -99,7 +99,7 @@ pub fn filter_side_err(plane: &[f64; 4], point: &[f64; 4], err: &[f64; 4]) -> Op
 /// covers the products that underflow (at most `2m`, each off by at most
 /// `2^-1075`: below `2^-1050` in all) as long as `t >= 2^-968`. Longer
 /// rings, smaller, infinite or NaN sums answer `None`.
-pub(crate) fn filter_ring_area(ring: impl Iterator<Item = [f64; 2]> + Clone) -> Option<i32> {
+pub fn filter_ring_area(ring: impl Iterator<Item = [f64; 2]> + Clone) -> Option<i32> {
     let mut pts = ring.clone().chain(ring.take(1));
     let Some(mut a) = pts.next() else {
         return Some(0);

@@ -42,18 +42,17 @@ mod grid;
 mod import;
 mod mesh;
 mod partition;
-mod pieces;
 mod plane;
 mod point;
 mod polygon;
-mod regions;
 mod sanity;
 mod topology;
 mod tree;
 
 pub use embedded::{SolidBoundary, SurfaceDefect, certify_solid_boundary};
 pub use exact::{
-    FILTER_REL, Homogeneous, approx, filter_side, filter_side_err, ratio_to_f64_exact,
+    FILTER_REL, Homogeneous, approx, filter_ring_area, filter_side, filter_side_err,
+    ratio_to_f64_exact,
 };
 pub use flat::FlatBsp;
 pub use grid::{GRID_BITS, Grid, GridPoint, MAX_COORD, MAX_VIEW_COORD, SnapError, ViewPoint};
@@ -66,14 +65,12 @@ pub use partition::{
     BOX_HALF, BoolOp, CellOp, Overlay, PLink, PNode, Partition, box_section, merge,
     merge_smaller_into_larger, solid_build_options,
 };
-pub use pieces::{ArenaMark, EdgeRef, Lazy, Piece, PieceArena, Sides, Vertex, VertexRef};
 pub use plane::{MAX_NORMAL_BITS, MAX_OFFSET_BITS, Plane};
 pub use point::{Implicit, Point, PointRef, rational_to_f64};
 pub use polygon::{
     ConvexFace, FaceDefect, GridPolygon, Parts, Polygon, PolygonSide, Side, Split, share_points,
     split_loop,
 };
-pub use regions::{MergeCache, MergedRegion, Region, Remerged, merge_cells, merge_cells_adjacent};
 pub use sanity::{ConvexParts, SanityError, check_convex};
 pub use topology::{TopologyError, check_closed_manifold};
 pub use tree::{

@@ -226,6 +226,22 @@ impl Plane {
         Plane::new(n, d)
     }
 
+    /// `n1 · (n2 × n3)` of the three planes' normals, exactly: zero when
+    /// they do not meet in one point.
+    pub fn normals_det(p1: &Plane, p2: &Plane, p3: &Plane) -> crate::I256 {
+        let (n1, n2, n3) = (p1.normal(), p2.normal(), p3.normal());
+        let m = |x: i64, y: i64| x as i128 * y as i128;
+        let c = [
+            m(n2[1], n3[2]) - m(n2[2], n3[1]),
+            m(n2[2], n3[0]) - m(n2[0], n3[2]),
+            m(n2[0], n3[1]) - m(n2[1], n3[0]),
+        ];
+        use crate::point::Wide;
+        (0..3)
+            .fold(Wide::ZERO, |s, i| s.add(Wide::product(n1[i] as i128, c[i])))
+            .to_i256()
+    }
+
     /// Index of the normal's component of largest magnitude.
     pub fn dominant_axis(&self) -> usize {
         let a = self.n.map(|c| c.unsigned_abs());

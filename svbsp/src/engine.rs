@@ -7,7 +7,7 @@
 //! a cut made on the way is undone when both sides turn out alike, so a
 //! piece comes back whole unless a shadow boundary crosses it. After the
 //! last light, the pieces with equal flags that touch along an edge are
-//! merged into maximal regions ([`bsp_core::merge_cells`]): a fragment is a
+//! merged into maximal regions ([`merge_cells`]): a fragment is a
 //! connected part of the face with one set of flags, an outer boundary
 //! and possibly holes. A face lit (or shadowed) all over by every light
 //! is one fragment: its own polygon.
@@ -19,13 +19,12 @@
 
 use std::ops::Range;
 
-use bsp_core::{
-    ArenaMark, EdgeRef, MergeCache, Piece, PieceArena, Plane, Polygon, Region, Remerged, Side,
-    Vertex, merge_cells,
-};
+use bsp_core::{Plane, Polygon, Side};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
+use crate::arena::pieces::{ArenaMark, EdgeRef, Piece, PieceArena, Vertex};
+use crate::arena::regions::{MergeCache, Region, Remerged, merge_cells};
 use crate::light::{Light, LightError, MAX_LIGHTS};
 use crate::psv::{LIT, SHADOW, ShadowVolumes, VolumeError};
 

@@ -41,6 +41,7 @@
 //! None.
 
 mod areas;
+mod arena;
 mod chin_feiner;
 mod engine;
 mod light;
@@ -48,6 +49,7 @@ mod psv;
 mod wide;
 
 pub use areas::{Areas, fragment_area, polygon_area};
+pub use arena::pieces::Vertex;
 pub use chin_feiner::{CfFragment, CfFragments, chin_feiner};
 pub use engine::{
     Batch, CHUNK, Cells, FragmentRef, Refined, Scratch, ShadeOptions, ShadowError, ShadowSet,

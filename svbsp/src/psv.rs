@@ -42,13 +42,11 @@
 
 use std::borrow::Borrow;
 
-use bsp_core::{
-    EdgeRef, GridPoint, Piece, PieceArena, Plane, Point, Polygon, SanityError, Side, Sides,
-    SplitMix,
-};
+use bsp_core::{GridPoint, Plane, Point, Polygon, SanityError, Side, SplitMix};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
+use crate::arena::pieces::{EdgeRef, Piece, PieceArena, Sides};
 use crate::light::Light;
 
 /// A leaf: lit.

@@ -901,7 +901,7 @@ enum Part<'a> {
 /// One fragment of a frame, with its exact vertices.
 #[derive(Clone, Copy)]
 pub enum FragmentView<'a> {
-    /// A region of the fast strategy (rings of exact [`bsp_core::Vertex`]
+    /// A region of the fast strategy (rings of exact [`svbsp::Vertex`]
     /// values, through [`Batch::vertex`]).
     Region(svbsp::FragmentRef<'a>),
     /// A convex fragment of the paper's strategy.

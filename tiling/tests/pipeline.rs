@@ -10,12 +10,13 @@
 use std::collections::{BTreeMap, HashMap};
 use std::str::FromStr;
 
-use bsp_core::{Grid, Polygon, Vertex};
+use bsp_core::{Grid, Polygon};
 use glam::{DMat4, DVec3};
 use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::Zero;
 use proptest::prelude::*;
+use svbsp::Vertex;
 use svbsp::{Batch, Light, LightSpec, place_lights, shadow_fragments, shared_grid};
 use tiling::{Dynamic, FragmentView, Motion, PipelineOptions, Strategy};
 

@@ -22,10 +22,11 @@
 
 use std::collections::HashMap;
 
-use bsp_core::{I256, I512, Polygon, Vertex};
+use bsp_core::{I256, I512, Polygon};
 use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::{One, Signed, ToPrimitive, Zero};
+use svbsp::Vertex;
 use svbsp::{Light, WPoint};
 
 /// An exact rational.

@@ -78,7 +78,8 @@ impl Transform {
 }
 
 /// The loops the generators describe, each cleaned to its polygon's
-/// vertices; invalid ones (no area, not convex) are skipped.
+/// vertices; invalid ones (no area, not convex, off the grid once
+/// transformed) are skipped.
 pub(crate) fn make_faces(gens: &[FaceGen], t: &Transform) -> Vec<Vec<P3>> {
     let mut out: Vec<Vec<P3>> = Vec::new();
     for g in gens {
@@ -108,8 +109,11 @@ pub(crate) fn make_faces(gens: &[FaceGen], t: &Transform) -> Vec<Vec<P3>> {
             );
         }
     }
+    // (faces the transform carries off the grid are left out: the
+    // kernel refuses coordinates beyond MAX_COORD)
     out.into_iter()
-        .map(|l| l.into_iter().map(|p| t.apply(p)).collect())
+        .map(|l| l.into_iter().map(|p| t.apply(p)).collect::<Vec<P3>>())
+        .filter(|l| l.iter().flatten().all(|c| c.abs() <= MAX_COORD))
         .collect()
 }
 

@@ -17,12 +17,11 @@ use std::cmp::Ordering;
 
 use smallvec::SmallVec;
 
-use crate::Side;
-use crate::grid::GridPoint;
-use crate::plane::Plane;
-use crate::point::{Implicit, Point};
-use crate::polygon::{Polygon, split_loop};
-use crate::sanity::{ConvexParts, SanityError, check_convex};
+#[cfg(test)]
+use bsp_core::{ConvexParts, SanityError, check_convex};
+use bsp_core::{
+    GridPoint, I256, Implicit, Plane, Point, Polygon, Side, filter_side_err, split_loop,
+};
 
 /// A vertex stored inline in a [`PieceArena`].
 #[derive(Clone, Debug)]
@@ -97,30 +96,30 @@ impl Vertex {
 /// `g` against coordinate `k` of `i`: `g w` against `x_k`.
 fn cmp_grid_implicit(g: i32, i: &Implicit, k: usize) -> Ordering {
     let h = i.coords();
-    (crate::I256::from(g) * h[3]).cmp(&h[k])
+    (I256::from(g) * h[3]).cmp(&h[k])
 }
 
 /// An edge plane of a cell: an index into [`PieceArena::planes`] and an
 /// orientation bit (the plane as stored, or flipped).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct EdgeRef(u32);
+pub(crate) struct EdgeRef(u32);
 
 impl EdgeRef {
     /// Plane `index` of the arena, flipped if `flipped`.
     #[inline]
-    pub fn new(index: u32, flipped: bool) -> EdgeRef {
+    pub(crate) fn new(index: u32, flipped: bool) -> EdgeRef {
         EdgeRef(index << 1 | flipped as u32)
     }
 
     /// The index of the plane in the arena.
     #[inline]
-    pub fn index(self) -> u32 {
+    pub(crate) fn index(self) -> u32 {
         self.0 >> 1
     }
 
     /// `true` if the edge is the stored plane flipped.
     #[inline]
-    pub fn flipped(self) -> bool {
+    pub(crate) fn flipped(self) -> bool {
         self.0 & 1 == 1
     }
 }
@@ -130,7 +129,7 @@ impl EdgeRef {
 /// seen from the front of the support plane, which the cells of one arena
 /// share.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Piece {
+pub(crate) struct Piece {
     /// Vertex indices into [`PieceArena::vertex`].
     pub verts: SmallVec<[u32; 6]>,
     /// Edge planes (edge `i` runs from vertex `i` to vertex `i + 1`).
@@ -144,13 +143,13 @@ pub struct Piece {
 /// bytes), and *lazy* points made here by splits ([`Lazy`], 80 bytes): the
 /// indices of their three planes in the arena and `f64` approximations of
 /// their homogeneous coordinates with certified error bounds. A lazy point
-/// is classified by the filter ([`crate::filter_side_err`]) and computes
+/// is classified by the filter ([`bsp_core::filter_side_err`]) and computes
 /// its exact coordinates only when the filter cannot decide, or for
 /// output. A vertex id is an index into one of the three lists, tagged in
 /// its top two bits; [`PieceArena::dense`] maps ids to `0..len()` for
 /// per-vertex tables.
 #[derive(Clone, Debug, Default)]
-pub struct PieceArena {
+pub(crate) struct PieceArena {
     grid: Vec<GridPoint>,
     exact: Vec<Implicit>,
     lazy: Vec<Lazy>,
@@ -170,7 +169,7 @@ const LAZY: u32 = 2 << 30;
 /// homogeneous coordinates `(x, y, z, w)` (`w > 0`) and bounds `err` on
 /// their absolute errors.
 #[derive(Clone, Debug)]
-pub struct Lazy {
+pub(crate) struct Lazy {
     approx: [f64; 4],
     err: [f64; 4],
     planes: [u32; 3],
@@ -222,7 +221,7 @@ impl Lazy {
             w < 0.0
         } else {
             let [p1, p2, p3] = idx.map(|i| &planes[i as usize]);
-            let det = exact_det(p1, p2, p3);
+            let det = Plane::normals_det(p1, p2, p3);
             if det.is_zero() {
                 return None;
             }
@@ -241,7 +240,7 @@ impl Lazy {
     }
 
     /// The exact point.
-    pub fn exact(&self, planes: &[Plane]) -> Implicit {
+    pub(crate) fn exact(&self, planes: &[Plane]) -> Implicit {
         if let Some(e) = &self.exact {
             return (**e).clone();
         }
@@ -259,7 +258,7 @@ impl Lazy {
         anchors: &[Option<[GridPoint; 2]>],
         plane: &Plane,
     ) -> Side {
-        if let Some(s) = crate::exact::filter_side_err(&plane.approx(), &self.approx, &self.err) {
+        if let Some(s) = filter_side_err(&plane.approx(), &self.approx, &self.err) {
             return s;
         }
         if self.on_by_construction(planes, anchors, plane) {
@@ -301,7 +300,7 @@ impl Lazy {
 
     /// [`Lazy::classify`] without keeping the exact point.
     fn classify_shared(&self, planes: &[Plane], plane: &Plane) -> Side {
-        if let Some(s) = crate::exact::filter_side_err(&plane.approx(), &self.approx, &self.err) {
+        if let Some(s) = filter_side_err(&plane.approx(), &self.approx, &self.err) {
             return s;
         }
         if self
@@ -318,24 +317,9 @@ impl Lazy {
     }
 }
 
-/// `n1 · (n2 × n3)` exactly.
-fn exact_det(p1: &Plane, p2: &Plane, p3: &Plane) -> crate::I256 {
-    let (n1, n2, n3) = (p1.normal(), p2.normal(), p3.normal());
-    let m = |x: i64, y: i64| x as i128 * y as i128;
-    let c = [
-        m(n2[1], n3[2]) - m(n2[2], n3[1]),
-        m(n2[2], n3[0]) - m(n2[0], n3[2]),
-        m(n2[0], n3[1]) - m(n2[1], n3[0]),
-    ];
-    use crate::point::Wide;
-    (0..3)
-        .fold(Wide::ZERO, |s, i| s.add(Wide::product(n1[i] as i128, c[i])))
-        .to_i256()
-}
-
 /// A vertex of a [`PieceArena`], borrowed.
 #[derive(Clone, Copy, Debug)]
-pub enum VertexRef<'a> {
+pub(crate) enum VertexRef<'a> {
     /// A grid point.
     Grid(GridPoint),
     /// An exact implicit point.
@@ -347,7 +331,7 @@ pub enum VertexRef<'a> {
 impl VertexRef<'_> {
     /// Exact side of `plane`.
     #[inline]
-    pub fn classify(self, plane: &Plane) -> Side {
+    pub(crate) fn classify(self, plane: &Plane) -> Side {
         match self {
             VertexRef::Grid(g) => plane.classify_grid(g),
             VertexRef::Exact(i) => i.classify(plane),
@@ -356,7 +340,7 @@ impl VertexRef<'_> {
     }
 
     /// An owned exact copy.
-    pub fn to_owned(self) -> Vertex {
+    pub(crate) fn to_owned(self) -> Vertex {
         match self {
             VertexRef::Grid(g) => Vertex::Grid(g),
             VertexRef::Exact(i) => Vertex::Implicit(i.clone()),
@@ -365,28 +349,18 @@ impl VertexRef<'_> {
     }
 
     /// The correctly rounded grid coordinates.
-    pub fn to_f64(self) -> [f64; 3] {
+    pub(crate) fn to_f64(self) -> [f64; 3] {
         match self {
             VertexRef::Grid(g) => g.map(f64::from),
             VertexRef::Exact(i) => i.to_f64(),
             VertexRef::Lazy(l, planes) => l.exact(planes).to_f64(),
         }
     }
-
-    /// Exact comparison of coordinate `k`.
-    pub fn cmp_axis(self, o: VertexRef<'_>, k: usize) -> Ordering {
-        self.to_owned().cmp_axis(&o.to_owned(), k)
-    }
-
-    /// Exact equality of the represented points.
-    pub fn same_point(self, o: VertexRef<'_>) -> bool {
-        self.to_owned().same_point(&o.to_owned())
-    }
 }
 
 /// Sizes of a [`PieceArena`] to go back to (see [`PieceArena::rollback`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ArenaMark {
+pub(crate) struct ArenaMark {
     grid: usize,
     exact: usize,
     lazy: usize,
@@ -395,7 +369,7 @@ pub struct ArenaMark {
 
 /// Where a cell lies relative to a plane, by its vertices' exact sides.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Sides {
+pub(crate) struct Sides {
     /// Some vertex is strictly in front.
     pub front: bool,
     /// Some vertex is strictly behind.
@@ -424,12 +398,13 @@ impl Sides {
 
 impl PieceArena {
     /// An empty arena.
-    pub fn new() -> PieceArena {
+    #[cfg(test)]
+    pub(crate) fn new() -> PieceArena {
         PieceArena::default()
     }
 
     /// Empties the arena, keeping its memory.
-    pub fn clear(&mut self) {
+    pub(crate) fn clear(&mut self) {
         self.grid.clear();
         self.exact.clear();
         self.lazy.clear();
@@ -439,7 +414,7 @@ impl PieceArena {
 
     /// The current sizes.
     #[inline]
-    pub fn mark(&self) -> ArenaMark {
+    pub(crate) fn mark(&self) -> ArenaMark {
         ArenaMark {
             grid: self.grid.len(),
             exact: self.exact.len(),
@@ -451,7 +426,7 @@ impl PieceArena {
     /// Drops every vertex and plane added since `mark`. Pieces that refer
     /// to them must be dropped too.
     #[inline]
-    pub fn rollback(&mut self, mark: ArenaMark) {
+    pub(crate) fn rollback(&mut self, mark: ArenaMark) {
         self.grid.truncate(mark.grid);
         self.exact.truncate(mark.exact);
         self.lazy.truncate(mark.lazy);
@@ -461,7 +436,7 @@ impl PieceArena {
 
     /// Adds a plane, returning its index.
     #[inline]
-    pub fn add_plane(&mut self, p: Plane) -> u32 {
+    pub(crate) fn add_plane(&mut self, p: Plane) -> u32 {
         self.planes.push(p);
         self.anchors.push(None);
         (self.planes.len() - 1) as u32
@@ -471,7 +446,7 @@ impl PieceArena {
     /// returning its index. Knowing the edge lets a vertex on it be found
     /// on any plane through the edge without arithmetic.
     #[inline]
-    pub fn add_edge_plane(&mut self, p: Plane, a: GridPoint, b: GridPoint) -> u32 {
+    pub(crate) fn add_edge_plane(&mut self, p: Plane, a: GridPoint, b: GridPoint) -> u32 {
         self.planes.push(p);
         self.anchors.push(Some([a, b]));
         (self.planes.len() - 1) as u32
@@ -480,34 +455,34 @@ impl PieceArena {
     /// The two grid points known on plane `i`'s line with the support (see
     /// [`PieceArena::add_edge_plane`]).
     #[inline]
-    pub fn anchors(&self, i: u32) -> Option<[GridPoint; 2]> {
+    pub(crate) fn anchors(&self, i: u32) -> Option<[GridPoint; 2]> {
         self.anchors[i as usize]
     }
 
     /// Adds a grid vertex, returning its id.
     #[inline]
-    pub fn add_grid(&mut self, g: GridPoint) -> u32 {
+    pub(crate) fn add_grid(&mut self, g: GridPoint) -> u32 {
         self.grid.push(g);
         (self.grid.len() - 1) as u32
     }
 
     /// Adds an exact implicit vertex, returning its id.
     #[inline]
-    pub fn add_exact(&mut self, i: Implicit) -> u32 {
+    pub(crate) fn add_exact(&mut self, i: Implicit) -> u32 {
         self.exact.push(i);
         (self.exact.len() - 1) as u32 | EXACT
     }
 
     /// Adds the intersection of planes `idx` of this arena as a lazy
     /// vertex, returning its id; `None` if they do not meet in one point.
-    pub fn add_meet(&mut self, idx: [u32; 3]) -> Option<u32> {
+    pub(crate) fn add_meet(&mut self, idx: [u32; 3]) -> Option<u32> {
         let l = Lazy::new(&self.planes, idx)?;
         self.lazy.push(l);
         Some((self.lazy.len() - 1) as u32 | LAZY)
     }
 
     /// Adds a vertex, returning its id.
-    pub fn add_vertex(&mut self, v: Vertex) -> u32 {
+    pub(crate) fn add_vertex(&mut self, v: Vertex) -> u32 {
         match v {
             Vertex::Grid(g) => self.add_grid(g),
             Vertex::Implicit(i) => self.add_exact(i),
@@ -516,7 +491,7 @@ impl PieceArena {
 
     /// Copies vertex `id` of another arena into this one (a lazy vertex
     /// with its three planes).
-    pub fn copy_vertex(&mut self, from: &PieceArena, id: u32) -> u32 {
+    pub(crate) fn copy_vertex(&mut self, from: &PieceArena, id: u32) -> u32 {
         match from.vertex(id) {
             VertexRef::Grid(g) => self.add_grid(g),
             VertexRef::Exact(i) => self.add_exact(i.clone()),
@@ -538,7 +513,7 @@ impl PieceArena {
 
     /// Vertex `id`.
     #[inline]
-    pub fn vertex(&self, id: u32) -> VertexRef<'_> {
+    pub(crate) fn vertex(&self, id: u32) -> VertexRef<'_> {
         let i = (id & !TAG) as usize;
         match id & TAG {
             0 => VertexRef::Grid(self.grid[i]),
@@ -548,19 +523,14 @@ impl PieceArena {
     }
 
     /// Number of vertices.
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.grid.len() + self.exact.len() + self.lazy.len()
-    }
-
-    /// `true` if the arena has no vertex.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
     }
 
     /// A dense index in `0..len()` for vertex `id`, valid until the next
     /// vertex is added.
     #[inline]
-    pub fn dense(&self, id: u32) -> usize {
+    pub(crate) fn dense(&self, id: u32) -> usize {
         let i = (id & !TAG) as usize;
         match id & TAG {
             0 => i,
@@ -571,14 +541,14 @@ impl PieceArena {
 
     /// The plane of an edge, oriented.
     #[inline]
-    pub fn plane(&self, e: EdgeRef) -> Plane {
+    pub(crate) fn plane(&self, e: EdgeRef) -> Plane {
         let p = self.planes[e.index() as usize];
         if e.flipped() { p.flip() } else { p }
     }
 
     /// A piece from a polygon lying on this arena's support plane: its
     /// vertices and edge planes are copied into the arena.
-    pub fn add_polygon(&mut self, p: &Polygon) -> Piece {
+    pub(crate) fn add_polygon(&mut self, p: &Polygon) -> Piece {
         let mut c = Piece::default();
         let vs = p.vertices();
         let k = vs.len();
@@ -596,7 +566,7 @@ impl PieceArena {
     /// The exact side of vertex `id` relative to `plane` (a lazy vertex
     /// keeps its exact coordinates if they had to be computed).
     #[inline]
-    pub fn classify(&mut self, id: u32, plane: &Plane) -> Side {
+    pub(crate) fn classify(&mut self, id: u32, plane: &Plane) -> Side {
         let i = (id & !TAG) as usize;
         match id & TAG {
             0 => plane.classify_grid(self.grid[i]),
@@ -607,21 +577,21 @@ impl PieceArena {
 
     /// Which sides of `plane` some vertex of `c` is strictly on.
     #[inline]
-    pub fn sides(&mut self, c: &Piece, plane: &Plane) -> Sides {
+    pub(crate) fn sides(&mut self, c: &Piece, plane: &Plane) -> Sides {
         Sides::of(c, |v| self.classify(v, plane))
     }
 
     /// [`PieceArena::sides`] through a shared reference (a lazy vertex
     /// that needs its exact coordinates computes them without keeping
     /// them), for classifying in parallel.
-    pub fn sides_shared(&self, c: &Piece, plane: &Plane) -> Sides {
+    pub(crate) fn sides_shared(&self, c: &Piece, plane: &Plane) -> Sides {
         Sides::of(c, |v| self.vertex(v).classify(plane))
     }
 
     /// The exact sides of `c`'s vertices relative to `plane`, written to
     /// `out` (cleared first).
     #[inline]
-    pub fn classify_into(
+    pub(crate) fn classify_into(
         &mut self,
         c: &Piece,
         plane: &Plane,
@@ -642,7 +612,13 @@ impl PieceArena {
     /// include both `Front` and `Back`: the front and back pieces. `support`
     /// and `cut` are indices into [`PieceArena::planes`]. Each crossing edge
     /// gets one new (lazy) vertex, shared by both pieces.
-    pub fn split(&mut self, support: u32, c: &Piece, cut: u32, sides: &[Side]) -> (Piece, Piece) {
+    pub(crate) fn split(
+        &mut self,
+        support: u32,
+        c: &Piece,
+        cut: u32,
+        sides: &[Side],
+    ) -> (Piece, Piece) {
         let mut f = Piece::default();
         let mut b = Piece::default();
         split_loop(
@@ -668,7 +644,8 @@ impl PieceArena {
     }
 
     /// Checks `c`'s invariants exactly (see [`check_convex`]).
-    pub fn sanity_check(&self, support: &Plane, c: &Piece) -> Result<(), SanityError> {
+    #[cfg(test)]
+    pub(crate) fn sanity_check(&self, support: &Plane, c: &Piece) -> Result<(), SanityError> {
         check_convex(&PieceView {
             arena: self,
             support,
@@ -677,12 +654,14 @@ impl PieceArena {
     }
 }
 
+#[cfg(test)]
 struct PieceView<'a> {
     arena: &'a PieceArena,
     support: &'a Plane,
     cell: &'a Piece,
 }
 
+#[cfg(test)]
 impl ConvexParts for PieceView<'_> {
     fn vertex_count(&self) -> usize {
         self.cell.verts.len()

@@ -22,13 +22,13 @@ use num_rational::BigRational;
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
-use crate::I256;
-use crate::pieces::{EdgeRef, Piece, PieceArena, Vertex};
-use crate::plane::Plane;
+use bsp_core::{I256, Plane, filter_ring_area};
+
+use super::pieces::{EdgeRef, Piece, PieceArena, Vertex};
 
 /// A maximal connected region of equally labelled cells.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Region {
+pub(crate) struct Region {
     /// The cells' common label.
     pub label: u64,
     /// The outer boundary: vertex indices into the arena, counter-clockwise
@@ -553,7 +553,7 @@ fn build<'a>(arena: &PieceArena, support: &Plane, cells: &[Piece], f: &Frame) ->
 /// their first cell.
 ///
 /// Panics (an internal error) if two cells overlap along an edge.
-pub fn merge_cells(
+pub(crate) fn merge_cells(
     arena: &PieceArena,
     support: &Plane,
     cells: &[Piece],
@@ -566,7 +566,7 @@ pub fn merge_cells(
 /// [`merge_cells`], also listing in `adjacent` every pair of cells
 /// `[a, b]` (`a < b`, each pair once, in increasing order) that share a
 /// piece of edge.
-pub fn merge_cells_adjacent(
+pub(crate) fn merge_cells_adjacent(
     arena: &PieceArena,
     support: &Plane,
     cells: &[Piece],
@@ -609,7 +609,7 @@ pub fn merge_cells_adjacent(
 /// that change; the regions are the same as a full [`merge_cells`] of the
 /// new cells would make.
 #[derive(Clone, Debug)]
-pub struct MergeCache {
+pub(crate) struct MergeCache {
     frame: Frame,
     support: Plane,
     points: Vec<MPoint>,
@@ -628,7 +628,7 @@ pub struct MergeCache {
 /// A merged region of a [`MergeCache::remerge`]: its label, its rings and
 /// cells as indices into the [`Remerged`] it belongs to.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct MergedRegion {
+pub(crate) struct MergedRegion {
     /// The cells' label.
     pub label: u64,
     /// The outer boundary (point indices), counter-clockwise seen from
@@ -642,7 +642,7 @@ pub struct MergedRegion {
 
 /// The result of [`MergeCache::remerge`].
 #[derive(Clone, Debug)]
-pub struct Remerged {
+pub(crate) struct Remerged {
     base: usize,
     extra: Vec<MPoint>,
     piece_points: Vec<SmallVec<[u32; 6]>>,
@@ -655,7 +655,7 @@ pub struct Remerged {
 
 impl Remerged {
     /// Point `i`'s exact value and correctly rounded coordinates.
-    pub fn point<'c>(&'c self, cache: &'c MergeCache, i: u32) -> (&'c Vertex, [f64; 3]) {
+    pub(crate) fn point<'c>(&'c self, cache: &'c MergeCache, i: u32) -> (&'c Vertex, [f64; 3]) {
         let p = if (i as usize) < self.base {
             &cache.points[i as usize]
         } else {
@@ -666,7 +666,7 @@ impl Remerged {
 
     /// The points of cell `c` (a cached cell below the cache's cell count,
     /// else a new piece).
-    pub fn cell_points<'c>(&'c self, cache: &'c MergeCache, c: u32) -> &'c [u32] {
+    pub(crate) fn cell_points<'c>(&'c self, cache: &'c MergeCache, c: u32) -> &'c [u32] {
         let n = cache.cell_points.len();
         if (c as usize) < n {
             &cache.cell_points[c as usize]
@@ -679,7 +679,7 @@ impl Remerged {
 impl MergeCache {
     /// Merges `cells` as [`merge_cells`] does and keeps what a re-merge
     /// needs. Returns the regions too, in the cache's region order.
-    pub fn new(
+    pub(crate) fn new(
         arena: &PieceArena,
         support: &Plane,
         cells: &[Piece],
@@ -725,28 +725,13 @@ impl MergeCache {
         (cache, out)
     }
 
-    /// Number of cached cells.
-    pub fn cell_count(&self) -> usize {
-        self.cell_points.len()
-    }
-
-    /// Number of cached regions.
-    pub fn region_count(&self) -> usize {
-        self.region_size.len()
-    }
-
-    /// Cell `c`'s region.
-    pub fn region_of(&self, c: u32) -> u32 {
-        self.region_of[c as usize]
-    }
-
     /// The regions after a change: the cached cells listed in `removed`
     /// are replaced by `pieces` (in `arena`, labelled `piece_labels`, on
     /// the same support plane, covering exactly the removed cells), and
     /// the cached cells in `relabel` take new labels. Only the lines the
     /// change touches are redone, and only the regions that change are
     /// traced: [`Remerged::standing`] lists the cached regions that stand.
-    pub fn remerge(
+    pub(crate) fn remerge(
         &self,
         removed: &[u32],
         relabel: &[(u32, u64)],
@@ -922,7 +907,7 @@ fn cmp_clockwise(r: [i128; 2], a: [i128; 2], b: [i128; 2], sigma: i32) -> Orderi
 
 /// The sign of a loop's signed area in `(u, v)` coordinates: the `f64`
 /// shoelace sum when the kernel's filter certifies it
-/// ([`crate::exact::filter_ring_area`]: the points' coordinates are
+/// ([`bsp_core::filter_ring_area`]: the points' coordinates are
 /// correctly rounded), else exact rationals.
 fn signed_area_sign(points: &Points<'_>, l: &[u32], u: usize, v: usize) -> i32 {
     let m = l.len();
@@ -930,7 +915,7 @@ fn signed_area_sign(points: &Points<'_>, l: &[u32], u: usize, v: usize) -> i32 {
         let r = points.get(i).rounded;
         [r[u], r[v]]
     });
-    if let Some(sign) = crate::exact::filter_ring_area(ring) {
+    if let Some(sign) = filter_ring_area(ring) {
         return sign;
     }
     let q = |i: usize| -> [BigRational; 2] {
@@ -971,7 +956,7 @@ fn signed_area_sign(points: &Points<'_>, l: &[u32], u: usize, v: usize) -> i32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::polygon::Polygon;
+    use bsp_core::Polygon;
 
     fn square_cells(
         n: i32,
