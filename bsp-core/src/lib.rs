@@ -12,7 +12,18 @@
 //! On top of the kernel, [`BspTree`] builds autopartitions (explicit
 //! stacks, no recursion limit), traverses them in painter's order,
 //! answers exact point membership for solids, and has a flattened
-//! array layout ([`FlatBsp`]) for fast traversal.
+//! array layout ([`FlatBsp`]) for fast traversal. [`merge`] combines two
+//! partitions cell by cell: the set operations of solids ([`BoolOp`]) and
+//! the overlay "+" ([`Overlay`]). For meshes, [`import_faces`] snaps faces
+//! to polygons, [`TriMesh`] turns a solid's boundary back into a
+//! watertight mesh, and [`certify_solid_boundary`] proves that polygons
+//! bound solids.
+//!
+//! The layers, each in its folder: `kernel` (grid, exact arithmetic,
+//! planes, points, polygons), `tree` (building, traversal, merging) and
+//! `solid` (import, meshes, topology and embedding checks). The crate
+//! root re-exports what a user needs; [`internals`] holds what the sibling
+//! crates of this workspace use besides.
 //!
 //! # Example
 //!
@@ -35,100 +46,43 @@
 //!
 //! None.
 
-mod embedded;
-mod exact;
-mod flat;
-mod grid;
-mod import;
-mod mesh;
-mod partition;
-mod plane;
-mod point;
-mod polygon;
-mod sanity;
-mod topology;
+mod error;
+mod kernel;
+mod solid;
 mod tree;
 
-pub use embedded::{SolidBoundary, SurfaceDefect, certify_solid_boundary};
-pub use exact::{
-    FILTER_REL, Homogeneous, approx, filter_ring_area, filter_side, filter_side_err,
-    ratio_to_f64_exact,
+pub use error::Error;
+pub use kernel::{
+    FaceDefect, GRID_BITS, Grid, GridPoint, Implicit, MAX_COORD, MAX_VIEW_COORD, Plane, Point,
+    Polygon, PolygonSide, SanityError, Side, SnapError, Split, ViewPoint,
 };
-pub use flat::FlatBsp;
-pub use grid::{GRID_BITS, Grid, GridPoint, MAX_COORD, MAX_VIEW_COORD, SnapError, ViewPoint};
-pub use import::{
-    FaceImporter, ImportReport, all_planar, import_faces, import_faces_par, import_indexed_par,
-    snap_positions,
+pub use solid::{
+    ImportReport, SolidBoundary, SurfaceDefect, TopologyError, TriMesh, certify_solid_boundary,
+    check_closed_manifold, import_faces, import_faces_par, import_indexed_par,
 };
-pub use mesh::TriMesh;
-pub use partition::{
-    BOX_HALF, BoolOp, CellOp, Overlay, PLink, PNode, Partition, box_section, merge,
-    merge_smaller_into_larger, solid_build_options,
-};
-pub use plane::{MAX_NORMAL_BITS, MAX_OFFSET_BITS, Plane};
-pub use point::{Implicit, Point, PointRef, rational_to_f64};
-pub use polygon::{
-    ConvexFace, FaceDefect, GridPolygon, Parts, Polygon, PolygonSide, Side, Split, share_points,
-    split_loop,
-};
-pub use sanity::{ConvexParts, SanityError, check_convex};
-pub use topology::{TopologyError, check_closed_manifold};
 pub use tree::{
-    BspTree, BuildOptions, Cell, Link, Membership, Node, NodeId, Order, RECURSION_LIMIT, SplitMix,
-    TreeStats,
+    BoolOp, BspTree, BuildOptions, Cell, CellOp, FlatBsp, Link, Membership, Node, NodeId, Order,
+    Overlay, Partition, RECURSION_LIMIT, TreeStats, merge,
 };
 
-/// Re-export of the wide integer type used for homogeneous coordinates.
-pub use bnum::types::{I256, I512};
+/// The 256-bit integer of implicit points' homogeneous coordinates.
+pub use bnum::types::I256;
 
-/// Errors of this crate.
-#[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum Error {
-    /// An input coordinate could not be snapped to the grid.
-    Snap {
-        /// Index of the face.
-        face: usize,
-        /// Index of the vertex within the face.
-        vertex: usize,
-        /// The offending coordinates.
-        value: [f64; 3],
-        /// Why.
-        reason: SnapError,
-    },
-    /// Grid parameters are unusable.
-    InvalidGrid(&'static str),
-    /// A face names a vertex the mesh does not have.
-    VertexIndex {
-        /// Index of the face.
-        face: usize,
-        /// Position of the index within the face.
-        vertex: usize,
-        /// The index.
-        index: u32,
-    },
+/// What the sibling crates of this workspace (`svbsp`, `bsp-csg`,
+/// `tiling`, the test kit) use of the kernel besides the crate root: the
+/// `f64` filters, wide integers, convex-polygon plumbing and the building
+/// blocks of merging. Everything here is exact and tested, but shaped for
+/// those crates' inner loops; it may change with them, without notice.
+pub mod internals {
+    pub use crate::kernel::{
+        ConvexFace, ConvexParts, GridPolygon, Homogeneous, MAX_NORMAL_BITS, MAX_OFFSET_BITS, Parts,
+        PointRef, approx, check_convex, filter_ring_area, filter_side, filter_side_err,
+        share_points, split_loop,
+    };
+    pub use crate::solid::{FaceImporter, all_planar, snap_positions};
+    pub use crate::tree::{PLink, PNode, SplitMix, box_section, merge_smaller_into_larger};
+    pub use bnum::types::I512;
 }
-
-impl std::fmt::Display for Error {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Error::Snap {
-                face,
-                vertex,
-                value,
-                reason,
-            } => write!(f, "face {face}, vertex {vertex} {value:?}: {reason}"),
-            Error::InvalidGrid(why) => write!(f, "invalid grid: {why}"),
-            Error::VertexIndex {
-                face,
-                vertex,
-                index,
-            } => write!(f, "face {face}, vertex {vertex}: no vertex {index}"),
-        }
-    }
-}
-
-impl std::error::Error for Error {}
 
 /// One step of the xorshift generator (13, 7, 17) the tests draw their
 /// cases from: the new state, which is also the number drawn.

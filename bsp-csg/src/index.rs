@@ -1,7 +1,7 @@
 //! A uniform grid of face boxes: the faces overlapping a box, and the
 //! faces a ray along `+x` may cross.
 
-use bsp_core::{ConvexFace, PointRef};
+use bsp_core::internals::{ConvexFace, PointRef};
 
 /// An integer box: inclusive grid coordinate ranges per axis.
 pub(crate) type IBox = ([i64; 3], [i64; 3]);

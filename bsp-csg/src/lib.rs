@@ -38,7 +38,7 @@
 //! 5. A face none of whose pieces the other surface cuts stays exactly as
 //!    it was, however many cells it spans; only cut faces are replaced by
 //!    pieces ([`Stats`]). An imported face is kept as its grid corners
-//!    ([`bsp_core::GridPolygon`]), and its edge planes are computed only
+//!    ([`bsp_core::internals::GridPolygon`]), and its edge planes are computed only
 //!    when a cell clips it: most faces of a large solid never are, and the
 //!    edge planes were most of a face's memory.
 //!
@@ -93,9 +93,10 @@ mod local;
 mod octree;
 mod winding;
 
+use bsp_core::internals::{ConvexFace, GridPolygon, PointRef, share_points};
 use bsp_core::{
-    BoolOp, ConvexFace, Grid, GridPoint, GridPolygon, ImportReport, Membership, Plane, PointRef,
-    Polygon, Side, TopologyError, TriMesh, check_closed_manifold, share_points,
+    BoolOp, Grid, GridPoint, ImportReport, Membership, Plane, Polygon, Side, TopologyError,
+    TriMesh, check_closed_manifold,
 };
 use glam::DVec3;
 use rayon::prelude::*;
@@ -2612,14 +2613,14 @@ pub fn snap_one(
     let mut faces: Vec<Option<Face>> = Vec::with_capacity(n);
     faces.par_extend((0..n).into_par_iter().map(|_| None));
     // each vertex snapped once, not once per face around it
-    let snapped = bsp_core::snap_positions(grid, mesh.positions);
+    let snapped = bsp_core::internals::snap_positions(grid, mesh.positions);
     type Run = (ImportReport, Vec<Face>, i128);
     let runs: Vec<Result<Run, bsp_core::Error>> = faces
         .par_chunks_mut(CHUNK)
         .zip(mesh.faces.par_chunks(CHUNK))
         .enumerate()
         .map(|(c, (slots, loops))| {
-            let mut imp = bsp_core::FaceImporter::default();
+            let mut imp = bsp_core::internals::FaceImporter::default();
             let (mut extra, mut six) = (Vec::new(), 0i128);
             for (i, (slot, face)) in slots.iter_mut().zip(loops).enumerate() {
                 imp.indexed_snapped(grid, mesh.positions, &snapped, face, c * CHUNK + i, |p| {
@@ -2715,7 +2716,8 @@ fn six_volume(p: &GridPolygon) -> i128 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use bsp_core::{Parts, Plane};
+    use bsp_core::Plane;
+    use bsp_core::internals::Parts;
 
     /// The same points in the same cyclic order.
     fn same_loop(a: &Polygon, b: &Polygon) -> bool {

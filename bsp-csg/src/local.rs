@@ -29,9 +29,9 @@
 //! check fails (the links then find the crossing and fail the operation),
 //! and for the merged cells.
 
+use bsp_core::internals::{ConvexFace, PLink, Parts, merge_smaller_into_larger};
 use bsp_core::{
-    BoolOp, BspTree, BuildOptions, Cell, ConvexFace, Link, PLink, Partition, Parts, Plane, Polygon,
-    PolygonSide, Side, merge_smaller_into_larger,
+    BoolOp, BspTree, BuildOptions, Cell, Link, Partition, Plane, Polygon, PolygonSide, Side,
 };
 
 use crate::CsgError;
@@ -587,7 +587,7 @@ fn walls_crossed<'w>(fb: &IBox, cell: &IBox, w: &'w [Plane; 6]) -> impl Iterator
 }
 
 /// [`clip_in`] for a solid's face: an imported face is clipped from its
-/// grid corners ([`GridPolygon::clipped`](bsp_core::GridPolygon::clipped):
+/// grid corners ([`GridPolygon::clipped`](bsp_core::internals::GridPolygon::clipped):
 /// the same piece, made more cheaply), only when its box meets the cell.
 pub(crate) fn clip_face(face: &crate::Face, cell: &IBox, w: &[Plane; 6]) -> Option<Polygon> {
     let fb = face.bx();
@@ -718,7 +718,7 @@ mod tests {
             // the plane 2z = z2 (half-integer z) through a strip x ∈ [-1, 7]
             let n = [0, 0, 2];
             let support = bsp_core::Plane::new(n, -(z2 as i128)).unwrap();
-            let mut p = bsp_core::box_section(&support).unwrap();
+            let mut p = bsp_core::internals::box_section(&support).unwrap();
             for w in walls(&bx) {
                 assert!(p.clip(&w, Side::Back));
             }

@@ -8,7 +8,8 @@
 //! both operands, more than `leaf_size` faces in all, and can be split.
 //! Faces are sent to every child their box overlaps.
 
-use bsp_core::{ConvexFace, Plane};
+use bsp_core::Plane;
+use bsp_core::internals::ConvexFace;
 use rayon::prelude::*;
 use smallvec::SmallVec;
 

@@ -30,7 +30,8 @@
 //! winding number of a point inside a closed, outward-oriented surface is
 //! 1 and outside 0.
 
-use bsp_core::{ConvexFace, I256, Plane};
+use bsp_core::internals::ConvexFace;
+use bsp_core::{I256, Plane};
 
 /// The sign of the first non-zero value.
 fn first_sign(values: &[i128]) -> i32 {

@@ -963,8 +963,8 @@ mod tests {
         // a third of them exactly on pixel centres or corners) cut into a
         // fan around a random inner point and into a strip of quads: the
         // pieces cover exactly the pixels the polygon covers, each once
-        let mut rng = bsp_core::SplitMix(0x7011_1e57);
-        let coord = |rng: &mut bsp_core::SplitMix| {
+        let mut rng = bsp_core::internals::SplitMix(0x7011_1e57);
+        let coord = |rng: &mut bsp_core::internals::SplitMix| {
             let base = rng.below(24 * 256) as i32;
             match rng.below(3) {
                 0 => base / 256 * 256 + 128,
@@ -1044,7 +1044,7 @@ mod tests {
                 i
             }) as i32
         };
-        let mut rng = bsp_core::SplitMix(0xf1_0a7);
+        let mut rng = bsp_core::internals::SplitMix(0xf1_0a7);
         let mut vals = vec![
             0.0,
             -0.0,
@@ -1085,13 +1085,13 @@ mod tests {
         let mut ortho = cam.view.clone();
         ortho.kind = Kind::Orthographic { scale: 0.01 };
         let ortho = ortho.ready();
-        let mut rng = bsp_core::SplitMix(0xb0_0d5);
+        let mut rng = bsp_core::internals::SplitMix(0xb0_0d5);
         for view in [&cam.view, &ortho] {
             let planes = view.clip_planes();
             let bounds = Bounds::of(view, &planes);
             let mut tested = [0usize; 2];
             for _ in 0..50_000 {
-                let r = |rng: &mut bsp_core::SplitMix| {
+                let r = |rng: &mut bsp_core::internals::SplitMix| {
                     (rng.below(1 << 20) as f64 - (1 << 19) as f64) / 1024.0
                 };
                 let mut c = DVec3::new(r(&mut rng), r(&mut rng), r(&mut rng));
@@ -1226,7 +1226,7 @@ mod tests {
         // random row ranges binned by runs of a few polygons (and by one
         // run) against a direct count: every band lists exactly the
         // polygons reaching it, in polygon order
-        let mut rng = bsp_core::SplitMix(0xb1_25);
+        let mut rng = bsp_core::internals::SplitMix(0xb1_25);
         let height = 100u32;
         let mut s = Screen::new();
         for _ in 0..500 {

@@ -297,7 +297,7 @@ mod tests {
 
     #[test]
     fn shared_vertices_are_the_distinct_points() {
-        let mut rng = bsp_core::SplitMix(0x5_4a7e);
+        let mut rng = bsp_core::internals::SplitMix(0x5_4a7e);
         let pool: Vec<DVec3> = (0..50)
             .map(|_| DVec3::new(rng.below(4) as f64, rng.below(3) as f64 - 1.0, 0.5))
             .chain([DVec3::new(0.0, 0.0, 0.5), DVec3::new(-0.0, 0.0, 0.5)])

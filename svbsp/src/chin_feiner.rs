@@ -24,9 +24,8 @@
 //! path; this one is kept for the paper's pipeline and as an independent
 //! cross-check.
 
-use bsp_core::{
-    BspTree, ConvexParts, Order, Plane, Polygon, SanityError, Side, check_convex, split_loop,
-};
+use bsp_core::internals::{ConvexParts, check_convex, split_loop};
+use bsp_core::{BspTree, Order, Plane, Polygon, SanityError, Side};
 use smallvec::SmallVec;
 
 use crate::light::{Light, LightError, MAX_LIGHTS};

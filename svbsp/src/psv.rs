@@ -42,7 +42,8 @@
 
 use std::borrow::Borrow;
 
-use bsp_core::{GridPoint, Plane, Point, Polygon, SanityError, Side, SplitMix};
+use bsp_core::internals::SplitMix;
+use bsp_core::{GridPoint, Plane, Point, Polygon, SanityError, Side};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 

@@ -11,7 +11,8 @@
 //! `2^509` — inside a signed 512-bit integer.
 
 use bnum::cast::As;
-use bsp_core::{Homogeneous, I256, I512, Plane, Side, approx};
+use bsp_core::internals::{Homogeneous, I512, approx};
+use bsp_core::{I256, Plane, Side};
 
 /// A plane with wide integer coefficients: an input plane, or a shadow
 /// plane through the light.
@@ -154,7 +155,7 @@ impl WidePlane {
 }
 
 /// An exact point of the shadow tier: homogeneous coordinates `(x, y, z,
-/// w)`, `w > 0`, in 512-bit integers ([`bsp_core::Homogeneous`]), and its
+/// w)`, `w > 0`, in 512-bit integers ([`bsp_core::internals::Homogeneous`]), and its
 /// grid coordinates when it is a grid point (classified in at most 256
 /// bits then).
 #[derive(Clone, Debug)]

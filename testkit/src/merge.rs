@@ -108,7 +108,7 @@ impl MergeInput {
             .collect();
         probes.extend(half);
         if self.op == 3 {
-            let o = bsp_core::merge_smaller_into_larger(&pa, &pb, &Overlay);
+            let o = bsp_core::internals::merge_smaller_into_larger(&pa, &pb, &Overlay);
             if let Err(e) = o.sanity_check() {
                 fail(self, format_args!("overlay: {e}"));
             }

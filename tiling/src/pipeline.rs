@@ -35,9 +35,9 @@
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
+use bsp_core::internals::merge_smaller_into_larger;
 use bsp_core::{
     BspTree, BuildOptions, Grid, GridPoint, Overlay, Partition, Point, Polygon, import_faces_par,
-    merge_smaller_into_larger,
 };
 use glam::{DMat4, DVec3};
 use rayon::prelude::*;

@@ -16,9 +16,10 @@
 
 use std::path::Path;
 
+use bsp_core::internals::{PLink, merge_smaller_into_larger};
 use bsp_core::{
-    BoolOp, Cell, Grid, GridPoint, MAX_COORD, Membership, Overlay, PLink, Partition, Plane, Point,
-    Polygon, Side, TriMesh, check_closed_manifold, import_faces, merge_smaller_into_larger,
+    BoolOp, Cell, Grid, GridPoint, MAX_COORD, Membership, Overlay, Partition, Plane, Point,
+    Polygon, Side, TriMesh, check_closed_manifold, import_faces,
 };
 use glam::DVec3;
 use proptest::collection::vec;

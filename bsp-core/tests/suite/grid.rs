@@ -2,7 +2,8 @@
 //! every scale and position, checked against exact rationals; and faces
 //! whose vertices are a few ulps off a plane, through `import_faces`.
 
-use bsp_core::{FaceDefect, Grid, GridPoint, MAX_COORD, all_planar, import_faces};
+use bsp_core::internals::all_planar;
+use bsp_core::{FaceDefect, Grid, GridPoint, MAX_COORD, import_faces};
 use glam::DVec3;
 use num_rational::BigRational;
 use num_traits::{One, Signed, Zero};

@@ -5,7 +5,8 @@
 
 use std::collections::HashMap;
 
-use bsp_core::{FaceDefect, Grid, GridPoint, Polygon, all_planar, import_faces};
+use bsp_core::internals::all_planar;
+use bsp_core::{FaceDefect, Grid, GridPoint, Polygon, import_faces};
 use glam::DVec3;
 use proptest::collection::vec;
 use proptest::prelude::*;

@@ -6,8 +6,9 @@
 use std::collections::HashMap;
 use std::path::Path;
 
+use bsp_core::internals::all_planar;
 use bsp_core::{
-    BspTree, BuildOptions, Grid, GridPoint, ImportReport, Point, Polygon, all_planar, import_faces,
+    BspTree, BuildOptions, Grid, GridPoint, ImportReport, Point, Polygon, import_faces,
 };
 use glam::DVec3;
 use num_traits::Zero;

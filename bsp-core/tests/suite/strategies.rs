@@ -3,9 +3,8 @@
 //! edge-sharing polygons, repeated and collinear vertices, nearly parallel
 //! planes, coordinates at the grid limits, far-away viewpoints.
 
-use bsp_core::{
-    BuildOptions, GridPoint, MAX_COORD, MAX_NORMAL_BITS, MAX_OFFSET_BITS, MAX_VIEW_COORD, Plane,
-};
+use bsp_core::internals::{MAX_NORMAL_BITS, MAX_OFFSET_BITS};
+use bsp_core::{BuildOptions, GridPoint, MAX_COORD, MAX_VIEW_COORD, Plane};
 use proptest::collection::vec;
 use proptest::prelude::*;
 

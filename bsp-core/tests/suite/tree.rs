@@ -4,9 +4,10 @@
 
 use std::collections::HashMap;
 
+use bsp_core::internals::merge_smaller_into_larger;
 use bsp_core::{
     BspTree, BuildOptions, FlatBsp, GridPoint, MAX_COORD, Membership, Order, Overlay, Partition,
-    Plane, Point, Polygon, RECURSION_LIMIT, Side, ViewPoint, merge_smaller_into_larger,
+    Plane, Point, Polygon, RECURSION_LIMIT, Side, ViewPoint,
 };
 use num_traits::One;
 use proptest::collection::vec;

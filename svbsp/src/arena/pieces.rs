@@ -17,10 +17,12 @@ use std::cmp::Ordering;
 
 use smallvec::SmallVec;
 
+use bsp_core::internals::{filter_side_err, split_loop};
+use bsp_core::{GridPoint, I256, Implicit, Plane, Point, Polygon, Side};
 #[cfg(test)]
-use bsp_core::{ConvexParts, SanityError, check_convex};
-use bsp_core::{
-    GridPoint, I256, Implicit, Plane, Point, Polygon, Side, filter_side_err, split_loop,
+use {
+    bsp_core::SanityError,
+    bsp_core::internals::{ConvexParts, check_convex},
 };
 
 /// A vertex stored inline in a [`PieceArena`].
@@ -143,7 +145,7 @@ pub(crate) struct Piece {
 /// bytes), and *lazy* points made here by splits ([`Lazy`], 80 bytes): the
 /// indices of their three planes in the arena and `f64` approximations of
 /// their homogeneous coordinates with certified error bounds. A lazy point
-/// is classified by the filter ([`bsp_core::filter_side_err`]) and computes
+/// is classified by the filter ([`bsp_core::internals::filter_side_err`]) and computes
 /// its exact coordinates only when the filter cannot decide, or for
 /// output. A vertex id is an index into one of the three lists, tagged in
 /// its top two bits; [`PieceArena::dense`] maps ids to `0..len()` for

@@ -22,7 +22,8 @@ use num_rational::BigRational;
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
-use bsp_core::{I256, Plane, filter_ring_area};
+use bsp_core::internals::filter_ring_area;
+use bsp_core::{I256, Plane};
 
 use super::pieces::{EdgeRef, Piece, PieceArena, Vertex};
 
@@ -907,7 +908,7 @@ fn cmp_clockwise(r: [i128; 2], a: [i128; 2], b: [i128; 2], sigma: i32) -> Orderi
 
 /// The sign of a loop's signed area in `(u, v)` coordinates: the `f64`
 /// shoelace sum when the kernel's filter certifies it
-/// ([`bsp_core::filter_ring_area`]: the points' coordinates are
+/// ([`bsp_core::internals::filter_ring_area`]: the points' coordinates are
 /// correctly rounded), else exact rationals.
 fn signed_area_sign(points: &Points<'_>, l: &[u32], u: usize, v: usize) -> i32 {
     let m = l.len();

@@ -22,7 +22,8 @@
 
 use std::collections::HashMap;
 
-use bsp_core::{I256, I512, Polygon};
+use bsp_core::internals::I512;
+use bsp_core::{I256, Polygon};
 use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::{One, Signed, ToPrimitive, Zero};

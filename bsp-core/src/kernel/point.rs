@@ -3,12 +3,12 @@
 use std::sync::Arc;
 
 use bnum::cast::As;
-use bnum::types::{I256, I512};
+use bnum::types::I256;
 
-use crate::Side;
-use crate::exact::Homogeneous;
-use crate::grid::GridPoint;
-use crate::plane::{Plane, cross_wide};
+use crate::kernel::Side;
+use crate::kernel::exact::{Homogeneous, Wide};
+use crate::kernel::grid::GridPoint;
+use crate::kernel::plane::{Plane, cross_wide};
 
 /// An exact point: either an input grid point or the intersection of three
 /// planes of the input budget, held in homogeneous integer coordinates.
@@ -33,103 +33,6 @@ pub type Implicit = Homogeneous<4>;
 
 fn wide(x: i128) -> I256 {
     I256::from(x)
-}
-
-/// A 256-bit two's complement integer in two `u128` halves, for sums of
-/// products of `i128`s: the products and sums run on native 128-bit
-/// operations (four 64 × 64-bit products each) instead of the general
-/// 256-bit arithmetic. Sums wrap modulo `2^256`, so a sum whose true
-/// value has fewer than 256 bits is exact whatever the order.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(crate) struct Wide {
-    lo: u128,
-    hi: u128,
-}
-
-impl Wide {
-    pub(crate) const ZERO: Wide = Wide { lo: 0, hi: 0 };
-
-    /// `a · b`, exactly (`|a|, |b| ≤ 2^127`: the magnitude is below
-    /// `2^254`).
-    #[inline]
-    pub(crate) fn product(a: i128, b: i128) -> Wide {
-        const M: u128 = u64::MAX as u128;
-        let (ua, ub) = (a.unsigned_abs(), b.unsigned_abs());
-        let (a0, a1) = (ua & M, ua >> 64);
-        let (b0, b1) = (ub & M, ub >> 64);
-        let (p00, p01, p10, p11) = (a0 * b0, a0 * b1, a1 * b0, a1 * b1);
-        // the middle products' sum has up to 129 bits: its carry is 2^192
-        let (mid, c_mid) = p01.overflowing_add(p10);
-        let (lo, c_lo) = p00.overflowing_add(mid << 64);
-        let hi = p11
-            .wrapping_add(mid >> 64)
-            .wrapping_add((c_mid as u128) << 64)
-            .wrapping_add(c_lo as u128);
-        let u = Wide { lo, hi };
-        if (a < 0) != (b < 0) { u.neg() } else { u }
-    }
-
-    /// `self + o` (modulo `2^256`).
-    #[inline]
-    pub(crate) fn add(self, o: Wide) -> Wide {
-        let (lo, c) = self.lo.overflowing_add(o.lo);
-        Wide {
-            lo,
-            hi: self.hi.wrapping_add(o.hi).wrapping_add(c as u128),
-        }
-    }
-
-    /// `-self` (modulo `2^256`).
-    #[inline]
-    pub(crate) fn neg(self) -> Wide {
-        let (lo, c) = (!self.lo).overflowing_add(1);
-        Wide {
-            lo,
-            hi: (!self.hi).wrapping_add(c as u128),
-        }
-    }
-
-    #[inline]
-    pub(crate) fn is_zero(self) -> bool {
-        self.lo == 0 && self.hi == 0
-    }
-
-    #[inline]
-    pub(crate) fn is_negative(self) -> bool {
-        (self.hi as i128) < 0
-    }
-
-    /// [`crate::exact::approx`] of the same value, from the halves.
-    #[inline]
-    pub(crate) fn approx(self) -> f64 {
-        use crate::exact::pow2;
-        let neg = self.is_negative();
-        let u = if neg { self.neg() } else { self };
-        let d = [
-            u.lo as u64,
-            (u.lo >> 64) as u64,
-            u.hi as u64,
-            (u.hi >> 64) as u64,
-        ];
-        let v = match d.iter().rposition(|&x| x != 0) {
-            None => return 0.0,
-            Some(0) => d[0] as f64,
-            Some(i) => (d[i] as f64 * pow2(64) + d[i - 1] as f64) * pow2(64 * (i as i32 - 1)),
-        };
-        if neg { -v } else { v }
-    }
-
-    /// The same value as a [`I256`].
-    #[inline]
-    pub(crate) fn to_i256(self) -> I256 {
-        let digits = [
-            self.lo as u64,
-            (self.lo >> 64) as u64,
-            self.hi as u64,
-            (self.hi >> 64) as u64,
-        ];
-        I256::from_bits(bnum::types::U256::from_digits(digits))
-    }
 }
 
 /// [`Implicit::from_planes`]'s coordinates `(x, y, z, w)` (`w ≥ 0`;
@@ -209,7 +112,7 @@ impl Homogeneous<4> {
             Some(h) if h[3] == 0 => None,
             Some(h) => Some(Homogeneous::with_approx(
                 h.map(I256::from),
-                h.map(crate::exact::approx_i128),
+                h.map(crate::kernel::exact::approx_i128),
             )),
             None => from_planes_wide(n1, c, d),
         }
@@ -238,7 +141,7 @@ impl Homogeneous<4> {
                 sq * p[k] as i128 - sp * q[k] as i128
             }
         });
-        Homogeneous::with_approx(h.map(I256::from), h.map(crate::exact::approx_i128))
+        Homogeneous::with_approx(h.map(I256::from), h.map(crate::kernel::exact::approx_i128))
     }
 
     /// The homogeneous coordinates `(x, y, z, w)` with `w > 0`.
@@ -289,7 +192,7 @@ impl Homogeneous<4> {
 }
 
 /// A point read where it is stored: a grid point by value, an implicit
-/// one by reference (see [`ConvexFace::corner`](crate::ConvexFace)).
+/// one by reference (see [`ConvexFace::corner`](crate::internals::ConvexFace)).
 #[derive(Clone, Copy, Debug)]
 pub enum PointRef<'a> {
     /// An input vertex on the grid.
@@ -331,7 +234,7 @@ impl PointRef<'_> {
             PointRef::Implicit(i) => {
                 let c = i.as_integer()?;
                 c.iter()
-                    .all(|v| v.abs() <= crate::MAX_COORD as i64)
+                    .all(|v| v.abs() <= crate::kernel::MAX_COORD as i64)
                     .then(|| c.map(|v| v as i32))
             }
         }
@@ -417,7 +320,7 @@ impl Point {
     /// ([`Point::to_f64`]) would be canonical, but cost an exact division
     /// per coordinate.
     pub fn approx_key(&self) -> u64 {
-        crate::polygon::approx_key(self.approx_f64())
+        approx_key(self.approx_f64())
     }
 
     /// Grid coordinates as `f64`, each the correctly rounded value of the
@@ -448,7 +351,7 @@ impl Point {
 }
 
 /// Whether the grid point `g` is the implicit point `i`, exactly.
-pub(crate) fn grid_is(g: &crate::GridPoint, i: &Implicit) -> bool {
+pub(crate) fn grid_is(g: &crate::kernel::GridPoint, i: &Implicit) -> bool {
     let h = i.coords();
     (0..3).all(|k| h[k] == wide(g[k] as i128) * h[3])
 }
@@ -456,25 +359,21 @@ pub(crate) fn grid_is(g: &crate::GridPoint, i: &Implicit) -> bool {
 /// The `f64` nearest to `num / den` (ties to even), `den > 0`.
 #[cfg(test)]
 fn ratio_to_f64(num: I256, den: I256) -> f64 {
-    crate::exact::ratio_to_f64_exact::<4, 9>(&num, &den)
+    crate::kernel::exact::ratio_to_f64_exact::<4, 9>(&num, &den)
 }
 
-/// The `f64` nearest to the rational `num / den` (round to nearest, ties
-/// to even), by long division. Requires `den > 0`; equal rationals give
-/// equal `f64`s however they are written.
-///
-/// ```
-/// use bsp_core::rational_to_f64;
-/// use bsp_core::I512;
-/// assert_eq!(rational_to_f64(I512::from(1i32), I512::from(3i32)), 1.0 / 3.0);
-/// assert_eq!(rational_to_f64(I512::from(-4i32), I512::from(2i32)), -2.0);
-/// ```
-pub fn rational_to_f64(num: I512, den: I512) -> f64 {
-    assert!(
-        den.is_positive(),
-        "rational_to_f64: the denominator must be positive"
-    );
-    crate::exact::ratio_to_f64_exact::<8, 9>(&num, &den)
+/// A hash of approximate coordinates, each mantissa rounded to its top 36
+/// bits (see [`Point::approx_key`]).
+pub(crate) fn approx_key(a: [f64; 3]) -> u64 {
+    hash_bits(a.map(|c| ((c + 0.0).to_bits() + 0x8000) & !0xffff))
+}
+
+/// A hash of three coordinates' bits.
+pub(crate) fn hash_bits(bits: [u64; 3]) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = rustc_hash::FxHasher::default();
+    bits.hash(&mut h);
+    h.finish()
 }
 
 #[cfg(test)]
@@ -537,7 +436,7 @@ mod tests {
             proptest::prop_assert_eq!(fast.to_i256(), slow);
             proptest::prop_assert_eq!(fast.is_negative(), slow.is_negative());
             proptest::prop_assert_eq!(fast.is_zero(), slow.is_zero());
-            proptest::prop_assert_eq!(fast.approx(), crate::exact::approx(&slow));
+            proptest::prop_assert_eq!(fast.approx(), crate::kernel::exact::approx(&slow));
         }
 
         /// Comparing coordinates by sign and 512-bit magnitudes agrees with
@@ -582,7 +481,7 @@ mod tests {
         /// `w > 0`, and the `f64` approximations the filter expects.
         #[test]
         fn a_segment_crosses_a_plane_where_the_planes_meet(
-            g in proptest::collection::vec(-crate::MAX_COORD..=crate::MAX_COORD, 18),
+            g in proptest::collection::vec(-crate::kernel::MAX_COORD..=crate::kernel::MAX_COORD, 18),
         ) {
             let pt = |k: usize| [g[3 * k], g[3 * k + 1], g[3 * k + 2]];
             let (p, q, r) = (pt(0), pt(1), pt(2));
@@ -603,7 +502,7 @@ mod tests {
             for c in 0..4 {
                 proptest::prop_assert_eq!(
                     direct.approx()[c],
-                    crate::exact::approx(&direct.coords()[c])
+                    crate::kernel::exact::approx(&direct.coords()[c])
                 );
             }
             let (a, b) = (Point::Grid(p), Point::Grid(q));

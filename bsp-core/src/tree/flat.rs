@@ -7,10 +7,10 @@
 //! node count, and traversal is a loop over a small explicit stack of
 //! `u32`s, without recursion.
 
-use crate::Side;
-use crate::grid::ViewPoint;
-use crate::plane::Plane;
-use crate::polygon::Polygon;
+use crate::kernel::Side;
+use crate::kernel::grid::ViewPoint;
+use crate::kernel::plane::Plane;
+use crate::kernel::polygon::Polygon;
 use crate::tree::{BspTree, Cell, Link, Order};
 
 const IN: u32 = u32::MAX;

@@ -1,7 +1,7 @@
 //! Planes with integer coefficients.
 
-use crate::Side;
-use crate::grid::{GridPoint, ViewPoint};
+use crate::kernel::Side;
+use crate::kernel::grid::{GridPoint, ViewPoint};
 
 /// Why an input face could not become one convex polygon.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -15,7 +15,7 @@ pub enum FaceDefect {
     /// Planar but not convex (or not simple).
     NonConvex,
     /// A coordinate beyond `±MAX_COORD`, the range the exact arithmetic
-    /// is proved for (snap input with a [`Grid`](crate::Grid) first).
+    /// is proved for (snap input with a [`Grid`](crate::kernel::Grid) first).
     OutOfRange,
 }
 
@@ -176,7 +176,7 @@ impl Plane {
     /// counter-clockwise seen from the front (right-hand normal).
     /// [`FaceDefect::ZeroArea`] if they are collinear,
     /// [`FaceDefect::OutOfRange`] if a coordinate exceeds
-    /// [`MAX_COORD`](crate::MAX_COORD) (the arithmetic's budget: beyond
+    /// [`MAX_COORD`](crate::kernel::MAX_COORD) (the arithmetic's budget: beyond
     /// it the normal could overflow).
     ///
     /// ```
@@ -195,7 +195,7 @@ impl Plane {
     }
 
     /// [`Plane::through`] for points the caller knows to be within
-    /// [`MAX_COORD`](crate::MAX_COORD); `None` if they are collinear.
+    /// [`MAX_COORD`](crate::kernel::MAX_COORD); `None` if they are collinear.
     pub(crate) fn through_in_range(a: GridPoint, b: GridPoint, c: GridPoint) -> Option<Plane> {
         debug_assert!(in_range(&[a, b, c]), "{a:?} {b:?} {c:?}");
         let u = sub(b, a);
@@ -228,7 +228,7 @@ impl Plane {
 
     /// `n1 · (n2 × n3)` of the three planes' normals, exactly: zero when
     /// they do not meet in one point.
-    pub fn normals_det(p1: &Plane, p2: &Plane, p3: &Plane) -> crate::I256 {
+    pub fn normals_det(p1: &Plane, p2: &Plane, p3: &Plane) -> bnum::types::I256 {
         let (n1, n2, n3) = (p1.normal(), p2.normal(), p3.normal());
         let m = |x: i64, y: i64| x as i128 * y as i128;
         let c = [
@@ -236,7 +236,7 @@ impl Plane {
             m(n2[2], n3[0]) - m(n2[0], n3[2]),
             m(n2[0], n3[1]) - m(n2[1], n3[0]),
         ];
-        use crate::point::Wide;
+        use crate::kernel::exact::Wide;
         (0..3)
             .fold(Wide::ZERO, |s, i| s.add(Wide::product(n1[i] as i128, c[i])))
             .to_i256()
@@ -329,7 +329,7 @@ pub(crate) fn sub(a: GridPoint, b: GridPoint) -> [i64; 3] {
 /// Cross product of grid differences (`|u_i|, |v_i| < 2^27`): `< 2^55`.
 /// `true` if every coordinate is within `±MAX_COORD`.
 pub(crate) fn in_range(points: &[GridPoint]) -> bool {
-    let m = crate::MAX_COORD;
+    let m = crate::kernel::MAX_COORD;
     points.iter().flatten().all(|c| (-m..=m).contains(c))
 }
 
@@ -359,7 +359,7 @@ fn dot_wide(n: [i64; 3], p: GridPoint) -> i128 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::MAX_COORD;
+    use crate::kernel::MAX_COORD;
 
     /// Near `2^31` the normal's cross product overflows `i64` (a panic in
     /// the test build, a wrong plane in a release build): points beyond
@@ -383,11 +383,14 @@ mod tests {
             vec![[0, 0, 0], big, [1, 1, 1]],
         ] {
             assert_eq!(
-                crate::Polygon::from_grid_points(&poly, 0).unwrap_err(),
+                crate::kernel::Polygon::from_grid_points(&poly, 0).unwrap_err(),
                 FaceDefect::OutOfRange
             );
         }
-        assert!(crate::Polygon::from_grid_points(&[[-m, -m, 0], [m, -m, 0], [m, m, 0]], 0).is_ok());
+        assert!(
+            crate::kernel::Polygon::from_grid_points(&[[-m, -m, 0], [m, -m, 0], [m, m, 0]], 0)
+                .is_ok()
+        );
     }
 
     #[test]

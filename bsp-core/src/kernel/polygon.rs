@@ -2,35 +2,13 @@
 
 use smallvec::SmallVec;
 
-use crate::grid::GridPoint;
-pub use crate::plane::FaceDefect;
-use crate::plane::{Plane, cross, in_range, sub};
+use crate::kernel::grid::GridPoint;
+use crate::kernel::plane::FaceDefect;
+use crate::kernel::plane::{Plane, cross, in_range, sub};
 use std::sync::Arc;
 
-use crate::point::{Implicit, Point, PointRef};
-use crate::sanity::{ConvexParts, SanityError, check_convex};
-
-/// Exact side of a point relative to a plane.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Side {
-    /// `n · p + d > 0`.
-    Front,
-    /// `n · p + d < 0`.
-    Back,
-    /// `n · p + d = 0`.
-    On,
-}
-
-impl Side {
-    #[inline]
-    pub(crate) fn from_sign(s: i32) -> Side {
-        match s {
-            1 => Side::Front,
-            -1 => Side::Back,
-            _ => Side::On,
-        }
-    }
-}
+use crate::kernel::convex::{ConvexParts, SanityError, check_convex};
+use crate::kernel::point::{Implicit, Point, PointRef, approx_key};
 
 /// Exact position of a polygon relative to a plane.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -163,7 +141,10 @@ pub(crate) fn support_plane(v: &[GridPoint]) -> Result<Plane, FaceDefect> {
     }
     let plane = plane.ok_or(FaceDefect::ZeroArea)?;
     // the plane through three points holds them exactly
-    if k > 3 && v.iter().any(|p| plane.classify_grid(*p) != crate::Side::On) {
+    if k > 3
+        && v.iter()
+            .any(|p| plane.classify_grid(*p) != crate::kernel::Side::On)
+    {
         return Err(FaceDefect::NonPlanar);
     }
     // orientation: twice the projected signed area along the dominant axis
@@ -245,7 +226,7 @@ impl GridPolygon {
             (0..k).all(|i| {
                 let e = g.edge_plane(i);
                 g.verts.iter().enumerate().all(|(j, p)| {
-                    j == i || j == (i + 1) % k || e.classify_grid(*p) == crate::Side::Back
+                    j == i || j == (i + 1) % k || e.classify_grid(*p) == crate::kernel::Side::Back
                 })
             })
         };
@@ -309,7 +290,7 @@ impl GridPolygon {
         planes: impl IntoIterator<Item = &'a Plane>,
         tag: u32,
     ) -> Option<Polygon> {
-        use crate::Side::{Back, Front, On};
+        use crate::kernel::Side::{Back, Front, On};
         /// An edge of the polygon being clipped: part of input edge `i`,
         /// or a piece of a cutting plane.
         #[derive(Clone, Copy)]
@@ -323,7 +304,7 @@ impl GridPolygon {
             .map(|i| (Point::Grid(self.verts[i]), Edge::Input(i as u8)))
             .collect();
         let mut next = Loop::new();
-        let mut sides: SmallVec<[crate::Side; 8]> = SmallVec::new();
+        let mut sides: SmallVec<[crate::kernel::Side; 8]> = SmallVec::new();
         for plane in planes {
             if self.support == *plane || self.support == plane.flip() {
                 return None;
@@ -470,7 +451,7 @@ impl Polygon {
     ///
     /// Repeated and collinear vertices are removed first; the rest must be
     /// planar and strictly convex, with every coordinate within
-    /// `±`[`MAX_COORD`](crate::MAX_COORD) ([`FaceDefect::OutOfRange`]).
+    /// `±`[`MAX_COORD`](crate::kernel::MAX_COORD) ([`FaceDefect::OutOfRange`]).
     ///
     /// ```
     /// use bsp_core::{Polygon, FaceDefect};
@@ -572,9 +553,9 @@ impl Polygon {
         let (mut front, mut back) = (false, false);
         for v in &self.verts {
             match v.classify(plane) {
-                crate::Side::Front => front = true,
-                crate::Side::Back => back = true,
-                crate::Side::On => {}
+                crate::kernel::Side::Front => front = true,
+                crate::kernel::Side::Back => back = true,
+                crate::kernel::Side::On => {}
             }
             if front && back {
                 return PolygonSide::Spanning;
@@ -636,10 +617,10 @@ impl Polygon {
         if let Some(c) = self.coplanar_with(plane) {
             return Parts::Whole(c);
         }
-        let sides: SmallVec<[crate::Side; 8]> =
+        let sides: SmallVec<[crate::kernel::Side; 8]> =
             self.verts.iter().map(|v| v.classify(plane)).collect();
-        let front = sides.contains(&crate::Side::Front);
-        let back = sides.contains(&crate::Side::Back);
+        let front = sides.contains(&crate::kernel::Side::Front);
+        let back = sides.contains(&crate::kernel::Side::Back);
         if front && back {
             let (front, back) = self.split_with_sides(plane, &sides);
             return Parts::Split { front, back };
@@ -652,13 +633,13 @@ impl Polygon {
     /// polygon is then unchanged and should be dropped). Cheaper than
     /// [`Polygon::split`] when one piece is not wanted: nothing is moved
     /// unless the polygon spans the plane, and only the kept piece is built.
-    pub fn clip(&mut self, plane: &Plane, keep: crate::Side) -> bool {
-        use crate::Side::{Back, Front, On};
+    pub fn clip(&mut self, plane: &Plane, keep: crate::kernel::Side) -> bool {
+        use crate::kernel::Side::{Back, Front, On};
         debug_assert!(keep != On, "keep the front or the back");
         if self.coplanar_with(plane).is_some() {
             return false;
         }
-        let sides: SmallVec<[crate::Side; 8]> =
+        let sides: SmallVec<[crate::kernel::Side; 8]> =
             self.verts.iter().map(|v| v.classify(plane)).collect();
         let away = if keep == Front { Back } else { Front };
         let has_keep = sides.contains(&keep);
@@ -706,7 +687,7 @@ impl Polygon {
         )
     }
 
-    fn split_with_sides(&self, plane: &Plane, sides: &[crate::Side]) -> (Polygon, Polygon) {
+    fn split_with_sides(&self, plane: &Plane, sides: &[crate::kernel::Side]) -> (Polygon, Polygon) {
         let mut f = Builder::new(self.support, self.tag);
         let mut b = Builder::new(self.support, self.tag);
         split_loop(
@@ -763,7 +744,7 @@ impl Polygon {
     /// [`Polygon::merge`] along this polygon's edge `i` (`u → v`) and
     /// `other`'s edge `j` (`v → u`).
     fn merge_at(&self, other: &Polygon, i: usize, j: usize) -> Option<Polygon> {
-        use crate::Side::{Front, On};
+        use crate::kernel::Side::{Front, On};
         let (n, m) = (self.verts.len(), other.verts.len());
         // at u: this polygon's edge into u, against other's vertex after u
         let at_u = other.verts[(j + 2) % m].classify(&self.edges[(i + n - 1) % n]);
@@ -807,10 +788,10 @@ impl ConvexParts for Polygon {
     fn edge_count(&self) -> usize {
         self.edges.len()
     }
-    fn support_side(&self, i: usize) -> crate::Side {
+    fn support_side(&self, i: usize) -> crate::kernel::Side {
         self.verts[i].classify(&self.support)
     }
-    fn edge_side(&self, i: usize, j: usize) -> crate::Side {
+    fn edge_side(&self, i: usize, j: usize) -> crate::kernel::Side {
         self.verts[i].classify(&self.edges[j])
     }
     fn edge_is_support(&self, j: usize) -> bool {
@@ -835,14 +816,14 @@ impl ConvexParts for Polygon {
 pub fn split_loop<V: Clone, E: Clone>(
     verts: &[V],
     edges: &[E],
-    sides: &[crate::Side],
+    sides: &[crate::kernel::Side],
     cut_front: E,
     cut_back: E,
     mut crossing: impl FnMut(usize) -> V,
     mut front: impl FnMut(V, E),
     mut back: impl FnMut(V, E),
 ) {
-    use crate::Side::{Back, Front, On};
+    use crate::kernel::Side::{Back, Front, On};
     let k = verts.len();
     for i in 0..k {
         let j = if i + 1 == k { 0 } else { i + 1 };
@@ -996,20 +977,6 @@ fn point_key(i: &Implicit) -> u64 {
     approx_key(i.approx_f64())
 }
 
-/// A hash of approximate coordinates, each mantissa rounded to its top 36
-/// bits (see [`Point::approx_key`]).
-pub(crate) fn approx_key(a: [f64; 3]) -> u64 {
-    hash_bits(a.map(|c| ((c + 0.0).to_bits() + 0x8000) & !0xffff))
-}
-
-/// A hash of three coordinates' bits.
-pub(crate) fn hash_bits(bits: [u64; 3]) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut h = rustc_hash::FxHasher::default();
-    bits.hash(&mut h);
-    h.finish()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1089,7 +1056,7 @@ mod tests {
             let mut reference = Some(g.to_polygon(7));
             for plane in &planes {
                 if let Some(p) = &mut reference
-                    && !p.clip(plane, crate::Side::Back)
+                    && !p.clip(plane, crate::kernel::Side::Back)
                 {
                     reference = None;
                 }
@@ -1253,7 +1220,7 @@ mod tests {
             assert!(p.vertices().iter().zip(o).all(|(v, w)| v.same_point(w)));
         }
     }
-    use crate::Side;
+    use crate::kernel::Side;
 
     fn square() -> Polygon {
         Polygon::from_grid_points(&[[0, 0, 0], [4, 0, 0], [4, 4, 0], [0, 4, 0]], 1).unwrap()

@@ -17,10 +17,10 @@ use num_rational::BigRational;
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
-use crate::Side;
-use crate::plane::{Plane, cross_wide};
-use crate::point::{Point, PointRef};
-use crate::polygon::{ConvexFace, Polygon};
+use crate::kernel::Side;
+use crate::kernel::plane::{Plane, cross_wide};
+use crate::kernel::point::{Point, PointRef};
+use crate::kernel::polygon::{ConvexFace, Polygon};
 
 /// A triangle mesh over exact, welded vertices.
 #[derive(Clone, Debug, Default)]
@@ -34,7 +34,7 @@ pub struct TriMesh {
 }
 
 /// An exact conversion of a wide integer.
-pub(crate) fn to_bigint(x: &crate::I256) -> BigInt {
+pub(crate) fn to_bigint(x: &bnum::types::I256) -> BigInt {
     let neg = x.is_negative();
     let mag = x.unsigned_abs();
     let mut bytes = Vec::with_capacity(32);
@@ -49,10 +49,10 @@ pub(crate) fn to_bigint(x: &crate::I256) -> BigInt {
 /// points get equal keys; unequal points rarely do (the welder compares
 /// them exactly).
 fn key(p: PointRef<'_>) -> u64 {
-    crate::polygon::hash_bits(p.to_f64().map(|c| (c + 0.0).to_bits()))
+    crate::kernel::point::hash_bits(p.to_f64().map(|c| (c + 0.0).to_bits()))
 }
 
-fn cross3(a: &[crate::I256; 3], b: &[crate::I256; 3]) -> [crate::I256; 3] {
+fn cross3(a: &[bnum::types::I256; 3], b: &[bnum::types::I256; 3]) -> [bnum::types::I256; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -69,7 +69,7 @@ fn cmp_axis(p: &Point, q: &Point, k: usize) -> Ordering {
         return a[k].cmp(&b[k]);
     }
     let (a, b) = (p.homogeneous(), q.homogeneous());
-    let big = |x: crate::I256| x.as_::<I512>();
+    let big = |x: bnum::types::I256| x.as_::<I512>();
     // a_k / a_w vs b_k / b_w with positive w
     (big(a[k]) * big(b[3])).cmp(&(big(b[k]) * big(a[3])))
 }
@@ -87,8 +87,8 @@ fn weld<P: ConvexFace + Sync>(polys: &[P], start: &[usize]) -> (Vec<Point>, Vec<
     /// implicit one by reference (no polygon is read again).
     #[derive(Clone, Copy)]
     enum Pt<'a> {
-        G(crate::GridPoint),
-        I(&'a Arc<crate::point::Implicit>),
+        G(crate::kernel::GridPoint),
+        I(&'a Arc<crate::kernel::point::Implicit>),
     }
     impl Default for Pt<'_> {
         fn default() -> Self {
@@ -98,14 +98,14 @@ fn weld<P: ConvexFace + Sync>(polys: &[P], start: &[usize]) -> (Vec<Point>, Vec<
     let same = |a: Pt<'_>, b: Pt<'_>| match (a, b) {
         (Pt::G(x), Pt::G(y)) => x == y,
         (Pt::I(x), Pt::I(y)) => x.same_point(y),
-        (Pt::G(g), Pt::I(i)) | (Pt::I(i), Pt::G(g)) => crate::point::grid_is(&g, i),
+        (Pt::G(g), Pt::I(i)) | (Pt::I(i), Pt::G(g)) => crate::kernel::point::grid_is(&g, i),
     };
     const SHARDS: usize = 16;
     let shard = |k: u64| (k >> 60) as usize % SHARDS;
     // the corners by shard, in order, with their points, in parallel (a
     // key is computed where it is needed: cheaper than lists of them, at
     // the peak of a large mesh's memory)
-    let (at, items) = crate::topology::bucket_par_corners(
+    let (at, items) = crate::solid::topology::bucket_par_corners(
         SHARDS,
         polys,
         start,
@@ -370,7 +370,9 @@ impl TriMesh {
     /// connected through paired edges. The copies are the same exact point.
     /// `true` if the mesh was a closed 2-manifold already (nothing done).
     fn split_non_manifold(&mut self) -> bool {
-        if crate::topology::check_closed_manifold(self.triangles.iter().map(|t| &t[..])).is_ok() {
+        if crate::solid::topology::check_closed_manifold(self.triangles.iter().map(|t| &t[..]))
+            .is_ok()
+        {
             return true; // the common case
         }
         let original = self.triangles.clone();
@@ -594,7 +596,7 @@ impl TriMesh {
             .all(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
         if distinct {
             // every edge used once each way
-            if crate::topology::corners_close(&self.triangles, false) {
+            if crate::solid::topology::corners_close(&self.triangles, false) {
                 return Ok(());
             }
         }
@@ -797,11 +799,12 @@ fn twinned_edges(corners: &[u32], start: &[usize]) -> Vec<bool> {
     }
     // each edge under its lower end: (upper end, place << 1 | direction)
     let n = corners.par_iter().max().map_or(0, |&v| v as usize + 1);
-    let (at, edges) = crate::topology::bucket(n, |emit| {
+    let (at, edges) = crate::solid::topology::bucket(n, |emit| {
         for p in 0..start.len() - 1 {
             let cs = &corners[start[p]..start[p + 1]];
             for i in 0..cs.len() {
-                let (lo, hi, dir) = crate::topology::undirected(cs[i], cs[(i + 1) % cs.len()]);
+                let (lo, hi, dir) =
+                    crate::solid::topology::undirected(cs[i], cs[(i + 1) % cs.len()]);
                 emit(lo as usize, (hi, ((start[p] + i) as u32) << 1 | dir));
             }
         }
@@ -1018,6 +1021,13 @@ fn clip_ears(
     }
 }
 
+impl crate::tree::Partition<crate::tree::Cell> {
+    /// The boundary as a watertight triangle mesh (see [`TriMesh`]).
+    pub fn to_mesh(&self) -> TriMesh {
+        TriMesh::from_polygons(&self.boundary())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1040,10 +1050,12 @@ mod tests {
                 let cut = Plane::new([1, 0, 0], -(x as i128 + 1)).unwrap();
                 let half = Plane::new([0, 2, 0], -(2 * y as i128 + 1)).unwrap();
                 match sq.parts(&cut) {
-                    crate::Parts::Split { front, back } => {
+                    crate::kernel::Parts::Split { front, back } => {
                         for q in [front, back] {
                             match q.parts(&half) {
-                                crate::Parts::Split { front, back } => polys.extend([front, back]),
+                                crate::kernel::Parts::Split { front, back } => {
+                                    polys.extend([front, back])
+                                }
                                 _ => polys.push(q),
                             }
                         }
@@ -1133,7 +1145,7 @@ mod tests {
         let cut = Plane::new([1, 2, 3], -17).unwrap();
         let mut polys = Vec::new();
         for f in &cube {
-            let g: Vec<crate::GridPoint> =
+            let g: Vec<crate::kernel::GridPoint> =
                 f.iter().map(|v| v.to_array().map(|c| c as i32)).collect();
             match Polygon::from_grid_points(&g, 0).unwrap().split(&cut) {
                 crate::Split::Spanning { front, back } => polys.extend([front, back]),
@@ -1168,7 +1180,7 @@ mod tests {
             bsp_fixtures::cuboid(glam::DVec3::splat(lo) + d, glam::DVec3::splat(lo + 4.0) + d)
                 .iter()
                 .map(|f| {
-                    let g: Vec<crate::GridPoint> =
+                    let g: Vec<crate::kernel::GridPoint> =
                         f.iter().map(|v| v.to_array().map(|c| c as i32)).collect();
                     Polygon::from_grid_points(&g, 0).unwrap()
                 })

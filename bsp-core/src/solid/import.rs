@@ -2,10 +2,12 @@
 
 use glam::DVec3;
 
-use crate::grid::{Grid, GridPoint};
-use crate::plane::Plane;
-use crate::polygon::{FaceDefect, GridPolygon, Polygon, support_plane};
-use crate::{Error, Side};
+use crate::error::Error;
+use crate::kernel::Side;
+use crate::kernel::grid::{Grid, GridPoint};
+use crate::kernel::plane::FaceDefect;
+use crate::kernel::plane::Plane;
+use crate::kernel::polygon::{GridPolygon, Polygon, support_plane};
 
 /// What happened to the input faces on the way to convex polygons.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -219,7 +221,8 @@ impl Importer {
 /// same polygons, tags and report as [`import_faces`].
 ///
 /// ```
-/// use bsp_core::{FaceImporter, Grid};
+/// use bsp_core::Grid;
+/// use bsp_core::internals::FaceImporter;
 /// use glam::DVec3;
 /// let p = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)];
 /// let grid = Grid::fit_points(&p).unwrap();

@@ -48,8 +48,8 @@
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
-use crate::plane::{cross, cross_wide};
-use crate::{GridPoint, Polygon};
+use crate::kernel::plane::{cross, cross_wide};
+use crate::kernel::{GridPoint, Polygon};
 
 /// Why polygons are not certified as the boundary of solids (the first
 /// reason found; polygons are indices into the list given).
@@ -815,7 +815,7 @@ mod tests {
         assert!(!disjoint(&t, &[[1, 1, 0], [5, 1, 0], [1, 5, 0]]));
         assert!(disjoint(&t, &[[3, 3, 0], [7, 3, 0], [3, 7, 0]]));
         // the coordinate budget: the largest grid coordinates
-        let m = crate::MAX_COORD;
+        let m = crate::kernel::MAX_COORD;
         let big = [[-m, -m, -m], [m, -m, -m], [-m, m, -m]];
         assert!(disjoint(&big, &[[-m, -m, m], [m, -m, m], [-m, m, m]]));
         assert!(!disjoint(

@@ -13,18 +13,16 @@
 //! and combines the labels of coinciding cells with a [`CellOp`]. Every
 //! operation here runs on explicit work stacks.
 
-use crate::Side;
-use crate::grid::MAX_COORD;
-use crate::mesh::TriMesh;
-use crate::plane::Plane;
-use crate::point::Point;
-use crate::polygon::{Polygon, PolygonSide, Split};
-use crate::sanity::{Ancestor, SanityError, walk_checked};
-use crate::tree::{BspTree, BuildOptions, Cell, Link, Membership, Node, NodeId, check_ancestors};
+use crate::kernel::{MAX_COORD, Plane, Point, Polygon, PolygonSide, SanityError, Side, Split};
+
+use super::{
+    Ancestor, BspTree, BuildOptions, Cell, Link, Membership, Node, NodeId, check_ancestors,
+    push_down_by, walk_checked,
+};
 
 /// Half-width of the box that bounds every sub-hyperplane: `2^26`, just
 /// outside every grid coordinate.
-pub const BOX_HALF: i64 = MAX_COORD as i64 + 1;
+pub(crate) const BOX_HALF: i64 = MAX_COORD as i64 + 1;
 
 /// A child reference of a [`Partition`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -231,7 +229,7 @@ fn section_in(plane: &Plane, walls: &[Plane]) -> Option<Polygon> {
 
 /// Options of [`Partition::solid`]: the BSP build with balance cuts every
 /// 64 polygons, which keeps convex meshes from turning into chains.
-pub fn solid_build_options() -> BuildOptions {
+pub(crate) fn solid_build_options() -> BuildOptions {
     BuildOptions::default().with_cut_threshold(64)
 }
 
@@ -244,11 +242,6 @@ impl Partition<Cell> {
         let mut p = Partition::from_tree(&tree);
         p.clear_polygons();
         p
-    }
-
-    /// The boundary as a watertight triangle mesh (see [`TriMesh`]).
-    pub fn to_mesh(&self) -> TriMesh {
-        TriMesh::from_polygons(&self.boundary())
     }
 
     /// The solid partition of a solid BSP tree (see [`BspTree`]): the same
@@ -752,33 +745,6 @@ where
     out
 }
 
-/// Splits `poly` down a tree from `start`: `step(link)` gives a node's
-/// plane and its front and back links, or the leaf's label. The pieces,
-/// each with the label of the leaf it lands in; a piece lying in a node's
-/// plane goes to the front.
-pub(crate) fn push_down_by<'t, K: Copy, L>(
-    poly: Polygon,
-    start: K,
-    step: impl Fn(K) -> Result<(&'t Plane, K, K), L>,
-) -> Vec<(Polygon, L)> {
-    let mut out = Vec::new();
-    let mut stack = vec![(poly, start)];
-    while let Some((p, k)) = stack.pop() {
-        match step(k) {
-            Err(x) => out.push((p, x)),
-            Ok((plane, front, back)) => match p.split(plane) {
-                Split::Front(q) | Split::Coplanar { polygon: q, .. } => stack.push((q, front)),
-                Split::Back(q) => stack.push((q, back)),
-                Split::Spanning { front: f, back: b } => {
-                    stack.push((f, front));
-                    stack.push((b, back));
-                }
-            },
-        }
-    }
-    out
-}
-
 fn first_leaf<L: Copy>(p: &Partition<L>) -> L {
     let mut l = p.root;
     loop {
@@ -1271,7 +1237,7 @@ mod tests {
             (BoolOp::Intersection, 8.0),
             (BoolOp::Difference, 56.0),
         ] {
-            let m = crate::TriMesh::from_polygons(&a.boolean(&b, op).boundary());
+            let m = crate::solid::TriMesh::from_polygons(&a.boolean(&b, op).boundary());
             m.check_watertight().unwrap();
             assert_eq!(m.volume_f64(), vol, "{op:?}");
             assert_eq!(

@@ -1,8 +1,7 @@
 //! Exact invariant checks shared by every polygon and tree type of the
 //! workspace, and the error they report.
 
-use crate::Side;
-use crate::plane::Plane;
+use crate::kernel::Side;
 
 /// Which exact invariant a polygon, tree or partition breaks.
 ///
@@ -165,7 +164,7 @@ pub trait ConvexParts {
 /// two edge planes, and strictly behind every other edge plane (strict
 /// convexity); no edge plane equal to the support plane.
 ///
-/// One implementation for every tier: `bsp-core`'s [`crate::Polygon`] and
+/// One implementation for every tier: `bsp-core`'s [`crate::kernel::Polygon`] and
 /// the fragments and cells of `svbsp` implement [`ConvexParts`].
 pub fn check_convex(p: &impl ConvexParts) -> Result<(), SanityError> {
     let k = p.vertex_count();
@@ -192,48 +191,6 @@ pub fn check_convex(p: &impl ConvexParts) -> Result<(), SanityError> {
         if p.edge_is_support(i) {
             return Err(SanityError::EdgeIsSupport { edge: i });
         }
-    }
-    Ok(())
-}
-
-/// An ancestor's plane and the side of it a subtree lies on.
-pub(crate) type Ancestor = (Plane, Side);
-
-/// Walks a tree of `count` nodes from `root` with an explicit stack,
-/// checking that the links form a tree over all of them (no missing,
-/// repeated or unreachable node), and calls `visit` with each node and its
-/// ancestors (plane and the side the node lies on), root first. `node`
-/// gives a node's plane and its front and back child nodes.
-pub(crate) fn walk_checked(
-    count: usize,
-    root: Option<u32>,
-    node: impl Fn(u32) -> (Plane, Option<u32>, Option<u32>),
-    mut visit: impl FnMut(u32, &[Ancestor]) -> Result<(), SanityError>,
-) -> Result<(), SanityError> {
-    let mut seen = vec![false; count];
-    let mut path: Vec<Ancestor> = Vec::new();
-    // (node, number of ancestors above its parent, edge from its parent)
-    let mut stack: Vec<(Option<u32>, usize, Option<Ancestor>)> = vec![(root, 0, None)];
-    while let Some((id, depth, edge)) = stack.pop() {
-        path.truncate(depth);
-        if let Some(e) = edge {
-            path.push(e);
-        }
-        let Some(id) = id else { continue };
-        let Some(flag) = seen.get_mut(id as usize) else {
-            return Err(SanityError::MissingNode { node: id });
-        };
-        if std::mem::replace(flag, true) {
-            return Err(SanityError::NodeReachedTwice { node: id });
-        }
-        visit(id, &path)?;
-        let (plane, front, back) = node(id);
-        let d = path.len();
-        stack.push((front, d, Some((plane, Side::Front))));
-        stack.push((back, d, Some((plane, Side::Back))));
-    }
-    if let Some(i) = seen.iter().position(|s| !s) {
-        return Err(SanityError::Unreachable { node: i as u32 });
     }
     Ok(())
 }

@@ -21,14 +21,14 @@ use std::cmp::Ordering;
 use bnum::cast::As;
 use bnum::{BInt, BUint};
 
-use crate::Side;
+use crate::kernel::Side;
 
 /// `2^-48`: the filter's relative error bound. Each of the eight inputs
 /// of a 4-term dot product carries a relative error of at most `3u`
 /// (`u = 2^-53`, see [`approx`]), each product one more rounding and the
 /// sum three: at most `10u · Σ|terms| < 2^-49.6 · Σ|terms|` in all, which
 /// this bound covers three times over.
-pub const FILTER_REL: f64 = 1.0 / (1u64 << 48) as f64;
+pub(crate) const FILTER_REL: f64 = 1.0 / (1u64 << 48) as f64;
 
 /// The sign of `plane · point` (four terms) when the `f64` evaluation
 /// certifies it, `None` when the value is too close to zero to tell.
@@ -435,7 +435,11 @@ impl<const N: usize> Homogeneous<N> {
 /// The correctly rounded value of `num / den` (`den > 0`) for any width,
 /// by long division in `M` limbs. Slow; [`Homogeneous::round_with`] is
 /// the fast path.
-pub fn ratio_to_f64_exact<const N: usize, const M: usize>(num: &BInt<N>, den: &BInt<N>) -> f64 {
+#[cfg(test)]
+pub(crate) fn ratio_to_f64_exact<const N: usize, const M: usize>(
+    num: &BInt<N>,
+    den: &BInt<N>,
+) -> f64 {
     let neg = num.is_negative();
     let v = ratio_by_division::<M>(
         num.unsigned_abs().as_::<BUint<M>>(),
@@ -443,6 +447,103 @@ pub fn ratio_to_f64_exact<const N: usize, const M: usize>(num: &BInt<N>, den: &B
     )
     .expect("ratio_to_f64_exact: operands exceed the width");
     if neg { -v } else { v }
+}
+
+/// A 256-bit two's complement integer in two `u128` halves, for sums of
+/// products of `i128`s: the products and sums run on native 128-bit
+/// operations (four 64 × 64-bit products each) instead of the general
+/// 256-bit arithmetic. Sums wrap modulo `2^256`, so a sum whose true
+/// value has fewer than 256 bits is exact whatever the order.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Wide {
+    lo: u128,
+    hi: u128,
+}
+
+impl Wide {
+    pub(crate) const ZERO: Wide = Wide { lo: 0, hi: 0 };
+
+    /// `a · b`, exactly (`|a|, |b| ≤ 2^127`: the magnitude is below
+    /// `2^254`).
+    #[inline]
+    pub(crate) fn product(a: i128, b: i128) -> Wide {
+        const M: u128 = u64::MAX as u128;
+        let (ua, ub) = (a.unsigned_abs(), b.unsigned_abs());
+        let (a0, a1) = (ua & M, ua >> 64);
+        let (b0, b1) = (ub & M, ub >> 64);
+        let (p00, p01, p10, p11) = (a0 * b0, a0 * b1, a1 * b0, a1 * b1);
+        // the middle products' sum has up to 129 bits: its carry is 2^192
+        let (mid, c_mid) = p01.overflowing_add(p10);
+        let (lo, c_lo) = p00.overflowing_add(mid << 64);
+        let hi = p11
+            .wrapping_add(mid >> 64)
+            .wrapping_add((c_mid as u128) << 64)
+            .wrapping_add(c_lo as u128);
+        let u = Wide { lo, hi };
+        if (a < 0) != (b < 0) { u.neg() } else { u }
+    }
+
+    /// `self + o` (modulo `2^256`).
+    #[inline]
+    pub(crate) fn add(self, o: Wide) -> Wide {
+        let (lo, c) = self.lo.overflowing_add(o.lo);
+        Wide {
+            lo,
+            hi: self.hi.wrapping_add(o.hi).wrapping_add(c as u128),
+        }
+    }
+
+    /// `-self` (modulo `2^256`).
+    #[inline]
+    pub(crate) fn neg(self) -> Wide {
+        let (lo, c) = (!self.lo).overflowing_add(1);
+        Wide {
+            lo,
+            hi: (!self.hi).wrapping_add(c as u128),
+        }
+    }
+
+    #[inline]
+    pub(crate) fn is_zero(self) -> bool {
+        self.lo == 0 && self.hi == 0
+    }
+
+    #[inline]
+    pub(crate) fn is_negative(self) -> bool {
+        (self.hi as i128) < 0
+    }
+
+    /// [`crate::kernel::exact::approx`] of the same value, from the halves.
+    #[inline]
+    pub(crate) fn approx(self) -> f64 {
+        use crate::kernel::exact::pow2;
+        let neg = self.is_negative();
+        let u = if neg { self.neg() } else { self };
+        let d = [
+            u.lo as u64,
+            (u.lo >> 64) as u64,
+            u.hi as u64,
+            (u.hi >> 64) as u64,
+        ];
+        let v = match d.iter().rposition(|&x| x != 0) {
+            None => return 0.0,
+            Some(0) => d[0] as f64,
+            Some(i) => (d[i] as f64 * pow2(64) + d[i - 1] as f64) * pow2(64 * (i as i32 - 1)),
+        };
+        if neg { -v } else { v }
+    }
+
+    /// The same value as a [`I256`].
+    #[inline]
+    pub(crate) fn to_i256(self) -> bnum::types::I256 {
+        let digits = [
+            self.lo as u64,
+            (self.lo >> 64) as u64,
+            self.hi as u64,
+            (self.hi >> 64) as u64,
+        ];
+        bnum::types::I256::from_bits(bnum::types::U256::from_digits(digits))
+    }
 }
 
 #[cfg(test)]
@@ -535,7 +636,7 @@ mod tests {
         assert_eq!(filter_ring_area(tiny.iter().copied()), None);
         // near-degenerate rings of large integers (exact in f64): a
         // certified sign is the exact one
-        let mut rng = crate::SplitMix(0x51de);
+        let mut rng = crate::tree::SplitMix(0x51de);
         let mut certified = 0;
         for _ in 0..20_000 {
             // offsets from 2^10 to 2^50: far ones leave the small area

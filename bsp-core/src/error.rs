@@ -1,0 +1,52 @@
+//! The crate's error.
+
+use crate::kernel::SnapError;
+
+/// Errors of this crate.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Error {
+    /// An input coordinate could not be snapped to the grid.
+    Snap {
+        /// Index of the face.
+        face: usize,
+        /// Index of the vertex within the face.
+        vertex: usize,
+        /// The offending coordinates.
+        value: [f64; 3],
+        /// Why.
+        reason: SnapError,
+    },
+    /// Grid parameters are unusable.
+    InvalidGrid(&'static str),
+    /// A face names a vertex the mesh does not have.
+    VertexIndex {
+        /// Index of the face.
+        face: usize,
+        /// Position of the index within the face.
+        vertex: usize,
+        /// The index.
+        index: u32,
+    },
+}
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Error::Snap {
+                face,
+                vertex,
+                value,
+                reason,
+            } => write!(f, "face {face}, vertex {vertex} {value:?}: {reason}"),
+            Error::InvalidGrid(why) => write!(f, "invalid grid: {why}"),
+            Error::VertexIndex {
+                face,
+                vertex,
+                index,
+            } => write!(f, "face {face}, vertex {vertex}: no vertex {index}"),
+        }
+    }
+}
+
+impl std::error::Error for Error {}

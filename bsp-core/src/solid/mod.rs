@@ -1,0 +1,16 @@
+//! Solids given by their boundary: faces snapped to polygons, the
+//! boundary back to a watertight triangle mesh, and the exact checks that
+//! a surface is closed, oriented and embedded.
+
+pub(crate) mod embedded;
+pub(crate) mod import;
+pub(crate) mod mesh;
+pub(crate) mod topology;
+
+pub use embedded::{SolidBoundary, SurfaceDefect, certify_solid_boundary};
+pub use import::{
+    FaceImporter, ImportReport, all_planar, import_faces, import_faces_par, import_indexed_par,
+    snap_positions,
+};
+pub use mesh::TriMesh;
+pub use topology::{TopologyError, check_closed_manifold};

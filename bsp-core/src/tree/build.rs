@@ -1,0 +1,336 @@
+//! Building a tree: an autopartition grown with an explicit stack, the
+//! planes chosen by sampling (or replayed from another tree), and pieces
+//! pushed down to the cells they land in.
+
+use crate::kernel::{Plane, Polygon, PolygonSide, Split};
+
+use super::{BspTree, BuildOptions, Cell, Link, Node, NodeId, SplitMix};
+
+#[derive(Clone, Copy)]
+enum Slot {
+    Root,
+    Front(NodeId),
+    Back(NodeId),
+}
+
+/// Splits a list by `plane` into (coplanar, front, back).
+pub(super) fn partition_list(
+    polys: Vec<Polygon>,
+    plane: &Plane,
+) -> (Vec<Polygon>, Vec<Polygon>, Vec<Polygon>) {
+    let (mut on, mut front, mut back) = (Vec::new(), Vec::new(), Vec::new());
+    for p in polys {
+        match p.split(plane) {
+            Split::Front(p) => front.push(p),
+            Split::Back(p) => back.push(p),
+            Split::Coplanar { polygon, .. } => on.push(polygon),
+            Split::Spanning { front: f, back: b } => {
+                front.push(f);
+                back.push(b);
+            }
+        }
+    }
+    (on, front, back)
+}
+
+/// [`partition_list`] of polygons whose sides of `plane` are known
+/// (`sides`, [`Polygon::classify`]'s): only the spanning ones are looked
+/// at again, to be split, and each list is made at its size.
+fn partition_known(
+    polys: Vec<Polygon>,
+    plane: &Plane,
+    sides: &[PolygonSide],
+) -> (Vec<Polygon>, Vec<Polygon>, Vec<Polygon>) {
+    let (mut n_on, mut n_front, mut n_back) = (0, 0, 0);
+    for s in sides {
+        match s {
+            PolygonSide::Front => n_front += 1,
+            PolygonSide::Back => n_back += 1,
+            PolygonSide::Coplanar { .. } => n_on += 1,
+            PolygonSide::Spanning => {
+                n_front += 1;
+                n_back += 1;
+            }
+        }
+    }
+    let (mut on, mut front, mut back) = (
+        Vec::with_capacity(n_on),
+        Vec::with_capacity(n_front),
+        Vec::with_capacity(n_back),
+    );
+    for (p, side) in polys.into_iter().zip(sides) {
+        match side {
+            PolygonSide::Front => front.push(p),
+            PolygonSide::Back => back.push(p),
+            PolygonSide::Coplanar { .. } => on.push(p),
+            PolygonSide::Spanning => match p.split(plane) {
+                Split::Spanning { front: f, back: b } => {
+                    front.push(f);
+                    back.push(b);
+                }
+                _ => unreachable!("a spanning polygon spans the plane"),
+            },
+        }
+    }
+    (on, front, back)
+}
+
+/// `true` if cutting by `plane` leaves each side with at most three
+/// quarters of the polygons (spanning ones count on both sides) and neither
+/// side empty. Decided before anything is split, so a rejected cut costs no
+/// fragments; without it, long parallel slivers would be cut again and
+/// again next to the previous cut.
+fn cut_balances(polys: &[Polygon], plane: &Plane) -> bool {
+    let (mut front, mut back) = (0usize, 0usize);
+    for p in polys {
+        match p.classify(plane) {
+            PolygonSide::Front => front += 1,
+            PolygonSide::Back => back += 1,
+            PolygonSide::Spanning => {
+                front += 1;
+                back += 1;
+            }
+            PolygonSide::Coplanar { .. } => {}
+        }
+    }
+    let limit = polys.len() * 3 / 4;
+    front > 0 && back > 0 && front <= limit && back <= limit
+}
+
+/// An axis-aligned plane `x_k = m` through the median of the polygons'
+/// first-vertex coordinate along the longest axis of their bounding box.
+/// How the plane is chosen does not affect exactness, so `f64` is fine here.
+fn balance_cut(polys: &[Polygon]) -> Option<Plane> {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    let mut firsts: Vec<[f64; 3]> = Vec::with_capacity(polys.len());
+    for p in polys {
+        let v = p.vertices()[0].approx_f64();
+        for k in 0..3 {
+            lo[k] = lo[k].min(v[k]);
+            hi[k] = hi[k].max(v[k]);
+        }
+        firsts.push(v);
+    }
+    let k = (0..3).max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))?;
+    let mid = firsts.len() / 2;
+    firsts.select_nth_unstable_by(mid, |a, b| a[k].total_cmp(&b[k]));
+    let m = firsts[mid][k].round() as i128;
+    let mut n = [0i64; 3];
+    n[k] = 1;
+    Plane::new(n, -m)
+}
+
+fn choose_plane(polys: &[Polygon], opts: &BuildOptions, rng: &mut SplitMix) -> Plane {
+    choose_plane_sides(polys, opts, rng, &mut Vec::new()).0
+}
+
+/// [`choose_plane`], and whether `sides` holds every polygon's side of
+/// the chosen plane ([`Polygon::classify`]): so when the sample is the
+/// whole list, which the scoring classified against each candidate.
+fn choose_plane_sides(
+    polys: &[Polygon],
+    opts: &BuildOptions,
+    rng: &mut SplitMix,
+    sides: &mut Vec<PolygonSide>,
+) -> (Plane, bool) {
+    let n = polys.len();
+    if n <= 2 {
+        return (*polys[0].support(), false);
+    }
+    let k = opts.candidates.min(n);
+    let s = opts.sample.min(n);
+    let sample: Vec<usize> = if s == n {
+        (0..n).collect()
+    } else {
+        (0..s).map(|_| rng.below(n)).collect()
+    };
+    // the best candidate's sides, and the current one's
+    let mut these: Vec<PolygonSide> = Vec::with_capacity(s);
+    sides.clear();
+    let mut best = (u64::MAX, *polys[0].support());
+    let mut tried: smallvec::SmallVec<[Plane; 8]> = smallvec::SmallVec::new();
+    for c in 0..k {
+        let plane = if k == n {
+            *polys[c].support()
+        } else {
+            *polys[rng.below(n)].support()
+        };
+        // a plane drawn again scores as it did, which does not beat itself
+        if tried.contains(&plane) {
+            continue;
+        }
+        tried.push(plane);
+        let (mut f, mut b, mut sp) = (0u64, 0u64, 0u64);
+        these.clear();
+        for &i in &sample {
+            let side = polys[i].classify(&plane);
+            match side {
+                PolygonSide::Front => f += 1,
+                PolygonSide::Back => b += 1,
+                PolygonSide::Spanning => sp += 1,
+                PolygonSide::Coplanar { .. } => {}
+            }
+            these.push(side);
+        }
+        let score = opts.split_weight as u64 * sp + f.abs_diff(b);
+        if score < best.0 {
+            best = (score, plane);
+            std::mem::swap(sides, &mut these);
+        }
+    }
+    (best.1, s == n)
+}
+
+/// A node's cut: its plane, the polygons in the plane, and the lists in
+/// front of it and behind it.
+type Cut = (Plane, Vec<Polygon>, Vec<Polygon>, Vec<Polygon>);
+
+/// The tree `split` grows from `polygons`: a non-empty list becomes a node
+/// by the cut `split` makes of it (given what the caller keeps with the
+/// list, `at`, and giving that of the front and back lists); an empty one
+/// is a leaf, inside behind its parent's plane and outside elsewhere.
+/// Nodes are numbered in the order they are made, front subtree first;
+/// an explicit stack, so any depth is fine.
+pub(super) fn grow<A>(
+    polygons: Vec<Polygon>,
+    at: A,
+    mut split: impl FnMut(Vec<Polygon>, A) -> (Cut, A, A),
+) -> BspTree {
+    let mut tree = BspTree {
+        nodes: Vec::new(),
+        root: Link::Cell(Cell::Out),
+    };
+    let mut stack: Vec<(Vec<Polygon>, A, Slot)> = vec![(polygons, at, Slot::Root)];
+    while let Some((polys, at, slot)) = stack.pop() {
+        let link = if polys.is_empty() {
+            Link::Cell(match slot {
+                Slot::Back(_) => Cell::In,
+                Slot::Front(_) | Slot::Root => Cell::Out,
+            })
+        } else {
+            let ((plane, on, front, back), at_front, at_back) = split(polys, at);
+            let id = tree.nodes.len() as NodeId;
+            tree.nodes.push(Node {
+                plane,
+                polygons: on,
+                front: Link::Cell(Cell::Out),
+                back: Link::Cell(Cell::In),
+            });
+            stack.push((back, at_back, Slot::Back(id)));
+            stack.push((front, at_front, Slot::Front(id)));
+            Link::Node(id)
+        };
+        match slot {
+            Slot::Root => tree.root = link,
+            Slot::Front(id) => tree.nodes[id as usize].front = link,
+            Slot::Back(id) => tree.nodes[id as usize].back = link,
+        }
+    }
+    tree
+}
+
+impl BspTree {
+    /// An autopartition of `polygons`: every partitioning plane is the
+    /// support plane of an input polygon; coplanar polygons of both
+    /// orientations stay at their node. Uses an explicit stack, so any
+    /// depth is fine.
+    pub fn build(polygons: Vec<Polygon>, opts: &BuildOptions) -> BspTree {
+        let mut rng = SplitMix(opts.seed);
+        let mut sides = Vec::new();
+        grow(polygons, (), |polys, ()| {
+            let cut = if opts.cut_threshold > 0 && polys.len() > opts.cut_threshold {
+                balance_cut(&polys)
+            } else {
+                None
+            };
+            if let Some(plane) = cut.filter(|c| cut_balances(&polys, c)) {
+                let (on, front, back) = partition_list(polys, &plane);
+                return ((plane, on, front, back), (), ());
+            }
+            let (plane, known) = choose_plane_sides(&polys, opts, &mut rng, &mut sides);
+            let (on, front, back) = if known {
+                partition_known(polys, &plane, &sides)
+            } else {
+                partition_list(polys, &plane)
+            };
+            ((plane, on, front, back), (), ())
+        })
+    }
+
+    /// A tree from its nodes and root (indices into `nodes`; every node
+    /// reached once).
+    pub(crate) fn from_parts(nodes: Vec<Node>, root: Link) -> BspTree {
+        BspTree { nodes, root }
+    }
+
+    /// This tree's splitting choices replayed on other copies of its
+    /// polygons (moved, or snapped again after a motion), tagged as this
+    /// tree's polygons are: where this tree split by the plane of face
+    /// `t`, the replay splits by the plane of `t`'s new copy, without a
+    /// candidate search. Where a copy is missing from its node's list, or
+    /// polygons reach what was a leaf here, the replay chooses as
+    /// [`BspTree::build`] does with `fallback`. The result is the same
+    /// tree wherever the new coordinates keep every polygon on the same
+    /// side of every plane, and a valid autopartition in any case.
+    pub fn replay(&self, polygons: Vec<Polygon>, fallback: &BuildOptions) -> BspTree {
+        let mut rng = SplitMix(fallback.seed);
+        // each list with the node of this tree it stands at
+        grow(polygons, self.root_id(), |polys, at| {
+            let old = at.map(|i| &self.nodes[i as usize]);
+            // the face whose plane this tree chose here
+            let chosen = old.and_then(|n| {
+                let t = n.polygons.iter().find(|p| p.support() == &n.plane)?.tag();
+                polys.iter().find(|p| p.tag() == t).map(|p| *p.support())
+            });
+            let plane = chosen.unwrap_or_else(|| choose_plane(&polys, fallback, &mut rng));
+            let (on, front, back) = partition_list(polys, &plane);
+            let child = |l: Link| match l {
+                Link::Node(j) => Some(j),
+                Link::Cell(_) => None,
+            };
+            let (f, b) = old.map_or((None, None), |n| (child(n.front), child(n.back)));
+            ((plane, on, front, back), f, b)
+        })
+    }
+
+    /// Splits `poly` down the tree by the node planes: the pieces, each with
+    /// the cell it lands in. A piece lying in a node's plane goes to the
+    /// front (as [`crate::Partition::push_down`]).
+    pub fn push_down(&self, poly: Polygon) -> Vec<(Polygon, Cell)> {
+        push_down_by(poly, self.root, |l| match l {
+            Link::Cell(c) => Err(c),
+            Link::Node(id) => {
+                let n = &self.nodes[id as usize];
+                Ok((&n.plane, n.front, n.back))
+            }
+        })
+    }
+}
+
+/// Splits `poly` down a tree from `start`: `step(link)` gives a node's
+/// plane and its front and back links, or the leaf's label. The pieces,
+/// each with the label of the leaf it lands in; a piece lying in a node's
+/// plane goes to the front.
+pub(crate) fn push_down_by<'t, K: Copy, L>(
+    poly: Polygon,
+    start: K,
+    step: impl Fn(K) -> Result<(&'t Plane, K, K), L>,
+) -> Vec<(Polygon, L)> {
+    let mut out = Vec::new();
+    let mut stack = vec![(poly, start)];
+    while let Some((p, k)) = stack.pop() {
+        match step(k) {
+            Err(x) => out.push((p, x)),
+            Ok((plane, front, back)) => match p.split(plane) {
+                Split::Front(q) | Split::Coplanar { polygon: q, .. } => stack.push((q, front)),
+                Split::Back(q) => stack.push((q, back)),
+                Split::Spanning { front: f, back: b } => {
+                    stack.push((f, front));
+                    stack.push((b, back));
+                }
+            },
+        }
+    }
+    out
+}
