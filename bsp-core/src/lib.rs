@@ -46,15 +46,13 @@
 //!
 //! None.
 
-mod error;
 mod kernel;
 mod solid;
 mod tree;
 
-pub use error::Error;
 pub use kernel::{
-    FaceDefect, GRID_BITS, Grid, GridPoint, Implicit, MAX_COORD, MAX_VIEW_COORD, Plane, Point,
-    Polygon, PolygonSide, SanityError, Side, SnapError, Split, ViewPoint,
+    Error, FaceDefect, GRID_BITS, Grid, GridPoint, Implicit, MAX_COORD, MAX_VIEW_COORD, Plane,
+    Point, Polygon, PolygonSide, SanityError, Side, SnapError, Split, ViewPoint,
 };
 pub use solid::{
     ImportReport, SolidBoundary, SurfaceDefect, TopologyError, TriMesh, certify_solid_boundary,

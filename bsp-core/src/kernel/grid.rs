@@ -7,7 +7,7 @@
 
 use glam::DVec3;
 
-use crate::error::Error;
+use crate::kernel::error::Error;
 
 /// Number of bits of an input grid coordinate: `|g| < 2^GRID_BITS`.
 pub const GRID_BITS: u32 = 26;

@@ -3,6 +3,7 @@
 //! Nothing here knows of trees or solids.
 
 pub(crate) mod convex;
+pub(crate) mod error;
 pub(crate) mod exact;
 pub(crate) mod grid;
 pub(crate) mod plane;
@@ -11,6 +12,7 @@ pub(crate) mod polygon;
 mod side;
 
 pub use convex::{ConvexParts, SanityError, check_convex};
+pub use error::Error;
 pub use exact::{Homogeneous, approx, filter_ring_area, filter_side, filter_side_err};
 pub use grid::{GRID_BITS, Grid, GridPoint, MAX_COORD, MAX_VIEW_COORD, SnapError, ViewPoint};
 pub use plane::{FaceDefect, MAX_NORMAL_BITS, MAX_OFFSET_BITS, Plane};

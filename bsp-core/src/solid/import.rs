@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use crate::error::Error;
+use crate::kernel::Error;
 use crate::kernel::Side;
 use crate::kernel::grid::{Grid, GridPoint};
 use crate::kernel::plane::FaceDefect;

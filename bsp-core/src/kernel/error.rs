@@ -1,6 +1,6 @@
-//! The crate's error.
+//! The crate's error: input that cannot become geometry.
 
-use crate::kernel::SnapError;
+use crate::kernel::grid::SnapError;
 
 /// Errors of this crate.
 #[derive(Clone, Debug, PartialEq)]
