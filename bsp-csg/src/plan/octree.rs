@@ -13,7 +13,7 @@ use bsp_core::internals::ConvexFace;
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
-use crate::index::IBox;
+use crate::index::{IBox, SmallBox};
 
 /// A leaf of the octree: its box and the faces of each operand whose box
 /// overlaps it.
@@ -127,10 +127,6 @@ pub(crate) fn polygon_meets(poly: &impl ConvexFace, bx: &IBox) -> bool {
 pub(crate) trait PlaneTest: Fn(u32, &IBox) -> bool + Sync {}
 
 impl<T: Fn(u32, &IBox) -> bool + Sync> PlaneTest for T {}
-
-/// A face's box in 32 bits (as a solid keeps it): the build reads one
-/// per face at every level, so half the room is half the traffic.
-pub(crate) type SmallBox = ([i32; 3], [i32; 3]);
 
 /// One operand's faces for [`build`]: each face's box, and a test of its
 /// plane against a cell (`true` whenever the face meets the cell; it may

@@ -34,9 +34,9 @@ use bsp_core::{
     BoolOp, BspTree, BuildOptions, Cell, Link, Partition, Plane, Polygon, PolygonSide, Side,
 };
 
+use super::octree::walls;
 use crate::CsgError;
 use crate::index::{IBox, overlaps};
-use crate::octree::walls;
 
 /// `true` if `piece` and `face` (convex, in the same plane) overlap with
 /// an area: no edge line of either has the other wholly on its outer side
@@ -589,7 +589,7 @@ fn walls_crossed<'w>(fb: &IBox, cell: &IBox, w: &'w [Plane; 6]) -> impl Iterator
 /// [`clip_in`] for a solid's face: an imported face is clipped from its
 /// grid corners ([`GridPolygon::clipped`](bsp_core::internals::GridPolygon::clipped):
 /// the same piece, made more cheaply), only when its box meets the cell.
-pub(crate) fn clip_face(face: &crate::Face, cell: &IBox, w: &[Plane; 6]) -> Option<Polygon> {
+pub(crate) fn clip_face(face: &crate::solid::Face, cell: &IBox, w: &[Plane; 6]) -> Option<Polygon> {
     let fb = face.bx();
     if !overlaps(&fb, cell) {
         return None;

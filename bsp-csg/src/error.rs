@@ -1,0 +1,50 @@
+//! The crate's error: why an operation cannot be done.
+
+use bsp_core::TopologyError;
+
+/// Why an operation cannot be done.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum CsgError {
+    /// Operand `operand` (0 for the first) is not a closed, consistently
+    /// oriented 2-manifold.
+    Topology {
+        /// The operand.
+        operand: usize,
+        /// What is wrong, with face and edge.
+        error: TopologyError,
+    },
+    /// Operand `operand`'s faces face inward: the solid they bound is
+    /// unbounded.
+    Inward {
+        /// The operand.
+        operand: usize,
+    },
+    /// A coordinate does not fit the grid (or is not finite).
+    Grid(bsp_core::Error),
+    /// Operand `operand` is closed and oriented as a mesh, but its snapped
+    /// surface does not bound a solid (it crosses itself).
+    NotASolid,
+    /// The result is not watertight: a bug, not a problem of the input.
+    Internal(String),
+}
+
+impl std::fmt::Display for CsgError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CsgError::Topology { operand, error } => write!(f, "operand {operand}: {error}"),
+            CsgError::Inward { operand } => write!(
+                f,
+                "operand {operand}: the faces are oriented inward (clockwise seen from outside): \
+                 the solid they bound is unbounded; reverse every face's vertex order"
+            ),
+            CsgError::Grid(e) => write!(f, "{e}"),
+            CsgError::NotASolid => f.write_str(
+                "a surface crosses itself (after snapping to the grid) and bounds no solid",
+            ),
+            CsgError::Internal(e) => write!(f, "internal error: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for CsgError {}
