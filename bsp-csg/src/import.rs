@@ -5,7 +5,7 @@ use bsp_core::{Grid, ImportReport, check_closed_manifold};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::solid::Face;
+use crate::solid::SolidFace;
 use crate::{CsgError, Solid};
 
 /// An indexed mesh in input units: positions and faces (vertex index
@@ -88,11 +88,11 @@ pub fn snap_one(
     // more; the rare extra polygons of triangulated faces go after
     const CHUNK: usize = 4096;
     let n = mesh.faces.len();
-    let mut faces: Vec<Option<Face>> = Vec::with_capacity(n);
+    let mut faces: Vec<Option<SolidFace>> = Vec::with_capacity(n);
     faces.par_extend((0..n).into_par_iter().map(|_| None));
     // each vertex snapped once, not once per face around it
     let snapped = bsp_core::internals::snap_positions(grid, mesh.positions);
-    type Run = (ImportReport, Vec<Face>, i128);
+    type Run = (ImportReport, Vec<SolidFace>, i128);
     let runs: Vec<Result<Run, bsp_core::Error>> = faces
         .par_chunks_mut(CHUNK)
         .zip(mesh.faces.par_chunks(CHUNK))
@@ -103,7 +103,7 @@ pub fn snap_one(
             for (i, (slot, face)) in slots.iter_mut().zip(loops).enumerate() {
                 imp.indexed_snapped(grid, mesh.positions, &snapped, face, c * CHUNK + i, |p| {
                     six += six_volume(&p);
-                    let face = Face::grid(p);
+                    let face = SolidFace::grid(p);
                     match slot {
                         None => *slot = Some(face),
                         Some(_) => extra.push(face),
@@ -142,7 +142,7 @@ pub fn snap_one(
 /// surface, six times the volume it bounds. Coordinates below 2^26 keep
 /// each cross product's coordinates below 2^53 (in `i64`) and each term
 /// below 2^81 (in `i128`).
-pub(crate) fn six_volume(p: &GridPolygon) -> i128 {
+fn six_volume(p: &GridPolygon) -> i128 {
     let g = p.vertices();
     let a = g[0].map(i128::from);
     g[1..]

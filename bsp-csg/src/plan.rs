@@ -1,32 +1,53 @@
-//! Planning an operation: everything `self ∘ other` decides, from the
-//! octree over the shared box to the faces removed and added.
+//! Operations on solids, and planning them: everything `a ∘ b` decides
+//! before a face is added to `a` ([`Solid::carry_out`]) or the result is
+//! meshed. [`Solid::plan`] runs the phases of the crate docs in turn:
+//!
+//! 1. the octree over the box where the two surfaces may meet, each leaf
+//!    listing its faces of each operand ([`Cells::build`], `octree`);
+//! 2. the regions of leaves free of each surface, labelled by winding
+//!    numbers ([`FreeRegions`]);
+//! 3. each face sorted: in free leaves only, or with pieces in mixed
+//!    leaves ([`sort_faces`]);
+//! 4. the faces the other surface may meet ([`Touched`]), and each mixed
+//!    cell run: easy, or its local partitions built (`mixed_cell`,
+//!    `local`);
+//! 5. the labels of the untouched faces and of the easy cells' pieces
+//!    ([`Labeller`]); an easy cell that a label does not reach is run
+//!    again and builds its partitions;
+//! 6. the faces settled: those in free leaves kept or dropped whole, the
+//!    others kept whole, dropped, or replaced by what stays of them
+//!    ([`settle`](fn@settle)); and the faces away from the shared box.
 
 mod labelling;
-pub(crate) mod local;
+mod local;
 mod mixed_cell;
-pub(crate) mod octree;
+mod octree;
+mod operands;
 mod settle;
 
 use bsp_core::internals::ConvexFace;
-use bsp_core::{BoolOp, Polygon};
+use bsp_core::{BoolOp, Plane, TriMesh};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
 use crate::index::{IBox, SmallBox, intersect, union};
-use crate::solid::{Other, drop_aside};
+use crate::solid::{AddedFace, Additions, OtherFaces, drop_aside};
 use crate::{CsgError, Options, Solid, Stats};
-use labelling::{Listed, Regions, label_easy, label_untouched, touched};
-use mixed_cell::{First, Made, PieceFate, clip_all, clip_rest};
+use labelling::{FreeRegions, Labeller};
+use mixed_cell::{CellOutcome, CellRun, CellWork, EasyPieces, PieceFate, Touched, WallCrossings};
 use octree::{Leaf, walls};
-use settle::{Piece, Settled, meeting_leaf, settle, sort_faces};
+use operands::{Both, Keep, Operand};
+use settle::{
+    FacePiece, PiecedFace, Remains, SettledFace, SortedFaces, meeting_leaf, settle, sort_faces,
+};
 
 /// An operation on two solids, decided ([`Solid::plan_owned`]).
 pub struct Planned {
-    pub(crate) solid: Solid,
-    pub(crate) other: Solid,
-    pub(crate) plan: Plan,
-    pub(crate) stats: Stats,
+    solid: Solid,
+    other: Solid,
+    additions: Additions,
+    stats: Stats,
 }
 
 impl Planned {
@@ -40,547 +61,701 @@ impl Planned {
         let Planned {
             mut solid,
             mut other,
-            plan,
+            additions,
             ..
         } = self;
-        solid.carry_out(plan, Other::Owned(&mut other));
+        solid.carry_out(additions, OtherFaces::Moved(&mut other));
         drop_aside(other);
         solid
+    }
+
+    /// The result's watertight mesh, the one [`Planned::into_solid`]'s
+    /// [`Solid::into_watertight_mesh`] gives (the same triangles in the
+    /// same order), made from the faces where they are: the result's
+    /// faces are not moved into one solid, and no index is made for them.
+    pub fn into_watertight_mesh(self) -> Result<TriMesh, CsgError> {
+        let Planned {
+            solid,
+            other,
+            additions,
+            ..
+        } = self;
+        solid.into_watertight_mesh_with(additions, other)
     }
 }
 
 impl Solid {
-    /// `self op other` for solids whose faces cannot meet.
-    pub(crate) fn apart(&mut self, other: &Solid, op: BoolOp) -> Result<(Stats, Plan), CsgError> {
-        let mut plan = Plan {
-            add: Vec::new(),
-            flip: false,
-        };
-        match op {
-            BoolOp::Union => {
-                plan.add = (0..other.faces.len() as u32)
-                    .filter(|&i| other.faces[i as usize].is_some())
-                    .map(Added::Whole)
-                    .collect()
-            }
-            BoolOp::Intersection => *self = Solid::empty(),
-            BoolOp::Difference => {}
-        }
-        Ok((Stats::default(), plan))
+    /// `self op other`, as a new solid.
+    pub fn boolean(&self, other: &Solid, op: BoolOp) -> Result<Solid, CsgError> {
+        let mut s = self.clone();
+        s.apply(other, op)?;
+        Ok(s)
+    }
+
+    /// `self ← self op other`, touching only the faces near `other`.
+    pub fn apply(&mut self, other: &Solid, op: BoolOp) -> Result<Stats, CsgError> {
+        self.apply_with(other, op, &Options::default())
+    }
+
+    /// [`Solid::apply`] with options.
+    pub fn apply_with(
+        &mut self,
+        other: &Solid,
+        op: BoolOp,
+        opts: &Options,
+    ) -> Result<Stats, CsgError> {
+        let (stats, additions) = self.plan(other, op, opts)?;
+        self.carry_out(additions, OtherFaces::Copied(other));
+        Ok(stats)
+    }
+
+    /// [`Solid::apply`], taking the other solid: the faces it keeps whole
+    /// move over instead of being copied, so that the two are not held
+    /// at once (the same result).
+    pub fn apply_owned(&mut self, other: Solid, op: BoolOp) -> Result<Stats, CsgError> {
+        self.apply_owned_with(other, op, &Options::default())
+    }
+
+    /// [`Solid::apply_owned`] with options.
+    pub fn apply_owned_with(
+        &mut self,
+        mut other: Solid,
+        op: BoolOp,
+        opts: &Options,
+    ) -> Result<Stats, CsgError> {
+        let (stats, additions) = self.plan(&other, op, opts)?;
+        self.carry_out(additions, OtherFaces::Moved(&mut other));
+        drop_aside(other);
+        Ok(stats)
+    }
+
+    /// `self op other`, decided but not yet carried out: the result is
+    /// then made as a mesh ([`Planned::into_watertight_mesh`]) straight
+    /// from the two solids' faces, with no solid of its own (the last
+    /// operation of a sequence needs none), or as a solid
+    /// ([`Planned::into_solid`], what [`Solid::apply_owned`] gives).
+    ///
+    /// ```
+    /// use bsp_core::BoolOp;
+    /// use bsp_csg::{MeshIn, fit_grid, snap_one};
+    /// use bsp_fixtures::sphere_pair;
+    ///
+    /// let (va, vb, faces) = sphere_pair(1000);
+    /// let (a, b) = (MeshIn::new(&va, &faces), MeshIn::new(&vb, &faces));
+    /// let grid = fit_grid(&[a, b]).unwrap();
+    /// let (sa, _) = snap_one(&grid, &a, 0).unwrap();
+    /// let (sb, _) = snap_one(&grid, &b, 1).unwrap();
+    /// let planned = sa.clone().plan_owned(sb.clone(), BoolOp::Union).unwrap();
+    /// assert!(planned.stats().cut_faces > 0);
+    /// let mesh = planned.into_watertight_mesh().unwrap();
+    /// // the mesh of the solid `apply_owned` makes, triangle for triangle
+    /// let mut solid = sa;
+    /// solid.apply_owned(sb, BoolOp::Union).unwrap();
+    /// assert_eq!(mesh.triangles, solid.into_watertight_mesh().unwrap().triangles);
+    /// ```
+    pub fn plan_owned(mut self, other: Solid, op: BoolOp) -> Result<Planned, CsgError> {
+        let (stats, additions) = self.plan(&other, op, &Options::default())?;
+        Ok(Planned {
+            solid: self,
+            other,
+            additions,
+            stats,
+        })
     }
 
     /// Everything an operation decides; of the changes to this solid it
     /// makes the removals (and empties it for an intersection with a
     /// solid apart), and leaves the additions to [`Solid::carry_out`].
-    pub(crate) fn plan(
+    fn plan(
         &mut self,
         other: &Solid,
         op: BoolOp,
         opts: &Options,
-    ) -> Result<(Stats, Plan), CsgError> {
-        let keep_a = |inside_b: bool| match op {
-            BoolOp::Union | BoolOp::Difference => !inside_b,
-            BoolOp::Intersection => inside_b,
+    ) -> Result<(Stats, Additions), CsgError> {
+        let Some(root) = self.octree_root(other) else {
+            return Ok(self.apart(other, op));
         };
-        let keep_b = |inside_a: bool| match op {
-            BoolOp::Union => !inside_a,
-            BoolOp::Intersection | BoolOp::Difference => inside_a,
+        let solids = Both {
+            a: &*self,
+            b: other,
         };
-        let flip_b = op == BoolOp::Difference;
-        let domain = match (self.bounds, other.bounds) {
+        let decided = Planning::new(solids, op, opts, root).decide()?;
+        self.remove_all(&decided.remove);
+        // the octree and its lists go on the pool (freeing them here, as
+        // the function returns, held up what follows)
+        let Decided {
+            stats,
+            add,
+            remove,
+            leftovers,
+        } = decided;
+        drop_aside((leftovers, remove));
+        let flip = op == BoolOp::Difference;
+        Ok((stats, Additions { faces: add, flip }))
+    }
+
+    /// The box the octree covers: where the two solids' bounds overlap,
+    /// the faces of either there may meet the other surface, and the box
+    /// they span holds every face of either in it (the octree's cells
+    /// must know all the faces in them to tell which cells are free of a
+    /// surface). `None` if no face of either may meet the other surface.
+    fn octree_root(&self, other: &Solid) -> Option<IBox> {
+        let domain = match (self.bounds(), other.bounds()) {
             (Some(a), Some(b)) => intersect(&a, &b),
             _ => None,
+        }?;
+        match (self.near_span(&domain), other.near_span(&domain)) {
+            (Some(a), Some(b)) => Some(union(&a, &b)),
+            (Some(x), None) | (None, Some(x)) => Some(x),
+            (None, None) => None,
+        }
+    }
+
+    /// `self op other` for solids whose faces cannot meet.
+    fn apart(&mut self, other: &Solid, op: BoolOp) -> (Stats, Additions) {
+        let faces = match op {
+            BoolOp::Union => other.face_ids().map(AddedFace::Theirs).collect(),
+            BoolOp::Intersection => {
+                *self = Solid::empty();
+                Vec::new()
+            }
+            BoolOp::Difference => Vec::new(),
         };
-        let Some(domain) = domain else {
-            return self.apart(other, op);
+        let additions = Additions { faces, flip: false };
+        (Stats::default(), additions)
+    }
+}
+
+/// The octree's leaves over the box where the two surfaces may meet, and
+/// each operand's faces in that box.
+struct Cells {
+    /// The octree's box.
+    root: IBox,
+    /// The leaves, each listing its faces of each operand by id.
+    leaves: Vec<Leaf>,
+    /// The pairs of leaves that share a piece of wall.
+    adjacent: Vec<(u32, u32)>,
+    /// Each operand's faces whose box overlaps the root (ascending ids).
+    near: Both<Vec<u32>>,
+    /// The leaves of each of those faces, by its place in `near`.
+    leaves_of: Both<Vec<SmallVec<[u32; 4]>>>,
+}
+
+impl Cells {
+    /// The octree over `root` for the two solids' faces there.
+    fn build(solids: Both<&Solid>, root: IBox, opts: &Options) -> Cells {
+        let near = Both {
+            a: solids.a.faces_near(&root),
+            b: solids.b.faces_near(&root),
         };
-        // the faces that may meet the other surface, and every face of
-        // either in the box they span: the octree's cells must know all
-        // the faces in them to tell which cells are free of a surface
-        let root = match (self.near_span(&domain), other.near_span(&domain)) {
-            (Some(a), Some(b)) => union(&a, &b),
-            (Some(x), None) | (None, Some(x)) => x,
-            (None, None) => return self.apart(other, op),
-        };
-        let a_c = self.faces_near(&root);
-        let b_c = other.faces_near(&root);
-        // the faces' boxes and planes side by side, by their place in
-        // `a_c` and `b_c` (a face slot is large: the build reads these often)
-        let geometry = |s: &Solid, fs: &[u32]| -> (Vec<SmallBox>, Vec<bsp_core::Plane>) {
-            fs.par_iter()
-                .map(|&f| (s.face(f).small_box(), *s.face(f).support()))
-                .unzip()
-        };
-        let (boxes_a, planes_a) = geometry(self, &a_c);
-        let (boxes_b, planes_b) = geometry(other, &b_c);
-        let mut leaves = octree::build(
-            root,
-            &octree::Faces {
-                boxes: &boxes_a,
-                plane_meets: |f: u32, c: &IBox| octree::plane_meets(&planes_a[f as usize], c),
-            },
-            &octree::Faces {
-                boxes: &boxes_b,
-                plane_meets: |f: u32, c: &IBox| octree::plane_meets(&planes_b[f as usize], c),
-            },
-            opts.leaf_size,
-        );
-        drop((boxes_a, planes_a, boxes_b, planes_b));
+        let mut leaves = grow_octree(solids, &near, root, opts.leaf_size);
         if opts.exact_cells {
             // the lists of the leaves holding both, by the exact test
             leaves.par_iter_mut().filter(|l| l.mixed()).for_each(|l| {
                 let bx = l.bx;
-                l.a.retain(|&f| octree::polygon_meets(self.face(a_c[f as usize]), &bx));
-                l.b.retain(|&f| octree::polygon_meets(other.face(b_c[f as usize]), &bx));
+                l.a.retain(|&f| octree::polygon_meets(solids.a.face(near.a[f as usize]), &bx));
+                l.b.retain(|&f| octree::polygon_meets(solids.b.face(near.b[f as usize]), &bx));
             });
         }
-        // each face's leaves, by its place in `a_c` and `b_c`
-        // (each operand's on its own thread)
-        let leaves_of = |n: usize, list: fn(&Leaf) -> &Vec<u32>| {
-            let mut of: Vec<SmallVec<[u32; 4]>> = vec![SmallVec::new(); n];
+        // each face's leaves, by its place in `near` (each operand's on
+        // its own thread)
+        let leaves_of = Both::join(|o| {
+            let mut of: Vec<SmallVec<[u32; 4]>> = vec![SmallVec::new(); near.get(o).len()];
             for (li, l) in leaves.iter().enumerate() {
-                for &f in list(l) {
+                for &f in l.faces(o) {
                     of[f as usize].push(li as u32);
                 }
             }
             of
-        };
-        let (a_leaves, b_leaves) = rayon::join(
-            || leaves_of(a_c.len(), |l| &l.a),
-            || leaves_of(b_c.len(), |l| &l.b),
-        );
+        });
         // the leaves' lists by face id
         leaves.par_iter_mut().for_each(|l| {
-            l.a.iter_mut().for_each(|f| *f = a_c[*f as usize]);
-            l.b.iter_mut().for_each(|f| *f = b_c[*f as usize]);
+            l.a.iter_mut().for_each(|f| *f = near.a[*f as usize]);
+            l.b.iter_mut().for_each(|f| *f = near.b[*f as usize]);
         });
         let adjacent = octree::adjacent(&leaves);
-        // the regions free of each surface, and their labels
-        let (inside_b, inside_a) = rayon::join(
-            || Regions::new(&leaves, &adjacent, |l| l.b.is_empty(), other),
-            || Regions::new(&leaves, &adjacent, |l| l.a.is_empty(), self),
-        );
+        Cells {
+            root,
+            leaves,
+            adjacent,
+            near,
+            leaves_of,
+        }
+    }
+}
 
-        // the faces wholly in free cells, and the pieces of the others
-        let root_walls = walls(&root);
-        let ((whole_a, pieces_a), (whole_b, pieces_b)) = rayon::join(
-            || {
-                sort_faces(
-                    &a_c,
-                    &a_leaves,
-                    &leaves,
-                    &root,
-                    |f| self.face(f).bx(),
-                    |l| (&l.a, l.b.is_empty()),
-                )
-            },
-            || {
-                sort_faces(
-                    &b_c,
-                    &b_leaves,
-                    &leaves,
-                    &root,
-                    |f| other.face(f).bx(),
-                    |l| (&l.b, l.a.is_empty()),
-                )
-            },
-        );
-        // the mixed cells, in parallel; a mixed leaf's lists are its
-        // listed faces (`Piece::Mixed` indexes them)
+/// The octree's leaves over `root` for each solid's faces `near` it,
+/// listed by their place in `near`.
+fn grow_octree(
+    solids: Both<&Solid>,
+    near: &Both<Vec<u32>>,
+    root: IBox,
+    leaf_size: usize,
+) -> Vec<Leaf> {
+    // the faces' boxes and planes side by side, by their place in `near`
+    // (a face slot is large: the build reads these often)
+    let geometry = |s: &Solid, fs: &[u32]| -> (Vec<SmallBox>, Vec<Plane>) {
+        fs.par_iter()
+            .map(|&f| (s.face(f).small_box(), *s.face(f).support()))
+            .unzip()
+    };
+    let (boxes_a, planes_a) = geometry(solids.a, &near.a);
+    let (boxes_b, planes_b) = geometry(solids.b, &near.b);
+    octree::build(
+        root,
+        &octree::Faces {
+            boxes: &boxes_a,
+            plane_meets: |f: u32, c: &IBox| octree::plane_meets(&planes_a[f as usize], c),
+        },
+        &octree::Faces {
+            boxes: &boxes_b,
+            plane_meets: |f: u32, c: &IBox| octree::plane_meets(&planes_b[f as usize], c),
+        },
+        leaf_size,
+    )
+}
+
+/// What the mixed cells decided, gathered cell by cell.
+struct MixedCells {
+    /// What became of each operand's listed faces, per cell that sorted
+    /// its pieces (built or easy).
+    fates: Both<FxHashMap<u32, Vec<PieceFate>>>,
+    /// The walls each isolated piece crosses, per cell that sorted its
+    /// pieces on its first run and per easy cell.
+    crossings: Both<FxHashMap<u32, WallCrossings>>,
+    /// The easy cells not settled yet, in order, and their pieces.
+    easy: Vec<u32>,
+    easy_pieces: Both<FxHashMap<u32, EasyPieces>>,
+    /// The faces to add so far: the merged cells' boundaries.
+    add: Vec<AddedFace>,
+    stats: Stats,
+}
+
+impl MixedCells {
+    /// Records cell `l`'s first run.
+    fn record(&mut self, l: u32, run: CellRun) {
+        match run {
+            CellRun::Easy { crossings, pieces } => {
+                self.easy.push(l);
+                self.crossings.a.insert(l, crossings.a);
+                self.crossings.b.insert(l, crossings.b);
+                self.easy_pieces.a.insert(l, pieces.a);
+                self.easy_pieces.b.insert(l, pieces.b);
+            }
+            CellRun::Built { outcome, crossings } => {
+                if matches!(outcome, CellOutcome::Sorted(_)) {
+                    self.crossings.a.insert(l, crossings.a);
+                    self.crossings.b.insert(l, crossings.b);
+                }
+                self.built(l, outcome);
+            }
+        }
+    }
+
+    /// Records what cell `l`'s partitions decided: its fates, or its
+    /// merged boundary to add.
+    fn built(&mut self, l: u32, outcome: CellOutcome) {
+        match outcome {
+            CellOutcome::Merged(ps) => {
+                self.stats.merged_cells += 1;
+                self.add
+                    .extend(ps.into_iter().map(|p| AddedFace::New(Box::new(p))));
+            }
+            CellOutcome::Sorted(fates) => {
+                self.fates.a.insert(l, fates.a);
+                self.fates.b.insert(l, fates.b);
+            }
+        }
+    }
+}
+
+/// What an operation decided for the first solid.
+struct Decided {
+    stats: Stats,
+    /// The faces to add, in order.
+    add: Vec<AddedFace>,
+    /// The faces to remove, in order.
+    remove: Vec<u32>,
+    /// What the decision was made with, to free on the pool.
+    leftovers: (
+        Cells,
+        Both<FreeRegions>,
+        Both<FxHashMap<u32, WallCrossings>>,
+    ),
+}
+
+/// An operation being decided: the two solids, the operation, and the
+/// octree over the box where their surfaces may meet.
+struct Planning<'s> {
+    solids: Both<&'s Solid>,
+    op: BoolOp,
+    keep: Keep,
+    easy_cells: bool,
+    cells: Cells,
+}
+
+impl<'s> Planning<'s> {
+    /// The operation `a op b` over the octree of `root`.
+    fn new(solids: Both<&'s Solid>, op: BoolOp, opts: &Options, root: IBox) -> Planning<'s> {
+        Planning {
+            solids,
+            op,
+            keep: Keep(op),
+            easy_cells: opts.easy_cells,
+            cells: Cells::build(solids, root, opts),
+        }
+    }
+
+    /// Every phase after the octree's, in turn.
+    fn decide(self) -> Result<Decided, CsgError> {
+        let leaves = &self.cells.leaves;
+        // the regions free of each surface, and their labels
+        let regions =
+            Both::join(|o| FreeRegions::new(leaves, &self.cells.adjacent, o, self.solids.get(o)));
+        // the faces wholly in free leaves, and the pieces of the others
+        let sorted = Both::join(|o| self.sort(o));
         let mixed: Vec<u32> = (0..leaves.len() as u32)
             .filter(|&l| leaves[l as usize].mixed())
             .collect();
-        // The faces that may meet the other surface: those not apart from
-        // some face of it in some mixed cell (whole faces, by their
-        // support planes). Every other face meets the other surface
-        // nowhere (a common point would lie in a cell listing both), so it
-        // is kept or dropped whole by one label (`label_untouched`); a
-        // mixed cell all of whose faces are such ("clean") does nothing.
-        // (without easy cells every mixed cell builds its trees, and the
-        // untouched faces take their labels from them: the same result)
-        let (meets_a, meets_b, mut clean) = touched(&mixed, &leaves, self, other);
-        if !opts.easy_cells {
-            clean.iter_mut().for_each(|c| *c = false);
-        }
-        let touched_a = |f: u32| meets_a.get(f as usize) != Some(&false);
-        let touched_b = |f: u32| meets_b.get(f as usize) != Some(&false);
-        let untouched_a = |f: u32| !touched_a(f);
-        let untouched_b = |f: u32| !touched_b(f);
-        // Each cell clips its faces to its walls itself, so that only the
-        // cells at work hold their pieces, and finds the pieces that meet
-        // no piece of the other surface (isolated). A cell whose pieces are
-        // all isolated ("easy") builds nothing: its pieces' labels are
-        // carried along their faces from the neighbouring cells
-        // (`label_easy`). The others build their partitions and give
-        // back what stays.
-        let run = |l: u32, allow_easy: bool| -> Result<First, CsgError> {
-            let leaf = &leaves[l as usize];
-            let (bx, w) = (leaf.bx, walls(&leaf.bx));
-            let masks = |pieces: &[Polygon], iso: &[bool], index: &[Option<u32>]| {
-                index
-                    .iter()
-                    .map(|i| {
-                        i.filter(|&i| iso[i as usize])
-                            .map(|i| local::wall_edges(&pieces[i as usize], &w))
-                    })
-                    .collect::<Vec<Option<u8>>>()
-            };
-            // Untouched faces are isolated, and their pieces need no
-            // labels of their own (their faces' are known): a cell tries
-            // to be easy with only the other faces clipped. Their pieces
-            // are the nodes of `label_easy`; an untouched face stands
-            // there by its grid corners in the cell, with its label.
-            let mut tried = None;
-            if allow_easy {
-                let (pa, ia) = clip_all(&leaf.a, |f| self.face(f), &bx, &w, &touched_a);
-                let (pb, ib) = clip_all(&leaf.b, |f| other.face(f), &bx, &w, &touched_b);
-                let (isa, isb) = local::isolated(&pa, &pb);
-                if isa.iter().chain(&isb).all(|&x| x) {
-                    let (ma, mb) = (masks(&pa, &isa, &ia), masks(&pb, &isb, &ib));
-                    let la = Listed::new(&leaf.a, |f| self.face(f), &pa, &ia, touched_a, &bx);
-                    let lb = Listed::new(&leaf.b, |f| other.face(f), &pb, &ib, touched_b, &bx);
-                    return Ok(First::Easy((ma, la), (mb, lb)));
-                }
-                tried = Some(((pa, ia), (pb, ib)));
-            }
-            // every face's piece (those clipped already reused)
-            let (pa, ia, pb, ib) = match tried {
-                Some(((pa, ia), (pb, ib))) => {
-                    let (pa, ia) =
-                        clip_rest(&leaf.a, |f| self.face(f), &bx, &w, &touched_a, pa, &ia);
-                    let (pb, ib) =
-                        clip_rest(&leaf.b, |f| other.face(f), &bx, &w, &touched_b, pb, &ib);
-                    (pa, ia, pb, ib)
-                }
-                None => {
-                    let (pa, ia) = clip_all(&leaf.a, |f| self.face(f), &bx, &w, &|_| true);
-                    let (pb, ib) = clip_all(&leaf.b, |f| other.face(f), &bx, &w, &|_| true);
-                    (pa, ia, pb, ib)
-                }
-            };
-            let (isa, isb) = local::isolated(&pa, &pb);
-            let (ma, mb) = (masks(&pa, &isa, &ia), masks(&pb, &isb, &ib));
-            let r = bx.0.map(|c| c as i32);
-            let c = local::boolean_pieces(
-                &bx,
-                pa,
-                pb,
-                op,
-                (keep_a, keep_b),
-                || self.winding(r),
-                || other.winding(r),
-            )?;
-            Ok(First::Done(Made::of(c, &ia, &ib), ma, mb))
+        let touched = Touched::find(&mixed, leaves, self.solids, self.easy_cells);
+        let work = CellWork {
+            solids: self.solids,
+            touched: &touched,
+            op: self.op,
         };
-        let first: Vec<(u32, First)> = mixed
+        let mut done = self.run_mixed_cells(&work, &mixed, &touched)?;
+        let untouched = Both::join(|o| {
+            self.labeller(o, &regions, &done.fates)
+                .untouched_faces(&sorted.get(o).pieced, &touched)
+        })
+        .transpose()?;
+        let easy = Both::join(|o| {
+            self.labeller(o, &regions, &done.fates).easy_cells(
+                &self.cells.adjacent,
+                done.crossings.get(o),
+                done.easy_pieces.get(o),
+                untouched.get(o),
+            )
+        })
+        .transpose()?;
+        drop_aside(std::mem::take(&mut done.easy_pieces));
+        self.settle_easy_cells(&work, &mut done, easy)?;
+        let remove = self.changes(&mut done, &regions, sorted, &untouched, &touched)?;
+        Ok(Decided {
+            stats: done.stats,
+            add: done.add,
+            remove,
+            leftovers: (self.cells, regions, done.crossings),
+        })
+    }
+
+    /// Operand `o`'s faces in the octree's box, sorted.
+    fn sort(&self, o: Operand) -> SortedFaces {
+        let solid = self.solids.get(o);
+        sort_faces(
+            self.cells.near.get(o),
+            self.cells.leaves_of.get(o),
+            &self.cells.leaves,
+            &self.cells.root,
+            |f| solid.face(f).bx(),
+            o,
+        )
+    }
+
+    /// The first run of each mixed cell that is not clean, in parallel,
+    /// recorded in order.
+    fn run_mixed_cells(
+        &self,
+        work: &CellWork<'_>,
+        mixed: &[u32],
+        touched: &Touched,
+    ) -> Result<MixedCells, CsgError> {
+        let leaves = &self.cells.leaves;
+        let first: Vec<(u32, CellRun)> = mixed
             .par_iter()
-            .filter(|&&l| !clean[l as usize])
-            .map(|&l| run(l, opts.easy_cells).map(|r| (l, r)))
+            .filter(|&&l| !touched.clean(l))
+            .map(|&l| {
+                work.run(&leaves[l as usize], self.easy_cells)
+                    .map(|r| (l, r))
+            })
             .collect::<Result<_, _>>()?;
-        let mut stats = Stats {
-            cells: leaves.len(),
-            mixed_cells: mixed.len(),
-            clean_cells: mixed.iter().filter(|&&l| clean[l as usize]).count(),
-            ..Stats::default()
+        let mut done = MixedCells {
+            fates: Both::default(),
+            crossings: Both::default(),
+            easy: Vec::new(),
+            easy_pieces: Both::default(),
+            add: Vec::new(),
+            stats: Stats {
+                cells: leaves.len(),
+                mixed_cells: mixed.len(),
+                clean_cells: mixed.iter().filter(|&&l| touched.clean(l)).count(),
+                ..Stats::default()
+            },
         };
-        let mut add: Vec<Added> = Vec::new();
-        let mut fates_a: FxHashMap<u32, Vec<PieceFate>> = FxHashMap::default();
-        let mut fates_b: FxHashMap<u32, Vec<PieceFate>> = FxHashMap::default();
-        let mut masks_a: FxHashMap<u32, Vec<Option<u8>>> = FxHashMap::default();
-        let mut masks_b: FxHashMap<u32, Vec<Option<u8>>> = FxHashMap::default();
-        let mut easy: Vec<u32> = Vec::new();
-        let mut listed_a: FxHashMap<u32, Listed> = FxHashMap::default();
-        let mut listed_b: FxHashMap<u32, Listed> = FxHashMap::default();
-        // a cell done: its boundary (merged) or its fates
-        let mut done = |l: u32,
-                        made: Made,
-                        fates_a: &mut FxHashMap<_, _>,
-                        fates_b: &mut FxHashMap<_, _>| match made {
-            Made::Merged(ps) => {
-                stats.merged_cells += 1;
-                add.extend(ps.into_iter().map(|p| Added::New(Box::new(p))))
-            }
-            Made::Fates(fa, fb) => {
-                fates_a.insert(l, fa);
-                fates_b.insert(l, fb);
-            }
-        };
-        for (l, r) in first {
-            match r {
-                First::Easy((ma, la), (mb, lb)) => {
-                    easy.push(l);
-                    masks_a.insert(l, ma);
-                    masks_b.insert(l, mb);
-                    listed_a.insert(l, la);
-                    listed_b.insert(l, lb);
-                }
-                First::Done(made, ma, mb) => {
-                    if matches!(made, Made::Fates(..)) {
-                        masks_a.insert(l, ma);
-                        masks_b.insert(l, mb);
-                    }
-                    done(l, made, &mut fates_a, &mut fates_b);
-                }
-            }
+        for (l, run) in first {
+            done.record(l, run);
         }
-        // the easy cells' labels
-        // a piece kept whole is inside when pieces inside are kept
-        fn label_of(
-            fates: &FxHashMap<u32, Vec<PieceFate>>,
-            keep_inside: bool,
-        ) -> impl Fn(u32, u32) -> Option<bool> + Sync + '_ {
-            move |l: u32, i: u32| match fates.get(&l).map(|v| &v[i as usize]) {
-                Some(PieceFate::Keep) => Some(keep_inside),
-                Some(PieceFate::Drop) => Some(!keep_inside),
-                _ => None,
-            }
+        Ok(done)
+    }
+
+    /// The labelling of operand `o`'s pieces.
+    fn labeller<'p>(
+        &'p self,
+        o: Operand,
+        regions: &'p Both<FreeRegions>,
+        fates: &'p Both<FxHashMap<u32, Vec<PieceFate>>>,
+    ) -> Labeller<'p> {
+        Labeller {
+            operand: o,
+            solid: self.solids.get(o),
+            other: self.solids.get(o.other()),
+            leaves: &self.cells.leaves,
+            other_regions: regions.get(o.other()),
+            fates: fates.get(o),
+            keep_inside: self.keep.piece(o, true),
         }
-        // the untouched faces' labels
-        let (untouched_la, untouched_lb) = rayon::join(
-            || {
-                label_untouched(
-                    &pieces_a,
-                    self.faces.len(),
-                    &untouched_a,
-                    |f| self.face(f),
-                    &leaves,
-                    &label_of(&fates_a, keep_a(true)),
-                    &|l| inside_b.inside(l),
-                    &|g| other.winding(g) != 0,
-                )
-            },
-            || {
-                label_untouched(
-                    &pieces_b,
-                    other.faces.len(),
-                    &untouched_b,
-                    |f| other.face(f),
-                    &leaves,
-                    &label_of(&fates_b, keep_b(true)),
-                    &|l| inside_a.inside(l),
-                    &|g| self.winding(g) != 0,
-                )
-            },
-        );
-        // (from the cells that built their trees, free cells, each other
-        // and winding numbers; by face id)
-        let (face_la, face_lb) = (untouched_la?, untouched_lb?);
-        let (labels_a, labels_b) = rayon::join(
-            || {
-                label_easy(
-                    true,
-                    |f| self.face(f),
-                    &leaves,
-                    &adjacent,
-                    &masks_a,
-                    &listed_a,
-                    &label_of(&fates_a, keep_a(true)),
-                    &|f| face_la[f as usize],
-                    &|l| inside_b.inside(l),
-                    &|g| other.winding(g) != 0,
-                )
-            },
-            || {
-                label_easy(
-                    false,
-                    |f| other.face(f),
-                    &leaves,
-                    &adjacent,
-                    &masks_b,
-                    &listed_b,
-                    &label_of(&fates_b, keep_b(true)),
-                    &|f| face_lb[f as usize],
-                    &|l| inside_a.inside(l),
-                    &|g| self.winding(g) != 0,
-                )
-            },
-        );
-        let (mut labels_a, mut labels_b) = (labels_a?, labels_b?);
-        drop_aside((listed_a, listed_b));
-        // an easy cell with a piece no label reached does the full work
+    }
+
+    /// The easy cells settled by their pieces' labels `labels`: an easy
+    /// cell with a piece no label reached does the full work.
+    fn settle_easy_cells(
+        &self,
+        work: &CellWork<'_>,
+        done: &mut MixedCells,
+        mut labels: Both<FxHashMap<u32, Vec<Option<bool>>>>,
+    ) -> Result<(), CsgError> {
         let mut again: Vec<u32> = Vec::new();
-        for l in easy {
-            let la = labels_a.remove(&l).expect("an easy cell");
-            let lb = labels_b.remove(&l).expect("an easy cell");
-            let settled =
-                |masks: &[Option<u8>], labels: &[Option<bool>], keep: &dyn Fn(bool) -> bool| {
-                    masks
-                        .iter()
-                        .zip(labels)
-                        .map(|(m, lab)| match (m, lab) {
-                            (None, _) => Some(PieceFate::Missing),
-                            (Some(_), Some(inside)) => Some(if keep(*inside) {
-                                PieceFate::Keep
-                            } else {
-                                PieceFate::Drop
-                            }),
-                            (Some(_), None) => None,
-                        })
-                        .collect::<Option<Vec<PieceFate>>>()
-                };
-            let sa = settled(&masks_a[&l], &la, &keep_a);
-            let sb = settled(&masks_b[&l], &lb, &keep_b);
-            match (sa, sb) {
-                (Some(sa), Some(sb)) => {
-                    stats.easy_cells += 1;
-                    fates_a.insert(l, sa);
-                    fates_b.insert(l, sb);
+        for l in std::mem::take(&mut done.easy) {
+            let la = labels.a.remove(&l).expect("an easy cell");
+            let lb = labels.b.remove(&l).expect("an easy cell");
+            let fa = easy_fates(&done.crossings.a[&l], &la, |x| {
+                self.keep.piece(Operand::A, x)
+            });
+            let fb = easy_fates(&done.crossings.b[&l], &lb, |x| {
+                self.keep.piece(Operand::B, x)
+            });
+            match (fa, fb) {
+                (Some(fa), Some(fb)) => {
+                    done.stats.easy_cells += 1;
+                    done.fates.a.insert(l, fa);
+                    done.fates.b.insert(l, fb);
                 }
                 _ => again.push(l),
             }
         }
-        let redone: Vec<(u32, First)> = again
+        let leaves = &self.cells.leaves;
+        let redone: Vec<(u32, CellRun)> = again
             .into_par_iter()
-            .map(|l| run(l, false).map(|r| (l, r)))
+            .map(|l| work.run(&leaves[l as usize], false).map(|r| (l, r)))
             .collect::<Result<_, _>>()?;
-        for (l, r) in redone {
-            match r {
-                First::Done(made, _, _) => done(l, made, &mut fates_a, &mut fates_b),
-                First::Easy(..) => unreachable!("a second run does the full work"),
+        for (l, run) in redone {
+            match run {
+                CellRun::Built { outcome, .. } => done.built(l, outcome),
+                CellRun::Easy { .. } => unreachable!("a second run does the full work"),
             }
         }
+        Ok(())
+    }
+}
 
-        // the changes, now that everything is known
-        // (decided in parallel, applied in order)
-        let mut remove: Vec<u32> = whole_a
-            .par_iter()
-            .filter(|&&i| {
-                let inside =
-                    meeting_leaf(self.face(a_c[i as usize]), &a_leaves[i as usize], &leaves)
-                        .is_some_and(|l| inside_b.inside(l));
-                !keep_a(inside)
-            })
-            .map(|&i| a_c[i as usize])
-            .collect();
-        // a piece beyond the octree's box is beyond the other solid's box
-        // (an untouched face stays or goes whole by its label; a face the
-        // other surface may meet has no piece in a clean cell)
-        let settle_all = |pieces: &[(u32, Vec<Piece>)],
-                          solid: &Solid,
-                          keep: &(dyn Fn(bool) -> bool + Sync),
-                          other_side: &Regions,
-                          fates: &FxHashMap<u32, Vec<PieceFate>>,
-                          labels: &[Option<bool>]|
-         -> Result<Settled, CsgError> {
-            pieces
-                .par_iter()
-                .map(|(f, pieces)| {
-                    if let Some(inside) = labels[*f as usize] {
-                        return Ok((*f, (!keep(inside)).then(Vec::new)));
-                    }
-                    if pieces
-                        .iter()
-                        .any(|p| matches!(p, Piece::Mixed(l, _) if clean[*l as usize]))
-                    {
-                        return Err(CsgError::Internal(
-                            "a face the other surface may meet has a piece in a clean cell".into(),
-                        ));
-                    }
-                    let kept = settle(
-                        solid.face(*f),
-                        pieces,
-                        &|l| keep(l.is_some_and(|l| other_side.inside(l))),
-                        fates,
-                        &leaves,
-                        &root_walls,
-                    );
-                    Ok((*f, kept))
-                })
-                .collect()
-        };
+impl Planning<'_> {
+    /// The changes to the first solid, now that everything is known
+    /// (decided in parallel, applied in order): the faces to remove, and
+    /// those to add after the merged cells' boundaries in `done.add`;
+    /// `labels` are the untouched faces'.
+    fn changes(
+        &self,
+        done: &mut MixedCells,
+        regions: &Both<FreeRegions>,
+        sorted: Both<SortedFaces>,
+        labels: &Both<Vec<Option<bool>>>,
+        touched: &Touched,
+    ) -> Result<Vec<u32>, CsgError> {
+        let mut remove = self.whole_faces(Operand::A, &sorted.a, regions, false);
         // the two operands' faces at once (each in parallel, but each
         // with sequential tails)
+        let settle_faces = |o: Operand| {
+            let pieced = &sorted.get(o).pieced;
+            self.settle_faces(
+                o,
+                pieced,
+                regions,
+                done.fates.get(o),
+                labels.get(o),
+                touched,
+            )
+        };
         let (settled_a, (kept_b, settled_b)) = rayon::join(
-            || settle_all(&pieces_a, self, &keep_a, &inside_b, &fates_a, &face_la),
+            || settle_faces(Operand::A),
             || {
                 rayon::join(
                     // the other solid's faces kept whole are listed, to be
-                    // copied or moved over (flipped for a difference)
-                    || -> Vec<u32> {
-                        whole_b
-                            .par_iter()
-                            .filter(|&&i| {
-                                let inside = meeting_leaf(
-                                    other.face(b_c[i as usize]),
-                                    &b_leaves[i as usize],
-                                    &leaves,
-                                )
-                                .is_some_and(|l| inside_a.inside(l));
-                                keep_b(inside)
-                            })
-                            .map(|&i| b_c[i as usize])
-                            .collect()
-                    },
-                    || settle_all(&pieces_b, other, &keep_b, &inside_a, &fates_b, &face_lb),
+                    // copied or moved over (turned around for a difference)
+                    || self.whole_faces(Operand::B, &sorted.b, regions, true),
+                    || settle_faces(Operand::B),
                 )
             },
         );
-        drop_aside((pieces_a, fates_a, pieces_b, fates_b));
+        drop_aside((sorted, std::mem::take(&mut done.fates)));
         let (settled_a, settled_b) = (settled_a?, settled_b?);
-        for (f, outcome) in settled_a {
-            if let Some(kept) = outcome {
-                remove.push(f);
-                if !kept.is_empty() {
-                    stats.cut_faces += 1;
-                    stats.pieces += kept.len();
-                }
-                add.extend(kept.into_iter().map(|p| Added::New(Box::new(p))));
+        let (stats, add) = (&mut done.stats, &mut done.add);
+        for s in settled_a {
+            if let Remains::Parts(kept) = s.remains {
+                remove.push(s.face);
+                count_cut(stats, &kept);
+                add.extend(kept.into_iter().map(|p| AddedFace::New(Box::new(p))));
             }
         }
-        add.extend(kept_b.into_iter().map(Added::Whole));
-        for (f, outcome) in settled_b {
-            match outcome {
-                None => add.push(Added::Whole(f)),
-                Some(kept) => {
-                    if !kept.is_empty() {
-                        stats.cut_faces += 1;
-                        stats.pieces += kept.len();
-                    }
+        add.extend(kept_b.into_iter().map(AddedFace::Theirs));
+        let flip = self.op == BoolOp::Difference;
+        for s in settled_b {
+            match s.remains {
+                Remains::Whole => add.push(AddedFace::Theirs(s.face)),
+                Remains::Parts(kept) => {
+                    count_cut(stats, &kept);
                     add.extend(
                         kept.into_iter()
-                            .map(|p| Added::New(Box::new(if flip_b { p.flipped() } else { p }))),
+                            .map(|p| AddedFace::New(Box::new(if flip { p.flipped() } else { p }))),
                     );
                 }
             }
         }
         // the faces away from the shared box: outside the other solid
-        if op == BoolOp::Union {
-            let mut near = vec![false; other.faces.len()];
-            b_c.iter().for_each(|&f| near[f as usize] = true);
-            for (i, f) in other.faces.iter().enumerate() {
-                if f.is_some() && !near[i] {
-                    add.push(Added::Whole(i as u32));
-                }
+        match self.op {
+            BoolOp::Union => {
+                let far = far_faces(self.solids.b, &self.cells.near.b);
+                add.extend(far.into_iter().map(AddedFace::Theirs));
             }
+            BoolOp::Intersection => remove.extend(far_faces(self.solids.a, &self.cells.near.a)),
+            BoolOp::Difference => {}
         }
-        if op == BoolOp::Intersection {
-            let mut near = vec![false; self.faces.len()];
-            a_c.iter().for_each(|&f| near[f as usize] = true);
-            for i in 0..self.faces.len() as u32 {
-                if self.faces[i as usize].is_some() && !near[i as usize] {
-                    remove.push(i);
+        Ok(remove)
+    }
+
+    /// Operand `o`'s faces in leaves free of the other surface only
+    /// (`sorted.whole`) that the operation keeps (`kept`) or drops (not
+    /// `kept`), by id: each lies wholly inside or outside the other solid,
+    /// as the region of a leaf it meets says (a face meeting none lies
+    /// beyond the octree's box, so outside the other solid).
+    fn whole_faces(
+        &self,
+        o: Operand,
+        sorted: &SortedFaces,
+        regions: &Both<FreeRegions>,
+        kept: bool,
+    ) -> Vec<u32> {
+        let (solid, other_regions) = (self.solids.get(o), regions.get(o.other()));
+        let (near, leaves_of) = (self.cells.near.get(o), self.cells.leaves_of.get(o));
+        sorted
+            .whole
+            .par_iter()
+            .filter(|&&i| {
+                let face = solid.face(near[i as usize]);
+                let inside = meeting_leaf(face, &leaves_of[i as usize], &self.cells.leaves)
+                    .is_some_and(|l| other_regions.inside(l));
+                self.keep.piece(o, inside) == kept
+            })
+            .map(|&i| near[i as usize])
+            .collect()
+    }
+
+    /// What stays of each of operand `o`'s faces with pieces: by its
+    /// label for an untouched face (`labels`), else piece by piece
+    /// ([`settle`](fn@settle); a piece beyond the octree's box is beyond the other
+    /// solid's box, so outside it).
+    fn settle_faces(
+        &self,
+        o: Operand,
+        pieced: &[PiecedFace],
+        regions: &Both<FreeRegions>,
+        fates: &FxHashMap<u32, Vec<PieceFate>>,
+        labels: &[Option<bool>],
+        touched: &Touched,
+    ) -> Result<Vec<SettledFace>, CsgError> {
+        let (solid, other_regions) = (self.solids.get(o), regions.get(o.other()));
+        let keep = |inside: bool| self.keep.piece(o, inside);
+        let free_stays = |p: &FacePiece| match *p {
+            FacePiece::InFreeLeaf(l) => keep(other_regions.inside(l)),
+            _ => keep(false),
+        };
+        let root_walls = walls(&self.cells.root);
+        pieced
+            .par_iter()
+            .map(|p| {
+                if let Some(inside) = labels[p.face as usize] {
+                    let remains = if keep(inside) {
+                        Remains::Whole
+                    } else {
+                        Remains::Parts(Vec::new())
+                    };
+                    return Ok(SettledFace {
+                        face: p.face,
+                        remains,
+                    });
                 }
-            }
-        }
-        self.remove_all(&remove);
-        // the octree and its lists go on the pool (freeing them here, as
-        // the function returns, held up what follows)
-        drop_aside((leaves, a_leaves, b_leaves, adjacent, a_c, b_c));
-        drop_aside((inside_a, inside_b, masks_a, masks_b, remove));
-        Ok((stats, Plan { add, flip: flip_b }))
+                // (an untouched face stays or goes whole by its label; a
+                // face the other surface may meet has no piece in a clean
+                // cell)
+                let in_clean_cell = |q: &FacePiece| {
+                    matches!(*q, FacePiece::InMixedLeaf { leaf, .. } if touched.clean(leaf))
+                };
+                if p.pieces.iter().any(in_clean_cell) {
+                    return Err(CsgError::Internal(
+                        "a face the other surface may meet has a piece in a clean cell".into(),
+                    ));
+                }
+                let remains = settle(
+                    solid.face(p.face),
+                    &p.pieces,
+                    &free_stays,
+                    fates,
+                    &self.cells.leaves,
+                    &root_walls,
+                );
+                Ok(SettledFace {
+                    face: p.face,
+                    remains,
+                })
+            })
+            .collect()
     }
 }
 
-/// What an operation adds to the first solid, in order: new faces, and
-/// the other solid's faces kept whole (flipped if `flip`).
-pub(crate) struct Plan {
-    pub(crate) add: Vec<Added>,
-    pub(crate) flip: bool,
+/// Counts a face the other surface cuts, into the pieces `kept` (none:
+/// the face is dropped, not cut).
+fn count_cut(stats: &mut Stats, kept: &[bsp_core::Polygon]) {
+    if !kept.is_empty() {
+        stats.cut_faces += 1;
+        stats.pieces += kept.len();
+    }
 }
 
-/// A new face, or (`Whole`) the other solid's face kept whole; new faces
-/// are boxed so that the many whole ones cost a few bytes each.
-pub(crate) enum Added {
-    New(Box<Polygon>),
-    Whole(u32),
+/// The live faces of `solid` not in `near` (ascending ids), in order.
+fn far_faces(solid: &Solid, near: &[u32]) -> Vec<u32> {
+    let mut is_near = vec![false; solid.slot_count()];
+    near.iter().for_each(|&f| is_near[f as usize] = true);
+    solid.face_ids().filter(|&i| !is_near[i as usize]).collect()
+}
+
+/// The fates of an easy cell's listed faces of one operand, from the
+/// walls their pieces cross (`None`: no piece) and the pieces' labels,
+/// `keep(inside)` saying which stay; `None` if a piece got no label.
+fn easy_fates(
+    crossings: &[Option<u8>],
+    labels: &[Option<bool>],
+    keep: impl Fn(bool) -> bool,
+) -> Option<Vec<PieceFate>> {
+    crossings
+        .iter()
+        .zip(labels)
+        .map(|(m, label)| match (m, label) {
+            (None, _) => Some(PieceFate::Missing),
+            (Some(_), Some(inside)) => Some(if keep(*inside) {
+                PieceFate::Keep
+            } else {
+                PieceFate::Drop
+            }),
+            (Some(_), None) => None,
+        })
+        .collect()
 }

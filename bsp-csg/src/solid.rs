@@ -1,49 +1,52 @@
-//! The [`Solid`]: its face slots, the spatial index of their boxes, and
-//! the operations on it.
+//! The [`Solid`]: its face slots and the spatial index of their boxes.
+//! What a solid answers is in `query`, how a planned operation's faces
+//! go into its slots in `carry_out`, its mesh in `mesh_out`.
 
 mod carry_out;
-pub(crate) mod face;
+mod face;
 mod mesh_out;
 mod query;
 mod winding;
 
-use bsp_core::{BoolOp, Polygon};
+use bsp_core::Polygon;
 use rayon::prelude::*;
 use std::borrow::Cow;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU32, Ordering};
 
-pub(crate) use carry_out::Other;
-pub(crate) use face::Face;
+pub(crate) use carry_out::{AddedFace, Additions, OtherFaces};
+pub(crate) use face::SolidFace;
 
 use crate::index::{FaceIndex, IBox, union};
-use crate::plan::Planned;
-use crate::{CsgError, Options, Stats};
 
 /// Faces removed or added at once from which the index is updated in
 /// parallel passes rather than face by face.
-pub(crate) const BULK: usize = 4096;
+const BULK: usize = 4096;
 
 /// The boundary of a closed, outward-oriented polyhedron: plane-based
 /// convex polygons on the grid, with a spatial index of their boxes (see
 /// the crate docs).
 #[derive(Clone, Debug)]
 pub struct Solid {
-    pub(crate) faces: Vec<Option<Face>>,
-    pub(crate) free: Vec<u32>,
+    /// The face slots (`None`: a free slot).
+    faces: Vec<Option<SolidFace>>,
+    /// The free slots; the last one is reused first.
+    free: Vec<u32>,
     /// The spatial index of the faces' boxes, once made: by an operation
     /// carried out on the solid (a solid changed in place is likely to
     /// be changed again), or by a solid's queries once it has been asked
     /// [`SCANS_BEFORE_INDEX`] times; until then a query reads every face
     /// (an operation on two new solids asks each a few times, and making
     /// the index costs more than those reads).
-    pub(crate) index: OnceLock<FaceIndex>,
+    index: OnceLock<FaceIndex>,
     /// The index's design size, to know when to rebuild it.
-    pub(crate) indexed: usize,
+    indexed: usize,
     /// Queries answered by reading every face.
-    pub(crate) scans: Scans,
-    pub(crate) bounds: Option<IBox>,
-    pub(crate) live: usize,
+    scans: Scans,
+    /// The box of the live faces' boxes.
+    bounds: Option<IBox>,
+    /// The number of live faces.
+    live: usize,
 }
 
 impl Solid {
@@ -51,16 +54,16 @@ impl Solid {
     /// closed, outward-oriented polyhedron (not checked; see
     /// [`mesh_boolean`](crate::mesh_boolean) for checked input).
     pub fn from_polygons(polys: Vec<Polygon>) -> Solid {
-        let faces: Vec<Option<Face>> = polys
+        let faces: Vec<Option<SolidFace>> = polys
             .into_par_iter()
-            .map(|p| Some(Face::made(Box::new(p))))
+            .map(|p| Some(SolidFace::made(Box::new(p))))
             .collect();
         Solid::from_faces(faces, Vec::new())
     }
 
     /// The solid of these face slots, indexed; the empty ones are `free`
     /// (each once).
-    pub(crate) fn from_faces(faces: Vec<Option<Face>>, free: Vec<u32>) -> Solid {
+    pub(crate) fn from_faces(faces: Vec<Option<SolidFace>>, free: Vec<u32>) -> Solid {
         debug_assert!(free.iter().all(|&f| faces[f as usize].is_none()));
         let live = faces.len() - free.len();
         let mut s = Solid {
@@ -77,10 +80,10 @@ impl Solid {
     }
 
     /// The box of the live faces' boxes.
-    pub(crate) fn faces_bounds(&self) -> Option<IBox> {
+    fn faces_bounds(&self) -> Option<IBox> {
         self.faces
             .par_iter()
-            .filter_map(|f| f.as_ref().map(Face::bx))
+            .filter_map(|f| f.as_ref().map(SolidFace::bx))
             .reduce_with(|a, b| union(&a, &b))
     }
 
@@ -91,7 +94,7 @@ impl Solid {
 
     /// The bounds found again and the index made anew, sized for the
     /// live faces.
-    pub(crate) fn reindex(&mut self) {
+    fn reindex(&mut self) {
         self.bounds = self.faces_bounds();
         self.indexed = self.live.max(1);
         self.make_index();
@@ -99,11 +102,11 @@ impl Solid {
 
     /// The index of the faces over the bounds, sized for `indexed`, made
     /// now (in parallel).
-    pub(crate) fn make_index(&mut self) {
+    fn make_index(&mut self) {
         self.index = OnceLock::from(FaceIndex::filled(
             self.bounds.unwrap_or(([0; 3], [0; 3])),
             self.indexed,
-            self.faces.par_iter().map(|f| f.as_ref().map(Face::bx)),
+            self.faces.par_iter().map(|f| f.as_ref().map(SolidFace::bx)),
         ));
     }
 
@@ -112,7 +115,7 @@ impl Solid {
     /// every face), then made. (Made on one thread: a query may run on
     /// the thread pool, and a thread making it with the pool's help could
     /// be handed another query that waits for it.)
-    pub(crate) fn query_index(&self) -> Option<&FaceIndex> {
+    fn query_index(&self) -> Option<&FaceIndex> {
         if let Some(index) = self.index.get() {
             return Some(index);
         }
@@ -130,6 +133,21 @@ impl Solid {
         }))
     }
 
+    /// The number of face slots, live or free: every face id is below it.
+    pub(crate) fn slot_count(&self) -> usize {
+        self.faces.len()
+    }
+
+    /// The ids of the live faces, in order.
+    pub(crate) fn face_ids(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.faces.len() as u32).filter(|&i| self.faces[i as usize].is_some())
+    }
+
+    /// The box of the live faces' boxes (`None` for an empty solid).
+    pub(crate) fn bounds(&self) -> Option<IBox> {
+        self.bounds
+    }
+
     /// Number of faces.
     pub fn len(&self) -> usize {
         self.live
@@ -143,14 +161,17 @@ impl Solid {
     /// The faces, each with its edge planes (made for a face kept as
     /// imported, which does not store them).
     pub fn polygons(&self) -> impl Iterator<Item = Cow<'_, Polygon>> + '_ {
-        self.faces.iter().flatten().map(Face::polygon)
+        self.faces.iter().flatten().map(SolidFace::polygon)
     }
 
-    pub(crate) fn face(&self, i: u32) -> &Face {
+    /// The face in slot `i`, which must be live.
+    pub(crate) fn face(&self, i: u32) -> &SolidFace {
         self.faces[i as usize].as_ref().expect("a live face")
     }
 
-    pub(crate) fn remove(&mut self, id: u32) {
+    /// The face in slot `id` taken out, if it is live: its slot is
+    /// free, and the index forgets it.
+    fn remove(&mut self, id: u32) {
         if let Some(f) = self.faces[id as usize].take() {
             if let Some(index) = self.index.get_mut() {
                 index.remove(id, &f.bx());
@@ -189,7 +210,7 @@ impl Solid {
 
     /// Adds the faces `ids` (live, not yet indexed) with their `boxes` to
     /// the bounds, and to the index if there is one, in order.
-    pub(crate) fn index_boxes(
+    fn index_boxes(
         index: Option<&mut FaceIndex>,
         bounds: &mut Option<IBox>,
         ids: &[u32],
@@ -207,94 +228,14 @@ impl Solid {
     }
 }
 
-impl Solid {
-    /// `self op other`, as a new solid.
-    pub fn boolean(&self, other: &Solid, op: BoolOp) -> Result<Solid, CsgError> {
-        let mut s = self.clone();
-        s.apply(other, op)?;
-        Ok(s)
-    }
-
-    /// `self ← self op other`, touching only the faces near `other`.
-    pub fn apply(&mut self, other: &Solid, op: BoolOp) -> Result<Stats, CsgError> {
-        self.apply_with(other, op, &Options::default())
-    }
-
-    /// [`Solid::apply`] with options.
-    pub fn apply_with(
-        &mut self,
-        other: &Solid,
-        op: BoolOp,
-        opts: &Options,
-    ) -> Result<Stats, CsgError> {
-        let (stats, plan) = self.plan(other, op, opts)?;
-        self.carry_out(plan, Other::Borrowed(other));
-        Ok(stats)
-    }
-
-    /// [`Solid::apply`], taking the other solid: the faces it keeps whole
-    /// move over instead of being copied, so that the two are not held
-    /// at once (the same result).
-    pub fn apply_owned(&mut self, other: Solid, op: BoolOp) -> Result<Stats, CsgError> {
-        self.apply_owned_with(other, op, &Options::default())
-    }
-
-    /// [`Solid::apply_owned`] with options.
-    pub fn apply_owned_with(
-        &mut self,
-        mut other: Solid,
-        op: BoolOp,
-        opts: &Options,
-    ) -> Result<Stats, CsgError> {
-        let (stats, plan) = self.plan(&other, op, opts)?;
-        self.carry_out(plan, Other::Owned(&mut other));
-        drop_aside(other);
-        Ok(stats)
-    }
-
-    /// `self op other`, decided but not yet carried out: the result is
-    /// then made as a mesh ([`Planned::into_watertight_mesh`]) straight
-    /// from the two solids' faces, with no solid of its own (the last
-    /// operation of a sequence needs none), or as a solid
-    /// ([`Planned::into_solid`], what [`Solid::apply_owned`] gives).
-    ///
-    /// ```
-    /// use bsp_core::BoolOp;
-    /// use bsp_csg::{MeshIn, fit_grid, snap_one};
-    /// use bsp_fixtures::sphere_pair;
-    ///
-    /// let (va, vb, faces) = sphere_pair(1000);
-    /// let (a, b) = (MeshIn::new(&va, &faces), MeshIn::new(&vb, &faces));
-    /// let grid = fit_grid(&[a, b]).unwrap();
-    /// let (sa, _) = snap_one(&grid, &a, 0).unwrap();
-    /// let (sb, _) = snap_one(&grid, &b, 1).unwrap();
-    /// let planned = sa.clone().plan_owned(sb.clone(), BoolOp::Union).unwrap();
-    /// assert!(planned.stats().cut_faces > 0);
-    /// let mesh = planned.into_watertight_mesh().unwrap();
-    /// // the mesh of the solid `apply_owned` makes, triangle for triangle
-    /// let mut solid = sa;
-    /// solid.apply_owned(sb, BoolOp::Union).unwrap();
-    /// assert_eq!(mesh.triangles, solid.into_watertight_mesh().unwrap().triangles);
-    /// ```
-    pub fn plan_owned(mut self, other: Solid, op: BoolOp) -> Result<Planned, CsgError> {
-        let (stats, plan) = self.plan(&other, op, &Options::default())?;
-        Ok(Planned {
-            solid: self,
-            other,
-            plan,
-            stats,
-        })
-    }
-}
-
 /// Queries a solid answers by reading every face before it makes its
 /// index ([`Solid::query_index`]).
-pub(crate) const SCANS_BEFORE_INDEX: u32 = 8;
+const SCANS_BEFORE_INDEX: u32 = 8;
 
 /// A count of queries, shared by the threads asking (a copy starts with
 /// the count so far).
 #[derive(Debug, Default)]
-pub(crate) struct Scans(AtomicU32);
+struct Scans(AtomicU32);
 
 impl Clone for Scans {
     fn clone(&self) -> Scans {

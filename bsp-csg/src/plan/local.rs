@@ -60,10 +60,10 @@ pub(crate) fn solid(
 }
 
 /// How a cell's trees choose their planes: 4 candidate planes, each
-/// scored on 16 of the pieces (the defaults, 8 on 48, are for large
-/// trees). A cell holds a few dozen pieces a side, and choosing was 7% of
-/// the samples of 1 000 subtractions (the drill's whole run about 6%
-/// faster with these, for 1% more output triangles).
+/// scored on 16 of the pieces. The defaults (8 on 48) are for large
+/// trees; a cell holds a few dozen pieces a side, where a cheaper choice
+/// saves more time than its slightly larger trees cost
+/// (`docs/bench-csg.md`).
 fn local_build() -> BuildOptions {
     BuildOptions::default().with_candidates(4).with_sample(16)
 }
@@ -589,7 +589,11 @@ fn walls_crossed<'w>(fb: &IBox, cell: &IBox, w: &'w [Plane; 6]) -> impl Iterator
 /// [`clip_in`] for a solid's face: an imported face is clipped from its
 /// grid corners ([`GridPolygon::clipped`](bsp_core::internals::GridPolygon::clipped):
 /// the same piece, made more cheaply), only when its box meets the cell.
-pub(crate) fn clip_face(face: &crate::solid::Face, cell: &IBox, w: &[Plane; 6]) -> Option<Polygon> {
+pub(crate) fn clip_face(
+    face: &crate::solid::SolidFace,
+    cell: &IBox,
+    w: &[Plane; 6],
+) -> Option<Polygon> {
     let fb = face.bx();
     if !overlaps(&fb, cell) {
         return None;

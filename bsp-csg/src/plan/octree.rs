@@ -13,6 +13,7 @@ use bsp_core::internals::ConvexFace;
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
+use super::operands::Operand;
 use crate::index::{IBox, SmallBox};
 
 /// A leaf of the octree: its box and the faces of each operand whose box
@@ -25,8 +26,23 @@ pub(crate) struct Leaf {
 }
 
 impl Leaf {
+    /// Whether the leaf holds faces of both operands.
     pub(crate) fn mixed(&self) -> bool {
         !self.a.is_empty() && !self.b.is_empty()
+    }
+
+    /// The leaf's faces of operand `o`.
+    pub(crate) fn faces(&self, o: Operand) -> &Vec<u32> {
+        match o {
+            Operand::A => &self.a,
+            Operand::B => &self.b,
+        }
+    }
+
+    /// Whether the leaf holds no face of operand `o`: it is free of that
+    /// operand's surface.
+    pub(crate) fn free_of(&self, o: Operand) -> bool {
+        self.faces(o).is_empty()
     }
 }
 
@@ -157,11 +173,11 @@ pub(crate) fn build<P: PlaneTest, Q: PlaneTest>(
         a: (0..a.boxes.len() as u32).collect(),
         b: (0..b.boxes.len() as u32).collect(),
     };
-    grow(root, 0, &Octree { a, b, leaf_size })
+    grow(root, 0, &Build { a, b, leaf_size })
 }
 
 /// What the build works from.
-struct Octree<'f, 'a, P, Q> {
+struct Build<'f, 'a, P, Q> {
     a: &'f Faces<'a, P>,
     b: &'f Faces<'a, Q>,
     leaf_size: usize,
@@ -173,11 +189,7 @@ const PARALLEL_FACES: usize = 2048;
 
 /// The leaves under `cell`, in order; `stalled` counts the splits in a row
 /// that made no progress.
-fn grow<P: PlaneTest, Q: PlaneTest>(
-    cell: Leaf,
-    stalled: u8,
-    o: &Octree<'_, '_, P, Q>,
-) -> Vec<Leaf> {
+fn grow<P: PlaneTest, Q: PlaneTest>(cell: Leaf, stalled: u8, o: &Build<'_, '_, P, Q>) -> Vec<Leaf> {
     let mut leaves = Vec::new();
     let mut stack = vec![(cell, stalled)];
     while let Some((cell, stalled)) = stack.pop() {
@@ -203,7 +215,7 @@ fn grow<P: PlaneTest, Q: PlaneTest>(
 fn split<P: PlaneTest, Q: PlaneTest>(
     cell: &Leaf,
     stalled: u8,
-    o: &Octree<'_, '_, P, Q>,
+    o: &Build<'_, '_, P, Q>,
 ) -> Option<(Vec<Leaf>, u8)> {
     let (a, b, leaf_size) = (o.a, o.b, o.leaf_size);
     let (lo, hi) = cell.bx;

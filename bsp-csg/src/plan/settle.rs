@@ -1,5 +1,8 @@
-//! Sorting each face into the cells it crosses, and settling what stays
-//! of it once every cell is decided.
+//! Sorting each face into the leaves it crosses ([`sort_faces`]), and
+//! settling what stays of it once every cell is decided ([`settle`]):
+//! a face none of whose pieces the other surface cuts stays exactly as
+//! it was, however many cells it spans; the others are replaced by their
+//! kept pieces and fragments, put back together where they can be.
 
 use bsp_core::Polygon;
 use bsp_core::internals::ConvexFace;
@@ -9,68 +12,98 @@ use smallvec::SmallVec;
 use super::local;
 use super::mixed_cell::PieceFate;
 use super::octree::{Leaf, walls};
+use super::operands::Operand;
 use crate::index::{IBox, holds};
-use crate::solid::Face;
+use crate::solid::SolidFace;
 
-/// A piece of a face cut by octree walls: in a cell free of the other
-/// surface (or `None`: beyond the octree's box), or in a mixed cell as
-/// the `i`-th face of the cell's list; neither is clipped until needed.
-pub(crate) enum Piece {
-    Free(Option<u32>),
-    Mixed(u32, u32),
+/// Where a piece of a face (the face cut by the octree's walls) lies; it
+/// is not clipped until it must be.
+pub(super) enum FacePiece {
+    /// In a leaf free of the other surface.
+    InFreeLeaf(u32),
+    /// Beyond the octree's box, so beyond the other solid's.
+    BeyondOctree,
+    /// In a mixed leaf, as the `listed`-th face of its list of this
+    /// operand.
+    InMixedLeaf { leaf: u32, listed: u32 },
 }
 
-/// Faces wholly in cells free of the other surface (by their place in the
-/// list sorted), and the pieces of every other face (by id).
-pub(crate) type Sorted = (Vec<u32>, Vec<(u32, Vec<Piece>)>);
+/// A face with pieces in mixed leaves, and all its pieces.
+pub(super) struct PiecedFace {
+    pub(super) face: u32,
+    pub(super) pieces: Vec<FacePiece>,
+}
 
-/// Faces with pieces, each with what stays of it ([`settle`]).
-pub(crate) type Settled = Vec<(u32, Option<Vec<Polygon>>)>;
+/// One operand's faces in the octree's box, sorted.
+pub(super) struct SortedFaces {
+    /// The faces only in leaves free of the other surface, by their place
+    /// in the list sorted.
+    pub(super) whole: Vec<u32>,
+    /// Every other face, by id, with its pieces.
+    pub(super) pieced: Vec<PiecedFace>,
+}
 
-/// Sorts `faces` (their leaves `leaves_of`, by place) into those in free
-/// cells only and those with pieces in mixed cells. `side(leaf)` gives the
-/// leaf's list of this operand's faces and whether it is free of the
-/// other surface; a face's piece in a mixed leaf is named by its place in
-/// that list (the leaves list the faces in the order of `faces`).
-pub(crate) fn sort_faces<'l>(
+/// A face with pieces, settled.
+pub(super) struct SettledFace {
+    pub(super) face: u32,
+    pub(super) remains: Remains,
+}
+
+/// What stays of a face with pieces.
+pub(super) enum Remains {
+    /// The whole face, as it is.
+    Whole,
+    /// These polygons instead (none: the face goes).
+    Parts(Vec<Polygon>),
+}
+
+/// Sorts operand `o`'s `faces` (their leaves `leaves_of`, by place) into
+/// those in leaves free of the other surface only and those with pieces
+/// in mixed leaves. A face's piece in a mixed leaf is named by its place
+/// in the leaf's list of `o`'s faces (the leaves list the faces in the
+/// order of `faces`); `bx` gives a face's box.
+pub(super) fn sort_faces(
     faces: &[u32],
     leaves_of: &[SmallVec<[u32; 4]>],
-    leaves: &'l [Leaf],
+    leaves: &[Leaf],
     root: &IBox,
     bx: impl Fn(u32) -> IBox,
-    side: impl Fn(&'l Leaf) -> (&'l Vec<u32>, bool),
-) -> Sorted {
+    o: Operand,
+) -> SortedFaces {
     let mut whole = Vec::new();
-    let mut pieces = Vec::new();
+    let mut pieced = Vec::new();
     // per leaf, the faces met so far
     let mut seen: Vec<u32> = vec![0; leaves.len()];
-    let free = |l: u32| side(&leaves[l as usize]).1;
+    let free = |l: u32| leaves[l as usize].free_of(o.other());
     for (i, (&f, ls)) in faces.iter().zip(leaves_of).enumerate() {
         // a face in no cell lies beyond the octree's box
         if ls.iter().all(|&l| free(l)) {
             whole.push(i as u32);
             continue;
         }
-        let mut mine: Vec<Piece> = ls
+        let mut pieces: Vec<FacePiece> = ls
             .iter()
             .map(|&l| {
                 if free(l) {
-                    Piece::Free(Some(l))
+                    FacePiece::InFreeLeaf(l)
                 } else {
                     let at = seen[l as usize];
                     seen[l as usize] += 1;
-                    debug_assert_eq!(side(&leaves[l as usize]).0[at as usize], f);
-                    Piece::Mixed(l, at)
+                    debug_assert_eq!(leaves[l as usize].faces(o)[at as usize], f);
+                    FacePiece::InMixedLeaf {
+                        leaf: l,
+                        listed: at,
+                    }
                 }
             })
             .collect();
         let fb = bx(f);
         if (0..3).any(|k| fb.0[k] < root.0[k] || fb.1[k] > root.1[k]) {
-            mine.push(Piece::Free(None));
+            pieces.push(FacePiece::BeyondOctree);
         }
-        pieces.push((f, mine));
+        pieced.push(PiecedFace { face: f, pieces });
     }
-    (whole, pieces)
+    SortedFaces { whole, pieced }
 }
 
 /// A leaf among `ls` (the leaves a face's box and plane tests put it in)
@@ -79,7 +112,7 @@ pub(crate) fn sort_faces<'l>(
 /// name leaves the face does not reach, whose region may lie on the other
 /// side of the other surface; `None` if it meets none (it lies beyond the
 /// octree's box, so beyond the other solid).
-pub(crate) fn meeting_leaf(face: &Face, ls: &[u32], leaves: &[Leaf]) -> Option<u32> {
+pub(super) fn meeting_leaf(face: &SolidFace, ls: &[u32], leaves: &[Leaf]) -> Option<u32> {
     for i in 0..face.corner_count() {
         if let Some(g) = face.corner(i).as_grid()
             && let Some(&l) = ls.iter().find(|&&l| holds(&leaves[l as usize].bx, &g))
@@ -95,45 +128,48 @@ pub(crate) fn meeting_leaf(face: &Face, ls: &[u32], leaves: &[Leaf]) -> Option<u
     })
 }
 
-/// What stays of a face cut into `pieces`: `None` if every piece stays
-/// (the face stays as it is), else the kept pieces and fragments.
-/// `keep_free(cell)` says whether a piece in a free cell (`None`: beyond
-/// the octree's box) stays; `fates` are the mixed cells' (the fragments
-/// kept are copied: faces settle in parallel). The face is clipped anew
-/// to the cells whose piece stays whole, joined into larger boxes.
-pub(crate) fn settle(
-    face: &Face,
-    pieces: &[Piece],
-    keep_free: &dyn Fn(Option<u32>) -> bool,
+/// What stays of a face cut into `pieces`. `free_stays(piece)` says
+/// whether a piece in a free leaf or beyond the octree's box stays;
+/// `fates` are the mixed cells' (the fragments kept are copied: faces
+/// settle in parallel). The face is clipped anew to the leaves whose
+/// piece stays whole, joined into larger boxes (`root` holds the walls
+/// of the octree's box).
+pub(super) fn settle(
+    face: &SolidFace,
+    pieces: &[FacePiece],
+    free_stays: &dyn Fn(&FacePiece) -> bool,
     fates: &FxHashMap<u32, Vec<PieceFate>>,
     leaves: &[Leaf],
     root: &[bsp_core::Plane; 6],
-) -> Option<Vec<Polygon>> {
-    // `None`: the piece is in a merged cell's output
-    let fate = |p: &Piece| match p {
-        Piece::Free(l) if keep_free(*l) => Some(Ok(())),
-        Piece::Free(_) => Some(Err(())),
-        Piece::Mixed(l, i) => fates.get(l).map(|v| match &v[*i as usize] {
-            PieceFate::Missing | PieceFate::Keep => Ok(()),
-            PieceFate::Drop | PieceFate::Cut(_) => Err(()),
-        }),
+) -> Remains {
+    let fate = |leaf: u32, listed: u32| fates.get(&leaf).map(|v| &v[listed as usize]);
+    // (a piece in a merged cell, with no fates, does not stay whole: the
+    // cell's boundary replaces it)
+    let stays_whole = |p: &FacePiece| match *p {
+        FacePiece::InMixedLeaf { leaf, listed } => {
+            matches!(
+                fate(leaf, listed),
+                Some(PieceFate::Missing | PieceFate::Keep)
+            )
+        }
+        _ => free_stays(p),
     };
-    if pieces.iter().all(|p| fate(p) == Some(Ok(()))) {
-        return None;
+    if pieces.iter().all(stays_whole) {
+        return Remains::Whole;
     }
     // the cells whose piece stays whole (the face clipped to the cell),
     // and the fragments of the cells that cut it
     let mut kept = Vec::new();
     let mut whole: Vec<IBox> = Vec::new();
     for p in pieces {
-        match p {
-            Piece::Free(Some(l)) if keep_free(Some(*l)) => whole.push(leaves[*l as usize].bx),
-            Piece::Free(None) if keep_free(None) => {
+        match *p {
+            FacePiece::InFreeLeaf(l) if free_stays(p) => whole.push(leaves[l as usize].bx),
+            FacePiece::BeyondOctree if free_stays(p) => {
                 kept.extend(local::outside(&face.polygon(), root))
             }
-            Piece::Free(_) => {}
-            Piece::Mixed(l, i) => match fates.get(l).map(|v| &v[*i as usize]) {
-                Some(PieceFate::Keep) => whole.push(leaves[*l as usize].bx),
+            FacePiece::InFreeLeaf(_) | FacePiece::BeyondOctree => {}
+            FacePiece::InMixedLeaf { leaf, listed } => match fate(leaf, listed) {
+                Some(PieceFate::Keep) => whole.push(leaves[leaf as usize].bx),
                 Some(PieceFate::Cut(frags)) => kept.extend(frags.iter().cloned()),
                 _ => {}
             },
@@ -148,7 +184,7 @@ pub(crate) fn settle(
             .iter()
             .filter_map(|bx| local::clip_face(face, bx, &walls(bx))),
     );
-    Some(rejoin(kept))
+    Remains::Parts(rejoin(kept))
 }
 
 /// Joins boxes that tile space without overlap into fewer boxes covering
@@ -156,7 +192,7 @@ pub(crate) fn settle(
 /// same extent along two axes, one just after the other along the
 /// third), axis after axis, until none do. The result does not depend on
 /// the boxes' order.
-pub(crate) fn join_boxes(boxes: &mut Vec<IBox>) {
+fn join_boxes(boxes: &mut Vec<IBox>) {
     loop {
         let before = boxes.len();
         for k in 0..3 {
@@ -186,7 +222,7 @@ pub(crate) fn join_boxes(boxes: &mut Vec<IBox>) {
 /// a piece per cell would be a polygon per cell in the result (more
 /// vertices to weld, more triangles). The same region, exactly; pieces
 /// whose edges meet partly (a T-junction) stay apart.
-pub(crate) fn rejoin(pieces: Vec<Polygon>) -> Vec<Polygon> {
+fn rejoin(pieces: Vec<Polygon>) -> Vec<Polygon> {
     if pieces.len() < 2 {
         return pieces;
     }

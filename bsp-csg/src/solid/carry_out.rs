@@ -1,68 +1,111 @@
-//! A planned operation carried out: the faces it adds written into the
-//! solid's slots.
+//! An operation's additions carried out: the faces it adds written into
+//! the solid's slots, and the index told of them.
 
 use bsp_core::Polygon;
 use bsp_core::internals::share_points;
 use rayon::prelude::*;
 
-use super::face::Shape;
-use super::{Face, Solid};
+use super::{Solid, SolidFace};
 use crate::index::IBox;
-use crate::plan::{Added, Plan};
+
+/// What an operation adds to the first solid, in order: new faces, and
+/// the other solid's faces kept whole (turned around if `flip`, for a
+/// difference).
+pub(crate) struct Additions {
+    pub(crate) faces: Vec<AddedFace>,
+    pub(crate) flip: bool,
+}
+
+/// A face an operation adds: a new one (boxed, so that the many faces
+/// kept whole cost a few bytes each), or the other solid's face kept
+/// whole, by its id there.
+pub(crate) enum AddedFace {
+    New(Box<Polygon>),
+    Theirs(u32),
+}
+
+/// The solid an operation takes the faces it keeps whole from.
+pub(crate) enum OtherFaces<'s> {
+    /// Its faces are copied.
+    Copied(&'s Solid),
+    /// Its faces move over (the solid is given up).
+    Moved(&'s mut Solid),
+}
+
+/// Where an added face comes from: a face kept whole from a solid given
+/// up is taken from its slot (distinct slots: one borrow each).
+enum Source<'s> {
+    New(Box<Polygon>),
+    Slot(&'s mut Option<SolidFace>),
+    Copy(&'s SolidFace),
+}
+
+impl Source<'_> {
+    /// The face, the other solid's turned around if `flip`.
+    fn make(self, flip: bool) -> SolidFace {
+        match self {
+            Source::New(p) => SolidFace::made(p),
+            Source::Slot(slot) => {
+                let face = slot.take().expect("a live face");
+                if flip { face.flipped() } else { face }
+            }
+            Source::Copy(face) if flip => face.flipped(),
+            Source::Copy(face) => face.clone(),
+        }
+    }
+}
+
+/// Where each of `faces` comes from, in order.
+fn sources<'s>(faces: Vec<AddedFace>, other: OtherFaces<'s>) -> Vec<Source<'s>> {
+    let (mut slots, borrowed): (Vec<Option<&mut Option<SolidFace>>>, Option<&Solid>) = match other {
+        OtherFaces::Moved(o) => (o.faces.iter_mut().map(Some).collect(), None),
+        OtherFaces::Copied(o) => (Vec::new(), Some(o)),
+    };
+    faces
+        .into_iter()
+        .map(|a| match a {
+            AddedFace::New(p) => Source::New(p),
+            AddedFace::Theirs(f) => match borrowed {
+                Some(o) => Source::Copy(o.face(f)),
+                None => Source::Slot(slots[f as usize].take().expect("a face kept once")),
+            },
+        })
+        .collect()
+}
 
 impl Solid {
-    /// Carries a plan out: its new faces, then the other solid's faces it
-    /// keeps whole, from `other`.
+    /// Carries an operation's additions out: its new faces, then the
+    /// other solid's faces it keeps whole, from `other`.
     ///
     /// The faces are made in parallel and written straight into their
     /// slots (freed slots first, in order, then the end of the array),
     /// each moved or copied once; the index takes them while the new
     /// faces' equal new vertices are made one.
-    pub(crate) fn carry_out(&mut self, plan: Plan, other: Other<'_>) {
-        // where each face comes from: a kept face of an owned solid is
-        // taken from its slot (distinct slots: one borrow each)
-        enum Source<'s> {
-            New(Box<Polygon>),
-            Slot(&'s mut Option<Face>),
-            Copy(&'s Face),
-        }
-        let (mut slots, borrowed): (Vec<Option<&mut Option<Face>>>, Option<&Solid>) = match other {
-            Other::Owned(o) => (o.faces.iter_mut().map(Some).collect(), None),
-            Other::Borrowed(o) => (Vec::new(), Some(o)),
-        };
-        let mut from: Vec<Source<'_>> = plan
-            .add
-            .into_iter()
-            .map(|a| match a {
-                Added::New(p) => Source::New(p),
-                Added::Whole(f) => match borrowed {
-                    Some(o) => Source::Copy(o.face(f)),
-                    None => Source::Slot(slots[f as usize].take().expect("a face kept once")),
-                },
-            })
-            .collect();
-        drop(slots);
-        let flip = plan.flip;
-        let make = |f: Source<'_>| -> Face {
-            match f {
-                Source::New(p) => Face::made(p),
-                Source::Slot(slot) => {
-                    let face = slot.take().expect("a live face");
-                    if flip { face.flipped() } else { face }
-                }
-                Source::Copy(face) if flip => face.flipped(),
-                Source::Copy(face) => face.clone(),
-            }
-        };
-        // freed slots first, in the order they are popped, then the end of
-        // the array, in place: room for all at once (growing by doubling
-        // would hold the old and a twice larger array)
+    pub(crate) fn carry_out(&mut self, additions: Additions, other: OtherFaces<'_>) {
+        let from = sources(additions.faces, other);
         let n = from.len();
-        let reused = reused_slots(&mut self.free, n);
+        let (ids, new_slots) = self.write_faces(from, additions.flip);
+        self.index_added(&ids, new_slots);
+        self.live += n;
+        if self.live > 4 * self.indexed + 1024 {
+            self.reindex();
+        } else if self.index.get().is_none() {
+            // a solid changed in place is likely to be changed again
+            self.make_index();
+        }
+    }
+
+    /// Writes the faces `from` into the freed slots, in the order they
+    /// are popped, then at the end of the array, in place: room for all
+    /// at once (growing by doubling would hold the old and a twice larger
+    /// array). The ids the faces went to, in order, and those of the new
+    /// faces.
+    fn write_faces(&mut self, mut from: Vec<Source<'_>>, flip: bool) -> (Vec<u32>, Vec<u32>) {
+        let reused = reused_slots(&mut self.free, from.len());
         let rest = from.split_off(reused.len());
         let first_new = self.faces.len();
         // the slots of the new faces
-        let mut new_slots: Vec<u32> = reused
+        let new_slots: Vec<u32> = reused
             .iter()
             .copied()
             .zip(&from)
@@ -77,17 +120,22 @@ impl Solid {
         borrow_sorted(&mut self.faces, &slots)
             .into_par_iter()
             .zip(sources)
-            .for_each(|(slot, f)| *slot = Some(make(f)));
+            .for_each(|(slot, f)| *slot = Some(f.make(flip)));
         self.faces.reserve_exact(rest.len());
         self.faces
-            .par_extend(rest.into_par_iter().map(|f| Some(make(f))));
-        // the index takes the faces while their equal new vertices become
-        // one each (pieces cut along a shared edge computed them each for
-        // itself); the boxes stay as they are
-        let ids: Vec<u32> = reused
+            .par_extend(rest.into_par_iter().map(|f| Some(f.make(flip))));
+        let ids = reused
             .into_iter()
             .chain(first_new as u32..self.faces.len() as u32)
             .collect();
+        (ids, new_slots)
+    }
+
+    /// The index (if made) and the bounds take the faces `ids` just
+    /// written, while the equal new vertices of the new faces among them
+    /// (`new_slots`) become one each: pieces cut along a shared edge
+    /// computed them each for itself. The boxes stay as they are.
+    fn index_added(&mut self, ids: &[u32], mut new_slots: Vec<u32>) {
         let boxes: Vec<IBox> = ids.par_iter().map(|&f| self.face(f).bx()).collect();
         let Solid {
             faces,
@@ -102,39 +150,27 @@ impl Solid {
                 new_slots.sort_unstable();
                 let mut new: Vec<&mut Polygon> = borrow_sorted(faces, &new_slots)
                     .into_iter()
-                    .filter_map(|slot| match slot {
-                        Some(Face {
-                            shape: Shape::Made(p, _),
-                        }) => Some(&mut **p),
-                        _ => None,
-                    })
+                    .filter_map(|slot| slot.as_mut().and_then(SolidFace::made_polygon_mut))
                     .collect();
                 share_points(&mut new);
             },
-            || Solid::index_boxes(index.get_mut(), bounds, &ids, &boxes),
+            || Solid::index_boxes(index.get_mut(), bounds, ids, &boxes),
         );
-        self.live += n;
-        if self.live > 4 * self.indexed + 1024 {
-            self.reindex();
-        } else if self.index.get().is_none() {
-            // a solid changed in place is likely to be changed again
-            self.make_index();
-        }
     }
 }
 
 /// The freed slots the first `n` faces an operation adds go to, in the
 /// order they take them (popped from the end of `free`); the rest go at
 /// the end of the array. One rule for [`Solid::carry_out`] and for
-/// [`Planned::into_watertight_mesh`](crate::Planned::into_watertight_mesh), which meshes the faces in the
+/// [`Solid::into_watertight_mesh_with`], which meshes the faces in the
 /// order the slots would hold them.
-pub(crate) fn reused_slots(free: &mut Vec<u32>, n: usize) -> Vec<u32> {
+pub(super) fn reused_slots(free: &mut Vec<u32>, n: usize) -> Vec<u32> {
     let k = n.min(free.len());
     free.drain(free.len() - k..).rev().collect()
 }
 
 /// The items at `ids` (strictly increasing), each borrowed once.
-pub(crate) fn borrow_sorted<'a, T>(items: &'a mut [T], ids: &[u32]) -> Vec<&'a mut T> {
+pub(super) fn borrow_sorted<'a, T>(items: &'a mut [T], ids: &[u32]) -> Vec<&'a mut T> {
     let mut out = Vec::with_capacity(ids.len());
     let (mut tail, mut at) = (items, 0);
     for &id in ids {
@@ -145,12 +181,4 @@ pub(crate) fn borrow_sorted<'a, T>(items: &'a mut [T], ids: &[u32]) -> Vec<&'a m
         (tail, at) = (rest, id as usize + 1);
     }
     out
-}
-
-/// The solid an operation takes kept faces from.
-pub(crate) enum Other<'s> {
-    /// Its faces are copied.
-    Borrowed(&'s Solid),
-    /// Its faces move over.
-    Owned(&'s mut Solid),
 }

@@ -1,9 +1,8 @@
 //! A solid's face slot: an imported face as its grid corners, or a face
 //! an operation made, with its edge planes.
 
-use bsp_core::Plane;
-use bsp_core::Polygon;
 use bsp_core::internals::{ConvexFace, GridPolygon, PointRef};
+use bsp_core::{Plane, Polygon};
 use std::borrow::Cow;
 
 use crate::index::{IBox, SmallBox, polygon_box};
@@ -13,7 +12,7 @@ use crate::index::{IBox, SmallBox, polygon_box};
 /// large solid are never cut, and the edge planes are most of a
 /// polygon's room.
 #[derive(Clone, Debug)]
-pub(crate) enum Shape {
+enum Shape {
     /// An imported face (or one kept whole from one); its box is read off
     /// its corners.
     Grid(GridPolygon),
@@ -26,25 +25,25 @@ pub(crate) enum Shape {
 /// imported triangle takes 112 bytes, and a box stored beside its
 /// corners would take 24 more).
 #[derive(Clone, Debug)]
-pub(crate) struct Face {
-    pub(crate) shape: Shape,
+pub(crate) struct SolidFace {
+    shape: Shape,
 }
 
-impl Face {
+impl SolidFace {
     /// An imported face (its polygon made with tag 0).
-    pub(crate) fn grid(g: GridPolygon) -> Face {
-        Face {
+    pub(crate) fn grid(g: GridPolygon) -> SolidFace {
+        SolidFace {
             shape: Shape::Grid(g),
         }
     }
 
     /// A face an operation made (tag 0).
-    pub(crate) fn made(mut p: Box<Polygon>) -> Face {
+    pub(crate) fn made(mut p: Box<Polygon>) -> SolidFace {
         p.set_tag(0);
         let bx = polygon_box(&*p);
         let narrow = |v: i64| v.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
         let small = (bx.0.map(narrow), bx.1.map(narrow));
-        Face {
+        SolidFace {
             shape: Shape::Made(p, small),
         }
     }
@@ -57,6 +56,15 @@ impl Face {
         }
     }
 
+    /// A made face's polygon, to change in place (an imported face's
+    /// vertices are its grid corners, shared already).
+    pub(crate) fn made_polygon_mut(&mut self) -> Option<&mut Polygon> {
+        match &mut self.shape {
+            Shape::Grid(_) => None,
+            Shape::Made(p, _) => Some(&mut **p),
+        }
+    }
+
     /// The polygon, with its edge planes (made for an imported face).
     pub(crate) fn polygon(&self) -> Cow<'_, Polygon> {
         match &self.shape {
@@ -66,8 +74,8 @@ impl Face {
     }
 
     /// The same face seen from the other side (the same box).
-    pub(crate) fn flipped(&self) -> Face {
-        Face {
+    pub(crate) fn flipped(&self) -> SolidFace {
+        SolidFace {
             shape: match &self.shape {
                 Shape::Grid(g) => Shape::Grid(g.flipped()),
                 Shape::Made(p, b) => Shape::Made(Box::new(p.flipped()), *b),
@@ -104,7 +112,7 @@ impl Face {
     }
 }
 
-impl ConvexFace for Face {
+impl ConvexFace for SolidFace {
     #[inline]
     fn support(&self) -> &Plane {
         match &self.shape {
@@ -144,13 +152,13 @@ mod tests {
     /// polygon, as a made face's stored one is.
     #[test]
     fn face_slots_are_small_and_know_their_boxes() {
-        assert!(std::mem::size_of::<Face>() <= 112);
+        assert!(std::mem::size_of::<SolidFace>() <= 112);
         let g = GridPolygon::from_grid_points(&[[5, -7, 1], [9, 2, -3], [-4, 0, 8]]).unwrap();
         let want = polygon_box(&g);
-        let grid = Face::grid(g.clone());
+        let grid = SolidFace::grid(g.clone());
         assert_eq!(grid.bx(), want);
         assert_eq!(grid.flipped().bx(), want);
-        let made = Face::made(Box::new(g.to_polygon(0)));
+        let made = SolidFace::made(Box::new(g.to_polygon(0)));
         assert_eq!(made.bx(), want);
         assert_eq!(made.flipped().bx(), want);
     }

@@ -5,7 +5,7 @@ use bsp_core::internals::ConvexFace;
 use bsp_core::{GridPoint, Membership, Side};
 use rayon::prelude::*;
 
-use super::{Face, Solid, winding};
+use super::{Solid, SolidFace, winding};
 use crate::index::{IBox, overlaps, union};
 
 /// Face ids a query near a box handles in parallel.
@@ -35,7 +35,7 @@ impl Solid {
 
     /// The box spanned by the live faces whose box overlaps `b`.
     pub(crate) fn near_span(&self, b: &IBox) -> Option<IBox> {
-        let bx = |i: u32| self.near_face(i, b).map(Face::bx);
+        let bx = |i: u32| self.near_face(i, b).map(SolidFace::bx);
         match self.near_ids(b) {
             None => (0..self.faces.len() as u32)
                 .into_par_iter()
@@ -50,7 +50,7 @@ impl Solid {
 
     /// Face `i` if it is live and its box overlaps `b`.
     #[inline]
-    pub(crate) fn near_face(&self, i: u32, b: &IBox) -> Option<&Face> {
+    fn near_face(&self, i: u32, b: &IBox) -> Option<&SolidFace> {
         self.faces[i as usize]
             .as_ref()
             .filter(|f| overlaps(&f.bx(), b))
@@ -60,7 +60,7 @@ impl Solid {
     /// `None` where a scan of the slots is cheaper: many ids, as many as
     /// half the slots (each face is listed in several index cells), which
     /// a scan in order gives sorted without listing them first.
-    pub(crate) fn near_ids(&self, b: &IBox) -> Option<Vec<u32>> {
+    fn near_ids(&self, b: &IBox) -> Option<Vec<u32>> {
         let index = self.query_index()?;
         let listed = index.near_count(b);
         if listed > MANY_NEAR && listed > self.faces.len() / 2 {
@@ -148,7 +148,7 @@ impl Solid {
 /// The crossing number of the ray from `q` along `+x` (displaced as
 /// [`Solid::winding`] says) with the face `f`: 0 where the face's box is
 /// beyond the ray's reach.
-pub(crate) fn ray_crossing(q: [i64; 3], f: &Face) -> i32 {
+fn ray_crossing(q: [i64; 3], f: &SolidFace) -> i32 {
     if ray_reaches(q, &f.bx()) {
         winding::crossing(q, f)
     } else {
@@ -158,13 +158,13 @@ pub(crate) fn ray_crossing(q: [i64; 3], f: &Face) -> i32 {
 
 /// Whether the ray from `q` along `+x` may meet a face in the box `bx`.
 #[inline]
-pub(crate) fn ray_reaches(q: [i64; 3], bx: &IBox) -> bool {
+fn ray_reaches(q: [i64; 3], bx: &IBox) -> bool {
     bx.1[0] >= q[0] && bx.0[1] <= q[1] && q[1] <= bx.1[1] && bx.0[2] <= q[2] && q[2] <= bx.1[2]
 }
 
 /// At most this many winding numbers are found in one pass over a
 /// solid's faces that has no index ([`Solid::windings`]).
-pub(crate) const FEW_WINDINGS: usize = 64;
+const FEW_WINDINGS: usize = 64;
 
 #[cfg(test)]
 mod tests {

@@ -50,7 +50,7 @@ fn eval(p: &Plane, q: [i64; 3]) -> i128 {
 }
 
 /// `+1`, `−1` or `0`: how the ray from `q_ε` along `+x` crosses `face`.
-pub(crate) fn crossing(q: [i64; 3], face: &impl ConvexFace) -> i32 {
+pub(super) fn crossing(q: [i64; 3], face: &impl ConvexFace) -> i32 {
     let s = face.support();
     let n = s.normal();
     if n[0] == 0 {
