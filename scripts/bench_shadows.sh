@@ -19,7 +19,7 @@ OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
 
 cargo build --profile dist -q -p shadow-cli
-cargo build --profile dist -q -p svbsp --example shade
+cargo build --profile dist -q -p shadow-raster --example shade
 BIN=target/dist/shadow
 SHADE=target/dist/examples/shade
 

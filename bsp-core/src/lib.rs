@@ -49,6 +49,7 @@
 mod kernel;
 mod solid;
 mod tree;
+mod union_find;
 
 pub use kernel::{
     Error, FaceDefect, GRID_BITS, Grid, GridPoint, Implicit, MAX_COORD, MAX_VIEW_COORD, Plane,
@@ -79,6 +80,7 @@ pub mod internals {
     };
     pub use crate::solid::{FaceImporter, all_planar, snap_positions};
     pub use crate::tree::{PLink, PNode, SplitMix, box_section, merge_smaller_into_larger};
+    pub use crate::union_find::UnionFind;
     pub use bnum::types::I512;
 }
 

@@ -20,19 +20,19 @@ use bsp_core::{BspTree, BuildOptions, Polygon};
 use clap::{Args, ValueEnum};
 use glam::{DMat4, DVec3};
 use rayon::prelude::*;
-use shadow_scene::{Face, Mesh};
-use svbsp::{Areas, LightSpec, PlacedLight};
+use shadow_raster::svg::{SvgFragment, SvgView, SvgViewpoint};
+use shadow_scene::{Face, Mesh, ROOM_EYE, ROOM_TARGET};
+use svbsp::export::{area_records, json_footer, json_fragments, json_header, world_vertices};
+use svbsp::{Areas, Light, PlacedLight};
 use tiling::{Dynamic, FrameStats, Motion, PipelineOptions, Strategy};
 
+use crate::args::{CameraArgs, ImageArgs, LightArgs, parse_vec3};
+use crate::input::load_mesh;
 use crate::lights::{fmt_input, place_lights, shared_grid};
-use crate::progress::{Output, Progress};
-use crate::render::{View, unit_normal};
-use crate::shadows::{
-    DrawFrag, area_records, json_footer, json_fragments, json_header, render_frags, world_vertices,
-};
-use crate::{DEMO_EYE, DEMO_TARGET, ImageArgs, load_mesh, parse_vec3};
+use crate::output::{Output, emit};
+use crate::progress::Progress;
+use crate::raster_error;
 
-/// What each frame writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub(crate) enum FrameFormat {
     /// A view of the shaded frame (`frame_0000.svg`).
@@ -68,14 +68,8 @@ pub(crate) struct AnimateArgs {
     /// own].
     #[arg(long, value_name = "FILE")]
     pub(crate) dynamic: Option<PathBuf>,
-    /// A point light at X,Y,Z (input units); repeatable [default for
-    /// --scene: the scene's light].
-    #[arg(long = "light", value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub(crate) lights: Vec<DVec3>,
-    /// A light at infinity in the direction X,Y,Z toward the light;
-    /// repeatable.
-    #[arg(long = "sun", value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub(crate) suns: Vec<DVec3>,
+    #[command(flatten)]
+    pub(crate) lights: LightArgs,
     /// Number of frames.
     #[arg(long, default_value_t = 24, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub(crate) frames: u32,
@@ -110,21 +104,12 @@ pub(crate) struct AnimateArgs {
     /// rule].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub(crate) tiles: Option<u32>,
-    /// SVG eye position [default for the room: the demo's viewpoint; for
-    /// other scenes: in front of and above the scene].
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub(crate) eye: Option<DVec3>,
-    /// SVG point looked at [default: the centre of the static scene].
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub(crate) target: Option<DVec3>,
-    /// SVG up direction [default: +Z, or +Y when looking along Z].
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub(crate) up: Option<DVec3>,
+    /// The frames' viewpoint [default for the room: its built-in one;
+    /// for other scenes: in front of and above the scene].
+    #[command(flatten)]
+    pub(crate) camera: CameraArgs,
     #[command(flatten)]
     pub(crate) image: ImageArgs,
-    /// Worker threads [default: one per core].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub(crate) threads: Option<u32>,
     /// Frames computed at the same time: 1 gives each frame every core
     /// (the lowest latency); 2 keeps every core busy (the highest frame
     /// rate, each frame a little later). The output is the same.
@@ -235,18 +220,8 @@ fn setup(args: &AnimateArgs) -> Result<Setup> {
     }
 }
 
+/// `shadow animate`.
 pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
-    match args.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n as usize)
-            .build()
-            .context("cannot start the worker threads")?
-            .install(|| run_here(args)),
-        None => run_here(args),
-    }
-}
-
-fn run_here(args: &AnimateArgs) -> Result<()> {
     let total = Instant::now();
     let note = |s: &str| {
         if !args.quiet {
@@ -260,11 +235,10 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
     if s.statics.faces.is_empty() {
         bail!("{}: no faces", s.name);
     }
-    let mut specs: Vec<LightSpec> = args.lights.iter().map(|&p| LightSpec::Point(p)).collect();
-    specs.extend(args.suns.iter().map(|&d| LightSpec::Sun(d)));
+    let mut specs = args.lights.specs();
     if specs.is_empty() {
         match s.light {
-            Some(l) => specs.push(LightSpec::Point(l)),
+            Some(l) => specs.push(svbsp::LightSpec::Point(l)),
             None => bail!(
                 "no light: give at least one --light X,Y,Z (a point light) or --sun X,Y,Z (a light \
                  at infinity); both can be repeated"
@@ -284,9 +258,7 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
     if degrees == 0.0 && step == DVec3::ZERO && args.frames > 1 {
         note("note: no motion given (--spin, --step): every frame is the same");
     }
-    if !matches!(args.format, FrameFormat::Svg | FrameFormat::Png)
-        && (args.eye.is_some() || args.target.is_some() || args.up.is_some())
-    {
+    if !matches!(args.format, FrameFormat::Svg | FrameFormat::Png) && args.camera.any() {
         note("note: --eye, --target and --up only apply to SVG and PNG frames");
     }
     std::fs::create_dir_all(&args.output)
@@ -324,12 +296,12 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
     let statics = s.statics.face_loops();
     let moving = s.moving.face_loops();
     let start = Instant::now();
-    let d = Dynamic::new(&statics, &moving, grid, &kernel, opts).map_err(|e| anyhow!("{e}"))?;
+    let d = Dynamic::new(&statics, &moving, grid, &kernel, opts)?;
     let t_pre = start.elapsed();
     let view =
         matches!(args.format, FrameFormat::Svg | FrameFormat::Png).then(|| frame_view(args, &s));
     // one colour per face, static faces then the moving object's
-    let colors = crate::color::face_colors(&frame_mesh(&s, &d, &DMat4::IDENTITY));
+    let colors = shadow_scene::face_colors(&frame_mesh(&s, &d, &DMat4::IDENTITY));
     let mut report = match &args.report {
         Some(p) => {
             let mut o = Output::create(p)?;
@@ -447,31 +419,32 @@ fn run_here(args: &AnimateArgs) -> Result<()> {
     if args.format != FrameFormat::None || args.export_scene {
         let _ = writeln!(out, "frames in {}", args.output.display());
     }
-    crate::csg::emit(&out)
+    emit(&out)
 }
 
-/// The camera for SVG and PNG frames.
-fn frame_view(args: &AnimateArgs, s: &Setup) -> View {
+/// The viewpoint of SVG and PNG frames.
+fn frame_view(args: &AnimateArgs, s: &Setup) -> SvgViewpoint {
     let (lo, hi) = s.statics.bounds().expect("the static scene has faces");
     let (c, half) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
     let bunny = s.name.starts_with("scene bunny");
-    let (eye, target, up) = match (args.eye, s.is_room, bunny) {
-        (Some(e), _, _) => (e, args.target, args.up),
-        (None, true, _) => (DEMO_EYE, Some(args.target.unwrap_or(DEMO_TARGET)), args.up),
+    let cam = &args.camera;
+    let (eye, target, up) = match (cam.eye, s.is_room, bunny) {
+        (Some(e), _, _) => (e, cam.target, cam.up),
+        (None, true, _) => (ROOM_EYE, Some(cam.target.unwrap_or(ROOM_TARGET)), cam.up),
         // the bunny stands along +y: from above, in front and to the side
         (None, _, true) => (
             c + DVec3::new(0.75 * half, 0.6 * half, 1.7 * half),
-            Some(args.target.unwrap_or(c - DVec3::Y * 0.25 * half)),
-            Some(args.up.unwrap_or(DVec3::Y)),
+            Some(cam.target.unwrap_or(c - DVec3::Y * 0.25 * half)),
+            Some(cam.up.unwrap_or(DVec3::Y)),
         ),
         // in front of the scene and above it
         (None, false, false) => (
             c + DVec3::new(0.7, -1.8, 1.2) * half,
-            Some(args.target.unwrap_or(c)),
-            args.up,
+            Some(cam.target.unwrap_or(c)),
+            cam.up,
         ),
     };
-    View {
+    SvgViewpoint {
         eye,
         target,
         up,
@@ -531,8 +504,8 @@ fn write_scene(
     )?;
     for (i, l) in lights.iter().enumerate() {
         let kind = match l.light {
-            svbsp::Light::Point(_) => "point light at",
-            svbsp::Light::Directional(_) => "sun toward",
+            Light::Point(_) => "point light at",
+            Light::Directional(_) => "sun toward",
         };
         writeln!(out, "# light {i}: {kind} {}", fmt_input(l.world))?;
     }
@@ -552,7 +525,7 @@ fn frame_json(
     let faces = d.static_faces() + d.moving().len();
     let mut areas = Areas::new(lights.len(), faces);
     for r in &records {
-        areas.add(r.0, r.1, r.2, r.3);
+        areas.add(r.face, r.area, r.lit, r.facing);
     }
     json_header(out, lights, faces)?;
     let text = json_fragments(&batch, &world, &records, lights.len());
@@ -568,7 +541,7 @@ fn frame_png(
     frame: &tiling::Frame,
     colors: &[glam::DVec3],
     lights: &[PlacedLight],
-    view: &View,
+    view: &SvgViewpoint,
     path: &std::path::Path,
 ) -> Result<()> {
     let grid = d.grid();
@@ -584,20 +557,11 @@ fn frame_png(
             .find(|u| forward.cross(*u).length() > 1e-3)
             .unwrap_or(DVec3::X)
     });
-    let camera = shadow_raster::Camera::look_at(
-        view.eye,
-        target,
-        up,
-        view.fov_deg,
-        view.width,
-        view.height,
-    )?;
-    let lights: Vec<_> = lights
-        .iter()
-        .map(shadow_raster::SceneLight::from_placed)
-        .collect();
+    let camera =
+        shadow_raster::Camera::look_at(view.eye, target, up, view.fov_deg, view.width, view.height)
+            .map_err(raster_error)?;
     let batch = d.fragments(frame);
-    let out = renderer.render_fragments(&scene, &batch, &lights, &camera, colors)?;
+    let out = renderer.render_fragments(&scene, &batch, lights, &camera, colors)?;
     let mut o = Output::create(path)?;
     o.write_all(&out.image.encode_png())
         .with_context(|| format!("could not write {}", path.display()))?;
@@ -618,14 +582,14 @@ fn bounds_of(d: &Dynamic) -> (DVec3, DVec3) {
 }
 
 /// Draws the frame: a BSP tree of the frame's polygons gives the painter's
-/// order, and each face's fragments are clipped (in `f64`, for the
-/// picture only) to the tree's pieces of the face.
+/// order, and each face's fragments are cut to the tree's pieces of the
+/// face.
 fn frame_svg(
     d: &Dynamic,
     frame: &tiling::Frame,
     scene: &Mesh,
     lights: &[PlacedLight],
-    view: &View,
+    at: &SvgViewpoint,
 ) -> Result<String> {
     let grid = d.grid();
     let mut polys: Vec<Polygon> = d.static_polygons().to_vec();
@@ -633,51 +597,17 @@ fn frame_svg(
     let tree = BspTree::build(polys, &BuildOptions::default());
     let batch = d.fragments(frame);
     let world = world_vertices(&batch, grid)?;
-    // the fragments' convex pieces, per face
     let faces = d.static_faces() + d.moving().len();
-    let mut of_face: Vec<Vec<usize>> = vec![Vec::new(); faces];
-    for (j, f) in batch.fragments().enumerate() {
-        of_face[f.face() as usize].push(j);
-    }
-    let mut frags = Vec::new();
-    for (pi, p) in tree.polygons().enumerate() {
-        let outline: Vec<DVec3> = p
-            .vertices_f64()
-            .into_iter()
-            .map(|v| grid.to_world(v))
-            .collect();
-        let n = unit_normal(p.support());
-        let face = p.tag() as usize;
-        for &j in &of_face[face] {
-            let f = batch.fragment(j);
-            let mut pieces = Vec::new();
-            for piece in f.pieces() {
-                let mut poly: Vec<DVec3> = piece.iter().map(|&v| world[v as usize]).collect();
-                for e in 0..outline.len() {
-                    let (a, b) = (outline[e], outline[(e + 1) % outline.len()]);
-                    // inside: to the left of a → b seen from the normal
-                    let m = n.cross(b - a);
-                    poly = crate::render::clip(&poly, m, -m.dot(a));
-                    if poly.len() < 3 {
-                        break;
-                    }
-                }
-                if poly.len() >= 3 {
-                    pieces.push(poly);
-                }
-            }
-            if !pieces.is_empty() {
-                frags.push(DrawFrag {
-                    polygon: pi,
-                    face,
-                    lit: f.lit_mask(),
-                    normal: unit_normal(f.support()),
-                    pieces,
-                });
-            }
-        }
-    }
-    let r = render_frags(scene, grid, lights, &tree, view, &frags, "shadow animate")?;
+    let frags = SvgFragment::of_faces_in_tree(&tree, grid, &batch, &world, faces);
+    let bounds = scene
+        .bounds()
+        .context("nothing to draw: the mesh has no vertices")?;
+    let view = SvgView::new(grid, bounds, at).map_err(raster_error)?;
+    let colors = shadow_scene::face_colors(scene);
+    let centres = scene.face_centres();
+    let r = view
+        .fragments(&tree, lights, &frags, (&colors, &centres), "shadow animate")
+        .map_err(raster_error)?;
     Ok(r.svg)
 }
 

@@ -106,7 +106,7 @@ impl Operand {
         let read: Vec<Result<Read>> = paths
             .par_iter()
             .map(|p| {
-                let (mut mesh, note) = crate::read_mesh(p)?;
+                let (mut mesh, note) = crate::input::read_mesh(p)?;
                 let file_loops = weld.then(|| {
                     let loops = mesh.faces.iter().map(|f| f.vertices.clone()).collect();
                     mesh.weld();
@@ -121,7 +121,7 @@ impl Operand {
             if let Some(m) = note {
                 eprintln!("note: {m}");
             }
-            let mesh = crate::with_faces(path, mesh)?;
+            let mesh = crate::input::with_faces(path, mesh)?;
             operands.push(Operand::new(path.display().to_string(), mesh, file_loops));
         }
         Ok(operands)

@@ -35,7 +35,7 @@ fn explain(e: LightError, specs: &[LightSpec]) -> anyhow::Error {
             fmt_input(centre)
         ),
         LightError::ZeroSun { index } => anyhow!("{}: the sun direction is zero", at(index)),
-        e => anyhow!("{e}"),
+        e => anyhow!(e),
     }
 }
 

@@ -8,12 +8,12 @@
 //! ```
 
 use glam::DVec3;
-use shadow_raster::{Camera, Method, RasterScene, RenderOptions, Renderer, SceneLight, render};
+use shadow_raster::{Camera, Method, RasterScene, RenderOptions, Renderer, render};
 
 #[path = "../benches/common/mod.rs"]
 mod common;
 
-fn setup(sun: bool) -> (RasterScene, Vec<SceneLight>, Camera) {
+fn setup(sun: bool) -> (RasterScene, Vec<svbsp::PlacedLight>, Camera) {
     let s = common::bunny("bunny-99k", sun);
     let cam = Camera::look_at(s.eye, s.target, DVec3::Y, 50.0, 1920, 1080).unwrap();
     (s.scene, s.lights, cam)

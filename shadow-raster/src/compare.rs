@@ -6,7 +6,9 @@ use glam::DVec3;
 
 use crate::hsr::{Frame, Hsr, NONE, visibility};
 use crate::image::{Image, composite, mask, shade};
-use crate::scene::{RasterScene, SceneLight};
+use svbsp::PlacedLight;
+
+use crate::scene::RasterScene;
 use crate::shadow::{Method, ShadowOptions, shadows};
 use crate::{Camera, RasterError};
 
@@ -99,12 +101,13 @@ impl Comparison {
 /// z-buffer visibility of `scene` from `camera`.
 pub fn compare(
     scene: &RasterScene,
-    lights: &[SceneLight],
+    lights: &[PlacedLight],
     camera: &Camera,
     colors: &[DVec3],
     opts: &ShadowOptions,
     methods: &[Method],
 ) -> Result<Comparison, RasterError> {
+    let lights = &crate::scene_lights(lights)?;
     opts.validate()?;
     let t = std::time::Instant::now();
     let frame = Frame::new(scene, camera, false)?;

@@ -33,8 +33,7 @@ pub(crate) fn visible_side_fragments(
 ) -> Result<Batch, RasterError> {
     let scene = frame.scene;
     let exact: Vec<svbsp::Light> = lights.iter().map(|l| l.exact).collect();
-    let shadows =
-        Shadows::new(&scene.polys, &exact).map_err(|e| RasterError::Shadows(e.to_string()))?;
+    let shadows = Shadows::new(&scene.polys, &exact).map_err(RasterError::Shadows)?;
     let receivers: Vec<bsp_core::Polygon> = scene
         .polys
         .iter()
@@ -45,7 +44,9 @@ pub(crate) fn visible_side_fragments(
             Side::On => None,
         })
         .collect();
-    Ok(shadows.shade_all(&receivers, &ShadeOptions::default().with_pieces(false)))
+    Ok(shadows
+        .set()
+        .shade_all(&receivers, &ShadeOptions::default().with_pieces(false)))
 }
 
 pub(crate) fn exact(

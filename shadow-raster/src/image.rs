@@ -9,6 +9,7 @@ use glam::DVec3;
 use crate::RasterError;
 use crate::hsr::{Frame, NONE, Visibility};
 use crate::scene::SceneLight;
+use crate::shading::Lambert;
 use crate::shadow::{LitBuffer, visible_normal};
 
 /// An 8-bit RGB image, row-major from the top-left corner.
@@ -24,13 +25,6 @@ pub struct Image {
 
 /// The background of images, as in the SVG views.
 pub const BACKGROUND: [u8; 3] = [0xe9, 0xec, 0xf0];
-
-/// Light reaching every surface, as in the SVG of `shadow shadows`.
-const AMBIENT: f64 = 0.28;
-/// More ambient on surfaces facing the viewer.
-const AMBIENT_FACING: f64 = 0.12;
-/// Total diffuse weight, shared among the lights.
-const DIFFUSE: f64 = 0.72;
 
 impl Image {
     /// A `width × height` image filled with `color`.
@@ -172,10 +166,10 @@ fn mix((c, mut b): (DVec3, f64), amount: &[f32], cosines: &[f64]) -> [u8; 3] {
     [v.x as u8, v.y as u8, v.z as u8]
 }
 
-/// Lambert shading, as the SVG views: the face's colour times ambient
-/// light (more on surfaces facing the viewer) plus each light's cosine
-/// times the amount of it that reaches the pixel, the cosines taken at
-/// each prim's centre (so a face's lit parts share one shade and only the
+/// Shading by the one lighting model ([`Lambert::SHADOWS`]), as the SVG
+/// views: the face's colour times ambient light (more on surfaces facing
+/// the viewer) plus each light's cosine times the amount of it that
+/// reaches the pixel, the cosines taken at each prim's centre (so a face's lit parts share one shade and only the
 /// shadow boundaries show).
 pub(crate) fn shade(
     frame: &Frame<'_>,
@@ -214,7 +208,7 @@ pub(crate) fn shade_in(
     }
     let scene = frame.scene;
     let eye = frame.camera.eye();
-    let weight = DIFFUSE / lights.len().max(1) as f64;
+    let weight = Lambert::weight(lights.len());
     let grey = DVec3::splat(0.7);
     let nl = lights.len();
     // per drawn prim, in one pass: colour, ambient, each light's weighted
@@ -235,9 +229,9 @@ pub(crate) fn shade_in(
         let n = visible_normal(frame, i);
         let to_eye = (eye - centre).normalize_or_zero();
         let c = colors.get(scene.face[i] as usize).copied().unwrap_or(grey);
-        *base = (c, AMBIENT + AMBIENT_FACING * n.dot(to_eye).max(0.0));
+        *base = (c, Lambert::SHADOWS.base(n, to_eye));
         for (cos, l) in cos.iter_mut().zip(lights) {
-            *cos = weight * n.dot(l.world.toward(centre)).max(0.0);
+            *cos = Lambert::cosine(weight, n, l.world.toward(centre));
         }
     };
     let per_prim = bufs

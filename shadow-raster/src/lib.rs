@@ -18,6 +18,9 @@
 //! - [`compare`]: every method on one camera, with the share of pixels
 //!   where each disagrees with `exact`, and its time.
 //! - [`hidden_lines`]: Roberts' hidden-line algorithm for convex polyhedra.
+//! - [`svg`]: SVG pictures by the painter's algorithm in a BSP tree's
+//!   exact order, of a scene's polygons or of their exact fragments.
+//! - [`shading`]: the one lighting model of every picture, PNG or SVG.
 //!
 //! Everything here is `f64` image-space arithmetic on the exact geometry;
 //! its tolerances (the shadow rays' self-intersection margin
@@ -29,7 +32,7 @@
 //!
 //! ```
 //! use glam::DVec3;
-//! use shadow_raster::{Camera, Method, RasterScene, RenderOptions, SceneLight, render};
+//! use shadow_raster::{Camera, Method, RasterScene, RenderOptions, render};
 //! use svbsp::{LightSpec, place_lights};
 //!
 //! // a floor and a floating square, a light above
@@ -39,7 +42,7 @@
 //! ];
 //! let specs = [LightSpec::Point(DVec3::new(0.0, 0.0, 5.0))];
 //! let grid = svbsp::shared_grid(&faces.concat(), &specs).unwrap();
-//! let lights: Vec<SceneLight> = place_lights(&grid, &specs).unwrap().iter().map(SceneLight::from_placed).collect();
+//! let lights = place_lights(&grid, &specs).unwrap();
 //! let (polys, _) = bsp_core::import_faces(&grid, faces.iter().map(Vec::as_slice)).unwrap();
 //! let scene = RasterScene::new(&grid, polys)?;
 //! let cam = Camera::look_at(DVec3::new(0.0, -8.0, 6.0), DVec3::ZERO, DVec3::Z, 50.0, 64, 48)?;
@@ -64,8 +67,10 @@ mod maps;
 mod planar;
 mod raster;
 mod scene;
+pub mod shading;
 mod shadow;
 mod stencil;
+pub mod svg;
 #[cfg(test)]
 mod testing;
 mod view;
@@ -73,6 +78,7 @@ mod view;
 use std::time::{Duration, Instant};
 
 use glam::DVec3;
+use svbsp::PlacedLight;
 
 pub use bvh::TriangleBvh;
 pub use compare::{Comparison, MethodReport, compare};
@@ -81,9 +87,10 @@ pub use hsr::{Hsr, NONE, Visibility, visible_surfaces};
 pub use image::{BACKGROUND, Image, composite, encode_pgm, mask, write_pgm};
 pub use lines::{HiddenLines, LINE_EPSILON, LineCheck, hidden_lines};
 pub use planar::{PLANAR_MARGIN, planar_matrix};
-pub use scene::{RasterLight, RasterScene, SceneLight};
+pub use scene::RasterScene;
+use scene::SceneLight;
 pub use shadow::{LitBuffer, Method, RAY_EPSILON, ShadowFigures, ShadowOptions};
-pub use view::{Camera, MAX_PIXELS, MAX_SIZE};
+pub use view::{Camera, CameraError, MAX_PIXELS, MAX_SIZE, default_up};
 
 /// Options of [`render`].
 #[derive(Clone, Debug, PartialEq)]
@@ -157,7 +164,9 @@ impl Rendered {
     }
 }
 
-fn check_lights(lights: &[SceneLight]) -> Result<(), RasterError> {
+/// The lights in the forms the image-space methods use, at most
+/// [`svbsp::MAX_LIGHTS`] of them.
+fn scene_lights(lights: &[PlacedLight]) -> Result<Vec<SceneLight>, RasterError> {
     if lights.len() > svbsp::MAX_LIGHTS {
         return Err(RasterError::Option(format!(
             "{} lights: at most {} are supported",
@@ -165,7 +174,7 @@ fn check_lights(lights: &[SceneLight]) -> Result<(), RasterError> {
             svbsp::MAX_LIGHTS
         )));
     }
-    Ok(())
+    Ok(lights.iter().map(SceneLight::from_placed).collect())
 }
 
 /// Renders `scene` from `camera` with `lights`: visibility, shadows and
@@ -176,7 +185,7 @@ fn check_lights(lights: &[SceneLight]) -> Result<(), RasterError> {
 /// to frame.
 pub fn render(
     scene: &RasterScene,
-    lights: &[SceneLight],
+    lights: &[PlacedLight],
     camera: &Camera,
     colors: &[DVec3],
     opts: &RenderOptions,
@@ -196,7 +205,7 @@ pub fn render(
 pub fn render_fragments(
     scene: &RasterScene,
     batch: &svbsp::Batch,
-    lights: &[SceneLight],
+    lights: &[PlacedLight],
     camera: &Camera,
     colors: &[DVec3],
 ) -> Result<Rendered, RasterError> {
@@ -258,12 +267,12 @@ impl Renderer {
     pub fn render(
         &mut self,
         scene: &RasterScene,
-        lights: &[SceneLight],
+        lights: &[PlacedLight],
         camera: &Camera,
         colors: &[DVec3],
         opts: &RenderOptions,
     ) -> Result<&Rendered, RasterError> {
-        check_lights(lights)?;
+        let lights = &scene_lights(lights)?;
         opts.shadow.validate()?;
         let (method, shadow) = (opts.method, &opts.shadow);
         self.frame_with(
@@ -281,10 +290,11 @@ impl Renderer {
         &mut self,
         scene: &RasterScene,
         batch: &svbsp::Batch,
-        lights: &[SceneLight],
+        lights: &[PlacedLight],
         camera: &Camera,
         colors: &[DVec3],
     ) -> Result<&Rendered, RasterError> {
+        let lights = &scene_lights(lights)?;
         self.frame_with(
             scene,
             camera,
@@ -316,7 +326,6 @@ impl Renderer {
             &mut shadow::ShadowBuffers,
         ) -> Result<(LitBuffer, ShadowFigures), RasterError>,
     ) -> Result<&Rendered, RasterError> {
-        check_lights(lights)?;
         let t = Instant::now();
         let last = self.last.take();
         let frame = hsr::Frame::with_buffers(scene, camera, cull, std::mem::take(&mut self.frame))?;

@@ -227,7 +227,7 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
         for &i in prims {
             for v in scene.prim(i) {
                 let Some(q) = to_q(*v) else {
-                    return Err(RasterError::Camera(format!(
+                    return Err(RasterError::BehindEye(format!(
                         "{} reaches behind the eye; Roberts' algorithm needs the scene in front \
                          of it",
                         describe()

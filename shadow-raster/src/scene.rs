@@ -9,7 +9,7 @@ use crate::RasterError;
 
 /// A light in input units.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum RasterLight {
+pub(crate) enum RasterLight {
     /// A point light at this position.
     Point(DVec3),
     /// A light at infinity: the unit direction from the scene toward it.
@@ -19,7 +19,7 @@ pub enum RasterLight {
 impl RasterLight {
     /// The unit direction from `p` toward the light.
     #[inline]
-    pub fn toward(&self, p: DVec3) -> DVec3 {
+    pub(crate) fn toward(&self, p: DVec3) -> DVec3 {
         match *self {
             RasterLight::Point(l) => (l - p).normalize_or_zero(),
             RasterLight::Sun(d) => d,
@@ -27,19 +27,21 @@ impl RasterLight {
     }
 }
 
-/// One light of a scene: its exact form (on the scene's grid) and its
-/// form in input units.
+/// One light as the image-space methods use it: its exact form (on the
+/// scene's grid) and its form in input units (a sun's direction
+/// normalized once more). Made from the [`PlacedLight`]s the public
+/// functions take.
 #[derive(Clone, Copy, Debug)]
-pub struct SceneLight {
+pub(crate) struct SceneLight {
     /// On the grid, as the exact shadows use it.
-    pub exact: Light,
+    pub(crate) exact: Light,
     /// In input units, as the image-space methods use it.
-    pub world: RasterLight,
+    pub(crate) world: RasterLight,
 }
 
 impl SceneLight {
     /// From a light placed on the scene's grid by [`svbsp::place_lights`].
-    pub fn from_placed(l: &PlacedLight) -> SceneLight {
+    pub(crate) fn from_placed(l: &PlacedLight) -> SceneLight {
         let world = match l.light {
             Light::Point(_) => RasterLight::Point(l.world),
             Light::Directional(_) => RasterLight::Sun(l.world.normalize()),
@@ -107,9 +109,7 @@ impl RasterScene {
             plane.push(world_plane(grid, p.support()));
         }
         if !(lo.is_finite() && hi.is_finite()) {
-            return Err(RasterError::Camera(
-                "a vertex is not finite in input units".into(),
-            ));
+            return Err(RasterError::NonFiniteVertex);
         }
         let (corner, verts) = shared_vertices(&pts);
         Ok(RasterScene {
@@ -233,33 +233,11 @@ pub(crate) fn components(
     n: usize,
     pairs: impl IntoIterator<Item = (usize, usize)>,
 ) -> (Vec<u32>, usize) {
-    fn find(p: &mut [usize], mut x: usize) -> usize {
-        while p[x] != x {
-            p[x] = p[p[x]];
-            x = p[x];
-        }
-        x
-    }
-    let mut parent: Vec<usize> = (0..n).collect();
+    let mut sets = bsp_core::internals::UnionFind::new(n);
     for (a, b) in pairs {
-        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-        if ra != rb {
-            parent[ra.max(rb)] = ra.min(rb);
-        }
+        sets.union(a as u32, b as u32);
     }
-    let mut id = vec![u32::MAX; n];
-    let mut count = 0u32;
-    let out = (0..n)
-        .map(|i| {
-            let r = find(&mut parent, i);
-            if id[r] == u32::MAX {
-                id[r] = count;
-                count += 1;
-            }
-            id[r]
-        })
-        .collect();
-    (out, count as usize)
+    sets.numbered()
 }
 
 /// An edge by its two endpoints' keys.

@@ -47,17 +47,65 @@ pub const MAX_PIXELS: u64 = 1 << 26;
 #[derive(Clone, Debug)]
 pub struct Camera {
     pub(crate) view: View,
+    target: DVec3,
     fov_deg: f64,
 }
+
+/// Why a camera cannot be set up.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum CameraError {
+    /// The eye, the target or the up vector is not finite.
+    NotFinite,
+    /// The field of view, in degrees, is not strictly between 0 and 180.
+    FieldOfView(f64),
+    /// The eye and the target are the same point.
+    EyeAtTarget,
+    /// The up vector is zero.
+    ZeroUp,
+    /// The up vector is parallel to the view direction.
+    UpAlongView,
+}
+
+impl std::fmt::Display for CameraError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CameraError::NotFinite => f.write_str("the eye, target and up vector must be finite"),
+            CameraError::FieldOfView(deg) => write!(
+                f,
+                "field of view {deg} degrees: it must lie strictly between 0 and 180"
+            ),
+            CameraError::EyeAtTarget => f.write_str("the eye and the target coincide"),
+            CameraError::ZeroUp => f.write_str("the up vector must not be zero"),
+            CameraError::UpAlongView => {
+                f.write_str("the up vector is parallel to the view direction")
+            }
+        }
+    }
+}
+
+impl std::error::Error for CameraError {}
 
 /// Sine of the smallest angle between the view direction and the up
 /// vector that still defines a camera roll.
 const MIN_UP_SINE: f64 = 1e-6;
 
+/// The up direction of a camera looking from `eye` at `target` when none
+/// is given: `+Z`, or `+Y` when looking along the `z` axis.
+pub fn default_up(eye: DVec3, target: DVec3) -> DVec3 {
+    let forward = (target - eye).normalize_or_zero();
+    if forward.cross(DVec3::Z).length() > MIN_UP_SINE {
+        DVec3::Z
+    } else {
+        DVec3::Y
+    }
+}
+
 impl Camera {
     /// A camera at `eye` looking at `target`, `up` giving the roll, with
     /// a vertical field of view of `fov_deg` degrees (strictly between 0
-    /// and 180), for a `width × height` image.
+    /// and 180), for a `width × height` image (at most [`MAX_SIZE`] on a
+    /// side and [`MAX_PIXELS`] in all).
     pub fn look_at(
         eye: DVec3,
         target: DVec3,
@@ -67,28 +115,37 @@ impl Camera {
         height: u32,
     ) -> Result<Camera, RasterError> {
         check_size(width, height)?;
+        Camera::look_at_any_size(eye, target, up, fov_deg, width, height)
+    }
+
+    /// [`Camera::look_at`] for a picture of any size of at least a pixel
+    /// (an SVG has no pixel buffer).
+    pub(crate) fn look_at_any_size(
+        eye: DVec3,
+        target: DVec3,
+        up: DVec3,
+        fov_deg: f64,
+        width: u32,
+        height: u32,
+    ) -> Result<Camera, RasterError> {
+        if width == 0 || height == 0 {
+            return Err(RasterError::Size { width, height });
+        }
+        let bad = RasterError::Camera;
         if !(eye.is_finite() && target.is_finite() && up.is_finite()) {
-            return Err(RasterError::Camera(
-                "the eye, target and up vector must be finite".into(),
-            ));
+            return Err(bad(CameraError::NotFinite));
         }
         if !(fov_deg > 0.0 && fov_deg < 180.0) {
-            return Err(RasterError::Camera(format!(
-                "field of view {fov_deg} degrees: it must lie strictly between 0 and 180"
-            )));
+            return Err(bad(CameraError::FieldOfView(fov_deg)));
         }
         let Some(f) = (target - eye).try_normalize() else {
-            return Err(RasterError::Camera(
-                "the eye and the target coincide; give a different --eye or --target".into(),
-            ));
+            return Err(bad(CameraError::EyeAtTarget));
         };
         let Some(upn) = up.try_normalize() else {
-            return Err(RasterError::Camera("the up vector must not be zero".into()));
+            return Err(bad(CameraError::ZeroUp));
         };
         if f.cross(upn).length() <= MIN_UP_SINE {
-            return Err(RasterError::Camera(
-                "the up vector is parallel to the view direction; give another --up".into(),
-            ));
+            return Err(bad(CameraError::UpAlongView));
         }
         let r = f.cross(up).normalize();
         let u = r.cross(f);
@@ -107,6 +164,7 @@ impl Camera {
                 scale: (0.0, 0.0),
             }
             .ready(),
+            target,
             fov_deg,
         })
     }
@@ -114,6 +172,11 @@ impl Camera {
     /// The eye.
     pub fn eye(&self) -> DVec3 {
         self.view.origin
+    }
+
+    /// The point looked at.
+    pub fn target(&self) -> DVec3 {
+        self.target
     }
 
     /// `f`, the unit view direction.

@@ -6,23 +6,19 @@ mod shadows;
 
 use bsp_core::import_faces;
 use glam::DVec3;
-use shadow_raster::{Camera, RasterScene, SceneLight};
+use shadow_raster::{Camera, RasterScene};
 use shadow_scene::Mesh;
 use svbsp::{LightSpec, place_lights, shared_grid};
 
 /// A mesh on one grid with its lights.
 pub(crate) struct Setup {
     pub(crate) scene: RasterScene,
-    pub(crate) lights: Vec<SceneLight>,
+    pub(crate) lights: Vec<svbsp::PlacedLight>,
 }
 
 pub(crate) fn setup(mesh: &Mesh, specs: &[LightSpec]) -> Setup {
     let grid = shared_grid(&mesh.positions, specs).unwrap();
-    let lights = place_lights(&grid, specs)
-        .unwrap()
-        .iter()
-        .map(SceneLight::from_placed)
-        .collect();
+    let lights = place_lights(&grid, specs).unwrap();
     let loops = mesh.face_loops();
     let (polys, _) = import_faces(&grid, loops.iter().map(Vec::as_slice)).unwrap();
     Setup {

@@ -279,7 +279,7 @@ fn fragments_from_elsewhere_draw_the_same_image() {
     // the animation hook: fragments of every face's front side
     let s = room();
     let cam = room_camera(240, 135);
-    let exact: Vec<svbsp::Light> = s.lights.iter().map(|l| l.exact).collect();
+    let exact: Vec<svbsp::Light> = s.lights.iter().map(|l| l.light).collect();
     let (batch, _) = svbsp::shadow_fragments(s.scene.polygons(), &exact).unwrap();
     let hook = render_fragments(&s.scene, &batch, &s.lights, &cam, &[]).unwrap();
     let direct = render(&s.scene, &s.lights, &cam, &[], &with(Method::Exact)).unwrap();

@@ -9,6 +9,13 @@ use crate::mesh::{Face, Mesh};
 /// of the room's centre and a little behind it.
 pub const ROOM_LIGHT: DVec3 = DVec3::new(0.9, 0.3, 2.45);
 
+/// The room's default viewpoint: from the open front side of the room,
+/// slightly above, looking at [`ROOM_TARGET`] (the whole room in view).
+pub const ROOM_EYE: DVec3 = DVec3::new(3.3, -7.4, 4.3);
+
+/// The point the room's default viewpoint looks at: its middle.
+pub const ROOM_TARGET: DVec3 = DVec3::new(-0.15, 0.3, 0.45);
+
 /// The bunny scenes' default point light: above and in front of the bunny.
 pub const BUNNY_LIGHT: DVec3 = DVec3::new(4.0, 20.6, 5.9);
 

@@ -12,7 +12,8 @@
 //!   welding exactly equal positions so triangles share vertices,
 //! - either, chosen by extension ([`load`]),
 //!
-//! or generated in code ([`scene`], [`room`]): the test room of Liu & Wu's
+//! or generated in code ([`scene`], [`room`]), with a base colour for
+//! every face ([`face_colors`]): the test room of Liu & Wu's
 //! real-time shadow paper, with a movable coordinate-axis object. Meshes
 //! are written back with [`write_obj`] or [`write_stl`] (binary), or
 //! [`save`]d with the format chosen by extension.
@@ -47,15 +48,19 @@ mod animated;
 mod error;
 mod mesh;
 mod obj;
+mod palette;
 mod prim;
 mod scan;
 mod scenes;
 mod stl;
 
-pub use animated::{ANIMATED_NAMES, Animated, BUNNY_LIGHT, ROOM_LIGHT, animated, torus};
+pub use animated::{
+    ANIMATED_NAMES, Animated, BUNNY_LIGHT, ROOM_EYE, ROOM_LIGHT, ROOM_TARGET, animated, torus,
+};
 pub use error::SceneError;
 pub use mesh::{Face, Mesh, MeshView, Triangles};
 pub use obj::{ObjNotes, parse_obj, parse_obj_notes, read_obj, read_obj_notes, write_obj};
+pub use palette::{Rgb, face_colors};
 pub use scan::{MAX_SUBDIVISIONS, bunny, sqrt3_subdivide};
 pub use scenes::{SCENE_NAMES, room, scene};
 pub use stl::{parse_stl, read_stl, stl_collisions, write_stl};

@@ -250,6 +250,81 @@ impl Mesh {
             .map_or("", String::as_str)
     }
 
+    /// The centre (the mean of the corners) of every face.
+    ///
+    /// ```
+    /// let cube = shadow_scene::scene("cube").unwrap();
+    /// let centres = cube.face_centres();
+    /// assert_eq!(centres.len(), cube.faces.len());
+    /// ```
+    pub fn face_centres(&self) -> Vec<DVec3> {
+        (0..self.faces.len())
+            .map(|f| {
+                let pts = self.face_points(f);
+                pts.iter().sum::<DVec3>() / pts.len().max(1) as f64
+            })
+            .collect()
+    }
+
+    /// The connected parts of the faces (faces sharing a vertex are in one
+    /// part), numbered in the order of their first face: each face's part.
+    ///
+    /// ```
+    /// use shadow_scene::{Face, Mesh};
+    /// use glam::DVec3;
+    /// let f = |vertices: Vec<u32>| Face { vertices, line: 0, group: 0 };
+    /// let m = Mesh {
+    ///     positions: vec![DVec3::ZERO; 7],
+    ///     faces: vec![f(vec![4, 5, 6]), f(vec![0, 1, 2]), f(vec![2, 3, 1])],
+    ///     groups: vec!["default".into()],
+    /// };
+    /// assert_eq!(m.parts(), vec![0, 1, 1]);
+    /// ```
+    pub fn parts(&self) -> Vec<usize> {
+        // the faces around each vertex, by a counting sort
+        let mut first = vec![0usize; self.positions.len() + 1];
+        for f in &self.faces {
+            for &v in &f.vertices {
+                first[v as usize + 1] += 1;
+            }
+        }
+        for k in 1..first.len() {
+            first[k] += first[k - 1];
+        }
+        let mut fill = first.clone();
+        let mut around = vec![0u32; first[self.positions.len()]];
+        for (i, f) in self.faces.iter().enumerate() {
+            for &v in &f.vertices {
+                around[fill[v as usize]] = i as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        // each part by a walk from its first face
+        const UNSEEN: usize = usize::MAX;
+        let mut part = vec![UNSEEN; self.faces.len()];
+        let mut count = 0;
+        let mut stack = Vec::new();
+        for start in 0..self.faces.len() {
+            if part[start] != UNSEEN {
+                continue;
+            }
+            part[start] = count;
+            stack.push(start);
+            while let Some(f) = stack.pop() {
+                for &v in &self.faces[f].vertices {
+                    for &g in &around[first[v as usize]..first[v as usize + 1]] {
+                        if part[g as usize] == UNSEEN {
+                            part[g as usize] = count;
+                            stack.push(g as usize);
+                        }
+                    }
+                }
+            }
+            count += 1;
+        }
+        part
+    }
+
     /// Merges vertices with exactly equal positions (`-0.0` equals `0.0`)
     /// and drops positions no face uses; faces keep their order and
     /// vertex loops.

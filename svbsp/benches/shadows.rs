@@ -1,5 +1,6 @@
-//! Exact shadows against Chin & Feiner's algorithm and against a
-//! ray-casting baseline, in one run.
+//! Exact shadows against Chin & Feiner's algorithm, in one run (the
+//! ray-casting baseline on the same scenes is `shadow-raster`'s `rays`
+//! bench).
 //!
 //! Scenes (see `common`): Chin & Feiner's sizes (27, 258 and 1026
 //! polygons: a floor under floating boxes, tetrahedra and parallelograms),
@@ -11,11 +12,7 @@
 //! - `psv/<scene>`: `Shadows::new` and `shade_all` (the default path:
 //!   fragments per face, on every core);
 //! - `chin_feiner/<scene>`: the scene BSP (`BspTree::build`) and
-//!   `chin_feiner` (the baseline algorithm), up to 10 000 polygons;
-//! - `rays/<scene>`: the renderer's alternative, a BVH built over the
-//!   scene and one `f64` shadow ray per sample toward each light, for one
-//!   million samples spread over the faces by area (a 1-megapixel image's
-//!   worth), on every core: build and rays together.
+//!   `chin_feiner` (the baseline algorithm), up to 10 000 polygons.
 //!
 //! Before each scene one timed run prints the counts criterion cannot
 //! report: fragments per face, shadow-tree nodes, and the peak memory of
@@ -35,7 +32,7 @@ use svbsp::{ShadeOptions, Shadows, chin_feiner};
 
 mod common;
 
-use common::{Bvh, Prepared};
+use common::Prepared;
 
 const SCENES: [&str; 6] = [
     "cf27",
@@ -61,9 +58,6 @@ fn light_sets(name: &str) -> &'static [usize] {
     }
 }
 
-/// Samples of the ray baseline.
-const RAYS: usize = 1_000_000;
-
 fn configure(g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>, big: bool) {
     g.sample_size(10);
     if big {
@@ -79,7 +73,9 @@ fn configure(g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallT
 /// The exact shadows of `p` for its first `nl` lights.
 fn exact(p: &Prepared, nl: usize) -> (Shadows, svbsp::Batch) {
     let shadows = Shadows::new(&p.polys, &p.lights[..nl]).expect("lights on the grid");
-    let b = shadows.shade_all(&p.polys, &ShadeOptions::default().with_pieces(false));
+    let b = shadows
+        .set()
+        .shade_all(&p.polys, &ShadeOptions::default().with_pieces(false));
     (shadows, b)
 }
 
@@ -144,21 +140,6 @@ fn bench_scene(c: &mut Criterion, name: &str) {
         }
         g.finish();
     }
-
-    let tris = common::triangles(&p.polys);
-    let samples = common::surface_samples(&tris, RAYS, 0x5a3e);
-    let mut g = c.benchmark_group(format!("rays/{name}"));
-    configure(&mut g, true);
-    g.throughput(Throughput::Elements(RAYS as u64));
-    for &nl in sets {
-        g.bench_function(format!("build+1M/{nl}light"), |b| {
-            b.iter(|| {
-                let bvh = Bvh::build(black_box(&tris));
-                common::shadow_ray_pass(&bvh, &samples, &p.lights_f64[..nl])
-            })
-        });
-    }
-    g.finish();
 }
 
 fn bench(c: &mut Criterion) {

@@ -52,7 +52,15 @@ impl std::fmt::Display for ShadowError {
     }
 }
 
-impl std::error::Error for ShadowError {}
+impl std::error::Error for ShadowError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ShadowError::Light(e) => Some(e),
+            ShadowError::Volume(e) => Some(e),
+            ShadowError::Mismatch => None,
+        }
+    }
+}
 
 impl From<LightError> for ShadowError {
     fn from(e: LightError) -> ShadowError {
@@ -174,7 +182,8 @@ impl Shadows {
         facing(&self.lights, support)
     }
 
-    /// The trees as a [`ShadowSet`] (which has every shading method).
+    /// The trees as a [`ShadowSet`], which shades receivers:
+    /// `shadows.set().shade_all(&polys, &opts)`.
     pub fn set(&self) -> ShadowSet<'_> {
         ShadowSet {
             lights: &self.lights,
@@ -199,77 +208,6 @@ impl Shadows {
         set.trees
             .extend(more.volumes.iter().enumerate().map(|(j, v)| (v, j)));
         Ok(set)
-    }
-
-    /// See [`ShadowSet::shade`].
-    pub fn shade(
-        &self,
-        polys: &[Polygon],
-        receiver: u32,
-        opts: &ShadeOptions,
-        scratch: &mut Scratch,
-        out: &mut Batch,
-    ) {
-        self.set().shade(polys, receiver, opts, scratch, out)
-    }
-
-    /// See [`ShadowSet::shade_keeping`].
-    pub fn shade_keeping(
-        &self,
-        polys: &[Polygon],
-        receiver: u32,
-        opts: &ShadeOptions,
-        scratch: &mut Scratch,
-        out: &mut Batch,
-    ) -> Option<Cells> {
-        self.set()
-            .shade_keeping(polys, receiver, opts, scratch, out)
-    }
-
-    /// See [`ShadowSet::refine`].
-    pub fn refine(
-        &self,
-        polys: &[Polygon],
-        start: &Start<'_>,
-        receiver: u32,
-        opts: &ShadeOptions,
-        scratch: &mut Scratch,
-        out: &mut Batch,
-    ) {
-        self.set()
-            .refine(polys, start, receiver, opts, scratch, out)
-    }
-
-    /// See [`ShadowSet::refine_cells`].
-    #[allow(clippy::too_many_arguments)]
-    pub fn refine_cells(
-        &self,
-        polys: &[Polygon],
-        start: &Start<'_>,
-        receiver: u32,
-        opts: &ShadeOptions,
-        scratch: &mut Scratch,
-        out: &mut Batch,
-        may_change: impl Fn(u32, usize) -> bool,
-    ) -> Refined {
-        self.set()
-            .refine_cells(polys, start, receiver, opts, scratch, out, may_change)
-    }
-
-    /// See [`ShadowSet::shade_ranges`].
-    pub fn shade_ranges(
-        &self,
-        polys: &[Polygon],
-        ranges: &[Range<usize>],
-        first_receiver: u32,
-        opts: &ShadeOptions,
-    ) -> Batch {
-        self.set().shade_ranges(polys, ranges, first_receiver, opts)
-    }
-
-    /// See [`ShadowSet::shade_all`].
-    pub fn shade_all(&self, polys: &[Polygon], opts: &ShadeOptions) -> Batch {
-        self.set().shade_all(polys, opts)
     }
 }
 
@@ -1322,7 +1260,7 @@ pub fn shadow_fragments(
     lights: &[Light],
 ) -> Result<(Batch, ShadowStats), ShadowError> {
     let shadows = Shadows::new(polys, lights)?;
-    let batch = shadows.shade_all(polys, &ShadeOptions::default());
+    let batch = shadows.set().shade_all(polys, &ShadeOptions::default());
     let stats = ShadowStats {
         receivers: receivers(polys).len(),
         fragments: batch.len(),

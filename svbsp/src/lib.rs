@@ -44,6 +44,7 @@ mod areas;
 mod arena;
 mod chin_feiner;
 mod engine;
+pub mod export;
 mod light;
 mod psv;
 mod wide;

@@ -72,7 +72,14 @@ impl std::fmt::Display for LightError {
     }
 }
 
-impl std::error::Error for LightError {}
+impl std::error::Error for LightError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            LightError::Grid(e) => Some(e),
+            _ => None,
+        }
+    }
+}
 
 fn sub(a: [i32; 3], b: [i32; 3]) -> [i64; 3] {
     [0, 1, 2].map(|k| a[k] as i64 - b[k] as i64)

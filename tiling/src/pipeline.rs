@@ -43,8 +43,8 @@ use glam::{DMat4, DVec3};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use svbsp::{
-    Batch, CHUNK, Cells, CfFragments, Light, Refined, Scratch, ShadeOptions, ShadowVolumes,
-    Shadows, Start, chin_feiner, receivers,
+    Batch, CHUNK, Cells, CfFragments, Light, Refined, Scratch, ShadeOptions, ShadowError,
+    ShadowVolumes, Shadows, Start, chin_feiner, receivers,
 };
 
 use crate::{Query, TileIndex, TilingError};
@@ -103,7 +103,7 @@ pub enum PipelineError {
     /// The tiling of a light cannot be built.
     Tiling(TilingError),
     /// The shadows cannot be computed (a light or an occluder is unusable).
-    Shadow(String),
+    Shadow(ShadowError),
 }
 
 impl std::fmt::Display for PipelineError {
@@ -117,7 +117,15 @@ impl std::fmt::Display for PipelineError {
     }
 }
 
-impl std::error::Error for PipelineError {}
+impl std::error::Error for PipelineError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            PipelineError::Static(e) | PipelineError::Moved(e) => Some(e),
+            PipelineError::Tiling(e) => Some(e),
+            PipelineError::Shadow(e) => Some(e),
+        }
+    }
+}
 
 /// A motion: frame `k` rotates the original coordinates by `k × degrees`
 /// about `axis` through `centre`, then translates them by `k × step`.
@@ -366,8 +374,7 @@ impl Dynamic {
         let t = Instant::now();
         let shadows = match opts.strategy {
             Strategy::Fast => {
-                let sh = Shadows::new(&polys, lights)
-                    .map_err(|e| PipelineError::Shadow(e.to_string()))?;
+                let sh = Shadows::new(&polys, lights).map_err(PipelineError::Shadow)?;
                 let sopts = ShadeOptions::default().with_pieces(opts.pieces);
                 let parts: Vec<(Batch, Vec<Option<Box<Cells>>>)> = ranges
                     .par_chunks(CHUNK)
@@ -379,7 +386,8 @@ impl Dynamic {
                             .enumerate()
                             .map(|(i, r)| {
                                 let rec = (c * CHUNK + i) as u32;
-                                sh.shade_keeping(&polys[r.clone()], rec, &sopts, &mut s, &mut b)
+                                sh.set()
+                                    .shade_keeping(&polys[r.clone()], rec, &sopts, &mut s, &mut b)
                                     .map(Box::new)
                             })
                             .collect();
@@ -408,8 +416,7 @@ impl Dynamic {
             }
             Strategy::Paper => {
                 let bsp1 = BspTree::build(polys.clone(), &BuildOptions::default());
-                let cf =
-                    chin_feiner(&bsp1, lights).map_err(|e| PipelineError::Shadow(e.to_string()))?;
+                let cf = chin_feiner(&bsp1, lights).map_err(|e| PipelineError::Shadow(e.into()))?;
                 let mut of_face = vec![Vec::new(); statics.len()];
                 for (i, f) in cf.iter().enumerate() {
                     of_face[f.face() as usize].push(i as u32);
@@ -656,13 +663,11 @@ impl Dynamic {
                         ShadowVolumes::build(*l, &occ)
                     })
                     .collect::<Result<Vec<_>, _>>()
-                    .map_err(|e| PipelineError::Shadow(e.to_string()))?;
-                let sh = Shadows::from_volumes(&self.lights, volumes)
-                    .map_err(|e| PipelineError::Shadow(e.to_string()))?;
+                    .map_err(|e| PipelineError::Shadow(e.into()))?;
+                let sh =
+                    Shadows::from_volumes(&self.lights, volumes).map_err(PipelineError::Shadow)?;
                 let for_moved = if layered {
-                    statics
-                        .with(&sh)
-                        .map_err(|e| PipelineError::Shadow(e.to_string()))?
+                    statics.with(&sh).map_err(PipelineError::Shadow)?
                 } else {
                     sh.set()
                 };
@@ -724,7 +729,10 @@ impl Dynamic {
                                 // what the moved object leaves alone keeps
                                 // its static fragments
                                 let may = |c: u32, j: usize| meets(r, c, j);
-                                match sh.refine_cells(polys, st, r, &sopts, &mut s, &mut b, may) {
+                                match sh
+                                    .set()
+                                    .refine_cells(polys, st, r, &sopts, &mut s, &mut b, may)
+                                {
                                     Refined::Unchanged => {}
                                     Refined::All => done.push((r, first..b.len(), None)),
                                     Refined::Some(kept) => {
@@ -786,8 +794,8 @@ impl Dynamic {
                 .polygon_tree(|(a, _)| a);
                 stats.t_merge = t.elapsed();
                 let t = Instant::now();
-                let shaded = chin_feiner(&b4, &self.lights)
-                    .map_err(|e| PipelineError::Shadow(e.to_string()))?;
+                let shaded =
+                    chin_feiner(&b4, &self.lights).map_err(|e| PipelineError::Shadow(e.into()))?;
                 let statics = self.static_faces as u32;
                 let out = shaded.overlay(cf, |face| {
                     (face < statics).then(|| &of_face[face as usize][..])

@@ -49,4 +49,11 @@ impl std::fmt::Display for Error {
     }
 }
 
-impl std::error::Error for Error {}
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Error::Snap { reason, .. } => Some(reason),
+            _ => None,
+        }
+    }
+}

@@ -168,6 +168,18 @@ impl Grid {
         1.0 / self.scale
     }
 
+    /// The grid step as a power of two: the step is `2^step_log2()` input
+    /// units.
+    ///
+    /// ```
+    /// let g = bsp_core::Grid::new(glam::DVec3::ZERO, 23).unwrap();
+    /// assert_eq!(g.step_log2(), -23);
+    /// assert_eq!(g.step(), 2f64.powi(-23));
+    /// ```
+    pub fn step_log2(&self) -> i32 {
+        -(self.scale.log2() as i32)
+    }
+
     fn snap_f64(&self, p: DVec3) -> Result<DVec3, SnapError> {
         if !p.is_finite() {
             return Err(SnapError::NonFinite);
@@ -232,6 +244,8 @@ impl std::fmt::Display for SnapError {
         }
     }
 }
+
+impl std::error::Error for SnapError {}
 
 #[cfg(test)]
 mod tests {

@@ -50,6 +50,7 @@ use smallvec::SmallVec;
 
 use crate::kernel::plane::{cross, cross_wide};
 use crate::kernel::{GridPoint, Polygon};
+use crate::union_find::UnionFind;
 
 /// Why polygons are not certified as the boundary of solids (the first
 /// reason found; polygons are indices into the list given).
@@ -234,15 +235,7 @@ fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefec
         fill[v as usize] += 1;
     }
     drop(fill);
-    let mut parent: Vec<u32> = (0..polys.len() as u32).collect();
-    let find = |parent: &mut Vec<u32>, mut x: u32| {
-        while parent[x as usize] != x {
-            let up = parent[parent[x as usize] as usize];
-            parent[x as usize] = up;
-            x = up;
-        }
-        x
-    };
+    let mut parts_of = UnionFind::new(polys.len());
     // per vertex: its star certified embedded (see `star_embedded`)
     let mut certified = vec![false; n_ids];
     let mut around: Vec<(u32, u32, u32)> = Vec::new();
@@ -277,13 +270,7 @@ fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefec
         let succ = |c: &(u32, u32, u32)| around.binary_search_by_key(&c.1, |d| d.0).unwrap_or(0);
         for c in &around {
             let d = &around[succ(c)];
-            let (rp, rq) = (
-                find(&mut parent, corner_poly[c.2 as usize]),
-                find(&mut parent, corner_poly[d.2 as usize]),
-            );
-            if rp != rq {
-                parent[rp.max(rq) as usize] = rp.min(rq);
-            }
+            parts_of.union(corner_poly[c.2 as usize], corner_poly[d.2 as usize]);
         }
         // one cycle around the vertex: its corners in order
         order.clear();
@@ -309,7 +296,7 @@ fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefec
     for i in 0..polys.len() {
         let r = loop_of(i);
         let (l, id) = (&pts[r.clone()], &ids[r]);
-        let root = find(&mut parent, i as u32) as usize;
+        let root = parts_of.find(i as u32) as usize;
         for j in 1..l.len() - 1 {
             let t = [l[0], l[j], l[j + 1]];
             let (a, b, c) = (sub(t[0], [0; 3]), sub(t[1], [0; 3]), sub(t[2], [0; 3]));
@@ -332,10 +319,10 @@ fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefec
         }
     }
     let mut parts = 0;
-    for i in 0..polys.len() {
-        if parent[i] == i as u32 {
+    for (i, v) in volume.iter().enumerate() {
+        if parts_of.is_root(i as u32) {
             parts += 1;
-            if volume[i] <= 0 {
+            if *v <= 0 {
                 return Err(SurfaceDefect::Inward { polygon: i });
             }
         }

@@ -21,6 +21,7 @@ use crate::kernel::Side;
 use crate::kernel::plane::{Plane, cross_wide};
 use crate::kernel::point::{Point, PointRef};
 use crate::kernel::polygon::{ConvexFace, Polygon};
+use crate::union_find::UnionFind;
 
 /// A triangle mesh over exact, welded vertices.
 #[derive(Clone, Debug, Default)]
@@ -436,21 +437,8 @@ impl TriMesh {
         by_edge: &HashMap<(u32, u32), SmallVec<[Corner; 2]>>,
         exterior: &std::collections::HashSet<(u32, u32)>,
     ) {
-        // union-find over corners (triangle, corner index)
-        let mut parent: Vec<u32> = (0..3 * self.triangles.len() as u32).collect();
-        fn find(p: &mut [u32], mut x: u32) -> u32 {
-            while p[x as usize] != x {
-                p[x as usize] = p[p[x as usize] as usize];
-                x = p[x as usize];
-            }
-            x
-        }
-        let unite = |p: &mut Vec<u32>, x: u32, y: u32| {
-            let (a, b) = (find(p, x), find(p, y));
-            if a != b {
-                p[a as usize] = b;
-            }
-        };
+        // the fans of corners (triangle, corner index) joined across edges
+        let mut fans = UnionFind::new(3 * self.triangles.len());
         let corner = |tri: u32, c: u8| 3 * tri + c as u32;
         let mut pairs: Vec<(Corner, Corner)> = Vec::new();
         for (&(a, b), ab) in by_edge {
@@ -468,15 +456,15 @@ impl TriMesh {
             // t1 uses a -> b at corner c1 (a at c1, b at c1 + 1); t2 uses b -> a
             let (a1, b1) = (corner(t1, c1), corner(t1, (c1 + 1) % 3));
             let (b2, a2) = (corner(t2, c2), corner(t2, (c2 + 1) % 3));
-            unite(&mut parent, a1, a2);
-            unite(&mut parent, b1, b2);
+            fans.union(a1, a2);
+            fans.union(b1, b2);
         }
         let mut copy_of: HashMap<(u32, u32), u32> = HashMap::new();
         let mut first_class: HashMap<u32, u32> = HashMap::new();
         for ti in 0..self.triangles.len() {
             for c in 0..3u8 {
                 let v = self.triangles[ti][c as usize];
-                let class = find(&mut parent, corner(ti as u32, c));
+                let class = fans.find(corner(ti as u32, c));
                 let fc = *first_class.entry(v).or_insert(class);
                 let id = if fc == class {
                     v

@@ -2,12 +2,12 @@
 //! scanned bunny at the default camera and light of `shadow render`.
 
 use glam::DVec3;
-use shadow_raster::{RasterScene, SceneLight};
+use shadow_raster::RasterScene;
 use svbsp::{LightSpec, place_lights, shared_grid};
 
 pub(crate) struct Setup {
     pub(crate) scene: RasterScene,
-    pub(crate) lights: Vec<SceneLight>,
+    pub(crate) lights: Vec<svbsp::PlacedLight>,
     pub(crate) eye: DVec3,
     pub(crate) target: DVec3,
 }
@@ -22,11 +22,7 @@ pub(crate) fn bunny(name: &str, sun: bool) -> Setup {
         LightSpec::Point(c + DVec3::Y * 1.6 * half + DVec3::X * 0.4 * half + DVec3::Z * 0.6 * half)
     };
     let grid = shared_grid(&mesh.positions, &[spec]).unwrap();
-    let lights = place_lights(&grid, &[spec])
-        .unwrap()
-        .iter()
-        .map(SceneLight::from_placed)
-        .collect();
+    let lights = place_lights(&grid, &[spec]).unwrap();
     let (polys, _) = bsp_core::import_faces_par(&grid, &mesh.face_loops()).unwrap();
     Setup {
         scene: RasterScene::new(&grid, polys).unwrap(),

@@ -22,7 +22,7 @@ use num_rational::BigRational;
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
-use bsp_core::internals::filter_ring_area;
+use bsp_core::internals::{UnionFind, filter_ring_area};
 use bsp_core::{I256, Plane};
 
 use super::pieces::{EdgeRef, Piece, PieceArena, Vertex};
@@ -101,26 +101,6 @@ fn line_key(support: &Plane, e: &Plane) -> LineKey {
         (a, b, c) = (-a, -b, -c);
     }
     LineKey { a, b, c }
-}
-
-struct UnionFind(Vec<u32>);
-impl UnionFind {
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.0[x as usize] != x {
-            let p = self.0[x as usize];
-            self.0[x as usize] = self.0[p as usize];
-            x = p;
-        }
-        x
-    }
-    fn union(&mut self, a: u32, b: u32) {
-        let (a, b) = (self.find(a), self.find(b));
-        if a != b {
-            // the smaller root stays: regions are named by their first cell
-            let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-            self.0[hi as usize] = lo;
-        }
-    }
 }
 
 /// The cells on the left and on the right of one interval of a line.
@@ -300,7 +280,7 @@ struct PRegion {
 /// set is its smallest cell). `adjacent` receives every pair of cells
 /// that share a piece of edge.
 fn unite(lines: &[&MLine], labels: &[u64], adjacent: Option<&mut Vec<[u32; 2]>>) -> UnionFind {
-    let mut uf = UnionFind((0..labels.len() as u32).collect());
+    let mut uf = UnionFind::new(labels.len());
     let mut adj = adjacent;
     for line in lines {
         for &(l, r) in &line.iv {

@@ -6,14 +6,14 @@
 //! default). Used by `scripts/bench_shadows.sh` and for profiling.
 //!
 //! ```sh
-//! cargo run --release -p svbsp --example shade -- SCENE [X,Y,Z | sun:X,Y,Z]... [rays=N]
+//! cargo run --profile dist -p shadow-raster --example shade -- SCENE [X,Y,Z | sun:X,Y,Z]... [rays=N]
 //! ```
 //!
 //! `SCENE` is a mesh file (`.obj`, `.stl`) or a built-in scene name
 //! (`room`, `bunny-99k`, ...). Without lights, the bench's lights for the
 //! scene are used (one key light).
 
-#[path = "../benches/common/mod.rs"]
+#[path = "../benches/baseline/mod.rs"]
 mod common;
 
 use std::time::Instant;
@@ -78,7 +78,9 @@ fn main() {
     let shadows = Shadows::new(&polys, &lights).expect("trees");
     let t_trees = t.elapsed();
     let t = Instant::now();
-    let batch = shadows.shade_all(&polys, &ShadeOptions::default().with_pieces(false));
+    let batch = shadows
+        .set()
+        .shade_all(&polys, &ShadeOptions::default().with_pieces(false));
     let t_shade = t.elapsed();
     let nodes: usize = shadows.volumes().iter().map(|v| v.node_count()).sum();
     let holes: usize = batch.fragments().map(|f| f.hole_count()).sum();

@@ -12,44 +12,17 @@ use bsp_core::import_faces_par;
 use clap::Args;
 use glam::DVec3;
 use shadow_raster::{
-    Camera, Hsr, Method, RasterScene, RenderOptions, SceneLight, ShadowOptions, compare,
-    hidden_lines, render, write_pgm,
+    Camera, Hsr, Method, RasterScene, RenderOptions, ShadowOptions, compare, hidden_lines, render,
+    write_pgm,
 };
-use svbsp::LightSpec;
+use shadow_scene::{ROOM_EYE, ROOM_LIGHT, ROOM_TARGET, face_colors};
+use svbsp::{LightSpec, PlacedLight};
 
-use crate::color::face_colors;
-use crate::csg::emit;
+use crate::args::{CameraArgs, LightArgs, SourceArgs, parse_fov, parse_size};
+use crate::input::load_source_quiet;
 use crate::lights::{describe, place_lights, shared_grid};
-use crate::shadows::ROOM_LIGHT;
-use crate::{DEMO_EYE, DEMO_TARGET, SourceArgs, load_source_quiet, parse_vec3};
-
-/// `WxH`, each side between 1 and [`shadow_raster::MAX_SIZE`].
-pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("`{s}` is not a size: expected WxH, such as 1280x720"))?;
-    let side = |v: &str, what: &str| -> Result<u32, String> {
-        let n: u32 = v
-            .trim()
-            .parse()
-            .map_err(|_| format!("`{s}`: the {what} `{v}` is not a whole number (expected WxH)"))?;
-        if n == 0 || n > shadow_raster::MAX_SIZE {
-            return Err(format!(
-                "`{s}`: the {what} must lie between 1 and {} pixels",
-                shadow_raster::MAX_SIZE
-            ));
-        }
-        Ok(n)
-    };
-    let (w, h) = (side(w, "width")?, side(h, "height")?);
-    if w as u64 * h as u64 > shadow_raster::MAX_PIXELS {
-        return Err(format!(
-            "`{s}`: at most {} pixels in all",
-            shadow_raster::MAX_PIXELS
-        ));
-    }
-    Ok((w, h))
-}
+use crate::output::emit;
+use crate::raster_error;
 
 fn parse_method(s: &str) -> Result<Method, String> {
     let s = s.trim();
@@ -94,34 +67,14 @@ fn parse_bias(s: &str) -> Result<(f64, f64), String> {
 pub(crate) struct SceneArgs {
     #[command(flatten)]
     pub(crate) source: SourceArgs,
-    /// A point light at X,Y,Z (input units); repeatable. Lights are
-    /// numbered all --light first, then all --sun; the mask is the first's
-    /// [default for --scene room: 0.9,0.3,2.45; for the bunnies a key light
-    /// above].
-    #[arg(long = "light", value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub(crate) lights: Vec<DVec3>,
-    /// A light at infinity in the direction X,Y,Z from the scene toward
-    /// it; repeatable.
-    #[arg(long = "sun", value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub(crate) suns: Vec<DVec3>,
-    /// Eye position [default for the built-in room and bunnies: a view of
-    /// the whole scene; required otherwise].
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub(crate) eye: Option<DVec3>,
-    /// Point looked at [default: the centre of the scene's bounding box].
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub(crate) target: Option<DVec3>,
-    /// Up direction [default: +Z (+Y for the bunnies), or another axis when
-    /// looking along it].
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    pub(crate) up: Option<DVec3>,
+    /// The lights; the mask is the first's.
+    #[command(flatten)]
+    pub(crate) lights: LightArgs,
+    #[command(flatten)]
+    pub(crate) camera: CameraArgs,
     /// Vertical field of view in degrees.
-    #[arg(long, value_name = "DEG", default_value_t = 50.0, value_parser = crate::parse_fov)]
+    #[arg(long, value_name = "DEG", default_value_t = 50.0, value_parser = parse_fov)]
     pub(crate) fov: f64,
-    /// Worker threads [default: one per core]; the image is the same for
-    /// every count.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub(crate) threads: Option<u32>,
     /// No notes on stderr (errors still go there).
     #[arg(long, short)]
     pub(crate) quiet: bool,
@@ -245,20 +198,11 @@ pub(crate) struct Prepared {
     pub(crate) name: String,
     pub(crate) faces: usize,
     pub(crate) scene: RasterScene,
-    pub(crate) lights: Vec<SceneLight>,
+    pub(crate) lights: Vec<PlacedLight>,
     pub(crate) light_notes: Vec<String>,
     pub(crate) camera: Camera,
     pub(crate) colors: Vec<DVec3>,
     pub(crate) load_time: Duration,
-}
-
-/// The built-in bunnies stand along +y: their default view and light.
-fn is_bunny(src: &SourceArgs) -> bool {
-    src.input.is_none() && src.scene.as_deref().is_some_and(|s| s.starts_with("bunny"))
-}
-
-fn is_room(src: &SourceArgs) -> bool {
-    src.input.is_none() && src.scene.as_deref() == Some("room")
 }
 
 fn check_ext(path: &std::path::Path, ext: &str, flag: &str) -> Result<()> {
@@ -276,12 +220,11 @@ fn check_ext(path: &std::path::Path, ext: &str, flag: &str) -> Result<()> {
 pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> Result<Prepared> {
     let start = Instant::now();
     let (mesh, name) = load_source_quiet(&args.source, args.quiet)?;
-    let bunny = is_bunny(&args.source);
-    let room = is_room(&args.source);
+    let bunny = args.source.is_bunny();
+    let room = args.source.is_scene("room");
     let (lo, hi) = mesh.bounds().context("the mesh has no vertices")?;
     let (centre, half) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
-    let mut specs: Vec<LightSpec> = args.lights.iter().map(|&p| LightSpec::Point(p)).collect();
-    specs.extend(args.suns.iter().map(|&d| LightSpec::Sun(d)));
+    let mut specs = args.lights.specs();
     if specs.is_empty() && need_lights {
         if room {
             specs.push(LightSpec::Point(ROOM_LIGHT));
@@ -297,9 +240,9 @@ pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> 
             );
         }
     }
-    let (eye, default_target) = match (args.eye, room, bunny) {
+    let (eye, default_target) = match (args.camera.eye, room, bunny) {
         (Some(e), _, _) => (e, centre),
-        (None, true, _) => (DEMO_EYE, DEMO_TARGET),
+        (None, true, _) => (ROOM_EYE, ROOM_TARGET),
         (None, _, true) => (
             centre + DVec3::new(0.75 * half, 0.6 * half, 1.7 * half),
             centre - DVec3::Y * 0.25 * half,
@@ -308,9 +251,9 @@ pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> 
             "no viewpoint: give --eye X,Y,Z (only the built-in room and bunnies have a default)"
         ),
     };
-    let target = args.target.unwrap_or(default_target);
+    let target = args.camera.target.unwrap_or(default_target);
     let forward = target - eye;
-    let up = match args.up {
+    let up = match args.camera.up {
         Some(u) => u,
         None => {
             let pref = if bunny { DVec3::Y } else { DVec3::Z };
@@ -320,7 +263,8 @@ pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> 
                 .unwrap_or(DVec3::X)
         }
     };
-    let camera = Camera::look_at(eye, target, up, args.fov, size.0, size.1)?;
+    let camera =
+        Camera::look_at(eye, target, up, args.fov, size.0, size.1).map_err(raster_error)?;
     let grid = shared_grid(&mesh.positions, &specs).with_context(|| name.clone())?;
     let placed = place_lights(&grid, &specs)?;
     let loops = mesh.face_loops();
@@ -339,22 +283,11 @@ pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> 
         colors: face_colors(&mesh),
         name,
         scene,
-        lights: placed.iter().map(SceneLight::from_placed).collect(),
         light_notes: placed.iter().map(describe).collect(),
+        lights: placed,
         camera,
         load_time: start.elapsed(),
     })
-}
-
-fn with_threads(threads: Option<u32>, f: impl FnOnce() -> Result<()> + Send) -> Result<()> {
-    match threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n as usize)
-            .build()
-            .context("cannot start the worker threads")?
-            .install(f),
-        None => f(),
-    }
 }
 
 fn ms(d: Duration) -> f64 {
@@ -368,7 +301,7 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
         check_ext(m, "pgm", "--mask")?;
     }
     let shadow = args.opts.options()?;
-    with_threads(args.scene.threads, || {
+    {
         let total = Instant::now();
         let p = prepare(&args.scene, args.size, true)?;
         let opts = RenderOptions::default()
@@ -425,7 +358,7 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
             text += &format!("total:          {:.1} ms\n", ms(total.elapsed()));
         }
         emit(&text)
-    })
+    }
 }
 
 /// `shadow compare`.
@@ -435,7 +368,7 @@ pub(crate) fn run_compare(args: &CompareArgs) -> Result<()> {
         check_ext(r, "csv", "--report")?;
     }
     let shadow = args.opts.options()?;
-    with_threads(args.scene.threads, || {
+    {
         let p = prepare(&args.scene, args.size, true)?;
         let methods = if args.methods.is_empty() {
             Method::ALL.to_vec()
@@ -472,13 +405,13 @@ pub(crate) fn run_compare(args: &CompareArgs) -> Result<()> {
             text += &format!("wrote {}\n", r.display());
         }
         emit(&text)
-    })
+    }
 }
 
 /// `shadow lines`.
 pub(crate) fn run_lines(args: &LinesArgs) -> Result<()> {
     check_ext(&args.output, "svg", "-o")?;
-    with_threads(args.scene.threads, || {
+    {
         let p = prepare(&args.scene, args.size, false)?;
         let lines = hidden_lines(&p.scene, &p.camera)?;
         std::fs::write(&args.output, lines.svg(args.hidden))
@@ -495,35 +428,12 @@ pub(crate) fn run_lines(args: &LinesArgs) -> Result<()> {
             lines.check.agree,
             lines.check.checked
         ))
-    })
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn sizes_parse_with_clear_errors() {
-        assert_eq!(parse_size("1920x1080"), Ok((1920, 1080)));
-        assert_eq!(parse_size("64X48"), Ok((64, 48)));
-        assert!(parse_size("1920").unwrap_err().contains("expected WxH"));
-        assert!(
-            parse_size("0x10")
-                .unwrap_err()
-                .contains("between 1 and 16384")
-        );
-        assert!(
-            parse_size("axb")
-                .unwrap_err()
-                .contains("not a whole number")
-        );
-        assert!(parse_size("99999x2").unwrap_err().contains("width"));
-        assert!(
-            parse_size("16384x16384")
-                .unwrap_err()
-                .contains("pixels in all")
-        );
-    }
 
     #[test]
     fn methods_and_biases_parse() {

@@ -1,12 +1,13 @@
-//! Base colours of faces: one per group, with two refinements for the
-//! built-in room (books get a colour each; the arrows of the axis object
-//! are red, green and blue along x, y and z).
+//! The palette: a base colour for every face of a mesh, one per group,
+//! with two refinements for the built-in room (books get a colour each;
+//! the arrows of the axis object are red, green and blue along x, y and
+//! z).
 
+use crate::Mesh;
 use glam::DVec3;
-use shadow_scene::Mesh;
 
 /// Linear-ish RGB in `[0, 1]`.
-pub(crate) type Rgb = DVec3;
+pub type Rgb = DVec3;
 
 const fn rgb(r: f64, g: f64, b: f64) -> Rgb {
     DVec3::new(r, g, b)
@@ -57,36 +58,13 @@ fn group_color(name: &str, index: u32) -> Rgb {
     }
 }
 
-fn find(parent: &mut [u32], mut x: u32) -> u32 {
-    while parent[x as usize] != x {
-        parent[x as usize] = parent[parent[x as usize] as usize];
-        x = parent[x as usize];
-    }
-    x
-}
-
 /// The base colour of every face of `mesh`.
-pub(crate) fn face_colors(mesh: &Mesh) -> Vec<Rgb> {
+pub fn face_colors(mesh: &Mesh) -> Vec<Rgb> {
     // connected parts (faces sharing a vertex), numbered in face order
-    let mut parent: Vec<u32> = (0..mesh.positions.len() as u32).collect();
-    for f in &mesh.faces {
-        for w in f.vertices.windows(2) {
-            let (a, b) = (find(&mut parent, w[0]), find(&mut parent, w[1]));
-            parent[a.max(b) as usize] = a.min(b);
-        }
-    }
-    let mut part_of_root = std::collections::HashMap::new();
-    let parts: Vec<usize> = mesh
-        .faces
-        .iter()
-        .map(|f| {
-            let root = f.vertices.first().map_or(0, |&v| find(&mut parent, v));
-            let next = part_of_root.len();
-            *part_of_root.entry(root).or_insert(next)
-        })
-        .collect();
-    let mut lo = vec![DVec3::splat(f64::INFINITY); part_of_root.len()];
-    let mut hi = vec![DVec3::splat(f64::NEG_INFINITY); part_of_root.len()];
+    let parts = mesh.parts();
+    let count = parts.iter().max().map_or(0, |&p| p + 1);
+    let mut lo = vec![DVec3::splat(f64::INFINITY); count];
+    let mut hi = vec![DVec3::splat(f64::NEG_INFINITY); count];
     for (f, &part) in mesh.faces.iter().zip(&parts) {
         for &v in &f.vertices {
             lo[part] = lo[part].min(mesh.positions[v as usize]);
@@ -124,27 +102,21 @@ pub(crate) fn face_colors(mesh: &Mesh) -> Vec<Rgb> {
         .collect()
 }
 
-/// `#rrggbb` of a colour scaled by `intensity`.
-pub(crate) fn hex(c: Rgb, intensity: f64) -> String {
-    let v = (c * intensity).clamp(DVec3::ZERO, DVec3::ONE) * 255.0;
-    format!(
-        "#{:02x}{:02x}{:02x}",
-        v.x.round() as u8,
-        v.y.round() as u8,
-        v.z.round() as u8
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// A colour's bits, to compare colours exactly.
+    fn hex(c: Rgb, _intensity: f64) -> [u64; 3] {
+        c.to_array().map(f64::to_bits)
+    }
+
     #[test]
     fn arrows_are_red_green_blue_and_books_differ() {
-        let room = shadow_scene::room();
+        let room = crate::room();
         let colors = face_colors(&room);
         let axes = room.group_index("axes").unwrap();
-        let used: std::collections::HashSet<String> = room
+        let used: std::collections::HashSet<[u64; 3]> = room
             .faces
             .iter()
             .zip(&colors)
@@ -156,7 +128,7 @@ mod tests {
         }
         assert_eq!(used.len(), 4, "three arrows and the grey pedestal");
         let books = room.group_index("books").unwrap();
-        let book_colors: std::collections::HashSet<String> = room
+        let book_colors: std::collections::HashSet<[u64; 3]> = room
             .faces
             .iter()
             .zip(&colors)
@@ -164,12 +136,5 @@ mod tests {
             .map(|(_, c)| hex(*c, 1.0))
             .collect();
         assert_eq!(book_colors.len(), BOOKS.len());
-    }
-
-    #[test]
-    fn hex_clamps() {
-        assert_eq!(hex(rgb(1.0, 0.5, 0.0), 1.0), "#ff8000");
-        assert_eq!(hex(rgb(1.0, 0.5, 0.0), 4.0), "#ffff00");
-        assert_eq!(hex(rgb(0.2, 0.2, 0.2), -1.0), "#000000");
     }
 }

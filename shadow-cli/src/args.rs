@@ -1,0 +1,214 @@
+//! The flags several commands share, declared once, and their parsers.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use glam::DVec3;
+use svbsp::LightSpec;
+
+/// Where the mesh comes from: a file or a built-in scene (exactly one).
+#[derive(Args, Debug)]
+pub(crate) struct SourceArgs {
+    /// Mesh file (.obj or .stl).
+    pub(crate) input: Option<PathBuf>,
+    /// Built-in scene instead of a file (room, chair, cube, bunny, or the
+    /// bunny refined to bunny-11k ... bunny-893k faces).
+    #[arg(long, value_name = "NAME")]
+    pub(crate) scene: Option<String>,
+}
+
+impl SourceArgs {
+    /// `true` for the built-in scene `name`.
+    pub(crate) fn is_scene(&self, name: &str) -> bool {
+        self.input.is_none() && self.scene.as_deref() == Some(name)
+    }
+
+    /// `true` for a built-in bunny scene.
+    pub(crate) fn is_bunny(&self) -> bool {
+        self.input.is_none()
+            && self
+                .scene
+                .as_deref()
+                .is_some_and(|s| s.starts_with("bunny"))
+    }
+}
+
+/// The lights: point lights and suns, numbered all `--light` first, then
+/// all `--sun`.
+#[derive(Args, Debug, Default)]
+pub(crate) struct LightArgs {
+    /// A point light at X,Y,Z (input units). Repeat for several lights;
+    /// lights are numbered all --light first, then all --sun [default for
+    /// the built-in scenes: the scene's own light].
+    #[arg(long = "light", value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) lights: Vec<DVec3>,
+    /// A light at infinity in the direction X,Y,Z from the scene toward
+    /// the light (0,0,1: straight overhead). Repeatable.
+    #[arg(long = "sun", value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) suns: Vec<DVec3>,
+}
+
+impl LightArgs {
+    /// The lights in their order.
+    pub(crate) fn specs(&self) -> Vec<LightSpec> {
+        let mut specs: Vec<LightSpec> = self.lights.iter().map(|&p| LightSpec::Point(p)).collect();
+        specs.extend(self.suns.iter().map(|&d| LightSpec::Sun(d)));
+        specs
+    }
+}
+
+/// Where a picture is seen from.
+#[derive(Args, Debug, Default)]
+pub(crate) struct CameraArgs {
+    /// Eye position [default for the built-in scenes that have a
+    /// viewpoint; required otherwise].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) eye: Option<DVec3>,
+    /// Point looked at [default: the centre of the scene's bounding box,
+    /// or the built-in viewpoint's target].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) target: Option<DVec3>,
+    /// Up direction [default: +Z, or another axis when looking along it].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(crate) up: Option<DVec3>,
+}
+
+impl CameraArgs {
+    /// `true` if any camera flag is given.
+    pub(crate) fn any(&self) -> bool {
+        self.eye.is_some() || self.target.is_some() || self.up.is_some()
+    }
+}
+
+/// The size and field of view of an SVG picture.
+#[derive(Args, Debug)]
+pub(crate) struct ImageArgs {
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 1200, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub(crate) width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 900, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub(crate) height: u32,
+    /// Vertical field of view in degrees (between 1 and 170).
+    #[arg(long, value_name = "DEG", default_value_t = 50.0, value_parser = parse_fov)]
+    pub(crate) fov: f64,
+}
+
+/// Parses `X,Y,Z` into a finite vector.
+pub(crate) fn parse_vec3(s: &str) -> Result<DVec3, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "expected three comma-separated numbers X,Y,Z, got {} value(s)",
+            parts.len()
+        ));
+    }
+    let mut v = [0.0; 3];
+    for (out, p) in v.iter_mut().zip(&parts) {
+        *out = p
+            .parse::<f64>()
+            .map_err(|_| format!("`{p}` is not a number (expected X,Y,Z)"))?;
+        if !out.is_finite() {
+            return Err(format!("`{p}` is not a finite number"));
+        }
+    }
+    Ok(DVec3::from_array(v))
+}
+
+/// Parses a field of view in degrees, between 1 and 170.
+pub(crate) fn parse_fov(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    if (1.0..=170.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v} is outside 1..=170 degrees"))
+    }
+}
+
+/// `WxH`, each side between 1 and [`shadow_raster::MAX_SIZE`].
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{s}` is not a size: expected WxH, such as 1280x720"))?;
+    let side = |v: &str, what: &str| -> Result<u32, String> {
+        let n: u32 = v
+            .trim()
+            .parse()
+            .map_err(|_| format!("`{s}`: the {what} `{v}` is not a whole number (expected WxH)"))?;
+        if n == 0 || n > shadow_raster::MAX_SIZE {
+            return Err(format!(
+                "`{s}`: the {what} must lie between 1 and {} pixels",
+                shadow_raster::MAX_SIZE
+            ));
+        }
+        Ok(n)
+    };
+    let (w, h) = (side(w, "width")?, side(h, "height")?);
+    if w as u64 * h as u64 > shadow_raster::MAX_PIXELS {
+        return Err(format!(
+            "`{s}`: at most {} pixels in all",
+            shadow_raster::MAX_PIXELS
+        ));
+    }
+    Ok((w, h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vectors_parse_with_clear_errors() {
+        assert_eq!(
+            parse_vec3("1,-2.5, 3e1").unwrap(),
+            DVec3::new(1.0, -2.5, 30.0)
+        );
+        assert_eq!(
+            parse_vec3("1,2").unwrap_err(),
+            "expected three comma-separated numbers X,Y,Z, got 2 value(s)"
+        );
+        assert_eq!(
+            parse_vec3("1,y,3").unwrap_err(),
+            "`y` is not a number (expected X,Y,Z)"
+        );
+        assert_eq!(
+            parse_vec3("1,nan,3").unwrap_err(),
+            "`nan` is not a finite number"
+        );
+        assert!(parse_vec3("").is_err());
+    }
+
+    #[test]
+    fn fov_range() {
+        assert_eq!(parse_fov("60").unwrap(), 60.0);
+        assert!(parse_fov("0").is_err());
+        assert!(parse_fov("180").is_err());
+        assert!(parse_fov("wide").is_err());
+    }
+
+    #[test]
+    fn sizes_parse_with_clear_errors() {
+        assert_eq!(parse_size("1920x1080"), Ok((1920, 1080)));
+        assert_eq!(parse_size("64X48"), Ok((64, 48)));
+        assert!(parse_size("1920").unwrap_err().contains("expected WxH"));
+        assert!(
+            parse_size("0x10")
+                .unwrap_err()
+                .contains("between 1 and 16384")
+        );
+        assert!(
+            parse_size("axb")
+                .unwrap_err()
+                .contains("not a whole number")
+        );
+        assert!(parse_size("99999x2").unwrap_err().contains("width"));
+        assert!(
+            parse_size("16384x16384")
+                .unwrap_err()
+                .contains("pixels in all")
+        );
+    }
+}

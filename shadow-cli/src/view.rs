@@ -1,0 +1,137 @@
+//! `shadow view`, `shadow stats` and `shadow demo`: a scene drawn by the
+//! painter's algorithm in its BSP tree's exact order, and the tree's
+//! figures.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use shadow_raster::svg::{SvgPicture, SvgView, SvgViewpoint};
+use shadow_scene::{ROOM_EYE, ROOM_TARGET};
+
+use crate::args::{CameraArgs, ImageArgs, SourceArgs};
+use crate::input::{Prepared, load_source};
+use crate::output::{emit, write_file};
+use crate::raster_error;
+
+#[derive(Args, Debug)]
+#[command(mut_arg("eye", |a| a.required(true)))]
+pub(crate) struct ViewArgs {
+    #[command(flatten)]
+    pub(crate) source: SourceArgs,
+    #[command(flatten)]
+    pub(crate) camera: CameraArgs,
+    /// Output SVG file.
+    #[arg(short, long, value_name = "OUT.svg")]
+    pub(crate) output: PathBuf,
+    #[command(flatten)]
+    pub(crate) image: ImageArgs,
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct DemoArgs {
+    /// Output SVG file.
+    #[arg(short, long, value_name = "OUT.svg", default_value = "room.svg")]
+    pub(crate) output: PathBuf,
+    #[command(flatten)]
+    pub(crate) image: ImageArgs,
+}
+
+/// The polygons of `p`'s tree drawn back to front from `at`.
+fn draw(p: &Prepared, at: SvgViewpoint) -> Result<SvgPicture> {
+    let bounds = p
+        .mesh
+        .bounds()
+        .context("nothing to draw: the mesh has no vertices")?;
+    if p.mesh.faces.is_empty() {
+        anyhow::bail!("nothing to draw: the mesh has no faces");
+    }
+    let view = SvgView::new(&p.grid, bounds, &at).map_err(raster_error)?;
+    let colors = shadow_scene::face_colors(&p.mesh);
+    Ok(view.polygons(&p.tree, &p.grid, &colors))
+}
+
+/// `shadow view`.
+pub(crate) fn view(args: &ViewArgs) -> Result<()> {
+    let (mesh, name) = load_source(&args.source)?;
+    let prepared = Prepared::new(mesh, &name)?;
+    let at = SvgViewpoint {
+        eye: args.camera.eye.expect("--eye is required"),
+        target: args.camera.target,
+        up: args.camera.up,
+        width: args.image.width,
+        height: args.image.height,
+        fov_deg: args.image.fov,
+    };
+    let out = draw(&prepared, at)?;
+    write_file(&args.output, out.svg.as_bytes())?;
+    emit(&format!(
+        "wrote {}: {} polygons of {} ({} faces), eye {}\n",
+        args.output.display(),
+        out.drawn,
+        name,
+        prepared.mesh.faces.len(),
+        fmt_vec(out.eye)
+    ))
+}
+
+/// `shadow stats`.
+pub(crate) fn stats(args: &SourceArgs) -> Result<()> {
+    let (mesh, name) = load_source(args)?;
+    let p = Prepared::new(mesh, &name)?;
+    let t = p.tree.stats();
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    emit(&format!(
+        "input:           {name}\n\
+         faces:           {}\n\
+         polygons:        {} after import ({} faces triangulated, {} dropped)\n\
+         bsp polygons:    {} after splitting\n\
+         nodes:           {}\n\
+         depth:           {}\n\
+         cells:           {} in, {} out\n\
+         grid step:       2^{} = {:.3e} units\n\
+         import time:     {:.2} ms\n\
+         build time:      {:.2} ms\n",
+        p.mesh.faces.len(),
+        p.report.polygons,
+        p.report.triangulated.len(),
+        p.report.dropped.len(),
+        t.polygons,
+        t.nodes,
+        t.depth,
+        t.in_cells,
+        t.out_cells,
+        p.grid.step_log2(),
+        p.grid.step(),
+        ms(p.import_time),
+        ms(p.build_time)
+    ))
+}
+
+/// `shadow demo`.
+pub(crate) fn demo(args: &DemoArgs) -> Result<()> {
+    let prepared = Prepared::new(shadow_scene::room(), "scene room")?;
+    let at = SvgViewpoint {
+        eye: ROOM_EYE,
+        target: Some(ROOM_TARGET),
+        up: None,
+        width: args.image.width,
+        height: args.image.height,
+        fov_deg: args.image.fov,
+    };
+    let out = draw(&prepared, at)?;
+    write_file(&args.output, out.svg.as_bytes())?;
+    emit(&format!(
+        "wrote {}: the built-in room, {} polygons ({} faces, {} BSP fragments), eye {}\n",
+        args.output.display(),
+        out.drawn,
+        prepared.mesh.faces.len(),
+        prepared.tree.stats().polygons,
+        fmt_vec(out.eye)
+    ))
+}
+
+/// A vector with three decimals, as the reports print eyes.
+pub(crate) fn fmt_vec(v: glam::DVec3) -> String {
+    format!("{:.3},{:.3},{:.3}", v.x, v.y, v.z)
+}

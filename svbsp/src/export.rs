@@ -1,0 +1,380 @@
+//! Fragments written to files, batch by batch: JSON (the schema of
+//! `shadow shadows`, documented in `docs/shadows.md`) and Wavefront OBJ
+//! (groups `lit` and `shadow`). A batch's vertices are rounded once to
+//! `f64` grid units and mapped to input units ([`world_vertices`]); each
+//! fragment's area is measured on those ([`area_records`]).
+//!
+//! A caller that shades many batches in parallel formats each one's JSON
+//! text where it is shaded ([`json_fragments`]) and writes the texts in
+//! order between [`json_header`] and [`json_footer`]; OBJ goes through one
+//! [`ObjWriter`], which welds equal positions over the whole file.
+
+use std::collections::HashMap;
+use std::io::{self, Write};
+
+use bsp_core::Grid;
+use glam::DVec3;
+use serde::Serialize;
+
+use crate::{Areas, Batch, Light, PlacedLight, polygon_area};
+
+/// Why a batch cannot be written.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum ExportError {
+    /// A vertex of `face` is not finite in input units: the grid's
+    /// coordinates, scaled back, leave `f64`'s range.
+    NonFiniteVertex {
+        /// The face.
+        face: u32,
+        /// The grid step in input units.
+        step: f64,
+    },
+}
+
+impl std::fmt::Display for ExportError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ExportError::NonFiniteVertex { face, step } => write!(
+                f,
+                "a vertex of face {face} is not finite in input units (grid step {step:e}): the \
+                 coordinates are too large for f64"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for ExportError {}
+
+/// The batch's vertices in input units, each converted once.
+pub fn world_vertices(b: &Batch, grid: &Grid) -> Result<Vec<DVec3>, ExportError> {
+    let world: Vec<DVec3> = (0..b.vertex_count() as u32)
+        .map(|v| grid.to_world(b.rounded(v)))
+        .collect();
+    if let Some(bad) = world.iter().position(|v| !v.is_finite()) {
+        let face = b
+            .fragments()
+            .find(|f| f.rings().flatten().any(|&v| v as usize == bad))
+            .map(|f| f.face())
+            .unwrap_or(0);
+        return Err(ExportError::NonFiniteVertex {
+            face,
+            step: grid.step(),
+        });
+    }
+    Ok(world)
+}
+
+/// A fragment's face, area and flags, as [`Areas::add`] takes them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AreaRecord {
+    /// The fragment's face.
+    pub face: u32,
+    /// Its area in input units (holes subtracted).
+    pub area: f64,
+    /// The lights that reach it.
+    pub lit: u64,
+    /// The lights its face turns toward.
+    pub facing: u64,
+}
+
+/// Every fragment's [`AreaRecord`], measured on `world` (the batch's
+/// vertices in input units).
+pub fn area_records(b: &Batch, world: &[DVec3]) -> Vec<AreaRecord> {
+    let mut buf = Vec::new();
+    b.fragments()
+        .map(|f| {
+            let mut area = 0.0;
+            for (k, ring) in f.rings().enumerate() {
+                buf.clear();
+                buf.extend(ring.iter().map(|&v| world[v as usize]));
+                let a = polygon_area(&buf);
+                area += if k == 0 { a } else { -a };
+            }
+            AreaRecord {
+                face: f.face(),
+                area,
+                lit: f.lit_mask(),
+                facing: f.facing_mask(),
+            }
+        })
+        .collect()
+}
+
+#[derive(Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+enum JsonLight {
+    Point { position: [f64; 3] },
+    Directional { direction: [f64; 3] },
+}
+
+#[derive(Serialize)]
+struct JsonSummary {
+    area: f64,
+    lit_area: Vec<f64>,
+    shadow_area: Vec<f64>,
+    cast_shadow_area: Vec<f64>,
+    dark_area: f64,
+}
+
+/// The JSON document's head: the lights, the face count, and the
+/// opening of the fragment list.
+pub fn json_header(out: &mut impl Write, lights: &[PlacedLight], faces: usize) -> io::Result<()> {
+    let lights: Vec<JsonLight> = lights
+        .iter()
+        .map(|l| match l.light {
+            Light::Point(_) => JsonLight::Point {
+                position: l.world.to_array(),
+            },
+            Light::Directional(_) => JsonLight::Directional {
+                direction: l.world.to_array(),
+            },
+        })
+        .collect();
+    write!(out, "{{\"lights\":")?;
+    serde_json::to_writer(&mut *out, &lights)?;
+    write!(out, ",\"faces\":{faces},\"fragments\":[")?;
+    Ok(())
+}
+
+/// The JSON document's tail: the fragment list closed, and the summary
+/// of `areas`.
+pub fn json_footer(out: &mut impl Write, areas: &Areas) -> io::Result<()> {
+    write!(out, "\n],\"summary\":")?;
+    let summary = JsonSummary {
+        area: areas.total,
+        lit_area: areas.lit.clone(),
+        shadow_area: areas.shadow(),
+        cast_shadow_area: areas.cast.clone(),
+        dark_area: areas.dark,
+    };
+    serde_json::to_writer(&mut *out, &summary)?;
+    writeln!(out, "}}")?;
+    Ok(())
+}
+
+/// Shortest round-trip decimal of a finite `f64`, as `serde_json` writes
+/// it.
+fn push_f64(s: &mut Vec<u8>, x: f64) {
+    let mut b = zmij::Buffer::new();
+    s.extend_from_slice(b.format_finite(x).as_bytes());
+}
+
+fn push_point(s: &mut Vec<u8>, p: DVec3) {
+    s.push(b'[');
+    push_f64(s, p.x);
+    s.push(b',');
+    push_f64(s, p.y);
+    s.push(b',');
+    push_f64(s, p.z);
+    s.push(b']');
+}
+
+fn push_ring(s: &mut Vec<u8>, ring: &[u32], world: &[DVec3]) {
+    s.push(b'[');
+    for (i, &v) in ring.iter().enumerate() {
+        if i > 0 {
+            s.push(b',');
+        }
+        push_point(s, world[v as usize]);
+    }
+    s.push(b']');
+}
+
+/// The fragments of a batch as JSON lines, each preceded by `,\n` (the
+/// first fragment of a document drops its comma).
+pub fn json_fragments(
+    b: &Batch,
+    world: &[DVec3],
+    records: &[AreaRecord],
+    lights: usize,
+) -> Vec<u8> {
+    let mut s = Vec::with_capacity(b.len() * 160);
+    for (f, rec) in b.fragments().zip(records) {
+        s.extend_from_slice(b",\n{\"face\":");
+        s.extend_from_slice(itoa::Buffer::new().format(f.face()).as_bytes());
+        s.extend_from_slice(b",\"vertices\":");
+        push_ring(&mut s, f.outer(), world);
+        if f.hole_count() > 0 {
+            s.extend_from_slice(b",\"holes\":[");
+            for (k, ring) in f.rings().skip(1).enumerate() {
+                if k > 0 {
+                    s.push(b',');
+                }
+                push_ring(&mut s, ring, world);
+            }
+            s.push(b']');
+        }
+        s.extend_from_slice(b",\"lit\":[");
+        for j in 0..lights {
+            if j > 0 {
+                s.push(b',');
+            }
+            s.extend_from_slice(if f.lit(j) { b"true" } else { b"false" });
+        }
+        s.extend_from_slice(b"],\"area\":");
+        push_f64(&mut s, rec.area);
+        s.push(b'}');
+    }
+    s
+}
+
+/// The OBJ group of a fragment: `shadow` when no light reaches it, else
+/// `lit`, and with several lights also `lit_I_J...` naming exactly the
+/// lights that reach it (an OBJ `g` line with two names puts the faces in
+/// both groups).
+fn obj_group(lit: u64, lights: usize) -> String {
+    let on: Vec<String> = (0..lights)
+        .filter(|&i| lit >> i & 1 == 1)
+        .map(|i| i.to_string())
+        .collect();
+    match (on.is_empty(), lights) {
+        (true, _) => "shadow".to_string(),
+        (false, 1) => "lit".to_string(),
+        (false, _) => format!("lit lit_{}", on.join("_")),
+    }
+}
+
+/// Writes OBJ text incrementally: positions welded by exact equality of
+/// their `f64` coordinates over the whole file, a `g` line whenever the
+/// group changes, each fragment as its convex pieces.
+#[derive(Debug, Default)]
+pub struct ObjWriter {
+    index: HashMap<[u64; 3], u32>,
+    group: Option<u64>,
+    faces: usize,
+    degenerate: usize,
+}
+
+impl ObjWriter {
+    /// A writer that has written nothing.
+    pub fn new() -> ObjWriter {
+        ObjWriter::default()
+    }
+
+    /// The file's head: what it holds, one comment line per light
+    /// (`lights`, described by the caller), and the groups.
+    pub fn header(
+        &self,
+        out: &mut impl Write,
+        name: &str,
+        lights: &[String],
+        faces: usize,
+    ) -> io::Result<()> {
+        writeln!(
+            out,
+            "# shadow shadows: the fragments of {faces} faces of {name}"
+        )?;
+        for (i, l) in lights.iter().enumerate() {
+            writeln!(out, "# light {i}: {l}")?;
+        }
+        if lights.len() > 1 {
+            writeln!(
+                out,
+                "# groups: lit (lit by at least one light), lit_I_J... (lit by exactly lights I, \
+                 J, ...), shadow (lit by none)"
+            )?;
+        } else {
+            writeln!(out, "# groups: lit, shadow")?;
+        }
+        writeln!(
+            out,
+            "# each fragment as its convex pieces, faces in input order, vertices welded"
+        )?;
+        Ok(())
+    }
+
+    /// Writes every convex piece of the batch's fragments (`world`: its
+    /// vertices in input units).
+    pub fn batch(
+        &mut self,
+        out: &mut impl Write,
+        b: &Batch,
+        world: &[DVec3],
+        lights: usize,
+    ) -> io::Result<()> {
+        let mut text = Vec::with_capacity(b.len() * 64);
+        let mut ids: Vec<u32> = Vec::new();
+        for f in b.fragments() {
+            if self.group != Some(f.lit_mask()) {
+                self.group = Some(f.lit_mask());
+                writeln!(text, "g {}", obj_group(f.lit_mask(), lights))?;
+            }
+            for piece in f.pieces() {
+                ids.clear();
+                for &v in piece {
+                    ids.push(self.vertex(&mut text, world[v as usize]));
+                }
+                let mut sorted = ids.clone();
+                sorted.sort_unstable();
+                if sorted.windows(2).any(|w| w[0] == w[1]) {
+                    self.degenerate += 1;
+                }
+                text.push(b'f');
+                for id in &ids {
+                    text.push(b' ');
+                    text.extend_from_slice(itoa::Buffer::new().format(*id).as_bytes());
+                }
+                text.push(b'\n');
+                self.faces += 1;
+            }
+        }
+        out.write_all(&text)
+    }
+
+    /// The 1-based index of position `p`, written as a `v` line into
+    /// `text` the first time.
+    fn vertex(&mut self, text: &mut Vec<u8>, p: DVec3) -> u32 {
+        let next = self.index.len() as u32 + 1;
+        *self
+            .index
+            .entry(p.to_array().map(f64::to_bits))
+            .or_insert_with(|| {
+                text.extend_from_slice(b"v ");
+                for (k, c) in p.to_array().into_iter().enumerate() {
+                    if k > 0 {
+                        text.push(b' ');
+                    }
+                    push_f64(text, c);
+                }
+                text.push(b'\n');
+                next
+            })
+    }
+
+    /// Positions written so far.
+    pub fn vertex_count(&self) -> usize {
+        self.index.len()
+    }
+
+    /// Pieces written so far whose distinct exact vertices coincide once
+    /// rounded to `f64` input units: they are degenerate in the file.
+    pub fn degenerate(&self) -> usize {
+        self.degenerate
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn obj_groups_name_the_lights() {
+        assert_eq!(obj_group(0b1, 1), "lit");
+        assert_eq!(obj_group(0b0, 1), "shadow");
+        assert_eq!(obj_group(0b101, 3), "lit lit_0_2");
+        assert_eq!(obj_group(0b00, 2), "shadow");
+    }
+
+    #[test]
+    fn json_numbers_are_serde_jsons() {
+        for x in [0.0, -0.5, 1.0, 1e-7, 123456.789, 2f64.powi(60), -3.25e-300] {
+            let mut s = Vec::new();
+            push_f64(&mut s, x);
+            assert_eq!(
+                String::from_utf8(s).unwrap(),
+                serde_json::to_string(&x).unwrap()
+            );
+        }
+    }
+}
