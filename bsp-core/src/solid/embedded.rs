@@ -174,150 +174,19 @@ pub fn certify_solid_boundary(polys: &[Polygon]) -> Result<SolidBoundary, Surfac
 /// with overlapping boxes is tested on its own (the reference the star
 /// tests are checked against).
 fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefect> {
-    // the loops as grid points, each numbered by its first occurrence
-    let mut start = Vec::with_capacity(polys.len() + 1);
-    let mut pts: Vec<GridPoint> = Vec::with_capacity(polys.len() * 3);
-    for (i, p) in polys.iter().enumerate() {
-        start.push(pts.len() as u32);
-        for v in p.vertices() {
-            pts.push(v.as_grid().ok_or(SurfaceDefect::NotGrid { polygon: i })?);
-        }
-    }
-    start.push(pts.len() as u32);
-    let lo = pts
+    let loops = Loops::new(polys)?;
+    let lo = loops
+        .pts
         .iter()
         .fold([i32::MAX; 3], |m, p| [0, 1, 2].map(|k| m[k].min(p[k])));
-    let hi = pts
+    let hi = loops
+        .pts
         .iter()
         .fold([i32::MIN; 3], |m, p| [0, 1, 2].map(|k| m[k].max(p[k])));
-    let mut number: FxHashMap<GridPoint, u32> = FxHashMap::default();
-    number.reserve(pts.len() / 2);
-    let ids: Vec<u32> = pts
-        .iter()
-        .map(|p| {
-            let next = number.len() as u32;
-            *number.entry(*p).or_insert(next)
-        })
-        .collect();
-    drop(number);
-    let loop_of = |i: usize| start[i] as usize..start[i + 1] as usize;
-
-    let n_ids = ids.iter().max().map_or(0, |&m| m as usize + 1);
-
-    // 1. closed and oriented, vertex by vertex: at each vertex the corners'
-    // outgoing edges `v → next` and incoming edges `prev → v` pair up one
-    // to one (an edge used once each way, by nothing else), which orders
-    // the corners around the vertex: a corner's successor is the corner
-    // across its outgoing edge
-    let mut corner_poly = vec![0u32; pts.len()];
-    for i in 0..polys.len() {
-        corner_poly[loop_of(i)].fill(i as u32);
-    }
-    let next_of = |g: usize| {
-        let r = loop_of(corner_poly[g] as usize);
-        if g + 1 == r.end { r.start } else { g + 1 }
-    };
-    let prev_of = |g: usize| {
-        let r = loop_of(corner_poly[g] as usize);
-        if g == r.start { r.end - 1 } else { g - 1 }
-    };
-    let mut first = vec![0u32; n_ids + 1];
-    for &v in &ids {
-        first[v as usize + 1] += 1;
-    }
-    for k in 1..first.len() {
-        first[k] += first[k - 1];
-    }
-    let mut fill = first.clone();
-    let mut corners = vec![0u32; pts.len()];
-    for (g, &v) in ids.iter().enumerate() {
-        corners[fill[v as usize] as usize] = g as u32;
-        fill[v as usize] += 1;
-    }
-    drop(fill);
-    let mut parts_of = UnionFind::new(polys.len());
-    // per vertex: its star certified embedded (see `star_embedded`)
-    let mut certified = vec![false; n_ids];
-    let mut around: Vec<(u32, u32, u32)> = Vec::new();
-    let mut order: Vec<u32> = Vec::new();
-    for v in 0..n_ids {
-        let star = &corners[first[v] as usize..first[v + 1] as usize];
-        // (prev, next, corner), sorted by prev
-        around.clear();
-        for &g in star {
-            let g = g as usize;
-            let (n, p) = (ids[next_of(g)], ids[prev_of(g)]);
-            if n == v as u32 || p == v as u32 {
-                return Err(SurfaceDefect::Open {
-                    polygon: corner_poly[g] as usize,
-                });
-            }
-            around.push((p, n, g as u32));
-        }
-        around.sort_unstable();
-        let mut nexts: SmallVec<[u32; 8]> = around.iter().map(|c| c.1).collect();
-        nexts.sort_unstable();
-        let bad = around.windows(2).any(|w| w[0].0 == w[1].0)
-            || nexts.windows(2).any(|w| w[0] == w[1])
-            || nexts.iter().zip(&around).any(|(n, c)| *n != c.0);
-        if bad {
-            return Err(SurfaceDefect::Open {
-                polygon: corner_poly[star[0] as usize] as usize,
-            });
-        }
-        // successor: the corner whose prev is this corner's next; the
-        // polygons across each edge are one part
-        let succ = |c: &(u32, u32, u32)| around.binary_search_by_key(&c.1, |d| d.0).unwrap_or(0);
-        for c in &around {
-            let d = &around[succ(c)];
-            parts_of.union(corner_poly[c.2 as usize], corner_poly[d.2 as usize]);
-        }
-        // one cycle around the vertex: its corners in order
-        order.clear();
-        let mut c = 0;
-        loop {
-            order.push(around[c].2);
-            c = succ(&around[c]);
-            if c == 0 || order.len() > around.len() {
-                break;
-            }
-        }
-        if stars && order.len() == around.len() {
-            certified[v] = star_embedded(pts[order[0] as usize], &order, |g| {
-                (pts[next_of(g as usize)], pts[prev_of(g as usize)])
-            });
-        }
-    }
-    drop(corners);
-
+    // 1. closed and oriented, the parts, and the stars certified embedded
+    let (mut parts_of, certified) = loops.closed_and_oriented(stars)?;
     // 3. each part encloses a positive volume (6 × the signed volume)
-    let mut volume = vec![0i128; polys.len()];
-    let mut tris: Vec<Tri> = Vec::with_capacity(pts.len());
-    for i in 0..polys.len() {
-        let r = loop_of(i);
-        let (l, id) = (&pts[r.clone()], &ids[r]);
-        let root = parts_of.find(i as u32) as usize;
-        for j in 1..l.len() - 1 {
-            let t = [l[0], l[j], l[j + 1]];
-            let (a, b, c) = (sub(t[0], [0; 3]), sub(t[1], [0; 3]), sub(t[2], [0; 3]));
-            // |a|, |b|, |c| < 2^26: the determinant is below 2^80
-            volume[root] += dot(a, cross(b, c));
-            if cross(sub(t[1], t[0]), sub(t[2], t[0])) == [0; 3] {
-                continue; // no area: covered by the next triangle's edge
-            }
-            // the fan triangle's edges: `l0 → lj` is an edge of the loop
-            // only for j = 1, `lj → lj+1` always, `lj+1 → l0` only last
-            let edges = u8::from(j == 1) | 2 | (u8::from(j + 2 == l.len()) << 2);
-            tris.push(Tri {
-                v: t,
-                id: [id[0], id[j], id[j + 1]],
-                edges,
-                poly: i as u32,
-                lo: [0, 1, 2].map(|k| t[0][k].min(t[1][k]).min(t[2][k])),
-                hi: [0, 1, 2].map(|k| t[0][k].max(t[1][k]).max(t[2][k])),
-            });
-        }
-    }
+    let (tris, volume) = loops.fan_triangles(&mut parts_of);
     let mut parts = 0;
     for (i, v) in volume.iter().enumerate() {
         if parts_of.is_root(i as u32) {
@@ -327,7 +196,6 @@ fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefec
             }
         }
     }
-
     // 2. embedded: the pairs of triangles whose boxes overlap
     // (pairs with a certified shared vertex are settled by its star)
     let settled = |s: &Tri, t: &Tri| {
@@ -342,6 +210,203 @@ fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefec
         });
     }
     Ok(SolidBoundary { lo, hi, parts })
+}
+
+/// The polygons' loops as grid points, every corner's point numbered by
+/// the point's first occurrence, and each corner's polygon.
+struct Loops {
+    /// Polygon `i`'s corners are `start[i]..start[i + 1]`.
+    start: Vec<u32>,
+    pts: Vec<GridPoint>,
+    ids: Vec<u32>,
+    corner_poly: Vec<u32>,
+    /// The number of distinct points.
+    n_ids: usize,
+}
+
+impl Loops {
+    fn new(polys: &[Polygon]) -> Result<Loops, SurfaceDefect> {
+        let mut start = Vec::with_capacity(polys.len() + 1);
+        let mut pts: Vec<GridPoint> = Vec::with_capacity(polys.len() * 3);
+        for (i, p) in polys.iter().enumerate() {
+            start.push(pts.len() as u32);
+            for v in p.vertices() {
+                pts.push(v.as_grid().ok_or(SurfaceDefect::NotGrid { polygon: i })?);
+            }
+        }
+        start.push(pts.len() as u32);
+        let mut number: FxHashMap<GridPoint, u32> = FxHashMap::default();
+        number.reserve(pts.len() / 2);
+        let ids: Vec<u32> = pts
+            .iter()
+            .map(|p| {
+                let next = number.len() as u32;
+                *number.entry(*p).or_insert(next)
+            })
+            .collect();
+        drop(number);
+        let n_ids = ids.iter().max().map_or(0, |&m| m as usize + 1);
+        let mut corner_poly = vec![0u32; pts.len()];
+        for i in 0..polys.len() {
+            corner_poly[start[i] as usize..start[i + 1] as usize].fill(i as u32);
+        }
+        Ok(Loops {
+            start,
+            pts,
+            ids,
+            corner_poly,
+            n_ids,
+        })
+    }
+
+    fn loop_of(&self, i: usize) -> std::ops::Range<usize> {
+        self.start[i] as usize..self.start[i + 1] as usize
+    }
+
+    /// The corner after `g` in its loop.
+    fn next_of(&self, g: usize) -> usize {
+        let r = self.loop_of(self.corner_poly[g] as usize);
+        if g + 1 == r.end { r.start } else { g + 1 }
+    }
+
+    /// The corner before `g` in its loop.
+    fn prev_of(&self, g: usize) -> usize {
+        let r = self.loop_of(self.corner_poly[g] as usize);
+        if g == r.start { r.end - 1 } else { g - 1 }
+    }
+
+    /// Step 1, vertex by vertex: at each vertex the corners' outgoing
+    /// edges `v → next` and incoming edges `prev → v` pair up one to one
+    /// (an edge used once each way, by nothing else), which orders the
+    /// corners around the vertex: a corner's successor is the corner
+    /// across its outgoing edge. The polygons' edge-connected parts, and
+    /// per vertex whether its star is certified embedded (with `stars`).
+    fn closed_and_oriented(&self, stars: bool) -> Result<(UnionFind, Vec<bool>), SurfaceDefect> {
+        let (ids, n_ids) = (&self.ids, self.n_ids);
+        // the corners at each vertex, by a counting sort
+        let mut first = vec![0u32; n_ids + 1];
+        for &v in ids {
+            first[v as usize + 1] += 1;
+        }
+        for k in 1..first.len() {
+            first[k] += first[k - 1];
+        }
+        let mut fill = first.clone();
+        let mut corners = vec![0u32; self.pts.len()];
+        for (g, &v) in ids.iter().enumerate() {
+            corners[fill[v as usize] as usize] = g as u32;
+            fill[v as usize] += 1;
+        }
+        drop(fill);
+        let mut parts_of = UnionFind::new(self.start.len() - 1);
+        // per vertex: its star certified embedded (see `star_embedded`)
+        let mut certified = vec![false; n_ids];
+        let mut around: Vec<(u32, u32, u32)> = Vec::new();
+        let mut order: Vec<u32> = Vec::new();
+        for v in 0..n_ids {
+            let star = &corners[first[v] as usize..first[v + 1] as usize];
+            self.pair_edges(v as u32, star, &mut around)?;
+            // successor: the corner whose prev is this corner's next; the
+            // polygons across each edge are one part
+            let succ =
+                |c: &(u32, u32, u32)| around.binary_search_by_key(&c.1, |d| d.0).unwrap_or(0);
+            for c in &around {
+                let d = &around[succ(c)];
+                parts_of.union(
+                    self.corner_poly[c.2 as usize],
+                    self.corner_poly[d.2 as usize],
+                );
+            }
+            // one cycle around the vertex: its corners in order
+            order.clear();
+            let mut c = 0;
+            loop {
+                order.push(around[c].2);
+                c = succ(&around[c]);
+                if c == 0 || order.len() > around.len() {
+                    break;
+                }
+            }
+            if stars && order.len() == around.len() {
+                certified[v] = star_embedded(self.pts[order[0] as usize], &order, |g| {
+                    (
+                        self.pts[self.next_of(g as usize)],
+                        self.pts[self.prev_of(g as usize)],
+                    )
+                });
+            }
+        }
+        Ok((parts_of, certified))
+    }
+
+    /// The corners `star` at vertex `v` as (prev, next, corner), sorted by
+    /// prev, into `around`; an error unless their outgoing and incoming
+    /// edges pair up one to one.
+    fn pair_edges(
+        &self,
+        v: u32,
+        star: &[u32],
+        around: &mut Vec<(u32, u32, u32)>,
+    ) -> Result<(), SurfaceDefect> {
+        around.clear();
+        for &g in star {
+            let g = g as usize;
+            let (n, p) = (self.ids[self.next_of(g)], self.ids[self.prev_of(g)]);
+            if n == v || p == v {
+                return Err(SurfaceDefect::Open {
+                    polygon: self.corner_poly[g] as usize,
+                });
+            }
+            around.push((p, n, g as u32));
+        }
+        around.sort_unstable();
+        let mut nexts: SmallVec<[u32; 8]> = around.iter().map(|c| c.1).collect();
+        nexts.sort_unstable();
+        let bad = around.windows(2).any(|w| w[0].0 == w[1].0)
+            || nexts.windows(2).any(|w| w[0] == w[1])
+            || nexts.iter().zip(around.iter()).any(|(n, c)| *n != c.0);
+        if bad {
+            return Err(SurfaceDefect::Open {
+                polygon: self.corner_poly[star[0] as usize] as usize,
+            });
+        }
+        Ok(())
+    }
+
+    /// Every polygon's fan triangles that have an area, and each part's
+    /// six times signed volume (by its root in `parts_of`).
+    fn fan_triangles(&self, parts_of: &mut UnionFind) -> (Vec<Tri>, Vec<i128>) {
+        let polys = self.start.len() - 1;
+        let mut volume = vec![0i128; polys];
+        let mut tris: Vec<Tri> = Vec::with_capacity(self.pts.len());
+        for i in 0..polys {
+            let r = self.loop_of(i);
+            let (l, id) = (&self.pts[r.clone()], &self.ids[r]);
+            let root = parts_of.find(i as u32) as usize;
+            for j in 1..l.len() - 1 {
+                let t = [l[0], l[j], l[j + 1]];
+                let (a, b, c) = (sub(t[0], [0; 3]), sub(t[1], [0; 3]), sub(t[2], [0; 3]));
+                // |a|, |b|, |c| < 2^26: the determinant is below 2^80
+                volume[root] += dot(a, cross(b, c));
+                if cross(sub(t[1], t[0]), sub(t[2], t[0])) == [0; 3] {
+                    continue; // no area: covered by the next triangle's edge
+                }
+                // the fan triangle's edges: `l0 → lj` is an edge of the
+                // loop only for j = 1, `lj → lj+1` always, `lj+1 → l0`
+                // only last
+                let edges = u8::from(j == 1) | 2 | (u8::from(j + 2 == l.len()) << 2);
+                tris.push(Tri {
+                    v: t,
+                    id: [id[0], id[j], id[j + 1]],
+                    edges,
+                    poly: i as u32,
+                    lo: [0, 1, 2].map(|k| t[0][k].min(t[1][k]).min(t[2][k])),
+                    hi: [0, 1, 2].map(|k| t[0][k].max(t[1][k]).max(t[2][k])),
+                });
+            }
+        }
+        (tris, volume)
+    }
 }
 
 /// `true` if the corners `order` around the vertex `v` (each corner's

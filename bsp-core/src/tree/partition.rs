@@ -474,275 +474,338 @@ where
     O: CellOp<A, B>,
     O::Out: Copy + PartialEq,
 {
-    let mut bn: Vec<PNode<B>> = b.nodes.clone();
-    let mut temps: Vec<Option<PLink<B>>> = Vec::new();
-    let mut out: Partition<O::Out> = Partition {
-        nodes: Vec::new(),
-        root: PLink::Leaf(op.apply(first_leaf(a), first_leaf(b))),
+    let mut m = Merger {
+        a,
+        op,
+        bn: b.nodes.clone(),
+        temps: Vec::new(),
+        out: Partition {
+            nodes: Vec::new(),
+            root: PLink::Leaf(op.apply(first_leaf(a), first_leaf(b))),
+        },
+        stack: vec![Task::Merge {
+            a: a.root,
+            b: BSource::Link(b.root),
+            out: OSlot::Root,
+        }],
     };
-    let mut stack: Vec<Task<A, B>> = vec![Task::Merge {
-        a: a.root,
-        b: BSource::Link(b.root),
-        out: OSlot::Root,
-    }];
-
-    fn put_b<B: Copy>(bn: &mut [PNode<B>], temps: &mut [Option<PLink<B>>], s: BSlot, v: PLink<B>) {
-        match s {
-            BSlot::Front(i) => bn[i as usize].front = v,
-            BSlot::Back(i) => bn[i as usize].back = v,
-            BSlot::Temp(i) => temps[i] = Some(v),
-        }
-    }
-    fn put_o<L>(out: &mut Partition<L>, s: OSlot, v: PLink<L>) {
-        match s {
-            OSlot::Root => out.root = v,
-            OSlot::Front(i) => out.nodes[i as usize].front = v,
-            OSlot::Back(i) => out.nodes[i as usize].back = v,
-        }
-    }
-
-    while let Some(task) = stack.pop() {
+    while let Some(task) = m.stack.pop() {
         match task {
-            Task::Merge {
-                a: la,
-                b: sb,
-                out: slot,
-            } => {
-                let lb = match sb {
-                    BSource::Link(l) => l,
-                    BSource::Temp(i) => temps[i].take().expect("partition result is ready"),
-                };
-                match (la, lb) {
-                    (PLink::Leaf(x), _) if op.left(x).is_some() => put_o(
-                        &mut out,
-                        slot,
-                        PLink::Leaf(op.left(x).unwrap_or_else(|| unreachable!())),
-                    ),
-                    (_, PLink::Leaf(y)) if op.right(y).is_some() => put_o(
-                        &mut out,
-                        slot,
-                        PLink::Leaf(op.right(y).unwrap_or_else(|| unreachable!())),
-                    ),
-                    (PLink::Leaf(x), _) => stack.push(Task::CopyB {
-                        a: x,
-                        b: lb,
-                        out: slot,
-                    }),
-                    (_, PLink::Leaf(y)) => stack.push(Task::CopyA {
-                        a: la,
-                        b: y,
-                        out: slot,
-                    }),
-                    (PLink::Node(ia), PLink::Node(_)) => {
-                        let na = &a.nodes[ia as usize];
-                        let me = out.nodes.len() as u32;
-                        out.nodes.push(PNode {
-                            plane: na.plane,
-                            shp: na.shp.clone(),
-                            polygons: na.polygons.clone(),
-                            front: PLink::Leaf(out.root_label()),
-                            back: PLink::Leaf(out.root_label()),
-                        });
-                        put_o(&mut out, slot, PLink::Node(me));
-                        let (tp, tm) = (temps.len(), temps.len() + 1);
-                        temps.push(None);
-                        temps.push(None);
-                        stack.push(Task::Merge {
-                            a: na.back,
-                            b: BSource::Temp(tm),
-                            out: OSlot::Back(me),
-                        });
-                        stack.push(Task::Merge {
-                            a: na.front,
-                            b: BSource::Temp(tp),
-                            out: OSlot::Front(me),
-                        });
-                        stack.push(Task::Partition {
-                            t: lb,
-                            h: na.shp.clone(),
-                            plus: BSlot::Temp(tp),
-                            minus: BSlot::Temp(tm),
-                            collect: me,
-                        });
-                    }
-                }
-            }
-            Task::CopyA {
-                a: la,
-                b: y,
-                out: slot,
-            } => match la {
-                PLink::Leaf(x) => put_o(&mut out, slot, PLink::Leaf(op.apply(x, y))),
-                PLink::Node(ia) => {
-                    let na = &a.nodes[ia as usize];
-                    let me = out.push_copy(na.plane, &na.shp, &na.polygons);
-                    put_o(&mut out, slot, PLink::Node(me));
-                    stack.push(Task::CopyA {
-                        a: na.back,
-                        b: y,
-                        out: OSlot::Back(me),
-                    });
-                    stack.push(Task::CopyA {
-                        a: na.front,
-                        b: y,
-                        out: OSlot::Front(me),
-                    });
-                }
-            },
-            Task::CopyB {
-                a: x,
-                b: lb,
-                out: slot,
-            } => match lb {
-                PLink::Leaf(y) => put_o(&mut out, slot, PLink::Leaf(op.apply(x, y))),
-                PLink::Node(ib) => {
-                    let nb = &bn[ib as usize];
-                    let me = out.push_copy(nb.plane, &nb.shp, &nb.polygons);
-                    let (f, bk) = (nb.front, nb.back);
-                    put_o(&mut out, slot, PLink::Node(me));
-                    stack.push(Task::CopyB {
-                        a: x,
-                        b: bk,
-                        out: OSlot::Back(me),
-                    });
-                    stack.push(Task::CopyB {
-                        a: x,
-                        b: f,
-                        out: OSlot::Front(me),
-                    });
-                }
-            },
+            Task::Merge { a, b, out } => m.merge_links(a, b, out),
+            Task::CopyA { a, b, out } => m.copy_a(a, b, out),
+            Task::CopyB { a, b, out } => m.copy_b(a, b, out),
             Task::Partition {
                 t,
                 h,
                 plus,
                 minus,
                 collect,
-            } => {
-                let PLink::Node(it) = t else {
-                    put_b(&mut bn, &mut temps, plus, t);
-                    put_b(&mut bn, &mut temps, minus, t);
-                    continue;
-                };
-                let hp = *h.support();
-                let (s, front, back) = {
-                    let n = &bn[it as usize];
-                    (n.plane, n.front, n.back)
-                };
-                if s == hp || s == hp.flip() {
-                    let polys = std::mem::take(&mut bn[it as usize].polygons);
-                    out.nodes[collect as usize].polygons.extend(polys);
-                    let (p, m) = if s == hp {
-                        (front, back)
-                    } else {
-                        (back, front)
-                    };
-                    put_b(&mut bn, &mut temps, plus, p);
-                    put_b(&mut bn, &mut temps, minus, m);
-                    continue;
-                }
-                let side_of_s = bn[it as usize].shp.classify(&hp);
-                match h.split(&s) {
-                    Split::Spanning {
-                        front: h_plus,
-                        back: h_minus,
-                    } => {
-                        let node = &mut bn[it as usize];
-                        let shp = node.shp.clone();
-                        let Split::Spanning {
-                            front: s_plus,
-                            back: s_minus,
-                        } = shp.split(&hp)
-                        else {
-                            panic!("sub-hyperplanes of one region span each other symmetrically");
-                        };
-                        let (mut pp, mut pm) = (Vec::new(), Vec::new());
-                        for poly in std::mem::take(&mut node.polygons) {
-                            match poly.split(&hp) {
-                                Split::Front(q) => pp.push(q),
-                                Split::Back(q) => pm.push(q),
-                                Split::Spanning { front: f, back: b } => {
-                                    pp.push(f);
-                                    pm.push(b);
-                                }
-                                Split::Coplanar { .. } => {
-                                    unreachable!("a node polygon lies in the node plane, not in h")
-                                }
-                            }
-                        }
-                        node.shp = s_plus;
-                        node.polygons = pp;
-                        let m = bn.len() as u32;
-                        bn.push(PNode {
-                            plane: s,
-                            shp: s_minus,
-                            polygons: pm,
-                            front,
-                            back,
-                        });
-                        put_b(&mut bn, &mut temps, plus, PLink::Node(it));
-                        put_b(&mut bn, &mut temps, minus, PLink::Node(m));
-                        stack.push(Task::Partition {
-                            t: back,
-                            h: h_minus,
-                            plus: BSlot::Back(it),
-                            minus: BSlot::Back(m),
-                            collect,
-                        });
-                        stack.push(Task::Partition {
-                            t: front,
-                            h: h_plus,
-                            plus: BSlot::Front(it),
-                            minus: BSlot::Front(m),
-                            collect,
-                        });
-                    }
-                    one_side @ (Split::Front(_) | Split::Back(_)) => {
-                        // H lies on one side of s: the subtree on the other
-                        // side does not meet h, so it lies on the side of h
-                        // where the node's sub-hyperplane is; only the
-                        // subtree on H's side is partitioned further
-                        let (h, h_in_front) = match one_side {
-                            Split::Front(h) => (h, true),
-                            Split::Back(h) => (h, false),
-                            _ => unreachable!("matched one side"),
-                        };
-                        let s_in_front = match side_of_s {
-                            PolygonSide::Front => true,
-                            PolygonSide::Back => false,
-                            other => panic!("inconsistent sub-hyperplanes: {other:?}"),
-                        };
-                        let (keep, pass) = if s_in_front {
-                            (plus, minus)
-                        } else {
-                            (minus, plus)
-                        };
-                        put_b(&mut bn, &mut temps, keep, PLink::Node(it));
-                        let (child, slot) = if h_in_front {
-                            (front, BSlot::Front(it))
-                        } else {
-                            (back, BSlot::Back(it))
-                        };
-                        let (p, m) = if s_in_front {
-                            (slot, pass)
-                        } else {
-                            (pass, slot)
-                        };
-                        stack.push(Task::Partition {
-                            t: child,
-                            h,
-                            plus: p,
-                            minus: m,
-                            collect,
-                        });
-                    }
-                    Split::Coplanar { .. } => unreachable!("coincident planes handled above"),
-                }
+            } => m.partition(t, h, (plus, minus), collect),
+        }
+    }
+    let mut out = m.out;
+    out.reduce_nodes(op.keeps_polygons());
+    out
+}
+
+/// The state of a [`merge`]: `a`, the nodes of `b` as they are cut by
+/// `a`'s sub-hyperplanes, the pieces of `b` waiting to be merged, the
+/// result so far and the work stack (no recursion: any depth is fine).
+struct Merger<'p, A, B, O: CellOp<A, B>> {
+    a: &'p Partition<A>,
+    op: &'p O,
+    bn: Vec<PNode<B>>,
+    temps: Vec<Option<PLink<B>>>,
+    out: Partition<O::Out>,
+    stack: Vec<Task<A, B>>,
+}
+
+impl<A, B, O> Merger<'_, A, B, O>
+where
+    A: Copy,
+    B: Copy,
+    O: CellOp<A, B>,
+    O::Out: Copy + PartialEq,
+{
+    /// Hangs `v` at slot `s` of `b`'s nodes or of the waiting pieces.
+    fn put_b(&mut self, s: BSlot, v: PLink<B>) {
+        match s {
+            BSlot::Front(i) => self.bn[i as usize].front = v,
+            BSlot::Back(i) => self.bn[i as usize].back = v,
+            BSlot::Temp(i) => self.temps[i] = Some(v),
+        }
+    }
+
+    /// Hangs `v` at slot `s` of the result.
+    fn put_o(&mut self, s: OSlot, v: PLink<O::Out>) {
+        match s {
+            OSlot::Root => self.out.root = v,
+            OSlot::Front(i) => self.out.nodes[i as usize].front = v,
+            OSlot::Back(i) => self.out.nodes[i as usize].back = v,
+        }
+    }
+
+    /// Merges a subtree of `a` with a subtree of `b` (or a piece of `b`
+    /// partitioned earlier) into result slot `slot`: a leaf that decides
+    /// the operation alone ends it, a leaf of either side copies the
+    /// other subtree, and a node of `a` over a node of `b` partitions
+    /// `b`'s subtree by `a`'s sub-hyperplane first.
+    fn merge_links(&mut self, la: PLink<A>, sb: BSource<B>, slot: OSlot) {
+        let lb = match sb {
+            BSource::Link(l) => l,
+            BSource::Temp(i) => self.temps[i].take().expect("partition result is ready"),
+        };
+        let op = self.op;
+        match (la, lb) {
+            (PLink::Leaf(x), _) if op.left(x).is_some() => self.put_o(
+                slot,
+                PLink::Leaf(op.left(x).unwrap_or_else(|| unreachable!())),
+            ),
+            (_, PLink::Leaf(y)) if op.right(y).is_some() => self.put_o(
+                slot,
+                PLink::Leaf(op.right(y).unwrap_or_else(|| unreachable!())),
+            ),
+            (PLink::Leaf(x), _) => self.stack.push(Task::CopyB {
+                a: x,
+                b: lb,
+                out: slot,
+            }),
+            (_, PLink::Leaf(y)) => self.stack.push(Task::CopyA {
+                a: la,
+                b: y,
+                out: slot,
+            }),
+            (PLink::Node(ia), PLink::Node(_)) => {
+                let na = &self.a.nodes[ia as usize];
+                let me = self.out.nodes.len() as u32;
+                let label = self.out.root_label();
+                self.out.nodes.push(PNode {
+                    plane: na.plane,
+                    shp: na.shp.clone(),
+                    polygons: na.polygons.clone(),
+                    front: PLink::Leaf(label),
+                    back: PLink::Leaf(label),
+                });
+                self.put_o(slot, PLink::Node(me));
+                let (tp, tm) = (self.temps.len(), self.temps.len() + 1);
+                self.temps.push(None);
+                self.temps.push(None);
+                self.stack.push(Task::Merge {
+                    a: na.back,
+                    b: BSource::Temp(tm),
+                    out: OSlot::Back(me),
+                });
+                self.stack.push(Task::Merge {
+                    a: na.front,
+                    b: BSource::Temp(tp),
+                    out: OSlot::Front(me),
+                });
+                self.stack.push(Task::Partition {
+                    t: lb,
+                    h: na.shp.clone(),
+                    plus: BSlot::Temp(tp),
+                    minus: BSlot::Temp(tm),
+                    collect: me,
+                });
             }
         }
     }
-    out.reduce_nodes(op.keeps_polygons());
-    out
+
+    /// Copies a subtree of `a` whose every cell meets one cell of `b`,
+    /// labelled `y`.
+    fn copy_a(&mut self, la: PLink<A>, y: B, slot: OSlot) {
+        match la {
+            PLink::Leaf(x) => self.put_o(slot, PLink::Leaf(self.op.apply(x, y))),
+            PLink::Node(ia) => {
+                let na = &self.a.nodes[ia as usize];
+                let me = self.out.push_copy(na.plane, &na.shp, &na.polygons);
+                self.put_o(slot, PLink::Node(me));
+                self.stack.push(Task::CopyA {
+                    a: na.back,
+                    b: y,
+                    out: OSlot::Back(me),
+                });
+                self.stack.push(Task::CopyA {
+                    a: na.front,
+                    b: y,
+                    out: OSlot::Front(me),
+                });
+            }
+        }
+    }
+
+    /// Copies a subtree of `b` whose every cell meets one cell of `a`,
+    /// labelled `x`.
+    fn copy_b(&mut self, x: A, lb: PLink<B>, slot: OSlot) {
+        match lb {
+            PLink::Leaf(y) => self.put_o(slot, PLink::Leaf(self.op.apply(x, y))),
+            PLink::Node(ib) => {
+                let nb = &self.bn[ib as usize];
+                let me = self.out.push_copy(nb.plane, &nb.shp, &nb.polygons);
+                let (f, bk) = (nb.front, nb.back);
+                self.put_o(slot, PLink::Node(me));
+                self.stack.push(Task::CopyB {
+                    a: x,
+                    b: bk,
+                    out: OSlot::Back(me),
+                });
+                self.stack.push(Task::CopyB {
+                    a: x,
+                    b: f,
+                    out: OSlot::Front(me),
+                });
+            }
+        }
+    }
+
+    /// Partitions `b`'s subtree `t` by the sub-hyperplane `h` of result
+    /// node `collect`: the part in front goes to `plus`, the part behind
+    /// to `minus`; polygons of `b` lying in `h`'s plane go to `collect`.
+    fn partition(&mut self, t: PLink<B>, h: Polygon, (plus, minus): (BSlot, BSlot), collect: u32) {
+        let PLink::Node(it) = t else {
+            self.put_b(plus, t);
+            self.put_b(minus, t);
+            return;
+        };
+        let hp = *h.support();
+        let (s, front, back) = {
+            let n = &self.bn[it as usize];
+            (n.plane, n.front, n.back)
+        };
+        if s == hp || s == hp.flip() {
+            let polys = std::mem::take(&mut self.bn[it as usize].polygons);
+            self.out.nodes[collect as usize].polygons.extend(polys);
+            let (p, m) = if s == hp {
+                (front, back)
+            } else {
+                (back, front)
+            };
+            self.put_b(plus, p);
+            self.put_b(minus, m);
+            return;
+        }
+        let side_of_s = self.bn[it as usize].shp.classify(&hp);
+        match h.split(&s) {
+            Split::Spanning {
+                front: h_plus,
+                back: h_minus,
+            } => self.split_node(it, (h_plus, h_minus), (plus, minus), collect),
+            Split::Front(h) => self.pass_by(it, (h, true), side_of_s, (plus, minus), collect),
+            Split::Back(h) => self.pass_by(it, (h, false), side_of_s, (plus, minus), collect),
+            Split::Coplanar { .. } => unreachable!("coincident planes handled above"),
+        }
+    }
+
+    /// `h` spans node `it`'s plane: the node is cut in two by `h`'s plane
+    /// (its sub-hyperplane and polygons), the front copy going to `plus`
+    /// and the back one to `minus`, and both children are partitioned by
+    /// the matching piece of `h`.
+    fn split_node(
+        &mut self,
+        it: u32,
+        (h_plus, h_minus): (Polygon, Polygon),
+        (plus, minus): (BSlot, BSlot),
+        collect: u32,
+    ) {
+        let hp = *h_plus.support();
+        let node = &mut self.bn[it as usize];
+        let (s, front, back) = (node.plane, node.front, node.back);
+        let shp = node.shp.clone();
+        let Split::Spanning {
+            front: s_plus,
+            back: s_minus,
+        } = shp.split(&hp)
+        else {
+            panic!("sub-hyperplanes of one region span each other symmetrically");
+        };
+        let (mut pp, mut pm) = (Vec::new(), Vec::new());
+        for poly in std::mem::take(&mut node.polygons) {
+            match poly.split(&hp) {
+                Split::Front(q) => pp.push(q),
+                Split::Back(q) => pm.push(q),
+                Split::Spanning { front: f, back: b } => {
+                    pp.push(f);
+                    pm.push(b);
+                }
+                Split::Coplanar { .. } => {
+                    unreachable!("a node polygon lies in the node plane, not in h")
+                }
+            }
+        }
+        node.shp = s_plus;
+        node.polygons = pp;
+        let m = self.bn.len() as u32;
+        self.bn.push(PNode {
+            plane: s,
+            shp: s_minus,
+            polygons: pm,
+            front,
+            back,
+        });
+        self.put_b(plus, PLink::Node(it));
+        self.put_b(minus, PLink::Node(m));
+        self.stack.push(Task::Partition {
+            t: back,
+            h: h_minus,
+            plus: BSlot::Back(it),
+            minus: BSlot::Back(m),
+            collect,
+        });
+        self.stack.push(Task::Partition {
+            t: front,
+            h: h_plus,
+            plus: BSlot::Front(it),
+            minus: BSlot::Front(m),
+            collect,
+        });
+    }
+
+    /// `h` lies on one side of node `it`'s plane (in front when
+    /// `h_in_front`): the subtree on the other side does not meet `h`, so
+    /// it lies on the side of `h` where the node's sub-hyperplane is
+    /// (`side_of_s`); only the subtree on `h`'s side is partitioned
+    /// further.
+    fn pass_by(
+        &mut self,
+        it: u32,
+        (h, h_in_front): (Polygon, bool),
+        side_of_s: PolygonSide,
+        (plus, minus): (BSlot, BSlot),
+        collect: u32,
+    ) {
+        let (front, back) = {
+            let n = &self.bn[it as usize];
+            (n.front, n.back)
+        };
+        let s_in_front = match side_of_s {
+            PolygonSide::Front => true,
+            PolygonSide::Back => false,
+            other => panic!("inconsistent sub-hyperplanes: {other:?}"),
+        };
+        let (keep, pass) = if s_in_front {
+            (plus, minus)
+        } else {
+            (minus, plus)
+        };
+        self.put_b(keep, PLink::Node(it));
+        let (child, slot) = if h_in_front {
+            (front, BSlot::Front(it))
+        } else {
+            (back, BSlot::Back(it))
+        };
+        let (p, m) = if s_in_front {
+            (slot, pass)
+        } else {
+            (pass, slot)
+        };
+        self.stack.push(Task::Partition {
+            t: child,
+            h,
+            plus: p,
+            minus: m,
+            collect,
+        });
+    }
 }
 
 fn first_leaf<L: Copy>(p: &Partition<L>) -> L {
