@@ -25,6 +25,44 @@ impl<'a> MeshIn<'a> {
     }
 }
 
+/// An indexed mesh in input units that owns its positions and faces: an
+/// operand handed over to [`mesh_sequence_with`](crate::mesh_sequence_with)
+/// this way is let go as soon as it is snapped.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshBuf {
+    /// The positions.
+    pub positions: Vec<DVec3>,
+    /// The faces (vertex index loops, counter-clockwise seen from
+    /// outside).
+    pub faces: Vec<Vec<u32>>,
+}
+
+impl MeshBuf {
+    /// A mesh from its parts.
+    pub fn new(positions: Vec<DVec3>, faces: Vec<Vec<u32>>) -> MeshBuf {
+        MeshBuf { positions, faces }
+    }
+}
+
+/// A mesh an operand is read from: borrowed ([`MeshIn`]) or owned
+/// ([`MeshBuf`]).
+pub trait AsMeshIn {
+    /// The mesh, borrowed.
+    fn as_mesh_in(&self) -> MeshIn<'_>;
+}
+
+impl AsMeshIn for MeshIn<'_> {
+    fn as_mesh_in(&self) -> MeshIn<'_> {
+        *self
+    }
+}
+
+impl AsMeshIn for MeshBuf {
+    fn as_mesh_in(&self) -> MeshIn<'_> {
+        MeshIn::new(&self.positions, &self.faces)
+    }
+}
+
 /// Checks that operand `operand` is a closed, consistently oriented
 /// 2-manifold ([`check_closed_manifold`]).
 pub fn check_mesh(m: &MeshIn<'_>, operand: usize) -> Result<(), CsgError> {

@@ -55,7 +55,10 @@
 //! comes, so that a long sequence holds only the result and one operand.
 //! Where only the mesh of the last result is wanted, [`Solid::plan_owned`]
 //! decides the operation and [`Planned::into_watertight_mesh`] meshes the
-//! result straight from the two solids' faces, with no solid of its own
+//! result straight from the two solids' faces, with no solid of its own.
+//! [`mesh_sequence_with`] does all of this for operands handed over one at
+//! a time (each let go once snapped), and tells its caller each step: the
+//! import reports, each operation's [`Stats`], when each [`Stage`] starts
 //! (what the CLI does).
 //!
 //! # Example
@@ -96,8 +99,10 @@ mod sequence;
 mod solid;
 
 pub use error::CsgError;
-pub use import::{MeshIn, Snapped, check_mesh, fit_grid, snap, snap_one};
+pub use import::{AsMeshIn, MeshBuf, MeshIn, Snapped, check_mesh, fit_grid, snap, snap_one};
 pub use options::{LEAF_SIZE, Options, Stats};
 pub use plan::Planned;
-pub use sequence::{Boolean, mesh_boolean, mesh_sequence};
+pub use sequence::{
+    Boolean, SequenceError, Stage, Step, mesh_boolean, mesh_sequence, mesh_sequence_with,
+};
 pub use solid::Solid;
