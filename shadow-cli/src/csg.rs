@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow};
 use bsp_core::{BoolOp, Grid, ImportReport, TopologyError, TriMesh};
-use bsp_csg::{CsgError, MeshIn, Planned, Solid};
+use bsp_csg::{CsgError, MeshBuf, MeshIn, SequenceError, Stage, Step};
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use shadow_scene::{Mesh, MeshFormat, MeshView, Triangles};
@@ -285,6 +285,61 @@ struct Outcome {
 }
 
 impl Outcome {
+    /// The operation applied to the first operand with each of the others
+    /// in turn ([`bsp_csg::mesh_sequence_with`]): each operand's faces are
+    /// handed over when its turn comes and its mesh is let go once snapped,
+    /// each import summary is printed to stderr as its operand is snapped,
+    /// and the library's stages are timed as "snap/import", "boolean" and
+    /// "boundary+mesh".
+    fn new(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Result<Outcome> {
+        // the meshes are checked, and messages from here on name the files
+        // only; one grid holds every operand
+        let grid = {
+            let meshes: Vec<MeshIn<'_>> = operands
+                .iter()
+                .map(|o| MeshIn::new(&o.mesh.positions, &[]))
+                .collect();
+            bsp_csg::fit_grid(&meshes)
+                .map_err(|e| anyhow!(e).context("cannot snap the faces to one grid"))?
+        };
+        let names: Vec<String> = operands.iter().map(|o| o.name.clone()).collect();
+        let mut meshes = operands.iter_mut().map(hand_over);
+        let first = meshes.next().expect("at least two operands");
+        let rest = meshes.map(|m| (op.kernel(), m));
+        let (mut reports, mut stats) = (Vec::new(), Vec::new());
+        let mut clock = StageClock {
+            phases,
+            running: None,
+        };
+        let exact = bsp_csg::mesh_sequence_with(&grid, first, rest, |step| {
+            clock.step(&step);
+            match step {
+                Step::Snapped { operand, report } => {
+                    print_import_summary(&names[operand], &report, &grid);
+                    reports.push(report);
+                }
+                Step::Planned { stats: s, .. } => stats.push(s),
+                _ => {}
+            }
+        })
+        .map_err(|e| sequence_error(e, &names, op, &grid))?;
+        let positions = exact
+            .vertices_f64()
+            .into_par_iter()
+            .map(|v| grid.to_world(v))
+            .collect();
+        // (the positions in input units are part of "boundary+mesh")
+        clock.stop();
+        Ok(Outcome {
+            positions,
+            group: op.name(),
+            exact,
+            grid,
+            reports,
+            stats,
+        })
+    }
+
     /// The result in input units, as written: its triangles beside their
     /// positions (no list per triangle), one group named after the
     /// operation.
@@ -297,97 +352,53 @@ impl Outcome {
     }
 }
 
-/// Snaps the operands to one grid and applies the operation to the first
-/// with each of the others in turn, then extracts the watertight
-/// boundary. Prints import summaries to stderr.
-fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Result<Outcome> {
-    // the meshes are checked, and messages from here on name the files
-    // only; one grid holds every operand, and each operand's solid is made
-    // when its turn comes, so that a long sequence holds the result and
-    // one operand's solid at a time
-    let grid = {
-        let meshes: Vec<MeshIn<'_>> = operands
-            .iter()
-            .map(|o| MeshIn::new(&o.mesh.positions, &[]))
-            .collect();
-        bsp_csg::fit_grid(&meshes)
-            .map_err(|e| anyhow!(e).context("cannot snap the faces to one grid"))?
-    };
-    // the result so far, and the last operation decided (its result is
-    // made as a mesh only, with no solid)
-    let mut solid: Option<Solid> = None;
-    let mut last: Option<Planned> = None;
-    let n_operands = operands.len();
-    let mut reports = Vec::with_capacity(operands.len());
-    let mut stats = Vec::new();
-    for (i, o) in operands.iter_mut().enumerate() {
-        // the face lists are moved out of the mesh as read, not copied
-        o.file_loops = None;
-        let loops: Vec<Vec<u32>> = std::mem::take(&mut o.mesh.faces)
-            .into_iter()
-            .map(|f| f.vertices)
-            .collect();
-        let snapped = phases.run("snap/import", || {
-            bsp_csg::snap_one(&grid, &MeshIn::new(&o.mesh.positions, &loops), i)
-        });
-        drop(loops);
-        o.mesh = Mesh::default();
-        let (next, report) = snapped.map_err(|e| match e {
-            CsgError::Inward { .. } => anyhow!(
-                "{}: the faces are oriented inward (clockwise seen from outside): the solid they \
-                 bound is unbounded; reverse every face's vertex order",
-                o.name
-            ),
-            CsgError::Grid(e) => anyhow!(e).context("cannot snap the faces to one grid"),
-            e => anyhow!(e),
-        })?;
-        let summary = report.summary();
-        if !summary.is_empty() {
-            eprint!("{}: {summary}", o.name);
-        }
-        if !report.dropped.is_empty() {
-            eprintln!(
-                "warning: {}: {} face(s) have no area on the grid (step 2^{}) and were dropped; \
-                 the solid may not be closed",
-                o.name,
-                report.dropped.len(),
-                -grid.scale().log2()
-            );
-        }
-        reports.push(report);
-        let Some(acc) = solid.take() else {
-            solid = Some(next);
-            continue;
-        };
-        let planned = phases
-            .run("boolean", || -> Result<Planned, CsgError> {
-                let planned = acc.plan_owned(next, op.kernel())?;
-                stats.push(*planned.stats());
-                Ok(planned)
-            })
-            .map_err(|e| match e {
-                CsgError::NotASolid => anyhow!(
-                    "{} or the result before it: a surface crosses itself after snapping to the \
-                     grid (step 2^{}) and bounds no solid",
-                    o.name,
-                    -grid.scale().log2()
-                ),
-                e => anyhow!(e),
-            })?;
-        // the last result is made as a mesh only, from the faces where
-        // they are (no solid of its own)
-        if i + 1 < n_operands {
-            solid = Some(phases.run("boolean", || planned.into_solid()));
-        } else {
-            last = Some(planned);
-        }
+/// Operand `o`'s mesh as the library takes it: the positions and the
+/// face lists moved out (not copied), the rest of the mesh let go.
+fn hand_over(o: &mut Operand) -> MeshBuf {
+    o.file_loops = None;
+    let mesh = std::mem::take(&mut o.mesh);
+    let faces = mesh.faces.into_iter().map(|f| f.vertices).collect();
+    MeshBuf::new(mesh.positions, faces)
+}
+
+/// Prints what snapping did to operand `name`'s faces, if anything.
+fn print_import_summary(name: &str, report: &ImportReport, grid: &Grid) {
+    let summary = report.summary();
+    if !summary.is_empty() {
+        eprint!("{name}: {summary}");
     }
-    let last = last.expect("at least two operands");
-    // the mesh is checked watertight as it is made (one check, the one
-    // that tells whether it needs mending where the solid touches itself)
-    let (exact, positions) = phases.run("boundary+mesh", || -> Result<(TriMesh, Vec<DVec3>)> {
-        let exact = last.into_watertight_mesh().map_err(|e| {
-            let names: Vec<&str> = operands.iter().map(|o| o.name.as_str()).collect();
+    if !report.dropped.is_empty() {
+        eprintln!(
+            "warning: {name}: {} face(s) have no area on the grid (step 2^{}) and were dropped; \
+             the solid may not be closed",
+            report.dropped.len(),
+            -grid.scale().log2()
+        );
+    }
+}
+
+/// The message for an operation that failed at `e.stage`, naming the
+/// file it comes from.
+fn sequence_error(e: SequenceError, names: &[String], op: Operation, grid: &Grid) -> anyhow::Error {
+    match (e.stage, e.error) {
+        (Stage::Snap(i), CsgError::Inward { .. }) => anyhow!(
+            "{}: the faces are oriented inward (clockwise seen from outside): the solid they \
+             bound is unbounded; reverse every face's vertex order",
+            names[i]
+        ),
+        (Stage::Snap(_), CsgError::Grid(e)) => {
+            anyhow!(e).context("cannot snap the faces to one grid")
+        }
+        (Stage::Operation(i), CsgError::NotASolid) => anyhow!(
+            "{} or the result before it: a surface crosses itself after snapping to the \
+             grid (step 2^{}) and bounds no solid",
+            names[i],
+            -grid.scale().log2()
+        ),
+        // the mesh is checked watertight as it is made (one check, the
+        // one that tells whether it needs mending where the solid touches
+        // itself)
+        (Stage::Mesh, e) => {
             let e = match e {
                 CsgError::Internal(why) => why,
                 e => e.to_string(),
@@ -399,22 +410,49 @@ fn compute(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Resu
                 op.name(),
                 names.join(", ")
             )
-        })?;
-        let positions = exact
-            .vertices_f64()
-            .into_par_iter()
-            .map(|v| grid.to_world(v))
-            .collect();
-        Ok((exact, positions))
-    })?;
-    Ok(Outcome {
-        positions,
-        group: op.name(),
-        exact,
-        grid,
-        reports,
-        stats,
-    })
+        }
+        (_, e) => anyhow!(e),
+    }
+}
+
+/// Times the library's stages into [`Phases`] from the steps it reports:
+/// a stage runs from its start to its end (the mesh's, to
+/// [`StageClock::stop`], after the positions are converted).
+struct StageClock<'p> {
+    phases: &'p mut Phases,
+    /// The phase running, and since when.
+    running: Option<(&'static str, Instant)>,
+}
+
+impl StageClock<'_> {
+    fn step(&mut self, step: &Step) {
+        match step {
+            Step::Started(stage) => {
+                let phase = match stage {
+                    Stage::Snap(_) => "snap/import",
+                    Stage::Operation(_) => "boolean",
+                    Stage::Mesh => "boundary+mesh",
+                };
+                self.stop();
+                self.running = Some((phase, Instant::now()));
+            }
+            Step::Finished(Stage::Mesh) => {}
+            Step::Finished(_) => self.stop(),
+            _ => {}
+        }
+    }
+
+    /// The running phase's time added to it (a new phase the first time).
+    fn stop(&mut self) {
+        let Some((name, start)) = self.running.take() else {
+            return;
+        };
+        let t = start.elapsed();
+        match self.phases.0.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, d)) => *d += t,
+            None => self.phases.0.push((name, t)),
+        }
+    }
 }
 
 /// The exact volume in input units, rounded once to `f64`.
@@ -494,7 +532,7 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
     let mut operands = phases.run("load", || Operand::load_all(&args.operands, args.weld))?;
     phases.run("validate", || Operand::validate_all(&operands))?;
     let out = guarded("the input files", || {
-        compute(&mut operands, args.op, &mut phases)
+        Outcome::new(&mut operands, args.op, &mut phases)
     })?;
     phases.run("write", || shadow_scene::save(&args.output, &out.mesh()))?;
     let total = total.elapsed();
@@ -799,7 +837,7 @@ f 4 1 5 8
             (Operation::Difference, 56.0),
         ] {
             let mut phases = Phases::default();
-            let out = compute(&mut [a.clone(), b.clone()], op, &mut phases).unwrap();
+            let out = Outcome::new(&mut [a.clone(), b.clone()], op, &mut phases).unwrap();
             assert_eq!(exact_volume(&out.exact, &out.grid), vol, "{op:?}");
             let mesh = out.mesh().to_mesh();
             assert_eq!(mesh.signed_volume(), vol, "{op:?}");
@@ -810,7 +848,7 @@ f 4 1 5 8
         }
         // disjoint: empty intersection
         let far = operand(&cube(1.0, [10.0; 3]), "far.obj", false);
-        let out = compute(
+        let out = Outcome::new(
             &mut [a, far],
             Operation::Intersection,
             &mut Phases::default(),
@@ -820,13 +858,40 @@ f 4 1 5 8
         assert_eq!(out.stats[0].cells, 0);
     }
 
+    /// Three operands: an import report for each, the stats of each
+    /// operation, the library's three phases timed, and every operand's
+    /// mesh let go (handed over to the library).
+    #[test]
+    fn three_operands_report_each_import_and_operation() {
+        let mut operands = [
+            operand(&cube(4.0, [0.0; 3]), "a.obj", false),
+            operand(&cube(4.0, [2.0; 3]), "b.obj", true),
+            operand(&cube(4.0, [3.0, 1.0, -1.0]), "c.obj", false),
+        ];
+        let mut phases = Phases::default();
+        let out = Outcome::new(&mut operands, Operation::Difference, &mut phases).unwrap();
+        // 64 − 8 − (the part of c in a but not in b: 1·3·3 − 1·2·1)
+        assert_eq!(exact_volume(&out.exact, &out.grid), 49.0);
+        assert_eq!(out.reports.len(), 3);
+        assert!(out.reports.iter().all(|r| r.polygons == 6));
+        assert_eq!(out.stats.len(), 2);
+        assert!(out.stats.iter().all(|s| s.mixed_cells > 0));
+        let names: Vec<&str> = phases.0.iter().map(|p| p.0).collect();
+        assert_eq!(names, ["snap/import", "boolean", "boundary+mesh"]);
+        for o in &operands {
+            assert!(o.mesh.positions.is_empty() && o.mesh.faces.is_empty());
+            assert!(o.file_loops.is_none());
+            assert_eq!(o.counts, (12, 6));
+        }
+    }
+
     #[test]
     fn exact_volume_scales_by_the_grid() {
         // a 3/4-unit cube at 1/8 offsets: the grid is finer than 1, so the
         // exact volume is divided by a power of two
         let a = operand(&cube(0.75, [0.125; 3]), "a.obj", false);
         let b = operand(&cube(0.75, [0.5; 3]), "b.obj", false);
-        let out = compute(&mut [a, b], Operation::Union, &mut Phases::default()).unwrap();
+        let out = Outcome::new(&mut [a, b], Operation::Union, &mut Phases::default()).unwrap();
         assert!(out.grid.scale() > 1.0);
         assert_eq!(
             exact_volume(&out.exact, &out.grid),
@@ -835,7 +900,8 @@ f 4 1 5 8
         // a coarse grid (scale < 1) multiplies instead
         let a = operand(&cube(4e9, [0.0; 3]), "a.obj", false);
         let b = operand(&cube(4e9, [2e9; 3]), "b.obj", false);
-        let out = compute(&mut [a, b], Operation::Intersection, &mut Phases::default()).unwrap();
+        let out =
+            Outcome::new(&mut [a, b], Operation::Intersection, &mut Phases::default()).unwrap();
         assert!(out.grid.scale() < 1.0);
         assert_eq!(exact_volume(&out.exact, &out.grid), 8e27);
     }
@@ -867,7 +933,8 @@ f 4 1 5 8
             (&a, &c, Operation::Difference),
             (&c, &b, Operation::Union),
         ] {
-            let out = compute(&mut [x.clone(), y.clone()], op, &mut Phases::default()).unwrap();
+            let out =
+                Outcome::new(&mut [x.clone(), y.clone()], op, &mut Phases::default()).unwrap();
             assert!(out.exact.vertices.iter().any(|p| p.as_grid().is_none()));
             // the cheap rounding is the exact fraction's, rounded once
             let exact = out.exact.volume_exact();
@@ -906,7 +973,7 @@ f 4 1 5 8
         let a = operand(&inside_out, "inv.obj", false);
         a.validate().unwrap();
         let b = operand(CUBE, "b.obj", false);
-        let e = compute(&mut [a, b], Operation::Union, &mut Phases::default())
+        let e = Outcome::new(&mut [a, b], Operation::Union, &mut Phases::default())
             .err()
             .unwrap();
         assert!(
@@ -930,7 +997,7 @@ f 4 1 5 8
             Operation::Intersection,
             Operation::Difference,
         ] {
-            let e = compute(&mut [a.clone(), b.clone()], op, &mut Phases::default())
+            let e = Outcome::new(&mut [a.clone(), b.clone()], op, &mut Phases::default())
                 .err()
                 .unwrap();
             assert!(e.to_string().contains("crosses itself"), "{op:?}: {e}");
