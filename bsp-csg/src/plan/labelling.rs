@@ -9,12 +9,13 @@
 //! - [`Labeller::easy_cells`]: the pieces of the easy cells are labelled
 //!   along their faces from the cells around.
 //!
-//! Pieces known to share a label are joined in a union-find whose nodes
+//! Pieces known to share a label are joined in the workspace's union-find
+//! ([`UnionFind`]: a set's root is its smallest member), whose nodes
 //! 0 and 1 stand for the labels outside and inside; a group no known
 //! label reaches asks the winding number at a grid vertex of a member.
 
 use bsp_core::GridPoint;
-use bsp_core::internals::ConvexFace;
+use bsp_core::internals::{ConvexFace, UnionFind};
 use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 use smallvec::SmallVec;
@@ -50,7 +51,7 @@ impl FreeRegions {
         let mut groups = UnionFind::new(n);
         for &(a, b) in adjacent {
             if free(&leaves[a as usize]) && free(&leaves[b as usize]) {
-                groups.join(a, b);
+                groups.union(a, b);
             }
         }
         let root: Vec<u32> = (0..n as u32).map(|x| groups.find(x)).collect();
@@ -221,12 +222,14 @@ impl Labeller<'_> {
             let node = i as u32 + 2;
             match *x {
                 OwnLabel::Touched => continue,
-                OwnLabel::Known(inside) => groups.join(node, u32::from(inside)),
+                OwnLabel::Known(inside) => {
+                    groups.union(node, u32::from(inside));
+                }
                 OwnLabel::Unknown => {}
             }
             for g in self.corners(pieced[i].face) {
                 let at = *first.entry(g).or_insert(node);
-                groups.join(node, at);
+                groups.union(node, at);
             }
         }
         if groups.find(1) == 0 {
@@ -245,9 +248,9 @@ impl Labeller<'_> {
                 }
             }
         }
-        groups.answer(&asked, &|g| self.inside(g));
+        answer(&mut groups, &asked, &|g| self.inside(g));
         Ok((0..pieced.len())
-            .map(|i| groups.label(i as u32 + 2))
+            .map(|i| label(&mut groups, i as u32 + 2))
             .collect())
     }
 
@@ -297,7 +300,7 @@ impl Labeller<'_> {
         }
         let mut groups = UnionFind::new(nodes.count as usize);
         for (a, b) in joins {
-            groups.join(a, b);
+            groups.union(a, b);
         }
         if groups.find(1) == 0 {
             return Err(CsgError::Internal(
@@ -319,12 +322,12 @@ impl Labeller<'_> {
         }
         let mut asked: Vec<(u32, GridPoint)> = asked.into_iter().collect();
         asked.sort_unstable();
-        groups.answer(&asked, &|g| self.inside(g));
+        answer(&mut groups, &asked, &|g| self.inside(g));
         let mut out = FxHashMap::default();
         for &l in &nodes.cells {
             let b = nodes.base[&l];
             let labels = (0..easy[&l].grid_vertex.len() as u32)
-                .map(|i| groups.label(b + i))
+                .map(|i| label(&mut groups, b + i))
                 .collect();
             out.insert(l, labels);
         }
@@ -483,52 +486,27 @@ fn facing(s: &IBox, l: &IBox) -> Option<usize> {
     None
 }
 
-/// Groups of nodes `0..n` by union and find; a group's root is its
-/// smallest node, so where nodes 0 and 1 stand for the labels outside and
-/// inside, they stay roots and name their groups' label.
-struct UnionFind {
-    parent: Vec<u32>,
+/// Joins each group `(root, g)` of `asked` to the label `inside(g)`
+/// (asked in parallel). Nodes 0 and 1 stand for the labels outside and
+/// inside: a group's root is its smallest node, so they stay roots and
+/// name their groups' label.
+fn answer(
+    groups: &mut UnionFind,
+    asked: &[(u32, GridPoint)],
+    inside: &(dyn Fn(GridPoint) -> bool + Sync),
+) {
+    let answers: Vec<(u32, bool)> = asked.par_iter().map(|&(r, g)| (r, inside(g))).collect();
+    for (r, x) in answers {
+        groups.union(r, u32::from(x));
+    }
 }
 
-impl UnionFind {
-    fn new(n: usize) -> UnionFind {
-        UnionFind {
-            parent: (0..n as u32).collect(),
-        }
-    }
-
-    fn find(&mut self, mut x: u32) -> u32 {
-        let p = &mut self.parent;
-        while p[x as usize] != x {
-            p[x as usize] = p[p[x as usize] as usize];
-            x = p[x as usize];
-        }
-        x
-    }
-
-    fn join(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.parent[ra.max(rb) as usize] = ra.min(rb);
-        }
-    }
-
-    /// Joins each group `(root, g)` of `asked` to the label `inside(g)`
-    /// (asked in parallel).
-    fn answer(&mut self, asked: &[(u32, GridPoint)], inside: &(dyn Fn(GridPoint) -> bool + Sync)) {
-        let answers: Vec<(u32, bool)> = asked.par_iter().map(|&(r, g)| (r, inside(g))).collect();
-        for (r, x) in answers {
-            self.join(r, u32::from(x));
-        }
-    }
-
-    /// The label of node `x`'s group: `Some(inside)`, or `None` if no
-    /// label reached it.
-    fn label(&mut self, x: u32) -> Option<bool> {
-        match self.find(x) {
-            0 => Some(false),
-            1 => Some(true),
-            _ => None,
-        }
+/// The label of node `x`'s group: `Some(inside)`, or `None` if no label
+/// reached it.
+fn label(groups: &mut UnionFind, x: u32) -> Option<bool> {
+    match groups.find(x) {
+        0 => Some(false),
+        1 => Some(true),
+        _ => None,
     }
 }
