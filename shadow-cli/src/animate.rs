@@ -12,18 +12,18 @@
 
 use std::fmt::Write as _;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
-use bsp_core::{BspTree, BuildOptions, Polygon};
+use bsp_core::{BspTree, BuildOptions, Grid, Polygon};
 use clap::{Args, ValueEnum};
 use glam::{DMat4, DVec3};
 use rayon::prelude::*;
 use shadow_raster::svg::{SvgFragment, SvgView, SvgViewpoint};
 use shadow_scene::{Face, Mesh, ROOM_EYE, ROOM_TARGET};
 use svbsp::export::{area_records, json_footer, json_fragments, json_header, world_vertices};
-use svbsp::{Areas, Light, PlacedLight};
+use svbsp::{Areas, Light, LightSpec, PlacedLight};
 use tiling::{Dynamic, FrameStats, Motion, PipelineOptions, Strategy};
 
 use crate::args::{CameraArgs, ImageArgs, LightArgs, parse_vec3};
@@ -220,105 +220,131 @@ fn setup(args: &AnimateArgs) -> Result<Setup> {
     }
 }
 
+/// What the command line asks for, checked before any work is done.
+struct Plan {
+    setup: Setup,
+    specs: Vec<LightSpec>,
+    motion: Motion,
+    strategy: Strategy,
+}
+
+impl Plan {
+    /// Loads the scene and fails on a missing object or light; creates
+    /// the output folder.
+    fn of(args: &AnimateArgs) -> Result<Plan> {
+        let s = setup(args)?;
+        if s.moving.faces.is_empty() {
+            bail!("the moving object has no faces");
+        }
+        if s.statics.faces.is_empty() {
+            bail!("{}: no faces", s.name);
+        }
+        let mut specs = args.lights.specs();
+        if specs.is_empty() {
+            match s.light {
+                Some(l) => specs.push(LightSpec::Point(l)),
+                None => bail!(
+                    "no light: give at least one --light X,Y,Z (a point light) or --sun X,Y,Z (a \
+                     light at infinity); both can be repeated"
+                ),
+            }
+        }
+        let (axis, degrees) = args.spin.or(s.spin).unwrap_or((DVec3::Z, 0.0));
+        let step = args.step.unwrap_or(DVec3::ZERO);
+        let (mlo, mhi) = s.moving.bounds().expect("the moving object has faces");
+        let centre = args.spin_center.or(s.centre).unwrap_or((mlo + mhi) * 0.5);
+        let motion = Motion {
+            axis,
+            degrees,
+            centre,
+            step,
+        };
+        if degrees == 0.0 && step == DVec3::ZERO && args.frames > 1 {
+            note(
+                args,
+                "note: no motion given (--spin, --step): every frame is the same",
+            );
+        }
+        if !has_view(args) && args.camera.any() {
+            note(
+                args,
+                "note: --eye, --target and --up only apply to SVG and PNG frames",
+            );
+        }
+        std::fs::create_dir_all(&args.output)
+            .with_context(|| format!("could not create {}", args.output.display()))?;
+        let strategy = match args.strategy {
+            StrategyArg::Paper => Strategy::Paper,
+            StrategyArg::Fast => Strategy::Fast,
+        };
+        Ok(Plan {
+            setup: s,
+            specs,
+            motion,
+            strategy,
+        })
+    }
+
+    /// One grid for every frame: the static scene, the lights and the box
+    /// of every position the object takes.
+    fn grid(&self, frames: u32) -> Result<Grid> {
+        let s = &self.setup;
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for k in 0..frames {
+            let m = self.motion.matrix(k);
+            for p in &s.moving.positions {
+                let q = m.transform_point3(*p);
+                lo = lo.min(q);
+                hi = hi.max(q);
+            }
+        }
+        let mut pts = s.statics.positions.clone();
+        pts.push(lo);
+        pts.push(hi);
+        shared_grid(&pts, &self.specs).with_context(|| s.name.clone())
+    }
+}
+
+/// Whether the frames are pictures (and need a viewpoint).
+fn has_view(args: &AnimateArgs) -> bool {
+    matches!(args.format, FrameFormat::Svg | FrameFormat::Png)
+}
+
+/// A note on stderr, unless `--quiet`.
+fn note(args: &AnimateArgs, s: &str) {
+    if !args.quiet {
+        eprintln!("{s}");
+    }
+}
+
 /// `shadow animate`.
 pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
     let total = Instant::now();
-    let note = |s: &str| {
-        if !args.quiet {
-            eprintln!("{s}");
-        }
-    };
-    let s = setup(args)?;
-    if s.moving.faces.is_empty() {
-        bail!("the moving object has no faces");
-    }
-    if s.statics.faces.is_empty() {
-        bail!("{}: no faces", s.name);
-    }
-    let mut specs = args.lights.specs();
-    if specs.is_empty() {
-        match s.light {
-            Some(l) => specs.push(svbsp::LightSpec::Point(l)),
-            None => bail!(
-                "no light: give at least one --light X,Y,Z (a point light) or --sun X,Y,Z (a light \
-                 at infinity); both can be repeated"
-            ),
-        }
-    }
-    let (axis, degrees) = args.spin.or(s.spin).unwrap_or((DVec3::Z, 0.0));
-    let step = args.step.unwrap_or(DVec3::ZERO);
-    let (mlo, mhi) = s.moving.bounds().expect("the moving object has faces");
-    let centre = args.spin_center.or(s.centre).unwrap_or((mlo + mhi) * 0.5);
-    let motion = Motion {
-        axis,
-        degrees,
-        centre,
-        step,
-    };
-    if degrees == 0.0 && step == DVec3::ZERO && args.frames > 1 {
-        note("note: no motion given (--spin, --step): every frame is the same");
-    }
-    if !matches!(args.format, FrameFormat::Svg | FrameFormat::Png) && args.camera.any() {
-        note("note: --eye, --target and --up only apply to SVG and PNG frames");
-    }
-    std::fs::create_dir_all(&args.output)
-        .with_context(|| format!("could not create {}", args.output.display()))?;
-
-    // one grid for every frame: the static scene, the lights and the box
-    // of every position the object takes
-    let mut lo = DVec3::splat(f64::INFINITY);
-    let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    for k in 0..args.frames {
-        let m = motion.matrix(k);
-        for p in &s.moving.positions {
-            let q = m.transform_point3(*p);
-            lo = lo.min(q);
-            hi = hi.max(q);
-        }
-    }
-    let mut pts = s.statics.positions.clone();
-    pts.push(lo);
-    pts.push(hi);
-    let grid = shared_grid(&pts, &specs).with_context(|| s.name.clone())?;
-    let placed = place_lights(&grid, &specs)?;
-    let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
-    let strategy = match args.strategy {
-        StrategyArg::Paper => Strategy::Paper,
-        StrategyArg::Fast => Strategy::Fast,
-    };
+    let plan = Plan::of(args)?;
+    let grid = plan.grid(args.frames)?;
+    let placed = place_lights(&grid, &plan.specs)?;
+    let kernel: Vec<Light> = placed.iter().map(|l| l.light).collect();
     let opts = PipelineOptions::default()
-        .with_strategy(strategy)
+        .with_strategy(plan.strategy)
         .with_tiles(args.tiles)
         .with_pieces(args.format == FrameFormat::Svg);
 
     let progress = Progress::new(!args.quiet);
     progress.phase("preprocessing", 1);
-    let statics = s.statics.face_loops();
-    let moving = s.moving.face_loops();
+    let s = &plan.setup;
     let start = Instant::now();
-    let d = Dynamic::new(&statics, &moving, grid, &kernel, opts)?;
+    let d = Dynamic::new(
+        &s.statics.face_loops(),
+        &s.moving.face_loops(),
+        grid,
+        &kernel,
+        opts,
+    )?;
     let t_pre = start.elapsed();
-    let view =
-        matches!(args.format, FrameFormat::Svg | FrameFormat::Png).then(|| frame_view(args, &s));
-    // one colour per face, static faces then the moving object's
-    let colors = shadow_scene::face_colors(&frame_mesh(&s, &d, &DMat4::IDENTITY));
-    let mut report = match &args.report {
-        Some(p) => {
-            let mut o = Output::create(p)?;
-            writeln!(o, "{REPORT_HEADER}")?;
-            Some(o)
-        }
-        None => None,
-    };
+    let mut files = FrameFiles::new(args, s, &d, &placed)?;
     progress.phase("frames", args.frames as u64);
-    let mut times: Vec<Duration> = Vec::with_capacity(args.frames as usize);
-    let mut related = 0usize;
-    // frames in which a light left out the object's faces turned away
-    let mut culled = 0u32;
-    let mut last = FrameStats::default();
-    // PNG frames are drawn one after the other in one renderer, which
-    // keeps its buffers from frame to frame
-    let mut renderer = shadow_raster::Renderer::new();
+    let mut tally = Tally::default();
     let loop_start = Instant::now();
     let in_flight = args.in_flight.max(1);
     let mut k0 = 0;
@@ -328,7 +354,7 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
         let batch: Vec<Result<tiling::Frame>> = (k0..k1)
             .into_par_iter()
             .map(|k| {
-                d.frame(&motion.matrix(k)).map_err(|e| {
+                d.frame(&plan.motion.matrix(k)).map_err(|e| {
                     anyhow!(
                         "frame {k}: {e} (the grid holds every position the object takes; is a \
                          vertex not finite?)"
@@ -338,81 +364,34 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
             .collect();
         for (k, frame) in (k0..k1).zip(batch) {
             let frame = frame?;
-            let m = motion.matrix(k);
-            times.push(frame.stats.t_frame);
-            related += frame.stats.related;
-            culled += (frame.stats.culled > 0) as u32;
-            if let Some(r) = &mut report {
-                writeln!(r, "{}", report_row(k, &frame.stats))?;
-            }
-            let stem = args.output.join(format!("frame_{k:04}"));
-            if args.export_scene || args.format == FrameFormat::Svg {
-                let scene = frame_mesh(&s, &d, &m);
-                if args.export_scene {
-                    let path = stem.with_extension("obj");
-                    let mut o = Output::create(&path)?;
-                    write_scene(&mut o, &scene, &d, k, &placed)
-                        .with_context(|| format!("could not write {}", path.display()))?;
-                    o.commit()?;
-                }
-                if let Some(view) = &view {
-                    let path = stem.with_extension("svg");
-                    let svg = frame_svg(&d, &frame, &scene, &placed, view)?;
-                    let mut o = Output::create(&path)?;
-                    o.write_all(svg.as_bytes())
-                        .with_context(|| format!("could not write {}", path.display()))?;
-                    o.commit()?;
-                }
-            }
-            if args.format == FrameFormat::Png {
-                let path = stem.with_extension("png");
-                let view = view.as_ref().expect("PNG frames have a view");
-                frame_png(&mut renderer, &d, &frame, &colors, &placed, view, &path)?;
-            }
-            if args.format == FrameFormat::Json {
-                let path = stem.with_extension("json");
-                let mut o = Output::create(&path)?;
-                frame_json(&mut o, &d, &frame, &placed)
-                    .with_context(|| format!("could not write {}", path.display()))?;
-                o.commit()?;
-            }
-            last = frame.stats;
+            files.write(k, &frame, &plan.motion.matrix(k))?;
+            tally.add(frame.stats);
             progress.inc(1);
         }
         k0 = k1;
     }
     let wall = loop_start.elapsed() / args.frames;
-    if let Some(r) = report {
-        r.commit()?;
-    }
+    files.finish()?;
     progress.finish();
-    let mut sorted = times.clone();
-    sorted.sort();
-    let ms = |d: Duration| d.as_secs_f64() * 1e3;
-    let median = sorted[sorted.len() / 2];
-    let mean = times.iter().sum::<Duration>() / times.len() as u32;
     let mut out = String::new();
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
     let _ = writeln!(
         out,
         "{} frames of {}: {} static faces, {} moving; {:?} strategy, {} light(s); frame time \
-         median {:.2} ms, mean {:.2} ms, max {:.2} ms; wall time a frame {:.2} ms ({} in \
-         flight); {:.0} related static polygons a frame; {} fragments in the last frame; \
-         faces turned away from a light left out in {} of the frames; preprocessing {:.1} ms, \
-         total {:.2} s",
+         {}; wall time a frame {:.2} ms ({in_flight} in flight); {:.0} related static polygons \
+         a frame; {} fragments in the last frame; faces turned away from a light left out in {} \
+         of the frames; preprocessing {:.1} ms, total {:.2} s",
         args.frames,
         s.name,
         s.statics.faces.len(),
         s.moving.faces.len(),
-        strategy,
+        plan.strategy,
         kernel.len(),
-        ms(median),
-        ms(mean),
-        ms(*sorted.last().expect("at least one frame")),
+        tally.frame_times(),
         ms(wall),
-        in_flight,
-        related as f64 / args.frames as f64,
-        last.total_drawn,
-        culled,
+        tally.related as f64 / args.frames as f64,
+        tally.last.total_drawn,
+        tally.culled,
         ms(t_pre),
         total.elapsed().as_secs_f64()
     );
@@ -420,6 +399,139 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
         let _ = writeln!(out, "frames in {}", args.output.display());
     }
     emit(&out)
+}
+
+/// What the frames report, added up.
+#[derive(Default)]
+struct Tally {
+    times: Vec<Duration>,
+    /// Related static polygons, over all frames.
+    related: usize,
+    /// Frames in which a light left out the object's faces turned away.
+    culled: u32,
+    last: FrameStats,
+}
+
+impl Tally {
+    fn add(&mut self, stats: FrameStats) {
+        self.times.push(stats.t_frame);
+        self.related += stats.related;
+        self.culled += (stats.culled > 0) as u32;
+        self.last = stats;
+    }
+
+    /// `median … ms, mean … ms, max … ms`.
+    fn frame_times(&self) -> String {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        let mut sorted = self.times.clone();
+        sorted.sort();
+        let median = sorted[sorted.len() / 2];
+        let mean = self.times.iter().sum::<Duration>() / self.times.len() as u32;
+        let max = *sorted.last().expect("at least one frame");
+        format!(
+            "median {:.2} ms, mean {:.2} ms, max {:.2} ms",
+            ms(median),
+            ms(mean),
+            ms(max)
+        )
+    }
+}
+
+/// The files each frame writes, and the Table 2 report.
+struct FrameFiles<'a> {
+    args: &'a AnimateArgs,
+    setup: &'a Setup,
+    d: &'a Dynamic,
+    lights: &'a [PlacedLight],
+    view: Option<SvgViewpoint>,
+    /// One colour per face, static faces then the moving object's.
+    colors: Vec<DVec3>,
+    /// PNG frames are drawn one after the other in one renderer, which
+    /// keeps its buffers from frame to frame.
+    renderer: shadow_raster::Renderer,
+    report: Option<Output>,
+}
+
+impl<'a> FrameFiles<'a> {
+    fn new(
+        args: &'a AnimateArgs,
+        setup: &'a Setup,
+        d: &'a Dynamic,
+        lights: &'a [PlacedLight],
+    ) -> Result<FrameFiles<'a>> {
+        let view = has_view(args).then(|| frame_view(args, setup));
+        let colors = shadow_scene::face_colors(&frame_mesh(setup, d, &DMat4::IDENTITY));
+        let report = match &args.report {
+            Some(p) => {
+                let mut o = Output::create(p)?;
+                writeln!(o, "{REPORT_HEADER}")?;
+                Some(o)
+            }
+            None => None,
+        };
+        Ok(FrameFiles {
+            args,
+            setup,
+            d,
+            lights,
+            view,
+            colors,
+            renderer: shadow_raster::Renderer::new(),
+            report,
+        })
+    }
+
+    /// Writes frame `k` (the object moved by `m`): its report row and its
+    /// files.
+    fn write(&mut self, k: u32, frame: &tiling::Frame, m: &DMat4) -> Result<()> {
+        let (args, d, lights) = (self.args, self.d, self.lights);
+        if let Some(r) = &mut self.report {
+            writeln!(r, "{}", report_row(k, &frame.stats))?;
+        }
+        let stem = args.output.join(format!("frame_{k:04}"));
+        if args.export_scene || args.format == FrameFormat::Svg {
+            let scene = frame_mesh(self.setup, d, m);
+            if args.export_scene {
+                write_file(&stem.with_extension("obj"), |o| {
+                    write_scene(o, &scene, d, k, lights)
+                })?;
+            }
+            if let Some(view) = &self.view {
+                let svg = frame_svg(d, frame, &scene, lights, view)?;
+                write_file(&stem.with_extension("svg"), |o| {
+                    Ok(o.write_all(svg.as_bytes())?)
+                })?;
+            }
+        }
+        match (args.format, &self.view) {
+            (FrameFormat::Png, Some(view)) => {
+                let png = frame_png(&mut self.renderer, d, frame, &self.colors, lights, view)?;
+                write_file(&stem.with_extension("png"), |o| Ok(o.write_all(&png)?))?;
+            }
+            (FrameFormat::Json, _) => {
+                write_file(&stem.with_extension("json"), |o| {
+                    frame_json(o, d, frame, lights)
+                })?;
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// Puts the report in place.
+    fn finish(self) -> Result<()> {
+        match self.report {
+            Some(r) => r.commit(),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Writes `path` with `f`, renamed into place when complete.
+fn write_file(path: &Path, f: impl FnOnce(&mut Output) -> Result<()>) -> Result<()> {
+    let mut o = Output::create(path)?;
+    f(&mut o).with_context(|| format!("could not write {}", path.display()))?;
+    o.commit()
 }
 
 /// The viewpoint of SVG and PNG frames.
@@ -539,33 +651,25 @@ fn frame_png(
     renderer: &mut shadow_raster::Renderer,
     d: &Dynamic,
     frame: &tiling::Frame,
-    colors: &[glam::DVec3],
+    colors: &[DVec3],
     lights: &[PlacedLight],
     view: &SvgViewpoint,
-    path: &std::path::Path,
-) -> Result<()> {
+) -> Result<Vec<u8>> {
     let grid = d.grid();
     let mut polys: Vec<Polygon> = d.static_polygons().to_vec();
     polys.extend(frame.moved.iter().cloned());
     let scene = shadow_raster::RasterScene::new(grid, polys)?;
     let (lo, hi) = bounds_of(d);
     let target = view.target.unwrap_or((lo + hi) * 0.5);
-    let forward = (target - view.eye).normalize_or_zero();
-    let up = view.up.unwrap_or_else(|| {
-        [DVec3::Z, DVec3::Y, DVec3::X]
-            .into_iter()
-            .find(|u| forward.cross(*u).length() > 1e-3)
-            .unwrap_or(DVec3::X)
-    });
+    let up = view
+        .up
+        .unwrap_or_else(|| shadow_raster::default_up(view.eye, target));
     let camera =
         shadow_raster::Camera::look_at(view.eye, target, up, view.fov_deg, view.width, view.height)
             .map_err(raster_error)?;
     let batch = d.fragments(frame);
     let out = renderer.render_fragments(&scene, &batch, lights, &camera, colors)?;
-    let mut o = Output::create(path)?;
-    o.write_all(&out.image.encode_png())
-        .with_context(|| format!("could not write {}", path.display()))?;
-    o.commit()
+    Ok(out.image.encode_png())
 }
 
 /// The static scene's bounding box in input units.

@@ -179,44 +179,126 @@ fn svg_view(args: &ShadowsArgs, is_room: bool) -> Result<SvgViewpoint> {
 
 // ------------------------------------------------------------- command
 
+/// What the command line asks for, checked before any work is done.
+struct Request {
+    format: Format,
+    /// The SVG's viewpoint (SVG output only).
+    view: Option<SvgViewpoint>,
+    specs: Vec<LightSpec>,
+    /// No light was given: the room's default light stands in.
+    default_light: bool,
+}
+
+impl Request {
+    /// Fails on a bad output name, a missing viewpoint or a missing light.
+    fn of(args: &ShadowsArgs) -> Result<Request> {
+        let format = Format::from_path(&args.output)?;
+        let is_room = args.source.is_scene("room");
+        let view = match format {
+            Format::Svg => Some(svg_view(args, is_room)?),
+            _ => None,
+        };
+        if view.is_none() && args.camera.any() {
+            note(
+                args,
+                "note: --eye, --target and --up only apply to SVG output",
+            );
+        }
+        let mut specs = args.lights.specs();
+        let default_light = specs.is_empty();
+        if default_light {
+            if !is_room {
+                bail!(
+                    "no light: give at least one --light X,Y,Z (a point light) or --sun X,Y,Z \
+                     (a light at infinity); both can be repeated"
+                );
+            }
+            specs.push(LightSpec::Point(ROOM_LIGHT));
+        }
+        Ok(Request {
+            format,
+            view,
+            specs,
+            default_light,
+        })
+    }
+
+    /// The lights, as the report names them.
+    fn light_count(&self) -> String {
+        match (self.specs.len(), self.default_light) {
+            (_, true) => format!(
+                "the room's default light ({})",
+                crate::lights::flag(&self.specs[0])
+            ),
+            (1, false) => "1 light".to_string(),
+            (n, false) => format!("{n} lights"),
+        }
+    }
+}
+
+/// A note on stderr, unless `--quiet`.
+fn note(args: &ShadowsArgs, s: &str) {
+    if !args.quiet {
+        eprintln!("{s}");
+    }
+}
+
 /// `shadow shadows`.
 pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
     let total = Instant::now();
-    // fail on a bad output name or a missing viewpoint before doing any work
-    let format = Format::from_path(&args.output)?;
-    let is_room = args.source.is_scene("room");
-    let view = match format {
-        Format::Svg => Some(svg_view(args, is_room)?),
-        _ => None,
-    };
-    let note = |s: &str| {
-        if !args.quiet {
-            eprintln!("{s}");
-        }
-    };
-    if view.is_none() && args.camera.any() {
-        note("note: --eye, --target and --up only apply to SVG output");
-    }
-    let mut specs = args.lights.specs();
-    let default_light = specs.is_empty();
-    if default_light {
-        if !is_room {
-            bail!(
-                "no light: give at least one --light X,Y,Z (a point light) or --sun X,Y,Z \
-                 (a light at infinity); both can be repeated"
-            );
-        }
-        specs.push(LightSpec::Point(ROOM_LIGHT));
-    }
-
+    let request = Request::of(args)?;
     let progress = Progress::new(!args.quiet);
     let mut phases = Phases::default();
+    let scene = load(args, &request.specs, &mut phases, &progress)?;
+    let mut out = Output::create(&args.output)?;
+    let mut job = Job {
+        args,
+        format: request.format,
+        scene: &scene,
+        kernel: scene.lights.iter().map(|l| l.light).collect(),
+        progress: &progress,
+        phases,
+        areas: Areas::new(scene.lights.len(), scene.mesh.faces.len()),
+        fig: Figures::default(),
+    };
+    guarded("the input and the command line", || {
+        job.run(request.view.as_ref(), &mut out)
+    })?;
+    out.commit()?;
+    progress.finish();
+    let total = total.elapsed();
+
+    let areas = &job.areas;
+    let lit_share = percent(areas.total - areas.dark, areas.total);
+    let mut report = format!(
+        "wrote {}: {} fragments of {} faces of {}{}; {}, {lit_share:.1}% of the area lit\n",
+        args.output.display(),
+        job.fig.fragments,
+        scene.mesh.faces.len(),
+        scene.name,
+        job.fig.extra,
+        request.light_count(),
+    );
+    if args.stats {
+        report += &stats_text(&scene, &job.fig, areas, &job.phases, total);
+    }
+    emit(&report)
+}
+
+/// Loads the scene, snaps it and its point lights to one grid and
+/// imports its faces.
+fn load(
+    args: &ShadowsArgs,
+    specs: &[LightSpec],
+    phases: &mut Phases,
+    progress: &Progress,
+) -> Result<Scene> {
     progress.phase("loading", 1);
     let (mesh, name) = phases.run("load", || load_source_quiet(&args.source, args.quiet))?;
     progress.phase("snapping", 1);
     let scene = phases.run("snap/import", || -> Result<Scene> {
-        let grid = shared_grid(&mesh.positions, &specs).with_context(|| name.clone())?;
-        let lights = place_lights(&grid, &specs)?;
+        let grid = shared_grid(&mesh.positions, specs).with_context(|| name.clone())?;
+        let lights = place_lights(&grid, specs)?;
         let loops = mesh.face_loops();
         let (polys, report) = import_faces_par(&grid, &loops)
             .with_context(|| format!("{name}: cannot import the faces"))?;
@@ -231,255 +313,272 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
     })?;
     let summary = scene.report.summary();
     if !summary.is_empty() {
-        note(&format!("{}: {}", scene.name, summary.trim_end()));
+        note(args, &format!("{}: {}", scene.name, summary.trim_end()));
     }
-    let kernel: Vec<svbsp::Light> = scene.lights.iter().map(|l| l.light).collect();
-    let faces = scene.mesh.faces.len();
-    let report_with = "the input and the command line";
-    let mut areas = Areas::new(kernel.len(), faces);
-    let mut out = Output::create(&args.output)?;
-    let write_err = || format!("could not write {}", args.output.display());
+    Ok(scene)
+}
 
-    let figures = guarded(report_with, || -> Result<Figures> {
-        let mut fig = Figures::default();
-        // the fragments of every face, or for the SVG of every BSP polygon
-        let (batches, tree): (Option<Batch>, Option<BspTree>) = match (args.algorithm, format) {
+/// One run's shading and writing, and what it counts.
+struct Job<'a> {
+    args: &'a ShadowsArgs,
+    format: Format,
+    scene: &'a Scene,
+    kernel: Vec<svbsp::Light>,
+    progress: &'a Progress,
+    phases: Phases,
+    areas: Areas,
+    fig: Figures,
+}
+
+impl Job<'_> {
+    /// Shades every face (or for the SVG every polygon of the scene's
+    /// BSP) and writes the file.
+    fn run(&mut self, view: Option<&SvgViewpoint>, out: &mut Output) -> Result<()> {
+        let write_err = || format!("could not write {}", self.args.output.display());
+        let (batch, tree) = match (self.args.algorithm, self.format) {
             (Algorithm::Psv, Format::Json | Format::Obj) => {
-                progress.phase("shadow trees", kernel.len() as u64);
-                let shadows = phases.run("trees", || Shadows::new(&scene.polys, &kernel))?;
-                fig.shadow_nodes = shadows.volumes().iter().map(|v| v.node_count()).sum();
-                let ranges = receivers(&scene.polys);
-                fig.receivers = ranges.len();
-                stream(
-                    args,
-                    format,
-                    &scene,
-                    &shadows,
-                    &ranges,
-                    &mut out,
-                    &mut areas,
-                    &mut fig,
-                    &mut phases,
-                    &progress,
-                )
-                .with_context(write_err)?;
-                (None, None)
+                let shadows = self.shadow_trees()?;
+                return self.stream(&shadows, out).with_context(write_err);
             }
             (Algorithm::Psv, Format::Svg) => {
-                progress.phase("scene tree", 1);
-                let tree = phases.run("bsp", || {
-                    BspTree::build(scene.polys.clone(), &BuildOptions::default())
-                });
-                progress.phase("shadow trees", kernel.len() as u64);
-                let shadows = phases.run("trees", || Shadows::new(&scene.polys, &kernel))?;
-                fig.shadow_nodes = shadows.volumes().iter().map(|v| v.node_count()).sum();
-                let polys: Vec<Polygon> = tree.polygons().cloned().collect();
-                fig.bsp_polygons = Some(polys.len());
-                fig.receivers = polys.len();
-                progress.phase("shading", polys.len() as u64);
-                let batch = phases.run("shading", || {
-                    let ranges: Vec<Range<usize>> = (0..polys.len()).map(|i| i..i + 1).collect();
-                    let parts: Vec<Batch> = ranges
-                        .par_chunks(CHUNK)
-                        .enumerate()
-                        .map(|(i, rs)| {
-                            let b = shadows.set().shade_ranges(
-                                &polys,
-                                rs,
-                                (i * CHUNK) as u32,
-                                &ShadeOptions::default(),
-                            );
-                            progress.inc(rs.len() as u64);
-                            b
-                        })
-                        .collect();
-                    let mut all = Batch::new();
-                    for b in &parts {
-                        all.append(b);
-                    }
-                    all
-                });
-                (Some(batch), Some(tree))
+                let tree = self.scene_tree();
+                let shadows = self.shadow_trees()?;
+                (self.shade_each(&shadows, &tree), tree)
             }
             (Algorithm::ChinFeiner, _) => {
-                progress.phase("scene tree", 1);
-                let tree = phases.run("bsp", || {
-                    BspTree::build(scene.polys.clone(), &BuildOptions::default())
-                });
-                fig.bsp_polygons = Some(tree.polygons().count());
-                fig.receivers = tree.polygons().count();
-                progress.phase("Chin & Feiner", 1);
-                let cf = phases.run("shadows", || chin_feiner(&tree, &kernel))?;
-                fig.shadow_nodes = cf.shadow_nodes;
-                (Some(Batch::from_chin_feiner(&cf, &kernel)), Some(tree))
+                let tree = self.scene_tree();
+                self.fig.receivers = tree.polygons().count();
+                self.progress.phase("Chin & Feiner", 1);
+                let cf = self
+                    .phases
+                    .run("shadows", || chin_feiner(&tree, &self.kernel))?;
+                self.fig.shadow_nodes = cf.shadow_nodes;
+                (Batch::from_chin_feiner(&cf, &self.kernel), tree)
             }
         };
-        if let Some(batch) = batches {
-            progress.phase("writing", 1);
-            let world = world_vertices(&batch, &scene.grid)?;
-            let records = area_records(&batch, &world);
-            for r in &records {
-                areas.add(r.face, r.area, r.lit, r.facing);
-            }
-            fig.fragments = batch.len();
-            phases
-                .run("write", || -> Result<()> {
-                    match format {
-                        Format::Json => {
-                            json_header(&mut out, &scene.lights, faces)?;
-                            let text = json_fragments(&batch, &world, &records, kernel.len());
-                            out.write_all(text.get(1..).unwrap_or_default())?;
-                            json_footer(&mut out, &areas)?;
-                        }
-                        Format::Obj => {
-                            let mut w = ObjWriter::new();
-                            w.header(&mut out, &scene.name, &light_notes(&scene.lights), faces)?;
-                            w.batch(&mut out, &batch, &world, kernel.len())?;
-                            fig.extra = format!(", {} vertices", w.vertex_count());
-                            warn_degenerate(&w, args.quiet);
-                        }
-                        Format::Svg => {
-                            let view = view.as_ref().expect("SVG output has a view");
-                            let tree = tree.as_ref().expect("SVG is drawn over the scene tree");
-                            let r = render(&scene, tree, view, &batch, &world)?;
-                            out.write_all(r.svg.as_bytes())?;
-                            fig.extra = format!(
-                                ", {} drawn, eye {:.3},{:.3},{:.3}",
-                                r.drawn, r.eye.x, r.eye.y, r.eye.z
-                            );
-                        }
-                    }
-                    Ok(())
+        self.progress.phase("writing", 1);
+        let world = world_vertices(&batch, &self.scene.grid)?;
+        let records = area_records(&batch, &world);
+        self.fig.fragments = batch.len();
+        let mut phases = std::mem::take(&mut self.phases);
+        phases
+            .run("write", || match (self.format, view) {
+                (Format::Svg, Some(view)) => self.write_svg(out, &tree, view, &batch, &world),
+                _ => {
+                    let text = match self.format {
+                        Format::Json => json_fragments(&batch, &world, &records, self.kernel.len()),
+                        _ => Vec::new(),
+                    };
+                    let mut file = FragmentFile::begin(self.format, out, self.scene)?;
+                    self.add_areas(&records);
+                    file.write(out, (&batch, &world, &text), self.kernel.len())?;
+                    file.end(out, &self.areas, &mut self.fig, self.args.quiet)
+                }
+            })
+            .with_context(write_err)?;
+        self.phases = phases;
+        Ok(())
+    }
+
+    /// One shadow-volume tree per light.
+    fn shadow_trees(&mut self) -> Result<Shadows> {
+        self.progress
+            .phase("shadow trees", self.kernel.len() as u64);
+        let shadows = self
+            .phases
+            .run("trees", || Shadows::new(&self.scene.polys, &self.kernel))?;
+        self.fig.shadow_nodes = shadows.volumes().iter().map(|v| v.node_count()).sum();
+        Ok(shadows)
+    }
+
+    /// The scene's BSP tree (the SVG's painter's order, and the polygons
+    /// Chin & Feiner shade).
+    fn scene_tree(&mut self) -> BspTree {
+        self.progress.phase("scene tree", 1);
+        let polys = &self.scene.polys;
+        let tree = self.phases.run("bsp", || {
+            BspTree::build(polys.clone(), &BuildOptions::default())
+        });
+        self.fig.bsp_polygons = Some(tree.polygons().count());
+        tree
+    }
+
+    /// Every polygon of `tree` shaded as its own receiver (receiver =
+    /// polygon index), in parallel.
+    fn shade_each(&mut self, shadows: &Shadows, tree: &BspTree) -> Batch {
+        let polys: Vec<Polygon> = tree.polygons().cloned().collect();
+        self.fig.receivers = polys.len();
+        self.progress.phase("shading", polys.len() as u64);
+        let progress = self.progress;
+        self.phases.run("shading", || {
+            let ranges: Vec<Range<usize>> = (0..polys.len()).map(|i| i..i + 1).collect();
+            let parts: Vec<Batch> = ranges
+                .par_chunks(CHUNK)
+                .enumerate()
+                .map(|(i, rs)| {
+                    let first = (i * CHUNK) as u32;
+                    let b = shadows
+                        .set()
+                        .shade_ranges(&polys, rs, first, &ShadeOptions::default());
+                    progress.inc(rs.len() as u64);
+                    b
                 })
-                .with_context(write_err)?;
+                .collect();
+            let mut all = Batch::new();
+            for b in &parts {
+                all.append(b);
+            }
+            all
+        })
+    }
+
+    fn add_areas(&mut self, records: &[AreaRecord]) {
+        for r in records {
+            self.areas.add(r.face, r.area, r.lit, r.facing);
         }
-        Ok(fig)
-    })?;
-    out.commit()?;
-    progress.finish();
-    let total = total.elapsed();
-
-    let lit_share = percent(areas.total - areas.dark, areas.total);
-    let light_count = match (scene.lights.len(), default_light) {
-        (_, true) => format!(
-            "the room's default light ({})",
-            crate::lights::flag(&specs[0])
-        ),
-        (1, false) => "1 light".to_string(),
-        (n, false) => format!("{n} lights"),
-    };
-    let mut report = format!(
-        "wrote {}: {} fragments of {faces} faces of {}{}; {light_count}, \
-         {lit_share:.1}% of the area lit\n",
-        args.output.display(),
-        figures.fragments,
-        scene.name,
-        figures.extra,
-    );
-    if args.stats {
-        report += &stats_text(&scene, &figures, &areas, &phases, total);
     }
-    emit(&report)
-}
 
-fn warn_degenerate(w: &ObjWriter, quiet: bool) {
-    if w.degenerate() > 0 && !quiet {
-        eprintln!(
-            "warning: {} fragment piece(s) have distinct exact vertices that coincide once \
-             rounded to f64 input units; they are degenerate in the file",
-            w.degenerate()
+    /// Draws the fragments of the scene tree's polygons.
+    fn write_svg(
+        &mut self,
+        out: &mut Output,
+        tree: &BspTree,
+        view: &SvgViewpoint,
+        batch: &Batch,
+        world: &[DVec3],
+    ) -> Result<()> {
+        self.add_areas(&area_records(batch, world));
+        let r = render(self.scene, tree, view, batch, world)?;
+        out.write_all(r.svg.as_bytes())?;
+        self.fig.extra = format!(
+            ", {} drawn, eye {:.3},{:.3},{:.3}",
+            r.drawn, r.eye.x, r.eye.y, r.eye.z
         );
+        Ok(())
     }
-}
 
-/// Each light described, for the OBJ file's head.
-fn light_notes(lights: &[PlacedLight]) -> Vec<String> {
-    lights.iter().map(describe).collect()
+    /// Shades the receivers round by round (each round in parallel) and
+    /// writes each round as soon as it is done.
+    fn stream(&mut self, shadows: &Shadows, out: &mut Output) -> Result<()> {
+        let scene = self.scene;
+        let (format, lights) = (self.format, self.kernel.len());
+        let ranges = receivers(&scene.polys);
+        self.fig.receivers = ranges.len();
+        let opts = ShadeOptions::default().with_pieces(format == Format::Obj);
+        let mut file = FragmentFile::begin(format, out, scene)?;
+        let (mut shading, mut writing) = (Duration::ZERO, Duration::ZERO);
+        let progress = self.progress;
+        progress.phase("shading", ranges.len() as u64);
+        for (r, round) in ranges.chunks(ROUND).enumerate() {
+            let start = Instant::now();
+            let parts: Vec<Result<Shaded>> = round
+                .par_chunks(CHUNK)
+                .enumerate()
+                .map(|(i, rs)| {
+                    let first_receiver = (r * ROUND + i * CHUNK) as u32;
+                    let b = shadows
+                        .set()
+                        .shade_ranges(&scene.polys, rs, first_receiver, &opts);
+                    let world = world_vertices(&b, &scene.grid)?;
+                    let records = area_records(&b, &world);
+                    let text = match format {
+                        Format::Json => json_fragments(&b, &world, &records, lights),
+                        _ => Vec::new(),
+                    };
+                    progress.inc(rs.len() as u64);
+                    Ok((b, world, records, text))
+                })
+                .collect();
+            shading += start.elapsed();
+            let start = Instant::now();
+            for part in parts {
+                let (b, world, records, text) = part?;
+                self.fig.fragments += b.len();
+                self.add_areas(&records);
+                file.write(out, (&b, &world, &text), lights)?;
+            }
+            writing += start.elapsed();
+        }
+        file.end(out, &self.areas, &mut self.fig, self.args.quiet)?;
+        self.phases.0.push(("shading", shading));
+        self.phases.0.push(("write", writing));
+        Ok(())
+    }
 }
 
 /// A chunk of receivers shaded: the fragments, their vertices in input
 /// units, their areas and (for JSON) their text.
 type Shaded = (Batch, Vec<DVec3>, Vec<AreaRecord>, Vec<u8>);
 
-/// Shades the receivers round by round (each round in parallel) and
-/// writes each round as soon as it is done.
-#[allow(clippy::too_many_arguments)]
-fn stream(
-    args: &ShadowsArgs,
-    format: Format,
-    scene: &Scene,
-    shadows: &Shadows,
-    ranges: &[Range<usize>],
-    out: &mut Output,
-    areas: &mut Areas,
-    fig: &mut Figures,
-    phases: &mut Phases,
-    progress: &Progress,
-) -> Result<()> {
-    let lights = scene.lights.len();
-    let faces = scene.mesh.faces.len();
-    let opts = ShadeOptions::default().with_pieces(format == Format::Obj);
-    let mut obj = ObjWriter::new();
-    match format {
-        Format::Json => json_header(out, &scene.lights, faces)?,
-        _ => obj.header(out, &scene.name, &light_notes(&scene.lights), faces)?,
+/// A JSON or OBJ file of fragments, written batch by batch.
+enum FragmentFile {
+    /// Whether the next fragment is the first (written without the
+    /// separating comma).
+    Json {
+        first: bool,
+    },
+    Obj(ObjWriter),
+}
+
+impl FragmentFile {
+    /// Writes the file's head.
+    fn begin(format: Format, out: &mut Output, scene: &Scene) -> Result<FragmentFile> {
+        let faces = scene.mesh.faces.len();
+        Ok(match format {
+            Format::Json => {
+                json_header(out, &scene.lights, faces)?;
+                FragmentFile::Json { first: true }
+            }
+            _ => {
+                let w = ObjWriter::new();
+                let notes: Vec<String> = scene.lights.iter().map(describe).collect();
+                w.header(out, &scene.name, &notes, faces)?;
+                FragmentFile::Obj(w)
+            }
+        })
     }
-    let (mut shading, mut writing) = (Duration::ZERO, Duration::ZERO);
-    let mut first = true;
-    progress.phase("shading", ranges.len() as u64);
-    for (r, round) in ranges.chunks(ROUND).enumerate() {
-        let start = Instant::now();
-        let parts: Vec<Result<Shaded>> = round
-            .par_chunks(CHUNK)
-            .enumerate()
-            .map(|(i, rs)| {
-                let first_receiver = (r * ROUND + i * CHUNK) as u32;
-                let b = shadows
-                    .set()
-                    .shade_ranges(&scene.polys, rs, first_receiver, &opts);
-                let world = world_vertices(&b, &scene.grid)?;
-                let records = area_records(&b, &world);
-                let text = match format {
-                    Format::Json => json_fragments(&b, &world, &records, lights),
-                    _ => Vec::new(),
+
+    /// Writes a batch: for JSON its text (from [`json_fragments`]).
+    fn write(
+        &mut self,
+        out: &mut Output,
+        (batch, world, text): (&Batch, &[DVec3], &[u8]),
+        lights: usize,
+    ) -> Result<()> {
+        match self {
+            FragmentFile::Json { first } => {
+                let body = if *first && !text.is_empty() {
+                    *first = false;
+                    &text[1..]
+                } else {
+                    text
                 };
-                progress.inc(rs.len() as u64);
-                Ok((b, world, records, text))
-            })
-            .collect();
-        shading += start.elapsed();
-        let start = Instant::now();
-        for part in parts {
-            let (b, world, records, text) = part?;
-            fig.fragments += b.len();
-            for rec in &records {
-                areas.add(rec.face, rec.area, rec.lit, rec.facing);
+                out.write_all(body)?;
             }
-            match format {
-                Format::Json => {
-                    let body = if first && !text.is_empty() {
-                        first = false;
-                        &text[1..]
-                    } else {
-                        &text[..]
-                    };
-                    out.write_all(body)?;
+            FragmentFile::Obj(w) => w.batch(out, batch, world, lights)?,
+        }
+        Ok(())
+    }
+
+    /// Writes the file's tail (JSON: the areas), notes the OBJ's vertex
+    /// count and warns of pieces degenerate once rounded.
+    fn end(self, out: &mut Output, areas: &Areas, fig: &mut Figures, quiet: bool) -> Result<()> {
+        match self {
+            FragmentFile::Json { .. } => json_footer(out, areas)?,
+            FragmentFile::Obj(w) => {
+                fig.extra = format!(", {} vertices", w.vertex_count());
+                if w.degenerate() > 0 && !quiet {
+                    eprintln!(
+                        "warning: {} fragment piece(s) have distinct exact vertices that \
+                         coincide once rounded to f64 input units; they are degenerate in the \
+                         file",
+                        w.degenerate()
+                    );
                 }
-                _ => obj.batch(out, &b, &world, lights)?,
             }
         }
-        writing += start.elapsed();
+        Ok(())
     }
-    match format {
-        Format::Json => json_footer(out, areas)?,
-        _ => {
-            fig.extra = format!(", {} vertices", obj.vertex_count());
-            warn_degenerate(&obj, args.quiet);
-        }
-    }
-    phases.0.push(("shading", shading));
-    phases.0.push(("write", writing));
-    Ok(())
 }
 
 fn percent(part: f64, whole: f64) -> f64 {
