@@ -21,9 +21,9 @@ use clap::{Args, ValueEnum};
 use glam::{DMat4, DVec3};
 use rayon::prelude::*;
 use shadow_raster::svg::{SvgFragment, SvgView, SvgViewpoint};
-use shadow_scene::{Face, Mesh, ROOM_EYE, ROOM_TARGET};
-use svbsp::export::{area_records, json_footer, json_fragments, json_header, world_vertices};
-use svbsp::{Areas, Light, LightSpec, PlacedLight};
+use shadow_scene::{Face, Mesh, Staging};
+use svbsp::export::{FragmentFile, FragmentFormat, area_records, world_vertices};
+use svbsp::{Light, LightSpec, PlacedLight};
 use tiling::{Dynamic, FrameStats, Motion, PipelineOptions, Strategy};
 
 use crate::args::{CameraArgs, ImageArgs, LightArgs, parse_vec3};
@@ -171,7 +171,8 @@ struct Setup {
     spin: Option<(DVec3, f64)>,
     centre: Option<DVec3>,
     light: Option<DVec3>,
-    is_room: bool,
+    /// A built-in scene's default camera.
+    staging: Option<Staging>,
 }
 
 fn setup(args: &AnimateArgs) -> Result<Setup> {
@@ -193,7 +194,7 @@ fn setup(args: &AnimateArgs) -> Result<Setup> {
             spin: None,
             centre: None,
             light: None,
-            is_room: false,
+            staging: None,
         }),
         (None, Some(name)) => {
             let a = shadow_scene::animated(name).with_context(|| {
@@ -202,6 +203,7 @@ fn setup(args: &AnimateArgs) -> Result<Setup> {
                     shadow_scene::ANIMATED_NAMES.join(", ")
                 )
             })?;
+            let staging = a.statics.bounds().and_then(|b| Staging::of_scene(name, b));
             Ok(Setup {
                 moving: dynamic(false)?.unwrap_or(a.moving),
                 statics: a.statics,
@@ -209,7 +211,7 @@ fn setup(args: &AnimateArgs) -> Result<Setup> {
                 spin: Some((a.axis, a.degrees)),
                 centre: a.centre,
                 light: Some(a.light),
-                is_room: name == "room",
+                staging,
             })
         }
         (Some(_), Some(_)) => bail!("give either a STATIC file or --scene NAME, not both"),
@@ -538,19 +540,16 @@ fn write_file(path: &Path, f: impl FnOnce(&mut Output) -> Result<()>) -> Result<
 fn frame_view(args: &AnimateArgs, s: &Setup) -> SvgViewpoint {
     let (lo, hi) = s.statics.bounds().expect("the static scene has faces");
     let (c, half) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
-    let bunny = s.name.starts_with("scene bunny");
     let cam = &args.camera;
-    let (eye, target, up) = match (cam.eye, s.is_room, bunny) {
-        (Some(e), _, _) => (e, cam.target, cam.up),
-        (None, true, _) => (ROOM_EYE, Some(cam.target.unwrap_or(ROOM_TARGET)), cam.up),
-        // the bunny stands along +y: from above, in front and to the side
-        (None, _, true) => (
-            c + DVec3::new(0.75 * half, 0.6 * half, 1.7 * half),
-            Some(cam.target.unwrap_or(c - DVec3::Y * 0.25 * half)),
-            Some(cam.up.unwrap_or(DVec3::Y)),
+    let (eye, target, up) = match (cam.eye, s.staging) {
+        (Some(e), _) => (e, cam.target, cam.up),
+        (None, Some(st)) => (
+            st.eye,
+            Some(cam.target.unwrap_or(st.target)),
+            cam.up.or(st.up),
         ),
         // in front of the scene and above it
-        (None, false, false) => (
+        (None, None) => (
             c + DVec3::new(0.7, -1.8, 1.2) * half,
             Some(cam.target.unwrap_or(c)),
             cam.up,
@@ -625,6 +624,7 @@ fn write_scene(
     Ok(())
 }
 
+/// The frame's fragments as a JSON document.
 fn frame_json(
     out: &mut impl Write,
     d: &Dynamic,
@@ -635,14 +635,9 @@ fn frame_json(
     let world = world_vertices(&batch, d.grid())?;
     let records = area_records(&batch, &world);
     let faces = d.static_faces() + d.moving().len();
-    let mut areas = Areas::new(lights.len(), faces);
-    for r in &records {
-        areas.add(r.face, r.area, r.lit, r.facing);
-    }
-    json_header(out, lights, faces)?;
-    let text = json_fragments(&batch, &world, &records, lights.len());
-    out.write_all(text.get(1..).unwrap_or_default())?;
-    json_footer(out, &areas)?;
+    let mut file = FragmentFile::begin(out, FragmentFormat::Json, lights, faces, ("", &[]))?;
+    file.write(out, (&batch, &world, &records), None)?;
+    file.finish(out)?;
     Ok(())
 }
 

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use glam::DVec3;
+use shadow_scene::Staging;
 use svbsp::LightSpec;
 
 /// Where the mesh comes from: a file or a built-in scene (exactly one).
@@ -23,13 +24,13 @@ impl SourceArgs {
         self.input.is_none() && self.scene.as_deref() == Some(name)
     }
 
-    /// `true` for a built-in bunny scene.
-    pub(crate) fn is_bunny(&self) -> bool {
-        self.input.is_none()
-            && self
-                .scene
-                .as_deref()
-                .is_some_and(|s| s.starts_with("bunny"))
+    /// The built-in scene's default camera and light, for its mesh's
+    /// `bounds` ([`Staging::of_scene`]).
+    pub(crate) fn staging(&self, bounds: (DVec3, DVec3)) -> Option<Staging> {
+        match (&self.input, &self.scene) {
+            (None, Some(name)) => Staging::of_scene(name, bounds),
+            _ => None,
+        }
     }
 }
 

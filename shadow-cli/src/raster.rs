@@ -15,7 +15,7 @@ use shadow_raster::{
     Camera, Hsr, Method, RasterScene, RenderOptions, ShadowOptions, compare, hidden_lines, render,
     write_pgm,
 };
-use shadow_scene::{ROOM_EYE, ROOM_LIGHT, ROOM_TARGET, face_colors};
+use shadow_scene::face_colors;
 use svbsp::{LightSpec, PlacedLight};
 
 use crate::args::{CameraArgs, LightArgs, SourceArgs, parse_fov, parse_size};
@@ -220,34 +220,22 @@ fn check_ext(path: &std::path::Path, ext: &str, flag: &str) -> Result<()> {
 pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> Result<Prepared> {
     let start = Instant::now();
     let (mesh, name) = load_source_quiet(&args.source, args.quiet)?;
-    let bunny = args.source.is_bunny();
-    let room = args.source.is_scene("room");
-    let (lo, hi) = mesh.bounds().context("the mesh has no vertices")?;
-    let (centre, half) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
+    let bounds = mesh.bounds().context("the mesh has no vertices")?;
+    let staging = args.source.staging(bounds);
     let mut specs = args.lights.specs();
     if specs.is_empty() && need_lights {
-        if room {
-            specs.push(LightSpec::Point(ROOM_LIGHT));
-        } else if bunny {
-            // the key light of the shadow benches
-            specs.push(LightSpec::Point(
-                centre + DVec3::Y * 1.6 * half + DVec3::X * 0.4 * half + DVec3::Z * 0.6 * half,
-            ));
-        } else {
-            bail!(
+        match staging {
+            Some(s) => specs.push(LightSpec::Point(s.light)),
+            None => bail!(
                 "no light: give at least one --light X,Y,Z (a point light) or --sun X,Y,Z (a light \
                  at infinity)"
-            );
+            ),
         }
     }
-    let (eye, default_target) = match (args.camera.eye, room, bunny) {
-        (Some(e), _, _) => (e, centre),
-        (None, true, _) => (ROOM_EYE, ROOM_TARGET),
-        (None, _, true) => (
-            centre + DVec3::new(0.75 * half, 0.6 * half, 1.7 * half),
-            centre - DVec3::Y * 0.25 * half,
-        ),
-        (None, false, false) => bail!(
+    let (eye, default_target) = match (args.camera.eye, staging) {
+        (Some(e), _) => (e, (bounds.0 + bounds.1) * 0.5),
+        (None, Some(s)) => (s.eye, s.target),
+        (None, None) => bail!(
             "no viewpoint: give --eye X,Y,Z (only the built-in room and bunnies have a default)"
         ),
     };
@@ -256,7 +244,7 @@ pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> 
     let up = match args.camera.up {
         Some(u) => u,
         None => {
-            let pref = if bunny { DVec3::Y } else { DVec3::Z };
+            let pref = staging.and_then(|s| s.up).unwrap_or(DVec3::Z);
             [pref, DVec3::Y, DVec3::X]
                 .into_iter()
                 .find(|u| forward.normalize_or_zero().cross(*u).length() > 1e-3)

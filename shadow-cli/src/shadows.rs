@@ -26,7 +26,7 @@ use rayon::prelude::*;
 use shadow_raster::svg::{SvgFragment, SvgPicture, SvgView, SvgViewpoint};
 use shadow_scene::{Mesh, ROOM_EYE, ROOM_LIGHT, ROOM_TARGET};
 use svbsp::export::{
-    AreaRecord, ObjWriter, area_records, json_footer, json_fragments, json_header, world_vertices,
+    AreaRecord, FragmentFile, FragmentFormat, area_records, json_fragments, world_vertices,
 };
 use svbsp::{
     Areas, Batch, CHUNK, LightSpec, PlacedLight, ShadeOptions, Shadows, chin_feiner, receivers,
@@ -365,14 +365,9 @@ impl Job<'_> {
             .run("write", || match (self.format, view) {
                 (Format::Svg, Some(view)) => self.write_svg(out, &tree, view, &batch, &world),
                 _ => {
-                    let text = match self.format {
-                        Format::Json => json_fragments(&batch, &world, &records, self.kernel.len()),
-                        _ => Vec::new(),
-                    };
-                    let mut file = FragmentFile::begin(self.format, out, self.scene)?;
-                    self.add_areas(&records);
-                    file.write(out, (&batch, &world, &text), self.kernel.len())?;
-                    file.end(out, &self.areas, &mut self.fig, self.args.quiet)
+                    let mut file = self.begin(out)?;
+                    file.write(out, (&batch, &world, &records), None)?;
+                    self.finish(file, out)
                 }
             })
             .with_context(write_err)?;
@@ -432,10 +427,41 @@ impl Job<'_> {
         })
     }
 
-    fn add_areas(&mut self, records: &[AreaRecord]) {
-        for r in records {
-            self.areas.add(r.face, r.area, r.lit, r.facing);
+    /// Starts the JSON or OBJ file.
+    fn begin(&self, out: &mut Output) -> Result<FragmentFile> {
+        let format = match self.format {
+            Format::Json => FragmentFormat::Json,
+            _ => FragmentFormat::Obj,
+        };
+        let scene = self.scene;
+        let notes: Vec<String> = scene.lights.iter().map(describe).collect();
+        let faces = scene.mesh.faces.len();
+        let head = (scene.name.as_str(), &notes[..]);
+        Ok(FragmentFile::begin(
+            out,
+            format,
+            &scene.lights,
+            faces,
+            head,
+        )?)
+    }
+
+    /// Ends the JSON or OBJ file, keeps its areas, notes the OBJ's vertex
+    /// count and warns of pieces degenerate once rounded.
+    fn finish(&mut self, file: FragmentFile, out: &mut Output) -> Result<()> {
+        let w = file.finish(out)?;
+        self.areas = w.areas;
+        if self.format == Format::Obj {
+            self.fig.extra = format!(", {} vertices", w.vertices);
         }
+        if w.degenerate > 0 && !self.args.quiet {
+            eprintln!(
+                "warning: {} fragment piece(s) have distinct exact vertices that coincide once \
+                 rounded to f64 input units; they are degenerate in the file",
+                w.degenerate
+            );
+        }
+        Ok(())
     }
 
     /// Draws the fragments of the scene tree's polygons.
@@ -447,7 +473,9 @@ impl Job<'_> {
         batch: &Batch,
         world: &[DVec3],
     ) -> Result<()> {
-        self.add_areas(&area_records(batch, world));
+        for r in area_records(batch, world) {
+            self.areas.add(r.face, r.area, r.lit, r.facing);
+        }
         let r = render(self.scene, tree, view, batch, world)?;
         out.write_all(r.svg.as_bytes())?;
         self.fig.extra = format!(
@@ -465,7 +493,7 @@ impl Job<'_> {
         let ranges = receivers(&scene.polys);
         self.fig.receivers = ranges.len();
         let opts = ShadeOptions::default().with_pieces(format == Format::Obj);
-        let mut file = FragmentFile::begin(format, out, scene)?;
+        let mut file = self.begin(out)?;
         let (mut shading, mut writing) = (Duration::ZERO, Duration::ZERO);
         let progress = self.progress;
         progress.phase("shading", ranges.len() as u64);
@@ -494,12 +522,12 @@ impl Job<'_> {
             for part in parts {
                 let (b, world, records, text) = part?;
                 self.fig.fragments += b.len();
-                self.add_areas(&records);
-                file.write(out, (&b, &world, &text), lights)?;
+                let json = (format == Format::Json).then_some(&text[..]);
+                file.write(out, (&b, &world, &records), json)?;
             }
             writing += start.elapsed();
         }
-        file.end(out, &self.areas, &mut self.fig, self.args.quiet)?;
+        self.finish(file, out)?;
         self.phases.0.push(("shading", shading));
         self.phases.0.push(("write", writing));
         Ok(())
@@ -509,77 +537,6 @@ impl Job<'_> {
 /// A chunk of receivers shaded: the fragments, their vertices in input
 /// units, their areas and (for JSON) their text.
 type Shaded = (Batch, Vec<DVec3>, Vec<AreaRecord>, Vec<u8>);
-
-/// A JSON or OBJ file of fragments, written batch by batch.
-enum FragmentFile {
-    /// Whether the next fragment is the first (written without the
-    /// separating comma).
-    Json {
-        first: bool,
-    },
-    Obj(ObjWriter),
-}
-
-impl FragmentFile {
-    /// Writes the file's head.
-    fn begin(format: Format, out: &mut Output, scene: &Scene) -> Result<FragmentFile> {
-        let faces = scene.mesh.faces.len();
-        Ok(match format {
-            Format::Json => {
-                json_header(out, &scene.lights, faces)?;
-                FragmentFile::Json { first: true }
-            }
-            _ => {
-                let w = ObjWriter::new();
-                let notes: Vec<String> = scene.lights.iter().map(describe).collect();
-                w.header(out, &scene.name, &notes, faces)?;
-                FragmentFile::Obj(w)
-            }
-        })
-    }
-
-    /// Writes a batch: for JSON its text (from [`json_fragments`]).
-    fn write(
-        &mut self,
-        out: &mut Output,
-        (batch, world, text): (&Batch, &[DVec3], &[u8]),
-        lights: usize,
-    ) -> Result<()> {
-        match self {
-            FragmentFile::Json { first } => {
-                let body = if *first && !text.is_empty() {
-                    *first = false;
-                    &text[1..]
-                } else {
-                    text
-                };
-                out.write_all(body)?;
-            }
-            FragmentFile::Obj(w) => w.batch(out, batch, world, lights)?,
-        }
-        Ok(())
-    }
-
-    /// Writes the file's tail (JSON: the areas), notes the OBJ's vertex
-    /// count and warns of pieces degenerate once rounded.
-    fn end(self, out: &mut Output, areas: &Areas, fig: &mut Figures, quiet: bool) -> Result<()> {
-        match self {
-            FragmentFile::Json { .. } => json_footer(out, areas)?,
-            FragmentFile::Obj(w) => {
-                fig.extra = format!(", {} vertices", w.vertex_count());
-                if w.degenerate() > 0 && !quiet {
-                    eprintln!(
-                        "warning: {} fragment piece(s) have distinct exact vertices that \
-                         coincide once rounded to f64 input units; they are degenerate in the \
-                         file",
-                        w.degenerate()
-                    );
-                }
-            }
-        }
-        Ok(())
-    }
-}
 
 fn percent(part: f64, whole: f64) -> f64 {
     if whole > 0.0 {

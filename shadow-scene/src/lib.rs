@@ -62,7 +62,7 @@ pub use mesh::{Face, Mesh, MeshView, Triangles};
 pub use obj::{ObjNotes, parse_obj, parse_obj_notes, read_obj, read_obj_notes, write_obj};
 pub use palette::{Rgb, face_colors};
 pub use scan::{MAX_SUBDIVISIONS, bunny, sqrt3_subdivide};
-pub use scenes::{SCENE_NAMES, room, scene};
+pub use scenes::{SCENE_NAMES, Staging, room, scene};
 pub use stl::{parse_stl, read_stl, stl_collisions, write_stl};
 
 /// A mesh file format.

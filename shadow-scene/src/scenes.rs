@@ -7,8 +7,8 @@
 
 use glam::DVec3;
 
-use crate::Mesh;
 use crate::prim::{Axis, Builder, SQUARE, q, regular};
+use crate::{Mesh, ROOM_EYE, ROOM_LIGHT, ROOM_TARGET};
 
 /// Names accepted by [`scene`].
 pub const SCENE_NAMES: &[&str] = &[
@@ -57,6 +57,52 @@ pub fn scene(name: &str) -> Option<Mesh> {
         "bunny-298k" => crate::bunny(4),
         "bunny-893k" => crate::bunny(5),
         _ => None,
+    }
+}
+
+/// Where a built-in scene is seen from and lit from by default.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Staging {
+    /// The default eye.
+    pub eye: DVec3,
+    /// The point the default eye looks at.
+    pub target: DVec3,
+    /// The default up direction; `None`: the camera's own default (`+z`).
+    pub up: Option<DVec3>,
+    /// The default point light.
+    pub light: DVec3,
+}
+
+impl Staging {
+    /// The staging of built-in scene `name` (see [`SCENE_NAMES`]) whose
+    /// mesh spans `bounds` (`lo`, `hi`): for the room [`ROOM_EYE`] looking
+    /// at [`ROOM_TARGET`] under [`ROOM_LIGHT`]; for the bunnies (`y` up) a
+    /// three-quarter view from the front, above and to the side, and a
+    /// light above and in front; `None` for the other scenes.
+    ///
+    /// ```
+    /// let room = shadow_scene::room();
+    /// let s = shadow_scene::Staging::of_scene("room", room.bounds().unwrap()).unwrap();
+    /// assert_eq!(s.eye, shadow_scene::ROOM_EYE);
+    /// assert!(shadow_scene::Staging::of_scene("cube", (glam::DVec3::ZERO, glam::DVec3::ONE)).is_none());
+    /// ```
+    pub fn of_scene(name: &str, (lo, hi): (DVec3, DVec3)) -> Option<Staging> {
+        let (c, half) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
+        match name {
+            "room" => Some(Staging {
+                eye: ROOM_EYE,
+                target: ROOM_TARGET,
+                up: None,
+                light: ROOM_LIGHT,
+            }),
+            _ if name.starts_with("bunny") => Some(Staging {
+                eye: c + DVec3::new(0.75, 0.6, 1.7) * half,
+                target: c - DVec3::Y * 0.25 * half,
+                up: Some(DVec3::Y),
+                light: c + DVec3::new(0.4, 1.6, 0.6) * half,
+            }),
+            _ => None,
+        }
     }
 }
 

@@ -8,6 +8,7 @@
 //! text where it is shaded ([`json_fragments`]) and writes the texts in
 //! order between [`json_header`] and [`json_footer`]; OBJ goes through one
 //! [`ObjWriter`], which welds equal positions over the whole file.
+//! [`FragmentFile`] does either, batch by batch, and adds up the areas.
 
 use std::collections::HashMap;
 use std::io::{self, Write};
@@ -354,9 +355,229 @@ impl ObjWriter {
     }
 }
 
+/// The format of a [`FragmentFile`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FragmentFormat {
+    /// The JSON document of `docs/shadows.md`.
+    Json,
+    /// Wavefront OBJ, groups `lit` and `shadow`.
+    Obj,
+}
+
+/// A JSON or OBJ file of fragments, written batch by batch in receiver
+/// order; it adds up the fragments' areas, which the JSON's summary
+/// reports.
+#[derive(Debug)]
+pub struct FragmentFile {
+    kind: FileKind,
+    lights: usize,
+    areas: Areas,
+}
+
+#[derive(Debug)]
+enum FileKind {
+    /// Whether the next fragment is the document's first (written without
+    /// its separating comma).
+    Json {
+        first: bool,
+    },
+    Obj(ObjWriter),
+}
+
+/// What a [`FragmentFile`] wrote.
+#[derive(Debug)]
+pub struct Written {
+    /// The fragments' areas, added up.
+    pub areas: Areas,
+    /// Positions in an OBJ file (0 for JSON).
+    pub vertices: usize,
+    /// OBJ pieces degenerate once rounded (see [`ObjWriter::degenerate`]).
+    pub degenerate: usize,
+}
+
+impl FragmentFile {
+    /// Writes the file's head for the fragments of `faces` faces lit by
+    /// `lights`. `name` (the scene) and `notes` (one line per light) are
+    /// the OBJ's comments.
+    pub fn begin(
+        out: &mut impl Write,
+        format: FragmentFormat,
+        lights: &[PlacedLight],
+        faces: usize,
+        (name, notes): (&str, &[String]),
+    ) -> io::Result<FragmentFile> {
+        let kind = match format {
+            FragmentFormat::Json => {
+                json_header(out, lights, faces)?;
+                FileKind::Json { first: true }
+            }
+            FragmentFormat::Obj => {
+                let w = ObjWriter::new();
+                w.header(out, name, notes, faces)?;
+                FileKind::Obj(w)
+            }
+        };
+        Ok(FragmentFile {
+            kind,
+            lights: lights.len(),
+            areas: Areas::new(lights.len(), faces),
+        })
+    }
+
+    /// Writes batch `b` (`world`: its vertices in input units, `records`:
+    /// its areas). `json` is the batch's text from [`json_fragments`] when
+    /// the caller formatted it already (in parallel, say); else it is
+    /// formatted here.
+    pub fn write(
+        &mut self,
+        out: &mut impl Write,
+        (b, world, records): (&Batch, &[DVec3], &[AreaRecord]),
+        json: Option<&[u8]>,
+    ) -> io::Result<()> {
+        for r in records {
+            self.areas.add(r.face, r.area, r.lit, r.facing);
+        }
+        match &mut self.kind {
+            FileKind::Json { first } => {
+                let own;
+                let text = match json {
+                    Some(t) => t,
+                    None => {
+                        own = json_fragments(b, world, records, self.lights);
+                        &own[..]
+                    }
+                };
+                let body = match text.split_first() {
+                    Some((_, rest)) if *first => {
+                        *first = false;
+                        rest
+                    }
+                    _ => text,
+                };
+                out.write_all(body)
+            }
+            FileKind::Obj(w) => w.batch(out, b, world, self.lights),
+        }
+    }
+
+    /// Writes the file's tail (JSON: the summary of the areas).
+    pub fn finish(self, out: &mut impl Write) -> io::Result<Written> {
+        let (vertices, degenerate) = match &self.kind {
+            FileKind::Json { .. } => {
+                json_footer(out, &self.areas)?;
+                (0, 0)
+            }
+            FileKind::Obj(w) => (w.vertex_count(), w.degenerate()),
+        };
+        Ok(Written {
+            areas: self.areas,
+            vertices,
+            degenerate,
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The floor `[0, 8]²` under the roof `[2, 4]²` at height 4, lit from
+    /// above by one point light and one sun, shaded in two batches.
+    fn floor_and_roof() -> (Grid, Vec<PlacedLight>, Batch, Batch) {
+        let loops: [[[f64; 3]; 4]; 2] = [
+            [[0., 0., 0.], [8., 0., 0.], [8., 8., 0.], [0., 8., 0.]],
+            [[2., 2., 4.], [4., 2., 4.], [4., 4., 4.], [2., 4., 4.]],
+        ];
+        let positions: Vec<DVec3> = loops.iter().flatten().map(|&p| DVec3::from(p)).collect();
+        let specs = [
+            crate::LightSpec::Point(DVec3::new(3.0, 3.0, 9.0)),
+            crate::LightSpec::Sun(DVec3::new(1.0, 0.0, 2.0)),
+        ];
+        let grid = crate::shared_grid(&positions, &specs).unwrap();
+        let lights = crate::place_lights(&grid, &specs).unwrap();
+        let polys: Vec<bsp_core::Polygon> = loops
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                let pts: Vec<_> = l.iter().map(|&p| grid.snap(p.into()).unwrap()).collect();
+                bsp_core::Polygon::from_grid_points(&pts, i as u32).unwrap()
+            })
+            .collect();
+        let kernel: Vec<Light> = lights.iter().map(|l| l.light).collect();
+        let shadows = crate::Shadows::new(&polys, &kernel).unwrap();
+        let opts = crate::ShadeOptions::default().with_pieces(true);
+        let ranges = crate::receivers(&polys);
+        let first = shadows.set().shade_ranges(&polys, &ranges[..1], 0, &opts);
+        let second = shadows.set().shade_ranges(&polys, &ranges[1..], 1, &opts);
+        (grid, lights, first, second)
+    }
+
+    /// The file written in `batches`, and what was written.
+    fn file_of(
+        format: FragmentFormat,
+        grid: &Grid,
+        lights: &[PlacedLight],
+        batches: &[&Batch],
+        preformat: bool,
+    ) -> (Vec<u8>, Written) {
+        let mut out = Vec::new();
+        let notes = ["a".to_string(), "b".to_string()];
+        let mut file =
+            FragmentFile::begin(&mut out, format, lights, 2, ("test", &notes[..])).unwrap();
+        for b in batches {
+            let world = world_vertices(b, grid).unwrap();
+            let records = area_records(b, &world);
+            let text = json_fragments(b, &world, &records, lights.len());
+            let json = preformat.then_some(&text[..]);
+            file.write(&mut out, (b, &world, &records), json).unwrap();
+        }
+        let written = file.finish(&mut out).unwrap();
+        (out, written)
+    }
+
+    #[test]
+    fn a_fragment_file_is_the_same_in_one_batch_or_several() {
+        let (grid, lights, first, second) = floor_and_roof();
+        let mut both = first.clone();
+        both.append(&second);
+        assert!(!first.is_empty() && !second.is_empty());
+        for format in [FragmentFormat::Json, FragmentFormat::Obj] {
+            let (whole, w) = file_of(format, &grid, &lights, &[&both], false);
+            for preformat in [false, true] {
+                let (parts, p) = file_of(format, &grid, &lights, &[&first, &second], preformat);
+                assert_eq!(
+                    String::from_utf8(parts).unwrap(),
+                    String::from_utf8(whole.clone()).unwrap()
+                );
+                assert_eq!(p.areas, w.areas);
+                assert_eq!((p.vertices, p.degenerate), (w.vertices, w.degenerate));
+            }
+            // the floor is 64 units², the roof 4, both facing up; the
+            // point light, 5 above the roof and 9 above the floor, casts
+            // the roof 9/5 times its size
+            let a = &w.areas;
+            assert!((a.total - 68.0).abs() < 1e-9);
+            assert!((a.cast[0] - 3.6 * 3.6).abs() < 1e-9, "{}", a.cast[0]);
+            assert!((a.lit[0] + a.cast[0] - a.total).abs() < 1e-9);
+            // the sun's direction is quantized: its shadow, the roof moved,
+            // is 4 up to the rounding of its corners
+            assert!((a.cast[1] - 4.0).abs() < 1e-6, "{}", a.cast[1]);
+            if format == FragmentFormat::Obj {
+                assert!(w.vertices > 8);
+            }
+        }
+        let (json, _) = file_of(
+            FragmentFormat::Json,
+            &grid,
+            &lights,
+            &[&first, &second],
+            true,
+        );
+        let doc: serde_json::Value = serde_json::from_slice(&json).unwrap();
+        assert_eq!(doc["faces"], 2);
+        assert_eq!(doc["fragments"].as_array().unwrap().len(), both.len());
+        assert_eq!(doc["lights"][1]["kind"], "directional");
+    }
 
     #[test]
     fn obj_groups_name_the_lights() {
