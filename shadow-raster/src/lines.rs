@@ -159,101 +159,25 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
     let diag = scene.diagonal();
     let eye = camera.eye();
     // camera and perspective-space coordinates
-    let to_q = |p: DVec3| -> Option<DVec3> {
-        let c = view.frame(p);
-        (c.z > 1e-9 * diag).then(|| DVec3::new(c.x / c.z, c.y / c.z, 1.0 / c.z))
+    let space = Perspective {
+        view,
+        eye,
+        diag,
+        kx,
+        ky,
+        w,
+        h,
     };
-    let to_px = |q: DVec3| DVec2::new(0.5 * w * (1.0 + q.x / kx), 0.5 * h * (1.0 - q.y / ky));
     // the prims of each object
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); count];
     for (i, &o) in obj.iter().enumerate() {
         members[o as usize].push(i);
     }
     let mut solids = Vec::with_capacity(count);
-    // candidate edges: (object, a, b, the two prims)
-    let mut edges: Vec<(usize, DVec3, DVec3, usize, usize)> = Vec::new();
+    let mut edges: Vec<Candidate> = Vec::new();
     for (o, prims) in members.iter().enumerate() {
-        let describe = || {
-            format!(
-                "polyhedron {o} (faces {}..={} of the input)",
-                prims.iter().map(|&i| scene.face[i]).min().unwrap_or(0),
-                prims.iter().map(|&i| scene.face[i]).max().unwrap_or(0)
-            )
-        };
-        // closed: every directed edge meets its reverse once
-        let mut directed: HashMap<EdgeKey, (usize, DVec3, DVec3)> = HashMap::new();
-        for &i in prims {
-            let pts = scene.prim(i);
-            for k in 0..pts.len() {
-                let (a, b) = (pts[k], pts[(k + 1) % pts.len()]);
-                if directed.insert((key(a), key(b)), (i, a, b)).is_some() {
-                    return Err(RasterError::NotConvex(format!(
-                        "{}: an edge is used twice the same way; Roberts' hidden lines need closed, \
-                         consistently oriented polyhedra",
-                        describe()
-                    )));
-                }
-            }
-        }
-        for (&(ka, kb), &(i, a, b)) in &directed {
-            let Some(&(j, _, _)) = directed.get(&(kb, ka)) else {
-                return Err(RasterError::NotConvex(format!(
-                    "{}: it is not closed (a border edge); Roberts' hidden lines need closed \
-                     polyhedra",
-                    describe()
-                )));
-            };
-            if ka < kb && !scene.support[i].is_coincident(&scene.support[j]) {
-                edges.push((o, a, b, i, j));
-            }
-        }
-        // convex when every vertex is behind or on every face plane
-        let mut planes: Vec<Plane> = prims.iter().map(|&i| scene.support[i]).collect();
-        planes.sort_by_key(|p| (p.normal(), p.offset()));
-        planes.dedup();
-        let convex = planes.iter().all(|p| {
-            let (n, d) = crate::scene::world_plane(&scene.grid, p);
-            prims
-                .iter()
-                .all(|&i| scene.prim(i).iter().all(|v| n.dot(*v) + d <= 1e-9 * diag))
-        });
-        let cells = if convex {
-            vec![planes]
-        } else {
-            bsp_cells(prims.iter().map(|&i| scene.polys[i].clone()).collect())
-        };
-        // perspective space
-        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for &i in prims {
-            for v in scene.prim(i) {
-                let Some(q) = to_q(*v) else {
-                    return Err(RasterError::BehindEye(format!(
-                        "{} reaches behind the eye; Roberts' algorithm needs the scene in front \
-                         of it",
-                        describe()
-                    )));
-                };
-                lo = lo.min(q);
-                hi = hi.max(q);
-            }
-        }
-        let to_qplane = |p: &Plane| {
-            let (n, d) = crate::scene::world_plane(&scene.grid, p);
-            // n · (eye + c.x r + c.y u + c.z f) + d = 0, times 1/c.z > 0
-            let (nr, nu, nf) = (n.dot(view.r), n.dot(view.u), n.dot(view.f));
-            let s = n.dot(eye) + d;
-            (DVec3::new(nr, nu, s), nf)
-        };
-        let cells = cells
-            .iter()
-            .map(|c| c.iter().map(to_qplane).collect())
-            .collect();
-        solids.push(Solid {
-            cells,
-            convex,
-            lo,
-            hi,
-        });
+        candidate_edges(scene, o, prims, &mut edges)?;
+        solids.push(perspective_solid(scene, o, prims, &space)?);
     }
     edges.sort_by(|x, y| {
         (x.1.to_array(), x.2.to_array())
@@ -275,71 +199,257 @@ pub fn hidden_lines(scene: &RasterScene, camera: &Camera) -> Result<HiddenLines,
         check: LineCheck::default(),
     };
     let vis = visibility(&frame, Hsr::ZBuffer);
+    let zbuffer = ZBufferCheck {
+        space: &space,
+        vis: &vis,
+        obj: &obj,
+        solids: &solids,
+    };
     for &(o, a, b, i, j) in &edges {
-        let (qa, qb) = (to_q(a).expect("checked"), to_q(b).expect("checked"));
+        let (qa, qb) = (
+            space.to_q(a).expect("checked"),
+            space.to_q(b).expect("checked"),
+        );
         if back(i) && back(j) {
-            out.hidden.push([to_px(qa), to_px(qb)]);
+            out.hidden.push([space.to_px(qa), space.to_px(qb)]);
             continue;
         }
-        let mut hidden: Vec<(f64, f64)> = Vec::new();
-        let (elo, ehi) = (qa.min(qb), qa.max(qb));
-        for (k, s) in solids.iter().enumerate() {
-            // only a solid nearer than some of the edge, overlapping it on screen
-            if (k == o && s.convex)
-                || s.hi.z <= elo.z
-                || s.hi.x < elo.x
-                || s.lo.x > ehi.x
-                || s.hi.y < elo.y
-                || s.lo.y > ehi.y
-            {
-                continue;
-            }
-            for cell in &s.cells {
-                if let Some(iv) = hidden_interval(cell, s.hi.z, qa, qb) {
-                    hidden.push(iv);
-                }
-            }
-        }
+        let hidden = hidden_by(&solids, o, qa, qb);
         let parts = subtract(&hidden);
         let hidden = merge(hidden);
         let at = |t: f64| qa + (qb - qa) * t;
         for &(t0, t1) in &parts {
-            out.visible.push([to_px(at(t0)), to_px(at(t1))]);
+            out.visible.push([space.to_px(at(t0)), space.to_px(at(t1))]);
         }
         for &(t0, t1) in &hidden {
-            out.hidden.push([to_px(at(t0)), to_px(at(t1))]);
+            out.hidden.push([space.to_px(at(t0)), space.to_px(at(t1))]);
         }
         // the cross-check at the midpoints of long enough parts
-        let mut check = |t0: f64, t1: f64, visible: bool| {
-            let (p0, p1) = (to_px(at(t0)), to_px(at(t1)));
+        zbuffer.check(&mut out.check, o, (qa, qb), &parts, true);
+        zbuffer.check(&mut out.check, o, (qa, qb), &hidden, false);
+    }
+    Ok(out)
+}
+
+/// A candidate edge: its polyhedron, its ends `a`, `b` and its two prims.
+type Candidate = (usize, DVec3, DVec3, usize, usize);
+
+/// Perspective space of a camera: a point `(x/z, y/z, 1/z)` for camera
+/// coordinates `(x, y, z)`, and the image's pixels.
+struct Perspective<'a> {
+    view: &'a crate::view::View,
+    eye: DVec3,
+    /// The scene's diagonal: a point must be farther than a billionth of
+    /// it in front of the eye.
+    diag: f64,
+    /// `tan` of half the horizontal and vertical fields of view.
+    kx: f64,
+    ky: f64,
+    /// The image's size in pixels.
+    w: f64,
+    h: f64,
+}
+
+impl Perspective<'_> {
+    /// World point `p` in perspective space (`None` when not in front of
+    /// the eye).
+    fn to_q(&self, p: DVec3) -> Option<DVec3> {
+        let c = self.view.frame(p);
+        (c.z > 1e-9 * self.diag).then(|| DVec3::new(c.x / c.z, c.y / c.z, 1.0 / c.z))
+    }
+
+    /// The pixel coordinates of perspective-space point `q`.
+    fn to_px(&self, q: DVec3) -> DVec2 {
+        DVec2::new(
+            0.5 * self.w * (1.0 + q.x / self.kx),
+            0.5 * self.h * (1.0 - q.y / self.ky),
+        )
+    }
+}
+
+/// Polyhedron `o` (prims `prims`) named for an error message.
+fn describe(scene: &RasterScene, o: usize, prims: &[usize]) -> String {
+    format!(
+        "polyhedron {o} (faces {}..={} of the input)",
+        prims.iter().map(|&i| scene.face[i]).min().unwrap_or(0),
+        prims.iter().map(|&i| scene.face[i]).max().unwrap_or(0)
+    )
+}
+
+/// Checks that polyhedron `o` (prims `prims`) is closed, every directed
+/// edge meeting its reverse once, and adds its candidate edges (between
+/// faces of different planes) to `edges`.
+fn candidate_edges(
+    scene: &RasterScene,
+    o: usize,
+    prims: &[usize],
+    edges: &mut Vec<Candidate>,
+) -> Result<(), RasterError> {
+    // closed: every directed edge meets its reverse once
+    let mut directed: HashMap<EdgeKey, (usize, DVec3, DVec3)> = HashMap::new();
+    for &i in prims {
+        let pts = scene.prim(i);
+        for k in 0..pts.len() {
+            let (a, b) = (pts[k], pts[(k + 1) % pts.len()]);
+            if directed.insert((key(a), key(b)), (i, a, b)).is_some() {
+                return Err(RasterError::NotConvex(format!(
+                    "{}: an edge is used twice the same way; Roberts' hidden lines need closed, \
+                     consistently oriented polyhedra",
+                    describe(scene, o, prims)
+                )));
+            }
+        }
+    }
+    for (&(ka, kb), &(i, a, b)) in &directed {
+        let Some(&(j, _, _)) = directed.get(&(kb, ka)) else {
+            return Err(RasterError::NotConvex(format!(
+                "{}: it is not closed (a border edge); Roberts' hidden lines need closed \
+                 polyhedra",
+                describe(scene, o, prims)
+            )));
+        };
+        if ka < kb && !scene.support[i].is_coincident(&scene.support[j]) {
+            edges.push((o, a, b, i, j));
+        }
+    }
+    Ok(())
+}
+
+/// Polyhedron `o` (prims `prims`) as a [`Solid`] in perspective space:
+/// one cell of its face planes when it is convex, else the inside cells
+/// of its BSP tree. Errors if it reaches behind the eye.
+fn perspective_solid(
+    scene: &RasterScene,
+    o: usize,
+    prims: &[usize],
+    space: &Perspective<'_>,
+) -> Result<Solid, RasterError> {
+    let (view, eye, diag) = (space.view, space.eye, space.diag);
+    // convex when every vertex is behind or on every face plane
+    let mut planes: Vec<Plane> = prims.iter().map(|&i| scene.support[i]).collect();
+    planes.sort_by_key(|p| (p.normal(), p.offset()));
+    planes.dedup();
+    let convex = planes.iter().all(|p| {
+        let (n, d) = crate::scene::world_plane(&scene.grid, p);
+        prims
+            .iter()
+            .all(|&i| scene.prim(i).iter().all(|v| n.dot(*v) + d <= 1e-9 * diag))
+    });
+    let cells = if convex {
+        vec![planes]
+    } else {
+        bsp_cells(prims.iter().map(|&i| scene.polys[i].clone()).collect())
+    };
+    // perspective space
+    let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    for &i in prims {
+        for v in scene.prim(i) {
+            let Some(q) = space.to_q(*v) else {
+                return Err(RasterError::BehindEye(format!(
+                    "{} reaches behind the eye; Roberts' algorithm needs the scene in front \
+                     of it",
+                    describe(scene, o, prims)
+                )));
+            };
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+    }
+    let to_qplane = |p: &Plane| {
+        let (n, d) = crate::scene::world_plane(&scene.grid, p);
+        // n · (eye + c.x r + c.y u + c.z f) + d = 0, times 1/c.z > 0
+        let (nr, nu, nf) = (n.dot(view.r), n.dot(view.u), n.dot(view.f));
+        let s = n.dot(eye) + d;
+        (DVec3::new(nr, nu, s), nf)
+    };
+    let cells = cells
+        .iter()
+        .map(|c| c.iter().map(to_qplane).collect())
+        .collect();
+    Ok(Solid {
+        cells,
+        convex,
+        lo,
+        hi,
+    })
+}
+
+/// The `t`-ranges of edge `qa → qb` (of polyhedron `o`) that the cells of
+/// `solids` hide, unsorted and possibly overlapping. Only a solid nearer
+/// than some of the edge and overlapping it on screen is tried, and the
+/// edge's own polyhedron only when it is not convex.
+fn hidden_by(solids: &[Solid], o: usize, qa: DVec3, qb: DVec3) -> Vec<(f64, f64)> {
+    let mut hidden: Vec<(f64, f64)> = Vec::new();
+    let (elo, ehi) = (qa.min(qb), qa.max(qb));
+    for (k, s) in solids.iter().enumerate() {
+        // only a solid nearer than some of the edge, overlapping it on screen
+        if (k == o && s.convex)
+            || s.hi.z <= elo.z
+            || s.hi.x < elo.x
+            || s.lo.x > ehi.x
+            || s.hi.y < elo.y
+            || s.lo.y > ehi.y
+        {
+            continue;
+        }
+        for cell in &s.cells {
+            if let Some(iv) = hidden_interval(cell, s.hi.z, qa, qb) {
+                hidden.push(iv);
+            }
+        }
+    }
+    hidden
+}
+
+/// What the cross-check against the z-buffer looks at (see
+/// [`LineCheck`]).
+struct ZBufferCheck<'a> {
+    space: &'a Perspective<'a>,
+    vis: &'a crate::hsr::Visibility,
+    /// Each prim's polyhedron.
+    obj: &'a [u32],
+    solids: &'a [Solid],
+}
+
+impl ZBufferCheck<'_> {
+    /// Checks the `parts` of edge `qa → qb` (of polyhedron `o`), all
+    /// `visible` or all hidden, against the z-buffer at their midpoints,
+    /// those at least a few pixels long and on the image, and counts them
+    /// in `check`.
+    fn check(
+        &self,
+        check: &mut LineCheck,
+        o: usize,
+        (qa, qb): (DVec3, DVec3),
+        parts: &[(f64, f64)],
+        visible: bool,
+    ) {
+        let (space, vis) = (self.space, self.vis);
+        let (w, h) = (space.w, space.h);
+        let at = |t: f64| qa + (qb - qa) * t;
+        for &(t0, t1) in parts {
+            let (p0, p1) = (space.to_px(at(t0)), space.to_px(at(t1)));
             if p0.distance(p1) < 6.0 {
-                return;
+                continue;
             }
             let q = at(0.5 * (t0 + t1));
-            let px = to_px(q);
+            let px = space.to_px(q);
             if !(0.0..w).contains(&px.x) || !(0.0..h).contains(&px.y) {
-                return;
+                continue;
             }
-            let pix = px.y as usize * view.width as usize + px.x as usize;
+            let pix = px.y as usize * space.view.width as usize + px.x as usize;
             let z = 1.0 / q.z;
             let (prim, zb) = (vis.prim[pix], 1.0 / vis.w[pix]);
-            let own = prim != NONE && obj[prim as usize] as usize == o;
+            let own = prim != NONE && self.obj[prim as usize] as usize == o;
             let ok = if visible {
                 prim == NONE || own || zb >= z * (1.0 - 1e-3)
             } else {
-                prim != NONE && (!own || !solids[o].convex) && zb < z
+                prim != NONE && (!own || !self.solids[o].convex) && zb < z
             };
-            out.check.checked += 1;
-            out.check.agree += ok as usize;
-        };
-        for &(t0, t1) in &parts {
-            check(t0, t1, true);
-        }
-        for &(t0, t1) in &hidden {
-            check(t0, t1, false);
+            check.checked += 1;
+            check.agree += ok as usize;
         }
     }
-    Ok(out)
 }
 
 /// The scene's polyhedra: prims joined across every edge that exactly two
