@@ -1212,40 +1212,7 @@ impl BuildInput {
     }
 
     fn check_traversals(&self, tree: &BspTree, frags: &[&Polygon]) -> usize {
-        let index: HashMap<*const Polygon, usize> = frags
-            .iter()
-            .enumerate()
-            .map(|(i, p)| (*p as *const Polygon, i))
-            .collect();
-        // the node holding each fragment, and each node's parent and depth
-        let mut node_of = vec![0 as NodeId; frags.len()];
-        let mut parent: Vec<Option<NodeId>> = vec![None; tree.nodes().len()];
-        let mut depth = vec![0usize; tree.nodes().len()];
-        for (id, n) in tree.nodes().iter().enumerate() {
-            for p in &n.polygons {
-                node_of[index[&(p as *const Polygon)]] = id as NodeId;
-            }
-        }
-        let mut stack = vec![(tree.root(), None, 0)];
-        while let Some((link, up, d)) = stack.pop() {
-            if let Link::Node(id) = link {
-                parent[id as usize] = up;
-                depth[id as usize] = d;
-                let n = tree.node(id);
-                stack.push((n.front, Some(id), d + 1));
-                stack.push((n.back, Some(id), d + 1));
-            }
-        }
-        let lca = |mut a: NodeId, mut b: NodeId| {
-            while a != b {
-                if depth[a as usize] >= depth[b as usize] {
-                    a = parent[a as usize].expect("a deeper node has a parent");
-                } else {
-                    b = parent[b as usize].expect("a deeper node has a parent");
-                }
-            }
-            a
-        };
+        let map = FragmentMap::new(tree, frags);
         let flat = FlatBsp::new(tree);
         ensure!(
             self,
@@ -1264,96 +1231,128 @@ impl BuildInput {
             for order in [Order::BackToFront, Order::FrontToBack] {
                 count += 1;
                 let what = format!("eye {ei} {e:?}, {order:?}");
-                let mut seq = Vec::with_capacity(frags.len());
-                tree.traverse(eye, order, |p| {
-                    seq.push(index.get(&(p as *const Polygon)).copied())
-                });
-                let mut seen = vec![false; frags.len()];
-                for (k, i) in seq.iter().enumerate() {
-                    let Some(i) = *i else {
-                        fail(
-                            self,
-                            format_args!("{what}: visit {k} is not a fragment of the tree"),
-                        )
-                    };
-                    ensure!(
-                        self,
-                        !std::mem::replace(&mut seen[i], true),
-                        "{what}: fragment {i} visited twice"
-                    );
-                }
-                ensure!(
-                    self,
-                    seq.len() == frags.len(),
-                    "{what}: {} visits for {} fragments",
-                    seq.len(),
-                    frags.len()
-                );
-                let seq: Vec<usize> = seq.into_iter().flatten().collect();
-                let mut rec = Vec::with_capacity(frags.len());
-                tree.traverse_recursive(eye, order, |p| {
-                    rec.push(index.get(&(p as *const Polygon)).copied())
-                });
-                ensure!(
-                    self,
-                    rec.iter().copied().eq(seq.iter().map(|i| Some(*i))),
-                    "{what}: traverse_recursive gives {rec:?}, traverse {seq:?}"
-                );
-                let mut k = 0;
-                let mut mismatch = None;
-                flat.traverse(eye, order, |p| {
-                    if mismatch.is_none() && seq.get(k).is_none_or(|&i| !same_polygon(p, frags[i]))
-                    {
-                        mismatch = Some(k);
-                    }
-                    k += 1;
-                });
-                ensure!(
-                    self,
-                    mismatch.is_none() && k == seq.len(),
-                    "{what}: FlatBsp::traverse differs from the tree at visit {mismatch:?} \
-                     ({k} visits, {} fragments)",
-                    seq.len()
-                );
+                let seq = self.check_visits(&map, &flat, eye, order, &what);
                 // painter's order, checked on the first eye only (quadratic)
                 if ei > 0 {
                     continue;
                 }
-                for x in 0..seq.len() {
-                    for y in x + 1..seq.len() {
-                        let (a, b) = (seq[x], seq[y]);
-                        let (na, nb) = (node_of[a], node_of[b]);
-                        if na == nb {
-                            continue;
-                        }
-                        let plane = tree.node(lca(na, nb)).plane;
-                        // drawn first: `far`; drawn later: `near`
-                        let (far, near) = match order {
-                            Order::BackToFront => (frags[a], frags[b]),
-                            Order::FrontToBack => (frags[b], frags[a]),
-                        };
-                        let separated = [plane, plane.flip()].iter().any(|p| {
-                            p.classify_viewpoint(eye) != Side::Back
-                                && matches!(
-                                    far.classify(p),
-                                    PolygonSide::Back | PolygonSide::Coplanar { .. }
-                                )
-                                && matches!(
-                                    near.classify(p),
-                                    PolygonSide::Front | PolygonSide::Coplanar { .. }
-                                )
-                        });
-                        ensure!(
-                            self,
-                            separated,
-                            "{what}: fragments {a} (visit {x}) and {b} (visit {y}) are not \
-                             separated from the eye by {plane:?}"
-                        );
-                    }
-                }
+                self.check_painter(&map, &seq, eye, order, &what);
             }
         }
         count
+    }
+
+    /// Checks that [`BspTree::traverse`] from `eye` in `order` visits
+    /// every fragment of `map` exactly once, and that
+    /// [`BspTree::traverse_recursive`] and [`FlatBsp::traverse`] (`flat`)
+    /// give the same sequence. Returns it (fragment indices).
+    fn check_visits(
+        &self,
+        map: &FragmentMap<'_>,
+        flat: &FlatBsp,
+        eye: ViewPoint,
+        order: Order,
+        what: &str,
+    ) -> Vec<usize> {
+        let (tree, frags, index) = (map.tree, map.frags, &map.index);
+        let mut seq = Vec::with_capacity(frags.len());
+        tree.traverse(eye, order, |p| {
+            seq.push(index.get(&(p as *const Polygon)).copied())
+        });
+        let mut seen = vec![false; frags.len()];
+        for (k, i) in seq.iter().enumerate() {
+            let Some(i) = *i else {
+                fail(
+                    self,
+                    format_args!("{what}: visit {k} is not a fragment of the tree"),
+                )
+            };
+            ensure!(
+                self,
+                !std::mem::replace(&mut seen[i], true),
+                "{what}: fragment {i} visited twice"
+            );
+        }
+        ensure!(
+            self,
+            seq.len() == frags.len(),
+            "{what}: {} visits for {} fragments",
+            seq.len(),
+            frags.len()
+        );
+        let seq: Vec<usize> = seq.into_iter().flatten().collect();
+        let mut rec = Vec::with_capacity(frags.len());
+        tree.traverse_recursive(eye, order, |p| {
+            rec.push(index.get(&(p as *const Polygon)).copied())
+        });
+        ensure!(
+            self,
+            rec.iter().copied().eq(seq.iter().map(|i| Some(*i))),
+            "{what}: traverse_recursive gives {rec:?}, traverse {seq:?}"
+        );
+        let mut k = 0;
+        let mut mismatch = None;
+        flat.traverse(eye, order, |p| {
+            if mismatch.is_none() && seq.get(k).is_none_or(|&i| !same_polygon(p, frags[i])) {
+                mismatch = Some(k);
+            }
+            k += 1;
+        });
+        ensure!(
+            self,
+            mismatch.is_none() && k == seq.len(),
+            "{what}: FlatBsp::traverse differs from the tree at visit {mismatch:?} \
+             ({k} visits, {} fragments)",
+            seq.len()
+        );
+        seq
+    }
+
+    /// Checks the painter's order of the visits `seq` from `eye` in
+    /// `order`: every pair of fragments in different nodes is separated
+    /// by the plane where their paths part, with the eye on the side drawn
+    /// last (back to front) or first (front to back).
+    fn check_painter(
+        &self,
+        map: &FragmentMap<'_>,
+        seq: &[usize],
+        eye: ViewPoint,
+        order: Order,
+        what: &str,
+    ) {
+        let (tree, frags) = (map.tree, map.frags);
+        for x in 0..seq.len() {
+            for y in x + 1..seq.len() {
+                let (a, b) = (seq[x], seq[y]);
+                let (na, nb) = (map.node_of[a], map.node_of[b]);
+                if na == nb {
+                    continue;
+                }
+                let plane = tree.node(map.lca(na, nb)).plane;
+                // drawn first: `far`; drawn later: `near`
+                let (far, near) = match order {
+                    Order::BackToFront => (frags[a], frags[b]),
+                    Order::FrontToBack => (frags[b], frags[a]),
+                };
+                let separated = [plane, plane.flip()].iter().any(|p| {
+                    p.classify_viewpoint(eye) != Side::Back
+                        && matches!(
+                            far.classify(p),
+                            PolygonSide::Back | PolygonSide::Coplanar { .. }
+                        )
+                        && matches!(
+                            near.classify(p),
+                            PolygonSide::Front | PolygonSide::Coplanar { .. }
+                        )
+                });
+                ensure!(
+                    self,
+                    separated,
+                    "{what}: fragments {a} (visit {x}) and {b} (visit {y}) are not \
+                     separated from the eye by {plane:?}"
+                );
+            }
+        }
     }
 
     fn check_membership(&self, bx: &BoxSolid, tree: &BspTree, report: &mut BuildReport) {
@@ -1440,6 +1439,73 @@ impl BuildInput {
             tally(want, report);
             report.implicit_probes += 1;
         }
+    }
+}
+
+/// A built tree's fragments and where they sit in it: what the traversal
+/// checks of [`BuildInput::check`] compare visits with.
+struct FragmentMap<'a> {
+    tree: &'a BspTree,
+    frags: &'a [&'a Polygon],
+    /// Each fragment's index, by address.
+    index: HashMap<*const Polygon, usize>,
+    /// The node holding each fragment.
+    node_of: Vec<NodeId>,
+    /// Each node's parent.
+    parent: Vec<Option<NodeId>>,
+    /// Each node's depth.
+    depth: Vec<usize>,
+}
+
+impl<'a> FragmentMap<'a> {
+    /// The index, node, and each node's parent and depth of `tree`'s
+    /// fragments `frags`.
+    fn new(tree: &'a BspTree, frags: &'a [&'a Polygon]) -> Self {
+        let index: HashMap<*const Polygon, usize> = frags
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (*p as *const Polygon, i))
+            .collect();
+        // the node holding each fragment, and each node's parent and depth
+        let mut node_of = vec![0 as NodeId; frags.len()];
+        let mut parent: Vec<Option<NodeId>> = vec![None; tree.nodes().len()];
+        let mut depth = vec![0usize; tree.nodes().len()];
+        for (id, n) in tree.nodes().iter().enumerate() {
+            for p in &n.polygons {
+                node_of[index[&(p as *const Polygon)]] = id as NodeId;
+            }
+        }
+        let mut stack = vec![(tree.root(), None, 0)];
+        while let Some((link, up, d)) = stack.pop() {
+            if let Link::Node(id) = link {
+                parent[id as usize] = up;
+                depth[id as usize] = d;
+                let n = tree.node(id);
+                stack.push((n.front, Some(id), d + 1));
+                stack.push((n.back, Some(id), d + 1));
+            }
+        }
+        FragmentMap {
+            tree,
+            frags,
+            index,
+            node_of,
+            parent,
+            depth,
+        }
+    }
+
+    /// The lowest common ancestor of nodes `a` and `b`: the node where
+    /// their paths from the root part.
+    fn lca(&self, mut a: NodeId, mut b: NodeId) -> NodeId {
+        while a != b {
+            if self.depth[a as usize] >= self.depth[b as usize] {
+                a = self.parent[a as usize].expect("a deeper node has a parent");
+            } else {
+                b = self.parent[b as usize].expect("a deeper node has a parent");
+            }
+        }
+        a
     }
 }
 
@@ -1822,6 +1888,33 @@ mod tests {
             seed: 0x5eed,
             eyes: eyes.to_vec(),
         };
+        let [unit, sheared, limit, flat] = seed_boxes();
+        let [soup_shared, fan, crossing, invalid] = seed_soups();
+        let far = MAX_VIEW_COORD;
+        let mut worst = bi(Scene::Box(sheared.clone()), &[[0, 0, 0]]);
+        worst.candidates = 1;
+        worst.sample = 1;
+        worst.split_weight = 0;
+        vec![
+            bi(Scene::Box(unit), &[[5, 5, 5], [0, 0, 0], [1, 0, 2]]),
+            bi(Scene::Box(sheared), &[[1000, -77, 5], [-far, far, -far]]),
+            bi(
+                Scene::Box(limit),
+                &[[far, far, far], [0, 0, 0], [m as i64, 0, 0]],
+            ),
+            bi(Scene::Box(flat), &[[50, 1, 50]]),
+            worst,
+            bi(soup_shared, &[[1, 1, 1], [2, 2, 0], [2, 2, -9]]),
+            bi(fan, &[[0, 0, 0], [9, -9, 9]]),
+            bi(crossing, &[[1, 2, 3], [-far, 0, 0], [0, 0, 0]]),
+            bi(invalid, &[[0, 0, 0]]),
+        ]
+    }
+
+    /// The boxes of the build seeds: a unit cube, a sheared, mirrored and
+    /// moved box, one at the limits of the grid, and a flat one.
+    fn seed_boxes() -> [BoxSolid; 4] {
+        let m = M32;
         let unit = BoxSolid {
             lo: [0, 0, 0],
             hi: [1, 1, 1],
@@ -1882,6 +1975,15 @@ mod tests {
             probes: vec![[50, 0, 50], [50, 1, 50], [50, 2, 50], [1, 1, 1]],
             rational_probes: vec![([100, 1, 100], 2)],
         };
+        [unit, sheared, limit, flat]
+    }
+
+    /// The polygon soups of the build seeds: triangles sharing edges with
+    /// two quads (and a repeated triangle), a fan over six points, three
+    /// planes and a triangle at the limits of the grid, and invalid
+    /// polygons.
+    fn seed_soups() -> [Scene; 4] {
+        let m = M32;
         let tri = |a: GridPoint, b: GridPoint, c: GridPoint| vec![a, b, c];
         let soup_shared = Scene::Soup(vec![
             tri([0, 0, 0], [4, 0, 0], [0, 4, 0]),
@@ -1915,25 +2017,7 @@ mod tests {
             tri([3, 3, 3], [3, 3, 3], [3, 3, 3]),
             vec![[0, 0, 0], [2, 2, 0], [2, 0, 0], [0, 2, 0]],
         ]);
-        let far = MAX_VIEW_COORD;
-        let mut worst = bi(Scene::Box(sheared.clone()), &[[0, 0, 0]]);
-        worst.candidates = 1;
-        worst.sample = 1;
-        worst.split_weight = 0;
-        vec![
-            bi(Scene::Box(unit), &[[5, 5, 5], [0, 0, 0], [1, 0, 2]]),
-            bi(Scene::Box(sheared), &[[1000, -77, 5], [-far, far, -far]]),
-            bi(
-                Scene::Box(limit),
-                &[[far, far, far], [0, 0, 0], [m as i64, 0, 0]],
-            ),
-            bi(Scene::Box(flat), &[[50, 1, 50]]),
-            worst,
-            bi(soup_shared, &[[1, 1, 1], [2, 2, 0], [2, 2, -9]]),
-            bi(fan, &[[0, 0, 0], [9, -9, 9]]),
-            bi(crossing, &[[1, 2, 3], [-far, 0, 0], [0, 0, 0]]),
-            bi(invalid, &[[0, 0, 0]]),
-        ]
+        [soup_shared, fan, crossing, invalid]
     }
 
     /// Raw byte strings for the corpus: empty, constant, and random ones
