@@ -398,55 +398,9 @@ enum Depth {
 /// All the identities of the brief on one pair of operands.
 fn check_pair(a: &Operand, b: &Operand, samples: &[Sample], depth: Depth) -> Seen {
     let full = depth == Depth::Full;
-    // the exact volume of a result, or `want` after checking the mesh when
-    // volumes are skipped
-    let volume_or = |what: &str, p: &Partition<Cell>, want: &Q| {
-        if full {
-            volume(what, p)
-        } else {
-            checked_mesh(what, p);
-            want.clone()
-        }
-    };
     let mut seen = Seen::default();
-    // the oracle's membership of each sample in A and B, which the input
-    // partitions must reproduce
-    let memb: Vec<(Membership, Membership)> = samples
-        .iter()
-        .map(|s| {
-            let (ma, mb) = (a.oracle.classify(s.scaled), b.oracle.classify(s.scaled));
-            assert_eq!(a.part.classify_point(&s.point), ma, "A at {:?}", s.scaled);
-            assert_eq!(b.part.classify_point(&s.point), mb, "B at {:?}", s.scaled);
-            (ma, mb)
-        })
-        .collect();
-
-    // inside(A op B) = op(inside A, inside B) off both boundaries; a result
-    // point is on the boundary only where an input point is
-    let mut results = Vec::new();
-    for op in OPS {
-        let r = a.part.boolean(&b.part, op);
-        let v = volume(&format!("{op:?}"), &r);
-        for (s, &(ma, mb)) in samples.iter().zip(&memb) {
-            let got = r.classify_point(&s.point);
-            if let (Some(x), Some(y)) = (inside(ma), inside(mb)) {
-                let want = if apply(op, x, y) {
-                    Membership::Inside
-                } else {
-                    Membership::Outside
-                };
-                assert_eq!(got, want, "{op:?} at {:?} (scaled)", s.scaled);
-            }
-            if got == Membership::Boundary {
-                assert!(
-                    ma == Membership::Boundary || mb == Membership::Boundary,
-                    "{op:?}: boundary at {:?} (scaled) off both inputs' boundaries",
-                    s.scaled
-                );
-            }
-        }
-        results.push((r, v));
-    }
+    let memb = sample_memberships(a, b, samples);
+    let results = check_operations(a, b, samples, &memb);
     for &(ma, mb) in &memb {
         if ma == Membership::Boundary || mb == Membership::Boundary {
             seen.boundary += 1;
@@ -466,18 +420,102 @@ fn check_pair(a: &Operand, b: &Operand, samples: &[Sample], depth: Depth) -> See
     assert_q(&add(&vd, &vi), &a.volume, "vol(A−B) + vol(A∩B)");
     assert!(sign(&vi) >= 0 && sign(&vd) >= 0);
 
-    // commutativity
-    for (op, r, v) in [(BoolOp::Union, &u, &vu), (BoolOp::Intersection, &i, &vi)] {
+    check_commutes(a, b, samples, full, [(&u, &vu), (&i, &vi)]);
+    check_same_twice(a, samples, full);
+    check_complements(a, b, samples, full, [(&u, &vu), (&i, &vi), (&d, &vd)]);
+    seen.overlay += check_overlay(a, b, samples, &memb);
+    seen
+}
+
+/// The exact volume of a result when `full`, else `want` after checking
+/// the result's mesh.
+fn volume_or(full: bool, what: &str, p: &Partition<Cell>, want: &Q) -> Q {
+    if full {
+        volume(what, p)
+    } else {
+        checked_mesh(what, p);
+        want.clone()
+    }
+}
+
+/// The oracle's membership of each sample in A and B, which the input
+/// partitions must reproduce.
+fn sample_memberships(
+    a: &Operand,
+    b: &Operand,
+    samples: &[Sample],
+) -> Vec<(Membership, Membership)> {
+    samples
+        .iter()
+        .map(|s| {
+            let (ma, mb) = (a.oracle.classify(s.scaled), b.oracle.classify(s.scaled));
+            assert_eq!(a.part.classify_point(&s.point), ma, "A at {:?}", s.scaled);
+            assert_eq!(b.part.classify_point(&s.point), mb, "B at {:?}", s.scaled);
+            (ma, mb)
+        })
+        .collect()
+}
+
+/// `A ∪ B`, `A ∩ B` and `A − B` with their exact volumes, each checked
+/// at the samples (memberships `memb`): inside(A op B) = op(inside A,
+/// inside B) off both boundaries, and a result point is on the boundary
+/// only where an input point is.
+fn check_operations(
+    a: &Operand,
+    b: &Operand,
+    samples: &[Sample],
+    memb: &[(Membership, Membership)],
+) -> Vec<(Partition<Cell>, Q)> {
+    let mut results = Vec::new();
+    for op in OPS {
+        let r = a.part.boolean(&b.part, op);
+        let v = volume(&format!("{op:?}"), &r);
+        for (s, &(ma, mb)) in samples.iter().zip(memb) {
+            let got = r.classify_point(&s.point);
+            if let (Some(x), Some(y)) = (inside(ma), inside(mb)) {
+                let want = if apply(op, x, y) {
+                    Membership::Inside
+                } else {
+                    Membership::Outside
+                };
+                assert_eq!(got, want, "{op:?} at {:?} (scaled)", s.scaled);
+            }
+            if got == Membership::Boundary {
+                assert!(
+                    ma == Membership::Boundary || mb == Membership::Boundary,
+                    "{op:?}: boundary at {:?} (scaled) off both inputs' boundaries",
+                    s.scaled
+                );
+            }
+        }
+        results.push((r, v));
+    }
+    results
+}
+
+/// Commutativity: `B ∪ A` and `B ∩ A` against `A ∪ B` and `A ∩ B`
+/// (`results`, with their volumes).
+fn check_commutes(
+    a: &Operand,
+    b: &Operand,
+    samples: &[Sample],
+    full: bool,
+    [(u, vu), (i, vi)]: [(&Partition<Cell>, &Q); 2],
+) {
+    for (op, r, v) in [(BoolOp::Union, u, vu), (BoolOp::Intersection, i, vi)] {
         let c = b.part.boolean(&a.part, op);
         assert_q(
-            &volume_or(&format!("B {op:?} A"), &c, v),
+            &volume_or(full, &format!("B {op:?} A"), &c, v),
             v,
             &format!("{op:?} commutes"),
         );
         same_membership(&format!("{op:?} commutes"), r, &c, samples);
     }
+}
 
-    // the same solid twice
+/// The same solid twice: `A − A` is a single Out cell, `A ∪ A` and
+/// `A ∩ A` are `A`.
+fn check_same_twice(a: &Operand, samples: &[Sample], full: bool) {
     let empty = a.part.boolean(&a.part, BoolOp::Difference);
     assert!(
         matches!(empty.root(), PLink::Leaf(Cell::Out)),
@@ -487,14 +525,23 @@ fn check_pair(a: &Operand, b: &Operand, samples: &[Sample], depth: Depth) -> See
     for op in [BoolOp::Union, BoolOp::Intersection] {
         let r = a.part.boolean(&a.part, op);
         assert_q(
-            &volume_or(&format!("A {op:?} A"), &r, &a.volume),
+            &volume_or(full, &format!("A {op:?} A"), &r, &a.volume),
             &a.volume,
             &format!("A {op:?} A"),
         );
         same_membership(&format!("A {op:?} A = A"), &r, &a.part, samples);
     }
+}
 
-    // De Morgan through the complement, and A − B = A ∩ ¬B
+/// De Morgan through the complement, and `A − B = A ∩ ¬B`, against
+/// `A ∪ B`, `A ∩ B` and `A − B` (`results`, with their volumes).
+fn check_complements(
+    a: &Operand,
+    b: &Operand,
+    samples: &[Sample],
+    full: bool,
+    [(u, vu), (i, vi), (d, vd)]: [(&Partition<Cell>, &Q); 3],
+) {
     let (na, nb) = (a.part.complement(), b.part.complement());
     check_unbounded("¬A", &na, &-a.volume.clone(), full);
     let nu = u.complement();
@@ -508,11 +555,19 @@ fn check_pair(a: &Operand, b: &Operand, samples: &[Sample], depth: Depth) -> See
         check_unbounded("¬A∪¬B", &na_or_nb, &-vi.clone(), full);
     }
     let a_nb = a.part.boolean(&nb, BoolOp::Intersection);
-    same_membership("A−B = A∩¬B", &d, &a_nb, samples);
-    assert_q(&volume_or("A∩¬B", &a_nb, &vd), &vd, "vol(A∩¬B)");
+    same_membership("A−B = A∩¬B", d, &a_nb, samples);
+    assert_q(&volume_or(full, "A∩¬B", &a_nb, vd), vd, "vol(A∩¬B)");
+}
 
-    // the overlay: a point off every plane of either partition lies in
-    // exactly one cell, labelled with its membership in A and in B
+/// The overlay: a sample (memberships `memb`) off every plane of either
+/// partition lies in exactly one cell, labelled with its membership in A
+/// and in B. Returns how many samples were off every plane.
+fn check_overlay(
+    a: &Operand,
+    b: &Operand,
+    samples: &[Sample],
+    memb: &[(Membership, Membership)],
+) -> usize {
     let o = merge_smaller_into_larger(&a.part, &b.part, &Overlay);
     o.sanity_check()
         .unwrap_or_else(|e| panic!("overlay: sanity_check: {e}"));
@@ -523,7 +578,8 @@ fn check_pair(a: &Operand, b: &Operand, samples: &[Sample], depth: Depth) -> See
         .chain(b.part.nodes())
         .map(|n| n.plane)
         .collect();
-    for (s, &(ma, mb)) in samples.iter().zip(&memb) {
+    let mut checked = 0;
+    for (s, &(ma, mb)) in samples.iter().zip(memb) {
         if planes.iter().any(|p| s.point.classify(p) == Side::On) {
             continue;
         }
@@ -534,9 +590,9 @@ fn check_pair(a: &Operand, b: &Operand, samples: &[Sample], depth: Depth) -> See
             "overlay at {:?} (scaled)",
             s.scaled
         );
-        seen.overlay += 1;
+        checked += 1;
     }
-    seen
+    checked
 }
 
 /// Samples for a pair of shapes, in the oracle's frame scaled by `unit`:
