@@ -74,7 +74,7 @@ impl From<VolumeError> for ShadowError {
     }
 }
 
-/// Options of [`Shadows::shade`].
+/// Options of [`ShadowSet::shade`].
 #[derive(Clone, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub struct ShadeOptions {
@@ -331,7 +331,7 @@ impl<'a> ShadowSet<'a> {
     /// nothing when every cell comes back whole with its flags
     /// ([`Refined::Unchanged`]); from [`Start::Cells`], only the cells the
     /// trees cut or shadow are filtered, the cached merge is redone only
-    /// where they are ([`MergeCache::remerge`]), and the receiver's other
+    /// where they are (`MergeCache::remerge`), and the receiver's other
     /// starting fragments stand ([`Refined::Some`]). The receiver's
     /// fragments are then those [`ShadowSet::refine`] makes (the same
     /// regions, perhaps in another order).
@@ -584,10 +584,10 @@ impl<'a> ShadowSet<'a> {
     }
 }
 
-/// Receivers per parallel task in [`Shadows::shade_all`].
+/// Receivers per parallel task in [`ShadowSet::shade_all`].
 pub const CHUNK: usize = 512;
 
-/// Work space of [`Shadows::shade`], reused from receiver to receiver so
+/// Work space of [`ShadowSet::shade`], reused from receiver to receiver so
 /// that shading allocates nothing once warm.
 #[derive(Default)]
 pub struct Scratch {
@@ -609,7 +609,7 @@ pub struct Scratch {
 }
 
 /// A receiver's convex cells with their flags (bit `j`: lit by light
-/// `j`), in their own arena: where [`Shadows::refine`] can start.
+/// `j`), in their own arena: where [`ShadowSet::refine`] can start.
 #[derive(Clone, Debug)]
 pub struct Cells {
     arena: PieceArena,
@@ -620,7 +620,7 @@ pub struct Cells {
     merge: MergeCache,
 }
 
-/// What [`Shadows::refine_cells`] did.
+/// What [`ShadowSet::refine_cells`] did.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Refined {
     /// Nothing changed and nothing was appended: the receiver's
@@ -638,7 +638,7 @@ impl Cells {
     /// Per cell, a box of grid points that holds it: the floor and ceiling
     /// of its vertices' correctly rounded coordinates widened by one step
     /// (a rounded coordinate is within half a step of the exact one), for
-    /// culling tests such as [`Shadows::refine_cells`]'s.
+    /// culling tests such as [`ShadowSet::refine_cells`]'s.
     pub fn bounds(&self) -> Vec<([i32; 3], [i32; 3])> {
         self.cells
             .iter()
@@ -676,12 +676,12 @@ impl Cells {
     }
 }
 
-/// Where [`Shadows::refine`] starts a receiver from.
+/// Where [`ShadowSet::refine`] starts a receiver from.
 #[derive(Clone, Copy, Debug)]
 pub enum Start<'a> {
     /// The receiver's polygons, all with these flags.
     Uniform(u64),
-    /// Cells kept by [`Shadows::shade_keeping`].
+    /// Cells kept by [`ShadowSet::shade_keeping`].
     Cells(&'a Cells),
 }
 
@@ -840,7 +840,7 @@ impl<'a> FragmentRef<'a> {
         self.batch.face[self.index]
     }
 
-    /// The receiver it was shaded as (see [`Shadows::shade`]).
+    /// The receiver it was shaded as (see [`ShadowSet::shade`]).
     pub fn receiver(&self) -> u32 {
         self.batch.receiver[self.index]
     }

@@ -25,7 +25,7 @@ use {
     bsp_core::internals::{ConvexParts, check_convex},
 };
 
-/// A vertex stored inline in a [`PieceArena`].
+/// A vertex of a piece, stored inline in the arena of pieces.
 #[derive(Clone, Debug)]
 pub enum Vertex {
     /// An input grid point.
