@@ -313,7 +313,30 @@ fn trace(
     skip: impl Fn(u32) -> bool,
 ) -> Vec<PRegion> {
     let n = labels.len();
-    // boundary pieces, each with its region on the left
+    let segs = boundary_pieces(lines, labels, uf, skip);
+    let loops = chain_loops(lines, &segs, f.sigma);
+    let (mut regions, by_region) = outline_regions(&segs, &loops, labels, points, f);
+    // the cells of each region, and regions in the order of their first cell
+    for ci in 0..n as u32 {
+        let root = uf.find(ci);
+        if let Some(&ri) = by_region.get(&root) {
+            regions[ri].cells.push(ci);
+        }
+    }
+    regions.sort_by_key(|r| r.cells.first().copied().unwrap_or(u32::MAX));
+    regions
+}
+
+/// The boundary pieces of the regions (the intervals of `lines` between
+/// cells of different labels, or with a cell on one side only), each
+/// directed with its region on the left; none of the regions whose root
+/// `skip` names.
+fn boundary_pieces(
+    lines: &[&MLine],
+    labels: &[u64],
+    uf: &mut UnionFind,
+    skip: impl Fn(u32) -> bool,
+) -> Vec<Seg> {
     let mut segs: Vec<Seg> = Vec::new();
     for (li, line) in lines.iter().enumerate() {
         for (i, &(l, r)) in line.iv.iter().enumerate() {
@@ -348,12 +371,17 @@ fn trace(
             }
         }
     }
+    segs
+}
+
+/// The boundary pieces `segs` chained into closed loops, each with its
+/// region: where a region touches itself at a vertex, a loop turns to
+/// the first outgoing piece clockwise (`sigma` as in [`Frame`]).
+fn chain_loops(lines: &[&MLine], segs: &[Seg], sigma: i32) -> Vec<(u32, Vec<u32>)> {
     let dir_of = |s: &Seg| {
         let d = lines[s.line as usize].dir;
         if s.forward { d } else { [-d[0], -d[1]] }
     };
-
-    // chain the pieces into loops
     let mut outgoing: FxHashMap<(u32, u32), SmallVec<[u32; 2]>> = FxHashMap::default();
     for (i, s) in segs.iter().enumerate() {
         outgoing
@@ -387,7 +415,7 @@ fn trace(
                             r,
                             dir_of(&segs[a as usize]),
                             dir_of(&segs[b as usize]),
-                            f.sigma,
+                            sigma,
                         )
                     })
                     .expect("a boundary piece continues")
@@ -402,12 +430,23 @@ fn trace(
         }
         loops.push((region, path));
     }
+    loops
+}
 
-    // corners only, then outer loop and holes per region
+/// The regions of `loops` (in the order of their first loop), each with
+/// its label, its outer loop and its holes, corners only (no cells yet);
+/// and each region's index by its root.
+fn outline_regions(
+    segs: &[Seg],
+    loops: &[(u32, Vec<u32>)],
+    labels: &[u64],
+    points: &Points<'_>,
+    f: Frame,
+) -> (Vec<PRegion>, FxHashMap<u32, usize>) {
     let mut by_region: FxHashMap<u32, usize> = FxHashMap::default();
     let mut regions: Vec<PRegion> = Vec::new();
     let mut loop_lists: Vec<Vec<Vec<u32>>> = Vec::new();
-    for (region, path) in &loops {
+    for (region, path) in loops {
         let m = path.len();
         let corners: Vec<u32> = (0..m)
             .filter(|&i| segs[path[(i + m - 1) % m] as usize].line != segs[path[i] as usize].line)
@@ -437,15 +476,7 @@ fn trace(
             }
         }
     }
-    // the cells of each region, and regions in the order of their first cell
-    for ci in 0..n as u32 {
-        let root = uf.find(ci);
-        if let Some(&ri) = by_region.get(&root) {
-            regions[ri].cells.push(ci);
-        }
-    }
-    regions.sort_by_key(|r| r.cells.first().copied().unwrap_or(u32::MAX));
-    regions
+    (regions, by_region)
 }
 
 /// The points, lines and per-cell indices of `cells`.
@@ -729,100 +760,17 @@ impl MergeCache {
             extra: Vec::new(),
             extra_bits: FxHashMap::default(),
         };
-        let mut labels = self.labels.clone();
-        let mut changed = vec![false; n];
-        for &(c, l) in relabel {
-            labels[c as usize] = l;
-            changed[c as usize] = true;
-        }
-        let mut gone = vec![false; n];
-        for &c in removed {
-            gone[c as usize] = true;
-            changed[c as usize] = true;
-        }
-        labels.extend_from_slice(piece_labels);
+        let (labels, changed, gone) = self.changed_cells(removed, relabel, piece_labels);
         // the new pieces' points and lines
         let piece_points = add_points(&mut points, arena, pieces);
-        // touched lines: copies of the cached ones, and new ones
-        let mut touched: FxHashMap<u32, MLine> = FxHashMap::default();
-        let mut fresh: Vec<MLine> = Vec::new();
-        let mut fresh_of: FxHashMap<LineKey, u32> = FxHashMap::default();
-        for &c in removed {
-            for &l in &self.cell_lines[c as usize] {
-                touched.entry(l).or_insert_with(|| {
-                    let mut line = self.lines[l as usize].clone();
-                    line.edges.retain(|e| !gone[e.0 as usize]);
-                    line
-                });
-            }
-        }
-        let nl = self.lines.len() as u32;
-        let mut keys = FxHashMap::default();
-        for (k, (c, pts)) in pieces.iter().zip(&piece_points).enumerate() {
-            let m = pts.len();
-            for j in 0..m {
-                let (a, b) = (pts[j], pts[(j + 1) % m]);
-                let key = line_key_cached(&mut keys, &self.support, arena, c.edges[j]);
-                let line = match self.line_of.get(&key) {
-                    Some(&l) => touched.entry(l).or_insert_with(|| {
-                        let mut line = self.lines[l as usize].clone();
-                        line.edges.retain(|e| !gone[e.0 as usize]);
-                        line
-                    }),
-                    None => {
-                        let i = *fresh_of.entry(key).or_insert_with(|| {
-                            fresh.push(new_line(&key, &f));
-                            nl + fresh.len() as u32 - 1
-                        });
-                        &mut fresh[(i - nl) as usize]
-                    }
-                };
-                if a != b {
-                    line.edges.push(((n + k) as u32, a, b));
-                }
-            }
-        }
-        for line in touched.values_mut().chain(fresh.iter_mut()) {
-            settle(line, &points);
-        }
+        let (touched, fresh) =
+            self.touched_lines(removed, &gone, arena, pieces, &piece_points, &points);
         let mut all: Vec<&MLine> = Vec::with_capacity(self.lines.len() + fresh.len());
         for (i, line) in self.lines.iter().enumerate() {
             all.push(touched.get(&(i as u32)).unwrap_or(line));
         }
         all.extend(fresh.iter());
-        // a cached region stands when none of its cells changed and its
-        // cells make up a whole new region (nothing joined it)
-        let regions = self.region_size.len();
-        let mut intact = vec![true; regions];
-        for c in 0..n {
-            if changed[c] {
-                intact[self.region_of[c] as usize] = false;
-            }
-        }
-        let mut uf = unite(&all, &labels, None);
-        let mut size = vec![0u32; labels.len()];
-        for c in 0..labels.len() as u32 {
-            if (c as usize) < n && gone[c as usize] {
-                continue;
-            }
-            size[uf.find(c) as usize] += 1;
-        }
-        let mut standing_root = vec![false; labels.len()];
-        let mut standing = Vec::new();
-        let mut first = vec![u32::MAX; regions];
-        for c in (0..n).rev() {
-            first[self.region_of[c] as usize] = c as u32;
-        }
-        for r in 0..regions {
-            if !intact[r] {
-                continue;
-            }
-            let root = uf.find(first[r]);
-            if size[root as usize] == self.region_size[r] {
-                standing_root[root as usize] = true;
-                standing.push(r as u32);
-            }
-        }
+        let (mut uf, standing_root, standing) = self.unite_standing(&all, &labels, &changed, &gone);
         let traced = trace(&all, &labels, &points, f, &mut uf, |root| {
             standing_root[root as usize]
         });
@@ -851,6 +799,141 @@ impl MergeCache {
             regions,
             standing,
         }
+    }
+
+    /// The labels after a change (the cached cells', with `relabel`
+    /// applied, then `piece_labels`), and per cached cell whether it
+    /// changed (relabelled or removed) and whether it is `removed`.
+    fn changed_cells(
+        &self,
+        removed: &[u32],
+        relabel: &[(u32, u64)],
+        piece_labels: &[u64],
+    ) -> (Vec<u64>, Vec<bool>, Vec<bool>) {
+        let n = self.cell_points.len();
+        let mut labels = self.labels.clone();
+        let mut changed = vec![false; n];
+        for &(c, l) in relabel {
+            labels[c as usize] = l;
+            changed[c as usize] = true;
+        }
+        let mut gone = vec![false; n];
+        for &c in removed {
+            gone[c as usize] = true;
+            changed[c as usize] = true;
+        }
+        labels.extend_from_slice(piece_labels);
+        (labels, changed, gone)
+    }
+
+    /// The lines a change touches, settled on `points`: copies of the
+    /// cached lines that the `removed` cells or the new `pieces` (with
+    /// points `piece_points`) lie on, without the removed cells' edges and
+    /// with the pieces', by cached line; and the new lines only pieces lie
+    /// on, numbered after the cached ones.
+    fn touched_lines(
+        &self,
+        removed: &[u32],
+        gone: &[bool],
+        arena: &PieceArena,
+        pieces: &[Piece],
+        piece_points: &[SmallVec<[u32; 6]>],
+        points: &Points<'_>,
+    ) -> (FxHashMap<u32, MLine>, Vec<MLine>) {
+        let n = self.cell_points.len();
+        let f = self.frame;
+        // touched lines: copies of the cached ones, and new ones
+        let mut touched: FxHashMap<u32, MLine> = FxHashMap::default();
+        let mut fresh: Vec<MLine> = Vec::new();
+        let mut fresh_of: FxHashMap<LineKey, u32> = FxHashMap::default();
+        for &c in removed {
+            for &l in &self.cell_lines[c as usize] {
+                touched.entry(l).or_insert_with(|| {
+                    let mut line = self.lines[l as usize].clone();
+                    line.edges.retain(|e| !gone[e.0 as usize]);
+                    line
+                });
+            }
+        }
+        let nl = self.lines.len() as u32;
+        let mut keys = FxHashMap::default();
+        for (k, (c, pts)) in pieces.iter().zip(piece_points).enumerate() {
+            let m = pts.len();
+            for j in 0..m {
+                let (a, b) = (pts[j], pts[(j + 1) % m]);
+                let key = line_key_cached(&mut keys, &self.support, arena, c.edges[j]);
+                let line = match self.line_of.get(&key) {
+                    Some(&l) => touched.entry(l).or_insert_with(|| {
+                        let mut line = self.lines[l as usize].clone();
+                        line.edges.retain(|e| !gone[e.0 as usize]);
+                        line
+                    }),
+                    None => {
+                        let i = *fresh_of.entry(key).or_insert_with(|| {
+                            fresh.push(new_line(&key, &f));
+                            nl + fresh.len() as u32 - 1
+                        });
+                        &mut fresh[(i - nl) as usize]
+                    }
+                };
+                if a != b {
+                    line.edges.push(((n + k) as u32, a, b));
+                }
+            }
+        }
+        for line in touched.values_mut().chain(fresh.iter_mut()) {
+            settle(line, points);
+        }
+        (touched, fresh)
+    }
+
+    /// The union-find of the changed cells (`labels`, on `all` lines),
+    /// and the cached regions that stand: none of their cells changed and
+    /// their cells make up a whole new region (nothing joined it). Returns
+    /// the union-find, per root whether its region stands, and the
+    /// standing regions (ascending).
+    fn unite_standing(
+        &self,
+        all: &[&MLine],
+        labels: &[u64],
+        changed: &[bool],
+        gone: &[bool],
+    ) -> (UnionFind, Vec<bool>, Vec<u32>) {
+        let n = self.cell_points.len();
+        // a cached region stands when none of its cells changed and its
+        // cells make up a whole new region (nothing joined it)
+        let regions = self.region_size.len();
+        let mut intact = vec![true; regions];
+        for c in 0..n {
+            if changed[c] {
+                intact[self.region_of[c] as usize] = false;
+            }
+        }
+        let mut uf = unite(all, labels, None);
+        let mut size = vec![0u32; labels.len()];
+        for c in 0..labels.len() as u32 {
+            if (c as usize) < n && gone[c as usize] {
+                continue;
+            }
+            size[uf.find(c) as usize] += 1;
+        }
+        let mut standing_root = vec![false; labels.len()];
+        let mut standing = Vec::new();
+        let mut first = vec![u32::MAX; regions];
+        for c in (0..n).rev() {
+            first[self.region_of[c] as usize] = c as u32;
+        }
+        for r in 0..regions {
+            if !intact[r] {
+                continue;
+            }
+            let root = uf.find(first[r]);
+            if size[root as usize] == self.region_size[r] {
+                standing_root[root as usize] = true;
+                standing.push(r as u32);
+            }
+        }
+        (uf, standing_root, standing)
     }
 }
 
