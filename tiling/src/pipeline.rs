@@ -187,26 +187,32 @@ pub struct Prepared {
 /// Per-strategy static data (one per scene: its size does not matter).
 #[allow(clippy::large_enum_variant)]
 enum StaticShadows {
-    Fast {
-        /// The static scene's shadow trees.
-        shadows: Shadows,
-        batch: Batch,
-        /// Per static receiver, its fragments in `batch`.
-        frags: Vec<Range<usize>>,
-        /// Per static receiver, its cells when its flags vary.
-        cells: Vec<Option<Box<Cells>>>,
-        /// Per static receiver with cells, per light, per cell: the tiles
-        /// of the cell's box (a frame leaves a cell alone when its box
-        /// meets none of the tiles of the moved object's box).
-        footprints: FxHashMap<u32, Vec<Vec<Vec<u32>>>>,
-    },
-    Paper {
-        cf: CfFragments,
-        /// Per static face, its fragments in `cf`.
-        of_face: Vec<Vec<u32>>,
-        /// `Bsp2`, built on the object as given.
-        bsp2: BspTree,
-    },
+    Fast(FastStatics),
+    Paper(PaperStatics),
+}
+
+/// The fast strategy's static data.
+struct FastStatics {
+    /// The static scene's shadow trees.
+    shadows: Shadows,
+    batch: Batch,
+    /// Per static receiver, its fragments in `batch`.
+    frags: Vec<Range<usize>>,
+    /// Per static receiver, its cells when its flags vary.
+    cells: Vec<Option<Box<Cells>>>,
+    /// Per static receiver with cells, per light, per cell: the tiles
+    /// of the cell's box (a frame leaves a cell alone when its box
+    /// meets none of the tiles of the moved object's box).
+    footprints: FxHashMap<u32, Vec<Vec<Vec<u32>>>>,
+}
+
+/// The paper's strategy's static data.
+struct PaperStatics {
+    cf: CfFragments,
+    /// Per static face, its fragments in `cf`.
+    of_face: Vec<Vec<u32>>,
+    /// `Bsp2`, built on the object as given.
+    bsp2: BspTree,
 }
 
 /// A static scene prepared once, and a moving object (see the module
@@ -335,6 +341,164 @@ fn grid_points(polys: &[Polygon]) -> impl Iterator<Item = GridPoint> + '_ {
         .filter_map(Point::as_grid)
 }
 
+/// Per static polygon, the receiver whose polygons `ranges` it is in.
+fn receiver_index(ranges: &[Range<usize>], polygons: usize) -> Vec<u32> {
+    let mut receiver_of = vec![0u32; polygons];
+    for (i, r) in ranges.iter().enumerate() {
+        receiver_of[r.clone()]
+            .iter_mut()
+            .for_each(|x| *x = i as u32);
+    }
+    receiver_of
+}
+
+/// Per face of `faces`, the range of its polygons in `polys` (a face's
+/// polygons are consecutive).
+fn face_ranges(polys: &[Polygon], faces: usize) -> Vec<Range<usize>> {
+    let mut face_polys = vec![0..0; faces];
+    for (i, p) in polys.iter().enumerate() {
+        let r = &mut face_polys[p.tag() as usize];
+        if r.start == r.end {
+            *r = i..i + 1;
+        } else {
+            r.end = i + 1;
+        }
+    }
+    face_polys
+}
+
+impl FastStatics {
+    /// The static shadows of `polys` (receivers `ranges`) for `lights`:
+    /// every receiver shaded once, keeping the cells of those whose flags
+    /// vary. The footprints are left empty ([`FastStatics::add_footprints`]
+    /// fills them once the tilings exist).
+    fn new(
+        polys: &[Polygon],
+        ranges: &[Range<usize>],
+        lights: &[Light],
+        opts: &PipelineOptions,
+        prepared: &mut Prepared,
+    ) -> Result<FastStatics, PipelineError> {
+        let sh = Shadows::new(polys, lights).map_err(PipelineError::Shadow)?;
+        let sopts = ShadeOptions::default().with_pieces(opts.pieces);
+        let parts: Vec<(Batch, Vec<Option<Box<Cells>>>)> = ranges
+            .par_chunks(CHUNK)
+            .enumerate()
+            .map(|(c, chunk)| {
+                let (mut s, mut b) = (Scratch::default(), Batch::new());
+                let cells = chunk
+                    .iter()
+                    .enumerate()
+                    .map(|(i, r)| {
+                        let rec = (c * CHUNK + i) as u32;
+                        sh.set()
+                            .shade_keeping(&polys[r.clone()], rec, &sopts, &mut s, &mut b)
+                            .map(Box::new)
+                    })
+                    .collect();
+                (b, cells)
+            })
+            .collect();
+        let mut batch = Batch::new();
+        let mut cells = Vec::with_capacity(ranges.len());
+        for (b, c) in parts {
+            batch.append(&b);
+            cells.extend(c);
+        }
+        let mut frags = vec![0..0; ranges.len()];
+        for (r, range) in batch.receiver_ranges() {
+            frags[r as usize] = range;
+        }
+        prepared.static_after_bsp = polys.len();
+        prepared.static_after_shadow = batch.len();
+        Ok(FastStatics {
+            shadows: sh,
+            batch,
+            frags,
+            cells,
+            footprints: FxHashMap::default(),
+        })
+    }
+
+    /// Records the tiles of every kept cell's box, per light of
+    /// `tilings`.
+    fn add_footprints(&mut self, tilings: &[TileIndex]) {
+        let kept: Vec<(u32, &Cells)> = self
+            .cells
+            .iter()
+            .enumerate()
+            .filter_map(|(r, c)| c.as_deref().map(|c| (r as u32, c)))
+            .collect();
+        let prints: Vec<(u32, Vec<Vec<Vec<u32>>>)> = kept
+            .par_iter()
+            .map(|&(r, c)| {
+                let bounds = c.bounds();
+                let mut q = Query::default();
+                let per_light = tilings
+                    .iter()
+                    .map(|ix| {
+                        bounds
+                            .iter()
+                            .map(|&(lo, hi)| {
+                                let mut t = Vec::new();
+                                if !ix.box_tiles(lo, hi, &mut q, &mut t) {
+                                    t = vec![u32::MAX]; // every tile
+                                }
+                                t
+                            })
+                            .collect()
+                    })
+                    .collect();
+                (r, per_light)
+            })
+            .collect();
+        self.footprints.extend(prints);
+    }
+}
+
+impl PaperStatics {
+    /// `Bsp1` of `polys` and its Chin & Feiner shadows for `lights`, and
+    /// `Bsp2` of `moving` (tagged after the `faces` static faces) as given.
+    fn new(
+        grid: &Grid,
+        polys: &[Polygon],
+        faces: usize,
+        moving: &[Vec<DVec3>],
+        lights: &[Light],
+        prepared: &mut Prepared,
+    ) -> Result<PaperStatics, PipelineError> {
+        let bsp1 = BspTree::build(polys.to_vec(), &BuildOptions::default());
+        let cf = chin_feiner(&bsp1, lights).map_err(|e| PipelineError::Shadow(e.into()))?;
+        let mut of_face = vec![Vec::new(); faces];
+        for (i, f) in cf.iter().enumerate() {
+            of_face[f.face() as usize].push(i as u32);
+        }
+        prepared.static_after_bsp = bsp1.stats().polygons;
+        prepared.static_after_shadow = cf.len();
+        let first = Dynamic::snap_moving(grid, moving, &DMat4::IDENTITY, faces)?;
+        let bsp2 = BspTree::build(first, &BuildOptions::default());
+        Ok(PaperStatics { cf, of_face, bsp2 })
+    }
+}
+
+/// What a frame's tiling queries find: the moved object's box, and per
+/// light the related static polygons and the tiles of the box.
+struct Related {
+    /// The moved object's box on the grid.
+    lo: GridPoint,
+    hi: GridPoint,
+    /// Per light, the related static polygons.
+    polygons: Vec<Vec<u32>>,
+    /// Per light, the tiles of the moved object's box (`None`: every
+    /// tile).
+    box_tiles: Vec<Option<Vec<u32>>>,
+}
+
+/// A chunk of refined related receivers: its fragments, and per receiver
+/// the range of its new fragments and the static fragments it keeps
+/// (`None`: all replaced).
+type RefinedChunk = (Batch, Vec<(u32, Range<usize>, Option<Vec<u32>>)>);
+
 impl Dynamic {
     /// Prepares `statics` (face loops in input units) on `grid` for
     /// `lights`, and keeps `moving` (the object's face loops in input
@@ -356,77 +520,25 @@ impl Dynamic {
         prepared.static_polygons = polys.len();
         prepared.t_import = t.elapsed();
         let ranges = receivers(&polys);
-        let mut receiver_of = vec![0u32; polys.len()];
-        for (i, r) in ranges.iter().enumerate() {
-            receiver_of[r.clone()]
-                .iter_mut()
-                .for_each(|x| *x = i as u32);
-        }
-        let mut face_polys = vec![0..0; statics.len()];
-        for (i, p) in polys.iter().enumerate() {
-            let r = &mut face_polys[p.tag() as usize];
-            if r.start == r.end {
-                *r = i..i + 1;
-            } else {
-                r.end = i + 1;
-            }
-        }
+        let receiver_of = receiver_index(&ranges, polys.len());
+        let face_polys = face_ranges(&polys, statics.len());
         let t = Instant::now();
         let shadows = match opts.strategy {
-            Strategy::Fast => {
-                let sh = Shadows::new(&polys, lights).map_err(PipelineError::Shadow)?;
-                let sopts = ShadeOptions::default().with_pieces(opts.pieces);
-                let parts: Vec<(Batch, Vec<Option<Box<Cells>>>)> = ranges
-                    .par_chunks(CHUNK)
-                    .enumerate()
-                    .map(|(c, chunk)| {
-                        let (mut s, mut b) = (Scratch::default(), Batch::new());
-                        let cells = chunk
-                            .iter()
-                            .enumerate()
-                            .map(|(i, r)| {
-                                let rec = (c * CHUNK + i) as u32;
-                                sh.set()
-                                    .shade_keeping(&polys[r.clone()], rec, &sopts, &mut s, &mut b)
-                                    .map(Box::new)
-                            })
-                            .collect();
-                        (b, cells)
-                    })
-                    .collect();
-                let mut batch = Batch::new();
-                let mut cells = Vec::with_capacity(ranges.len());
-                for (b, c) in parts {
-                    batch.append(&b);
-                    cells.extend(c);
-                }
-                let mut frags = vec![0..0; ranges.len()];
-                for (r, range) in batch.receiver_ranges() {
-                    frags[r as usize] = range;
-                }
-                prepared.static_after_bsp = polys.len();
-                prepared.static_after_shadow = batch.len();
-                StaticShadows::Fast {
-                    shadows: sh,
-                    batch,
-                    frags,
-                    cells,
-                    footprints: FxHashMap::default(),
-                }
-            }
-            Strategy::Paper => {
-                let bsp1 = BspTree::build(polys.clone(), &BuildOptions::default());
-                let cf = chin_feiner(&bsp1, lights).map_err(|e| PipelineError::Shadow(e.into()))?;
-                let mut of_face = vec![Vec::new(); statics.len()];
-                for (i, f) in cf.iter().enumerate() {
-                    of_face[f.face() as usize].push(i as u32);
-                }
-                prepared.static_after_bsp = bsp1.stats().polygons;
-                prepared.static_after_shadow = cf.len();
-                let first = Self::snap_moving(&grid, moving, &DMat4::IDENTITY, statics.len())?;
-                let bsp2 = BspTree::build(first, &BuildOptions::default());
-                StaticShadows::Paper { cf, of_face, bsp2 }
-            }
+            Strategy::Fast => StaticShadows::Fast(FastStatics::new(
+                &polys,
+                &ranges,
+                lights,
+                &opts,
+                &mut prepared,
+            )?),
+            Strategy::Paper => StaticShadows::Paper(PaperStatics::new(
+                &grid,
+                &polys,
+                statics.len(),
+                moving,
+                lights,
+                &mut prepared,
+            )?),
         };
         prepared.t_shadows = t.elapsed();
         let t = Instant::now();
@@ -437,39 +549,8 @@ impl Dynamic {
             .map_err(PipelineError::Tiling)?;
         // the tiles of every kept cell's box, per light
         let mut shadows = shadows;
-        if let StaticShadows::Fast {
-            cells, footprints, ..
-        } = &mut shadows
-        {
-            let kept: Vec<(u32, &Cells)> = cells
-                .iter()
-                .enumerate()
-                .filter_map(|(r, c)| c.as_deref().map(|c| (r as u32, c)))
-                .collect();
-            let prints: Vec<(u32, Vec<Vec<Vec<u32>>>)> = kept
-                .par_iter()
-                .map(|&(r, c)| {
-                    let bounds = c.bounds();
-                    let mut q = Query::default();
-                    let per_light = tilings
-                        .iter()
-                        .map(|ix| {
-                            bounds
-                                .iter()
-                                .map(|&(lo, hi)| {
-                                    let mut t = Vec::new();
-                                    if !ix.box_tiles(lo, hi, &mut q, &mut t) {
-                                        t = vec![u32::MAX]; // every tile
-                                    }
-                                    t
-                                })
-                                .collect()
-                        })
-                        .collect();
-                    (r, per_light)
-                })
-                .collect();
-            footprints.extend(prints);
+        if let StaticShadows::Fast(fast) = &mut shadows {
+            fast.add_footprints(&tilings);
         }
         prepared.t_tiling = t.elapsed();
         Ok(Dynamic {
@@ -565,9 +646,39 @@ impl Dynamic {
         };
         // the related static polygons, per light
         let t = Instant::now();
+        let related = self.related(&moved);
+        let mut all: Vec<u32> = related.polygons.iter().flatten().copied().collect();
+        all.sort_unstable();
+        all.dedup();
+        stats.related = all.len();
+        let mut related_faces: Vec<u32> = all
+            .iter()
+            .map(|&p| self.statics[p as usize].tag())
+            .collect();
+        related_faces.dedup();
+        stats.t_tiling = t.elapsed();
+
+        let fragments = match &self.shadows {
+            StaticShadows::Fast(fast) => self.frame_fast(fast, &moved, &related, &mut stats)?,
+            StaticShadows::Paper(paper) => {
+                self.frame_paper(paper, &moved, &related_faces, &mut stats)?
+            }
+        };
+        stats.t_frame = start.elapsed();
+        Ok(Frame {
+            moved,
+            related_faces,
+            fragments,
+            stats,
+        })
+    }
+
+    /// The moved object's box, and each light's tiling queried with it
+    /// (see [`Related`]).
+    fn related(&self, moved: &[Polygon]) -> Related {
         let mut lo = [i32::MAX; 3];
         let mut hi = [i32::MIN; 3];
-        for g in grid_points(&moved) {
+        for g in grid_points(moved) {
             for k in 0..3 {
                 lo[k] = lo[k].min(g[k]);
                 hi[k] = hi[k].max(g[k]);
@@ -575,7 +686,7 @@ impl Dynamic {
         }
         // per light: the related static polygons, and the tiles of the
         // moved object's box (`None`: every tile)
-        let (related, box_tiles): (Vec<Vec<u32>>, Vec<Option<Vec<u32>>>) = if moved.is_empty() {
+        let (polygons, box_tiles): (Vec<Vec<u32>>, Vec<Option<Vec<u32>>>) = if moved.is_empty() {
             (
                 vec![Vec::new(); self.lights.len()],
                 vec![Some(Vec::new()); self.lights.len()],
@@ -591,232 +702,277 @@ impl Dynamic {
                 })
                 .unzip()
         };
-        let mut all: Vec<u32> = related.iter().flatten().copied().collect();
-        all.sort_unstable();
-        all.dedup();
-        stats.related = all.len();
-        let mut related_faces: Vec<u32> = all
-            .iter()
-            .map(|&p| self.statics[p as usize].tag())
-            .collect();
-        related_faces.dedup();
-        stats.t_tiling = t.elapsed();
+        Related {
+            lo,
+            hi,
+            polygons,
+            box_tiles,
+        }
+    }
 
-        let fragments = match &self.shadows {
-            StaticShadows::Fast {
-                shadows: statics,
-                batch,
-                frags,
-                cells,
-                footprints,
-            } => {
-                let t = Instant::now();
-                // per light, the related static polygons that may block
-                // light on its way to the object: a polygon whose plane has
-                // the object's whole box on the light's side only receives
-                // its shadow
-                let blockers: Vec<Vec<&Polygon>> = self
-                    .lights
-                    .iter()
-                    .zip(&related)
-                    .map(|(l, rel)| {
-                        rel.iter()
-                            .map(|&p| &self.statics[p as usize])
-                            .filter(|p| !box_before(l, p.support(), lo, hi))
-                            .collect()
-                    })
-                    .collect();
-                // the object's faces turned away from a light hide nothing
-                // more when its snapped surface is certified to bound
-                // solids and the light is outside them (not certified
-                // when no light could use it)
-                let solid = self
-                    .lights
-                    .iter()
-                    .any(|l| l.outside_box(lo, hi))
-                    .then(|| bsp_core::certify_solid_boundary(&moved).ok())
-                    .flatten();
-                let culls: Vec<bool> = self
-                    .lights
-                    .iter()
-                    .map(|l| solid.as_ref().is_some_and(|s| l.culls_back_faces(s)))
-                    .collect();
-                stats.culled = culls.iter().filter(|&&c| c).count();
-                // few of them: one tree of the object and those; many: a
-                // tree of the object alone, and for the object's own faces
-                // the static trees too (a point is lit where neither blocks)
-                let layered = blockers.iter().map(Vec::len).sum::<usize>() * 4
-                    > moved.len() * self.lights.len();
-                stats.layered = layered;
-                let volumes = self
-                    .lights
-                    .iter()
-                    .zip(&blockers)
-                    .zip(&culls)
-                    .map(|((l, b), &cull)| {
-                        let own = moved.iter().filter(|p| !cull || l.faces(p.support()));
-                        let occ: Vec<&Polygon> = if layered {
-                            own.collect()
-                        } else {
-                            own.chain(b.iter().copied()).collect()
-                        };
-                        ShadowVolumes::build(*l, &occ)
-                    })
-                    .collect::<Result<Vec<_>, _>>()
-                    .map_err(|e| PipelineError::Shadow(e.into()))?;
-                let sh =
-                    Shadows::from_volumes(&self.lights, volumes).map_err(PipelineError::Shadow)?;
-                let for_moved = if layered {
-                    statics.with(&sh).map_err(PipelineError::Shadow)?
-                } else {
-                    sh.set()
-                };
-                stats.t_merge = t.elapsed();
-                let t = Instant::now();
-                let sopts = ShadeOptions::default().with_pieces(self.opts.pieces);
-                // the related static receivers, with the lights for which
-                // they may change: related for that light, still lit
-                // somewhere, and not with the whole box of the moved object
-                // behind their plane (a segment from the light to them
-                // then stays on the light's side)
-                let mut lights_of: FxHashMap<u32, u64> = FxHashMap::default();
-                for (j, rel) in related.iter().enumerate() {
-                    for &p in rel {
-                        let poly = &self.statics[p as usize];
-                        if !box_behind(&self.lights[j], poly.support(), lo, hi) {
-                            *lights_of.entry(self.receiver_of[p as usize]).or_default() |= 1 << j;
-                        }
-                    }
-                }
-                let mut recs: Vec<u32> = lights_of.keys().copied().collect();
-                recs.sort_unstable();
-                recs.retain(|&r| {
-                    let range = &frags[r as usize];
-                    cells[r as usize].is_some()
-                        || (range.start..range.end).any(|i| batch.fragment(i).lit_mask() != 0)
-                });
-                let starts: Vec<Start<'_>> = recs
-                    .iter()
-                    .map(|&r| match &cells[r as usize] {
-                        Some(c) => Start::Cells(c),
-                        None => Start::Uniform(batch.fragment(frags[r as usize].start).lit_mask()),
-                    })
-                    .collect();
-                // a cell may change only if its box's tiles meet the moved
-                // object's box's tiles
-                let meets = |r: u32, cell: u32, j: usize| -> bool {
-                    if lights_of[&r] >> j & 1 == 0 {
-                        return false;
-                    }
-                    let Some(bt) = &box_tiles[j] else { return true };
-                    let Some(fp) = footprints.get(&r) else {
-                        return true;
-                    };
-                    let ct = &fp[j][cell as usize];
-                    ct.first() == Some(&u32::MAX) || ct.iter().any(|t| bt.binary_search(t).is_ok())
-                };
-                // per receiver the fragments it keeps (None: all replaced)
-                type Done = (Batch, Vec<(u32, Range<usize>, Option<Vec<u32>>)>);
-                let refine = || -> Vec<Done> {
-                    recs.par_chunks(16)
-                        .zip(starts.par_chunks(16))
-                        .map(|(rs, ss)| {
-                            let (mut s, mut b) = (Scratch::default(), Batch::new());
-                            let mut done = Vec::new();
-                            for (&r, st) in rs.iter().zip(ss) {
-                                let polys = &self.statics[self.receivers[r as usize].clone()];
-                                let first = b.len();
-                                // what the moved object leaves alone keeps
-                                // its static fragments
-                                let may = |c: u32, j: usize| meets(r, c, j);
-                                match sh
-                                    .set()
-                                    .refine_cells(polys, st, r, &sopts, &mut s, &mut b, may)
-                                {
-                                    Refined::Unchanged => {}
-                                    Refined::All => done.push((r, first..b.len(), None)),
-                                    Refined::Some(kept) => {
-                                        done.push((r, first..b.len(), Some(kept)))
-                                    }
-                                }
-                            }
-                            (b, done)
-                        })
-                        .collect()
-                };
-                // the related static faces and the moved object side by side
-                let (parts, dynamic) = rayon::join(refine, || for_moved.shade_all(&moved, &sopts));
-                let mut out = Batch::new();
-                let mut related_ranges = Vec::new();
-                for (b, done) in parts {
-                    let off = out.len();
-                    out.append(&b);
-                    related_ranges.extend(
-                        done.into_iter()
-                            .map(|(r, range, kept)| (r, range.start + off..range.end + off, kept)),
-                    );
-                }
-                let m0 = out.len();
-                out.append(&dynamic);
-                stats.t_dynamic_shadows = t.elapsed();
-                stats.dynamic_after_bsp = moved.len();
-                stats.dynamic_shadow_polygons = out.len();
-                let replaced: usize = related_ranges
-                    .iter()
-                    .map(|(r, _, kept)| {
-                        frags[*r as usize].len() - kept.as_ref().map_or(0, Vec::len)
-                    })
-                    .sum();
-                stats.total_drawn = batch.len() - replaced + out.len();
-                let len = out.len();
-                FrameFragments::Fast {
-                    batch: out,
-                    related: related_ranges,
-                    moved: m0..len,
-                }
-            }
-            StaticShadows::Paper { cf, of_face, bsp2 } => {
-                let t = Instant::now();
-                let b2 = bsp2.replay(moved.clone(), &BuildOptions::default());
-                stats.dynamic_after_bsp = b2.stats().polygons;
-                // whole faces: a related face's fragments all come from Bsp4
-                let near: Vec<Polygon> = related_faces
-                    .iter()
-                    .flat_map(|&f| self.statics[self.face_polys[f as usize].clone()].iter())
-                    .cloned()
-                    .collect();
-                let b3 = BspTree::build(near, &BuildOptions::default());
-                let b4 = merge_smaller_into_larger(
-                    &Partition::from_tree(&b2),
-                    &Partition::from_tree(&b3),
-                    &Overlay,
-                )
-                .polygon_tree(|(a, _)| a);
-                stats.t_merge = t.elapsed();
-                let t = Instant::now();
-                let shaded =
-                    chin_feiner(&b4, &self.lights).map_err(|e| PipelineError::Shadow(e.into()))?;
-                let statics = self.static_faces as u32;
-                let out = shaded.overlay(cf, |face| {
-                    (face < statics).then(|| &of_face[face as usize][..])
-                });
-                stats.t_dynamic_shadows = t.elapsed();
-                stats.dynamic_shadow_polygons = out.len();
-                let replaced: usize = related_faces
-                    .iter()
-                    .map(|&f| of_face[f as usize].len())
-                    .sum();
-                stats.total_drawn = cf.len() - replaced + out.len();
-                FrameFragments::Paper(out)
-            }
+    /// The fast strategy's frame: the frame's shadow trees
+    /// ([`Dynamic::frame_trees`]), then the related static receivers
+    /// refined through them and the moved object shaded, side by side.
+    fn frame_fast(
+        &self,
+        fast: &FastStatics,
+        moved: &[Polygon],
+        related: &Related,
+        stats: &mut FrameStats,
+    ) -> Result<FrameFragments, PipelineError> {
+        let FastStatics {
+            shadows: statics,
+            batch,
+            frags,
+            cells,
+            footprints,
+        } = fast;
+        let t = Instant::now();
+        let (sh, layered) = self.frame_trees(moved, related, stats)?;
+        let for_moved = if layered {
+            statics.with(&sh).map_err(PipelineError::Shadow)?
+        } else {
+            sh.set()
         };
-        stats.t_frame = start.elapsed();
-        Ok(Frame {
-            moved,
-            related_faces,
-            fragments,
-            stats,
+        stats.t_merge = t.elapsed();
+        let t = Instant::now();
+        let sopts = ShadeOptions::default().with_pieces(self.opts.pieces);
+        let (lights_of, recs) = self.changing_receivers(fast, related);
+        let starts: Vec<Start<'_>> = recs
+            .iter()
+            .map(|&r| match &cells[r as usize] {
+                Some(c) => Start::Cells(c),
+                None => Start::Uniform(batch.fragment(frags[r as usize].start).lit_mask()),
+            })
+            .collect();
+        // a cell may change only if its box's tiles meet the moved
+        // object's box's tiles
+        let meets = |r: u32, cell: u32, j: usize| -> bool {
+            if lights_of[&r] >> j & 1 == 0 {
+                return false;
+            }
+            let Some(bt) = &related.box_tiles[j] else {
+                return true;
+            };
+            let Some(fp) = footprints.get(&r) else {
+                return true;
+            };
+            let ct = &fp[j][cell as usize];
+            ct.first() == Some(&u32::MAX) || ct.iter().any(|t| bt.binary_search(t).is_ok())
+        };
+        // the related static faces and the moved object side by side
+        let (parts, dynamic) = rayon::join(
+            || self.refine_receivers(&sh, &recs, &starts, &sopts, &meets),
+            || for_moved.shade_all(moved, &sopts),
+        );
+        let mut out = Batch::new();
+        let mut related_ranges = Vec::new();
+        for (b, done) in parts {
+            let off = out.len();
+            out.append(&b);
+            related_ranges.extend(
+                done.into_iter()
+                    .map(|(r, range, kept)| (r, range.start + off..range.end + off, kept)),
+            );
+        }
+        let m0 = out.len();
+        out.append(&dynamic);
+        stats.t_dynamic_shadows = t.elapsed();
+        stats.dynamic_after_bsp = moved.len();
+        stats.dynamic_shadow_polygons = out.len();
+        let replaced: usize = related_ranges
+            .iter()
+            .map(|(r, _, kept)| frags[*r as usize].len() - kept.as_ref().map_or(0, Vec::len))
+            .sum();
+        stats.total_drawn = batch.len() - replaced + out.len();
+        let len = out.len();
+        Ok(FrameFragments::Fast {
+            batch: out,
+            related: related_ranges,
+            moved: m0..len,
         })
+    }
+
+    /// The fast strategy's shadow trees of a frame, one per light: the
+    /// moved object's faces (less, for a light outside its certified
+    /// solids, those turned away from it) and the related polygons that
+    /// may block light on its way to the object. When those are many, the
+    /// trees hold the object alone and its faces are shaded through the
+    /// static trees too (*layered*). Returns the trees and whether they
+    /// are layered; records `culled` and `layered` in `stats`.
+    fn frame_trees(
+        &self,
+        moved: &[Polygon],
+        related: &Related,
+        stats: &mut FrameStats,
+    ) -> Result<(Shadows, bool), PipelineError> {
+        let (lo, hi) = (related.lo, related.hi);
+        // per light, the related static polygons that may block
+        // light on its way to the object: a polygon whose plane has
+        // the object's whole box on the light's side only receives
+        // its shadow
+        let blockers: Vec<Vec<&Polygon>> = self
+            .lights
+            .iter()
+            .zip(&related.polygons)
+            .map(|(l, rel)| {
+                rel.iter()
+                    .map(|&p| &self.statics[p as usize])
+                    .filter(|p| !box_before(l, p.support(), lo, hi))
+                    .collect()
+            })
+            .collect();
+        // the object's faces turned away from a light hide nothing
+        // more when its snapped surface is certified to bound
+        // solids and the light is outside them (not certified
+        // when no light could use it)
+        let solid = self
+            .lights
+            .iter()
+            .any(|l| l.outside_box(lo, hi))
+            .then(|| bsp_core::certify_solid_boundary(moved).ok())
+            .flatten();
+        let culls: Vec<bool> = self
+            .lights
+            .iter()
+            .map(|l| solid.as_ref().is_some_and(|s| l.culls_back_faces(s)))
+            .collect();
+        stats.culled = culls.iter().filter(|&&c| c).count();
+        // few of them: one tree of the object and those; many: a
+        // tree of the object alone, and for the object's own faces
+        // the static trees too (a point is lit where neither blocks)
+        let layered =
+            blockers.iter().map(Vec::len).sum::<usize>() * 4 > moved.len() * self.lights.len();
+        stats.layered = layered;
+        let volumes = self
+            .lights
+            .iter()
+            .zip(&blockers)
+            .zip(&culls)
+            .map(|((l, b), &cull)| {
+                let own = moved.iter().filter(|p| !cull || l.faces(p.support()));
+                let occ: Vec<&Polygon> = if layered {
+                    own.collect()
+                } else {
+                    own.chain(b.iter().copied()).collect()
+                };
+                ShadowVolumes::build(*l, &occ)
+            })
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| PipelineError::Shadow(e.into()))?;
+        let sh = Shadows::from_volumes(&self.lights, volumes).map_err(PipelineError::Shadow)?;
+        Ok((sh, layered))
+    }
+
+    /// The related static receivers (ascending) a frame may change, with
+    /// the lights for which they may (a bit per light): related for that
+    /// light, still lit somewhere, and not with the whole box of the
+    /// moved object behind their plane (a segment from the light to them
+    /// then stays on the light's side).
+    fn changing_receivers(
+        &self,
+        fast: &FastStatics,
+        related: &Related,
+    ) -> (FxHashMap<u32, u64>, Vec<u32>) {
+        let (lo, hi) = (related.lo, related.hi);
+        let mut lights_of: FxHashMap<u32, u64> = FxHashMap::default();
+        for (j, rel) in related.polygons.iter().enumerate() {
+            for &p in rel {
+                let poly = &self.statics[p as usize];
+                if !box_behind(&self.lights[j], poly.support(), lo, hi) {
+                    *lights_of.entry(self.receiver_of[p as usize]).or_default() |= 1 << j;
+                }
+            }
+        }
+        let mut recs: Vec<u32> = lights_of.keys().copied().collect();
+        recs.sort_unstable();
+        recs.retain(|&r| {
+            let range = &fast.frags[r as usize];
+            fast.cells[r as usize].is_some()
+                || (range.start..range.end).any(|i| fast.batch.fragment(i).lit_mask() != 0)
+        });
+        (lights_of, recs)
+    }
+
+    /// The related static receivers `recs` (from `starts`) refined
+    /// through the frame's trees `sh`, in parallel chunks. What the moved
+    /// object leaves alone (`meets(receiver, cell, light)` is `false`)
+    /// keeps its static fragments.
+    fn refine_receivers(
+        &self,
+        sh: &Shadows,
+        recs: &[u32],
+        starts: &[Start<'_>],
+        sopts: &ShadeOptions,
+        meets: &(impl Fn(u32, u32, usize) -> bool + Sync),
+    ) -> Vec<RefinedChunk> {
+        recs.par_chunks(16)
+            .zip(starts.par_chunks(16))
+            .map(|(rs, ss)| {
+                let (mut s, mut b) = (Scratch::default(), Batch::new());
+                let mut done = Vec::new();
+                for (&r, st) in rs.iter().zip(ss) {
+                    let polys = &self.statics[self.receivers[r as usize].clone()];
+                    let first = b.len();
+                    // what the moved object leaves alone keeps
+                    // its static fragments
+                    let may = |c: u32, j: usize| meets(r, c, j);
+                    match sh
+                        .set()
+                        .refine_cells(polys, st, r, sopts, &mut s, &mut b, may)
+                    {
+                        Refined::Unchanged => {}
+                        Refined::All => done.push((r, first..b.len(), None)),
+                        Refined::Some(kept) => done.push((r, first..b.len(), Some(kept))),
+                    }
+                }
+                (b, done)
+            })
+            .collect()
+    }
+
+    /// The paper's strategy's frame: `Bsp2` replayed on the moved faces,
+    /// `Bsp3` built from the related static faces, `Bsp4 = Bsp2 + Bsp3`
+    /// and its Chin & Feiner shadows, overlaid with the static fragments.
+    fn frame_paper(
+        &self,
+        paper: &PaperStatics,
+        moved: &[Polygon],
+        related_faces: &[u32],
+        stats: &mut FrameStats,
+    ) -> Result<FrameFragments, PipelineError> {
+        let PaperStatics { cf, of_face, bsp2 } = paper;
+        let t = Instant::now();
+        let b2 = bsp2.replay(moved.to_vec(), &BuildOptions::default());
+        stats.dynamic_after_bsp = b2.stats().polygons;
+        // whole faces: a related face's fragments all come from Bsp4
+        let near: Vec<Polygon> = related_faces
+            .iter()
+            .flat_map(|&f| self.statics[self.face_polys[f as usize].clone()].iter())
+            .cloned()
+            .collect();
+        let b3 = BspTree::build(near, &BuildOptions::default());
+        let b4 = merge_smaller_into_larger(
+            &Partition::from_tree(&b2),
+            &Partition::from_tree(&b3),
+            &Overlay,
+        )
+        .polygon_tree(|(a, _)| a);
+        stats.t_merge = t.elapsed();
+        let t = Instant::now();
+        let shaded = chin_feiner(&b4, &self.lights).map_err(|e| PipelineError::Shadow(e.into()))?;
+        let statics = self.static_faces as u32;
+        let out = shaded.overlay(cf, |face| {
+            (face < statics).then(|| &of_face[face as usize][..])
+        });
+        stats.t_dynamic_shadows = t.elapsed();
+        stats.dynamic_shadow_polygons = out.len();
+        let replaced: usize = related_faces
+            .iter()
+            .map(|&f| of_face[f as usize].len())
+            .sum();
+        stats.total_drawn = cf.len() - replaced + out.len();
+        Ok(FrameFragments::Paper(out))
     }
 
     /// The whole frame's fragments in face order (static faces, then the
@@ -850,7 +1006,7 @@ impl Dynamic {
     fn walk(&self, frame: &Frame, mut emit: impl FnMut(Part<'_>)) {
         match (&self.shadows, &frame.fragments) {
             (
-                StaticShadows::Fast { batch, frags, .. },
+                StaticShadows::Fast(FastStatics { batch, frags, .. }),
                 FrameFragments::Fast {
                     batch: fb,
                     related,
@@ -879,7 +1035,7 @@ impl Dynamic {
                 }
                 emit(Part::Batch(fb, moved.clone()));
             }
-            (StaticShadows::Paper { cf, of_face, .. }, FrameFragments::Paper(fc)) => {
+            (StaticShadows::Paper(PaperStatics { cf, of_face, .. }), FrameFragments::Paper(fc)) => {
                 let mut mine: Vec<Vec<u32>> =
                     vec![Vec::new(); self.static_faces + self.moving.len()];
                 for (i, f) in fc.iter().enumerate() {
