@@ -106,3 +106,8 @@ pub use sequence::{
     Boolean, SequenceError, Stage, Step, mesh_boolean, mesh_sequence, mesh_sequence_with,
 };
 pub use solid::Solid;
+
+/// The README's example, compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

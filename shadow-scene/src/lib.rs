@@ -146,6 +146,11 @@ pub fn save<M: MeshView + ?Sized>(path: &Path, mesh: &M) -> Result<(), SceneErro
     .map_err(io)
 }
 
+/// The README's example, compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -62,3 +62,8 @@ pub use light::{
 };
 pub use psv::{ShadowVolumes, VolumeError, VolumeSanity};
 pub use wide::{WPoint, WidePlane};
+
+/// The README's example, compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -1752,6 +1752,11 @@ fn decode_soup(b: &mut Bytes<'_>) -> Vec<Vec<GridPoint>> {
     polys
 }
 
+/// The README's example, compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -46,3 +46,8 @@ pub use pipeline::{
     Dynamic, FragmentView, Frame, FrameStats, Motion, PipelineError, PipelineOptions, Prepared,
     Strategy,
 };
+
+/// The README's example, compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
