@@ -8,8 +8,9 @@ use crate::hsr::{Frame, Hsr, NONE, visibility};
 use crate::image::{Image, composite, mask, shade};
 use svbsp::PlacedLight;
 
+use crate::lit::{Method, ShadowOptions};
 use crate::scene::RasterScene;
-use crate::shadow::{Method, ShadowOptions, shadows};
+use crate::shadow::shadows;
 use crate::{Camera, RasterError};
 
 /// One method's result in a [`Comparison`].

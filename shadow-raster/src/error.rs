@@ -97,3 +97,28 @@ impl std::error::Error for RasterError {
         }
     }
 }
+
+/// A name that [`Method`](crate::Method) or [`Hsr`](crate::Hsr) does not
+/// know (their `FromStr`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnknownName {
+    /// What was named: "method" or "visibility method".
+    pub what: &'static str,
+    /// The name given.
+    pub name: String,
+    /// The names there are, joined by ", ".
+    pub available: String,
+}
+
+impl std::fmt::Display for UnknownName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let UnknownName {
+            what,
+            name,
+            available,
+        } = self;
+        write!(f, "unknown {what} `{name}` (available: {available})")
+    }
+}
+
+impl std::error::Error for UnknownName {}

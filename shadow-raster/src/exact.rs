@@ -20,9 +20,9 @@ use svbsp::{Batch, ShadeOptions, Shadows};
 
 use crate::RasterError;
 use crate::hsr::{Frame, NONE, Visibility};
+use crate::lit::{LitBuffer, ShadowFigures, pixel_point};
 use crate::raster::{Bins, for_bands, project_all};
 use crate::scene::SceneLight;
-use crate::shadow::{LitBuffer, ShadowFigures, pixel_point};
 
 /// The fragments of the scene's prims for the side the eye sees of each:
 /// every prim is an occluder; each receiver is a prim turned toward the

@@ -77,10 +77,22 @@ impl Hsr {
             Hsr::Bsp => "bsp",
         }
     }
+}
 
-    /// The method of a name (see [`Hsr::name`]).
-    pub fn from_name(s: &str) -> Option<Hsr> {
-        Hsr::ALL.into_iter().find(|h| h.name() == s)
+impl std::str::FromStr for Hsr {
+    type Err = crate::error::UnknownName;
+
+    /// The method of a name (see [`Hsr::name`]), spaces around it ignored.
+    fn from_str(s: &str) -> Result<Hsr, Self::Err> {
+        let s = s.trim();
+        Hsr::ALL
+            .into_iter()
+            .find(|h| h.name() == s)
+            .ok_or_else(|| crate::error::UnknownName {
+                what: "visibility method",
+                name: s.to_string(),
+                available: Hsr::ALL.map(Hsr::name).join(", "),
+            })
     }
 }
 

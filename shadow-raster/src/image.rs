@@ -8,9 +8,9 @@ use glam::DVec3;
 
 use crate::RasterError;
 use crate::hsr::{Frame, NONE, Visibility};
+use crate::lit::{LitBuffer, visible_normal};
 use crate::scene::SceneLight;
 use crate::shading::Lambert;
-use crate::shadow::{LitBuffer, visible_normal};
 
 /// An 8-bit RGB image, row-major from the top-left corner.
 #[derive(Clone, Debug, PartialEq, Eq)]

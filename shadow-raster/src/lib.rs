@@ -63,6 +63,7 @@ mod exact;
 mod hsr;
 mod image;
 mod lines;
+mod lit;
 mod maps;
 mod planar;
 mod raster;
@@ -82,14 +83,14 @@ use svbsp::PlacedLight;
 
 pub use bvh::TriangleBvh;
 pub use compare::{Comparison, MethodReport, compare};
-pub use error::RasterError;
+pub use error::{RasterError, UnknownName};
 pub use hsr::{Hsr, NONE, Visibility, visible_surfaces};
 pub use image::{BACKGROUND, Image, composite, encode_pgm, mask, write_pgm};
 pub use lines::{HiddenLines, LINE_EPSILON, LineCheck, hidden_lines};
+pub use lit::{LitBuffer, Method, RAY_EPSILON, ShadowFigures, ShadowOptions};
 pub use planar::{PLANAR_MARGIN, planar_matrix};
 pub use scene::RasterScene;
 use scene::SceneLight;
-pub use shadow::{LitBuffer, Method, RAY_EPSILON, ShadowFigures, ShadowOptions};
 pub use view::{Camera, CameraError, MAX_PIXELS, MAX_SIZE, default_up};
 
 /// Options of [`render`].

@@ -22,9 +22,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::hsr::{Frame, NONE, Visibility};
+use crate::lit::{LitBuffer, ShadowFigures, ShadowOptions, set_amounts, visible_normal};
 use crate::raster::{Bins, Corners, Projector, Screen, for_bands, project_all_into, row_term};
 use crate::scene::{RasterLight, RasterScene, SceneLight};
-use crate::shadow::{LitBuffer, ShadowFigures, ShadowOptions, set_amounts, visible_normal};
 use crate::view::{Kind, Rays, View};
 
 /// The views of a light's map: six cube faces (`+x, −x, +y, −y, +z, −z`)
@@ -738,7 +738,7 @@ mod tests {
             for cam in &cams {
                 let frame = Frame::new(&scene, cam, false).unwrap();
                 let vis = crate::hsr::visibility(&frame, crate::Hsr::ZBuffer);
-                let facing = crate::shadow::facing_bits(&frame, &lights);
+                let facing = crate::lit::facing_bits(&frame, &lights);
                 for (pcf, size) in [(1, 256), (3, 64), (1, 16)] {
                     let opts = ShadowOptions::default().with_pcf(pcf).with_map_size(size);
                     let args = (lights.as_slice(), facing.as_slice());

@@ -23,9 +23,9 @@ use bsp_core::Plane;
 use glam::{DVec3, DVec4};
 
 use crate::hsr::{Frame, NONE, Visibility};
+use crate::lit::{LitBuffer, ShadowFigures, ShadowOptions, facing_only};
 use crate::raster::{Bins, for_bands, project_all};
 use crate::scene::{RasterLight, SceneLight};
-use crate::shadow::{LitBuffer, ShadowFigures, ShadowOptions, facing_only};
 
 /// Planar shadows clip occluders this fraction of the light's height
 /// below the light: a point at the light's height would project to

@@ -29,9 +29,9 @@ use std::collections::HashMap;
 use glam::DVec3;
 
 use crate::hsr::{Frame, NONE, Visibility};
+use crate::lit::{LitBuffer, ShadowFigures, facing_only};
 use crate::raster::{Bins, for_bands, project_all, row_term};
 use crate::scene::{EdgeKey, RasterLight, SceneLight, point_key as key};
-use crate::shadow::{LitBuffer, ShadowFigures, facing_only};
 
 /// The polygons of a light's shadow volumes, in input units, with a
 /// weight (silhouette edges met more than once count more).

@@ -224,6 +224,26 @@ impl SvgView {
         canvas.finish()
     }
 
+    /// [`SvgView::fragments`] of the faces of `mesh` (snapped to `grid`,
+    /// its polygons in `tree`) seen from `at`: the mesh gives the view's
+    /// box, each face's colour ([`shadow_scene::face_colors`]) and the
+    /// centres its shading is taken at.
+    pub fn mesh_fragments(
+        grid: &Grid,
+        mesh: &shadow_scene::Mesh,
+        at: &SvgViewpoint,
+        tree: &BspTree,
+        lights: &[PlacedLight],
+        frags: &[SvgFragment],
+        what: &str,
+    ) -> Result<SvgPicture, RasterError> {
+        let bounds = mesh.bounds().ok_or(RasterError::EmptyScene)?;
+        let view = SvgView::new(grid, bounds, at)?;
+        let colors = shadow_scene::face_colors(mesh);
+        let centres = mesh.face_centres();
+        view.fragments(tree, lights, frags, (&colors, &centres), what)
+    }
+
     /// Exact fragments of `tree`'s polygons drawn in the tree's painter's
     /// order, each shaded by the lights that reach it under the
     /// [`Lambert::SHADOWS`] lighting, the cosines taken at its face's
