@@ -120,6 +120,67 @@ impl Areas {
         faces.truncate(n);
         faces
     }
+
+    /// The area report: the total, each light's lit, cast and attached
+    /// shares (and the area no light reaches, with several), then a table
+    /// of the `top` faces with the most cast shadow, each face named by
+    /// `group` (its group or material).
+    pub fn report(&self, top: usize, group: impl Fn(usize) -> String) -> String {
+        use std::fmt::Write;
+        let total = self.total;
+        let mut s =
+            format!("area:            {total:.6} units² (every face once, its front side)\n");
+        for i in 0..self.lights {
+            let (lit, cast, att) = (self.lit[i], self.cast[i], self.attached[i]);
+            let _ = writeln!(
+                s,
+                "light {i} area:    lit {lit:.6} ({:.1}%), in shadow {:.6} ({:.1}%): cast \
+                 {cast:.6} ({:.1}%), facing away {att:.6} ({:.1}%)",
+                percent(lit, total),
+                total - lit,
+                percent(total - lit, total),
+                percent(cast, total),
+                percent(att, total),
+            );
+        }
+        if self.lights > 1 {
+            let dark = self.dark;
+            let _ = writeln!(
+                s,
+                "no light:        {dark:.6} ({:.1}%)",
+                percent(dark, total)
+            );
+        }
+        let faces = self.most_shaded(top);
+        if faces.is_empty() {
+            s += "cast shadow:     none\n";
+            return s;
+        }
+        s += "faces with the most cast shadow (area in shadow while facing the light, % of the face):\n";
+        let _ = write!(s, "  {:>7}  {:<12} {:>12}", "face", "group", "area");
+        for i in 0..self.lights {
+            let _ = write!(s, "  {:>20}", format!("light {i} shadow"));
+        }
+        s.push('\n');
+        for f in faces {
+            let area = self.face_area(f);
+            let _ = write!(s, "  {f:>7}  {:<12} {area:>12.6}", group(f));
+            for c in self.face_cast(f) {
+                let _ = write!(s, "  {:>20}", format!("{c:.6} ({:.1}%)", percent(*c, area)));
+            }
+            s.push('\n');
+        }
+        s
+    }
+}
+
+/// `part` as a percentage of `whole` (0 when `whole` is not positive).
+pub fn percent(part: f64, whole: f64) -> f64 {
+    if whole > 0.0 {
+        100.0 * part / whole
+    } else {
+        0.0
+    }
 }
 
 #[cfg(test)]

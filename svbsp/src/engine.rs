@@ -570,11 +570,29 @@ impl<'a> ShadowSet<'a> {
     /// Shades every receiver of `polys`, in parallel, into one batch in
     /// receiver order (the same for every thread count).
     pub fn shade_all(&self, polys: &[Polygon], opts: &ShadeOptions) -> Batch {
-        let ranges = receivers(polys);
+        self.shade_par(polys, &receivers(polys), opts, |_| {})
+    }
+
+    /// [`ShadowSet::shade_ranges`] of the receivers `ranges` (receiver
+    /// `i`: `ranges[i]`), in parallel by [`CHUNK`] receivers, into one
+    /// batch in receiver order (the same for every thread count);
+    /// `done(n)` is told of every `n` receivers shaded (for a progress
+    /// bar).
+    pub fn shade_par(
+        &self,
+        polys: &[Polygon],
+        ranges: &[Range<usize>],
+        opts: &ShadeOptions,
+        done: impl Fn(usize) + Sync,
+    ) -> Batch {
         let batches: Vec<Batch> = ranges
             .par_chunks(CHUNK)
             .enumerate()
-            .map(|(i, chunk)| self.shade_ranges(polys, chunk, (i * CHUNK) as u32, opts))
+            .map(|(i, chunk)| {
+                let b = self.shade_ranges(polys, chunk, (i * CHUNK) as u32, opts);
+                done(chunk.len());
+                b
+            })
             .collect();
         let mut out = Batch::new();
         for b in &batches {

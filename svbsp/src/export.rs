@@ -460,6 +460,29 @@ impl FragmentFile {
         }
     }
 
+    /// The whole file of one batch `b` on `grid` in one call: [`begin`],
+    /// [`write`], [`finish`]. A vertex that is not finite in input units
+    /// is an [`io::ErrorKind::InvalidData`] error carrying the
+    /// [`ExportError`].
+    ///
+    /// [`begin`]: FragmentFile::begin
+    /// [`write`]: FragmentFile::write
+    /// [`finish`]: FragmentFile::finish
+    pub fn of_batch(
+        out: &mut impl Write,
+        format: FragmentFormat,
+        lights: &[PlacedLight],
+        faces: usize,
+        (b, grid): (&Batch, &Grid),
+    ) -> io::Result<Written> {
+        let world =
+            world_vertices(b, grid).map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))?;
+        let records = area_records(b, &world);
+        let mut file = FragmentFile::begin(out, format, lights, faces, ("", &[]))?;
+        file.write(out, (b, &world, &records), None)?;
+        file.finish(out)
+    }
+
     /// Writes the file's tail (JSON: the summary of the areas).
     pub fn finish(self, out: &mut impl Write) -> io::Result<Written> {
         let (vertices, degenerate) = match &self.kind {

@@ -49,7 +49,7 @@ mod light;
 mod psv;
 mod wide;
 
-pub use areas::{Areas, fragment_area, polygon_area};
+pub use areas::{Areas, fragment_area, percent, polygon_area};
 pub use arena::pieces::Vertex;
 pub use chin_feiner::{CfFragment, CfFragments, chin_feiner};
 pub use engine::{
