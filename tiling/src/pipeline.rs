@@ -162,6 +162,22 @@ impl Motion {
             * rot
             * DMat4::from_translation(-self.centre)
     }
+
+    /// The box of `points` over frames `0..frames`: the corners of the
+    /// box of every position they take.
+    pub fn swept_bounds(&self, points: &[DVec3], frames: u32) -> (DVec3, DVec3) {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for k in 0..frames {
+            let m = self.matrix(k);
+            for p in points {
+                let q = m.transform_point3(*p);
+                lo = lo.min(q);
+                hi = hi.max(q);
+            }
+        }
+        (lo, hi)
+    }
 }
 
 /// Figures of the preprocessing.
@@ -275,6 +291,39 @@ pub struct FrameStats {
     pub t_dynamic_shadows: Duration,
     /// Time of the whole frame, from transform to fragments.
     pub t_frame: Duration,
+}
+
+impl FrameStats {
+    /// The header of [`FrameStats::csv_row`]: the paper's Table 2
+    /// columns, in order, times in seconds.
+    pub const CSV_HEADER: &'static str = "frame,static_polygons,dynamic_polygons,\
+dynamic_after_bsp,static_after_bsp,static_after_shadow,dynamic_shadow_polygons,total_drawn,\
+t_tiling_s,t_merge_s,t_dynamic_shadows_s,t_frame_s";
+
+    /// Frame `k`'s figures as a CSV row under [`FrameStats::CSV_HEADER`].
+    ///
+    /// ```
+    /// let row = tiling::FrameStats::default().csv_row(3);
+    /// assert!(row.starts_with("3,0,0,"));
+    /// assert_eq!(row.split(',').count(), tiling::FrameStats::CSV_HEADER.split(',').count());
+    /// ```
+    pub fn csv_row(&self, k: u32) -> String {
+        let secs = |d: Duration| format!("{:.6}", d.as_secs_f64());
+        format!(
+            "{k},{},{},{},{},{},{},{},{},{},{},{}",
+            self.static_polygons,
+            self.dynamic_polygons,
+            self.dynamic_after_bsp,
+            self.static_after_bsp,
+            self.static_after_shadow,
+            self.dynamic_shadow_polygons,
+            self.total_drawn,
+            secs(self.t_tiling),
+            secs(self.t_merge),
+            secs(self.t_dynamic_shadows),
+            secs(self.t_frame)
+        )
+    }
 }
 
 /// One frame's result.
@@ -592,6 +641,33 @@ impl Dynamic {
     /// Number of static faces (the moved object's faces follow them).
     pub fn static_faces(&self) -> usize {
         self.static_faces
+    }
+
+    /// Number of faces of a frame: the static ones, then the object's.
+    pub fn faces(&self) -> usize {
+        self.static_faces + self.moving.len()
+    }
+
+    /// A frame's polygons: the static ones ([`Dynamic::static_polygons`])
+    /// followed by the moved object's ([`Frame::moved`]).
+    pub fn frame_polygons(&self, frame: &Frame) -> Vec<Polygon> {
+        let mut polys = Vec::with_capacity(self.statics.len() + frame.moved.len());
+        polys.extend_from_slice(&self.statics);
+        polys.extend(frame.moved.iter().cloned());
+        polys
+    }
+
+    /// The box of the static polygons' vertices in input units.
+    pub fn static_bounds(&self) -> (DVec3, DVec3) {
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for p in &self.statics {
+            for v in p.vertices_f64() {
+                let w = self.grid.to_world(v);
+                lo = lo.min(w);
+                hi = hi.max(w);
+            }
+        }
+        (lo, hi)
     }
 
     /// The tiling of each light.
