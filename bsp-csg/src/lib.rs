@@ -91,6 +91,7 @@
 //!
 //! None.
 mod error;
+pub mod files;
 mod import;
 mod index;
 mod options;

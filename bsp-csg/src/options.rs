@@ -81,3 +81,18 @@ pub struct Stats {
     /// faces were kept or dropped whole.
     pub clean_cells: usize,
 }
+
+impl<'a> std::iter::Sum<&'a Stats> for Stats {
+    /// The figures of several operations added up.
+    fn sum<I: Iterator<Item = &'a Stats>>(iter: I) -> Stats {
+        iter.fold(Stats::default(), |a, b| Stats {
+            cells: a.cells + b.cells,
+            mixed_cells: a.mixed_cells + b.mixed_cells,
+            merged_cells: a.merged_cells + b.merged_cells,
+            cut_faces: a.cut_faces + b.cut_faces,
+            pieces: a.pieces + b.pieces,
+            easy_cells: a.easy_cells + b.easy_cells,
+            clean_cells: a.clean_cells + b.clean_cells,
+        })
+    }
+}

@@ -1,0 +1,699 @@
+//! Booleans of meshes read from files, with messages that point into the
+//! files: the file, line, face and vertex of a topology error, and the
+//! file whose surface bounds no solid.
+//!
+//! A reader's [`Mesh`] goes in as an [`Operand`]; [`Operand::check_all`]
+//! checks them; [`FileBoolean::apply`] snaps every operand to one grid, applies the operation to
+//! the first with each of the others in turn ([`mesh_sequence_with`]) and
+//! gives the exact result with its vertices in input units, ready for a
+//! writer ([`FileBoolean::mesh`]).
+//!
+//! ```
+//! use bsp_core::BoolOp;
+//! use bsp_csg::files::{FileBoolean, Operand};
+//! let cube = shadow_scene::scene("cube").unwrap();
+//! let mut moved = cube.clone();
+//! moved.positions.iter_mut().for_each(|p| *p += 0.5);
+//! let mut operands = [Operand::new("a.obj", cube), Operand::new("b.obj", moved)];
+//! let checked = Operand::check_all(&mut operands).unwrap();
+//! let union = FileBoolean::apply(checked, BoolOp::Union, |_, _| {}).unwrap();
+//! assert_eq!(union.volume(), 2.0 - 0.125);
+//! ```
+
+use bsp_core::{BoolOp, Grid, ImportReport, TopologyError, TriMesh};
+use glam::DVec3;
+use rayon::prelude::*;
+use shadow_scene::{Mesh, MeshView, Triangles};
+
+use crate::{CsgError, MeshBuf, MeshIn, SequenceError, Stage, Step, mesh_sequence_with};
+
+/// A mesh read from a file, with what messages need to point into it.
+#[derive(Clone, Debug)]
+pub struct Operand {
+    /// The file, as given: messages name it.
+    pub name: String,
+    /// The mesh; [`FileBoolean::apply`] takes it when its turn comes.
+    pub mesh: Mesh,
+    /// Triangles and faces as read.
+    pub counts: (usize, usize),
+    /// The faces' vertex loops as in the file, kept when
+    /// [`Operand::welded`] renumbered them, so that messages quote the
+    /// file's indices.
+    file_loops: Option<Vec<Vec<u32>>>,
+}
+
+/// An operand's or the operation's error, worded to point into the files.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FileError {
+    /// The message: `file:line: what`, or `file: what`.
+    pub message: String,
+    /// A topology error of a mesh that was not welded and repeats
+    /// positions: merging equal positions first may mend it.
+    pub weld_may_help: bool,
+}
+
+impl std::fmt::Display for FileError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for FileError {}
+
+impl FileError {
+    fn new(message: String) -> FileError {
+        FileError {
+            message,
+            weld_may_help: false,
+        }
+    }
+}
+
+impl Operand {
+    /// `mesh`, read from file `name`.
+    pub fn new(name: impl Into<String>, mesh: Mesh) -> Operand {
+        Operand {
+            name: name.into(),
+            counts: (mesh.triangle_count(), mesh.faces.len()),
+            mesh,
+            file_loops: None,
+        }
+    }
+
+    /// `mesh` with vertices at exactly equal positions merged (for files
+    /// that repeat the vertices of every face); messages still quote the
+    /// file's vertex indices.
+    pub fn welded(name: impl Into<String>, mut mesh: Mesh) -> Operand {
+        let counts = (mesh.triangle_count(), mesh.faces.len());
+        let loops = mesh.faces.iter().map(|f| f.vertices.clone()).collect();
+        mesh.weld();
+        Operand {
+            name: name.into(),
+            counts,
+            mesh,
+            file_loops: Some(loops),
+        }
+    }
+
+    /// Checks that the faces form a closed, consistently oriented
+    /// 2-manifold; the error names the file, line, face and edge (the
+    /// check of [`crate::check_mesh`], on the faces as they are).
+    pub fn check(&self) -> Result<(), FileError> {
+        bsp_core::check_closed_manifold(self.mesh.faces.iter().map(|f| f.vertices.as_slice()))
+            .map_err(|e| FileError {
+                message: self.topology_message(&e),
+                weld_may_help: self.file_loops.is_none() && self.mesh.repeated_positions() > 0,
+            })
+    }
+
+    /// [`Operand::check`] of each operand, in parallel; the first error
+    /// in their order. The operands checked are what
+    /// [`FileBoolean::apply`] takes.
+    pub fn check_all(operands: &mut [Operand]) -> Result<Checked<'_>, FileError> {
+        let checked: Vec<Result<(), FileError>> = operands.par_iter().map(Operand::check).collect();
+        checked.into_iter().collect::<Result<(), FileError>>()?;
+        Ok(Checked(operands))
+    }
+
+    /// `file:line` of face `face` for text formats, else `file`.
+    fn locate(&self, face: usize) -> String {
+        match self.mesh.faces.get(face).map(|f| f.line) {
+            Some(line) if line > 0 => format!("{}:{line}", self.name),
+            _ => self.name.clone(),
+        }
+    }
+
+    /// Vertex `v` (a mesh index) of face `face` as the user can find it:
+    /// its index as written in the file (1-based) when the format has
+    /// indices, else its coordinates.
+    fn vertex(&self, face: usize, v: u32) -> String {
+        let f = &self.mesh.faces[face];
+        if f.line == 0 {
+            let p = self.mesh.positions[v as usize];
+            return format!("({}, {}, {})", p.x, p.y, p.z);
+        }
+        let at = f.vertices.iter().position(|&x| x == v);
+        let in_file = match (&self.file_loops, at) {
+            (Some(loops), Some(i)) => loops[face][i],
+            _ => v,
+        };
+        (in_file + 1).to_string()
+    }
+
+    fn topology_message(&self, e: &TopologyError) -> String {
+        let v = |face, x| self.vertex(face, x);
+        let (face, what) = match *e {
+            TopologyError::OpenEdge { a, b, face } => (
+                Some(face),
+                format!(
+                    "edge {}-{} of face {face} is a boundary edge (the mesh is not closed)",
+                    v(face, a),
+                    v(face, b)
+                ),
+            ),
+            TopologyError::Misoriented {
+                a,
+                b,
+                faces: [first, face],
+            } => {
+                let first_at = match self.mesh.faces[first].line {
+                    0 => String::new(),
+                    line => format!(" (line {line})"),
+                };
+                let (a, b) = (v(face, a), v(face, b));
+                let what = format!(
+                    "face {face} uses edge {a}->{b} in the same direction as face \
+                     {first}{first_at} (the faces are not consistently oriented)"
+                );
+                (Some(face), what)
+            }
+            TopologyError::NonManifoldEdge { a, b, face, .. } => (
+                Some(face),
+                format!(
+                    "edge {}-{} of face {face} is shared by more than two faces (the mesh is \
+                     not a 2-manifold)",
+                    v(face, a),
+                    v(face, b)
+                ),
+            ),
+            TopologyError::DegenerateFace { face } => {
+                let f = &self.mesh.faces[face];
+                // without a line to look at, show the corners
+                let corners: String = match f.line {
+                    0 => f
+                        .vertices
+                        .iter()
+                        .map(|&x| format!(" {}", v(face, x)))
+                        .collect(),
+                    _ => String::new(),
+                };
+                let welded = match self.file_loops {
+                    Some(_) => " (after welding merged equal positions)",
+                    None => "",
+                };
+                (
+                    Some(face),
+                    format!("face {face}{corners} repeats a vertex{welded}"),
+                )
+            }
+            TopologyError::NonManifoldVertex { vertex } => {
+                let face = self
+                    .mesh
+                    .faces
+                    .iter()
+                    .position(|f| f.vertices.contains(&vertex));
+                let what = match face {
+                    Some(face) => format!(
+                        "vertex {} of face {face} joins separate fans of faces (a pinch: the \
+                         mesh is not a 2-manifold there)",
+                        v(face, vertex)
+                    ),
+                    None => e.to_string(),
+                };
+                (face, what)
+            }
+            _ => (None, e.to_string()),
+        };
+        let at = face.map_or_else(|| self.name.clone(), |f| self.locate(f));
+        format!("{at}: {what}")
+    }
+
+    /// The mesh as the library takes it: the positions and the face lists
+    /// moved out (not copied), the rest of the mesh let go.
+    fn hand_over(&mut self) -> MeshBuf {
+        self.file_loops = None;
+        let mesh = std::mem::take(&mut self.mesh);
+        let faces = mesh.faces.into_iter().map(|f| f.vertices).collect();
+        MeshBuf::new(mesh.positions, faces)
+    }
+}
+
+/// Operands that passed [`Operand::check_all`]: closed, consistently
+/// oriented 2-manifolds.
+#[derive(Debug)]
+pub struct Checked<'a>(&'a mut [Operand]);
+
+/// A Boolean operation of files: the exact result, its vertices in input
+/// units, and what each step reported.
+#[derive(Clone, Debug)]
+pub struct FileBoolean {
+    /// The result's vertices in input units (its triangles are `exact`'s).
+    pub positions: Vec<DVec3>,
+    /// The exact result (grid units).
+    pub exact: TriMesh,
+    /// The grid every operand was snapped to.
+    pub grid: Grid,
+    /// What snapping did to each operand's faces.
+    pub reports: Vec<ImportReport>,
+    /// What each operation did.
+    pub stats: Vec<crate::Stats>,
+    /// The operation's name, the result's one group.
+    pub group: &'static str,
+}
+
+impl FileBoolean {
+    /// `op` applied to the first operand with each of the others in turn
+    /// ([`mesh_sequence_with`]), all snapped to one grid. Each operand's
+    /// mesh is handed over when its turn comes and let go once snapped;
+    /// `on_step` sees every step as the library reports it, with the grid
+    /// (to time the stages or to print an import summary).
+    pub fn apply(
+        operands: Checked<'_>,
+        op: BoolOp,
+        mut on_step: impl FnMut(&Step, &Grid),
+    ) -> Result<FileBoolean, FileError> {
+        let operands = operands.0;
+        let grid = {
+            let meshes: Vec<MeshIn<'_>> = operands
+                .iter()
+                .map(|o| MeshIn::new(&o.mesh.positions, &[]))
+                .collect();
+            crate::fit_grid(&meshes)
+                .map_err(|e| FileError::new(format!("cannot snap the faces to one grid: {e}")))?
+        };
+        let names: Vec<String> = operands.iter().map(|o| o.name.clone()).collect();
+        let mut meshes = operands.iter_mut().map(Operand::hand_over);
+        let Some(first) = meshes.next() else {
+            return Err(FileError::new("no operand".to_string()));
+        };
+        let rest = meshes.map(|m| (op, m));
+        let (mut reports, mut stats) = (Vec::new(), Vec::new());
+        let exact = mesh_sequence_with(&grid, first, rest, |step| {
+            on_step(&step, &grid);
+            match step {
+                Step::Snapped { report, .. } => reports.push(report),
+                Step::Planned { stats: s, .. } => stats.push(s),
+                _ => {}
+            }
+        })
+        .map_err(|e| sequence_error(e, &names, op, &grid))?;
+        let positions = exact
+            .vertices_f64()
+            .into_par_iter()
+            .map(|v| grid.to_world(v))
+            .collect();
+        Ok(FileBoolean {
+            positions,
+            exact,
+            grid,
+            reports,
+            stats,
+            group: op_name(op),
+        })
+    }
+
+    /// The result in input units, as a writer takes it: its triangles
+    /// beside their positions, one group named after the operation.
+    pub fn mesh(&self) -> Triangles<'_> {
+        Triangles {
+            positions: &self.positions,
+            triangles: &self.exact.triangles,
+            group: self.group,
+        }
+    }
+
+    /// The exact volume in input units, rounded once to `f64`.
+    pub fn volume(&self) -> f64 {
+        // the scale is a power of two: the division is exact
+        self.exact.volume_rounded() / self.grid.scale().powi(3)
+    }
+}
+
+/// "union", "intersection" or "difference".
+pub fn op_name(op: BoolOp) -> &'static str {
+    match op {
+        BoolOp::Union => "union",
+        BoolOp::Intersection => "intersection",
+        BoolOp::Difference => "difference",
+    }
+}
+
+/// The message for an operation that failed at `e.stage`, naming the
+/// file it comes from.
+fn sequence_error(e: SequenceError, names: &[String], op: BoolOp, grid: &Grid) -> FileError {
+    let message = match (e.stage, e.error) {
+        (Stage::Snap(i), CsgError::Inward { .. }) => format!(
+            "{}: the faces are oriented inward (clockwise seen from outside): the solid they \
+             bound is unbounded; reverse every face's vertex order",
+            names[i]
+        ),
+        (Stage::Snap(_), CsgError::Grid(e)) => format!("cannot snap the faces to one grid: {e}"),
+        (Stage::Operation(i), CsgError::NotASolid) => format!(
+            "{} or the result before it: a surface crosses itself after snapping to the \
+             grid (step 2^{}) and bounds no solid",
+            names[i],
+            grid.step_log2()
+        ),
+        // the mesh is checked watertight as it is made (one check, the
+        // one that tells whether it needs mending where the solid touches
+        // itself)
+        (Stage::Mesh, e) => {
+            let e = match e {
+                CsgError::Internal(why) => why,
+                e => e.to_string(),
+            };
+            format!(
+                "internal error: the {} of {} is not watertight ({e}); this is a bug in the \
+                 exact kernel, not a problem with the input, and nothing was written — please \
+                 report it with the input files",
+                op_name(op),
+                names.join(", ")
+            )
+        }
+        (_, e) => e.to_string(),
+    };
+    FileError::new(message)
+}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_bigint::BigInt;
+    use num_rational::BigRational;
+    use num_traits::{One, ToPrimitive, Zero};
+    use shadow_scene::parse_obj;
+
+    const CUBE: &str = "\
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+v 0 0 1
+v 1 0 1
+v 1 1 1
+v 0 1 1
+f 1 4 3 2
+f 5 6 7 8
+f 1 2 6 5
+f 2 3 7 6
+f 3 4 8 7
+f 4 1 5 8
+";
+
+    fn operand(text: &str, name: &str, weld: bool) -> Operand {
+        let mesh = parse_obj(text, name).unwrap();
+        match weld {
+            true => Operand::welded(name, mesh),
+            false => Operand::new(name, mesh),
+        }
+    }
+
+    /// The operation of `operands` after their check, and the stages it
+    /// went through in order (each once).
+    fn apply_staged(
+        operands: &mut [Operand],
+        op: BoolOp,
+    ) -> Result<(FileBoolean, Vec<&'static str>), FileError> {
+        let mut stages: Vec<&'static str> = Vec::new();
+        let out = FileBoolean::apply(Operand::check_all(operands)?, op, |step, _| {
+            if let Step::Started(stage) = step {
+                let name = match stage {
+                    Stage::Snap(_) => "snap/import",
+                    Stage::Operation(_) => "boolean",
+                    Stage::Mesh => "boundary+mesh",
+                };
+                if !stages.contains(&name) {
+                    stages.push(name);
+                }
+            }
+        })?;
+        Ok((out, stages))
+    }
+
+    fn apply(operands: &mut [Operand], op: BoolOp) -> Result<FileBoolean, FileError> {
+        apply_staged(operands, op).map(|(out, _)| out)
+    }
+
+    const STAGES: [&str; 3] = ["snap/import", "boolean", "boundary+mesh"];
+
+    /// The cube scaled by `s` and moved by `d`, as OBJ text with relative
+    /// face indices (so that such texts can be concatenated).
+    fn cube(s: f64, d: [f64; 3]) -> String {
+        CUBE.lines()
+            .map(|l| {
+                if let Some(v) = l.strip_prefix("v ") {
+                    let c: Vec<f64> = v.split(' ').map(|x| x.parse().unwrap()).collect();
+                    format!(
+                        "v {} {} {}\n",
+                        c[0] * s + d[0],
+                        c[1] * s + d[1],
+                        c[2] * s + d[2]
+                    )
+                } else {
+                    let f = l.strip_prefix("f ").unwrap();
+                    let rel: Vec<String> = f
+                        .split(' ')
+                        .map(|i| (i.parse::<i32>().unwrap() - 9).to_string())
+                        .collect();
+                    format!("f {}\n", rel.join(" "))
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn open_mesh_names_line_face_and_file_indices() {
+        // drop the top face (line 10)
+        let text: String = CUBE
+            .lines()
+            .filter(|l| *l != "f 5 6 7 8")
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let e = operand(&text, "open.obj", false).check().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "open.obj:10: edge 6-5 of face 1 is a boundary edge (the mesh is not closed)"
+        );
+    }
+
+    #[test]
+    fn misoriented_face_names_both_faces() {
+        let text = CUBE.replace("f 2 3 7 6", "f 6 7 3 2");
+        let e = operand(&text, "flip.obj", false).check().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "flip.obj:12: face 3 uses edge 6->7 in the same direction as face 1 (line 10) \
+             (the faces are not consistently oriented)"
+        );
+    }
+
+    #[test]
+    fn unwelded_file_gets_the_hint_and_welded_indices_map_back() {
+        // every face with its own four vertices: 24 positions
+        let m = parse_obj(CUBE, "c.obj").unwrap();
+        let mut text = String::new();
+        let mut faces = String::new();
+        for (i, f) in m.faces.iter().enumerate() {
+            for v in &f.vertices {
+                let p = m.positions[*v as usize];
+                text += &format!("v {} {} {}\n", p.x, p.y, p.z);
+            }
+            let k = 4 * i + 1;
+            faces += &format!("f {} {} {} {}\n", k, k + 1, k + 2, k + 3);
+        }
+        let text = text + &faces;
+        let e = operand(&text, "soup.obj", false).check().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "soup.obj:25: edge 1-2 of face 0 is a boundary edge (the mesh is not closed)"
+        );
+        assert!(e.weld_may_help);
+        operand(&text, "soup.obj", true).check().unwrap();
+        // with --weld, a defect is still reported with the file's indices
+        let broken = text.replace("f 5 6 7 8\n", "");
+        let e = operand(&broken, "soup.obj", true).check().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "soup.obj:26: edge 11-12 of face 1 is a boundary edge (the mesh is not closed)"
+        );
+    }
+
+    #[test]
+    fn pinch_and_degenerate_faces() {
+        // two cubes sharing only the corner (1, 1, 1), which --weld merges
+        let two = cube(1.0, [0.0; 3]) + &cube(1.0, [1.0; 3]);
+        operand(&two, "two.obj", false).check().unwrap();
+        let e = operand(&two, "pinch.obj", true).check().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "pinch.obj:10: vertex 7 of face 1 joins separate fans of faces \
+             (a pinch: the mesh is not a 2-manifold there)"
+        );
+        let e = operand(&CUBE.replace("f 1 4 3 2", "f 1 4 3 1"), "d.obj", false)
+            .check()
+            .unwrap_err();
+        assert_eq!(e.to_string(), "d.obj:9: face 0 repeats a vertex");
+    }
+
+    #[test]
+    fn stl_defects_name_coordinates() {
+        let m = parse_obj(CUBE, "c.obj").unwrap();
+        let mut mesh = m.clone();
+        for f in &mut mesh.faces {
+            f.line = 0;
+        }
+        mesh.faces.remove(1);
+        let o = Operand::new("open.stl", mesh);
+        assert_eq!(
+            o.check().unwrap_err().to_string(),
+            "open.stl: edge (1, 0, 1)-(0, 0, 1) of face 1 is a boundary edge (the mesh is not closed)"
+        );
+        let mut mesh = o.mesh;
+        mesh.faces[0].vertices = vec![0, 3, 0];
+        let o = Operand::new("sliver.stl", mesh);
+        assert_eq!(
+            o.check().unwrap_err().to_string(),
+            "sliver.stl: face 0 (0, 0, 0) (0, 1, 0) (0, 0, 0) repeats a vertex"
+        );
+    }
+
+    #[test]
+    fn overlapping_cubes_exactly() {
+        let a = operand(&cube(4.0, [0.0; 3]), "a.obj", false);
+        let b = operand(&cube(4.0, [2.0; 3]), "b.obj", false);
+        for (op, vol) in [
+            (BoolOp::Union, 120.0),
+            (BoolOp::Intersection, 8.0),
+            (BoolOp::Difference, 56.0),
+        ] {
+            let (out, stages) = apply_staged(&mut [a.clone(), b.clone()], op).unwrap();
+            assert_eq!(stages, STAGES);
+            assert_eq!(out.volume(), vol, "{op:?}");
+            let mesh = out.mesh().to_mesh();
+            assert_eq!(mesh.signed_volume(), vol, "{op:?}");
+            assert!(mesh.is_closed_oriented());
+            assert_eq!(mesh.groups, vec![op_name(op)]);
+        }
+        // disjoint: empty intersection
+        let far = operand(&cube(1.0, [10.0; 3]), "far.obj", false);
+        let out = apply(&mut [a, far], BoolOp::Intersection).unwrap();
+        assert!(out.exact.triangles.is_empty() && out.positions.is_empty());
+        assert_eq!(out.stats[0].cells, 0);
+    }
+
+    /// Three operands: an import report for each, the stats of each
+    /// operation, the library's three phases timed, and every operand's
+    /// mesh let go (handed over to the library).
+    #[test]
+    fn three_operands_report_each_import_and_operation() {
+        let mut operands = [
+            operand(&cube(4.0, [0.0; 3]), "a.obj", false),
+            operand(&cube(4.0, [2.0; 3]), "b.obj", true),
+            operand(&cube(4.0, [3.0, 1.0, -1.0]), "c.obj", false),
+        ];
+        let (out, stages) = apply_staged(&mut operands, BoolOp::Difference).unwrap();
+        assert_eq!(stages, STAGES);
+        // 64 − 8 − (the part of c in a but not in b: 1·3·3 − 1·2·1)
+        assert_eq!(out.volume(), 49.0);
+        assert_eq!(out.reports.len(), 3);
+        assert!(out.reports.iter().all(|r| r.polygons == 6));
+        assert_eq!(out.stats.len(), 2);
+        assert!(out.stats.iter().all(|s| s.mixed_cells > 0));
+        for o in &operands {
+            assert!(o.mesh.positions.is_empty() && o.mesh.faces.is_empty());
+            assert!(o.file_loops.is_none());
+            assert_eq!(o.counts, (12, 6));
+        }
+    }
+
+    #[test]
+    fn exact_volume_scales_by_the_grid() {
+        // a 3/4-unit cube at 1/8 offsets: the grid is finer than 1, so the
+        // exact volume is divided by a power of two
+        let a = operand(&cube(0.75, [0.125; 3]), "a.obj", false);
+        let b = operand(&cube(0.75, [0.5; 3]), "b.obj", false);
+        let out = apply(&mut [a, b], BoolOp::Union).unwrap();
+        assert!(out.grid.scale() > 1.0);
+        assert_eq!(out.volume(), 2.0 * 0.421875 - 0.052734375);
+        // a coarse grid (scale < 1) multiplies instead
+        let a = operand(&cube(4e9, [0.0; 3]), "a.obj", false);
+        let b = operand(&cube(4e9, [2e9; 3]), "b.obj", false);
+        let out = apply(&mut [a, b], BoolOp::Intersection).unwrap();
+        assert!(out.grid.scale() < 1.0);
+        assert_eq!(out.volume(), 8e27);
+    }
+
+    #[test]
+    fn exact_volume_agrees_with_the_kernel() {
+        // tilted planes make implicit vertices with many denominators
+        let tet = |d: [f64; 3]| {
+            let v = [
+                [0.0, 0.0, 0.0],
+                [3.0, 0.2, 0.1],
+                [0.3, 2.9, 0.7],
+                [0.4, 0.5, 3.1],
+            ];
+            let mut t = String::new();
+            for p in v {
+                t += &format!("v {} {} {}\n", p[0] + d[0], p[1] + d[1], p[2] + d[2]);
+            }
+            t + "f -4 -2 -3\nf -4 -3 -1\nf -4 -1 -2\nf -3 -2 -1\n"
+        };
+        let a = operand(&tet([0.0; 3]), "a.obj", false);
+        let b = operand(&tet([0.7, 0.6, 0.5]), "b.obj", false);
+        let c = operand(&cube(1.3, [0.45, 0.35, 0.25]), "c.obj", false);
+        a.check().unwrap();
+        for (x, y, op) in [
+            (&a, &b, BoolOp::Union),
+            (&a, &b, BoolOp::Intersection),
+            (&a, &b, BoolOp::Difference),
+            (&a, &c, BoolOp::Difference),
+            (&c, &b, BoolOp::Union),
+        ] {
+            let out = apply(&mut [x.clone(), y.clone()], op).unwrap();
+            assert!(out.exact.vertices.iter().any(|p| p.as_grid().is_none()));
+            // the cheap rounding is the exact fraction's, rounded once
+            let exact = out.exact.volume_exact();
+            let k = out.grid.scale().log2() as i32;
+            let scaled = if k >= 0 {
+                exact / BigRational::from_integer(BigInt::one() << (3 * k) as usize)
+            } else {
+                exact * BigRational::from_integer(BigInt::one() << (-3 * k) as usize)
+            };
+            assert_eq!(out.volume(), scaled.to_f64().unwrap(), "{op:?}");
+            assert!(out.volume() > 0.0);
+        }
+        assert_eq!(
+            TriMesh::default().six_volume(),
+            (BigInt::zero(), BigInt::one())
+        );
+    }
+
+    #[test]
+    fn inward_faces_are_rejected() {
+        let mut inside_out = String::new();
+        for l in CUBE.lines() {
+            match l.strip_prefix("f ") {
+                Some(f) => {
+                    let mut v: Vec<&str> = f.split(' ').collect();
+                    v.reverse();
+                    inside_out += &format!("f {}\n", v.join(" "));
+                }
+                None => inside_out += &format!("{l}\n"),
+            }
+        }
+        let a = operand(&inside_out, "inv.obj", false);
+        a.check().unwrap();
+        let b = operand(CUBE, "b.obj", false);
+        let e = apply(&mut [a, b], BoolOp::Union).err().unwrap();
+        assert!(
+            e.to_string()
+                .starts_with("inv.obj: the faces are oriented inward"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn overlapping_shells_in_one_file_are_rejected() {
+        // two closed cubes that overlap, in one file: each is a closed
+        // manifold, but together they bound no solid (winding number 2
+        // where they overlap); the other operand's surface crosses there
+        let shells = cube(4.0, [0.0; 3]) + &cube(4.0, [2.0; 3]);
+        let a = operand(&shells, "shells.obj", false);
+        a.check().unwrap();
+        let b = operand(&cube(3.0, [2.5, -0.5, 1.5]), "b.obj", false);
+        for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
+            let e = apply(&mut [a.clone(), b.clone()], op).err().unwrap();
+            assert!(e.to_string().contains("crosses itself"), "{op:?}: {e}");
+        }
+    }
+}
