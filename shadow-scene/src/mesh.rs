@@ -489,6 +489,33 @@ impl Mesh {
         }
         Some(count)
     }
+
+    /// Appends `other`'s faces, each vertex at `at(position)`, its groups
+    /// named `prefix` + their name (the faces keep no line: they are not
+    /// in this mesh's file).
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// let mut two = shadow_scene::scene("cube").unwrap();
+    /// let cube = two.clone();
+    /// two.append(&cube, "moved_", |p| p + DVec3::X * 2.0);
+    /// assert_eq!(two.faces.len(), 12);
+    /// assert_eq!(two.signed_volume(), 2.0);
+    /// assert_eq!(two.group_name(two.faces[6].group as usize), "moved_cube");
+    /// ```
+    pub fn append(&mut self, other: &Mesh, prefix: &str, at: impl Fn(DVec3) -> DVec3) {
+        let first = self.positions.len() as u32;
+        let groups = self.groups.len() as u32;
+        self.positions
+            .extend(other.positions.iter().map(|&p| at(p)));
+        self.groups
+            .extend(other.groups.iter().map(|g| format!("{prefix}{g}")));
+        self.faces.extend(other.faces.iter().map(|f| Face {
+            vertices: f.vertices.iter().map(|&v| v + first).collect(),
+            line: 0,
+            group: f.group + groups,
+        }));
+    }
 }
 
 #[cfg(test)]

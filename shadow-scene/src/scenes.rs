@@ -104,6 +104,79 @@ impl Staging {
             _ => None,
         }
     }
+
+    /// A view of `points` (a mesh's positions) with `up` (a unit axis,
+    /// such as `+z`, or `+y` for most scans) pointing up: a three-quarter
+    /// view from the front, to the right and above, from the nearest
+    /// distance at which every point lies inside a picture of vertical
+    /// field of view `fov_deg` and width / height `aspect` (with a 4%
+    /// margin), the points centred in it; and a light above, in front and
+    /// to the left, three bounding-sphere radii from the centre of their
+    /// box (outside every face). "Front" is `-y` for `z` up, `+z` for `y`
+    /// up and `+y` for `x` up (the way scans usually face). `None` without
+    /// points.
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// let cube = shadow_scene::scene("cube").unwrap();
+    /// let s = shadow_scene::Staging::framing(&cube.positions, DVec3::Z, 50.0, 4.0 / 3.0).unwrap();
+    /// assert!((s.target - DVec3::splat(0.5)).length() < 0.1);
+    /// assert!(s.eye.z > 1.0 && s.eye.y < 0.0 && s.light.z > 1.0);
+    /// assert_eq!(s.up, Some(DVec3::Z));
+    /// ```
+    pub fn framing(points: &[DVec3], up: DVec3, fov_deg: f64, aspect: f64) -> Option<Staging> {
+        let (lo, hi) = points.iter().fold(None, |b: Option<(DVec3, DVec3)>, &p| {
+            Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
+        })?;
+        let up = up.try_normalize().unwrap_or(DVec3::Z);
+        let c = (lo + hi) * 0.5;
+        let r = (0.5 * (hi - lo).length()).max(f64::MIN_POSITIVE);
+        let a = up.abs();
+        let front = if a.z >= a.x && a.z >= a.y {
+            -DVec3::Y
+        } else if a.y >= a.x {
+            DVec3::Z
+        } else {
+            DVec3::Y
+        };
+        let side = up.cross(front);
+        let dir = (0.55 * side + front + 0.6 * up).normalize();
+        // the camera's axes, looking along -dir
+        let right = (-dir).cross(up).normalize();
+        let cam_up = right.cross(-dir);
+        let tan_v = (0.5 * fov_deg).to_radians().tan();
+        let tan_h = tan_v * aspect.max(1e-3);
+        // the nearest distance from `t` along `dir` that shows every point
+        let fit = |t: DVec3| {
+            points.iter().fold(0.0_f64, |dist, &p| {
+                let d = p - t;
+                // the point is seen at depth dist + behind
+                let behind = -d.dot(dir);
+                let need_h = d.dot(right).abs() / tan_h - behind;
+                let need_v = d.dot(cam_up).abs() / tan_v - behind;
+                dist.max(need_h).max(need_v).max(r * 1e-3 - behind)
+            })
+        };
+        // centre the points' picture: move the target across the view by
+        // the middle of their extent, then fit again
+        let dist = fit(c);
+        let (mut u, mut v) = ((f64::MAX, f64::MIN), (f64::MAX, f64::MIN));
+        for &p in points {
+            let d = p - c;
+            let depth = dist - d.dot(dir);
+            let (x, y) = (d.dot(right) / depth, d.dot(cam_up) / depth);
+            u = (u.0.min(x), u.1.max(x));
+            v = (v.0.min(y), v.1.max(y));
+        }
+        let target = c + (right * (u.0 + u.1) + cam_up * (v.0 + v.1)) * (0.5 * dist);
+        let dist = fit(target);
+        Some(Staging {
+            eye: target + dir * (1.04 * dist).max(f64::MIN_POSITIVE),
+            target,
+            up: Some(up),
+            light: c + (-0.4 * side + 0.5 * front + up).normalize() * 3.0 * r,
+        })
+    }
 }
 
 /// The test room of Liu & Wu's real-time shadow paper, rebuilt in code.
