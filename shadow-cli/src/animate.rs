@@ -16,17 +16,17 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
-use bsp_core::{BspTree, BuildOptions, Grid, Polygon};
+use bsp_core::{BspTree, BuildOptions, Grid};
 use clap::{Args, ValueEnum};
 use glam::{DMat4, DVec3};
 use rayon::prelude::*;
 use shadow_raster::svg::{SvgFragment, SvgView, SvgViewpoint};
-use shadow_scene::{Face, Mesh, Staging};
-use svbsp::export::{FragmentFile, FragmentFormat, area_records, world_vertices};
+use shadow_scene::{Mesh, Staging};
+use svbsp::export::{FragmentFile, FragmentFormat, world_vertices};
 use svbsp::{Light, LightSpec, PlacedLight};
 use tiling::{Dynamic, FrameStats, Motion, PipelineOptions, Strategy};
 
-use crate::args::{CameraArgs, ImageArgs, LightArgs, parse_vec3};
+use crate::args::{CameraArgs, ImageArgs, LightArgs, parse_vec3, viewpoint_flags};
 use crate::input::load_mesh;
 use crate::lights::{fmt_input, place_lights, shared_grid};
 use crate::output::{Output, emit};
@@ -137,29 +137,6 @@ fn parse_spin(s: &str) -> Result<(DVec3, f64), String> {
         return Err(format!("`{deg}` is not a finite number of degrees"));
     }
     Ok((axis, deg))
-}
-
-/// The Table 2 columns, in order.
-pub(crate) const REPORT_HEADER: &str = "frame,static_polygons,dynamic_polygons,dynamic_after_bsp,\
-static_after_bsp,static_after_shadow,dynamic_shadow_polygons,total_drawn,t_tiling_s,t_merge_s,\
-t_dynamic_shadows_s,t_frame_s";
-
-fn report_row(k: u32, s: &FrameStats) -> String {
-    let secs = |d: Duration| format!("{:.6}", d.as_secs_f64());
-    format!(
-        "{k},{},{},{},{},{},{},{},{},{},{},{}",
-        s.static_polygons,
-        s.dynamic_polygons,
-        s.dynamic_after_bsp,
-        s.static_after_bsp,
-        s.static_after_shadow,
-        s.dynamic_shadow_polygons,
-        s.total_drawn,
-        secs(s.t_tiling),
-        secs(s.t_merge),
-        secs(s.t_dynamic_shadows),
-        secs(s.t_frame)
-    )
 }
 
 /// The static scene, the moving object and the defaults that come with a
@@ -291,16 +268,7 @@ impl Plan {
     /// of every position the object takes.
     fn grid(&self, frames: u32) -> Result<Grid> {
         let s = &self.setup;
-        let mut lo = DVec3::splat(f64::INFINITY);
-        let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        for k in 0..frames {
-            let m = self.motion.matrix(k);
-            for p in &s.moving.positions {
-                let q = m.transform_point3(*p);
-                lo = lo.min(q);
-                hi = hi.max(q);
-            }
-        }
+        let (lo, hi) = self.motion.swept_bounds(&s.moving.positions, frames);
         let mut pts = s.statics.positions.clone();
         pts.push(lo);
         pts.push(hi);
@@ -466,7 +434,7 @@ impl<'a> FrameFiles<'a> {
         let report = match &args.report {
             Some(p) => {
                 let mut o = Output::create(p)?;
-                writeln!(o, "{REPORT_HEADER}")?;
+                writeln!(o, "{}", FrameStats::CSV_HEADER)?;
                 Some(o)
             }
             None => None,
@@ -488,7 +456,7 @@ impl<'a> FrameFiles<'a> {
     fn write(&mut self, k: u32, frame: &tiling::Frame, m: &DMat4) -> Result<()> {
         let (args, d, lights) = (self.args, self.d, self.lights);
         if let Some(r) = &mut self.report {
-            writeln!(r, "{}", report_row(k, &frame.stats))?;
+            writeln!(r, "{}", frame.stats.csv_row(k))?;
         }
         let stem = args.output.join(format!("frame_{k:04}"));
         if args.export_scene || args.format == FrameFormat::Svg {
@@ -538,31 +506,17 @@ fn write_file(path: &Path, f: impl FnOnce(&mut Output) -> Result<()>) -> Result<
 
 /// The viewpoint of SVG and PNG frames.
 fn frame_view(args: &AnimateArgs, s: &Setup) -> SvgViewpoint {
-    let (lo, hi) = s.statics.bounds().expect("the static scene has faces");
-    let (c, half) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
-    let cam = &args.camera;
-    let (eye, target, up) = match (cam.eye, s.staging) {
-        (Some(e), _) => (e, cam.target, cam.up),
-        (None, Some(st)) => (
-            st.eye,
-            Some(cam.target.unwrap_or(st.target)),
-            cam.up.or(st.up),
-        ),
-        // in front of the scene and above it
-        (None, None) => (
-            c + DVec3::new(0.7, -1.8, 1.2) * half,
-            Some(cam.target.unwrap_or(c)),
-            cam.up,
-        ),
-    };
-    SvgViewpoint {
-        eye,
-        target,
-        up,
-        width: args.image.width,
-        height: args.image.height,
-        fov_deg: args.image.fov,
+    let bounds = s.statics.bounds().expect("the static scene has faces");
+    let (at, framed) =
+        args.camera
+            .viewpoint(&s.statics, s.staging, args.image.size(), args.image.fov);
+    if framed {
+        note(
+            args,
+            &format!("note: camera {}", viewpoint_flags(&at, bounds)),
+        );
     }
+    at
 }
 
 /// The frame's whole scene in input units, faces numbered as the frame's
@@ -581,21 +535,7 @@ fn frame_mesh(s: &Setup, d: &Dynamic, m: &DMat4) -> Mesh {
         faces: s.statics.faces.clone(),
         groups: s.statics.groups.clone(),
     };
-    let first = mesh.positions.len() as u32;
-    mesh.positions.extend(
-        s.moving
-            .positions
-            .iter()
-            .map(|&p| snap(m.transform_point3(p))),
-    );
-    let gshift = mesh.groups.len() as u32;
-    mesh.groups
-        .extend(s.moving.groups.iter().map(|g| format!("moving_{g}")));
-    mesh.faces.extend(s.moving.faces.iter().map(|f| Face {
-        vertices: f.vertices.iter().map(|&v| v + first).collect(),
-        line: 0,
-        group: f.group + gshift,
-    }));
+    mesh.append(&s.moving, "moving_", |p| snap(m.transform_point3(p)));
     mesh
 }
 
@@ -632,12 +572,13 @@ fn frame_json(
     lights: &[PlacedLight],
 ) -> Result<()> {
     let batch = d.fragments(frame);
-    let world = world_vertices(&batch, d.grid())?;
-    let records = area_records(&batch, &world);
-    let faces = d.static_faces() + d.moving().len();
-    let mut file = FragmentFile::begin(out, FragmentFormat::Json, lights, faces, ("", &[]))?;
-    file.write(out, (&batch, &world, &records), None)?;
-    file.finish(out)?;
+    FragmentFile::of_batch(
+        out,
+        FragmentFormat::Json,
+        lights,
+        d.faces(),
+        (&batch, d.grid()),
+    )?;
     Ok(())
 }
 
@@ -650,11 +591,8 @@ fn frame_png(
     lights: &[PlacedLight],
     view: &SvgViewpoint,
 ) -> Result<Vec<u8>> {
-    let grid = d.grid();
-    let mut polys: Vec<Polygon> = d.static_polygons().to_vec();
-    polys.extend(frame.moved.iter().cloned());
-    let scene = shadow_raster::RasterScene::new(grid, polys)?;
-    let (lo, hi) = bounds_of(d);
+    let scene = shadow_raster::RasterScene::new(d.grid(), d.frame_polygons(frame))?;
+    let (lo, hi) = d.static_bounds();
     let target = view.target.unwrap_or((lo + hi) * 0.5);
     let up = view
         .up
@@ -665,19 +603,6 @@ fn frame_png(
     let batch = d.fragments(frame);
     let out = renderer.render_fragments(&scene, &batch, lights, &camera, colors)?;
     Ok(out.image.encode_png())
-}
-
-/// The static scene's bounding box in input units.
-fn bounds_of(d: &Dynamic) -> (DVec3, DVec3) {
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    for p in d.static_polygons() {
-        for v in p.vertices_f64() {
-            let w = d.grid().to_world(v);
-            lo = lo.min(w);
-            hi = hi.max(w);
-        }
-    }
-    (lo, hi)
 }
 
 /// Draws the frame: a BSP tree of the frame's polygons gives the painter's
@@ -691,21 +616,13 @@ fn frame_svg(
     at: &SvgViewpoint,
 ) -> Result<String> {
     let grid = d.grid();
-    let mut polys: Vec<Polygon> = d.static_polygons().to_vec();
-    polys.extend(frame.moved.iter().cloned());
-    let tree = BspTree::build(polys, &BuildOptions::default());
+    let tree = BspTree::build(d.frame_polygons(frame), &BuildOptions::default());
     let batch = d.fragments(frame);
     let world = world_vertices(&batch, grid)?;
-    let faces = d.static_faces() + d.moving().len();
+    let faces = d.faces();
     let frags = SvgFragment::of_faces_in_tree(&tree, grid, &batch, &world, faces);
-    let bounds = scene
-        .bounds()
-        .context("nothing to draw: the mesh has no vertices")?;
-    let view = SvgView::new(grid, bounds, at).map_err(raster_error)?;
-    let colors = shadow_scene::face_colors(scene);
-    let centres = scene.face_centres();
-    let r = view
-        .fragments(&tree, lights, &frags, (&colors, &centres), "shadow animate")
+    let what = "shadow animate";
+    let r = SvgView::mesh_fragments(grid, scene, at, &tree, lights, &frags, what)
         .map_err(raster_error)?;
     Ok(r.svg)
 }
@@ -733,14 +650,6 @@ mod tests {
             parse_spin("0,0,1:x").unwrap_err(),
             "`x` is not a number of degrees"
         );
-    }
-
-    #[test]
-    fn report_has_the_papers_columns() {
-        assert_eq!(REPORT_HEADER.split(',').count(), 12);
-        let row = report_row(3, &FrameStats::default());
-        assert_eq!(row.split(',').count(), 12);
-        assert!(row.starts_with("3,0,0,"));
     }
 
     #[test]

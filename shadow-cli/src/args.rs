@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 use glam::DVec3;
-use shadow_scene::Staging;
+use shadow_raster::svg::SvgViewpoint;
+use shadow_scene::{Mesh, Staging};
 use svbsp::LightSpec;
 
 /// Where the mesh comes from: a file or a built-in scene (exactly one).
@@ -19,11 +20,6 @@ pub(crate) struct SourceArgs {
 }
 
 impl SourceArgs {
-    /// `true` for the built-in scene `name`.
-    pub(crate) fn is_scene(&self, name: &str) -> bool {
-        self.input.is_none() && self.scene.as_deref() == Some(name)
-    }
-
     /// The built-in scene's default camera and light, for its mesh's
     /// `bounds` ([`Staging::of_scene`]).
     pub(crate) fn staging(&self, bounds: (DVec3, DVec3)) -> Option<Staging> {
@@ -69,8 +65,9 @@ pub(crate) struct CameraArgs {
     /// or the built-in viewpoint's target].
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub(crate) target: Option<DVec3>,
-    /// Up direction [default: +Z, or another axis when looking along it].
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    /// Up direction: x, y, z (y for most scans), -x, -y, -z or X,Y,Z
+    /// [default: the built-in scene's, else z; +y when looking along z].
+    #[arg(long, value_name = "AXIS|X,Y,Z", value_parser = parse_up, allow_hyphen_values = true)]
     pub(crate) up: Option<DVec3>,
 }
 
@@ -79,6 +76,59 @@ impl CameraArgs {
     pub(crate) fn any(&self) -> bool {
         self.eye.is_some() || self.target.is_some() || self.up.is_some()
     }
+
+    /// The viewpoint of a picture of `mesh`: the flags given, the rest
+    /// from the built-in scene's `staging`, else (no `--eye`) the mesh
+    /// framed from the front, right and above ([`Staging::framing`]) with
+    /// `--up`'s axis up. The second value says whether it was framed so:
+    /// the flags that reproduce it are then worth a note
+    /// ([`viewpoint_flags`]).
+    pub(crate) fn viewpoint(
+        &self,
+        mesh: &Mesh,
+        staging: Option<Staging>,
+        (width, height): (u32, u32),
+        fov_deg: f64,
+    ) -> (SvgViewpoint, bool) {
+        let aspect = width as f64 / height as f64;
+        let up_axis = self.up.unwrap_or(DVec3::Z);
+        let ((eye, target, up), framed) = match (self.eye, staging) {
+            (Some(e), s) => ((e, self.target, self.up.or(s.and_then(|s| s.up))), false),
+            (None, Some(s)) => (
+                (
+                    s.eye,
+                    Some(self.target.unwrap_or(s.target)),
+                    self.up.or(s.up),
+                ),
+                false,
+            ),
+            (None, None) => match Staging::framing(&mesh.positions, up_axis, fov_deg, aspect) {
+                Some(s) => ((s.eye, Some(self.target.unwrap_or(s.target)), s.up), true),
+                // no vertex: nothing to frame (drawing it fails later)
+                None => ((DVec3::ONE, self.target, self.up), false),
+            },
+        };
+        let at = SvgViewpoint {
+            eye,
+            target,
+            up,
+            width,
+            height,
+            fov_deg,
+        };
+        (at, framed)
+    }
+}
+
+/// `--eye X,Y,Z --target X,Y,Z --up X,Y,Z`: the flags that give `at`.
+pub(crate) fn viewpoint_flags(at: &SvgViewpoint, bounds: (DVec3, DVec3)) -> String {
+    let v = |p: DVec3| format!("{},{},{}", p.x, p.y, p.z);
+    let target = at.target.unwrap_or((bounds.0 + bounds.1) * 0.5);
+    let mut s = format!("--eye {} --target {}", v(at.eye), v(target));
+    if let Some(up) = at.up {
+        s += &format!(" --up {}", v(up));
+    }
+    s
 }
 
 /// The size and field of view of an SVG picture.
@@ -93,6 +143,13 @@ pub(crate) struct ImageArgs {
     /// Vertical field of view in degrees (between 1 and 170).
     #[arg(long, value_name = "DEG", default_value_t = 50.0, value_parser = parse_fov)]
     pub(crate) fov: f64,
+}
+
+impl ImageArgs {
+    /// Width and height.
+    pub(crate) fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
 }
 
 /// Parses `X,Y,Z` into a finite vector.
@@ -114,6 +171,30 @@ pub(crate) fn parse_vec3(s: &str) -> Result<DVec3, String> {
         }
     }
     Ok(DVec3::from_array(v))
+}
+
+/// Parses an up direction: an axis (`x`, `y`, `z`, `-x`, `-y`, `-z`) or
+/// a non-zero `X,Y,Z`.
+pub(crate) fn parse_up(s: &str) -> Result<DVec3, String> {
+    let axis = match s.trim() {
+        "x" | "+x" => Some(DVec3::X),
+        "y" | "+y" => Some(DVec3::Y),
+        "z" | "+z" => Some(DVec3::Z),
+        "-x" => Some(DVec3::NEG_X),
+        "-y" => Some(DVec3::NEG_Y),
+        "-z" => Some(DVec3::NEG_Z),
+        _ => None,
+    };
+    match axis {
+        Some(a) => Ok(a),
+        None => {
+            let v = parse_vec3(s).map_err(|e| format!("{e}; or an axis: x, y, z, -x, -y, -z"))?;
+            if v == DVec3::ZERO {
+                return Err("the up direction must not be zero".to_string());
+            }
+            Ok(v)
+        }
+    }
 }
 
 /// Parses a field of view in degrees, between 1 and 170.

@@ -5,10 +5,16 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
-use bsp_core::{BspTree, BuildOptions, Grid, ImportReport, import_faces};
-use shadow_scene::Mesh;
+use bsp_core::{
+    BspTree, BuildOptions, Grid, ImportReport, Polygon, import_faces, import_faces_par,
+};
+use glam::DVec3;
+use shadow_scene::{Mesh, Staging};
+use svbsp::{LightSpec, PlacedLight};
 
 use crate::args::SourceArgs;
+use crate::lights::{place_lights, shared_grid};
+use crate::output::Phases;
 
 /// Reads a mesh file: an error if it has no faces; a note on stderr
 /// (unless `quiet`) if the reader skipped unknown statements.
@@ -58,6 +64,85 @@ pub(crate) fn load_source_quiet(
         }
         (Some(_), Some(_)) => bail!("give either an INPUT file or --scene NAME, not both"),
         (None, None) => bail!("no input: give a mesh file (.obj or .stl) or --scene NAME"),
+    }
+}
+
+/// The message for a scene without a light.
+pub(crate) const NO_LIGHT: &str = "no light: give at least one --light X,Y,Z (a point light) or \
+     --sun X,Y,Z (a light at infinity); both can be repeated";
+
+/// A scene ready to be shaded: its mesh, grid, lights and polygons.
+pub(crate) struct Scene {
+    pub(crate) mesh: Mesh,
+    pub(crate) name: String,
+    pub(crate) bounds: (DVec3, DVec3),
+    /// A built-in scene's viewpoint and light.
+    pub(crate) staging: Option<Staging>,
+    /// No light was given: the scene's own stands in.
+    pub(crate) default_light: bool,
+    pub(crate) grid: Grid,
+    pub(crate) lights: Vec<PlacedLight>,
+    pub(crate) polys: Vec<Polygon>,
+    pub(crate) report: ImportReport,
+}
+
+impl Scene {
+    /// Loads the scene ("load"), snaps it and its point lights to one
+    /// grid and imports its faces in parallel ("snap/import"). With no
+    /// light given, a built-in scene's own light stands in; a scene
+    /// without one is an error if `need_light`.
+    pub(crate) fn load(
+        source: &SourceArgs,
+        mut specs: Vec<LightSpec>,
+        need_light: bool,
+        quiet: bool,
+        phases: &mut Phases,
+    ) -> Result<Scene> {
+        let (mesh, name) = phases.run("load", || load_source_quiet(source, quiet))?;
+        let bounds = mesh
+            .bounds()
+            .with_context(|| format!("{name}: no vertices"))?;
+        let staging = source.staging(bounds);
+        let default_light = specs.is_empty() && need_light;
+        if default_light {
+            let s = staging.with_context(|| format!("{name}: {NO_LIGHT}"))?;
+            specs.push(LightSpec::Point(s.light));
+        }
+        let scene = phases.run("snap/import", || -> Result<Scene> {
+            let grid = shared_grid(&mesh.positions, &specs).with_context(|| name.clone())?;
+            let lights = place_lights(&grid, &specs)?;
+            let (polys, report) = import_faces_par(&grid, &mesh.face_loops())
+                .with_context(|| format!("{name}: cannot import the faces"))?;
+            Ok(Scene {
+                mesh,
+                name,
+                bounds,
+                staging,
+                default_light,
+                grid,
+                lights,
+                polys,
+                report,
+            })
+        })?;
+        let summary = scene.report.summary();
+        if !summary.is_empty() && !quiet {
+            eprintln!("note: {}: {}", scene.name, summary.trim_end());
+        }
+        Ok(scene)
+    }
+
+    /// The lights, as the report names them.
+    pub(crate) fn light_count(&self) -> String {
+        match (self.lights.len(), self.default_light) {
+            (_, true) => format!(
+                "the {}'s default light ({})",
+                self.name.trim_start_matches("scene "),
+                crate::lights::flag(&self.lights[0].spec)
+            ),
+            (1, false) => "1 light".to_string(),
+            (n, false) => format!("{n} lights"),
+        }
     }
 }
 

@@ -101,12 +101,16 @@ impl Phases {
     pub(crate) fn run<T>(&mut self, name: &'static str, f: impl FnOnce() -> T) -> T {
         let start = Instant::now();
         let out = f();
-        let t = start.elapsed();
+        self.add(name, start.elapsed());
+        out
+    }
+
+    /// `t` added to phase `name` (a new phase the first time).
+    pub(crate) fn add(&mut self, name: &'static str, t: Duration) {
         match self.0.iter_mut().find(|(n, _)| *n == name) {
             Some((_, d)) => *d += t,
             None => self.0.push((name, t)),
         }
-        out
     }
 }
 
@@ -190,5 +194,21 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "whole");
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn guarded_turns_a_panic_into_an_error() {
+        let e = guarded("both input files", || -> Result<()> {
+            panic!("inconsistent sub-hyperplanes")
+        })
+        .unwrap_err();
+        let s = e.to_string();
+        assert!(
+            s.starts_with("internal error: inconsistent sub-hyperplanes ("),
+            "{s}"
+        );
+        assert!(s.contains("output.rs:"), "{s}");
+        assert!(s.ends_with("please report it with both input files"), "{s}");
+        assert_eq!(guarded("x", || Ok(7)).unwrap(), 7);
     }
 }

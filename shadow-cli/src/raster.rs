@@ -8,40 +8,20 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
-use bsp_core::import_faces_par;
 use clap::Args;
 use glam::DVec3;
 use shadow_raster::{
-    Camera, Hsr, Method, RasterScene, RenderOptions, ShadowOptions, compare, hidden_lines, render,
-    write_pgm,
+    Camera, Hsr, Method, RasterScene, RenderOptions, ShadowOptions, compare, default_up,
+    hidden_lines, render, write_pgm,
 };
 use shadow_scene::face_colors;
-use svbsp::{LightSpec, PlacedLight};
+use svbsp::PlacedLight;
 
-use crate::args::{CameraArgs, LightArgs, SourceArgs, parse_fov, parse_size};
-use crate::input::load_source_quiet;
-use crate::lights::{describe, place_lights, shared_grid};
-use crate::output::emit;
+use crate::args::{CameraArgs, LightArgs, SourceArgs, parse_fov, parse_size, viewpoint_flags};
+use crate::input::Scene;
+use crate::lights::describe;
+use crate::output::{Phases, emit};
 use crate::raster_error;
-
-fn parse_method(s: &str) -> Result<Method, String> {
-    let s = s.trim();
-    Method::from_name(s).ok_or_else(|| {
-        format!(
-            "unknown method `{s}` (available: {})",
-            Method::ALL.map(Method::name).join(", ")
-        )
-    })
-}
-
-fn parse_hsr(s: &str) -> Result<Hsr, String> {
-    Hsr::from_name(s).ok_or_else(|| {
-        format!(
-            "unknown visibility method `{s}` (available: {})",
-            Hsr::ALL.map(Hsr::name).join(", ")
-        )
-    })
-}
 
 /// `C` or `C,S`: constant and slope-scaled bias, not negative.
 fn parse_bias(s: &str) -> Result<(f64, f64), String> {
@@ -129,11 +109,11 @@ pub(crate) struct RenderArgs {
     pub(crate) size: (u32, u32),
     /// Shadow method: exact, raycast, shadow-map, stencil-zpass,
     /// stencil-zfail, planar or texture.
-    #[arg(long, value_name = "M", default_value = "exact", value_parser = parse_method)]
+    #[arg(long, value_name = "M", default_value = "exact")]
     pub(crate) method: Method,
     /// Visible-surface method: zbuffer, scanline, warnock, raycast or bsp
     /// (all give the same image).
-    #[arg(long, value_name = "H", default_value = "zbuffer", value_parser = parse_hsr)]
+    #[arg(long, value_name = "H", default_value = "zbuffer")]
     pub(crate) hsr: Hsr,
     /// Back-face culling: leave out faces whose back faces the eye.
     #[arg(long)]
@@ -160,7 +140,7 @@ pub(crate) struct CompareArgs {
     #[arg(long, value_name = "WxH", default_value = "640x360", value_parser = parse_size)]
     pub(crate) size: (u32, u32),
     /// The methods to compare with exact, comma-separated [default: all].
-    #[arg(long, value_name = "M,M...", value_delimiter = ',', value_parser = parse_method)]
+    #[arg(long, value_name = "M,M...", value_delimiter = ',')]
     pub(crate) methods: Vec<Method>,
     #[command(flatten)]
     pub(crate) opts: MethodArgs,
@@ -219,60 +199,32 @@ fn check_ext(path: &std::path::Path, ext: &str, flag: &str) -> Result<()> {
 /// Loads the scene, places the lights and sets up the camera.
 pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> Result<Prepared> {
     let start = Instant::now();
-    let (mesh, name) = load_source_quiet(&args.source, args.quiet)?;
-    let bounds = mesh.bounds().context("the mesh has no vertices")?;
-    let staging = args.source.staging(bounds);
-    let mut specs = args.lights.specs();
-    if specs.is_empty() && need_lights {
-        match staging {
-            Some(s) => specs.push(LightSpec::Point(s.light)),
-            None => bail!(
-                "no light: give at least one --light X,Y,Z (a point light) or --sun X,Y,Z (a light \
-                 at infinity)"
-            ),
-        }
+    let specs = args.lights.specs();
+    let s = Scene::load(
+        &args.source,
+        specs,
+        need_lights,
+        args.quiet,
+        &mut Phases::default(),
+    )?;
+    let (at, framed) = args.camera.viewpoint(&s.mesh, s.staging, size, args.fov);
+    if framed && !args.quiet {
+        eprintln!("note: camera {}", viewpoint_flags(&at, s.bounds));
     }
-    let (eye, default_target) = match (args.camera.eye, staging) {
-        (Some(e), _) => (e, (bounds.0 + bounds.1) * 0.5),
-        (None, Some(s)) => (s.eye, s.target),
-        (None, None) => bail!(
-            "no viewpoint: give --eye X,Y,Z (only the built-in room and bunnies have a default)"
-        ),
-    };
-    let target = args.camera.target.unwrap_or(default_target);
-    let forward = target - eye;
-    let up = match args.camera.up {
-        Some(u) => u,
-        None => {
-            let pref = staging.and_then(|s| s.up).unwrap_or(DVec3::Z);
-            [pref, DVec3::Y, DVec3::X]
-                .into_iter()
-                .find(|u| forward.normalize_or_zero().cross(*u).length() > 1e-3)
-                .unwrap_or(DVec3::X)
-        }
-    };
+    let target = at.target.unwrap_or((s.bounds.0 + s.bounds.1) * 0.5);
+    let up = at.up.unwrap_or_else(|| default_up(at.eye, target));
     let camera =
-        Camera::look_at(eye, target, up, args.fov, size.0, size.1).map_err(raster_error)?;
-    let grid = shared_grid(&mesh.positions, &specs).with_context(|| name.clone())?;
-    let placed = place_lights(&grid, &specs)?;
-    let loops = mesh.face_loops();
-    let (polys, report) = import_faces_par(&grid, &loops)
-        .with_context(|| format!("{name}: cannot import the faces"))?;
-    let summary = report.summary();
-    if !summary.is_empty() && !args.quiet {
-        eprintln!("note: {name}: {}", summary.trim_end());
+        Camera::look_at(at.eye, target, up, args.fov, size.0, size.1).map_err(raster_error)?;
+    if s.polys.is_empty() {
+        bail!("{}: nothing to draw: no face has an area", s.name);
     }
-    if polys.is_empty() {
-        bail!("{name}: nothing to draw: no face has an area");
-    }
-    let scene = RasterScene::new(&grid, polys)?;
     Ok(Prepared {
-        faces: mesh.faces.len(),
-        colors: face_colors(&mesh),
-        name,
-        scene,
-        light_notes: placed.iter().map(describe).collect(),
-        lights: placed,
+        faces: s.mesh.faces.len(),
+        colors: face_colors(&s.mesh),
+        scene: RasterScene::new(&s.grid, s.polys)?,
+        light_notes: s.lights.iter().map(describe).collect(),
+        lights: s.lights,
+        name: s.name,
         camera,
         load_time: start.elapsed(),
     })
@@ -425,14 +377,11 @@ mod tests {
 
     #[test]
     fn methods_and_biases_parse() {
-        assert_eq!(parse_method("shadow-map"), Ok(Method::ShadowMap));
-        assert!(
-            parse_method("phong")
-                .unwrap_err()
-                .contains("available: exact, raycast")
-        );
-        assert_eq!(parse_hsr("warnock"), Ok(Hsr::Warnock));
-        assert!(parse_hsr("painter").is_err());
+        assert_eq!(" shadow-map".parse(), Ok(Method::ShadowMap));
+        let e = "phong".parse::<Method>().unwrap_err().to_string();
+        assert!(e.contains("available: exact, raycast"), "{e}");
+        assert_eq!("warnock".parse(), Ok(Hsr::Warnock));
+        assert!("painter".parse::<Hsr>().is_err());
         assert_eq!(parse_bias("0.01"), Ok((0.01, 1.5)));
         assert_eq!(parse_bias("0,2"), Ok((0.0, 2.0)));
         assert!(parse_bias("-1").is_err());

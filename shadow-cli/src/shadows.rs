@@ -19,22 +19,21 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
-use bsp_core::{BspTree, BuildOptions, Grid, ImportReport, Polygon, import_faces_par};
+use bsp_core::{BspTree, BuildOptions, Polygon};
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use rayon::prelude::*;
-use shadow_raster::svg::{SvgFragment, SvgPicture, SvgView, SvgViewpoint};
-use shadow_scene::{Mesh, ROOM_EYE, ROOM_LIGHT, ROOM_TARGET};
+use shadow_raster::svg::{SvgFragment, SvgView, SvgViewpoint};
 use svbsp::export::{
     AreaRecord, FragmentFile, FragmentFormat, area_records, json_fragments, world_vertices,
 };
 use svbsp::{
-    Areas, Batch, CHUNK, LightSpec, PlacedLight, ShadeOptions, Shadows, chin_feiner, receivers,
+    Areas, Batch, CHUNK, LightSpec, ShadeOptions, Shadows, chin_feiner, percent, receivers,
 };
 
-use crate::args::{CameraArgs, ImageArgs, LightArgs, SourceArgs};
-use crate::input::load_source_quiet;
-use crate::lights::{describe, place_lights, shared_grid};
+use crate::args::{CameraArgs, ImageArgs, LightArgs, SourceArgs, viewpoint_flags};
+use crate::input::{NO_LIGHT, Scene};
+use crate::lights::describe;
 use crate::output::{Output, Phases, emit, guarded};
 use crate::progress::Progress;
 use crate::raster_error;
@@ -110,16 +109,6 @@ impl Format {
     }
 }
 
-/// A scene ready to be shaded: its mesh, grid, lights and polygons.
-struct Scene {
-    mesh: Mesh,
-    name: String,
-    grid: Grid,
-    lights: Vec<PlacedLight>,
-    polys: Vec<Polygon>,
-    report: ImportReport,
-}
-
 /// What a run reports.
 #[derive(Default)]
 struct Figures {
@@ -130,109 +119,31 @@ struct Figures {
     extra: String,
 }
 
-/// Draws the fragments of the scene tree's polygons (`batch`, receiver =
-/// polygon index) in the tree's painter's order.
-fn render(
-    scene: &Scene,
-    tree: &BspTree,
-    at: &SvgViewpoint,
-    batch: &Batch,
-    world: &[DVec3],
-) -> Result<SvgPicture> {
-    let bounds = scene
-        .mesh
-        .bounds()
-        .context("nothing to draw: the mesh has no vertices")?;
-    let view = SvgView::new(&scene.grid, bounds, at).map_err(raster_error)?;
-    let colors = shadow_scene::face_colors(&scene.mesh);
-    let centres = scene.mesh.face_centres();
-    let frags = SvgFragment::of_batch(batch, world);
-    view.fragments(
-        tree,
-        &scene.lights,
-        &frags,
-        (&colors, &centres),
-        "shadow shadows",
-    )
-    .map_err(raster_error)
-}
-
-/// The SVG camera: the given eye, or for the room the demo's viewpoint.
-fn svg_view(args: &ShadowsArgs, is_room: bool) -> Result<SvgViewpoint> {
-    let c = &args.camera;
-    let (eye, target) = match (c.eye, is_room) {
-        (Some(eye), _) => (eye, c.target),
-        (None, true) => (ROOM_EYE, Some(c.target.unwrap_or(ROOM_TARGET))),
-        (None, false) => bail!(
-            "SVG output needs a viewpoint: give --eye X,Y,Z (only --scene room has a default)"
-        ),
-    };
-    Ok(SvgViewpoint {
-        eye,
-        target,
-        up: c.up,
-        width: args.image.width,
-        height: args.image.height,
-        fov_deg: args.image.fov,
-    })
-}
-
 // ------------------------------------------------------------- command
 
 /// What the command line asks for, checked before any work is done.
 struct Request {
     format: Format,
-    /// The SVG's viewpoint (SVG output only).
-    view: Option<SvgViewpoint>,
+    /// The lights given.
     specs: Vec<LightSpec>,
-    /// No light was given: the room's default light stands in.
-    default_light: bool,
 }
 
 impl Request {
-    /// Fails on a bad output name, a missing viewpoint or a missing light.
+    /// Fails on a bad output name, or no light for a file (a built-in
+    /// scene may have its own).
     fn of(args: &ShadowsArgs) -> Result<Request> {
         let format = Format::from_path(&args.output)?;
-        let is_room = args.source.is_scene("room");
-        let view = match format {
-            Format::Svg => Some(svg_view(args, is_room)?),
-            _ => None,
-        };
-        if view.is_none() && args.camera.any() {
+        if format != Format::Svg && args.camera.any() {
             note(
                 args,
                 "note: --eye, --target and --up only apply to SVG output",
             );
         }
-        let mut specs = args.lights.specs();
-        let default_light = specs.is_empty();
-        if default_light {
-            if !is_room {
-                bail!(
-                    "no light: give at least one --light X,Y,Z (a point light) or --sun X,Y,Z \
-                     (a light at infinity); both can be repeated"
-                );
-            }
-            specs.push(LightSpec::Point(ROOM_LIGHT));
+        let specs = args.lights.specs();
+        if specs.is_empty() && args.source.input.is_some() {
+            bail!("{NO_LIGHT}");
         }
-        Ok(Request {
-            format,
-            view,
-            specs,
-            default_light,
-        })
-    }
-
-    /// The lights, as the report names them.
-    fn light_count(&self) -> String {
-        match (self.specs.len(), self.default_light) {
-            (_, true) => format!(
-                "the room's default light ({})",
-                crate::lights::flag(&self.specs[0])
-            ),
-            (1, false) => "1 light".to_string(),
-            (n, false) => format!("{n} lights"),
-        }
+        Ok(Request { format, specs })
     }
 }
 
@@ -249,7 +160,21 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
     let request = Request::of(args)?;
     let progress = Progress::new(!args.quiet);
     let mut phases = Phases::default();
-    let scene = load(args, &request.specs, &mut phases, &progress)?;
+    progress.phase("loading", 1);
+    let scene = Scene::load(&args.source, request.specs, true, args.quiet, &mut phases)?;
+    let view = (request.format == Format::Svg).then(|| {
+        let size = args.image.size();
+        let (at, framed) = args
+            .camera
+            .viewpoint(&scene.mesh, scene.staging, size, args.image.fov);
+        if framed {
+            note(
+                args,
+                &format!("note: camera {}", viewpoint_flags(&at, scene.bounds)),
+            );
+        }
+        at
+    });
     let mut out = Output::create(&args.output)?;
     let mut job = Job {
         args,
@@ -262,7 +187,7 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
         fig: Figures::default(),
     };
     guarded("the input and the command line", || {
-        job.run(request.view.as_ref(), &mut out)
+        job.run(view.as_ref(), &mut out)
     })?;
     out.commit()?;
     progress.finish();
@@ -277,45 +202,12 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
         scene.mesh.faces.len(),
         scene.name,
         job.fig.extra,
-        request.light_count(),
+        scene.light_count(),
     );
     if args.stats {
         report += &stats_text(&scene, &job.fig, areas, &job.phases, total);
     }
     emit(&report)
-}
-
-/// Loads the scene, snaps it and its point lights to one grid and
-/// imports its faces.
-fn load(
-    args: &ShadowsArgs,
-    specs: &[LightSpec],
-    phases: &mut Phases,
-    progress: &Progress,
-) -> Result<Scene> {
-    progress.phase("loading", 1);
-    let (mesh, name) = phases.run("load", || load_source_quiet(&args.source, args.quiet))?;
-    progress.phase("snapping", 1);
-    let scene = phases.run("snap/import", || -> Result<Scene> {
-        let grid = shared_grid(&mesh.positions, specs).with_context(|| name.clone())?;
-        let lights = place_lights(&grid, specs)?;
-        let loops = mesh.face_loops();
-        let (polys, report) = import_faces_par(&grid, &loops)
-            .with_context(|| format!("{name}: cannot import the faces"))?;
-        Ok(Scene {
-            mesh,
-            name,
-            grid,
-            lights,
-            polys,
-            report,
-        })
-    })?;
-    let summary = scene.report.summary();
-    if !summary.is_empty() {
-        note(args, &format!("{}: {}", scene.name, summary.trim_end()));
-    }
-    Ok(scene)
 }
 
 /// One run's shading and writing, and what it counts.
@@ -405,25 +297,12 @@ impl Job<'_> {
         self.fig.receivers = polys.len();
         self.progress.phase("shading", polys.len() as u64);
         let progress = self.progress;
+        let ranges: Vec<Range<usize>> = (0..polys.len()).map(|i| i..i + 1).collect();
         self.phases.run("shading", || {
-            let ranges: Vec<Range<usize>> = (0..polys.len()).map(|i| i..i + 1).collect();
-            let parts: Vec<Batch> = ranges
-                .par_chunks(CHUNK)
-                .enumerate()
-                .map(|(i, rs)| {
-                    let first = (i * CHUNK) as u32;
-                    let b = shadows
-                        .set()
-                        .shade_ranges(&polys, rs, first, &ShadeOptions::default());
-                    progress.inc(rs.len() as u64);
-                    b
-                })
-                .collect();
-            let mut all = Batch::new();
-            for b in &parts {
-                all.append(b);
-            }
-            all
+            let opts = ShadeOptions::default();
+            shadows
+                .set()
+                .shade_par(&polys, &ranges, &opts, |n| progress.inc(n as u64))
         })
     }
 
@@ -476,7 +355,18 @@ impl Job<'_> {
         for r in area_records(batch, world) {
             self.areas.add(r.face, r.area, r.lit, r.facing);
         }
-        let r = render(self.scene, tree, view, batch, world)?;
+        let frags = SvgFragment::of_batch(batch, world);
+        let (scene, what) = (self.scene, "shadow shadows");
+        let r = SvgView::mesh_fragments(
+            &scene.grid,
+            &scene.mesh,
+            view,
+            tree,
+            &scene.lights,
+            &frags,
+            what,
+        )
+        .map_err(raster_error)?;
         out.write_all(r.svg.as_bytes())?;
         self.fig.extra = format!(
             ", {} drawn, eye {:.3},{:.3},{:.3}",
@@ -538,14 +428,6 @@ impl Job<'_> {
 /// units, their areas and (for JSON) their text.
 type Shaded = (Batch, Vec<DVec3>, Vec<AreaRecord>, Vec<u8>);
 
-fn percent(part: f64, whole: f64) -> f64 {
-    if whole > 0.0 {
-        100.0 * part / whole
-    } else {
-        0.0
-    }
-}
-
 /// The `--stats` report.
 fn stats_text(
     scene: &Scene,
@@ -606,62 +488,14 @@ fn stats_text(
         total.as_secs_f64() * 1e3,
         rayon::current_num_threads()
     );
-    let _ = writeln!(
-        s,
-        "area:            {:.6} units² (every face once, its front side)",
-        areas.total
-    );
-    for i in 0..lights.len() {
-        let _ = writeln!(
-            s,
-            "light {i} area:    lit {:.6} ({:.1}%), in shadow {:.6} ({:.1}%): cast {:.6} ({:.1}%), \
-             facing away {:.6} ({:.1}%)",
-            areas.lit[i],
-            percent(areas.lit[i], areas.total),
-            areas.total - areas.lit[i],
-            percent(areas.total - areas.lit[i], areas.total),
-            areas.cast[i],
-            percent(areas.cast[i], areas.total),
-            areas.attached[i],
-            percent(areas.attached[i], areas.total),
-        );
-    }
-    if lights.len() > 1 {
-        let _ = writeln!(
-            s,
-            "no light:        {:.6} ({:.1}%)",
-            areas.dark,
-            percent(areas.dark, areas.total)
-        );
-    }
-    let top = areas.most_shaded(TOP_FACES);
-    if top.is_empty() {
-        let _ = writeln!(s, "cast shadow:     none");
-        return s;
-    }
-    let _ = writeln!(
-        s,
-        "faces with the most cast shadow (area in shadow while facing the light, % of the face):"
-    );
-    let mut header = format!("  {:>7}  {:<12} {:>12}", "face", "group", "area");
-    for i in 0..lights.len() {
-        header += &format!("  {:>20}", format!("light {i} shadow"));
-    }
-    let _ = writeln!(s, "{header}");
-    for f in top {
-        let area = areas.face_area(f);
-        let mut line = format!("  {f:>7}  {:<12} {area:>12.6}", scene.mesh.group_name(f));
-        for c in areas.face_cast(f) {
-            line += &format!("  {:>20}", format!("{c:.6} ({:.1}%)", percent(*c, area)));
-        }
-        let _ = writeln!(s, "{line}");
-    }
+    s += &areas.report(TOP_FACES, |f| scene.mesh.group_name(f).to_string());
     s
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use shadow_scene::{ROOM_EYE, ROOM_TARGET};
 
     #[test]
     fn formats_by_extension() {
@@ -683,7 +517,7 @@ mod tests {
     }
 
     #[test]
-    fn svg_needs_an_eye_except_for_the_room() {
+    fn svg_viewpoints_from_flags_staging_or_framing() {
         use clap::Parser;
         let parse = |extra: &[&str]| {
             let mut argv = vec!["shadow", "shadows", "-o", "x.svg"];
@@ -694,18 +528,33 @@ mod tests {
                 _ => panic!("not a shadows command"),
             }
         };
+        let cube = shadow_scene::scene("cube").unwrap();
+        let view = |a: &ShadowsArgs, staging| {
+            a.camera
+                .viewpoint(&cube, staging, a.image.size(), a.image.fov)
+        };
         let (room, _) = parse(&["--scene", "room"]);
-        let v = svg_view(&room, true).unwrap();
-        assert_eq!((v.eye, v.target), (ROOM_EYE, Some(ROOM_TARGET)));
-        let (file, _) = parse(&["a.obj", "--light", "0,0,-1"]);
+        let room_box = shadow_scene::room().bounds().unwrap();
+        let (v, framed) = view(&room, room.source.staging(room_box));
+        assert_eq!(
+            (v.eye, v.target, framed),
+            (ROOM_EYE, Some(ROOM_TARGET), false)
+        );
+        let (file, _) = parse(&["a.obj", "--light", "0,0,-1", "--up", "y"]);
         assert_eq!(file.lights.lights, vec![DVec3::NEG_Z]);
-        let e = svg_view(&file, false).unwrap_err().to_string();
-        assert!(e.contains("--eye"), "{e}");
+        let (v, framed) = view(&file, None);
+        assert!(framed);
+        assert_eq!(v.up, Some(DVec3::Y));
+        assert!((v.target.unwrap() - DVec3::splat(0.5)).length() < 0.1);
+        assert!(v.eye.y > 1.0 && v.eye.z > 1.0, "{:?}", v.eye);
         let (file, _) = parse(&[
             "a.obj", "--eye", "1,2,3", "--sun", "0,0,1", "--sun", "1,0,1",
         ]);
-        let v = svg_view(&file, false).unwrap();
-        assert_eq!((v.eye, v.target), (DVec3::new(1.0, 2.0, 3.0), None));
+        let (v, framed) = view(&file, None);
+        assert_eq!(
+            (v.eye, v.target, framed),
+            (DVec3::new(1.0, 2.0, 3.0), None, false)
+        );
         assert_eq!(file.lights.suns.len(), 2);
         let (file, threads) = parse(&[
             "a.obj",

@@ -9,13 +9,12 @@ use clap::Args;
 use shadow_raster::svg::{SvgPicture, SvgView, SvgViewpoint};
 use shadow_scene::{ROOM_EYE, ROOM_TARGET};
 
-use crate::args::{CameraArgs, ImageArgs, SourceArgs};
-use crate::input::{Prepared, load_source};
+use crate::args::{CameraArgs, ImageArgs, SourceArgs, viewpoint_flags};
+use crate::input::{Prepared, load_source, load_source_quiet};
 use crate::output::{emit, write_file};
 use crate::raster_error;
 
 #[derive(Args, Debug)]
-#[command(mut_arg("eye", |a| a.required(true)))]
 pub(crate) struct ViewArgs {
     #[command(flatten)]
     pub(crate) source: SourceArgs,
@@ -26,6 +25,9 @@ pub(crate) struct ViewArgs {
     pub(crate) output: PathBuf,
     #[command(flatten)]
     pub(crate) image: ImageArgs,
+    /// No notes on stderr (errors still go there).
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
 }
 
 #[derive(Args, Debug)]
@@ -53,16 +55,19 @@ fn draw(p: &Prepared, at: SvgViewpoint) -> Result<SvgPicture> {
 
 /// `shadow view`.
 pub(crate) fn view(args: &ViewArgs) -> Result<()> {
-    let (mesh, name) = load_source(&args.source)?;
+    let (mesh, name) = load_source_quiet(&args.source, args.quiet)?;
     let prepared = Prepared::new(mesh, &name)?;
-    let at = SvgViewpoint {
-        eye: args.camera.eye.expect("--eye is required"),
-        target: args.camera.target,
-        up: args.camera.up,
-        width: args.image.width,
-        height: args.image.height,
-        fov_deg: args.image.fov,
-    };
+    let bounds = prepared
+        .mesh
+        .bounds()
+        .context("nothing to draw: the mesh has no vertices")?;
+    let staging = args.source.staging(bounds);
+    let (at, framed) =
+        args.camera
+            .viewpoint(&prepared.mesh, staging, args.image.size(), args.image.fov);
+    if framed && !args.quiet {
+        eprintln!("note: camera {}", viewpoint_flags(&at, bounds));
+    }
     let out = draw(&prepared, at)?;
     write_file(&args.output, out.svg.as_bytes())?;
     emit(&format!(

@@ -10,6 +10,22 @@ fn png_size(path: &std::path::Path) -> (u32, u32) {
     (be(16), be(20))
 }
 
+/// A PNG's pixels, RGB row by row, and its width.
+fn rgb_of(path: &std::path::Path) -> (Vec<[u8; 3]>, u32) {
+    let file = std::fs::File::open(path).unwrap();
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    let px = buf[..info.buffer_size()]
+        .chunks(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect();
+    (px, info.width)
+}
+
 /// A usage error: exit code 1, `error: ` and a clear message, no panic.
 fn assert_usage_error(o: &std::process::Output, needles: &[&str]) {
     crate::assert_failed_with(o, needles);
@@ -301,10 +317,6 @@ fn bad_runs_are_clear_errors() {
     let teapot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/meshes/teapot.obj");
     let teapot = teapot.to_str().unwrap();
     fail(
-        &["render", teapot, "--light", "0,10,0", "-o", "x.png"],
-        &["--eye"],
-    );
-    fail(
         &["render", teapot, "--eye", "12,9,14", "-o", "x.png"],
         &["no light"],
     );
@@ -343,4 +355,59 @@ fn lines_need_closed_polyhedra() {
         scratch("teapot_lines.svg").to_str().unwrap(),
     ]);
     crate::assert_failed_with(&o, &["polyhedron 0", "not closed", "closed polyhedra"]);
+}
+
+/// A file with no camera flags is framed: the picture is written, the
+/// chosen camera is printed as the flags that give it, and with `--up y`
+/// a y-up scan stands upright (its top, the ears, is in the upper half)
+/// and fills more than a third of the picture.
+#[test]
+fn files_are_framed_without_camera_flags() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/meshes");
+    let bunny = data.join("bunny.obj");
+    let png = scratch("framed_bunny.png");
+    let o = shadow(&[
+        "render",
+        bunny.to_str().unwrap(),
+        "--up",
+        "y",
+        "--light",
+        "0.1,0.5,0.3",
+        "--size",
+        "320x240",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let note = stderr(&o);
+    assert!(
+        note.contains("note: camera --eye ") && note.contains(" --up 0,1,0"),
+        "{note}"
+    );
+    let (px, width) = rgb_of(&png);
+    let covered: Vec<(u32, u32)> = (0..px.len() as u32)
+        .filter(|&i| px[i as usize] != shadow_raster::BACKGROUND)
+        .map(|i| (i % width, i / width))
+        .collect();
+    let share = covered.len() as f64 / (320.0 * 240.0);
+    assert!(
+        share > 1.0 / 3.0,
+        "the bunny covers {share:.3} of the picture"
+    );
+    // upright: the ears reach higher than the body reaches wide of centre
+    let top = covered.iter().map(|p| p.1).min().unwrap();
+    let bottom = covered.iter().map(|p| p.1).max().unwrap();
+    assert!(top < 40 && bottom > 200, "rows {top}..{bottom}");
+    // the same framing for view (SVG), with the same note
+    let svg = scratch("framed_bunny.svg");
+    let o = shadow(&[
+        "view",
+        bunny.to_str().unwrap(),
+        "--up",
+        "y",
+        "-o",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("note: camera --eye "));
 }
