@@ -1,7 +1,5 @@
 //! The crate's error: input that cannot become geometry.
 
-use crate::kernel::grid::SnapError;
-
 /// Errors of this crate.
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
@@ -57,3 +55,23 @@ impl std::error::Error for Error {
         }
     }
 }
+
+/// Why a single coordinate could not be snapped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SnapError {
+    /// NaN or infinite.
+    NonFinite,
+    /// Outside the grid's range.
+    OutOfRange,
+}
+
+impl std::fmt::Display for SnapError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SnapError::NonFinite => f.write_str("coordinate is NaN or infinite"),
+            SnapError::OutOfRange => f.write_str("coordinate is outside the grid's range"),
+        }
+    }
+}
+
+impl std::error::Error for SnapError {}

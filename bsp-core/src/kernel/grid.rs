@@ -7,7 +7,7 @@
 
 use glam::DVec3;
 
-use crate::kernel::error::Error;
+use crate::kernel::error::{Error, SnapError};
 
 /// Number of bits of an input grid coordinate: `|g| < 2^GRID_BITS`.
 pub const GRID_BITS: u32 = 26;
@@ -226,26 +226,6 @@ impl Grid {
         self.to_world(v.0.map(|c| c as f64))
     }
 }
-
-/// Why a single coordinate could not be snapped.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SnapError {
-    /// NaN or infinite.
-    NonFinite,
-    /// Outside the grid's range.
-    OutOfRange,
-}
-
-impl std::fmt::Display for SnapError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            SnapError::NonFinite => f.write_str("coordinate is NaN or infinite"),
-            SnapError::OutOfRange => f.write_str("coordinate is outside the grid's range"),
-        }
-    }
-}
-
-impl std::error::Error for SnapError {}
 
 #[cfg(test)]
 mod tests {

@@ -12,9 +12,9 @@ pub(crate) mod polygon;
 mod side;
 
 pub use convex::{ConvexParts, SanityError, check_convex};
-pub use error::Error;
+pub use error::{Error, SnapError};
 pub use exact::{Homogeneous, approx, filter_ring_area, filter_side, filter_side_err};
-pub use grid::{GRID_BITS, Grid, GridPoint, MAX_COORD, MAX_VIEW_COORD, SnapError, ViewPoint};
+pub use grid::{GRID_BITS, Grid, GridPoint, MAX_COORD, MAX_VIEW_COORD, ViewPoint};
 pub use plane::{FaceDefect, MAX_NORMAL_BITS, MAX_OFFSET_BITS, Plane};
 pub use point::{Implicit, Point, PointRef};
 pub use polygon::{
