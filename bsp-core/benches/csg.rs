@@ -179,21 +179,7 @@ fn bench(c: &mut Criterion) {
 
 /// An axis-aligned box `[lo, hi]` as six outward quads.
 fn cuboid(lo: DVec3, hi: DVec3) -> Faces {
-    let p = |x: usize, y: usize, z: usize| {
-        DVec3::new(
-            if x == 1 { hi.x } else { lo.x },
-            if y == 1 { hi.y } else { lo.y },
-            if z == 1 { hi.z } else { lo.z },
-        )
-    };
-    vec![
-        vec![p(0, 0, 0), p(0, 1, 0), p(1, 1, 0), p(1, 0, 0)], // z = lo
-        vec![p(0, 0, 1), p(1, 0, 1), p(1, 1, 1), p(0, 1, 1)], // z = hi
-        vec![p(0, 0, 0), p(1, 0, 0), p(1, 0, 1), p(0, 0, 1)], // y = lo
-        vec![p(0, 1, 0), p(0, 1, 1), p(1, 1, 1), p(1, 1, 0)], // y = hi
-        vec![p(0, 0, 0), p(0, 0, 1), p(0, 1, 1), p(0, 1, 0)], // x = lo
-        vec![p(1, 0, 0), p(1, 1, 0), p(1, 1, 1), p(1, 0, 1)], // x = hi
-    ]
+    bsp_fixtures::cuboid(lo, hi)
 }
 
 /// 100 successive subtractions (alternately a 168-triangle sphere of

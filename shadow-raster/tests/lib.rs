@@ -83,27 +83,9 @@ pub(crate) fn mesh(faces: &[Vec<DVec3>]) -> Mesh {
     m
 }
 
-/// A closed box `[lo, hi]`, faces counter-clockwise from outside, vertices
-/// shared.
+/// A closed box `[lo, hi]`, faces counter-clockwise from outside.
 pub(crate) fn cuboid(lo: DVec3, hi: DVec3) -> Vec<Vec<DVec3>> {
-    let v = |i: usize| {
-        DVec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        )
-    };
-    [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [1, 3, 7, 5],
-        [3, 2, 6, 7],
-        [2, 0, 4, 6],
-    ]
-    .iter()
-    .map(|f| f.iter().map(|&i| v(i)).collect())
-    .collect()
+    bsp_fixtures::cuboid(lo, hi)
 }
 
 /// Share of pixels where two masks differ.

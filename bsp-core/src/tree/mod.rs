@@ -262,17 +262,7 @@ mod tests {
     use crate::kernel::{Point, PolygonSide, ViewPoint};
 
     fn cube(lo: i32, hi: i32) -> Vec<Polygon> {
-        let c = |x, y, z| [x, y, z];
-        let (l, h) = (lo, hi);
-        let quads = [
-            [c(l, l, l), c(l, h, l), c(h, h, l), c(h, l, l)],
-            [c(l, l, h), c(h, l, h), c(h, h, h), c(l, h, h)],
-            [c(l, l, l), c(h, l, l), c(h, l, h), c(l, l, h)],
-            [c(l, h, l), c(l, h, h), c(h, h, h), c(h, h, l)],
-            [c(l, l, l), c(l, l, h), c(l, h, h), c(l, h, l)],
-            [c(h, l, l), c(h, h, l), c(h, h, h), c(h, l, h)],
-        ];
-        quads
+        bsp_fixtures::grid_cuboid([lo; 3], [hi; 3])
             .iter()
             .enumerate()
             .map(|(i, q)| Polygon::from_grid_points(q, i as u32).unwrap())

@@ -1128,24 +1128,7 @@ mod tests {
     use super::*;
 
     fn cube(lo: [i32; 3], hi: [i32; 3]) -> Vec<Polygon> {
-        let (l, h) = (lo, hi);
-        let c = |x: bool, y: bool, z: bool| {
-            [
-                if x { h[0] } else { l[0] },
-                if y { h[1] } else { l[1] },
-                if z { h[2] } else { l[2] },
-            ]
-        };
-        let (f, t) = (false, true);
-        let quads = [
-            [c(f, f, f), c(f, t, f), c(t, t, f), c(t, f, f)],
-            [c(f, f, t), c(t, f, t), c(t, t, t), c(f, t, t)],
-            [c(f, f, f), c(t, f, f), c(t, f, t), c(f, f, t)],
-            [c(f, t, f), c(f, t, t), c(t, t, t), c(t, t, f)],
-            [c(f, f, f), c(f, f, t), c(f, t, t), c(f, t, f)],
-            [c(t, f, f), c(t, t, f), c(t, t, t), c(t, f, t)],
-        ];
-        quads
+        bsp_fixtures::grid_cuboid(lo, hi)
             .iter()
             .map(|q| Polygon::from_grid_points(q, 0).unwrap())
             .collect()

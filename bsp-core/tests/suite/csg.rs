@@ -125,24 +125,8 @@ impl Shape {
 /// An axis-aligned box, faces counter-clockwise seen from outside.
 fn cuboid(lo: GridPoint, hi: GridPoint) -> Shape {
     assert!((0..3).all(|k| lo[k] < hi[k]), "{lo:?} {hi:?}");
-    let c = |x: bool, y: bool, z: bool| {
-        [
-            if x { hi[0] } else { lo[0] },
-            if y { hi[1] } else { lo[1] },
-            if z { hi[2] } else { lo[2] },
-        ]
-    };
-    let (f, t) = (false, true);
-    let faces = [
-        [c(f, f, f), c(f, t, f), c(t, t, f), c(t, f, f)],
-        [c(f, f, t), c(t, f, t), c(t, t, t), c(f, t, t)],
-        [c(f, f, f), c(t, f, f), c(t, f, t), c(f, f, t)],
-        [c(f, t, f), c(f, t, t), c(t, t, t), c(t, t, f)],
-        [c(f, f, f), c(f, f, t), c(f, t, t), c(f, t, f)],
-        [c(t, f, f), c(t, t, f), c(t, t, t), c(t, f, t)],
-    ];
     Shape {
-        faces: faces.iter().map(|q| q.to_vec()).collect(),
+        faces: bsp_fixtures::grid_cuboid(lo, hi),
     }
 }
 

@@ -95,25 +95,10 @@ mod tests {
     }
 
     fn cube(lo: i32, hi: i32) -> Vec<Polygon> {
-        let c = |x: bool, y: bool, z: bool| {
-            [
-                if x { hi } else { lo },
-                if y { hi } else { lo },
-                if z { hi } else { lo },
-            ]
-        };
-        let (f, t) = (false, true);
-        [
-            [c(f, f, f), c(f, t, f), c(t, t, f), c(t, f, f)],
-            [c(f, f, t), c(t, f, t), c(t, t, t), c(f, t, t)],
-            [c(f, f, f), c(t, f, f), c(t, f, t), c(f, f, t)],
-            [c(f, t, f), c(f, t, t), c(t, t, t), c(t, t, f)],
-            [c(f, f, f), c(f, f, t), c(f, t, t), c(f, t, f)],
-            [c(t, f, f), c(t, t, f), c(t, t, t), c(t, f, t)],
-        ]
-        .iter()
-        .map(|q| Polygon::from_grid_points(q, 0).unwrap())
-        .collect()
+        bsp_fixtures::grid_cuboid([lo; 3], [hi; 3])
+            .iter()
+            .map(|q| Polygon::from_grid_points(q, 0).unwrap())
+            .collect()
     }
 
     #[test]

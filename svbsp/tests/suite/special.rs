@@ -20,16 +20,7 @@ fn flip(l: &Loop) -> Loop {
 
 /// The six faces of the box `[a, b]`, facing outward.
 fn cube(a: [i32; 3], b: [i32; 3]) -> Vec<Loop> {
-    let [x0, y0, z0] = a;
-    let [x1, y1, z1] = b;
-    vec![
-        up(x0, y0, x1, y1, z1),
-        flip(&up(x0, y0, x1, y1, z0)),
-        vec![[x0, y0, z0], [x1, y0, z0], [x1, y0, z1], [x0, y0, z1]], // y = y0, faces -y
-        vec![[x0, y1, z0], [x0, y1, z1], [x1, y1, z1], [x1, y1, z0]], // y = y1, faces +y
-        vec![[x0, y0, z0], [x0, y0, z1], [x0, y1, z1], [x0, y1, z0]], // x = x0, faces -x
-        vec![[x1, y0, z0], [x1, y1, z0], [x1, y1, z1], [x1, y0, z1]], // x = x1, faces +x
-    ]
+    bsp_fixtures::grid_cuboid(a, b)
 }
 
 #[test]
