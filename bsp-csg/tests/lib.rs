@@ -1,0 +1,5 @@
+//! bsp-csg's integration tests, one binary: each module is one subject.
+
+mod certify;
+mod differential;
+mod drill;

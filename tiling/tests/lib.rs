@@ -1,0 +1,4 @@
+//! tiling's integration tests, one binary: each module is one subject.
+
+mod conservative;
+mod pipeline;
