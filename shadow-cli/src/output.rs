@@ -3,91 +3,53 @@
 //! no half-written file), the report on stdout, the time of each phase,
 //! and panics turned into errors that say they are bugs.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::panic;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow};
+use shadow_scene::AtomicFile;
 
-/// The temporary file being written, removed if the run is interrupted.
-static PARTIAL: Mutex<Option<PathBuf>> = Mutex::new(None);
-
-/// Removes the partial output (if any) when the user interrupts the run,
-/// then exits with the conventional status 130.
+/// Removes the unfinished outputs when the user interrupts the run
+/// (Ctrl-C) or it is told to stop (SIGTERM, as from `timeout`), then exits
+/// with the conventional status 130.
 pub(crate) fn clean_up_on_interrupt() {
     // a second installation (in tests) fails harmlessly
     let _ = ctrlc::set_handler(|| {
-        if let Some(p) = PARTIAL.lock().unwrap_or_else(|e| e.into_inner()).take() {
-            let _ = std::fs::remove_file(p);
-        }
+        shadow_scene::remove_unfinished();
         std::process::exit(130);
     });
 }
 
-/// An output file written under a temporary name beside it and renamed
-/// into place by [`Output::commit`]; dropped without a commit, it removes
-/// the temporary file.
-pub(crate) struct Output {
-    path: PathBuf,
-    tmp: PathBuf,
-    file: Option<BufWriter<File>>,
-}
+/// An output file written whole or not at all ([`AtomicFile`]), its
+/// errors naming it.
+pub(crate) struct Output(AtomicFile);
 
 impl Output {
     /// Creates the temporary file for `path`.
     pub(crate) fn create(path: &Path) -> Result<Output> {
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "output".into());
-        let tmp = path.with_file_name(format!(".{name}.{}.partial", std::process::id()));
-        let file =
-            File::create(&tmp).with_context(|| format!("could not write {}", path.display()))?;
-        *PARTIAL.lock().unwrap_or_else(|e| e.into_inner()) = Some(tmp.clone());
-        Ok(Output {
-            path: path.to_path_buf(),
-            tmp,
-            file: Some(BufWriter::with_capacity(1 << 20, file)),
-        })
-    }
-
-    /// The writer.
-    pub(crate) fn writer(&mut self) -> &mut BufWriter<File> {
-        self.file.as_mut().expect("not committed yet")
+        let f = AtomicFile::create(path)
+            .with_context(|| format!("could not write {}", path.display()))?;
+        Ok(Output(f))
     }
 
     /// Flushes the file and renames it into place.
-    pub(crate) fn commit(mut self) -> Result<()> {
-        let ctx = || format!("could not write {}", self.path.display());
-        let file = self.file.take().expect("not committed yet");
-        file.into_inner()
-            .map_err(|e| e.into_error())
-            .and_then(|f| f.sync_data())
-            .with_context(ctx)?;
-        std::fs::rename(&self.tmp, &self.path).with_context(ctx)?;
-        PARTIAL.lock().unwrap_or_else(|e| e.into_inner()).take();
-        Ok(())
-    }
-}
-
-impl Drop for Output {
-    fn drop(&mut self) {
-        if self.file.take().is_some() {
-            let _ = std::fs::remove_file(&self.tmp);
-            PARTIAL.lock().unwrap_or_else(|e| e.into_inner()).take();
-        }
+    pub(crate) fn commit(self) -> Result<()> {
+        let path = self.0.path().to_path_buf();
+        self.0
+            .commit()
+            .with_context(|| format!("could not write {}", path.display()))
     }
 }
 
 impl Write for Output {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.writer().write(buf)
+        self.0.write(buf)
     }
     fn flush(&mut self) -> std::io::Result<()> {
-        self.writer().flush()
+        self.0.flush()
     }
 }
 
@@ -163,12 +125,23 @@ pub(crate) fn emit(text: &str) -> Result<()> {
     }
 }
 
-/// Writes `contents` to `path` through an [`Output`].
+/// Writes `path` whole or not at all.
 pub(crate) fn write_file(path: &Path, contents: &[u8]) -> Result<()> {
-    let mut o = Output::create(path)?;
-    o.write_all(contents)
-        .with_context(|| format!("could not write {}", path.display()))?;
-    o.commit()
+    write_files(&[(path, contents)])
+}
+
+/// Writes every file whole, or none of them: each is written under its
+/// temporary name first, and only when all are written are they renamed
+/// into place.
+pub(crate) fn write_files(files: &[(&Path, &[u8])]) -> Result<()> {
+    let mut outs = Vec::with_capacity(files.len());
+    for &(path, contents) in files {
+        let mut o = Output::create(path)?;
+        o.write_all(contents)
+            .with_context(|| format!("could not write {}", path.display()))?;
+        outs.push(o);
+    }
+    outs.into_iter().try_for_each(Output::commit)
 }
 
 #[cfg(test)]

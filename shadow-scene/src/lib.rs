@@ -45,6 +45,7 @@
 use std::path::Path;
 
 mod animated;
+mod atomic;
 mod error;
 mod mesh;
 mod obj;
@@ -57,6 +58,7 @@ mod stl;
 pub use animated::{
     ANIMATED_NAMES, Animated, BUNNY_LIGHT, ROOM_EYE, ROOM_LIGHT, ROOM_TARGET, animated, torus,
 };
+pub use atomic::{AtomicFile, remove_unfinished};
 pub use error::SceneError;
 pub use mesh::{Face, Mesh, MeshView, Triangles};
 pub use obj::{ObjNotes, parse_obj, parse_obj_notes, read_obj, read_obj_notes, write_obj};
@@ -123,7 +125,8 @@ pub fn load_notes(path: &Path) -> Result<(Mesh, ObjNotes), SceneError> {
 }
 
 /// Writes `mesh` as OBJ ([`write_obj`]) or binary STL ([`write_stl`]),
-/// chosen by `path`'s extension as for [`load`]. Errors name the file.
+/// chosen by `path`'s extension as for [`load`], whole or not at all
+/// ([`AtomicFile`]). Errors name the file.
 ///
 /// ```
 /// use std::path::Path;
@@ -138,11 +141,12 @@ pub fn save<M: MeshView + ?Sized>(path: &Path, mesh: &M) -> Result<(), SceneErro
         path: path.display().to_string(),
         source,
     };
-    let file = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+    let mut file = AtomicFile::create(path).map_err(io)?;
     match format {
-        MeshFormat::Obj => write_obj(mesh, file),
-        MeshFormat::Stl => write_stl(mesh, file),
+        MeshFormat::Obj => write_obj(mesh, &mut file),
+        MeshFormat::Stl => write_stl(mesh, &mut file),
     }
+    .and_then(|()| file.commit())
     .map_err(io)
 }
 

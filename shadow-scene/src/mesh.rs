@@ -501,7 +501,7 @@ impl Mesh {
     /// two.append(&cube, "moved_", |p| p + DVec3::X * 2.0);
     /// assert_eq!(two.faces.len(), 12);
     /// assert_eq!(two.signed_volume(), 2.0);
-    /// assert_eq!(two.group_name(two.faces[6].group as usize), "moved_cube");
+    /// assert_eq!(two.group_name(6), "moved_cube");
     /// ```
     pub fn append(&mut self, other: &Mesh, prefix: &str, at: impl Fn(DVec3) -> DVec3) {
         let first = self.positions.len() as u32;
