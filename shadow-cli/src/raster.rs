@@ -7,12 +7,12 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::Args;
 use glam::DVec3;
 use shadow_raster::{
     Camera, Hsr, Method, RasterScene, RenderOptions, ShadowOptions, compare, default_up,
-    hidden_lines, render, write_pgm,
+    encode_pgm, hidden_lines, render,
 };
 use shadow_scene::face_colors;
 use svbsp::PlacedLight;
@@ -20,7 +20,7 @@ use svbsp::PlacedLight;
 use crate::args::{CameraArgs, LightArgs, SourceArgs, parse_fov, parse_size, viewpoint_flags};
 use crate::input::Scene;
 use crate::lights::describe;
-use crate::output::{Phases, emit};
+use crate::output::{Phases, emit, write_file, write_files};
 use crate::raster_error;
 
 /// `C` or `C,S`: constant and slope-scaled bias, not negative.
@@ -251,11 +251,12 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
             .with_shadow(shadow);
         let out = render(&p.scene, &p.lights, &p.camera, &p.colors, &opts)?;
         let t = Instant::now();
-        out.image.write_png(&args.output)?;
         let mask = out.mask();
-        if let Some(path) = &args.mask {
-            write_pgm(path, args.size.0, args.size.1, &mask)?;
-        }
+        let png = out.image.encode_png();
+        let pgm = encode_pgm(args.size.0, args.size.1, &mask);
+        let mut files = vec![(args.output.as_path(), &png[..])];
+        files.extend(args.mask.as_deref().map(|m| (m, &pgm[..])));
+        write_files(&files)?;
         let write = t.elapsed();
         let seen = mask.iter().filter(|&&m| m != 0).count();
         let lit = mask.iter().filter(|&&m| m == 255).count();
@@ -316,12 +317,13 @@ pub(crate) fn run_compare(args: &CompareArgs) -> Result<()> {
             args.methods.clone()
         };
         let cmp = compare(&p.scene, &p.lights, &p.camera, &p.colors, &shadow, &methods)?;
-        cmp.image(args.columns as usize, args.highlight)
-            .write_png(&args.output)?;
+        let png = cmp
+            .image(args.columns as usize, args.highlight)
+            .encode_png();
         let csv = cmp.csv();
-        if let Some(r) = &args.report {
-            std::fs::write(r, &csv).with_context(|| format!("could not write {}", r.display()))?;
-        }
+        let mut files = vec![(args.output.as_path(), &png[..])];
+        files.extend(args.report.as_deref().map(|r| (r, csv.as_bytes())));
+        write_files(&files)?;
         let mut text = format!(
             "wrote {}: {} methods on {} ({} faces), {}x{} each; visibility {:.1} ms\n",
             args.output.display(),
@@ -354,8 +356,7 @@ pub(crate) fn run_lines(args: &LinesArgs) -> Result<()> {
     {
         let p = prepare(&args.scene, args.size, false)?;
         let lines = hidden_lines(&p.scene, &p.camera)?;
-        std::fs::write(&args.output, lines.svg(args.hidden))
-            .with_context(|| format!("could not write {}", args.output.display()))?;
+        write_file(&args.output, lines.svg(args.hidden).as_bytes())?;
         emit(&format!(
             "wrote {}: {} polyhedra ({} convex), {} edges, {} visible and {} hidden parts; \
              z-buffer check: {} of {} points agree\n",

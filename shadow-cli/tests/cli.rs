@@ -347,3 +347,85 @@ fn csg_operands_read_in_parallel_report_in_the_order_of_the_files() {
     );
     assert!(!out.exists());
 }
+
+/// Every command writes the same bytes on 1, 2 and 8 worker threads
+/// (`shadows` has its own test on a scene of many rounds).
+#[test]
+fn every_command_writes_the_same_for_every_thread_count() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/meshes");
+    let sphere = data.join("pyvista_sphere.obj");
+    let moved = scratch("threads_moved_sphere.obj");
+    let text = std::fs::read_to_string(&sphere).unwrap();
+    let shifted: String = text
+        .lines()
+        .map(|l| match l.strip_prefix("v ") {
+            Some(v) => {
+                let c: Vec<f64> = v.split_whitespace().map(|x| x.parse().unwrap()).collect();
+                format!("v {} {} {}\n", c[0] + 0.1, c[1] + 0.05, c[2] + 0.02)
+            }
+            None => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(&moved, shifted).unwrap();
+    let (a, b) = (sphere.to_str().unwrap(), moved.to_str().unwrap());
+    // each command and the files it writes (under the name OUT)
+    let runs: [(&[&str], &[&str]); 6] = [
+        (&["csg", "union", a, b, "-o", "OUT.obj"], &["OUT.obj"]),
+        (
+            &[
+                "render",
+                "--scene",
+                "room",
+                "--size",
+                "160x90",
+                "--method",
+                "shadow-map",
+                "-o",
+                "OUT.png",
+                "--mask",
+                "OUT.pgm",
+            ],
+            &["OUT.png", "OUT.pgm"],
+        ),
+        (
+            &[
+                "compare", "--scene", "room", "--size", "96x54", "-o", "OUT.png", "--report",
+                "OUT.csv",
+            ],
+            &["OUT.png"],
+        ),
+        (&["view", "--scene", "room", "-o", "OUT.svg"], &["OUT.svg"]),
+        (
+            &["lines", "--scene", "chair", "-o", "OUT.svg"],
+            &["OUT.svg"],
+        ),
+        (
+            &[
+                "animate", "--scene", "room", "--frames", "2", "--format", "json", "-o", "OUT",
+            ],
+            &["OUT/frame_0000.json", "OUT/frame_0001.json"],
+        ),
+    ];
+    for (k, (args, files)) in runs.iter().enumerate() {
+        let mut outputs: Vec<Vec<Vec<u8>>> = Vec::new();
+        for threads in ["1", "2", "8"] {
+            let out = scratch(&format!("threads_{k}_{threads}"));
+            let out = out.to_str().unwrap();
+            let argv: Vec<String> = args.iter().map(|a| a.replace("OUT", out)).collect();
+            let mut argv: Vec<&str> = argv.iter().map(String::as_str).collect();
+            argv.extend(["--threads", threads]);
+            let o = shadow(&argv);
+            assert!(o.status.success(), "{argv:?}: {}", stderr(&o));
+            let bytes = files
+                .iter()
+                .map(|f| std::fs::read(f.replace("OUT", out)).unwrap())
+                .collect();
+            outputs.push(bytes);
+        }
+        assert!(outputs[0].iter().all(|f| !f.is_empty()), "{args:?}");
+        assert!(
+            outputs.iter().all(|o| *o == outputs[0]),
+            "{args:?} differs with the thread count"
+        );
+    }
+}
