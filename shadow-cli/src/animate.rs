@@ -24,7 +24,7 @@ use shadow_raster::svg::{SvgFragment, SvgView, SvgViewpoint};
 use shadow_scene::{Mesh, Staging};
 use svbsp::export::{FragmentFile, FragmentFormat, world_vertices};
 use svbsp::{Light, LightSpec, PlacedLight};
-use tiling::{Dynamic, FrameStats, Motion, PipelineOptions, Strategy};
+use tiling::{Dynamic, FrameStats, FrameTally, Motion, PipelineOptions, Strategy};
 
 use crate::args::{CameraArgs, ImageArgs, LightArgs, parse_vec3, viewpoint_flags};
 use crate::input::load_mesh;
@@ -314,7 +314,7 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
     let t_pre = start.elapsed();
     let mut files = FrameFiles::new(args, s, &d, &placed)?;
     progress.phase("frames", args.frames as u64);
-    let mut tally = Tally::default();
+    let mut tally = FrameTally::default();
     let loop_start = Instant::now();
     let in_flight = args.in_flight.max(1);
     let mut k0 = 0;
@@ -335,7 +335,7 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
         for (k, frame) in (k0..k1).zip(batch) {
             let frame = frame?;
             files.write(k, &frame, &plan.motion.matrix(k))?;
-            tally.add(frame.stats);
+            tally.add(&frame.stats);
             progress.inc(1);
         }
         k0 = k1;
@@ -357,11 +357,11 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
         s.moving.faces.len(),
         plan.strategy,
         kernel.len(),
-        tally.frame_times(),
+        frame_times(&tally),
         ms(wall),
-        tally.related as f64 / args.frames as f64,
+        tally.related_per_frame(),
         tally.last.total_drawn,
-        tally.culled,
+        tally.culled_frames,
         ms(t_pre),
         total.elapsed().as_secs_f64()
     );
@@ -371,40 +371,16 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
     emit(&out)
 }
 
-/// What the frames report, added up.
-#[derive(Default)]
-struct Tally {
-    times: Vec<Duration>,
-    /// Related static polygons, over all frames.
-    related: usize,
-    /// Frames in which a light left out the object's faces turned away.
-    culled: u32,
-    last: FrameStats,
-}
-
-impl Tally {
-    fn add(&mut self, stats: FrameStats) {
-        self.times.push(stats.t_frame);
-        self.related += stats.related;
-        self.culled += (stats.culled > 0) as u32;
-        self.last = stats;
-    }
-
-    /// `median … ms, mean … ms, max … ms`.
-    fn frame_times(&self) -> String {
-        let ms = |d: Duration| d.as_secs_f64() * 1e3;
-        let mut sorted = self.times.clone();
-        sorted.sort();
-        let median = sorted[sorted.len() / 2];
-        let mean = self.times.iter().sum::<Duration>() / self.times.len() as u32;
-        let max = *sorted.last().expect("at least one frame");
-        format!(
-            "median {:.2} ms, mean {:.2} ms, max {:.2} ms",
-            ms(median),
-            ms(mean),
-            ms(max)
-        )
-    }
+/// `median … ms, mean … ms, max … ms` of the frames' times.
+fn frame_times(t: &FrameTally) -> String {
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    let (median, mean, max) = t.times();
+    format!(
+        "median {:.2} ms, mean {:.2} ms, max {:.2} ms",
+        ms(median),
+        ms(mean),
+        ms(max)
+    )
 }
 
 /// The files each frame writes, and the Table 2 report.
@@ -592,14 +568,7 @@ fn frame_png(
     view: &SvgViewpoint,
 ) -> Result<Vec<u8>> {
     let scene = shadow_raster::RasterScene::new(d.grid(), d.frame_polygons(frame))?;
-    let (lo, hi) = d.static_bounds();
-    let target = view.target.unwrap_or((lo + hi) * 0.5);
-    let up = view
-        .up
-        .unwrap_or_else(|| shadow_raster::default_up(view.eye, target));
-    let camera =
-        shadow_raster::Camera::look_at(view.eye, target, up, view.fov_deg, view.width, view.height)
-            .map_err(raster_error)?;
+    let camera = view.camera(d.static_bounds()).map_err(raster_error)?;
     let batch = d.fragments(frame);
     let out = renderer.render_fragments(&scene, &batch, lights, &camera, colors)?;
     Ok(out.image.encode_png())

@@ -11,8 +11,8 @@ use anyhow::{Result, bail};
 use clap::Args;
 use glam::DVec3;
 use shadow_raster::{
-    Camera, Hsr, Method, RasterScene, RenderOptions, ShadowOptions, compare, default_up,
-    encode_pgm, hidden_lines, render,
+    Camera, Hsr, Method, RasterScene, RenderOptions, ShadowOptions, compare, encode_pgm,
+    hidden_lines, render,
 };
 use shadow_scene::face_colors;
 use svbsp::PlacedLight;
@@ -211,10 +211,7 @@ pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> 
     if framed && !args.quiet {
         eprintln!("note: camera {}", viewpoint_flags(&at, s.bounds));
     }
-    let target = at.target.unwrap_or((s.bounds.0 + s.bounds.1) * 0.5);
-    let up = at.up.unwrap_or_else(|| default_up(at.eye, target));
-    let camera =
-        Camera::look_at(at.eye, target, up, args.fov, size.0, size.1).map_err(raster_error)?;
+    let camera = at.camera(s.bounds).map_err(raster_error)?;
     if s.polys.is_empty() {
         bail!("{}: nothing to draw: no face has an area", s.name);
     }

@@ -117,6 +117,17 @@ pub struct SvgViewpoint {
     pub fov_deg: f64,
 }
 
+impl SvgViewpoint {
+    /// The raster camera of this viewpoint (the eye as given) for a scene
+    /// spanning `bounds`: the target defaults to the box's centre, the up
+    /// direction to [`default_up`].
+    pub fn camera(&self, bounds: (DVec3, DVec3)) -> Result<Camera, RasterError> {
+        let target = self.target.unwrap_or((bounds.0 + bounds.1) * 0.5);
+        let up = self.up.unwrap_or_else(|| default_up(self.eye, target));
+        Camera::look_at(self.eye, target, up, self.fov_deg, self.width, self.height)
+    }
+}
+
 impl SvgView {
     /// The view of a scene on `grid` whose vertices span `bounds`, from
     /// `at.eye` snapped to the grid.

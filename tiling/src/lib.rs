@@ -43,8 +43,8 @@ pub use index::{
     MAX_CUBE_TILES, MAX_PLANE_TILES, Query, TileIndex, TilingError, TilingStats, tiles_for,
 };
 pub use pipeline::{
-    Dynamic, FragmentView, Frame, FrameStats, Motion, PipelineError, PipelineOptions, Prepared,
-    Strategy,
+    Dynamic, FragmentView, Frame, FrameStats, FrameTally, Motion, PipelineError, PipelineOptions,
+    Prepared, Strategy,
 };
 
 /// The README's example, compiled and run as a doctest.

@@ -293,6 +293,55 @@ pub struct FrameStats {
     pub t_frame: Duration,
 }
 
+/// What the frames of a run report, added up.
+#[derive(Clone, Debug, Default)]
+pub struct FrameTally {
+    /// Each frame's time, in order.
+    pub frame_times: Vec<Duration>,
+    /// Related static polygons, over all frames.
+    pub related: usize,
+    /// Frames in which a light left out the object's faces turned away.
+    pub culled_frames: u32,
+    /// The last frame's figures.
+    pub last: FrameStats,
+}
+
+impl FrameTally {
+    /// Adds a frame's figures.
+    pub fn add(&mut self, stats: &FrameStats) {
+        self.frame_times.push(stats.t_frame);
+        self.related += stats.related;
+        self.culled_frames += u32::from(stats.culled > 0);
+        self.last = *stats;
+    }
+
+    /// Related static polygons a frame, on average.
+    pub fn related_per_frame(&self) -> f64 {
+        self.related as f64 / self.frame_times.len().max(1) as f64
+    }
+
+    /// The median, mean and largest frame time (zero without frames).
+    ///
+    /// ```
+    /// use std::time::Duration;
+    /// let mut t = tiling::FrameTally::default();
+    /// for ms in [3, 1, 2, 10] {
+    ///     t.add(&tiling::FrameStats { t_frame: Duration::from_millis(ms), ..Default::default() });
+    /// }
+    /// let ms = Duration::from_millis;
+    /// assert_eq!(t.times(), (ms(3), ms(4), ms(10)));
+    /// ```
+    pub fn times(&self) -> (Duration, Duration, Duration) {
+        let mut sorted = self.frame_times.clone();
+        sorted.sort();
+        let Some(&max) = sorted.last() else {
+            return (Duration::ZERO, Duration::ZERO, Duration::ZERO);
+        };
+        let mean = sorted.iter().sum::<Duration>() / sorted.len() as u32;
+        (sorted[sorted.len() / 2], mean, max)
+    }
+}
+
 impl FrameStats {
     /// The header of [`FrameStats::csv_row`]: the paper's Table 2
     /// columns, in order, times in seconds.
