@@ -98,6 +98,15 @@ fn load_all(paths: &[PathBuf], weld: bool) -> Result<Vec<Operand>> {
         if o.mesh.faces.is_empty() {
             bail!("{}: no faces", path.display());
         }
+        let (lo, hi) = o.mesh.bounds().expect("a mesh with faces has vertices");
+        let extent = (hi - lo).max_element();
+        if !(extent * extent * extent).is_finite() {
+            bail!(
+                "{}: the mesh spans {extent:.3e} units, so its volume does not fit in f64; \
+                 scale it below about 1e100",
+                path.display()
+            );
+        }
         operands.push(o);
     }
     Ok(operands)

@@ -102,6 +102,13 @@ impl Scene {
         let bounds = mesh
             .bounds()
             .with_context(|| format!("{name}: no vertices"))?;
+        let extent = (bounds.1 - bounds.0).max_element();
+        if !(extent * extent).is_finite() {
+            bail!(
+                "{name}: the scene spans {extent:.3e} units, so its areas do not fit in f64 (the \
+                 fragments would be exact, their areas infinite); scale it below about 1e150"
+            );
+        }
         let staging = source.staging(bounds);
         let default_light = specs.is_empty() && need_light;
         if default_light {

@@ -429,3 +429,41 @@ fn every_command_writes_the_same_for_every_thread_count() {
         );
     }
 }
+
+/// Coordinates whose areas or volumes leave `f64`'s range, or a scene too
+/// small for the finest grid: a clear error, not a NaN or a coarse snap.
+#[test]
+fn huge_and_tiny_coordinates_are_clear_errors() {
+    let write = |name: &str, s: f64| {
+        let p = scratch(name);
+        let text = format!(
+            "v 0 0 0\nv {s:e} 0 0\nv 0 {s:e} 0\nv 0 0 {s:e}\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+        );
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let huge = write("huge_tetra.obj", 1e300);
+    let tiny = write("tiny_tetra.obj", 1e-300);
+    let (h, t) = (huge.to_str().unwrap(), tiny.to_str().unwrap());
+    let out = scratch("never.json");
+    let out = out.to_str().unwrap();
+    let o = shadow(&["shadows", h, "--sun", "0,0,1", "-o", out]);
+    assert_failed_with(&o, &["huge_tetra.obj", "areas do not fit in f64"]);
+    let o = shadow(&["csg", "union", h, h, "-o", "never.obj"]);
+    assert_failed_with(&o, &["huge_tetra.obj", "volume does not fit in f64"]);
+    let o = shadow(&["shadows", t, "--sun", "0,0,1", "-o", out]);
+    assert_failed_with(&o, &["too small"]);
+    let o = shadow(&["csg", "union", t, t, "-o", "never.obj"]);
+    assert_failed_with(&o, &["too small"]);
+    // a sane scale of the same tetrahedron works
+    let fine = write("fine_tetra.obj", 2.0);
+    let o = shadow(&[
+        "shadows",
+        fine.to_str().unwrap(),
+        "--sun",
+        "1,2,3",
+        "-o",
+        out,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

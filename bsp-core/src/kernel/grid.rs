@@ -119,7 +119,15 @@ impl Grid {
         let log2 = if half > 0.0 {
             // largest k with half * 2^k <= target
             let mut k = (target / half).log2().floor() as i32;
-            k = k.clamp(-1000, 1000);
+            if k > 1000 {
+                // the finest grid would still give the box only a few
+                // steps: snapping would move its points by a good part of
+                // its size
+                return Err(Error::InvalidGrid(
+                    "bounding box too small (under about 2^-975 units across)",
+                ));
+            }
+            k = k.max(-1000);
             while k > -1000 && half * 2f64.powi(k) > target {
                 k -= 1;
             }
@@ -242,6 +250,20 @@ mod tests {
     }
 
     #[test]
+    fn fit_refuses_a_box_too_small_for_the_finest_grid() {
+        let tiny = DVec3::splat(1e-300);
+        assert!(matches!(
+            Grid::fit(DVec3::ZERO, tiny),
+            Err(Error::InvalidGrid(why)) if why.contains("too small")
+        ));
+        // a box a little larger still gets its 2^24 steps and more
+        let g = Grid::fit(DVec3::ZERO, DVec3::splat(1e-285)).unwrap();
+        assert!(g.step() <= 1e-285 / 2f64.powi(24), "{}", g.step());
+        // a single point (no extent) is fine
+        assert!(Grid::fit(tiny, tiny).is_ok());
+    }
+
+    #[test]
     fn snap_rejects_nan_and_far_points() {
         let g = Grid::fit(DVec3::ZERO, DVec3::ONE).unwrap();
         assert_eq!(
@@ -269,12 +291,10 @@ mod tests {
         assert_eq!(g.snap(DVec3::splat(7.0)).unwrap(), [0, 0, 0]);
         let g = Grid::fit(DVec3::splat(-1e300), DVec3::splat(1e300)).unwrap();
         assert!(g.snap(DVec3::splat(1e300)).is_ok());
-        let g = Grid::fit(
-            DVec3::splat(-(2f64.powi(-997))),
-            DVec3::splat(2f64.powi(-997)),
-        )
-        .unwrap();
-        assert!(g.snap(DVec3::splat(2f64.powi(-997))).is_ok());
+        // so small a box that even the finest grid (2^1000) would give it
+        // eight steps: refused, rather than snapped coarsely
+        let tiny = DVec3::splat(2f64.powi(-997));
+        assert!(Grid::fit(-tiny, tiny).is_err());
         assert!(Grid::fit(DVec3::splat(f64::NAN), DVec3::ONE).is_err());
     }
 }
