@@ -445,15 +445,17 @@ fn huge_and_tiny_coordinates_are_clear_errors() {
     let huge = write("huge_tetra.obj", 1e300);
     let tiny = write("tiny_tetra.obj", 1e-300);
     let (h, t) = (huge.to_str().unwrap(), tiny.to_str().unwrap());
-    let out = scratch("never.json");
+    let out = scratch("hostile_coordinates.json");
     let out = out.to_str().unwrap();
     let o = shadow(&["shadows", h, "--sun", "0,0,1", "-o", out]);
     assert_failed_with(&o, &["huge_tetra.obj", "areas do not fit in f64"]);
-    let o = shadow(&["csg", "union", h, h, "-o", "never.obj"]);
+    let never = scratch("hostile_coordinates.obj");
+    let never = never.to_str().unwrap();
+    let o = shadow(&["csg", "union", h, h, "-o", never]);
     assert_failed_with(&o, &["huge_tetra.obj", "volume does not fit in f64"]);
     let o = shadow(&["shadows", t, "--sun", "0,0,1", "-o", out]);
     assert_failed_with(&o, &["too small"]);
-    let o = shadow(&["csg", "union", t, t, "-o", "never.obj"]);
+    let o = shadow(&["csg", "union", t, t, "-o", never]);
     assert_failed_with(&o, &["too small"]);
     // a sane scale of the same tetrahedron works
     let fine = write("fine_tetra.obj", 2.0);
