@@ -205,6 +205,8 @@ struct Plan {
     specs: Vec<LightSpec>,
     motion: Motion,
     strategy: Strategy,
+    /// The report, its header written by [`FrameFiles::new`].
+    report: Option<Output>,
 }
 
 impl Plan {
@@ -250,8 +252,21 @@ impl Plan {
                 "note: --eye, --target and --up only apply to SVG and PNG frames",
             );
         }
+        // the folder first (the report may be in it); a report that cannot
+        // be written then takes back a folder this run made
+        let made = !args.output.exists();
         std::fs::create_dir_all(&args.output)
             .with_context(|| format!("could not create {}", args.output.display()))?;
+        let report = args.report.as_deref().map(Output::create).transpose();
+        let report = match report {
+            Ok(r) => r,
+            Err(e) => {
+                if made {
+                    let _ = std::fs::remove_dir(&args.output);
+                }
+                return Err(e);
+            }
+        };
         let strategy = match args.strategy {
             StrategyArg::Paper => Strategy::Paper,
             StrategyArg::Fast => Strategy::Fast,
@@ -261,6 +276,7 @@ impl Plan {
             specs,
             motion,
             strategy,
+            report,
         })
     }
 
@@ -291,7 +307,7 @@ fn note(args: &AnimateArgs, s: &str) {
 /// `shadow animate`.
 pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
     let total = Instant::now();
-    let plan = Plan::of(args)?;
+    let mut plan = Plan::of(args)?;
     let grid = plan.grid(args.frames)?;
     let placed = place_lights(&grid, &plan.specs)?;
     let kernel: Vec<Light> = placed.iter().map(|l| l.light).collect();
@@ -302,6 +318,7 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
 
     let progress = Progress::new(!args.quiet);
     progress.phase("preprocessing", 1);
+    let report = plan.report.take();
     let s = &plan.setup;
     let start = Instant::now();
     let d = Dynamic::new(
@@ -312,7 +329,7 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
         opts,
     )?;
     let t_pre = start.elapsed();
-    let mut files = FrameFiles::new(args, s, &d, &placed)?;
+    let mut files = FrameFiles::new(args, s, (&d, &placed), report)?;
     progress.phase("frames", args.frames as u64);
     let mut tally = FrameTally::default();
     let loop_start = Instant::now();
@@ -402,19 +419,14 @@ impl<'a> FrameFiles<'a> {
     fn new(
         args: &'a AnimateArgs,
         setup: &'a Setup,
-        d: &'a Dynamic,
-        lights: &'a [PlacedLight],
+        (d, lights): (&'a Dynamic, &'a [PlacedLight]),
+        mut report: Option<Output>,
     ) -> Result<FrameFiles<'a>> {
         let view = has_view(args).then(|| frame_view(args, setup));
         let colors = shadow_scene::face_colors(&frame_mesh(setup, d, &DMat4::IDENTITY));
-        let report = match &args.report {
-            Some(p) => {
-                let mut o = Output::create(p)?;
-                writeln!(o, "{}", FrameStats::CSV_HEADER)?;
-                Some(o)
-            }
-            None => None,
-        };
+        if let Some(o) = &mut report {
+            writeln!(o, "{}", FrameStats::CSV_HEADER)?;
+        }
         Ok(FrameFiles {
             args,
             setup,

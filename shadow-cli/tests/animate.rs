@@ -314,3 +314,28 @@ fn files_need_a_moving_object_a_light_and_a_good_spin() {
             .any(|f| f["lit"][0] == true && f.get("holes").is_some())
     );
 }
+
+/// A report that cannot be written stops the run before anything is
+/// made: no frames folder is left behind.
+#[test]
+fn an_unwritable_report_leaves_no_folder() {
+    let dir = scratch("never_frames");
+    let _ = std::fs::remove_dir_all(&dir);
+    let report = scratch("no_such_dir").join("deeper").join("rep.csv");
+    let o = shadow(&[
+        "animate",
+        "--scene",
+        "room",
+        "--frames",
+        "1",
+        "--format",
+        "none",
+        "--report",
+        report.to_str().unwrap(),
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("rep.csv"), "{}", stderr(&o));
+    assert!(!dir.exists());
+}
