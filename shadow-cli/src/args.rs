@@ -20,6 +20,19 @@ pub(crate) struct SourceArgs {
 }
 
 impl SourceArgs {
+    /// Fails unless exactly one of a file and `--scene` is given.
+    pub(crate) fn check(&self) -> anyhow::Result<()> {
+        match (&self.input, &self.scene) {
+            (Some(_), Some(_)) => {
+                anyhow::bail!("give either an INPUT file or --scene NAME, not both")
+            }
+            (None, None) => {
+                anyhow::bail!("no input: give a mesh file (.obj or .stl) or --scene NAME")
+            }
+            _ => Ok(()),
+        }
+    }
+
     /// The built-in scene's default camera and light, for its mesh's
     /// `bounds` ([`Staging::of_scene`]).
     pub(crate) fn staging(&self, bounds: (DVec3, DVec3)) -> Option<Staging> {

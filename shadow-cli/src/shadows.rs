@@ -139,6 +139,7 @@ impl Request {
                 "note: --eye, --target and --up only apply to SVG output",
             );
         }
+        args.source.check()?;
         let specs = args.lights.specs();
         if specs.is_empty() && args.source.input.is_some() {
             bail!("{NO_LIGHT}");

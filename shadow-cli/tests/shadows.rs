@@ -568,3 +568,11 @@ fn chin_feiner_gives_the_same_areas() {
     let n = |d: &Value| d["fragments"].as_array().unwrap().len();
     assert!(n(&b) >= n(&a), "{} {}", n(&a), n(&b));
 }
+
+/// A file and `--scene` together is named as the conflict it is, before
+/// anything about lights.
+#[test]
+fn a_file_and_a_scene_conflict() {
+    let o = shadow(&["shadows", "a.obj", "--scene", "room", "-o", "x.json"]);
+    assert_failed_with(&o, &["not both"]);
+}

@@ -29,6 +29,8 @@ pub fn read_stl(path: &Path) -> Result<Mesh, SceneError> {
 ///
 /// ```
 /// use shadow_scene::parse_stl;
+/// let empty = parse_stl(b"", "e.stl").unwrap_err().to_string();
+/// assert!(empty.contains("80-byte header"), "{empty}");
 /// let text = b"solid t
 /// facet normal 0 0 1
 ///   outer loop
@@ -48,6 +50,13 @@ pub fn parse_stl(bytes: &[u8], path_for_messages: &str) -> Result<Mesh, SceneErr
         line: 0,
         message,
     };
+    if !bytes.trim_ascii_start().starts_with(b"solid") && bytes.len() < 84 {
+        return Err(err(format!(
+            "invalid STL: a binary STL file has an 80-byte header and a 4-byte triangle count; this one \
+             has {} byte(s) in all",
+            bytes.len()
+        )));
+    }
     let mut data = Cow::Borrowed(bytes);
     if looks_binary(bytes) && bytes.starts_with(b"solid") {
         // stl_io takes any file starting with "solid " for ASCII; the
