@@ -61,7 +61,9 @@ pub use animated::{
 pub use atomic::{AtomicFile, remove_unfinished};
 pub use error::SceneError;
 pub use mesh::{Face, Mesh, MeshView, Triangles};
-pub use obj::{ObjNotes, parse_obj, parse_obj_notes, read_obj, read_obj_notes, write_obj};
+pub use obj::{
+    MAX_FACE_VERTICES, ObjNotes, parse_obj, parse_obj_notes, read_obj, read_obj_notes, write_obj,
+};
 pub use palette::{Rgb, face_colors};
 pub use scan::{MAX_SUBDIVISIONS, bunny, sqrt3_subdivide};
 pub use scenes::{SCENE_NAMES, Staging, room, scene};

@@ -341,12 +341,22 @@ fn parse_vertex<'a>(tokens: impl Iterator<Item = &'a str>) -> Result<DVec3, Stri
     Ok(DVec3::from_array(xyz))
 }
 
+/// The most vertices a face may have: a bound on the memory one line of
+/// a file can ask for (the geometry made from a face takes some 40 times
+/// its text), far above any real face.
+pub const MAX_FACE_VERTICES: usize = 1 << 20;
+
 fn parse_face<'a>(
     tokens: impl Iterator<Item = &'a str>,
     vertex_count: usize,
 ) -> Result<Vec<u32>, String> {
     let mut out = Vec::new();
     for token in tokens {
+        if out.len() == MAX_FACE_VERTICES {
+            return Err(format!(
+                "face has more than {MAX_FACE_VERTICES} vertices (the most a face may have)"
+            ));
+        }
         // (most tokens are a bare index: no search set up for the slashes)
         let (index, rest) = match token.bytes().position(|c| c == b'/') {
             None => (token, [None, None]),
@@ -710,6 +720,20 @@ f 4 1 5 8
             assert_eq!(line, 3);
             assert_eq!(msg, format!("coordinate `{tok}` is not finite"));
         }
+    }
+
+    #[test]
+    fn a_face_of_too_many_vertices_is_refused() {
+        let mut text = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\nf");
+        for _ in 0..=MAX_FACE_VERTICES {
+            text += " 1";
+        }
+        let (line, msg) = error(&(text + "\n"));
+        assert_eq!(line, 4);
+        assert!(
+            msg.starts_with("face has more than 1048576 vertices"),
+            "{msg}"
+        );
     }
 
     #[test]
