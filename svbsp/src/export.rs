@@ -513,8 +513,8 @@ mod tests {
         ];
         let positions: Vec<DVec3> = loops.iter().flatten().map(|&p| DVec3::from(p)).collect();
         let specs = [
-            crate::LightSpec::Point(DVec3::new(3.0, 3.0, 9.0)),
-            crate::LightSpec::Sun(DVec3::new(1.0, 0.0, 2.0)),
+            crate::LightSpec::Point(DVec3::new(3.0, 3.0, 8.0)),
+            crate::LightSpec::Sun(DVec3::new(0.0, 0.0, 1.0)),
         ];
         let grid = crate::shared_grid(&positions, &specs).unwrap();
         let lights = crate::place_lights(&grid, &specs).unwrap();
@@ -576,15 +576,16 @@ mod tests {
                 assert_eq!((p.vertices, p.degenerate), (w.vertices, w.degenerate));
             }
             // the floor is 64 units², the roof 4, both facing up; the
-            // point light, 5 above the roof and 9 above the floor, casts
-            // the roof 9/5 times its size
+            // point light, 4 above the roof and 8 above the floor, casts the
+            // roof twice its size, onto [1, 5]²; the sun straight overhead
+            // (a direction the quantization keeps exactly) casts it onto
+            // [2, 4]². Every corner is an integer in input units, so every
+            // area is exact in f64
             let a = &w.areas;
-            assert!((a.total - 68.0).abs() < 1e-9);
-            assert!((a.cast[0] - 3.6 * 3.6).abs() < 1e-9, "{}", a.cast[0]);
-            assert!((a.lit[0] + a.cast[0] - a.total).abs() < 1e-9);
-            // the sun's direction is quantized: its shadow, the roof moved,
-            // is 4 up to the rounding of its corners
-            assert!((a.cast[1] - 4.0).abs() < 1e-6, "{}", a.cast[1]);
+            assert_eq!(a.total, 68.0);
+            assert_eq!(a.cast[0], 16.0);
+            assert_eq!(a.lit[0], 68.0 - 16.0);
+            assert_eq!(a.cast[1], 4.0);
             if format == FragmentFormat::Obj {
                 assert!(w.vertices > 8);
             }

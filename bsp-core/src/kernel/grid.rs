@@ -251,14 +251,16 @@ mod tests {
 
     #[test]
     fn fit_refuses_a_box_too_small_for_the_finest_grid() {
-        let tiny = DVec3::splat(1e-300);
+        let tiny = DVec3::splat(2f64.powi(-1000));
         assert!(matches!(
             Grid::fit(DVec3::ZERO, tiny),
             Err(Error::InvalidGrid(why)) if why.contains("too small")
         ));
-        // a box a little larger still gets its 2^24 steps and more
-        let g = Grid::fit(DVec3::ZERO, DVec3::splat(1e-285)).unwrap();
-        assert!(g.step() <= 1e-285 / 2f64.powi(24), "{}", g.step());
+        // a box a little larger still spans 2^24 steps and more (powers of
+        // two: the product is exact)
+        let small = DVec3::splat(2f64.powi(-960));
+        let g = Grid::fit(DVec3::ZERO, small).unwrap();
+        assert!(small.x * g.scale() >= 2f64.powi(24), "{}", g.scale());
         // a single point (no extent) is fine
         assert!(Grid::fit(tiny, tiny).is_ok());
     }
