@@ -27,7 +27,7 @@ use svbsp::{Light, LightSpec, PlacedLight};
 use tiling::{Dynamic, FrameStats, FrameTally, Motion, PipelineOptions, Strategy};
 
 use crate::args::{CameraArgs, ImageArgs, LightArgs, parse_vec3, viewpoint_flags};
-use crate::input::load_mesh;
+use crate::input::{NO_LIGHT, load_mesh};
 use crate::lights::{fmt_input, place_lights, shared_grid};
 use crate::output::{Output, emit};
 use crate::progress::Progress;
@@ -224,10 +224,7 @@ impl Plan {
         if specs.is_empty() {
             match s.light {
                 Some(l) => specs.push(LightSpec::Point(l)),
-                None => bail!(
-                    "no light: give at least one --light X,Y,Z (a point light) or --sun X,Y,Z (a \
-                     light at infinity); both can be repeated"
-                ),
+                None => bail!("{NO_LIGHT}"),
             }
         }
         let (axis, degrees) = args.spin.or(s.spin).unwrap_or((DVec3::Z, 0.0));

@@ -51,20 +51,18 @@ pub(crate) fn load_source_quiet(
     src: &SourceArgs,
     quiet: bool,
 ) -> Result<(shadow_scene::Mesh, String)> {
-    match (&src.input, &src.scene) {
-        (Some(path), None) => Ok((load_mesh(path, quiet)?, path.display().to_string())),
-        (None, Some(name)) => {
-            let mesh = shadow_scene::scene(name).with_context(|| {
-                format!(
-                    "unknown scene `{name}` (available: {})",
-                    shadow_scene::SCENE_NAMES.join(", ")
-                )
-            })?;
-            Ok((mesh, format!("scene {name}")))
-        }
-        (Some(_), Some(_)) => bail!("give either an INPUT file or --scene NAME, not both"),
-        (None, None) => bail!("no input: give a mesh file (.obj or .stl) or --scene NAME"),
+    src.check()?;
+    if let Some(path) = &src.input {
+        return Ok((load_mesh(path, quiet)?, path.display().to_string()));
     }
+    let name = src.scene.as_deref().unwrap_or_default();
+    let mesh = shadow_scene::scene(name).with_context(|| {
+        format!(
+            "unknown scene `{name}` (available: {})",
+            shadow_scene::SCENE_NAMES.join(", ")
+        )
+    })?;
+    Ok((mesh, format!("scene {name}")))
 }
 
 /// The message for a scene without a light.

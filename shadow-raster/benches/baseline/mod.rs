@@ -16,51 +16,10 @@ use svbsp::Light;
 pub use bsp_fixtures::scenes::{SceneSpec, WorldLight, lights, scene};
 pub use shadow_raster::TriangleBvh as Bvh;
 
-/// A scene on its grid, ready for the shadows and the baseline.
-pub struct Prepared {
-    pub name: String,
-    pub grid: Grid,
-    pub polys: Vec<Polygon>,
-    pub lights: Vec<Light>,
-    /// The lights in `f64` grid units: `true` and the point, or `false`
-    /// and the sun's direction.
-    pub lights_f64: Vec<(bool, DVec3)>,
-}
-
-/// Snaps the scene and its lights to one grid and imports it.
-pub fn prepare(spec: &SceneSpec, world_lights: &[WorldLight]) -> Prepared {
-    let mut pts: Vec<DVec3> = spec.faces.iter().flatten().copied().collect();
-    for l in world_lights {
-        if let WorldLight::Point(p) = l {
-            pts.push(*p);
-        }
-    }
-    let grid = Grid::fit_points(&pts).expect("scene fits a grid");
-    let (polys, _report) =
-        import_faces(&grid, spec.faces.iter().map(|f| &f[..])).expect("scene snaps");
-    let mut lights = Vec::new();
-    let mut lights_f64 = Vec::new();
-    for l in world_lights {
-        match l {
-            WorldLight::Point(p) => {
-                let g = grid.snap(*p).expect("light on the grid");
-                lights.push(Light::Point(g));
-                lights_f64.push((true, DVec3::new(g[0] as f64, g[1] as f64, g[2] as f64)));
-            }
-            WorldLight::Sun(d) => {
-                lights.push(Light::Directional(*d));
-                lights_f64.push((false, DVec3::new(d[0] as f64, d[1] as f64, d[2] as f64)));
-            }
-        }
-    }
-    Prepared {
-        name: spec.name.clone(),
-        grid,
-        polys,
-        lights,
-        lights_f64,
-    }
-}
+/// The scenes on their grids: the `shadows` bench's own helper, shared.
+#[path = "../../../svbsp/benches/common/mod.rs"]
+mod on_grids;
+pub use on_grids::{Prepared, prepare};
 
 /// The scene's triangles in `f64` grid units (each convex polygon as a
 /// fan), for the baseline.
