@@ -98,12 +98,33 @@ impl Operand {
     /// Checks that the faces form a closed, consistently oriented
     /// 2-manifold; the error names the file, line, face and edge (the
     /// check of [`crate::check_mesh`], on the faces as they are).
+    ///
+    /// A mesh with no faces, or so large that its volume overflows `f64`,
+    /// is an error too.
     pub fn check(&self) -> Result<(), FileError> {
+        self.check_faces()?;
         bsp_core::check_closed_manifold(self.mesh.faces.iter().map(|f| f.vertices.as_slice()))
             .map_err(|e| FileError {
                 message: self.topology_message(&e),
                 weld_may_help: self.file_loops.is_none() && self.mesh.repeated_positions() > 0,
             })
+    }
+
+    /// The part of [`Operand::check`] that needs no topology: the mesh
+    /// has faces, and its volume fits in `f64`.
+    pub fn check_faces(&self) -> Result<(), FileError> {
+        let Some((lo, hi)) = self.mesh.bounds().filter(|_| !self.mesh.faces.is_empty()) else {
+            return Err(FileError::new(format!("{}: no faces", self.name)));
+        };
+        let extent = (hi - lo).max_element();
+        if !(extent * extent * extent).is_finite() {
+            return Err(FileError::new(format!(
+                "{}: the mesh spans {extent:.3e} units, so its volume does not fit in f64; \
+                 scale it below about 1e100",
+                self.name
+            )));
+        }
+        Ok(())
     }
 
     /// [`Operand::check`] of each operand, in parallel; the first error
@@ -310,6 +331,70 @@ impl FileBoolean {
             triangles: &self.exact.triangles,
             group: self.group,
         }
+    }
+
+    /// The figures for people, one per line: each operand as read and
+    /// imported, the grid step, the octree, the result and its `volume`
+    /// (exact, rounded once; [`FileBoolean::volume`], which the caller may
+    /// want to time) beside the plain `f64` sum.
+    pub fn report(&self, operands: &[Operand], volume: f64) -> String {
+        let mut s = String::new();
+        for (i, (o, r)) in operands.iter().zip(&self.reports).enumerate() {
+            let label = match i {
+                0 => "A".to_string(),
+                1 if operands.len() == 2 => "B".to_string(),
+                i => format!("{}", i + 1),
+            };
+            s += &format!(
+                "input {label}:{:pad$}{}: {} triangles ({} faces), {}\n",
+                "",
+                o.name,
+                o.counts.0,
+                o.counts.1,
+                r.counts(),
+                pad = 9usize.saturating_sub(label.len())
+            );
+        }
+        let k = self.grid.scale();
+        let sum: crate::Stats = self.stats.iter().sum();
+        s += &format!("grid step:      {}\n", self.grid.step_text());
+        s += &format!("octree:         {sum}\n");
+        s += &format!(
+            "output:         {} triangles, {} vertices\n",
+            self.exact.triangles.len(),
+            self.positions.len()
+        );
+        s += &format!(
+            "volume:         {volume} (exact, rounded once); {} (f64 sum)\n",
+            self.exact.volume_f64() / (k * k * k)
+        );
+        s
+    }
+
+    /// Warnings for what rounding the exact vertices does to the file:
+    /// distinct vertices equal in `f64` (their triangles degenerate), and
+    /// for STL (`stl`) vertices that `f32` merges.
+    pub fn rounding_warnings(&self, stl: bool) -> Vec<String> {
+        let mut w = Vec::new();
+        let coincide = self.mesh().repeated_positions();
+        if coincide > 0 {
+            w.push(format!(
+                "{coincide} distinct exact vertices coincide once rounded to f64 input units; \
+                 their triangles are degenerate in the file"
+            ));
+        }
+        let merged = if stl {
+            shadow_scene::stl_collisions(&self.mesh())
+        } else {
+            0
+        };
+        if merged > 0 {
+            w.push(format!(
+                "{merged} vertices coincide once rounded to f32 for STL; the file may not be \
+                 closed when read back (write .obj to keep full precision)"
+            ));
+        }
+        w
     }
 
     /// The exact volume in input units, rounded once to `f64`.
@@ -593,6 +678,50 @@ f 4 1 5 8
             assert!(o.file_loops.is_none());
             assert_eq!(o.counts, (12, 6));
         }
+    }
+
+    /// The report, the rounding warnings and the checks that need no
+    /// topology, as a person reads them.
+    #[test]
+    fn the_report_and_the_warnings_read_as_documented() {
+        let mut operands = [
+            operand(&cube(4.0, [0.0; 3]), "a.obj", false),
+            operand(&cube(4.0, [2.0; 3]), "b.obj", false),
+        ];
+        let out = apply(&mut operands, BoolOp::Union).unwrap();
+        let r = out.report(&operands, out.volume());
+        let lines: Vec<&str> = r.lines().collect();
+        assert_eq!(lines.len(), 6, "{r}");
+        assert!(lines[0].starts_with("input A:        a.obj: 12 triangles (6 faces), 6 polygons"));
+        assert!(lines[1].starts_with("input B:        b.obj: "));
+        assert_eq!(
+            lines[2],
+            format!("grid step:      {}", out.grid.step_text())
+        );
+        assert!(lines[3].starts_with(&format!("octree:         {} cells,", out.stats[0].cells)));
+        assert_eq!(
+            lines[4],
+            format!(
+                "output:         {} triangles, {} vertices",
+                out.exact.triangles.len(),
+                out.positions.len()
+            )
+        );
+        assert_eq!(
+            lines[5],
+            "volume:         120 (exact, rounded once); 120 (f64 sum)"
+        );
+        // integer vertices: nothing coincides once rounded, even in f32
+        assert!(out.rounding_warnings(true).is_empty());
+
+        let empty = Operand::new("e.obj", Mesh::default());
+        assert_eq!(empty.check().unwrap_err().message, "e.obj: no faces");
+        let huge = operand(&cube(1e120, [0.0; 3]), "h.obj", false);
+        let e = huge.check_faces().unwrap_err().message;
+        assert!(
+            e.starts_with("h.obj: the mesh spans 1.000e120 units"),
+            "{e}"
+        );
     }
 
     #[test]

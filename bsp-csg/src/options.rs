@@ -82,6 +82,27 @@ pub struct Stats {
     pub clean_cells: usize,
 }
 
+impl std::fmt::Display for Stats {
+    /// One line: the cells, the mixed ones by how they were settled, and
+    /// the faces cut.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} cells, {} with both surfaces ({} with shared planes, {} where they do not meet: \
+             {} with every face apart from the other surface, {} labelled from the cells \
+             around); {} faces cut into {} pieces",
+            self.cells,
+            self.mixed_cells,
+            self.merged_cells,
+            self.easy_cells + self.clean_cells,
+            self.clean_cells,
+            self.easy_cells,
+            self.cut_faces,
+            self.pieces
+        )
+    }
+}
+
 impl<'a> std::iter::Sum<&'a Stats> for Stats {
     /// The figures of several operations added up.
     fn sum<I: Iterator<Item = &'a Stats>>(iter: I) -> Stats {

@@ -26,7 +26,7 @@ use svbsp::export::{FragmentFile, FragmentFormat, world_vertices};
 use svbsp::{Light, LightSpec, PlacedLight};
 use tiling::{Dynamic, FrameStats, FrameTally, Motion, PipelineOptions, Strategy};
 
-use crate::args::{CameraArgs, ImageArgs, LightArgs, parse_vec3, viewpoint_flags};
+use crate::args::{CameraArgs, ImageArgs, LightArgs, parse_vec3};
 use crate::input::{NO_LIGHT, load_mesh};
 use crate::lights::{fmt_input, place_lights, shared_grid};
 use crate::output::{Output, emit};
@@ -361,21 +361,16 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
     let ms = |d: Duration| d.as_secs_f64() * 1e3;
     let _ = writeln!(
         out,
-        "{} frames of {}: {} static faces, {} moving; {:?} strategy, {} light(s); frame time \
-         {}; wall time a frame {:.2} ms ({in_flight} in flight); {:.0} related static polygons \
-         a frame; {} fragments in the last frame; faces turned away from a light left out in {} \
-         of the frames; preprocessing {:.1} ms, total {:.2} s",
+        "{} frames of {}: {} static faces, {} moving; {:?} strategy, {} light(s); {}; wall time \
+         a frame {:.2} ms ({in_flight} in flight); preprocessing {:.1} ms, total {:.2} s",
         args.frames,
         s.name,
         s.statics.faces.len(),
         s.moving.faces.len(),
         plan.strategy,
         kernel.len(),
-        frame_times(&tally),
+        tally.summary(),
         ms(wall),
-        tally.related_per_frame(),
-        tally.last.total_drawn,
-        tally.culled_frames,
         ms(t_pre),
         total.elapsed().as_secs_f64()
     );
@@ -383,18 +378,6 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
         let _ = writeln!(out, "frames in {}", args.output.display());
     }
     emit(&out)
-}
-
-/// `median … ms, mean … ms, max … ms` of the frames' times.
-fn frame_times(t: &FrameTally) -> String {
-    let ms = |d: Duration| d.as_secs_f64() * 1e3;
-    let (median, mean, max) = t.times();
-    format!(
-        "median {:.2} ms, mean {:.2} ms, max {:.2} ms",
-        ms(median),
-        ms(mean),
-        ms(max)
-    )
 }
 
 /// The files each frame writes, and the Table 2 report.
@@ -491,17 +474,8 @@ fn write_file(path: &Path, f: impl FnOnce(&mut Output) -> Result<()>) -> Result<
 
 /// The viewpoint of SVG and PNG frames.
 fn frame_view(args: &AnimateArgs, s: &Setup) -> SvgViewpoint {
-    let bounds = s.statics.bounds().expect("the static scene has faces");
-    let (at, framed) =
-        args.camera
-            .viewpoint(&s.statics, s.staging, args.image.size(), args.image.fov);
-    if framed {
-        note(
-            args,
-            &format!("note: camera {}", viewpoint_flags(&at, bounds)),
-        );
-    }
-    at
+    let image = (args.image.size(), args.image.fov);
+    args.camera.pick(&s.statics, s.staging, image, args.quiet)
 }
 
 /// The frame's whole scene in input units, faces numbered as the frame's

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use glam::DVec3;
-use shadow_raster::svg::SvgViewpoint;
+use shadow_raster::svg::{SvgViewpoint, ViewRequest};
 use shadow_scene::{Mesh, Staging};
 use svbsp::LightSpec;
 
@@ -100,36 +100,34 @@ impl CameraArgs {
         &self,
         mesh: &Mesh,
         staging: Option<Staging>,
-        (width, height): (u32, u32),
+        size: (u32, u32),
         fov_deg: f64,
     ) -> (SvgViewpoint, bool) {
-        let aspect = width as f64 / height as f64;
-        let up_axis = self.up.unwrap_or(DVec3::Z);
-        let ((eye, target, up), framed) = match (self.eye, staging) {
-            (Some(e), s) => ((e, self.target, self.up.or(s.and_then(|s| s.up))), false),
-            (None, Some(s)) => (
-                (
-                    s.eye,
-                    Some(self.target.unwrap_or(s.target)),
-                    self.up.or(s.up),
-                ),
-                false,
-            ),
-            (None, None) => match Staging::framing(&mesh.positions, up_axis, fov_deg, aspect) {
-                Some(s) => ((s.eye, Some(self.target.unwrap_or(s.target)), s.up), true),
-                // no vertex: nothing to frame (drawing it fails later)
-                None => ((DVec3::ONE, self.target, self.up), false),
-            },
+        let given = ViewRequest {
+            eye: self.eye,
+            target: self.target,
+            up: self.up,
         };
-        let at = SvgViewpoint {
-            eye,
-            target,
-            up,
-            width,
-            height,
-            fov_deg,
-        };
-        (at, framed)
+        SvgViewpoint::choose(given, &mesh.positions, staging, size, fov_deg)
+    }
+}
+
+impl CameraArgs {
+    /// [`CameraArgs::viewpoint`], with a note on stderr (unless `quiet`)
+    /// of the flags that reproduce a framed camera.
+    pub(crate) fn pick(
+        &self,
+        mesh: &Mesh,
+        staging: Option<Staging>,
+        (size, fov_deg): ((u32, u32), f64),
+        quiet: bool,
+    ) -> SvgViewpoint {
+        let (at, framed) = self.viewpoint(mesh, staging, size, fov_deg);
+        if framed && !quiet {
+            let bounds = mesh.bounds().unwrap_or_default();
+            eprintln!("note: camera {}", viewpoint_flags(&at, bounds));
+        }
+        at
     }
 }
 

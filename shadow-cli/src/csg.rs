@@ -12,13 +12,13 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Result, anyhow};
 use bsp_core::{BoolOp, Grid, ImportReport};
 use bsp_csg::files::{FileBoolean, FileError, Operand};
 use bsp_csg::{Stage, Step};
 use clap::{Args, ValueEnum};
 use rayon::prelude::*;
-use shadow_scene::{MeshFormat, MeshView};
+use shadow_scene::MeshFormat;
 
 use crate::output::{Phases, emit, guarded};
 
@@ -35,11 +35,7 @@ pub(crate) enum Operation {
 
 impl Operation {
     fn name(self) -> &'static str {
-        match self {
-            Operation::Union => "union",
-            Operation::Intersection => "intersection",
-            Operation::Difference => "difference",
-        }
+        bsp_csg::files::op_name(self.kernel())
     }
 
     fn kernel(self) -> BoolOp {
@@ -90,23 +86,13 @@ fn load_all(paths: &[PathBuf], weld: bool) -> Result<Vec<Operand>> {
         })
         .collect();
     let mut operands = Vec::with_capacity(paths.len());
-    for (path, r) in paths.iter().zip(read) {
+    for r in read {
         let (o, note) = r?;
         if let Some(m) = note {
             eprintln!("note: {m}");
         }
-        if o.mesh.faces.is_empty() {
-            bail!("{}: no faces", path.display());
-        }
-        let (lo, hi) = o.mesh.bounds().expect("a mesh with faces has vertices");
-        let extent = (hi - lo).max_element();
-        if !(extent * extent * extent).is_finite() {
-            bail!(
-                "{}: the mesh spans {extent:.3e} units, so its volume does not fit in f64; \
-                 scale it below about 1e100",
-                path.display()
-            );
-        }
+        // (in the files' order, before a later file's read error)
+        o.check_faces().map_err(file_error)?;
         operands.push(o);
     }
     Ok(operands)
@@ -244,21 +230,9 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
     if tris == 0 {
         eprintln!("note: the {} is empty", args.op.name());
     }
-    let coincide = out.mesh().repeated_positions();
-    if coincide > 0 {
-        eprintln!(
-            "warning: {coincide} distinct exact vertices coincide once rounded to f64 input units; \
-             their triangles are degenerate in the file"
-        );
-    }
-    if MeshFormat::from_path(&args.output)? == MeshFormat::Stl {
-        let merged = shadow_scene::stl_collisions(&out.mesh());
-        if merged > 0 {
-            eprintln!(
-                "warning: {merged} vertices coincide once rounded to f32 for STL; the file may \
-                 not be closed when read back (write .obj to keep full precision)"
-            );
-        }
+    let stl = MeshFormat::from_path(&args.output)? == MeshFormat::Stl;
+    for w in out.rounding_warnings(stl) {
+        eprintln!("warning: {w}");
     }
     if args.stats {
         report += &stats_text(args.op, &operands, &out, &phases, total);
@@ -276,57 +250,10 @@ fn stats_text(
     total: Duration,
 ) -> String {
     let mut s = format!("operation:      {}\n", op.name());
-    for (i, (o, r)) in operands.iter().zip(&out.reports).enumerate() {
-        let label = match i {
-            0 => "A".to_string(),
-            1 if operands.len() == 2 => "B".to_string(),
-            i => format!("{}", i + 1),
-        };
-        s += &format!(
-            "input {label}:{:pad$}{}: {} triangles ({} faces), {} polygons after import \
-             ({} faces triangulated, {} dropped)\n",
-            "",
-            o.name,
-            o.counts.0,
-            o.counts.1,
-            r.polygons,
-            r.triangulated.len(),
-            r.dropped.len(),
-            pad = 9usize.saturating_sub(label.len())
-        );
-    }
-    s += &format!(
-        "grid step:      2^{} = {:.3e} units\n",
-        out.grid.step_log2(),
-        out.grid.step()
-    );
-    let sum: bsp_csg::Stats = out.stats.iter().sum();
-    s += &format!(
-        "octree:         {} cells, {} with both surfaces ({} with shared planes, {} where \
-         they do not meet: {} with every face apart from the other surface, {} labelled from \
-         the cells around); {} faces cut into {} pieces\n",
-        sum.cells,
-        sum.mixed_cells,
-        sum.merged_cells,
-        sum.easy_cells + sum.clean_cells,
-        sum.clean_cells,
-        sum.easy_cells,
-        sum.cut_faces,
-        sum.pieces
-    );
-    s += &format!(
-        "output:         {} triangles, {} vertices\n",
-        out.exact.triangles.len(),
-        out.positions.len()
-    );
     let start = Instant::now();
-    let exact = out.volume();
+    let volume = out.volume();
     let exact_time = start.elapsed();
-    let k = out.grid.scale();
-    s += &format!(
-        "volume:         {exact} (exact, rounded once); {} (f64 sum)\n",
-        out.exact.volume_f64() / (k * k * k)
-    );
+    s += &out.report(operands, volume);
     s += "time (ms):\n";
     let ms = |d: Duration| d.as_secs_f64() * 1e3;
     for (name, d) in &phases.0 {

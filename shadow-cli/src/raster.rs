@@ -17,7 +17,7 @@ use shadow_raster::{
 use shadow_scene::face_colors;
 use svbsp::PlacedLight;
 
-use crate::args::{CameraArgs, LightArgs, SourceArgs, parse_fov, parse_size, viewpoint_flags};
+use crate::args::{CameraArgs, LightArgs, SourceArgs, parse_fov, parse_size};
 use crate::input::Scene;
 use crate::lights::describe;
 use crate::output::{Phases, emit, write_file, write_files};
@@ -207,10 +207,9 @@ pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> 
         args.quiet,
         &mut Phases::default(),
     )?;
-    let (at, framed) = args.camera.viewpoint(&s.mesh, s.staging, size, args.fov);
-    if framed && !args.quiet {
-        eprintln!("note: camera {}", viewpoint_flags(&at, s.bounds));
-    }
+    let at = args
+        .camera
+        .pick(&s.mesh, s.staging, (size, args.fov), args.quiet);
     let camera = at.camera(s.bounds).map_err(raster_error)?;
     if s.polys.is_empty() {
         bail!("{}: nothing to draw: no face has an area", s.name);
@@ -238,65 +237,49 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
         check_ext(m, "pgm", "--mask")?;
     }
     let shadow = args.opts.options()?;
-    {
-        let total = Instant::now();
-        let p = prepare(&args.scene, args.size, true)?;
-        let opts = RenderOptions::default()
-            .with_hsr(args.hsr)
-            .with_culling(args.cull)
-            .with_method(args.method)
-            .with_shadow(shadow);
-        let out = render(&p.scene, &p.lights, &p.camera, &p.colors, &opts)?;
-        let t = Instant::now();
-        let mask = out.mask();
-        let png = out.image.encode_png();
-        let pgm = encode_pgm(args.size.0, args.size.1, &mask);
-        let mut files = vec![(args.output.as_path(), &png[..])];
-        files.extend(args.mask.as_deref().map(|m| (m, &pgm[..])));
-        write_files(&files)?;
-        let write = t.elapsed();
-        let seen = mask.iter().filter(|&&m| m != 0).count();
-        let lit = mask.iter().filter(|&&m| m == 255).count();
-        let mut text = format!(
-            "wrote {}: {}x{} of {} ({} faces), {} shadows, {} visibility; {:.1}% of the visible \
-             pixels lit by light 0\n",
-            args.output.display(),
-            args.size.0,
-            args.size.1,
-            p.name,
-            p.faces,
-            args.method.name(),
-            args.hsr.name(),
-            100.0 * lit as f64 / seen.max(1) as f64
-        );
-        if let Some(m) = &args.mask {
-            text += &format!("wrote {}: the mask of light 0\n", m.display());
-        }
-        if args.stats {
-            for (i, n) in p.light_notes.iter().enumerate() {
-                text += &format!("light {i}:        {n}\n");
-            }
-            text += &format!("load/import:    {:.1} ms\n", ms(p.load_time));
-            text += &format!("visibility:     {:.1} ms\n", ms(out.visibility_time));
-            text += &format!(
-                "shadows:        {:.1} ms ({} primitives{})\n",
-                ms(out.figures.time),
-                out.figures.primitives,
-                if out.figures.fallback_pixels > 0 {
-                    format!(
-                        ", {} pixels settled by a point test",
-                        out.figures.fallback_pixels
-                    )
-                } else {
-                    String::new()
-                }
-            );
-            text += &format!("shading:        {:.1} ms\n", ms(out.shading_time));
-            text += &format!("write:          {:.1} ms\n", ms(write));
-            text += &format!("total:          {:.1} ms\n", ms(total.elapsed()));
-        }
-        emit(&text)
+    let total = Instant::now();
+    let p = prepare(&args.scene, args.size, true)?;
+    let opts = RenderOptions::default()
+        .with_hsr(args.hsr)
+        .with_culling(args.cull)
+        .with_method(args.method)
+        .with_shadow(shadow);
+    let out = render(&p.scene, &p.lights, &p.camera, &p.colors, &opts)?;
+    let t = Instant::now();
+    let mask = out.mask();
+    let png = out.image.encode_png();
+    let pgm = encode_pgm(args.size.0, args.size.1, &mask);
+    let mut files = vec![(args.output.as_path(), &png[..])];
+    files.extend(args.mask.as_deref().map(|m| (m, &pgm[..])));
+    write_files(&files)?;
+    let write = t.elapsed();
+    let seen = mask.iter().filter(|&&m| m != 0).count();
+    let lit = mask.iter().filter(|&&m| m == 255).count();
+    let mut text = format!(
+        "wrote {}: {}x{} of {} ({} faces), {} shadows, {} visibility; {:.1}% of the visible \
+         pixels lit by light 0\n",
+        args.output.display(),
+        args.size.0,
+        args.size.1,
+        p.name,
+        p.faces,
+        args.method.name(),
+        args.hsr.name(),
+        100.0 * lit as f64 / seen.max(1) as f64
+    );
+    if let Some(m) = &args.mask {
+        text += &format!("wrote {}: the mask of light 0\n", m.display());
     }
+    if args.stats {
+        for (i, n) in p.light_notes.iter().enumerate() {
+            text += &format!("light {i}:        {n}\n");
+        }
+        text += &format!("load/import:    {:.1} ms\n", ms(p.load_time));
+        text += &out.timings();
+        text += &format!("write:          {:.1} ms\n", ms(write));
+        text += &format!("total:          {:.1} ms\n", ms(total.elapsed()));
+    }
+    emit(&text)
 }
 
 /// `shadow compare`.
@@ -306,67 +289,55 @@ pub(crate) fn run_compare(args: &CompareArgs) -> Result<()> {
         check_ext(r, "csv", "--report")?;
     }
     let shadow = args.opts.options()?;
-    {
-        let p = prepare(&args.scene, args.size, true)?;
-        let methods = if args.methods.is_empty() {
-            Method::ALL.to_vec()
-        } else {
-            args.methods.clone()
-        };
-        let cmp = compare(&p.scene, &p.lights, &p.camera, &p.colors, &shadow, &methods)?;
-        let png = cmp
-            .image(args.columns as usize, args.highlight)
-            .encode_png();
-        let csv = cmp.csv();
-        let mut files = vec![(args.output.as_path(), &png[..])];
-        files.extend(args.report.as_deref().map(|r| (r, csv.as_bytes())));
-        write_files(&files)?;
-        let mut text = format!(
-            "wrote {}: {} methods on {} ({} faces), {}x{} each; visibility {:.1} ms\n",
-            args.output.display(),
-            cmp.reports.len(),
-            p.name,
-            p.faces,
-            args.size.0,
-            args.size.1,
-            ms(cmp.visibility_time)
-        );
-        text += &format!("{:<15} {:>12} {:>10}\n", "method", "disagree", "time");
-        for r in &cmp.reports {
-            text += &format!(
-                "{:<15} {:>11.3}% {:>7.1} ms\n",
-                r.method.name(),
-                r.disagree_percent(),
-                ms(r.time)
-            );
-        }
-        if let Some(r) = &args.report {
-            text += &format!("wrote {}\n", r.display());
-        }
-        emit(&text)
+    let p = prepare(&args.scene, args.size, true)?;
+    let methods = if args.methods.is_empty() {
+        Method::ALL.to_vec()
+    } else {
+        args.methods.clone()
+    };
+    let cmp = compare(&p.scene, &p.lights, &p.camera, &p.colors, &shadow, &methods)?;
+    let png = cmp
+        .image(args.columns as usize, args.highlight)
+        .encode_png();
+    let csv = cmp.csv();
+    let mut files = vec![(args.output.as_path(), &png[..])];
+    files.extend(args.report.as_deref().map(|r| (r, csv.as_bytes())));
+    write_files(&files)?;
+    let mut text = format!(
+        "wrote {}: {} methods on {} ({} faces), {}x{} each; visibility {:.1} ms\n",
+        args.output.display(),
+        cmp.reports.len(),
+        p.name,
+        p.faces,
+        args.size.0,
+        args.size.1,
+        ms(cmp.visibility_time)
+    );
+    text += &cmp.table();
+    if let Some(r) = &args.report {
+        text += &format!("wrote {}\n", r.display());
     }
+    emit(&text)
 }
 
 /// `shadow lines`.
 pub(crate) fn run_lines(args: &LinesArgs) -> Result<()> {
     check_ext(&args.output, "svg", "-o")?;
-    {
-        let p = prepare(&args.scene, args.size, false)?;
-        let lines = hidden_lines(&p.scene, &p.camera)?;
-        write_file(&args.output, lines.svg(args.hidden).as_bytes())?;
-        emit(&format!(
-            "wrote {}: {} polyhedra ({} convex), {} edges, {} visible and {} hidden parts; \
-             z-buffer check: {} of {} points agree\n",
-            args.output.display(),
-            lines.polyhedra,
-            lines.convex,
-            lines.edges,
-            lines.visible.len(),
-            lines.hidden.len(),
-            lines.check.agree,
-            lines.check.checked
-        ))
-    }
+    let p = prepare(&args.scene, args.size, false)?;
+    let lines = hidden_lines(&p.scene, &p.camera)?;
+    write_file(&args.output, lines.svg(args.hidden).as_bytes())?;
+    emit(&format!(
+        "wrote {}: {} polyhedra ({} convex), {} edges, {} visible and {} hidden parts; \
+         z-buffer check: {} of {} points agree\n",
+        args.output.display(),
+        lines.polyhedra,
+        lines.convex,
+        lines.edges,
+        lines.visible.len(),
+        lines.hidden.len(),
+        lines.check.agree,
+        lines.check.checked
+    ))
 }
 
 #[cfg(test)]

@@ -22,16 +22,11 @@ use anyhow::{Context, Result, bail};
 use bsp_core::{BspTree, BuildOptions, Polygon};
 use clap::{Args, ValueEnum};
 use glam::DVec3;
-use rayon::prelude::*;
 use shadow_raster::svg::{SvgFragment, SvgView, SvgViewpoint};
-use svbsp::export::{
-    AreaRecord, FragmentFile, FragmentFormat, area_records, json_fragments, world_vertices,
-};
-use svbsp::{
-    Areas, Batch, CHUNK, LightSpec, ShadeOptions, Shadows, chin_feiner, percent, receivers,
-};
+use svbsp::export::{FragmentFile, FragmentFormat, area_records, world_vertices};
+use svbsp::{Areas, Batch, LightSpec, ShadeOptions, Shadows, chin_feiner, percent, receivers};
 
-use crate::args::{CameraArgs, ImageArgs, LightArgs, SourceArgs, viewpoint_flags};
+use crate::args::{CameraArgs, ImageArgs, LightArgs, SourceArgs};
 use crate::input::{NO_LIGHT, Scene};
 use crate::lights::describe;
 use crate::output::{Output, Phases, emit, guarded};
@@ -78,10 +73,6 @@ pub(crate) struct ShadowsArgs {
 
 /// How many faces `--stats` lists.
 const TOP_FACES: usize = 10;
-
-/// Receivers shaded per round: each round is shaded and formatted in
-/// parallel (in chunks of [`CHUNK`]), then written.
-const ROUND: usize = CHUNK * 32;
 
 /// The output format, by the file's extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -165,16 +156,9 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
     let scene = Scene::load(&args.source, request.specs, true, args.quiet, &mut phases)?;
     let view = (request.format == Format::Svg).then(|| {
         let size = args.image.size();
-        let (at, framed) = args
-            .camera
-            .viewpoint(&scene.mesh, scene.staging, size, args.image.fov);
-        if framed {
-            note(
-                args,
-                &format!("note: camera {}", viewpoint_flags(&at, scene.bounds)),
-            );
-        }
-        at
+        let image = (size, args.image.fov);
+        args.camera
+            .pick(&scene.mesh, scene.staging, image, args.quiet)
     });
     let mut out = Output::create(&args.output)?;
     let mut job = Job {
@@ -376,58 +360,26 @@ impl Job<'_> {
         Ok(())
     }
 
-    /// Shades the receivers round by round (each round in parallel) and
-    /// writes each round as soon as it is done.
+    /// Shades the receivers and writes them as they are done
+    /// ([`FragmentFile::stream`]).
     fn stream(&mut self, shadows: &Shadows, out: &mut Output) -> Result<()> {
         let scene = self.scene;
-        let (format, lights) = (self.format, self.kernel.len());
-        let ranges = receivers(&scene.polys);
-        self.fig.receivers = ranges.len();
-        let opts = ShadeOptions::default().with_pieces(format == Format::Obj);
+        let opts = ShadeOptions::default().with_pieces(self.format == Format::Obj);
         let mut file = self.begin(out)?;
-        let (mut shading, mut writing) = (Duration::ZERO, Duration::ZERO);
         let progress = self.progress;
-        progress.phase("shading", ranges.len() as u64);
-        for (r, round) in ranges.chunks(ROUND).enumerate() {
-            let start = Instant::now();
-            let parts: Vec<Result<Shaded>> = round
-                .par_chunks(CHUNK)
-                .enumerate()
-                .map(|(i, rs)| {
-                    let first_receiver = (r * ROUND + i * CHUNK) as u32;
-                    let b = shadows
-                        .set()
-                        .shade_ranges(&scene.polys, rs, first_receiver, &opts);
-                    let world = world_vertices(&b, &scene.grid)?;
-                    let records = area_records(&b, &world);
-                    let text = match format {
-                        Format::Json => json_fragments(&b, &world, &records, lights),
-                        _ => Vec::new(),
-                    };
-                    progress.inc(rs.len() as u64);
-                    Ok((b, world, records, text))
-                })
-                .collect();
-            shading += start.elapsed();
-            let start = Instant::now();
-            for part in parts {
-                let (b, world, records, text) = part?;
-                self.fig.fragments += b.len();
-                let json = (format == Format::Json).then_some(&text[..]);
-                file.write(out, (&b, &world, &records), json)?;
-            }
-            writing += start.elapsed();
-        }
+        progress.phase("shading", receivers(&scene.polys).len() as u64);
+        let polys = (&scene.polys[..], &scene.grid);
+        let s = file.stream(out, shadows.set(), polys, &opts, |n| {
+            progress.inc(n as u64);
+        })?;
+        self.fig.receivers = s.receivers;
+        self.fig.fragments = s.fragments;
         self.finish(file, out)?;
-        self.phases.0.push(("shading", shading));
-        self.phases.0.push(("write", writing));
+        self.phases.0.push(("shading", s.shading));
+        self.phases.0.push(("write", s.writing));
         Ok(())
     }
 }
-
-/// A chunk of receivers shaded: the fragments, their vertices in input
-/// units, their areas and (for JSON) their text.
-type Shaded = (Batch, Vec<DVec3>, Vec<AreaRecord>, Vec<u8>);
 
 /// The `--stats` report.
 fn stats_text(
@@ -440,19 +392,8 @@ fn stats_text(
     let faces = scene.mesh.faces.len();
     let lights = &scene.lights;
     let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "faces:           {faces} ({} polygons after import: {} faces triangulated, {} dropped)",
-        scene.report.polygons,
-        scene.report.triangulated.len(),
-        scene.report.dropped.len()
-    );
-    let _ = writeln!(
-        s,
-        "grid step:       2^{} = {:.3e} units",
-        scene.grid.step_log2(),
-        scene.grid.step()
-    );
+    let _ = writeln!(s, "faces:           {faces}; {}", scene.report.counts());
+    let _ = writeln!(s, "grid step:       {}", scene.grid.step_text());
     if let Some(n) = fig.bsp_polygons {
         let _ = writeln!(s, "bsp:             {n} polygons");
     }

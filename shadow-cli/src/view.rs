@@ -9,7 +9,7 @@ use clap::Args;
 use shadow_raster::svg::{SvgPicture, SvgView, SvgViewpoint};
 use shadow_scene::{ROOM_EYE, ROOM_TARGET};
 
-use crate::args::{CameraArgs, ImageArgs, SourceArgs, viewpoint_flags};
+use crate::args::{CameraArgs, ImageArgs, SourceArgs};
 use crate::input::{Prepared, load_source, load_source_quiet};
 use crate::output::{emit, write_file};
 use crate::raster_error;
@@ -62,12 +62,8 @@ pub(crate) fn view(args: &ViewArgs) -> Result<()> {
         .bounds()
         .context("nothing to draw: the mesh has no vertices")?;
     let staging = args.source.staging(bounds);
-    let (at, framed) =
-        args.camera
-            .viewpoint(&prepared.mesh, staging, args.image.size(), args.image.fov);
-    if framed && !args.quiet {
-        eprintln!("note: camera {}", viewpoint_flags(&at, bounds));
-    }
+    let image = (args.image.size(), args.image.fov);
+    let at = args.camera.pick(&prepared.mesh, staging, image, args.quiet);
     let out = draw(&prepared, at)?;
     write_file(&args.output, out.svg.as_bytes())?;
     emit(&format!(
@@ -88,26 +84,22 @@ pub(crate) fn stats(args: &SourceArgs) -> Result<()> {
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     emit(&format!(
         "input:           {name}\n\
-         faces:           {}\n\
-         polygons:        {} after import ({} faces triangulated, {} dropped)\n\
+         faces:           {}; {}\n\
          bsp polygons:    {} after splitting\n\
          nodes:           {}\n\
          depth:           {}\n\
          cells:           {} in, {} out\n\
-         grid step:       2^{} = {:.3e} units\n\
+         grid step:       {}\n\
          import time:     {:.2} ms\n\
          build time:      {:.2} ms\n",
         p.mesh.faces.len(),
-        p.report.polygons,
-        p.report.triangulated.len(),
-        p.report.dropped.len(),
+        p.report.counts(),
         t.polygons,
         t.nodes,
         t.depth,
         t.in_cells,
         t.out_cells,
-        p.grid.step_log2(),
-        p.grid.step(),
+        p.grid.step_text(),
         ms(p.import_time),
         ms(p.build_time)
     ))

@@ -92,7 +92,7 @@ fn stats_prints_the_tree_figures() {
     let s = stdout(&o);
     for key in [
         "faces:           992",
-        "polygons:",
+        "polygons after import",
         "bsp polygons:",
         "nodes:",
         "depth:",

@@ -77,6 +77,21 @@ impl Comparison {
         composite(&panels, columns)
     }
 
+    /// The report as a table for people: method, the share of visible
+    /// pixels that disagree with the exact shadows, and the time.
+    pub fn table(&self) -> String {
+        let mut s = format!("{:<15} {:>12} {:>10}\n", "method", "disagree", "time");
+        for r in &self.reports {
+            s += &format!(
+                "{:<15} {:>11.3}% {:>7.1} ms\n",
+                r.method.name(),
+                r.disagree_percent(),
+                r.time.as_secs_f64() * 1e3
+            );
+        }
+        s
+    }
+
     /// The report as CSV: `method,disagree_pixels,visible_pixels,disagree_percent,ms`.
     pub fn csv(&self) -> String {
         let mut s = String::from("method,disagree_pixels,visible_pixels,disagree_percent,ms\n");

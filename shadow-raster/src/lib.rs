@@ -163,6 +163,26 @@ impl Rendered {
     pub fn mask(&self) -> Vec<u8> {
         mask(&self.visibility, &self.lit)
     }
+
+    /// The passes' times for people, one line each: visibility, shadows
+    /// (with the method's primitive count, and the pixels a point test
+    /// settled) and shading.
+    pub fn timings(&self) -> String {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        let f = &self.figures;
+        let fallback = match f.fallback_pixels {
+            0 => String::new(),
+            n => format!(", {n} pixels settled by a point test"),
+        };
+        format!(
+            "visibility:     {:.1} ms\nshadows:        {:.1} ms ({} primitives{fallback})\n\
+             shading:        {:.1} ms\n",
+            ms(self.visibility_time),
+            ms(f.time),
+            f.primitives,
+            ms(self.shading_time)
+        )
+    }
 }
 
 /// The lights in the forms the image-space methods use, at most

@@ -12,6 +12,7 @@ use std::fmt::Write;
 
 use bsp_core::{BspTree, Grid, Order, Plane, Polygon, Side, ViewPoint};
 use glam::DVec3;
+use shadow_scene::Staging;
 use svbsp::{Light, PlacedLight};
 
 use crate::shading::Lambert;
@@ -117,7 +118,58 @@ pub struct SvgViewpoint {
     pub fov_deg: f64,
 }
 
+/// What a user gave of a viewpoint: any of the eye, the target and the
+/// up direction.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ViewRequest {
+    /// The eye.
+    pub eye: Option<DVec3>,
+    /// The point looked at.
+    pub target: Option<DVec3>,
+    /// The up direction.
+    pub up: Option<DVec3>,
+}
+
 impl SvgViewpoint {
+    /// The viewpoint of a `width`×`height` picture of `positions` with a
+    /// vertical field of view of `fov_deg`, completing what was `given`:
+    /// an eye given is kept (its up from `staging` unless given); else a
+    /// built-in scene's `staging` is used; else the camera frames every
+    /// vertex ([`Staging::framing`], with `given.up`, default +z, as up).
+    /// The flag says whether the camera was framed, which is worth
+    /// telling the user.
+    pub fn choose(
+        given: ViewRequest,
+        positions: &[DVec3],
+        staging: Option<Staging>,
+        (width, height): (u32, u32),
+        fov_deg: f64,
+    ) -> (SvgViewpoint, bool) {
+        let aspect = width as f64 / height as f64;
+        let up_axis = given.up.unwrap_or(DVec3::Z);
+        let ((eye, target, up), framed) = match (given.eye, staging) {
+            (Some(e), s) => ((e, given.target, given.up.or(s.and_then(|s| s.up))), false),
+            (None, Some(s)) => {
+                let target = Some(given.target.unwrap_or(s.target));
+                ((s.eye, target, given.up.or(s.up)), false)
+            }
+            (None, None) => match Staging::framing(positions, up_axis, fov_deg, aspect) {
+                Some(s) => ((s.eye, Some(given.target.unwrap_or(s.target)), s.up), true),
+                // no vertex: nothing to frame (drawing it fails later)
+                None => ((DVec3::ONE, given.target, given.up), false),
+            },
+        };
+        let at = SvgViewpoint {
+            eye,
+            target,
+            up,
+            width,
+            height,
+            fov_deg,
+        };
+        (at, framed)
+    }
+
     /// The raster camera of this viewpoint (the eye as given) for a scene
     /// spanning `bounds`: the target defaults to the box's centre, the up
     /// direction to [`default_up`].

@@ -217,6 +217,33 @@ fn every_method_and_visibility_runs_on_the_room() {
 }
 
 #[test]
+fn a_comparison_and_a_render_report_for_people() {
+    let s = room();
+    let cam = room_camera(128, 72);
+    let opts = ShadowOptions::default();
+    let cmp = shadow_raster::compare(&s.scene, &s.lights, &cam, &[], &opts, &[Method::ShadowMap])
+        .unwrap();
+    let methods: Vec<&str> = cmp.reports.iter().map(|r| r.method.name()).collect();
+    assert_eq!(methods, ["exact", "shadow-map"]);
+    assert_eq!(cmp.reports[0].disagree, 0);
+    let table = cmp.table();
+    let table: Vec<&str> = table.lines().collect();
+    assert_eq!(table.len(), 3);
+    assert!(table[0].starts_with("method") && table[0].contains("disagree"));
+    assert!(table[1].starts_with("exact") && table[1].contains(" 0.000% "));
+    let shown = format!("{:.3}%", cmp.reports[1].disagree_percent());
+    assert!(table[2].starts_with("shadow-map") && table[2].contains(&shown));
+    assert_eq!(cmp.csv().lines().count(), 3);
+
+    let out = render(&s.scene, &s.lights, &cam, &[], &with(Method::ShadowMap)).unwrap();
+    let t = out.timings();
+    let names: Vec<&str> = t.lines().map(|l| l.split(':').next().unwrap()).collect();
+    assert_eq!(names, ["visibility", "shadows", "shading"]);
+    let primitives = format!("({} primitives", out.figures.primitives);
+    assert!(t.contains(&primitives), "{t}");
+}
+
+#[test]
 fn images_do_not_depend_on_the_thread_count() {
     let s = room();
     let cam = room_camera(200, 120);

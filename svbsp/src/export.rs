@@ -12,12 +12,16 @@
 
 use std::collections::HashMap;
 use std::io::{self, Write};
+use std::time::{Duration, Instant};
 
-use bsp_core::Grid;
+use bsp_core::{Grid, Polygon};
 use glam::DVec3;
+use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::{Areas, Batch, Light, PlacedLight, polygon_area};
+use crate::{
+    Areas, Batch, CHUNK, Light, PlacedLight, ShadeOptions, ShadowSet, polygon_area, receivers,
+};
 
 /// Why a batch cannot be written.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -355,6 +359,28 @@ impl ObjWriter {
     }
 }
 
+/// Receivers shaded per round of [`FragmentFile::stream`]: each round is
+/// shaded and formatted in parallel (in chunks of [`CHUNK`]), then
+/// written.
+const ROUND: usize = CHUNK * 32;
+
+/// What [`FragmentFile::stream`] did.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Streamed {
+    /// Fragments written.
+    pub fragments: usize,
+    /// Receivers shaded (see [`receivers`]).
+    pub receivers: usize,
+    /// Time spent shading and formatting (in parallel).
+    pub shading: Duration,
+    /// Time spent writing.
+    pub writing: Duration,
+}
+
+/// A chunk of receivers shaded: the fragments, their vertices in input
+/// units, their areas and (for JSON) their text.
+type Shaded = (Batch, Vec<DVec3>, Vec<AreaRecord>, Vec<u8>);
+
 /// The format of a [`FragmentFile`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FragmentFormat {
@@ -483,6 +509,59 @@ impl FragmentFile {
         file.finish(out)
     }
 
+    /// Shades every receiver of `polys` on `grid` by `shadows` and writes
+    /// its fragments, round by round: each round's chunks are shaded and
+    /// formatted in parallel, then written in order, so the file is the
+    /// same for every thread count and memory stays bounded. `done(n)` is
+    /// told of every `n` receivers shaded (for a progress bar). A vertex
+    /// that is not finite in input units is an
+    /// [`io::ErrorKind::InvalidData`] error carrying the [`ExportError`].
+    pub fn stream(
+        &mut self,
+        out: &mut impl Write,
+        shadows: ShadowSet<'_>,
+        (polys, grid): (&[Polygon], &Grid),
+        opts: &ShadeOptions,
+        done: impl Fn(usize) + Sync,
+    ) -> io::Result<Streamed> {
+        let ranges = receivers(polys);
+        let json = matches!(self.kind, FileKind::Json { .. });
+        let lights = self.lights;
+        let mut s = Streamed {
+            receivers: ranges.len(),
+            ..Streamed::default()
+        };
+        for (r, round) in ranges.chunks(ROUND).enumerate() {
+            let start = Instant::now();
+            let parts: Vec<Result<Shaded, ExportError>> = round
+                .par_chunks(CHUNK)
+                .enumerate()
+                .map(|(i, rs)| {
+                    let first_receiver = (r * ROUND + i * CHUNK) as u32;
+                    let b = shadows.shade_ranges(polys, rs, first_receiver, opts);
+                    let world = world_vertices(&b, grid)?;
+                    let records = area_records(&b, &world);
+                    let text = match json {
+                        true => json_fragments(&b, &world, &records, lights),
+                        false => Vec::new(),
+                    };
+                    done(rs.len());
+                    Ok((b, world, records, text))
+                })
+                .collect();
+            s.shading += start.elapsed();
+            let start = Instant::now();
+            for part in parts {
+                let (b, world, records, text) =
+                    part.map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))?;
+                s.fragments += b.len();
+                self.write(out, (&b, &world, &records), json.then_some(&text[..]))?;
+            }
+            s.writing += start.elapsed();
+        }
+        Ok(s)
+    }
+
     /// Writes the file's tail (JSON: the summary of the areas).
     pub fn finish(self, out: &mut impl Write) -> io::Result<Written> {
         let (vertices, degenerate) = match &self.kind {
@@ -507,6 +586,17 @@ mod tests {
     /// The floor `[0, 8]²` under the roof `[2, 4]²` at height 4, lit from
     /// above by one point light and one sun, shaded in two batches.
     fn floor_and_roof() -> (Grid, Vec<PlacedLight>, Batch, Batch) {
+        let (grid, lights, polys, shadows) = floor_and_roof_scene();
+        let opts = crate::ShadeOptions::default().with_pieces(true);
+        let ranges = crate::receivers(&polys);
+        let first = shadows.set().shade_ranges(&polys, &ranges[..1], 0, &opts);
+        let second = shadows.set().shade_ranges(&polys, &ranges[1..], 1, &opts);
+        (grid, lights, first, second)
+    }
+
+    /// The scene of [`floor_and_roof`]: its grid, lights, polygons and
+    /// shadow trees.
+    fn floor_and_roof_scene() -> (Grid, Vec<PlacedLight>, Vec<Polygon>, crate::Shadows) {
         let loops: [[[f64; 3]; 4]; 2] = [
             [[0., 0., 0.], [8., 0., 0.], [8., 8., 0.], [0., 8., 0.]],
             [[2., 2., 4.], [4., 2., 4.], [4., 4., 4.], [2., 4., 4.]],
@@ -528,11 +618,35 @@ mod tests {
             .collect();
         let kernel: Vec<Light> = lights.iter().map(|l| l.light).collect();
         let shadows = crate::Shadows::new(&polys, &kernel).unwrap();
+        (grid, lights, polys, shadows)
+    }
+
+    #[test]
+    fn a_streamed_file_is_the_file_of_its_batches() {
+        let (grid, lights, polys, shadows) = floor_and_roof_scene();
+        let (_, _, first, second) = floor_and_roof();
         let opts = crate::ShadeOptions::default().with_pieces(true);
-        let ranges = crate::receivers(&polys);
-        let first = shadows.set().shade_ranges(&polys, &ranges[..1], 0, &opts);
-        let second = shadows.set().shade_ranges(&polys, &ranges[1..], 1, &opts);
-        (grid, lights, first, second)
+        for format in [FragmentFormat::Json, FragmentFormat::Obj] {
+            let (whole, w) = file_of(format, &grid, &lights, &[&first, &second], false);
+            let mut out = Vec::new();
+            let notes = ["a".to_string(), "b".to_string()];
+            let head = ("test", &notes[..]);
+            let mut file = FragmentFile::begin(&mut out, format, &lights, 2, head).unwrap();
+            let done = std::sync::atomic::AtomicUsize::new(0);
+            let s = file
+                .stream(&mut out, shadows.set(), (&polys, &grid), &opts, |n| {
+                    done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+                })
+                .unwrap();
+            let streamed = file.finish(&mut out).unwrap();
+            assert_eq!(
+                String::from_utf8(out).unwrap(),
+                String::from_utf8(whole).unwrap()
+            );
+            assert_eq!(streamed.areas, w.areas);
+            assert_eq!((s.receivers, done.into_inner()), (2, 2));
+            assert_eq!(s.fragments, first.len() + second.len());
+        }
     }
 
     /// The file written in `batches`, and what was written.

@@ -340,6 +340,45 @@ impl FrameTally {
         let mean = sorted.iter().sum::<Duration>() / sorted.len() as u32;
         (sorted[sorted.len() / 2], mean, max)
     }
+
+    /// The frames' figures for people: `frame time median … ms, mean …
+    /// ms, max … ms; … related static polygons a frame; … fragments in the
+    /// last frame; faces turned away from a light left out in … of the
+    /// frames`.
+    ///
+    /// ```
+    /// use std::time::Duration;
+    /// let mut t = tiling::FrameTally::default();
+    /// let frame = tiling::FrameStats {
+    ///     t_frame: Duration::from_millis(2),
+    ///     related: 10,
+    ///     total_drawn: 7,
+    ///     culled: 1,
+    ///     ..Default::default()
+    /// };
+    /// t.add(&frame);
+    /// assert_eq!(
+    ///     t.summary(),
+    ///     "frame time median 2.00 ms, mean 2.00 ms, max 2.00 ms; 10 related static polygons \
+    ///      a frame; 7 fragments in the last frame; faces turned away from a light left out \
+    ///      in 1 of the frames"
+    /// );
+    /// ```
+    pub fn summary(&self) -> String {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        let (median, mean, max) = self.times();
+        format!(
+            "frame time median {:.2} ms, mean {:.2} ms, max {:.2} ms; {:.0} related static \
+             polygons a frame; {} fragments in the last frame; faces turned away from a light \
+             left out in {} of the frames",
+            ms(median),
+            ms(mean),
+            ms(max),
+            self.related_per_frame(),
+            self.last.total_drawn,
+            self.culled_frames
+        )
+    }
 }
 
 impl FrameStats {

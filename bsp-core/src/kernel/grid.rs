@@ -188,6 +188,11 @@ impl Grid {
         -(self.scale.log2() as i32)
     }
 
+    /// The step for people: `2^-7 = 7.812e-3 units`.
+    pub fn step_text(&self) -> String {
+        format!("2^{} = {:.3e} units", self.step_log2(), self.step())
+    }
+
     fn snap_f64(&self, p: DVec3) -> Result<DVec3, SnapError> {
         if !p.is_finite() {
             return Err(SnapError::NonFinite);
@@ -247,6 +252,19 @@ mod tests {
             assert!(s.iter().all(|c| c.abs() <= MAX_COORD / 2 + 1));
         }
         assert_eq!(g.scale().log2().fract(), 0.0);
+    }
+
+    #[test]
+    fn the_step_reads_as_a_power_of_two() {
+        let g = Grid::fit(DVec3::ZERO, DVec3::splat(1000.0)).unwrap();
+        let k = g.step_log2();
+        assert_eq!(2f64.powi(k), g.step());
+        assert_eq!(g.step_text(), format!("2^{k} = {:.3e} units", g.step()));
+        let g = Grid::fit(DVec3::ZERO, DVec3::splat(2f64.powi(20))).unwrap();
+        assert_eq!(
+            g.step_text(),
+            format!("2^{} = {:.3e} units", g.step_log2(), g.step())
+        );
     }
 
     #[test]

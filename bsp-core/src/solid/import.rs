@@ -51,6 +51,16 @@ impl ImportReport {
         }
         s
     }
+
+    /// `N polygons after import (T faces triangulated, D dropped)`.
+    pub fn counts(&self) -> String {
+        format!(
+            "{} polygons after import ({} faces triangulated, {} dropped)",
+            self.polygons,
+            self.triangulated.len(),
+            self.dropped.len()
+        )
+    }
 }
 
 /// Snaps `faces` to `grid` and turns each into convex polygons tagged with
@@ -600,6 +610,10 @@ mod tests {
         assert_eq!(p.len(), 4);
         assert_eq!(r.triangulated, vec![(0, FaceDefect::NonConvex)]);
         assert!(p.iter().all(|q| q.support().normal() == [0, 0, 1]));
+        assert_eq!(
+            r.counts(),
+            "4 polygons after import (1 faces triangulated, 0 dropped)"
+        );
     }
 
     #[test]
