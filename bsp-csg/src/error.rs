@@ -22,8 +22,12 @@ pub enum CsgError {
     },
     /// A coordinate does not fit the grid (or is not finite).
     Grid(bsp_core::Error),
-    /// Operand `operand` is closed and oriented as a mesh, but its snapped
-    /// surface does not bound a solid (it crosses itself).
+    /// A surface is closed and oriented as a mesh, but its winding
+    /// numbers disagree within a cell (it crosses itself after snapping).
+    /// [`Solid::plan_owned`](crate::Solid::plan_owned) meets it by
+    /// resolving both solids ([`Solid::resolved`](crate::Solid::resolved));
+    /// from there, it means the winding numbers disagree around a loop of
+    /// the partition (the surface is not closed after all).
     NotASolid,
     /// The result is not watertight: a bug, not a problem of the input.
     Internal(String),

@@ -40,6 +40,9 @@ pub struct Operand {
     /// [`Operand::welded`] renumbered them, so that messages quote the
     /// file's indices.
     file_loops: Option<Vec<Vec<u32>>>,
+    /// Faces that welding collapsed and left out (see
+    /// [`Operand::welded`]).
+    pub collapsed: usize,
 }
 
 /// An operand's or the operation's error, worded to point into the files.
@@ -77,21 +80,33 @@ impl Operand {
             counts: (mesh.triangle_count(), mesh.faces.len()),
             mesh,
             file_loops: None,
+            collapsed: 0,
         }
     }
 
     /// `mesh` with vertices at exactly equal positions merged (for files
     /// that repeat the vertices of every face); messages still quote the
     /// file's vertex indices.
+    ///
+    /// A face whose corners merge ([`Mesh::collapse_repeats`]: a sliver
+    /// whose vertices a writer rounded to one position) loses the corners
+    /// that repeat, and is left out if fewer than three remain; their
+    /// number is [`Operand::collapsed`]. The check that follows tells
+    /// whether the surface is still closed.
     pub fn welded(name: impl Into<String>, mut mesh: Mesh) -> Operand {
         let counts = (mesh.triangle_count(), mesh.faces.len());
-        let loops = mesh.faces.iter().map(|f| f.vertices.clone()).collect();
+        let mut loops: Vec<Vec<u32>> = mesh.faces.iter().map(|f| f.vertices.clone()).collect();
         mesh.weld();
+        let dropped = mesh.collapse_repeats();
+        for &f in dropped.iter().rev() {
+            loops.remove(f);
+        }
         Operand {
             name: name.into(),
             counts,
             mesh,
             file_loops: Some(loops),
+            collapsed: dropped.len(),
         }
     }
 
@@ -371,30 +386,36 @@ impl FileBoolean {
         s
     }
 
-    /// Warnings for what rounding the exact vertices does to the file:
-    /// distinct vertices equal in `f64` (their triangles degenerate), and
-    /// for STL (`stl`) vertices that `f32` merges.
-    pub fn rounding_warnings(&self, stl: bool) -> Vec<String> {
-        let mut w = Vec::new();
-        let coincide = self.mesh().repeated_positions();
-        if coincide > 0 {
-            w.push(format!(
-                "{coincide} distinct exact vertices coincide once rounded to f64 input units; \
-                 their triangles are degenerate in the file"
-            ));
-        }
-        let merged = if stl {
-            shadow_scene::stl_collisions(&self.mesh())
-        } else {
-            0
+    /// The result as a file holds it where rounding its exact vertices
+    /// to `f64` (or for `stl`, to `f32`) makes distinct ones equal:
+    /// welded, with the faces that collapse left out
+    /// ([`Mesh::collapse_repeats`]), so that a reader that welds by
+    /// position finds no face repeating a vertex. `None` where no two
+    /// vertices round to one position (the file is [`FileBoolean::mesh`]
+    /// as it is).
+    pub fn rounded(&self, stl: bool) -> Option<Rounded> {
+        let view = self.mesh();
+        let coincide = match stl {
+            true => shadow_scene::stl_collisions(&view),
+            false => view.repeated_positions(),
         };
-        if merged > 0 {
-            w.push(format!(
-                "{merged} vertices coincide once rounded to f32 for STL; the file may not be \
-                 closed when read back (write .obj to keep full precision)"
-            ));
+        if coincide == 0 {
+            return None;
         }
-        w
+        let mut mesh = view.to_mesh();
+        if stl {
+            for p in &mut mesh.positions {
+                *p = p.as_vec3().as_dvec3();
+            }
+        }
+        mesh.weld();
+        let collapsed = mesh.collapse_repeats().len();
+        let closed = mesh.is_closed_oriented();
+        Some(Rounded {
+            mesh,
+            collapsed,
+            closed,
+        })
     }
 
     /// The exact volume in input units, rounded once to `f64`.
@@ -402,6 +423,19 @@ impl FileBoolean {
         // the scale is a power of two: the division is exact
         self.exact.volume_rounded() / self.grid.scale().powi(3)
     }
+}
+
+/// A result as a file holds it once rounded ([`FileBoolean::rounded`]).
+#[derive(Clone, Debug)]
+pub struct Rounded {
+    /// The mesh to write.
+    pub mesh: Mesh,
+    /// Faces that rounding collapsed, left out.
+    pub collapsed: usize,
+    /// Whether the mesh is still closed and oriented by vertex index
+    /// (where a collapsed edge's ends had other neighbours in common, it
+    /// is not).
+    pub closed: bool,
 }
 
 /// "union", "intersection" or "difference".
@@ -712,7 +746,7 @@ f 4 1 5 8
             "volume:         120 (exact, rounded once); 120 (f64 sum)"
         );
         // integer vertices: nothing coincides once rounded, even in f32
-        assert!(out.rounding_warnings(true).is_empty());
+        assert!(out.rounded(true).is_none() && out.rounded(false).is_none());
 
         let empty = Operand::new("e.obj", Mesh::default());
         assert_eq!(empty.check().unwrap_err().message, "e.obj: no faces");
@@ -812,17 +846,22 @@ f 4 1 5 8
     }
 
     #[test]
-    fn overlapping_shells_in_one_file_are_rejected() {
+    fn overlapping_shells_in_one_file_count_once() {
         // two closed cubes that overlap, in one file: each is a closed
-        // manifold, but together they bound no solid (winding number 2
-        // where they overlap); the other operand's surface crosses there
+        // manifold, and together they bound their union (the points where
+        // the winding number is positive; it is 2 where they overlap)
         let shells = cube(4.0, [0.0; 3]) + &cube(4.0, [2.0; 3]);
         let a = operand(&shells, "shells.obj", false);
         a.check().unwrap();
         let b = operand(&cube(3.0, [2.5, -0.5, 1.5]), "b.obj", false);
-        for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
-            let e = apply(&mut [a.clone(), b.clone()], op).err().unwrap();
-            assert!(e.to_string().contains("crosses itself"), "{op:?}: {e}");
+        // A ∪ B = 120; C = 27; (A ∪ B) ∩ C = 9.375 + 3.75 − 1.5
+        for (op, volume) in [
+            (BoolOp::Union, 135.375),
+            (BoolOp::Intersection, 11.625),
+            (BoolOp::Difference, 108.375),
+        ] {
+            let out = apply(&mut [a.clone(), b.clone()], op).unwrap();
+            assert_eq!(out.volume(), volume, "{op:?}");
         }
     }
 }

@@ -172,7 +172,33 @@ pub fn snap_one(
         .rev()
         .map(|&(f, _)| f as u32)
         .collect();
-    Ok((Solid::from_faces(faces, free), report))
+    let solid = Solid::from_faces(faces, free);
+    // several shells may cross, overlap or nest: their solid is where the
+    // winding number is positive (one shell is clean or crosses itself;
+    // see the crate docs)
+    let solid = match shells(mesh) > 1 {
+        true => solid.resolved()?,
+        false => solid,
+    };
+    Ok((solid, report))
+}
+
+/// The number of vertex-connected shells of `mesh`'s faces (by vertex
+/// index).
+fn shells(mesh: &MeshIn<'_>) -> usize {
+    let mut uf = bsp_core::internals::UnionFind::new(mesh.positions.len());
+    let mut used = vec![false; mesh.positions.len()];
+    for f in mesh.faces {
+        for w in f.windows(2) {
+            uf.union(w[0], w[1]);
+        }
+        for &v in f {
+            used[v as usize] = true;
+        }
+    }
+    (0..used.len() as u32)
+        .filter(|&v| used[v as usize] && uf.find(v) == v)
+        .count()
 }
 
 /// Six times the signed volume of the cone from the origin over an

@@ -85,6 +85,19 @@ impl Planned {
 }
 
 impl Solid {
+    /// The solid of the points where this surface's winding number is
+    /// positive: for a surface whose shells cross, overlap or nest (two
+    /// copies of a part, a part inside another turned the same way, a
+    /// cavity outside any part), the solid those shells bound by the
+    /// rule of mesh-arrangement Booleans; for a clean solid, the same
+    /// solid. Exact; one partition of every face, so it costs more than
+    /// an operation does.
+    pub fn resolved(self) -> Result<Solid, CsgError> {
+        let faces: Vec<bsp_core::Polygon> = self.polygons().map(|p| p.into_owned()).collect();
+        drop_aside(self);
+        Ok(Solid::from_polygons(local::positive_region(faces)?))
+    }
+
     /// `self op other`, as a new solid.
     pub fn boolean(&self, other: &Solid, op: BoolOp) -> Result<Solid, CsgError> {
         let mut s = self.clone();
@@ -153,8 +166,22 @@ impl Solid {
     /// solid.apply_owned(sb, BoolOp::Union).unwrap();
     /// assert_eq!(mesh.triangles, solid.into_watertight_mesh().unwrap().triangles);
     /// ```
-    pub fn plan_owned(mut self, other: Solid, op: BoolOp) -> Result<Planned, CsgError> {
-        let (stats, additions) = self.plan(&other, op, &Options::default())?;
+    ///
+    /// Where a surface turns out to cross itself (the local winding
+    /// numbers disagree), both solids are [resolved](Solid::resolved) and
+    /// the operation is planned again: what it decides then is the
+    /// operation on the solids where the winding numbers are positive.
+    pub fn plan_owned(mut self, mut other: Solid, op: BoolOp) -> Result<Planned, CsgError> {
+        let opts = Options::default();
+        // (a failed plan changed neither solid)
+        let (stats, additions) = match self.plan(&other, op, &opts) {
+            Err(CsgError::NotASolid) => {
+                self = self.resolved()?;
+                other = other.resolved()?;
+                self.plan(&other, op, &opts)?
+            }
+            planned => planned?,
+        };
         Ok(Planned {
             solid: self,
             other,

@@ -3,3 +3,4 @@
 mod certify;
 mod differential;
 mod drill;
+mod resolve;

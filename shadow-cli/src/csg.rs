@@ -12,7 +12,7 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use anyhow::{Result, anyhow};
+use anyhow::{Result, anyhow, bail};
 use bsp_core::{BoolOp, Grid, ImportReport};
 use bsp_csg::files::{FileBoolean, FileError, Operand};
 use bsp_csg::{Stage, Step};
@@ -53,9 +53,10 @@ pub(crate) struct CsgArgs {
     /// every tool from the part; union and intersection combine all.
     #[arg(value_enum)]
     pub(crate) op: Operation,
-    /// The operands (.obj or .stl), two or more: closed, consistently
-    /// oriented meshes.
-    #[arg(value_name = "MESH", num_args = 2.., required = true)]
+    /// The operands (.obj or .stl): closed, consistently oriented meshes,
+    /// two or more; a union of one cleans it (shells that cross, overlap
+    /// or nest become the solid where the winding number is positive).
+    #[arg(value_name = "MESH", num_args = 1.., required = true)]
     pub(crate) operands: Vec<PathBuf>,
     /// Output file: .obj, or .stl for binary STL.
     #[arg(short, long, value_name = "OUT")]
@@ -207,17 +208,32 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
     keep_freed_blocks();
     // fail on a bad output name before doing any work
     MeshFormat::from_path(&args.output)?;
+    if args.operands.len() == 1 && args.op != Operation::Union {
+        bail!(
+            "the {} of one mesh: give two or more (a union of one mesh cleans it)",
+            args.op.name()
+        );
+    }
     let mut phases = Phases::default();
     let mut operands = phases.run("load", || load_all(&args.operands, args.weld))?;
     let out = guarded("the input files", || {
         apply(&mut operands, args.op, &mut phases)
     })?;
-    phases.run("write", || shadow_scene::save(&args.output, &out.mesh()))?;
+    let stl = MeshFormat::from_path(&args.output)? == MeshFormat::Stl;
+    let rounded = out.rounded(stl);
+    phases.run("write", || match &rounded {
+        Some(r) => shadow_scene::save(&args.output, &r.mesh),
+        None => shadow_scene::save(&args.output, &out.mesh()),
+    })?;
     let total = total.elapsed();
 
-    let (tris, verts) = (out.exact.triangles.len(), out.positions.len());
+    let (tris, verts) = match &rounded {
+        Some(r) => (r.mesh.faces.len(), r.mesh.positions.len()),
+        None => (out.exact.triangles.len(), out.positions.len()),
+    };
     let names: Vec<&str> = operands.iter().map(|o| o.name.as_str()).collect();
     let of = match names.as_slice() {
+        [a] => format!("{a} alone"),
         [a, b] => format!("{a} and {b}"),
         [first, rest @ ..] => format!("{first} and {} more", rest.len()),
         [] => String::new(),
@@ -230,9 +246,25 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
     if tris == 0 {
         eprintln!("note: the {} is empty", args.op.name());
     }
-    let stl = MeshFormat::from_path(&args.output)? == MeshFormat::Stl;
-    for w in out.rounding_warnings(stl) {
-        eprintln!("warning: {w}");
+    if let Some(r) = &rounded {
+        let to = if stl { "f32 for STL" } else { "f64" };
+        match r.closed {
+            true => eprintln!(
+                "note: rounding to {to} made distinct vertices equal: {} collapsed triangle(s) \
+                 left out; the file is closed as read back",
+                r.collapsed
+            ),
+            false => eprintln!(
+                "warning: rounding to {to} made distinct vertices equal and {} triangle(s) \
+                 collapse; the file is not closed as read back{}",
+                r.collapsed,
+                if stl {
+                    " (write .obj to keep full precision)"
+                } else {
+                    ""
+                }
+            ),
+        }
     }
     if args.stats {
         report += &stats_text(args.op, &operands, &out, &phases, total);

@@ -356,8 +356,18 @@ fn argument_and_file_errors() {
         &[],
     );
     assert_failed_with(&o, &["out.obj"]);
-    let o = shadow(&["csg", "union", a.to_str().unwrap()]);
-    assert_failed_with(&o, &["2 values required", "<MESH>"]);
+    let o = shadow(&["csg", "union"]);
+    assert_failed_with(&o, &["required", "<MESH>"]);
+    let one = scratch("one.obj");
+    let o = shadow(&[
+        "csg",
+        "difference",
+        a.to_str().unwrap(),
+        "-o",
+        one.to_str().unwrap(),
+    ]);
+    assert_failed_with(&o, &["the difference of one mesh: give two or more"]);
+    assert!(!one.exists());
     assert!(!out.exists());
 }
 
@@ -444,4 +454,61 @@ fn several_tools_in_turn() {
     assert_eq!(closed_result(&i).signed_volume(), 0.125);
     run("intersection", &[&part, &t2, &t3, &t4], &i);
     assert!(closed_result(&i).faces.is_empty());
+}
+
+#[test]
+fn a_union_of_one_cleans_shells_that_overlap_or_nest() {
+    // two overlapping cubes and a third inside the first, all outward, in
+    // one file: the solid where the winding number is positive is the
+    // union of the two overlapping ones (8 + 8 − 1)
+    let shells = [([0.0; 3], 2.0), ([1.0; 3], 2.0), ([0.25; 3], 0.5)];
+    let mut text = String::new();
+    for (k, (lo, size)) in shells.iter().enumerate() {
+        let cube = cube_obj(*lo, *size);
+        for line in cube.lines() {
+            match line.strip_prefix("f ") {
+                Some(f) => {
+                    let ids: Vec<String> = f
+                        .split(' ')
+                        .map(|i| (i.parse::<usize>().unwrap() + 8 * k).to_string())
+                        .collect();
+                    text += &format!("f {}\n", ids.join(" "));
+                }
+                None => text += &format!("{line}\n"),
+            }
+        }
+    }
+    let dirty = write("shells.obj", &text);
+    let out = scratch("shells_clean.obj");
+    let o = shadow(&[
+        "csg",
+        "union",
+        dirty.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--stats",
+    ]);
+    assert_ok(&o);
+    let s = stdout(&o);
+    assert!(
+        s.starts_with(&format!(
+            "wrote {}: union of {} alone",
+            out.display(),
+            dirty.display()
+        )),
+        "{s}"
+    );
+    assert_eq!(stat(&s, "volume:").split(' ').next(), Some("15"));
+    closed_result(&out);
+    // as an operand of a Boolean: the same solid
+    let far = write("far_cube.obj", &cube_obj([5.0; 3], 1.0));
+    let o = csg(
+        "union",
+        &dirty,
+        &far,
+        &scratch("shells_far.obj"),
+        &["--stats"],
+    );
+    assert_ok(&o);
+    assert_eq!(stat(&stdout(&o), "volume:").split(' ').next(), Some("16"));
 }

@@ -364,6 +364,44 @@ impl Mesh {
         self.positions = positions;
     }
 
+    /// Takes out of each face the corners that repeat the one before
+    /// (around the loop), as [`Mesh::weld`] makes them where distinct
+    /// vertices share a position, and drops the faces left with fewer
+    /// than three: on a closed surface this collapses the edges between
+    /// equal positions (the surface stays closed where each collapsed
+    /// edge's ends have only its two faces' third corners as common
+    /// neighbours; [`Mesh::is_closed_oriented`] tells). Returns the
+    /// indices of the faces dropped, in order.
+    ///
+    /// ```
+    /// use shadow_scene::{Face, Mesh};
+    /// let face = |v: Vec<u32>| Face { vertices: v, line: 0, group: 0 };
+    /// let mut m = Mesh {
+    ///     positions: vec![glam::DVec3::ZERO; 4],
+    ///     faces: vec![face(vec![0, 1, 1]), face(vec![0, 1, 1, 2, 3, 0])],
+    ///     groups: vec!["default".into()],
+    /// };
+    /// assert_eq!(m.collapse_repeats(), vec![0]);
+    /// assert_eq!(m.faces[0].vertices, vec![0, 1, 2, 3]);
+    /// ```
+    pub fn collapse_repeats(&mut self) -> Vec<usize> {
+        let mut dropped = Vec::new();
+        let mut i = 0;
+        self.faces.retain_mut(|f| {
+            f.vertices.dedup();
+            while f.vertices.len() > 1 && f.vertices.first() == f.vertices.last() {
+                f.vertices.pop();
+            }
+            let keep = f.vertices.len() >= 3;
+            if !keep {
+                dropped.push(i);
+            }
+            i += 1;
+            keep
+        });
+        dropped
+    }
+
     /// `true` if every directed edge `a → b` of every face appears exactly
     /// once and its reverse `b → a` exactly once: the faces (compared by
     /// vertex index, so weld first) bound closed, consistently oriented

@@ -13,7 +13,11 @@
 //! overlap test with one face decides it. A covered piece fixes both labels (the
 //! winding numbers of a solid are 0 and 1); the others carry them across.
 //! Only a cell whose pieces cover nothing with a net orientation needs a
-//! reference: the winding number of a grid point in it, by a ray.
+//! reference: the winding number of a grid point in it, by a ray. Labels
+//! that disagree (a surface crossing itself) are an error here, which the
+//! operation meets by resolving the solids: [`positive_region`] carries the
+//! winding number from a box corner through one partition of every face,
+//! whatever its values.
 //!
 //! **Labels without regions.** Where every node's pieces face its plane's
 //! way (no two coplanar pieces face opposite ways), each leaf is the
@@ -76,33 +80,7 @@ fn solid_of(
 ) -> Result<Partition<Cell>, CsgError> {
     let w = walls(bx);
     let (part, leaves) = Partition::from_tree_in(tree, &w);
-    // w(back) − w(front) across every piece of every sub-hyperplane
-    let mut links: Vec<(u32, u32, i32)> = Vec::new();
-    for n in part.nodes() {
-        for (pf, lf) in part.push_down(n.shp.clone(), n.front) {
-            for (pb, lb) in part.push_down(pf, n.back) {
-                // the surface on the node's plane covers the piece all
-                // over or not at all (it may be cut into several faces):
-                // one overlapping face of each orientation tells
-                let (mut up, mut down) = (false, false);
-                for g in &n.polygons {
-                    let same = g.support() == &n.plane;
-                    if (same && up) || (!same && down) {
-                        continue;
-                    }
-                    if overlap(&pb, g) {
-                        if same {
-                            up = true;
-                        } else {
-                            down = true;
-                        }
-                    }
-                }
-                let cov = up as i32 - down as i32;
-                links.push((lf, lb, cov));
-            }
-        }
-    }
+    let links = links(&part);
     let mut w: Vec<Option<i32>> = vec![None; leaves as usize];
     let mut adj: Vec<Vec<(u32, i32)>> = vec![Vec::new(); leaves as usize];
     for &(f, b, c) in &links {
@@ -153,6 +131,95 @@ fn solid_of(
         });
     }
     Ok(part.map_labels(|l| cells[l as usize]))
+}
+
+/// `(front leaf, back leaf, w(back) − w(front))` across every piece of
+/// every sub-hyperplane of `part`. The surface on a node's plane covers a
+/// piece all over or not at all (it may be cut into several faces): one
+/// overlapping face of each orientation tells. (Faces of one orientation
+/// that lie on each other, as two copies of a shell would, count once.)
+fn links(part: &Partition<u32>) -> Vec<(u32, u32, i32)> {
+    let mut links: Vec<(u32, u32, i32)> = Vec::new();
+    for n in part.nodes() {
+        for (pf, lf) in part.push_down(n.shp.clone(), n.front) {
+            for (pb, lb) in part.push_down(pf, n.back) {
+                let (mut up, mut down) = (false, false);
+                for g in &n.polygons {
+                    let same = g.support() == &n.plane;
+                    if (same && up) || (!same && down) {
+                        continue;
+                    }
+                    if overlap(&pb, g) {
+                        if same {
+                            up = true;
+                        } else {
+                            down = true;
+                        }
+                    }
+                }
+                links.push((lf, lb, i32::from(up) - i32::from(down)));
+            }
+        }
+    }
+    links
+}
+
+/// The boundary of the points where the winding number of the closed,
+/// oriented surface `faces` is positive (the rule of mesh-arrangement
+/// Booleans): faces may cross, overlap, nest or touch one another; what
+/// comes out bounds a solid, outward. One partition of all the faces (an
+/// autopartition in a box around them) carries the winding number from a
+/// corner of the box, where it is 0, across every piece of every
+/// sub-hyperplane; every decision is exact. `Err(NotASolid)` if the
+/// surface is not closed (the numbers disagree around a loop).
+pub(crate) fn positive_region(faces: Vec<Polygon>) -> Result<Vec<Polygon>, CsgError> {
+    let Some(bx) = faces
+        .iter()
+        .map(crate::index::polygon_box)
+        .reduce(|a, b| crate::index::union(&a, &b))
+    else {
+        return Ok(Vec::new());
+    };
+    let corner = bx.0.map(|c| c - 1);
+    let bx: IBox = (bx.0.map(|c| c - 2), bx.1.map(|c| c + 2));
+    let tree = BspTree::build(faces, &BuildOptions::default());
+    let (part, leaves) = Partition::from_tree_in(&tree, &walls(&bx));
+    let mut adj: Vec<Vec<(u32, i32)>> = vec![Vec::new(); leaves as usize];
+    for (f, b, c) in links(&part) {
+        adj[f as usize].push((b, c));
+        adj[b as usize].push((f, -c));
+    }
+    let mut w: Vec<Option<i32>> = vec![None; leaves as usize];
+    let corner = bsp_core::Point::Grid(corner.map(|c| c as i32));
+    let mut queue = part.locate(&corner);
+    for &l in &queue {
+        w[l as usize] = Some(0);
+    }
+    while let Some(l) = queue.pop() {
+        let v = w[l as usize].expect("queued leaves are labelled");
+        for &(m, c) in &adj[l as usize] {
+            match w[m as usize] {
+                None => {
+                    w[m as usize] = Some(v + c);
+                    queue.push(m);
+                }
+                Some(x) if x == v + c => {}
+                Some(_) => return Err(CsgError::NotASolid),
+            }
+        }
+    }
+    let cells: Vec<Cell> = w
+        .iter()
+        .map(|v| match v {
+            Some(x) if *x > 0 => Cell::In,
+            _ => Cell::Out,
+        })
+        .collect();
+    let region = part.map_labels(|l| cells[l as usize]);
+    Ok(match region.root() {
+        PLink::Leaf(_) => Vec::new(),
+        PLink::Node(_) => region.boundary(),
+    })
 }
 
 /// The boundary of `a op b` inside the cell `bx`, from the two operands'

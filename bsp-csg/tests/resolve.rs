@@ -1,0 +1,231 @@
+//! Surfaces whose shells cross, overlap, nest or turn inside out,
+//! resolved to the solid where their winding number is positive
+//! (`Solid::resolved`), checked against exact winding numbers of the
+//! surface as given; and such surfaces as operands of Booleans.
+
+use bsp_core::{BoolOp, Polygon};
+use bsp_csg::files::{FileBoolean, Operand};
+use bsp_csg::{MeshBuf, MeshIn, Solid, mesh_sequence};
+use bsp_fixtures::{self as shapes, GridPoint, Loop, Rng};
+use glam::DVec3;
+
+fn polys(loops: &[Loop]) -> Vec<Polygon> {
+    loops
+        .iter()
+        .map(|l| Polygon::from_grid_points(l, 0).unwrap())
+        .collect()
+}
+
+/// `surface` resolved: a closed mesh whose winding number is 1 where the
+/// surface's is positive and 0 elsewhere, at `samples` random grid points
+/// of the surface's box and at `extra`.
+fn check_resolved(surface: &[Loop], samples: usize, extra: &[GridPoint], rng: &mut Rng) -> Solid {
+    let before = Solid::from_polygons(polys(surface));
+    let after = Solid::from_polygons(polys(surface)).resolved().unwrap();
+    after.to_watertight_mesh().unwrap();
+    let (mut lo, mut hi) = ([i32::MAX; 3], [i32::MIN; 3]);
+    for p in surface.iter().flatten() {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k] - 1);
+            hi[k] = hi[k].max(p[k] + 1);
+        }
+    }
+    let random = (0..samples)
+        .map(|_| [0, 1, 2].map(|k| lo[k] + (rng.next_u64() % (hi[k] - lo[k] + 1) as u64) as i32));
+    for q in random.chain(extra.iter().copied()) {
+        let w = before.winding(q);
+        assert_eq!(after.winding(q), i32::from(w > 0), "at {q:?} (winding {w})");
+    }
+    after
+}
+
+#[test]
+fn folded_and_overlapping_spheres_resolve_to_their_positive_winding() {
+    let mut rng = Rng(0x5e50);
+    for case in 0..16 {
+        let jitter = 1 + case % 4;
+        let mut surface = shapes::jittered_uv_sphere(24, 7.0, jitter, &mut rng);
+        if case % 2 == 1 {
+            // a second sphere, apart, overlapping or inside
+            let off = (rng.next_u64() % 20) as i32 - 4;
+            let other = shapes::jittered_uv_sphere(16, 3.0, 1, &mut rng);
+            surface.extend(
+                other
+                    .iter()
+                    .map(|l| l.iter().map(|g| [g[0] + off, g[1], g[2]]).collect()),
+            );
+        }
+        check_resolved(&surface, 3000, &[], &mut rng);
+    }
+}
+
+#[test]
+fn a_crossing_along_a_diagonal_resolves_to_the_outward_solid() {
+    let mut rng = Rng(0xd1a6);
+    for _ in 0..12 {
+        let c = shapes::crossing_along_diagonal(&mut rng);
+        let extra = [c.negative, c.positive];
+        let after = check_resolved(&c.surface, 1000, &extra, &mut rng);
+        assert_eq!(after.winding(c.negative), 0);
+        assert_eq!(after.winding(c.positive), 1);
+    }
+}
+
+fn view(m: &MeshBuf) -> MeshIn<'_> {
+    MeshIn::new(&m.positions, &m.faces)
+}
+
+/// The boxes `[lo, hi]` (each turned inward if its flag says so) as one
+/// mesh.
+fn boxes(list: &[([f64; 3], [f64; 3], bool)]) -> MeshBuf {
+    let mut positions: Vec<DVec3> = Vec::new();
+    let mut faces = Vec::new();
+    for &(lo, hi, inward) in list {
+        let first = positions.len();
+        for mut face in shapes::cuboid(DVec3::from(lo), DVec3::from(hi)) {
+            if inward {
+                face.reverse();
+            }
+            // each box's corners once (boxes share none)
+            let index = |p: DVec3, positions: &mut Vec<DVec3>| match positions[first..]
+                .iter()
+                .position(|&q| q == p)
+            {
+                Some(i) => (first + i) as u32,
+                None => {
+                    positions.push(p);
+                    (positions.len() - 1) as u32
+                }
+            };
+            faces.push(face.into_iter().map(|p| index(p, &mut positions)).collect());
+        }
+    }
+    MeshBuf::new(positions, faces)
+}
+
+#[test]
+fn shells_that_nest_or_overlap_in_one_operand_count_once() {
+    let far = boxes(&[([10.0; 3], [11.0; 3], false)]);
+    let cases = [
+        // a box in a box, both outward: the inner one is inside already
+        (
+            boxes(&[([0.0; 3], [4.0; 3], false), ([1.0; 3], [2.0; 3], false)]),
+            64.0,
+        ),
+        // two overlapping boxes: 8 + 8 − 1
+        (
+            boxes(&[([0.0; 3], [2.0; 3], false), ([1.0; 3], [3.0; 3], false)]),
+            15.0,
+        ),
+        // a box with a cavity: 64 − 1 (a clean solid, unchanged)
+        (
+            boxes(&[([0.0; 3], [4.0; 3], false), ([1.0; 3], [2.0; 3], true)]),
+            63.0,
+        ),
+        // an inward box alone outside another: nothing
+        (
+            boxes(&[([0.0; 3], [4.0; 3], false), ([5.0; 3], [6.0; 3], true)]),
+            64.0,
+        ),
+    ];
+    for (i, (mesh, volume)) in cases.iter().enumerate() {
+        let alone = mesh_sequence(&view(mesh), &[]).unwrap();
+        assert_eq!(alone.volume(), *volume, "case {i} alone");
+        let with_far = mesh_sequence(&view(mesh), &[(BoolOp::Union, view(&far))]).unwrap();
+        assert_eq!(with_far.volume(), volume + 1.0, "case {i} and a box apart");
+        // the box apart first: the shells are the second operand
+        let far_first = mesh_sequence(&view(&far), &[(BoolOp::Union, view(mesh))]).unwrap();
+        assert_eq!(
+            far_first.volume(),
+            volume + 1.0,
+            "case {i} after a box apart"
+        );
+        let cut = boxes(&[([-1.0; 3], [1.5, 5.0, 5.0], false)]);
+        let kept = mesh_sequence(&view(mesh), &[(BoolOp::Intersection, view(&cut))]).unwrap();
+        // x ≤ 1.5: 1.5 · 16; 1.5 · 4 + 0.5 · 4 − 0.5 · 1; 24 − 0.5
+        let expected = [24.0, 7.5, 23.5, 24.0][i];
+        assert_eq!(kept.volume(), expected, "case {i} cut");
+    }
+}
+
+/// `positions` and `faces` as OBJ text.
+fn obj_text(positions: &[DVec3], faces: &[Vec<u32>]) -> String {
+    let mut s = String::new();
+    for p in positions {
+        s += &format!("v {} {} {}\n", p.x, p.y, p.z);
+    }
+    for f in faces {
+        let ids: Vec<String> = f.iter().map(|i| (i + 1).to_string()).collect();
+        s += &format!("f {}\n", ids.join(" "));
+    }
+    s
+}
+
+/// `out` written as OBJ (`f64`) or STL (`f32`), read back and united
+/// with itself: the volume moves at most by the surface's area times the
+/// farthest a vertex moves, half a step of the new grid along each axis
+/// plus the rounding to `f32` for STL.
+fn round_trip(out: &FileBoolean, stl: bool) {
+    let mut bytes = Vec::new();
+    let rounded = out.rounded(stl);
+    if let Some(r) = &rounded {
+        assert!(r.closed, "{}: {} collapsed", out.group, r.collapsed);
+    }
+    match (&rounded, stl) {
+        (Some(r), true) => shadow_scene::write_stl(&r.mesh, &mut bytes).unwrap(),
+        (Some(r), false) => shadow_scene::write_obj(&r.mesh, &mut bytes).unwrap(),
+        (None, true) => shadow_scene::write_stl(&out.mesh(), &mut bytes).unwrap(),
+        (None, false) => shadow_scene::write_obj(&out.mesh(), &mut bytes).unwrap(),
+    }
+    let mesh = match stl {
+        true => shadow_scene::parse_stl(&bytes, "r.stl").unwrap(),
+        false => shadow_scene::parse_obj(std::str::from_utf8(&bytes).unwrap(), "r.obj").unwrap(),
+    };
+    let mut twice = [
+        Operand::welded("r", mesh.clone()),
+        Operand::welded("r", mesh),
+    ];
+    let checked = Operand::check_all(&mut twice).unwrap();
+    let again = FileBoolean::apply(checked, BoolOp::Union, |_, _| {}).unwrap();
+    let area: f64 = out
+        .exact
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| out.positions[i as usize]);
+            (b - a).cross(c - a).length() / 2.0
+        })
+        .sum();
+    let reach = out
+        .positions
+        .iter()
+        .map(|p| p.abs().max_element())
+        .fold(0.0, f64::max);
+    let moved =
+        3f64.sqrt() * (again.grid.step() / 2.0 + if stl { reach * 2f64.powi(-24) } else { 0.0 });
+    let (v0, v1) = (out.volume(), again.volume());
+    assert!(
+        (v1 - v0).abs() <= area * moved,
+        "{} {}: {v0} then {v1}, more than {area} · {moved}",
+        out.group,
+        if stl { "STL" } else { "OBJ" }
+    );
+}
+
+#[test]
+fn results_written_and_read_back_are_inputs_again() {
+    let (a, b, faces) = shapes::sphere_pair(800);
+    for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
+        let read = |p: &[DVec3], name: &str| {
+            Operand::new(
+                name,
+                shadow_scene::parse_obj(&obj_text(p, &faces), name).unwrap(),
+            )
+        };
+        let mut pair = [read(&a, "a.obj"), read(&b, "b.obj")];
+        let checked = Operand::check_all(&mut pair).unwrap();
+        let out = FileBoolean::apply(checked, op, |_, _| {}).unwrap();
+        round_trip(&out, false);
+        round_trip(&out, true);
+    }
+}
