@@ -32,15 +32,19 @@ use std::fmt::{self, Debug};
 
 #[macro_use]
 mod report;
+mod boolean;
 mod build;
 mod bytes;
 mod exact;
+mod files;
 mod merge;
 mod split;
 
+pub use boolean::{BooleanInput, IntBox, mesh_boolean_case};
 pub use build::*;
 use bytes::*;
 use exact::*;
+pub use files::{obj_case, stl_case};
 pub use merge::{MergeInput, merge_case};
 use report::*;
 pub use split::*;
@@ -361,12 +365,110 @@ mod tests {
         v
     }
 
+    /// Boxes `lo + [0, size]`, outward, or inward where `inward`.
+    fn int_box(lo: [i32; 3], size: [i32; 3], inward: bool) -> IntBox {
+        IntBox { lo, size, inward }
+    }
+
+    fn boolean_seeds() -> Vec<BooleanInput> {
+        let b = |lo: [i32; 3], size: i32| int_box(lo, [size; 3], false);
+        let case = |op, a: Vec<IntBox>, bb: Vec<IntBox>| BooleanInput { op, a, b: bb };
+        let ops = [
+            BoolOpSeed::Union,
+            BoolOpSeed::Intersection,
+            BoolOpSeed::Difference,
+        ];
+        let mut v = Vec::new();
+        for op in ops.map(BoolOpSeed::op) {
+            // overlapping
+            v.push(case(op, vec![b([0, 0, 0], 3)], vec![b([1, 1, 1], 3)]));
+            // a shared face, and an edge only
+            v.push(case(op, vec![b([0, 0, 0], 2)], vec![b([2, 0, 0], 2)]));
+            v.push(case(op, vec![b([0, 0, 0], 2)], vec![b([2, 2, 0], 2)]));
+            // the same box twice
+            v.push(case(op, vec![b([1, 1, 1], 2)], vec![b([1, 1, 1], 2)]));
+            // shells that overlap and nest in one operand, a cavity in the other
+            v.push(case(
+                op,
+                vec![b([0, 0, 0], 3), b([2, 2, 2], 3), b([0, 0, 0], 1)],
+                vec![b([1, 0, 1], 4), int_box([2, 1, 2], [1, 2, 1], true)],
+            ));
+        }
+        v
+    }
+
+    /// [`BoolOp`](bsp_core::BoolOp) by name, for the seed table.
+    #[derive(Clone, Copy)]
+    enum BoolOpSeed {
+        Union,
+        Intersection,
+        Difference,
+    }
+
+    impl BoolOpSeed {
+        fn op(self) -> bsp_core::BoolOp {
+            match self {
+                BoolOpSeed::Union => bsp_core::BoolOp::Union,
+                BoolOpSeed::Intersection => bsp_core::BoolOp::Intersection,
+                BoolOpSeed::Difference => bsp_core::BoolOp::Difference,
+            }
+        }
+    }
+
+    /// Files for the readers: well-formed, odd and broken ones.
+    fn file_seeds(target: &str) -> Vec<Vec<u8>> {
+        match target {
+            "obj" => [
+                "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+                 f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\ng a\nf 1/1/1 2/1/1 3/1/1\n",
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\no x\nusemtl m\ns off\n",
+                "v 0 0 0\nf 1 2 3\n",
+                "v 1e400 0 0\nv nan 0 0\nv 0 0\nf 1 1 1\n",
+                "v 0 0 0 1\nv 1 0 0\nv 0 1 0\nf 1 2 3 4294967296\n\\\n",
+                "\u{feff}# comment\r\nv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n",
+            ]
+            .map(|s| s.as_bytes().to_vec())
+            .to_vec(),
+            _ => {
+                let ascii = b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n\
+                              vertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+                let binary = |claimed: u32, triangles: usize| {
+                    let mut b = vec![0u8; 80];
+                    b.extend(claimed.to_le_bytes());
+                    for t in 0..triangles {
+                        b.extend([0u8; 12]);
+                        for c in [[0.0f32, 0.0, 0.0], [1.0, 0.0, t as f32], [0.0, 1.0, 0.0]] {
+                            c.iter().for_each(|x| b.extend(x.to_le_bytes()));
+                        }
+                        b.extend([0u8; 2]);
+                    }
+                    b
+                };
+                vec![
+                    ascii.to_vec(),
+                    binary(1, 1),
+                    binary(3, 3),
+                    binary(4_000_000_000, 1),
+                    binary(2, 1),
+                    b"solid x\nfacet\nvertex 1 2\nendsolid\n".to_vec(),
+                    vec![0u8; 83],
+                ]
+            }
+        }
+    }
+
     fn seed_files(target: &str) -> Vec<(String, Vec<u8>)> {
         let (named, raw): (Vec<Vec<u8>>, Vec<Vec<u8>>) = match target {
             "split" => (
                 split_seeds().iter().map(SplitInput::encode).collect(),
                 raw_seeds(8, 4),
             ),
+            "mesh_boolean" => (
+                boolean_seeds().iter().map(BooleanInput::encode).collect(),
+                raw_seeds(8, 3),
+            ),
+            "obj" | "stl" => (file_seeds(target), raw_seeds(4, 255)),
             _ => (
                 build_seeds().iter().map(BuildInput::encode).collect(),
                 raw_seeds(8, 4),
@@ -388,7 +490,7 @@ mod tests {
     #[test]
     #[ignore = "writes fuzz/corpus; run by hand after changing the seeds or the decoders"]
     fn write_seed_corpus() {
-        for target in ["split", "build_tree"] {
+        for target in ["split", "build_tree", "mesh_boolean", "obj", "stl"] {
             let dir = corpus_dir(target);
             std::fs::create_dir_all(&dir).unwrap();
             for e in std::fs::read_dir(&dir).unwrap() {
@@ -409,7 +511,7 @@ mod tests {
 
     #[test]
     fn seed_corpus_is_up_to_date() {
-        for target in ["split", "build_tree"] {
+        for target in ["split", "build_tree", "mesh_boolean", "obj", "stl"] {
             for (name, bytes) in seed_files(target) {
                 let path = corpus_dir(target).join(&name);
                 let on_disk = std::fs::read(&path)
@@ -430,6 +532,9 @@ mod tests {
         }
         for s in build_seeds() {
             assert_eq!(BuildInput::decode(&s.encode()), s);
+        }
+        for s in boolean_seeds() {
+            assert_eq!(BooleanInput::decode(&s.encode()), s);
         }
     }
 
@@ -520,6 +625,51 @@ mod tests {
         );
         assert!(total.membership.iter().all(|&n| n >= 10), "{total:?}");
         assert!(total.implicit_probes >= 10, "{total:?}");
+    }
+
+    #[test]
+    fn mesh_boolean_corpus_passes() {
+        let files = corpus_files("mesh_boolean");
+        assert!(
+            files.len() >= 20,
+            "fuzz/corpus/mesh_boolean has {} files",
+            files.len()
+        );
+        let (mut checked, mut cells) = (0, 0);
+        for f in &files {
+            let input = BooleanInput::decode(&std::fs::read(f).unwrap());
+            if let Some(n) = run_reporting(&f.display().to_string(), &input, BooleanInput::check) {
+                checked += 1;
+                cells += n;
+            }
+        }
+        eprintln!(
+            "mesh_boolean corpus: {} files, {checked} checked, {cells} cells",
+            files.len()
+        );
+        assert!(checked >= files.len() * 3 / 4 && cells > 100);
+    }
+
+    #[test]
+    fn reader_corpora_pass() {
+        for (target, case) in [("obj", obj_case as fn(&[u8]) -> bool), ("stl", stl_case)] {
+            let files = corpus_files(target);
+            assert!(
+                files.len() >= 10,
+                "fuzz/corpus/{target} has {} files",
+                files.len()
+            );
+            let read = files
+                .iter()
+                .filter(|f| case(&std::fs::read(f).unwrap()))
+                .count();
+            // both outcomes are exercised
+            assert!(
+                read >= 2 && read < files.len(),
+                "{target}: {read} of {} read",
+                files.len()
+            );
+        }
     }
 
     #[test]

@@ -136,8 +136,8 @@ fn solid_of(
 /// `(front leaf, back leaf, w(back) − w(front))` across every piece of
 /// every sub-hyperplane of `part`. The surface on a node's plane covers a
 /// piece all over or not at all (it may be cut into several faces): one
-/// overlapping face of each orientation tells. (Faces of one orientation
-/// that lie on each other, as two copies of a shell would, count once.)
+/// overlapping face of each orientation tells, for a solid (faces lying
+/// on each other are counted as layers in [`positive_region`]).
 fn links(part: &Partition<u32>) -> Vec<(u32, u32, i32)> {
     let mut links: Vec<(u32, u32, i32)> = Vec::new();
     for n in part.nodes() {
@@ -164,13 +164,37 @@ fn links(part: &Partition<u32>) -> Vec<(u32, u32, i32)> {
     links
 }
 
+/// `w(back) − w(front)` across `piece` (in the plane `plane`, which
+/// `faces` lie in): the layers of faces covering it, those facing the
+/// plane's front counted `+1`, the others `−1`. The faces of one layer
+/// tile the piece without overlapping, and each layer covers it all over
+/// or not at all; so the piece, shrunk to the inside of each face that
+/// still overlaps it in turn, meets each layer once.
+fn layers(piece: &Polygon, faces: &[Polygon], plane: &Plane) -> i32 {
+    let mut region: Option<Polygon> = None;
+    let mut count = 0;
+    for g in faces {
+        let r = region.as_ref().unwrap_or(piece);
+        if !overlap(r, g) {
+            continue;
+        }
+        let mut inside = r.clone();
+        if g.edge_planes().iter().all(|e| inside.clip(e, Side::Back)) {
+            region = Some(inside);
+            count += if g.support() == plane { 1 } else { -1 };
+        }
+    }
+    count
+}
+
 /// The boundary of the points where the winding number of the closed,
 /// oriented surface `faces` is positive (the rule of mesh-arrangement
 /// Booleans): faces may cross, overlap, nest or touch one another; what
 /// comes out bounds a solid, outward. One partition of all the faces (an
 /// autopartition in a box around them) carries the winding number from a
 /// corner of the box, where it is 0, across every piece of every
-/// sub-hyperplane; every decision is exact. `Err(NotASolid)` if the
+/// sub-hyperplane ([`layers`]: faces of several shells lying on each other
+/// count once each); every decision is exact. `Err(NotASolid)` if the
 /// surface is not closed (the numbers disagree around a loop).
 pub(crate) fn positive_region(faces: Vec<Polygon>) -> Result<Vec<Polygon>, CsgError> {
     let Some(bx) = faces
@@ -185,9 +209,14 @@ pub(crate) fn positive_region(faces: Vec<Polygon>) -> Result<Vec<Polygon>, CsgEr
     let tree = BspTree::build(faces, &BuildOptions::default());
     let (part, leaves) = Partition::from_tree_in(&tree, &walls(&bx));
     let mut adj: Vec<Vec<(u32, i32)>> = vec![Vec::new(); leaves as usize];
-    for (f, b, c) in links(&part) {
-        adj[f as usize].push((b, c));
-        adj[b as usize].push((f, -c));
+    for n in part.nodes() {
+        for (pf, lf) in part.push_down(n.shp.clone(), n.front) {
+            for (pb, lb) in part.push_down(pf, n.back) {
+                let c = layers(&pb, &n.polygons, &n.plane);
+                adj[lf as usize].push((lb, c));
+                adj[lb as usize].push((lf, -c));
+            }
+        }
     }
     let mut w: Vec<Option<i32>> = vec![None; leaves as usize];
     let corner = bsp_core::Point::Grid(corner.map(|c| c as i32));

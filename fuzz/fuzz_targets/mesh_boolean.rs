@@ -1,0 +1,8 @@
+//! Booleans of decoded unions of integer boxes (overlapping, nested, touching, inward), checked cell by cell and by exact volume; see `bsp_testkit::mesh_boolean_case`.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    bsp_testkit::mesh_boolean_case(data);
+});
