@@ -68,12 +68,15 @@ pub(crate) struct CsgArgs {
     /// Print counts, the exact volume and the time of each phase.
     #[arg(long)]
     pub(crate) stats: bool,
+    /// No notes or warnings on stderr (errors still go there).
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
 }
 
 /// The operands from `paths`, read (and welded) in parallel; the
 /// readers' notes are printed, and the first error returned, in the order
 /// of the files, as reading them in turn would.
-fn load_all(paths: &[PathBuf], weld: bool) -> Result<Vec<Operand>> {
+fn load_all(paths: &[PathBuf], weld: bool, quiet: bool) -> Result<Vec<Operand>> {
     let read: Vec<Result<(Operand, Option<String>)>> = paths
         .par_iter()
         .map(|p| {
@@ -89,8 +92,16 @@ fn load_all(paths: &[PathBuf], weld: bool) -> Result<Vec<Operand>> {
     let mut operands = Vec::with_capacity(paths.len());
     for r in read {
         let (o, note) = r?;
-        if let Some(m) = note {
+        if let Some(m) = note
+            && !quiet
+        {
             eprintln!("note: {m}");
+        }
+        if o.collapsed > 0 && !quiet {
+            eprintln!(
+                "note: {}: welding left out {} face(s) whose corners became one position",
+                o.name, o.collapsed
+            );
         }
         // (in the files' order, before a later file's read error)
         o.check_faces().map_err(file_error)?;
@@ -103,7 +114,12 @@ fn load_all(paths: &[PathBuf], weld: bool) -> Result<Vec<Operand>> {
 /// turn ([`FileBoolean::apply`]): each import summary is printed to stderr
 /// as its operand is snapped, and the library's stages are timed as
 /// "validate", "snap/import", "boolean" and "boundary+mesh".
-fn apply(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Result<FileBoolean> {
+fn apply(
+    operands: &mut [Operand],
+    op: Operation,
+    phases: &mut Phases,
+    quiet: bool,
+) -> Result<FileBoolean> {
     let names: Vec<String> = operands.iter().map(|o| o.name.clone()).collect();
     let checked = phases
         .run("validate", || Operand::check_all(operands))
@@ -114,7 +130,9 @@ fn apply(operands: &mut [Operand], op: Operation, phases: &mut Phases) -> Result
     };
     let out = FileBoolean::apply(checked, op.kernel(), |step, grid| {
         clock.step(step);
-        if let Step::Snapped { operand, report } = step {
+        if let Step::Snapped { operand, report } = step
+            && !quiet
+        {
             print_import_summary(&names[*operand], report, grid);
         }
     });
@@ -215,9 +233,9 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
         );
     }
     let mut phases = Phases::default();
-    let mut operands = phases.run("load", || load_all(&args.operands, args.weld))?;
+    let mut operands = phases.run("load", || load_all(&args.operands, args.weld, args.quiet))?;
     let out = guarded("the input files", || {
-        apply(&mut operands, args.op, &mut phases)
+        apply(&mut operands, args.op, &mut phases, args.quiet)
     })?;
     let stl = MeshFormat::from_path(&args.output)? == MeshFormat::Stl;
     let rounded = out.rounded(stl);
@@ -243,10 +261,10 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
         args.output.display(),
         args.op.name(),
     );
-    if tris == 0 {
+    if tris == 0 && !args.quiet {
         eprintln!("note: the {} is empty", args.op.name());
     }
-    if let Some(r) = &rounded {
+    if let Some(r) = rounded.as_ref().filter(|_| !args.quiet) {
         let to = if stl { "f32 for STL" } else { "f64" };
         match r.closed {
             true => eprintln!(
@@ -308,7 +326,7 @@ mod tests {
         moved.positions.iter_mut().for_each(|p| *p += 0.5);
         let mut operands = [Operand::new("a.obj", cube), Operand::new("b.obj", moved)];
         let mut phases = Phases::default();
-        let out = apply(&mut operands, Operation::Union, &mut phases).unwrap();
+        let out = apply(&mut operands, Operation::Union, &mut phases, false).unwrap();
         assert_eq!(out.volume(), 2.0 - 0.125);
         let names: Vec<&str> = phases.0.iter().map(|p| p.0).collect();
         assert_eq!(

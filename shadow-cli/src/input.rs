@@ -43,10 +43,6 @@ pub(crate) fn with_faces(path: &Path, mesh: shadow_scene::Mesh) -> Result<shadow
     Ok(mesh)
 }
 
-pub(crate) fn load_source(src: &SourceArgs) -> Result<(shadow_scene::Mesh, String)> {
-    load_source_quiet(src, false)
-}
-
 pub(crate) fn load_source_quiet(
     src: &SourceArgs,
     quiet: bool,
@@ -167,21 +163,21 @@ impl Prepared {
     /// Snaps `mesh` to a fitted grid, imports its faces (printing the
     /// import summary to stderr when faces were changed) and builds the
     /// tree. `name` names the mesh in messages.
-    pub(crate) fn new(mesh: Mesh, name: &str) -> Result<Prepared> {
+    pub(crate) fn new(mesh: Mesh, name: &str, quiet: bool) -> Result<Prepared> {
         let grid = Grid::fit_points(&mesh.positions)
             .with_context(|| format!("{name}: cannot fit a grid to the positions"))?;
-        Prepared::on_grid(mesh, name, grid)
+        Prepared::on_grid(mesh, name, grid, quiet)
     }
 
     /// As [`Prepared::new`], on a given grid (one shared with other
     /// operands, such as lights). Faces are tagged with their index.
-    pub(crate) fn on_grid(mesh: Mesh, name: &str, grid: Grid) -> Result<Prepared> {
+    pub(crate) fn on_grid(mesh: Mesh, name: &str, grid: Grid, quiet: bool) -> Result<Prepared> {
         let start = Instant::now();
         let loops = mesh.face_loops();
         let (polys, report) = import_faces(&grid, loops.iter().map(Vec::as_slice))
             .with_context(|| format!("{name}: cannot import the faces"))?;
         let summary = report.summary();
-        if !summary.is_empty() {
+        if !summary.is_empty() && !quiet {
             eprint!("{name}: {summary}");
         }
         let import_time = start.elapsed();
@@ -205,7 +201,7 @@ mod tests {
 
     #[test]
     fn room_imports_without_changes() {
-        let p = Prepared::new(shadow_scene::room(), "room").unwrap();
+        let p = Prepared::new(shadow_scene::room(), "room", false).unwrap();
         assert!(p.report.triangulated.is_empty() && p.report.dropped.is_empty());
         assert_eq!(p.report.polygons, p.mesh.faces.len());
         p.tree.sanity_check().unwrap();
@@ -214,7 +210,7 @@ mod tests {
 
     #[test]
     fn empty_mesh_gives_an_empty_tree() {
-        let p = Prepared::new(Mesh::default(), "empty").unwrap();
+        let p = Prepared::new(Mesh::default(), "empty", false).unwrap();
         assert_eq!(p.tree.stats().nodes, 0);
     }
 
@@ -225,7 +221,7 @@ mod tests {
             scene: Some("room".into()),
         };
         assert!(
-            load_source(&both)
+            load_source_quiet(&both, false)
                 .unwrap_err()
                 .to_string()
                 .contains("not both")
@@ -235,7 +231,7 @@ mod tests {
             scene: None,
         };
         assert!(
-            load_source(&none)
+            load_source_quiet(&none, false)
                 .unwrap_err()
                 .to_string()
                 .starts_with("no input")
@@ -245,7 +241,7 @@ mod tests {
             scene: Some("kitchen".into()),
         };
         assert_eq!(
-            load_source(&unknown).unwrap_err().to_string(),
+            load_source_quiet(&unknown, false).unwrap_err().to_string(),
             "unknown scene `kitchen` (available: room, chair, cube, bunny, bunny-11k, bunny-33k, \
              bunny-99k, bunny-298k, bunny-893k)"
         );

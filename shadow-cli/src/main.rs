@@ -47,25 +47,46 @@ struct Cli {
 enum Command {
     /// Exact lit and shadowed fragments for point lights and suns, as
     /// JSON, OBJ or an SVG view.
+    #[command(
+        after_help = "Examples:\n  shadow shadows --scene room -o room.svg\n  shadow shadows part.obj --light 2,3,5 --sun 1,1,3 -o part.json --stats"
+    )]
     Shadows(Box<shadows::ShadowsArgs>),
     /// Render a mesh or built-in scene to SVG in exact BSP back-to-front order.
+    #[command(
+        after_help = "Examples:\n  shadow view --scene bunny -o bunny.svg\n  shadow view scan.obj --up y -o scan.svg"
+    )]
     View(view::ViewArgs),
     /// Print import and BSP tree statistics of a mesh or built-in scene.
-    Stats(args::SourceArgs),
+    #[command(after_help = "Examples:\n  shadow stats part.obj")]
+    Stats(view::StatsArgs),
     /// Render the built-in room from a viewpoint that shows all of it.
+    #[command(after_help = "Examples:\n  shadow demo -o room.svg")]
     Demo(view::DemoArgs),
     /// Exact union, intersection or difference of two closed meshes.
+    #[command(
+        after_help = "Examples:\n  shadow csg union a.obj b.obj -o u.obj\n  shadow csg difference part.stl tool1.stl tool2.stl -o cut.stl --stats\n  shadow csg union dirty.obj -o clean.obj"
+    )]
     Csg(csg::CsgArgs),
     /// The core paper's real-time pipeline: a moving object's exact
     /// shadows in a static scene, frame by frame, with Table 2's figures.
+    #[command(
+        after_help = "Examples:\n  shadow animate --scene room --frames 24 -o frames/ --report table2.csv\n  shadow animate ground.obj --dynamic cube.obj --light 0,0,9 --spin 0,0,1:15 -o frames/"
+    )]
     Animate(Box<animate::AnimateArgs>),
     /// Render a scene and its shadows to PNG by the exact method or a
     /// classic image-space one (shadow map, stencil volumes, ...).
+    #[command(
+        after_help = "Examples:\n  shadow render --scene room --method shadow-map -o room.png\n  shadow render part.obj --light 2,3,5 --size 1920x1080 -o part.png --mask lit.pgm"
+    )]
     Render(Box<raster::RenderArgs>),
     /// Every shadow method side by side, with the share of pixels where
     /// each disagrees with the exact shadows.
+    #[command(
+        after_help = "Examples:\n  shadow compare --scene room -o compare.png --report compare.csv"
+    )]
     Compare(Box<raster::CompareArgs>),
     /// Hidden-line drawing of convex polyhedra (Roberts' algorithm) to SVG.
+    #[command(after_help = "Examples:\n  shadow lines --scene room -o lines.svg --hidden")]
     Lines(Box<raster::LinesArgs>),
 }
 

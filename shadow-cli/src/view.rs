@@ -10,7 +10,7 @@ use shadow_raster::svg::{SvgPicture, SvgView, SvgViewpoint};
 use shadow_scene::{ROOM_EYE, ROOM_TARGET};
 
 use crate::args::{CameraArgs, ImageArgs, SourceArgs};
-use crate::input::{Prepared, load_source, load_source_quiet};
+use crate::input::{Prepared, load_source_quiet};
 use crate::output::{emit, write_file};
 use crate::raster_error;
 
@@ -30,6 +30,16 @@ pub(crate) struct ViewArgs {
     pub(crate) quiet: bool,
 }
 
+/// `shadow stats`.
+#[derive(Args, Debug)]
+pub(crate) struct StatsArgs {
+    #[command(flatten)]
+    pub(crate) source: SourceArgs,
+    /// No notes on stderr (errors still go there).
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
 #[derive(Args, Debug)]
 pub(crate) struct DemoArgs {
     /// Output SVG file.
@@ -37,6 +47,9 @@ pub(crate) struct DemoArgs {
     pub(crate) output: PathBuf,
     #[command(flatten)]
     pub(crate) image: ImageArgs,
+    /// No notes on stderr (errors still go there).
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
 }
 
 /// The polygons of `p`'s tree drawn back to front from `at`.
@@ -56,7 +69,7 @@ fn draw(p: &Prepared, at: SvgViewpoint) -> Result<SvgPicture> {
 /// `shadow view`.
 pub(crate) fn view(args: &ViewArgs) -> Result<()> {
     let (mesh, name) = load_source_quiet(&args.source, args.quiet)?;
-    let prepared = Prepared::new(mesh, &name)?;
+    let prepared = Prepared::new(mesh, &name, args.quiet)?;
     let bounds = prepared
         .mesh
         .bounds()
@@ -77,9 +90,9 @@ pub(crate) fn view(args: &ViewArgs) -> Result<()> {
 }
 
 /// `shadow stats`.
-pub(crate) fn stats(args: &SourceArgs) -> Result<()> {
-    let (mesh, name) = load_source(args)?;
-    let p = Prepared::new(mesh, &name)?;
+pub(crate) fn stats(args: &StatsArgs) -> Result<()> {
+    let (mesh, name) = load_source_quiet(&args.source, args.quiet)?;
+    let p = Prepared::new(mesh, &name, args.quiet)?;
     let t = p.tree.stats();
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     emit(&format!(
@@ -107,7 +120,7 @@ pub(crate) fn stats(args: &SourceArgs) -> Result<()> {
 
 /// `shadow demo`.
 pub(crate) fn demo(args: &DemoArgs) -> Result<()> {
-    let prepared = Prepared::new(shadow_scene::room(), "scene room")?;
+    let prepared = Prepared::new(shadow_scene::room(), "scene room", args.quiet)?;
     let at = SvgViewpoint {
         eye: ROOM_EYE,
         target: Some(ROOM_TARGET),

@@ -406,6 +406,27 @@ fn dropped_faces_are_reported() {
     assert!(err.contains("the solid may not be closed"), "{err}");
     assert!(stat(&stdout(&o), "input A:").ends_with("(0 faces triangulated, 1 dropped)"));
     assert_eq!(closed_result(&out).signed_volume(), 2.0 - 0.125);
+    // --quiet: the same file, and nothing on stderr
+    let quiet = scratch("sliver_union_quiet.obj");
+    let o = csg("union", &sliver, &b, &quiet, &["-q"]);
+    assert_ok(&o);
+    assert_eq!(stderr(&o), "");
+    assert_eq!(std::fs::read(&quiet).unwrap(), std::fs::read(&out).unwrap());
+    let svg = quiet.with_extension("svg");
+    for args in [
+        vec!["stats", sliver.to_str().unwrap(), "-q"],
+        vec![
+            "view",
+            sliver.to_str().unwrap(),
+            "-q",
+            "-o",
+            svg.to_str().unwrap(),
+        ],
+    ] {
+        let o = shadow(&args);
+        assert_ok(&o);
+        assert_eq!(stderr(&o), "", "{args:?}");
+    }
 }
 
 #[test]
