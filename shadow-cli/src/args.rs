@@ -142,15 +142,18 @@ pub(crate) fn viewpoint_flags(at: &SvgViewpoint, bounds: (DVec3, DVec3)) -> Stri
     s
 }
 
-/// The size and field of view of an SVG picture.
+/// The size and field of view of a picture (SVG or PNG frames).
 #[derive(Args, Debug)]
 pub(crate) struct ImageArgs {
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 1200, value_parser = clap::value_parser!(u32).range(1..=100_000))]
-    pub(crate) width: u32,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 900, value_parser = clap::value_parser!(u32).range(1..=100_000))]
-    pub(crate) height: u32,
+    /// Picture size in pixels, the same flag as `render`'s.
+    #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
+    pub(crate) size: (u32, u32),
+    /// The width alone (overrides --size's).
+    #[arg(long, hide = true, value_parser = clap::value_parser!(u32).range(1..=shadow_raster::MAX_SIZE as i64))]
+    pub(crate) width: Option<u32>,
+    /// The height alone (overrides --size's).
+    #[arg(long, hide = true, value_parser = clap::value_parser!(u32).range(1..=shadow_raster::MAX_SIZE as i64))]
+    pub(crate) height: Option<u32>,
     /// Vertical field of view in degrees (between 1 and 170).
     #[arg(long, value_name = "DEG", default_value_t = 50.0, value_parser = parse_fov)]
     pub(crate) fov: f64,
@@ -159,7 +162,10 @@ pub(crate) struct ImageArgs {
 impl ImageArgs {
     /// Width and height.
     pub(crate) fn size(&self) -> (u32, u32) {
-        (self.width, self.height)
+        (
+            self.width.unwrap_or(self.size.0),
+            self.height.unwrap_or(self.size.1),
+        )
     }
 }
 

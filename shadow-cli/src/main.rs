@@ -193,10 +193,7 @@ mod tests {
             panic!("not a view command")
         };
         assert_eq!(v.camera.eye, Some(DVec3::new(-3.0, 2.0, 1.0)));
-        assert_eq!(
-            (v.image.width, v.image.height, v.image.fov),
-            (1200, 900, 50.0)
-        );
+        assert_eq!((v.image.size(), v.image.fov), ((1280, 720), 50.0));
         // no --eye: the scene's viewpoint, or the mesh framed
         assert!(Cli::try_parse_from(["shadow", "view", "--scene", "room", "-o", "x.svg"]).is_ok());
         assert!(Cli::try_parse_from(["shadow", "view", "--up", "0,0,0", "-o", "x.svg"]).is_err());
@@ -207,5 +204,11 @@ mod tests {
             .is_err()
         );
         assert!(Cli::try_parse_from(["shadow", "demo", "--width", "0"]).is_err());
+        assert!(Cli::try_parse_from(["shadow", "demo", "--size", "0x10"]).is_err());
+        let cli = Cli::try_parse_from(["shadow", "demo", "--size", "640x480", "--height", "400"]);
+        let Command::Demo(d) = cli.unwrap().command else {
+            panic!("not a demo command")
+        };
+        assert_eq!(d.image.size(), (640, 400));
     }
 }

@@ -125,8 +125,8 @@ pub(crate) fn demo(args: &DemoArgs) -> Result<()> {
         eye: ROOM_EYE,
         target: Some(ROOM_TARGET),
         up: None,
-        width: args.image.width,
-        height: args.image.height,
+        width: args.image.size().0,
+        height: args.image.size().1,
         fov_deg: args.image.fov,
     };
     let out = draw(&prepared, at)?;
