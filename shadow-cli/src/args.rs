@@ -70,8 +70,8 @@ impl LightArgs {
 /// Where a picture is seen from.
 #[derive(Args, Debug, Default)]
 pub(crate) struct CameraArgs {
-    /// Eye position [default for the built-in scenes that have a
-    /// viewpoint; required otherwise].
+    /// Eye position [default: the built-in scene's viewpoint; else the
+    /// scene framed from the front, right and above, the flags printed].
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub(crate) eye: Option<DVec3>,
     /// Point looked at [default: the centre of the scene's bounding box,

@@ -42,14 +42,11 @@ fn parse_bias(s: &str) -> Result<(f64, f64), String> {
     }
 }
 
-/// Where the scene, lights and camera come from.
+/// Where the scene and camera come from.
 #[derive(Args, Debug)]
 pub(crate) struct SceneArgs {
     #[command(flatten)]
     pub(crate) source: SourceArgs,
-    /// The lights; the mask is the first's.
-    #[command(flatten)]
-    pub(crate) lights: LightArgs,
     #[command(flatten)]
     pub(crate) camera: CameraArgs,
     /// Vertical field of view in degrees.
@@ -104,6 +101,9 @@ impl MethodArgs {
 pub(crate) struct RenderArgs {
     #[command(flatten)]
     pub(crate) scene: SceneArgs,
+    /// The lights; the mask is the first's.
+    #[command(flatten)]
+    pub(crate) lights: LightArgs,
     /// Image size.
     #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
     pub(crate) size: (u32, u32),
@@ -136,6 +136,9 @@ pub(crate) struct RenderArgs {
 pub(crate) struct CompareArgs {
     #[command(flatten)]
     pub(crate) scene: SceneArgs,
+    /// The lights.
+    #[command(flatten)]
+    pub(crate) lights: LightArgs,
     /// Size of each panel.
     #[arg(long, value_name = "WxH", default_value = "640x360", value_parser = parse_size)]
     pub(crate) size: (u32, u32),
@@ -196,14 +199,19 @@ fn check_ext(path: &std::path::Path, ext: &str, flag: &str) -> Result<()> {
     Ok(())
 }
 
-/// Loads the scene, places the lights and sets up the camera.
-pub(crate) fn prepare(args: &SceneArgs, size: (u32, u32), need_lights: bool) -> Result<Prepared> {
+/// Loads the scene, places the lights (`None`: a drawing without
+/// shadows) and sets up the camera.
+pub(crate) fn prepare(
+    args: &SceneArgs,
+    lights: Option<&LightArgs>,
+    size: (u32, u32),
+) -> Result<Prepared> {
     let start = Instant::now();
-    let specs = args.lights.specs();
+    let specs = lights.map(LightArgs::specs).unwrap_or_default();
     let s = Scene::load(
         &args.source,
         specs,
-        need_lights,
+        lights.is_some(),
         args.quiet,
         &mut Phases::default(),
     )?;
@@ -238,7 +246,7 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
     }
     let shadow = args.opts.options()?;
     let total = Instant::now();
-    let p = prepare(&args.scene, args.size, true)?;
+    let p = prepare(&args.scene, Some(&args.lights), args.size)?;
     let opts = RenderOptions::default()
         .with_hsr(args.hsr)
         .with_culling(args.cull)
@@ -289,7 +297,7 @@ pub(crate) fn run_compare(args: &CompareArgs) -> Result<()> {
         check_ext(r, "csv", "--report")?;
     }
     let shadow = args.opts.options()?;
-    let p = prepare(&args.scene, args.size, true)?;
+    let p = prepare(&args.scene, Some(&args.lights), args.size)?;
     let methods = if args.methods.is_empty() {
         Method::ALL.to_vec()
     } else {
@@ -323,7 +331,7 @@ pub(crate) fn run_compare(args: &CompareArgs) -> Result<()> {
 /// `shadow lines`.
 pub(crate) fn run_lines(args: &LinesArgs) -> Result<()> {
     check_ext(&args.output, "svg", "-o")?;
-    let p = prepare(&args.scene, args.size, false)?;
+    let p = prepare(&args.scene, None, args.size)?;
     let lines = hidden_lines(&p.scene, &p.camera)?;
     write_file(&args.output, lines.svg(args.hidden).as_bytes())?;
     emit(&format!(

@@ -355,6 +355,18 @@ fn lines_need_closed_polyhedra() {
         scratch("teapot_lines.svg").to_str().unwrap(),
     ]);
     crate::assert_failed_with(&o, &["polyhedron 0", "not closed", "closed polyhedra"]);
+    // a drawing has no shadows: no light flags
+    let out = scratch("lines_light.svg");
+    let o = shadow(&[
+        "lines",
+        "--scene",
+        "room",
+        "--light",
+        "1,2,3",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    crate::assert_failed_with(&o, &["unexpected argument '--light'"]);
 }
 
 /// A file with no camera flags is framed: the picture is written, the
