@@ -48,8 +48,8 @@ run render --scene bunny --size 320x180 --sun 1,2,3 --light 4,20.6,5.9 -o render
 for m in shadow-map stencil-zpass stencil-zfail planar texture raycast; do
   run render --scene room --size 320x180 --method "$m" -o "render_$m.png"
 done
-run compare --scene room --size 320x180 -o cmp_room.png --report cmp_room.csv
-run compare --scene bunny --size 320x180 -o cmp_bunny.png --report cmp_bunny.csv
+run compare --scene room --panel 320x180 -o cmp_room.png --report cmp_room.csv
+run compare --scene bunny --panel 320x180 -o cmp_bunny.png --report cmp_bunny.csv
 run lines --scene room -o lines.svg
 run animate --scene room --frames 3 --format png --width 320 --height 180 -o anim_png \
   --report anim.csv
@@ -66,7 +66,7 @@ if [[ $SCALE == full ]]; then
   run csg difference "$ROOT/data/meshes/bunny.obj" moved_bunny.obj -o bunny_diff.stl
   run animate --scene bunny-11k --frames 4 --format png --width 320 --height 180 \
     -o anim_bunny --report anim_bunny.csv
-  run compare --scene bunny-99k --size 960x540 -o cmp_b99k.png --report cmp_b99k.csv
+  run compare --scene bunny-99k --panel 960x540 -o cmp_b99k.png --report cmp_b99k.csv
 fi
 
 # (compare's panels print each method's time: its report stands for it)

@@ -17,7 +17,7 @@ $S compare $B $FEET --methods shadow-map --bias 2,0 -o $D/raster_panning.png
 $S compare $B --methods shadow-map --map-size 64 -o $D/raster_aliasing.png
 $S compare $B --methods texture --highlight -o $D/raster_texture.png
 # the eye under a chair's seat, in its shadow volume
-$S compare --scene room --size 400x225 --columns 3 --eye -2.25,-0.26,0.2 --target 1.5,1.2,0.3 --fov 70 \
+$S compare --scene room --panel 400x225 --columns 3 --eye -2.25,-0.26,0.2 --target 1.5,1.2,0.3 --fov 70 \
   --methods stencil-zpass,stencil-zfail -o $D/raster_zpass.png
 # planar shadows: a ground, a post taller than the light (anti-shadow) and
 # a box under the ground (false shadow)
@@ -62,7 +62,7 @@ OBJ
 PL="$P --light 0,0,3 --eye 0,-14,12 --target 0,0,0 --size 400x300 --columns 3"
 $S compare $PL --methods planar --no-clip --highlight -o $D/raster_planar_naive.png
 $S compare $PL --methods planar --highlight -o $D/raster_planar.png
-$S compare --scene room --size 320x180 --columns 4 --highlight --report $D/raster_room.csv -o $D/raster_room.png
+$S compare --scene room --panel 320x180 --columns 4 --highlight --report $D/raster_room.csv -o $D/raster_room.png
 $S lines --scene room --size 800x450 --hidden -o $D/raster_lines.svg
 python3 - "$D"/raster_*.png <<'PY'
 import struct, sys, zlib

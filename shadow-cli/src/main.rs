@@ -13,7 +13,7 @@
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow};
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use shadow_raster::{CameraError, RasterError};
 
 mod animate;
@@ -88,6 +88,18 @@ enum Command {
     /// Hidden-line drawing of convex polyhedra (Roberts' algorithm) to SVG.
     #[command(after_help = "Examples:\n  shadow lines --scene room -o lines.svg --hidden")]
     Lines(Box<raster::LinesArgs>),
+    /// Print a shell completion script (bash, zsh, fish, elvish or
+    /// powershell).
+    #[command(
+        after_help = "Examples:\n  shadow completions bash > ~/.local/share/bash-completion/completions/shadow"
+    )]
+    Completions {
+        /// The shell.
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff).
+    #[command(after_help = "Examples:\n  shadow man > shadow.1 && man ./shadow.1")]
+    Man,
 }
 
 /// A rendering error worded for the command line: a camera that cannot
@@ -125,6 +137,16 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Render(a) => raster::run_render(a),
         Command::Compare(a) => raster::run_compare(a),
         Command::Lines(a) => raster::run_lines(a),
+        Command::Completions { shell } => {
+            let mut out = Vec::new();
+            clap_complete::generate(*shell, &mut Cli::command(), "shadow", &mut out);
+            output::emit(&String::from_utf8_lossy(&out))
+        }
+        Command::Man => {
+            let mut out = Vec::new();
+            clap_mangen::Man::new(Cli::command()).render(&mut out)?;
+            output::emit(&String::from_utf8_lossy(&out))
+        }
     }
 }
 
@@ -183,6 +205,47 @@ mod tests {
         assert_eq!(message(&e), "outer: inner");
     }
 
+    /// Every flag that several commands have has one default (or none)
+    /// everywhere, and every command's help ends with an example.
+    #[test]
+    fn flags_of_one_name_share_their_default() {
+        let cli = Cli::command();
+        let mut seen: std::collections::HashMap<String, (String, Vec<String>)> = Default::default();
+        for sub in cli.get_subcommands() {
+            let help = sub
+                .get_after_help()
+                .map(|h| h.to_string())
+                .unwrap_or_default();
+            assert!(
+                help.contains(&format!("shadow {}", sub.get_name())),
+                "{}: no example",
+                sub.get_name()
+            );
+            let quiet = sub.get_arguments().any(|a| a.get_long() == Some("quiet"));
+            let tool = matches!(sub.get_name(), "completions" | "man");
+            assert!(quiet || tool, "{}: no --quiet", sub.get_name());
+            for arg in sub.get_arguments().filter(|a| !a.is_hide_set()) {
+                let Some(long) = arg.get_long() else { continue };
+                let default: Vec<String> = arg
+                    .get_default_values()
+                    .iter()
+                    .map(|v| v.to_string_lossy().into_owned())
+                    .collect();
+                let e = seen
+                    .entry(long.to_string())
+                    .or_insert_with(|| (sub.get_name().to_string(), default.clone()));
+                assert_eq!(
+                    e.1,
+                    default,
+                    "--{long}: {} and {} differ",
+                    e.0,
+                    sub.get_name()
+                );
+            }
+        }
+        assert!(seen.len() > 20);
+    }
+
     #[test]
     fn command_line_shapes() {
         let cli = Cli::try_parse_from([
@@ -205,7 +268,9 @@ mod tests {
         );
         assert!(Cli::try_parse_from(["shadow", "demo", "--width", "0"]).is_err());
         assert!(Cli::try_parse_from(["shadow", "demo", "--size", "0x10"]).is_err());
-        let cli = Cli::try_parse_from(["shadow", "demo", "--size", "640x480", "--height", "400"]);
+        let cli = Cli::try_parse_from([
+            "shadow", "demo", "-o", "d.svg", "--size", "640x480", "--height", "400",
+        ]);
         let Command::Demo(d) = cli.unwrap().command else {
             panic!("not a demo command")
         };

@@ -139,8 +139,8 @@ pub(crate) struct CompareArgs {
     /// The lights.
     #[command(flatten)]
     pub(crate) lights: LightArgs,
-    /// Size of each panel.
-    #[arg(long, value_name = "WxH", default_value = "640x360", value_parser = parse_size)]
+    /// Size of each method's panel (`--size` is a hidden alias).
+    #[arg(long = "panel", alias = "size", value_name = "WxH", default_value = "640x360", value_parser = parse_size)]
     pub(crate) size: (u32, u32),
     /// The methods to compare with exact, comma-separated [default: all].
     #[arg(long, value_name = "M,M...", value_delimiter = ',')]

@@ -43,7 +43,7 @@ pub(crate) struct StatsArgs {
 #[derive(Args, Debug)]
 pub(crate) struct DemoArgs {
     /// Output SVG file.
-    #[arg(short, long, value_name = "OUT.svg", default_value = "room.svg")]
+    #[arg(short, long, value_name = "OUT.svg")]
     pub(crate) output: PathBuf,
     #[command(flatten)]
     pub(crate) image: ImageArgs,

@@ -192,6 +192,23 @@ fn source_and_argument_errors() {
 }
 
 #[test]
+fn completions_and_man_page_cover_the_commands() {
+    for shell in ["bash", "zsh", "fish"] {
+        let o = shadow(&["completions", shell]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let s = stdout(&o);
+        assert!(s.contains("--scene") && s.contains("csg"), "{shell}");
+    }
+    let o = shadow(&["man"]);
+    assert!(o.status.success());
+    let s = stdout(&o);
+    assert!(s.starts_with(".ie") && s.contains(".TH shadow 1"), "{s}");
+    assert!(s.contains("shadows") && s.contains("animate"));
+    let o = shadow(&["completions", "tcsh"]);
+    assert!(!o.status.success());
+}
+
+#[test]
 fn help_succeeds() {
     let o = shadow(&["--help"]);
     assert!(o.status.success());
