@@ -243,10 +243,10 @@ impl Plan {
                 "note: no motion given (--spin, --step): every frame is the same",
             );
         }
-        if !has_view(args) && args.camera.any() {
+        if !has_view(args) && (args.camera.any() || args.image.any()) {
             note(
                 args,
-                "note: --eye, --target and --up only apply to SVG and PNG frames",
+                "note: --eye, --target, --up, --size and --fov only apply to SVG and PNG frames",
             );
         }
         // the folder first (the report may be in it); a report that cannot

@@ -160,6 +160,11 @@ pub(crate) struct ImageArgs {
 }
 
 impl ImageArgs {
+    /// `true` if a size or field of view other than the default is given.
+    pub(crate) fn any(&self) -> bool {
+        self.size() != (1280, 720) || self.fov != 50.0
+    }
+
     /// Width and height.
     pub(crate) fn size(&self) -> (u32, u32) {
         (

@@ -82,6 +82,30 @@ pub(crate) struct MethodArgs {
 }
 
 impl MethodArgs {
+    /// The flags given that `method` does not use, as a note.
+    fn unused_by(&self, method: Method) -> Option<String> {
+        let d = ShadowOptions::default();
+        let mut unused = Vec::new();
+        let map = matches!(method, Method::ShadowMap | Method::Texture);
+        if !map && self.map_size != d.map_size {
+            unused.push("--map-size (shadow maps and textures)");
+        }
+        if method != Method::ShadowMap && (self.bias.is_some() || self.pcf != d.pcf) {
+            unused.push("--bias and --pcf (shadow maps)");
+        }
+        let planar = self.no_clip || self.receivers as usize != d.planar_receivers;
+        if method != Method::Planar && planar {
+            unused.push("--no-clip and --receivers (planar shadows)");
+        }
+        (!unused.is_empty()).then(|| {
+            format!(
+                "note: --method {} does not use {}",
+                method.name(),
+                unused.join(", ")
+            )
+        })
+    }
+
     fn options(&self) -> Result<ShadowOptions> {
         if self.pcf.is_multiple_of(2) {
             bail!("--pcf {}: the kernel must be odd (1, 3, 5, ...)", self.pcf);
@@ -245,6 +269,13 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
         check_ext(m, "pgm", "--mask")?;
     }
     let shadow = args.opts.options()?;
+    if let Some(n) = args
+        .opts
+        .unused_by(args.method)
+        .filter(|_| !args.scene.quiet)
+    {
+        eprintln!("{n}");
+    }
     let total = Instant::now();
     let p = prepare(&args.scene, Some(&args.lights), args.size)?;
     let opts = RenderOptions::default()

@@ -124,10 +124,10 @@ impl Request {
     /// scene may have its own).
     fn of(args: &ShadowsArgs) -> Result<Request> {
         let format = Format::from_path(&args.output)?;
-        if format != Format::Svg && args.camera.any() {
+        if format != Format::Svg && (args.camera.any() || args.image.any()) {
             note(
                 args,
-                "note: --eye, --target and --up only apply to SVG output",
+                "note: --eye, --target, --up, --size and --fov only apply to SVG output",
             );
         }
         args.source.check()?;
@@ -180,15 +180,35 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
 
     let areas = &job.areas;
     let lit_share = percent(areas.total - areas.dark, areas.total);
+    // the SVG's fragments are pieces of the scene tree's polygons, the
+    // files' pieces of the faces: say which
+    let of = match job.fig.bsp_polygons {
+        Some(n) => format!(
+            "the scene tree's {n} polygons ({} faces)",
+            scene.mesh.faces.len()
+        ),
+        None => format!("{} faces", scene.mesh.faces.len()),
+    };
     let mut report = format!(
-        "wrote {}: {} fragments of {} faces of {}{}; {}, {lit_share:.1}% of the area lit\n",
+        "wrote {}: {} fragments of {of} of {}{}; {}, {lit_share:.1}% of the area lit\n",
         args.output.display(),
         job.fig.fragments,
-        scene.mesh.faces.len(),
         scene.name,
         job.fig.extra,
         scene.light_count(),
     );
+    if job.fig.fragments == 0 {
+        note(
+            args,
+            "note: no face has an area on the grid, so nothing was shaded (are the faces \
+             collinear or repeated?)",
+        );
+    } else if areas.total > 0.0 && areas.dark >= areas.total {
+        note(
+            args,
+            "note: nothing is lit (is a point light inside a closed mesh, or behind every face?)",
+        );
+    }
     if args.stats {
         report += &stats_text(&scene, &job.fig, areas, &job.phases, total);
     }
