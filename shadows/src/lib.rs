@@ -1,0 +1,270 @@
+//! The BSP shadow toolkit in one dependency, for the common jobs: read a
+//! mesh, combine meshes exactly, find the lit and shadowed part of every
+//! face for point lights and suns, and write the results. Each job is one
+//! to three calls; the crates underneath (`bsp-core`, `bsp-csg`, `svbsp`,
+//! `shadow-scene`) hold the rest.
+//!
+//! ```
+//! use bsp_shadows::{DVec3, Light};
+//! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../data/meshes/pyvista_sphere.obj");
+//! let sphere = bsp_shadows::read_mesh(path)?;
+//! let moved = bsp_shadows::translated(&sphere, DVec3::new(40.0, 20.0, 10.0));
+//! let both = bsp_shadows::union(&sphere, &moved)?;
+//! let lit = bsp_shadows::shadows(&both, &[Light::Point(DVec3::new(500.0, 300.0, 900.0))])?;
+//! let share = lit.lit_fraction(0);
+//! assert!(share > 0.3 && share < 0.7, "{share}");
+//! # Ok::<(), bsp_shadows::Error>(())
+//! ```
+//!
+//! Every decision is exact for the input snapped to a grid fitted to it
+//! (`bsp_core::Grid`): which parts of two meshes a Boolean keeps, which
+//! parts of a face a light reaches. The results are rounded once to
+//! `f64`.
+
+use std::path::Path;
+
+use bsp_core::BoolOp;
+use bsp_csg::files::{FileBoolean, FileError, Operand};
+use shadow_scene::SceneError;
+use svbsp::export::{ExportError, FragmentFile, FragmentFormat, area_records, world_vertices};
+use svbsp::{Batch, LightError, PlacedLight, ShadeOptions, ShadowError};
+
+pub use glam::DVec3;
+pub use shadow_scene::{Face, Mesh};
+/// A point light at a position, or a sun in a direction (from the scene
+/// toward it), in the mesh's units.
+pub use svbsp::LightSpec as Light;
+
+/// Why a job failed; [`std::error::Error::source`] gives the cause.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum Error {
+    /// A file could not be read or written, or is not a mesh.
+    File(SceneError),
+    /// An operand of a Boolean is not a closed, oriented surface (the
+    /// message names the face and edge).
+    Boolean(FileError),
+    /// A light cannot be placed on the scene's grid.
+    Light(LightError),
+    /// A face does not fit the grid.
+    Import(bsp_core::Error),
+    /// The shadow computation refused its input (too many lights).
+    Shadow(ShadowError),
+    /// A fragment's vertex leaves `f64` in the mesh's units.
+    Export(ExportError),
+}
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Error::File(e) => e.fmt(f),
+            Error::Boolean(e) => e.fmt(f),
+            Error::Light(e) => e.fmt(f),
+            Error::Import(e) => write!(f, "cannot import the faces: {e}"),
+            Error::Shadow(e) => e.fmt(f),
+            Error::Export(e) => e.fmt(f),
+        }
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        Some(match self {
+            Error::File(e) => e,
+            Error::Boolean(e) => e,
+            Error::Light(e) => e,
+            Error::Import(e) => e,
+            Error::Shadow(e) => e,
+            Error::Export(e) => e,
+        })
+    }
+}
+
+/// Reads an OBJ or STL file (by its extension).
+pub fn read_mesh(path: impl AsRef<Path>) -> Result<Mesh, Error> {
+    shadow_scene::load(path.as_ref()).map_err(Error::File)
+}
+
+/// Writes `mesh` as OBJ or STL (by the extension), through a temporary
+/// file renamed into place when complete.
+pub fn write_mesh(path: impl AsRef<Path>, mesh: &Mesh) -> Result<(), Error> {
+    shadow_scene::save(path.as_ref(), mesh).map_err(Error::File)
+}
+
+/// `mesh` moved by `by`.
+pub fn translated(mesh: &Mesh, by: DVec3) -> Mesh {
+    let mut m = mesh.clone();
+    m.positions.iter_mut().for_each(|p| *p += by);
+    m
+}
+
+/// The exact union of two closed, consistently oriented meshes (each the
+/// set where its winding number is positive), as a closed triangle mesh
+/// whose vertices are the exact ones rounded to `f64` (vertices that
+/// rounding makes equal are welded).
+pub fn union(a: &Mesh, b: &Mesh) -> Result<Mesh, Error> {
+    boolean(a, b, BoolOp::Union)
+}
+
+/// The exact intersection of two meshes; see [`union`].
+pub fn intersection(a: &Mesh, b: &Mesh) -> Result<Mesh, Error> {
+    boolean(a, b, BoolOp::Intersection)
+}
+
+/// The exact difference `a − b` of two meshes; see [`union`].
+pub fn difference(a: &Mesh, b: &Mesh) -> Result<Mesh, Error> {
+    boolean(a, b, BoolOp::Difference)
+}
+
+fn boolean(a: &Mesh, b: &Mesh, op: BoolOp) -> Result<Mesh, Error> {
+    let mut operands = [Operand::new("a", a.clone()), Operand::new("b", b.clone())];
+    let checked = Operand::check_all(&mut operands).map_err(Error::Boolean)?;
+    let out = FileBoolean::apply(checked, op, |_, _| {}).map_err(Error::Boolean)?;
+    Ok(match out.rounded(false) {
+        Some(r) => r.mesh,
+        None => out.mesh().to_mesh(),
+    })
+}
+
+/// The lit and shadowed parts of every face of a mesh, for its lights.
+#[derive(Debug)]
+pub struct Shadows {
+    lights: Vec<PlacedLight>,
+    faces: usize,
+    batch: Batch,
+    world: Vec<DVec3>,
+    /// `faces × lights`: the area each light reaches.
+    lit: Vec<f64>,
+    area: Vec<f64>,
+}
+
+/// One fragment of a face: a part that every light either reaches all
+/// over or not at all.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fragment {
+    /// The face (its index in the mesh).
+    pub face: usize,
+    /// Bit `i` set: light `i` reaches it.
+    pub lit: u64,
+    /// The outer boundary, counter-clockwise seen from the face's front,
+    /// then the holes; in the mesh's units.
+    pub rings: Vec<Vec<DVec3>>,
+}
+
+/// Shades every face of `mesh` for `lights` (at most 64): see
+/// [`Shadows`]. Faces are receivers and occluders alike; a face is lit
+/// on its front side only.
+///
+/// ```
+/// use bsp_shadows::{DVec3, Light};
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../data/meshes/teapot.obj");
+/// let teapot = bsp_shadows::read_mesh(path)?;
+/// let s = bsp_shadows::shadows(&teapot, &[Light::Sun(DVec3::new(1.0, 2.0, 4.0))])?;
+/// let face = 0;
+/// assert!(s.lit_area(face, 0) <= s.face_area(face));
+/// assert!(s.fragments().all(|f| f.rings[0].len() >= 3));
+/// # Ok::<(), bsp_shadows::Error>(())
+/// ```
+pub fn shadows(mesh: &Mesh, lights: &[Light]) -> Result<Shadows, Error> {
+    let grid = svbsp::shared_grid(&mesh.positions, lights).map_err(Error::Light)?;
+    let placed = svbsp::place_lights(&grid, lights).map_err(Error::Light)?;
+    let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
+    let (polys, _) =
+        bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(Error::Import)?;
+    let trees = svbsp::Shadows::new(&polys, &kernel).map_err(Error::Shadow)?;
+    // (with convex pieces: the OBJ writer draws them)
+    let batch = trees
+        .set()
+        .shade_all(&polys, &ShadeOptions::default().with_pieces(true));
+    let world = world_vertices(&batch, &grid).map_err(Error::Export)?;
+    let faces = mesh.faces.len();
+    let (mut lit, mut area) = (vec![0.0; faces * placed.len()], vec![0.0; faces]);
+    for r in area_records(&batch, &world) {
+        let f = r.face as usize;
+        area[f] += r.area;
+        for (i, l) in lit[f * placed.len()..(f + 1) * placed.len()]
+            .iter_mut()
+            .enumerate()
+        {
+            if r.lit >> i & 1 == 1 {
+                *l += r.area;
+            }
+        }
+    }
+    Ok(Shadows {
+        lights: placed,
+        faces,
+        batch,
+        world,
+        lit,
+        area,
+    })
+}
+
+impl Shadows {
+    /// The area of `face` that light `light` reaches (in the mesh's
+    /// units squared; lights numbered as given).
+    pub fn lit_area(&self, face: usize, light: usize) -> f64 {
+        self.lit[face * self.lights.len() + light]
+    }
+
+    /// The area of `face`.
+    pub fn face_area(&self, face: usize) -> f64 {
+        self.area[face]
+    }
+
+    /// The share of the whole surface that light `light` reaches.
+    pub fn lit_fraction(&self, light: usize) -> f64 {
+        let total: f64 = self.area.iter().sum();
+        let lit: f64 = (0..self.faces).map(|f| self.lit_area(f, light)).sum();
+        if total > 0.0 { lit / total } else { 0.0 }
+    }
+
+    /// Every fragment, face by face.
+    pub fn fragments(&self) -> impl Iterator<Item = Fragment> + '_ {
+        self.batch.fragments().map(|f| Fragment {
+            face: f.face() as usize,
+            lit: f.lit_mask(),
+            rings: f
+                .rings()
+                .map(|r| r.iter().map(|&v| self.world[v as usize]).collect())
+                .collect(),
+        })
+    }
+
+    /// Writes the fragments as JSON (the schema of `docs/shadows.md`) or
+    /// OBJ (groups `lit` and `shadow`), by the extension, through a
+    /// temporary file renamed into place when complete.
+    pub fn write(&self, path: impl AsRef<Path>) -> Result<(), Error> {
+        let path = path.as_ref();
+        let format = match path.extension().and_then(|e| e.to_str()) {
+            Some(e) if e.eq_ignore_ascii_case("json") => FragmentFormat::Json,
+            _ => FragmentFormat::Obj,
+        };
+        let io = |source| {
+            Error::File(SceneError::Io {
+                path: path.display().to_string(),
+                source,
+            })
+        };
+        let mut out = shadow_scene::AtomicFile::create(path).map_err(io)?;
+        let records = area_records(&self.batch, &self.world);
+        let mut file = FragmentFile::begin(&mut out, format, &self.lights, self.faces, ("", &[]))
+            .map_err(io)?;
+        file.write(&mut out, (&self.batch, &self.world, &records), None)
+            .map_err(io)?;
+        file.finish(&mut out).map_err(io)?;
+        out.commit().map_err(io)
+    }
+}
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
+
+/// The workspace README's library example, run as a doctest (from the
+/// workspace root, where its paths are).
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+pub struct WorkspaceReadmeDoctests;

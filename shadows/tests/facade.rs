@@ -1,0 +1,111 @@
+//! The facade's jobs on a real mesh: Booleans that are closed and add up,
+//! shadows whose areas agree with their fragments, files written whole,
+//! errors with their causes.
+
+use bsp_shadows::{DVec3, Error, Light, Mesh};
+
+fn sphere() -> Mesh {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../data/meshes/pyvista_sphere.obj"
+    );
+    bsp_shadows::read_mesh(path).unwrap()
+}
+
+/// Twice the area of a planar ring (its normal's length).
+fn ring_area(r: &[DVec3]) -> f64 {
+    let mut n = DVec3::ZERO;
+    for i in 1..r.len().saturating_sub(1) {
+        n += (r[i] - r[0]).cross(r[i + 1] - r[0]);
+    }
+    n.length() / 2.0
+}
+
+#[test]
+fn booleans_are_closed_and_add_up() {
+    let a = sphere();
+    let b = bsp_shadows::translated(&a, DVec3::new(60.0, 30.0, 15.0));
+    let u = bsp_shadows::union(&a, &b).unwrap();
+    let i = bsp_shadows::intersection(&a, &b).unwrap();
+    let d = bsp_shadows::difference(&a, &b).unwrap();
+    for m in [&u, &i, &d] {
+        assert!(m.is_closed_oriented());
+    }
+    let (va, vb) = (a.signed_volume(), b.signed_volume());
+    let (vu, vi, vd) = (u.signed_volume(), i.signed_volume(), d.signed_volume());
+    // exact results rounded once: the identities hold to rounding
+    let tol = 1e-9 * va;
+    assert!(
+        (vu + vi - va - vb).abs() < tol,
+        "{vu} + {vi} vs {va} + {vb}"
+    );
+    assert!((vd + vi - va).abs() < tol, "{vd} + {vi} vs {va}");
+    assert!(vi > 0.0 && vd > 0.0);
+}
+
+#[test]
+fn shadow_areas_agree_with_the_fragments_and_files() {
+    let a = sphere();
+    let b = bsp_shadows::translated(&a, DVec3::new(100.0, 50.0, 200.0));
+    let both = bsp_shadows::union(&a, &b).unwrap();
+    let lights = [
+        Light::Point(DVec3::new(300.0, 200.0, 900.0)),
+        Light::Sun(DVec3::new(-1.0, 0.5, 1.0)),
+    ];
+    let s = bsp_shadows::shadows(&both, &lights).unwrap();
+    let faces = both.faces.len();
+    let mut lit = vec![[0.0; 2]; faces];
+    let mut area = vec![0.0; faces];
+    for f in s.fragments() {
+        let a = ring_area(&f.rings[0]) - f.rings[1..].iter().map(|r| ring_area(r)).sum::<f64>();
+        area[f.face] += a;
+        for (l, x) in lit[f.face].iter_mut().enumerate() {
+            if f.lit >> l & 1 == 1 {
+                *x += a;
+            }
+        }
+    }
+    for f in 0..faces {
+        assert!(
+            (s.face_area(f) - area[f]).abs() <= 1e-9 * area[f].max(1.0),
+            "face {f}"
+        );
+        for (l, want) in lit[f].iter().enumerate() {
+            assert!((s.lit_area(f, l) - want).abs() <= 1e-9 * area[f].max(1.0));
+            assert!(s.lit_area(f, l) <= s.face_area(f) * (1.0 + 1e-12));
+        }
+    }
+    // the upper sphere shadows the lower one from the point light above
+    assert!(
+        s.lit_fraction(0) > 0.2 && s.lit_fraction(0) < 0.5,
+        "{}",
+        s.lit_fraction(0)
+    );
+    let dir = std::env::temp_dir().join(format!("bsp-shadows-facade-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    s.write(dir.join("s.json")).unwrap();
+    s.write(dir.join("s.obj")).unwrap();
+    let json = std::fs::read_to_string(dir.join("s.json")).unwrap();
+    assert!(json.starts_with('{') && json.trim_end().ends_with('}'));
+    let obj = std::fs::read_to_string(dir.join("s.obj")).unwrap();
+    assert!(obj.contains("\ng lit") && obj.contains("\ng shadow"));
+    bsp_shadows::write_mesh(dir.join("both.stl"), &both).unwrap();
+    let back = bsp_shadows::read_mesh(dir.join("both.stl")).unwrap();
+    assert_eq!(back.faces.len(), both.faces.len());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn errors_keep_their_causes() {
+    let e = bsp_shadows::read_mesh("/no/such/mesh.obj").unwrap_err();
+    assert!(matches!(e, Error::File(_)));
+    assert!(std::error::Error::source(&e).is_some());
+    assert!(e.to_string().contains("/no/such/mesh.obj"), "{e}");
+    let mut open = sphere();
+    open.faces.pop();
+    let e = bsp_shadows::union(&open, &sphere()).unwrap_err();
+    assert!(matches!(e, Error::Boolean(_)));
+    assert!(e.to_string().contains("boundary edge"), "{e}");
+    let e = bsp_shadows::shadows(&sphere(), &[Light::Sun(DVec3::ZERO)]).unwrap_err();
+    assert!(matches!(e, Error::Light(_)), "{e}");
+}
