@@ -29,6 +29,13 @@ pub enum CsgError {
     /// from there, it means the winding numbers disagree around a loop of
     /// the partition (the surface is not closed after all).
     NotASolid,
+    /// A surface of `faces` faces is too large for
+    /// [`Solid::resolved`](crate::Solid::resolved), which builds one
+    /// partition of all its faces (at most [`RESOLVE_LIMIT`](crate::RESOLVE_LIMIT)).
+    TooLargeToResolve {
+        /// The surface's faces.
+        faces: usize,
+    },
     /// The result is not watertight: a bug, not a problem of the input.
     Internal(String),
 }
@@ -45,6 +52,12 @@ impl std::fmt::Display for CsgError {
             CsgError::Grid(e) => write!(f, "{e}"),
             CsgError::NotASolid => f.write_str(
                 "a surface crosses itself (after snapping to the grid) and bounds no solid",
+            ),
+            CsgError::TooLargeToResolve { faces } => write!(
+                f,
+                "a surface of {faces} faces crosses, overlaps or nests in itself; resolving that \
+                 takes one partition of every face, done for at most {} faces",
+                crate::RESOLVE_LIMIT
             ),
             CsgError::Internal(e) => write!(f, "internal error: {e}"),
         }

@@ -102,7 +102,7 @@ mod solid;
 pub use error::CsgError;
 pub use import::{AsMeshIn, MeshBuf, MeshIn, Snapped, check_mesh, fit_grid, snap, snap_one};
 pub use options::{LEAF_SIZE, Options, Stats};
-pub use plan::Planned;
+pub use plan::{Planned, RESOLVE_LIMIT};
 pub use sequence::{
     Boolean, SequenceError, Stage, Step, mesh_boolean, mesh_sequence, mesh_sequence_with,
 };

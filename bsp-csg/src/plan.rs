@@ -42,6 +42,11 @@ use settle::{
     FacePiece, PiecedFace, Remains, SettledFace, SortedFaces, meeting_leaf, settle, sort_faces,
 };
 
+/// The most faces [`Solid::resolved`] takes: one partition of every face
+/// of a smooth closed surface of 20,000 faces takes about 2 s on the
+/// machine of `docs/bench-csg.md`, and it grows faster than the faces.
+pub const RESOLVE_LIMIT: usize = 20_000;
+
 /// An operation on two solids, decided ([`Solid::plan_owned`]).
 pub struct Planned {
     solid: Solid,
@@ -92,7 +97,14 @@ impl Solid {
     /// rule of mesh-arrangement Booleans; for a clean solid, the same
     /// solid. Exact; one partition of every face, so it costs more than
     /// an operation does.
+    ///
+    /// A partition of a smooth closed surface can grow much faster than
+    /// its faces, so a surface of more than [`RESOLVE_LIMIT`] faces is
+    /// refused ([`CsgError::TooLargeToResolve`]).
     pub fn resolved(self) -> Result<Solid, CsgError> {
+        if self.len() > RESOLVE_LIMIT {
+            return Err(CsgError::TooLargeToResolve { faces: self.len() });
+        }
         let faces: Vec<bsp_core::Polygon> = self.polygons().map(|p| p.into_owned()).collect();
         drop_aside(self);
         Ok(Solid::from_polygons(local::positive_region(faces)?))
@@ -175,7 +187,7 @@ impl Solid {
         let opts = Options::default();
         // (a failed plan changed neither solid)
         let (stats, additions) = match self.plan(&other, op, &opts) {
-            Err(CsgError::NotASolid) => {
+            Err(CsgError::NotASolid) if self.len().max(other.len()) <= RESOLVE_LIMIT => {
                 self = self.resolved()?;
                 other = other.resolved()?;
                 self.plan(&other, op, &opts)?
