@@ -55,8 +55,8 @@ impl std::fmt::Display for CsgError {
             ),
             CsgError::TooLargeToResolve { faces } => write!(
                 f,
-                "a surface of {faces} faces crosses, overlaps or nests in itself; resolving that \
-                 takes one partition of every face, done for at most {} faces",
+                "a surface of {faces} faces is too large to resolve where it crosses, overlaps \
+                 or nests in itself (one partition of every face, done for at most {} faces)",
                 crate::RESOLVE_LIMIT
             ),
             CsgError::Internal(e) => write!(f, "internal error: {e}"),
