@@ -577,100 +577,59 @@ fn a_file_and_a_scene_conflict() {
     assert_failed_with(&o, &["not both"]);
 }
 
+/// `shadow shadows INPUT --light LIGHT -o OUT EXTRA...`, its output.
+fn lit_by(input: &str, light: &str, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "shadows",
+        input,
+        "--light",
+        light,
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let o = shadow(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    o
+}
+
 /// Outcomes that usually mean a mistake get a note: a light inside a
 /// closed mesh lights nothing; faces without area shade nothing.
 #[test]
 fn nothing_lit_and_nothing_shaded_are_noted() {
-    let out = scratch("inside.json");
-    let o = shadow(&[
-        "shadows",
-        &unit_cube(),
-        "--light",
-        "0.5,0.5,0.5",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let (cube, out) = (unit_cube(), scratch("inside.json"));
+    let o = lit_by(&cube, "0.5,0.5,0.5", &out, &[]);
     assert!(
         stdout(&o).contains("0.0% of the area lit"),
         "{}",
         stdout(&o)
     );
-    assert!(
-        stderr(&o).contains("note: nothing is lit (is a point light inside a closed mesh"),
-        "{}",
-        stderr(&o)
-    );
-    let o = shadow(&[
-        "shadows",
-        &unit_cube(),
-        "--light",
-        "3,2,5",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let note = "note: nothing is lit (is a point light inside a closed mesh";
+    assert!(stderr(&o).contains(note), "{}", stderr(&o));
+    let o = lit_by(&cube, "3,2,5", &out, &[]);
     assert!(!stderr(&o).contains("nothing is lit"), "{}", stderr(&o));
 
     let flat = scratch("collinear.obj");
     std::fs::write(&flat, "v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\n").unwrap();
-    let o = shadow(&[
-        "shadows",
-        flat.to_str().unwrap(),
-        "--light",
-        "3,2,5",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("note: no face has an area on the grid"),
-        "{}",
-        stderr(&o)
-    );
+    let o = lit_by(flat.to_str().unwrap(), "3,2,5", &out, &[]);
+    let note = "note: no face has an area on the grid";
+    assert!(stderr(&o).contains(note), "{}", stderr(&o));
     // the SVG counts pieces of the scene tree's polygons, and says so
-    let svg = scratch("cube_counts.svg");
-    let o = shadow(&[
-        "shadows",
-        &unit_cube(),
-        "--light",
-        "3,2,5",
-        "-o",
-        svg.to_str().unwrap(),
-    ]);
-    assert!(
-        stdout(&o).contains("fragments of the scene tree's 6 polygons (6 faces)"),
-        "{}",
-        stdout(&o)
-    );
+    let o = lit_by(&cube, "3,2,5", &scratch("cube_counts.svg"), &[]);
+    let counts = "fragments of the scene tree's 6 polygons (6 faces)";
+    assert!(stdout(&o).contains(counts), "{}", stdout(&o));
 }
 
 /// Flags that do not apply to the chosen output get a note, and the
 /// output is what it is without them.
 #[test]
 fn flags_that_do_not_apply_are_noted() {
-    let out = scratch("flags.json");
-    let plain = shadow(&[
-        "shadows",
-        &unit_cube(),
-        "--light",
-        "3,2,5",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let (cube, out) = (unit_cube(), scratch("flags.json"));
+    let plain = lit_by(&cube, "3,2,5", &out, &[]);
+    assert!(!stderr(&plain).contains("only apply"));
     let first = std::fs::read(&out).unwrap();
-    let cube = unit_cube();
     for extra in [["--fov", "30"], ["--size", "64x48"], ["--eye", "5,5,5"]] {
-        let mut args = vec![
-            "shadows",
-            &cube,
-            "--light",
-            "3,2,5",
-            "-o",
-            out.to_str().unwrap(),
-        ];
-        args.extend(extra);
-        let o = shadow(&args);
-        assert!(o.status.success(), "{}", stderr(&o));
+        let o = lit_by(&cube, "3,2,5", &out, &extra);
         assert!(
             stderr(&o).contains("only apply to SVG output"),
             "{extra:?}: {}",
@@ -678,39 +637,22 @@ fn flags_that_do_not_apply_are_noted() {
         );
         assert_eq!(std::fs::read(&out).unwrap(), first);
     }
-    assert!(!stderr(&plain).contains("only apply"));
     let png = scratch("flags.png");
-    let o = shadow(&[
-        "render",
-        &unit_cube(),
-        "--light",
-        "3,2,5",
-        "--size",
-        "64x48",
-        "--pcf",
-        "3",
-        "-o",
-        png.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("note: --method exact does not use --bias and --pcf"),
-        "{}",
+    let render = |extra: &[&str]| {
+        let mut args = vec![
+            "render", &cube, "--light", "3,2,5", "--size", "64x48", "--pcf", "3",
+        ];
+        args.extend(extra);
+        args.extend(["-o", png.to_str().unwrap()]);
+        let o = shadow(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
         stderr(&o)
+    };
+    let err = render(&[]);
+    assert!(
+        err.contains("note: --method exact does not use --bias and --pcf"),
+        "{err}"
     );
-    let o = shadow(&[
-        "render",
-        &unit_cube(),
-        "--light",
-        "3,2,5",
-        "--size",
-        "64x48",
-        "--pcf",
-        "3",
-        "--method",
-        "shadow-map",
-        "-o",
-        png.to_str().unwrap(),
-    ]);
-    assert!(!stderr(&o).contains("does not use"), "{}", stderr(&o));
+    let err = render(&["--method", "shadow-map"]);
+    assert!(!err.contains("does not use"), "{err}");
 }
