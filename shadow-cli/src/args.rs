@@ -126,6 +126,14 @@ impl CameraArgs {
         if framed && !quiet {
             let bounds = mesh.bounds().unwrap_or_default();
             eprintln!("note: camera {}", viewpoint_flags(&at, bounds));
+            // most scans are Y-up: a mesh taller along y than along z may be
+            // one (a hint only: the axes of a file are its own)
+            let ext = bounds.1 - bounds.0;
+            if self.up.is_none() && ext.y > ext.z {
+                eprintln!(
+                    "note: the mesh is taller along y than along z; if it is Y-up, add --up y"
+                );
+            }
         }
         at
     }

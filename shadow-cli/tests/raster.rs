@@ -422,4 +422,13 @@ fn files_are_framed_without_camera_flags() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("note: camera --eye "));
+    assert!(!stderr(&o).contains("add --up y"));
+    // without --up, a mesh taller along y than along z gets the hint
+    let o = shadow(&["view", bunny.to_str().unwrap(), "-o", svg.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("if it is Y-up, add --up y"),
+        "{}",
+        stderr(&o)
+    );
 }
