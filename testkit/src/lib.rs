@@ -35,6 +35,7 @@ mod report;
 mod boolean;
 mod build;
 mod bytes;
+mod certify;
 mod exact;
 mod files;
 mod merge;
@@ -43,6 +44,7 @@ mod split;
 pub use boolean::{BooleanInput, IntBox, mesh_boolean_case};
 pub use build::*;
 use bytes::*;
+pub use certify::certify_case;
 use exact::*;
 pub use files::{obj_case, stl_case};
 pub use merge::{MergeInput, merge_case};
@@ -469,6 +471,16 @@ mod tests {
                 raw_seeds(8, 3),
             ),
             "obj" | "stl" => (file_seeds(target), raw_seeds(4, 255)),
+            "certify" => (
+                (0..24u64)
+                    .map(|i| {
+                        let mut b = vec![(i % 3) as u8];
+                        b.extend((0x5eed + i).to_le_bytes());
+                        b
+                    })
+                    .collect(),
+                raw_seeds(4, 3),
+            ),
             _ => (
                 build_seeds().iter().map(BuildInput::encode).collect(),
                 raw_seeds(8, 4),
@@ -490,7 +502,14 @@ mod tests {
     #[test]
     #[ignore = "writes fuzz/corpus; run by hand after changing the seeds or the decoders"]
     fn write_seed_corpus() {
-        for target in ["split", "build_tree", "mesh_boolean", "obj", "stl"] {
+        for target in [
+            "split",
+            "build_tree",
+            "mesh_boolean",
+            "obj",
+            "stl",
+            "certify",
+        ] {
             let dir = corpus_dir(target);
             std::fs::create_dir_all(&dir).unwrap();
             for e in std::fs::read_dir(&dir).unwrap() {
@@ -511,7 +530,14 @@ mod tests {
 
     #[test]
     fn seed_corpus_is_up_to_date() {
-        for target in ["split", "build_tree", "mesh_boolean", "obj", "stl"] {
+        for target in [
+            "split",
+            "build_tree",
+            "mesh_boolean",
+            "obj",
+            "stl",
+            "certify",
+        ] {
             for (name, bytes) in seed_files(target) {
                 let path = corpus_dir(target).join(&name);
                 let on_disk = std::fs::read(&path)
@@ -648,6 +674,26 @@ mod tests {
             files.len()
         );
         assert!(checked >= files.len() * 3 / 4 && cells > 100);
+    }
+
+    #[test]
+    fn certify_corpus_passes() {
+        let files = corpus_files("certify");
+        assert!(
+            files.len() >= 20,
+            "fuzz/corpus/certify has {} files",
+            files.len()
+        );
+        let certified = files
+            .iter()
+            .filter(|f| certify_case(&std::fs::read(f).unwrap()))
+            .count();
+        // both verdicts are exercised
+        assert!(
+            certified >= 3 && certified < files.len(),
+            "{certified} of {}",
+            files.len()
+        );
     }
 
     #[test]
