@@ -676,45 +676,25 @@ mod tests {
         assert!(checked >= files.len() * 3 / 4 && cells > 100);
     }
 
+    /// The corpora of the targets whose case says yes or no (certified,
+    /// read): every file passes, and both verdicts are exercised.
     #[test]
-    fn certify_corpus_passes() {
-        let files = corpus_files("certify");
-        assert!(
-            files.len() >= 20,
-            "fuzz/corpus/certify has {} files",
-            files.len()
-        );
-        let certified = files
-            .iter()
-            .filter(|f| certify_case(&std::fs::read(f).unwrap()))
-            .count();
-        // both verdicts are exercised
-        assert!(
-            certified >= 3 && certified < files.len(),
-            "{certified} of {}",
-            files.len()
-        );
-    }
-
-    #[test]
-    fn reader_corpora_pass() {
-        for (target, case) in [("obj", obj_case as fn(&[u8]) -> bool), ("stl", stl_case)] {
+    fn verdict_corpora_pass() {
+        type Case = fn(&[u8]) -> bool;
+        let targets: [(&str, Case, usize); 3] = [
+            ("certify", certify_case, 20),
+            ("obj", obj_case, 10),
+            ("stl", stl_case, 10),
+        ];
+        for (target, case, least) in targets {
             let files = corpus_files(target);
-            assert!(
-                files.len() >= 10,
-                "fuzz/corpus/{target} has {} files",
-                files.len()
-            );
-            let read = files
+            let n = files.len();
+            assert!(n >= least, "fuzz/corpus/{target} has {n} files");
+            let yes = files
                 .iter()
                 .filter(|f| case(&std::fs::read(f).unwrap()))
                 .count();
-            // both outcomes are exercised
-            assert!(
-                read >= 2 && read < files.len(),
-                "{target}: {read} of {} read",
-                files.len()
-            );
+            assert!(yes >= 2 && yes < n, "{target}: {yes} of {n}");
         }
     }
 
