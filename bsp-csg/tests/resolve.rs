@@ -229,3 +229,29 @@ fn results_written_and_read_back_are_inputs_again() {
         round_trip(&out, true);
     }
 }
+
+/// A union of one surface too large to resolve is kept as it is when the
+/// certificate says it bounds a solid already (one part, embedded,
+/// outward); one that nests is refused with the limit named.
+#[test]
+fn a_large_clean_surface_alone_is_kept() {
+    let (a, _, faces) = shapes::sphere_pair(2 * bsp_csg::RESOLVE_LIMIT);
+    assert!(faces.len() > bsp_csg::RESOLVE_LIMIT);
+    let out = mesh_sequence(&MeshIn::new(&a, &faces), &[]).unwrap();
+    assert_eq!(out.mesh.triangles.len(), faces.len());
+    // the same sphere twice, one inside the other: too large to resolve
+    let inner: Vec<DVec3> = a.iter().map(|&p| p * 0.5).collect();
+    let mut both = a.clone();
+    both.extend(inner);
+    let n = a.len() as u32;
+    let mut two = faces.clone();
+    two.extend(
+        faces
+            .iter()
+            .map(|f| f.iter().map(|&v| v + n).collect::<Vec<u32>>()),
+    );
+    let Err(e) = mesh_sequence(&MeshIn::new(&both, &two), &[]) else {
+        panic!("nested shells too large to resolve were accepted");
+    };
+    assert!(e.to_string().contains("too large to resolve"), "{e}");
+}

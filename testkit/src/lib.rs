@@ -497,19 +497,23 @@ mod tests {
         named.chain(raw).collect()
     }
 
+    /// The targets whose `seed-*` files come from the seeds above (merge's
+    /// are its own, in `merge.rs`).
+    const SEEDED: [&str; 6] = [
+        "split",
+        "build_tree",
+        "mesh_boolean",
+        "obj",
+        "stl",
+        "certify",
+    ];
+
     /// Rewrites the `seed-*` files of `fuzz/corpus/` from the seeds above:
     /// `cargo test -p bsp-testkit --lib tests::write_seed_corpus -- --ignored`.
     #[test]
     #[ignore = "writes fuzz/corpus; run by hand after changing the seeds or the decoders"]
     fn write_seed_corpus() {
-        for target in [
-            "split",
-            "build_tree",
-            "mesh_boolean",
-            "obj",
-            "stl",
-            "certify",
-        ] {
+        for target in SEEDED {
             let dir = corpus_dir(target);
             std::fs::create_dir_all(&dir).unwrap();
             for e in std::fs::read_dir(&dir).unwrap() {
@@ -530,14 +534,7 @@ mod tests {
 
     #[test]
     fn seed_corpus_is_up_to_date() {
-        for target in [
-            "split",
-            "build_tree",
-            "mesh_boolean",
-            "obj",
-            "stl",
-            "certify",
-        ] {
+        for target in SEEDED {
             for (name, bytes) in seed_files(target) {
                 let path = corpus_dir(target).join(&name);
                 let on_disk = std::fs::read(&path)
