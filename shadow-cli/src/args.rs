@@ -150,11 +150,16 @@ pub(crate) fn viewpoint_flags(at: &SvgViewpoint, bounds: (DVec3, DVec3)) -> Stri
     s
 }
 
+/// The picture size when none is given.
+const DEFAULT_SIZE: &str = "1280x720";
+/// The field of view when none is given, in degrees.
+const DEFAULT_FOV: f64 = 50.0;
+
 /// The size and field of view of a picture (SVG or PNG frames).
 #[derive(Args, Debug)]
 pub(crate) struct ImageArgs {
     /// Picture size in pixels, the same flag as `render`'s.
-    #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
+    #[arg(long, value_name = "WxH", default_value = DEFAULT_SIZE, value_parser = parse_size)]
     pub(crate) size: (u32, u32),
     /// The width alone (overrides --size's).
     #[arg(long, hide = true, value_parser = clap::value_parser!(u32).range(1..=shadow_raster::MAX_SIZE as i64))]
@@ -163,14 +168,14 @@ pub(crate) struct ImageArgs {
     #[arg(long, hide = true, value_parser = clap::value_parser!(u32).range(1..=shadow_raster::MAX_SIZE as i64))]
     pub(crate) height: Option<u32>,
     /// Vertical field of view in degrees (between 1 and 170).
-    #[arg(long, value_name = "DEG", default_value_t = 50.0, value_parser = parse_fov)]
+    #[arg(long, value_name = "DEG", default_value_t = DEFAULT_FOV, value_parser = parse_fov)]
     pub(crate) fov: f64,
 }
 
 impl ImageArgs {
     /// `true` if a size or field of view other than the default is given.
     pub(crate) fn any(&self) -> bool {
-        self.size() != (1280, 720) || self.fov != 50.0
+        Ok(self.size()) != parse_size(DEFAULT_SIZE) || self.fov != DEFAULT_FOV
     }
 
     /// Width and height.

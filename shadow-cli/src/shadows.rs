@@ -387,8 +387,9 @@ impl Job<'_> {
         let opts = ShadeOptions::default().with_pieces(self.format == Format::Obj);
         let mut file = self.begin(out)?;
         let progress = self.progress;
-        progress.phase("shading", receivers(&scene.polys).len() as u64);
-        let polys = (&scene.polys[..], &scene.grid);
+        let ranges = receivers(&scene.polys);
+        progress.phase("shading", ranges.len() as u64);
+        let polys = (&scene.polys[..], &ranges[..], &scene.grid);
         let s = file.stream(out, shadows.set(), polys, &opts, |n| {
             progress.inc(n as u64);
         })?;

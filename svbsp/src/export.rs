@@ -19,9 +19,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::{
-    Areas, Batch, CHUNK, Light, PlacedLight, ShadeOptions, ShadowSet, polygon_area, receivers,
-};
+use crate::{Areas, Batch, CHUNK, Light, PlacedLight, ShadeOptions, ShadowSet, polygon_area};
 
 /// Why a batch cannot be written.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -369,7 +367,7 @@ const ROUND: usize = CHUNK * 32;
 pub struct Streamed {
     /// Fragments written.
     pub fragments: usize,
-    /// Receivers shaded (see [`receivers`]).
+    /// Receivers shaded.
     pub receivers: usize,
     /// Time spent shading and formatting (in parallel).
     pub shading: Duration,
@@ -509,7 +507,8 @@ impl FragmentFile {
         file.finish(out)
     }
 
-    /// Shades every receiver of `polys` on `grid` by `shadows` and writes
+    /// Shades the receivers `ranges` of `polys` (see [`receivers`]) on
+    /// `grid` by `shadows` and writes
     /// its fragments, round by round: each round's chunks are shaded and
     /// formatted in parallel, then written in order, so the file is the
     /// same for every thread count and memory stays bounded. `done(n)` is
@@ -520,11 +519,10 @@ impl FragmentFile {
         &mut self,
         out: &mut impl Write,
         shadows: ShadowSet<'_>,
-        (polys, grid): (&[Polygon], &Grid),
+        (polys, ranges, grid): (&[Polygon], &[std::ops::Range<usize>], &Grid),
         opts: &ShadeOptions,
         done: impl Fn(usize) + Sync,
     ) -> io::Result<Streamed> {
-        let ranges = receivers(polys);
         let json = matches!(self.kind, FileKind::Json { .. });
         let lights = self.lights;
         let mut s = Streamed {
@@ -634,9 +632,15 @@ mod tests {
             let mut file = FragmentFile::begin(&mut out, format, &lights, 2, head).unwrap();
             let done = std::sync::atomic::AtomicUsize::new(0);
             let s = file
-                .stream(&mut out, shadows.set(), (&polys, &grid), &opts, |n| {
-                    done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
-                })
+                .stream(
+                    &mut out,
+                    shadows.set(),
+                    (&polys, &crate::receivers(&polys), &grid),
+                    &opts,
+                    |n| {
+                        done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+                    },
+                )
                 .unwrap();
             let streamed = file.finish(&mut out).unwrap();
             assert_eq!(
@@ -727,6 +731,7 @@ mod tests {
 
     #[test]
     fn json_numbers_are_serde_jsons() {
+        // numbers to print (no tolerance: the text must equal serde_json's)
         for x in [0.0, -0.5, 1.0, 1e-7, 123456.789, 2f64.powi(60), -3.25e-300] {
             let mut s = Vec::new();
             push_f64(&mut s, x);

@@ -80,7 +80,7 @@ fn solid_of(
 ) -> Result<Partition<Cell>, CsgError> {
     let w = walls(bx);
     let (part, leaves) = Partition::from_tree_in(tree, &w);
-    let links = links(&part);
+    let links = links(&part, sheet);
     let mut w: Vec<Option<i32>> = vec![None; leaves as usize];
     let mut adj: Vec<Vec<(u32, i32)>> = vec![Vec::new(); leaves as usize];
     for &(f, b, c) in &links {
@@ -134,34 +134,43 @@ fn solid_of(
 }
 
 /// `(front leaf, back leaf, w(back) − w(front))` across every piece of
-/// every sub-hyperplane of `part`. The surface on a node's plane covers a
-/// piece all over or not at all (it may be cut into several faces): one
-/// overlapping face of each orientation tells, for a solid (faces lying
-/// on each other are counted as layers in [`positive_region`]).
-fn links(part: &Partition<u32>) -> Vec<(u32, u32, i32)> {
+/// every sub-hyperplane of `part`, the difference `cover(piece, node's
+/// polygons, node's plane)`: [`sheet`] for a solid, [`layers`] where
+/// faces may lie on each other.
+fn links(
+    part: &Partition<u32>,
+    cover: impl Fn(&Polygon, &[Polygon], &Plane) -> i32,
+) -> Vec<(u32, u32, i32)> {
     let mut links: Vec<(u32, u32, i32)> = Vec::new();
     for n in part.nodes() {
         for (pf, lf) in part.push_down(n.shp.clone(), n.front) {
             for (pb, lb) in part.push_down(pf, n.back) {
-                let (mut up, mut down) = (false, false);
-                for g in &n.polygons {
-                    let same = g.support() == &n.plane;
-                    if (same && up) || (!same && down) {
-                        continue;
-                    }
-                    if overlap(&pb, g) {
-                        if same {
-                            up = true;
-                        } else {
-                            down = true;
-                        }
-                    }
-                }
-                links.push((lf, lb, i32::from(up) - i32::from(down)));
+                links.push((lf, lb, cover(&pb, &n.polygons, &n.plane)));
             }
         }
     }
     links
+}
+
+/// `w(back) − w(front)` across `piece` for a solid: the surface on the
+/// plane covers a piece all over or not at all (it may be cut into several
+/// faces), so one overlapping face of each orientation tells.
+fn sheet(piece: &Polygon, faces: &[Polygon], plane: &Plane) -> i32 {
+    let (mut up, mut down) = (false, false);
+    for g in faces {
+        let same = g.support() == plane;
+        if (same && up) || (!same && down) {
+            continue;
+        }
+        if overlap(piece, g) {
+            if same {
+                up = true;
+            } else {
+                down = true;
+            }
+        }
+    }
+    i32::from(up) - i32::from(down)
 }
 
 /// `w(back) − w(front)` across `piece` (in the plane `plane`, which
@@ -209,14 +218,9 @@ pub(crate) fn positive_region(faces: Vec<Polygon>) -> Result<Vec<Polygon>, CsgEr
     let tree = BspTree::build(faces, &BuildOptions::default());
     let (part, leaves) = Partition::from_tree_in(&tree, &walls(&bx));
     let mut adj: Vec<Vec<(u32, i32)>> = vec![Vec::new(); leaves as usize];
-    for n in part.nodes() {
-        for (pf, lf) in part.push_down(n.shp.clone(), n.front) {
-            for (pb, lb) in part.push_down(pf, n.back) {
-                let c = layers(&pb, &n.polygons, &n.plane);
-                adj[lf as usize].push((lb, c));
-                adj[lb as usize].push((lf, -c));
-            }
-        }
+    for (f, b, c) in links(&part, layers) {
+        adj[f as usize].push((b, c));
+        adj[b as usize].push((f, -c));
     }
     let mut w: Vec<Option<i32>> = vec![None; leaves as usize];
     let corner = bsp_core::Point::Grid(corner.map(|c| c as i32));
