@@ -507,7 +507,7 @@ impl FragmentFile {
         file.finish(out)
     }
 
-    /// Shades the receivers `ranges` of `polys` (see [`receivers`]) on
+    /// Shades the receivers `ranges` of `polys` (see [`crate::receivers`]) on
     /// `grid` by `shadows` and writes
     /// its fragments, round by round: each round's chunks are shaded and
     /// formatted in parallel, then written in order, so the file is the
