@@ -387,33 +387,33 @@ impl FileBoolean {
     }
 
     /// The result as a file holds it where rounding its exact vertices
-    /// to `f64` (or for `stl`, to `f32`) makes distinct ones equal:
-    /// welded, with the faces that collapse left out
-    /// ([`Mesh::collapse_repeats`]), so that a reader that welds by
-    /// position finds no face repeating a vertex. `None` where no two
-    /// vertices round to one position (the file is [`FileBoolean::mesh`]
-    /// as it is).
+    /// to `f64` (or for `stl`, to `f32`) makes distinct ones equal or
+    /// puts three corners of a triangle on one line: welded, with the
+    /// faces that collapse left out ([`Mesh::collapse_repeats`]) and the
+    /// flat triangles split away ([`Mesh::split_flat_triangles`]), so
+    /// that a reader that welds by position finds no face repeating a
+    /// vertex and no face without area. `None` where rounding does
+    /// neither (the file is [`FileBoolean::mesh`] as it is).
     pub fn rounded(&self, stl: bool) -> Option<Rounded> {
         let view = self.mesh();
         let coincide = match stl {
             true => shadow_scene::stl_collisions(&view),
             false => view.repeated_positions(),
         };
-        if coincide == 0 {
+        let round: fn(DVec3) -> DVec3 = match stl {
+            true => shadow_scene::to_f32,
+            false => |p| p,
+        };
+        if coincide == 0 && view.flat_triangles(round) == 0 {
             return None;
         }
         let mut mesh = view.to_mesh();
-        if stl {
-            for p in &mut mesh.positions {
-                *p = p.as_vec3().as_dvec3();
-            }
-        }
-        mesh.weld();
-        let collapsed = mesh.collapse_repeats().len();
-        let closed = mesh.is_closed_oriented();
+        let r = mesh.round_positions(round);
+        let closed = r.left_flat == 0 && mesh.is_closed_oriented();
         Some(Rounded {
             mesh,
-            collapsed,
+            collapsed: r.collapsed,
+            flattened: r.flattened,
             closed,
         })
     }
@@ -432,10 +432,47 @@ pub struct Rounded {
     pub mesh: Mesh,
     /// Faces that rounding collapsed, left out.
     pub collapsed: usize,
-    /// Whether the mesh is still closed and oriented by vertex index
-    /// (where a collapsed edge's ends had other neighbours in common, it
-    /// is not).
+    /// Triangles that rounding made flat (three corners on one line),
+    /// split away: the face across each one's long edge is cut at its
+    /// middle corner, so the surface stays closed.
+    pub flattened: usize,
+    /// Whether the mesh is still closed and oriented by vertex index,
+    /// with no flat triangle (where a collapsed edge's ends had other
+    /// neighbours in common, it is not).
     pub closed: bool,
+}
+
+impl Rounded {
+    /// What rounding did, as a note (the file is closed as read back) or
+    /// a warning (it is not); `stl`: rounded to `f32`.
+    pub fn message(&self, stl: bool) -> String {
+        let to = if stl { "f32 for STL" } else { "f64" };
+        let mut did = Vec::new();
+        if self.collapsed > 0 {
+            did.push(format!(
+                "made distinct vertices equal ({} collapsed triangle(s) left out)",
+                self.collapsed
+            ));
+        }
+        if self.flattened > 0 {
+            did.push(format!(
+                "put the corners of {} triangle(s) on one line (split away: the face across \
+                 each long edge is cut at the middle corner)",
+                self.flattened
+            ));
+        }
+        let did = did.join(" and ");
+        match (self.closed, stl) {
+            (true, _) => format!("note: rounding to {to} {did}; the file is closed as read back"),
+            (false, true) => format!(
+                "warning: rounding to {to} {did}; the file is not closed as read back (write \
+                 .obj to keep full precision)"
+            ),
+            (false, false) => {
+                format!("warning: rounding to {to} {did}; the file is not closed as read back")
+            }
+        }
+    }
 }
 
 /// "union", "intersection" or "difference".

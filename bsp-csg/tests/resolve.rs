@@ -8,6 +8,7 @@ use bsp_csg::files::{FileBoolean, Operand};
 use bsp_csg::{MeshBuf, MeshIn, Solid, mesh_sequence};
 use bsp_fixtures::{self as shapes, GridPoint, Loop, Rng};
 use glam::DVec3;
+use shadow_scene::MeshView;
 
 fn polys(loops: &[Loop]) -> Vec<Polygon> {
     loops
@@ -181,6 +182,13 @@ fn round_trip(out: &FileBoolean, stl: bool) {
         true => shadow_scene::parse_stl(&bytes, "r.stl").unwrap(),
         false => shadow_scene::parse_obj(std::str::from_utf8(&bytes).unwrap(), "r.obj").unwrap(),
     };
+    // as read back: no face without area
+    assert_eq!(
+        mesh.flat_triangles(|p| p),
+        0,
+        "{}: flat triangles",
+        out.group
+    );
     let mut twice = [
         Operand::welded("r", mesh.clone()),
         Operand::welded("r", mesh),
@@ -228,6 +236,45 @@ fn results_written_and_read_back_are_inputs_again() {
         round_trip(&out, false);
         round_trip(&out, true);
     }
+}
+
+/// The nut and a copy moved by a skew fraction of its size: their
+/// results rounded to `f32` put the three corners of some triangles on
+/// one line (and make some vertices equal); as written they have no flat
+/// face and are closed, and they are inputs again.
+#[test]
+fn results_that_round_flat_are_split_and_closed() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../data/meshes/pyvista_nut.obj"
+    );
+    let nut = shadow_scene::load(std::path::Path::new(path)).unwrap();
+    let (lo, hi) = nut.bounds().unwrap();
+    let moved = {
+        let mut m = nut.clone();
+        let by = (hi - lo) * DVec3::new(0.31, 0.17, 0.23);
+        m.positions.iter_mut().for_each(|p| *p += by);
+        m
+    };
+    let mut flattened = 0;
+    for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
+        let mut pair = [
+            Operand::new("nut", nut.clone()),
+            Operand::new("moved", moved.clone()),
+        ];
+        let checked = Operand::check_all(&mut pair).unwrap();
+        let out = FileBoolean::apply(checked, op, |_, _| {}).unwrap();
+        let r = out
+            .rounded(true)
+            .expect("f32 rounding makes vertices equal");
+        assert!(r.closed, "{op:?}");
+        assert_eq!(r.mesh.flat_triangles(|p| p), 0, "{op:?}");
+        flattened += r.flattened;
+        round_trip(&out, true);
+        round_trip(&out, false);
+    }
+    // (the case this test is for happens: 8, 11 and 10 triangles)
+    assert!(flattened > 0);
 }
 
 /// A union of one surface too large to resolve is kept as it is when the

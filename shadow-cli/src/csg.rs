@@ -265,24 +265,7 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
         eprintln!("note: the {} is empty", args.op.name());
     }
     if let Some(r) = rounded.as_ref().filter(|_| !args.quiet) {
-        let to = if stl { "f32 for STL" } else { "f64" };
-        match r.closed {
-            true => eprintln!(
-                "note: rounding to {to} made distinct vertices equal: {} collapsed triangle(s) \
-                 left out; the file is closed as read back",
-                r.collapsed
-            ),
-            false => eprintln!(
-                "warning: rounding to {to} made distinct vertices equal and {} triangle(s) \
-                 collapse; the file is not closed as read back{}",
-                r.collapsed,
-                if stl {
-                    " (write .obj to keep full precision)"
-                } else {
-                    ""
-                }
-            ),
-        }
+        eprintln!("{}", r.message(stl));
     }
     if args.stats {
         report += &stats_text(args.op, &operands, &out, &phases, total);

@@ -62,6 +62,28 @@ pub trait MeshView: Sync {
             .filter(|p| !seen.insert(key(**p)))
             .count()
     }
+
+    /// How many triangles have three distinct corners that lie exactly on
+    /// one line once each position is mapped by `round` (the identity for
+    /// `f64` files, a rounding to `f32` for STL): the faces a reader would
+    /// find flat ([`Mesh::split_flat_triangles`] takes them out).
+    fn flat_triangles(&self, round: fn(DVec3) -> DVec3) -> usize {
+        use rayon::prelude::*;
+        let positions = self.positions();
+        (0..self.face_count())
+            .into_par_iter()
+            .filter(|&f| {
+                let &[a, b, c] = self.face(f) else {
+                    return false;
+                };
+                let [pa, pb, pc] = [a, b, c].map(|v| round(positions[v as usize]));
+                key(pa) != key(pb)
+                    && key(pb) != key(pc)
+                    && key(pc) != key(pa)
+                    && collinear(pa, pb, pc)
+            })
+            .count()
+    }
 }
 
 /// The positions some face uses, in order (each once).
@@ -168,6 +190,49 @@ impl MeshView for Triangles<'_> {
 pub(crate) fn key(p: DVec3) -> [u64; 3] {
     // adding +0.0 turns -0.0 into +0.0 and leaves every other value alone
     [p.x, p.y, p.z].map(|c| (c + 0.0).to_bits())
+}
+
+/// `true` if `a`, `b` and `c` lie exactly on one line: the three
+/// components of `(b − a) × (c − a)` are the orientations of the points'
+/// projections on the three coordinate planes, each of whose signs
+/// `robust` computes exactly.
+pub fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
+    let o = |i: usize, j: usize| {
+        let q = |p: DVec3| robust::Coord { x: p[i], y: p[j] };
+        robust::orient2d(q(a), q(b), q(c))
+    };
+    o(0, 1) == 0.0 && o(1, 2) == 0.0 && o(2, 0) == 0.0
+}
+
+/// `true` if `m` lies between `p` and `q` along every axis (for collinear
+/// points: on the segment `pq`).
+fn between(m: DVec3, p: DVec3, q: DVec3) -> bool {
+    (0..3).all(|i| p[i].min(q[i]) <= m[i] && m[i] <= p[i].max(q[i]))
+}
+
+/// What [`Mesh::round_positions`] mended.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Rounding {
+    /// Faces left out because rounding made their corners one position.
+    pub collapsed: usize,
+    /// Flat triangles split away.
+    pub flattened: usize,
+    /// Flat triangles that stay ([`FlatFix::left`]).
+    pub left_flat: usize,
+}
+
+/// `p` rounded to `f32` and back: the positions an STL file holds.
+pub fn to_f32(p: DVec3) -> DVec3 {
+    p.as_vec3().as_dvec3()
+}
+
+/// What [`Mesh::split_flat_triangles`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FlatFix {
+    /// Flat triangles taken out (of those there were at the start).
+    pub removed: usize,
+    /// Flat triangles that stay (no single face across the long edge).
+    pub left: usize,
 }
 
 impl Mesh {
@@ -402,6 +467,154 @@ impl Mesh {
         dropped
     }
 
+    /// Rounds every position with `round` (to `f32` for STL, say) and
+    /// mends what rounding did to a closed surface: vertices that became
+    /// equal are welded ([`Mesh::weld`]), the faces that collapse are left
+    /// out ([`Mesh::collapse_repeats`]) and triangles that became flat are
+    /// split away ([`Mesh::split_flat_triangles`]).
+    pub fn round_positions(&mut self, round: fn(DVec3) -> DVec3) -> Rounding {
+        for p in &mut self.positions {
+            *p = round(*p);
+        }
+        self.weld();
+        let collapsed = self.collapse_repeats().len();
+        let flat = self.split_flat_triangles();
+        Rounding {
+            collapsed,
+            flattened: flat.removed,
+            left_flat: flat.left,
+        }
+    }
+
+    /// Takes out the triangles whose three distinct corners lie exactly
+    /// on one line (zero-area faces, as rounding a closed surface's
+    /// vertices can make them) without opening the surface: the middle
+    /// corner lies on the triangle's long edge, so the face across that
+    /// edge is split there in two (or, where that face is the same flat
+    /// triangle turned over, both go). The surface's points are unchanged,
+    /// so it stays closed and oriented, and its volume is the same.
+    /// Collinearity is decided exactly ([`collinear`]). A flat triangle
+    /// whose long edge has no single face across it (an open or
+    /// non-manifold surface) stays, and is counted in
+    /// [`FlatFix::left`].
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// use shadow_scene::{Face, Mesh};
+    /// let face = |v: Vec<u32>| Face { vertices: v, line: 0, group: 0 };
+    /// // a tetrahedron whose edge 0-1 carries its midpoint 4, with the flat
+    /// // triangle (1, 4, 0) filling the notch
+    /// let mut m = Mesh {
+    ///     positions: vec![
+    ///         DVec3::ZERO, DVec3::new(2.0, 0.0, 0.0), DVec3::new(0.0, 2.0, 0.0),
+    ///         DVec3::new(0.0, 0.0, 2.0), DVec3::new(1.0, 0.0, 0.0),
+    ///     ],
+    ///     faces: [[0, 4, 3], [4, 1, 3], [1, 4, 0], [1, 0, 2], [1, 2, 3], [0, 3, 2]]
+    ///         .map(|f| face(f.to_vec())).to_vec(),
+    ///     groups: vec!["default".into()],
+    /// };
+    /// assert!(m.is_closed_oriented());
+    /// let fix = m.split_flat_triangles();
+    /// assert_eq!((fix.removed, fix.left), (1, 0));
+    /// assert!(m.is_closed_oriented() && m.faces.len() == 6);
+    /// assert_eq!(m.signed_volume(), 8.0 / 6.0);
+    /// ```
+    pub fn split_flat_triangles(&mut self) -> FlatFix {
+        let positions = &self.positions;
+        let flat = |f: &Face| {
+            let [a, b, c] = f.vertices[..] else {
+                return false;
+            };
+            let [pa, pb, pc] = [a, b, c].map(|v| positions[v as usize]);
+            a != b && b != c && c != a && collinear(pa, pb, pc)
+        };
+        let mut queue: Vec<usize> = (0..self.faces.len())
+            .filter(|&i| flat(&self.faces[i]))
+            .collect();
+        if queue.is_empty() {
+            return FlatFix::default();
+        }
+        // directed edge → its face; `usize::MAX` where several faces use it
+        const SHARED: usize = usize::MAX;
+        let mut edges: rustc_hash::FxHashMap<(u32, u32), usize> = Default::default();
+        let ring = |f: &Face| {
+            let v = f.vertices.clone();
+            (0..v.len()).map(move |i| (v[i], v[(i + 1) % v.len()]))
+        };
+        for (i, f) in self.faces.iter().enumerate() {
+            for e in ring(f) {
+                edges.entry(e).and_modify(|x| *x = SHARED).or_insert(i);
+            }
+        }
+        let mut alive = vec![true; self.faces.len()];
+        let at_start = queue.len();
+        // each step takes one flat triangle out and may make two: bounded
+        let mut budget = 8 * queue.len() + 64;
+        while let Some(t) = queue.pop() {
+            if budget == 0 {
+                break;
+            }
+            budget -= 1;
+            if !alive[t] || !flat(&self.faces[t]) {
+                continue;
+            }
+            let v = self.faces[t].vertices.clone();
+            let at = |i: usize| self.positions[v[i] as usize];
+            let i = (0..3)
+                .find(|&i| between(at(i), at((i + 1) % 3), at((i + 2) % 3)))
+                .expect("one of three distinct collinear points lies between the others");
+            let (m, p, q) = (v[i], v[(i + 1) % 3], v[(i + 2) % 3]);
+            let n = match edges.get(&(q, p)) {
+                Some(&n) if n != SHARED && alive[n] && self.faces[n].vertices.len() == 3 => n,
+                _ => continue,
+            };
+            let nv = &self.faces[n].vertices;
+            let k = nv
+                .iter()
+                .position(|&x| x == q)
+                .expect("the edge's face has it");
+            let d = nv[(k + 2) % 3];
+            let unlink = |f: &Face, i: usize, edges: &mut rustc_hash::FxHashMap<_, _>| {
+                for e in ring(f) {
+                    if edges.get(&e) == Some(&i) {
+                        edges.remove(&e);
+                    }
+                }
+            };
+            unlink(&self.faces[t], t, &mut edges);
+            unlink(&self.faces[n], n, &mut edges);
+            alive[t] = false;
+            if d == m {
+                // the same flat triangle turned over: the two close each other
+                alive[n] = false;
+                continue;
+            }
+            let (line, group) = (self.faces[n].line, self.faces[n].group);
+            self.faces[n].vertices = vec![q, m, d];
+            self.faces.push(Face {
+                vertices: vec![m, p, d],
+                line,
+                group,
+            });
+            alive.push(true);
+            for j in [n, self.faces.len() - 1] {
+                for e in ring(&self.faces[j]) {
+                    edges.entry(e).and_modify(|x| *x = SHARED).or_insert(j);
+                }
+                if flat(&self.faces[j]) {
+                    queue.push(j);
+                }
+            }
+        }
+        let mut alive = alive.into_iter();
+        self.faces.retain(|_| alive.next().unwrap_or(true));
+        let left = self.faces.iter().filter(|f| flat(f)).count();
+        FlatFix {
+            removed: at_start.saturating_sub(left),
+            left,
+        }
+    }
+
     /// `true` if every directed edge `a → b` of every face appears exactly
     /// once and its reverse `b → a` exactly once: the faces (compared by
     /// vertex index, so weld first) bound closed, consistently oriented
@@ -573,6 +786,117 @@ mod tests {
                 .collect(),
             groups: vec!["default".into()],
         }
+    }
+
+    fn faces(list: &[[u32; 3]]) -> Vec<Face> {
+        list.iter()
+            .map(|v| Face {
+                vertices: v.to_vec(),
+                line: 0,
+                group: 0,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn flat_triangles_are_split_away_and_the_surface_stays_closed() {
+        // a tetrahedron three units large whose edge 0-1 carries the points
+        // 4 and 5, the notch filled by two flat triangles in a fan: fixing
+        // one makes others flat before the face across 0-1 takes them
+        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        let positions = vec![
+            p(0.0, 0.0, 0.0),
+            p(3.0, 0.0, 0.0),
+            p(0.0, 3.0, 0.0),
+            p(0.0, 0.0, 3.0),
+            p(1.0, 0.0, 0.0),
+            p(2.0, 0.0, 0.0),
+        ];
+        let solid = [
+            [0, 4, 3],
+            [4, 5, 3],
+            [5, 1, 3],
+            [1, 0, 2],
+            [1, 2, 3],
+            [0, 3, 2],
+        ];
+        for notch in [
+            [[1, 5, 4], [1, 4, 0]],
+            [[1, 4, 0], [1, 5, 4]],
+            [[0, 1, 5], [5, 4, 0]],
+        ] {
+            let mut m = Mesh {
+                positions: positions.clone(),
+                faces: faces(&[&solid[..], &notch[..]].concat()),
+                groups: vec!["default".into()],
+            };
+            assert!(m.is_closed_oriented(), "{notch:?}");
+            assert_eq!(m.flat_triangles(|p| p), 2);
+            let fix = m.split_flat_triangles();
+            assert_eq!(
+                fix,
+                FlatFix {
+                    removed: 2,
+                    left: 0
+                },
+                "{notch:?}"
+            );
+            assert!(m.is_closed_oriented(), "{notch:?}");
+            assert_eq!(m.flat_triangles(|p| p), 0);
+            assert_eq!(m.signed_volume(), 27.0 / 6.0);
+        }
+    }
+
+    #[test]
+    fn a_flat_pair_turned_over_goes_and_an_open_one_stays() {
+        let mut m = tetra();
+        m.positions
+            .extend([DVec3::new(5.0, 0.0, 0.0), DVec3::new(7.0, 1.0, 0.0)]);
+        m.positions.push(DVec3::new(6.0, 0.5, 0.0));
+        m.faces.extend(faces(&[[4, 5, 6], [5, 4, 6]]));
+        assert!(m.is_closed_oriented());
+        assert_eq!(
+            m.split_flat_triangles(),
+            FlatFix {
+                removed: 2,
+                left: 0
+            }
+        );
+        assert_eq!(m.faces.len(), 4);
+        assert!(m.is_closed_oriented());
+        // alone, a flat triangle has no face across its long edge
+        let mut open = tetra();
+        open.positions
+            .extend([DVec3::new(5.0, 0.0, 0.0), DVec3::new(7.0, 1.0, 0.0)]);
+        open.positions.push(DVec3::new(6.0, 0.5, 0.0));
+        open.faces.extend(faces(&[[4, 5, 6]]));
+        assert_eq!(
+            open.split_flat_triangles(),
+            FlatFix {
+                removed: 0,
+                left: 1
+            }
+        );
+        assert_eq!(open.faces.len(), 5);
+    }
+
+    #[test]
+    fn collinearity_is_exact() {
+        let a = DVec3::new(0.1, 0.2, 0.3);
+        let b = DVec3::new(0.7, 1.4, 2.1);
+        // the midpoint rounded: on the line only if it rounds onto it
+        assert!(collinear(DVec3::ZERO, a, a * 2.0));
+        assert!(!collinear(
+            DVec3::ZERO,
+            a,
+            DVec3::new(0.2, 0.4, 0.6000000000000001)
+        ));
+        assert!(!collinear(
+            a,
+            b,
+            (a + b) * 0.5 + DVec3::new(0.0, 0.0, 1e-300)
+        ));
+        assert!(collinear(DVec3::X, DVec3::X * 2.0, DVec3::X * -1e300));
     }
 
     #[test]

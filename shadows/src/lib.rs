@@ -30,7 +30,7 @@ use svbsp::export::{ExportError, FragmentFile, FragmentFormat, area_records, wor
 use svbsp::{Batch, LightError, PlacedLight, ShadeOptions, ShadowError};
 
 pub use glam::DVec3;
-pub use shadow_scene::{Face, Mesh};
+pub use shadow_scene::{Face, Mesh, MeshView};
 /// A point light at a position, or a sun in a direction (from the scene
 /// toward it), in the mesh's units.
 pub use svbsp::LightSpec as Light;
@@ -86,9 +86,19 @@ pub fn read_mesh(path: impl AsRef<Path>) -> Result<Mesh, Error> {
 }
 
 /// Writes `mesh` as OBJ or STL (by the extension), through a temporary
-/// file renamed into place when complete.
+/// file renamed into place when complete. For STL the positions are
+/// rounded to `f32` first and what that does to a closed surface is
+/// mended ([`Mesh::round_positions`]): vertices made equal are welded,
+/// the faces that collapse left out, triangles made flat split away.
 pub fn write_mesh(path: impl AsRef<Path>, mesh: &Mesh) -> Result<(), Error> {
-    shadow_scene::save(path.as_ref(), mesh).map_err(Error::File)
+    let path = path.as_ref();
+    let format = shadow_scene::MeshFormat::from_path(path).map_err(Error::File)?;
+    if format == shadow_scene::MeshFormat::Stl {
+        let mut rounded = mesh.clone();
+        rounded.round_positions(shadow_scene::to_f32);
+        return shadow_scene::save(path, &rounded).map_err(Error::File);
+    }
+    shadow_scene::save(path, mesh).map_err(Error::File)
 }
 
 /// `mesh` moved by `by`.
