@@ -8,6 +8,8 @@
 //! The modules live in `suite/` rather than next to this file because
 //! Cargo would build every `tests/*.rs` as a test binary of its own.
 
+#[path = "suite/fuzzcase.rs"]
+mod fuzzcase;
 #[path = "suite/harness.rs"]
 mod harness;
 #[path = "suite/meshes.rs"]
@@ -16,5 +18,7 @@ mod meshes;
 mod oracle;
 #[path = "suite/random.rs"]
 mod random;
+#[path = "suite/scenes.rs"]
+mod scenes;
 #[path = "suite/special.rs"]
 mod special;

@@ -1,0 +1,146 @@
+//! The `pipeline` fuzz target's case, shared with the tests (the target
+//! includes this file and `scratch.rs` by path): bytes decoded into a
+//! ground with blocks, a moving object (a tetrahedron, or two tetrahedra
+//! touching along an edge whose faces through it cross, which the
+//! culling certificate must refuse), lights and a motion; every frame
+//! must give every face exactly the lit area per set of flags that the
+//! answer from scratch gives ([`crate::scratch::check_motion`]).
+//! `cargo test` replays the corpus in `fuzz/corpus/pipeline`.
+
+use glam::DVec3;
+use svbsp::LightSpec;
+use tiling::{Motion, Strategy};
+
+use crate::scratch::{check_motion, tetra};
+
+/// The bytes, read one at a time; zeros once they run out.
+struct Reader<'a>(&'a [u8]);
+
+impl Reader<'_> {
+    fn byte(&mut self) -> u8 {
+        match self.0.split_first() {
+            Some((&b, rest)) => {
+                self.0 = rest;
+                b
+            }
+            None => 0,
+        }
+    }
+
+    /// A number in `lo..=hi` in 256 steps.
+    fn num(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * f64::from(self.byte()) / 255.0
+    }
+
+    fn vec(&mut self, lo: f64, hi: f64) -> DVec3 {
+        DVec3::new(self.num(lo, hi), self.num(lo, hi), self.num(lo, hi))
+    }
+}
+
+/// Two tetrahedra touching along `ab`, their faces through `ab` merged
+/// into two quads that cross along it (the certificate's counterexample),
+/// scaled by `s` and moved to `at`.
+fn crossing(at: DVec3, s: f64) -> Vec<Vec<DVec3>> {
+    let p = |x: f64, y: f64, z: f64| at + DVec3::new(x, y, z) * s;
+    let (a, b) = (p(0.0, 0.0, 0.0), p(0.0, 0.0, 6.0));
+    let g = [
+        p(-2.0, -1.0, 3.0),
+        p(-2.0, 1.0, 3.0),
+        p(4.0, -2.0, 3.0),
+        p(4.0, 2.0, 3.0),
+    ];
+    vec![
+        vec![a, g[1], g[0]],
+        vec![b, g[0], g[1]],
+        vec![a, g[2], b, g[1]],
+        vec![a, g[3], g[2]],
+        vec![b, g[2], g[3]],
+        vec![a, g[0], b, g[3]],
+    ]
+}
+
+/// Decodes a scene, its lights and a motion from `data` and checks every
+/// frame against the answer from scratch (panicking on a difference).
+pub(crate) fn pipeline_case(data: &[u8]) {
+    let mut b = Reader(data);
+    let mut statics = vec![vec![
+        DVec3::new(-6.0, -6.0, 0.0),
+        DVec3::new(6.0, -6.0, 0.0),
+        DVec3::new(6.0, 6.0, 0.0),
+        DVec3::new(-6.0, 6.0, 0.0),
+    ]];
+    for _ in 0..1 + b.byte() % 4 {
+        let lo = b.vec(-4.0, 4.0) * DVec3::new(1.0, 1.0, 0.0) + DVec3::Z * b.num(0.0, 2.0);
+        statics.extend(bsp_fixtures::cuboid(lo, lo + b.vec(0.2, 1.5)));
+    }
+    let at = b.vec(-2.0, 2.0) * DVec3::new(1.0, 1.0, 0.0) + DVec3::Z * b.num(0.3, 2.3);
+    let object = match b.byte() % 3 {
+        0 => crossing(at, b.num(0.1, 0.4)),
+        _ => tetra(at, 0.7),
+    };
+    let light = b.vec(-3.0, 3.0) * DVec3::new(1.0, 1.0, 0.0) + DVec3::Z * b.num(4.0, 7.0);
+    let mut lights = vec![LightSpec::Point(light)];
+    if b.byte() % 2 == 1 {
+        lights.push(LightSpec::Sun(DVec3::new(0.4, -0.3, 1.0)));
+    }
+    let motion = Motion {
+        axis: b.vec(-1.0, 1.0) + DVec3::Z * 1e-3,
+        degrees: b.num(-90.0, 90.0),
+        centre: DVec3::new(at.x, at.y, 1.0),
+        step: b.vec(-0.8, 0.8) * DVec3::new(1.0, 1.0, 0.3),
+    };
+    let strategy = match b.byte() % 2 {
+        0 => Strategy::Fast,
+        _ => Strategy::Paper,
+    };
+    let tiles = [None, Some(1), Some(3), Some(17)][usize::from(b.byte() % 4)];
+    check_motion(&statics, &object, &lights, &motion, 3, strategy, tiles);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn corpus() -> std::path::PathBuf {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/pipeline")
+    }
+
+    /// Deterministic bytes for the seed files.
+    fn seeds() -> Vec<Vec<u8>> {
+        let mut s = 0x0b1e_c7ed_5eed_0001u64;
+        (0..12)
+            .map(|_| {
+                (0..40)
+                    .map(|_| {
+                        s ^= s << 13;
+                        s ^= s >> 7;
+                        s ^= s << 17;
+                        (s >> 24) as u8
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Rewrites `fuzz/corpus/pipeline/seed-*`:
+    /// `cargo test -p tiling --release --test lib write_pipeline_seeds -- --ignored`.
+    #[test]
+    #[ignore = "writes fuzz/corpus/pipeline; run by hand after changing the decoder"]
+    fn write_pipeline_seeds() {
+        std::fs::create_dir_all(corpus()).unwrap();
+        for (i, bytes) in seeds().iter().enumerate() {
+            std::fs::write(corpus().join(format!("seed-{i:02}")), bytes).unwrap();
+        }
+    }
+
+    /// Every file of the corpus (the seeds and what fuzzing kept) passes.
+    #[test]
+    fn the_pipeline_corpus_replays() {
+        let mut files = 0;
+        for e in std::fs::read_dir(corpus()).unwrap() {
+            pipeline_case(&std::fs::read(e.unwrap().path()).unwrap());
+            files += 1;
+        }
+        assert!(files >= seeds().len(), "{files} files");
+    }
+}
