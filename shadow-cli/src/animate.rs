@@ -16,22 +16,22 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
-use bsp_core::{BspTree, BuildOptions, Grid};
+use bsp_core::Grid;
+use bsp_shadows::frames;
 use clap::{Args, ValueEnum};
 use glam::{DMat4, DVec3};
 use rayon::prelude::*;
-use shadow_raster::svg::{SvgFragment, SvgView, SvgViewpoint};
+use shadow_raster::svg::SvgViewpoint;
 use shadow_scene::{Mesh, Staging};
-use svbsp::export::{FragmentFile, FragmentFormat, world_vertices};
 use svbsp::{Light, LightSpec, PlacedLight};
 use tiling::{Dynamic, FrameStats, FrameTally, Motion, PipelineOptions, Strategy};
 
 use crate::args::{CameraArgs, ImageArgs, LightArgs, parse_vec3};
+use crate::facade_error;
 use crate::input::{NO_LIGHT, load_mesh};
-use crate::lights::{fmt_input, place_lights, shared_grid};
+use crate::lights::{place_lights, shared_grid};
 use crate::output::{Output, emit};
 use crate::progress::Progress;
-use crate::raster_error;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub(crate) enum FrameFormat {
@@ -403,7 +403,8 @@ impl<'a> FrameFiles<'a> {
         mut report: Option<Output>,
     ) -> Result<FrameFiles<'a>> {
         let view = has_view(args).then(|| frame_view(args, setup));
-        let colors = shadow_scene::face_colors(&frame_mesh(setup, d, &DMat4::IDENTITY));
+        let still = frames::frame_mesh(d, &setup.statics, &setup.moving, &DMat4::IDENTITY);
+        let colors = shadow_scene::face_colors(&still);
         if let Some(o) = &mut report {
             writeln!(o, "{}", FrameStats::CSV_HEADER)?;
         }
@@ -428,14 +429,15 @@ impl<'a> FrameFiles<'a> {
         }
         let stem = args.output.join(format!("frame_{k:04}"));
         if args.export_scene || args.format == FrameFormat::Svg {
-            let scene = frame_mesh(self.setup, d, m);
+            let scene = frames::frame_mesh(d, &self.setup.statics, &self.setup.moving, m);
             if args.export_scene {
                 write_file(&stem.with_extension("obj"), |o| {
-                    write_scene(o, &scene, d, k, lights)
+                    Ok(frames::write_frame_obj(o, d, &scene, k, lights)?)
                 })?;
             }
             if let Some(view) = &self.view {
-                let svg = frame_svg(d, frame, &scene, lights, view)?;
+                let svg =
+                    frames::frame_svg((d, frame), &scene, lights, view).map_err(facade_error)?;
                 write_file(&stem.with_extension("svg"), |o| {
                     Ok(o.write_all(svg.as_bytes())?)
                 })?;
@@ -443,12 +445,14 @@ impl<'a> FrameFiles<'a> {
         }
         match (args.format, &self.view) {
             (FrameFormat::Png, Some(view)) => {
-                let png = frame_png(&mut self.renderer, d, frame, &self.colors, lights, view)?;
+                let png =
+                    frames::frame_png(&mut self.renderer, (d, frame), &self.colors, lights, view)
+                        .map_err(facade_error)?;
                 write_file(&stem.with_extension("png"), |o| Ok(o.write_all(&png)?))?;
             }
             (FrameFormat::Json, _) => {
                 write_file(&stem.with_extension("json"), |o| {
-                    frame_json(o, d, frame, lights)
+                    Ok(frames::write_frame_json(o, d, frame, lights)?)
                 })?;
             }
             _ => {}
@@ -476,107 +480,6 @@ fn write_file(path: &Path, f: impl FnOnce(&mut Output) -> Result<()>) -> Result<
 fn frame_view(args: &AnimateArgs, s: &Setup) -> SvgViewpoint {
     let image = (args.image.size(), args.image.fov);
     args.camera.pick(&s.statics, s.staging, image, args.quiet)
-}
-
-/// The frame's whole scene in input units, faces numbered as the frame's
-/// fragments are (static first, then the moved object): every vertex is
-/// the frame's grid point mapped back to input units, so the file is
-/// exactly the scene the frame's shadows were computed for.
-fn frame_mesh(s: &Setup, d: &Dynamic, m: &DMat4) -> Mesh {
-    let grid = d.grid();
-    let snap = |p: DVec3| {
-        grid.snap(p)
-            .map(|g| grid.to_world(g.map(f64::from)))
-            .unwrap_or(p)
-    };
-    let mut mesh = Mesh {
-        positions: s.statics.positions.iter().map(|&p| snap(p)).collect(),
-        faces: s.statics.faces.clone(),
-        groups: s.statics.groups.clone(),
-    };
-    mesh.append(&s.moving, "moving_", |p| snap(m.transform_point3(p)));
-    mesh
-}
-
-fn write_scene(
-    out: &mut impl Write,
-    mesh: &Mesh,
-    d: &Dynamic,
-    k: u32,
-    lights: &[PlacedLight],
-) -> Result<()> {
-    writeln!(
-        out,
-        "# shadow animate: frame {k}, {} static faces then {} moving ones; vertices are the \
-         frame's grid points",
-        d.static_faces(),
-        mesh.faces.len() - d.static_faces()
-    )?;
-    for (i, l) in lights.iter().enumerate() {
-        let kind = match l.light {
-            Light::Point(_) => "point light at",
-            Light::Directional(_) => "sun toward",
-        };
-        writeln!(out, "# light {i}: {kind} {}", fmt_input(l.world))?;
-    }
-    shadow_scene::write_obj(mesh, out)?;
-    Ok(())
-}
-
-/// The frame's fragments as a JSON document.
-fn frame_json(
-    out: &mut impl Write,
-    d: &Dynamic,
-    frame: &tiling::Frame,
-    lights: &[PlacedLight],
-) -> Result<()> {
-    let batch = d.fragments(frame);
-    FragmentFile::of_batch(
-        out,
-        FragmentFormat::Json,
-        lights,
-        d.faces(),
-        (&batch, d.grid()),
-    )?;
-    Ok(())
-}
-
-/// Rasterizes the frame's exact fragments to a PNG (`shadow-raster`).
-fn frame_png(
-    renderer: &mut shadow_raster::Renderer,
-    d: &Dynamic,
-    frame: &tiling::Frame,
-    colors: &[DVec3],
-    lights: &[PlacedLight],
-    view: &SvgViewpoint,
-) -> Result<Vec<u8>> {
-    let scene = shadow_raster::RasterScene::new(d.grid(), d.frame_polygons(frame))?;
-    let camera = view.camera(d.static_bounds()).map_err(raster_error)?;
-    let batch = d.fragments(frame);
-    let out = renderer.render_fragments(&scene, &batch, lights, &camera, colors)?;
-    Ok(out.image.encode_png())
-}
-
-/// Draws the frame: a BSP tree of the frame's polygons gives the painter's
-/// order, and each face's fragments are cut to the tree's pieces of the
-/// face.
-fn frame_svg(
-    d: &Dynamic,
-    frame: &tiling::Frame,
-    scene: &Mesh,
-    lights: &[PlacedLight],
-    at: &SvgViewpoint,
-) -> Result<String> {
-    let grid = d.grid();
-    let tree = BspTree::build(d.frame_polygons(frame), &BuildOptions::default());
-    let batch = d.fragments(frame);
-    let world = world_vertices(&batch, grid)?;
-    let faces = d.faces();
-    let frags = SvgFragment::of_faces_in_tree(&tree, grid, &batch, &world, faces);
-    let what = "shadow animate";
-    let r = SvgView::mesh_fragments(grid, scene, at, &tree, lights, &frags, what)
-        .map_err(raster_error)?;
-    Ok(r.svg)
 }
 
 #[cfg(test)]

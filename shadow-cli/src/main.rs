@@ -119,6 +119,15 @@ pub(crate) fn raster_error(e: RasterError) -> anyhow::Error {
     }
 }
 
+/// A facade error worded for the command line: a picture's error as
+/// [`raster_error`] words it.
+pub(crate) fn facade_error(e: bsp_shadows::Error) -> anyhow::Error {
+    match e {
+        bsp_shadows::Error::Raster(e) => raster_error(e),
+        e => anyhow!(e),
+    }
+}
+
 /// Runs the command, on `threads` worker threads if given.
 fn run(cli: &Cli) -> Result<()> {
     if let Some(n) = cli.threads {

@@ -21,6 +21,8 @@
 //! parts of a face a light reaches. The results are rounded once to
 //! `f64`.
 
+pub mod frames;
+
 use std::path::Path;
 
 use bsp_core::BoolOp;
@@ -52,6 +54,9 @@ pub enum Error {
     Shadow(ShadowError),
     /// A fragment's vertex leaves `f64` in the mesh's units.
     Export(ExportError),
+    /// A picture cannot be drawn (no faces, or a camera that cannot be
+    /// set up).
+    Raster(shadow_raster::RasterError),
 }
 
 impl std::fmt::Display for Error {
@@ -63,6 +68,7 @@ impl std::fmt::Display for Error {
             Error::Import(e) => write!(f, "cannot import the faces: {e}"),
             Error::Shadow(e) => e.fmt(f),
             Error::Export(e) => e.fmt(f),
+            Error::Raster(e) => e.fmt(f),
         }
     }
 }
@@ -76,6 +82,7 @@ impl std::error::Error for Error {
             Error::Import(e) => e,
             Error::Shadow(e) => e,
             Error::Export(e) => e,
+            Error::Raster(e) => e,
         })
     }
 }
