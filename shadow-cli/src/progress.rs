@@ -54,6 +54,15 @@ impl Progress {
     }
 }
 
+impl bsp_shadows::shadow_file::Progress for Progress {
+    fn phase(&self, name: &'static str, steps: u64) {
+        Progress::phase(self, name, steps);
+    }
+    fn advance(&self, steps: u64) {
+        self.inc(steps);
+    }
+}
+
 impl Drop for Progress {
     fn drop(&mut self) {
         self.bar.finish_and_clear();

@@ -13,25 +13,20 @@
 //! those vertices.
 
 use std::fmt::Write as _;
-use std::io::Write;
-use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, bail};
-use bsp_core::{BspTree, BuildOptions, Polygon};
+use anyhow::{Result, bail};
+use bsp_shadows::shadow_file::{self, FileKind, LitScene, ShadowFile, write_shadows};
 use clap::{Args, ValueEnum};
-use glam::DVec3;
-use shadow_raster::svg::{SvgFragment, SvgView, SvgViewpoint};
-use svbsp::export::{FragmentFile, FragmentFormat, area_records, world_vertices};
-use svbsp::{Areas, Batch, LightSpec, ShadeOptions, Shadows, chin_feiner, percent, receivers};
+use svbsp::{LightSpec, percent};
 
 use crate::args::{CameraArgs, ImageArgs, LightArgs, SourceArgs};
+use crate::facade_error;
 use crate::input::{NO_LIGHT, Scene};
 use crate::lights::describe;
 use crate::output::{Output, Phases, emit, guarded};
 use crate::progress::Progress;
-use crate::raster_error;
 
 /// Which algorithm computes the shadows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -100,16 +95,6 @@ impl Format {
     }
 }
 
-/// What a run reports.
-#[derive(Default)]
-struct Figures {
-    fragments: usize,
-    receivers: usize,
-    shadow_nodes: usize,
-    bsp_polygons: Option<usize>,
-    extra: String,
-}
-
 // ------------------------------------------------------------- command
 
 /// What the command line asks for, checked before any work is done.
@@ -161,43 +146,73 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
             .pick(&scene.mesh, scene.staging, image, args.quiet)
     });
     let mut out = Output::create(&args.output)?;
-    let mut job = Job {
-        args,
-        format: request.format,
-        scene: &scene,
-        kernel: scene.lights.iter().map(|l| l.light).collect(),
-        progress: &progress,
-        phases,
-        areas: Areas::new(scene.lights.len(), scene.mesh.faces.len()),
-        fig: Figures::default(),
+    let kind = match (request.format, &view) {
+        (Format::Svg, Some(v)) => FileKind::Svg(v),
+        (Format::Obj, _) => FileKind::Obj,
+        _ => FileKind::Json,
     };
-    guarded("the input and the command line", || {
-        job.run(view.as_ref(), &mut out)
+    let algorithm = match args.algorithm {
+        Algorithm::Psv => shadow_file::Algorithm::Psv,
+        Algorithm::ChinFeiner => shadow_file::Algorithm::ChinFeiner,
+    };
+    let notes: Vec<String> = scene.lights.iter().map(describe).collect();
+    let lit = LitScene {
+        name: &scene.name,
+        mesh: &scene.mesh,
+        grid: &scene.grid,
+        lights: &scene.lights,
+        light_notes: &notes,
+        polys: &scene.polys,
+    };
+    let fig = guarded("the input and the command line", || {
+        write_shadows(&lit, algorithm, kind, &mut out, &progress).map_err(|e| match e {
+            bsp_shadows::Error::Io(_)
+            | bsp_shadows::Error::Export(_)
+            | bsp_shadows::Error::Raster(_) => {
+                facade_error(e).context(format!("could not write {}", args.output.display()))
+            }
+            e => facade_error(e),
+        })
     })?;
     out.commit()?;
     progress.finish();
     let total = total.elapsed();
+    phases.0.extend(fig.phases.iter().copied());
+    if fig.degenerate > 0 && !args.quiet {
+        eprintln!(
+            "warning: {} fragment piece(s) have distinct exact vertices that coincide once \
+             rounded to f64 input units; they are degenerate in the file",
+            fig.degenerate
+        );
+    }
 
-    let areas = &job.areas;
+    let areas = &fig.areas;
     let lit_share = percent(areas.total - areas.dark, areas.total);
     // the SVG's fragments are pieces of the scene tree's polygons, the
     // files' pieces of the faces: say which
-    let of = match job.fig.bsp_polygons {
+    let of = match fig.bsp_polygons {
         Some(n) => format!(
             "the scene tree's {n} polygons ({} faces)",
             scene.mesh.faces.len()
         ),
         None => format!("{} faces", scene.mesh.faces.len()),
     };
+    let extra = match (fig.vertices, fig.drawn) {
+        (_, Some((drawn, eye))) => format!(
+            ", {drawn} drawn, eye {:.3},{:.3},{:.3}",
+            eye.x, eye.y, eye.z
+        ),
+        (Some(v), None) => format!(", {v} vertices"),
+        (None, None) => String::new(),
+    };
     let mut report = format!(
-        "wrote {}: {} fragments of {of} of {}{}; {}, {lit_share:.1}% of the area lit\n",
+        "wrote {}: {} fragments of {of} of {}{extra}; {}, {lit_share:.1}% of the area lit\n",
         args.output.display(),
-        job.fig.fragments,
+        fig.fragments,
         scene.name,
-        job.fig.extra,
         scene.light_count(),
     );
-    if job.fig.fragments == 0 {
+    if fig.fragments == 0 {
         note(
             args,
             "note: no face has an area on the grid, so nothing was shaded (are the faces \
@@ -210,206 +225,13 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
         );
     }
     if args.stats {
-        report += &stats_text(&scene, &job.fig, areas, &job.phases, total);
+        report += &stats_text(&scene, &fig, &phases, total);
     }
     emit(&report)
 }
 
-/// One run's shading and writing, and what it counts.
-struct Job<'a> {
-    args: &'a ShadowsArgs,
-    format: Format,
-    scene: &'a Scene,
-    kernel: Vec<svbsp::Light>,
-    progress: &'a Progress,
-    phases: Phases,
-    areas: Areas,
-    fig: Figures,
-}
-
-impl Job<'_> {
-    /// Shades every face (or for the SVG every polygon of the scene's
-    /// BSP) and writes the file.
-    fn run(&mut self, view: Option<&SvgViewpoint>, out: &mut Output) -> Result<()> {
-        let write_err = || format!("could not write {}", self.args.output.display());
-        let (batch, tree) = match (self.args.algorithm, self.format) {
-            (Algorithm::Psv, Format::Json | Format::Obj) => {
-                let shadows = self.shadow_trees()?;
-                return self.stream(&shadows, out).with_context(write_err);
-            }
-            (Algorithm::Psv, Format::Svg) => {
-                let tree = self.scene_tree();
-                let shadows = self.shadow_trees()?;
-                (self.shade_each(&shadows, &tree), tree)
-            }
-            (Algorithm::ChinFeiner, _) => {
-                let tree = self.scene_tree();
-                self.fig.receivers = tree.polygons().count();
-                self.progress.phase("Chin & Feiner", 1);
-                let cf = self
-                    .phases
-                    .run("shadows", || chin_feiner(&tree, &self.kernel))?;
-                self.fig.shadow_nodes = cf.shadow_nodes;
-                (Batch::from_chin_feiner(&cf, &self.kernel), tree)
-            }
-        };
-        self.progress.phase("writing", 1);
-        let world = world_vertices(&batch, &self.scene.grid)?;
-        let records = area_records(&batch, &world);
-        self.fig.fragments = batch.len();
-        let mut phases = std::mem::take(&mut self.phases);
-        phases
-            .run("write", || match (self.format, view) {
-                (Format::Svg, Some(view)) => self.write_svg(out, &tree, view, &batch, &world),
-                _ => {
-                    let mut file = self.begin(out)?;
-                    file.write(out, (&batch, &world, &records), None)?;
-                    self.finish(file, out)
-                }
-            })
-            .with_context(write_err)?;
-        self.phases = phases;
-        Ok(())
-    }
-
-    /// One shadow-volume tree per light.
-    fn shadow_trees(&mut self) -> Result<Shadows> {
-        self.progress
-            .phase("shadow trees", self.kernel.len() as u64);
-        let shadows = self
-            .phases
-            .run("trees", || Shadows::new(&self.scene.polys, &self.kernel))?;
-        self.fig.shadow_nodes = shadows.volumes().iter().map(|v| v.node_count()).sum();
-        Ok(shadows)
-    }
-
-    /// The scene's BSP tree (the SVG's painter's order, and the polygons
-    /// Chin & Feiner shade).
-    fn scene_tree(&mut self) -> BspTree {
-        self.progress.phase("scene tree", 1);
-        let polys = &self.scene.polys;
-        let tree = self.phases.run("bsp", || {
-            BspTree::build(polys.clone(), &BuildOptions::default())
-        });
-        self.fig.bsp_polygons = Some(tree.polygons().count());
-        tree
-    }
-
-    /// Every polygon of `tree` shaded as its own receiver (receiver =
-    /// polygon index), in parallel.
-    fn shade_each(&mut self, shadows: &Shadows, tree: &BspTree) -> Batch {
-        let polys: Vec<Polygon> = tree.polygons().cloned().collect();
-        self.fig.receivers = polys.len();
-        self.progress.phase("shading", polys.len() as u64);
-        let progress = self.progress;
-        let ranges: Vec<Range<usize>> = (0..polys.len()).map(|i| i..i + 1).collect();
-        self.phases.run("shading", || {
-            let opts = ShadeOptions::default();
-            shadows
-                .set()
-                .shade_par(&polys, &ranges, &opts, |n| progress.inc(n as u64))
-        })
-    }
-
-    /// Starts the JSON or OBJ file.
-    fn begin(&self, out: &mut Output) -> Result<FragmentFile> {
-        let format = match self.format {
-            Format::Json => FragmentFormat::Json,
-            _ => FragmentFormat::Obj,
-        };
-        let scene = self.scene;
-        let notes: Vec<String> = scene.lights.iter().map(describe).collect();
-        let faces = scene.mesh.faces.len();
-        let head = (scene.name.as_str(), &notes[..]);
-        Ok(FragmentFile::begin(
-            out,
-            format,
-            &scene.lights,
-            faces,
-            head,
-        )?)
-    }
-
-    /// Ends the JSON or OBJ file, keeps its areas, notes the OBJ's vertex
-    /// count and warns of pieces degenerate once rounded.
-    fn finish(&mut self, file: FragmentFile, out: &mut Output) -> Result<()> {
-        let w = file.finish(out)?;
-        self.areas = w.areas;
-        if self.format == Format::Obj {
-            self.fig.extra = format!(", {} vertices", w.vertices);
-        }
-        if w.degenerate > 0 && !self.args.quiet {
-            eprintln!(
-                "warning: {} fragment piece(s) have distinct exact vertices that coincide once \
-                 rounded to f64 input units; they are degenerate in the file",
-                w.degenerate
-            );
-        }
-        Ok(())
-    }
-
-    /// Draws the fragments of the scene tree's polygons.
-    fn write_svg(
-        &mut self,
-        out: &mut Output,
-        tree: &BspTree,
-        view: &SvgViewpoint,
-        batch: &Batch,
-        world: &[DVec3],
-    ) -> Result<()> {
-        for r in area_records(batch, world) {
-            self.areas.add(r.face, r.area, r.lit, r.facing);
-        }
-        let frags = SvgFragment::of_batch(batch, world);
-        let (scene, what) = (self.scene, "shadow shadows");
-        let r = SvgView::mesh_fragments(
-            &scene.grid,
-            &scene.mesh,
-            view,
-            tree,
-            &scene.lights,
-            &frags,
-            what,
-        )
-        .map_err(raster_error)?;
-        out.write_all(r.svg.as_bytes())?;
-        self.fig.extra = format!(
-            ", {} drawn, eye {:.3},{:.3},{:.3}",
-            r.drawn, r.eye.x, r.eye.y, r.eye.z
-        );
-        Ok(())
-    }
-
-    /// Shades the receivers and writes them as they are done
-    /// ([`FragmentFile::stream`]).
-    fn stream(&mut self, shadows: &Shadows, out: &mut Output) -> Result<()> {
-        let scene = self.scene;
-        let opts = ShadeOptions::default().with_pieces(self.format == Format::Obj);
-        let mut file = self.begin(out)?;
-        let progress = self.progress;
-        let ranges = receivers(&scene.polys);
-        progress.phase("shading", ranges.len() as u64);
-        let polys = (&scene.polys[..], &ranges[..], &scene.grid);
-        let s = file.stream(out, shadows.set(), polys, &opts, |n| {
-            progress.inc(n as u64);
-        })?;
-        self.fig.receivers = s.receivers;
-        self.fig.fragments = s.fragments;
-        self.finish(file, out)?;
-        self.phases.0.push(("shading", s.shading));
-        self.phases.0.push(("write", s.writing));
-        Ok(())
-    }
-}
-
 /// The `--stats` report.
-fn stats_text(
-    scene: &Scene,
-    fig: &Figures,
-    areas: &Areas,
-    phases: &Phases,
-    total: Duration,
-) -> String {
+fn stats_text(scene: &Scene, fig: &ShadowFile, phases: &Phases, total: Duration) -> String {
     let faces = scene.mesh.faces.len();
     let lights = &scene.lights;
     let mut s = String::new();
@@ -451,13 +273,16 @@ fn stats_text(
         total.as_secs_f64() * 1e3,
         rayon::current_num_threads()
     );
-    s += &areas.report(TOP_FACES, |f| scene.mesh.group_name(f).to_string());
+    s += &fig
+        .areas
+        .report(TOP_FACES, |f| scene.mesh.group_name(f).to_string());
     s
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::DVec3;
     use shadow_scene::{ROOM_EYE, ROOM_TARGET};
 
     #[test]

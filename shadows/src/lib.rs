@@ -22,6 +22,7 @@
 //! `f64`.
 
 pub mod frames;
+pub mod shadow_file;
 
 use std::path::Path;
 
@@ -57,6 +58,8 @@ pub enum Error {
     /// A picture cannot be drawn (no faces, or a camera that cannot be
     /// set up).
     Raster(shadow_raster::RasterError),
+    /// An output could not be written.
+    Io(std::io::Error),
 }
 
 impl std::fmt::Display for Error {
@@ -69,6 +72,7 @@ impl std::fmt::Display for Error {
             Error::Shadow(e) => e.fmt(f),
             Error::Export(e) => e.fmt(f),
             Error::Raster(e) => e.fmt(f),
+            Error::Io(e) => e.fmt(f),
         }
     }
 }
@@ -83,6 +87,7 @@ impl std::error::Error for Error {
             Error::Shadow(e) => e,
             Error::Export(e) => e,
             Error::Raster(e) => e,
+            Error::Io(e) => e,
         })
     }
 }

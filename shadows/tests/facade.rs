@@ -133,3 +133,75 @@ fn errors_keep_their_causes() {
     let e = bsp_shadows::shadows(&sphere(), &[Light::Sun(DVec3::ZERO)]).unwrap_err();
     assert!(matches!(e, Error::Light(_)), "{e}");
 }
+
+/// Counts the phases and steps a job reports.
+#[derive(Default)]
+struct Heard {
+    phases: std::sync::Mutex<Vec<&'static str>>,
+    steps: std::sync::atomic::AtomicU64,
+}
+
+impl bsp_shadows::shadow_file::Progress for Heard {
+    fn phase(&self, name: &'static str, _: u64) {
+        self.phases.lock().unwrap().push(name);
+    }
+    fn advance(&self, steps: u64) {
+        self.steps
+            .fetch_add(steps, std::sync::atomic::Ordering::Relaxed);
+    }
+}
+
+/// The shadow file job: JSON, OBJ and SVG by both algorithms agree on
+/// the lit area, report their phases and steps, and the JSON holds one
+/// record per fragment.
+#[test]
+fn shadow_files_by_both_algorithms_agree() {
+    use bsp_shadows::shadow_file::{Algorithm, FileKind, LitScene, write_shadows};
+    let mesh = shadow_scene::scene("chair").unwrap();
+    let specs = [Light::Point(DVec3::new(1.0, -2.0, 3.0))];
+    let grid = svbsp::shared_grid(&mesh.positions, &specs).unwrap();
+    let lights = svbsp::place_lights(&grid, &specs).unwrap();
+    let (polys, _) = bsp_core::import_faces_par(&grid, &mesh.face_loops()).unwrap();
+    let notes = vec!["a point light".to_string()];
+    let scene = LitScene {
+        name: "chair",
+        mesh: &mesh,
+        grid: &grid,
+        lights: &lights,
+        light_notes: &notes,
+        polys: &polys,
+    };
+    let view = shadow_raster::svg::SvgViewpoint::choose(
+        Default::default(),
+        &mesh.positions,
+        None,
+        (320, 180),
+        50.0,
+    )
+    .0;
+    let mut lit = Vec::new();
+    for algorithm in [Algorithm::Psv, Algorithm::ChinFeiner] {
+        for kind in [FileKind::Json, FileKind::Obj, FileKind::Svg(&view)] {
+            let heard = Heard::default();
+            let mut out = Vec::new();
+            let f = write_shadows(&scene, algorithm, kind, &mut out, &heard).unwrap();
+            assert!(f.fragments > 0 && !out.is_empty());
+            assert!(heard.steps.into_inner() > 0 || algorithm == Algorithm::ChinFeiner);
+            assert!(!heard.phases.into_inner().unwrap().is_empty() && !f.phases.is_empty());
+            assert_eq!(
+                f.bsp_polygons.is_some(),
+                algorithm == Algorithm::ChinFeiner || matches!(kind, FileKind::Svg(_))
+            );
+            assert_eq!(f.drawn.is_some(), matches!(kind, FileKind::Svg(_)));
+            assert_eq!(f.vertices.is_some(), matches!(kind, FileKind::Obj));
+            if matches!(kind, FileKind::Json) {
+                let v: serde_json::Value = serde_json::from_slice(&out).unwrap();
+                assert_eq!(v["fragments"].as_array().unwrap().len(), f.fragments);
+            }
+            lit.push(f.areas.total - f.areas.dark);
+        }
+    }
+    for l in &lit {
+        assert!((l - lit[0]).abs() <= 1e-9 * lit[0], "{lit:?}");
+    }
+}
