@@ -20,6 +20,8 @@
 //! assert_eq!(union.volume(), 2.0 - 0.125);
 //! ```
 
+use std::time::{Duration, Instant};
+
 use bsp_core::{BoolOp, Grid, ImportReport, TopologyError, TriMesh};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -285,6 +287,43 @@ pub struct FileBoolean {
     pub stats: Vec<crate::Stats>,
     /// The operation's name, the result's one group.
     pub group: &'static str,
+    /// The wall time of each kind of stage.
+    pub times: StageTimes,
+}
+
+/// The wall time of each kind of stage of a [`FileBoolean::apply`],
+/// summed over the operands; `None` for a stage that did not run.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StageTimes {
+    /// Snapping the operands to the grid (their solids).
+    pub snap: Option<Duration>,
+    /// The operations.
+    pub operations: Option<Duration>,
+    /// The result's mesh, to its positions in input units.
+    pub mesh: Option<Duration>,
+    /// The stage running, and since when.
+    running: Option<(Stage, Instant)>,
+}
+
+impl StageTimes {
+    /// Stage `stage` starts (the one running, if any, is over).
+    fn start(&mut self, stage: Stage) {
+        self.stop();
+        self.running = Some((stage, Instant::now()));
+    }
+
+    /// The running stage is over: its time is added to its kind's.
+    fn stop(&mut self) {
+        let Some((stage, since)) = self.running.take() else {
+            return;
+        };
+        let kind = match stage {
+            Stage::Snap(_) => &mut self.snap,
+            Stage::Operation(_) => &mut self.operations,
+            Stage::Mesh => &mut self.mesh,
+        };
+        *kind = Some(kind.unwrap_or_default() + since.elapsed());
+    }
 }
 
 impl FileBoolean {
@@ -314,12 +353,16 @@ impl FileBoolean {
         };
         let rest = meshes.map(|m| (op, m));
         let (mut reports, mut stats) = (Vec::new(), Vec::new());
+        let mut times = StageTimes::default();
         let exact = mesh_sequence_with(&grid, first, rest, |step| {
             on_step(&step, &grid);
             match step {
+                Step::Started(stage) => times.start(stage),
+                // (the mesh's stage goes on through the positions below)
+                Step::Finished(Stage::Mesh) => {}
+                Step::Finished(_) => times.stop(),
                 Step::Snapped { report, .. } => reports.push(report),
                 Step::Planned { stats: s, .. } => stats.push(s),
-                _ => {}
             }
         })
         .map_err(|e| sequence_error(e, &names, op, &grid))?;
@@ -328,7 +371,9 @@ impl FileBoolean {
             .into_par_iter()
             .map(|v| grid.to_world(v))
             .collect();
+        times.stop();
         Ok(FileBoolean {
+            times,
             positions,
             exact,
             grid,
@@ -784,6 +829,9 @@ f 4 1 5 8
         );
         // integer vertices: nothing coincides once rounded, even in f32
         assert!(out.rounded(true).is_none() && out.rounded(false).is_none());
+        // every kind of stage ran, and was timed
+        let t = out.times;
+        assert!(t.snap.is_some() && t.operations.is_some() && t.mesh.is_some());
 
         let empty = Operand::new("e.obj", Mesh::default());
         assert_eq!(empty.check().unwrap_err().message, "e.obj: no faces");

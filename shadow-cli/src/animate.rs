@@ -13,7 +13,7 @@
 use std::fmt::Write as _;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow, bail};
 use bsp_core::Grid;
@@ -30,7 +30,7 @@ use crate::args::{CameraArgs, ImageArgs, LightArgs, parse_vec3};
 use crate::facade_error;
 use crate::input::{NO_LIGHT, load_mesh};
 use crate::lights::{place_lights, shared_grid};
-use crate::output::{Output, emit};
+use crate::output::{Output, emit, ms, note};
 use crate::progress::Progress;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -239,13 +239,13 @@ impl Plan {
         };
         if degrees == 0.0 && step == DVec3::ZERO && args.frames > 1 {
             note(
-                args,
+                args.quiet,
                 "note: no motion given (--spin, --step): every frame is the same",
             );
         }
         if !has_view(args) && (args.camera.any() || args.image.any()) {
             note(
-                args,
+                args.quiet,
                 "note: --eye, --target, --up, --size and --fov only apply to SVG and PNG frames",
             );
         }
@@ -294,13 +294,6 @@ fn has_view(args: &AnimateArgs) -> bool {
     matches!(args.format, FrameFormat::Svg | FrameFormat::Png)
 }
 
-/// A note on stderr, unless `--quiet`.
-fn note(args: &AnimateArgs, s: &str) {
-    if !args.quiet {
-        eprintln!("{s}");
-    }
-}
-
 /// `shadow animate`.
 pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
     let total = Instant::now();
@@ -331,8 +324,7 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
     let mut tally = FrameTally::default();
     let loop_start = Instant::now();
     let in_flight = args.in_flight.max(1);
-    let mut k0 = 0;
-    while k0 < args.frames {
+    for k0 in (0..args.frames).step_by(in_flight as usize) {
         let k1 = (k0 + in_flight).min(args.frames);
         // frames are independent: several at a time keep every core busy
         let batch: Vec<Result<tiling::Frame>> = (k0..k1)
@@ -352,13 +344,11 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
             tally.add(&frame.stats);
             progress.inc(1);
         }
-        k0 = k1;
     }
     let wall = loop_start.elapsed() / args.frames;
     files.finish()?;
     progress.finish();
     let mut out = String::new();
-    let ms = |d: Duration| d.as_secs_f64() * 1e3;
     let _ = writeln!(
         out,
         "{} frames of {}: {} static faces, {} moving; {:?} strategy, {} light(s); {}; wall time \

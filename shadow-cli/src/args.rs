@@ -110,9 +110,7 @@ impl CameraArgs {
         };
         SvgViewpoint::choose(given, &mesh.positions, staging, size, fov_deg)
     }
-}
 
-impl CameraArgs {
     /// [`CameraArgs::viewpoint`], with a note on stderr (unless `quiet`)
     /// of the flags that reproduce a framed camera.
     pub(crate) fn pick(

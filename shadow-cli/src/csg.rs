@@ -14,13 +14,13 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
 use bsp_core::{BoolOp, Grid, ImportReport};
+use bsp_csg::Step;
 use bsp_csg::files::{FileBoolean, FileError, Operand};
-use bsp_csg::{Stage, Step};
 use clap::{Args, ValueEnum};
 use rayon::prelude::*;
 use shadow_scene::MeshFormat;
 
-use crate::output::{Phases, emit, guarded};
+use crate::output::{Phases, emit, guarded, ms, note};
 
 /// A Boolean operation as named on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -91,17 +91,15 @@ fn load_all(paths: &[PathBuf], weld: bool, quiet: bool) -> Result<Vec<Operand>> 
         .collect();
     let mut operands = Vec::with_capacity(paths.len());
     for r in read {
-        let (o, note) = r?;
-        if let Some(m) = note
-            && !quiet
-        {
-            eprintln!("note: {m}");
+        let (o, skipped) = r?;
+        if let Some(m) = skipped {
+            note(quiet, &format!("note: {m}"));
         }
-        if o.collapsed > 0 && !quiet {
-            eprintln!(
-                "note: {}: welding left out {} face(s) whose corners became one position",
-                o.name, o.collapsed
-            );
+        if o.collapsed > 0 {
+            let (name, n) = (&o.name, o.collapsed);
+            let what =
+                format!("{name}: welding left out {n} face(s) whose corners became one position");
+            note(quiet, &format!("note: {what}"));
         }
         // (in the files' order, before a later file's read error)
         o.check_faces().map_err(file_error)?;
@@ -124,21 +122,24 @@ fn apply(
     let checked = phases
         .run("validate", || Operand::check_all(operands))
         .map_err(file_error)?;
-    let mut clock = StageClock {
-        phases,
-        running: None,
-    };
     let out = FileBoolean::apply(checked, op.kernel(), |step, grid| {
-        clock.step(step);
         if let Step::Snapped { operand, report } = step
             && !quiet
         {
             print_import_summary(&names[*operand], report, grid);
         }
-    });
-    // (the positions in input units are part of "boundary+mesh")
-    clock.stop();
-    out.map_err(file_error)
+    })
+    .map_err(file_error)?;
+    let t = out.times;
+    let stages = [
+        ("snap/import", t.snap),
+        ("boolean", t.operations),
+        ("boundary+mesh", t.mesh),
+    ];
+    for (name, d) in stages {
+        d.into_iter().for_each(|d| phases.add(name, d));
+    }
+    Ok(out)
 }
 
 /// An operand's error, with the hint of `--weld` where welding may mend it.
@@ -165,42 +166,6 @@ fn print_import_summary(name: &str, report: &ImportReport, grid: &Grid) {
             report.dropped.len(),
             grid.step_log2()
         );
-    }
-}
-
-/// Times the library's stages into [`Phases`] from the steps it reports:
-/// a stage runs from its start to its end (the mesh's, to
-/// [`StageClock::stop`], after the positions are converted).
-struct StageClock<'p> {
-    phases: &'p mut Phases,
-    /// The phase running, and since when.
-    running: Option<(&'static str, Instant)>,
-}
-
-impl StageClock<'_> {
-    fn step(&mut self, step: &Step) {
-        match step {
-            Step::Started(stage) => {
-                let phase = match stage {
-                    Stage::Snap(_) => "snap/import",
-                    Stage::Operation(_) => "boolean",
-                    Stage::Mesh => "boundary+mesh",
-                };
-                self.stop();
-                self.running = Some((phase, Instant::now()));
-            }
-            Step::Finished(Stage::Mesh) => {}
-            Step::Finished(_) => self.stop(),
-            _ => {}
-        }
-    }
-
-    /// The running phase's time added to it (a new phase the first time).
-    fn stop(&mut self) {
-        let Some((name, start)) = self.running.take() else {
-            return;
-        };
-        self.phases.add(name, start.elapsed());
     }
 }
 
@@ -261,11 +226,14 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
         args.output.display(),
         args.op.name(),
     );
-    if tris == 0 && !args.quiet {
-        eprintln!("note: the {} is empty", args.op.name());
+    if tris == 0 {
+        note(
+            args.quiet,
+            &format!("note: the {} is empty", args.op.name()),
+        );
     }
-    if let Some(r) = rounded.as_ref().filter(|_| !args.quiet) {
-        eprintln!("{}", r.message(stl));
+    if let Some(r) = &rounded {
+        note(args.quiet, &r.message(stl));
     }
     if args.stats {
         report += &stats_text(args.op, &operands, &out, &phases, total);
@@ -288,7 +256,6 @@ fn stats_text(
     let exact_time = start.elapsed();
     s += &out.report(operands, volume);
     s += "time (ms):\n";
-    let ms = |d: Duration| d.as_secs_f64() * 1e3;
     for (name, d) in &phases.0 {
         s += &format!("  {name:<15}{:10.3}\n", ms(*d));
     }

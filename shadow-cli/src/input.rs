@@ -20,12 +20,13 @@ use crate::output::Phases;
 /// (unless `quiet`) if the reader skipped unknown statements.
 pub(crate) fn load_mesh(path: &Path, quiet: bool) -> Result<shadow_scene::Mesh> {
     let (mesh, note) = read_mesh(path)?;
-    if let Some(m) = note
-        && !quiet
-    {
-        eprintln!("note: {m}");
+    if let Some(m) = note {
+        crate::output::note(quiet, &format!("note: {m}"));
     }
-    with_faces(path, mesh)
+    if mesh.faces.is_empty() {
+        bail!("{}: no faces", path.display());
+    }
+    Ok(mesh)
 }
 
 /// [`load_mesh`]'s reading, printing nothing: the mesh, faces or not, and
@@ -33,14 +34,6 @@ pub(crate) fn load_mesh(path: &Path, quiet: bool) -> Result<shadow_scene::Mesh> 
 pub(crate) fn read_mesh(path: &Path) -> Result<(shadow_scene::Mesh, Option<String>)> {
     let (mesh, notes) = shadow_scene::load_notes(path)?;
     Ok((mesh, notes.message(&path.display().to_string())))
-}
-
-/// `mesh` read from `path`, unless it has no faces.
-pub(crate) fn with_faces(path: &Path, mesh: shadow_scene::Mesh) -> Result<shadow_scene::Mesh> {
-    if mesh.faces.is_empty() {
-        bail!("{}: no faces", path.display());
-    }
-    Ok(mesh)
 }
 
 pub(crate) fn load_source_quiet(
@@ -160,18 +153,12 @@ pub(crate) struct Prepared {
 }
 
 impl Prepared {
-    /// Snaps `mesh` to a fitted grid, imports its faces (printing the
-    /// import summary to stderr when faces were changed) and builds the
-    /// tree. `name` names the mesh in messages.
+    /// Snaps `mesh` to a fitted grid, imports its faces, each tagged with
+    /// its index (printing the import summary to stderr when faces were
+    /// changed) and builds the tree. `name` names the mesh in messages.
     pub(crate) fn new(mesh: Mesh, name: &str, quiet: bool) -> Result<Prepared> {
         let grid = Grid::fit_points(&mesh.positions)
             .with_context(|| format!("{name}: cannot fit a grid to the positions"))?;
-        Prepared::on_grid(mesh, name, grid, quiet)
-    }
-
-    /// As [`Prepared::new`], on a given grid (one shared with other
-    /// operands, such as lights). Faces are tagged with their index.
-    pub(crate) fn on_grid(mesh: Mesh, name: &str, grid: Grid, quiet: bool) -> Result<Prepared> {
         let start = Instant::now();
         let loops = mesh.face_loops();
         let (polys, report) = import_faces(&grid, loops.iter().map(Vec::as_slice))

@@ -110,6 +110,18 @@ pub(crate) fn guarded<T>(inputs: &str, f: impl FnOnce() -> Result<T>) -> Result<
     })
 }
 
+/// A note or warning on stderr, unless `quiet`.
+pub(crate) fn note(quiet: bool, text: &str) {
+    if !quiet {
+        eprintln!("{text}");
+    }
+}
+
+/// A duration in milliseconds.
+pub(crate) fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
 /// Writes to stdout; a closed pipe (`shadow csg ... --stats | head`) is
 /// not an error.
 pub(crate) fn emit(text: &str) -> Result<()> {

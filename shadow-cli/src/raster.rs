@@ -20,7 +20,7 @@ use svbsp::PlacedLight;
 use crate::args::{CameraArgs, LightArgs, SourceArgs, parse_fov, parse_size};
 use crate::input::Scene;
 use crate::lights::describe;
-use crate::output::{Phases, emit, write_file, write_files};
+use crate::output::{Phases, emit, ms, note, write_file, write_files};
 use crate::raster_error;
 
 /// `C` or `C,S`: constant and slope-scaled bias, not negative.
@@ -258,10 +258,6 @@ pub(crate) fn prepare(
     })
 }
 
-fn ms(d: Duration) -> f64 {
-    d.as_secs_f64() * 1e3
-}
-
 /// `shadow render`.
 pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
     check_ext(&args.output, "png", "-o")?;
@@ -269,12 +265,8 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
         check_ext(m, "pgm", "--mask")?;
     }
     let shadow = args.opts.options()?;
-    if let Some(n) = args
-        .opts
-        .unused_by(args.method)
-        .filter(|_| !args.scene.quiet)
-    {
-        eprintln!("{n}");
+    if let Some(n) = args.opts.unused_by(args.method) {
+        note(args.scene.quiet, &n);
     }
     let total = Instant::now();
     let p = prepare(&args.scene, Some(&args.lights), args.size)?;

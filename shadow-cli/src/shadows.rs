@@ -97,56 +97,46 @@ impl Format {
 
 // ------------------------------------------------------------- command
 
-/// What the command line asks for, checked before any work is done.
-struct Request {
-    format: Format,
-    /// The lights given.
-    specs: Vec<LightSpec>,
-}
-
-impl Request {
-    /// Fails on a bad output name, or no light for a file (a built-in
-    /// scene may have its own).
-    fn of(args: &ShadowsArgs) -> Result<Request> {
-        let format = Format::from_path(&args.output)?;
-        if format != Format::Svg && (args.camera.any() || args.image.any()) {
-            note(
-                args,
-                "note: --eye, --target, --up, --size and --fov only apply to SVG output",
-            );
-        }
-        args.source.check()?;
-        let specs = args.lights.specs();
-        if specs.is_empty() && args.source.input.is_some() {
-            bail!("{NO_LIGHT}");
-        }
-        Ok(Request { format, specs })
+/// The output format and the lights given, checked before any work is
+/// done: fails on a bad output name, or no light for a file (a built-in
+/// scene may have its own).
+fn request(args: &ShadowsArgs) -> Result<(Format, Vec<LightSpec>)> {
+    let format = Format::from_path(&args.output)?;
+    if format != Format::Svg && (args.camera.any() || args.image.any()) {
+        note(
+            args,
+            "note: --eye, --target, --up, --size and --fov only apply to SVG output",
+        );
     }
+    args.source.check()?;
+    let specs = args.lights.specs();
+    if specs.is_empty() && args.source.input.is_some() {
+        bail!("{NO_LIGHT}");
+    }
+    Ok((format, specs))
 }
 
 /// A note on stderr, unless `--quiet`.
 fn note(args: &ShadowsArgs, s: &str) {
-    if !args.quiet {
-        eprintln!("{s}");
-    }
+    crate::output::note(args.quiet, s);
 }
 
 /// `shadow shadows`.
 pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
     let total = Instant::now();
-    let request = Request::of(args)?;
+    let (format, specs) = request(args)?;
     let progress = Progress::new(!args.quiet);
     let mut phases = Phases::default();
     progress.phase("loading", 1);
-    let scene = Scene::load(&args.source, request.specs, true, args.quiet, &mut phases)?;
-    let view = (request.format == Format::Svg).then(|| {
+    let scene = Scene::load(&args.source, specs, true, args.quiet, &mut phases)?;
+    let view = (format == Format::Svg).then(|| {
         let size = args.image.size();
         let image = (size, args.image.fov);
         args.camera
             .pick(&scene.mesh, scene.staging, image, args.quiet)
     });
     let mut out = Output::create(&args.output)?;
-    let kind = match (request.format, &view) {
+    let kind = match (format, &view) {
         (Format::Svg, Some(v)) => FileKind::Svg(v),
         (Format::Obj, _) => FileKind::Obj,
         _ => FileKind::Json,
@@ -178,11 +168,14 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
     progress.finish();
     let total = total.elapsed();
     phases.0.extend(fig.phases.iter().copied());
-    if fig.degenerate > 0 && !args.quiet {
-        eprintln!(
-            "warning: {} fragment piece(s) have distinct exact vertices that coincide once \
-             rounded to f64 input units; they are degenerate in the file",
-            fig.degenerate
+    if fig.degenerate > 0 {
+        let n = fig.degenerate;
+        note(
+            args,
+            &format!(
+                "warning: {n} fragment piece(s) have distinct exact vertices that \
+             coincide once rounded to f64 input units; they are degenerate in the file"
+            ),
         );
     }
 

@@ -11,7 +11,7 @@ use shadow_scene::{ROOM_EYE, ROOM_TARGET};
 
 use crate::args::{CameraArgs, ImageArgs, SourceArgs};
 use crate::input::{Prepared, load_source_quiet};
-use crate::output::{emit, write_file};
+use crate::output::{emit, ms, write_file};
 use crate::raster_error;
 
 #[derive(Args, Debug)]
@@ -94,7 +94,6 @@ pub(crate) fn stats(args: &StatsArgs) -> Result<()> {
     let (mesh, name) = load_source_quiet(&args.source, args.quiet)?;
     let p = Prepared::new(mesh, &name, args.quiet)?;
     let t = p.tree.stats();
-    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     emit(&format!(
         "input:           {name}\n\
          faces:           {}; {}\n\
