@@ -5,7 +5,10 @@
 //! integer, so the exact answer is a set of unit cells: the result must
 //! be watertight, its winding number at every unit cell's centre must be
 //! the operation on the operands' (positive or not), and its exact volume
-//! must be the number of cells inside.
+//! must be the number of cells inside. Both operands may be sheared by
+//! one integer shear (`x += a·y + b·z`, `y += c·z`): it maps the integer
+//! lattice onto itself and keeps volumes, so the answer is the same cells,
+//! sheared, and the faces are no longer axis-aligned.
 
 use bsp_core::BoolOp;
 use bsp_csg::{CsgError, MeshBuf, MeshIn, mesh_sequence};
@@ -34,6 +37,21 @@ pub struct BooleanInput {
     pub a: Vec<IntBox>,
     /// The second operand's boxes, in one mesh.
     pub b: Vec<IntBox>,
+    /// The shear `[a, b, c]` of both operands: `x += a·y + b·z`,
+    /// `y += c·z`; each in `-2..=2`.
+    pub shear: [i32; 3],
+}
+
+/// A shear coefficient from a byte: 0, 1, −1, 2, −2 (so that missing
+/// bytes, read as zeros, shear nothing).
+fn shear_of(byte: usize) -> i32 {
+    [0, 1, -1, 2, -2][byte % 5]
+}
+
+/// `p` sheared by `s` (see [`BooleanInput::shear`]).
+fn sheared(s: [i32; 3], p: DVec3) -> DVec3 {
+    let [a, b, c] = s.map(f64::from);
+    DVec3::new(p.x + a * p.y + b * p.z, p.y + c * p.z, p.z)
 }
 
 /// Cells `0..SPAN` along each axis hold every box.
@@ -67,15 +85,16 @@ impl IntBox {
     }
 }
 
-/// The boxes as one mesh (eight corners and six quads each).
-fn mesh(boxes: &[IntBox]) -> MeshBuf {
+/// The boxes as one mesh (eight corners and six quads each), sheared by
+/// `shear`.
+fn mesh(boxes: &[IntBox], shear: [i32; 3]) -> MeshBuf {
     let mut positions = Vec::new();
     let mut faces = Vec::new();
     for bx in boxes {
         let first = positions.len() as u32;
         for i in 0..8u32 {
             let c = |k: usize| f64::from(bx.lo[k] + if i >> k & 1 == 1 { bx.size[k] } else { 0 });
-            positions.push(DVec3::new(c(0), c(1), c(2)));
+            positions.push(sheared(shear, DVec3::new(c(0), c(1), c(2))));
         }
         let quads: [[u32; 4]; 6] = [
             [0, 2, 3, 1],
@@ -103,14 +122,20 @@ impl BooleanInput {
         let op = [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference][b.below(3)];
         let a = decode_boxes(&mut b);
         let bb = decode_boxes(&mut b);
-        BooleanInput { op, a, b: bb }
+        let shear = [(); 3].map(|()| shear_of(b.below(5)));
+        BooleanInput {
+            op,
+            a,
+            b: bb,
+            shear,
+        }
     }
 
     /// Runs the operation and checks it (see the module docs). Returns
     /// the number of unit cells inside the result, or `None` for an
     /// operand whose snapped volume is negative (refused as inward).
     pub fn check(&self) -> Option<usize> {
-        let (ma, mb) = (mesh(&self.a), mesh(&self.b));
+        let (ma, mb) = (mesh(&self.a, self.shear), mesh(&self.b, self.shear));
         let (va, vb) = (
             MeshIn::new(&ma.positions, &ma.faces),
             MeshIn::new(&mb.positions, &mb.faces),
@@ -140,6 +165,7 @@ impl BooleanInput {
                         BoolOp::Difference => a && !b,
                     };
                     let centre = DVec3::new(f64::from(x), f64::from(y), f64::from(z)) + 0.5;
+                    let centre = sheared(self.shear, centre);
                     let Ok(g) = out.grid.snap(centre) else {
                         fail(
                             self,
@@ -182,6 +208,10 @@ impl BooleanInput {
                 out.extend(bx.size.map(|s| (s - 1) as u8));
                 out.push(if bx.inward { 0 } else { 1 });
             }
+        }
+        if self.shear != [0; 3] {
+            let byte = |v: i32| [0, 1, -1, 2, -2].iter().position(|&x| x == v).unwrap_or(0) as u8;
+            out.extend(self.shear.map(byte));
         }
         out
     }

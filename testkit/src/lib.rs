@@ -374,7 +374,12 @@ mod tests {
 
     fn boolean_seeds() -> Vec<BooleanInput> {
         let b = |lo: [i32; 3], size: i32| int_box(lo, [size; 3], false);
-        let case = |op, a: Vec<IntBox>, bb: Vec<IntBox>| BooleanInput { op, a, b: bb };
+        let case = |op, a: Vec<IntBox>, bb: Vec<IntBox>| BooleanInput {
+            op,
+            a,
+            b: bb,
+            shear: [0; 3],
+        };
         let ops = [
             BoolOpSeed::Union,
             BoolOpSeed::Intersection,
@@ -395,6 +400,16 @@ mod tests {
                 vec![b([0, 0, 0], 3), b([2, 2, 2], 3), b([0, 0, 0], 1)],
                 vec![b([1, 0, 1], 4), int_box([2, 1, 2], [1, 2, 1], true)],
             ));
+            // overlapping and sharing a face, sheared
+            for shear in [[1, 0, 0], [-2, 1, 2]] {
+                let mut c = case(
+                    op,
+                    vec![b([0, 0, 0], 3), b([3, 0, 0], 2)],
+                    vec![b([1, 1, 1], 3)],
+                );
+                c.shear = shear;
+                v.push(c);
+            }
         }
         v
     }
