@@ -48,13 +48,16 @@ pub struct Operand {
 }
 
 /// An operand's or the operation's error, worded to point into the files.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct FileError {
     /// The message: `file:line: what`, or `file: what`.
     pub message: String,
     /// A topology error of a mesh that was not welded and repeats
     /// positions: merging equal positions first may mend it.
     pub weld_may_help: bool,
+    /// A surface crosses itself once snapped: the operands it may be
+    /// (their indices) and the grid, for [`find_crossing`] to say where.
+    pub crossing: Option<(Vec<usize>, Grid)>,
 }
 
 impl std::fmt::Display for FileError {
@@ -66,10 +69,23 @@ impl std::fmt::Display for FileError {
 impl std::error::Error for FileError {}
 
 impl FileError {
+    /// Where a surface crosses itself, for an error that says one does
+    /// ([`FileError::crossing`]): the operands it may be are read again
+    /// from their `names` (the paths they were read from) and searched
+    /// ([`find_crossing`]); `name: faces … cross near …`.
+    pub fn locate_crossing(&self, names: &[String]) -> Option<String> {
+        let (operands, grid) = self.crossing.as_ref()?;
+        operands.iter().find_map(|&i| {
+            let mesh = shadow_scene::load(std::path::Path::new(names.get(i)?)).ok()?;
+            find_crossing(&mesh, grid).map(|c| format!("{}: {c}", names[i]))
+        })
+    }
+
     fn new(message: String) -> FileError {
         FileError {
             message,
             weld_may_help: false,
+            crossing: None,
         }
     }
 }
@@ -124,6 +140,7 @@ impl Operand {
             .map_err(|e| FileError {
                 message: self.topology_message(&e),
                 weld_may_help: self.file_loops.is_none() && self.mesh.repeated_positions() > 0,
+                crossing: None,
             })
     }
 
@@ -532,6 +549,12 @@ pub fn op_name(op: BoolOp) -> &'static str {
 /// The message for an operation that failed at `e.stage`, naming the
 /// file it comes from.
 fn sequence_error(e: SequenceError, names: &[String], op: BoolOp, grid: &Grid) -> FileError {
+    let crossing = match (e.stage, &e.error) {
+        (Stage::Operation(1), CsgError::NotASolid) => Some(vec![1, 0]),
+        (Stage::Operation(i), CsgError::NotASolid) => Some(vec![i]),
+        (Stage::Snap(i) | Stage::Operation(i), CsgError::TooLargeToResolve { .. }) => Some(vec![i]),
+        _ => None,
+    };
     let message = match (e.stage, e.error) {
         (Stage::Snap(i), CsgError::Inward { .. }) => format!(
             "{}: the faces are oriented inward (clockwise seen from outside): the solid they \
@@ -563,7 +586,93 @@ fn sequence_error(e: SequenceError, names: &[String], op: BoolOp, grid: &Grid) -
         }
         (_, e) => e.to_string(),
     };
-    FileError::new(message)
+    FileError {
+        crossing: crossing.map(|c| (c, *grid)),
+        ..FileError::new(message)
+    }
+}
+
+/// Two faces of a mesh that cross once snapped to a grid (or touch in a
+/// way the certificate cannot settle), and a point near where they meet.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Crossing {
+    /// The faces (indices into the mesh's faces).
+    pub faces: [usize; 2],
+    /// Their lines in the file (0 for generated faces).
+    pub lines: [usize; 2],
+    /// A point where they meet, in input units (rounded: for a message).
+    pub point: DVec3,
+}
+
+impl std::fmt::Display for Crossing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let [a, b] = self.faces;
+        let [la, lb] = self.lines;
+        let p = self.point;
+        write!(
+            f,
+            "faces {a} (line {la}) and {b} (line {lb}) cross near {:.6},{:.6},{:.6}",
+            p.x, p.y, p.z
+        )
+    }
+}
+
+/// Where `mesh`, snapped to `grid`, crosses itself: two faces that the
+/// culling certificate ([`bsp_core::certify_solid_boundary`]) finds
+/// meeting other than in shared vertices and edges, and a point near
+/// their meeting. `None` if it finds no such pair (or the faces do not
+/// fit the grid).
+pub fn find_crossing(mesh: &Mesh, grid: &Grid) -> Option<Crossing> {
+    let loops = mesh.face_loops();
+    let (polys, _) = bsp_core::import_faces_par(grid, &loops).ok()?;
+    let Err(bsp_core::SurfaceDefect::Intersecting { polygons: [i, j] }) =
+        bsp_core::certify_solid_boundary(&polys)
+    else {
+        return None;
+    };
+    let faces = [polys[i].tag() as usize, polys[j].tag() as usize];
+    let ring = |p: &bsp_core::Polygon| -> Vec<DVec3> {
+        p.vertices_f64()
+            .into_iter()
+            .map(|v| grid.to_world(v))
+            .collect()
+    };
+    let (a, b) = (ring(&polys[i]), ring(&polys[j]));
+    let point = meeting_point(&a, &b)
+        .or_else(|| meeting_point(&b, &a))
+        .unwrap_or_else(|| (centre(&a) + centre(&b)) * 0.5);
+    Some(Crossing {
+        faces,
+        lines: faces.map(|f| mesh.faces[f].line),
+        point,
+    })
+}
+
+fn centre(ring: &[DVec3]) -> DVec3 {
+    ring.iter().sum::<DVec3>() / ring.len().max(1) as f64
+}
+
+/// A point where an edge of convex polygon `a` passes through convex
+/// polygon `b` (`f64`, for a message).
+fn meeting_point(a: &[DVec3], b: &[DVec3]) -> Option<DVec3> {
+    let normal = (1..b.len().saturating_sub(1))
+        .map(|k| (b[k] - b[0]).cross(b[k + 1] - b[0]))
+        .sum::<DVec3>();
+    let side = |p: DVec3| normal.dot(p - b[0]);
+    (0..a.len()).find_map(|k| {
+        let (p, q) = (a[k], a[(k + 1) % a.len()]);
+        let (sp, sq) = (side(p), side(q));
+        if sp * sq > 0.0 || sp == sq {
+            return None;
+        }
+        let x = p + (q - p) * (sp / (sp - sq));
+        // inside b: on the inner side of every edge, seen along the normal
+        let inside = (0..b.len()).all(|m| {
+            let (u, v) = (b[m], b[(m + 1) % b.len()]);
+            (v - u).cross(x - u).dot(normal) >= 0.0
+        });
+        inside.then_some(x)
+    })
 }
 #[cfg(test)]
 mod tests {

@@ -4,7 +4,7 @@
 //! surface as given; and such surfaces as operands of Booleans.
 
 use bsp_core::{BoolOp, Polygon};
-use bsp_csg::files::{FileBoolean, Operand};
+use bsp_csg::files::{FileBoolean, Operand, find_crossing};
 use bsp_csg::{MeshBuf, MeshIn, Solid, mesh_sequence};
 use bsp_fixtures::{self as shapes, GridPoint, Loop, Rng};
 use glam::DVec3;
@@ -301,4 +301,46 @@ fn a_large_clean_surface_alone_is_kept() {
         panic!("nested shells too large to resolve were accepted");
     };
     assert!(e.to_string().contains("too large to resolve"), "{e}");
+}
+
+/// One file holding two overlapping spheres of 12,000 triangles each, too
+/// large to resolve: the error says the surface crosses itself and where,
+/// one face of each sphere and a point on both.
+#[test]
+fn a_crossing_too_large_to_resolve_is_located() {
+    let (a, b, faces) = shapes::sphere_pair(12_000);
+    let n = a.len() as u32;
+    let positions: Vec<DVec3> = a.iter().chain(&b).copied().collect();
+    let both: Vec<Vec<u32>> = faces
+        .iter()
+        .cloned()
+        .chain(faces.iter().map(|f| f.iter().map(|v| v + n).collect()))
+        .collect();
+    let mesh = shadow_scene::parse_obj(&obj_text(&positions, &both), "two.obj").unwrap();
+    assert!(mesh.faces.len() > bsp_csg::RESOLVE_LIMIT);
+    let mut one = [Operand::new("two.obj", mesh.clone())];
+    let checked = Operand::check_all(&mut one).unwrap();
+    let e = FileBoolean::apply(checked, BoolOp::Union, |_, _| {}).unwrap_err();
+    assert!(e.message.contains("too large to resolve"), "{}", e.message);
+    let (operands, grid) = e.crossing.clone().expect("a crossing to locate");
+    assert_eq!(operands, vec![0]);
+    let c = find_crossing(&mesh, &grid).expect("the certificate finds the pair");
+    let half = faces.len();
+    assert!((c.faces[0] < half) != (c.faces[1] < half), "{c}");
+    assert_eq!(c.lines, c.faces.map(|f| mesh.faces[f].line));
+    // on both unit spheres, to the faces' flatness
+    let centre = |p: &[DVec3]| p.iter().sum::<DVec3>() / p.len() as f64;
+    for sphere in [&a, &b] {
+        let r = (c.point - centre(sphere)).length();
+        assert!((r - 1.0).abs() < 0.01, "{c}: {r} from a centre");
+    }
+    // the same, read again from the file the operand came from
+    let path = std::env::temp_dir().join(format!("two-{}.obj", std::process::id()));
+    std::fs::write(&path, obj_text(&positions, &both)).unwrap();
+    let at = e.locate_crossing(&[path.display().to_string()]);
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(at, Some(format!("{}: {c}", path.display())));
+    // a clean surface has none
+    let single = shadow_scene::parse_obj(&obj_text(&a, &faces), "a.obj").unwrap();
+    assert_eq!(find_crossing(&single, &grid), None);
 }

@@ -129,7 +129,10 @@ fn apply(
             print_import_summary(&names[*operand], report, grid);
         }
     })
-    .map_err(file_error)?;
+    .map_err(|e| match e.locate_crossing(&names) {
+        Some(at) => anyhow!("{}; {at}", e.message),
+        None => file_error(e),
+    })?;
     let t = out.times;
     let stages = [
         ("snap/import", t.snap),
@@ -288,6 +291,7 @@ mod tests {
     #[test]
     fn an_unwelded_soup_gets_the_weld_hint() {
         let e = FileError {
+            crossing: None,
             message: "soup.obj:25: edge 1-2 of face 0 is a boundary edge".into(),
             weld_may_help: true,
         };

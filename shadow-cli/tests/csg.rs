@@ -533,3 +533,60 @@ fn a_union_of_one_cleans_shells_that_overlap_or_nest() {
     assert_ok(&o);
     assert_eq!(stat(&stdout(&o), "volume:").split(' ').next(), Some("16"));
 }
+
+/// Two overlapping UV spheres of 12,100 triangles each in one OBJ text.
+fn two_spheres_obj() -> String {
+    let (nu, nv) = (110, 56);
+    let mut s = String::new();
+    let mut faces = Vec::new();
+    for (k, c) in [DVec3::ZERO, DVec3::new(0.9, 0.2, 0.1)].iter().enumerate() {
+        let first = 1 + k * (2 + (nv - 1) * nu);
+        let ring = |i: usize, j: usize| first + 1 + (i - 1) * nu + j % nu;
+        let top = first + 1 + (nv - 1) * nu;
+        s += &format!("v {} {} {}\n", c.x, c.y, c.z - 1.0);
+        for i in 1..nv {
+            let th = std::f64::consts::PI * (i as f64 / nv as f64 - 0.5);
+            for j in 0..nu {
+                let ph = std::f64::consts::TAU * j as f64 / nu as f64;
+                let p = *c + DVec3::new(th.cos() * ph.cos(), th.cos() * ph.sin(), th.sin());
+                s += &format!("v {} {} {}\n", p.x, p.y, p.z);
+            }
+        }
+        s += &format!("v {} {} {}\n", c.x, c.y, c.z + 1.0);
+        for j in 0..nu {
+            faces.push([first, ring(1, j + 1), ring(1, j)]);
+            faces.push([top, ring(nv - 1, j), ring(nv - 1, j + 1)]);
+            for i in 1..nv - 1 {
+                faces.push([ring(i, j), ring(i, j + 1), ring(i + 1, j + 1)]);
+                faces.push([ring(i, j), ring(i + 1, j + 1), ring(i + 1, j)]);
+            }
+        }
+    }
+    for f in faces {
+        s += &format!("f {} {} {}\n", f[0], f[1], f[2]);
+    }
+    s
+}
+
+#[test]
+fn a_crossing_too_large_to_resolve_names_two_faces_and_a_point() {
+    let two = write("two_spheres.obj", &two_spheres_obj());
+    let out = scratch("two_spheres_u.obj");
+    let o = shadow(&[
+        "csg",
+        "union",
+        two.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_failed_with(
+        &o,
+        &[
+            "too large to resolve",
+            "two_spheres.obj: faces ",
+            "(line ",
+            "cross near ",
+        ],
+    );
+    assert!(!out.exists());
+}
