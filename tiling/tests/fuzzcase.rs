@@ -7,24 +7,19 @@
 //! answer from scratch gives ([`crate::scratch::check_motion`]).
 //! `cargo test` replays the corpus in `fuzz/corpus/pipeline`.
 
+use bsp_fixtures::corpus::ByteReader;
 use glam::DVec3;
 use svbsp::LightSpec;
 use tiling::{Motion, Strategy};
 
-use crate::scratch::{check_motion, tetra};
+use crate::scratch::{check_motion, ground, tetra};
 
-/// The bytes, read one at a time; zeros once they run out.
-struct Reader<'a>(&'a [u8]);
+/// The decoder's reads on top of [`ByteReader`].
+struct Reader<'a>(ByteReader<'a>);
 
 impl Reader<'_> {
     fn byte(&mut self) -> u8 {
-        match self.0.split_first() {
-            Some((&b, rest)) => {
-                self.0 = rest;
-                b
-            }
-            None => 0,
-        }
+        self.0.byte()
     }
 
     /// A number in `lo..=hi` in 256 steps.
@@ -62,13 +57,8 @@ fn crossing(at: DVec3, s: f64) -> Vec<Vec<DVec3>> {
 /// Decodes a scene, its lights and a motion from `data` and checks every
 /// frame against the answer from scratch (panicking on a difference).
 pub(crate) fn pipeline_case(data: &[u8]) {
-    let mut b = Reader(data);
-    let mut statics = vec![vec![
-        DVec3::new(-6.0, -6.0, 0.0),
-        DVec3::new(6.0, -6.0, 0.0),
-        DVec3::new(6.0, 6.0, 0.0),
-        DVec3::new(-6.0, 6.0, 0.0),
-    ]];
+    let mut b = Reader(ByteReader(data));
+    let mut statics = vec![ground()];
     for _ in 0..1 + b.byte() % 4 {
         let lo = b.vec(-4.0, 4.0) * DVec3::new(1.0, 1.0, 0.0) + DVec3::Z * b.num(0.0, 2.0);
         statics.extend(bsp_fixtures::cuboid(lo, lo + b.vec(0.2, 1.5)));
@@ -99,27 +89,12 @@ pub(crate) fn pipeline_case(data: &[u8]) {
 
 #[cfg(test)]
 mod tests {
+    use bsp_fixtures::corpus::{replay, seed_bytes, write_seeds};
+
     use super::*;
 
-    fn corpus() -> std::path::PathBuf {
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/pipeline")
-    }
-
-    /// Deterministic bytes for the seed files.
     fn seeds() -> Vec<Vec<u8>> {
-        let mut s = 0x0b1e_c7ed_5eed_0001u64;
-        (0..12)
-            .map(|_| {
-                (0..40)
-                    .map(|_| {
-                        s ^= s << 13;
-                        s ^= s >> 7;
-                        s ^= s << 17;
-                        (s >> 24) as u8
-                    })
-                    .collect()
-            })
-            .collect()
+        seed_bytes(0x0b1e_c7ed_5eed_0001, 12, |_| 40)
     }
 
     /// Rewrites `fuzz/corpus/pipeline/seed-*`:
@@ -127,20 +102,16 @@ mod tests {
     #[test]
     #[ignore = "writes fuzz/corpus/pipeline; run by hand after changing the decoder"]
     fn write_pipeline_seeds() {
-        std::fs::create_dir_all(corpus()).unwrap();
-        for (i, bytes) in seeds().iter().enumerate() {
-            std::fs::write(corpus().join(format!("seed-{i:02}")), bytes).unwrap();
-        }
+        write_seeds("pipeline", &seeds());
     }
 
     /// Every file of the corpus (the seeds and what fuzzing kept) passes.
     #[test]
     fn the_pipeline_corpus_replays() {
-        let mut files = 0;
-        for e in std::fs::read_dir(corpus()).unwrap() {
-            pipeline_case(&std::fs::read(e.unwrap().path()).unwrap());
-            files += 1;
-        }
+        let (files, _) = replay("pipeline", |data| {
+            pipeline_case(data);
+            true
+        });
         assert!(files >= seeds().len(), "{files} files");
     }
 }

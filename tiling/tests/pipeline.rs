@@ -15,7 +15,7 @@ use proptest::prelude::*;
 use svbsp::{LightSpec, place_lights, shared_grid};
 use tiling::{Dynamic, Motion, PipelineOptions, Strategy};
 
-use crate::scratch::{check_motion, tetra};
+use crate::scratch::{check_motion, ground, tetra};
 
 /// The number of static polygons the faces import to.
 fn d_polygons(st: &[Vec<DVec3>]) -> usize {
@@ -164,12 +164,7 @@ proptest! {
         paper in any::<bool>(),
         tiles in prop::sample::select(vec![None, Some(1u32), Some(3), Some(17)]),
     ) {
-        let mut st = vec![vec![
-            DVec3::new(-6.0, -6.0, 0.0),
-            DVec3::new(6.0, -6.0, 0.0),
-            DVec3::new(6.0, 6.0, 0.0),
-            DVec3::new(-6.0, 6.0, 0.0),
-        ]];
+        let mut st = vec![ground()];
         for (p, s) in &blocks {
             let lo = DVec3::new(p[0], p[1], p[2].abs() * 0.5);
             st.extend(cuboid(lo, lo + DVec3::from_array(*s)));
@@ -194,12 +189,7 @@ proptest! {
 fn both_ways_of_shading_the_object_are_checked() {
     // a tall block between the light and a tetrahedron: many related
     // blockers (layered trees); the same with a small one (one tree)
-    let ground = vec![vec![
-        DVec3::new(-6.0, -6.0, 0.0),
-        DVec3::new(6.0, -6.0, 0.0),
-        DVec3::new(6.0, 6.0, 0.0),
-        DVec3::new(-6.0, 6.0, 0.0),
-    ]];
+    let ground = vec![ground()];
     let light = [LightSpec::Point(DVec3::new(0.0, 0.0, 8.0))];
     let slide = Motion {
         axis: DVec3::Z,
@@ -286,12 +276,7 @@ fn faces_turned_away_are_left_out_only_where_that_is_exact() {
     // shadow tree when its snapped surface is certified to bound solids
     // and the light is outside them; every other case keeps them, and
     // each frame must still match the computation from scratch
-    let ground = vec![vec![
-        DVec3::new(-6.0, -6.0, 0.0),
-        DVec3::new(6.0, -6.0, 0.0),
-        DVec3::new(6.0, 6.0, 0.0),
-        DVec3::new(-6.0, 6.0, 0.0),
-    ]];
+    let ground = vec![ground()];
     let light = [LightSpec::Point(DVec3::new(0.2, 0.1, 8.0))];
     let turn = Motion {
         axis: DVec3::new(0.3, 1.0, 0.2),

@@ -194,3 +194,13 @@ pub(crate) fn tetra(at: DVec3, s: f64) -> Vec<Vec<DVec3>> {
         vec![v[1], v[2], v[3]],
     ]
 }
+
+/// The ground of the random scenes: the square `[-6, 6]²` at height 0.
+pub(crate) fn ground() -> Vec<DVec3> {
+    vec![
+        DVec3::new(-6.0, -6.0, 0.0),
+        DVec3::new(6.0, -6.0, 0.0),
+        DVec3::new(6.0, 6.0, 0.0),
+        DVec3::new(-6.0, 6.0, 0.0),
+    ]
+}

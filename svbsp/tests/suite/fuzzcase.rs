@@ -7,26 +7,17 @@
 //! the same area per face and set of flags. `cargo test` replays the
 //! corpus in `fuzz/corpus/shadows`.
 
+use bsp_fixtures::corpus::ByteReader;
+
 use crate::harness::{Opts, check, polygons, scene_of};
 use crate::scenes::{FaceGen, LightGen, P3, Transform, make_faces, make_lights};
 
-/// The bytes, read one at a time; zeros once they run out.
-struct Reader<'a>(&'a [u8]);
+/// The decoder's reads on top of [`ByteReader`].
+struct Reader<'a>(ByteReader<'a>);
 
 impl Reader<'_> {
-    fn byte(&mut self) -> u8 {
-        match self.0.split_first() {
-            Some((&b, rest)) => {
-                self.0 = rest;
-                b
-            }
-            None => 0,
-        }
-    }
-
-    /// A number in `0..n` (`n` ≤ 256).
     fn below(&mut self, n: u32) -> u32 {
-        u32::from(self.byte()) % n
+        self.0.below(n)
     }
 
     fn int(&mut self, lo: i32, hi: i32) -> i32 {
@@ -38,7 +29,7 @@ impl Reader<'_> {
     }
 
     fn index(&mut self) -> usize {
-        usize::from(self.byte())
+        usize::from(self.0.byte())
     }
 }
 
@@ -78,7 +69,7 @@ fn transform(b: &mut Reader) -> Transform {
 /// algorithms against the oracle, panicking with the scene on any
 /// disagreement. Returns whether a scene with faces came out.
 pub(crate) fn shadows_case(data: &[u8]) -> bool {
-    let mut b = Reader(data);
+    let mut b = Reader(ByteReader(data));
     let faces: Vec<FaceGen> = (0..3 + b.below(10)).map(|_| face(&mut b)).collect();
     let lights: Vec<LightGen> = (0..1 + b.below(3)).map(|_| light(&mut b)).collect();
     let t = transform(&mut b);
@@ -100,27 +91,12 @@ pub(crate) fn shadows_case(data: &[u8]) -> bool {
 
 #[cfg(test)]
 mod tests {
+    use bsp_fixtures::corpus::{replay, seed_bytes, write_seeds};
+
     use super::*;
 
-    fn corpus() -> std::path::PathBuf {
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/shadows")
-    }
-
-    /// Deterministic bytes for the seed files.
     fn seeds() -> Vec<Vec<u8>> {
-        let mut s = 0x5eed_5ad0_0ca5_e5e5u64;
-        (0..24)
-            .map(|i| {
-                (0..32 + 4 * i)
-                    .map(|_| {
-                        s ^= s << 13;
-                        s ^= s >> 7;
-                        s ^= s << 17;
-                        (s >> 24) as u8
-                    })
-                    .collect()
-            })
-            .collect()
+        seed_bytes(0x5eed_5ad0_0ca5_e5e5, 24, |i| 32 + 4 * i)
     }
 
     /// Rewrites `fuzz/corpus/shadows/seed-*`:
@@ -128,22 +104,14 @@ mod tests {
     #[test]
     #[ignore = "writes fuzz/corpus/shadows; run by hand after changing the decoder"]
     fn write_shadows_seeds() {
-        std::fs::create_dir_all(corpus()).unwrap();
-        for (i, bytes) in seeds().iter().enumerate() {
-            std::fs::write(corpus().join(format!("seed-{i:02}")), bytes).unwrap();
-        }
+        write_seeds("shadows", &seeds());
     }
 
     /// Every file of the corpus (the seeds and what fuzzing kept) passes,
     /// and most of them are scenes.
     #[test]
     fn the_shadows_corpus_replays() {
-        let (mut files, mut scenes) = (0, 0);
-        for e in std::fs::read_dir(corpus()).unwrap() {
-            let path = e.unwrap().path();
-            files += 1;
-            scenes += usize::from(shadows_case(&std::fs::read(&path).unwrap()));
-        }
+        let (files, scenes) = replay("shadows", shadows_case);
         assert!(files >= seeds().len(), "{files} files");
         assert!(scenes * 4 >= files * 3, "{scenes} scenes of {files} files");
     }
