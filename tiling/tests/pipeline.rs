@@ -15,7 +15,7 @@ use proptest::prelude::*;
 use svbsp::{LightSpec, place_lights, shared_grid};
 use tiling::{Dynamic, Motion, PipelineOptions, Strategy};
 
-use crate::scratch::{check_motion, ground, tetra};
+use crate::scratch::{check_motion, crossing, ground, tetra};
 
 /// The number of static polygons the faces import to.
 fn d_polygons(st: &[Vec<DVec3>]) -> usize {
@@ -329,21 +329,7 @@ fn faces_turned_away_are_left_out_only_where_that_is_exact() {
 #[test]
 fn regress_quads_crossing_along_a_diagonal_keep_every_face() {
     let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
-    let (a, b) = (p(0.0, 0.0, -3.0), p(0.0, 0.0, 3.0));
-    let g = [
-        p(-2.0, -1.0, 0.0),
-        p(-2.0, 1.0, 0.0),
-        p(4.0, -2.0, 0.0),
-        p(4.0, 2.0, 0.0),
-    ];
-    let object = vec![
-        vec![a, g[1], g[0]],
-        vec![b, g[0], g[1]],
-        vec![a, g[2], b, g[1]],
-        vec![a, g[3], g[2]],
-        vec![b, g[2], g[3]],
-        vec![a, g[0], b, g[3]],
-    ];
+    let object = crossing(p(0.0, 0.0, -3.0), 1.0);
     let wall = vec![vec![
         p(20.0, -30.0, -30.0),
         p(20.0, -30.0, 30.0),

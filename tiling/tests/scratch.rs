@@ -204,3 +204,25 @@ pub(crate) fn ground() -> Vec<DVec3> {
         DVec3::new(-6.0, 6.0, 0.0),
     ]
 }
+
+/// Two tetrahedra touching along `ab`, their faces through `ab` merged
+/// into two quads that cross along it (the certificate's counterexample),
+/// scaled by `s` and moved to `at`.
+pub(crate) fn crossing(at: DVec3, s: f64) -> Vec<Vec<DVec3>> {
+    let p = |x: f64, y: f64, z: f64| at + DVec3::new(x, y, z) * s;
+    let (a, b) = (p(0.0, 0.0, 0.0), p(0.0, 0.0, 6.0));
+    let g = [
+        p(-2.0, -1.0, 3.0),
+        p(-2.0, 1.0, 3.0),
+        p(4.0, -2.0, 3.0),
+        p(4.0, 2.0, 3.0),
+    ];
+    vec![
+        vec![a, g[1], g[0]],
+        vec![b, g[0], g[1]],
+        vec![a, g[2], b, g[1]],
+        vec![a, g[3], g[2]],
+        vec![b, g[2], g[3]],
+        vec![a, g[0], b, g[3]],
+    ]
+}
