@@ -5,7 +5,9 @@
 //! certified surface must have a winding number of at least 0 at every
 //! grid point around it, and 0 outside its box (what leaving out faces
 //! turned away from a light relies on); a diagonal crossing must be
-//! refused.
+//! refused. The fourth kind is two integer boxes, apart, touching,
+//! overlapping or nested, the second sometimes turned inward, both
+//! sheared by one integer shear (faces that are not axis-aligned).
 
 use bsp_core::{Polygon, certify_solid_boundary};
 use bsp_csg::Solid;
@@ -39,7 +41,7 @@ struct Case {
 pub fn certify_case(data: &[u8]) -> bool {
     let mut b = Bytes { data };
     let case = Case {
-        kind: b.u8() % 3,
+        kind: b.u8() % 4,
         seed: b.u64(),
     };
     let mut rng = Rng(case.seed);
@@ -53,9 +55,14 @@ pub fn certify_case(data: &[u8]) -> bool {
         }
         return false;
     }
-    let n = 8 + (rng.next_u64() % 24) as usize;
-    let jitter = 1 + (rng.next_u64() % 3) as i32;
-    let mut surface = jittered_uv_sphere(n, 6.0, jitter, &mut rng);
+    let mut surface = match case.kind {
+        3 => sheared_boxes(&mut rng),
+        _ => {
+            let n = 8 + (rng.next_u64() % 24) as usize;
+            let jitter = 1 + (rng.next_u64() % 3) as i32;
+            jittered_uv_sphere(n, 6.0, jitter, &mut rng)
+        }
+    };
     if case.kind == 1 {
         // a second sphere beside, across or inside the first
         let off = (rng.next_u64() % 17) as i32 - 4;
@@ -91,4 +98,29 @@ pub fn certify_case(data: &[u8]) -> bool {
         }
     }
     true
+}
+
+/// Two integer boxes (the second turned inward one time in four), both
+/// sheared by `x += a·y + b·z`, `y += c·z` with `a`, `b`, `c` in `-1..=1`.
+fn sheared_boxes(rng: &mut Rng) -> Vec<Loop> {
+    let mut r = |n: u64| (rng.next_u64() % n) as i32;
+    let shear = [r(3) - 1, r(3) - 1, r(3) - 1];
+    let mut loops = Vec::new();
+    for k in 0..2 {
+        let lo = [r(7) - 5, r(7) - 5, r(7) - 5];
+        let hi = [0, 1, 2].map(|i| lo[i] + 1 + r(6));
+        let inward = k == 1 && r(4) == 0;
+        for mut quad in bsp_fixtures::grid_cuboid(lo, hi) {
+            if inward {
+                quad.reverse();
+            }
+            let [a, b, c] = shear;
+            loops.push(
+                quad.into_iter()
+                    .map(|[x, y, z]| [x + a * y + b * z, y + c * z, z])
+                    .collect(),
+            );
+        }
+    }
+    loops
 }

@@ -489,7 +489,7 @@ mod tests {
             "certify" => (
                 (0..24u64)
                     .map(|i| {
-                        let mut b = vec![(i % 3) as u8];
+                        let mut b = vec![(i % 4) as u8];
                         b.extend((0x5eed + i).to_le_bytes());
                         b
                     })
