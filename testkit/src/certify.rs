@@ -7,7 +7,8 @@
 //! turned away from a light relies on); a diagonal crossing must be
 //! refused. The fourth kind is two integer boxes, apart, touching,
 //! overlapping or nested, the second sometimes turned inward, both
-//! sheared by one integer shear (faces that are not axis-aligned).
+//! sheared by one integer shear and turned by one of the lattice's
+//! rotations (faces that are not axis-aligned).
 
 use bsp_core::{Polygon, certify_solid_boundary};
 use bsp_csg::Solid;
@@ -101,10 +102,15 @@ pub fn certify_case(data: &[u8]) -> bool {
 }
 
 /// Two integer boxes (the second turned inward one time in four), both
-/// sheared by `x += a·y + b·z`, `y += c·z` with `a`, `b`, `c` in `-1..=1`.
+/// sheared by `x += a·y + b·z`, `y += c·z` with `a`, `b`, `c` in `-1..=1`,
+/// then turned by one of the lattice's rotations (an even permutation of
+/// the axes, two of them possibly negated).
 fn sheared_boxes(rng: &mut Rng) -> Vec<Loop> {
     let mut r = |n: u64| (rng.next_u64() % n) as i32;
     let shear = [r(3) - 1, r(3) - 1, r(3) - 1];
+    let axes = [[0, 1, 2], [1, 2, 0], [2, 0, 1]][r(3) as usize];
+    let signs = [[1, 1, 1], [-1, -1, 1], [-1, 1, -1], [1, -1, -1]][r(4) as usize];
+    let turn = |p: [i32; 3]| [0, 1, 2].map(|i| signs[i] * p[axes[i]]);
     let mut loops = Vec::new();
     for k in 0..2 {
         let lo = [r(7) - 5, r(7) - 5, r(7) - 5];
