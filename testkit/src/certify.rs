@@ -123,7 +123,7 @@ fn sheared_boxes(rng: &mut Rng) -> Vec<Loop> {
             let [a, b, c] = shear;
             loops.push(
                 quad.into_iter()
-                    .map(|[x, y, z]| [x + a * y + b * z, y + c * z, z])
+                    .map(|[x, y, z]| turn([x + a * y + b * z, y + c * z, z]))
                     .collect(),
             );
         }
