@@ -125,15 +125,19 @@ struct Job<'a> {
     fig: ShadowFile,
 }
 
-impl Job<'_> {
-    /// Runs `f`, its time added to phase `name`.
-    fn timed<T>(&mut self, name: &'static str, f: impl FnOnce() -> T) -> T {
-        let start = Instant::now();
-        let out = f();
-        self.fig.phases.push((name, start.elapsed()));
-        out
-    }
+/// Runs `f`, its time pushed to `phases` as phase `name`.
+fn timed<T>(
+    phases: &mut Vec<(&'static str, Duration)>,
+    name: &'static str,
+    f: impl FnOnce() -> T,
+) -> T {
+    let start = Instant::now();
+    let out = f();
+    phases.push((name, start.elapsed()));
+    out
+}
 
+impl Job<'_> {
     fn run(
         &mut self,
         algorithm: Algorithm,
@@ -154,10 +158,11 @@ impl Job<'_> {
                 let tree = self.scene_tree();
                 self.fig.receivers = tree.polygons().count();
                 self.progress.phase("Chin & Feiner", 1);
-                let kernel = std::mem::take(&mut self.kernel);
-                let cf = self.timed("shadows", || chin_feiner(&tree, &kernel));
-                self.kernel = kernel;
-                let cf = cf.map_err(Error::Light)?;
+                let kernel = &self.kernel;
+                let cf = timed(&mut self.fig.phases, "shadows", || {
+                    chin_feiner(&tree, kernel)
+                })
+                .map_err(Error::Light)?;
                 self.fig.shadow_nodes = cf.shadow_nodes;
                 (Batch::from_chin_feiner(&cf, &self.kernel), tree)
             }
@@ -184,10 +189,11 @@ impl Job<'_> {
     fn shadow_trees(&mut self) -> Result<svbsp::Shadows, Error> {
         self.progress
             .phase("shadow trees", self.kernel.len() as u64);
-        let (polys, kernel) = (self.scene.polys, std::mem::take(&mut self.kernel));
-        let shadows = self.timed("trees", || svbsp::Shadows::new(polys, &kernel));
-        self.kernel = kernel;
-        let shadows = shadows.map_err(Error::Shadow)?;
+        let (polys, kernel) = (self.scene.polys, &self.kernel);
+        let shadows = timed(&mut self.fig.phases, "trees", || {
+            svbsp::Shadows::new(polys, kernel)
+        })
+        .map_err(Error::Shadow)?;
         self.fig.shadow_nodes = shadows.volumes().iter().map(|v| v.node_count()).sum();
         Ok(shadows)
     }
@@ -197,7 +203,7 @@ impl Job<'_> {
     fn scene_tree(&mut self) -> BspTree {
         self.progress.phase("scene tree", 1);
         let polys = self.scene.polys;
-        let tree = self.timed("bsp", || {
+        let tree = timed(&mut self.fig.phases, "bsp", || {
             BspTree::build(polys.to_vec(), &BuildOptions::default())
         });
         self.fig.bsp_polygons = Some(tree.polygons().count());
@@ -212,7 +218,7 @@ impl Job<'_> {
         self.progress.phase("shading", polys.len() as u64);
         let progress = self.progress;
         let ranges: Vec<Range<usize>> = (0..polys.len()).map(|i| i..i + 1).collect();
-        self.timed("shading", || {
+        timed(&mut self.fig.phases, "shading", || {
             let opts = ShadeOptions::default();
             shadows
                 .set()
