@@ -72,16 +72,7 @@ pub trait MeshView: Sync {
         let positions = self.positions();
         (0..self.face_count())
             .into_par_iter()
-            .filter(|&f| {
-                let &[a, b, c] = self.face(f) else {
-                    return false;
-                };
-                let [pa, pb, pc] = [a, b, c].map(|v| round(positions[v as usize]));
-                key(pa) != key(pb)
-                    && key(pb) != key(pc)
-                    && key(pc) != key(pa)
-                    && collinear(pa, pb, pc)
-            })
+            .filter(|&f| flat(self.face(f), |v| round(positions[v as usize])))
             .count()
     }
 }
@@ -202,6 +193,21 @@ pub fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
         robust::orient2d(q(a), q(b), q(c))
     };
     o(0, 1) == 0.0 && o(1, 2) == 0.0 && o(2, 0) == 0.0
+}
+
+/// `true` if `face` is a triangle whose three corners (positions by
+/// `at`) are distinct and lie exactly on one line.
+fn flat(face: &[u32], at: impl Fn(u32) -> DVec3) -> bool {
+    let &[a, b, c] = face else {
+        return false;
+    };
+    let [pa, pb, pc] = [a, b, c].map(at);
+    key(pa) != key(pb) && key(pb) != key(pc) && key(pc) != key(pa) && collinear(pa, pb, pc)
+}
+
+/// The directed edges of a vertex loop, in order.
+fn ring(v: &[u32]) -> impl Iterator<Item = (u32, u32)> + '_ {
+    (0..v.len()).map(move |i| (v[i], v[(i + 1) % v.len()]))
 }
 
 /// `true` if `m` lies between `p` and `q` along every axis (for collinear
@@ -521,15 +527,9 @@ impl Mesh {
     /// ```
     pub fn split_flat_triangles(&mut self) -> FlatFix {
         let positions = &self.positions;
-        let flat = |f: &Face| {
-            let [a, b, c] = f.vertices[..] else {
-                return false;
-            };
-            let [pa, pb, pc] = [a, b, c].map(|v| positions[v as usize]);
-            a != b && b != c && c != a && collinear(pa, pb, pc)
-        };
+        let is_flat = |f: &Face| flat(&f.vertices, |v| positions[v as usize]);
         let mut queue: Vec<usize> = (0..self.faces.len())
-            .filter(|&i| flat(&self.faces[i]))
+            .filter(|&i| is_flat(&self.faces[i]))
             .collect();
         if queue.is_empty() {
             return FlatFix::default();
@@ -537,12 +537,8 @@ impl Mesh {
         // directed edge → its face; `usize::MAX` where several faces use it
         const SHARED: usize = usize::MAX;
         let mut edges: rustc_hash::FxHashMap<(u32, u32), usize> = Default::default();
-        let ring = |f: &Face| {
-            let v = f.vertices.clone();
-            (0..v.len()).map(move |i| (v[i], v[(i + 1) % v.len()]))
-        };
         for (i, f) in self.faces.iter().enumerate() {
-            for e in ring(f) {
+            for e in ring(&f.vertices) {
                 edges.entry(e).and_modify(|x| *x = SHARED).or_insert(i);
             }
         }
@@ -555,10 +551,12 @@ impl Mesh {
                 break;
             }
             budget -= 1;
-            if !alive[t] || !flat(&self.faces[t]) {
+            if !alive[t] || !is_flat(&self.faces[t]) {
                 continue;
             }
-            let v = self.faces[t].vertices.clone();
+            let v: [u32; 3] = self.faces[t].vertices[..]
+                .try_into()
+                .expect("a flat face is a triangle");
             let at = |i: usize| self.positions[v[i] as usize];
             let i = (0..3)
                 .find(|&i| between(at(i), at((i + 1) % 3), at((i + 2) % 3)))
@@ -575,7 +573,7 @@ impl Mesh {
                 .expect("the edge's face has it");
             let d = nv[(k + 2) % 3];
             let unlink = |f: &Face, i: usize, edges: &mut rustc_hash::FxHashMap<_, _>| {
-                for e in ring(f) {
+                for e in ring(&f.vertices) {
                     if edges.get(&e) == Some(&i) {
                         edges.remove(&e);
                     }
@@ -598,17 +596,17 @@ impl Mesh {
             });
             alive.push(true);
             for j in [n, self.faces.len() - 1] {
-                for e in ring(&self.faces[j]) {
+                for e in ring(&self.faces[j].vertices) {
                     edges.entry(e).and_modify(|x| *x = SHARED).or_insert(j);
                 }
-                if flat(&self.faces[j]) {
+                if is_flat(&self.faces[j]) {
                     queue.push(j);
                 }
             }
         }
         let mut alive = alive.into_iter();
         self.faces.retain(|_| alive.next().unwrap_or(true));
-        let left = self.faces.iter().filter(|f| flat(f)).count();
+        let left = self.faces.iter().filter(|f| is_flat(f)).count();
         FlatFix {
             removed: at_start.saturating_sub(left),
             left,

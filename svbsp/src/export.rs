@@ -729,10 +729,23 @@ mod tests {
         assert_eq!(obj_group(0b00, 2), "shadow");
     }
 
+    /// Values to print, each compared as text with `serde_json`'s printing
+    /// of it: zero, a fraction, an integer, small and tiny values that
+    /// print in exponent form, a long decimal and 2^60. (Sample inputs,
+    /// not a tolerance: nothing is compared within a margin.)
+    const PRINTED: [f64; 7] = [
+        0.0,
+        -0.5,
+        1.0,
+        1e-7,
+        123456.789,
+        1_152_921_504_606_846_976.0,
+        -3.25e-300,
+    ];
+
     #[test]
     fn json_numbers_are_serde_jsons() {
-        // numbers to print (no tolerance: the text must equal serde_json's)
-        for x in [0.0, -0.5, 1.0, 1e-7, 123456.789, 2f64.powi(60), -3.25e-300] {
+        for x in PRINTED {
             let mut s = Vec::new();
             push_f64(&mut s, x);
             assert_eq!(

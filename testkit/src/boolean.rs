@@ -48,10 +48,19 @@ fn shear_of(byte: usize) -> i32 {
     [0, 1, -1, 2, -2][byte % 5]
 }
 
+/// `[x, y, z]` sheared by `[a, b, c]`: `x += a·y + b·z`, `y += c·z`
+/// (integer grid points, or for the cell centres `f64`).
+pub(crate) fn shear<T>(s: [i32; 3], [x, y, z]: [T; 3]) -> [T; 3]
+where
+    T: Copy + From<i32> + std::ops::Add<Output = T> + std::ops::Mul<Output = T>,
+{
+    let [a, b, c] = s.map(T::from);
+    [x + a * y + b * z, y + c * z, z]
+}
+
 /// `p` sheared by `s` (see [`BooleanInput::shear`]).
 fn sheared(s: [i32; 3], p: DVec3) -> DVec3 {
-    let [a, b, c] = s.map(f64::from);
-    DVec3::new(p.x + a * p.y + b * p.z, p.y + c * p.z, p.z)
+    DVec3::from_array(shear(s, p.to_array()))
 }
 
 /// Cells `0..SPAN` along each axis hold every box.

@@ -14,6 +14,7 @@ use bsp_core::{Polygon, certify_solid_boundary};
 use bsp_csg::Solid;
 use bsp_fixtures::{Loop, Rng, crossing_along_diagonal, jittered_uv_sphere};
 
+use crate::boolean::shear;
 use crate::bytes::Bytes;
 use crate::report::fail;
 
@@ -107,7 +108,7 @@ pub fn certify_case(data: &[u8]) -> bool {
 /// the axes, two of them possibly negated).
 fn sheared_boxes(rng: &mut Rng) -> Vec<Loop> {
     let mut r = |n: u64| (rng.next_u64() % n) as i32;
-    let shear = [r(3) - 1, r(3) - 1, r(3) - 1];
+    let s = [r(3) - 1, r(3) - 1, r(3) - 1];
     let axes = [[0, 1, 2], [1, 2, 0], [2, 0, 1]][r(3) as usize];
     let signs = [[1, 1, 1], [-1, -1, 1], [-1, 1, -1], [1, -1, -1]][r(4) as usize];
     let turn = |p: [i32; 3]| [0, 1, 2].map(|i| signs[i] * p[axes[i]]);
@@ -120,12 +121,7 @@ fn sheared_boxes(rng: &mut Rng) -> Vec<Loop> {
             if inward {
                 quad.reverse();
             }
-            let [a, b, c] = shear;
-            loops.push(
-                quad.into_iter()
-                    .map(|[x, y, z]| turn([x + a * y + b * z, y + c * z, z]))
-                    .collect(),
-            );
+            loops.push(quad.into_iter().map(|p| turn(shear(s, p))).collect());
         }
     }
     loops
