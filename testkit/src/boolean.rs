@@ -9,10 +9,25 @@
 //! one integer shear (`x += a·y + b·z`, `y += c·z`): it maps the integer
 //! lattice onto itself and keeps volumes, so the answer is the same cells,
 //! sheared, and the faces are no longer axis-aligned.
+//!
+//! A byte after the shear may make the case curved ([`Curved`]): the
+//! first operand is then a UV sphere, and the second another sphere, a
+//! copy of the first moved by a power of two (down to below the grid
+//! step, and not at all), a half-size copy nested inside, or the boxes.
+//! No set of cells is the answer then; the check runs all three
+//! operations and asks, exactly, that each result be watertight, that
+//! the volumes obey `V(A ∪ B) + V(A ∩ B) = V(A) + V(B)` and
+//! `V(A − B) = V(A) − V(A ∩ B)` (the operands snapped to the same grid),
+//! and that at every vertex of both operands and at pseudo-random grid
+//! points, each result's winding number is the operation on the
+//! operands' (all symbolically displaced alike, so points on a surface
+//! are decided too).
 
 use bsp_core::BoolOp;
+use bsp_core::GridPoint;
+use bsp_csg::snap;
 use bsp_csg::{CsgError, MeshBuf, MeshIn, mesh_sequence};
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 
 use crate::bytes::Bytes;
 use crate::report::fail;
@@ -40,6 +55,51 @@ pub struct BooleanInput {
     /// The shear `[a, b, c]` of both operands: `x += a·y + b·z`,
     /// `y += c·z`; each in `-2..=2`.
     pub shear: [i32; 3],
+    /// A curved case: spheres in place of the first operand's boxes
+    /// (and of the second's, unless [`Partner::Boxes`]); `op` and the
+    /// shear are then not used.
+    pub curved: Option<Curved>,
+}
+
+/// A UV sphere: `4s(s − 1)` triangles for `stacks = s`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Ball {
+    /// Stacks, `3..=8`.
+    pub stacks: u8,
+    /// The radius, `1..=4`.
+    pub radius: u8,
+    /// The centre in half units, each `0..=8`.
+    pub centre: [u8; 3],
+    /// A turn about `(1, 2, 3)` by `0.37·turn` radians.
+    pub turn: u8,
+}
+
+/// The second operand of a curved case.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Partner {
+    /// Another sphere.
+    Ball(Ball),
+    /// The first sphere moved by `2^−shift · (1, 1/2, 1/4)`, `shift` in
+    /// `1..=47`, or not moved for `shift = 0`.
+    Copy {
+        /// The power of two.
+        shift: u8,
+    },
+    /// The first sphere at half its size, about its centre.
+    Nested,
+    /// The decoded boxes of [`BooleanInput::b`].
+    Boxes,
+}
+
+/// The spheres of a curved case (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Curved {
+    /// The first operand.
+    pub a: Ball,
+    /// The second.
+    pub b: Partner,
+    /// Seeds the pseudo-random probes.
+    pub probes: u8,
 }
 
 /// A shear coefficient from a byte: 0, 1, −1, 2, −2 (so that missing
@@ -132,11 +192,28 @@ impl BooleanInput {
         let a = decode_boxes(&mut b);
         let bb = decode_boxes(&mut b);
         let shear = [(); 3].map(|()| shear_of(b.below(5)));
+        let curved = (b.below(4) != 0).then(|| {
+            let a = Ball::decode(&mut b);
+            let partner = match b.below(4) {
+                0 => Partner::Ball(Ball::decode(&mut b)),
+                1 => Partner::Copy {
+                    shift: b.below(48) as u8,
+                },
+                2 => Partner::Nested,
+                _ => Partner::Boxes,
+            };
+            Curved {
+                a,
+                b: partner,
+                probes: b.u8(),
+            }
+        });
         BooleanInput {
             op,
             a,
             b: bb,
             shear,
+            curved,
         }
     }
 
@@ -144,6 +221,9 @@ impl BooleanInput {
     /// the number of unit cells inside the result, or `None` for an
     /// operand whose snapped volume is negative (refused as inward).
     pub fn check(&self) -> Option<usize> {
+        if let Some(c) = self.curved {
+            return self.check_curved(c);
+        }
         let (ma, mb) = (mesh(&self.a, self.shear), mesh(&self.b, self.shear));
         let (va, vb) = (
             MeshIn::new(&ma.positions, &ma.faces),
@@ -218,11 +298,158 @@ impl BooleanInput {
                 out.push(if bx.inward { 0 } else { 1 });
             }
         }
-        if self.shear != [0; 3] {
-            let byte = |v: i32| [0, 1, -1, 2, -2].iter().position(|&x| x == v).unwrap_or(0) as u8;
-            out.extend(self.shear.map(byte));
+        let byte = |v: i32| [0, 1, -1, 2, -2].iter().position(|&x| x == v).unwrap_or(0) as u8;
+        match self.curved {
+            None if self.shear == [0; 3] => {}
+            None => out.extend(self.shear.map(byte)),
+            Some(c) => {
+                out.extend(self.shear.map(byte));
+                out.push(1);
+                c.a.encode(&mut out);
+                match c.b {
+                    Partner::Ball(ball) => {
+                        out.push(0);
+                        ball.encode(&mut out);
+                    }
+                    Partner::Copy { shift } => out.extend([1, shift]),
+                    Partner::Nested => out.push(2),
+                    Partner::Boxes => out.push(3),
+                }
+                out.push(c.probes);
+            }
         }
         out
+    }
+
+    /// The check of a curved case (see the module docs); returns the
+    /// number of probes inside the union, or `None` if the boxes of
+    /// [`Partner::Boxes`] are refused as inward.
+    fn check_curved(&self, c: Curved) -> Option<usize> {
+        let (pa, fa) = c.a.mesh();
+        let (pb, fb) = match c.b {
+            Partner::Ball(ball) => ball.mesh(),
+            Partner::Copy { shift } => {
+                let d = if shift == 0 {
+                    DVec3::ZERO
+                } else {
+                    DVec3::new(1.0, 0.5, 0.25) * 2f64.powi(-i32::from(shift))
+                };
+                (pa.iter().map(|&p| p + d).collect(), fa.clone())
+            }
+            Partner::Nested => {
+                let o = c.a.centre();
+                (pa.iter().map(|&p| o + 0.5 * (p - o)).collect(), fa.clone())
+            }
+            Partner::Boxes => {
+                let m = mesh(&self.b, [0; 3]);
+                (m.positions, m.faces)
+            }
+        };
+        let (va, vb) = (MeshIn::new(&pa, &fa), MeshIn::new(&pb, &fb));
+        let snapped = match snap(&[va, vb]) {
+            Ok(s) => s,
+            Err(CsgError::Inward { .. }) => return None,
+            Err(e) => fail(self, format_args!("snapping failed: {e}")),
+        };
+        let [sa, sb] = [0, 1].map(|i| &snapped.solids[i]);
+        let grid = &snapped.grid;
+        // probes: every vertex of both, and grid points in their box
+        let mut probes: Vec<GridPoint> = pa
+            .iter()
+            .chain(&pb)
+            .filter_map(|&p| grid.snap(p).ok())
+            .collect();
+        let (lo, hi) = pa.iter().chain(&pb).fold(
+            (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        );
+        let mut state = u64::from(c.probes);
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..64 {
+            let t = DVec3::new(next(), next(), next());
+            if let Ok(g) = grid.snap(lo + t * (hi - lo)) {
+                probes.push(g);
+            }
+        }
+        let wa: Vec<bool> = probes.iter().map(|&q| sa.winding(q) > 0).collect();
+        let wb: Vec<bool> = probes.iter().map(|&q| sb.winding(q) > 0).collect();
+        let mut volumes = Vec::new();
+        let mut inside = 0;
+        for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
+            let out = match mesh_sequence(&va, &[(op, vb)]) {
+                Ok(out) => out,
+                Err(e) => fail(self, format_args!("{op:?} failed: {e}")),
+            };
+            if let Err(e) = out.mesh.check_watertight() {
+                fail(self, format_args!("the {op:?} is not watertight: {e}"));
+            }
+            for (k, &q) in probes.iter().enumerate() {
+                let want = match op {
+                    BoolOp::Union => wa[k] || wb[k],
+                    BoolOp::Intersection => wa[k] && wb[k],
+                    BoolOp::Difference => wa[k] && !wb[k],
+                };
+                let got = out.solid.winding(q);
+                if got != i32::from(want) {
+                    fail(
+                        self,
+                        format_args!(
+                            "{op:?}: winding {got} at grid point {q:?}, want {}",
+                            i32::from(want)
+                        ),
+                    );
+                }
+                inside += usize::from(want && op == BoolOp::Union);
+            }
+            volumes.push(out.mesh.volume_exact());
+        }
+        let (va, vb) = (sa.to_mesh().volume_exact(), sb.to_mesh().volume_exact());
+        let [u, i, d] = [0, 1, 2].map(|k| volumes[k].clone());
+        if u + i.clone() != va.clone() + vb {
+            fail(self, format_args!("V(A ∪ B) + V(A ∩ B) ≠ V(A) + V(B)"));
+        }
+        if d != va - i {
+            fail(self, format_args!("V(A − B) ≠ V(A) − V(A ∩ B)"));
+        }
+        Some(inside)
+    }
+}
+
+impl Ball {
+    fn decode(b: &mut Bytes<'_>) -> Ball {
+        Ball {
+            stacks: 3 + b.below(6) as u8,
+            radius: 1 + b.below(4) as u8,
+            centre: [(); 3].map(|()| b.below(9) as u8),
+            turn: b.u8(),
+        }
+    }
+
+    fn encode(&self, out: &mut Vec<u8>) {
+        out.extend([self.stacks - 3, self.radius - 1]);
+        out.extend(self.centre);
+        out.push(self.turn);
+    }
+
+    fn centre(&self) -> DVec3 {
+        DVec3::from_array(self.centre.map(|c| f64::from(c) / 2.0))
+    }
+
+    /// The sphere's positions and triangles.
+    fn mesh(&self) -> (Vec<DVec3>, Vec<Vec<u32>>) {
+        let s = usize::from(self.stacks);
+        let (v, f) = bsp_fixtures::shapes::uv_sphere(4 * s * (s - 1));
+        let turn = DMat3::from_axis_angle(
+            DVec3::new(1.0, 2.0, 3.0).normalize(),
+            0.37 * f64::from(self.turn),
+        );
+        let (r, o) = (f64::from(self.radius), self.centre());
+        (v.iter().map(|&p| o + r * (turn * p)).collect(), f)
     }
 }
 

@@ -41,7 +41,7 @@ mod files;
 mod merge;
 mod split;
 
-pub use boolean::{BooleanInput, IntBox, mesh_boolean_case};
+pub use boolean::{Ball, BooleanInput, Curved, IntBox, Partner, mesh_boolean_case};
 pub use build::*;
 use bytes::*;
 pub use certify::certify_case;
@@ -379,6 +379,7 @@ mod tests {
             a,
             b: bb,
             shear: [0; 3],
+            curved: None,
         };
         let ops = [
             BoolOpSeed::Union,
@@ -410,6 +411,37 @@ mod tests {
                 c.shear = shear;
                 v.push(c);
             }
+        }
+        // curved: overlapping spheres, a copy moved by nothing, by a bit
+        // and by less than the grid step, one nested, one with boxes
+        let ball = |stacks, radius, centre, turn| Ball {
+            stacks,
+            radius,
+            centre,
+            turn,
+        };
+        let a = ball(6, 2, [4, 4, 4], 0);
+        let partners = [
+            Partner::Ball(ball(5, 2, [5, 4, 3], 3)),
+            Partner::Ball(ball(4, 1, [4, 4, 8], 1)),
+            Partner::Copy { shift: 0 },
+            Partner::Copy { shift: 3 },
+            Partner::Copy { shift: 40 },
+            Partner::Nested,
+            Partner::Boxes,
+        ];
+        for (k, partner) in partners.into_iter().enumerate() {
+            let mut c = case(
+                bsp_core::BoolOp::Union,
+                vec![b([0, 0, 0], 1)],
+                vec![b([2, 1, 2], 3)],
+            );
+            c.curved = Some(Curved {
+                a,
+                b: partner,
+                probes: k as u8,
+            });
+            v.push(c);
         }
         v
     }
