@@ -57,7 +57,7 @@ pub use kernel::{
 };
 pub use solid::{
     ImportReport, SolidBoundary, SurfaceDefect, TopologyError, TriMesh, certify_solid_boundary,
-    check_closed_manifold, import_faces, import_faces_par, import_indexed_par,
+    check_closed_manifold, import_faces, import_faces_par, import_indexed_par, meeting_pairs,
 };
 pub use tree::{
     BoolOp, BspTree, BuildOptions, Cell, CellOp, FlatBsp, Link, Membership, Node, NodeId, Order,

@@ -552,7 +552,9 @@ fn sequence_error(e: SequenceError, names: &[String], op: BoolOp, grid: &Grid) -
     let crossing = match (e.stage, &e.error) {
         (Stage::Operation(1), CsgError::NotASolid) => Some(vec![1, 0]),
         (Stage::Operation(i), CsgError::NotASolid) => Some(vec![i]),
-        (Stage::Snap(i) | Stage::Operation(i), CsgError::TooLargeToResolve { .. }) => Some(vec![i]),
+        // the result of the operands before `i`, made by operations
+        (Stage::Operation(i), CsgError::TooLargeToResolve { .. }) => Some((0..i).collect()),
+        (Stage::Snap(i), CsgError::TooLargeToResolve { .. }) => Some(vec![i]),
         _ => None,
     };
     let message = match (e.stage, e.error) {

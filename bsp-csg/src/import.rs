@@ -176,9 +176,7 @@ pub fn snap_one(
     // several shells may cross, overlap or nest: their solid is where the
     // winding number is positive (one shell is clean or crosses itself;
     // see the crate docs)
-    // (a surface too large for that is taken as it is: its shells must
-    // then bound apart, as they did before)
-    let solid = match shells(mesh) > 1 && solid.len() <= crate::RESOLVE_LIMIT {
+    let solid = match shells(mesh) > 1 {
         true => solid.resolved()?,
         false => solid,
     };

@@ -23,6 +23,7 @@ mod local;
 mod mixed_cell;
 mod octree;
 mod operands;
+mod resolve;
 mod settle;
 
 use bsp_core::internals::ConvexFace;
@@ -42,7 +43,8 @@ use settle::{
     FacePiece, PiecedFace, Remains, SettledFace, SortedFaces, meeting_leaf, settle, sort_faces,
 };
 
-/// The most faces [`Solid::resolved`] takes: one partition of every face
+/// The most faces [`Solid::resolved`] takes for a solid made by an
+/// operation (faces with corners off the grid): one partition of every face
 /// of a smooth closed surface of 20,000 faces takes about 2 s on the
 /// machine of `docs/bench-csg.md`, and it grows faster than the faces.
 pub const RESOLVE_LIMIT: usize = 20_000;
@@ -95,19 +97,41 @@ impl Solid {
     /// copies of a part, a part inside another turned the same way, a
     /// cavity outside any part), the solid those shells bound by the
     /// rule of mesh-arrangement Booleans; for a clean solid, the same
-    /// solid. Exact; one partition of every face, so it costs more than
-    /// an operation does.
+    /// solid. Exact.
     ///
-    /// A partition of a smooth closed surface can grow much faster than
-    /// its faces, so a surface of more than [`RESOLVE_LIMIT`] faces is
-    /// refused ([`CsgError::TooLargeToResolve`]).
-    pub fn resolved(self) -> Result<Solid, CsgError> {
-        if self.len() > RESOLVE_LIMIT {
-            return Err(CsgError::TooLargeToResolve { faces: self.len() });
+    /// A surface of faces with grid corners (as snapped from a mesh) is
+    /// resolved cell by cell: partitions only where faces meet, one small
+    /// partition per edge-connected part elsewhere (`plan/resolve.rs`),
+    /// and the faces that meet nothing kept whole. A solid made by an
+    /// operation (corners off the grid) takes one partition of every
+    /// face, which can grow much faster than the faces; such a surface of
+    /// more than [`RESOLVE_LIMIT`] faces is refused
+    /// ([`CsgError::TooLargeToResolve`]).
+    pub fn resolved(mut self) -> Result<Solid, CsgError> {
+        if self.resolved {
+            return Ok(self);
         }
-        let faces: Vec<bsp_core::Polygon> = self.polygons().map(|p| p.into_owned()).collect();
-        drop_aside(self);
-        Ok(Solid::from_polygons(local::positive_region(faces)?))
+        let mut out = match resolve::resolve_locally(&self)? {
+            resolve::Resolved::Unchanged => {
+                self.resolved = true;
+                return Ok(self);
+            }
+            resolve::Resolved::Faces(faces) => {
+                drop_aside(self);
+                Solid::from_polygons(faces)
+            }
+            resolve::Resolved::OffGrid if self.len() > RESOLVE_LIMIT => {
+                return Err(CsgError::TooLargeToResolve { faces: self.len() });
+            }
+            resolve::Resolved::OffGrid => {
+                let faces: Vec<bsp_core::Polygon> =
+                    self.polygons().map(|p| p.into_owned()).collect();
+                drop_aside(self);
+                Solid::from_polygons(local::positive_region(faces)?)
+            }
+        };
+        out.resolved = true;
+        Ok(out)
     }
 
     /// `self op other`, as a new solid.
@@ -180,17 +204,26 @@ impl Solid {
     /// ```
     ///
     /// Where a surface turns out to cross itself (the local winding
-    /// numbers disagree), both solids are [resolved](Solid::resolved) and
-    /// the operation is planned again: what it decides then is the
+    /// numbers disagree), `other` is [resolved](Solid::resolved) and the
+    /// operation planned again, and if that still fails, this solid too: what it decides then is the
     /// operation on the solids where the winding numbers are positive.
     pub fn plan_owned(mut self, mut other: Solid, op: BoolOp) -> Result<Planned, CsgError> {
         let opts = Options::default();
         // (a failed plan changed neither solid)
         let (stats, additions) = match self.plan(&other, op, &opts) {
-            Err(CsgError::NotASolid) if self.len().max(other.len()) <= RESOLVE_LIMIT => {
-                self = self.resolved()?;
+            Err(CsgError::NotASolid) => {
+                // the operand coming in first (it is usually fresh from a
+                // file; a solid made by operations on resolved solids is
+                // resolved already, and one that is not may be too large
+                // to resolve whole)
                 other = other.resolved()?;
-                self.plan(&other, op, &opts)?
+                match self.plan(&other, op, &opts) {
+                    Err(CsgError::NotASolid) => {
+                        self = self.resolved()?;
+                        self.plan(&other, op, &opts)?
+                    }
+                    planned => planned?,
+                }
             }
             planned => planned?,
         };

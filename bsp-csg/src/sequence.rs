@@ -245,20 +245,11 @@ fn operate<M: AsMeshIn>(
     let mut solid = snap_operand(grid, first, 0, on_step)?;
     if rest.len() == 0 {
         // a sequence of one: its solid, cleaned (a shell that crosses
-        // itself bounds where its winding number is positive); a surface
-        // too large to resolve is kept if it is certified clean already (one
-        // part: nested parts are certified too, yet count twice)
+        // itself bounds where its winding number is positive)
         let stage = Stage::Snap(0);
-        let clean = solid.len() > crate::RESOLVE_LIMIT && {
-            let polys: Vec<bsp_core::Polygon> = solid.polygons().map(|p| p.into_owned()).collect();
-            // one part, embedded and outward: a clean solid
-            bsp_core::certify_solid_boundary(&polys).is_ok_and(|b| b.parts == 1)
-        };
-        if !clean {
-            solid = solid
-                .resolved()
-                .map_err(|error| SequenceError { stage, error })?;
-        }
+        solid = solid
+            .resolved()
+            .map_err(|error| SequenceError { stage, error })?;
     }
     let mut operand = 0;
     while let Some((op, mesh)) = rest.next() {

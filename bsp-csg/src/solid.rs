@@ -47,6 +47,9 @@ pub struct Solid {
     bounds: Option<IBox>,
     /// The number of live faces.
     live: usize,
+    /// The faces are known to bound where their winding number is
+    /// positive ([`Solid::resolved`] made them, or found them so).
+    pub(crate) resolved: bool,
 }
 
 impl Solid {
@@ -74,6 +77,7 @@ impl Solid {
             indexed: live.max(1),
             scans: Scans::default(),
             bounds: None,
+            resolved: false,
         };
         s.bounds = s.faces_bounds();
         s

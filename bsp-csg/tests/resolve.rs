@@ -4,7 +4,7 @@
 //! surface as given; and such surfaces as operands of Booleans.
 
 use bsp_core::{BoolOp, Polygon};
-use bsp_csg::files::{FileBoolean, Operand, find_crossing};
+use bsp_csg::files::{FileBoolean, FileError, Operand, find_crossing};
 use bsp_csg::{MeshBuf, MeshIn, Solid, mesh_sequence};
 use bsp_fixtures::{self as shapes, GridPoint, Loop, Rng};
 use glam::DVec3;
@@ -277,16 +277,16 @@ fn results_that_round_flat_are_split_and_closed() {
     assert!(flattened > 0);
 }
 
-/// A union of one surface too large to resolve is kept as it is when the
-/// certificate says it bounds a solid already (one part, embedded,
-/// outward); one that nests is refused with the limit named.
+/// A union of one large surface: a clean one is kept face for face; one
+/// sphere inside another, both outward, is the outer sphere alone.
+/// Resolved cell by cell (more than the 20,000 faces one partition of
+/// every face takes).
 #[test]
-fn a_large_clean_surface_alone_is_kept() {
+fn a_large_surface_alone_is_kept_or_resolved_cell_by_cell() {
     let (a, _, faces) = shapes::sphere_pair(2 * bsp_csg::RESOLVE_LIMIT);
     assert!(faces.len() > bsp_csg::RESOLVE_LIMIT);
-    let out = mesh_sequence(&MeshIn::new(&a, &faces), &[]).unwrap();
-    assert_eq!(out.mesh.triangles.len(), faces.len());
-    // the same sphere twice, one inside the other: too large to resolve
+    let alone = mesh_sequence(&MeshIn::new(&a, &faces), &[]).unwrap();
+    assert_eq!(alone.mesh.triangles.len(), faces.len());
     let inner: Vec<DVec3> = a.iter().map(|&p| p * 0.5).collect();
     let mut both = a.clone();
     both.extend(inner);
@@ -297,17 +297,21 @@ fn a_large_clean_surface_alone_is_kept() {
             .iter()
             .map(|f| f.iter().map(|&v| v + n).collect::<Vec<u32>>()),
     );
-    let Err(e) = mesh_sequence(&MeshIn::new(&both, &two), &[]) else {
-        panic!("nested shells too large to resolve were accepted");
-    };
-    assert!(e.to_string().contains("too large to resolve"), "{e}");
+    let nested = mesh_sequence(&MeshIn::new(&both, &two), &[]).unwrap();
+    nested.mesh.check_watertight().unwrap();
+    assert_eq!(nested.mesh.triangles.len(), faces.len());
+    // the same grid (the outer sphere holds every position), the same solid
+    assert_eq!(nested.grid, alone.grid);
+    let ((n1, d1), (n2, d2)) = (nested.mesh.six_volume(), alone.mesh.six_volume());
+    assert_eq!(n1 * d2, n2 * d1);
 }
 
-/// One file holding two overlapping spheres of 12,000 triangles each, too
-/// large to resolve: the error says the surface crosses itself and where,
-/// one face of each sphere and a point on both.
+/// One file holding two overlapping spheres of 12,000 triangles each,
+/// more than one partition of every face takes: its union of one is the
+/// union of the two spheres as two operands, to the exact volume; and
+/// `find_crossing` names one face of each sphere and a point on both.
 #[test]
-fn a_crossing_too_large_to_resolve_is_located() {
+fn two_large_crossing_shells_resolve_to_their_union() {
     let (a, b, faces) = shapes::sphere_pair(12_000);
     let n = a.len() as u32;
     let positions: Vec<DVec3> = a.iter().chain(&b).copied().collect();
@@ -316,14 +320,20 @@ fn a_crossing_too_large_to_resolve_is_located() {
         .cloned()
         .chain(faces.iter().map(|f| f.iter().map(|v| v + n).collect()))
         .collect();
+    assert!(both.len() > bsp_csg::RESOLVE_LIMIT);
+    let one = mesh_sequence(&MeshIn::new(&positions, &both), &[]).unwrap();
+    one.mesh.check_watertight().unwrap();
+    let two = mesh_sequence(
+        &MeshIn::new(&a, &faces),
+        &[(BoolOp::Union, MeshIn::new(&b, &faces))],
+    )
+    .unwrap();
+    assert_eq!(one.grid, two.grid);
+    let ((n1, d1), (n2, d2)) = (one.mesh.six_volume(), two.mesh.six_volume());
+    assert_eq!(n1 * d2, n2 * d1, "the resolved volume is the union's");
+    // where the file crosses itself
     let mesh = shadow_scene::parse_obj(&obj_text(&positions, &both), "two.obj").unwrap();
-    assert!(mesh.faces.len() > bsp_csg::RESOLVE_LIMIT);
-    let mut one = [Operand::new("two.obj", mesh.clone())];
-    let checked = Operand::check_all(&mut one).unwrap();
-    let e = FileBoolean::apply(checked, BoolOp::Union, |_, _| {}).unwrap_err();
-    assert!(e.message.contains("too large to resolve"), "{}", e.message);
-    let (operands, grid) = e.crossing.clone().expect("a crossing to locate");
-    assert_eq!(operands, vec![0]);
+    let grid = one.grid;
     let c = find_crossing(&mesh, &grid).expect("the certificate finds the pair");
     let half = faces.len();
     assert!((c.faces[0] < half) != (c.faces[1] < half), "{c}");
@@ -334,9 +344,14 @@ fn a_crossing_too_large_to_resolve_is_located() {
         let r = (c.point - centre(sphere)).length();
         assert!((r - 1.0).abs() < 0.01, "{c}: {r} from a centre");
     }
-    // the same, read again from the file the operand came from
+    // the same, read again from the file an operand came from
     let path = std::env::temp_dir().join(format!("two-{}.obj", std::process::id()));
     std::fs::write(&path, obj_text(&positions, &both)).unwrap();
+    let e = FileError {
+        message: String::new(),
+        weld_may_help: false,
+        crossing: Some((vec![0], grid)),
+    };
     let at = e.locate_crossing(&[path.display().to_string()]);
     std::fs::remove_file(&path).unwrap();
     assert_eq!(at, Some(format!("{}: {c}", path.display())));

@@ -534,12 +534,16 @@ fn a_union_of_one_cleans_shells_that_overlap_or_nest() {
     assert_eq!(stat(&stdout(&o), "volume:").split(' ').next(), Some("16"));
 }
 
-/// Two overlapping UV spheres of 12,100 triangles each in one OBJ text.
-fn two_spheres_obj() -> String {
+/// The second sphere's centre of [`spheres_obj`]'s overlapping pair.
+const SECOND: DVec3 = DVec3::new(0.9, 0.2, 0.1);
+
+/// Unit UV spheres of 12,100 triangles each around `centres`, in one OBJ
+/// text.
+fn spheres_obj(centres: &[DVec3]) -> String {
     let (nu, nv) = (110, 56);
     let mut s = String::new();
     let mut faces = Vec::new();
-    for (k, c) in [DVec3::ZERO, DVec3::new(0.9, 0.2, 0.1)].iter().enumerate() {
+    for (k, c) in centres.iter().enumerate() {
         let first = 1 + k * (2 + (nv - 1) * nu);
         let ring = |i: usize, j: usize| first + 1 + (i - 1) * nu + j % nu;
         let top = first + 1 + (nv - 1) * nu;
@@ -568,9 +572,14 @@ fn two_spheres_obj() -> String {
     s
 }
 
+/// Two overlapping spheres in one file, more faces than one partition
+/// of every face takes: resolved cell by cell, the union of one is the
+/// union of the two spheres as two files, to the exact volume.
 #[test]
-fn a_crossing_too_large_to_resolve_names_two_faces_and_a_point() {
-    let two = write("two_spheres.obj", &two_spheres_obj());
+fn two_large_crossing_shells_in_one_file_resolve_to_their_union() {
+    let two = write("two_spheres.obj", &spheres_obj(&[DVec3::ZERO, SECOND]));
+    let a = write("sphere_a.obj", &spheres_obj(&[DVec3::ZERO]));
+    let b = write("sphere_b.obj", &spheres_obj(&[SECOND]));
     let out = scratch("two_spheres_u.obj");
     let o = shadow(&[
         "csg",
@@ -578,15 +587,18 @@ fn a_crossing_too_large_to_resolve_names_two_faces_and_a_point() {
         two.to_str().unwrap(),
         "-o",
         out.to_str().unwrap(),
+        "--stats",
     ]);
-    assert_failed_with(
-        &o,
-        &[
-            "too large to resolve",
-            "two_spheres.obj: faces ",
-            "(line ",
-            "cross near ",
-        ],
-    );
-    assert!(!out.exists());
+    assert_ok(&o);
+    closed_result(&out);
+    let o2 = csg("union", &a, &b, &scratch("spheres_ab.obj"), &["--stats"]);
+    assert_ok(&o2);
+    let volume = |o: &Output| {
+        stat(&stdout(o), "volume:")
+            .split(' ')
+            .next()
+            .map(String::from)
+    };
+    assert_eq!(volume(&o), volume(&o2));
+    assert!(volume(&o).is_some());
 }

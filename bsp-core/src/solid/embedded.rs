@@ -45,6 +45,8 @@
 //!    `±1` inside and `0` outside, with the sign of its volume, so every
 //!    part positive gives `w ≥ 0`.
 
+use std::ops::ControlFlow;
+
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
@@ -210,6 +212,35 @@ fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefec
         });
     }
     Ok(SolidBoundary { lo, hi, parts })
+}
+
+/// Every pair of polygons `[i, j]` (`i < j`, sorted, each once) whose
+/// fan triangles the test of step 2 of the module docs does not find
+/// apart: polygons that cross, overlap or touch other than in shared
+/// vertices and edges, or that the test cannot tell apart (it is
+/// conservative). No pair of polygons that meet elsewhere is left out.
+/// Nothing needs to be closed; `Err` only for a vertex off the grid.
+pub fn meeting_pairs(polys: &[Polygon]) -> Result<Vec<[usize; 2]>, SurfaceDefect> {
+    let loops = Loops::new(polys)?;
+    let lo = loops
+        .pts
+        .iter()
+        .fold([i32::MAX; 3], |m, p| [0, 1, 2].map(|k| m[k].min(p[k])));
+    let hi = loops
+        .pts
+        .iter()
+        .fold([i32::MIN; 3], |m, p| [0, 1, 2].map(|k| m[k].max(p[k])));
+    let (tris, _) = loops.fan_triangles(&mut UnionFind::new(polys.len()));
+    let mut pairs = Vec::new();
+    each_overlapping_pair(&tris, lo, hi, |s, t| {
+        if s.poly != t.poly && !apart(s, t) {
+            pairs.push([s.poly.min(t.poly) as usize, s.poly.max(t.poly) as usize]);
+        }
+        ControlFlow::Continue(())
+    });
+    pairs.sort_unstable();
+    pairs.dedup();
+    Ok(pairs)
 }
 
 /// The polygons' loops as grid points, every corner's point numbered by
@@ -470,8 +501,27 @@ fn overlapping_pairs(
     hi: GridPoint,
     mut fine: impl FnMut(&Tri, &Tri) -> bool,
 ) -> Option<(u32, u32)> {
+    let mut refused = None;
+    each_overlapping_pair(tris, lo, hi, |s, t| {
+        if fine(s, t) {
+            return ControlFlow::Continue(());
+        }
+        refused = Some((s.poly.min(t.poly), s.poly.max(t.poly)));
+        ControlFlow::Break(())
+    });
+    refused
+}
+
+/// Calls `visit` on each pair of triangles whose closed boxes overlap,
+/// once, until it breaks (see [`overlapping_pairs`]).
+fn each_overlapping_pair(
+    tris: &[Tri],
+    lo: GridPoint,
+    hi: GridPoint,
+    mut visit: impl FnMut(&Tri, &Tri) -> ControlFlow<()>,
+) {
     if tris.len() < 2 {
-        return None;
+        return;
     }
     // cells of the median of the triangles' largest box extents, grown
     // until there are at most 8 cells a triangle
@@ -545,15 +595,15 @@ fn overlapping_pairs(
                 // the cell of the common part's low corner: the larger of
                 // the two low cells
                 let (cs, ct) = (cells[si].0, cells[ti].0);
-                let (s, t) = (&tris[si], &tris[ti]);
-                if key([0, 1, 2].map(|k| cs[k].max(ct[k]))) != k || fine(s, t) {
+                if key([0, 1, 2].map(|k| cs[k].max(ct[k]))) != k {
                     continue;
                 }
-                return Some((s.poly.min(t.poly), s.poly.max(t.poly)));
+                if visit(&tris[si], &tris[ti]).is_break() {
+                    return;
+                }
             }
         }
     }
-    None
 }
 
 /// `true` if the closed triangles `s` and `t` (each with area) meet at

@@ -7,7 +7,7 @@ pub(crate) mod import;
 pub(crate) mod mesh;
 pub(crate) mod topology;
 
-pub use embedded::{SolidBoundary, SurfaceDefect, certify_solid_boundary};
+pub use embedded::{SolidBoundary, SurfaceDefect, certify_solid_boundary, meeting_pairs};
 pub use import::{
     FaceImporter, ImportReport, all_planar, import_faces, import_faces_par, import_indexed_par,
     snap_positions,

@@ -35,7 +35,7 @@
 
 use bsp_core::internals::{ConvexFace, PLink, Parts, merge_smaller_into_larger};
 use bsp_core::{
-    BoolOp, BspTree, BuildOptions, Cell, Link, Partition, Plane, Polygon, PolygonSide, Side,
+    BoolOp, BspTree, BuildOptions, Cell, Link, Partition, Plane, Polygon, PolygonSide, Side, Split,
 };
 
 use super::octree::walls;
@@ -217,16 +217,48 @@ pub(crate) fn positive_region(faces: Vec<Polygon>) -> Result<Vec<Polygon>, CsgEr
     let bx: IBox = (bx.0.map(|c| c - 2), bx.1.map(|c| c + 2));
     let tree = BspTree::build(faces, &BuildOptions::default());
     let (part, leaves) = Partition::from_tree_in(&tree, &walls(&bx));
+    let corner = bsp_core::Point::Grid(corner.map(|c| c as i32));
+    let start = part.locate(&corner);
+    let w = carry_windings(&part, leaves, &start, 0)?;
+    Ok(positive_boundary(&part, &w))
+}
+
+/// The boundary, outward, of the leaves of `part` whose winding number
+/// `w[leaf]` is positive.
+pub(crate) fn positive_boundary(part: &Partition<u32>, w: &[i32]) -> Vec<Polygon> {
+    let region = part.map_labels(|l| {
+        if w[l as usize] > 0 {
+            Cell::In
+        } else {
+            Cell::Out
+        }
+    });
+    match region.root() {
+        PLink::Leaf(_) => Vec::new(),
+        PLink::Node(_) => region.boundary(),
+    }
+}
+
+/// The winding numbers of the `leaves` leaves of `part` (an
+/// autopartition of faces that may cross, overlap or nest: [`layers`]),
+/// carried from `start`, the leaves where it is `w0`, across every piece
+/// of every sub-hyperplane. `Err(NotASolid)` where they disagree around
+/// a loop (a surface that is not closed).
+fn carry_windings(
+    part: &Partition<u32>,
+    leaves: u32,
+    start: &[u32],
+    w0: i32,
+) -> Result<Vec<i32>, CsgError> {
     let mut adj: Vec<Vec<(u32, i32)>> = vec![Vec::new(); leaves as usize];
-    for (f, b, c) in links(&part, layers) {
+    for (f, b, c) in links(part, layers) {
         adj[f as usize].push((b, c));
         adj[b as usize].push((f, -c));
     }
     let mut w: Vec<Option<i32>> = vec![None; leaves as usize];
-    let corner = bsp_core::Point::Grid(corner.map(|c| c as i32));
-    let mut queue = part.locate(&corner);
+    let mut queue = start.to_vec();
     for &l in &queue {
-        w[l as usize] = Some(0);
+        w[l as usize] = Some(w0);
     }
     while let Some(l) = queue.pop() {
         let v = w[l as usize].expect("queued leaves are labelled");
@@ -241,18 +273,92 @@ pub(crate) fn positive_region(faces: Vec<Polygon>) -> Result<Vec<Polygon>, CsgEr
             }
         }
     }
-    let cells: Vec<Cell> = w
-        .iter()
-        .map(|v| match v {
-            Some(x) if *x > 0 => Cell::In,
-            _ => Cell::Out,
-        })
-        .collect();
-    let region = part.map_labels(|l| cells[l as usize]);
-    Ok(match region.root() {
-        PLink::Leaf(_) => Vec::new(),
-        PLink::Node(_) => region.boundary(),
-    })
+    // every leaf is reached: the partition's cells are connected
+    Ok(w.into_iter().map(|v| v.unwrap_or(0)).collect())
+}
+
+/// The partition of `pieces` (faces that may cross, overlap or nest,
+/// clipped to the cell `bx`) in the cell, and the winding number of every
+/// leaf, carried from `wc`, the surface's winding number at the grid
+/// point `c` of the cell displaced by `(ε³, ε, ε²)` (as
+/// [`Solid::winding`](crate::Solid::winding) gives it).
+pub(crate) fn cell_windings(
+    bx: &IBox,
+    pieces: Vec<Polygon>,
+    c: bsp_core::GridPoint,
+    wc: i32,
+) -> Result<(Partition<u32>, Vec<i32>), CsgError> {
+    let tree = BspTree::build(pieces, &local_build());
+    let (part, leaves) = Partition::from_tree_in(&tree, &walls(bx));
+    let start = [locate_displaced(&part, c)];
+    let w = carry_windings(&part, leaves, &start, wc)?;
+    Ok((part, w))
+}
+
+/// The leaf of `part` holding the grid point `c` displaced by
+/// `(ε³, ε, ε²)`: on a node's plane, the side of the displacement, the
+/// sign of the first non-zero of the normal's `y`, `z`, `x`.
+fn locate_displaced(part: &Partition<u32>, c: bsp_core::GridPoint) -> u32 {
+    let mut link = part.root();
+    loop {
+        match link {
+            PLink::Leaf(l) => return l,
+            PLink::Node(i) => {
+                let n = &part.nodes()[i as usize];
+                let side = match n.plane.classify_grid(c) {
+                    Side::On => {
+                        let [x, y, z] = n.plane.normal();
+                        let first = [y, z, x].into_iter().find(|&v| v != 0).unwrap_or(0);
+                        if first > 0 { Side::Front } else { Side::Back }
+                    }
+                    s => s,
+                };
+                link = if side == Side::Front { n.front } else { n.back };
+            }
+        }
+    }
+}
+
+/// The winding numbers in front of and behind `piece` (part of a face
+/// among the pieces `part` was built from, that no other face meets):
+/// the leaf it lies against on its front side, and its back side.
+pub(crate) fn side_windings(
+    part: &Partition<u32>,
+    w: &[i32],
+    piece: &Polygon,
+) -> Option<(i32, i32)> {
+    let mut link = part.root();
+    let mut piece = piece.clone();
+    // whether the node whose plane holds the piece faces the piece's way
+    let mut facing: Option<bool> = None;
+    loop {
+        match link {
+            PLink::Leaf(l) => {
+                let wl = w[l as usize];
+                return match facing? {
+                    true => Some((wl, wl + 1)),
+                    false => Some((wl - 1, wl)),
+                };
+            }
+            PLink::Node(i) => {
+                let n = &part.nodes()[i as usize];
+                link = match piece.clone().split(&n.plane) {
+                    Split::Front(_) => n.front,
+                    Split::Back(_) => n.back,
+                    Split::Spanning { front, .. } => {
+                        piece = front;
+                        n.front
+                    }
+                    Split::Coplanar {
+                        same_orientation, ..
+                    } => {
+                        facing = Some(same_orientation);
+                        n.front
+                    }
+                };
+            }
+        }
+    }
 }
 
 /// The boundary of `a op b` inside the cell `bx`, from the two operands'

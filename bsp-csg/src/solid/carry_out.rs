@@ -82,6 +82,11 @@ impl Solid {
     /// each moved or copied once; the index takes them while the new
     /// faces' equal new vertices are made one.
     pub(crate) fn carry_out(&mut self, additions: Additions, other: OtherFaces<'_>) {
+        // an operation on two resolved solids gives one
+        self.resolved &= match &other {
+            OtherFaces::Copied(o) => o.resolved,
+            OtherFaces::Moved(o) => o.resolved,
+        };
         let from = sources(additions.faces, other);
         let n = from.len();
         let (ids, new_slots) = self.write_faces(from, additions.flip);

@@ -1,0 +1,277 @@
+//! Resolving a surface that crosses, overlaps or nests in itself, cell by
+//! cell: the solid where its winding number is positive, with a
+//! partition only where faces meet.
+//!
+//! 1. **Where faces meet.** The pairs of faces that meet other than in
+//!    shared vertices and edges ([`bsp_core::meeting_pairs`], exact and
+//!    conservative) mark the cells of a uniform grid that hold the common
+//!    box of each pair: the *dirty* cells. Cells are integer boxes whose
+//!    walls lie half-way between grid planes, so no face with grid
+//!    corners lies in a wall.
+//! 2. **Dirty cells.** In each, the faces near it, clipped to it, are
+//!    partitioned, and the winding number is carried from the cell's low
+//!    corner (displaced as [`Solid::winding`] displaces it, and found by
+//!    a ray through the whole surface) across every piece; what stays is
+//!    the boundary of the leaves with a positive number.
+//! 3. **Clean parts.** What lies outside every dirty cell meets nothing:
+//!    each face there keeps one winding number in front and one behind,
+//!    the same across an edge shared once each way (at a point outside
+//!    the dirty cells). Each edge-connected part gets its numbers from one
+//!    small partition around one of its pieces, and is kept whole where
+//!    they are 0 in front and 1 behind, dropped otherwise.
+//!
+//! Every decision is exact, and the cost grows with the faces near the
+//! places where the surface meets itself, not with the whole surface.
+
+use bsp_core::internals::UnionFind;
+use bsp_core::{GridPoint, Polygon, Split, meeting_pairs};
+use rayon::prelude::*;
+use rustc_hash::{FxHashMap, FxHashSet};
+
+use super::local::{cell_windings, positive_boundary, side_windings};
+use super::octree::walls;
+use crate::index::{IBox, overlaps, polygon_box};
+use crate::{CsgError, Solid};
+
+/// A cell of the uniform grid: its integer position.
+type CellKey = [i64; 3];
+
+/// The uniform grid of cells: cell `k` along an axis holds the grid
+/// coordinates `origin + k·size ..= origin + (k + 1)·size − 1`.
+struct Cells {
+    origin: [i64; 3],
+    size: i64,
+    dirty: FxHashSet<CellKey>,
+}
+
+impl Cells {
+    fn key(&self, p: [i64; 3]) -> CellKey {
+        [0, 1, 2].map(|k| (p[k] - self.origin[k]).div_euclid(self.size))
+    }
+
+    fn cell_box(&self, c: CellKey) -> IBox {
+        let lo = [0, 1, 2].map(|k| self.origin[k] + c[k] * self.size);
+        (lo, lo.map(|x| x + self.size - 1))
+    }
+
+    /// The cells whose real extent meets the integer box `b`.
+    fn keys_of(&self, b: &IBox) -> impl Iterator<Item = CellKey> {
+        let (lo, hi) = (self.key(b.0), self.key(b.1));
+        (lo[2]..=hi[2]).flat_map(move |z| {
+            (lo[1]..=hi[1]).flat_map(move |y| (lo[0]..=hi[0]).map(move |x| [x, y, z]))
+        })
+    }
+
+    /// The dirty cells meeting the box `b`.
+    fn dirty_near(&self, b: &IBox) -> Vec<CellKey> {
+        let (lo, hi) = (self.key(b.0), self.key(b.1));
+        let span: i64 = (0..3).map(|k| hi[k] - lo[k] + 1).product();
+        let mut out: Vec<CellKey> = if span as usize <= self.dirty.len() {
+            self.keys_of(b).filter(|c| self.dirty.contains(c)).collect()
+        } else {
+            self.dirty
+                .iter()
+                .filter(|c| (0..3).all(|k| lo[k] <= c[k] && c[k] <= hi[k]))
+                .copied()
+                .collect()
+        };
+        out.sort_unstable();
+        out
+    }
+}
+
+/// The faces of `solid` near `bx`, clipped to the cell (its closed real
+/// extent).
+fn clipped_to(solid: &Solid, bx: &IBox) -> Vec<Polygon> {
+    let w = walls(bx);
+    solid
+        .faces_near(bx)
+        .into_iter()
+        .filter_map(|i| {
+            let mut p = solid.face(i).polygon().into_owned();
+            w.iter()
+                .all(|wall| p.clip(wall, bsp_core::Side::Back))
+                .then_some(p)
+        })
+        .collect()
+}
+
+/// The parts of `p` outside the cells `cells` (convex pieces).
+fn outside(p: Polygon, cells: &Cells, near: &[CellKey]) -> Vec<Polygon> {
+    let mut pieces = vec![p];
+    for &c in near {
+        let bx = cells.cell_box(c);
+        let mut next = Vec::with_capacity(pieces.len());
+        for piece in pieces {
+            if !overlaps(&polygon_box(&piece), &bx) {
+                next.push(piece);
+                continue;
+            }
+            // peel the parts in front of each wall off; what is left
+            // after the six is inside the cell
+            let mut rest = Some(piece);
+            for wall in walls(&bx) {
+                let Some(r) = rest.take() else { break };
+                match r.split(&wall) {
+                    Split::Front(f) => next.push(f),
+                    Split::Back(b) => rest = Some(b),
+                    Split::Spanning { front, back } => {
+                        next.push(front);
+                        rest = Some(back);
+                    }
+                    // a face with grid corners never lies in a wall
+                    Split::Coplanar { polygon, .. } => next.push(polygon),
+                }
+            }
+        }
+        pieces = next;
+    }
+    pieces
+}
+
+/// What [`resolve_locally`] finds.
+pub(crate) enum Resolved {
+    /// A face has a corner off the grid (a solid made by an operation):
+    /// only the partition of every face resolves it.
+    OffGrid,
+    /// No two faces meet, and every face bounds the positive region
+    /// already: the solid as it is.
+    Unchanged,
+    /// The boundary of the positive region.
+    Faces(Vec<Polygon>),
+}
+
+/// The boundary of the points where the winding number of `solid`'s
+/// surface is positive (see the module docs).
+pub(crate) fn resolve_locally(solid: &Solid) -> Result<Resolved, CsgError> {
+    let ids: Vec<u32> = solid.face_ids().collect();
+    let owned: Vec<Polygon> = ids
+        .iter()
+        .map(|&i| solid.face(i).polygon().into_owned())
+        .collect();
+    let Ok(pairs) = meeting_pairs(&owned) else {
+        return Ok(Resolved::OffGrid);
+    };
+    let boxes: Vec<IBox> = owned.iter().map(polygon_box).collect();
+    let Some(bounds) = boxes
+        .iter()
+        .copied()
+        .reduce(|a, b| crate::index::union(&a, &b))
+    else {
+        return Ok(Resolved::Unchanged);
+    };
+    // cells of twice the median face extent
+    let mut ext: Vec<i64> = boxes
+        .iter()
+        .map(|b| (0..3).map(|k| b.1[k] - b.0[k]).max().unwrap_or(0))
+        .collect();
+    let mid = ext.len() / 2;
+    let size = (2 * *ext.select_nth_unstable(mid).1).max(2);
+    let mut cells = Cells {
+        origin: bounds.0,
+        size,
+        dirty: FxHashSet::default(),
+    };
+    for &[i, j] in &pairs {
+        if let Some(common) = crate::index::intersect(&boxes[i], &boxes[j]) {
+            let keys: Vec<CellKey> = cells.keys_of(&common).collect();
+            cells.dirty.extend(keys);
+        }
+    }
+    let mut dirty: Vec<CellKey> = cells.dirty.iter().copied().collect();
+    dirty.sort_unstable();
+    // 2. the dirty cells, each on its own
+    let inside: Vec<Vec<Polygon>> = dirty
+        .par_iter()
+        .map(|&c| {
+            let bx = cells.cell_box(c);
+            let corner = bx.0.map(|x| x as i32);
+            let wc = solid.winding(corner);
+            let (part, w) = cell_windings(&bx, clipped_to(solid, &bx), corner, wc)?;
+            Ok(positive_boundary(&part, &w))
+        })
+        .collect::<Result<_, CsgError>>()?;
+    // 3. the clean parts: each face's pieces outside the dirty cells
+    let rest: Vec<Vec<Polygon>> = owned
+        .into_par_iter()
+        .zip(&boxes)
+        .map(|(p, b)| {
+            let near = cells.dirty_near(b);
+            if near.is_empty() {
+                vec![p]
+            } else {
+                outside(p, &cells, &near)
+            }
+        })
+        .collect();
+    let parts = clean_parts(solid, &ids, &rest, &cells);
+    // one probe per part: its first face's first piece
+    let mut first: FxHashMap<u32, usize> = FxHashMap::default();
+    for (f, &part) in parts.iter().enumerate() {
+        if !rest[f].is_empty() {
+            first.entry(part).or_insert(f);
+        }
+    }
+    let mut probes: Vec<(u32, usize)> = first.into_iter().collect();
+    probes.sort_unstable();
+    let keep: FxHashMap<u32, bool> = probes
+        .par_iter()
+        .map(|&(part, f)| Ok((part, probe(solid, &rest[f][0])?)))
+        .collect::<Result<_, CsgError>>()?;
+    if pairs.is_empty() && keep.values().all(|&k| k) {
+        return Ok(Resolved::Unchanged);
+    }
+    let mut out: Vec<Polygon> = inside.into_iter().flatten().collect();
+    for (f, pieces) in rest.into_iter().enumerate() {
+        if keep.get(&parts[f]).copied().unwrap_or(false) {
+            out.extend(pieces);
+        }
+    }
+    Ok(Resolved::Faces(out))
+}
+
+/// The edge-connected parts of the faces' clean pieces: two faces are
+/// joined across an edge that the one uses one way and the other the
+/// other way, nothing else uses, and that has an end outside every dirty
+/// cell (there, nothing else meets it). Returns each face's part.
+fn clean_parts(solid: &Solid, ids: &[u32], rest: &[Vec<Polygon>], cells: &Cells) -> Vec<u32> {
+    let mut edges: FxHashMap<(GridPoint, GridPoint), (u32, u32)> = FxHashMap::default();
+    for (f, &id) in ids.iter().enumerate() {
+        if rest[f].is_empty() {
+            continue;
+        }
+        let p = solid.face(id).polygon();
+        let v: Vec<GridPoint> = p.vertices().iter().filter_map(|v| v.as_grid()).collect();
+        for k in 0..v.len() {
+            let e = edges.entry((v[k], v[(k + 1) % v.len()])).or_insert((0, 0));
+            e.0 += 1;
+            e.1 = f as u32;
+        }
+    }
+    let clean = |g: &GridPoint| !cells.dirty.contains(&cells.key(g.map(i64::from)));
+    let mut uf = UnionFind::new(ids.len());
+    for (&(a, b), &(n, f)) in &edges {
+        if n != 1 || !(clean(&a) || clean(&b)) {
+            continue;
+        }
+        if let Some(&(1, g)) = edges.get(&(b, a)) {
+            uf.union(f, g);
+        }
+    }
+    (0..ids.len() as u32).map(|f| uf.find(f)).collect()
+}
+
+/// Whether the clean piece `piece` (and so its whole part) is kept: the
+/// winding numbers in front of it and behind it, from a partition of the
+/// faces near it, are 0 and 1.
+fn probe(solid: &Solid, piece: &Polygon) -> Result<bool, CsgError> {
+    let b = polygon_box(piece);
+    let bx: IBox = (b.0.map(|x| x - 1), b.1.map(|x| x + 1));
+    let corner = bx.0.map(|x| x as i32);
+    let wc = solid.winding(corner);
+    let (part, w) = cell_windings(&bx, clipped_to(solid, &bx), corner, wc)?;
+    match side_windings(&part, &w, piece) {
+        Some((front, back)) if back == front + 1 => Ok(front == 0),
+        _ => Err(CsgError::NotASolid),
+    }
+}
