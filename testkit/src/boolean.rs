@@ -406,14 +406,19 @@ impl BooleanInput {
                 }
                 inside += usize::from(want && op == BoolOp::Union);
             }
-            volumes.push(out.mesh.volume_exact());
+            volumes.push(out.mesh.six_volume());
         }
-        let (va, vb) = (sa.to_mesh().volume_exact(), sb.to_mesh().volume_exact());
-        let [u, i, d] = [0, 1, 2].map(|k| volumes[k].clone());
-        if u + i.clone() != va.clone() + vb {
+        // six times the volumes as fractions with positive denominators,
+        // compared by cross-multiplication (`Ratio` comparisons of such
+        // long unreduced values recurse deeply)
+        let [(na, da), (nb, db)] = [sa, sb].map(|s| s.to_mesh().six_volume());
+        let [(nu, du), (ni, di), (nd, dd)] = [0, 1, 2].map(|k| volumes[k].clone());
+        let union_and_meet = (&nu * &di + &ni * &du) * (&da * &db);
+        let operands = (&na * &db + &nb * &da) * (&du * &di);
+        if union_and_meet != operands {
             fail(self, format_args!("V(A ∪ B) + V(A ∩ B) ≠ V(A) + V(B)"));
         }
-        if d != va - i {
+        if &nd * &da * &di != (&na * &di - &ni * &da) * &dd {
             fail(self, format_args!("V(A − B) ≠ V(A) − V(A ∩ B)"));
         }
         Some(inside)
