@@ -359,3 +359,58 @@ fn two_large_crossing_shells_resolve_to_their_union() {
     let single = shadow_scene::parse_obj(&obj_text(&a, &faces), "a.obj").unwrap();
     assert_eq!(find_crossing(&single, &grid), None);
 }
+
+/// A surface of two overlapping shells in one mesh, resolved cell by
+/// cell, is the union of the two as two operands, to the exact volume:
+/// coarse faces that cross the other shell have pieces outside the cells
+/// where it crosses on both of its sides (inside and outside the other
+/// shell), which must be kept or dropped each on its own.
+#[test]
+fn coarse_faces_crossing_a_fine_shell_resolve_piece_by_piece() {
+    let (fine, fine_faces) = shapes::uv_sphere(8_000);
+    let (coarse, coarse_faces) = shapes::uv_sphere(60);
+    // a box of eight shared corners (corner `i` takes the high end along
+    // axis `k` where bit `k` of `i` is set), its quads outward
+    let (lo, hi) = (DVec3::new(-0.3, -0.2, -0.25), DVec3::new(1.4, 0.5, 0.6));
+    let cube_points: Vec<DVec3> = (0..8)
+        .map(|i| DVec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), hi, lo))
+        .collect();
+    let cube_faces: Vec<Vec<u32>> = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ]
+    .iter()
+    .map(|q| q.to_vec())
+    .collect();
+    let moved: Vec<DVec3> = coarse
+        .iter()
+        .map(|&p| 0.9 * p + DVec3::new(0.7, 0.3, -0.2))
+        .collect();
+    for (other, other_faces) in [(&moved, &coarse_faces), (&cube_points, &cube_faces)] {
+        let n = fine.len() as u32;
+        let positions: Vec<DVec3> = fine.iter().chain(other.iter()).copied().collect();
+        let faces: Vec<Vec<u32>> = fine_faces
+            .iter()
+            .cloned()
+            .chain(
+                other_faces
+                    .iter()
+                    .map(|f| f.iter().map(|v| v + n).collect()),
+            )
+            .collect();
+        let one = mesh_sequence(&MeshIn::new(&positions, &faces), &[]).unwrap();
+        one.mesh.check_watertight().unwrap();
+        let two = mesh_sequence(
+            &MeshIn::new(&fine, &fine_faces),
+            &[(BoolOp::Union, MeshIn::new(other, other_faces))],
+        )
+        .unwrap();
+        assert_eq!(one.grid, two.grid);
+        let ((n1, d1), (n2, d2)) = (one.mesh.six_volume(), two.mesh.six_volume());
+        assert_eq!(n1 * d2, n2 * d1, "the resolved volume is the union's");
+    }
+}

@@ -14,11 +14,13 @@
 //!    a ray through the whole surface) across every piece; what stays is
 //!    the boundary of the leaves with a positive number.
 //! 3. **Clean parts.** What lies outside every dirty cell meets nothing:
-//!    each face there keeps one winding number in front and one behind,
-//!    the same across an edge shared once each way (at a point outside
-//!    the dirty cells). Each edge-connected part gets its numbers from one
-//!    small partition around one of its pieces, and is kept whole where
-//!    they are 0 in front and 1 behind, dropped otherwise.
+//!    each piece of a face there keeps one winding number in front and one
+//!    behind, the same as the piece of the next face across an edge shared
+//!    once each way, at an end outside the dirty cells. (Two pieces of one
+//!    face may differ: the face may cross the surface in a dirty cell.)
+//!    Each part so connected gets its numbers from one small partition
+//!    around one of its pieces, and is kept where they are 0 in front and
+//!    1 behind, dropped otherwise.
 //!
 //! Every decision is exact, and the cost grows with the faces near the
 //! places where the surface meets itself, not with the whole surface.
@@ -160,13 +162,14 @@ pub(crate) fn resolve_locally(solid: &Solid) -> Result<Resolved, CsgError> {
     else {
         return Ok(Resolved::Unchanged);
     };
-    // cells of twice the median face extent
+    // cells of the median face extent: a few faces each (larger cells
+    // cut fewer faces at their walls, but partition more faces together)
     let mut ext: Vec<i64> = boxes
         .iter()
         .map(|b| (0..3).map(|k| b.1[k] - b.0[k]).max().unwrap_or(0))
         .collect();
     let mid = ext.len() / 2;
-    let size = (2 * *ext.select_nth_unstable(mid).1).max(2);
+    let size = (*ext.select_nth_unstable(mid).1).max(2);
     let mut cells = Cells {
         origin: bounds.0,
         size,
@@ -192,6 +195,10 @@ pub(crate) fn resolve_locally(solid: &Solid) -> Result<Resolved, CsgError> {
         })
         .collect::<Result<_, CsgError>>()?;
     // 3. the clean parts: each face's pieces outside the dirty cells
+    let loops: Vec<Vec<GridPoint>> = owned
+        .iter()
+        .map(|p| p.vertices().iter().filter_map(|v| v.as_grid()).collect())
+        .collect();
     let rest: Vec<Vec<Polygon>> = owned
         .into_par_iter()
         .zip(&boxes)
@@ -204,61 +211,100 @@ pub(crate) fn resolve_locally(solid: &Solid) -> Result<Resolved, CsgError> {
             }
         })
         .collect();
-    let parts = clean_parts(solid, &ids, &rest, &cells);
-    // one probe per part: its first face's first piece
-    let mut first: FxHashMap<u32, usize> = FxHashMap::default();
-    for (f, &part) in parts.iter().enumerate() {
-        if !rest[f].is_empty() {
-            first.entry(part).or_insert(f);
+    // the pieces numbered in face order
+    let mut first_piece = Vec::with_capacity(rest.len() + 1);
+    first_piece.push(0u32);
+    for r in &rest {
+        first_piece.push(first_piece.last().copied().unwrap_or(0) + r.len() as u32);
+    }
+    let parts = clean_parts(&loops, &rest, &first_piece, &cells);
+    // one probe per part: its first piece
+    let mut first: FxHashMap<u32, (usize, usize)> = FxHashMap::default();
+    for (f, r) in rest.iter().enumerate() {
+        for k in 0..r.len() {
+            let n = first_piece[f] as usize + k;
+            first.entry(parts[n]).or_insert((f, k));
         }
     }
-    let mut probes: Vec<(u32, usize)> = first.into_iter().collect();
+    let mut probes: Vec<(u32, (usize, usize))> = first.into_iter().collect();
     probes.sort_unstable();
     let keep: FxHashMap<u32, bool> = probes
         .par_iter()
-        .map(|&(part, f)| Ok((part, probe(solid, &rest[f][0])?)))
+        .map(|&(part, (f, k))| Ok((part, probe(solid, &rest[f][k])?)))
         .collect::<Result<_, CsgError>>()?;
     if pairs.is_empty() && keep.values().all(|&k| k) {
         return Ok(Resolved::Unchanged);
     }
     let mut out: Vec<Polygon> = inside.into_iter().flatten().collect();
     for (f, pieces) in rest.into_iter().enumerate() {
-        if keep.get(&parts[f]).copied().unwrap_or(false) {
-            out.extend(pieces);
+        for (k, piece) in pieces.into_iter().enumerate() {
+            let n = first_piece[f] as usize + k;
+            if keep.get(&parts[n]).copied().unwrap_or(false) {
+                out.push(piece);
+            }
         }
     }
     Ok(Resolved::Faces(out))
 }
 
-/// The edge-connected parts of the faces' clean pieces: two faces are
-/// joined across an edge that the one uses one way and the other the
-/// other way, nothing else uses, and that has an end outside every dirty
-/// cell (there, nothing else meets it). Returns each face's part.
-fn clean_parts(solid: &Solid, ids: &[u32], rest: &[Vec<Polygon>], cells: &Cells) -> Vec<u32> {
+/// The edge-connected parts of the faces' pieces outside the dirty cells
+/// (`rest[f]`, numbered from `first_piece[f]`). Two pieces of different
+/// faces are joined across an edge of the faces (`loops`) that the one
+/// uses one way and the other the other way, that nothing else uses,
+/// and that has an end outside every dirty cell: the pieces holding that
+/// end. There nothing else meets the faces, so the winding numbers in
+/// front of the two pieces are one. (Two pieces of one face are not
+/// joined as such: a face may cross the surface inside a dirty cell, and
+/// its pieces lie on both sides.) Returns each piece's part.
+fn clean_parts(
+    loops: &[Vec<GridPoint>],
+    rest: &[Vec<Polygon>],
+    first_piece: &[u32],
+    cells: &Cells,
+) -> Vec<u32> {
+    let clean = |g: &GridPoint| !cells.dirty.contains(&cells.key(g.map(i64::from)));
+    // the piece of face `f` with the corner `g` (a corner of the face
+    // outside the dirty cells is a corner of exactly one piece)
+    let holding = |f: usize, g: GridPoint| -> Option<u32> {
+        rest[f]
+            .iter()
+            .position(|p| p.vertices().iter().any(|v| v.as_grid() == Some(g)))
+            .map(|k| first_piece[f] + k as u32)
+    };
+    // each directed edge with a clean end: how many faces use it, and the
+    // piece holding its clean end (the smaller end if both are clean)
     let mut edges: FxHashMap<(GridPoint, GridPoint), (u32, u32)> = FxHashMap::default();
-    for (f, &id) in ids.iter().enumerate() {
+    edges.reserve(3 * loops.len());
+    for (f, v) in loops.iter().enumerate() {
         if rest[f].is_empty() {
             continue;
         }
-        let p = solid.face(id).polygon();
-        let v: Vec<GridPoint> = p.vertices().iter().filter_map(|v| v.as_grid()).collect();
         for k in 0..v.len() {
-            let e = edges.entry((v[k], v[(k + 1) % v.len()])).or_insert((0, 0));
+            let (a, b) = (v[k], v[(k + 1) % v.len()]);
+            let end = match (clean(&a.min(b)), clean(&a.max(b))) {
+                (true, _) => a.min(b),
+                (false, true) => a.max(b),
+                (false, false) => continue,
+            };
+            let Some(piece) = holding(f, end) else {
+                continue;
+            };
+            let e = edges.entry((a, b)).or_insert((0, 0));
             e.0 += 1;
-            e.1 = f as u32;
+            e.1 = piece;
         }
     }
-    let clean = |g: &GridPoint| !cells.dirty.contains(&cells.key(g.map(i64::from)));
-    let mut uf = UnionFind::new(ids.len());
-    for (&(a, b), &(n, f)) in &edges {
-        if n != 1 || !(clean(&a) || clean(&b)) {
+    let n = first_piece.last().copied().unwrap_or(0) as usize;
+    let mut uf = UnionFind::new(n);
+    for (&(a, b), &(count, p)) in &edges {
+        if count != 1 {
             continue;
         }
-        if let Some(&(1, g)) = edges.get(&(b, a)) {
-            uf.union(f, g);
+        if let Some(&(1, q)) = edges.get(&(b, a)) {
+            uf.union(p, q);
         }
     }
-    (0..ids.len() as u32).map(|f| uf.find(f)).collect()
+    (0..n as u32).map(|p| uf.find(p)).collect()
 }
 
 /// Whether the clean piece `piece` (and so its whole part) is kept: the
