@@ -16,6 +16,11 @@
 //!   (radius 0.05, centred on the surface along a Fibonacci spiral) from a
 //!   10k-triangle sphere, on snapped solids (the `drill` example runs the
 //!   1000-tool case of the docs).
+//! * `octree_csg/resolve/spheres N`: the sphere pair of `union` in one
+//!   mesh (two shells that cross), snapped and resolved to where its
+//!   winding number is positive (`Solid::resolved`, cell by cell), and
+//!   meshed: what `shadow csg union TWO.obj` does; compare with
+//!   `union/sphere N`, the same solid from two operands.
 
 use bsp_core::BoolOp;
 use bsp_csg::{MeshIn, Snapped, Solid, snap};
@@ -77,6 +82,28 @@ fn union(c: &mut Criterion) {
     g.finish();
 }
 
+fn resolve(c: &mut Criterion) {
+    let mut g = c.benchmark_group("octree_csg/resolve");
+    g.sample_size(10);
+    for n in [10_000, 100_000] {
+        let (va, vb, f) = sphere_pair(n);
+        let k = va.len() as u32;
+        let positions: Vec<_> = va.iter().chain(&vb).copied().collect();
+        let faces: Vec<Vec<u32>> = f
+            .iter()
+            .cloned()
+            .chain(f.iter().map(|t| t.iter().map(|v| v + k).collect()))
+            .collect();
+        g.bench_with_input(BenchmarkId::new("spheres", f.len()), &(), |bch, _| {
+            bch.iter(|| {
+                let r = bsp_csg::mesh_sequence(&MeshIn::new(&positions, &faces), &[]).unwrap();
+                r.mesh.triangles.len()
+            })
+        });
+    }
+    g.finish();
+}
+
 fn drill(c: &mut Criterion) {
     let mut g = c.benchmark_group("octree_csg/drill");
     g.sample_size(10);
@@ -101,5 +128,5 @@ fn drill(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, union, drill);
+criterion_group!(benches, union, resolve, drill);
 criterion_main!(benches);
