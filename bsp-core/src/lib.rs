@@ -57,7 +57,8 @@ pub use kernel::{
 };
 pub use solid::{
     ImportReport, SolidBoundary, SurfaceDefect, TopologyError, TriMesh, certify_solid_boundary,
-    check_closed_manifold, import_faces, import_faces_par, import_indexed_par, meeting_pairs,
+    check_closed_manifold, import_faces, import_faces_par, import_indexed_par, is_closed_cycle,
+    meeting_pairs,
 };
 pub use tree::{
     BoolOp, BspTree, BuildOptions, Cell, CellOp, FlatBsp, Link, Membership, Node, NodeId, Order,

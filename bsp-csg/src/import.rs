@@ -64,10 +64,16 @@ impl AsMeshIn for MeshBuf {
 }
 
 /// Checks that operand `operand` is a closed, consistently oriented
-/// 2-manifold ([`check_closed_manifold`]).
+/// 2-manifold ([`check_closed_manifold`]), or at least a closed cycle
+/// ([`bsp_core::is_closed_cycle`]: every edge used as often each way, as
+/// where a surface touches itself along an edge, folds, or a shell is
+/// turned inside out), which [`snap_one`] resolves to where its winding
+/// number is positive. The error is the manifold check's.
 pub fn check_mesh(m: &MeshIn<'_>, operand: usize) -> Result<(), CsgError> {
-    check_closed_manifold(m.faces.iter().map(Vec::as_slice))
-        .map_err(|error| CsgError::Topology { operand, error })
+    match check_closed_manifold(m.faces.iter().map(Vec::as_slice)) {
+        Err(_) if bsp_core::is_closed_cycle(m.faces.iter().map(Vec::as_slice)) => Ok(()),
+        checked => checked.map_err(|error| CsgError::Topology { operand, error }),
+    }
 }
 
 /// The snapped operands: one grid for all, and per mesh its solid and what
@@ -173,10 +179,13 @@ pub fn snap_one(
         .map(|&(f, _)| f as u32)
         .collect();
     let solid = Solid::from_faces(faces, free);
-    // several shells may cross, overlap or nest: their solid is where the
-    // winding number is positive (one shell is clean or crosses itself;
-    // see the crate docs)
-    let solid = match shells(mesh) > 1 {
+    // several shells may cross, overlap or nest, and a surface that is a
+    // closed cycle but no manifold may touch itself or fold: their solid
+    // is where the winding number is positive (one manifold shell is
+    // clean or crosses itself; see the crate docs)
+    let solid = match shells(mesh) > 1
+        || check_closed_manifold(mesh.faces.iter().map(Vec::as_slice)).is_err()
+    {
         true => solid.resolved()?,
         false => solid,
     };

@@ -602,3 +602,31 @@ fn two_large_crossing_shells_in_one_file_resolve_to_their_union() {
     assert_eq!(volume(&o), volume(&o2));
     assert!(volume(&o).is_some());
 }
+
+/// Two cubes touching along an edge, united and written as STL: read back
+/// (STL is welded by position), four faces share that edge, two each
+/// way. Such a closed cycle is no 2-manifold, yet a valid input again: it
+/// is resolved to where its winding number is positive, the two cubes.
+#[test]
+fn solids_touching_along_an_edge_written_as_stl_are_inputs_again() {
+    let a = write("edge_a.obj", &cube_obj([0.0; 3], 1.0));
+    let b = write("edge_b.obj", &cube_obj([1.0, 1.0, 0.0], 1.0));
+    let stl = scratch("edge_ab.stl");
+    assert_ok(&csg("union", &a, &b, &stl, &[]));
+    let back = scratch("edge_ab_back.obj");
+    let o = shadow(&[
+        "csg",
+        "union",
+        stl.to_str().unwrap(),
+        "-o",
+        back.to_str().unwrap(),
+        "--stats",
+    ]);
+    assert_ok(&o);
+    assert_eq!(stat(&stdout(&o), "volume:").split(' ').next(), Some("2"));
+    // and united with itself
+    let twice = scratch("edge_ab_twice.obj");
+    let o = csg("union", &stl, &stl, &twice, &["--stats"]);
+    assert_ok(&o);
+    assert_eq!(stat(&stdout(&o), "volume:").split(' ').next(), Some("2"));
+}

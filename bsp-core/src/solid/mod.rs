@@ -13,4 +13,4 @@ pub use import::{
     snap_positions,
 };
 pub use mesh::TriMesh;
-pub use topology::{TopologyError, check_closed_manifold};
+pub use topology::{TopologyError, check_closed_manifold, is_closed_cycle};

@@ -80,6 +80,38 @@ impl std::fmt::Display for TopologyError {
 
 impl std::error::Error for TopologyError {}
 
+/// Whether `faces` (vertex index loops) form a closed cycle: no face
+/// repeats a vertex or has fewer than three, and every edge `{a, b}` is
+/// used as often from `a` to `b` as from `b` to `a`. That is what a
+/// winding number needs to be defined everywhere off the surface; a
+/// closed, consistently oriented 2-manifold is one, and so is a surface
+/// that touches itself along an edge or at a vertex, folds, or holds a
+/// shell turned inside out.
+///
+/// ```
+/// use bsp_core::is_closed_cycle;
+/// let tet = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+/// assert!(is_closed_cycle(tet.iter().map(|f| &f[..])));
+/// // one face turned: its edges are used twice one way
+/// let turned = [[0, 1, 2], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+/// assert!(!is_closed_cycle(turned.iter().map(|f| &f[..])));
+/// ```
+pub fn is_closed_cycle<'a>(faces: impl IntoIterator<Item = &'a [u32]>) -> bool {
+    let mut net: rustc_hash::FxHashMap<(u32, u32), i64> = rustc_hash::FxHashMap::default();
+    for f in faces {
+        let mut v: smallvec::SmallVec<[u32; 8]> = f.iter().copied().collect();
+        v.sort_unstable();
+        if f.len() < 3 || v.windows(2).any(|w| w[0] == w[1]) {
+            return false;
+        }
+        for (k, &a) in f.iter().enumerate() {
+            let b = f[(k + 1) % f.len()];
+            *net.entry((a.min(b), a.max(b))).or_default() += if a < b { 1 } else { -1 };
+        }
+    }
+    net.values().all(|&n| n == 0)
+}
+
 /// Checks that `faces` (vertex index loops) form a closed, consistently
 /// oriented 2-manifold: every directed edge is used once and its reverse
 /// once, and the faces around every vertex form a single fan. Reports the
