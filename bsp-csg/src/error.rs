@@ -25,13 +25,14 @@ pub enum CsgError {
     /// A surface is closed and oriented as a mesh, but its winding
     /// numbers disagree within a cell (it crosses itself after snapping).
     /// [`Solid::plan_owned`](crate::Solid::plan_owned) meets it by
-    /// resolving both solids ([`Solid::resolved`](crate::Solid::resolved));
+    /// resolving the solids ([`Solid::resolved`](crate::Solid::resolved));
     /// from there, it means the winding numbers disagree around a loop of
     /// the partition (the surface is not closed after all).
     NotASolid,
-    /// A surface of `faces` faces is too large for
-    /// [`Solid::resolved`](crate::Solid::resolved), which builds one
-    /// partition of all its faces (at most [`RESOLVE_LIMIT`](crate::RESOLVE_LIMIT)).
+    /// A solid made by operations (its corners off the grid) of `faces`
+    /// faces is too large for [`Solid::resolved`](crate::Solid::resolved),
+    /// which resolves such a solid by one partition of all its faces (at
+    /// most [`RESOLVE_LIMIT`](crate::RESOLVE_LIMIT)).
     TooLargeToResolve {
         /// The surface's faces.
         faces: usize,
@@ -55,8 +56,9 @@ impl std::fmt::Display for CsgError {
             ),
             CsgError::TooLargeToResolve { faces } => write!(
                 f,
-                "a surface of {faces} faces is too large to resolve where it crosses, overlaps \
-                 or nests in itself (one partition of every face, done for at most {} faces)",
+                "a result of {faces} faces made by the operations so far is too large to resolve \
+                 where it crosses, overlaps or nests in itself (one partition of every face, \
+                 done for at most {} faces)",
                 crate::RESOLVE_LIMIT
             ),
             CsgError::Internal(e) => write!(f, "internal error: {e}"),
