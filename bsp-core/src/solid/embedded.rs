@@ -177,14 +177,7 @@ pub fn certify_solid_boundary(polys: &[Polygon]) -> Result<SolidBoundary, Surfac
 /// tests are checked against).
 fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefect> {
     let loops = Loops::new(polys)?;
-    let lo = loops
-        .pts
-        .iter()
-        .fold([i32::MAX; 3], |m, p| [0, 1, 2].map(|k| m[k].min(p[k])));
-    let hi = loops
-        .pts
-        .iter()
-        .fold([i32::MIN; 3], |m, p| [0, 1, 2].map(|k| m[k].max(p[k])));
+    let (lo, hi) = loops.bounds();
     // 1. closed and oriented, the parts, and the stars certified embedded
     let (mut parts_of, certified) = loops.closed_and_oriented(stars)?;
     // 3. each part encloses a positive volume (6 × the signed volume)
@@ -222,14 +215,7 @@ fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefec
 /// Nothing needs to be closed; `Err` only for a vertex off the grid.
 pub fn meeting_pairs(polys: &[Polygon]) -> Result<Vec<[usize; 2]>, SurfaceDefect> {
     let loops = Loops::new(polys)?;
-    let lo = loops
-        .pts
-        .iter()
-        .fold([i32::MAX; 3], |m, p| [0, 1, 2].map(|k| m[k].min(p[k])));
-    let hi = loops
-        .pts
-        .iter()
-        .fold([i32::MIN; 3], |m, p| [0, 1, 2].map(|k| m[k].max(p[k])));
+    let (lo, hi) = loops.bounds();
     let (tris, _) = loops.fan_triangles(&mut UnionFind::new(polys.len()));
     let mut pairs = Vec::new();
     each_overlapping_pair(&tris, lo, hi, |s, t| {
@@ -288,6 +274,18 @@ impl Loops {
             corner_poly,
             n_ids,
         })
+    }
+
+    /// The box of every corner: its low and high corners.
+    fn bounds(&self) -> (GridPoint, GridPoint) {
+        self.pts
+            .iter()
+            .fold(([i32::MAX; 3], [i32::MIN; 3]), |(lo, hi), p| {
+                (
+                    [0, 1, 2].map(|k| lo[k].min(p[k])),
+                    [0, 1, 2].map(|k| hi[k].max(p[k])),
+                )
+            })
     }
 
     fn loop_of(&self, i: usize) -> std::ops::Range<usize> {
