@@ -24,7 +24,7 @@
 
 use bsp_core::BoolOp;
 use bsp_csg::{MeshIn, Snapped, Solid, snap};
-use bsp_fixtures::{drill_tools, sphere_pair, uv_sphere};
+use bsp_fixtures::{drill_tools, joined, sphere_pair, uv_sphere};
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 
 /// Both meshes snapped to one grid, as solids (what a mesh boolean does
@@ -87,13 +87,7 @@ fn resolve(c: &mut Criterion) {
     g.sample_size(10);
     for n in [10_000, 100_000] {
         let (va, vb, f) = sphere_pair(n);
-        let k = va.len() as u32;
-        let positions: Vec<_> = va.iter().chain(&vb).copied().collect();
-        let faces: Vec<Vec<u32>> = f
-            .iter()
-            .cloned()
-            .chain(f.iter().map(|t| t.iter().map(|v| v + k).collect()))
-            .collect();
+        let (positions, faces) = joined(&[(&va, &f), (&vb, &f)]);
         g.bench_with_input(BenchmarkId::new("spheres", f.len()), &(), |bch, _| {
             bch.iter(|| {
                 let r = bsp_csg::mesh_sequence(&MeshIn::new(&positions, &faces), &[]).unwrap();

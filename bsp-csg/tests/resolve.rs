@@ -288,15 +288,7 @@ fn a_large_surface_alone_is_kept_or_resolved_cell_by_cell() {
     let alone = mesh_sequence(&MeshIn::new(&a, &faces), &[]).unwrap();
     assert_eq!(alone.mesh.triangles.len(), faces.len());
     let inner: Vec<DVec3> = a.iter().map(|&p| p * 0.5).collect();
-    let mut both = a.clone();
-    both.extend(inner);
-    let n = a.len() as u32;
-    let mut two = faces.clone();
-    two.extend(
-        faces
-            .iter()
-            .map(|f| f.iter().map(|&v| v + n).collect::<Vec<u32>>()),
-    );
+    let (both, two) = shapes::joined(&[(&a, &faces), (&inner, &faces)]);
     let nested = mesh_sequence(&MeshIn::new(&both, &two), &[]).unwrap();
     nested.mesh.check_watertight().unwrap();
     assert_eq!(nested.mesh.triangles.len(), faces.len());
@@ -313,13 +305,7 @@ fn a_large_surface_alone_is_kept_or_resolved_cell_by_cell() {
 #[test]
 fn two_large_crossing_shells_resolve_to_their_union() {
     let (a, b, faces) = shapes::sphere_pair(12_000);
-    let n = a.len() as u32;
-    let positions: Vec<DVec3> = a.iter().chain(&b).copied().collect();
-    let both: Vec<Vec<u32>> = faces
-        .iter()
-        .cloned()
-        .chain(faces.iter().map(|f| f.iter().map(|v| v + n).collect()))
-        .collect();
+    let (positions, both) = shapes::joined(&[(&a, &faces), (&b, &faces)]);
     assert!(both.len() > bsp_csg::RESOLVE_LIMIT);
     let one = mesh_sequence(&MeshIn::new(&positions, &both), &[]).unwrap();
     one.mesh.check_watertight().unwrap();
@@ -369,39 +355,17 @@ fn two_large_crossing_shells_resolve_to_their_union() {
 fn coarse_faces_crossing_a_fine_shell_resolve_piece_by_piece() {
     let (fine, fine_faces) = shapes::uv_sphere(8_000);
     let (coarse, coarse_faces) = shapes::uv_sphere(60);
-    // a box of eight shared corners (corner `i` takes the high end along
-    // axis `k` where bit `k` of `i` is set), its quads outward
-    let (lo, hi) = (DVec3::new(-0.3, -0.2, -0.25), DVec3::new(1.4, 0.5, 0.6));
-    let cube_points: Vec<DVec3> = (0..8)
-        .map(|i| DVec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), hi, lo))
-        .collect();
-    let cube_faces: Vec<Vec<u32>> = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ]
-    .iter()
-    .map(|q| q.to_vec())
-    .collect();
+    let (cube_points, cube_faces) =
+        shapes::indexed_box(DVec3::new(-0.3, -0.2, -0.25), DVec3::new(1.4, 0.5, 0.6));
     let moved: Vec<DVec3> = coarse
         .iter()
         .map(|&p| 0.9 * p + DVec3::new(0.7, 0.3, -0.2))
         .collect();
     for (other, other_faces) in [(&moved, &coarse_faces), (&cube_points, &cube_faces)] {
-        let n = fine.len() as u32;
-        let positions: Vec<DVec3> = fine.iter().chain(other.iter()).copied().collect();
-        let faces: Vec<Vec<u32>> = fine_faces
-            .iter()
-            .cloned()
-            .chain(
-                other_faces
-                    .iter()
-                    .map(|f| f.iter().map(|v| v + n).collect()),
-            )
-            .collect();
+        let (positions, faces) = shapes::joined(&[
+            (&fine, &fine_faces),
+            (other.as_slice(), other_faces.as_slice()),
+        ]);
         let one = mesh_sequence(&MeshIn::new(&positions, &faces), &[]).unwrap();
         one.mesh.check_watertight().unwrap();
         let two = mesh_sequence(

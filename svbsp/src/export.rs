@@ -729,23 +729,24 @@ mod tests {
         assert_eq!(obj_group(0b00, 2), "shadow");
     }
 
-    /// Values to print, each compared as text with `serde_json`'s printing
-    /// of it: zero, a fraction, an integer, small and tiny values that
-    /// print in exponent form, a long decimal and 2^60. (Sample inputs,
-    /// not a tolerance: nothing is compared within a margin.)
-    const PRINTED: [f64; 7] = [
-        0.0,
-        -0.5,
-        1.0,
-        1e-7,
-        123456.789,
-        1_152_921_504_606_846_976.0,
-        -3.25e-300,
+    /// Numbers to print, read from this text, each printed value compared
+    /// as text with `serde_json`'s printing: zero, a fraction, an
+    /// integer, small and tiny values that print in exponent form, a long
+    /// decimal and 2^60.
+    const PRINTED: [&str; 7] = [
+        "0",
+        "-0.5",
+        "1",
+        "1e-7",
+        "123456.789",
+        "1152921504606846976",
+        "-3.25e-300",
     ];
 
     #[test]
     fn json_numbers_are_serde_jsons() {
-        for x in PRINTED {
+        for text in PRINTED {
+            let x: f64 = text.parse().unwrap();
             let mut s = Vec::new();
             push_f64(&mut s, x);
             assert_eq!(

@@ -157,30 +157,26 @@ impl IntBox {
 /// The boxes as one mesh (eight corners and six quads each), sheared by
 /// `shear`.
 fn mesh(boxes: &[IntBox], shear: [i32; 3]) -> MeshBuf {
-    let mut positions = Vec::new();
-    let mut faces = Vec::new();
-    for bx in boxes {
-        let first = positions.len() as u32;
-        for i in 0..8u32 {
-            let c = |k: usize| f64::from(bx.lo[k] + if i >> k & 1 == 1 { bx.size[k] } else { 0 });
-            positions.push(sheared(shear, DVec3::new(c(0), c(1), c(2))));
-        }
-        let quads: [[u32; 4]; 6] = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        for q in quads {
-            let mut f: Vec<u32> = q.iter().map(|v| first + v).collect();
+    let each: Vec<(Vec<DVec3>, Vec<Vec<u32>>)> = boxes
+        .iter()
+        .map(|bx| {
+            let corner = |c: [i32; 3]| DVec3::from_array(c.map(f64::from));
+            let hi = [0, 1, 2].map(|k| bx.lo[k] + bx.size[k]);
+            let (points, mut faces) = bsp_fixtures::indexed_box(corner(bx.lo), corner(hi));
             if bx.inward {
-                f.reverse();
+                faces.iter_mut().for_each(|f| f.reverse());
             }
-            faces.push(f);
-        }
-    }
+            (
+                points.into_iter().map(|p| sheared(shear, p)).collect(),
+                faces,
+            )
+        })
+        .collect();
+    let parts: Vec<(&[DVec3], &[Vec<u32>])> = each
+        .iter()
+        .map(|(p, f)| (p.as_slice(), f.as_slice()))
+        .collect();
+    let (positions, faces) = bsp_fixtures::joined(&parts);
     MeshBuf::new(positions, faces)
 }
 

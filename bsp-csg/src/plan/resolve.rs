@@ -26,7 +26,7 @@
 //! places where the surface meets itself, not with the whole surface.
 
 use bsp_core::internals::UnionFind;
-use bsp_core::{GridPoint, Polygon, Split, meeting_pairs};
+use bsp_core::{GridPoint, Partition, Polygon, Split, meeting_pairs};
 use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -96,6 +96,14 @@ fn clipped_to(solid: &Solid, bx: &IBox) -> Vec<Polygon> {
                 .then_some(p)
         })
         .collect()
+}
+
+/// The partition of the faces of `solid` near the box `bx`, clipped to
+/// it, and the winding number of each leaf, carried from the box's low
+/// corner (displaced; its number by a ray through the whole surface).
+fn windings_in(solid: &Solid, bx: &IBox) -> Result<(Partition<u32>, Vec<i32>), CsgError> {
+    let corner = bx.0.map(|x| x as i32);
+    cell_windings(bx, clipped_to(solid, bx), corner, solid.winding(corner))
 }
 
 /// The parts of `p` outside the cells `cells` (convex pieces).
@@ -187,10 +195,7 @@ pub(crate) fn resolve_locally(solid: &Solid) -> Result<Resolved, CsgError> {
     let inside: Vec<Vec<Polygon>> = dirty
         .par_iter()
         .map(|&c| {
-            let bx = cells.cell_box(c);
-            let corner = bx.0.map(|x| x as i32);
-            let wc = solid.winding(corner);
-            let (part, w) = cell_windings(&bx, clipped_to(solid, &bx), corner, wc)?;
+            let (part, w) = windings_in(solid, &cells.cell_box(c))?;
             Ok(positive_boundary(&part, &w))
         })
         .collect::<Result<_, CsgError>>()?;
@@ -312,10 +317,7 @@ fn clean_parts(
 /// faces near it, are 0 and 1.
 fn probe(solid: &Solid, piece: &Polygon) -> Result<bool, CsgError> {
     let b = polygon_box(piece);
-    let bx: IBox = (b.0.map(|x| x - 1), b.1.map(|x| x + 1));
-    let corner = bx.0.map(|x| x as i32);
-    let wc = solid.winding(corner);
-    let (part, w) = cell_windings(&bx, clipped_to(solid, &bx), corner, wc)?;
+    let (part, w) = windings_in(solid, &(b.0.map(|x| x - 1), b.1.map(|x| x + 1)))?;
     match side_windings(&part, &w, piece) {
         Some((front, back)) if back == front + 1 => Ok(front == 0),
         _ => Err(CsgError::NotASolid),
