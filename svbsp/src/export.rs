@@ -729,24 +729,24 @@ mod tests {
         assert_eq!(obj_group(0b00, 2), "shadow");
     }
 
-    /// Numbers to print, read from this text, each printed value compared
-    /// as text with `serde_json`'s printing: zero, a fraction, an
-    /// integer, small and tiny values that print in exponent form, a long
-    /// decimal and 2^60.
-    const PRINTED: [&str; 7] = [
-        "0",
-        "-0.5",
-        "1",
-        "1e-7",
-        "123456.789",
-        "1152921504606846976",
-        "-3.25e-300",
-    ];
+    /// Numbers to print, each compared as text with `serde_json`'s
+    /// printing of it: zero, a fraction, an integer, a small and a tiny
+    /// value that print in exponent form, a long decimal and 2^60.
+    fn printed() -> [f64; 7] {
+        [
+            0.0,
+            -0.5,
+            1.0,
+            10f64.powi(-7),
+            123_456.789,
+            2f64.powi(60),
+            -3.25 * 10f64.powi(-300),
+        ]
+    }
 
     #[test]
     fn json_numbers_are_serde_jsons() {
-        for text in PRINTED {
-            let x: f64 = text.parse().unwrap();
+        for x in printed() {
             let mut s = Vec::new();
             push_f64(&mut s, x);
             assert_eq!(
