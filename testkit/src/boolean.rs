@@ -21,13 +21,17 @@
 //! and that at every vertex of both operands and at pseudo-random grid
 //! points, each result's winding number is the operation on the
 //! operands' (all symbolically displaced alike, so points on a surface
-//! are decided too).
+//! are decided too). A last byte may join both operands into one mesh,
+//! which crosses itself where they meet; resolved alone it must be their
+//! union, and less the first, the second less the first: the same
+//! windings at the same probes, the same exact volumes.
 
 use bsp_core::BoolOp;
 use bsp_core::GridPoint;
 use bsp_csg::snap;
 use bsp_csg::{CsgError, MeshBuf, MeshIn, mesh_sequence};
 use glam::{DMat3, DVec3};
+use num_bigint::BigInt;
 
 use crate::bytes::Bytes;
 use crate::report::fail;
@@ -100,6 +104,11 @@ pub struct Curved {
     pub b: Partner,
     /// Seeds the pseudo-random probes.
     pub probes: u8,
+    /// Also both operands joined into one mesh, which crosses itself
+    /// wherever they meet (a coarse sphere's faces across a fine one's,
+    /// the boxes' large faces across a sphere): resolved alone, it must
+    /// be their union, and less the first operand, the second less it.
+    pub joined: bool,
 }
 
 /// A shear coefficient from a byte: 0, 1, −1, 2, −2 (so that missing
@@ -198,10 +207,12 @@ impl BooleanInput {
                 2 => Partner::Nested,
                 _ => Partner::Boxes,
             };
+            let probes = b.u8();
             Curved {
                 a,
                 b: partner,
-                probes: b.u8(),
+                probes,
+                joined: b.below(2) == 1,
             }
         });
         BooleanInput {
@@ -312,6 +323,9 @@ impl BooleanInput {
                     Partner::Boxes => out.push(3),
                 }
                 out.push(c.probes);
+                if c.joined {
+                    out.push(1);
+                }
             }
         }
         out
@@ -417,7 +431,92 @@ impl BooleanInput {
         if &nd * &da * &di != (&na * &di - &ni * &da) * &dd {
             fail(self, format_args!("V(A − B) ≠ V(A) − V(A ∩ B)"));
         }
+        let outward = c.b != Partner::Boxes || self.b.iter().all(|bx| !bx.inward);
+        if c.joined && outward {
+            let operands = [
+                (pa.as_slice(), fa.as_slice()),
+                (pb.as_slice(), fb.as_slice()),
+            ];
+            self.check_joined(
+                operands,
+                grid,
+                &probes,
+                [&wa, &wb],
+                [(&nu, &du), (&na, &da)],
+            );
+        }
         Some(inside)
+    }
+
+    /// The check of a case's operands joined into one mesh (see
+    /// [`Curved::joined`]): resolved alone it is `A ∪ B`, less `A` it is
+    /// `B − A`, at the probes and by exact volume (`union` and `a`: six
+    /// times the volumes as numerators and denominators).
+    fn check_joined(
+        &self,
+        [(pa, fa), (pb, fb)]: [(&[DVec3], &[Vec<u32>]); 2],
+        grid: &bsp_core::Grid,
+        probes: &[GridPoint],
+        [wa, wb]: [&[bool]; 2],
+        [(nu, du), (na, da)]: [(&BigInt, &BigInt); 2],
+    ) {
+        let va = MeshIn::new(pa, fa);
+        let (pj, fj) = bsp_fixtures::joined(&[(pa, fa), (pb, fb)]);
+        let vj = MeshIn::new(&pj, &fj);
+        for less_a in [false, true] {
+            let name = if less_a { "less A" } else { "resolved" };
+            let ops = if less_a {
+                vec![(BoolOp::Difference, va)]
+            } else {
+                vec![]
+            };
+            let out = match mesh_sequence(&vj, &ops) {
+                Ok(out) => out,
+                Err(e) => fail(self, format_args!("the joined operands {name} failed: {e}")),
+            };
+            if out.grid != *grid {
+                fail(
+                    self,
+                    format_args!("the joined operands {name}: another grid"),
+                );
+            }
+            if let Err(e) = out.mesh.check_watertight() {
+                fail(
+                    self,
+                    format_args!("the joined operands {name}: not watertight: {e}"),
+                );
+            }
+            for (k, &q) in probes.iter().enumerate() {
+                let want = if less_a {
+                    wb[k] && !wa[k]
+                } else {
+                    wa[k] || wb[k]
+                };
+                let got = out.solid.winding(q);
+                if got != i32::from(want) {
+                    fail(
+                        self,
+                        format_args!(
+                            "the joined operands {name}: winding {got} at grid point {q:?}, want {}",
+                            i32::from(want)
+                        ),
+                    );
+                }
+            }
+            // resolved: V(A ∪ B); less A: V(A ∪ B) − V(A)
+            let (nj, dj) = out.mesh.six_volume();
+            let ok = if less_a {
+                &nj * du * da == (nu * da - na * du) * &dj
+            } else {
+                &nj * du == nu * &dj
+            };
+            if !ok {
+                fail(
+                    self,
+                    format_args!("the joined operands {name}: wrong volume"),
+                );
+            }
+        }
     }
 }
 

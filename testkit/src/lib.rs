@@ -440,6 +440,28 @@ mod tests {
                 a,
                 b: partner,
                 probes: k as u8,
+                joined: false,
+            });
+            v.push(c);
+        }
+        // joined into one mesh that crosses itself: a coarse sphere's
+        // faces across a fine one, a fine sphere across a box's faces
+        let coarse_fine = (
+            ball(3, 3, [4, 4, 4], 2),
+            Partner::Ball(ball(8, 2, [5, 4, 4], 5)),
+        );
+        let fine_boxes = (ball(8, 2, [4, 4, 4], 1), Partner::Boxes);
+        for (k, (a, partner)) in [coarse_fine, fine_boxes].into_iter().enumerate() {
+            let mut c = case(
+                bsp_core::BoolOp::Union,
+                vec![b([0, 0, 0], 1)],
+                vec![b([1, 2, 1], 3)],
+            );
+            c.curved = Some(Curved {
+                a,
+                b: partner,
+                probes: 9 + k as u8,
+                joined: true,
             });
             v.push(c);
         }
