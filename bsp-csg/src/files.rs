@@ -460,8 +460,12 @@ impl FileBoolean {
     /// faces that collapse left out ([`Mesh::collapse_repeats`]) and the
     /// flat triangles split away ([`Mesh::split_flat_triangles`]), so
     /// that a reader that welds by position finds no face repeating a
-    /// vertex and no face without area. `None` where rounding does
-    /// neither (the file is [`FileBoolean::mesh`] as it is).
+    /// vertex and no face without area. Where welding would pinch the
+    /// surface (two sheets closer than the format resolves), vertices are
+    /// kept apart and off one line instead, one step of the format off
+    /// their rounded position ([`Mesh::round_closed`]). `None`
+    /// where rounding does nothing of this (the file is
+    /// [`FileBoolean::mesh`] as it is).
     pub fn rounded(&self, stl: bool) -> Option<Rounded> {
         let view = self.mesh();
         let coincide = match stl {
@@ -475,13 +479,18 @@ impl FileBoolean {
         if coincide == 0 && view.flat_triangles(round) == 0 {
             return None;
         }
+        let step = match stl {
+            true => shadow_scene::f32_step,
+            false => shadow_scene::f64_step,
+        };
         let mut mesh = view.to_mesh();
-        let r = mesh.round_positions(round);
+        let r = mesh.round_closed(round, step);
         let closed = r.left_flat == 0 && mesh.is_closed_oriented();
         Some(Rounded {
             mesh,
             collapsed: r.collapsed,
             flattened: r.flattened,
+            moved: r.moved,
             closed,
         })
     }
@@ -504,9 +513,12 @@ pub struct Rounded {
     /// split away: the face across each one's long edge is cut at its
     /// middle corner, so the surface stays closed.
     pub flattened: usize,
+    /// Vertices moved one step of the format off their rounded position
+    /// to keep the surface from pinching or a triangle from going flat.
+    pub moved: usize,
     /// Whether the mesh is still closed and oriented by vertex index,
     /// with no flat triangle (where a collapsed edge's ends had other
-    /// neighbours in common, it is not).
+    /// neighbours in common and no vertex could be kept apart, it is not).
     pub closed: bool,
 }
 
@@ -527,6 +539,14 @@ impl Rounded {
                 "put the corners of {} triangle(s) on one line (split away: the face across \
                  each long edge is cut at the middle corner)",
                 self.flattened
+            ));
+        }
+        if self.moved > 0 {
+            did.push(format!(
+                "would have pinched the surface or flattened triangles at {} vertex(es) (each \
+                 kept apart, one {} step off)",
+                self.moved,
+                if stl { "f32" } else { "f64" }
             ));
         }
         let did = did.join(" and ");

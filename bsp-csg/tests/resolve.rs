@@ -209,8 +209,15 @@ fn round_trip(out: &FileBoolean, stl: bool) {
         .iter()
         .map(|p| p.abs().max_element())
         .fold(0.0, f64::max);
-    let moved =
-        3f64.sqrt() * (again.grid.step() / 2.0 + if stl { reach * 2f64.powi(-24) } else { 0.0 });
+    // rounding to f32 moves a coordinate by half a step, at most
+    // reach·2^-24; one kept apart, by one and a half steps
+    let apart = rounded.as_ref().is_some_and(|r| r.moved > 0);
+    let f32_move = match (stl, apart) {
+        (false, _) => 0.0,
+        (true, false) => reach * 2f64.powi(-24),
+        (true, true) => 3.0 * reach * 2f64.powi(-24),
+    };
+    let moved = 3f64.sqrt() * (again.grid.step() / 2.0 + f32_move);
     let (v0, v1) = (out.volume(), again.volume());
     assert!(
         (v1 - v0).abs() <= area * moved,
@@ -275,6 +282,34 @@ fn results_that_round_flat_are_split_and_closed() {
     }
     // (the case this test is for happens: 8, 11 and 10 triangles)
     assert!(flattened > 0);
+}
+
+/// Two 8,000-triangle spheres, the second turned and moved a little:
+/// rounded to `f32`, their difference has vertices of two sheets closer
+/// than `f32` resolves, which welding would make one (an edge used four
+/// times). They are kept apart one step instead, and the file is closed
+/// as read back, and an input again.
+#[test]
+fn results_that_would_pinch_in_f32_keep_their_vertices_apart() {
+    let (a, b, faces) = shapes::sphere_pair(8_000);
+    let read = |p: &[DVec3], name: &str| {
+        Operand::new(
+            name,
+            shadow_scene::parse_obj(&obj_text(p, &faces), name).unwrap(),
+        )
+    };
+    let mut pair = [read(&a, "a.obj"), read(&b, "b.obj")];
+    let checked = Operand::check_all(&mut pair).unwrap();
+    let out = FileBoolean::apply(checked, BoolOp::Difference, |_, _| {}).unwrap();
+    let mut welded = out.mesh().to_mesh();
+    welded.round_positions(shadow_scene::to_f32);
+    assert!(!welded.is_closed_oriented(), "the case this test is for");
+    let r = out
+        .rounded(true)
+        .expect("f32 rounding makes vertices equal");
+    assert!(r.closed && r.moved > 0 && r.collapsed == 0, "{r:?}");
+    assert_eq!(r.mesh.flat_triangles(|p| p), 0);
+    round_trip(&out, true);
 }
 
 /// A union of one large surface: a clean one is kept face for face; one

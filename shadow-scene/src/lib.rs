@@ -60,7 +60,9 @@ pub use animated::{
 };
 pub use atomic::{AtomicFile, remove_unfinished};
 pub use error::SceneError;
-pub use mesh::{Face, FlatFix, Mesh, MeshView, Rounding, Triangles, collinear, to_f32};
+pub use mesh::{
+    Face, FlatFix, Mesh, MeshView, Rounding, Triangles, collinear, f32_step, f64_step, to_f32,
+};
 pub use obj::{
     MAX_FACE_VERTICES, ObjNotes, parse_obj, parse_obj_notes, read_obj, read_obj_notes, write_obj,
 };

@@ -205,6 +205,25 @@ fn flat(face: &[u32], at: impl Fn(u32) -> DVec3) -> bool {
     key(pa) != key(pb) && key(pb) != key(pc) && key(pc) != key(pa) && collinear(pa, pb, pc)
 }
 
+/// The 26 positions one `step` from `at` along one, two or three axes,
+/// the nearest to `to` first (ties in a fixed order).
+fn neighbours(at: DVec3, to: DVec3, step: fn(f64, bool) -> f64) -> Vec<DVec3> {
+    let mut near: Vec<(f64, DVec3)> = (0..27u32)
+        .filter(|&d| d != 13)
+        .map(|d| {
+            let c = |x: f64, k: u32| match (d / 3u32.pow(k)) % 3 {
+                0 => step(x, false),
+                1 => x,
+                _ => step(x, true),
+            };
+            let q = DVec3::new(c(at.x, 0), c(at.y, 1), c(at.z, 2));
+            (q.distance_squared(to), q)
+        })
+        .collect();
+    near.sort_by(|a, b| a.0.total_cmp(&b.0));
+    near.into_iter().map(|(_, q)| q).collect()
+}
+
 /// The directed edges of a vertex loop, in order.
 fn ring(v: &[u32]) -> impl Iterator<Item = (u32, u32)> + '_ {
     (0..v.len()).map(move |i| (v[i], v[(i + 1) % v.len()]))
@@ -225,11 +244,26 @@ pub struct Rounding {
     pub flattened: usize,
     /// Flat triangles that stay ([`FlatFix::left`]).
     pub left_flat: usize,
+    /// Vertices moved one step of the rounded format off their rounded
+    /// position, to keep them apart from another vertex rounded there
+    /// ([`Mesh::round_positions_apart`]).
+    pub moved: usize,
 }
 
 /// `p` rounded to `f32` and back: the positions an STL file holds.
 pub fn to_f32(p: DVec3) -> DVec3 {
     p.as_vec3().as_dvec3()
+}
+
+/// The `f32` next to `x` (itself an `f32` value), above it if `up`.
+pub fn f32_step(x: f64, up: bool) -> f64 {
+    let x = x as f32;
+    f64::from(if up { x.next_up() } else { x.next_down() })
+}
+
+/// The `f64` next to `x`, above it if `up`.
+pub fn f64_step(x: f64, up: bool) -> f64 {
+    if up { x.next_up() } else { x.next_down() }
 }
 
 /// What [`Mesh::split_flat_triangles`] did.
@@ -489,6 +523,170 @@ impl Mesh {
             collapsed,
             flattened: flat.removed,
             left_flat: flat.left,
+            moved: 0,
+        }
+    }
+
+    /// Rounds every position with `round` as a file holds it, keeping a
+    /// closed, oriented surface so as read back where it can: as
+    /// [`Mesh::round_positions`] does (weld, leave out what collapses,
+    /// split flat triangles away), and where that pinches the surface or
+    /// leaves a flat triangle, as [`Mesh::round_positions_apart`] does
+    /// instead, if that keeps it closed. [`Mesh::is_closed_oriented`]
+    /// tells whether either did.
+    pub fn round_closed(
+        &mut self,
+        round: fn(DVec3) -> DVec3,
+        step: fn(f64, bool) -> f64,
+    ) -> Rounding {
+        let before = self.clone();
+        let r = self.round_positions(round);
+        if r.left_flat == 0 && self.is_closed_oriented() {
+            return r;
+        }
+        let mut apart = before;
+        let a = apart.round_positions_apart(round, step);
+        if a.left_flat == 0 && apart.is_closed_oriented() {
+            *self = apart;
+            return a;
+        }
+        r
+    }
+
+    /// Rounds every position with `round` like [`Mesh::round_positions`],
+    /// but keeps distinct positions distinct and triangles off one line
+    /// where it can, by moving vertices one step of the rounded format
+    /// (`step` moves one coordinate one value up or down, e.g.
+    /// [`f32_step`]) to one of the 26 neighbouring positions, the nearest
+    /// to the vertex's position before rounding first:
+    /// - a vertex that rounds onto a position an earlier vertex (by
+    ///   index) took moves to a free neighbour;
+    /// - a triangle that rounding made flat has one of its corners, the
+    ///   middle one first, moved to a free neighbour where none of that
+    ///   corner's triangles is flat.
+    ///
+    /// So where welding would pinch a closed surface (two sheets closer
+    /// than the format resolves, made one), the surface stays closed as
+    /// read back; each coordinate then lies within one and a half steps,
+    /// not half a step, of its value before rounding. What finds no free
+    /// neighbour is welded and split away as [`Mesh::round_positions`]
+    /// does. The result does not depend on hashing: vertices go in index
+    /// order, candidates by distance with ties in a fixed order.
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// use shadow_scene::{Face, Mesh, f32_step, to_f32};
+    /// let face = |v: [u32; 3]| Face { vertices: v.to_vec(), line: 0, group: 0 };
+    /// // a flat double pyramid: apexes 2^-30 above and below its base at
+    /// // z = 1, where f32 steps are 2^-24 and 2^-23
+    /// let h = 2f64.powi(-30);
+    /// let mut m = Mesh {
+    ///     positions: vec![
+    ///         DVec3::Z, DVec3::new(1.0, 0.0, 1.0), DVec3::new(0.0, 1.0, 1.0),
+    ///         DVec3::new(0.25, 0.25, 1.0 + h), DVec3::new(0.25, 0.25, 1.0 - h),
+    ///     ],
+    ///     faces: [[0, 1, 3], [1, 2, 3], [2, 0, 3], [1, 0, 4], [2, 1, 4], [0, 2, 4]]
+    ///         .map(face).to_vec(),
+    ///     groups: vec!["default".into()],
+    /// };
+    /// let mut welded = m.clone();
+    /// welded.round_positions(to_f32);
+    /// assert!(!welded.is_closed_oriented()); // the apexes became one
+    /// let r = m.round_positions_apart(to_f32, f32_step);
+    /// assert_eq!(r.moved, 1); // the lower apex, one step (2^-26) along y
+    /// assert_eq!(m.positions[4], DVec3::new(0.25, 0.25 - 2f64.powi(-26), 1.0));
+    /// assert!(m.is_closed_oriented());
+    /// ```
+    pub fn round_positions_apart(
+        &mut self,
+        round: fn(DVec3) -> DVec3,
+        step: fn(f64, bool) -> f64,
+    ) -> Rounding {
+        let before = std::mem::take(&mut self.positions);
+        self.positions = before.iter().map(|&p| round(p)).collect();
+        let mut taken: rustc_hash::FxHashMap<[u64; 3], u32> = Default::default();
+        let mut moved = vec![false; before.len()];
+        for i in 0..before.len() {
+            if taken.insert(key(self.positions[i]), i as u32).is_some() {
+                let at = self.positions[i];
+                if let Some(q) = neighbours(at, before[i], step)
+                    .into_iter()
+                    .find(|q| !taken.contains_key(&key(*q)))
+                {
+                    taken.insert(key(q), i as u32);
+                    self.positions[i] = q;
+                    moved[i] = true;
+                }
+            }
+        }
+        self.nudge_flat(&before, &mut taken, &mut moved, step);
+        let moved = moved.iter().filter(|&&m| m).count();
+        self.weld();
+        let collapsed = self.collapse_repeats().len();
+        let flat = self.split_flat_triangles();
+        Rounding {
+            collapsed,
+            flattened: flat.removed,
+            left_flat: flat.left,
+            moved,
+        }
+    }
+
+    /// Moves a corner of each flat triangle one step off the line (see
+    /// [`Mesh::round_positions_apart`]).
+    fn nudge_flat(
+        &mut self,
+        before: &[DVec3],
+        taken: &mut rustc_hash::FxHashMap<[u64; 3], u32>,
+        moved: &mut [bool],
+        step: fn(f64, bool) -> f64,
+    ) {
+        let flat_at = |positions: &[DVec3], f: &Face| flat(&f.vertices, |v| positions[v as usize]);
+        let queue: Vec<usize> = (0..self.faces.len())
+            .filter(|&i| flat_at(&self.positions, &self.faces[i]))
+            .collect();
+        if queue.is_empty() {
+            return;
+        }
+        let mut around: Vec<Vec<u32>> = vec![Vec::new(); self.positions.len()];
+        for (i, f) in self.faces.iter().enumerate() {
+            for &v in &f.vertices {
+                around[v as usize].push(i as u32);
+            }
+        }
+        for t in queue {
+            let positions = &self.positions;
+            if !flat_at(positions, &self.faces[t]) {
+                continue;
+            }
+            let v: [u32; 3] = [0, 1, 2].map(|k| self.faces[t].vertices[k]);
+            let at = |k: usize| positions[v[k] as usize];
+            let middle = (0..3)
+                .find(|&k| between(at(k), at((k + 1) % 3), at((k + 2) % 3)))
+                .unwrap_or(0);
+            'corners: for k in [middle, (middle + 1) % 3, (middle + 2) % 3] {
+                let c = v[k] as usize;
+                let here = self.positions[c];
+                for q in neighbours(here, before[c], step) {
+                    if taken.contains_key(&key(q)) {
+                        continue;
+                    }
+                    self.positions[c] = q;
+                    let faces = &self.faces;
+                    if around[c]
+                        .iter()
+                        .all(|&f| !flat_at(&self.positions, &faces[f as usize]))
+                    {
+                        if taken.get(&key(here)) == Some(&(c as u32)) {
+                            taken.remove(&key(here));
+                        }
+                        taken.insert(key(q), c as u32);
+                        moved[c] = true;
+                        break 'corners;
+                    }
+                    self.positions[c] = here;
+                }
+            }
         }
     }
 

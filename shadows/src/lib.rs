@@ -100,14 +100,16 @@ pub fn read_mesh(path: impl AsRef<Path>) -> Result<Mesh, Error> {
 /// Writes `mesh` as OBJ or STL (by the extension), through a temporary
 /// file renamed into place when complete. For STL the positions are
 /// rounded to `f32` first and what that does to a closed surface is
-/// mended ([`Mesh::round_positions`]): vertices made equal are welded,
-/// the faces that collapse left out, triangles made flat split away.
+/// mended ([`Mesh::round_closed`]): vertices made equal are welded,
+/// the faces that collapse left out, triangles made flat split away, and
+/// where that would pinch the surface, vertices are kept one `f32` step
+/// apart instead.
 pub fn write_mesh(path: impl AsRef<Path>, mesh: &Mesh) -> Result<(), Error> {
     let path = path.as_ref();
     let format = shadow_scene::MeshFormat::from_path(path).map_err(Error::File)?;
     if format == shadow_scene::MeshFormat::Stl {
         let mut rounded = mesh.clone();
-        rounded.round_positions(shadow_scene::to_f32);
+        rounded.round_closed(shadow_scene::to_f32, shadow_scene::f32_step);
         return shadow_scene::save(path, &rounded).map_err(Error::File);
     }
     shadow_scene::save(path, mesh).map_err(Error::File)
