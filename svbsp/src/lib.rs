@@ -40,6 +40,7 @@
 //!
 //! None.
 
+mod area;
 mod areas;
 mod arena;
 mod chin_feiner;
@@ -49,6 +50,7 @@ mod light;
 mod psv;
 mod wide;
 
+pub use area::{AreaLight, AreaLightError, LightView, Occluder, Visibility, form_factor};
 pub use areas::{Areas, fragment_area, percent, polygon_area};
 pub use arena::pieces::Vertex;
 pub use chin_feiner::{CfFragment, CfFragments, chin_feiner};

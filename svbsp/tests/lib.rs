@@ -8,6 +8,8 @@
 //! The modules live in `suite/` rather than next to this file because
 //! Cargo would build every `tests/*.rs` as a test binary of its own.
 
+#[path = "suite/area.rs"]
+mod area;
 #[path = "suite/fuzzcase.rs"]
 mod fuzzcase;
 #[path = "suite/harness.rs"]

@@ -31,6 +31,8 @@ impl std::fmt::Display for FaceDefect {
     }
 }
 
+impl std::error::Error for FaceDefect {}
+
 /// Exclusive bound on the absolute value of a normal component: `2^55`.
 pub const MAX_NORMAL_BITS: u32 = 55;
 /// Exclusive bound on the absolute value of an offset: `2^83`.

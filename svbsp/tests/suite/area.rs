@@ -1,0 +1,200 @@
+//! What a point sees of an area light (`AreaLight::view`), against the
+//! exact ray-casting oracle: the light sampled at a lattice of grid points,
+//! each a point light, and the point's verdict for each. A point that sees
+//! all of the light must be lit by every sample, one that sees none must
+//! be shadowed from every sample (both but for samples whose segment only
+//! grazes an occluder, which the oracle calls degenerate), and the share
+//! of the irradiance that arrives must match the samples' weighted share.
+
+use bsp_core::Polygon;
+use bsp_fixtures::Rng;
+use glam::DVec3;
+use svbsp::{AreaLight, Light, Occluder, Visibility};
+
+use crate::oracle::{HPoint, Scene, Verdict};
+
+/// A number in `0..n`.
+fn below(rng: &mut Rng, n: u64) -> i32 {
+    (rng.next_u64() % n) as i32
+}
+
+/// The light: a `side`-square at height `h`, its corner at `(x0, y0)`,
+/// shining down.
+fn square_light(x0: i32, y0: i32, side: i32, h: i32) -> [[i32; 3]; 4] {
+    [
+        [x0, y0, h],
+        [x0, y0 + side, h],
+        [x0 + side, y0 + side, h],
+        [x0 + side, y0, h],
+    ]
+}
+
+/// The samples' verdicts at `x` on the ground (face 0 of `faces`) and the
+/// irradiance-weighted share of lit samples: the light's lattice points
+/// with odd coordinates (the centres of a `2 × 2` tiling, so the
+/// weighted share is a midpoint rule for the form factor).
+fn sampled(faces: &[Vec<[i32; 3]>], light: &[[i32; 3]; 4], x: [i32; 3]) -> (Vec<Verdict>, f64) {
+    let polys: Vec<Polygon> = faces
+        .iter()
+        .enumerate()
+        .map(|(i, f)| Polygon::from_grid_points(f, i as u32).unwrap())
+        .collect();
+    let scene = Scene::from_polygons(&polys);
+    let (lo, hi) = (light[0], light[2]);
+    let hx = HPoint::grid(x.map(i64::from));
+    let xf = DVec3::from_array(x.map(f64::from));
+    let (mut verdicts, mut lit, mut all) = (Vec::new(), 0.0, 0.0);
+    for sx in (lo[0] + 1..hi[0]).step_by(2) {
+        for sy in (lo[1] + 1..hi[1]).step_by(2) {
+            let s = [sx, sy, lo[2]];
+            let d = DVec3::from_array(s.map(f64::from)) - xf;
+            // cosines at the ground (normal +z) and at the light (-z)
+            let w = (d.z / d.length()).powi(2) / d.length_squared();
+            let v = scene.verdict(&Light::Point(s), 0, &hx);
+            let seen = match v {
+                Verdict::Lit => true,
+                Verdict::Shadowed => false,
+                Verdict::Degenerate { lit } => lit,
+            };
+            all += w;
+            lit += if seen { w } else { 0.0 };
+            verdicts.push(v);
+        }
+    }
+    (verdicts, lit / all)
+}
+
+/// `view` at `x` on the ground of `faces` (face 0), checked against the
+/// samples; returns the visibility.
+fn check(faces: &[Vec<[i32; 3]>], light: &[[i32; 3]; 4], x: [i32; 3]) -> Visibility {
+    let area = AreaLight::new(light).unwrap();
+    let occluders: Vec<Occluder> = faces.iter().map(|f| Occluder::new(f).unwrap()).collect();
+    let ground = *occluders[0].plane();
+    let view = area.view(x, Some(&ground), &occluders);
+    let (verdicts, share) = sampled(faces, light, x);
+    let degenerate = |v: &Verdict| matches!(v, Verdict::Degenerate { .. });
+    match view.visibility {
+        Visibility::All => assert!(
+            verdicts.iter().all(|v| *v == Verdict::Lit || degenerate(v)),
+            "{x:?} sees all of the light, yet a sample is shadowed"
+        ),
+        Visibility::None => assert!(
+            verdicts
+                .iter()
+                .all(|v| *v == Verdict::Shadowed || degenerate(v)),
+            "{x:?} sees none of the light, yet a sample is lit"
+        ),
+        Visibility::Part => {}
+    }
+    let fraction = view
+        .fraction(DVec3::from_array(x.map(f64::from)), DVec3::Z)
+        .unwrap();
+    assert!(
+        (fraction - share).abs() < 0.03,
+        "{x:?}: fraction {fraction}, the samples' share {share}"
+    );
+    view.visibility
+}
+
+fn ground(r: i32) -> Vec<[i32; 3]> {
+    vec![[-r, -r, 0], [r, -r, 0], [r, r, 0], [-r, r, 0]]
+}
+
+/// A square occluder half-way under a square light: seen from below its
+/// centre it hides the middle quarter; two occluders whose shadows only
+/// together cover the light (each alone leaves some of it) make umbra.
+#[test]
+fn known_answers() {
+    let light = square_light(0, 0, 40, 80);
+    let small = vec![[15, 15, 40], [25, 15, 40], [25, 25, 40], [15, 25, 40]];
+    assert_eq!(
+        check(&[ground(200), small.clone()], &light, [20, 20, 0]),
+        Visibility::Part
+    );
+    // the quarter, exactly: 1200 of 1600 seen
+    let area = AreaLight::new(&light).unwrap();
+    let view = area.view([20, 20, 0], None, &[Occluder::new(&small).unwrap()]);
+    let seen: f64 = view
+        .seen
+        .iter()
+        .map(|p| {
+            let v: Vec<DVec3> = p
+                .vertices_f64()
+                .iter()
+                .map(|&c| DVec3::from_array(c))
+                .collect();
+            svbsp::polygon_area(&v)
+        })
+        .sum();
+    assert_eq!(seen, 1200.0);
+    // two halves at different heights, each hiding half of the light
+    let left = vec![[0, -20, 40], [10, -20, 40], [10, 60, 40], [0, 60, 40]];
+    let right = vec![[10, -40, 60], [40, -40, 60], [40, 80, 60], [10, 80, 60]];
+    let x = [10, 20, 0];
+    assert_eq!(
+        check(&[ground(200), left.clone()], &light, x),
+        Visibility::Part
+    );
+    assert_eq!(
+        check(&[ground(200), right.clone()], &light, x),
+        Visibility::Part
+    );
+    assert_eq!(
+        check(&[ground(200), left, right], &light, x),
+        Visibility::None
+    );
+    // no occluder: all of it; behind the light: none
+    assert_eq!(check(&[ground(200)], &light, [20, 20, 0]), Visibility::All);
+    assert_eq!(
+        area.view([20, 20, 90], None, &[]).visibility,
+        Visibility::None
+    );
+}
+
+/// Random triangles between a square light and the ground, random points
+/// on the ground: every class and fraction against the samples.
+#[test]
+fn random_occluders_against_the_oracle() {
+    let mut rng = Rng::new(0x0a4e_a116);
+    let light = square_light(-16, -16, 32, 96);
+    let mut seen = [0usize; 3];
+    for _ in 0..24 {
+        let mut faces = vec![ground(400)];
+        for _ in 0..1 + below(&mut rng, 3) {
+            let z = 24 + below(&mut rng, 48);
+            let c = [below(&mut rng, 80) - 40, below(&mut rng, 80) - 40];
+            let corner = |rng: &mut Rng| {
+                [
+                    c[0] + below(rng, 81) - 40,
+                    c[1] + below(rng, 81) - 40,
+                    z + below(rng, 9) - 4,
+                ]
+            };
+            let t = [corner(&mut rng), corner(&mut rng), corner(&mut rng)];
+            if Occluder::new(&t).is_ok() {
+                faces.push(t.to_vec());
+            }
+        }
+        for _ in 0..6 {
+            let x = [below(&mut rng, 120) - 60, below(&mut rng, 120) - 60, 0];
+            seen[match check(&faces, &light, x) {
+                Visibility::All => 0,
+                Visibility::Part => 1,
+                Visibility::None => 2,
+            }] += 1;
+        }
+    }
+    // every class was met
+    assert!(seen.iter().all(|&n| n > 0), "{seen:?}");
+}
+
+/// Corners that make no light are refused, naming why.
+#[test]
+fn bad_lights_are_refused() {
+    let msg = |c: &[[i32; 3]]| AreaLight::new(c).unwrap_err().to_string();
+    assert!(msg(&[[0, 0, 0], [1, 0, 0]]).contains("three corners"));
+    assert!(msg(&[[0, 0, 0], [1, 0, 0], [2, 0, 0]]).contains("zero area"));
+    assert!(msg(&[[0, 0, 0], [2, 0, 0], [2, 2, 1], [0, 2, 0]]).contains("not in one plane"));
+    let bow = msg(&[[0, 0, 0], [4, 0, 0], [1, 1, 0], [0, 4, 0]]);
+    assert!(bow.contains("not convex"), "{bow}");
+}
