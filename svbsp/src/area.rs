@@ -18,9 +18,25 @@
 //! The share of the light's irradiance that arrives ([`LightView::fraction`])
 //! is the point-to-polygon form factor of the pieces over the light's own,
 //! in closed form (Lambert), in `f64`.
+//!
+//! A whole face is cut into fragments of one class each by
+//! [`AreaLight::classify_face`]. The points an occluder `O` keeps from
+//! seeing all of the light, `PV(O) = {x : conv(x, L) ∩ O ≠ ∅}`, form a
+//! convex set (a convex combination of two witnesses is one) bounded by
+//! the planes through a light corner and an occluder edge, or through a
+//! light edge and an occluder corner, that separate the light from the
+//! occluder, and, where the light lies on one side of the occluder's
+//! plane, by that plane. All pass through grid points, so a face cut by
+//! them is classified piece by piece by exact signs alone: lit is exact.
+//! A piece inside one occluder's umbra (behind it from every light corner:
+//! the light is convex, so it is then hidden whole) is umbra; a piece from
+//! which some light corner is seen is penumbra; a piece whose every light
+//! corner is hidden, by different occluders, is undecided: its umbra may
+//! end on a quadric (EEE) surface, or on a plane of occluders that only
+//! together hide the light, which this first version does not resolve.
 
 use bsp_core::internals::GridPolygon;
-use bsp_core::{FaceDefect, GridPoint, Plane, Polygon, Side, Split};
+use bsp_core::{FaceDefect, GridPoint, Plane, Polygon, PolygonSide, Side, Split};
 use glam::DVec3;
 
 /// A planar convex polygon that emits light on the side its corners turn
@@ -67,9 +83,10 @@ impl std::error::Error for AreaLightError {
     }
 }
 
-/// A face that may hide an area light: a planar, strictly convex polygon
-/// with corners on the grid (either way round: every face blocks light
-/// whichever way it faces).
+/// A face of the scene as area lights meet it, as an occluder or a
+/// receiver: a planar, strictly convex polygon with corners on the grid
+/// (counter-clockwise about its front; every face blocks light whichever
+/// way it faces).
 #[derive(Clone, Debug)]
 pub struct Occluder {
     polygon: GridPolygon,
@@ -320,4 +337,255 @@ impl Cone {
         }
         true
     }
+}
+
+/// What part of an area light the points of a fragment see.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum AreaClass {
+    /// All of it.
+    Lit,
+    /// Part of it: some light corner is seen, not all of the light.
+    Penumbra,
+    /// None of it.
+    Umbra,
+    /// Every light corner is hidden, by different occluders, and no one
+    /// occluder hides the light: umbra or penumbra, not decided here.
+    Undecided,
+}
+
+/// A piece of a face with one [`AreaClass`].
+#[derive(Clone, Debug)]
+pub struct AreaFragment {
+    /// The piece: convex, with exact corners.
+    pub polygon: Polygon,
+    /// What its points see.
+    pub class: AreaClass,
+}
+
+/// Half-spaces as planes and the side that is inside.
+type HalfSpaces = Vec<(Plane, Side)>;
+
+/// An occluder's regions for an area light: its penumbra volume (the
+/// points it keeps from seeing all of the light) and, per light corner,
+/// its shadow volume from that corner (`None` where the corner lies in
+/// its plane and it hides nothing from there).
+struct Regions {
+    penumbra: HalfSpaces,
+    from_corner: Vec<Option<HalfSpaces>>,
+}
+
+impl AreaLight {
+    /// `face` cut into fragments of one class each (see the module docs),
+    /// with every other face of `occluders` as an occluder (`face` may be
+    /// among them: it hides nothing from its own points). Adjacent pieces
+    /// of one class are merged where their union is convex. Where the
+    /// light lies wholly behind the face's plane, the face is umbra
+    /// (attached shadow); where it lies partly behind, no point of the
+    /// face sees all of it.
+    ///
+    /// ```
+    /// use svbsp::{AreaClass, AreaLight, Occluder};
+    /// let light = AreaLight::new(&[[0, 0, 80], [0, 40, 80], [40, 40, 80], [40, 0, 80]]).unwrap();
+    /// let ground = Occluder::new(&[[-200, -200, 0], [200, -200, 0], [200, 200, 0], [-200, 200, 0]]).unwrap();
+    /// let roof = Occluder::new(&[[0, 0, 40], [40, 0, 40], [40, 40, 40], [0, 40, 40]]).unwrap();
+    /// let fragments = light.classify_face(&ground, &[ground.clone(), roof]);
+    /// let has = |c| fragments.iter().any(|f| f.class == c);
+    /// assert!(has(AreaClass::Lit) && has(AreaClass::Penumbra) && has(AreaClass::Umbra));
+    /// assert!(!has(AreaClass::Undecided));
+    /// ```
+    pub fn classify_face(&self, face: &Occluder, occluders: &[Occluder]) -> Vec<AreaFragment> {
+        let fragment = |polygon, class| AreaFragment { polygon, class };
+        let whole = face.polygon.to_polygon(0);
+        let behind_face: Vec<bool> = self
+            .corners()
+            .iter()
+            .map(|&v| face.plane().classify_grid(v) != Side::Front)
+            .collect();
+        if behind_face.iter().all(|&b| b) {
+            return vec![fragment(whole, AreaClass::Umbra)];
+        }
+        let partly_behind = behind_face.iter().any(|&b| b);
+        // points not strictly in front of the light see none of it
+        let mut out = Vec::new();
+        let front = match whole.split(self.plane()) {
+            Split::Front(p) => p,
+            Split::Spanning { front, back } => {
+                out.push(fragment(back, AreaClass::Umbra));
+                front
+            }
+            Split::Back(p) | Split::Coplanar { polygon: p, .. } => {
+                return vec![fragment(p, AreaClass::Umbra)];
+            }
+        };
+        let regions: Vec<Regions> = occluders
+            .iter()
+            .filter(|o| o.polygon.vertices() != face.polygon.vertices())
+            .filter_map(|o| self.regions(o))
+            .filter(|r| {
+                let mut probe = front.clone();
+                r.penumbra.iter().all(|(h, s)| probe.clip(h, *s))
+            })
+            .collect();
+        let mut pieces = vec![front];
+        for r in &regions {
+            let planes = r
+                .penumbra
+                .iter()
+                .chain(r.from_corner.iter().flatten().flatten());
+            for (h, _) in planes {
+                pieces = pieces
+                    .into_iter()
+                    .flat_map(|p| match p.split(h) {
+                        Split::Spanning { front, back } => vec![front, back],
+                        Split::Front(p) | Split::Back(p) | Split::Coplanar { polygon: p, .. } => {
+                            vec![p]
+                        }
+                    })
+                    .collect();
+            }
+        }
+        let corners = self.corners().len();
+        for piece in pieces {
+            let within = |hs: &HalfSpaces| {
+                hs.iter().all(|(h, s)| match piece.classify(h) {
+                    PolygonSide::Front => *s == Side::Front,
+                    PolygonSide::Back => *s == Side::Back,
+                    _ => false,
+                })
+            };
+            let class = if !regions.iter().any(|r| within(&r.penumbra)) {
+                if partly_behind {
+                    AreaClass::Penumbra
+                } else {
+                    AreaClass::Lit
+                }
+            } else if regions
+                .iter()
+                .any(|r| r.from_corner.iter().all(|c| c.as_ref().is_some_and(within)))
+            {
+                AreaClass::Umbra
+            } else if (0..corners).all(|i| {
+                // a corner in an occluder's plane may be hidden but for
+                // itself: not taken as seen
+                behind_face[i]
+                    || regions.iter().any(|r| match &r.from_corner[i] {
+                        Some(hs) => within(hs),
+                        None => true,
+                    })
+            }) {
+                AreaClass::Undecided
+            } else {
+                AreaClass::Penumbra
+            };
+            out.push(fragment(piece, class));
+        }
+        merge_alike(out)
+    }
+
+    /// The occluder's regions (see [`Regions`]); `None` where it lies in
+    /// the light's plane and hides none of it.
+    fn regions(&self, o: &Occluder) -> Option<Regions> {
+        let (lv, ov) = (self.corners(), o.polygon.vertices());
+        let light_sides: Vec<Side> = lv.iter().map(|&v| o.plane().classify_grid(v)).collect();
+        if light_sides.iter().all(|&s| s == Side::On) {
+            return None;
+        }
+        let mut penumbra = HalfSpaces::new();
+        // the occluder's plane bounds the volume where the light is on one side
+        let light_front = light_sides.contains(&Side::Front);
+        let light_back = light_sides.contains(&Side::Back);
+        if light_front != light_back {
+            penumbra.push((
+                *o.plane(),
+                if light_front { Side::Back } else { Side::Front },
+            ));
+        }
+        let (nl, no) = (lv.len(), ov.len());
+        let candidates = (0..nl).flat_map(|i| {
+            (0..no).flat_map(move |j| {
+                [
+                    (lv[i], ov[j], ov[(j + 1) % no]),
+                    (lv[i], lv[(i + 1) % nl], ov[j]),
+                ]
+            })
+        });
+        for (a, b, c) in candidates {
+            let Ok(h) = Plane::through(a, b, c) else {
+                continue;
+            };
+            if let Some(inside) = separating(&h, lv, ov) {
+                penumbra.push((h, inside));
+            }
+        }
+        let from_corner = lv
+            .iter()
+            .zip(&light_sides)
+            .map(|(&l, &side)| {
+                let far = match side {
+                    Side::Front => Side::Back,
+                    Side::Back => Side::Front,
+                    Side::On => return None,
+                };
+                let mut hs = vec![(*o.plane(), far)];
+                for j in 0..no {
+                    let h = Plane::through(l, ov[j], ov[(j + 1) % no]).ok()?;
+                    hs.push((h, h.classify_grid(ov[(j + 2) % no])));
+                }
+                Some(hs)
+            })
+            .collect();
+        Some(Regions {
+            penumbra,
+            from_corner,
+        })
+    }
+}
+
+/// The occluder's side of `h` if `h` separates the light's corners `lv`
+/// from the occluder's `ov` (each on one closed side, opposite, neither
+/// wholly in `h`).
+fn separating(h: &Plane, lv: &[GridPoint], ov: &[GridPoint]) -> Option<Side> {
+    let side_of = |pts: &[GridPoint]| {
+        let (mut front, mut back) = (false, false);
+        for &p in pts {
+            match h.classify_grid(p) {
+                Side::Front => front = true,
+                Side::Back => back = true,
+                Side::On => {}
+            }
+        }
+        match (front, back) {
+            (true, false) => Some(Side::Front),
+            (false, true) => Some(Side::Back),
+            _ => None,
+        }
+    };
+    match (side_of(lv)?, side_of(ov)?) {
+        (l, o) if l != o => Some(o),
+        _ => None,
+    }
+}
+
+/// Merges fragments of one class whose union is convex, until none do.
+fn merge_alike(mut fragments: Vec<AreaFragment>) -> Vec<AreaFragment> {
+    let mut i = 0;
+    while i < fragments.len() {
+        let mut j = i + 1;
+        let mut merged = false;
+        while j < fragments.len() {
+            if fragments[j].class == fragments[i].class
+                && let Some(m) = fragments[i].polygon.merge(&fragments[j].polygon)
+            {
+                fragments[i].polygon = m;
+                fragments.swap_remove(j);
+                merged = true;
+            } else {
+                j += 1;
+            }
+        }
+        if !merged {
+            i += 1;
+        }
+    }
+    fragments
 }

@@ -50,7 +50,10 @@ mod light;
 mod psv;
 mod wide;
 
-pub use area::{AreaLight, AreaLightError, LightView, Occluder, Visibility, form_factor};
+pub use area::{
+    AreaClass, AreaFragment, AreaLight, AreaLightError, LightView, Occluder, Visibility,
+    form_factor,
+};
 pub use areas::{Areas, fragment_area, percent, polygon_area};
 pub use arena::pieces::Vertex;
 pub use chin_feiner::{CfFragment, CfFragments, chin_feiner};

@@ -9,7 +9,7 @@
 use bsp_core::Polygon;
 use bsp_fixtures::Rng;
 use glam::DVec3;
-use svbsp::{AreaLight, Light, Occluder, Visibility};
+use svbsp::{AreaClass, AreaLight, Light, Occluder, Visibility};
 
 use crate::oracle::{HPoint, Scene, Verdict};
 
@@ -197,4 +197,131 @@ fn bad_lights_are_refused() {
     assert!(msg(&[[0, 0, 0], [2, 0, 0], [2, 2, 1], [0, 2, 0]]).contains("not in one plane"));
     let bow = msg(&[[0, 0, 0], [4, 0, 0], [1, 1, 0], [0, 4, 0]]);
     assert!(bow.contains("not convex"), "{bow}");
+}
+
+/// Whether the grid point `x` lies strictly inside the convex `piece`.
+fn strictly_inside(piece: &Polygon, x: [i32; 3]) -> bool {
+    piece
+        .edge_planes()
+        .iter()
+        .all(|h| h.classify_grid(x) == bsp_core::Side::Back)
+}
+
+/// Random occluders between a square light and the ground and a wall
+/// (sometimes a square split into two triangles, whose umbra neither
+/// makes alone, sometimes an upright fin whose plane cuts the light): each receiver cut into classes, and at grid points
+/// strictly inside each piece the exact view agrees (lit: sees all;
+/// umbra: none; penumbra: part; undecided: part or none), and the pieces
+/// tile the receiver.
+#[test]
+fn classified_faces_agree_with_the_view() {
+    let mut rng = Rng::new(0x5eed_a4ea);
+    let light = AreaLight::new(&square_light(-16, -16, 32, 96)).unwrap();
+    let wall = [[60, -120, 0], [60, -120, 120], [60, 120, 120], [60, 120, 0]];
+    let mut met = std::collections::HashMap::new();
+    for round in 0..24 {
+        let mut faces = vec![
+            Occluder::new(&ground(120)).unwrap(),
+            Occluder::new(&wall).unwrap(),
+        ];
+        for _ in 0..1 + below(&mut rng, 3) {
+            let z = 24 + below(&mut rng, 48);
+            let c = [below(&mut rng, 80) - 40, below(&mut rng, 80) - 40];
+            let corner = |rng: &mut Rng| {
+                [
+                    c[0] + below(rng, 81) - 40,
+                    c[1] + below(rng, 81) - 40,
+                    z + below(rng, 9) - 4,
+                ]
+            };
+            let t = [corner(&mut rng), corner(&mut rng), corner(&mut rng)];
+            if let Ok(o) = Occluder::new(&t) {
+                faces.push(o);
+            }
+        }
+        if round % 3 == 1 {
+            // a fin whose plane cuts the light in two
+            let (x, y) = (below(&mut rng, 31) - 15, below(&mut rng, 60) - 30);
+            let fin = [[x, y, 30], [x, y + 50, 30], [x, y + 30, 70]];
+            faces.push(Occluder::new(&fin).unwrap());
+        }
+        if round % 3 == 0 {
+            let (x, y, z) = (below(&mut rng, 40) - 40, below(&mut rng, 40) - 20, 48);
+            let q = [
+                [x, y, z],
+                [x + 40, y, z],
+                [x + 40, y + 40, z],
+                [x, y + 40, z],
+            ];
+            faces.push(Occluder::new(&[q[0], q[1], q[2]]).unwrap());
+            faces.push(Occluder::new(&[q[0], q[2], q[3]]).unwrap());
+        }
+        for (r, total) in [(0, 240.0 * 240.0), (1, 240.0 * 120.0)] {
+            let fragments = light.classify_face(&faces[r], &faces);
+            let area: f64 = fragments
+                .iter()
+                .map(|f| {
+                    let v: Vec<DVec3> = f
+                        .polygon
+                        .vertices_f64()
+                        .iter()
+                        .map(|&c| DVec3::from_array(c))
+                        .collect();
+                    svbsp::polygon_area(&v)
+                })
+                .sum();
+            assert!((area - total).abs() < 1e-6 * total, "{area}");
+            let plane = *faces[r].plane();
+            for _ in 0..96 {
+                let (u, v) = (below(&mut rng, 240) - 120, below(&mut rng, 120));
+                let x = if r == 0 { [u, v - 60, 0] } else { [60, u, v] };
+                let Some(f) = fragments.iter().find(|f| strictly_inside(&f.polygon, x)) else {
+                    continue;
+                };
+                // in an occluder's plane, it is edge-on: it hides no area
+                // from the point, but some from points beside it
+                let edge_on = |o: &Occluder| o.plane().classify_grid(x) == bsp_core::Side::On;
+                if faces.iter().enumerate().any(|(i, o)| i != r && edge_on(o)) {
+                    continue;
+                }
+                let seen = light.view(x, Some(&plane), &faces).visibility;
+                let ok = match f.class {
+                    AreaClass::Lit => seen == Visibility::All,
+                    AreaClass::Umbra => seen == Visibility::None,
+                    AreaClass::Penumbra => seen == Visibility::Part,
+                    AreaClass::Undecided => seen != Visibility::All,
+                };
+                assert!(ok, "{x:?}: class {:?}, the view says {seen:?}", f.class);
+                *met.entry(f.class).or_insert(0) += 1;
+            }
+        }
+    }
+    for class in [
+        AreaClass::Lit,
+        AreaClass::Penumbra,
+        AreaClass::Umbra,
+        AreaClass::Undecided,
+    ] {
+        assert!(met.contains_key(&class), "{class:?} never met: {met:?}");
+    }
+}
+
+/// A face just above an occluder, under the light, is lit: it lies on the
+/// occluder's side of every separating plane (they cross between light
+/// and occluder), and only the occluder's own plane bounds its penumbra
+/// volume there.
+#[test]
+fn a_face_between_the_light_and_an_occluder_is_lit() {
+    let light = AreaLight::new(&square_light(0, 0, 40, 80)).unwrap();
+    let below = Occluder::new(&[[0, 0, 40], [40, 0, 40], [40, 40, 40], [0, 40, 40]]).unwrap();
+    let above = Occluder::new(&[[10, 10, 44], [30, 10, 44], [30, 30, 44], [10, 30, 44]]).unwrap();
+    let faces = [above.clone(), below];
+    let fragments = light.classify_face(&above, &faces);
+    assert!(fragments.iter().all(|f| f.class == AreaClass::Lit));
+    assert_eq!(
+        light
+            .view([20, 20, 44], Some(above.plane()), &faces)
+            .visibility,
+        Visibility::All
+    );
 }
