@@ -12,7 +12,11 @@
 //! - `psv/<scene>`: `Shadows::new` and `shade_all` (the default path:
 //!   fragments per face, on every core);
 //! - `chin_feiner/<scene>`: the scene BSP (`BspTree::build`) and
-//!   `chin_feiner` (the baseline algorithm), up to 10 000 polygons.
+//!   `chin_feiner` (the baseline algorithm), up to 10 000 polygons;
+//! - `area/<scene>`: a 0.4 × 0.4 area light facing down, centred on the
+//!   key light, every face cut into lit, penumbra, umbra and undecided
+//!   fragments (`AreaLight::classify_faces`: every face against every
+//!   other, so up to 1 026 polygons), beside one point light's `1light`.
 //!
 //! Before each scene one timed run prints the counts criterion cannot
 //! report: fragments per face, shadow-tree nodes, and the peak memory of
@@ -28,7 +32,7 @@ use std::time::{Duration, Instant};
 
 use bsp_core::{BspTree, BuildOptions};
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
-use svbsp::{ShadeOptions, Shadows, chin_feiner};
+use svbsp::{AreaClass, AreaLight, Occluder, ShadeOptions, Shadows, chin_feiner};
 
 mod common;
 
@@ -142,9 +146,87 @@ fn bench_scene(c: &mut Criterion, name: &str) {
     }
 }
 
+/// The scene's faces as occluders and a 0.4 × 0.4 area light centred on
+/// its key light, facing down; the faces that do not snap to a convex
+/// polygon are left out (counted).
+fn area_scene(name: &str) -> (AreaLight, Vec<Occluder>, usize) {
+    let spec = common::scene(name);
+    let world = common::lights(&spec, 1);
+    let p = common::prepare(&spec, &world);
+    let common::WorldLight::Point(at) = world[0] else {
+        panic!("the key light is a point light");
+    };
+    let corner = |dx: f64, dy: f64| p.grid.snap(at + glam::DVec3::new(dx, dy, 0.0)).unwrap();
+    let light = AreaLight::new(&[
+        corner(-0.2, -0.2),
+        corner(-0.2, 0.2),
+        corner(0.2, 0.2),
+        corner(0.2, -0.2),
+    ])
+    .expect("a square light");
+    let mut faces = Vec::new();
+    let mut left_out = 0;
+    for f in &spec.faces {
+        let loop_: Vec<[i32; 3]> = f.iter().map(|&v| p.grid.snap(v).unwrap()).collect();
+        match Occluder::new(&loop_) {
+            Ok(o) => faces.push(o),
+            Err(_) => left_out += 1,
+        }
+    }
+    (light, faces, left_out)
+}
+
+fn bench_area(c: &mut Criterion, name: &str) {
+    let (light, faces, left_out) = area_scene(name);
+    let t = Instant::now();
+    let all = light.classify_faces(&faces);
+    let time = t.elapsed();
+    let mut area = [0.0f64; 4];
+    for f in all.iter().flatten() {
+        let v: Vec<glam::DVec3> = f
+            .polygon
+            .vertices_f64()
+            .iter()
+            .map(|&c| glam::DVec3::from_array(c))
+            .collect();
+        let k = match f.class {
+            AreaClass::Lit => 0,
+            AreaClass::Penumbra => 1,
+            AreaClass::Umbra => 2,
+            AreaClass::Undecided => 3,
+        };
+        area[k] += svbsp::polygon_area(&v);
+    }
+    let total: f64 = area.iter().sum();
+    let share = |k: usize| 100.0 * area[k] / total;
+    let fragments: usize = all.iter().map(Vec::len).sum();
+    eprintln!(
+        "{name} / area light: {} faces ({left_out} left out: not convex once snapped), {fragments} \
+         fragments ({:.3} per face); area lit {:.1}%, penumbra {:.1}%, umbra {:.1}%, \
+         undecided {:.1}%; {:.1} ms",
+        faces.len(),
+        fragments as f64 / faces.len() as f64,
+        share(0),
+        share(1),
+        share(2),
+        share(3),
+        time.as_secs_f64() * 1e3
+    );
+    let mut g = c.benchmark_group(format!("area/{name}"));
+    configure(&mut g, false);
+    g.throughput(Throughput::Elements(faces.len() as u64));
+    g.bench_function("area_light", |b| {
+        b.iter(|| light.classify_faces(black_box(&faces)))
+    });
+    g.finish();
+}
+
 fn bench(c: &mut Criterion) {
     for name in scenes() {
         bench_scene(c, &name);
+        if common::scene(&name).faces.len() <= 1_026 {
+            bench_area(c, &name);
+        }
     }
 }
 

@@ -36,7 +36,7 @@
 //! together hide the light, which this first version does not resolve.
 
 use bsp_core::internals::GridPolygon;
-use bsp_core::{FaceDefect, GridPoint, Plane, Polygon, PolygonSide, Side, Split};
+use bsp_core::{FaceDefect, GridPoint, Plane, Polygon, Side, Split};
 use glam::DVec3;
 
 /// A planar convex polygon that emits light on the side its corners turn
@@ -52,6 +52,8 @@ pub struct AreaLight {
 pub enum AreaLightError {
     /// Fewer than three corners.
     TooFewCorners(usize),
+    /// An area light of more than 64 corners.
+    TooManyCorners(usize),
     /// The corners are not a planar, strictly convex polygon with area
     /// (collinear, not planar, not convex, turning twice, or out of the
     /// grid); the cause as the kernel found it.
@@ -67,6 +69,9 @@ impl std::fmt::Display for AreaLightError {
                     "a polygon of {n} corners: it takes at least three corners"
                 )
             }
+            AreaLightError::TooManyCorners(n) => {
+                write!(f, "an area light of {n} corners: at most 64 are supported")
+            }
             AreaLightError::Shape(d) => {
                 write!(f, "not a planar convex polygon with area: {d}")
             }
@@ -78,7 +83,7 @@ impl std::error::Error for AreaLightError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             AreaLightError::Shape(d) => Some(d),
-            AreaLightError::TooFewCorners(_) => None,
+            AreaLightError::TooFewCorners(_) | AreaLightError::TooManyCorners(_) => None,
         }
     }
 }
@@ -152,6 +157,9 @@ impl AreaLight {
             return Err(AreaLightError::TooFewCorners(corners.len()));
         }
         let polygon = GridPolygon::from_grid_points(corners).map_err(AreaLightError::Shape)?;
+        if polygon.len() > 64 {
+            return Err(AreaLightError::TooManyCorners(polygon.len()));
+        }
         Ok(AreaLight { polygon })
     }
 
@@ -316,26 +324,107 @@ impl Cone {
     /// Pushes onto `out` the parts of `piece` outside the cone; returns
     /// whether a part with area lay inside (hidden).
     fn subtract(&self, piece: Polygon, out: &mut Vec<Polygon>) -> bool {
-        let mut rest = piece;
-        for (plane, inside) in &self.planes {
-            let (within, outside) = match rest.split(plane) {
-                Split::Spanning { front, back } => match inside {
-                    Side::Front => (front, Some(back)),
-                    _ => (back, Some(front)),
-                },
-                Split::Front(p) if *inside == Side::Front => (p, None),
-                Split::Back(p) if *inside == Side::Back => (p, None),
-                Split::Front(p) | Split::Back(p) | Split::Coplanar { polygon: p, .. } => {
-                    out.push(p);
-                    return false;
-                }
-            };
-            if let Some(o) = outside {
-                out.push(o);
+        subtract(&self.planes, piece, out).is_some()
+    }
+}
+
+/// Pushes onto `out` the parts of `piece` outside the convex region
+/// `halfspaces`, and returns the part inside, if it has area. Where no
+/// part lies inside, `piece` is pushed whole (the cuts are undone); else
+/// the parts outside, each cut off by one plane, are merged where their
+/// union is convex.
+fn subtract(
+    halfspaces: &[(Plane, Side)],
+    piece: Polygon,
+    out: &mut Vec<Polygon>,
+) -> Option<Polygon> {
+    let start = out.len();
+    let original = piece.clone();
+    let mut rest = piece;
+    for (plane, inside) in halfspaces {
+        let (within, outside) = match rest.split(plane) {
+            Split::Spanning { front, back } => match inside {
+                Side::Front => (front, Some(back)),
+                _ => (back, Some(front)),
+            },
+            Split::Front(p) if *inside == Side::Front => (p, None),
+            Split::Back(p) if *inside == Side::Back => (p, None),
+            Split::Front(_) | Split::Back(_) | Split::Coplanar { .. } => {
+                out.truncate(start);
+                out.push(original);
+                return None;
             }
-            rest = within;
+        };
+        out.extend(outside);
+        rest = within;
+    }
+    merge_run(out, start);
+    Some(rest)
+}
+
+/// Merges the polygons of `v[start..]` pairwise where their union is
+/// convex, until none do.
+fn merge_run(v: &mut Vec<Polygon>, start: usize) {
+    let tail: Vec<Polygon> = v.drain(start..).collect();
+    let merged = merge_convex(tail.into_iter().map(|p| (p, ())).collect());
+    v.extend(merged.into_iter().map(|(p, ())| p));
+}
+
+/// The vertices' correctly rounded coordinates, as bits: equal exact
+/// points have equal keys, so two polygons that share an edge share two.
+fn vertex_keys(p: &Polygon) -> Vec<[u64; 3]> {
+    p.vertices_f64()
+        .iter()
+        .map(|c| c.map(|x| (x + 0.0).to_bits()))
+        .collect()
+}
+
+/// Merges polygons of equal labels pairwise where their union is convex
+/// (`Polygon::merge`, exact), until none do; only pairs that share two
+/// vertex keys are tried. Deterministic: the order of the input decides.
+fn merge_convex<T: Copy + PartialEq>(mut items: Vec<(Polygon, T)>) -> Vec<(Polygon, T)> {
+    loop {
+        let keys: Vec<Vec<[u64; 3]>> = items.iter().map(|(p, _)| vertex_keys(p)).collect();
+        let mut at: rustc_hash::FxHashMap<[u64; 3], Vec<usize>> = Default::default();
+        for (i, ks) in keys.iter().enumerate() {
+            for k in ks {
+                at.entry(*k).or_default().push(i);
+            }
         }
-        true
+        let mut dead = vec![false; items.len()];
+        let mut any = false;
+        for i in 0..items.len() {
+            if dead[i] {
+                continue;
+            }
+            let mut seen: Vec<usize> = keys[i].iter().flat_map(|k| at[k].iter().copied()).collect();
+            seen.sort_unstable();
+            let shared = seen
+                .windows(2)
+                .filter(|w| w[0] == w[1] && w[0] > i)
+                .map(|w| w[0]);
+            let mut candidates: Vec<usize> = shared.collect();
+            candidates.dedup();
+            for j in candidates {
+                if dead[j] || items[j].1 != items[i].1 {
+                    continue;
+                }
+                if let Some(m) = items[i].0.merge(&items[j].0) {
+                    items[i].0 = m;
+                    dead[j] = true;
+                    any = true;
+                    break;
+                }
+            }
+        }
+        let mut k = 0;
+        items.retain(|_| {
+            k += 1;
+            !dead[k - 1]
+        });
+        if !any {
+            return items;
+        }
     }
 }
 
@@ -394,6 +483,53 @@ impl AreaLight {
     /// assert!(!has(AreaClass::Undecided));
     /// ```
     pub fn classify_face(&self, face: &Occluder, occluders: &[Occluder]) -> Vec<AreaFragment> {
+        let regions: Vec<(usize, Regions)> = occluders
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o.polygon.vertices() != face.polygon.vertices())
+            .filter_map(|(i, o)| Some((i, self.regions(o)?)))
+            .collect();
+        self.classify_with(face, regions.iter().map(|(_, r)| r))
+    }
+
+    /// Every face of `faces` cut into fragments of one class each, with
+    /// all the others as occluders: [`AreaLight::classify_face`] for each,
+    /// each occluder's volumes built once, the faces in parallel (the
+    /// result is in face order, the same for every thread count).
+    ///
+    /// ```
+    /// use svbsp::{AreaClass, AreaLight, Occluder};
+    /// let light = AreaLight::new(&[[0, 0, 80], [0, 40, 80], [40, 40, 80], [40, 0, 80]]).unwrap();
+    /// let faces = [
+    ///     Occluder::new(&[[-200, -200, 0], [200, -200, 0], [200, 200, 0], [-200, 200, 0]]).unwrap(),
+    ///     Occluder::new(&[[0, 0, 40], [40, 0, 40], [40, 40, 40], [0, 40, 40]]).unwrap(),
+    /// ];
+    /// let all = light.classify_faces(&faces);
+    /// assert!(all[1].iter().all(|f| f.class == AreaClass::Lit)); // the roof
+    /// ```
+    pub fn classify_faces(&self, faces: &[Occluder]) -> Vec<Vec<AreaFragment>> {
+        use rayon::prelude::*;
+        let regions: Vec<Option<Regions>> = faces.par_iter().map(|o| self.regions(o)).collect();
+        faces
+            .par_iter()
+            .enumerate()
+            .map(|(i, face)| {
+                let others = regions
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, _)| j != i)
+                    .filter_map(|(_, r)| r.as_ref());
+                self.classify_with(face, others)
+            })
+            .collect()
+    }
+
+    /// [`AreaLight::classify_face`] with the occluders' regions given.
+    fn classify_with<'r>(
+        &self,
+        face: &Occluder,
+        occluders: impl Iterator<Item = &'r Regions>,
+    ) -> Vec<AreaFragment> {
         let fragment = |polygon, class| AreaFragment { polygon, class };
         let whole = face.polygon.to_polygon(0);
         let behind_face: Vec<bool> = self
@@ -417,67 +553,84 @@ impl AreaLight {
                 return vec![fragment(p, AreaClass::Umbra)];
             }
         };
-        let regions: Vec<Regions> = occluders
-            .iter()
-            .filter(|o| o.polygon.vertices() != face.polygon.vertices())
-            .filter_map(|o| self.regions(o))
+        let regions: Vec<&Regions> = occluders
             .filter(|r| {
                 let mut probe = front.clone();
                 r.penumbra.iter().all(|(h, s)| probe.clip(h, *s))
             })
             .collect();
-        let mut pieces = vec![front];
-        for r in &regions {
-            let planes = r
-                .penumbra
-                .iter()
-                .chain(r.from_corner.iter().flatten().flatten());
-            for (h, _) in planes {
-                pieces = pieces
-                    .into_iter()
-                    .flat_map(|p| match p.split(h) {
-                        Split::Spanning { front, back } => vec![front, back],
-                        Split::Front(p) | Split::Back(p) | Split::Coplanar { polygon: p, .. } => {
-                            vec![p]
-                        }
-                    })
-                    .collect();
-            }
+        // each piece's state: inside some penumbra volume, the light
+        // corners hidden from it (or behind the face), inside one
+        // occluder's umbra
+        struct Piece {
+            polygon: Polygon,
+            not_lit: bool,
+            hidden: u64,
+            umbra: bool,
         }
         let corners = self.corners().len();
-        for piece in pieces {
-            let within = |hs: &HalfSpaces| {
-                hs.iter().all(|(h, s)| match piece.classify(h) {
-                    PolygonSide::Front => *s == Side::Front,
-                    PolygonSide::Back => *s == Side::Back,
-                    _ => false,
-                })
-            };
-            let class = if !regions.iter().any(|r| within(&r.penumbra)) {
-                if partly_behind {
-                    AreaClass::Penumbra
-                } else {
-                    AreaClass::Lit
+        let all = u64::MAX >> (64 - corners);
+        let behind = (0..corners).fold(0u64, |m, i| m | u64::from(behind_face[i]) << i);
+        let mut pieces = vec![Piece {
+            polygon: front,
+            not_lit: false,
+            hidden: behind,
+            umbra: false,
+        }];
+        for r in &regions {
+            let mut next = Vec::with_capacity(pieces.len());
+            for piece in pieces {
+                if piece.umbra {
+                    next.push(piece);
+                    continue;
                 }
-            } else if regions
-                .iter()
-                .any(|r| r.from_corner.iter().all(|c| c.as_ref().is_some_and(within)))
-            {
-                AreaClass::Umbra
-            } else if (0..corners).all(|i| {
-                // a corner in an occluder's plane may be hidden but for
-                // itself: not taken as seen
-                behind_face[i]
-                    || regions.iter().any(|r| match &r.from_corner[i] {
-                        Some(hs) => within(hs),
-                        None => true,
-                    })
-            }) {
-                AreaClass::Undecided
-            } else {
-                AreaClass::Penumbra
+                let mut outside = Vec::new();
+                let inside = subtract(&r.penumbra, piece.polygon, &mut outside);
+                next.extend(
+                    outside
+                        .into_iter()
+                        .map(|polygon| Piece { polygon, ..piece }),
+                );
+                let Some(inside) = inside else {
+                    continue;
+                };
+                // inside the penumbra volume: cut by each corner's shadow
+                // volume, noting the corners it hides (a corner in the
+                // occluder's plane may be hidden but for itself: not seen)
+                let mut parts = vec![(inside, 0u64)];
+                for (i, volume) in r.from_corner.iter().enumerate() {
+                    let Some(hs) = volume else {
+                        parts.iter_mut().for_each(|(_, m)| *m |= 1 << i);
+                        continue;
+                    };
+                    let mut cut = Vec::with_capacity(parts.len());
+                    for (p, m) in parts {
+                        let mut out = Vec::new();
+                        let within = subtract(hs, p, &mut out);
+                        cut.extend(out.into_iter().map(|q| (q, m)));
+                        cut.extend(within.map(|q| (q, m | 1 << i)));
+                    }
+                    parts = cut;
+                }
+                let whole = r.from_corner.iter().all(Option::is_some);
+                next.extend(parts.into_iter().map(|(polygon, m)| Piece {
+                    polygon,
+                    not_lit: true,
+                    hidden: piece.hidden | m,
+                    umbra: whole && m == all,
+                }));
+            }
+            pieces = next;
+        }
+        for piece in pieces {
+            let class = match piece {
+                Piece { not_lit: false, .. } if partly_behind => AreaClass::Penumbra,
+                Piece { not_lit: false, .. } => AreaClass::Lit,
+                Piece { umbra: true, .. } => AreaClass::Umbra,
+                Piece { hidden, .. } if hidden == all => AreaClass::Undecided,
+                _ => AreaClass::Penumbra,
             };
-            out.push(fragment(piece, class));
+            out.push(fragment(piece.polygon, class));
         }
         merge_alike(out)
     }
@@ -567,25 +720,14 @@ fn separating(h: &Plane, lv: &[GridPoint], ov: &[GridPoint]) -> Option<Side> {
 }
 
 /// Merges fragments of one class whose union is convex, until none do.
-fn merge_alike(mut fragments: Vec<AreaFragment>) -> Vec<AreaFragment> {
-    let mut i = 0;
-    while i < fragments.len() {
-        let mut j = i + 1;
-        let mut merged = false;
-        while j < fragments.len() {
-            if fragments[j].class == fragments[i].class
-                && let Some(m) = fragments[i].polygon.merge(&fragments[j].polygon)
-            {
-                fragments[i].polygon = m;
-                fragments.swap_remove(j);
-                merged = true;
-            } else {
-                j += 1;
-            }
-        }
-        if !merged {
-            i += 1;
-        }
-    }
-    fragments
+fn merge_alike(fragments: Vec<AreaFragment>) -> Vec<AreaFragment> {
+    merge_convex(
+        fragments
+            .into_iter()
+            .map(|f| (f.polygon, f.class))
+            .collect(),
+    )
+    .into_iter()
+    .map(|(polygon, class)| AreaFragment { polygon, class })
+    .collect()
 }
