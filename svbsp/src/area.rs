@@ -36,7 +36,7 @@
 //! together hide the light, which this first version does not resolve.
 
 use bsp_core::internals::GridPolygon;
-use bsp_core::{FaceDefect, GridPoint, Plane, Polygon, Side, Split};
+use bsp_core::{FaceDefect, GridPoint, Plane, Polygon, PolygonSide, Side, Split};
 use glam::DVec3;
 
 /// A planar convex polygon that emits light on the side its corners turn
@@ -553,10 +553,16 @@ impl AreaLight {
                 return vec![fragment(p, AreaClass::Umbra)];
             }
         };
+        // an occluder whose penumbra volume lies wholly beyond one of its
+        // planes from the face hides nothing from it
         let regions: Vec<&Regions> = occluders
             .filter(|r| {
-                let mut probe = front.clone();
-                r.penumbra.iter().all(|(h, s)| probe.clip(h, *s))
+                r.penumbra.iter().all(|(h, s)| match front.classify(h) {
+                    PolygonSide::Front => *s == Side::Front,
+                    PolygonSide::Back => *s == Side::Back,
+                    PolygonSide::Spanning => true,
+                    PolygonSide::Coplanar { .. } => false,
+                })
             })
             .collect();
         // each piece's state: inside some penumbra volume, the light
