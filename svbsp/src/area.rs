@@ -112,6 +112,11 @@ impl Occluder {
     pub fn plane(&self) -> &Plane {
         self.polygon.support()
     }
+
+    /// Its corners, in order (without repeated or collinear ones).
+    pub fn corners(&self) -> &[GridPoint] {
+        self.polygon.vertices()
+    }
 }
 
 /// How much of a light a point sees, exactly (up to sets of zero area).

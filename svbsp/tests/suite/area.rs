@@ -325,3 +325,71 @@ fn a_face_between_the_light_and_an_occluder_is_lit() {
         Visibility::All
     );
 }
+
+/// Chin & Feiner's 258-polygon scene under a square light: every face's
+/// fragments tile it, and the result is the same on one thread as on
+/// several.
+#[test]
+fn classified_scenes_tile_their_faces_on_any_thread_count() {
+    let spec = bsp_fixtures::scenes::scene("cf258");
+    let world = bsp_fixtures::scenes::lights(&spec, 1);
+    let bsp_fixtures::scenes::WorldLight::Point(at) = world[0] else {
+        panic!("the key light is a point light");
+    };
+    let mut pts: Vec<DVec3> = spec.faces.iter().flatten().copied().collect();
+    pts.push(at);
+    let grid = bsp_core::Grid::fit_points(&pts).unwrap();
+    let corner = |dx: f64, dy: f64| grid.snap(at + DVec3::new(dx, dy, 0.0)).unwrap();
+    let light = AreaLight::new(&[
+        corner(-1.0, -1.0),
+        corner(-1.0, 1.0),
+        corner(1.0, 1.0),
+        corner(1.0, -1.0),
+    ])
+    .unwrap();
+    let faces: Vec<Occluder> = spec
+        .faces
+        .iter()
+        .filter_map(|f| {
+            let l: Vec<[i32; 3]> = f.iter().map(|&v| grid.snap(v).unwrap()).collect();
+            Occluder::new(&l).ok()
+        })
+        .collect();
+    assert!(faces.len() > 200);
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| light.classify_faces(&faces))
+    };
+    let key = |all: &Vec<Vec<svbsp::AreaFragment>>| -> Vec<(Vec<[f64; 3]>, AreaClass)> {
+        all.iter()
+            .flatten()
+            .map(|f| (f.polygon.vertices_f64(), f.class))
+            .collect()
+    };
+    let one = run(1);
+    assert_eq!(key(&one), key(&run(3)));
+    let area = |p: &[[f64; 3]]| {
+        let v: Vec<DVec3> = p.iter().map(|&c| DVec3::from_array(c)).collect();
+        svbsp::polygon_area(&v)
+    };
+    let mut classes = std::collections::HashSet::new();
+    for (face, fragments) in faces.iter().zip(&one) {
+        let whole = area(
+            &face
+                .corners()
+                .iter()
+                .map(|c| c.map(f64::from))
+                .collect::<Vec<_>>(),
+        );
+        let parts: f64 = fragments
+            .iter()
+            .map(|f| area(&f.polygon.vertices_f64()))
+            .sum();
+        assert!((parts - whole).abs() <= 1e-9 * whole, "{parts} of {whole}");
+        classes.extend(fragments.iter().map(|f| f.class));
+    }
+    assert!(classes.contains(&AreaClass::Penumbra) && classes.contains(&AreaClass::Umbra));
+}
