@@ -162,6 +162,18 @@ fn obj_text(positions: &[DVec3], faces: &[Vec<u32>]) -> String {
     s
 }
 
+/// The bench's sphere pair of about `n` triangles each, as OBJ files read.
+fn sphere_pair_read(n: usize) -> [Operand; 2] {
+    let (a, b, faces) = shapes::sphere_pair(n);
+    let read = |p: &[DVec3], name: &str| {
+        Operand::new(
+            name,
+            shadow_scene::parse_obj(&obj_text(p, &faces), name).unwrap(),
+        )
+    };
+    [read(&a, "a.obj"), read(&b, "b.obj")]
+}
+
 /// `out` written as OBJ (`f64`) or STL (`f32`), read back and united
 /// with itself: the volume moves at most by the surface's area times the
 /// farthest a vertex moves, half a step of the new grid along each axis
@@ -229,15 +241,8 @@ fn round_trip(out: &FileBoolean, stl: bool) {
 
 #[test]
 fn results_written_and_read_back_are_inputs_again() {
-    let (a, b, faces) = shapes::sphere_pair(800);
     for op in [BoolOp::Union, BoolOp::Intersection, BoolOp::Difference] {
-        let read = |p: &[DVec3], name: &str| {
-            Operand::new(
-                name,
-                shadow_scene::parse_obj(&obj_text(p, &faces), name).unwrap(),
-            )
-        };
-        let mut pair = [read(&a, "a.obj"), read(&b, "b.obj")];
+        let mut pair = sphere_pair_read(800);
         let checked = Operand::check_all(&mut pair).unwrap();
         let out = FileBoolean::apply(checked, op, |_, _| {}).unwrap();
         round_trip(&out, false);
@@ -291,14 +296,7 @@ fn results_that_round_flat_are_split_and_closed() {
 /// as read back, and an input again.
 #[test]
 fn results_that_would_pinch_in_f32_keep_their_vertices_apart() {
-    let (a, b, faces) = shapes::sphere_pair(8_000);
-    let read = |p: &[DVec3], name: &str| {
-        Operand::new(
-            name,
-            shadow_scene::parse_obj(&obj_text(p, &faces), name).unwrap(),
-        )
-    };
-    let mut pair = [read(&a, "a.obj"), read(&b, "b.obj")];
+    let mut pair = sphere_pair_read(8_000);
     let checked = Operand::check_all(&mut pair).unwrap();
     let out = FileBoolean::apply(checked, BoolOp::Difference, |_, _| {}).unwrap();
     let mut welded = out.mesh().to_mesh();

@@ -516,6 +516,12 @@ impl Mesh {
         for p in &mut self.positions {
             *p = round(*p);
         }
+        self.mend(0)
+    }
+
+    /// Welds, leaves out what collapses and splits flat triangles away,
+    /// after rounding that moved `moved` vertices apart.
+    fn mend(&mut self, moved: usize) -> Rounding {
         self.weld();
         let collapsed = self.collapse_repeats().len();
         let flat = self.split_flat_triangles();
@@ -523,7 +529,7 @@ impl Mesh {
             collapsed,
             flattened: flat.removed,
             left_flat: flat.left,
-            moved: 0,
+            moved,
         }
     }
 
@@ -620,16 +626,7 @@ impl Mesh {
             }
         }
         self.nudge_flat(&before, &mut taken, &mut moved, step);
-        let moved = moved.iter().filter(|&&m| m).count();
-        self.weld();
-        let collapsed = self.collapse_repeats().len();
-        let flat = self.split_flat_triangles();
-        Rounding {
-            collapsed,
-            flattened: flat.removed,
-            left_flat: flat.left,
-            moved,
-        }
+        self.mend(moved.iter().filter(|&&m| m).count())
     }
 
     /// Moves a corner of each flat triangle one step off the line (see

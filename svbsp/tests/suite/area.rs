@@ -18,6 +18,21 @@ fn below(rng: &mut Rng, n: u64) -> i32 {
     (rng.next_u64() % n) as i32
 }
 
+/// A triangle of corners within 40 of a centre within 40 of the axis,
+/// at a height from 20 to 75 (slightly tilted).
+fn random_triangle(rng: &mut Rng) -> [[i32; 3]; 3] {
+    let z = 24 + below(rng, 48);
+    let c = [below(rng, 80) - 40, below(rng, 80) - 40];
+    let mut corner = || {
+        [
+            c[0] + below(rng, 81) - 40,
+            c[1] + below(rng, 81) - 40,
+            z + below(rng, 9) - 4,
+        ]
+    };
+    [corner(), corner(), corner()]
+}
+
 /// The light: a `side`-square at height `h`, its corner at `(x0, y0)`,
 /// shining down.
 fn square_light(x0: i32, y0: i32, side: i32, h: i32) -> [[i32; 3]; 4] {
@@ -161,16 +176,7 @@ fn random_occluders_against_the_oracle() {
     for _ in 0..24 {
         let mut faces = vec![ground(400)];
         for _ in 0..1 + below(&mut rng, 3) {
-            let z = 24 + below(&mut rng, 48);
-            let c = [below(&mut rng, 80) - 40, below(&mut rng, 80) - 40];
-            let corner = |rng: &mut Rng| {
-                [
-                    c[0] + below(rng, 81) - 40,
-                    c[1] + below(rng, 81) - 40,
-                    z + below(rng, 9) - 4,
-                ]
-            };
-            let t = [corner(&mut rng), corner(&mut rng), corner(&mut rng)];
+            let t = random_triangle(&mut rng);
             if Occluder::new(&t).is_ok() {
                 faces.push(t.to_vec());
             }
@@ -225,17 +231,7 @@ fn classified_faces_agree_with_the_view() {
             Occluder::new(&wall).unwrap(),
         ];
         for _ in 0..1 + below(&mut rng, 3) {
-            let z = 24 + below(&mut rng, 48);
-            let c = [below(&mut rng, 80) - 40, below(&mut rng, 80) - 40];
-            let corner = |rng: &mut Rng| {
-                [
-                    c[0] + below(rng, 81) - 40,
-                    c[1] + below(rng, 81) - 40,
-                    z + below(rng, 9) - 4,
-                ]
-            };
-            let t = [corner(&mut rng), corner(&mut rng), corner(&mut rng)];
-            if let Ok(o) = Occluder::new(&t) {
+            if let Ok(o) = Occluder::new(&random_triangle(&mut rng)) {
                 faces.push(o);
             }
         }
