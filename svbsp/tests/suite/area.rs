@@ -18,6 +18,16 @@ fn below(rng: &mut Rng, n: u64) -> i32 {
     (rng.next_u64() % n) as i32
 }
 
+/// A convex polygon's area, from its correctly rounded corners.
+fn area_of(p: &Polygon) -> f64 {
+    let v: Vec<DVec3> = p
+        .vertices_f64()
+        .iter()
+        .map(|&c| DVec3::from_array(c))
+        .collect();
+    svbsp::polygon_area(&v)
+}
+
 /// A triangle of corners within 40 of a centre within 40 of the axis,
 /// at a height from 20 to 75 (slightly tilted).
 fn random_triangle(rng: &mut Rng) -> [[i32; 3]; 3] {
@@ -129,18 +139,7 @@ fn known_answers() {
     // the quarter, exactly: 1200 of 1600 seen
     let area = AreaLight::new(&light).unwrap();
     let view = area.view([20, 20, 0], None, &[Occluder::new(&small).unwrap()]);
-    let seen: f64 = view
-        .seen
-        .iter()
-        .map(|p| {
-            let v: Vec<DVec3> = p
-                .vertices_f64()
-                .iter()
-                .map(|&c| DVec3::from_array(c))
-                .collect();
-            svbsp::polygon_area(&v)
-        })
-        .sum();
+    let seen: f64 = view.seen.iter().map(area_of).sum();
     assert_eq!(seen, 1200.0);
     // two halves at different heights, each hiding half of the light
     let left = vec![[0, -20, 40], [10, -20, 40], [10, 60, 40], [0, 60, 40]];
@@ -254,18 +253,7 @@ fn classified_faces_agree_with_the_view() {
         }
         for (r, total) in [(0, 240.0 * 240.0), (1, 240.0 * 120.0)] {
             let fragments = light.classify_face(&faces[r], &faces);
-            let area: f64 = fragments
-                .iter()
-                .map(|f| {
-                    let v: Vec<DVec3> = f
-                        .polygon
-                        .vertices_f64()
-                        .iter()
-                        .map(|&c| DVec3::from_array(c))
-                        .collect();
-                    svbsp::polygon_area(&v)
-                })
-                .sum();
+            let area: f64 = fragments.iter().map(|f| area_of(&f.polygon)).sum();
             assert!((area - total).abs() < 1e-6 * total, "{area}");
             let plane = *faces[r].plane();
             for _ in 0..96 {
