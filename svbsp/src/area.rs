@@ -343,6 +343,19 @@ fn subtract(
     piece: Polygon,
     out: &mut Vec<Polygon>,
 ) -> Option<Polygon> {
+    // wholly outside one half-space: nothing to cut (the common case)
+    let outside_one = halfspaces.iter().any(|(h, inside)| {
+        !matches!(
+            (piece.classify(h), inside),
+            (PolygonSide::Spanning, _)
+                | (PolygonSide::Front, Side::Front)
+                | (PolygonSide::Back, Side::Back)
+        )
+    });
+    if outside_one {
+        out.push(piece);
+        return None;
+    }
     let start = out.len();
     let original = piece.clone();
     let mut rest = piece;
@@ -466,6 +479,26 @@ type HalfSpaces = Vec<(Plane, Side)>;
 struct Regions {
     penumbra: HalfSpaces,
     from_corner: Vec<Option<HalfSpaces>>,
+    /// A box holding the penumbra volume, per axis `[lo, hi]` (unbounded
+    /// as `i64::MIN` or `i64::MAX`): every point of it is `o + t(o − l)`
+    /// for an occluder point `o`, a light point `l` and `t ≥ 0`, so along
+    /// an axis on which the occluder lies wholly beyond the light it
+    /// starts at the occluder.
+    reach: [[i64; 2]; 3],
+}
+
+/// The box of grid points, per axis `[lo, hi]`.
+fn grid_box(points: &[GridPoint]) -> [[i64; 2]; 3] {
+    [0, 1, 2].map(|k| {
+        let c = points.iter().map(|p| i64::from(p[k]));
+        [c.clone().min().unwrap_or(0), c.max().unwrap_or(0)]
+    })
+}
+
+/// Whether the face's box and an occluder's reach overlap (touching
+/// counts): where they do not, the occluder hides nothing from the face.
+fn may_reach(face: &[[i64; 2]; 3], reach: &[[i64; 2]; 3]) -> bool {
+    (0..3).all(|k| face[k][1] >= reach[k][0] && face[k][0] <= reach[k][1])
 }
 
 impl AreaLight {
@@ -519,11 +552,13 @@ impl AreaLight {
             .par_iter()
             .enumerate()
             .map(|(i, face)| {
+                let bx = grid_box(face.corners());
                 let others = regions
                     .iter()
                     .enumerate()
                     .filter(|&(j, _)| j != i)
-                    .filter_map(|(_, r)| r.as_ref());
+                    .filter_map(|(_, r)| r.as_ref())
+                    .filter(|r| may_reach(&bx, &r.reach));
                 self.classify_with(face, others)
             })
             .collect()
@@ -698,9 +733,24 @@ impl AreaLight {
                 Some(hs)
             })
             .collect();
+        let (lb, ob) = (grid_box(lv), grid_box(ov));
+        let reach = [0, 1, 2].map(|k| {
+            let lo = if ob[k][0] >= lb[k][1] {
+                ob[k][0]
+            } else {
+                i64::MIN
+            };
+            let hi = if ob[k][1] <= lb[k][0] {
+                ob[k][1]
+            } else {
+                i64::MAX
+            };
+            [lo, hi]
+        });
         Some(Regions {
             penumbra,
             from_corner,
+            reach,
         })
     }
 }
