@@ -484,8 +484,7 @@ impl FileBoolean {
             false => shadow_scene::f64_step,
         };
         let mut mesh = view.to_mesh();
-        let r = mesh.round_closed(round, step);
-        let closed = r.left_flat == 0 && mesh.is_closed_oriented();
+        let (r, closed) = mesh.round_closed(round, step);
         Some(Rounded {
             mesh,
             collapsed: r.collapsed,

@@ -538,25 +538,26 @@ impl Mesh {
     /// [`Mesh::round_positions`] does (weld, leave out what collapses,
     /// split flat triangles away), and where that pinches the surface or
     /// leaves a flat triangle, as [`Mesh::round_positions_apart`] does
-    /// instead, if that keeps it closed. [`Mesh::is_closed_oriented`]
-    /// tells whether either did.
+    /// instead, if that keeps it closed. Returns what it did and whether
+    /// the mesh is closed and oriented with no flat triangle
+    /// ([`Mesh::is_closed_oriented`]).
     pub fn round_closed(
         &mut self,
         round: fn(DVec3) -> DVec3,
         step: fn(f64, bool) -> f64,
-    ) -> Rounding {
+    ) -> (Rounding, bool) {
         let before = self.clone();
         let r = self.round_positions(round);
         if r.left_flat == 0 && self.is_closed_oriented() {
-            return r;
+            return (r, true);
         }
         let mut apart = before;
         let a = apart.round_positions_apart(round, step);
         if a.left_flat == 0 && apart.is_closed_oriented() {
             *self = apart;
-            return a;
+            return (a, true);
         }
-        r
+        (r, false)
     }
 
     /// Rounds every position with `round` like [`Mesh::round_positions`],

@@ -101,11 +101,7 @@ impl Occluder {
     /// The occluder with these corners (see [`AreaLight::new`] for what
     /// they must be).
     pub fn new(corners: &[GridPoint]) -> Result<Occluder, AreaLightError> {
-        if corners.len() < 3 {
-            return Err(AreaLightError::TooFewCorners(corners.len()));
-        }
-        let polygon = GridPolygon::from_grid_points(corners).map_err(AreaLightError::Shape)?;
-        Ok(Occluder { polygon })
+        convex(corners).map(|polygon| Occluder { polygon })
     }
 
     /// Its plane.
@@ -117,6 +113,15 @@ impl Occluder {
     pub fn corners(&self) -> &[GridPoint] {
         self.polygon.vertices()
     }
+}
+
+/// The planar, strictly convex polygon with these corners (see
+/// [`AreaLight::new`]).
+fn convex(corners: &[GridPoint]) -> Result<GridPolygon, AreaLightError> {
+    if corners.len() < 3 {
+        return Err(AreaLightError::TooFewCorners(corners.len()));
+    }
+    GridPolygon::from_grid_points(corners).map_err(AreaLightError::Shape)
 }
 
 /// How much of a light a point sees, exactly (up to sets of zero area).
@@ -158,10 +163,7 @@ impl AreaLight {
     /// assert!(AreaLight::new(&[[0, 0, 8], [2, 2, 8], [0, 2, 8], [2, 0, 8]]).is_err());
     /// ```
     pub fn new(corners: &[GridPoint]) -> Result<AreaLight, AreaLightError> {
-        if corners.len() < 3 {
-            return Err(AreaLightError::TooFewCorners(corners.len()));
-        }
-        let polygon = GridPolygon::from_grid_points(corners).map_err(AreaLightError::Shape)?;
+        let polygon = convex(corners)?;
         if polygon.len() > 64 {
             return Err(AreaLightError::TooManyCorners(polygon.len()));
         }
@@ -214,12 +216,12 @@ impl AreaLight {
         let mut seen = reachable.clone();
         let mut hidden = false;
         for o in occluders {
-            let Some(cone) = Cone::of(x, &o.polygon) else {
+            let Some(cone) = shadow_volume(x, &o.polygon) else {
                 continue;
             };
             let mut next = Vec::with_capacity(seen.len());
             for piece in seen {
-                hidden |= cone.subtract(piece, &mut next);
+                hidden |= subtract(&cone, piece, &mut next).is_some();
             }
             seen = next;
             if seen.is_empty() {
@@ -298,39 +300,43 @@ pub fn form_factor(x: DVec3, normal: DVec3, polygon: &[[f64; 3]]) -> f64 {
     (sum / (2.0 * std::f64::consts::PI)).abs()
 }
 
-/// An occluder's cone from a point: the planes through the point and its
-/// edges, each with the side its interior is on, and its own plane with
-/// the side away from the point.
-struct Cone {
-    planes: Vec<(Plane, Side)>,
+/// The shadow volume of occluder `o` from the grid point `from` (the
+/// cone behind it): behind the planes through `from` and its edges, on
+/// the far side of its plane. `None` where `from` lies in its plane (it
+/// hides no area from there).
+fn shadow_volume(from: GridPoint, o: &GridPolygon) -> Option<HalfSpaces> {
+    let far = beyond(o.support().classify_grid(from))?;
+    let v = o.vertices();
+    let n = v.len();
+    let mut hs = Vec::with_capacity(n + 1);
+    hs.push((*o.support(), far));
+    for i in 0..n {
+        // `from` is off the occluder's plane: never on a line of its edges
+        let h = Plane::through(from, v[i], v[(i + 1) % n]).ok()?;
+        hs.push((h, h.classify_grid(v[(i + 2) % n])));
+    }
+    Some(hs)
 }
 
-impl Cone {
-    /// `None` where `x` lies in the occluder's plane (it hides no area).
-    fn of(x: GridPoint, o: &GridPolygon) -> Option<Cone> {
-        let far = match o.support().classify_grid(x) {
-            Side::Front => Side::Back,
-            Side::Back => Side::Front,
-            Side::On => return None,
-        };
-        let v = o.vertices();
-        let n = v.len();
-        let mut planes = Vec::with_capacity(n + 1);
-        planes.push((*o.support(), far));
-        for i in 0..n {
-            // x is off the occluder's plane: never on a line of its edges
-            let plane = Plane::through(x, v[i], v[(i + 1) % n]).ok()?;
-            let inside = plane.classify_grid(v[(i + 2) % n]);
-            planes.push((plane, inside));
-        }
-        Some(Cone { planes })
+/// The side opposite `side`; `None` for [`Side::On`].
+fn beyond(side: Side) -> Option<Side> {
+    match side {
+        Side::Front => Some(Side::Back),
+        Side::Back => Some(Side::Front),
+        Side::On => None,
     }
+}
 
-    /// Pushes onto `out` the parts of `piece` outside the cone; returns
-    /// whether a part with area lay inside (hidden).
-    fn subtract(&self, piece: Polygon, out: &mut Vec<Polygon>) -> bool {
-        subtract(&self.planes, piece, out).is_some()
-    }
+/// Whether a polygon on `side` of a plane lies wholly outside the
+/// half-space `inside` of it (in the plane counts as outside: no area
+/// inside).
+fn wholly_outside(side: PolygonSide, inside: Side) -> bool {
+    !matches!(
+        (side, inside),
+        (PolygonSide::Spanning, _)
+            | (PolygonSide::Front, Side::Front)
+            | (PolygonSide::Back, Side::Back)
+    )
 }
 
 /// Pushes onto `out` the parts of `piece` outside the convex region
@@ -344,14 +350,9 @@ fn subtract(
     out: &mut Vec<Polygon>,
 ) -> Option<Polygon> {
     // wholly outside one half-space: nothing to cut (the common case)
-    let outside_one = halfspaces.iter().any(|(h, inside)| {
-        !matches!(
-            (piece.classify(h), inside),
-            (PolygonSide::Spanning, _)
-                | (PolygonSide::Front, Side::Front)
-                | (PolygonSide::Back, Side::Back)
-        )
-    });
+    let outside_one = halfspaces
+        .iter()
+        .any(|(h, inside)| wholly_outside(piece.classify(h), *inside));
     if outside_one {
         out.push(piece);
         return None;
@@ -597,12 +598,9 @@ impl AreaLight {
         // planes from the face hides nothing from it
         let regions: Vec<&Regions> = occluders
             .filter(|r| {
-                r.penumbra.iter().all(|(h, s)| match front.classify(h) {
-                    PolygonSide::Front => *s == Side::Front,
-                    PolygonSide::Back => *s == Side::Back,
-                    PolygonSide::Spanning => true,
-                    PolygonSide::Coplanar { .. } => false,
-                })
+                !r.penumbra
+                    .iter()
+                    .any(|(h, s)| wholly_outside(front.classify(h), *s))
             })
             .collect();
         // each piece's state: inside some penumbra volume, the light
@@ -716,23 +714,7 @@ impl AreaLight {
                 penumbra.push((h, inside));
             }
         }
-        let from_corner = lv
-            .iter()
-            .zip(&light_sides)
-            .map(|(&l, &side)| {
-                let far = match side {
-                    Side::Front => Side::Back,
-                    Side::Back => Side::Front,
-                    Side::On => return None,
-                };
-                let mut hs = vec![(*o.plane(), far)];
-                for j in 0..no {
-                    let h = Plane::through(l, ov[j], ov[(j + 1) % no]).ok()?;
-                    hs.push((h, h.classify_grid(ov[(j + 2) % no])));
-                }
-                Some(hs)
-            })
-            .collect();
+        let from_corner = lv.iter().map(|&l| shadow_volume(l, &o.polygon)).collect();
         let (lb, ob) = (grid_box(lv), grid_box(ov));
         let reach = [0, 1, 2].map(|k| {
             let lo = if ob[k][0] >= lb[k][1] {

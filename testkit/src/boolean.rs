@@ -398,23 +398,14 @@ impl BooleanInput {
             if let Err(e) = out.mesh.check_watertight() {
                 fail(self, format_args!("the {op:?} is not watertight: {e}"));
             }
-            for (k, &q) in probes.iter().enumerate() {
-                let want = match op {
-                    BoolOp::Union => wa[k] || wb[k],
-                    BoolOp::Intersection => wa[k] && wb[k],
-                    BoolOp::Difference => wa[k] && !wb[k],
-                };
-                let got = out.solid.winding(q);
-                if got != i32::from(want) {
-                    fail(
-                        self,
-                        format_args!(
-                            "{op:?}: winding {got} at grid point {q:?}, want {}",
-                            i32::from(want)
-                        ),
-                    );
-                }
-                inside += usize::from(want && op == BoolOp::Union);
+            let want = |k: usize| match op {
+                BoolOp::Union => wa[k] || wb[k],
+                BoolOp::Intersection => wa[k] && wb[k],
+                BoolOp::Difference => wa[k] && !wb[k],
+            };
+            self.check_windings(&out.solid, &probes, want, &format!("{op:?}"));
+            if op == BoolOp::Union {
+                inside += (0..probes.len()).filter(|&k| want(k)).count();
             }
             volumes.push(out.mesh.six_volume());
         }
@@ -446,6 +437,26 @@ impl BooleanInput {
             );
         }
         Some(inside)
+    }
+
+    /// Fails unless `solid`'s winding number at every probe `k` is 1
+    /// where `want(k)` and 0 elsewhere; `what` names the result.
+    fn check_windings(
+        &self,
+        solid: &bsp_csg::Solid,
+        probes: &[GridPoint],
+        want: impl Fn(usize) -> bool,
+        what: &str,
+    ) {
+        for (k, &q) in probes.iter().enumerate() {
+            let (got, want) = (solid.winding(q), i32::from(want(k)));
+            if got != want {
+                fail(
+                    self,
+                    format_args!("{what}: winding {got} at grid point {q:?}, want {want}"),
+                );
+            }
+        }
     }
 
     /// The check of a case's operands joined into one mesh (see
@@ -486,23 +497,19 @@ impl BooleanInput {
                     format_args!("the joined operands {name}: not watertight: {e}"),
                 );
             }
-            for (k, &q) in probes.iter().enumerate() {
-                let want = if less_a {
+            let want = |k: usize| {
+                if less_a {
                     wb[k] && !wa[k]
                 } else {
                     wa[k] || wb[k]
-                };
-                let got = out.solid.winding(q);
-                if got != i32::from(want) {
-                    fail(
-                        self,
-                        format_args!(
-                            "the joined operands {name}: winding {got} at grid point {q:?}, want {}",
-                            i32::from(want)
-                        ),
-                    );
                 }
-            }
+            };
+            self.check_windings(
+                &out.solid,
+                probes,
+                want,
+                &format!("the joined operands {name}"),
+            );
             // resolved: V(A ∪ B); less A: V(A ∪ B) − V(A)
             let (nj, dj) = out.mesh.six_volume();
             let ok = if less_a {
