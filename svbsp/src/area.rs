@@ -36,14 +36,40 @@
 //! together hide the light, which this first version does not resolve.
 
 use bsp_core::internals::GridPolygon;
-use bsp_core::{FaceDefect, GridPoint, Plane, Polygon, PolygonSide, Side, Split};
+use bsp_core::{FaceDefect, GridPoint, MAX_COORD, Plane, Polygon, PolygonSide, Side, Split};
 use glam::DVec3;
 
-/// A planar convex polygon that emits light on the side its corners turn
-/// counter-clockwise about, with corners on the scene's grid.
+use crate::light::{Light, LightError, quantize_direction};
+
+/// A light with extent, or its limit, as a convex set of light points
+/// given by its corners ([`Light`]s, all of one kind):
+///
+/// - a planar convex polygon on the grid that emits on the side its
+///   corners turn counter-clockwise about ([`AreaLight::new`]);
+/// - a convex polygon of directions, a disc of the sky bounded by a
+///   regular polygon ([`AreaLight::sun_disc`]);
+/// - one point or one direction, the limits of both
+///   ([`AreaLight::point`], [`AreaLight::sun`]): classified as an area
+///   light of no extent, lit or umbra, never penumbra.
 #[derive(Clone, Debug)]
 pub struct AreaLight {
-    polygon: GridPolygon,
+    corners: Vec<Light>,
+    /// The polygon of a light with area at finite distance.
+    polygon: Option<GridPolygon>,
+}
+
+/// How many directions bound a sun disc ([`AreaLight::sun_disc`]): the
+/// polygon's area is `8 tan(π/8) / π ≈ 1.055` times the disc's.
+pub const DISC_SIDES: usize = 8;
+
+/// The largest angular radius of a sun disc, in radians (30°: the real
+/// sun's is 0.2666°).
+pub const MAX_DISC_RADIUS: f64 = std::f64::consts::FRAC_PI_6;
+
+/// `det[a; b; c]`, exact for components below `2^40`.
+fn det3(a: [i128; 3], b: [i128; 3], c: [i128; 3]) -> i128 {
+    a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+        + a[2] * (b[0] * c[1] - b[1] * c[0])
 }
 
 /// Why corners make no area light (or occluder).
@@ -58,6 +84,16 @@ pub enum AreaLightError {
     /// (collinear, not planar, not convex, turning twice, or out of the
     /// grid); the cause as the kernel found it.
     Shape(FaceDefect),
+    /// A point or direction outside the grid, or a zero direction.
+    Corner(LightError),
+    /// A sun disc's direction is zero or not finite, or its angular
+    /// radius (radians) is not in `[0, MAX_DISC_RADIUS]`.
+    Disc {
+        /// The direction given.
+        direction: DVec3,
+        /// The angular radius given, in radians.
+        radius: f64,
+    },
 }
 
 impl std::fmt::Display for AreaLightError {
@@ -75,6 +111,17 @@ impl std::fmt::Display for AreaLightError {
             AreaLightError::Shape(d) => {
                 write!(f, "not a planar convex polygon with area: {d}")
             }
+            AreaLightError::Corner(e) => write!(f, "{e}"),
+            AreaLightError::Disc { direction, radius } => write!(
+                f,
+                "a sun disc toward {},{},{} of angular radius {}°: the direction must be \
+                 non-zero and the radius between 0° and {}°",
+                direction.x,
+                direction.y,
+                direction.z,
+                radius.to_degrees(),
+                MAX_DISC_RADIUS.to_degrees()
+            ),
         }
     }
 }
@@ -83,7 +130,10 @@ impl std::error::Error for AreaLightError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             AreaLightError::Shape(d) => Some(d),
-            AreaLightError::TooFewCorners(_) | AreaLightError::TooManyCorners(_) => None,
+            AreaLightError::Corner(e) => Some(e),
+            AreaLightError::TooFewCorners(_)
+            | AreaLightError::TooManyCorners(_)
+            | AreaLightError::Disc { .. } => None,
         }
     }
 }
@@ -167,23 +217,108 @@ impl AreaLight {
         if polygon.len() > 64 {
             return Err(AreaLightError::TooManyCorners(polygon.len()));
         }
-        Ok(AreaLight { polygon })
+        Ok(AreaLight {
+            corners: polygon.vertices().iter().map(|&c| Light::Point(c)).collect(),
+            polygon: Some(polygon),
+        })
     }
 
-    /// The corners, in order (without repeated or collinear ones).
-    pub fn corners(&self) -> &[GridPoint] {
-        self.polygon.vertices()
+    /// A point light as the limit of area lights: its fragments are lit
+    /// or umbra, exactly where [`Light::Point`]'s are lit or shadowed.
+    pub fn point(at: GridPoint) -> Result<AreaLight, AreaLightError> {
+        Self::one(Light::Point(at))
     }
 
-    /// The light's plane; it emits on the front side.
-    pub fn plane(&self) -> &Plane {
-        self.polygon.support()
+    /// A sun as the limit of sun discs (see [`AreaLight::point`]).
+    pub fn sun(direction: [i32; 3]) -> Result<AreaLight, AreaLightError> {
+        Self::one(Light::Directional(direction))
+    }
+
+    fn one(light: Light) -> Result<AreaLight, AreaLightError> {
+        light.validate().map_err(AreaLightError::Corner)?;
+        Ok(AreaLight {
+            corners: vec![light],
+            polygon: None,
+        })
+    }
+
+    /// The sun as a disc of the sky: the directions within the angular
+    /// `radius` (radians) of `direction` (from the scene toward the sun),
+    /// bounded by a regular polygon of [`DISC_SIDES`] directions that
+    /// contains the disc (circumscribed, and widened by more than the
+    /// quantization of its corners, see [`quantize_direction`]). What is
+    /// classified lit therefore sees all of the true disc, and what is
+    /// umbra sees none of it; the penumbra is a little wider than the
+    /// disc's. A radius of 0 is [`AreaLight::sun`] of the quantized
+    /// direction.
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// use svbsp::{AreaLight, DISC_SIDES};
+    /// let sun = AreaLight::sun_disc(DVec3::new(1.0, 2.0, 5.0), 0.2666f64.to_radians()).unwrap();
+    /// assert_eq!(sun.corners().len(), DISC_SIDES);
+    /// assert!(AreaLight::sun_disc(DVec3::ZERO, 0.01).is_err());
+    /// ```
+    pub fn sun_disc(direction: DVec3, radius: f64) -> Result<AreaLight, AreaLightError> {
+        let bad = AreaLightError::Disc { direction, radius };
+        if !(0.0..=MAX_DISC_RADIUS).contains(&radius) {
+            return Err(bad);
+        }
+        let q = quantize_direction(direction).ok_or(bad.clone())?;
+        if radius == 0.0 {
+            return Self::sun(q);
+        }
+        let d = direction.normalize();
+        // an orthonormal frame about d, and the circumscribed polygon in
+        // the tangent plane at distance 1, widened by the corners'
+        // quantization (under 1.3e-8 rad each) and f64 rounding
+        let u = d.any_orthonormal_vector();
+        let v = d.cross(u);
+        let step = std::f64::consts::TAU / DISC_SIDES as f64;
+        let widen = 4.0 / MAX_COORD as f64;
+        let reach = (radius.tan() + widen) / (step / 2.0).cos() * (1.0 + 1e-9);
+        let corners: Option<Vec<Light>> = (0..DISC_SIDES)
+            .map(|i| {
+                let a = step * i as f64;
+                let c = d + (u * a.cos() + v * a.sin()) * reach;
+                quantize_direction(c).map(Light::Directional)
+            })
+            .collect();
+        let corners = corners.ok_or(bad.clone())?;
+        // the quantized corners still turn one way about d, strictly
+        let turns = (0..DISC_SIDES).all(|i| {
+            let [a, b, c] = [0, 1, 2].map(|k| match corners[(i + k) % DISC_SIDES] {
+                Light::Directional(x) => x.map(i128::from),
+                Light::Point(_) => unreachable!("disc corners are directions"),
+            });
+            det3(a, b, c) > 0
+        });
+        if !turns {
+            return Err(bad);
+        }
+        Ok(AreaLight {
+            corners,
+            polygon: None,
+        })
+    }
+
+    /// The corners, in order (without repeated or collinear ones): grid
+    /// points, or directions for a sun.
+    pub fn corners(&self) -> &[Light] {
+        &self.corners
+    }
+
+    /// The light's plane, for a polygon at finite distance; it emits on
+    /// the front side.
+    pub fn plane(&self) -> Option<&Plane> {
+        self.polygon.as_ref().map(GridPolygon::support)
     }
 
     /// What the grid point `x` sees of the light: `face`, the plane of the
     /// face `x` lies on (light behind it does not arrive), and the
     /// occluders, each a convex polygon on the grid (a face `x` lies on
-    /// hides nothing from it, and may be among them).
+    /// hides nothing from it, and may be among them). `None` for a light
+    /// without a polygon at finite distance (a point, a sun, a sun disc).
     ///
     /// ```
     /// use svbsp::{AreaLight, Occluder, Visibility};
@@ -191,32 +326,38 @@ impl AreaLight {
     /// // a square half-way up, a quarter of the light's side, seen from
     /// // below its centre: it hides the light's middle quarter
     /// let roof = Occluder::new(&[[15, 15, 40], [25, 15, 40], [25, 25, 40], [15, 25, 40]]).unwrap();
-    /// let view = light.view([20, 20, 0], None, &[roof]);
+    /// let view = light.view([20, 20, 0], None, &[roof]).unwrap();
     /// assert_eq!(view.visibility, Visibility::Part);
     /// let area: f64 = view.seen.iter().map(|p| svbsp::polygon_area(&p.vertices_f64()
     ///     .iter().map(|&v| glam::DVec3::from_array(v)).collect::<Vec<_>>())).sum();
     /// assert_eq!(area, 1200.0);
     /// ```
-    pub fn view(&self, x: GridPoint, face: Option<&Plane>, occluders: &[Occluder]) -> LightView {
+    pub fn view(
+        &self,
+        x: GridPoint,
+        face: Option<&Plane>,
+        occluders: &[Occluder],
+    ) -> Option<LightView> {
         let nothing = || LightView {
             reachable: Vec::new(),
             seen: Vec::new(),
             visibility: Visibility::None,
         };
-        if self.plane().classify_grid(x) != Side::Front {
-            return nothing();
+        let polygon = self.polygon.as_ref()?;
+        if polygon.support().classify_grid(x) != Side::Front {
+            return Some(nothing());
         }
-        let mut light = self.polygon.to_polygon(0);
+        let mut light = polygon.to_polygon(0);
         if let Some(face) = face
             && !light.clip(face, Side::Front)
         {
-            return nothing();
+            return Some(nothing());
         }
         let reachable = vec![light];
         let mut seen = reachable.clone();
         let mut hidden = false;
         for o in occluders {
-            let Some(cone) = shadow_volume(x, &o.polygon) else {
+            let Some(cone) = shadow_volume(Light::Point(x), &o.polygon) else {
                 continue;
             };
             let mut next = Vec::with_capacity(seen.len());
@@ -233,11 +374,11 @@ impl AreaLight {
             (false, true) => Visibility::Part,
             (false, false) => Visibility::All,
         };
-        LightView {
+        Some(LightView {
             reachable,
             seen,
             visibility,
-        }
+        })
     }
 }
 
@@ -251,7 +392,7 @@ impl LightView {
     /// use glam::DVec3;
     /// use svbsp::AreaLight;
     /// let light = AreaLight::new(&[[0, 0, 80], [0, 40, 80], [40, 40, 80], [40, 0, 80]]).unwrap();
-    /// let view = light.view([20, 20, 0], None, &[]);
+    /// let view = light.view([20, 20, 0], None, &[]).unwrap();
     /// assert_eq!(view.fraction(DVec3::new(20.0, 20.0, 0.0), DVec3::Z), Some(1.0));
     /// ```
     pub fn fraction(&self, x: DVec3, normal: DVec3) -> Option<f64> {
@@ -304,18 +445,27 @@ pub fn form_factor(x: DVec3, normal: DVec3, polygon: &[[f64; 3]]) -> f64 {
 /// cone behind it): behind the planes through `from` and its edges, on
 /// the far side of its plane. `None` where `from` lies in its plane (it
 /// hides no area from there).
-fn shadow_volume(from: GridPoint, o: &GridPolygon) -> Option<HalfSpaces> {
-    let far = beyond(o.support().classify_grid(from))?;
+fn shadow_volume(from: Light, o: &GridPolygon) -> Option<HalfSpaces> {
+    let far = beyond(sign(from.eval(o.support())))?;
     let v = o.vertices();
     let n = v.len();
     let mut hs = Vec::with_capacity(n + 1);
     hs.push((*o.support(), far));
     for i in 0..n {
         // `from` is off the occluder's plane: never on a line of its edges
-        let h = Plane::through(from, v[i], v[(i + 1) % n]).ok()?;
-        hs.push((h, h.classify_grid(v[(i + 2) % n])));
+        let h = from.edge_plane(v[i], v[(i + 1) % n], v[(i + 2) % n])?;
+        hs.push((h, Side::Back));
     }
     Some(hs)
+}
+
+/// The side of a plane a value of it stands for.
+fn sign(value: i128) -> Side {
+    match value.signum() {
+        1 => Side::Front,
+        -1 => Side::Back,
+        _ => Side::On,
+    }
 }
 
 /// The side opposite `side`; `None` for [`Side::On`].
@@ -576,15 +726,19 @@ impl AreaLight {
         let behind_face: Vec<bool> = self
             .corners()
             .iter()
-            .map(|&v| face.plane().classify_grid(v) != Side::Front)
+            .map(|l| !l.faces(face.plane()))
             .collect();
         if behind_face.iter().all(|&b| b) {
             return vec![fragment(whole, AreaClass::Umbra)];
         }
         let partly_behind = behind_face.iter().any(|&b| b);
-        // points not strictly in front of the light see none of it
+        // points not strictly in front of a polygon light see none of it
         let mut out = Vec::new();
-        let front = match whole.split(self.plane()) {
+        let split = match self.plane() {
+            Some(plane) => whole.split(plane),
+            None => Split::Front(whole),
+        };
+        let front = match split {
             Split::Front(p) => p,
             Split::Spanning { front, back } => {
                 out.push(fragment(back, AreaClass::Umbra));
@@ -683,10 +837,29 @@ impl AreaLight {
     /// the light's plane and hides none of it.
     fn regions(&self, o: &Occluder) -> Option<Regions> {
         let (lv, ov) = (self.corners(), o.polygon.vertices());
-        let light_sides: Vec<Side> = lv.iter().map(|&v| o.plane().classify_grid(v)).collect();
+        let light_sides: Vec<Side> = lv.iter().map(|l| sign(l.eval(o.plane()))).collect();
         if light_sides.iter().all(|&s| s == Side::On) {
             return None;
         }
+        let from_corner: Vec<Option<HalfSpaces>> =
+            lv.iter().map(|&l| shadow_volume(l, &o.polygon)).collect();
+        let penumbra = if let [one] = &from_corner[..] {
+            // a light of one point: the volume is its shadow volume
+            one.clone()?
+        } else {
+            self.penumbra_volume(&light_sides, o)
+        };
+        Some(Regions {
+            penumbra,
+            from_corner,
+            reach: reach(lv, ov),
+        })
+    }
+
+    /// The half-spaces of an occluder's penumbra volume (see the module
+    /// docs), for a light of several corners.
+    fn penumbra_volume(&self, light_sides: &[Side], o: &Occluder) -> HalfSpaces {
+        let (lv, ov) = (self.corners(), o.polygon.vertices());
         let mut penumbra = HalfSpaces::new();
         // the occluder's plane bounds the volume where the light is on one side
         let light_front = light_sides.contains(&Side::Front);
@@ -698,25 +871,86 @@ impl AreaLight {
             ));
         }
         let (nl, no) = (lv.len(), ov.len());
-        let candidates = (0..nl).flat_map(|i| {
-            (0..no).flat_map(move |j| {
-                [
-                    (lv[i], ov[j], ov[(j + 1) % no]),
-                    (lv[i], lv[(i + 1) % nl], ov[j]),
-                ]
-            })
-        });
-        for (a, b, c) in candidates {
-            let Ok(h) = Plane::through(a, b, c) else {
-                continue;
-            };
-            if let Some(inside) = separating(&h, lv, ov) {
-                penumbra.push((h, inside));
+        for i in 0..nl {
+            for j in 0..no {
+                let planes = [
+                    corner_edge_plane(lv[i], ov[j], ov[(j + 1) % no]),
+                    edge_corner_plane(lv[i], lv[(i + 1) % nl], ov[j]),
+                ];
+                for h in planes.into_iter().flatten() {
+                    if let Some(inside) = separating(&h, lv, ov) {
+                        penumbra.push((h, inside));
+                    }
+                }
             }
         }
-        let from_corner = lv.iter().map(|&l| shadow_volume(l, &o.polygon)).collect();
-        let (lb, ob) = (grid_box(lv), grid_box(ov));
-        let reach = [0, 1, 2].map(|k| {
+        penumbra
+    }
+}
+
+/// The plane through the light corner `l` and the occluder edge `a, b`
+/// (for a direction, through the edge and parallel to it); `None` where
+/// `l` lies on the edge's line.
+fn corner_edge_plane(l: Light, a: GridPoint, b: GridPoint) -> Option<Plane> {
+    match l {
+        Light::Point(p) => Plane::through(p, a, b).ok(),
+        Light::Directional(d) => {
+            let n = cross(sub(b, a), d.map(i64::from));
+            Plane::new(n, -dot(n, o_at(a)))
+        }
+    }
+}
+
+/// The plane through the light edge `l1, l2` and the occluder corner `o`
+/// (for two directions, through `o` and parallel to both); `None` where
+/// they are collinear (or parallel).
+fn edge_corner_plane(l1: Light, l2: Light, o: GridPoint) -> Option<Plane> {
+    match (l1, l2) {
+        (Light::Point(a), Light::Point(b)) => Plane::through(a, b, o).ok(),
+        (Light::Directional(a), Light::Directional(b)) => {
+            let n = cross(a.map(i64::from), b.map(i64::from));
+            Plane::new(n, -dot(n, o_at(o)))
+        }
+        _ => None,
+    }
+}
+
+fn sub(a: GridPoint, b: GridPoint) -> [i64; 3] {
+    [0, 1, 2].map(|k| i64::from(a[k]) - i64::from(b[k]))
+}
+
+/// `u × v`, exact for components below `2^31`.
+fn cross(u: [i64; 3], v: [i64; 3]) -> [i64; 3] {
+    [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ]
+}
+
+fn o_at(p: GridPoint) -> [i128; 3] {
+    p.map(i128::from)
+}
+
+fn dot(n: [i64; 3], p: [i128; 3]) -> i128 {
+    (0..3).map(|k| i128::from(n[k]) * p[k]).sum()
+}
+
+/// A box holding an occluder's penumbra volume (see [`Regions::reach`]).
+fn reach(lv: &[Light], ov: &[GridPoint]) -> [[i64; 2]; 3] {
+    let ob = grid_box(ov);
+    let points: Vec<GridPoint> = lv
+        .iter()
+        .filter_map(|l| match l {
+            Light::Point(p) => Some(*p),
+            Light::Directional(_) => None,
+        })
+        .collect();
+    let unbounded = [i64::MIN, i64::MAX];
+    if points.len() == lv.len() {
+        // o + t(o − l), t ≥ 0
+        let lb = grid_box(&points);
+        return [0, 1, 2].map(|k| {
             let lo = if ob[k][0] >= lb[k][1] {
                 ob[k][0]
             } else {
@@ -729,22 +963,29 @@ impl AreaLight {
             };
             [lo, hi]
         });
-        Some(Regions {
-            penumbra,
-            from_corner,
-            reach,
-        })
     }
+    // o − t d, t ≥ 0, for directions d toward the light
+    [0, 1, 2].map(|k| {
+        let along = |f: fn(i32) -> bool| {
+            lv.iter()
+                .all(|l| matches!(l, Light::Directional(d) if f(d[k])))
+        };
+        match (along(|c| c > 0), along(|c| c < 0)) {
+            (true, _) => [i64::MIN, ob[k][1]],
+            (_, true) => [ob[k][0], i64::MAX],
+            _ => unbounded,
+        }
+    })
 }
 
 /// The occluder's side of `h` if `h` separates the light's corners `lv`
 /// from the occluder's `ov` (each on one closed side, opposite, neither
 /// wholly in `h`).
-fn separating(h: &Plane, lv: &[GridPoint], ov: &[GridPoint]) -> Option<Side> {
-    let side_of = |pts: &[GridPoint]| {
+fn separating(h: &Plane, lv: &[Light], ov: &[GridPoint]) -> Option<Side> {
+    let side_of = |sides: &mut dyn Iterator<Item = Side>| {
         let (mut front, mut back) = (false, false);
-        for &p in pts {
-            match h.classify_grid(p) {
+        for side in sides {
+            match side {
                 Side::Front => front = true,
                 Side::Back => back = true,
                 Side::On => {}
@@ -756,7 +997,9 @@ fn separating(h: &Plane, lv: &[GridPoint], ov: &[GridPoint]) -> Option<Side> {
             _ => None,
         }
     };
-    match (side_of(lv)?, side_of(ov)?) {
+    let light = &mut lv.iter().map(|l| sign(l.eval(h)));
+    let occluder = &mut ov.iter().map(|&p| h.classify_grid(p));
+    match (side_of(light)?, side_of(occluder)?) {
         (l, o) if l != o => Some(o),
         _ => None,
     }

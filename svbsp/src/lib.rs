@@ -51,7 +51,8 @@ mod psv;
 mod wide;
 
 pub use area::{
-    AreaClass, AreaFragment, AreaLight, AreaLightError, LightView, Occluder, Visibility,
+    AreaClass, AreaFragment, AreaLight, AreaLightError, DISC_SIDES, LightView, MAX_DISC_RADIUS,
+    Occluder, Visibility,
     form_factor,
 };
 pub use areas::{Areas, fragment_area, percent, polygon_area};

@@ -95,7 +95,7 @@ fn check(faces: &[Vec<[i32; 3]>], light: &[[i32; 3]; 4], x: [i32; 3]) -> Visibil
     let area = AreaLight::new(light).unwrap();
     let occluders: Vec<Occluder> = faces.iter().map(|f| Occluder::new(f).unwrap()).collect();
     let ground = *occluders[0].plane();
-    let view = area.view(x, Some(&ground), &occluders);
+    let view = area.view(x, Some(&ground), &occluders).unwrap();
     let (verdicts, share) = sampled(faces, light, x);
     let degenerate = |v: &Verdict| matches!(v, Verdict::Degenerate { .. });
     match view.visibility {
@@ -138,7 +138,9 @@ fn known_answers() {
     );
     // the quarter, exactly: 1200 of 1600 seen
     let area = AreaLight::new(&light).unwrap();
-    let view = area.view([20, 20, 0], None, &[Occluder::new(&small).unwrap()]);
+    let view = area
+        .view([20, 20, 0], None, &[Occluder::new(&small).unwrap()])
+        .unwrap();
     let seen: f64 = view.seen.iter().map(area_of).sum();
     assert_eq!(seen, 1200.0);
     // two halves at different heights, each hiding half of the light
@@ -160,7 +162,7 @@ fn known_answers() {
     // no occluder: all of it; behind the light: none
     assert_eq!(check(&[ground(200)], &light, [20, 20, 0]), Visibility::All);
     assert_eq!(
-        area.view([20, 20, 90], None, &[]).visibility,
+        area.view([20, 20, 90], None, &[]).unwrap().visibility,
         Visibility::None
     );
 }
@@ -268,7 +270,7 @@ fn classified_faces_agree_with_the_view() {
                 if faces.iter().enumerate().any(|(i, o)| i != r && edge_on(o)) {
                     continue;
                 }
-                let seen = light.view(x, Some(&plane), &faces).visibility;
+                let seen = light.view(x, Some(&plane), &faces).unwrap().visibility;
                 let ok = match f.class {
                     AreaClass::Lit => seen == Visibility::All,
                     AreaClass::Umbra => seen == Visibility::None,
@@ -305,6 +307,7 @@ fn a_face_between_the_light_and_an_occluder_is_lit() {
     assert_eq!(
         light
             .view([20, 20, 44], Some(above.plane()), &faces)
+            .unwrap()
             .visibility,
         Visibility::All
     );
@@ -376,4 +379,163 @@ fn classified_scenes_tile_their_faces_on_any_thread_count() {
         classes.extend(fragments.iter().map(|f| f.class));
     }
     assert!(classes.contains(&AreaClass::Penumbra) && classes.contains(&AreaClass::Umbra));
+}
+
+/// Per face, the area classified lit by `light` in the area engine, and
+/// the lit area of the same faces under `point` by the partitioned
+/// shadow volumes.
+fn lit_areas(light: &AreaLight, point: Light, faces: &[Vec<[i32; 3]>]) -> (Vec<f64>, Vec<f64>) {
+    let occluders: Vec<Occluder> = faces.iter().map(|f| Occluder::new(f).unwrap()).collect();
+    let polys: Vec<Polygon> = faces
+        .iter()
+        .enumerate()
+        .map(|(i, f)| Polygon::from_grid_points(f, i as u32).unwrap())
+        .collect();
+    let area = light
+        .classify_faces(&occluders)
+        .iter()
+        .map(|fs| {
+            assert!(
+                fs.iter()
+                    .all(|f| matches!(f.class, AreaClass::Lit | AreaClass::Umbra)),
+                "a light of no extent makes no penumbra"
+            );
+            fs.iter()
+                .filter(|f| f.class == AreaClass::Lit)
+                .map(|f| area_of(&f.polygon))
+                .sum()
+        })
+        .collect();
+    let (batch, _) = svbsp::shadow_fragments(&polys, &[point]).unwrap();
+    let grid = bsp_core::Grid::new(DVec3::ZERO, 0).unwrap();
+    let mut psv = vec![0.0; faces.len()];
+    let mut buf = Vec::new();
+    for f in batch.fragments().filter(|f| f.lit(0)) {
+        psv[f.face() as usize] += svbsp::fragment_area(&f, &grid, &mut buf);
+    }
+    (area, psv)
+}
+
+/// A light shrunk to a point is the point light, and a sun disc of radius
+/// 0 the sun: the same lit area on every face as the partitioned shadow
+/// volumes give (random triangles over a ground and a wall).
+#[test]
+fn lights_of_no_extent_equal_the_point_light_and_the_sun() {
+    let mut rng = Rng::new(0x11_6475);
+    let wall = vec![[60, -120, 0], [60, -120, 120], [60, 120, 120], [60, 120, 0]];
+    for round in 0..8 {
+        let mut faces = vec![ground(120), wall.clone()];
+        for _ in 0..4 {
+            let t = random_triangle(&mut rng);
+            if Occluder::new(&t).is_ok() {
+                faces.push(t.to_vec());
+            }
+        }
+        let at = [below(&mut rng, 40) - 20, below(&mut rng, 40) - 20, 90];
+        let d = glam::DVec3::new(
+            f64::from(below(&mut rng, 9)) - 4.0,
+            f64::from(below(&mut rng, 9)) - 4.0,
+            5.0,
+        );
+        let q = svbsp::quantize_direction(d).unwrap();
+        let cases = [
+            (AreaLight::point(at).unwrap(), Light::Point(at)),
+            (AreaLight::sun_disc(d, 0.0).unwrap(), Light::Directional(q)),
+        ];
+        for (light, point) in cases {
+            let (area, psv) = lit_areas(&light, point, &faces);
+            for (i, (a, p)) in area.iter().zip(&psv).enumerate() {
+                assert!(
+                    (a - p).abs() <= 1e-9 * 240.0 * 240.0,
+                    "round {round}, face {i}: {a} lit by the limit, {p} by {point:?}"
+                );
+            }
+            assert!(area.iter().sum::<f64>() > 0.0);
+        }
+    }
+}
+
+/// A sun disc of 3° over random triangles: at grid points strictly inside
+/// each fragment, directions sampled over the true disc (its rim and a
+/// lattice inside) are all unblocked from a lit point, all blocked from an
+/// umbra point, and both meet from penumbra points somewhere in the run.
+#[test]
+fn sun_disc_fragments_agree_with_sampled_directions() {
+    let mut rng = Rng::new(0x5_d15c);
+    let d = glam::DVec3::new(0.3, -0.2, 1.0).normalize();
+    let radius = 3f64.to_radians();
+    let sun = AreaLight::sun_disc(d, radius).unwrap();
+    let u = d.any_orthonormal_vector();
+    let v = d.cross(u);
+    let mut samples = Vec::new();
+    for k in 0..32 {
+        let a = std::f64::consts::TAU * f64::from(k) / 32.0;
+        samples.push(d + (u * a.cos() + v * a.sin()) * radius.tan());
+    }
+    for i in -3..=3 {
+        for j in -3..=3 {
+            let (s, t) = (f64::from(i) / 3.0, f64::from(j) / 3.0);
+            if s * s + t * t <= 1.0 {
+                samples.push(d + (u * s + v * t) * radius.tan());
+            }
+        }
+    }
+    let samples: Vec<Light> = samples
+        .iter()
+        .map(|&s| Light::Directional(svbsp::quantize_direction(s).unwrap()))
+        .collect();
+    let mut met = std::collections::HashMap::new();
+    for _ in 0..6 {
+        let mut faces = vec![ground(120)];
+        for _ in 0..3 {
+            let t = random_triangle(&mut rng);
+            if Occluder::new(&t).is_ok() {
+                faces.push(t.to_vec());
+            }
+        }
+        let occluders: Vec<Occluder> = faces.iter().map(|f| Occluder::new(f).unwrap()).collect();
+        let polys: Vec<Polygon> = faces
+            .iter()
+            .enumerate()
+            .map(|(i, f)| Polygon::from_grid_points(f, i as u32).unwrap())
+            .collect();
+        let scene = Scene::from_polygons(&polys);
+        let fragments = sun.classify_face(&occluders[0], &occluders);
+        for _ in 0..400 {
+            let x = [below(&mut rng, 240) - 120, below(&mut rng, 240) - 120, 0];
+            let Some(f) = fragments.iter().find(|f| strictly_inside(&f.polygon, x)) else {
+                continue;
+            };
+            let hx = HPoint::grid(x.map(i64::from));
+            let lit: Vec<Verdict> = samples.iter().map(|s| scene.verdict(s, 0, &hx)).collect();
+            let degenerate = |v: &Verdict| matches!(v, Verdict::Degenerate { .. });
+            match f.class {
+                AreaClass::Lit => assert!(
+                    lit.iter().all(|v| *v == Verdict::Lit || degenerate(v)),
+                    "{x:?} is lit, yet a direction of the disc is blocked"
+                ),
+                AreaClass::Umbra => assert!(
+                    lit.iter().all(|v| *v == Verdict::Shadowed || degenerate(v)),
+                    "{x:?} is umbra, yet a direction of the disc is open"
+                ),
+                AreaClass::Penumbra | AreaClass::Undecided => {}
+            }
+            *met.entry(f.class).or_insert(0) += 1;
+        }
+    }
+    for class in [AreaClass::Lit, AreaClass::Penumbra, AreaClass::Umbra] {
+        assert!(met.contains_key(&class), "{class:?} never met: {met:?}");
+    }
+}
+
+/// A sun disc is checked: a zero direction or a radius out of range is an
+/// error naming both.
+#[test]
+fn bad_sun_discs_are_errors() {
+    let e = AreaLight::sun_disc(glam::DVec3::ZERO, 0.01).unwrap_err();
+    assert!(e.to_string().contains("non-zero"), "{e}");
+    let e = AreaLight::sun_disc(glam::DVec3::Z, 1.0).unwrap_err();
+    assert!(e.to_string().contains("57.29"), "{e}");
+    assert!(AreaLight::sun_disc(glam::DVec3::Z, f64::NAN).is_err());
+    assert!(AreaLight::point([1 << 27, 0, 0]).is_err());
 }
