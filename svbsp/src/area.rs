@@ -154,9 +154,23 @@ impl Occluder {
         convex(corners).map(|polygon| Occluder { polygon })
     }
 
+    /// The occluder of a polygon with grid corners (an imported face);
+    /// `None` where a corner is not a grid point or the corners make no
+    /// occluder.
+    pub fn of_polygon(p: &Polygon) -> Option<Occluder> {
+        let corners: Option<Vec<GridPoint>> =
+            p.vertices().iter().map(|v| v.as_ref().as_grid()).collect();
+        Occluder::new(&corners?).ok()
+    }
+
     /// Its plane.
     pub fn plane(&self) -> &Plane {
         self.polygon.support()
+    }
+
+    /// The occluder as a polygon (tag 0).
+    pub(crate) fn to_polygon(&self) -> Polygon {
+        self.polygon.to_polygon(0)
     }
 
     /// Its corners, in order (without repeated or collinear ones).
@@ -218,7 +232,11 @@ impl AreaLight {
             return Err(AreaLightError::TooManyCorners(polygon.len()));
         }
         Ok(AreaLight {
-            corners: polygon.vertices().iter().map(|&c| Light::Point(c)).collect(),
+            corners: polygon
+                .vertices()
+                .iter()
+                .map(|&c| Light::Point(c))
+                .collect(),
             polygon: Some(polygon),
         })
     }
@@ -337,6 +355,16 @@ impl AreaLight {
         x: GridPoint,
         face: Option<&Plane>,
         occluders: &[Occluder],
+    ) -> Option<LightView> {
+        self.view_among(x, face, occluders.iter())
+    }
+
+    /// [`AreaLight::view`] with the occluders as an iterator.
+    pub(crate) fn view_among<'o>(
+        &self,
+        x: GridPoint,
+        face: Option<&Plane>,
+        occluders: impl Iterator<Item = &'o Occluder>,
     ) -> Option<LightView> {
         let nothing = || LightView {
             reachable: Vec::new(),
@@ -551,7 +579,7 @@ fn vertex_keys(p: &Polygon) -> Vec<[u64; 3]> {
 /// Merges polygons of equal labels pairwise where their union is convex
 /// (`Polygon::merge`, exact), until none do; only pairs that share two
 /// vertex keys are tried. Deterministic: the order of the input decides.
-fn merge_convex<T: Copy + PartialEq>(mut items: Vec<(Polygon, T)>) -> Vec<(Polygon, T)> {
+pub(crate) fn merge_convex<T: Copy + PartialEq>(mut items: Vec<(Polygon, T)>) -> Vec<(Polygon, T)> {
     loop {
         let keys: Vec<Vec<[u64; 3]>> = items.iter().map(|(p, _)| vertex_keys(p)).collect();
         let mut at: rustc_hash::FxHashMap<[u64; 3], Vec<usize>> = Default::default();
@@ -621,25 +649,25 @@ pub struct AreaFragment {
 }
 
 /// Half-spaces as planes and the side that is inside.
-type HalfSpaces = Vec<(Plane, Side)>;
+pub(crate) type HalfSpaces = Vec<(Plane, Side)>;
 
 /// An occluder's regions for an area light: its penumbra volume (the
 /// points it keeps from seeing all of the light) and, per light corner,
 /// its shadow volume from that corner (`None` where the corner lies in
 /// its plane and it hides nothing from there).
-struct Regions {
-    penumbra: HalfSpaces,
-    from_corner: Vec<Option<HalfSpaces>>,
+pub(crate) struct Regions {
+    pub(crate) penumbra: HalfSpaces,
+    pub(crate) from_corner: Vec<Option<HalfSpaces>>,
     /// A box holding the penumbra volume, per axis `[lo, hi]` (unbounded
     /// as `i64::MIN` or `i64::MAX`): every point of it is `o + t(o − l)`
     /// for an occluder point `o`, a light point `l` and `t ≥ 0`, so along
     /// an axis on which the occluder lies wholly beyond the light it
     /// starts at the occluder.
-    reach: [[i64; 2]; 3],
+    pub(crate) reach: [[i64; 2]; 3],
 }
 
 /// The box of grid points, per axis `[lo, hi]`.
-fn grid_box(points: &[GridPoint]) -> [[i64; 2]; 3] {
+pub(crate) fn grid_box(points: &[GridPoint]) -> [[i64; 2]; 3] {
     [0, 1, 2].map(|k| {
         let c = points.iter().map(|p| i64::from(p[k]));
         [c.clone().min().unwrap_or(0), c.max().unwrap_or(0)]
@@ -648,7 +676,7 @@ fn grid_box(points: &[GridPoint]) -> [[i64; 2]; 3] {
 
 /// Whether the face's box and an occluder's reach overlap (touching
 /// counts): where they do not, the occluder hides nothing from the face.
-fn may_reach(face: &[[i64; 2]; 3], reach: &[[i64; 2]; 3]) -> bool {
+pub(crate) fn may_reach(face: &[[i64; 2]; 3], reach: &[[i64; 2]; 3]) -> bool {
     (0..3).all(|k| face[k][1] >= reach[k][0] && face[k][0] <= reach[k][1])
 }
 
@@ -721,47 +749,70 @@ impl AreaLight {
         face: &Occluder,
         occluders: impl Iterator<Item = &'r Regions>,
     ) -> Vec<AreaFragment> {
-        let fragment = |polygon, class| AreaFragment { polygon, class };
         let whole = face.polygon.to_polygon(0);
+        let cut = self.cut(face, vec![(whole, ())], occluders);
+        merge_convex(cut.into_iter().map(|(p, (), c)| (p, c)).collect())
+            .into_iter()
+            .map(|(polygon, class)| AreaFragment { polygon, class })
+            .collect()
+    }
+
+    /// Convex `pieces` of `face`, each with a label, cut where this
+    /// light's class changes (see the module docs); each part keeps its
+    /// piece's label. Not merged.
+    pub(crate) fn cut<'r, K: Copy>(
+        &self,
+        face: &Occluder,
+        pieces: Vec<(Polygon, K)>,
+        occluders: impl Iterator<Item = &'r Regions>,
+    ) -> Vec<(Polygon, K, AreaClass)> {
         let behind_face: Vec<bool> = self
             .corners()
             .iter()
             .map(|l| !l.faces(face.plane()))
             .collect();
         if behind_face.iter().all(|&b| b) {
-            return vec![fragment(whole, AreaClass::Umbra)];
+            return pieces
+                .into_iter()
+                .map(|(p, k)| (p, k, AreaClass::Umbra))
+                .collect();
         }
         let partly_behind = behind_face.iter().any(|&b| b);
         // points not strictly in front of a polygon light see none of it
         let mut out = Vec::new();
-        let split = match self.plane() {
-            Some(plane) => whole.split(plane),
-            None => Split::Front(whole),
-        };
-        let front = match split {
-            Split::Front(p) => p,
-            Split::Spanning { front, back } => {
-                out.push(fragment(back, AreaClass::Umbra));
-                front
+        let mut front = Vec::with_capacity(pieces.len());
+        for (piece, label) in pieces {
+            let split = match self.plane() {
+                Some(plane) => piece.split(plane),
+                None => Split::Front(piece),
+            };
+            match split {
+                Split::Front(p) => front.push((p, label)),
+                Split::Spanning { front: f, back } => {
+                    out.push((back, label, AreaClass::Umbra));
+                    front.push((f, label));
+                }
+                Split::Back(p) | Split::Coplanar { polygon: p, .. } => {
+                    out.push((p, label, AreaClass::Umbra));
+                }
             }
-            Split::Back(p) | Split::Coplanar { polygon: p, .. } => {
-                return vec![fragment(p, AreaClass::Umbra)];
-            }
-        };
+        }
         // an occluder whose penumbra volume lies wholly beyond one of its
         // planes from the face hides nothing from it
+        let whole = face.polygon.to_polygon(0);
         let regions: Vec<&Regions> = occluders
             .filter(|r| {
                 !r.penumbra
                     .iter()
-                    .any(|(h, s)| wholly_outside(front.classify(h), *s))
+                    .any(|(h, s)| wholly_outside(whole.classify(h), *s))
             })
             .collect();
         // each piece's state: inside some penumbra volume, the light
         // corners hidden from it (or behind the face), inside one
         // occluder's umbra
-        struct Piece {
+        struct Piece<K> {
             polygon: Polygon,
+            label: K,
             not_lit: bool,
             hidden: u64,
             umbra: bool,
@@ -769,12 +820,16 @@ impl AreaLight {
         let corners = self.corners().len();
         let all = u64::MAX >> (64 - corners);
         let behind = (0..corners).fold(0u64, |m, i| m | u64::from(behind_face[i]) << i);
-        let mut pieces = vec![Piece {
-            polygon: front,
-            not_lit: false,
-            hidden: behind,
-            umbra: false,
-        }];
+        let mut pieces: Vec<Piece<K>> = front
+            .into_iter()
+            .map(|(polygon, label)| Piece {
+                polygon,
+                label,
+                not_lit: false,
+                hidden: behind,
+                umbra: false,
+            })
+            .collect();
         for r in &regions {
             let mut next = Vec::with_capacity(pieces.len());
             for piece in pieces {
@@ -813,6 +868,7 @@ impl AreaLight {
                 let whole = r.from_corner.iter().all(Option::is_some);
                 next.extend(parts.into_iter().map(|(polygon, m)| Piece {
                     polygon,
+                    label: piece.label,
                     not_lit: true,
                     hidden: piece.hidden | m,
                     umbra: whole && m == all,
@@ -828,14 +884,14 @@ impl AreaLight {
                 Piece { hidden, .. } if hidden == all => AreaClass::Undecided,
                 _ => AreaClass::Penumbra,
             };
-            out.push(fragment(piece.polygon, class));
+            out.push((piece.polygon, piece.label, class));
         }
-        merge_alike(out)
+        out
     }
 
     /// The occluder's regions (see [`Regions`]); `None` where it lies in
     /// the light's plane and hides none of it.
-    fn regions(&self, o: &Occluder) -> Option<Regions> {
+    pub(crate) fn regions(&self, o: &Occluder) -> Option<Regions> {
         let (lv, ov) = (self.corners(), o.polygon.vertices());
         let light_sides: Vec<Side> = lv.iter().map(|l| sign(l.eval(o.plane()))).collect();
         if light_sides.iter().all(|&s| s == Side::On) {
@@ -1003,17 +1059,4 @@ fn separating(h: &Plane, lv: &[Light], ov: &[GridPoint]) -> Option<Side> {
         (l, o) if l != o => Some(o),
         _ => None,
     }
-}
-
-/// Merges fragments of one class whose union is convex, until none do.
-fn merge_alike(fragments: Vec<AreaFragment>) -> Vec<AreaFragment> {
-    merge_convex(
-        fragments
-            .into_iter()
-            .map(|f| (f.polygon, f.class))
-            .collect(),
-    )
-    .into_iter()
-    .map(|(polygon, class)| AreaFragment { polygon, class })
-    .collect()
 }

@@ -48,12 +48,12 @@ mod engine;
 pub mod export;
 mod light;
 mod psv;
+mod soft;
 mod wide;
 
 pub use area::{
     AreaClass, AreaFragment, AreaLight, AreaLightError, DISC_SIDES, LightView, MAX_DISC_RADIUS,
-    Occluder, Visibility,
-    form_factor,
+    Occluder, Visibility, form_factor,
 };
 pub use areas::{Areas, fragment_area, percent, polygon_area};
 pub use arena::pieces::Vertex;
@@ -67,6 +67,7 @@ pub use light::{
     place_lights, quantize_direction, shared_grid,
 };
 pub use psv::{ShadowVolumes, VolumeError, VolumeSanity};
+pub use soft::{Share, SoftFragment, soft_shadows};
 pub use wide::{WPoint, WidePlane};
 
 /// The README's example, compiled and run as a doctest.

@@ -539,3 +539,75 @@ fn bad_sun_discs_are_errors() {
     assert!(AreaLight::sun_disc(glam::DVec3::Z, f64::NAN).is_err());
     assert!(AreaLight::point([1 << 27, 0, 0]).is_err());
 }
+
+/// Several lights at once (a square light, a sun disc, a point light):
+/// at grid points strictly inside each fragment, the class of each light
+/// is the class that light alone gives there; the fragments tile each
+/// face; and the fragments are the same, face by face, when the faces
+/// come in another order or on another thread count.
+#[test]
+fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
+    let mut rng = Rng::new(0x50f7);
+    let lights = [
+        AreaLight::new(&square_light(-16, -16, 32, 96)).unwrap(),
+        AreaLight::sun_disc(glam::DVec3::new(-0.4, 0.2, 1.0), 2f64.to_radians()).unwrap(),
+        AreaLight::point([30, 10, 90]).unwrap(),
+    ];
+    let mut faces = vec![Occluder::new(&ground(120)).unwrap()];
+    for _ in 0..5 {
+        if let Ok(o) = Occluder::new(&random_triangle(&mut rng)) {
+            faces.push(o);
+        }
+    }
+    let all = svbsp::soft_shadows(&lights, &faces);
+    let alone: Vec<Vec<svbsp::AreaFragment>> = lights
+        .iter()
+        .map(|l| l.classify_face(&faces[0], &faces))
+        .collect();
+    let ground_fragments = &all[0];
+    let area: f64 = ground_fragments.iter().map(|f| area_of(&f.polygon)).sum();
+    assert!((area - 240.0 * 240.0).abs() < 1e-6 * area, "{area}");
+    let mut checked = 0;
+    let mut kinds = std::collections::HashSet::new();
+    for _ in 0..2000 {
+        let x = [below(&mut rng, 240) - 120, below(&mut rng, 240) - 120, 0];
+        let Some(f) = ground_fragments
+            .iter()
+            .find(|f| strictly_inside(&f.polygon, x))
+        else {
+            continue;
+        };
+        for (k, frags) in alone.iter().enumerate() {
+            if let Some(a) = frags.iter().find(|a| strictly_inside(&a.polygon, x)) {
+                assert_eq!(f.class(k), a.class, "{x:?}, light {k}");
+                checked += 1;
+            }
+            kinds.insert((k, f.class(k)));
+            assert_eq!(f.visible[k].is_some(), k == 0 && f.class(0) == AreaClass::Penumbra);
+        }
+    }
+    assert!(checked > 3000, "{checked}");
+    for k in 0..2 {
+        for class in [AreaClass::Lit, AreaClass::Penumbra, AreaClass::Umbra] {
+            assert!(kinds.contains(&(k, class)), "light {k} never {class:?}");
+        }
+    }
+    // another order of the faces, and one thread
+    let key = |fs: &[svbsp::SoftFragment]| -> Vec<(Vec<[f64; 3]>, u64, u64, u64)> {
+        fs.iter()
+            .map(|f| (f.polygon.vertices_f64(), f.lit, f.umbra, f.undecided))
+            .collect()
+    };
+    let mut order: Vec<usize> = (0..faces.len()).collect();
+    order.reverse();
+    order.swap(0, 2);
+    let shuffled: Vec<Occluder> = order.iter().map(|&i| faces[i].clone()).collect();
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| svbsp::soft_shadows(&lights, &shuffled));
+    for (s, &i) in order.iter().enumerate() {
+        assert_eq!(key(&one[s]), key(&all[i]), "face {i}");
+    }
+}

@@ -1,0 +1,215 @@
+//! Several lights, some with extent, over one scene: every face cut where
+//! the class of any light changes ([`soft_shadows`]), each fragment with
+//! one [`AreaClass`] per light, and for a penumbra fragment of a polygon
+//! light the share of its irradiance that arrives.
+//!
+//! Each light cuts the pieces the lights before it left
+//! ([`AreaLight::classify_face`]'s cuts, by planes through grid points
+//! only), so the classes are exact for every light at once; pieces of one
+//! face with the same classes are then merged where their union is
+//! convex. Points and suns take part as the limits of area lights
+//! ([`AreaLight::point`], [`AreaLight::sun`]): lit or umbra.
+
+use bsp_core::{GridPoint, Polygon};
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::area::{AreaClass, AreaLight, Occluder, Regions, grid_box, may_reach, merge_convex};
+
+/// The share of a polygon light's irradiance that arrives on a penumbra
+/// fragment ([`crate::LightView::fraction`]): at the grid point nearest its
+/// centroid, and the least and most at the grid points nearest its
+/// corners.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Share {
+    /// At the centroid.
+    pub centroid: f64,
+    /// The least at a corner.
+    pub min: f64,
+    /// The most at a corner.
+    pub max: f64,
+}
+
+/// A piece of a face with one class per light.
+#[derive(Clone, Debug)]
+pub struct SoftFragment {
+    /// The piece: convex, with exact corners.
+    pub polygon: Polygon,
+    /// Bit `i`: light `i` is wholly seen ([`AreaClass::Lit`]).
+    pub lit: u64,
+    /// Bit `i`: none of light `i` is seen ([`AreaClass::Umbra`]).
+    pub umbra: u64,
+    /// Bit `i`: light `i`'s class is [`AreaClass::Undecided`].
+    pub undecided: u64,
+    /// Per light, for a penumbra fragment of a polygon light, the share
+    /// of its irradiance that arrives; `None` otherwise.
+    pub visible: Vec<Option<Share>>,
+}
+
+impl SoftFragment {
+    /// The class for light `i`.
+    pub fn class(&self, i: usize) -> AreaClass {
+        let bit = |m: u64| m >> i & 1 == 1;
+        if bit(self.lit) {
+            AreaClass::Lit
+        } else if bit(self.umbra) {
+            AreaClass::Umbra
+        } else if bit(self.undecided) {
+            AreaClass::Undecided
+        } else {
+            AreaClass::Penumbra
+        }
+    }
+}
+
+/// Per light, the classes as bits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+struct Classes {
+    lit: u64,
+    umbra: u64,
+    undecided: u64,
+}
+
+impl Classes {
+    fn with(mut self, i: usize, class: AreaClass) -> Classes {
+        match class {
+            AreaClass::Lit => self.lit |= 1 << i,
+            AreaClass::Umbra => self.umbra |= 1 << i,
+            AreaClass::Undecided => self.undecided |= 1 << i,
+            AreaClass::Penumbra => {}
+        }
+        self
+    }
+}
+
+/// Every face of `faces` cut into fragments of one class per light, with
+/// all the other faces as occluders (see the module docs), in face order;
+/// the faces in parallel, the same result for every thread count. At most
+/// 64 lights (the classes are bits of a `u64`): more panic.
+///
+/// ```
+/// use svbsp::{AreaClass, AreaLight, Occluder, soft_shadows};
+/// let lights = [
+///     AreaLight::new(&[[0, 0, 80], [0, 40, 80], [40, 40, 80], [40, 0, 80]]).unwrap(),
+///     AreaLight::point([20, 20, 80]).unwrap(),
+/// ];
+/// let faces = [
+///     Occluder::new(&[[-200, -200, 0], [200, -200, 0], [200, 200, 0], [-200, 200, 0]]).unwrap(),
+///     Occluder::new(&[[0, 0, 40], [40, 0, 40], [40, 40, 40], [0, 40, 40]]).unwrap(),
+/// ];
+/// let all = soft_shadows(&lights, &faces);
+/// let ground = &all[0];
+/// // under the roof's middle: umbra of both
+/// assert!(ground.iter().any(|f| f.class(0) == AreaClass::Umbra && f.class(1) == AreaClass::Umbra));
+/// // the square light's penumbra, lit by the point
+/// let soft = ground.iter().find(|f| f.class(0) == AreaClass::Penumbra && f.class(1) == AreaClass::Lit);
+/// let share = soft.unwrap().visible[0].unwrap();
+/// assert!(0.0 <= share.min && share.min <= share.max && share.max <= 1.0);
+/// assert!(share.centroid > 0.0 && share.centroid < 1.0);
+/// ```
+pub fn soft_shadows(lights: &[AreaLight], faces: &[Occluder]) -> Vec<Vec<SoftFragment>> {
+    assert!(lights.len() <= 64, "at most 64 lights");
+    let regions: Vec<Vec<Option<Regions>>> = lights
+        .iter()
+        .map(|l| faces.par_iter().map(|o| l.regions(o)).collect())
+        .collect();
+    faces
+        .par_iter()
+        .enumerate()
+        .map(|(i, face)| soft_face(lights, faces, &regions, i, face))
+        .collect()
+}
+
+/// The fragments of face `i`.
+fn soft_face(
+    lights: &[AreaLight],
+    faces: &[Occluder],
+    regions: &[Vec<Option<Regions>>],
+    i: usize,
+    face: &Occluder,
+) -> Vec<SoftFragment> {
+    let bx = grid_box(face.corners());
+    // per light, the occluders that may hide some of it from the face, in
+    // the order of their corners (so the cuts, and the fragments, do not
+    // depend on the order the faces come in)
+    let near: Vec<Vec<usize>> = regions
+        .iter()
+        .map(|rs| {
+            let mut near: Vec<usize> = (0..faces.len())
+                .filter(|&j| j != i)
+                .filter(|&j| rs[j].as_ref().is_some_and(|r| may_reach(&bx, &r.reach)))
+                .collect();
+            near.sort_by(|&a, &b| faces[a].corners().cmp(faces[b].corners()));
+            near
+        })
+        .collect();
+    let mut pieces = vec![(face.to_polygon(), Classes::default())];
+    for (k, light) in lights.iter().enumerate() {
+        let occluders = near[k].iter().filter_map(|&j| regions[k][j].as_ref());
+        pieces = light
+            .cut(face, pieces, occluders)
+            .into_iter()
+            .map(|(p, c, class)| (p, c.with(k, class)))
+            .collect();
+    }
+    merge_convex(pieces)
+        .into_iter()
+        .map(|(polygon, c)| {
+            let visible = (0..lights.len())
+                .map(|k| {
+                    let penumbra = (c.lit | c.umbra | c.undecided) >> k & 1 == 0;
+                    let among = near[k].iter().map(|&j| &faces[j]);
+                    penumbra
+                        .then(|| share(&lights[k], face, &polygon, among))
+                        .flatten()
+                })
+                .collect();
+            SoftFragment {
+                polygon,
+                lit: c.lit,
+                umbra: c.umbra,
+                undecided: c.undecided,
+                visible,
+            }
+        })
+        .collect()
+}
+
+/// The grid point nearest `p` (grid units).
+fn nearest(p: [f64; 3]) -> GridPoint {
+    p.map(|c| c.round() as i32)
+}
+
+/// The share of `light` arriving on `piece` of `face` (see [`Share`]);
+/// `None` for a light without a polygon.
+fn share<'o>(
+    light: &AreaLight,
+    face: &Occluder,
+    piece: &Polygon,
+    occluders: impl Iterator<Item = &'o Occluder> + Clone,
+) -> Option<Share> {
+    light.plane()?;
+    let n = face.plane().normal().map(|c| c as f64);
+    let normal = DVec3::from_array(n).normalize();
+    let at = |p: [f64; 3]| -> Option<f64> {
+        let x = nearest(p);
+        let view = light.view_among(x, Some(face.plane()), occluders.clone())?;
+        view.fraction(DVec3::from_array(x.map(f64::from)), normal)
+    };
+    let corners = piece.vertices_f64();
+    let centroid = corners
+        .iter()
+        .fold(DVec3::ZERO, |s, &c| s + DVec3::from_array(c))
+        / corners.len() as f64;
+    let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &c in &corners {
+        let f = at(c).unwrap_or(0.0);
+        min = min.min(f);
+        max = max.max(f);
+    }
+    Some(Share {
+        centroid: at(centroid.to_array()).unwrap_or(0.0),
+        min,
+        max,
+    })
+}
