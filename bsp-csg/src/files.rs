@@ -91,6 +91,16 @@ impl FileError {
 }
 
 impl Operand {
+    /// The operands named in words: "a alone", "a and b", "a and 2 more".
+    pub fn names(operands: &[Operand]) -> String {
+        match operands {
+            [a] => format!("{} alone", a.name),
+            [a, b] => format!("{} and {}", a.name, b.name),
+            [first, rest @ ..] => format!("{} and {} more", first.name, rest.len()),
+            [] => String::new(),
+        }
+    }
+
     /// `mesh`, read from file `name`.
     pub fn new(name: impl Into<String>, mesh: Mesh) -> Operand {
         Operand {
@@ -559,6 +569,23 @@ impl Rounded {
                 format!("warning: rounding to {to} {did}; the file is not closed as read back")
             }
         }
+    }
+}
+
+/// Has glibc keep the large blocks a run frees, to be used again, instead
+/// of unmapping each one and faulting the next one in page by page: freeing
+/// one untouched block just under 32 MiB raises glibc's dynamic mmap
+/// threshold at once (mallopt(3)). `docs/bench-csg.md` has the
+/// measurement; other allocators see one allocation made and freed. A
+/// program that runs a large Boolean calls it once, first.
+pub fn keep_freed_blocks() {
+    // (two pages under 32 MiB: with glibc's header the mapped block is one
+    // page under, within the largest threshold glibc raises to; where even
+    // that much address space is refused, nothing is done)
+    let mut block: Vec<u8> = Vec::new();
+    if block.try_reserve_exact((32 << 20) - 8192).is_ok() {
+        // (kept from being optimized away: the allocation is the point)
+        drop(std::hint::black_box(block));
     }
 }
 

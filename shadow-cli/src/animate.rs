@@ -220,6 +220,9 @@ impl Plan {
         if s.statics.faces.is_empty() {
             bail!("{}: no faces", s.name);
         }
+        if !args.lights.soft().is_empty() {
+            bail!("--area-light and --sun-disc are for `shadow shadows` so far");
+        }
         let mut specs = args.lights.specs();
         if specs.is_empty() {
             match s.light {
@@ -285,7 +288,7 @@ impl Plan {
         let mut pts = s.statics.positions.clone();
         pts.push(lo);
         pts.push(hi);
-        shared_grid(&pts, &self.specs).with_context(|| s.name.clone())
+        shared_grid(&pts, &self.specs, &[]).with_context(|| s.name.clone())
     }
 }
 
@@ -299,7 +302,7 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
     let total = Instant::now();
     let mut plan = Plan::of(args)?;
     let grid = plan.grid(args.frames)?;
-    let placed = place_lights(&grid, &plan.specs)?;
+    let (placed, _) = place_lights(&grid, &plan.specs, &[])?;
     let kernel: Vec<Light> = placed.iter().map(|l| l.light).collect();
     let opts = PipelineOptions::default()
         .with_strategy(plan.strategy)

@@ -6,7 +6,7 @@ use clap::Args;
 use glam::DVec3;
 use shadow_raster::svg::{SvgViewpoint, ViewRequest};
 use shadow_scene::{Mesh, Staging};
-use svbsp::LightSpec;
+use svbsp::{LightSpec, SUN_RADIUS_DEG, SoftSpec};
 
 /// Where the mesh comes from: a file or a built-in scene (exactly one).
 #[derive(Args, Debug)]
@@ -43,8 +43,8 @@ impl SourceArgs {
     }
 }
 
-/// The lights: point lights and suns, numbered all `--light` first, then
-/// all `--sun`.
+/// The lights: point lights, suns, area lights and sun discs, numbered
+/// in that order.
 #[derive(Args, Debug, Default)]
 pub(crate) struct LightArgs {
     /// A point light at X,Y,Z (input units). Repeat for several lights;
@@ -56,6 +56,16 @@ pub(crate) struct LightArgs {
     /// the light (0,0,1: straight overhead). Repeatable.
     #[arg(long = "sun", value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub(crate) suns: Vec<DVec3>,
+    /// An area light: a planar convex polygon, its corners in order; it
+    /// shines on the side they turn counter-clockwise about. Soft
+    /// shadows: lit, penumbra and umbra (`shadows`, JSON and OBJ).
+    #[arg(long = "area-light", value_name = "X,Y,Z;X,Y,Z;X,Y,Z[;...]", value_parser = parse_area, allow_hyphen_values = true)]
+    pub(crate) areas: Vec<SoftSpec>,
+    /// The sun as a disc toward DX,DY,DZ of angular radius DEG [default:
+    /// 0.2666], bounded by an octagon that holds it: what is lit sees
+    /// the whole disc, what is umbra none of it.
+    #[arg(long = "sun-disc", value_name = "DX,DY,DZ[:DEG]", value_parser = parse_disc, allow_hyphen_values = true)]
+    pub(crate) discs: Vec<SoftSpec>,
 }
 
 impl LightArgs {
@@ -65,6 +75,39 @@ impl LightArgs {
         specs.extend(self.suns.iter().map(|&d| LightSpec::Sun(d)));
         specs
     }
+
+    /// The lights with extent in their order, after [`LightArgs::specs`].
+    pub(crate) fn soft(&self) -> Vec<SoftSpec> {
+        self.areas.iter().chain(&self.discs).cloned().collect()
+    }
+}
+
+/// Parses `X,Y,Z;X,Y,Z;X,Y,Z[;...]`, an area light's corners.
+fn parse_area(s: &str) -> Result<SoftSpec, String> {
+    let corners = s.split(';').map(parse_vec3).collect::<Result<Vec<_>, _>>();
+    let corners = corners.map_err(|e| format!("{e}; corners go as X,Y,Z;X,Y,Z;X,Y,Z"))?;
+    if corners.len() < 3 {
+        return Err(format!(
+            "{} corner(s): an area light takes at least three",
+            corners.len()
+        ));
+    }
+    Ok(SoftSpec::Area(corners))
+}
+
+/// Parses `DX,DY,DZ[:DEG]`, a sun disc.
+fn parse_disc(s: &str) -> Result<SoftSpec, String> {
+    let (d, deg) = s.split_once(':').unwrap_or((s, ""));
+    let radius_deg = match deg.trim() {
+        "" => SUN_RADIUS_DEG,
+        r => r
+            .parse()
+            .map_err(|_| format!("`{r}` is not an angle in degrees"))?,
+    };
+    Ok(SoftSpec::SunDisc {
+        direction: parse_vec3(d)?,
+        radius_deg,
+    })
 }
 
 /// Where a picture is seen from.

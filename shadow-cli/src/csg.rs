@@ -13,7 +13,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
-use bsp_core::{BoolOp, Grid, ImportReport};
+use bsp_core::BoolOp;
 use bsp_csg::Step;
 use bsp_csg::files::{FileBoolean, FileError, Operand};
 use clap::{Args, ValueEnum};
@@ -126,7 +126,7 @@ fn apply(
         if let Step::Snapped { operand, report } = step
             && !quiet
         {
-            print_import_summary(&names[*operand], report, grid);
+            eprint!("{}", report.notes(&names[*operand], grid));
         }
     })
     .map_err(|e| match e.locate_crossing(&names) {
@@ -156,42 +156,10 @@ fn file_error(e: FileError) -> anyhow::Error {
     }
 }
 
-/// Prints what snapping did to operand `name`'s faces, if anything.
-fn print_import_summary(name: &str, report: &ImportReport, grid: &Grid) {
-    let summary = report.summary();
-    if !summary.is_empty() {
-        eprint!("{name}: {summary}");
-    }
-    if !report.dropped.is_empty() {
-        eprintln!(
-            "warning: {name}: {} face(s) have no area on the grid (step 2^{}) and were dropped; \
-             the solid may not be closed",
-            report.dropped.len(),
-            grid.step_log2()
-        );
-    }
-}
-
-/// Has glibc keep the large blocks a run frees, to be used again, instead
-/// of unmapping each one and faulting the next one in page by page: freeing
-/// one untouched block just under 32 MiB raises glibc's dynamic mmap
-/// threshold at once (mallopt(3)). docs/bench-csg.md has the measurement;
-/// other allocators see one allocation made and freed.
-fn keep_freed_blocks() {
-    // (two pages under 32 MiB: with glibc's header the mapped block is one
-    // page under, within the largest threshold glibc raises to; where even
-    // that much address space is refused, nothing is done)
-    let mut block: Vec<u8> = Vec::new();
-    if block.try_reserve_exact((32 << 20) - 8192).is_ok() {
-        // (kept from being optimized away: the allocation is the point)
-        drop(std::hint::black_box(block));
-    }
-}
-
 /// `shadow csg`.
 pub(crate) fn run(args: &CsgArgs) -> Result<()> {
     let total = Instant::now();
-    keep_freed_blocks();
+    bsp_csg::files::keep_freed_blocks();
     // fail on a bad output name before doing any work
     MeshFormat::from_path(&args.output)?;
     if args.operands.len() == 1 && args.op != Operation::Union {
@@ -217,13 +185,7 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
         Some(r) => (r.mesh.faces.len(), r.mesh.positions.len()),
         None => (out.exact.triangles.len(), out.positions.len()),
     };
-    let names: Vec<&str> = operands.iter().map(|o| o.name.as_str()).collect();
-    let of = match names.as_slice() {
-        [a] => format!("{a} alone"),
-        [a, b] => format!("{a} and {b}"),
-        [first, rest @ ..] => format!("{first} and {} more", rest.len()),
-        [] => String::new(),
-    };
+    let of = Operand::names(&operands);
     let mut report = format!(
         "wrote {}: {} of {of}, {tris} triangles, {verts} vertices\n",
         args.output.display(),

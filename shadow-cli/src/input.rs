@@ -2,15 +2,13 @@
 //! mesh snapped to a grid, imported and built into a BSP tree.
 
 use std::path::Path;
-use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
-use bsp_core::{
-    BspTree, BuildOptions, Grid, ImportReport, Polygon, import_faces, import_faces_par,
-};
+use bsp_core::{Grid, ImportReport, Polygon, import_faces_par};
+use bsp_shadows::prepared::Prepared;
 use glam::DVec3;
 use shadow_scene::{Mesh, Staging};
-use svbsp::{LightSpec, PlacedLight};
+use svbsp::{LightSpec, PlacedLight, SoftLight, SoftSpec};
 
 use crate::args::SourceArgs;
 use crate::lights::{place_lights, shared_grid};
@@ -69,6 +67,8 @@ pub(crate) struct Scene {
     pub(crate) default_light: bool,
     pub(crate) grid: Grid,
     pub(crate) lights: Vec<PlacedLight>,
+    /// Where lights with extent are given: every light, for soft shadows.
+    pub(crate) soft: Vec<SoftLight>,
     pub(crate) polys: Vec<Polygon>,
     pub(crate) report: ImportReport,
 }
@@ -80,7 +80,7 @@ impl Scene {
     /// without one is an error if `need_light`.
     pub(crate) fn load(
         source: &SourceArgs,
-        mut specs: Vec<LightSpec>,
+        (mut specs, soft): (Vec<LightSpec>, &[SoftSpec]),
         need_light: bool,
         quiet: bool,
         phases: &mut Phases,
@@ -97,14 +97,14 @@ impl Scene {
             );
         }
         let staging = source.staging(bounds);
-        let default_light = specs.is_empty() && need_light;
+        let default_light = specs.is_empty() && soft.is_empty() && need_light;
         if default_light {
             let s = staging.with_context(|| format!("{name}: {NO_LIGHT}"))?;
             specs.push(LightSpec::Point(s.light));
         }
         let scene = phases.run("snap/import", || -> Result<Scene> {
-            let grid = shared_grid(&mesh.positions, &specs).with_context(|| name.clone())?;
-            let lights = place_lights(&grid, &specs)?;
+            let grid = shared_grid(&mesh.positions, &specs, soft).with_context(|| name.clone())?;
+            let (lights, soft) = place_lights(&grid, &specs, soft)?;
             let (polys, report) = import_faces_par(&grid, &mesh.face_loops())
                 .with_context(|| format!("{name}: cannot import the faces"))?;
             Ok(Scene {
@@ -115,6 +115,7 @@ impl Scene {
                 default_light,
                 grid,
                 lights,
+                soft,
                 polys,
                 report,
             })
@@ -128,7 +129,7 @@ impl Scene {
 
     /// The lights, as the report names them.
     pub(crate) fn light_count(&self) -> String {
-        match (self.lights.len(), self.default_light) {
+        match (self.lights.len().max(self.soft.len()), self.default_light) {
             (_, true) => format!(
                 "the {}'s default light ({})",
                 self.name.trim_start_matches("scene "),
@@ -140,46 +141,15 @@ impl Scene {
     }
 }
 
-/// A mesh with its grid and BSP tree.
-pub(crate) struct Prepared {
-    pub(crate) mesh: Mesh,
-    pub(crate) grid: Grid,
-    pub(crate) report: ImportReport,
-    pub(crate) tree: BspTree,
-    /// Wall time of snapping and importing the faces.
-    pub(crate) import_time: Duration,
-    /// Wall time of the BSP build.
-    pub(crate) build_time: Duration,
-}
-
-impl Prepared {
-    /// Snaps `mesh` to a fitted grid, imports its faces, each tagged with
-    /// its index (printing the import summary to stderr when faces were
-    /// changed) and builds the tree. `name` names the mesh in messages.
-    pub(crate) fn new(mesh: Mesh, name: &str, quiet: bool) -> Result<Prepared> {
-        let grid = Grid::fit_points(&mesh.positions)
-            .with_context(|| format!("{name}: cannot fit a grid to the positions"))?;
-        let start = Instant::now();
-        let loops = mesh.face_loops();
-        let (polys, report) = import_faces(&grid, loops.iter().map(Vec::as_slice))
-            .with_context(|| format!("{name}: cannot import the faces"))?;
-        let summary = report.summary();
-        if !summary.is_empty() && !quiet {
-            eprint!("{name}: {summary}");
-        }
-        let import_time = start.elapsed();
-        let start = Instant::now();
-        let tree = BspTree::build(polys, &BuildOptions::default());
-        let build_time = start.elapsed();
-        Ok(Prepared {
-            mesh,
-            grid,
-            report,
-            tree,
-            import_time,
-            build_time,
-        })
+/// Snaps, imports and builds `mesh` ([`Prepared::new`]), printing the
+/// import summary to stderr when faces were changed (unless `quiet`).
+pub(crate) fn prepare(mesh: Mesh, name: &str, quiet: bool) -> Result<Prepared> {
+    let p = Prepared::new(mesh).map_err(|e| anyhow::anyhow!(e).context(name.to_string()))?;
+    let summary = p.report.summary();
+    if !summary.is_empty() && !quiet {
+        eprint!("{name}: {summary}");
     }
+    Ok(p)
 }
 
 #[cfg(test)]
@@ -188,7 +158,7 @@ mod tests {
 
     #[test]
     fn room_imports_without_changes() {
-        let p = Prepared::new(shadow_scene::room(), "room", false).unwrap();
+        let p = prepare(shadow_scene::room(), "room", false).unwrap();
         assert!(p.report.triangulated.is_empty() && p.report.dropped.is_empty());
         assert_eq!(p.report.polygons, p.mesh.faces.len());
         p.tree.sanity_check().unwrap();
@@ -197,7 +167,7 @@ mod tests {
 
     #[test]
     fn empty_mesh_gives_an_empty_tree() {
-        let p = Prepared::new(Mesh::default(), "empty", false).unwrap();
+        let p = prepare(Mesh::default(), "empty", false).unwrap();
         assert_eq!(p.tree.stats().nodes, 0);
     }
 

@@ -5,7 +5,7 @@
 use anyhow::{Result, anyhow};
 use bsp_core::Grid;
 use glam::DVec3;
-use svbsp::{Light, LightError, LightSpec, PlacedLight};
+use svbsp::{Light, LightError, LightSpec, PlacedLight, SoftLight, SoftSpec};
 
 /// `x,y,z` with the shortest representation of each coordinate.
 pub(crate) fn fmt_input(v: DVec3) -> String {
@@ -20,9 +20,13 @@ pub(crate) fn flag(spec: &LightSpec) -> String {
     }
 }
 
-/// An error about the lights, naming the light by its number and flag.
-fn explain(e: LightError, specs: &[LightSpec]) -> anyhow::Error {
-    let at = |i: usize| format!("light {i} ({})", flag(&specs[i]));
+/// An error about the lights, naming the light by its number and flag
+/// (`specs`, then `soft`).
+fn explain(e: LightError, specs: &[LightSpec], soft: &[SoftSpec]) -> anyhow::Error {
+    let at = |i: usize| match specs.get(i) {
+        Some(s) => format!("light {i} ({})", flag(s)),
+        None => format!("light {i} ({})", soft[i - specs.len()]),
+    };
     match e {
         LightError::FarPoint {
             index,
@@ -35,19 +39,35 @@ fn explain(e: LightError, specs: &[LightSpec]) -> anyhow::Error {
             fmt_input(centre)
         ),
         LightError::ZeroSun { index } => anyhow!("{}: the sun direction is zero", at(index)),
+        LightError::Extent { index, cause } => anyhow!("{}: {cause}", at(index)),
         e => anyhow!(e),
     }
 }
 
-/// The grid shared by the scene and its point lights (see
-/// [`svbsp::shared_grid`]).
-pub(crate) fn shared_grid(positions: &[DVec3], specs: &[LightSpec]) -> Result<Grid> {
-    svbsp::shared_grid(positions, specs).map_err(|e| explain(e, specs))
+/// The grid shared by the scene and its point lights and area lights'
+/// corners (see [`svbsp::shared_grid`]).
+pub(crate) fn shared_grid(
+    positions: &[DVec3],
+    specs: &[LightSpec],
+    soft: &[SoftSpec],
+) -> Result<Grid> {
+    svbsp::shared_soft_grid(positions, specs, soft).map_err(|e| explain(e, specs, soft))
 }
 
-/// Every light on `grid`, errors naming the light and its flag.
-pub(crate) fn place_lights(grid: &Grid, specs: &[LightSpec]) -> Result<Vec<PlacedLight>> {
-    svbsp::place_lights(grid, specs).map_err(|e| explain(e, specs))
+/// Every light on `grid`, errors naming the light and its flag: the
+/// point lights and suns, and where lights with extent are given, every
+/// light as one for soft shadows.
+pub(crate) fn place_lights(
+    grid: &Grid,
+    specs: &[LightSpec],
+    soft: &[SoftSpec],
+) -> Result<(Vec<PlacedLight>, Vec<SoftLight>)> {
+    let placed = svbsp::place_lights(grid, specs).map_err(|e| explain(e, specs, soft))?;
+    if soft.is_empty() {
+        return Ok((placed, Vec::new()));
+    }
+    let all = svbsp::place_soft_lights(grid, &placed, soft).map_err(|e| explain(e, specs, soft))?;
+    Ok((placed, all))
 }
 
 /// A light in words: the flag that gave it and what became of it on the
@@ -86,18 +106,18 @@ mod tests {
             LightSpec::Point(DVec3::new(0.5, 0.5, 2.0)),
             LightSpec::Point(DVec3::new(0.5, 0.5, 1e6)),
         ];
-        let g = shared_grid(&scene, &specs).unwrap();
-        let e = place_lights(&g, &specs).unwrap_err().to_string();
+        let g = shared_grid(&scene, &specs, &[]).unwrap();
+        let e = place_lights(&g, &specs, &[]).unwrap_err().to_string();
         assert!(
             e.starts_with("light 1 (--light 0.5,0.5,1000000): outside the grid"),
             "{e}"
         );
         assert!(e.contains("--sun"), "{e}");
-        let e = place_lights(&g, &[LightSpec::Sun(DVec3::ZERO)])
+        let e = place_lights(&g, &[LightSpec::Sun(DVec3::ZERO)], &[])
             .unwrap_err()
             .to_string();
         assert_eq!(e, "light 0 (--sun 0,0,0): the sun direction is zero");
-        let placed = place_lights(&g, &specs[..1]).unwrap();
+        let (placed, _) = place_lights(&g, &specs[..1], &[]).unwrap();
         assert_eq!(
             describe(&placed[0]),
             "point light --light 0.5,0.5,2, on the grid"

@@ -232,9 +232,12 @@ pub(crate) fn prepare(
 ) -> Result<Prepared> {
     let start = Instant::now();
     let specs = lights.map(LightArgs::specs).unwrap_or_default();
+    if lights.is_some_and(|l| !l.soft().is_empty()) {
+        bail!("--area-light and --sun-disc are for `shadow shadows` so far");
+    }
     let s = Scene::load(
         &args.source,
-        specs,
+        (specs, &[]),
         lights.is_some(),
         args.quiet,
         &mut Phases::default(),
@@ -357,18 +360,8 @@ pub(crate) fn run_lines(args: &LinesArgs) -> Result<()> {
     let p = prepare(&args.scene, None, args.size)?;
     let lines = hidden_lines(&p.scene, &p.camera)?;
     write_file(&args.output, lines.svg(args.hidden).as_bytes())?;
-    emit(&format!(
-        "wrote {}: {} polyhedra ({} convex), {} edges, {} visible and {} hidden parts; \
-         z-buffer check: {} of {} points agree\n",
-        args.output.display(),
-        lines.polyhedra,
-        lines.convex,
-        lines.edges,
-        lines.visible.len(),
-        lines.hidden.len(),
-        lines.check.agree,
-        lines.check.checked
-    ))
+    let what = lines.summary();
+    emit(&format!("wrote {}: {what}\n", args.output.display()))
 }
 
 #[cfg(test)]

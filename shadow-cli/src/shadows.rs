@@ -16,10 +16,14 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use anyhow::{Result, bail};
-use bsp_shadows::shadow_file::{self, FileKind, LitScene, ShadowFile, write_shadows};
+use anyhow::{Context, Result, bail};
+use bsp_shadows::shadow_file::{
+    self, FileKind, LitScene, OutputFormat as Format, ShadowFile, write_shadows,
+};
+use bsp_shadows::soft_file::{SoftScene, write_soft_shadows};
 use clap::{Args, ValueEnum};
-use svbsp::{LightSpec, percent};
+use svbsp::export::FragmentFormat;
+use svbsp::{LightSpec, SoftSpec, percent};
 
 use crate::args::{CameraArgs, ImageArgs, LightArgs, SourceArgs};
 use crate::facade_error;
@@ -70,29 +74,14 @@ pub(crate) struct ShadowsArgs {
 const TOP_FACES: usize = 10;
 
 /// The output format, by the file's extension.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Format {
-    Json,
-    Obj,
-    Svg,
-}
-
-impl Format {
-    fn from_path(path: &Path) -> Result<Format> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        match ext.as_deref() {
-            Some("json") => Ok(Format::Json),
-            Some("obj") => Ok(Format::Obj),
-            Some("svg") => Ok(Format::Svg),
-            _ => bail!(
-                "{}: unknown output format (use .json, .obj or .svg)",
-                path.display()
-            ),
-        }
-    }
+fn format_of(path: &Path) -> Result<Format> {
+    let known = Format::from_path(path);
+    known.with_context(|| {
+        format!(
+            "{}: unknown output format (use .json, .obj or .svg)",
+            path.display()
+        )
+    })
 }
 
 // ------------------------------------------------------------- command
@@ -100,8 +89,8 @@ impl Format {
 /// The output format and the lights given, checked before any work is
 /// done: fails on a bad output name, or no light for a file (a built-in
 /// scene may have its own).
-fn request(args: &ShadowsArgs) -> Result<(Format, Vec<LightSpec>)> {
-    let format = Format::from_path(&args.output)?;
+fn request(args: &ShadowsArgs) -> Result<(Format, Vec<LightSpec>, Vec<SoftSpec>)> {
+    let format = format_of(&args.output)?;
     if format != Format::Svg && (args.camera.any() || args.image.any()) {
         note(
             args,
@@ -110,10 +99,14 @@ fn request(args: &ShadowsArgs) -> Result<(Format, Vec<LightSpec>)> {
     }
     args.source.check()?;
     let specs = args.lights.specs();
-    if specs.is_empty() && args.source.input.is_some() {
+    let soft = args.lights.soft();
+    if specs.is_empty() && soft.is_empty() && args.source.input.is_some() {
         bail!("{NO_LIGHT}");
     }
-    Ok((format, specs))
+    if !soft.is_empty() && (format == Format::Svg || args.algorithm != Algorithm::Psv) {
+        bail!("soft shadows (--area-light, --sun-disc) are written as .json or .obj so far");
+    }
+    Ok((format, specs, soft))
 }
 
 /// A note on stderr, unless `--quiet`.
@@ -124,11 +117,14 @@ fn note(args: &ShadowsArgs, s: &str) {
 /// `shadow shadows`.
 pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
     let total = Instant::now();
-    let (format, specs) = request(args)?;
+    let (format, specs, soft) = request(args)?;
     let progress = Progress::new(!args.quiet);
     let mut phases = Phases::default();
     progress.phase("loading", 1);
-    let scene = Scene::load(&args.source, specs, true, args.quiet, &mut phases)?;
+    let scene = Scene::load(&args.source, (specs, &soft), true, args.quiet, &mut phases)?;
+    if !scene.soft.is_empty() {
+        return soft_shadows(args, &scene, format, &progress);
+    }
     let view = (format == Format::Svg).then(|| {
         let size = args.image.size();
         let image = (size, args.image.fov);
@@ -223,6 +219,48 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
     emit(&report)
 }
 
+/// `shadow shadows` with lights of extent: every light's lit, penumbra
+/// and umbra fragments as JSON or OBJ.
+fn soft_shadows(
+    args: &ShadowsArgs,
+    scene: &Scene,
+    format: Format,
+    progress: &Progress,
+) -> Result<()> {
+    let (name, faces, grid) = (&scene.name, scene.mesh.faces.len(), &scene.grid);
+    let (lights, polys) = (&scene.soft, &scene.polys);
+    let job = SoftScene {
+        name,
+        faces,
+        grid,
+        lights,
+        polys,
+    };
+    let obj = format == Format::Obj;
+    let format = if obj {
+        FragmentFormat::Obj
+    } else {
+        FragmentFormat::Json
+    };
+    let mut out = Output::create(&args.output)?;
+    let fig = guarded("the input and the command line", || {
+        write_soft_shadows(&job, format, &mut out, progress).map_err(facade_error)
+    })?;
+    out.commit()?;
+    progress.finish();
+    let w = &fig.written;
+    let mut report = format!(
+        "wrote {}: {} fragments of {} faces of {} under {}\n",
+        args.output.display(),
+        w.fragments,
+        job.faces,
+        scene.name,
+        scene.light_count()
+    );
+    report += &fig.report();
+    emit(&report)
+}
+
 /// The `--stats` report.
 fn stats_text(scene: &Scene, fig: &ShadowFile, phases: &Phases, total: Duration) -> String {
     let faces = scene.mesh.faces.len();
@@ -280,21 +318,15 @@ mod tests {
 
     #[test]
     fn formats_by_extension() {
-        assert_eq!(
-            Format::from_path(Path::new("a.JSON")).unwrap(),
-            Format::Json
-        );
-        assert_eq!(
-            Format::from_path(Path::new("a/b.obj")).unwrap(),
-            Format::Obj
-        );
-        assert_eq!(Format::from_path(Path::new("c.Svg")).unwrap(), Format::Svg);
-        let e = Format::from_path(Path::new("out.png")).unwrap_err();
+        assert_eq!(format_of(Path::new("a.JSON")).unwrap(), Format::Json);
+        assert_eq!(format_of(Path::new("a/b.obj")).unwrap(), Format::Obj);
+        assert_eq!(format_of(Path::new("c.Svg")).unwrap(), Format::Svg);
+        let e = format_of(Path::new("out.png")).unwrap_err();
         assert_eq!(
             e.to_string(),
             "out.png: unknown output format (use .json, .obj or .svg)"
         );
-        assert!(Format::from_path(Path::new("json")).is_err());
+        assert!(format_of(Path::new("json")).is_err());
     }
 
     #[test]

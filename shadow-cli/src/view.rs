@@ -6,13 +6,13 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use shadow_raster::svg::{SvgPicture, SvgView, SvgViewpoint};
+use shadow_raster::svg::SvgViewpoint;
 use shadow_scene::{ROOM_EYE, ROOM_TARGET};
 
 use crate::args::{CameraArgs, ImageArgs, SourceArgs};
-use crate::input::{Prepared, load_source_quiet};
-use crate::output::{emit, ms, write_file};
-use crate::raster_error;
+use crate::facade_error;
+use crate::input::{load_source_quiet, prepare};
+use crate::output::{emit, write_file};
 
 #[derive(Args, Debug)]
 pub(crate) struct ViewArgs {
@@ -52,24 +52,10 @@ pub(crate) struct DemoArgs {
     pub(crate) quiet: bool,
 }
 
-/// The polygons of `p`'s tree drawn back to front from `at`.
-fn draw(p: &Prepared, at: SvgViewpoint) -> Result<SvgPicture> {
-    let bounds = p
-        .mesh
-        .bounds()
-        .context("nothing to draw: the mesh has no vertices")?;
-    if p.mesh.faces.is_empty() {
-        anyhow::bail!("nothing to draw: the mesh has no faces");
-    }
-    let view = SvgView::new(&p.grid, bounds, &at).map_err(raster_error)?;
-    let colors = shadow_scene::face_colors(&p.mesh);
-    Ok(view.polygons(&p.tree, &p.grid, &colors))
-}
-
 /// `shadow view`.
 pub(crate) fn view(args: &ViewArgs) -> Result<()> {
     let (mesh, name) = load_source_quiet(&args.source, args.quiet)?;
-    let prepared = Prepared::new(mesh, &name, args.quiet)?;
+    let prepared = prepare(mesh, &name, args.quiet)?;
     let bounds = prepared
         .mesh
         .bounds()
@@ -77,7 +63,7 @@ pub(crate) fn view(args: &ViewArgs) -> Result<()> {
     let staging = args.source.staging(bounds);
     let image = (args.image.size(), args.image.fov);
     let at = args.camera.pick(&prepared.mesh, staging, image, args.quiet);
-    let out = draw(&prepared, at)?;
+    let out = prepared.draw(&at).map_err(facade_error)?;
     write_file(&args.output, out.svg.as_bytes())?;
     emit(&format!(
         "wrote {}: {} polygons of {} ({} faces), eye {}\n",
@@ -92,34 +78,13 @@ pub(crate) fn view(args: &ViewArgs) -> Result<()> {
 /// `shadow stats`.
 pub(crate) fn stats(args: &StatsArgs) -> Result<()> {
     let (mesh, name) = load_source_quiet(&args.source, args.quiet)?;
-    let p = Prepared::new(mesh, &name, args.quiet)?;
-    let t = p.tree.stats();
-    emit(&format!(
-        "input:           {name}\n\
-         faces:           {}; {}\n\
-         bsp polygons:    {} after splitting\n\
-         nodes:           {}\n\
-         depth:           {}\n\
-         cells:           {} in, {} out\n\
-         grid step:       {}\n\
-         import time:     {:.2} ms\n\
-         build time:      {:.2} ms\n",
-        p.mesh.faces.len(),
-        p.report.counts(),
-        t.polygons,
-        t.nodes,
-        t.depth,
-        t.in_cells,
-        t.out_cells,
-        p.grid.step_text(),
-        ms(p.import_time),
-        ms(p.build_time)
-    ))
+    let p = prepare(mesh, &name, args.quiet)?;
+    emit(&p.stats_text(&name))
 }
 
 /// `shadow demo`.
 pub(crate) fn demo(args: &DemoArgs) -> Result<()> {
-    let prepared = Prepared::new(shadow_scene::room(), "scene room", args.quiet)?;
+    let prepared = prepare(shadow_scene::room(), "scene room", args.quiet)?;
     let at = SvgViewpoint {
         eye: ROOM_EYE,
         target: Some(ROOM_TARGET),
@@ -128,7 +93,7 @@ pub(crate) fn demo(args: &DemoArgs) -> Result<()> {
         height: args.image.size().1,
         fov_deg: args.image.fov,
     };
-    let out = draw(&prepared, at)?;
+    let out = prepared.draw(&at).map_err(facade_error)?;
     write_file(&args.output, out.svg.as_bytes())?;
     emit(&format!(
         "wrote {}: the built-in room, {} polygons ({} faces, {} BSP fragments), eye {}\n",

@@ -656,3 +656,141 @@ fn flags_that_do_not_apply_are_noted() {
     let err = render(&["--method", "shadow-map"]);
     assert!(!err.contains("does not use"), "{err}");
 }
+
+/// Runs `shadow shadows` on the floor and occluder with an area light
+/// (0.2 × 0.2 at height 2 over the occluder's centre) and more flags.
+fn soft_json(extra: &[&str], name: &str) -> Value {
+    let input = floor_and_occluder();
+    let mut args = vec![
+        "--area-light",
+        "0.65,0.65,2;0.65,0.85,2;0.85,0.85,2;0.85,0.65,2",
+    ];
+    args.extend(extra);
+    shadows_json(&input, &args, name)
+}
+
+/// The area light's regions in closed form: from height 2 through the
+/// occluder at height 1, the umbra on the floor is `[0.35, 1.15]²`, the
+/// penumbra reaches `[0.15, 1.35]²`; the occluder's top is lit. Every
+/// fragment has one flag per light, penumbra fragments the share of the
+/// light they see, and the areas add up.
+#[test]
+fn an_area_light_gives_umbra_and_penumbra_in_closed_form() {
+    let doc = soft_json(&[], "soft_area.json");
+    assert_eq!(doc["lights"][0]["kind"], "area");
+    let s = &doc["summary"];
+    let first = |key: &str| s[key][0].as_f64().unwrap();
+    let near = |a: f64, b: f64| (a - b).abs() < 1e-6;
+    assert!(near(first("umbra_area"), 0.64), "{s}");
+    assert!(near(first("penumbra_area"), 0.80), "{s}");
+    assert!(near(first("lit_area"), 2.56 + 0.25), "{s}");
+    assert_eq!(first("undecided_area"), 0.0);
+    let mut shares = 0;
+    for f in doc["fragments"].as_array().unwrap() {
+        let (lit, umbra) = (
+            f["lit"][0].as_bool().unwrap(),
+            f["umbra"][0].as_bool().unwrap(),
+        );
+        assert!(!(lit && umbra), "{f}");
+        let visible = &f["visible"][0];
+        if lit || umbra {
+            assert!(visible.is_null(), "{f}");
+            continue;
+        }
+        let (v, lo, hi) = (
+            visible.as_f64().unwrap(),
+            f["visible_min"][0].as_f64().unwrap(),
+            f["visible_max"][0].as_f64().unwrap(),
+        );
+        assert!(
+            (0.0..=1.0).contains(&v) && 0.0 <= lo && lo <= hi && hi <= 1.0,
+            "{f}"
+        );
+        shares += 1;
+    }
+    assert!(shares >= 4, "{shares} penumbra fragments");
+}
+
+/// A point light among soft lights is classified exactly as alone: lit
+/// or umbra, with the lit area the partitioned shadow volumes give; a sun
+/// disc of radius 0 likewise equals the sun. The OBJ has the classes'
+/// groups.
+#[test]
+fn point_lights_and_suns_among_soft_lights_keep_their_shadows() {
+    let input = floor_and_occluder();
+    let hard = shadows_json(
+        &input,
+        &["--light", "0.75,0.75,2", "--sun", "1,2,5"],
+        "hard.json",
+    );
+    let doc = soft_json(
+        &[
+            "--light",
+            "0.75,0.75,2",
+            "--sun-disc",
+            "1,2,5:0",
+            "--sun-disc",
+            "1,2,5",
+        ],
+        "soft_mixed.json",
+    );
+    let kinds: Vec<&str> = doc["lights"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["kind"].as_str().unwrap())
+        .collect();
+    assert_eq!(kinds, ["point", "area", "sun_disc", "sun_disc"]);
+    let (s, h) = (&doc["summary"], &hard["summary"]);
+    for (soft, hard) in [(0, 0), (2, 1)] {
+        let lit = s["lit_area"][soft].as_f64().unwrap();
+        let want = h["lit_area"][hard].as_f64().unwrap();
+        assert!(
+            (lit - want).abs() < 1e-9,
+            "light {soft}: {lit} against {want}"
+        );
+        assert_eq!(s["penumbra_area"][soft].as_f64(), Some(0.0));
+    }
+    // the real sun's disc blurs the occluder's shadow a little
+    let disc = s["penumbra_area"][3].as_f64().unwrap();
+    assert!(disc > 0.0 && disc < 0.05, "{disc}");
+    let out = scratch("soft.obj");
+    let o = shadow(&[
+        "shadows",
+        input.to_str().unwrap(),
+        "--area-light",
+        "0.65,0.65,2;0.65,0.85,2;0.85,0.85,2;0.85,0.65,2",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).unwrap();
+    for g in ["g lit", "g penumbra", "g umbra"] {
+        assert!(text.lines().any(|l| l == g), "no `{g}` in\n{text}");
+    }
+}
+
+/// Lights with extent that are no light, or outputs they cannot go to,
+/// are errors naming the light.
+#[test]
+fn bad_soft_lights_are_errors() {
+    let input = floor_and_occluder();
+    let run = |args: &[&str], out: &str| {
+        let out = scratch(out);
+        let mut argv = vec!["shadows", input.to_str().unwrap()];
+        argv.extend(args);
+        argv.extend(["-o", out.to_str().unwrap()]);
+        shadow(&argv)
+    };
+    let bent = run(&["--area-light", "0,0,3;1,0,3;1,1,3.5;0,1,3"], "bent.json");
+    assert_failed_with(&bent, &["light 0 (area light", "not in one plane"]);
+    let two = run(&["--area-light", "0,0,3;1,0,3"], "two.json");
+    assert_failed_with(&two, &["at least three"]);
+    let wide = run(&["--sun", "0,0,1", "--sun-disc", "0,0,1:45"], "wide.json");
+    assert_failed_with(
+        &wide,
+        &["light 1 (sun disc", "between 0° and 30° (given 45°)"],
+    );
+    let svg = run(&["--area-light", "0,0,3;0,1,3;1,1,3"], "soft.svg");
+    assert_failed_with(&svg, &[".json or .obj"]);
+}

@@ -70,6 +70,22 @@ pub struct LineCheck {
 }
 
 impl HiddenLines {
+    /// One line: the polyhedra, edges and parts drawn, and how many of the
+    /// points checked against a z-buffer agree.
+    pub fn summary(&self) -> String {
+        format!(
+            "{} polyhedra ({} convex), {} edges, {} visible and {} hidden parts; z-buffer \
+             check: {} of {} points agree",
+            self.polyhedra,
+            self.convex,
+            self.edges,
+            self.visible.len(),
+            self.hidden.len(),
+            self.check.agree,
+            self.check.checked
+        )
+    }
+
     /// The drawing as SVG: visible lines black, hidden ones (if `hidden`)
     /// dashed grey.
     pub fn svg(&self, hidden: bool) -> String {

@@ -22,7 +22,9 @@
 //! `f64`.
 
 pub mod frames;
+pub mod prepared;
 pub mod shadow_file;
+pub mod soft_file;
 
 use std::path::Path;
 

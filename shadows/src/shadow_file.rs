@@ -47,6 +47,31 @@ pub enum Algorithm {
     ChinFeiner,
 }
 
+/// The format of a shadows file, by its extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutputFormat {
+    /// `.json`: the fragments.
+    Json,
+    /// `.obj`: the fragments as groups.
+    Obj,
+    /// `.svg`: a view of the shaded scene.
+    Svg,
+}
+
+impl OutputFormat {
+    /// The format of `path` by its extension (any case); `None` for
+    /// another.
+    pub fn from_path(path: &std::path::Path) -> Option<OutputFormat> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "json" => Some(OutputFormat::Json),
+            "obj" => Some(OutputFormat::Obj),
+            "svg" => Some(OutputFormat::Svg),
+            _ => None,
+        }
+    }
+}
+
 /// What the file holds.
 #[derive(Clone, Copy, Debug)]
 pub enum FileKind<'a> {

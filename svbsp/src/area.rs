@@ -36,10 +36,10 @@
 //! together hide the light, which this first version does not resolve.
 
 use bsp_core::internals::GridPolygon;
-use bsp_core::{FaceDefect, GridPoint, MAX_COORD, Plane, Polygon, PolygonSide, Side, Split};
+use bsp_core::{GridPoint, MAX_COORD, Plane, Polygon, PolygonSide, Side, Split};
 use glam::DVec3;
 
-use crate::light::{Light, LightError, quantize_direction};
+use crate::light::{AreaLightError, Light, MAX_DISC_RADIUS, quantize_direction};
 
 /// A light with extent, or its limit, as a convex set of light points
 /// given by its corners ([`Light`]s, all of one kind):
@@ -62,80 +62,10 @@ pub struct AreaLight {
 /// polygon's area is `8 tan(π/8) / π ≈ 1.055` times the disc's.
 pub const DISC_SIDES: usize = 8;
 
-/// The largest angular radius of a sun disc, in radians (30°: the real
-/// sun's is 0.2666°).
-pub const MAX_DISC_RADIUS: f64 = std::f64::consts::FRAC_PI_6;
-
 /// `det[a; b; c]`, exact for components below `2^40`.
 fn det3(a: [i128; 3], b: [i128; 3], c: [i128; 3]) -> i128 {
     a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
         + a[2] * (b[0] * c[1] - b[1] * c[0])
-}
-
-/// Why corners make no area light (or occluder).
-#[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum AreaLightError {
-    /// Fewer than three corners.
-    TooFewCorners(usize),
-    /// An area light of more than 64 corners.
-    TooManyCorners(usize),
-    /// The corners are not a planar, strictly convex polygon with area
-    /// (collinear, not planar, not convex, turning twice, or out of the
-    /// grid); the cause as the kernel found it.
-    Shape(FaceDefect),
-    /// A point or direction outside the grid, or a zero direction.
-    Corner(LightError),
-    /// A sun disc's direction is zero or not finite, or its angular
-    /// radius (radians) is not in `[0, MAX_DISC_RADIUS]`.
-    Disc {
-        /// The direction given.
-        direction: DVec3,
-        /// The angular radius given, in radians.
-        radius: f64,
-    },
-}
-
-impl std::fmt::Display for AreaLightError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            AreaLightError::TooFewCorners(n) => {
-                write!(
-                    f,
-                    "a polygon of {n} corners: it takes at least three corners"
-                )
-            }
-            AreaLightError::TooManyCorners(n) => {
-                write!(f, "an area light of {n} corners: at most 64 are supported")
-            }
-            AreaLightError::Shape(d) => {
-                write!(f, "not a planar convex polygon with area: {d}")
-            }
-            AreaLightError::Corner(e) => write!(f, "{e}"),
-            AreaLightError::Disc { direction, radius } => write!(
-                f,
-                "a sun disc toward {},{},{} of angular radius {}°: the direction must be \
-                 non-zero and the radius between 0° and {}°",
-                direction.x,
-                direction.y,
-                direction.z,
-                radius.to_degrees(),
-                MAX_DISC_RADIUS.to_degrees()
-            ),
-        }
-    }
-}
-
-impl std::error::Error for AreaLightError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            AreaLightError::Shape(d) => Some(d),
-            AreaLightError::Corner(e) => Some(e),
-            AreaLightError::TooFewCorners(_)
-            | AreaLightError::TooManyCorners(_)
-            | AreaLightError::Disc { .. } => None,
-        }
-    }
 }
 
 /// A face of the scene as area lights meet it, as an occluder or a
@@ -253,7 +183,7 @@ impl AreaLight {
     }
 
     fn one(light: Light) -> Result<AreaLight, AreaLightError> {
-        light.validate().map_err(AreaLightError::Corner)?;
+        light.validate().map_err(|_| AreaLightError::Corner)?;
         Ok(AreaLight {
             corners: vec![light],
             polygon: None,

@@ -19,7 +19,10 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::{Areas, Batch, CHUNK, Light, PlacedLight, ShadeOptions, ShadowSet, polygon_area};
+use crate::{
+    AreaClass, Areas, Batch, CHUNK, Light, PlacedLight, ShadeOptions, ShadowSet, SoftFragment,
+    SoftLight, SoftShape, polygon_area,
+};
 
 /// Why a batch cannot be written.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -105,10 +108,21 @@ pub fn area_records(b: &Batch, world: &[DVec3]) -> Vec<AreaRecord> {
 }
 
 #[derive(Serialize)]
-#[serde(tag = "kind", rename_all = "lowercase")]
+#[serde(tag = "kind", rename_all = "snake_case")]
 enum JsonLight {
-    Point { position: [f64; 3] },
-    Directional { direction: [f64; 3] },
+    Point {
+        position: [f64; 3],
+    },
+    Directional {
+        direction: [f64; 3],
+    },
+    Area {
+        corners: Vec<[f64; 3]>,
+    },
+    SunDisc {
+        direction: [f64; 3],
+        radius_deg: f64,
+    },
 }
 
 #[derive(Serialize)]
@@ -308,21 +322,26 @@ impl ObjWriter {
                 for &v in piece {
                     ids.push(self.vertex(&mut text, world[v as usize]));
                 }
-                let mut sorted = ids.clone();
-                sorted.sort_unstable();
-                if sorted.windows(2).any(|w| w[0] == w[1]) {
-                    self.degenerate += 1;
-                }
-                text.push(b'f');
-                for id in &ids {
-                    text.push(b' ');
-                    text.extend_from_slice(itoa::Buffer::new().format(*id).as_bytes());
-                }
-                text.push(b'\n');
-                self.faces += 1;
+                self.face(&mut text, &ids);
             }
         }
         out.write_all(&text)
+    }
+
+    /// An `f` line of the positions `ids` (1-based) into `text`.
+    fn face(&mut self, text: &mut Vec<u8>, ids: &[u32]) {
+        let mut sorted = ids.to_vec();
+        sorted.sort_unstable();
+        if sorted.windows(2).any(|w| w[0] == w[1]) {
+            self.degenerate += 1;
+        }
+        text.push(b'f');
+        for id in ids {
+            text.push(b' ');
+            text.extend_from_slice(itoa::Buffer::new().format(*id).as_bytes());
+        }
+        text.push(b'\n');
+        self.faces += 1;
     }
 
     /// The 1-based index of position `p`, written as a `v` line into
@@ -755,4 +774,282 @@ mod tests {
             );
         }
     }
+}
+
+// ------------------------------------------------------- soft shadows
+
+/// A soft-shadow run's areas, per light (input units).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SoftAreas {
+    /// Every fragment's area (each face once).
+    #[serde(rename = "area")]
+    pub total: f64,
+    /// Per light: seeing all of it.
+    #[serde(rename = "lit_area")]
+    pub lit: Vec<f64>,
+    /// Per light: seeing part of it (the undecided area included).
+    #[serde(rename = "penumbra_area")]
+    pub penumbra: Vec<f64>,
+    /// Per light: seeing none of it.
+    #[serde(rename = "umbra_area")]
+    pub umbra: Vec<f64>,
+    /// Per light: penumbra or umbra, not decided (where an umbra boundary
+    /// may be a quadric surface of three occluders' edges).
+    #[serde(rename = "undecided_area")]
+    pub undecided: Vec<f64>,
+}
+
+impl SoftAreas {
+    fn new(lights: usize) -> SoftAreas {
+        SoftAreas {
+            total: 0.0,
+            lit: vec![0.0; lights],
+            penumbra: vec![0.0; lights],
+            umbra: vec![0.0; lights],
+            undecided: vec![0.0; lights],
+        }
+    }
+
+    fn add(&mut self, f: &SoftFragment, area: f64) {
+        self.total += area;
+        for i in 0..self.lit.len() {
+            match f.class(i) {
+                AreaClass::Lit => self.lit[i] += area,
+                AreaClass::Umbra => self.umbra[i] += area,
+                AreaClass::Penumbra => self.penumbra[i] += area,
+                AreaClass::Undecided => {
+                    self.penumbra[i] += area;
+                    self.undecided[i] += area;
+                }
+            }
+        }
+    }
+}
+
+/// What [`write_soft`] wrote.
+#[derive(Clone, Debug)]
+pub struct SoftWritten {
+    /// The areas, per light.
+    pub areas: SoftAreas,
+    /// Fragments written.
+    pub fragments: usize,
+    /// Positions of an OBJ file.
+    pub vertices: Option<usize>,
+    /// OBJ pieces degenerate once rounded (see [`ObjWriter::degenerate`]).
+    pub degenerate: usize,
+}
+
+fn json_light(l: &SoftLight) -> JsonLight {
+    match &l.shape {
+        SoftShape::Point(p) => JsonLight::Point {
+            position: p.to_array(),
+        },
+        SoftShape::Sun(d) => JsonLight::Directional {
+            direction: d.to_array(),
+        },
+        SoftShape::Area(c) => JsonLight::Area {
+            corners: c.iter().map(|p| p.to_array()).collect(),
+        },
+        SoftShape::SunDisc {
+            direction,
+            radius_deg,
+        } => JsonLight::SunDisc {
+            direction: direction.to_array(),
+            radius_deg: *radius_deg,
+        },
+    }
+}
+
+/// The OBJ groups of a soft fragment: `lit` where some light is wholly
+/// seen, `penumbra` where some is partly seen, `umbra` where none is
+/// seen at all; with several lights also `lit_I_J...` and
+/// `penumbra_I_J...` naming the lights.
+fn soft_group(f: &SoftFragment, lights: usize) -> String {
+    let of = |want: &dyn Fn(AreaClass) -> bool| -> Vec<String> {
+        (0..lights)
+            .filter(|&i| want(f.class(i)))
+            .map(|i| i.to_string())
+            .collect()
+    };
+    let lit = of(&|c| c == AreaClass::Lit);
+    let part = of(&|c| matches!(c, AreaClass::Penumbra | AreaClass::Undecided));
+    let mut names = Vec::new();
+    for (name, on) in [("lit", &lit), ("penumbra", &part)] {
+        if !on.is_empty() {
+            names.push(name.to_string());
+            if lights > 1 {
+                names.push(format!("{name}_{}", on.join("_")));
+            }
+        }
+    }
+    if names.is_empty() {
+        names.push("umbra".to_string());
+    }
+    names.join(" ")
+}
+
+/// The bits of a fragment's classes, for telling groups apart.
+fn soft_key(f: &SoftFragment) -> u64 {
+    f.lit.wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        ^ f.umbra.rotate_left(21)
+        ^ f.undecided.rotate_left(42)
+}
+
+/// Writes a soft-shadow run's fragments (`fragments[k]`: those of
+/// polygon `k`, which belongs to face `faces_of[k]`) as JSON (the schema
+/// of `docs/shadows.md`, with per light `umbra` flags and the `visible`
+/// share of penumbra fragments) or OBJ (groups by class, see
+/// [`FragmentFormat`]). Vertices are rounded once to `f64` grid units and
+/// mapped to input units by `grid`.
+pub fn write_soft(
+    out: &mut impl Write,
+    format: FragmentFormat,
+    lights: &[SoftLight],
+    (name, notes, faces): (&str, &[String], usize),
+    (fragments, faces_of): (&[Vec<SoftFragment>], &[u32]),
+    grid: &Grid,
+) -> io::Result<SoftWritten> {
+    let n = lights.len();
+    let mut areas = SoftAreas::new(n);
+    let mut obj = ObjWriter::new();
+    let mut group = None;
+    let mut count = 0;
+    match format {
+        FragmentFormat::Json => {
+            let lights: Vec<JsonLight> = lights.iter().map(json_light).collect();
+            write!(out, "{{\"lights\":")?;
+            serde_json::to_writer(&mut *out, &lights)?;
+            write!(out, ",\"faces\":{faces},\"fragments\":[")?;
+        }
+        FragmentFormat::Obj => {
+            writeln!(
+                out,
+                "# shadow shadows: the fragments of {faces} faces of {name}"
+            )?;
+            for (i, l) in notes.iter().enumerate() {
+                writeln!(out, "# light {i}: {l}")?;
+            }
+            writeln!(
+                out,
+                "# groups: lit (sees all of a light), penumbra (part of one), umbra (none of any){}",
+                if n > 1 {
+                    "; lit_I_J..., penumbra_I_J... name the lights"
+                } else {
+                    ""
+                }
+            )?;
+            writeln!(
+                out,
+                "# each fragment convex, faces in input order, vertices welded"
+            )?;
+        }
+    }
+    let mut text = Vec::new();
+    let mut ids = Vec::new();
+    for (k, frags) in fragments.iter().enumerate() {
+        for f in frags {
+            let world: Vec<DVec3> = f
+                .polygon
+                .vertices_f64()
+                .iter()
+                .map(|&c| grid.to_world(c))
+                .collect();
+            if world.iter().any(|v| !v.is_finite()) {
+                return Err(io::Error::other(ExportError::NonFiniteVertex {
+                    face: faces_of[k],
+                    step: grid.step(),
+                }));
+            }
+            let area = polygon_area(&world);
+            areas.add(f, area);
+            text.clear();
+            match format {
+                FragmentFormat::Json => {
+                    soft_json(&mut text, f, faces_of[k], &world, area, n, count == 0);
+                }
+                FragmentFormat::Obj => {
+                    if group != Some(soft_key(f)) {
+                        group = Some(soft_key(f));
+                        writeln!(text, "g {}", soft_group(f, n))?;
+                    }
+                    ids.clear();
+                    for &p in &world {
+                        ids.push(obj.vertex(&mut text, p));
+                    }
+                    obj.face(&mut text, &ids);
+                }
+            }
+            out.write_all(&text)?;
+            count += 1;
+        }
+    }
+    if format == FragmentFormat::Json {
+        write!(out, "\n],\"summary\":")?;
+        serde_json::to_writer(&mut *out, &areas)?;
+        writeln!(out, "}}")?;
+    }
+    Ok(SoftWritten {
+        areas,
+        fragments: count,
+        vertices: (format == FragmentFormat::Obj).then(|| obj.vertex_count()),
+        degenerate: obj.degenerate(),
+    })
+}
+
+/// One soft fragment as a JSON object, preceded by `,\n` unless `first`.
+fn soft_json(
+    s: &mut Vec<u8>,
+    f: &SoftFragment,
+    face: u32,
+    world: &[DVec3],
+    area: f64,
+    lights: usize,
+    first: bool,
+) {
+    s.extend_from_slice(if first { b"\n" } else { b",\n" });
+    s.extend_from_slice(b"{\"face\":");
+    s.extend_from_slice(itoa::Buffer::new().format(face).as_bytes());
+    s.extend_from_slice(b",\"vertices\":[");
+    for (i, &p) in world.iter().enumerate() {
+        if i > 0 {
+            s.push(b',');
+        }
+        push_point(s, p);
+    }
+    s.push(b']');
+    let flags = |s: &mut Vec<u8>, key: &[u8], mask: u64| {
+        s.extend_from_slice(key);
+        for j in 0..lights {
+            if j > 0 {
+                s.push(b',');
+            }
+            s.extend_from_slice(if mask >> j & 1 == 1 {
+                b"true"
+            } else {
+                b"false"
+            });
+        }
+        s.push(b']');
+    };
+    flags(s, b",\"lit\":[", f.lit);
+    flags(s, b",\"umbra\":[", f.umbra);
+    let shares = |s: &mut Vec<u8>, key: &[u8], pick: fn(&crate::Share) -> f64| {
+        s.extend_from_slice(key);
+        for (j, v) in f.visible.iter().enumerate() {
+            if j > 0 {
+                s.push(b',');
+            }
+            match v {
+                Some(v) => push_f64(s, pick(v)),
+                None => s.extend_from_slice(b"null"),
+            }
+        }
+        s.push(b']');
+    };
+    shares(s, b",\"visible\":[", |v| v.centroid);
+    shares(s, b",\"visible_min\":[", |v| v.min);
+    shares(s, b",\"visible_max\":[", |v| v.max);
+    s.extend_from_slice(b",\"area\":");
+    push_f64(s, area);
+    s.push(b'}');
 }

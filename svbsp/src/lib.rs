@@ -52,8 +52,7 @@ mod soft;
 mod wide;
 
 pub use area::{
-    AreaClass, AreaFragment, AreaLight, AreaLightError, DISC_SIDES, LightView, MAX_DISC_RADIUS,
-    Occluder, Visibility, form_factor,
+    AreaClass, AreaFragment, AreaLight, DISC_SIDES, LightView, Occluder, Visibility, form_factor,
 };
 pub use areas::{Areas, fragment_area, percent, polygon_area};
 pub use arena::pieces::Vertex;
@@ -63,11 +62,14 @@ pub use engine::{
     ShadowStats, Shadows, Start, receivers, shadow_fragments,
 };
 pub use light::{
-    LIGHT_RANGE_BITS, Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, angle_between,
-    place_lights, quantize_direction, shared_grid,
+    AreaLightError, LIGHT_RANGE_BITS, Light, LightError, LightSpec, MAX_DISC_RADIUS, MAX_LIGHTS,
+    PlacedLight, SUN_RADIUS_DEG, SoftSpec, angle_between, place_lights, quantize_direction,
+    shared_grid,
 };
 pub use psv::{ShadowVolumes, VolumeError, VolumeSanity};
-pub use soft::{Share, SoftFragment, soft_shadows};
+pub use soft::{
+    Share, SoftFragment, SoftLight, SoftShape, place_soft_lights, shared_soft_grid, soft_shadows,
+};
 pub use wide::{WPoint, WidePlane};
 
 /// The README's example, compiled and run as a doctest.

@@ -1,7 +1,7 @@
 //! Lights on the scene's grid: exact point lights and suns, and how lights
 //! given in input units are placed on the grid.
 
-use bsp_core::{Grid, GridPoint, MAX_COORD, Plane, Side};
+use bsp_core::{FaceDefect, Grid, GridPoint, MAX_COORD, Plane, Side};
 use glam::DVec3;
 
 /// A light source, on the scene's grid.
@@ -47,6 +47,14 @@ pub enum LightError {
     },
     /// No grid fits the scene and its lights.
     Grid(bsp_core::Error),
+    /// Placing lights given in input units: light `index`, an area light
+    /// or a sun disc, is no light once on the grid.
+    Extent {
+        /// The light's number.
+        index: usize,
+        /// Why.
+        cause: AreaLightError,
+    },
 }
 
 impl std::fmt::Display for LightError {
@@ -68,6 +76,7 @@ impl std::fmt::Display for LightError {
             ),
             LightError::ZeroSun { index } => write!(f, "light {index}: the sun direction is zero"),
             LightError::Grid(e) => write!(f, "cannot fit a grid to the scene and its lights: {e}"),
+            LightError::Extent { index, cause } => write!(f, "light {index}: {cause}"),
         }
     }
 }
@@ -76,6 +85,7 @@ impl std::error::Error for LightError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             LightError::Grid(e) => Some(e),
+            LightError::Extent { cause, .. } => Some(cause),
             _ => None,
         }
     }
@@ -270,6 +280,107 @@ pub fn place_lights(grid: &Grid, lights: &[LightSpec]) -> Result<Vec<PlacedLight
             }
         })
         .collect()
+}
+
+/// The largest angular radius of a sun disc, in radians (30°: the real
+/// sun's is 0.2666°).
+pub const MAX_DISC_RADIUS: f64 = std::f64::consts::FRAC_PI_6;
+
+/// Why corners make no area light (or occluder).
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum AreaLightError {
+    /// Fewer than three corners.
+    TooFewCorners(usize),
+    /// An area light of more than 64 corners.
+    TooManyCorners(usize),
+    /// The corners are not a planar, strictly convex polygon with area
+    /// (collinear, not planar, not convex, turning twice, or out of the
+    /// grid); the cause as the kernel found it.
+    Shape(FaceDefect),
+    /// A point or direction outside the grid, or a zero direction.
+    Corner,
+    /// A sun disc's direction is zero or not finite, or its angular
+    /// radius (radians) is not in `[0, MAX_DISC_RADIUS]`.
+    Disc {
+        /// The direction given.
+        direction: DVec3,
+        /// The angular radius given, in radians.
+        radius: f64,
+    },
+}
+
+impl std::fmt::Display for AreaLightError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AreaLightError::TooFewCorners(n) => {
+                write!(
+                    f,
+                    "a polygon of {n} corners: it takes at least three corners"
+                )
+            }
+            AreaLightError::TooManyCorners(n) => {
+                write!(f, "an area light of {n} corners: at most 64 are supported")
+            }
+            AreaLightError::Shape(d) => {
+                write!(f, "not a planar convex polygon with area: {d}")
+            }
+            AreaLightError::Corner => {
+                f.write_str("a point or direction outside the grid, or a zero direction")
+            }
+            AreaLightError::Disc { direction, radius } => write!(
+                f,
+                "a sun disc needs a non-zero direction (given {},{},{}) and an angular radius \
+                 between 0° and {}° (given {}°)",
+                direction.x,
+                direction.y,
+                direction.z,
+                (MAX_DISC_RADIUS.to_degrees() * 1e6).round() / 1e6,
+                radius.to_degrees()
+            ),
+        }
+    }
+}
+
+impl std::error::Error for AreaLightError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            AreaLightError::Shape(d) => Some(d),
+            AreaLightError::TooFewCorners(_)
+            | AreaLightError::TooManyCorners(_)
+            | AreaLightError::Corner
+            | AreaLightError::Disc { .. } => None,
+        }
+    }
+}
+
+/// A light with extent as given in input units.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SoftSpec {
+    /// A planar convex polygon, its corners in order; it emits on the
+    /// side they turn counter-clockwise about.
+    Area(Vec<DVec3>),
+    /// The sun as a disc of the sky: the direction from the scene toward
+    /// its centre and its angular radius in degrees.
+    SunDisc {
+        /// Toward the centre.
+        direction: DVec3,
+        /// The angular radius, degrees.
+        radius_deg: f64,
+    },
+}
+
+/// The real sun's mean angular radius, in degrees.
+pub const SUN_RADIUS_DEG: f64 = 0.2666;
+
+impl SoftSpec {
+    /// The points that must lie on the grid (an area light's corners).
+    pub fn points(&self) -> &[DVec3] {
+        match self {
+            SoftSpec::Area(c) => c,
+            SoftSpec::SunDisc { .. } => &[],
+        }
+    }
 }
 
 /// The integer direction of `d`: scaled so that its largest component is

@@ -10,11 +10,12 @@
 //! convex. Points and suns take part as the limits of area lights
 //! ([`AreaLight::point`], [`AreaLight::sun`]): lit or umbra.
 
-use bsp_core::{GridPoint, Polygon};
+use bsp_core::{Grid, GridPoint, MAX_COORD, Polygon};
 use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::area::{AreaClass, AreaLight, Occluder, Regions, grid_box, may_reach, merge_convex};
+use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
 
 /// The share of a polygon light's irradiance that arrives on a penumbra
 /// fragment ([`crate::LightView::fraction`]): at the grid point nearest its
@@ -41,8 +42,8 @@ pub struct SoftFragment {
     pub umbra: u64,
     /// Bit `i`: light `i`'s class is [`AreaClass::Undecided`].
     pub undecided: u64,
-    /// Per light, for a penumbra fragment of a polygon light, the share
-    /// of its irradiance that arrives; `None` otherwise.
+    /// Per light, for a penumbra (or undecided) fragment of a polygon
+    /// light, the share of its irradiance that arrives; `None` otherwise.
     pub visible: Vec<Option<Share>>,
 }
 
@@ -157,8 +158,10 @@ fn soft_face(
         .map(|(polygon, c)| {
             let visible = (0..lights.len())
                 .map(|k| {
-                    let penumbra = (c.lit | c.umbra | c.undecided) >> k & 1 == 0;
-                    let among = near[k].iter().map(|&j| &faces[j]);
+                    let penumbra = (c.lit | c.umbra) >> k & 1 == 0;
+                    let among = near[k]
+                        .iter()
+                        .filter_map(|&j| Some((&faces[j], regions[k][j].as_ref()?)));
                     penumbra
                         .then(|| share(&lights[k], face, &polygon, among))
                         .flatten()
@@ -186,14 +189,18 @@ fn share<'o>(
     light: &AreaLight,
     face: &Occluder,
     piece: &Polygon,
-    occluders: impl Iterator<Item = &'o Occluder> + Clone,
+    occluders: impl Iterator<Item = (&'o Occluder, &'o Regions)> + Clone,
 ) -> Option<Share> {
     light.plane()?;
     let n = face.plane().normal().map(|c| c as f64);
     let normal = DVec3::from_array(n).normalize();
     let at = |p: [f64; 3]| -> Option<f64> {
         let x = nearest(p);
-        let view = light.view_among(x, Some(face.plane()), occluders.clone())?;
+        // an occluder hides some of the light from x only if x lies
+        // strictly inside its penumbra volume
+        let inside = |r: &Regions| r.penumbra.iter().all(|(h, s)| h.classify_grid(x) == *s);
+        let hiding = occluders.clone().filter(|(_, r)| inside(r)).map(|(o, _)| o);
+        let view = light.view_among(x, Some(face.plane()), hiding)?;
         view.fraction(DVec3::from_array(x.map(f64::from)), normal)
     };
     let corners = piece.vertices_f64();
@@ -212,4 +219,144 @@ fn share<'o>(
         min,
         max,
     })
+}
+
+/// A light of a soft-shadow run ([`crate::soft_shadows`]): any light as an
+/// [`AreaLight`] on the grid, and what the outputs say of it.
+#[derive(Clone, Debug)]
+pub struct SoftLight {
+    /// The exact light.
+    pub light: AreaLight,
+    /// What it is, in input units.
+    pub shape: SoftShape,
+}
+
+/// A [`SoftLight`] in input units, as the outputs name it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SoftShape {
+    /// A point light, at its snapped position.
+    Point(DVec3),
+    /// A sun, its quantized direction normalized.
+    Sun(DVec3),
+    /// An area light, its snapped corners.
+    Area(Vec<DVec3>),
+    /// A sun disc as given (its bounding polygon is
+    /// [`AreaLight::sun_disc`]'s).
+    SunDisc {
+        /// Toward the centre, normalized.
+        direction: DVec3,
+        /// The angular radius, degrees.
+        radius_deg: f64,
+    },
+}
+
+/// The grid of a soft-shadow run: [`crate::shared_grid`] with the corners
+/// of the area lights among `soft` counted as point lights.
+pub fn shared_soft_grid(
+    positions: &[DVec3],
+    lights: &[LightSpec],
+    soft: &[SoftSpec],
+) -> Result<Grid, LightError> {
+    let mut all = lights.to_vec();
+    all.extend(
+        soft.iter()
+            .flat_map(SoftSpec::points)
+            .map(|&c| LightSpec::Point(c)),
+    );
+    crate::light::shared_grid(positions, &all)
+}
+
+/// Every light of a soft-shadow run on `grid`, numbered in order: the
+/// placed point lights and suns (`placed`, from [`place_lights`]), then
+/// `specs`. Errors name the light by its number.
+pub fn place_soft_lights(
+    grid: &Grid,
+    placed: &[PlacedLight],
+    specs: &[SoftSpec],
+) -> Result<Vec<SoftLight>, LightError> {
+    let total = placed.len() + specs.len();
+    if total > MAX_LIGHTS {
+        return Err(LightError::TooMany(total));
+    }
+    let mut out = Vec::with_capacity(total);
+    for p in placed {
+        let (light, shape) = match p.light {
+            Light::Point(at) => (AreaLight::point(at), SoftShape::Point(p.world)),
+            Light::Directional(d) => (AreaLight::sun(d), SoftShape::Sun(p.world)),
+        };
+        let index = out.len();
+        let light = light.map_err(|cause| LightError::Extent { index, cause })?;
+        out.push(SoftLight { light, shape });
+    }
+    for spec in specs {
+        let index = out.len();
+        let extent = |cause| LightError::Extent { index, cause };
+        let (light, shape) = match spec {
+            SoftSpec::Area(corners) => {
+                let far = |_| LightError::FarPoint {
+                    index,
+                    reach: MAX_COORD as f64 / grid.scale(),
+                    centre: grid.origin(),
+                };
+                let g: Vec<GridPoint> = corners
+                    .iter()
+                    .map(|&c| grid.snap(c).map_err(far))
+                    .collect::<Result<_, _>>()?;
+                let world = g.iter().map(|c| grid.to_world(c.map(f64::from))).collect();
+                (AreaLight::new(&g).map_err(extent)?, SoftShape::Area(world))
+            }
+            &SoftSpec::SunDisc {
+                direction,
+                radius_deg,
+            } => {
+                let light = AreaLight::sun_disc(direction, radius_deg.to_radians());
+                let direction = direction.normalize_or_zero();
+                let shape = SoftShape::SunDisc {
+                    direction,
+                    radius_deg,
+                };
+                (light.map_err(extent)?, shape)
+            }
+        };
+        out.push(SoftLight { light, shape });
+    }
+    Ok(out)
+}
+
+impl std::fmt::Display for SoftShape {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let v = |p: &DVec3| format!("{},{},{}", p.x, p.y, p.z);
+        match self {
+            SoftShape::Point(p) => write!(f, "point light at {}", v(p)),
+            SoftShape::Sun(d) => write!(f, "sun toward {}", v(d)),
+            SoftShape::Area(c) => {
+                let c: Vec<String> = c.iter().map(v).collect();
+                write!(f, "area light {}", c.join(";"))
+            }
+            SoftShape::SunDisc {
+                direction,
+                radius_deg,
+            } => write!(
+                f,
+                "sun disc toward {}, radius {radius_deg} degrees",
+                v(direction)
+            ),
+        }
+    }
+}
+
+impl std::fmt::Display for SoftSpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SoftSpec::Area(c) => SoftShape::Area(c.clone()).fmt(f),
+            &SoftSpec::SunDisc {
+                direction,
+                radius_deg,
+            } => SoftShape::SunDisc {
+                direction,
+                radius_deg,
+            }
+            .fmt(f),
+        }
+    }
 }

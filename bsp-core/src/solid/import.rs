@@ -52,6 +52,27 @@ impl ImportReport {
         s
     }
 
+    /// The summary of operand `name` ([`ImportReport::summary`], each line
+    /// prefixed with the name) and, where faces were dropped, a warning
+    /// that the solid may no longer be closed (`grid`: the grid they were
+    /// snapped to). Empty when every face was kept whole.
+    pub fn notes(&self, name: &str, grid: &Grid) -> String {
+        let mut s = String::new();
+        let summary = self.summary();
+        if !summary.is_empty() {
+            s += &format!("{name}: {summary}");
+        }
+        if !self.dropped.is_empty() {
+            s += &format!(
+                "warning: {name}: {} face(s) have no area on the grid (step 2^{}) and were \
+                 dropped; the solid may not be closed\n",
+                self.dropped.len(),
+                grid.step_log2()
+            );
+        }
+        s
+    }
+
     /// `N polygons after import (T faces triangulated, D dropped)`.
     pub fn counts(&self) -> String {
         format!(

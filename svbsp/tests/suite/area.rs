@@ -535,7 +535,7 @@ fn bad_sun_discs_are_errors() {
     let e = AreaLight::sun_disc(glam::DVec3::ZERO, 0.01).unwrap_err();
     assert!(e.to_string().contains("non-zero"), "{e}");
     let e = AreaLight::sun_disc(glam::DVec3::Z, 1.0).unwrap_err();
-    assert!(e.to_string().contains("57.29"), "{e}");
+    assert!(e.to_string().contains("(given 57.29"), "{e}");
     assert!(AreaLight::sun_disc(glam::DVec3::Z, f64::NAN).is_err());
     assert!(AreaLight::point([1 << 27, 0, 0]).is_err());
 }
@@ -583,7 +583,8 @@ fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
                 checked += 1;
             }
             kinds.insert((k, f.class(k)));
-            assert_eq!(f.visible[k].is_some(), k == 0 && f.class(0) == AreaClass::Penumbra);
+            let soft = matches!(f.class(0), AreaClass::Penumbra | AreaClass::Undecided);
+            assert_eq!(f.visible[k].is_some(), k == 0 && soft);
         }
     }
     assert!(checked > 3000, "{checked}");
