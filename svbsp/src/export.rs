@@ -229,6 +229,14 @@ pub fn json_fragments(
             }
             s.extend_from_slice(if f.lit(j) { b"true" } else { b"false" });
         }
+        // a point light or a sun has no penumbra: umbra where not lit
+        s.extend_from_slice(b"],\"umbra\":[");
+        for j in 0..lights {
+            if j > 0 {
+                s.push(b',');
+            }
+            s.extend_from_slice(if f.lit(j) { b"false" } else { b"true" });
+        }
         s.extend_from_slice(b"],\"area\":");
         push_f64(&mut s, rec.area);
         s.push(b'}');
