@@ -588,6 +588,10 @@ pub(crate) type HalfSpaces = Vec<(Plane, Side)>;
 pub(crate) struct Regions {
     pub(crate) penumbra: HalfSpaces,
     pub(crate) from_corner: Vec<Option<HalfSpaces>>,
+    /// Its umbra: the points inside its shadow volume from every corner
+    /// (`None` where that is empty: a corner in its plane, or corners on
+    /// both sides of it).
+    pub(crate) umbra: Option<HalfSpaces>,
     /// A box holding the penumbra volume, per axis `[lo, hi]` (unbounded
     /// as `i64::MIN` or `i64::MAX`): every point of it is `o + t(o − l)`
     /// for an occluder point `o`, a light point `l` and `t ≥ 0`, so along
@@ -639,42 +643,8 @@ impl AreaLight {
         self.classify_with(face, regions.iter().map(|(_, r)| r))
     }
 
-    /// Every face of `faces` cut into fragments of one class each, with
-    /// all the others as occluders: [`AreaLight::classify_face`] for each,
-    /// each occluder's volumes built once, the faces in parallel (the
-    /// result is in face order, the same for every thread count).
-    ///
-    /// ```
-    /// use svbsp::{AreaClass, AreaLight, Occluder};
-    /// let light = AreaLight::new(&[[0, 0, 80], [0, 40, 80], [40, 40, 80], [40, 0, 80]]).unwrap();
-    /// let faces = [
-    ///     Occluder::new(&[[-200, -200, 0], [200, -200, 0], [200, 200, 0], [-200, 200, 0]]).unwrap(),
-    ///     Occluder::new(&[[0, 0, 40], [40, 0, 40], [40, 40, 40], [0, 40, 40]]).unwrap(),
-    /// ];
-    /// let all = light.classify_faces(&faces);
-    /// assert!(all[1].iter().all(|f| f.class == AreaClass::Lit)); // the roof
-    /// ```
-    pub fn classify_faces(&self, faces: &[Occluder]) -> Vec<Vec<AreaFragment>> {
-        use rayon::prelude::*;
-        let regions: Vec<Option<Regions>> = faces.par_iter().map(|o| self.regions(o)).collect();
-        faces
-            .par_iter()
-            .enumerate()
-            .map(|(i, face)| {
-                let bx = grid_box(face.corners());
-                let others = regions
-                    .iter()
-                    .enumerate()
-                    .filter(|&(j, _)| j != i)
-                    .filter_map(|(_, r)| r.as_ref())
-                    .filter(|r| may_reach(&bx, &r.reach));
-                self.classify_with(face, others)
-            })
-            .collect()
-    }
-
     /// [`AreaLight::classify_face`] with the occluders' regions given.
-    fn classify_with<'r>(
+    pub(crate) fn classify_with<'r>(
         &self,
         face: &Occluder,
         occluders: impl Iterator<Item = &'r Regions>,
@@ -690,7 +660,7 @@ impl AreaLight {
     /// Convex `pieces` of `face`, each with a label, cut where this
     /// light's class changes (see the module docs); each part keeps its
     /// piece's label. Not merged.
-    pub(crate) fn cut<'r, K: Copy>(
+    pub(crate) fn cut<'r, K: Copy + PartialEq>(
         &self,
         face: &Occluder,
         pieces: Vec<(Polygon, K)>,
@@ -760,11 +730,45 @@ impl AreaLight {
                 umbra: false,
             })
             .collect();
+        let mut merged = 0;
         for r in &regions {
             let mut next = Vec::with_capacity(pieces.len());
             for piece in pieces {
                 if piece.umbra {
                     next.push(piece);
+                    continue;
+                }
+                if piece.not_lit && r.from_corner.iter().all(Option::is_some) {
+                    // not lit already: only this occluder's umbra and the
+                    // corners not hidden yet can change its class
+                    let mut parts = Vec::new();
+                    let umbra = match &r.umbra {
+                        Some(u) => subtract(u, piece.polygon, &mut parts),
+                        None => {
+                            parts.push(piece.polygon);
+                            None
+                        }
+                    };
+                    next.extend(umbra.map(|polygon| Piece {
+                        polygon,
+                        hidden: all,
+                        umbra: true,
+                        ..piece
+                    }));
+                    let mut parts: Vec<(Polygon, u64)> =
+                        parts.into_iter().map(|p| (p, 0)).collect();
+                    for (i, hs) in r.from_corner.iter().enumerate() {
+                        if piece.hidden >> i & 1 == 1 {
+                            continue;
+                        }
+                        let Some(hs) = hs else { continue };
+                        parts = hide_corner(hs, i, parts);
+                    }
+                    next.extend(parts.into_iter().map(|(polygon, m)| Piece {
+                        polygon,
+                        hidden: piece.hidden | m,
+                        ..piece
+                    }));
                     continue;
                 }
                 let mut outside = Vec::new();
@@ -786,14 +790,7 @@ impl AreaLight {
                         parts.iter_mut().for_each(|(_, m)| *m |= 1 << i);
                         continue;
                     };
-                    let mut cut = Vec::with_capacity(parts.len());
-                    for (p, m) in parts {
-                        let mut out = Vec::new();
-                        let within = subtract(hs, p, &mut out);
-                        cut.extend(out.into_iter().map(|q| (q, m)));
-                        cut.extend(within.map(|q| (q, m | 1 << i)));
-                    }
-                    parts = cut;
+                    parts = hide_corner(hs, i, parts);
                 }
                 let whole = r.from_corner.iter().all(Option::is_some);
                 next.extend(parts.into_iter().map(|(polygon, m)| Piece {
@@ -805,6 +802,25 @@ impl AreaLight {
                 }));
             }
             pieces = next;
+            // pieces cut apart by one occluder and alike after it are
+            // merged again as they pile up, so later occluders meet few
+            if pieces.len() > 16 && pieces.len() > 2 * merged {
+                let items = pieces
+                    .into_iter()
+                    .map(|p| (p.polygon, (p.label, p.not_lit, p.hidden, p.umbra)))
+                    .collect();
+                pieces = merge_convex(items)
+                    .into_iter()
+                    .map(|(polygon, (label, not_lit, hidden, umbra))| Piece {
+                        polygon,
+                        label,
+                        not_lit,
+                        hidden,
+                        umbra,
+                    })
+                    .collect();
+                merged = pieces.len();
+            }
         }
         for piece in pieces {
             let class = match piece {
@@ -837,6 +853,7 @@ impl AreaLight {
         };
         Some(Regions {
             penumbra,
+            umbra: umbra_volume(&from_corner),
             from_corner,
             reach: reach(lv, ov),
         })
@@ -872,6 +889,23 @@ impl AreaLight {
         }
         penumbra
     }
+}
+
+/// The intersection of the corners' shadow volumes (each the occluder's
+/// plane, far side first, then its edges' planes): one occluder plane and
+/// every edge plane; `None` where it is empty.
+fn umbra_volume(from_corner: &[Option<HalfSpaces>]) -> Option<HalfSpaces> {
+    let volumes: Vec<&HalfSpaces> = from_corner
+        .iter()
+        .map(Option::as_ref)
+        .collect::<Option<_>>()?;
+    let far = volumes.first()?.first()?.1;
+    if volumes.iter().any(|v| v[0].1 != far) {
+        return None;
+    }
+    let mut u = vec![volumes[0][0]];
+    u.extend(volumes.iter().flat_map(|v| v[1..].iter().copied()));
+    Some(u)
 }
 
 /// The plane through the light corner `l` and the occluder edge `a, b`
@@ -962,6 +996,19 @@ fn reach(lv: &[Light], ov: &[GridPoint]) -> [[i64; 2]; 3] {
             _ => unbounded,
         }
     })
+}
+
+/// `parts` cut by the shadow volume `hs` of light corner `i`, the parts
+/// inside it marked with bit `i`.
+fn hide_corner(hs: &[(Plane, Side)], i: usize, parts: Vec<(Polygon, u64)>) -> Vec<(Polygon, u64)> {
+    let mut cut = Vec::with_capacity(parts.len());
+    for (p, m) in parts {
+        let mut out = Vec::new();
+        let within = subtract(hs, p, &mut out);
+        cut.extend(out.into_iter().map(|q| (q, m)));
+        cut.extend(within.map(|q| (q, m | 1 << i)));
+    }
+    cut
 }
 
 /// The occluder's side of `h` if `h` separates the light's corners `lv`

@@ -47,6 +47,7 @@ mod chin_feiner;
 mod engine;
 pub mod export;
 mod light;
+mod near;
 mod psv;
 mod soft;
 mod wide;

@@ -14,8 +14,9 @@ use bsp_core::{Grid, GridPoint, MAX_COORD, Polygon};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::area::{AreaClass, AreaLight, Occluder, Regions, grid_box, may_reach, merge_convex};
+use crate::area::{AreaClass, AreaFragment, AreaLight, Occluder, Regions, merge_convex};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
+use crate::near::near_lists;
 
 /// The share of a polygon light's irradiance that arrives on a penumbra
 /// fragment ([`crate::LightView::fraction`]): at the grid point nearest its
@@ -114,34 +115,69 @@ pub fn soft_shadows(lights: &[AreaLight], faces: &[Occluder]) -> Vec<Vec<SoftFra
         .iter()
         .map(|l| faces.par_iter().map(|o| l.regions(o)).collect())
         .collect();
+    let near: Vec<Vec<Vec<u32>>> = lights
+        .iter()
+        .zip(&regions)
+        .map(|(l, r)| near_lists(l.corners(), faces, r))
+        .collect();
     faces
         .par_iter()
         .enumerate()
-        .map(|(i, face)| soft_face(lights, faces, &regions, i, face))
+        .map(|(i, face)| {
+            let near: Vec<&[u32]> = near.iter().map(|n| &n[i][..]).collect();
+            soft_face(lights, faces, &regions, &near, face)
+        })
         .collect()
 }
 
-/// The fragments of face `i`.
+impl AreaLight {
+    /// Every face of `faces` cut into fragments of one class each, with
+    /// all the others as occluders: [`AreaLight::classify_face`] for each,
+    /// each occluder's volumes built once and met only by the faces near
+    /// it, the faces in parallel (the result is in face order, the same
+    /// for every thread count).
+    ///
+    /// ```
+    /// use svbsp::{AreaClass, AreaLight, Occluder};
+    /// let light = AreaLight::new(&[[0, 0, 80], [0, 40, 80], [40, 40, 80], [40, 0, 80]]).unwrap();
+    /// let faces = [
+    ///     Occluder::new(&[[-200, -200, 0], [200, -200, 0], [200, 200, 0], [-200, 200, 0]]).unwrap(),
+    ///     Occluder::new(&[[0, 0, 40], [40, 0, 40], [40, 40, 40], [0, 40, 40]]).unwrap(),
+    /// ];
+    /// let all = light.classify_faces(&faces);
+    /// assert!(all[1].iter().all(|f| f.class == AreaClass::Lit)); // the roof
+    /// ```
+    pub fn classify_faces(&self, faces: &[Occluder]) -> Vec<Vec<AreaFragment>> {
+        let regions: Vec<Option<Regions>> = faces.par_iter().map(|o| self.regions(o)).collect();
+        let near = near_lists(self.corners(), faces, &regions);
+        faces
+            .par_iter()
+            .zip(&near)
+            .map(|(face, near)| {
+                let others = near.iter().filter_map(|&j| regions[j as usize].as_ref());
+                self.classify_with(face, others)
+            })
+            .collect()
+    }
+}
+
+/// The fragments of `face`, with `near[k]` the occluders that may hide
+/// part of light `k` from it.
 fn soft_face(
     lights: &[AreaLight],
     faces: &[Occluder],
     regions: &[Vec<Option<Regions>>],
-    i: usize,
+    near: &[&[u32]],
     face: &Occluder,
 ) -> Vec<SoftFragment> {
-    let bx = grid_box(face.corners());
-    // per light, the occluders that may hide some of it from the face, in
-    // the order of their corners (so the cuts, and the fragments, do not
-    // depend on the order the faces come in)
-    let near: Vec<Vec<usize>> = regions
+    // the occluders in the order of their corners, so the cuts, and the
+    // fragments, do not depend on the order the faces come in
+    let near: Vec<Vec<usize>> = near
         .iter()
-        .map(|rs| {
-            let mut near: Vec<usize> = (0..faces.len())
-                .filter(|&j| j != i)
-                .filter(|&j| rs[j].as_ref().is_some_and(|r| may_reach(&bx, &r.reach)))
-                .collect();
-            near.sort_by(|&a, &b| faces[a].corners().cmp(faces[b].corners()));
-            near
+        .map(|n| {
+            let mut n: Vec<usize> = n.iter().map(|&j| j as usize).collect();
+            n.sort_by(|&a, &b| faces[a].corners().cmp(faces[b].corners()));
+            n
         })
         .collect();
     let mut pieces = vec![(face.to_polygon(), Classes::default())];

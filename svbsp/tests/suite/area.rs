@@ -612,3 +612,59 @@ fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
         assert_eq!(key(&one[s]), key(&all[i]), "face {i}");
     }
 }
+
+/// The occluders a face meets are found through boxes of their penumbra
+/// volumes (`classify_faces`, `soft_shadows`); every face of Chin &
+/// Feiner's scene under a square light and under a sun disc gets the same
+/// area of each class as when it meets every other face
+/// (`classify_face`).
+#[test]
+fn the_near_occluders_are_all_that_matter() {
+    let spec = bsp_fixtures::scenes::scene("cf258");
+    let grid = bsp_core::Grid::fit_points(spec.faces.iter().flatten()).unwrap();
+    let faces: Vec<Occluder> = spec
+        .faces
+        .iter()
+        .filter_map(|f| {
+            let l: Vec<[i32; 3]> = f.iter().map(|&v| grid.snap(v).unwrap()).collect();
+            Occluder::new(&l).ok()
+        })
+        .collect();
+    let (lo, hi) = faces.iter().flat_map(|f| f.corners()).fold(
+        ([i32::MAX; 3], [i32::MIN; 3]),
+        |(lo, hi), c| {
+            (
+                [0, 1, 2].map(|k| lo[k].min(c[k])),
+                [0, 1, 2].map(|k| hi[k].max(c[k])),
+            )
+        },
+    );
+    let (cx, cy, top) = ((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2]);
+    let side = (hi[0] - lo[0]) / 8;
+    let lights = [
+        AreaLight::new(&square_light(cx - side, cy - side, 2 * side, top + side)).unwrap(),
+        AreaLight::sun_disc(glam::DVec3::new(0.3, -0.2, 1.0), 2f64.to_radians()).unwrap(),
+    ];
+    let areas = |fs: &[svbsp::AreaFragment]| -> [f64; 4] {
+        let mut a = [0.0; 4];
+        for f in fs {
+            a[f.class as usize] += area_of(&f.polygon);
+        }
+        a
+    };
+    for light in &lights {
+        let fast = light.classify_faces(&faces);
+        let mut classes = std::collections::HashSet::new();
+        for (i, face) in faces.iter().enumerate() {
+            let (a, b) = (areas(&fast[i]), areas(&light.classify_face(face, &faces)));
+            for k in 0..4 {
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-9 * (1.0 + b[k]),
+                    "face {i}: {a:?} against {b:?}"
+                );
+            }
+            classes.extend(fast[i].iter().map(|f| f.class));
+        }
+        assert!(classes.len() >= 3, "{classes:?}");
+    }
+}
