@@ -707,16 +707,6 @@ impl AreaLight {
                     .any(|(h, s)| wholly_outside(whole.classify(h), *s))
             })
             .collect();
-        // each piece's state: inside some penumbra volume, the light
-        // corners hidden from it (or behind the face), inside one
-        // occluder's umbra
-        struct Piece<K> {
-            polygon: Polygon,
-            label: K,
-            not_lit: bool,
-            hidden: u64,
-            umbra: bool,
-        }
         let corners = self.corners().len();
         let all = u64::MAX >> (64 - corners);
         let behind = (0..corners).fold(0u64, |m, i| m | u64::from(behind_face[i]) << i);
@@ -734,91 +724,13 @@ impl AreaLight {
         for r in &regions {
             let mut next = Vec::with_capacity(pieces.len());
             for piece in pieces {
-                if piece.umbra {
-                    next.push(piece);
-                    continue;
-                }
-                if piece.not_lit && r.from_corner.iter().all(Option::is_some) {
-                    // not lit already: only this occluder's umbra and the
-                    // corners not hidden yet can change its class
-                    let mut parts = Vec::new();
-                    let umbra = match &r.umbra {
-                        Some(u) => subtract(u, piece.polygon, &mut parts),
-                        None => {
-                            parts.push(piece.polygon);
-                            None
-                        }
-                    };
-                    next.extend(umbra.map(|polygon| Piece {
-                        polygon,
-                        hidden: all,
-                        umbra: true,
-                        ..piece
-                    }));
-                    let mut parts: Vec<(Polygon, u64)> =
-                        parts.into_iter().map(|p| (p, 0)).collect();
-                    for (i, hs) in r.from_corner.iter().enumerate() {
-                        if piece.hidden >> i & 1 == 1 {
-                            continue;
-                        }
-                        let Some(hs) = hs else { continue };
-                        parts = hide_corner(hs, i, parts);
-                    }
-                    next.extend(parts.into_iter().map(|(polygon, m)| Piece {
-                        polygon,
-                        hidden: piece.hidden | m,
-                        ..piece
-                    }));
-                    continue;
-                }
-                let mut outside = Vec::new();
-                let inside = subtract(&r.penumbra, piece.polygon, &mut outside);
-                next.extend(
-                    outside
-                        .into_iter()
-                        .map(|polygon| Piece { polygon, ..piece }),
-                );
-                let Some(inside) = inside else {
-                    continue;
-                };
-                // inside the penumbra volume: cut by each corner's shadow
-                // volume, noting the corners it hides (a corner in the
-                // occluder's plane may be hidden but for itself: not seen)
-                let mut parts = vec![(inside, 0u64)];
-                for (i, volume) in r.from_corner.iter().enumerate() {
-                    let Some(hs) = volume else {
-                        parts.iter_mut().for_each(|(_, m)| *m |= 1 << i);
-                        continue;
-                    };
-                    parts = hide_corner(hs, i, parts);
-                }
-                let whole = r.from_corner.iter().all(Option::is_some);
-                next.extend(parts.into_iter().map(|(polygon, m)| Piece {
-                    polygon,
-                    label: piece.label,
-                    not_lit: true,
-                    hidden: piece.hidden | m,
-                    umbra: whole && m == all,
-                }));
+                cut_piece(r, piece, all, &mut next);
             }
             pieces = next;
             // pieces cut apart by one occluder and alike after it are
             // merged again as they pile up, so later occluders meet few
             if pieces.len() > 16 && pieces.len() > 2 * merged {
-                let items = pieces
-                    .into_iter()
-                    .map(|p| (p.polygon, (p.label, p.not_lit, p.hidden, p.umbra)))
-                    .collect();
-                pieces = merge_convex(items)
-                    .into_iter()
-                    .map(|(polygon, (label, not_lit, hidden, umbra))| Piece {
-                        polygon,
-                        label,
-                        not_lit,
-                        hidden,
-                        umbra,
-                    })
-                    .collect();
+                pieces = merge_pieces(pieces);
                 merged = pieces.len();
             }
         }
@@ -996,6 +908,103 @@ fn reach(lv: &[Light], ov: &[GridPoint]) -> [[i64; 2]; 3] {
             _ => unbounded,
         }
     })
+}
+
+/// A piece of a face being cut for one light, and its state: inside some
+/// penumbra volume (not lit), the light corners hidden from it (or behind
+/// the face), inside one occluder's umbra.
+struct Piece<K> {
+    polygon: Polygon,
+    label: K,
+    not_lit: bool,
+    hidden: u64,
+    umbra: bool,
+}
+
+/// `piece` cut by occluder regions `r` (`all`: the bits of every light
+/// corner), the parts pushed onto `next`.
+fn cut_piece<K: Copy>(r: &Regions, piece: Piece<K>, all: u64, next: &mut Vec<Piece<K>>) {
+    if piece.umbra {
+        next.push(piece);
+        return;
+    }
+    if piece.not_lit && r.from_corner.iter().all(Option::is_some) {
+        // not lit already: only this occluder's umbra and the corners not
+        // hidden yet can change its class
+        let mut parts = Vec::new();
+        let umbra = match &r.umbra {
+            Some(u) => subtract(u, piece.polygon, &mut parts),
+            None => {
+                parts.push(piece.polygon);
+                None
+            }
+        };
+        next.extend(umbra.map(|polygon| Piece {
+            polygon,
+            hidden: all,
+            umbra: true,
+            ..piece
+        }));
+        let mut parts: Vec<(Polygon, u64)> = parts.into_iter().map(|p| (p, 0)).collect();
+        for (i, hs) in r.from_corner.iter().enumerate() {
+            if let Some(hs) = hs.as_ref().filter(|_| piece.hidden >> i & 1 == 0) {
+                parts = hide_corner(hs, i, parts);
+            }
+        }
+        next.extend(parts.into_iter().map(|(polygon, m)| Piece {
+            polygon,
+            hidden: piece.hidden | m,
+            ..piece
+        }));
+        return;
+    }
+    let mut outside = Vec::new();
+    let inside = subtract(&r.penumbra, piece.polygon, &mut outside);
+    next.extend(
+        outside
+            .into_iter()
+            .map(|polygon| Piece { polygon, ..piece }),
+    );
+    let Some(inside) = inside else {
+        return;
+    };
+    // inside the penumbra volume: cut by each corner's shadow volume,
+    // noting the corners it hides (a corner in the occluder's plane may be
+    // hidden but for itself: not seen)
+    let mut parts = vec![(inside, 0u64)];
+    for (i, volume) in r.from_corner.iter().enumerate() {
+        let Some(hs) = volume else {
+            parts.iter_mut().for_each(|(_, m)| *m |= 1 << i);
+            continue;
+        };
+        parts = hide_corner(hs, i, parts);
+    }
+    let whole = r.from_corner.iter().all(Option::is_some);
+    next.extend(parts.into_iter().map(|(polygon, m)| Piece {
+        polygon,
+        label: piece.label,
+        not_lit: true,
+        hidden: piece.hidden | m,
+        umbra: whole && m == all,
+    }));
+}
+
+/// Pieces of equal label and state merged where their union is convex.
+fn merge_pieces<K: Copy + PartialEq>(pieces: Vec<Piece<K>>) -> Vec<Piece<K>> {
+    let items = pieces
+        .into_iter()
+        .map(|p| (p.polygon, (p.label, p.not_lit, p.hidden, p.umbra)))
+        .collect();
+    merge_convex(items)
+        .into_iter()
+        .map(|(polygon, (label, not_lit, hidden, umbra))| Piece {
+            polygon,
+            label,
+            not_lit,
+            hidden,
+            umbra,
+        })
+        .collect()
 }
 
 /// `parts` cut by the shadow volume `hs` of light corner `i`, the parts
