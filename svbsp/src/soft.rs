@@ -1,7 +1,7 @@
 //! Several lights, some with extent, over one scene: every face cut where
 //! the class of any light changes ([`soft_shadows`]), each fragment with
 //! one [`AreaClass`] per light, and for a penumbra fragment of a polygon
-//! light the share of its irradiance that arrives.
+//! light or a sun disc the share of its irradiance that arrives.
 //!
 //! Each light cuts the pieces the lights before it left
 //! ([`AreaLight::classify_face`]'s cuts, by planes through grid points
@@ -11,7 +11,7 @@
 //! ([`AreaLight::point`], [`AreaLight::sun`]): lit or umbra.
 
 use bsp_core::{Grid, GridPoint, MAX_COORD, Polygon};
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::area::{AreaClass, AreaFragment, AreaLight, Occluder, Regions, merge_convex};
@@ -44,7 +44,8 @@ pub struct SoftFragment {
     /// Bit `i`: light `i`'s class is [`AreaClass::Undecided`].
     pub undecided: u64,
     /// Per light, for a penumbra (or undecided) fragment of a polygon
-    /// light, the share of its irradiance that arrives; `None` otherwise.
+    /// light or a sun disc, the share of its irradiance that arrives;
+    /// `None` otherwise.
     pub visible: Vec<Option<Share>>,
 }
 
@@ -220,14 +221,24 @@ fn nearest(p: [f64; 3]) -> GridPoint {
 }
 
 /// The share of `light` arriving on `piece` of `face` (see [`Share`]);
-/// `None` for a light without a polygon.
+/// `None` for a point or a sun.
 fn share<'o>(
     light: &AreaLight,
     face: &Occluder,
     piece: &Polygon,
     occluders: impl Iterator<Item = (&'o Occluder, &'o Regions)> + Clone,
 ) -> Option<Share> {
-    light.plane()?;
+    let sky: Vec<DVec3> = light
+        .corners()
+        .iter()
+        .filter_map(|l| match l {
+            Light::Directional(d) => Some(DVec3::from_array(d.map(f64::from))),
+            Light::Point(_) => None,
+        })
+        .collect();
+    if light.plane().is_none() && sky.len() < 3 {
+        return None;
+    }
     let n = face.plane().normal().map(|c| c as f64);
     let normal = DVec3::from_array(n).normalize();
     let at = |p: [f64; 3]| -> Option<f64> {
@@ -236,8 +247,12 @@ fn share<'o>(
         // strictly inside its penumbra volume
         let inside = |r: &Regions| r.penumbra.iter().all(|(h, s)| h.classify_grid(x) == *s);
         let hiding = occluders.clone().filter(|(_, r)| inside(r)).map(|(o, _)| o);
+        let xf = DVec3::from_array(x.map(f64::from));
+        if light.plane().is_none() {
+            return sky_share(&sky, xf, normal, hiding);
+        }
         let view = light.view_among(x, Some(face.plane()), hiding)?;
-        view.fraction(DVec3::from_array(x.map(f64::from)), normal)
+        view.fraction(xf, normal)
     };
     let corners = piece.vertices_f64();
     let centroid = corners
@@ -255,6 +270,130 @@ fn share<'o>(
         min,
         max,
     })
+}
+
+/// The share of a sun disc's polygon of directions `sky` that `x` (on a
+/// face with unit `normal`) sees, in `f64`: the directions drawn in the
+/// plane tangent to the sky at their centre (`d ↦ d / (d · c)`), less each
+/// occluder's part beyond `x` drawn alike, over the part in front of the
+/// face; the cosine at the face is taken as constant over the disc (it
+/// varies by less than its radius). `None` where no direction is in
+/// front of the face.
+fn sky_share<'o>(
+    sky: &[DVec3],
+    x: DVec3,
+    normal: DVec3,
+    occluders: impl Iterator<Item = &'o Occluder>,
+) -> Option<f64> {
+    let c = sky.iter().sum::<DVec3>().normalize();
+    let u = c.any_orthonormal_vector();
+    let v = c.cross(u);
+    let chart = |d: DVec3| DVec2::new(d.dot(u), d.dot(v)) / d.dot(c);
+    let disc: Vec<DVec2> = sky.iter().map(|&d| chart(d)).collect();
+    // in front of the face: n · (c + a u + b v) > 0
+    let front = [normal.dot(u), normal.dot(v), normal.dot(c)];
+    let reachable = clip2(&ccw(disc), front);
+    let all = area2(&reachable);
+    if all <= 0.0 {
+        return None;
+    }
+    let mut seen = vec![reachable];
+    for o in occluders {
+        // the occluder's part strictly beyond x along c, seen from x
+        let rel: Vec<DVec3> = o
+            .corners()
+            .iter()
+            .map(|p| DVec3::from_array(p.map(f64::from)) - x)
+            .collect();
+        let ahead = clip3(
+            &rel,
+            c,
+            1e-9 * rel.iter().map(|r| r.length()).fold(0.0, f64::max),
+        );
+        if ahead.len() < 3 {
+            continue;
+        }
+        let shadow = ccw(ahead.iter().map(|&r| chart(r)).collect());
+        if area2(&shadow) <= 0.0 {
+            continue;
+        }
+        seen = seen
+            .into_iter()
+            .flat_map(|piece| subtract2(piece, &shadow))
+            .collect();
+    }
+    let left: f64 = seen.iter().map(|p| area2(p)).sum();
+    Some((left / all).clamp(0.0, 1.0))
+}
+
+/// The part of a 3D polygon where `r · c >= eps`.
+fn clip3(poly: &[DVec3], c: DVec3, eps: f64) -> Vec<DVec3> {
+    let mut out = Vec::new();
+    for (i, &a) in poly.iter().enumerate() {
+        let b = poly[(i + 1) % poly.len()];
+        let (da, db) = (a.dot(c) - eps, b.dot(c) - eps);
+        if da >= 0.0 {
+            out.push(a);
+        }
+        if (da >= 0.0) != (db >= 0.0) {
+            out.push(a + (b - a) * (da / (da - db)));
+        }
+    }
+    out
+}
+
+/// The part of a 2D polygon where `h[0] a + h[1] b + h[2] >= 0`.
+fn clip2(poly: &[DVec2], h: [f64; 3]) -> Vec<DVec2> {
+    let f = |p: DVec2| h[0] * p.x + h[1] * p.y + h[2];
+    let mut out = Vec::new();
+    for (i, &a) in poly.iter().enumerate() {
+        let b = poly[(i + 1) % poly.len()];
+        let (fa, fb) = (f(a), f(b));
+        if fa >= 0.0 {
+            out.push(a);
+        }
+        if (fa >= 0.0) != (fb >= 0.0) {
+            out.push(a + (b - a) * (fa / (fa - fb)));
+        }
+    }
+    out
+}
+
+fn area2(p: &[DVec2]) -> f64 {
+    let n = p.len();
+    (0..n).map(|i| p[i].perp_dot(p[(i + 1) % n])).sum::<f64>() / 2.0
+}
+
+/// The polygon turned counter-clockwise.
+fn ccw(mut p: Vec<DVec2>) -> Vec<DVec2> {
+    if area2(&p) < 0.0 {
+        p.reverse();
+    }
+    p
+}
+
+/// The convex `piece` less the convex `hole` (both counter-clockwise), as
+/// convex parts.
+fn subtract2(mut piece: Vec<DVec2>, hole: &[DVec2]) -> Vec<Vec<DVec2>> {
+    let mut out = Vec::new();
+    for (i, &a) in hole.iter().enumerate() {
+        let b = hole[(i + 1) % hole.len()];
+        // outside the edge a→b: to its right
+        let e = b - a;
+        if e == DVec2::ZERO {
+            continue;
+        }
+        let right = [e.y, -e.x, -(e.y * a.x - e.x * a.y)];
+        let outside = clip2(&piece, right);
+        if area2(&outside) > 0.0 {
+            out.push(outside);
+        }
+        piece = clip2(&piece, right.map(|k| -k));
+        if piece.len() < 3 {
+            return out;
+        }
+    }
+    out
 }
 
 /// A light of a soft-shadow run ([`crate::soft_shadows`]): any light as an

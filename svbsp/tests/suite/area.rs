@@ -472,9 +472,9 @@ fn sun_disc_fragments_agree_with_sampled_directions() {
         let a = std::f64::consts::TAU * f64::from(k) / 32.0;
         samples.push(d + (u * a.cos() + v * a.sin()) * radius.tan());
     }
-    for i in -3..=3 {
-        for j in -3..=3 {
-            let (s, t) = (f64::from(i) / 3.0, f64::from(j) / 3.0);
+    for i in -6..=6 {
+        for j in -6..=6 {
+            let (s, t) = (f64::from(i) / 6.0, f64::from(j) / 6.0);
             if s * s + t * t <= 1.0 {
                 samples.push(d + (u * s + v * t) * radius.tan());
             }
@@ -485,6 +485,7 @@ fn sun_disc_fragments_agree_with_sampled_directions() {
         .map(|&s| Light::Directional(svbsp::quantize_direction(s).unwrap()))
         .collect();
     let mut met = std::collections::HashMap::new();
+    let mut shares = 0;
     for _ in 0..6 {
         let mut faces = vec![ground(120)];
         for _ in 0..3 {
@@ -500,6 +501,8 @@ fn sun_disc_fragments_agree_with_sampled_directions() {
             .map(|(i, f)| Polygon::from_grid_points(f, i as u32).unwrap())
             .collect();
         let scene = Scene::from_polygons(&polys);
+        let lattice: Vec<Light> = samples[32..].to_vec();
+        shares += check_disc_shares(&sun, &occluders, &scene, &lattice);
         let fragments = sun.classify_face(&occluders[0], &occluders);
         for _ in 0..400 {
             let x = [below(&mut rng, 240) - 120, below(&mut rng, 240) - 120, 0];
@@ -526,6 +529,47 @@ fn sun_disc_fragments_agree_with_sampled_directions() {
     for class in [AreaClass::Lit, AreaClass::Penumbra, AreaClass::Umbra] {
         assert!(met.contains_key(&class), "{class:?} never met: {met:?}");
     }
+    assert!(shares > 10, "{shares} penumbra shares checked");
+}
+
+/// The share of a sun disc a penumbra fragment sees, at the grid point
+/// nearest its centroid, against the share of a lattice of directions over
+/// the disc that reach that point (the share is the bounding octagon's, a
+/// little wider than the disc: within 0.15).
+fn check_disc_shares(
+    sun: &AreaLight,
+    occluders: &[Occluder],
+    scene: &Scene,
+    lattice: &[Light],
+) -> usize {
+    let fragments = &svbsp::soft_shadows(std::slice::from_ref(sun), occluders)[0];
+    let mut checked = 0;
+    for f in fragments
+        .iter()
+        .filter(|f| f.class(0) == AreaClass::Penumbra)
+    {
+        let v = f.polygon.vertices_f64();
+        let c = v
+            .iter()
+            .fold([0.0; 3], |s, p| [0, 1, 2].map(|k| s[k] + p[k]));
+        let x = c.map(|s| (s / v.len() as f64).round() as i32);
+        if !strictly_inside(&f.polygon, x) {
+            continue;
+        }
+        let hx = HPoint::grid(x.map(i64::from));
+        let open = lattice
+            .iter()
+            .filter(|s| !matches!(scene.verdict(s, 0, &hx), Verdict::Shadowed))
+            .count();
+        let want = open as f64 / lattice.len() as f64;
+        let got = f.visible[0].unwrap().centroid;
+        assert!(
+            (got - want).abs() < 0.15,
+            "{x:?}: share {got}, the lattice's {want}"
+        );
+        checked += 1;
+    }
+    checked
 }
 
 /// A sun disc is checked: a zero direction or a radius out of range is an
@@ -583,8 +627,8 @@ fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
                 checked += 1;
             }
             kinds.insert((k, f.class(k)));
-            let soft = matches!(f.class(0), AreaClass::Penumbra | AreaClass::Undecided);
-            assert_eq!(f.visible[k].is_some(), k == 0 && soft);
+            let soft = matches!(f.class(k), AreaClass::Penumbra | AreaClass::Undecided);
+            assert_eq!(f.visible[k].is_some(), k < 2 && soft, "light {k}");
         }
     }
     assert!(checked > 3000, "{checked}");
