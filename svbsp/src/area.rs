@@ -640,14 +640,14 @@ impl AreaLight {
             .filter(|(_, o)| o.polygon.vertices() != face.polygon.vertices())
             .filter_map(|(i, o)| Some((i, self.regions(o)?)))
             .collect();
-        self.classify_with(face, regions.iter().map(|(_, r)| r))
+        self.classify_with(face, regions.iter().map(|(_, r)| (r, EVERYWHERE)))
     }
 
     /// [`AreaLight::classify_face`] with the occluders' regions given.
     pub(crate) fn classify_with<'r>(
         &self,
         face: &Occluder,
-        occluders: impl Iterator<Item = &'r Regions>,
+        occluders: impl Iterator<Item = (&'r Regions, Box3)>,
     ) -> Vec<AreaFragment> {
         let whole = face.polygon.to_polygon(0);
         let cut = self.cut(face, vec![(whole, ())], occluders);
@@ -664,7 +664,7 @@ impl AreaLight {
         &self,
         face: &Occluder,
         pieces: Vec<(Polygon, K)>,
-        occluders: impl Iterator<Item = &'r Regions>,
+        occluders: impl Iterator<Item = (&'r Regions, Box3)>,
     ) -> Vec<(Polygon, K, AreaClass)> {
         let behind_face: Vec<bool> = self
             .corners()
@@ -700,8 +700,8 @@ impl AreaLight {
         // an occluder whose penumbra volume lies wholly beyond one of its
         // planes from the face hides nothing from it
         let whole = face.polygon.to_polygon(0);
-        let regions: Vec<&Regions> = occluders
-            .filter(|r| {
+        let regions: Vec<(&Regions, Box3)> = occluders
+            .filter(|(r, _)| {
                 !r.penumbra
                     .iter()
                     .any(|(h, s)| wholly_outside(whole.classify(h), *s))
@@ -713,6 +713,7 @@ impl AreaLight {
         let mut pieces: Vec<Piece<K>> = front
             .into_iter()
             .map(|(polygon, label)| Piece {
+                bbox: polygon_box(&polygon),
                 polygon,
                 label,
                 not_lit: false,
@@ -721,12 +722,19 @@ impl AreaLight {
             })
             .collect();
         let mut merged = 0;
-        for r in &regions {
-            let mut next = Vec::with_capacity(pieces.len());
-            for piece in pieces {
-                cut_piece(r, piece, all, &mut next);
+        for &(r, reach) in &regions {
+            // pieces this occluder leaves as they are stay in place; the
+            // others are cut and their parts appended
+            let mut parts = Vec::new();
+            let mut i = 0;
+            while i < pieces.len() {
+                if !overlap(&pieces[i].bbox, &reach) || untouched(r, &pieces[i]) {
+                    i += 1;
+                    continue;
+                }
+                cut_piece(r, pieces.swap_remove(i), all, &mut parts);
             }
-            pieces = next;
+            pieces.append(&mut parts);
             // pieces cut apart by one occluder and alike after it are
             // merged again as they pile up, so later occluders meet few
             if pieces.len() > 16 && pieces.len() > 2 * merged {
@@ -915,10 +923,34 @@ fn reach(lv: &[Light], ov: &[GridPoint]) -> [[i64; 2]; 3] {
 /// the face), inside one occluder's umbra.
 struct Piece<K> {
     polygon: Polygon,
+    /// A box holding it (a part of a piece keeps the piece's box).
+    bbox: Box3,
     label: K,
     not_lit: bool,
     hidden: u64,
     umbra: bool,
+}
+
+/// Whether occluder regions `r` leave `piece` as it is ([`cut_piece`]
+/// would give it back whole): it is umbra already, or it lies wholly
+/// outside every volume that could change its state.
+fn untouched<K>(r: &Regions, piece: &Piece<K>) -> bool {
+    let outside = |hs: &HalfSpaces| {
+        hs.iter()
+            .any(|(h, s)| wholly_outside(piece.polygon.classify(h), *s))
+    };
+    if piece.umbra {
+        return true;
+    }
+    if !piece.not_lit || r.from_corner.iter().any(Option::is_none) {
+        return outside(&r.penumbra);
+    }
+    r.umbra.as_ref().is_none_or(outside)
+        && r.from_corner
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| piece.hidden >> i & 1 == 0)
+            .all(|(_, hs)| hs.as_ref().is_none_or(outside))
 }
 
 /// `piece` cut by occluder regions `r` (`all`: the bits of every light
@@ -982,6 +1014,7 @@ fn cut_piece<K: Copy>(r: &Regions, piece: Piece<K>, all: u64, next: &mut Vec<Pie
     let whole = r.from_corner.iter().all(Option::is_some);
     next.extend(parts.into_iter().map(|(polygon, m)| Piece {
         polygon,
+        bbox: piece.bbox,
         label: piece.label,
         not_lit: true,
         hidden: piece.hidden | m,
@@ -998,6 +1031,7 @@ fn merge_pieces<K: Copy + PartialEq>(pieces: Vec<Piece<K>>) -> Vec<Piece<K>> {
     merge_convex(items)
         .into_iter()
         .map(|(polygon, (label, not_lit, hidden, umbra))| Piece {
+            bbox: polygon_box(&polygon),
             polygon,
             label,
             not_lit,
@@ -1045,4 +1079,30 @@ fn separating(h: &Plane, lv: &[Light], ov: &[GridPoint]) -> Option<Side> {
         (l, o) if l != o => Some(o),
         _ => None,
     }
+}
+
+/// A box per axis, `[lo, hi]`, in grid units.
+pub(crate) type Box3 = [[f64; 2]; 3];
+
+/// Whether two boxes meet (touching counts).
+pub(crate) fn overlap(a: &Box3, b: &Box3) -> bool {
+    (0..3).all(|k| a[k][0] <= b[k][1] && b[k][0] <= a[k][1])
+}
+
+/// A box holding every point.
+pub(crate) const EVERYWHERE: Box3 = [[f64::NEG_INFINITY, f64::INFINITY]; 3];
+
+/// The box of a polygon's correctly rounded corners, widened by a grid
+/// unit and a billionth against rounding (grid units).
+pub(crate) fn polygon_box(p: &bsp_core::Polygon) -> Box3 {
+    let mut b = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
+    for v in p.vertices_f64() {
+        for k in 0..3 {
+            b[k] = [b[k][0].min(v[k]), b[k][1].max(v[k])];
+        }
+    }
+    b.map(|[lo, hi]| {
+        let m = 1.0 + 1e-9 * (lo.abs() + hi.abs());
+        [lo - m, hi + m]
+    })
 }

@@ -7,36 +7,37 @@
 use bsp_core::GridPoint;
 use rayon::prelude::*;
 
-use crate::area::{Occluder, Regions, grid_box, may_reach};
+use crate::area::{Box3, Occluder, Regions, grid_box, may_reach, overlap};
 use crate::light::Light;
-
-/// A box per axis, `[lo, hi]`, in grid units.
-type Box3 = [[f64; 2]; 3];
 
 /// Per face, the indices of the other faces whose penumbra volume
 /// (`regions`, per face; `None`: it hides nothing) may meet it, in index
-/// order.
+/// order; and per face, a box of its penumbra volume within the scene.
 pub(crate) fn near_lists(
     lights: &[Light],
     faces: &[Occluder],
     regions: &[Option<Regions>],
-) -> Vec<Vec<u32>> {
+) -> (Vec<Vec<u32>>, Vec<Box3>) {
     let exact: Vec<[[i64; 2]; 3]> = faces.iter().map(|f| grid_box(f.corners())).collect();
     let boxes: Vec<Box3> = exact
         .iter()
         .map(|b| b.map(|[lo, hi]| [lo as f64, hi as f64]))
         .collect();
     let Some(scene) = boxes.iter().copied().reduce(union) else {
-        return Vec::new();
+        return (Vec::new(), Vec::new());
     };
     let grid = CellGrid::new(scene, &boxes);
+    let reaches: Vec<Box3> = faces
+        .par_iter()
+        .map(|f| penumbra_box(lights, f.corners(), scene))
+        .collect();
     let mut pairs: Vec<(u32, u32)> = regions
         .par_iter()
         .enumerate()
         .flat_map_iter(|(j, r)| {
             let mut hit = Vec::new();
             if let Some(r) = r {
-                let reach = penumbra_box(lights, faces[j].corners(), scene);
+                let reach = reaches[j];
                 grid.visit(reach, |i| {
                     let i = i as usize;
                     if i != j && overlap(&boxes[i], &reach) && may_reach(&exact[i], &r.reach) {
@@ -54,15 +55,11 @@ pub(crate) fn near_lists(
     for (i, j) in pairs {
         near[i as usize].push(j);
     }
-    near
+    (near, reaches)
 }
 
 fn union(a: Box3, b: Box3) -> Box3 {
     [0, 1, 2].map(|k| [a[k][0].min(b[k][0]), a[k][1].max(b[k][1])])
-}
-
-fn overlap(a: &Box3, b: &Box3) -> bool {
-    (0..3).all(|k| a[k][0] <= b[k][1] && b[k][0] <= a[k][1])
 }
 
 /// A box holding the part of occluder `o`'s penumbra volume inside

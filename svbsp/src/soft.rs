@@ -14,7 +14,7 @@ use bsp_core::{Grid, GridPoint, MAX_COORD, Polygon};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use crate::area::{AreaClass, AreaFragment, AreaLight, Occluder, Regions, merge_convex};
+use crate::area::{AreaClass, AreaFragment, AreaLight, Box3, Occluder, Regions, merge_convex};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
 use crate::near::near_lists;
 
@@ -116,17 +116,17 @@ pub fn soft_shadows(lights: &[AreaLight], faces: &[Occluder]) -> Vec<Vec<SoftFra
         .iter()
         .map(|l| faces.par_iter().map(|o| l.regions(o)).collect())
         .collect();
-    let near: Vec<Vec<Vec<u32>>> = lights
+    let (near, reach): (Vec<Vec<Vec<u32>>>, Vec<Vec<Box3>>) = lights
         .iter()
         .zip(&regions)
         .map(|(l, r)| near_lists(l.corners(), faces, r))
-        .collect();
+        .unzip();
     faces
         .par_iter()
         .enumerate()
         .map(|(i, face)| {
             let near: Vec<&[u32]> = near.iter().map(|n| &n[i][..]).collect();
-            soft_face(lights, faces, &regions, &near, face)
+            soft_face(lights, faces, (&regions, &reach), &near, face)
         })
         .collect()
 }
@@ -150,12 +150,14 @@ impl AreaLight {
     /// ```
     pub fn classify_faces(&self, faces: &[Occluder]) -> Vec<Vec<AreaFragment>> {
         let regions: Vec<Option<Regions>> = faces.par_iter().map(|o| self.regions(o)).collect();
-        let near = near_lists(self.corners(), faces, &regions);
+        let (near, reach) = near_lists(self.corners(), faces, &regions);
         faces
             .par_iter()
             .zip(&near)
             .map(|(face, near)| {
-                let others = near.iter().filter_map(|&j| regions[j as usize].as_ref());
+                let others = near
+                    .iter()
+                    .filter_map(|&j| Some((regions[j as usize].as_ref()?, reach[j as usize])));
                 self.classify_with(face, others)
             })
             .collect()
@@ -167,7 +169,7 @@ impl AreaLight {
 fn soft_face(
     lights: &[AreaLight],
     faces: &[Occluder],
-    regions: &[Vec<Option<Regions>>],
+    (regions, reach): (&[Vec<Option<Regions>>], &[Vec<Box3>]),
     near: &[&[u32]],
     face: &Occluder,
 ) -> Vec<SoftFragment> {
@@ -183,7 +185,9 @@ fn soft_face(
         .collect();
     let mut pieces = vec![(face.to_polygon(), Classes::default())];
     for (k, light) in lights.iter().enumerate() {
-        let occluders = near[k].iter().filter_map(|&j| regions[k][j].as_ref());
+        let occluders = near[k]
+            .iter()
+            .filter_map(|&j| Some((regions[k][j].as_ref()?, reach[k][j])));
         pieces = light
             .cut(face, pieces, occluders)
             .into_iter()
