@@ -39,7 +39,9 @@ use bsp_core::internals::GridPolygon;
 use bsp_core::{GridPoint, MAX_COORD, Plane, Polygon, PolygonSide, Side, Split};
 use glam::DVec3;
 
-use crate::light::{AreaLightError, Light, MAX_DISC_RADIUS, quantize_direction};
+use crate::light::{
+    AreaLightError, Light, MAX_DISC_RADIUS, cross, plane_along, quantize_direction,
+};
 
 /// A light with extent, or its limit, as a convex set of light points
 /// given by its corners ([`Light`]s, all of one kind):
@@ -797,7 +799,7 @@ impl AreaLight {
         for i in 0..nl {
             for j in 0..no {
                 let planes = [
-                    corner_edge_plane(lv[i], ov[j], ov[(j + 1) % no]),
+                    lv[i].plane_with(ov[j], ov[(j + 1) % no]),
                     edge_corner_plane(lv[i], lv[(i + 1) % nl], ov[j]),
                 ];
                 for h in planes.into_iter().flatten() {
@@ -828,19 +830,6 @@ fn umbra_volume(from_corner: &[Option<HalfSpaces>]) -> Option<HalfSpaces> {
     Some(u)
 }
 
-/// The plane through the light corner `l` and the occluder edge `a, b`
-/// (for a direction, through the edge and parallel to it); `None` where
-/// `l` lies on the edge's line.
-fn corner_edge_plane(l: Light, a: GridPoint, b: GridPoint) -> Option<Plane> {
-    match l {
-        Light::Point(p) => Plane::through(p, a, b).ok(),
-        Light::Directional(d) => {
-            let n = cross(sub(b, a), d.map(i64::from));
-            Plane::new(n, -dot(n, o_at(a)))
-        }
-    }
-}
-
 /// The plane through the light edge `l1, l2` and the occluder corner `o`
 /// (for two directions, through `o` and parallel to both); `None` where
 /// they are collinear (or parallel).
@@ -848,32 +837,10 @@ fn edge_corner_plane(l1: Light, l2: Light, o: GridPoint) -> Option<Plane> {
     match (l1, l2) {
         (Light::Point(a), Light::Point(b)) => Plane::through(a, b, o).ok(),
         (Light::Directional(a), Light::Directional(b)) => {
-            let n = cross(a.map(i64::from), b.map(i64::from));
-            Plane::new(n, -dot(n, o_at(o)))
+            plane_along(cross(a.map(i64::from), b.map(i64::from)), o)
         }
         _ => None,
     }
-}
-
-fn sub(a: GridPoint, b: GridPoint) -> [i64; 3] {
-    [0, 1, 2].map(|k| i64::from(a[k]) - i64::from(b[k]))
-}
-
-/// `u × v`, exact for components below `2^31`.
-fn cross(u: [i64; 3], v: [i64; 3]) -> [i64; 3] {
-    [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ]
-}
-
-fn o_at(p: GridPoint) -> [i128; 3] {
-    p.map(i128::from)
-}
-
-fn dot(n: [i64; 3], p: [i128; 3]) -> i128 {
-    (0..3).map(|k| i128::from(n[k]) * p[k]).sum()
 }
 
 /// A box holding an occluder's penumbra volume (see [`Regions::reach`]).

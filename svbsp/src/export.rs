@@ -148,9 +148,25 @@ pub fn json_header(out: &mut impl Write, lights: &[PlacedLight], faces: usize) -
             },
         })
         .collect();
+    json_head(out, &lights, faces)
+}
+
+/// `{"lights":[...],"faces":N,"fragments":[`.
+fn json_head(out: &mut impl Write, lights: &[JsonLight], faces: usize) -> io::Result<()> {
     write!(out, "{{\"lights\":")?;
-    serde_json::to_writer(&mut *out, &lights)?;
-    write!(out, ",\"faces\":{faces},\"fragments\":[")?;
+    serde_json::to_writer(&mut *out, lights)?;
+    write!(out, ",\"faces\":{faces},\"fragments\":[")
+}
+
+/// An OBJ file's first comments: what it holds, and one line per light.
+fn obj_head(out: &mut impl Write, name: &str, lights: &[String], faces: usize) -> io::Result<()> {
+    writeln!(
+        out,
+        "# shadow shadows: the fragments of {faces} faces of {name}"
+    )?;
+    for (i, l) in lights.iter().enumerate() {
+        writeln!(out, "# light {i}: {l}")?;
+    }
     Ok(())
 }
 
@@ -286,13 +302,7 @@ impl ObjWriter {
         lights: &[String],
         faces: usize,
     ) -> io::Result<()> {
-        writeln!(
-            out,
-            "# shadow shadows: the fragments of {faces} faces of {name}"
-        )?;
-        for (i, l) in lights.iter().enumerate() {
-            writeln!(out, "# light {i}: {l}")?;
-        }
+        obj_head(out, name, lights, faces)?;
         if lights.len() > 1 {
             writeln!(
                 out,
@@ -925,18 +935,10 @@ pub fn write_soft(
     match format {
         FragmentFormat::Json => {
             let lights: Vec<JsonLight> = lights.iter().map(json_light).collect();
-            write!(out, "{{\"lights\":")?;
-            serde_json::to_writer(&mut *out, &lights)?;
-            write!(out, ",\"faces\":{faces},\"fragments\":[")?;
+            json_head(out, &lights, faces)?;
         }
         FragmentFormat::Obj => {
-            writeln!(
-                out,
-                "# shadow shadows: the fragments of {faces} faces of {name}"
-            )?;
-            for (i, l) in notes.iter().enumerate() {
-                writeln!(out, "# light {i}: {l}")?;
-            }
+            obj_head(out, name, notes, faces)?;
             writeln!(
                 out,
                 "# groups: lit (sees all of a light), penumbra (part of one), umbra (none of any){}",

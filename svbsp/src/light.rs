@@ -91,11 +91,17 @@ impl std::error::Error for LightError {
     }
 }
 
-fn sub(a: [i32; 3], b: [i32; 3]) -> [i64; 3] {
+/// The plane with normal `n` through the grid point `a`.
+pub(crate) fn plane_along(n: [i64; 3], a: GridPoint) -> Option<Plane> {
+    let offset = -(0..3).map(|k| n[k] as i128 * a[k] as i128).sum::<i128>();
+    Plane::new(n, offset)
+}
+
+pub(crate) fn sub(a: [i32; 3], b: [i32; 3]) -> [i64; 3] {
     [0, 1, 2].map(|k| a[k] as i64 - b[k] as i64)
 }
 
-fn cross(u: [i64; 3], v: [i64; 3]) -> [i64; 3] {
+pub(crate) fn cross(u: [i64; 3], v: [i64; 3]) -> [i64; 3] {
     [
         u[1] * v[2] - u[2] * v[1],
         u[2] * v[0] - u[0] * v[2],
@@ -159,6 +165,16 @@ impl Light {
         }
     }
 
+    /// The plane through the light and the points `a`, `b` (for a sun,
+    /// through them and parallel to its direction), unoriented; `None`
+    /// where the light lies on their line.
+    pub(crate) fn plane_with(&self, a: GridPoint, b: GridPoint) -> Option<Plane> {
+        match self {
+            Light::Point(l) => Plane::through(*l, a, b).ok(),
+            Light::Directional(d) => plane_along(cross(sub(b, a), d.map(i64::from)), a),
+        }
+    }
+
     /// The shadow plane of the edge `a → b` of a polygon with grid
     /// vertices: the plane through the light and the edge (for a sun, the
     /// plane through the edge parallel to the direction), oriented so that
@@ -169,14 +185,7 @@ impl Light {
     /// 2^55` and `|d| < 2^83`, and for a sun `n = (b - a) × D` has
     /// `|n_i| < 2^54`, `|d| < 2^82` (see `docs/architecture.md`).
     pub fn edge_plane(&self, a: GridPoint, b: GridPoint, inside: GridPoint) -> Option<Plane> {
-        let p = match self {
-            Light::Point(l) => Plane::through(*l, a, b).ok()?,
-            Light::Directional(d) => {
-                let n = cross(sub(b, a), d.map(i64::from));
-                let off = -(0..3).map(|k| n[k] as i128 * a[k] as i128).sum::<i128>();
-                Plane::new(n, off)?
-            }
-        };
+        let p = self.plane_with(a, b)?;
         match p.classify_grid(inside) {
             Side::Back => Some(p),
             Side::Front => Some(p.flip()),

@@ -313,6 +313,18 @@ fn a_face_between_the_light_and_an_occluder_is_lit() {
     );
 }
 
+/// The faces snapped to `grid` as occluders (those that stay convex
+/// polygons with area).
+fn snapped(faces: &[Vec<DVec3>], grid: &bsp_core::Grid) -> Vec<Occluder> {
+    faces
+        .iter()
+        .filter_map(|f| {
+            let l: Vec<[i32; 3]> = f.iter().map(|&v| grid.snap(v).unwrap()).collect();
+            Occluder::new(&l).ok()
+        })
+        .collect()
+}
+
 /// Chin & Feiner's 258-polygon scene under a square light: every face's
 /// fragments tile it, and the result is the same on one thread as on
 /// several.
@@ -334,14 +346,7 @@ fn classified_scenes_tile_their_faces_on_any_thread_count() {
         corner(1.0, -1.0),
     ])
     .unwrap();
-    let faces: Vec<Occluder> = spec
-        .faces
-        .iter()
-        .filter_map(|f| {
-            let l: Vec<[i32; 3]> = f.iter().map(|&v| grid.snap(v).unwrap()).collect();
-            Occluder::new(&l).ok()
-        })
-        .collect();
+    let faces = snapped(&spec.faces, &grid);
     assert!(faces.len() > 200);
     let run = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
@@ -666,14 +671,7 @@ fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
 fn the_near_occluders_are_all_that_matter() {
     let spec = bsp_fixtures::scenes::scene("cf258");
     let grid = bsp_core::Grid::fit_points(spec.faces.iter().flatten()).unwrap();
-    let faces: Vec<Occluder> = spec
-        .faces
-        .iter()
-        .filter_map(|f| {
-            let l: Vec<[i32; 3]> = f.iter().map(|&v| grid.snap(v).unwrap()).collect();
-            Occluder::new(&l).ok()
-        })
-        .collect();
+    let faces = snapped(&spec.faces, &grid);
     let (lo, hi) = faces.iter().flat_map(|f| f.corners()).fold(
         ([i32::MAX; 3], [i32::MIN; 3]),
         |(lo, hi), c| {
