@@ -54,16 +54,29 @@ fn square_light(x0: i32, y0: i32, side: i32, h: i32) -> [[i32; 3]; 4] {
     ]
 }
 
+/// The faces as polygons, each tagged with its index.
+fn polygons(faces: &[Vec<[i32; 3]>]) -> Vec<Polygon> {
+    faces
+        .iter()
+        .enumerate()
+        .map(|(i, f)| Polygon::from_grid_points(f, i as u32).unwrap())
+        .collect()
+}
+
+/// Whether every verdict but the degenerate ones (segments that only
+/// graze an occluder) is `want`.
+fn all_are(verdicts: &[Verdict], want: Verdict) -> bool {
+    verdicts
+        .iter()
+        .all(|v| *v == want || matches!(v, Verdict::Degenerate { .. }))
+}
+
 /// The samples' verdicts at `x` on the ground (face 0 of `faces`) and the
 /// irradiance-weighted share of lit samples: the light's lattice points
 /// with odd coordinates (the centres of a `2 × 2` tiling, so the
 /// weighted share is a midpoint rule for the form factor).
 fn sampled(faces: &[Vec<[i32; 3]>], light: &[[i32; 3]; 4], x: [i32; 3]) -> (Vec<Verdict>, f64) {
-    let polys: Vec<Polygon> = faces
-        .iter()
-        .enumerate()
-        .map(|(i, f)| Polygon::from_grid_points(f, i as u32).unwrap())
-        .collect();
+    let polys = polygons(faces);
     let scene = Scene::from_polygons(&polys);
     let (lo, hi) = (light[0], light[2]);
     let hx = HPoint::grid(x.map(i64::from));
@@ -97,16 +110,13 @@ fn check(faces: &[Vec<[i32; 3]>], light: &[[i32; 3]; 4], x: [i32; 3]) -> Visibil
     let ground = *occluders[0].plane();
     let view = area.view(x, Some(&ground), &occluders).unwrap();
     let (verdicts, share) = sampled(faces, light, x);
-    let degenerate = |v: &Verdict| matches!(v, Verdict::Degenerate { .. });
     match view.visibility {
         Visibility::All => assert!(
-            verdicts.iter().all(|v| *v == Verdict::Lit || degenerate(v)),
+            all_are(&verdicts, Verdict::Lit),
             "{x:?} sees all of the light, yet a sample is shadowed"
         ),
         Visibility::None => assert!(
-            verdicts
-                .iter()
-                .all(|v| *v == Verdict::Shadowed || degenerate(v)),
+            all_are(&verdicts, Verdict::Shadowed),
             "{x:?} sees none of the light, yet a sample is lit"
         ),
         Visibility::Part => {}
@@ -391,11 +401,7 @@ fn classified_scenes_tile_their_faces_on_any_thread_count() {
 /// shadow volumes.
 fn lit_areas(light: &AreaLight, point: Light, faces: &[Vec<[i32; 3]>]) -> (Vec<f64>, Vec<f64>) {
     let occluders: Vec<Occluder> = faces.iter().map(|f| Occluder::new(f).unwrap()).collect();
-    let polys: Vec<Polygon> = faces
-        .iter()
-        .enumerate()
-        .map(|(i, f)| Polygon::from_grid_points(f, i as u32).unwrap())
-        .collect();
+    let polys = polygons(faces);
     let area = light
         .classify_faces(&occluders)
         .iter()
@@ -500,11 +506,7 @@ fn sun_disc_fragments_agree_with_sampled_directions() {
             }
         }
         let occluders: Vec<Occluder> = faces.iter().map(|f| Occluder::new(f).unwrap()).collect();
-        let polys: Vec<Polygon> = faces
-            .iter()
-            .enumerate()
-            .map(|(i, f)| Polygon::from_grid_points(f, i as u32).unwrap())
-            .collect();
+        let polys = polygons(&faces);
         let scene = Scene::from_polygons(&polys);
         let lattice: Vec<Light> = samples[32..].to_vec();
         shares += check_disc_shares(&sun, &occluders, &scene, &lattice);
@@ -516,14 +518,13 @@ fn sun_disc_fragments_agree_with_sampled_directions() {
             };
             let hx = HPoint::grid(x.map(i64::from));
             let lit: Vec<Verdict> = samples.iter().map(|s| scene.verdict(s, 0, &hx)).collect();
-            let degenerate = |v: &Verdict| matches!(v, Verdict::Degenerate { .. });
             match f.class {
                 AreaClass::Lit => assert!(
-                    lit.iter().all(|v| *v == Verdict::Lit || degenerate(v)),
+                    all_are(&lit, Verdict::Lit),
                     "{x:?} is lit, yet a direction of the disc is blocked"
                 ),
                 AreaClass::Umbra => assert!(
-                    lit.iter().all(|v| *v == Verdict::Shadowed || degenerate(v)),
+                    all_are(&lit, Verdict::Shadowed),
                     "{x:?} is umbra, yet a direction of the disc is open"
                 ),
                 AreaClass::Penumbra | AreaClass::Undecided => {}
