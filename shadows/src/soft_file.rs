@@ -77,7 +77,7 @@ pub fn write_soft_shadows(
         .filter_map(|p| Some((Occluder::of_polygon(p)?, p.tag())))
         .unzip();
     let lights: Vec<AreaLight> = scene.lights.iter().map(|l| l.light.clone()).collect();
-    let fragments = svbsp::soft_shadows(&lights, &occluders);
+    let fragments = svbsp::soft_shadows(&lights, &occluders).map_err(Error::Light)?;
     phases.push(("shadows", start.elapsed()));
     progress.advance(1);
     progress.phase("writing", 1);

@@ -88,7 +88,8 @@ impl Classes {
 /// Every face of `faces` cut into fragments of one class per light, with
 /// all the other faces as occluders (see the module docs), in face order;
 /// the faces in parallel, the same result for every thread count. At most
-/// 64 lights (the classes are bits of a `u64`): more panic.
+/// [`MAX_LIGHTS`] lights (the classes are bits of a `u64`): more are
+/// [`LightError::TooMany`].
 ///
 /// ```
 /// use svbsp::{AreaClass, AreaLight, Occluder, soft_shadows};
@@ -100,7 +101,7 @@ impl Classes {
 ///     Occluder::new(&[[-200, -200, 0], [200, -200, 0], [200, 200, 0], [-200, 200, 0]]).unwrap(),
 ///     Occluder::new(&[[0, 0, 40], [40, 0, 40], [40, 40, 40], [0, 40, 40]]).unwrap(),
 /// ];
-/// let all = soft_shadows(&lights, &faces);
+/// let all = soft_shadows(&lights, &faces).unwrap();
 /// let ground = &all[0];
 /// // under the roof's middle: umbra of both
 /// assert!(ground.iter().any(|f| f.class(0) == AreaClass::Umbra && f.class(1) == AreaClass::Umbra));
@@ -110,8 +111,13 @@ impl Classes {
 /// assert!(0.0 <= share.min && share.min <= share.max && share.max <= 1.0);
 /// assert!(share.centroid > 0.0 && share.centroid < 1.0);
 /// ```
-pub fn soft_shadows(lights: &[AreaLight], faces: &[Occluder]) -> Vec<Vec<SoftFragment>> {
-    assert!(lights.len() <= 64, "at most 64 lights");
+pub fn soft_shadows(
+    lights: &[AreaLight],
+    faces: &[Occluder],
+) -> Result<Vec<Vec<SoftFragment>>, LightError> {
+    if lights.len() > MAX_LIGHTS {
+        return Err(LightError::TooMany(lights.len()));
+    }
     let regions: Vec<Vec<Option<Regions>>> = lights
         .iter()
         .map(|l| faces.par_iter().map(|o| l.regions(o)).collect())
@@ -121,14 +127,14 @@ pub fn soft_shadows(lights: &[AreaLight], faces: &[Occluder]) -> Vec<Vec<SoftFra
         .zip(&regions)
         .map(|(l, r)| near_lists(l.corners(), faces, r))
         .unzip();
-    faces
+    Ok(faces
         .par_iter()
         .enumerate()
         .map(|(i, face)| {
             let near: Vec<&[u32]> = near.iter().map(|n| &n[i][..]).collect();
             soft_face(lights, faces, (&regions, &reach), &near, face)
         })
-        .collect()
+        .collect())
 }
 
 impl AreaLight {

@@ -548,7 +548,7 @@ fn check_disc_shares(
     scene: &Scene,
     lattice: &[Light],
 ) -> usize {
-    let fragments = &svbsp::soft_shadows(std::slice::from_ref(sun), occluders)[0];
+    let fragments = &svbsp::soft_shadows(std::slice::from_ref(sun), occluders).unwrap()[0];
     let mut checked = 0;
     for f in fragments
         .iter()
@@ -588,6 +588,10 @@ fn bad_sun_discs_are_errors() {
     assert!(e.to_string().contains("(given 57.29"), "{e}");
     assert!(AreaLight::sun_disc(glam::DVec3::Z, f64::NAN).is_err());
     assert!(AreaLight::point([1 << 27, 0, 0]).is_err());
+    // at most 64 lights at once
+    let many = vec![AreaLight::point([0, 0, 9]).unwrap(); 65];
+    let e = svbsp::soft_shadows(&many, &[]).unwrap_err();
+    assert_eq!(e, svbsp::LightError::TooMany(65));
 }
 
 /// Several lights at once (a square light, a sun disc, a point light):
@@ -609,7 +613,7 @@ fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
             faces.push(o);
         }
     }
-    let all = svbsp::soft_shadows(&lights, &faces);
+    let all = svbsp::soft_shadows(&lights, &faces).unwrap();
     let alone: Vec<Vec<svbsp::AreaFragment>> = lights
         .iter()
         .map(|l| l.classify_face(&faces[0], &faces))
@@ -657,7 +661,8 @@ fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
         .num_threads(1)
         .build()
         .unwrap()
-        .install(|| svbsp::soft_shadows(&lights, &shuffled));
+        .install(|| svbsp::soft_shadows(&lights, &shuffled))
+        .unwrap();
     for (s, &i) in order.iter().enumerate() {
         assert_eq!(key(&one[s]), key(&all[i]), "face {i}");
     }
