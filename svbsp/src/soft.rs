@@ -452,7 +452,7 @@ pub fn shared_soft_grid(
 }
 
 /// Every light of a soft-shadow run on `grid`, numbered in order: the
-/// placed point lights and suns (`placed`, from [`place_lights`]), then
+/// placed point lights and suns (`placed`, from [`crate::place_lights`]), then
 /// `specs`. Errors name the light by its number.
 pub fn place_soft_lights(
     grid: &Grid,
