@@ -617,34 +617,6 @@ pub(crate) fn may_reach(face: &[[i64; 2]; 3], reach: &[[i64; 2]; 3]) -> bool {
 }
 
 impl AreaLight {
-    /// `face` cut into fragments of one class each (see the module docs),
-    /// with every other face of `occluders` as an occluder (`face` may be
-    /// among them: it hides nothing from its own points). Adjacent pieces
-    /// of one class are merged where their union is convex. Where the
-    /// light lies wholly behind the face's plane, the face is umbra
-    /// (attached shadow); where it lies partly behind, no point of the
-    /// face sees all of it.
-    ///
-    /// ```
-    /// use svbsp::{AreaClass, AreaLight, Occluder};
-    /// let light = AreaLight::new(&[[0, 0, 80], [0, 40, 80], [40, 40, 80], [40, 0, 80]]).unwrap();
-    /// let ground = Occluder::new(&[[-200, -200, 0], [200, -200, 0], [200, 200, 0], [-200, 200, 0]]).unwrap();
-    /// let roof = Occluder::new(&[[0, 0, 40], [40, 0, 40], [40, 40, 40], [0, 40, 40]]).unwrap();
-    /// let fragments = light.classify_face(&ground, &[ground.clone(), roof]);
-    /// let has = |c| fragments.iter().any(|f| f.class == c);
-    /// assert!(has(AreaClass::Lit) && has(AreaClass::Penumbra) && has(AreaClass::Umbra));
-    /// assert!(!has(AreaClass::Undecided));
-    /// ```
-    pub fn classify_face(&self, face: &Occluder, occluders: &[Occluder]) -> Vec<AreaFragment> {
-        let regions: Vec<(usize, Regions)> = occluders
-            .iter()
-            .enumerate()
-            .filter(|(_, o)| o.polygon.vertices() != face.polygon.vertices())
-            .filter_map(|(i, o)| Some((i, self.regions(o)?)))
-            .collect();
-        self.classify_with(face, regions.iter().map(|(_, r)| (r, EVERYWHERE)))
-    }
-
     /// [`AreaLight::classify_face`] with the occluders' regions given.
     pub(crate) fn classify_with<'r>(
         &self,

@@ -43,6 +43,7 @@
 mod area;
 mod areas;
 mod arena;
+mod blockers;
 mod chin_feiner;
 mod engine;
 pub mod export;

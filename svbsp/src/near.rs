@@ -8,17 +8,20 @@ use bsp_core::GridPoint;
 use rayon::prelude::*;
 
 use crate::area::{Box3, Occluder, Regions, grid_box, may_reach, overlap};
+use crate::blockers::plane_key;
 use crate::light::Light;
 
-/// Per face, the indices of the other faces whose penumbra volume
-/// (`regions`, per face; `None`: it hides nothing) may meet it, in index
-/// order; and per face, a box of its penumbra volume within the scene.
+/// Per receiving face, the indices of the occluders not in its plane whose
+/// penumbra volume (`regions`, per occluder; `None`: it hides nothing) may
+/// meet it, in index order; and per occluder, a box of its penumbra
+/// volume within the scene.
 pub(crate) fn near_lists(
     lights: &[Light],
     faces: &[Occluder],
-    regions: &[Option<Regions>],
+    (occluders, regions): (&[Occluder], &[Option<Regions>]),
 ) -> (Vec<Vec<u32>>, Vec<Box3>) {
     let exact: Vec<[[i64; 2]; 3]> = faces.iter().map(|f| grid_box(f.corners())).collect();
+    let planes: Vec<_> = faces.iter().map(|f| plane_key(f.plane())).collect();
     let boxes: Vec<Box3> = exact
         .iter()
         .map(|b| b.map(|[lo, hi]| [lo as f64, hi as f64]))
@@ -27,7 +30,7 @@ pub(crate) fn near_lists(
         return (Vec::new(), Vec::new());
     };
     let grid = CellGrid::new(scene, &boxes);
-    let reaches: Vec<Box3> = faces
+    let reaches: Vec<Box3> = occluders
         .par_iter()
         .map(|f| penumbra_box(lights, f.corners(), scene))
         .collect();
@@ -38,9 +41,13 @@ pub(crate) fn near_lists(
             let mut hit = Vec::new();
             if let Some(r) = r {
                 let reach = reaches[j];
+                let plane = plane_key(occluders[j].plane());
                 grid.visit(reach, |i| {
                     let i = i as usize;
-                    if i != j && overlap(&boxes[i], &reach) && may_reach(&exact[i], &r.reach) {
+                    if planes[i] != plane
+                        && overlap(&boxes[i], &reach)
+                        && may_reach(&exact[i], &r.reach)
+                    {
                         hit.push(i as u32);
                     }
                 });

@@ -14,7 +14,10 @@ use bsp_core::{Grid, GridPoint, MAX_COORD, Polygon};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use crate::area::{AreaClass, AreaFragment, AreaLight, Box3, Occluder, Regions, merge_convex};
+use crate::area::{
+    AreaClass, AreaFragment, AreaLight, Box3, EVERYWHERE, Occluder, Regions, merge_convex,
+};
+use crate::blockers::{coplanar_blockers, plane_key};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
 use crate::near::near_lists;
 
@@ -118,26 +121,57 @@ pub fn soft_shadows(
     if lights.len() > MAX_LIGHTS {
         return Err(LightError::TooMany(lights.len()));
     }
+    let blockers = coplanar_blockers(faces);
     let regions: Vec<Vec<Option<Regions>>> = lights
         .iter()
-        .map(|l| faces.par_iter().map(|o| l.regions(o)).collect())
+        .map(|l| blockers.par_iter().map(|o| l.regions(o)).collect())
         .collect();
     let (near, reach): (Vec<Vec<Vec<u32>>>, Vec<Vec<Box3>>) = lights
         .iter()
         .zip(&regions)
-        .map(|(l, r)| near_lists(l.corners(), faces, r))
+        .map(|(l, r)| near_lists(l.corners(), faces, (&blockers, r)))
         .unzip();
     Ok(faces
         .par_iter()
         .enumerate()
         .map(|(i, face)| {
             let near: Vec<&[u32]> = near.iter().map(|n| &n[i][..]).collect();
-            soft_face(lights, faces, (&regions, &reach), &near, face)
+            soft_face(lights, &blockers, (&regions, &reach), &near, face)
         })
         .collect())
 }
 
 impl AreaLight {
+    /// `face` cut into fragments of one class each (see the module docs),
+    /// with the faces of `occluders` not in its plane as occluders (`face`
+    /// may be among them: it hides nothing from its own points), those of
+    /// one plane that share an edge merged where their union is convex. Adjacent pieces
+    /// of one class are merged where their union is convex. Where the
+    /// light lies wholly behind the face's plane, the face is umbra
+    /// (attached shadow); where it lies partly behind, no point of the
+    /// face sees all of it.
+    ///
+    /// ```
+    /// use svbsp::{AreaClass, AreaLight, Occluder};
+    /// let light = AreaLight::new(&[[0, 0, 80], [0, 40, 80], [40, 40, 80], [40, 0, 80]]).unwrap();
+    /// let ground = Occluder::new(&[[-200, -200, 0], [200, -200, 0], [200, 200, 0], [-200, 200, 0]]).unwrap();
+    /// let roof = Occluder::new(&[[0, 0, 40], [40, 0, 40], [40, 40, 40], [0, 40, 40]]).unwrap();
+    /// let fragments = light.classify_face(&ground, &[ground.clone(), roof]);
+    /// let has = |c| fragments.iter().any(|f| f.class == c);
+    /// assert!(has(AreaClass::Lit) && has(AreaClass::Penumbra) && has(AreaClass::Umbra));
+    /// assert!(!has(AreaClass::Undecided));
+    /// ```
+    pub fn classify_face(&self, face: &Occluder, occluders: &[Occluder]) -> Vec<AreaFragment> {
+        let own = plane_key(face.plane());
+        let blockers = coplanar_blockers(occluders);
+        let regions: Vec<Regions> = blockers
+            .iter()
+            .filter(|o| plane_key(o.plane()) != own)
+            .filter_map(|o| self.regions(o))
+            .collect();
+        self.classify_with(face, regions.iter().map(|r| (r, EVERYWHERE)))
+    }
+
     /// Every face of `faces` cut into fragments of one class each, with
     /// all the others as occluders: [`AreaLight::classify_face`] for each,
     /// each occluder's volumes built once and met only by the faces near
@@ -155,8 +189,9 @@ impl AreaLight {
     /// assert!(all[1].iter().all(|f| f.class == AreaClass::Lit)); // the roof
     /// ```
     pub fn classify_faces(&self, faces: &[Occluder]) -> Vec<Vec<AreaFragment>> {
-        let regions: Vec<Option<Regions>> = faces.par_iter().map(|o| self.regions(o)).collect();
-        let (near, reach) = near_lists(self.corners(), faces, &regions);
+        let blockers = coplanar_blockers(faces);
+        let regions: Vec<Option<Regions>> = blockers.par_iter().map(|o| self.regions(o)).collect();
+        let (near, reach) = near_lists(self.corners(), faces, (&blockers, &regions));
         faces
             .par_iter()
             .zip(&near)
@@ -174,7 +209,7 @@ impl AreaLight {
 /// part of light `k` from it.
 fn soft_face(
     lights: &[AreaLight],
-    faces: &[Occluder],
+    blockers: &[Occluder],
     (regions, reach): (&[Vec<Option<Regions>>], &[Vec<Box3>]),
     near: &[&[u32]],
     face: &Occluder,
@@ -185,7 +220,7 @@ fn soft_face(
         .iter()
         .map(|n| {
             let mut n: Vec<usize> = n.iter().map(|&j| j as usize).collect();
-            n.sort_by(|&a, &b| faces[a].corners().cmp(faces[b].corners()));
+            n.sort_by(|&a, &b| blockers[a].corners().cmp(blockers[b].corners()));
             n
         })
         .collect();
@@ -208,7 +243,7 @@ fn soft_face(
                     let penumbra = (c.lit | c.umbra) >> k & 1 == 0;
                     let among = near[k]
                         .iter()
-                        .filter_map(|&j| Some((&faces[j], regions[k][j].as_ref()?)));
+                        .filter_map(|&j| Some((&blockers[j], regions[k][j].as_ref()?)));
                     penumbra
                         .then(|| share(&lights[k], face, &polygon, among))
                         .flatten()

@@ -716,3 +716,41 @@ fn the_near_occluders_are_all_that_matter() {
         assert!(classes.len() >= 3, "{classes:?}");
     }
 }
+
+/// A square occluder over the ground under a square light, in closed
+/// form: light `[0, 40]²` at height 80, occluder `[0, 40]²` at height 40;
+/// light point `l` shadows `2o − l`, so on the ground the umbra is the
+/// intersection over `l` of `[−l, 80 − l]²`, `[0, 40]²` (1,600), and the
+/// penumbra reaches their union `[−40, 80]²` (14,400). The same square
+/// split into two triangles (faces of one plane sharing an edge, as a mesh
+/// gives it) casts exactly the same regions: its halves are merged into
+/// one occluder, so its umbra is umbra, not undecided.
+#[test]
+fn a_square_and_its_two_triangles_cast_the_same_umbra() {
+    let light = AreaLight::new(&square_light(0, 0, 40, 80)).unwrap();
+    let q = [[0, 0, 40], [40, 0, 40], [40, 40, 40], [0, 40, 40]];
+    let ground = Occluder::new(&ground(200)).unwrap();
+    let whole = vec![ground.clone(), Occluder::new(&q).unwrap()];
+    let halves = vec![
+        ground.clone(),
+        Occluder::new(&[q[0], q[1], q[2]]).unwrap(),
+        Occluder::new(&[q[0], q[2], q[3]]).unwrap(),
+    ];
+    let areas = |faces: &[Occluder]| -> [f64; 4] {
+        let mut a = [0.0; 4];
+        for f in light.classify_face(&ground, faces) {
+            a[f.class as usize] += area_of(&f.polygon);
+        }
+        a
+    };
+    let total = 400.0 * 400.0;
+    let mut want = [0.0; 4];
+    want[AreaClass::Lit as usize] = total - 14_400.0;
+    want[AreaClass::Penumbra as usize] = 14_400.0 - 1_600.0;
+    want[AreaClass::Umbra as usize] = 1_600.0;
+    for got in [areas(&whole), areas(&halves)] {
+        for k in 0..4 {
+            assert!((got[k] - want[k]).abs() < 1e-6, "{got:?} against {want:?}");
+        }
+    }
+}
