@@ -258,6 +258,9 @@ fn soft_shadows(
         scene.light_count()
     );
     report += &fig.report();
+    if args.stats {
+        report += &fig.stats_text(job.faces);
+    }
     emit(&report)
 }
 

@@ -760,10 +760,17 @@ fn point_lights_and_suns_among_soft_lights_keep_their_shadows() {
         input.to_str().unwrap(),
         "--area-light",
         "0.65,0.65,2;0.65,0.85,2;0.85,0.85,2;0.85,0.65,2",
+        "--stats",
         "-o",
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+    let report = stdout(&o);
+    assert!(report.contains("light 0: lit "), "{report}");
+    assert!(
+        report.contains("per face)") && report.contains("time: "),
+        "{report}"
+    );
     let text = std::fs::read_to_string(&out).unwrap();
     for g in ["g lit", "g penumbra", "g umbra"] {
         assert!(text.lines().any(|l| l == g), "no `{g}` in\n{text}");

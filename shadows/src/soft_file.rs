@@ -40,6 +40,21 @@ pub struct SoftFile {
 }
 
 impl SoftFile {
+    /// The `--stats` lines: fragments (per face) and the phases' times.
+    pub fn stats_text(&self, faces: usize) -> String {
+        let n = self.written.fragments;
+        let times: Vec<String> = self
+            .phases
+            .iter()
+            .map(|(name, d)| format!("{name} {:.2} ms", d.as_secs_f64() * 1e3))
+            .collect();
+        format!(
+            "fragments:       {n} ({:.3} per face)\ntime:            {}\n",
+            n as f64 / faces.max(1) as f64,
+            times.join(", ")
+        )
+    }
+
     /// One line per light: the shares of the area lit, in penumbra (and
     /// of it undecided) and in umbra.
     pub fn report(&self) -> String {
