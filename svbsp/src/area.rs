@@ -64,10 +64,60 @@ pub struct AreaLight {
 /// polygon's area is `8 tan(π/8) / π ≈ 1.055` times the disc's.
 pub const DISC_SIDES: usize = 8;
 
-/// `det[a; b; c]`, exact for components below `2^40`.
-fn det3(a: [i128; 3], b: [i128; 3], c: [i128; 3]) -> i128 {
-    a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-        + a[2] * (b[0] * c[1] - b[1] * c[0])
+/// An upper bound of `sin² r`: `sin r` rounded up by one unit in the last
+/// place (the platform's `sin` is within one), squared and rounded up.
+fn upper_sin2(r: f64) -> f64 {
+    let s = r.sin().next_up();
+    (s * s).next_up()
+}
+
+/// Whether the polygon of directions `corners` turns counter-clockwise
+/// about `q`, strictly convex, and holds every direction within the angle
+/// whose squared sine is at most `sin2` of `q`: for each edge's normal
+/// `n = c_i × c_(i+1)`, `n · q > 0` and `(n · q)² ≥ sin2 · |n|² |q|²`,
+/// decided exactly (`sin2` is a dyadic rational).
+fn holds_disc(corners: &[[i32; 3]], q: [i32; 3], sin2: f64) -> bool {
+    use bnum::types::U512;
+    let k = corners.len();
+    let wide = |p: [i32; 3]| p.map(i128::from);
+    let dot = |a: [i128; 3], b: [i128; 3]| (0..3).map(|i| a[i] * b[i]).sum::<i128>();
+    let cross = |a: [i128; 3], b: [i128; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let q = wide(q);
+    // sin2 = m · 2^-e, m < 2^53
+    let bits = sin2.to_bits();
+    let (exp, frac) = ((bits >> 52) as i64, bits & ((1 << 52) - 1));
+    let (m, e) = if exp == 0 {
+        (frac, 1074)
+    } else {
+        (frac | 1 << 52, 1075 - exp)
+    };
+    (0..k).all(|i| {
+        let (a, b, c) = (
+            wide(corners[i]),
+            wide(corners[(i + 1) % k]),
+            wide(corners[(i + 2) % k]),
+        );
+        let n = cross(a, b);
+        let nq = dot(n, q);
+        // convex, turning one way, and q inside
+        if dot(n, c) <= 0 || nq <= 0 {
+            return false;
+        }
+        // (n·q)² < 2^164, |n|²|q|² < 2^164: A · 2^e ≥ m · B
+        if e >= 240 {
+            return true;
+        }
+        let big = |x: i128| U512::from(x.unsigned_abs());
+        let lhs = (big(nq) * big(nq)) << (e as u32);
+        let rhs = U512::from(m) * big(dot(n, n)) * big(dot(q, q));
+        lhs >= rhs
+    })
 }
 
 /// A face of the scene as area lights meet it, as an occluder or a
@@ -193,14 +243,16 @@ impl AreaLight {
     }
 
     /// The sun as a disc of the sky: the directions within the angular
-    /// `radius` (radians) of `direction` (from the scene toward the sun),
-    /// bounded by a regular polygon of [`DISC_SIDES`] directions that
-    /// contains the disc (circumscribed, and widened by more than the
-    /// quantization of its corners, see [`quantize_direction`]). What is
-    /// classified lit therefore sees all of the true disc, and what is
-    /// umbra sees none of it; the penumbra is a little wider than the
-    /// disc's. A radius of 0 is [`AreaLight::sun`] of the quantized
-    /// direction.
+    /// `radius` (radians) of `direction` (from the scene toward the sun)
+    /// once quantized ([`quantize_direction`], as for a sun: within
+    /// a ten-millionth of a degree of the given one), bounded by a regular polygon of
+    /// [`DISC_SIDES`] quantized directions that contains the disc: each
+    /// edge's plane is checked exactly to leave the whole disc inside (with
+    /// `sin r` rounded up), and a polygon that fails is widened by one
+    /// quantization step and built again. What is classified lit
+    /// therefore sees all of the disc, and what is umbra sees none of it;
+    /// the penumbra is a little wider than the disc's. A radius of 0 is
+    /// [`AreaLight::sun`] of the quantized direction.
     ///
     /// ```
     /// use glam::DVec3;
@@ -218,38 +270,31 @@ impl AreaLight {
         if radius == 0.0 {
             return Self::sun(q);
         }
-        let d = direction.normalize();
-        // an orthonormal frame about d, and the circumscribed polygon in
-        // the tangent plane at distance 1, widened by the corners'
-        // quantization (under 1.3e-8 rad each) and f64 rounding
+        // an orthonormal frame about the quantized centre, and the
+        // circumscribed polygon in the tangent plane at distance 1
+        let d = DVec3::from_array(q.map(f64::from)).normalize();
         let u = d.any_orthonormal_vector();
         let v = d.cross(u);
         let step = std::f64::consts::TAU / DISC_SIDES as f64;
-        let widen = 4.0 / MAX_COORD as f64;
-        let reach = (radius.tan() + widen) / (step / 2.0).cos() * (1.0 + 1e-9);
-        let corners: Option<Vec<Light>> = (0..DISC_SIDES)
-            .map(|i| {
-                let a = step * i as f64;
-                let c = d + (u * a.cos() + v * a.sin()) * reach;
-                quantize_direction(c).map(Light::Directional)
-            })
-            .collect();
-        let corners = corners.ok_or(bad.clone())?;
-        // the quantized corners still turn one way about d, strictly
-        let turns = (0..DISC_SIDES).all(|i| {
-            let [a, b, c] = [0, 1, 2].map(|k| match corners[(i + k) % DISC_SIDES] {
-                Light::Directional(x) => x.map(i128::from),
-                Light::Point(_) => unreachable!("disc corners are directions"),
-            });
-            det3(a, b, c) > 0
-        });
-        if !turns {
-            return Err(bad);
+        let mut reach = radius.tan() / (step / 2.0).cos();
+        let sin2 = upper_sin2(radius);
+        for _ in 0..64 {
+            let corners: Option<Vec<[i32; 3]>> = (0..DISC_SIDES)
+                .map(|i| {
+                    let a = step * i as f64;
+                    quantize_direction(d + (u * a.cos() + v * a.sin()) * reach)
+                })
+                .collect();
+            let corners = corners.ok_or(bad.clone())?;
+            if holds_disc(&corners, q, sin2) {
+                return Ok(AreaLight {
+                    corners: corners.into_iter().map(Light::Directional).collect(),
+                    polygon: None,
+                });
+            }
+            reach += 1.0 / f64::from(MAX_COORD);
         }
-        Ok(AreaLight {
-            corners,
-            polygon: None,
-        })
+        Err(bad)
     }
 
     /// The corners, in order (without repeated or collinear ones): grid
@@ -1020,8 +1065,8 @@ fn separating(h: &Plane, lv: &[Light], ov: &[GridPoint]) -> Option<Side> {
     }
 }
 
-/// A box per axis, `[lo, hi]`, in grid units.
-pub(crate) type Box3 = [[f64; 2]; 3];
+/// A box per axis, `[lo, hi]`, in grid units (exact integers).
+pub(crate) type Box3 = [[i64; 2]; 3];
 
 /// Whether two boxes meet (touching counts).
 pub(crate) fn overlap(a: &Box3, b: &Box3) -> bool {
@@ -1029,19 +1074,35 @@ pub(crate) fn overlap(a: &Box3, b: &Box3) -> bool {
 }
 
 /// A box holding every point.
-pub(crate) const EVERYWHERE: Box3 = [[f64::NEG_INFINITY, f64::INFINITY]; 3];
+pub(crate) const EVERYWHERE: Box3 = [[i64::MIN, i64::MAX]; 3];
 
-/// The box of a polygon's correctly rounded corners, widened by a grid
-/// unit and a billionth against rounding (grid units).
-pub(crate) fn polygon_box(p: &bsp_core::Polygon) -> Box3 {
-    let mut b = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
-    for v in p.vertices_f64() {
+/// The smallest box of integers holding a polygon: each exact corner's
+/// coordinates rounded down and up (`x / w` with `w > 0`, in 256 bits).
+pub(crate) fn polygon_box(p: &Polygon) -> Box3 {
+    use bnum::cast::As;
+    let mut b = [[i64::MAX, i64::MIN]; 3];
+    for v in p.vertices() {
+        let (lo, hi) = match v {
+            bsp_core::Point::Grid(g) => (g.map(i64::from), g.map(i64::from)),
+            bsp_core::Point::Implicit(_) => {
+                let h = v.homogeneous();
+                let w = h[3];
+                let floor_ceil = |x: bnum::types::I256| {
+                    let (q, r) = (x / w, x % w);
+                    let q: i64 = q.as_::<i64>();
+                    match (r.is_zero(), x.is_negative()) {
+                        (true, _) => (q, q),
+                        (false, true) => (q - 1, q),
+                        (false, false) => (q, q + 1),
+                    }
+                };
+                let c = [0, 1, 2].map(|k| floor_ceil(h[k]));
+                (c.map(|c| c.0), c.map(|c| c.1))
+            }
+        };
         for k in 0..3 {
-            b[k] = [b[k][0].min(v[k]), b[k][1].max(v[k])];
+            b[k] = [b[k][0].min(lo[k]), b[k][1].max(hi[k])];
         }
     }
-    b.map(|[lo, hi]| {
-        let m = 1.0 + 1e-9 * (lo.abs() + hi.abs());
-        [lo - m, hi + m]
-    })
+    b
 }

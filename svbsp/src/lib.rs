@@ -64,9 +64,9 @@ pub use engine::{
     ShadowStats, Shadows, Start, receivers, shadow_fragments,
 };
 pub use light::{
-    AreaLightError, LIGHT_RANGE_BITS, Light, LightError, LightSpec, MAX_DISC_RADIUS, MAX_LIGHTS,
-    PlacedLight, SUN_RADIUS_DEG, SoftSpec, angle_between, place_lights, quantize_direction,
-    shared_grid,
+    AreaLightError, LIGHT_RANGE_BITS, Light, LightError, LightSpec, MAX_DISC_RADIUS,
+    MAX_DISC_RADIUS_DEG, MAX_LIGHTS, PlacedLight, SUN_RADIUS_DEG, SoftSpec, angle_between,
+    place_lights, quantize_direction, shared_grid,
 };
 pub use psv::{ShadowVolumes, VolumeError, VolumeSanity};
 pub use soft::{

@@ -293,7 +293,10 @@ pub fn place_lights(grid: &Grid, lights: &[LightSpec]) -> Result<Vec<PlacedLight
 
 /// The largest angular radius of a sun disc, in radians (30°: the real
 /// sun's is 0.2666°).
-pub const MAX_DISC_RADIUS: f64 = std::f64::consts::FRAC_PI_6;
+pub const MAX_DISC_RADIUS: f64 = MAX_DISC_RADIUS_DEG.to_radians();
+
+/// [`MAX_DISC_RADIUS`] in degrees.
+pub const MAX_DISC_RADIUS_DEG: f64 = 30.0;
 
 /// Why corners make no area light (or occluder).
 #[derive(Clone, Debug, PartialEq)]
@@ -344,7 +347,7 @@ impl std::fmt::Display for AreaLightError {
                 direction.x,
                 direction.y,
                 direction.z,
-                (MAX_DISC_RADIUS.to_degrees() * 1e6).round() / 1e6,
+                MAX_DISC_RADIUS_DEG,
                 radius.to_degrees()
             ),
         }

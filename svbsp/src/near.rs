@@ -20,12 +20,8 @@ pub(crate) fn near_lists(
     faces: &[Occluder],
     (occluders, regions): (&[Occluder], &[Option<Regions>]),
 ) -> (Vec<Vec<u32>>, Vec<Box3>) {
-    let exact: Vec<[[i64; 2]; 3]> = faces.iter().map(|f| grid_box(f.corners())).collect();
+    let boxes: Vec<Box3> = faces.iter().map(|f| grid_box(f.corners())).collect();
     let planes: Vec<_> = faces.iter().map(|f| plane_key(f.plane())).collect();
-    let boxes: Vec<Box3> = exact
-        .iter()
-        .map(|b| b.map(|[lo, hi]| [lo as f64, hi as f64]))
-        .collect();
     let Some(scene) = boxes.iter().copied().reduce(union) else {
         return (Vec::new(), Vec::new());
     };
@@ -46,7 +42,7 @@ pub(crate) fn near_lists(
                     let i = i as usize;
                     if planes[i] != plane
                         && overlap(&boxes[i], &reach)
-                        && may_reach(&exact[i], &r.reach)
+                        && may_reach(&boxes[i], &r.reach)
                     {
                         hit.push(i as u32);
                     }
@@ -70,89 +66,74 @@ fn union(a: Box3, b: Box3) -> Box3 {
 }
 
 /// A box holding the part of occluder `o`'s penumbra volume inside
-/// `scene`, widened a little against rounding. Every point of the volume
-/// is `o + t(o − l)` for an occluder point `o`, a light point `l` and
-/// `t ≥ 0` (for a direction `d`, `o − t d`), unless the light touches
-/// the occluder (then it may be anywhere). With `D` the box of the
-/// vectors `o − l`, along an axis on which `D` has one sign the point
-/// leaves the scene once `t` passes a bound `T`, and the volume lies in
-/// `box(O) + [0, T]·D`.
+/// `scene`, in exact integers. Every point of the volume is `o + t(o − l)`
+/// for an occluder point `o`, a light point `l` and `t ≥ 0` (for a
+/// direction `d`, `o − t d`), unless the light touches the occluder (then
+/// it may be anywhere). With `D` the box of the vectors `o − l`, along an
+/// axis on which `D` has one sign the point leaves the scene once `t`
+/// passes a bound `T = num / den` (the least over such axes), and the
+/// volume lies in `box(O) + [0, T]·D`, its bounds rounded outward.
 fn penumbra_box(lights: &[Light], o: &[GridPoint], scene: Box3) -> Box3 {
-    let ob = grid_box(o).map(|[lo, hi]| [lo as f64, hi as f64]);
-    let mut d = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
-    let mut touches = true;
+    let ob = grid_box(o);
+    let points: Vec<GridPoint> = lights
+        .iter()
+        .filter_map(|l| match l {
+            Light::Point(p) => Some(*p),
+            Light::Directional(_) => None,
+        })
+        .collect();
+    // a light point on the occluder's box: the volume may be anywhere
+    if !points.is_empty() && overlap(&grid_box(&points), &ob) {
+        return scene;
+    }
+    let mut d = [[i64::MAX, i64::MIN]; 3];
     for l in lights {
-        let (lo, hi) = match l {
-            Light::Point(p) => {
-                let p = p.map(f64::from);
-                (p, p)
-            }
-            Light::Directional(v) => {
-                touches = false;
-                let v = v.map(|c| -f64::from(c));
-                (v, v)
-            }
-        };
         for k in 0..3 {
             let (a, b) = match l {
-                Light::Point(_) => (ob[k][0] - hi[k], ob[k][1] - lo[k]),
-                Light::Directional(_) => (lo[k], hi[k]),
+                Light::Point(p) => (ob[k][0] - i64::from(p[k]), ob[k][1] - i64::from(p[k])),
+                Light::Directional(v) => (-i64::from(v[k]), -i64::from(v[k])),
             };
             d[k] = [d[k][0].min(a), d[k][1].max(b)];
         }
     }
-    // a light point on the occluder's box: the volume may be anywhere
-    if touches {
-        let lb = grid_box(
-            &lights
-                .iter()
-                .filter_map(|l| match l {
-                    Light::Point(p) => Some(*p),
-                    Light::Directional(_) => None,
-                })
-                .collect::<Vec<_>>(),
-        );
-        let lb = lb.map(|[lo, hi]| [lo as f64, hi as f64]);
-        if overlap(&lb, &ob) {
-            return widen(scene, scene);
-        }
-    }
-    let mut t = f64::INFINITY;
+    // T = num / den, den > 0; None: no bound
+    let mut t: Option<(i128, i128)> = None;
     for k in 0..3 {
-        if d[k][0] > 0.0 {
-            t = t.min((scene[k][1] - ob[k][0]) / d[k][0]);
-        } else if d[k][1] < 0.0 {
-            t = t.min((ob[k][1] - scene[k][0]) / -d[k][1]);
+        let bound = if d[k][0] > 0 {
+            Some((scene[k][1] - ob[k][0], d[k][0]))
+        } else if d[k][1] < 0 {
+            Some((ob[k][1] - scene[k][0], -d[k][1]))
+        } else {
+            None
+        };
+        if let Some((num, den)) = bound {
+            let c = (i128::from(num.max(0)), i128::from(den));
+            if t.is_none_or(|(n, m)| c.0 * m < n * c.1) {
+                t = Some(c);
+            }
         }
     }
-    let t = t.max(0.0) * (1.0 + 1e-9);
+    let Some((num, den)) = t else {
+        return scene;
+    };
     let b = [0, 1, 2].map(|k| {
-        if t.is_finite() {
-            [
-                ob[k][0] + t * d[k][0].min(0.0),
-                ob[k][1] + t * d[k][1].max(0.0),
-            ]
-        } else {
-            [f64::NEG_INFINITY, f64::INFINITY]
-        }
+        let lo = num * i128::from(d[k][0].min(0));
+        let hi = num * i128::from(d[k][1].max(0));
+        [
+            ob[k][0] + lo.div_euclid(den) as i64,
+            ob[k][1] - (-hi).div_euclid(den) as i64,
+        ]
     });
-    widen(b, scene)
-}
-
-/// `b` within `scene`, widened by two grid units and a billionth of the
-/// scene's size against rounding.
-fn widen(b: Box3, scene: Box3) -> Box3 {
-    [0, 1, 2].map(|k| {
-        let m = 2.0 + 1e-9 * (scene[k][1] - scene[k][0]);
-        [b[k][0].max(scene[k][0]) - m, b[k][1].min(scene[k][1]) + m]
-    })
+    [0, 1, 2].map(|k| [b[k][0].max(scene[k][0]), b[k][1].min(scene[k][1])])
 }
 
 /// A uniform grid of cells over the scene, each listing the faces whose
-/// box meets it.
+/// box meets it. A coordinate's cell is `(v − lo)·n / extent`, rounded
+/// down, in integers: it never decreases as `v` grows, so a box meets
+/// every cell of every face box it meets.
 struct CellGrid {
-    lo: [f64; 3],
-    size: [f64; 3],
+    lo: [i64; 3],
+    extent: [i64; 3],
     n: [usize; 3],
     cells: Vec<Vec<u32>>,
 }
@@ -160,14 +141,13 @@ struct CellGrid {
 impl CellGrid {
     /// About one cell per face, cubes as far as the scene's shape allows.
     fn new(scene: Box3, boxes: &[Box3]) -> CellGrid {
-        let extent = scene.map(|[lo, hi]| (hi - lo).max(1.0));
-        let volume: f64 = extent.iter().product();
+        let extent = scene.map(|[lo, hi]| hi - lo + 1);
+        let volume: f64 = extent.iter().map(|&e| e as f64).product();
         let side = (volume / boxes.len().max(1) as f64).cbrt();
-        let n = extent.map(|e| ((e / side).ceil() as usize).clamp(1, 512));
-        let size = [0, 1, 2].map(|k| extent[k] / n[k] as f64);
+        let n = extent.map(|e| ((e as f64 / side).ceil() as usize).clamp(1, 512));
         let mut grid = CellGrid {
             lo: scene.map(|[lo, _]| lo),
-            size,
+            extent,
             n,
             cells: vec![Vec::new(); n[0] * n[1] * n[2]],
         };
@@ -191,9 +171,9 @@ impl CellGrid {
 
     /// The cells a box meets, per axis from and to (inclusive).
     fn range(&self, b: Box3) -> ([usize; 3], [usize; 3]) {
-        let at = |k: usize, v: f64| {
-            let c = ((v - self.lo[k]) / self.size[k]).floor();
-            (c.max(0.0) as usize).min(self.n[k] - 1)
+        let at = |k: usize, v: i64| {
+            let off = i128::from(v.clamp(self.lo[k], self.lo[k] + self.extent[k] - 1) - self.lo[k]);
+            (off * self.n[k] as i128 / i128::from(self.extent[k])) as usize
         };
         (
             [0, 1, 2].map(|k| at(k, b[k][0])),

@@ -342,19 +342,28 @@ fn sky_share<'o>(
     if all <= 0.0 {
         return None;
     }
+    // the planes through x bounding the light's cone, inward
+    let n = sky.len();
+    let cone: Vec<DVec3> = (0..n)
+        .map(|i| {
+            let h = sky[i].cross(sky[(i + 1) % n]);
+            if h.dot(c) < 0.0 { -h } else { h }
+        })
+        .collect();
     let mut seen = vec![reachable];
     for o in occluders {
-        // the occluder's part strictly beyond x along c, seen from x
-        let rel: Vec<DVec3> = o
+        // the occluder's part inside the light's cone from x (where the
+        // chart is defined: every direction there is within the disc's
+        // bounding polygon, so `r · c > 0` unless `r` is x itself)
+        let mut ahead: Vec<DVec3> = o
             .corners()
             .iter()
             .map(|p| DVec3::from_array(p.map(f64::from)) - x)
             .collect();
-        let ahead = clip3(
-            &rel,
-            c,
-            1e-9 * rel.iter().map(|r| r.length()).fold(0.0, f64::max),
-        );
+        for h in &cone {
+            ahead = clip3(&ahead, *h);
+        }
+        ahead.retain(|r| *r != DVec3::ZERO);
         if ahead.len() < 3 {
             continue;
         }
@@ -371,12 +380,12 @@ fn sky_share<'o>(
     Some((left / all).clamp(0.0, 1.0))
 }
 
-/// The part of a 3D polygon where `r · c >= eps`.
-fn clip3(poly: &[DVec3], c: DVec3, eps: f64) -> Vec<DVec3> {
+/// The part of a 3D polygon where `r · h >= 0`.
+fn clip3(poly: &[DVec3], h: DVec3) -> Vec<DVec3> {
     let mut out = Vec::new();
     for (i, &a) in poly.iter().enumerate() {
         let b = poly[(i + 1) % poly.len()];
-        let (da, db) = (a.dot(c) - eps, b.dot(c) - eps);
+        let (da, db) = (a.dot(h), b.dot(h));
         if da >= 0.0 {
             out.push(a);
         }
