@@ -639,12 +639,6 @@ pub(crate) struct Regions {
     /// (`None` where that is empty: a corner in its plane, or corners on
     /// both sides of it).
     pub(crate) umbra: Option<HalfSpaces>,
-    /// A box holding the penumbra volume, per axis `[lo, hi]` (unbounded
-    /// as `i64::MIN` or `i64::MAX`): every point of it is `o + t(o − l)`
-    /// for an occluder point `o`, a light point `l` and `t ≥ 0`, so along
-    /// an axis on which the occluder lies wholly beyond the light it
-    /// starts at the occluder.
-    pub(crate) reach: [[i64; 2]; 3],
 }
 
 /// The box of grid points, per axis `[lo, hi]`.
@@ -653,12 +647,6 @@ pub(crate) fn grid_box(points: &[GridPoint]) -> [[i64; 2]; 3] {
         let c = points.iter().map(|p| i64::from(p[k]));
         [c.clone().min().unwrap_or(0), c.max().unwrap_or(0)]
     })
-}
-
-/// Whether the face's box and an occluder's reach overlap (touching
-/// counts): where they do not, the occluder hides nothing from the face.
-pub(crate) fn may_reach(face: &[[i64; 2]; 3], reach: &[[i64; 2]; 3]) -> bool {
-    (0..3).all(|k| face[k][1] >= reach[k][0] && face[k][0] <= reach[k][1])
 }
 
 impl AreaLight {
@@ -777,7 +765,7 @@ impl AreaLight {
     /// The occluder's regions (see [`Regions`]); `None` where it lies in
     /// the light's plane and hides none of it.
     pub(crate) fn regions(&self, o: &Occluder) -> Option<Regions> {
-        let (lv, ov) = (self.corners(), o.polygon.vertices());
+        let lv = self.corners();
         let light_sides: Vec<Side> = lv.iter().map(|l| sign(l.eval(o.plane()))).collect();
         if light_sides.iter().all(|&s| s == Side::On) {
             return None;
@@ -794,7 +782,6 @@ impl AreaLight {
             penumbra,
             umbra: umbra_volume(&from_corner),
             from_corner,
-            reach: reach(lv, ov),
         })
     }
 
@@ -858,48 +845,6 @@ fn edge_corner_plane(l1: Light, l2: Light, o: GridPoint) -> Option<Plane> {
         }
         _ => None,
     }
-}
-
-/// A box holding an occluder's penumbra volume (see [`Regions::reach`]).
-fn reach(lv: &[Light], ov: &[GridPoint]) -> [[i64; 2]; 3] {
-    let ob = grid_box(ov);
-    let points: Vec<GridPoint> = lv
-        .iter()
-        .filter_map(|l| match l {
-            Light::Point(p) => Some(*p),
-            Light::Directional(_) => None,
-        })
-        .collect();
-    let unbounded = [i64::MIN, i64::MAX];
-    if points.len() == lv.len() {
-        // o + t(o − l), t ≥ 0
-        let lb = grid_box(&points);
-        return [0, 1, 2].map(|k| {
-            let lo = if ob[k][0] >= lb[k][1] {
-                ob[k][0]
-            } else {
-                i64::MIN
-            };
-            let hi = if ob[k][1] <= lb[k][0] {
-                ob[k][1]
-            } else {
-                i64::MAX
-            };
-            [lo, hi]
-        });
-    }
-    // o − t d, t ≥ 0, for directions d toward the light
-    [0, 1, 2].map(|k| {
-        let along = |f: fn(i32) -> bool| {
-            lv.iter()
-                .all(|l| matches!(l, Light::Directional(d) if f(d[k])))
-        };
-        match (along(|c| c > 0), along(|c| c < 0)) {
-            (true, _) => [i64::MIN, ob[k][1]],
-            (_, true) => [ob[k][0], i64::MAX],
-            _ => unbounded,
-        }
-    })
 }
 
 /// A piece of a face being cut for one light, and its state: inside some

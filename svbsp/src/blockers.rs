@@ -62,6 +62,9 @@ pub(crate) fn coplanar_blockers(faces: &[Occluder]) -> Vec<Occluder> {
         polys.sort();
         out.extend(merge_group(polys));
     }
+    // in the order of their corners: every face meets its occluders in
+    // that order (index order), whatever order the faces came in
+    out.sort_by(|a, b| a.corners().cmp(b.corners()));
     out
 }
 

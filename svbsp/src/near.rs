@@ -7,7 +7,7 @@
 use bsp_core::GridPoint;
 use rayon::prelude::*;
 
-use crate::area::{Box3, Occluder, Regions, grid_box, may_reach, overlap};
+use crate::area::{Box3, Occluder, Regions, grid_box, overlap};
 use crate::blockers::plane_key;
 use crate::light::Light;
 
@@ -35,15 +35,12 @@ pub(crate) fn near_lists(
         .enumerate()
         .flat_map_iter(|(j, r)| {
             let mut hit = Vec::new();
-            if let Some(r) = r {
+            if r.is_some() {
                 let reach = reaches[j];
                 let plane = plane_key(occluders[j].plane());
                 grid.visit(reach, |i| {
                     let i = i as usize;
-                    if planes[i] != plane
-                        && overlap(&boxes[i], &reach)
-                        && may_reach(&boxes[i], &r.reach)
-                    {
+                    if planes[i] != plane && overlap(&boxes[i], &reach) {
                         hit.push(i as u32);
                     }
                 });

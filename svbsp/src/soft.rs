@@ -214,21 +214,11 @@ fn soft_face(
     near: &[&[u32]],
     face: &Occluder,
 ) -> Vec<SoftFragment> {
-    // the occluders in the order of their corners, so the cuts, and the
-    // fragments, do not depend on the order the faces come in
-    let near: Vec<Vec<usize>> = near
-        .iter()
-        .map(|n| {
-            let mut n: Vec<usize> = n.iter().map(|&j| j as usize).collect();
-            n.sort_by(|&a, &b| blockers[a].corners().cmp(blockers[b].corners()));
-            n
-        })
-        .collect();
     let mut pieces = vec![(face.to_polygon(), Classes::default())];
     for (k, light) in lights.iter().enumerate() {
         let occluders = near[k]
             .iter()
-            .filter_map(|&j| Some((regions[k][j].as_ref()?, reach[k][j])));
+            .filter_map(|&j| Some((regions[k][j as usize].as_ref()?, reach[k][j as usize])));
         pieces = light
             .cut(face, pieces, occluders)
             .into_iter()
@@ -241,9 +231,9 @@ fn soft_face(
             let visible = (0..lights.len())
                 .map(|k| {
                     let penumbra = (c.lit | c.umbra) >> k & 1 == 0;
-                    let among = near[k]
-                        .iter()
-                        .filter_map(|&j| Some((&blockers[j], regions[k][j].as_ref()?)));
+                    let among = near[k].iter().filter_map(|&j| {
+                        Some((&blockers[j as usize], regions[k][j as usize].as_ref()?))
+                    });
                     penumbra
                         .then(|| share(&lights[k], face, &polygon, among))
                         .flatten()
