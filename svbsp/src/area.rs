@@ -654,10 +654,11 @@ impl AreaLight {
     pub(crate) fn classify_with<'r>(
         &self,
         face: &Occluder,
-        occluders: impl Iterator<Item = (&'r Regions, Box3)>,
+        occluders: impl Iterator<Item = (&'r Regions, Reach)>,
+        corners: Option<&mut SeenCorners<'_>>,
     ) -> Vec<AreaFragment> {
         let whole = face.polygon.to_polygon(0);
-        let cut = self.cut(face, vec![(whole, ())], occluders);
+        let cut = self.cut(face, vec![(whole, ())], occluders, corners);
         merge_convex(cut.into_iter().map(|(p, (), c)| (p, c)).collect())
             .into_iter()
             .map(|(polygon, class)| AreaFragment { polygon, class })
@@ -667,11 +668,19 @@ impl AreaLight {
     /// Convex `pieces` of `face`, each with a label, cut where this
     /// light's class changes (see the module docs); each part keeps its
     /// piece's label. Not merged.
+    ///
+    /// `corners`, where given, cuts a piece where the light's corners it
+    /// sees change (bit `i` of each part's mask: corner `i` seen, as the
+    /// point lights' shadow volumes of the corners say); the pieces are
+    /// then cut only by the occluders' penumbra and umbra volumes.
+    /// Without it (or where it answers `None`), by every occluder's
+    /// shadow volume from each corner too.
     pub(crate) fn cut<'r, K: Copy + PartialEq>(
         &self,
         face: &Occluder,
         pieces: Vec<(Polygon, K)>,
-        occluders: impl Iterator<Item = (&'r Regions, Box3)>,
+        occluders: impl Iterator<Item = (&'r Regions, Reach)>,
+        mut corners: Option<&mut SeenCorners<'_>>,
     ) -> Vec<(Polygon, K, AreaClass)> {
         let behind_face: Vec<bool> = self
             .corners()
@@ -707,27 +716,39 @@ impl AreaLight {
         // an occluder whose penumbra volume lies wholly beyond one of its
         // planes from the face hides nothing from it
         let whole = face.polygon.to_polygon(0);
-        let regions: Vec<(&Regions, Box3)> = occluders
+        let mut regions: Vec<(&Regions, Reach)> = occluders
             .filter(|(r, _)| {
                 !r.penumbra
                     .iter()
                     .any(|(h, s)| wholly_outside(whole.classify(h), *s))
             })
             .collect();
-        let corners = self.corners().len();
-        let all = u64::MAX >> (64 - corners);
-        let behind = (0..corners).fold(0u64, |m, i| m | u64::from(behind_face[i]) << i);
-        let mut pieces: Vec<Piece<K>> = front
-            .into_iter()
-            .map(|(polygon, label)| Piece {
-                bbox: polygon_box(&polygon),
-                polygon,
-                label,
-                not_lit: false,
-                hidden: behind,
-                umbra: false,
-            })
-            .collect();
+        let n = self.corners().len();
+        let all = u64::MAX >> (64 - n);
+        let behind = (0..n).fold(0u64, |m, i| m | u64::from(behind_face[i]) << i);
+        let mut pieces = Vec::with_capacity(front.len());
+        let mut known = corners.is_some();
+        for (polygon, label) in front {
+            let Some(cells) = corners.as_mut().and_then(|c| c(&polygon)) else {
+                known = false;
+                pieces.push(Piece::new(polygon, label, behind, false));
+                continue;
+            };
+            for (polygon, seen) in cells {
+                let hidden = behind | (all & !seen);
+                let mut piece = Piece::new(polygon, label, hidden, hidden != 0);
+                // a point (or a sun) hidden is umbra
+                piece.umbra = n == 1 && hidden == all;
+                pieces.push(piece);
+            }
+        }
+        if known {
+            pieces = merge_pieces(pieces);
+            // occluders with a corner in their plane first: they hide that
+            // corner (for lack of a seen neighbourhood of it), and every
+            // piece that ends up hiding all corners must meet every umbra
+            regions.sort_by_key(|(r, _)| r.from_corner.iter().all(Option::is_some));
+        }
         let mut merged = 0;
         for &(r, reach) in &regions {
             // pieces this occluder leaves as they are stay in place; the
@@ -735,11 +756,26 @@ impl AreaLight {
             let mut parts = Vec::new();
             let mut i = 0;
             while i < pieces.len() {
-                if !overlap(&pieces[i].bbox, &reach) || untouched(r, &pieces[i]) {
+                let piece = &pieces[i];
+                // a piece that hides every corner can only enter the umbra
+                let near = match known && piece.hidden == all {
+                    true => overlap(&piece.bbox, &reach[1]),
+                    false => overlap(&piece.bbox, &reach[0]),
+                };
+                if !near
+                    || match known {
+                        true => untouched_known(r, piece, all),
+                        false => untouched(r, piece),
+                    }
+                {
                     i += 1;
                     continue;
                 }
-                cut_piece(r, pieces.swap_remove(i), all, &mut parts);
+                let piece = pieces.swap_remove(i);
+                match known {
+                    true => cut_piece_known(r, piece, all, &mut parts),
+                    false => cut_piece(r, piece, all, &mut parts),
+                }
             }
             pieces.append(&mut parts);
             // pieces cut apart by one occluder and alike after it are
@@ -852,12 +888,108 @@ fn edge_corner_plane(l1: Light, l2: Light, o: GridPoint) -> Option<Plane> {
 /// the face), inside one occluder's umbra.
 struct Piece<K> {
     polygon: Polygon,
-    /// A box holding it (a part of a piece keeps the piece's box).
+    /// The smallest box of integers holding it.
     bbox: Box3,
     label: K,
     not_lit: bool,
     hidden: u64,
     umbra: bool,
+}
+
+impl<K> Piece<K> {
+    fn new(polygon: Polygon, label: K, hidden: u64, not_lit: bool) -> Piece<K> {
+        Piece {
+            bbox: polygon_box(&polygon),
+            polygon,
+            label,
+            not_lit,
+            hidden,
+            umbra: false,
+        }
+    }
+}
+
+/// The light corners in occluder `r`'s plane (from which it casts no
+/// shadow volume).
+fn flat_corners(r: &Regions) -> u64 {
+    r.from_corner
+        .iter()
+        .enumerate()
+        .fold(0, |m, (i, v)| m | u64::from(v.is_none()) << i)
+}
+
+/// Whether a piece lies wholly outside one of the half-spaces `hs`: its
+/// box first (exact integers, cheap), then its corners.
+fn outside<K>(piece: &Piece<K>, hs: &HalfSpaces) -> bool {
+    hs.iter().any(|(h, s)| box_outside(&piece.bbox, h, *s))
+        || hs
+            .iter()
+            .any(|(h, s)| wholly_outside(piece.polygon.classify(h), *s))
+}
+
+/// Whether box `b` lies in the closed half-space opposite `inside` of
+/// `h`: the extreme value of `n · x + d` over its corners, in `i128`
+/// (`false` where that would overflow).
+fn box_outside(b: &Box3, h: &Plane, inside: Side) -> bool {
+    let n = h.normal();
+    let toward = match inside {
+        Side::Front => 1,
+        Side::Back => -1,
+        Side::On => return false,
+    };
+    // the corner furthest into the inside
+    let mut v = Some(h.offset());
+    for k in 0..3 {
+        let c = if (n[k] >= 0) == (toward > 0) {
+            b[k][1]
+        } else {
+            b[k][0]
+        };
+        v = v.and_then(|v| v.checked_add(i128::from(n[k]).checked_mul(i128::from(c))?));
+    }
+    v.is_some_and(|v| v * toward <= 0)
+}
+
+/// [`untouched`] for pieces whose seen corners are known: a piece that
+/// hides every corner can only become umbra, one that sees every corner
+/// only penumbra, and one that sees some corners and hides others is
+/// penumbra already (but for a corner in the occluder's plane, which the
+/// occluder then hides where it hides part of the light).
+fn untouched_known<K>(r: &Regions, piece: &Piece<K>, all: u64) -> bool {
+    if piece.umbra {
+        return true;
+    }
+    if piece.hidden == all {
+        return r.umbra.as_ref().is_none_or(|u| outside(piece, u));
+    }
+    if !piece.not_lit || flat_corners(r) & !piece.hidden != 0 {
+        return outside(piece, &r.penumbra);
+    }
+    true
+}
+
+/// [`cut_piece`] for pieces whose seen corners are known (see
+/// [`untouched_known`]).
+fn cut_piece_known<K: Copy>(r: &Regions, piece: Piece<K>, all: u64, next: &mut Vec<Piece<K>>) {
+    let (volume, inside) = match (&r.umbra, piece.hidden == all) {
+        (Some(u), true) => (u, (all, true)),
+        (None, true) => {
+            next.push(piece);
+            return;
+        }
+        (_, false) => (&r.penumbra, (piece.hidden | flat_corners(r), false)),
+    };
+    let mut outside = Vec::new();
+    let within = subtract(volume, piece.polygon, &mut outside);
+    next.extend(
+        outside
+            .into_iter()
+            .map(|polygon| Piece::new(polygon, piece.label, piece.hidden, piece.not_lit)),
+    );
+    next.extend(within.map(|polygon| Piece {
+        umbra: inside.1,
+        ..Piece::new(polygon, piece.label, inside.0, true)
+    }));
 }
 
 /// Whether occluder regions `r` leave `piece` as it is ([`cut_piece`]
@@ -901,6 +1033,7 @@ fn cut_piece<K: Copy>(r: &Regions, piece: Piece<K>, all: u64, next: &mut Vec<Pie
             }
         };
         next.extend(umbra.map(|polygon| Piece {
+            bbox: polygon_box(&polygon),
             polygon,
             hidden: all,
             umbra: true,
@@ -913,6 +1046,7 @@ fn cut_piece<K: Copy>(r: &Regions, piece: Piece<K>, all: u64, next: &mut Vec<Pie
             }
         }
         next.extend(parts.into_iter().map(|(polygon, m)| Piece {
+            bbox: polygon_box(&polygon),
             polygon,
             hidden: piece.hidden | m,
             ..piece
@@ -921,11 +1055,11 @@ fn cut_piece<K: Copy>(r: &Regions, piece: Piece<K>, all: u64, next: &mut Vec<Pie
     }
     let mut outside = Vec::new();
     let inside = subtract(&r.penumbra, piece.polygon, &mut outside);
-    next.extend(
-        outside
-            .into_iter()
-            .map(|polygon| Piece { polygon, ..piece }),
-    );
+    next.extend(outside.into_iter().map(|polygon| Piece {
+        bbox: polygon_box(&polygon),
+        polygon,
+        ..piece
+    }));
     let Some(inside) = inside else {
         return;
     };
@@ -942,8 +1076,8 @@ fn cut_piece<K: Copy>(r: &Regions, piece: Piece<K>, all: u64, next: &mut Vec<Pie
     }
     let whole = r.from_corner.iter().all(Option::is_some);
     next.extend(parts.into_iter().map(|(polygon, m)| Piece {
+        bbox: polygon_box(&polygon),
         polygon,
-        bbox: piece.bbox,
         label: piece.label,
         not_lit: true,
         hidden: piece.hidden | m,
@@ -1009,6 +1143,14 @@ fn separating(h: &Plane, lv: &[Light], ov: &[GridPoint]) -> Option<Side> {
         _ => None,
     }
 }
+
+/// The convex parts of a polygon with the light corners each sees (bit
+/// `i`: corner `i`), where that is known.
+pub(crate) type SeenCorners<'a> = dyn FnMut(&Polygon) -> Option<Vec<(Polygon, u64)>> + 'a;
+
+/// Boxes of an occluder's penumbra volume and of its umbra volume (empty
+/// where some `lo > hi`), within the scene.
+pub(crate) type Reach = [Box3; 2];
 
 /// A box per axis, `[lo, hi]`, in grid units (exact integers).
 pub(crate) type Box3 = [[i64; 2]; 3];

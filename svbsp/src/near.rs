@@ -7,40 +7,52 @@
 use bsp_core::GridPoint;
 use rayon::prelude::*;
 
-use crate::area::{Box3, Occluder, Regions, grid_box, overlap};
+use crate::area::{Box3, HalfSpaces, Occluder, Reach, Regions, grid_box, overlap};
 use crate::blockers::plane_key;
 use crate::light::Light;
 
 /// Per receiving face, the indices of the occluders not in its plane whose
 /// penumbra volume (`regions`, per occluder; `None`: it hides nothing) may
-/// meet it, in index order; and per occluder, a box of its penumbra
-/// volume within the scene.
+/// meet it, in index order; and per occluder, boxes of its penumbra and
+/// umbra volumes within the scene ([`Reach`]).
 pub(crate) fn near_lists(
     lights: &[Light],
     faces: &[Occluder],
     (occluders, regions): (&[Occluder], &[Option<Regions>]),
-) -> (Vec<Vec<u32>>, Vec<Box3>) {
+) -> (Vec<Vec<u32>>, Vec<Reach>) {
     let boxes: Vec<Box3> = faces.iter().map(|f| grid_box(f.corners())).collect();
     let planes: Vec<_> = faces.iter().map(|f| plane_key(f.plane())).collect();
     let Some(scene) = boxes.iter().copied().reduce(union) else {
         return (Vec::new(), Vec::new());
     };
     let grid = CellGrid::new(scene, &boxes);
-    let reaches: Vec<Box3> = occluders
+    let reaches: Vec<Reach> = occluders
         .par_iter()
-        .map(|f| penumbra_box(lights, f.corners(), scene))
+        .map(|f| {
+            // the umbra lies in the shadow volume from every corner
+            let umbra = lights
+                .iter()
+                .map(|l| penumbra_box(std::slice::from_ref(l), f.corners(), scene))
+                .fold(scene, |a, b| {
+                    [0, 1, 2].map(|k| [a[k][0].max(b[k][0]), a[k][1].min(b[k][1])])
+                });
+            [penumbra_box(lights, f.corners(), scene), umbra]
+        })
         .collect();
     let mut pairs: Vec<(u32, u32)> = regions
         .par_iter()
         .enumerate()
         .flat_map_iter(|(j, r)| {
             let mut hit = Vec::new();
-            if r.is_some() {
-                let reach = reaches[j];
+            if let Some(r) = r {
+                let reach = reaches[j][0];
                 let plane = plane_key(occluders[j].plane());
                 grid.visit(reach, |i| {
                     let i = i as usize;
-                    if planes[i] != plane && overlap(&boxes[i], &reach) {
+                    if planes[i] != plane
+                        && overlap(&boxes[i], &reach)
+                        && !outside(faces[i].corners(), &r.penumbra)
+                    {
                         hit.push(i as u32);
                     }
                 });
@@ -56,6 +68,13 @@ pub(crate) fn near_lists(
         near[i as usize].push(j);
     }
     (near, reaches)
+}
+
+/// Whether grid points `corners` lie in the closed outside of one of the
+/// half-spaces `hs` (a face there has no area inside the volume).
+fn outside(corners: &[GridPoint], hs: &HalfSpaces) -> bool {
+    hs.iter()
+        .any(|(h, inside)| corners.iter().all(|&c| h.classify_grid(c) != *inside))
 }
 
 fn union(a: Box3, b: Box3) -> Box3 {
@@ -128,7 +147,7 @@ fn penumbra_box(lights: &[Light], o: &[GridPoint], scene: Box3) -> Box3 {
 /// box meets it. A coordinate's cell is `(v − lo)·n / extent`, rounded
 /// down, in integers: it never decreases as `v` grows, so a box meets
 /// every cell of every face box it meets.
-struct CellGrid {
+pub(crate) struct CellGrid {
     lo: [i64; 3],
     extent: [i64; 3],
     n: [usize; 3],
@@ -137,7 +156,7 @@ struct CellGrid {
 
 impl CellGrid {
     /// About one cell per face, cubes as far as the scene's shape allows.
-    fn new(scene: Box3, boxes: &[Box3]) -> CellGrid {
+    pub(crate) fn new(scene: Box3, boxes: &[Box3]) -> CellGrid {
         let extent = scene.map(|[lo, hi]| hi - lo + 1);
         let volume: f64 = extent.iter().map(|&e| e as f64).product();
         let side = (volume / boxes.len().max(1) as f64).cbrt();
@@ -180,7 +199,7 @@ impl CellGrid {
 
     /// Calls `f` with every face listed in a cell that `b` meets (a face
     /// may come more than once).
-    fn visit(&self, b: Box3, mut f: impl FnMut(u32)) {
+    pub(crate) fn visit(&self, b: Box3, mut f: impl FnMut(u32)) {
         let (lo, hi) = self.range(b);
         for x in lo[0]..=hi[0] {
             for y in lo[1]..=hi[1] {

@@ -10,16 +10,20 @@
 //! convex. Points and suns take part as the limits of area lights
 //! ([`AreaLight::point`], [`AreaLight::sun`]): lit or umbra.
 
+use std::collections::HashMap;
+
 use bsp_core::{Grid, GridPoint, MAX_COORD, Polygon};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::area::{
-    AreaClass, AreaFragment, AreaLight, Box3, EVERYWHERE, Occluder, Regions, merge_convex,
+    AreaClass, AreaFragment, AreaLight, Box3, EVERYWHERE, Occluder, Reach, Regions, grid_box,
+    merge_convex,
 };
 use crate::blockers::{coplanar_blockers, plane_key};
+use crate::engine::{Scratch, Shadows};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
-use crate::near::near_lists;
+use crate::near::{CellGrid, near_lists};
 
 /// The share of a polygon light's irradiance that arrives on a penumbra
 /// fragment ([`crate::LightView::fraction`]): at the grid point nearest its
@@ -126,19 +130,48 @@ pub fn soft_shadows(
         .iter()
         .map(|l| blockers.par_iter().map(|o| l.regions(o)).collect())
         .collect();
-    let (near, reach): (Vec<Vec<Vec<u32>>>, Vec<Vec<Box3>>) = lights
+    let (near, reach): (Vec<Vec<Vec<u32>>>, Vec<Vec<Reach>>) = lights
         .iter()
         .zip(&regions)
         .map(|(l, r)| near_lists(l.corners(), faces, (&blockers, r)))
         .unzip();
+    let corners = corner_shadows(lights, faces);
     Ok(faces
         .par_iter()
         .enumerate()
-        .map(|(i, face)| {
+        .map_init(Scratch::default, |scratch, (i, face)| {
             let near: Vec<&[u32]> = near.iter().map(|n| &n[i][..]).collect();
-            soft_face(lights, &blockers, (&regions, &reach), &near, face)
+            let scene = Scene {
+                lights,
+                blockers: &blockers,
+                regions: &regions,
+                reach: &reach,
+                corners: &corners,
+            };
+            soft_face(&scene, &near, face, scratch)
         })
         .collect())
+}
+
+/// Per light, the point lights' shadow volumes of its corners over
+/// `faces` (which corners each point of a face sees); `None` for a light
+/// of more corners than the trees take (its pieces are then cut by each
+/// occluder's shadow volume from each corner instead).
+fn corner_shadows(lights: &[AreaLight], faces: &[Occluder]) -> Vec<Option<Shadows>> {
+    let polygons: Vec<Polygon> = faces.iter().map(Occluder::to_polygon).collect();
+    lights
+        .iter()
+        .map(|l| Shadows::new(&polygons, l.corners()).ok())
+        .collect()
+}
+
+/// What [`soft_face`] cuts a face with.
+struct Scene<'a> {
+    lights: &'a [AreaLight],
+    blockers: &'a [Occluder],
+    regions: &'a [Vec<Option<Regions>>],
+    reach: &'a [Vec<Reach>],
+    corners: &'a [Option<Shadows>],
 }
 
 impl AreaLight {
@@ -169,7 +202,7 @@ impl AreaLight {
             .filter(|o| plane_key(o.plane()) != own)
             .filter_map(|o| self.regions(o))
             .collect();
-        self.classify_with(face, regions.iter().map(|r| (r, EVERYWHERE)))
+        self.classify_with(face, regions.iter().map(|r| (r, [EVERYWHERE; 2])), None)
     }
 
     /// Every face of `faces` cut into fragments of one class each, with
@@ -192,14 +225,19 @@ impl AreaLight {
         let blockers = coplanar_blockers(faces);
         let regions: Vec<Option<Regions>> = blockers.par_iter().map(|o| self.regions(o)).collect();
         let (near, reach) = near_lists(self.corners(), faces, (&blockers, &regions));
+        let corners = corner_shadows(std::slice::from_ref(self), faces)
+            .pop()
+            .flatten();
+        let set = corners.as_ref().map(Shadows::set);
         faces
             .par_iter()
             .zip(&near)
-            .map(|(face, near)| {
+            .map_init(Scratch::default, |scratch, (face, near)| {
                 let others = near
                     .iter()
                     .filter_map(|&j| Some((regions[j as usize].as_ref()?, reach[j as usize])));
-                self.classify_with(face, others)
+                let mut seen = |p: &Polygon| set.as_ref()?.cells(p, scratch);
+                self.classify_with(face, others, Some(&mut seen))
             })
             .collect()
     }
@@ -208,35 +246,52 @@ impl AreaLight {
 /// The fragments of `face`, with `near[k]` the occluders that may hide
 /// part of light `k` from it.
 fn soft_face(
-    lights: &[AreaLight],
-    blockers: &[Occluder],
-    (regions, reach): (&[Vec<Option<Regions>>], &[Vec<Box3>]),
+    scene: &Scene<'_>,
     near: &[&[u32]],
     face: &Occluder,
+    scratch: &mut Scratch,
 ) -> Vec<SoftFragment> {
+    let Scene {
+        lights,
+        blockers,
+        regions,
+        reach,
+        corners,
+    } = *scene;
     let mut pieces = vec![(face.to_polygon(), Classes::default())];
     for (k, light) in lights.iter().enumerate() {
         let occluders = near[k]
             .iter()
             .filter_map(|&j| Some((regions[k][j as usize].as_ref()?, reach[k][j as usize])));
+        let set = corners[k].as_ref().map(Shadows::set);
+        let mut seen = |p: &Polygon| set.as_ref()?.cells(p, scratch);
         pieces = light
-            .cut(face, pieces, occluders)
+            .cut(face, pieces, occluders, Some(&mut seen))
             .into_iter()
             .map(|(p, c, class)| (p, c.with(k, class)))
             .collect();
     }
+    // the shares at grid points, which neighbouring fragments' corners
+    // share, and the occluders that may hide light from them
+    let mut seen = vec![HashMap::new(); lights.len()];
+    let mut hiders: Vec<Option<Hiders<'_>>> = (0..lights.len()).map(|_| None).collect();
+    let whole = grid_box(face.corners());
     merge_convex(pieces)
         .into_iter()
         .map(|(polygon, c)| {
             let visible = (0..lights.len())
                 .map(|k| {
-                    let penumbra = (c.lit | c.umbra) >> k & 1 == 0;
-                    let among = near[k].iter().filter_map(|&j| {
-                        Some((&blockers[j as usize], regions[k][j as usize].as_ref()?))
+                    if (c.lit | c.umbra) >> k & 1 != 0 {
+                        return None;
+                    }
+                    let hiders = hiders[k].get_or_insert_with(|| {
+                        let near = near[k].iter().filter_map(|&j| {
+                            let j = j as usize;
+                            Some((&blockers[j], regions[k][j].as_ref()?, reach[k][j][0]))
+                        });
+                        Hiders::new(whole, near.collect())
                     });
-                    penumbra
-                        .then(|| share(&lights[k], face, &polygon, among))
-                        .flatten()
+                    share(&lights[k], face, &polygon, hiders, &mut seen[k])
                 })
                 .collect();
             SoftFragment {
@@ -257,11 +312,12 @@ fn nearest(p: [f64; 3]) -> GridPoint {
 
 /// The share of `light` arriving on `piece` of `face` (see [`Share`]);
 /// `None` for a point or a sun.
-fn share<'o>(
+fn share(
     light: &AreaLight,
     face: &Occluder,
     piece: &Polygon,
-    occluders: impl Iterator<Item = (&'o Occluder, &'o Regions)> + Clone,
+    hiders: &Hiders<'_>,
+    seen: &mut HashMap<GridPoint, Option<f64>>,
 ) -> Option<Share> {
     let sky: Vec<DVec3> = light
         .corners()
@@ -276,18 +332,17 @@ fn share<'o>(
     }
     let n = face.plane().normal().map(|c| c as f64);
     let normal = DVec3::from_array(n).normalize();
-    let at = |p: [f64; 3]| -> Option<f64> {
+    let mut at = |p: [f64; 3]| -> Option<f64> {
         let x = nearest(p);
-        // an occluder hides some of the light from x only if x lies
-        // strictly inside its penumbra volume
-        let inside = |r: &Regions| r.penumbra.iter().all(|(h, s)| h.classify_grid(x) == *s);
-        let hiding = occluders.clone().filter(|(_, r)| inside(r)).map(|(o, _)| o);
-        let xf = DVec3::from_array(x.map(f64::from));
-        if light.plane().is_none() {
-            return sky_share(&sky, xf, normal, hiding);
-        }
-        let view = light.view_among(x, Some(face.plane()), hiding)?;
-        view.fraction(xf, normal)
+        *seen.entry(x).or_insert_with(|| {
+            let hiding = hiders.at(x).into_iter();
+            let xf = DVec3::from_array(x.map(f64::from));
+            if light.plane().is_none() {
+                return sky_share(&sky, xf, normal, hiding);
+            }
+            let view = light.view_among(x, Some(face.plane()), hiding)?;
+            view.fraction(xf, normal)
+        })
     };
     let corners = piece.vertices_f64();
     let centroid = corners
@@ -305,6 +360,43 @@ fn share<'o>(
         min,
         max,
     })
+}
+
+/// The occluders near a face that may hide part of one light from its
+/// points, found through a grid of cells over the face's box holding
+/// their penumbra volumes' boxes.
+struct Hiders<'a> {
+    occluders: Vec<(&'a Occluder, &'a Regions, Box3)>,
+    grid: CellGrid,
+}
+
+impl<'a> Hiders<'a> {
+    fn new(face: Box3, occluders: Vec<(&'a Occluder, &'a Regions, Box3)>) -> Hiders<'a> {
+        let boxes: Vec<Box3> = occluders.iter().map(|o| o.2).collect();
+        Hiders {
+            grid: CellGrid::new(face, &boxes),
+            occluders,
+        }
+    }
+
+    /// The occluders that hide some of the light from grid point `x`:
+    /// those whose penumbra volume holds it strictly (and so their box
+    /// does), in the near list's order.
+    fn at(&self, x: GridPoint) -> Vec<&'a Occluder> {
+        let at = x.map(i64::from);
+        let mut found = Vec::new();
+        self.grid.visit([0, 1, 2].map(|k| [at[k], at[k]]), |i| {
+            let (o, r, b) = &self.occluders[i as usize];
+            let in_box = (0..3).all(|k| b[k][0] <= at[k] && at[k] <= b[k][1]);
+            if in_box && r.penumbra.iter().all(|(h, s)| h.classify_grid(x) == *s) {
+                found.push((i, *o));
+            }
+        });
+        // a point meets one cell, but keep the order whatever the grid
+        found.sort_unstable_by_key(|&(i, _)| i);
+        found.dedup_by_key(|&mut (i, _)| i);
+        found.into_iter().map(|(_, o)| o).collect()
+    }
 }
 
 /// The share of a sun disc's polygon of directions `sky` that `x` (on a

@@ -252,6 +252,13 @@ fn classified_faces_agree_with_the_view() {
             let fin = [[x, y, 30], [x, y + 50, 30], [x, y + 30, 70]];
             faces.push(Occluder::new(&fin).unwrap());
         }
+        if round % 3 == 2 {
+            // a fin in the plane of two light corners (x = -16): it casts
+            // no shadow volume from them, but hides light near them
+            let (y, z) = (below(&mut rng, 60) - 40, 20 + below(&mut rng, 40));
+            let fin = [[-16, y, z], [-16, y + 40, z], [-16, y + 20, z + 30]];
+            faces.push(Occluder::new(&fin).unwrap());
+        }
         if round % 3 == 0 {
             let (x, y, z) = (below(&mut rng, 40) - 40, below(&mut rng, 40) - 20, 48);
             let q = [
@@ -263,8 +270,17 @@ fn classified_faces_agree_with_the_view() {
             faces.push(Occluder::new(&[q[0], q[1], q[2]]).unwrap());
             faces.push(Occluder::new(&[q[0], q[2], q[3]]).unwrap());
         }
-        for (r, total) in [(0, 240.0 * 240.0), (1, 240.0 * 120.0)] {
-            let fragments = light.classify_face(&faces[r], &faces);
+        // one face against every occluder's volumes from each corner, and
+        // every face with the corners' point-light shadow volumes
+        let together = light.classify_faces(&faces);
+        let ways = [(0, false), (1, false), (0, true), (1, true)];
+        for (r, total, fragments) in ways.map(|(r, all)| {
+            let total = [240.0 * 240.0, 240.0 * 120.0][r];
+            match all {
+                true => (r, total, together[r].clone()),
+                false => (r, total, light.classify_face(&faces[r], &faces)),
+            }
+        }) {
             let area: f64 = fragments.iter().map(|f| area_of(&f.polygon)).sum();
             assert!((area - total).abs() < 1e-6 * total, "{area}");
             let plane = *faces[r].plane();
