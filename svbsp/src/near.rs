@@ -159,8 +159,16 @@ impl CellGrid {
     pub(crate) fn new(scene: Box3, boxes: &[Box3]) -> CellGrid {
         let extent = scene.map(|[lo, hi]| hi - lo + 1);
         let volume: f64 = extent.iter().map(|&e| e as f64).product();
-        let side = (volume / boxes.len().max(1) as f64).cbrt();
-        let n = extent.map(|e| ((e as f64 / side).ceil() as usize).clamp(1, 512));
+        let target = boxes.len().max(1) as f64;
+        let mut side = (volume / target).cbrt();
+        // a flat scene (one face's box) would get too many thin cells
+        let n = loop {
+            let n = extent.map(|e| ((e as f64 / side).ceil() as usize).clamp(1, 512));
+            if (n[0] * n[1] * n[2]) as f64 <= 2.0 * target + 8.0 {
+                break n;
+            }
+            side *= 1.25;
+        };
         let mut grid = CellGrid {
             lo: scene.map(|[lo, _]| lo),
             extent,
