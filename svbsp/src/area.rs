@@ -38,6 +38,7 @@
 use bsp_core::internals::GridPolygon;
 use bsp_core::{GridPoint, MAX_COORD, Plane, Polygon, PolygonSide, Side, Split};
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::light::{
     AreaLightError, Light, MAX_DISC_RADIUS, cross, plane_along, quantize_direction,
@@ -675,7 +676,7 @@ impl AreaLight {
     /// then cut only by the occluders' penumbra and umbra volumes.
     /// Without it (or where it answers `None`), by every occluder's
     /// shadow volume from each corner too.
-    pub(crate) fn cut<'r, K: Copy + PartialEq>(
+    pub(crate) fn cut<'r, K: Copy + PartialEq + Send + Sync>(
         &self,
         face: &Occluder,
         pieces: Vec<(Polygon, K)>,
@@ -749,43 +750,28 @@ impl AreaLight {
             // piece that ends up hiding all corners must meet every umbra
             regions.sort_by_key(|(r, _)| r.from_corner.iter().all(Option::is_some));
         }
-        let mut merged = 0;
-        for &(r, reach) in &regions {
-            // pieces this occluder leaves as they are stay in place; the
-            // others are cut and their parts appended
-            let mut parts = Vec::new();
-            let mut i = 0;
-            while i < pieces.len() {
-                let piece = &pieces[i];
-                // a piece that hides every corner can only enter the umbra
-                let near = match known && piece.hidden == all {
-                    true => overlap(&piece.bbox, &reach[1]),
-                    false => overlap(&piece.bbox, &reach[0]),
-                };
-                if !near
-                    || match known {
-                        true => untouched_known(r, piece, all),
-                        false => untouched(r, piece),
-                    }
-                {
-                    i += 1;
-                    continue;
-                }
-                let piece = pieces.swap_remove(i);
-                match known {
-                    true => cut_piece_known(r, piece, all, &mut parts),
-                    false => cut_piece(r, piece, all, &mut parts),
-                }
-            }
-            pieces.append(&mut parts);
-            // pieces cut apart by one occluder and alike after it are
-            // merged again as they pile up, so later occluders meet few
-            if pieces.len() > 16 && pieces.len() > 2 * merged {
-                pieces = merge_pieces(pieces);
-                merged = pieces.len();
-            }
-        }
-        for piece in pieces {
+        // pieces whose class no occluder can change stay as they are (with
+        // their corners known: umbra, or seeing some corners and hiding
+        // others while no occluder has a corner in its plane)
+        let flat = regions.iter().any(|(r, _)| flat_corners(r) != 0);
+        let (active, done): (Vec<Piece<K>>, Vec<Piece<K>>) = pieces.into_iter().partition(|p| {
+            !known || !p.umbra && (p.hidden == 0 || p.hidden == all || flat)
+        });
+        let how = Cutting {
+            regions: &regions,
+            all,
+            known,
+        };
+        // each piece and its parts on their own, in parallel where there
+        // are several (in order: the same for every thread count)
+        let pieces = match active.len() {
+            0 | 1 => active.into_iter().flat_map(|p| how.family(p)).collect(),
+            _ => active
+                .into_par_iter()
+                .flat_map_iter(|p| how.family(p))
+                .collect::<Vec<_>>(),
+        };
+        for piece in pieces.into_iter().chain(done) {
             let class = match piece {
                 Piece { not_lit: false, .. } if partly_behind => AreaClass::Penumbra,
                 Piece { not_lit: false, .. } => AreaClass::Lit,
@@ -894,6 +880,59 @@ struct Piece<K> {
     not_lit: bool,
     hidden: u64,
     umbra: bool,
+}
+
+/// How [`AreaLight::cut`] cuts one piece: by these occluders' regions,
+/// with `all` the bits of every light corner, and whether the corners each
+/// piece sees are known.
+struct Cutting<'a, 'r> {
+    regions: &'a [(&'r Regions, Reach)],
+    all: u64,
+    known: bool,
+}
+
+impl Cutting<'_, '_> {
+    /// `first` cut by every occluder in turn, its parts alike after an
+    /// occluder merged again as they pile up (so later occluders meet few).
+    fn family<K: Copy + PartialEq>(&self, first: Piece<K>) -> Vec<Piece<K>> {
+        let (all, known) = (self.all, self.known);
+        let mut pieces = vec![first];
+        let mut merged = 0;
+        for &(r, reach) in self.regions {
+            // pieces this occluder leaves as they are stay in place; the
+            // others are cut and their parts appended
+            let mut parts = Vec::new();
+            let mut i = 0;
+            while i < pieces.len() {
+                let piece = &pieces[i];
+                // a piece that hides every corner can only enter the umbra
+                let near = match known && piece.hidden == all {
+                    true => overlap(&piece.bbox, &reach[1]),
+                    false => overlap(&piece.bbox, &reach[0]),
+                };
+                if !near
+                    || match known {
+                        true => untouched_known(r, piece, all),
+                        false => untouched(r, piece),
+                    }
+                {
+                    i += 1;
+                    continue;
+                }
+                let piece = pieces.swap_remove(i);
+                match known {
+                    true => cut_piece_known(r, piece, all, &mut parts),
+                    false => cut_piece(r, piece, all, &mut parts),
+                }
+            }
+            pieces.append(&mut parts);
+            if pieces.len() > 16 && pieces.len() > 2 * merged {
+                pieces = merge_pieces(pieces);
+                merged = pieces.len();
+            }
+        }
+        pieces
+    }
 }
 
 impl<K> Piece<K> {

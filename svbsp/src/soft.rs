@@ -10,8 +10,6 @@
 //! convex. Points and suns take part as the limits of area lights
 //! ([`AreaLight::point`], [`AreaLight::sun`]): lit or umbra.
 
-use std::collections::HashMap;
-
 use bsp_core::{Grid, GridPoint, MAX_COORD, Polygon};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -271,28 +269,53 @@ fn soft_face(
             .map(|(p, c, class)| (p, c.with(k, class)))
             .collect();
     }
-    // the shares at grid points, which neighbouring fragments' corners
-    // share, and the occluders that may hide light from them
-    let mut seen = vec![HashMap::new(); lights.len()];
-    let mut hiders: Vec<Option<Hiders<'_>>> = (0..lights.len()).map(|_| None).collect();
-    let whole = grid_box(face.corners());
-    merge_convex(pieces)
-        .into_iter()
+    let fragments = merge_convex(pieces);
+    // per light, the grid points nearest the penumbra fragments' centroids
+    // and corners (neighbours share corners), each viewed once, in
+    // parallel; then each fragment's share from its points
+    let probes: Vec<Vec<Option<Probes>>> = fragments
+        .iter()
         .map(|(polygon, c)| {
-            let visible = (0..lights.len())
+            (0..lights.len())
                 .map(|k| {
-                    if (c.lit | c.umbra) >> k & 1 != 0 {
-                        return None;
-                    }
-                    let hiders = hiders[k].get_or_insert_with(|| {
-                        let near = near[k].iter().filter_map(|&j| {
-                            let j = j as usize;
-                            Some((&blockers[j], regions[k][j].as_ref()?, reach[k][j][0]))
-                        });
-                        Hiders::new(whole, near.collect())
-                    });
-                    share(&lights[k], face, &polygon, hiders, &mut seen[k])
+                    let penumbra = (c.lit | c.umbra) >> k & 1 == 0;
+                    (penumbra && has_share(&lights[k])).then(|| Probes::of(polygon))
                 })
+                .collect()
+        })
+        .collect();
+    let values: Vec<Option<Viewed>> = (0..lights.len())
+        .map(|k| {
+            let mut points: Vec<GridPoint> = probes
+                .iter()
+                .filter_map(|p| p[k].as_ref())
+                .flat_map(|p| std::iter::once(p.centroid).chain(p.corners.iter().copied()))
+                .collect();
+            if points.is_empty() {
+                return None;
+            }
+            points.sort_unstable();
+            points.dedup();
+            let near = near[k].iter().filter_map(|&j| {
+                let j = j as usize;
+                Some((&blockers[j], regions[k][j].as_ref()?, reach[k][j][0]))
+            });
+            let hiders = Hiders::new(grid_box(face.corners()), near.collect());
+            let fractions = points
+                .par_iter()
+                .map(|&x| fraction_at(&lights[k], face, &hiders, x))
+                .collect();
+            Some(Viewed { points, fractions })
+        })
+        .collect();
+    fragments
+        .into_iter()
+        .zip(probes)
+        .map(|((polygon, c), probes)| {
+            let visible = probes
+                .iter()
+                .zip(&values)
+                .map(|(p, v)| Some(p.as_ref()?.share(v.as_ref()?)))
                 .collect();
             SoftFragment {
                 polygon,
@@ -305,61 +328,83 @@ fn soft_face(
         .collect()
 }
 
+/// The grid points nearest a fragment's centroid and corners, where its
+/// visible share is taken.
+struct Probes {
+    centroid: GridPoint,
+    corners: Vec<GridPoint>,
+}
+
+/// The share of one light at sorted grid points.
+struct Viewed {
+    points: Vec<GridPoint>,
+    fractions: Vec<Option<f64>>,
+}
+
+impl Probes {
+    fn of(piece: &Polygon) -> Probes {
+        let corners = piece.vertices_f64();
+        let centroid = corners
+            .iter()
+            .fold(DVec3::ZERO, |s, &c| s + DVec3::from_array(c))
+            / corners.len() as f64;
+        Probes {
+            centroid: nearest(centroid.to_array()),
+            corners: corners.into_iter().map(nearest).collect(),
+        }
+    }
+
+    /// The fragment's [`Share`] from the values at its points (nothing
+    /// reachable counts as 0).
+    fn share(&self, viewed: &Viewed) -> Share {
+        let at = |x: &GridPoint| {
+            let i = viewed.points.binary_search(x).ok()?;
+            viewed.fractions[i]
+        };
+        let values = self.corners.iter().map(|x| at(x).unwrap_or(0.0));
+        let (min, max) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), f| {
+            (lo.min(f), hi.max(f))
+        });
+        Share {
+            centroid: at(&self.centroid).unwrap_or(0.0),
+            min,
+            max,
+        }
+    }
+}
+
+/// Whether `light` has a share to report: a polygon, or a disc of the sky
+/// (not a point or a sun).
+fn has_share(light: &AreaLight) -> bool {
+    light.plane().is_some() || light.corners().len() >= 3
+}
+
 /// The grid point nearest `p` (grid units).
 fn nearest(p: [f64; 3]) -> GridPoint {
     p.map(|c| c.round() as i32)
 }
 
-/// The share of `light` arriving on `piece` of `face` (see [`Share`]);
-/// `None` for a point or a sun.
-fn share(
-    light: &AreaLight,
-    face: &Occluder,
-    piece: &Polygon,
-    hiders: &Hiders<'_>,
-    seen: &mut HashMap<GridPoint, Option<f64>>,
-) -> Option<Share> {
-    let sky: Vec<DVec3> = light
-        .corners()
-        .iter()
-        .filter_map(|l| match l {
-            Light::Directional(d) => Some(DVec3::from_array(d.map(f64::from))),
-            Light::Point(_) => None,
-        })
-        .collect();
-    if light.plane().is_none() && sky.len() < 3 {
-        return None;
-    }
+/// The share of `light` (a polygon or a disc: [`has_share`]) arriving at
+/// grid point `x` near `face` (see [`Share`]); `None` where nothing of it
+/// is reachable.
+fn fraction_at(light: &AreaLight, face: &Occluder, hiders: &Hiders<'_>, x: GridPoint) -> Option<f64> {
     let n = face.plane().normal().map(|c| c as f64);
     let normal = DVec3::from_array(n).normalize();
-    let mut at = |p: [f64; 3]| -> Option<f64> {
-        let x = nearest(p);
-        *seen.entry(x).or_insert_with(|| {
-            let hiding = hiders.at(x).into_iter();
-            let xf = DVec3::from_array(x.map(f64::from));
-            if light.plane().is_none() {
-                return sky_share(&sky, xf, normal, hiding);
-            }
-            let view = light.view_among(x, Some(face.plane()), hiding)?;
-            view.fraction(xf, normal)
-        })
-    };
-    let corners = piece.vertices_f64();
-    let centroid = corners
-        .iter()
-        .fold(DVec3::ZERO, |s, &c| s + DVec3::from_array(c))
-        / corners.len() as f64;
-    let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
-    for &c in &corners {
-        let f = at(c).unwrap_or(0.0);
-        min = min.min(f);
-        max = max.max(f);
+    let hiding = hiders.at(x).into_iter();
+    let xf = DVec3::from_array(x.map(f64::from));
+    if light.plane().is_none() {
+        let sky: Vec<DVec3> = light
+            .corners()
+            .iter()
+            .filter_map(|l| match l {
+                Light::Directional(d) => Some(DVec3::from_array(d.map(f64::from))),
+                Light::Point(_) => None,
+            })
+            .collect();
+        return sky_share(&sky, xf, normal, hiding);
     }
-    Some(Share {
-        centroid: at(centroid.to_array()).unwrap_or(0.0),
-        min,
-        max,
-    })
+    let view = light.view_among(x, Some(face.plane()), hiding)?;
+    view.fraction(xf, normal)
 }
 
 /// The occluders near a face that may hide part of one light from its
