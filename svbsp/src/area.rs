@@ -557,11 +557,18 @@ fn vertex_keys(p: &Polygon) -> Vec<[u64; 3]> {
 /// Merges polygons of equal labels pairwise where their union is convex
 /// (`Polygon::merge`, exact), until none do; only pairs that share two
 /// vertex keys are tried. Deterministic: the order of the input decides.
-pub(crate) fn merge_convex<T: Copy + PartialEq>(mut items: Vec<(Polygon, T)>) -> Vec<(Polygon, T)> {
+pub(crate) fn merge_convex<T: Copy + PartialEq>(items: Vec<(Polygon, T)>) -> Vec<(Polygon, T)> {
+    // each polygon's keys, made again only when it grows
+    let mut items: Vec<(Polygon, T, Vec<[u64; 3]>)> = items
+        .into_iter()
+        .map(|(p, t)| {
+            let keys = vertex_keys(&p);
+            (p, t, keys)
+        })
+        .collect();
     loop {
-        let keys: Vec<Vec<[u64; 3]>> = items.iter().map(|(p, _)| vertex_keys(p)).collect();
         let mut at: rustc_hash::FxHashMap<[u64; 3], Vec<usize>> = Default::default();
-        for (i, ks) in keys.iter().enumerate() {
+        for (i, (_, _, ks)) in items.iter().enumerate() {
             for k in ks {
                 at.entry(*k).or_default().push(i);
             }
@@ -572,7 +579,7 @@ pub(crate) fn merge_convex<T: Copy + PartialEq>(mut items: Vec<(Polygon, T)>) ->
             if dead[i] {
                 continue;
             }
-            let mut seen: Vec<usize> = keys[i].iter().flat_map(|k| at[k].iter().copied()).collect();
+            let mut seen: Vec<usize> = items[i].2.iter().flat_map(|k| at[k].iter().copied()).collect();
             seen.sort_unstable();
             let shared = seen
                 .windows(2)
@@ -585,6 +592,9 @@ pub(crate) fn merge_convex<T: Copy + PartialEq>(mut items: Vec<(Polygon, T)>) ->
                     continue;
                 }
                 if let Some(m) = items[i].0.merge(&items[j].0) {
+                    // later polygons of this pass look only for partners
+                    // after them: this one's new keys count from the next
+                    items[i].2 = vertex_keys(&m);
                     items[i].0 = m;
                     dead[j] = true;
                     any = true;
@@ -598,7 +608,7 @@ pub(crate) fn merge_convex<T: Copy + PartialEq>(mut items: Vec<(Polygon, T)>) ->
             !dead[k - 1]
         });
         if !any {
-            return items;
+            return items.into_iter().map(|(p, t, _)| (p, t)).collect();
         }
     }
 }
