@@ -58,7 +58,7 @@ pub(crate) struct LightArgs {
     pub(crate) suns: Vec<DVec3>,
     /// An area light: a planar convex polygon, its corners in order; it
     /// shines on the side they turn counter-clockwise about. Soft
-    /// shadows: lit, penumbra and umbra (`shadows`, JSON and OBJ).
+    /// shadows: lit, penumbra and umbra (`shadows`: JSON, OBJ, SVG).
     #[arg(long = "area-light", value_name = "X,Y,Z;X,Y,Z;X,Y,Z[;...]", value_parser = parse_area, allow_hyphen_values = true)]
     pub(crate) areas: Vec<SoftSpec>,
     /// The sun as a disc toward DX,DY,DZ of angular radius DEG [default:

@@ -20,8 +20,9 @@ use anyhow::{Context, Result, bail};
 use bsp_shadows::shadow_file::{
     self, FileKind, LitScene, OutputFormat as Format, ShadowFile, write_shadows,
 };
-use bsp_shadows::soft_file::{SoftScene, write_soft_shadows};
+use bsp_shadows::soft_file::{SoftScene, draw_soft_shadows, write_soft_shadows};
 use clap::{Args, ValueEnum};
+use shadow_raster::svg::SvgViewpoint;
 use svbsp::export::FragmentFormat;
 use svbsp::{LightSpec, SoftSpec, percent};
 
@@ -103,8 +104,8 @@ fn request(args: &ShadowsArgs) -> Result<(Format, Vec<LightSpec>, Vec<SoftSpec>)
     if specs.is_empty() && soft.is_empty() && args.source.input.is_some() {
         bail!("{NO_LIGHT}");
     }
-    if !soft.is_empty() && (format == Format::Svg || args.algorithm != Algorithm::Psv) {
-        bail!("soft shadows (--area-light, --sun-disc) are written as .json or .obj so far");
+    if !soft.is_empty() && args.algorithm != Algorithm::Psv {
+        bail!("soft shadows (--area-light, --sun-disc) are made with --algorithm psv only");
     }
     Ok((format, specs, soft))
 }
@@ -122,15 +123,15 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
     let mut phases = Phases::default();
     progress.phase("loading", 1);
     let scene = Scene::load(&args.source, (specs, &soft), true, args.quiet, &mut phases)?;
-    if !scene.soft.is_empty() {
-        return soft_shadows(args, &scene, format, &progress);
-    }
     let view = (format == Format::Svg).then(|| {
         let size = args.image.size();
         let image = (size, args.image.fov);
         args.camera
             .pick(&scene.mesh, scene.staging, image, args.quiet)
     });
+    if !scene.soft.is_empty() {
+        return soft_shadows(args, &scene, (format, view.as_ref()), &progress);
+    }
     let mut out = Output::create(&args.output)?;
     let kind = match (format, &view) {
         (Format::Svg, Some(v)) => FileKind::Svg(v),
@@ -220,11 +221,11 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
 }
 
 /// `shadow shadows` with lights of extent: every light's lit, penumbra
-/// and umbra fragments as JSON or OBJ.
+/// and umbra fragments as JSON or OBJ, or drawn as SVG.
 fn soft_shadows(
     args: &ShadowsArgs,
     scene: &Scene,
-    format: Format,
+    (format, view): (Format, Option<&SvgViewpoint>),
     progress: &Progress,
 ) -> Result<()> {
     let (name, faces, grid) = (&scene.name, scene.mesh.faces.len(), &scene.grid);
@@ -236,27 +237,20 @@ fn soft_shadows(
         lights,
         polys,
     };
-    let obj = format == Format::Obj;
-    let format = if obj {
-        FragmentFormat::Obj
-    } else {
-        FragmentFormat::Json
-    };
     let mut out = Output::create(&args.output)?;
     let fig = guarded("the input and the command line", || {
-        write_soft_shadows(&job, format, &mut out, progress).map_err(facade_error)
+        match view {
+            Some(at) => draw_soft_shadows(&job, &scene.mesh, at, &mut out, progress),
+            None if format == Format::Obj => {
+                write_soft_shadows(&job, FragmentFormat::Obj, &mut out, progress)
+            }
+            None => write_soft_shadows(&job, FragmentFormat::Json, &mut out, progress),
+        }
+        .map_err(facade_error)
     })?;
     out.commit()?;
     progress.finish();
-    let w = &fig.written;
-    let mut report = format!(
-        "wrote {}: {} fragments of {} faces of {} under {}\n",
-        args.output.display(),
-        w.fragments,
-        job.faces,
-        scene.name,
-        scene.light_count()
-    );
+    let mut report = fig.wrote(&args.output, &job, &scene.light_count());
     report += &fig.report();
     if args.stats {
         report += &fig.stats_text(job.faces);

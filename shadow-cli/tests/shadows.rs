@@ -798,6 +798,58 @@ fn bad_soft_lights_are_errors() {
         &wide,
         &["light 1 (sun disc", "between 0° and 30° (given 45°)"],
     );
-    let svg = run(&["--area-light", "0,0,3;0,1,3;1,1,3"], "soft.svg");
-    assert_failed_with(&svg, &[".json or .obj"]);
+    let cf = run(
+        &[
+            "--area-light",
+            "0,0,3;0,1,3;1,1,3",
+            "--algorithm",
+            "chin-feiner",
+        ],
+        "soft_cf.json",
+    );
+    assert_failed_with(&cf, &["--algorithm psv only"]);
+}
+
+/// Soft shadows drawn: under a small square light, the floor's lit and
+/// umbra parts have the colours of the point light at its centre, lit
+/// and in shadow, and its penumbra shades lie between them.
+#[test]
+fn soft_shadows_are_drawn_between_lit_and_shadow() {
+    let input = floor_and_occluder();
+    let fills = |args: &[&str], name: &str| -> BTreeSet<String> {
+        let out = scratch(name);
+        let mut argv = vec!["shadows", input.to_str().unwrap(), "--eye", "1,-3,3"];
+        argv.extend(args);
+        argv.extend(["-o", out.to_str().unwrap()]);
+        let o = shadow(&argv);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(stdout(&o).contains(" drawn, eye "), "{}", stdout(&o));
+        let svg = std::fs::read_to_string(&out).unwrap();
+        assert!(svg.trim_end().ends_with("</svg>"));
+        svg.split("fill=\"")
+            .skip(2) // the background
+            .map(|s| s[..7].to_string())
+            .collect()
+    };
+    let hard = fills(&["--light", "0.75,0.75,2"], "hard_floor.svg");
+    let light = "0.65,0.65,2;0.65,0.85,2;0.85,0.85,2;0.85,0.65,2";
+    let soft = fills(&["--area-light", light], "soft_floor.svg");
+    assert!(hard.is_subset(&soft), "{hard:?} not in {soft:?}");
+    let rgb = |f: &str| [1, 3, 5].map(|i| u8::from_str_radix(&f[i..i + 2], 16).unwrap());
+    // the floor's lit and shadowed colours: the two of one hue
+    let floor: Vec<[u8; 3]> = hard.iter().map(|f| rgb(f)).collect();
+    let pair = floor
+        .iter()
+        .flat_map(|a| floor.iter().map(move |b| (*a, *b)));
+    let (lit, dark) = pair
+        .filter(|(a, b)| (0..3).all(|k| a[k] > b[k]))
+        .max_by_key(|(a, b)| (0..3).map(|k| a[k] - b[k]).min())
+        .unwrap();
+    let between = soft
+        .difference(&hard)
+        .map(|f| rgb(f))
+        .filter(|c| (0..3).all(|k| dark[k] < c[k] && c[k] < lit[k]))
+        .count();
+    // (the penumbra's four sides see the same share: one shade)
+    assert!(between >= 1, "no penumbra shade in {soft:?}");
 }

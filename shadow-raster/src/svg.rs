@@ -384,15 +384,16 @@ impl SvgView {
 fn brightness(f: &SvgFragment, centre: DVec3, lights: &[PlacedLight], to_viewer: DVec3) -> f64 {
     let weight = Lambert::weight(lights.len());
     let mut b = Lambert::SHADOWS.base(f.normal, to_viewer);
-    for (j, l) in lights.iter().enumerate() {
-        if f.lit >> j & 1 == 0 {
-            continue;
-        }
+    let full = (0..lights.len())
+        .filter(|j| f.lit >> j & 1 == 1)
+        .map(|j| (j, 1.0));
+    for (j, share) in full.chain(f.shares.iter().copied()) {
+        let Some(l) = lights.get(j) else { continue };
         let to_light = match l.light {
             Light::Point(_) => (l.world - centre).normalize_or_zero(),
             Light::Directional(_) => l.world,
         };
-        b += Lambert::cosine(weight, f.normal, to_light);
+        b += share * Lambert::cosine(weight, f.normal, to_light);
     }
     b
 }
@@ -406,8 +407,11 @@ pub struct SvgFragment {
     pub polygon: usize,
     /// Its face.
     pub face: usize,
-    /// The lights that reach it (bit `j`: light `j`).
+    /// The lights that reach all of it (bit `j`: light `j`).
     pub lit: u64,
+    /// Lights of extent that reach part of it: the light's index and the
+    /// share of its irradiance that arrives (soft shadows' penumbra).
+    pub shares: Vec<(usize, f64)>,
     /// The unit normal of its front.
     pub normal: DVec3,
     /// Its convex pieces, in input units.
@@ -425,6 +429,7 @@ impl SvgFragment {
                 polygon: f.receiver() as usize,
                 face: f.face() as usize,
                 lit: f.lit_mask(),
+                shares: Vec::new(),
                 normal: unit_normal(f.support()),
                 pieces: f
                     .pieces()
@@ -448,9 +453,39 @@ impl SvgFragment {
         world: &[DVec3],
         faces: usize,
     ) -> Vec<SvgFragment> {
-        let mut of_face: Vec<Vec<usize>> = vec![Vec::new(); faces];
-        for (j, f) in batch.fragments().enumerate() {
-            of_face[f.face() as usize].push(j);
+        let of_faces: Vec<SvgFragment> = batch
+            .fragments()
+            .map(|f| SvgFragment {
+                polygon: 0,
+                face: f.face() as usize,
+                lit: f.lit_mask(),
+                shares: Vec::new(),
+                normal: unit_normal(f.support()),
+                pieces: f
+                    .pieces()
+                    .map(|p| p.iter().map(|&v| world[v as usize]).collect())
+                    .collect(),
+            })
+            .collect();
+        SvgFragment::cut_to_tree(tree, grid, &of_faces, faces)
+    }
+
+    /// Fragments of faces (`face` set, `polygon` not yet; `faces` faces)
+    /// cut to the polygons of `tree`, a BSP tree of the same faces (each
+    /// polygon tagged with its face): each fragment's pieces clipped, in
+    /// `f64` and for the picture only, to every polygon of its face in
+    /// turn.
+    pub fn cut_to_tree(
+        tree: &BspTree,
+        grid: &Grid,
+        of_faces: &[SvgFragment],
+        faces: usize,
+    ) -> Vec<SvgFragment> {
+        let mut of_face: Vec<Vec<&SvgFragment>> = vec![Vec::new(); faces];
+        for f in of_faces {
+            if let Some(list) = of_face.get_mut(f.face) {
+                list.push(f);
+            }
         }
         let mut frags = Vec::new();
         for (pi, p) in tree.polygons().enumerate() {
@@ -460,23 +495,20 @@ impl SvgFragment {
                 .map(|v| grid.to_world(v))
                 .collect();
             let n = unit_normal(p.support());
-            let face = p.tag() as usize;
-            for &j in &of_face[face] {
-                let f = batch.fragment(j);
+            let Some(list) = of_face.get(p.tag() as usize) else {
+                continue;
+            };
+            for f in list {
                 let pieces: Vec<Vec<DVec3>> = f
-                    .pieces()
-                    .filter_map(|piece| {
-                        let poly = piece.iter().map(|&v| world[v as usize]).collect();
-                        clip_to_outline(poly, &outline, n)
-                    })
+                    .pieces
+                    .iter()
+                    .filter_map(|piece| clip_to_outline(piece.clone(), &outline, n))
                     .collect();
                 if !pieces.is_empty() {
                     frags.push(SvgFragment {
                         polygon: pi,
-                        face,
-                        lit: f.lit_mask(),
-                        normal: unit_normal(f.support()),
                         pieces,
+                        ..(*f).clone()
                     });
                 }
             }

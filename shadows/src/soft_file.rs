@@ -7,9 +7,14 @@
 use std::io::Write;
 use std::time::{Duration, Instant};
 
-use bsp_core::{Grid, Polygon};
-use svbsp::export::{FragmentFormat, SoftWritten, write_soft};
-use svbsp::{AreaLight, Occluder, SoftLight};
+use bsp_core::{BspTree, BuildOptions, Grid, Polygon};
+use glam::DVec3;
+use shadow_raster::svg::{SvgFragment, SvgView, SvgViewpoint, unit_normal};
+use shadow_scene::Mesh;
+use svbsp::export::{FragmentFormat, SoftWritten, soft_areas, write_soft};
+use svbsp::{
+    AreaClass, AreaLight, LightSpec, Occluder, PlacedLight, SoftFragment, SoftLight, SoftShape,
+};
 
 use crate::Error;
 use crate::shadow_file::Progress;
@@ -37,6 +42,8 @@ pub struct SoftFile {
     pub written: SoftWritten,
     /// The wall time of each phase, in order.
     pub phases: Vec<(&'static str, Duration)>,
+    /// For a picture: the pieces drawn, and the eye (input units).
+    pub drawn: Option<(usize, DVec3)>,
 }
 
 impl SoftFile {
@@ -52,6 +59,23 @@ impl SoftFile {
             "fragments:       {n} ({:.3} per face)\ntime:            {}\n",
             n as f64 / faces.max(1) as f64,
             times.join(", ")
+        )
+    }
+
+    /// The line saying what was written to `output`: the fragments of
+    /// `scene` (and for a picture the pieces drawn and the eye) under
+    /// `lights` (e.g. "2 lights").
+    pub fn wrote(&self, output: &std::path::Path, scene: &SoftScene, lights: &str) -> String {
+        let drawn = match self.drawn {
+            Some((n, e)) => format!(", {n} drawn, eye {:.3},{:.3},{:.3}", e.x, e.y, e.z),
+            None => String::new(),
+        };
+        format!(
+            "wrote {}: {} fragments of {} faces of {}{drawn} under {lights}\n",
+            output.display(),
+            self.written.fragments,
+            scene.faces,
+            scene.name,
         )
     }
 
@@ -75,6 +99,113 @@ impl SoftFile {
     }
 }
 
+/// The faces of `scene` as occluders, with the index of each one's face.
+fn occluders(scene: &SoftScene) -> (Vec<Occluder>, Vec<u32>) {
+    scene
+        .polys
+        .iter()
+        .filter_map(|p| Some((Occluder::of_polygon(p)?, p.tag())))
+        .unzip()
+}
+
+/// Every face of `scene` cut for its lights, timed.
+fn shade(
+    scene: &SoftScene,
+    occluders: &[Occluder],
+    phases: &mut Vec<(&'static str, Duration)>,
+    progress: &dyn Progress,
+) -> Result<Vec<Vec<SoftFragment>>, Error> {
+    progress.phase("soft shadows", occluders.len() as u64);
+    let start = Instant::now();
+    let lights: Vec<AreaLight> = scene.lights.iter().map(|l| l.light.clone()).collect();
+    let on_face = |n: usize| progress.advance(n as u64);
+    let fragments = svbsp::soft_shadows_with(&lights, occluders, &on_face).map_err(Error::Light)?;
+    phases.push(("shadows", start.elapsed()));
+    Ok(fragments)
+}
+
+/// Soft shadows drawn as an SVG view of `mesh` (the mesh `scene` was
+/// snapped from) seen from `at`, written to `out`: every face cut as for
+/// the files, and each fragment shaded by what reaches it of each light
+/// (all of a light it sees whole, none of one it does not see, and in
+/// penumbra the visible share at its centroid, [`svbsp::Share`]), under
+/// the one lighting model of the point lights' pictures.
+pub fn draw_soft_shadows(
+    scene: &SoftScene,
+    mesh: &Mesh,
+    at: &SvgViewpoint,
+    out: &mut impl Write,
+    progress: &dyn Progress,
+) -> Result<SoftFile, Error> {
+    let mut phases = Vec::new();
+    let (occluders, faces_of) = occluders(scene);
+    let fragments = shade(scene, &occluders, &mut phases, progress)?;
+    progress.phase("drawing", 1);
+    let start = Instant::now();
+    let grid = scene.grid;
+    let mut of_faces = Vec::new();
+    for (frags, &face) in fragments.iter().zip(&faces_of) {
+        for f in frags {
+            let shares = (0..scene.lights.len())
+                .filter(|&j| matches!(f.class(j), AreaClass::Penumbra | AreaClass::Undecided))
+                .filter_map(|j| Some((j, f.visible[j]?.centroid)))
+                .collect();
+            let piece = f
+                .polygon
+                .vertices_f64()
+                .into_iter()
+                .map(|c| grid.to_world(c));
+            of_faces.push(SvgFragment {
+                polygon: 0,
+                face: face as usize,
+                lit: f.lit,
+                shares,
+                normal: unit_normal(f.polygon.support()),
+                pieces: vec![piece.collect()],
+            });
+        }
+    }
+    let tree = BspTree::build(scene.polys.to_vec(), &BuildOptions::default());
+    let drawn = SvgFragment::cut_to_tree(&tree, grid, &of_faces, scene.faces);
+    let lights: Vec<PlacedLight> = scene.lights.iter().map(shading_light).collect();
+    let what = "shadow shadows (soft)";
+    let picture = SvgView::mesh_fragments(grid, mesh, at, &tree, &lights, &drawn, what)
+        .map_err(Error::Raster)?;
+    out.write_all(picture.svg.as_bytes()).map_err(Error::Io)?;
+    phases.push(("draw", start.elapsed()));
+    let written = SoftWritten {
+        areas: soft_areas(&fragments, scene.lights.len(), grid),
+        fragments: fragments.iter().map(Vec::len).sum(),
+        vertices: None,
+        degenerate: 0,
+    };
+    Ok(SoftFile {
+        written,
+        phases,
+        drawn: Some((picture.drawn, picture.eye)),
+    })
+}
+
+/// A light of a soft-shadow run as the pictures' shading takes it: a
+/// point or a direction (an area light from its corners' centre, a disc
+/// from its centre's direction).
+fn shading_light(l: &SoftLight) -> PlacedLight {
+    let (spec, world) = match &l.shape {
+        SoftShape::Point(p) => (LightSpec::Point(*p), *p),
+        SoftShape::Area(c) => {
+            let centre = c.iter().sum::<DVec3>() / c.len().max(1) as f64;
+            (LightSpec::Point(centre), centre)
+        }
+        SoftShape::Sun(d) | SoftShape::SunDisc { direction: d, .. } => (LightSpec::Sun(*d), *d),
+    };
+    PlacedLight {
+        spec,
+        light: l.light.corners()[0],
+        world,
+        angle: 0.0,
+    }
+}
+
 /// Cuts every face of `scene` for its lights and writes the fragments to
 /// `out` as `format`.
 pub fn write_soft_shadows(
@@ -84,17 +215,8 @@ pub fn write_soft_shadows(
     progress: &dyn Progress,
 ) -> Result<SoftFile, Error> {
     let mut phases = Vec::new();
-    progress.phase("soft shadows", 1);
-    let start = Instant::now();
-    let (occluders, faces_of): (Vec<Occluder>, Vec<u32>) = scene
-        .polys
-        .iter()
-        .filter_map(|p| Some((Occluder::of_polygon(p)?, p.tag())))
-        .unzip();
-    let lights: Vec<AreaLight> = scene.lights.iter().map(|l| l.light.clone()).collect();
-    let fragments = svbsp::soft_shadows(&lights, &occluders).map_err(Error::Light)?;
-    phases.push(("shadows", start.elapsed()));
-    progress.advance(1);
+    let (occluders, faces_of) = occluders(scene);
+    let fragments = shade(scene, &occluders, &mut phases, progress)?;
     progress.phase("writing", 1);
     let start = Instant::now();
     let notes: Vec<String> = scene.lights.iter().map(|l| l.shape.to_string()).collect();
@@ -109,5 +231,9 @@ pub fn write_soft_shadows(
     )
     .map_err(Error::Io)?;
     phases.push(("write", start.elapsed()));
-    Ok(SoftFile { written, phases })
+    Ok(SoftFile {
+        written,
+        phases,
+        drawn: None,
+    })
 }

@@ -579,7 +579,11 @@ pub(crate) fn merge_convex<T: Copy + PartialEq>(items: Vec<(Polygon, T)>) -> Vec
             if dead[i] {
                 continue;
             }
-            let mut seen: Vec<usize> = items[i].2.iter().flat_map(|k| at[k].iter().copied()).collect();
+            let mut seen: Vec<usize> = items[i]
+                .2
+                .iter()
+                .flat_map(|k| at[k].iter().copied())
+                .collect();
             seen.sort_unstable();
             let shared = seen
                 .windows(2)
@@ -764,9 +768,9 @@ impl AreaLight {
         // their corners known: umbra, or seeing some corners and hiding
         // others while no occluder has a corner in its plane)
         let flat = regions.iter().any(|(r, _)| flat_corners(r) != 0);
-        let (active, done): (Vec<Piece<K>>, Vec<Piece<K>>) = pieces.into_iter().partition(|p| {
-            !known || !p.umbra && (p.hidden == 0 || p.hidden == all || flat)
-        });
+        let (active, done): (Vec<Piece<K>>, Vec<Piece<K>>) = pieces
+            .into_iter()
+            .partition(|p| !known || !p.umbra && (p.hidden == 0 || p.hidden == all || flat));
         let how = Cutting {
             regions: &regions,
             all,

@@ -857,6 +857,22 @@ pub struct SoftWritten {
     pub degenerate: usize,
 }
 
+/// The areas of soft fragments (`fragments`, per face) per light, in
+/// input units: what [`write_soft`] sums into its summary.
+pub fn soft_areas(fragments: &[Vec<SoftFragment>], lights: usize, grid: &Grid) -> SoftAreas {
+    let mut areas = SoftAreas::new(lights);
+    for f in fragments.iter().flatten() {
+        let world: Vec<DVec3> = f
+            .polygon
+            .vertices_f64()
+            .iter()
+            .map(|&c| grid.to_world(c))
+            .collect();
+        areas.add(f, polygon_area(&world));
+    }
+    areas
+}
+
 fn json_light(l: &SoftLight) -> JsonLight {
     match &l.shape {
         SoftShape::Point(p) => JsonLight::Point {

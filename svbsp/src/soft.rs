@@ -120,6 +120,16 @@ pub fn soft_shadows(
     lights: &[AreaLight],
     faces: &[Occluder],
 ) -> Result<Vec<Vec<SoftFragment>>, LightError> {
+    soft_shadows_with(lights, faces, &|_| {})
+}
+
+/// [`soft_shadows`], calling `on_faces(n)` as each `n` more faces are done
+/// (from the worker threads: a progress bar's tick).
+pub fn soft_shadows_with(
+    lights: &[AreaLight],
+    faces: &[Occluder],
+    on_faces: &(dyn Fn(usize) + Sync),
+) -> Result<Vec<Vec<SoftFragment>>, LightError> {
     if lights.len() > MAX_LIGHTS {
         return Err(LightError::TooMany(lights.len()));
     }
@@ -146,7 +156,9 @@ pub fn soft_shadows(
                 reach: &reach,
                 corners: &corners,
             };
-            soft_face(&scene, &near, face, scratch)
+            let fragments = soft_face(&scene, &near, face, scratch);
+            on_faces(1);
+            fragments
         })
         .collect())
 }
@@ -387,7 +399,12 @@ fn nearest(p: [f64; 3]) -> GridPoint {
 /// The share of `light` (a polygon or a disc: [`has_share`]) arriving at
 /// grid point `x` near `face` (see [`Share`]); `None` where nothing of it
 /// is reachable.
-fn fraction_at(light: &AreaLight, face: &Occluder, hiders: &Hiders<'_>, x: GridPoint) -> Option<f64> {
+fn fraction_at(
+    light: &AreaLight,
+    face: &Occluder,
+    hiders: &Hiders<'_>,
+    x: GridPoint,
+) -> Option<f64> {
     let n = face.plane().normal().map(|c| c as f64);
     let normal = DVec3::from_array(n).normalize();
     let hiding = hiders.at(x).into_iter();
