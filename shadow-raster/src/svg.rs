@@ -453,24 +453,11 @@ impl SvgFragment {
         world: &[DVec3],
         faces: usize,
     ) -> Vec<SvgFragment> {
-        let of_faces: Vec<SvgFragment> = batch
-            .fragments()
-            .map(|f| SvgFragment {
-                polygon: 0,
-                face: f.face() as usize,
-                lit: f.lit_mask(),
-                shares: Vec::new(),
-                normal: unit_normal(f.support()),
-                pieces: f
-                    .pieces()
-                    .map(|p| p.iter().map(|&v| world[v as usize]).collect())
-                    .collect(),
-            })
-            .collect();
+        let of_faces = SvgFragment::of_batch(batch, world);
         SvgFragment::cut_to_tree(tree, grid, &of_faces, faces)
     }
 
-    /// Fragments of faces (`face` set, `polygon` not yet; `faces` faces)
+    /// Fragments of faces (`face` set, `polygon` ignored; `faces` faces)
     /// cut to the polygons of `tree`, a BSP tree of the same faces (each
     /// polygon tagged with its face): each fragment's pieces clipped, in
     /// `f64` and for the picture only, to every polygon of its face in

@@ -99,29 +99,28 @@ impl SoftFile {
     }
 }
 
-/// The faces of `scene` as occluders, with the index of each one's face.
-fn occluders(scene: &SoftScene) -> (Vec<Occluder>, Vec<u32>) {
-    scene
+/// Every face of `scene` cut for its lights: the phases' times so far,
+/// each occluder's face, and the fragments per occluder.
+type Shaded = (
+    Vec<(&'static str, Duration)>,
+    Vec<u32>,
+    Vec<Vec<SoftFragment>>,
+);
+
+/// Every face of `scene` cut for its lights, timed ([`Shaded`]).
+fn shade(scene: &SoftScene, progress: &dyn Progress) -> Result<Shaded, Error> {
+    let (occluders, faces_of): (Vec<Occluder>, Vec<u32>) = scene
         .polys
         .iter()
         .filter_map(|p| Some((Occluder::of_polygon(p)?, p.tag())))
-        .unzip()
-}
-
-/// Every face of `scene` cut for its lights, timed.
-fn shade(
-    scene: &SoftScene,
-    occluders: &[Occluder],
-    phases: &mut Vec<(&'static str, Duration)>,
-    progress: &dyn Progress,
-) -> Result<Vec<Vec<SoftFragment>>, Error> {
+        .unzip();
     progress.phase("soft shadows", occluders.len() as u64);
     let start = Instant::now();
     let lights: Vec<AreaLight> = scene.lights.iter().map(|l| l.light.clone()).collect();
     let on_face = |n: usize| progress.advance(n as u64);
-    let fragments = svbsp::soft_shadows_with(&lights, occluders, &on_face).map_err(Error::Light)?;
-    phases.push(("shadows", start.elapsed()));
-    Ok(fragments)
+    let fragments =
+        svbsp::soft_shadows_with(&lights, &occluders, &on_face).map_err(Error::Light)?;
+    Ok((vec![("shadows", start.elapsed())], faces_of, fragments))
 }
 
 /// Soft shadows drawn as an SVG view of `mesh` (the mesh `scene` was
@@ -137,9 +136,7 @@ pub fn draw_soft_shadows(
     out: &mut impl Write,
     progress: &dyn Progress,
 ) -> Result<SoftFile, Error> {
-    let mut phases = Vec::new();
-    let (occluders, faces_of) = occluders(scene);
-    let fragments = shade(scene, &occluders, &mut phases, progress)?;
+    let (mut phases, faces_of, fragments) = shade(scene, progress)?;
     progress.phase("drawing", 1);
     let start = Instant::now();
     let grid = scene.grid;
@@ -214,9 +211,7 @@ pub fn write_soft_shadows(
     out: &mut impl Write,
     progress: &dyn Progress,
 ) -> Result<SoftFile, Error> {
-    let mut phases = Vec::new();
-    let (occluders, faces_of) = occluders(scene);
-    let fragments = shade(scene, &occluders, &mut phases, progress)?;
+    let (mut phases, faces_of, fragments) = shade(scene, progress)?;
     progress.phase("writing", 1);
     let start = Instant::now();
     let notes: Vec<String> = scene.lights.iter().map(|l| l.shape.to_string()).collect();

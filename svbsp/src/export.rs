@@ -862,15 +862,14 @@ pub struct SoftWritten {
 pub fn soft_areas(fragments: &[Vec<SoftFragment>], lights: usize, grid: &Grid) -> SoftAreas {
     let mut areas = SoftAreas::new(lights);
     for f in fragments.iter().flatten() {
-        let world: Vec<DVec3> = f
-            .polygon
-            .vertices_f64()
-            .iter()
-            .map(|&c| grid.to_world(c))
-            .collect();
-        areas.add(f, polygon_area(&world));
+        areas.add(f, polygon_area(&in_world(&f.polygon, grid)));
     }
     areas
+}
+
+/// A polygon's corners in input units.
+fn in_world(p: &Polygon, grid: &Grid) -> Vec<DVec3> {
+    p.vertices_f64().iter().map(|&c| grid.to_world(c)).collect()
 }
 
 fn json_light(l: &SoftLight) -> JsonLight {
@@ -974,12 +973,7 @@ pub fn write_soft(
     let mut ids = Vec::new();
     for (k, frags) in fragments.iter().enumerate() {
         for f in frags {
-            let world: Vec<DVec3> = f
-                .polygon
-                .vertices_f64()
-                .iter()
-                .map(|&c| grid.to_world(c))
-                .collect();
+            let world = in_world(&f.polygon, grid);
             if world.iter().any(|v| !v.is_finite()) {
                 return Err(io::Error::other(ExportError::NonFiniteVertex {
                     face: faces_of[k],
