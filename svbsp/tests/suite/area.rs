@@ -770,3 +770,79 @@ fn a_square_and_its_two_triangles_cast_the_same_umbra() {
         }
     }
 }
+
+/// A closed mesh (a UV sphere of 400 triangles) over the ground under a
+/// square light: its faces hide the light mostly together. The faces cut
+/// with the corners' point-light trees (`classify_faces`) have the same
+/// area of each class as when cut by every occluder's volume from each
+/// corner (`classify_face`), and at grid points strictly inside the
+/// ground's fragments the exact view agrees with their class.
+#[test]
+fn a_mesh_cut_both_ways_agrees_with_the_view() {
+    let (v, tris) = bsp_fixtures::shapes::uv_sphere(400);
+    let at = DVec3::new(0.2, -0.1, 2.0);
+    let mut world: Vec<Vec<DVec3>> = vec![vec![
+        DVec3::new(-6.0, -6.0, 0.0),
+        DVec3::new(6.0, -6.0, 0.0),
+        DVec3::new(6.0, 6.0, 0.0),
+        DVec3::new(-6.0, 6.0, 0.0),
+    ]];
+    world.extend(
+        tris.iter()
+            .map(|t| t.iter().map(|&i| v[i as usize] + at).collect()),
+    );
+    // a 1.2 × 1.2 light at height 6, its corners turning clockwise seen
+    // from above: it shines down
+    let corners =
+        [(-0.4, -0.6), (-0.4, 0.6), (0.8, 0.6), (0.8, -0.6)].map(|(x, y)| DVec3::new(x, y, 6.0));
+    let grid = bsp_core::Grid::fit_points(world.iter().flatten().chain(&corners)).unwrap();
+    let faces = snapped(&world, &grid);
+    assert_eq!(faces.len(), world.len());
+    let light = AreaLight::new(&corners.map(|c| grid.snap(c).unwrap())).unwrap();
+    let fast = light.classify_faces(&faces);
+    let areas = |fs: &[svbsp::AreaFragment]| -> [f64; 4] {
+        let mut a = [0.0; 4];
+        for f in fs {
+            a[f.class as usize] += area_of(&f.polygon);
+        }
+        a
+    };
+    for i in (0..faces.len()).step_by(10) {
+        let (a, b) = (
+            areas(&fast[i]),
+            areas(&light.classify_face(&faces[i], &faces)),
+        );
+        for k in 0..4 {
+            assert!(
+                (a[k] - b[k]).abs() <= 1e-9 * (1.0 + b[k]),
+                "face {i}: {a:?} against {b:?}"
+            );
+        }
+    }
+    let mut rng = Rng::new(0x5f3e_4e);
+    let plane = *faces[0].plane();
+    let half = grid.snap(DVec3::new(3.0, 3.0, 0.0)).unwrap();
+    let mut met = std::collections::HashMap::new();
+    for _ in 0..400 {
+        let x = [
+            below(&mut rng, 2 * half[0] as u64) - half[0],
+            below(&mut rng, 2 * half[1] as u64) - half[1],
+            grid.snap(DVec3::ZERO).unwrap()[2],
+        ];
+        let Some(f) = fast[0].iter().find(|f| strictly_inside(&f.polygon, x)) else {
+            continue;
+        };
+        let seen = light.view(x, Some(&plane), &faces).unwrap().visibility;
+        let ok = match f.class {
+            AreaClass::Lit => seen == Visibility::All,
+            AreaClass::Umbra => seen == Visibility::None,
+            AreaClass::Penumbra => seen == Visibility::Part,
+            AreaClass::Undecided => seen != Visibility::All,
+        };
+        assert!(ok, "{x:?}: class {:?}, the view says {seen:?}", f.class);
+        *met.entry(f.class).or_insert(0) += 1;
+    }
+    for class in [AreaClass::Lit, AreaClass::Penumbra, AreaClass::Undecided] {
+        assert!(met.contains_key(&class), "{class:?} never met: {met:?}");
+    }
+}
