@@ -819,7 +819,7 @@ fn a_mesh_cut_both_ways_agrees_with_the_view() {
             );
         }
     }
-    let mut rng = Rng::new(0x5f3e_4e);
+    let mut rng = Rng::new(0x005f_3e4e);
     let plane = *faces[0].plane();
     let half = grid.snap(DVec3::new(3.0, 3.0, 0.0)).unwrap();
     let mut met = std::collections::HashMap::new();
