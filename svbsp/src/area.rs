@@ -558,18 +558,41 @@ fn vertex_keys(p: &Polygon) -> Vec<[u64; 3]> {
 /// (`Polygon::merge`, exact), until none do; only pairs that share two
 /// vertex keys are tried. Deterministic: the order of the input decides.
 pub(crate) fn merge_convex<T: Copy + PartialEq>(items: Vec<(Polygon, T)>) -> Vec<(Polygon, T)> {
-    // each polygon's keys, made again only when it grows
-    let mut items: Vec<(Polygon, T, Vec<[u64; 3]>)> = items
+    let items = items
         .into_iter()
-        .map(|(p, t)| {
-            let keys = vertex_keys(&p);
-            (p, t, keys)
+        .map(|(polygon, label)| Keyed {
+            keys: vertex_keys(&polygon),
+            polygon,
+            label,
+            extra: (),
         })
         .collect();
+    merge_keyed(items, |_, _| ())
+        .into_iter()
+        .map(|m| (m.polygon, m.label))
+        .collect()
+}
+
+/// A polygon to merge: its label, its vertex keys, and something that two
+/// merged polygons join.
+struct Keyed<T, X> {
+    polygon: Polygon,
+    label: T,
+    keys: Vec<[u64; 3]>,
+    extra: X,
+}
+
+/// [`merge_convex`] of polygons with their keys; `join` makes a merged
+/// polygon's `extra` of its two parts'. A polygon's keys are made again
+/// only when it grows.
+fn merge_keyed<T: Copy + PartialEq, X>(
+    mut items: Vec<Keyed<T, X>>,
+    join: impl Fn(&X, &X) -> X,
+) -> Vec<Keyed<T, X>> {
     loop {
         let mut at: rustc_hash::FxHashMap<[u64; 3], Vec<usize>> = Default::default();
-        for (i, (_, _, ks)) in items.iter().enumerate() {
-            for k in ks {
+        for (i, item) in items.iter().enumerate() {
+            for k in &item.keys {
                 at.entry(*k).or_default().push(i);
             }
         }
@@ -580,7 +603,7 @@ pub(crate) fn merge_convex<T: Copy + PartialEq>(items: Vec<(Polygon, T)>) -> Vec
                 continue;
             }
             let mut seen: Vec<usize> = items[i]
-                .2
+                .keys
                 .iter()
                 .flat_map(|k| at[k].iter().copied())
                 .collect();
@@ -592,14 +615,15 @@ pub(crate) fn merge_convex<T: Copy + PartialEq>(items: Vec<(Polygon, T)>) -> Vec
             let mut candidates: Vec<usize> = shared.collect();
             candidates.dedup();
             for j in candidates {
-                if dead[j] || items[j].1 != items[i].1 {
+                if dead[j] || items[j].label != items[i].label {
                     continue;
                 }
-                if let Some(m) = items[i].0.merge(&items[j].0) {
+                if let Some(m) = items[i].polygon.merge(&items[j].polygon) {
                     // later polygons of this pass look only for partners
                     // after them: this one's new keys count from the next
-                    items[i].2 = vertex_keys(&m);
-                    items[i].0 = m;
+                    items[i].keys = vertex_keys(&m);
+                    items[i].polygon = m;
+                    items[i].extra = join(&items[i].extra, &items[j].extra);
                     dead[j] = true;
                     any = true;
                     break;
@@ -612,7 +636,7 @@ pub(crate) fn merge_convex<T: Copy + PartialEq>(items: Vec<(Polygon, T)>) -> Vec
             !dead[k - 1]
         });
         if !any {
-            return items.into_iter().map(|(p, t, _)| (p, t)).collect();
+            return items;
         }
     }
 }
@@ -894,6 +918,8 @@ struct Piece<K> {
     not_lit: bool,
     hidden: u64,
     umbra: bool,
+    /// Its vertex keys ([`vertex_keys`]), once a merge has made them.
+    keys: Option<Vec<[u64; 3]>>,
 }
 
 /// How [`AreaLight::cut`] cuts one piece: by these occluders' regions,
@@ -958,6 +984,19 @@ impl<K> Piece<K> {
             not_lit,
             hidden,
             umbra: false,
+            keys: None,
+        }
+    }
+
+    /// A maker of parts of this piece, in its state.
+    fn parts(&self) -> impl Fn(Polygon) -> Piece<K> + use<K>
+    where
+        K: Copy,
+    {
+        let (label, hidden, not_lit, umbra) = (self.label, self.hidden, self.not_lit, self.umbra);
+        move |polygon| Piece {
+            umbra,
+            ..Piece::new(polygon, label, hidden, not_lit)
         }
     }
 }
@@ -1074,6 +1113,7 @@ fn cut_piece<K: Copy>(r: &Regions, piece: Piece<K>, all: u64, next: &mut Vec<Pie
         next.push(piece);
         return;
     }
+    let part = piece.parts();
     if piece.not_lit && r.from_corner.iter().all(Option::is_some) {
         // not lit already: only this occluder's umbra and the corners not
         // hidden yet can change its class
@@ -1086,11 +1126,9 @@ fn cut_piece<K: Copy>(r: &Regions, piece: Piece<K>, all: u64, next: &mut Vec<Pie
             }
         };
         next.extend(umbra.map(|polygon| Piece {
-            bbox: polygon_box(&polygon),
-            polygon,
             hidden: all,
             umbra: true,
-            ..piece
+            ..part(polygon)
         }));
         let mut parts: Vec<(Polygon, u64)> = parts.into_iter().map(|p| (p, 0)).collect();
         for (i, hs) in r.from_corner.iter().enumerate() {
@@ -1099,20 +1137,14 @@ fn cut_piece<K: Copy>(r: &Regions, piece: Piece<K>, all: u64, next: &mut Vec<Pie
             }
         }
         next.extend(parts.into_iter().map(|(polygon, m)| Piece {
-            bbox: polygon_box(&polygon),
-            polygon,
             hidden: piece.hidden | m,
-            ..piece
+            ..part(polygon)
         }));
         return;
     }
     let mut outside = Vec::new();
     let inside = subtract(&r.penumbra, piece.polygon, &mut outside);
-    next.extend(outside.into_iter().map(|polygon| Piece {
-        bbox: polygon_box(&polygon),
-        polygon,
-        ..piece
-    }));
+    next.extend(outside.into_iter().map(&part));
     let Some(inside) = inside else {
         return;
     };
@@ -1129,30 +1161,38 @@ fn cut_piece<K: Copy>(r: &Regions, piece: Piece<K>, all: u64, next: &mut Vec<Pie
     }
     let whole = r.from_corner.iter().all(Option::is_some);
     next.extend(parts.into_iter().map(|(polygon, m)| Piece {
-        bbox: polygon_box(&polygon),
-        polygon,
-        label: piece.label,
-        not_lit: true,
-        hidden: piece.hidden | m,
         umbra: whole && m == all,
+        ..Piece::new(polygon, piece.label, piece.hidden | m, true)
     }));
 }
 
-/// Pieces of equal label and state merged where their union is convex.
+/// Pieces of equal label and state merged where their union is convex
+/// (their keys kept; a merged piece's box is its parts' boxes' union).
 fn merge_pieces<K: Copy + PartialEq>(pieces: Vec<Piece<K>>) -> Vec<Piece<K>> {
     let items = pieces
         .into_iter()
-        .map(|p| (p.polygon, (p.label, p.not_lit, p.hidden, p.umbra)))
+        .map(|p| Keyed {
+            keys: p.keys.unwrap_or_else(|| vertex_keys(&p.polygon)),
+            polygon: p.polygon,
+            label: (p.label, p.not_lit, p.hidden, p.umbra),
+            extra: p.bbox,
+        })
         .collect();
-    merge_convex(items)
+    let union =
+        |a: &Box3, b: &Box3| [0, 1, 2].map(|k| [a[k][0].min(b[k][0]), a[k][1].max(b[k][1])]);
+    merge_keyed(items, union)
         .into_iter()
-        .map(|(polygon, (label, not_lit, hidden, umbra))| Piece {
-            bbox: polygon_box(&polygon),
-            polygon,
-            label,
-            not_lit,
-            hidden,
-            umbra,
+        .map(|m| {
+            let (label, not_lit, hidden, umbra) = m.label;
+            Piece {
+                polygon: m.polygon,
+                bbox: m.extra,
+                label,
+                not_lit,
+                hidden,
+                umbra,
+                keys: Some(m.keys),
+            }
         })
         .collect()
 }
