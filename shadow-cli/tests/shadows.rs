@@ -810,6 +810,38 @@ fn bad_soft_lights_are_errors() {
     assert_failed_with(&cf, &["--algorithm psv only"]);
 }
 
+/// An area light turned away from every face lights nothing, and the
+/// report says which light and why that may be.
+#[test]
+fn an_area_light_turned_away_is_named() {
+    let input = floor_and_occluder();
+    // counter-clockwise seen from above: it shines up, away from both
+    let up = "0.65,0.65,2;0.85,0.65,2;0.85,0.85,2;0.65,0.85,2";
+    let out = scratch("turned_away.json");
+    let o = shadow(&[
+        "shadows",
+        input.to_str().unwrap(),
+        "--area-light",
+        up,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = stdout(&o);
+    assert!(report.contains("umbra 100.0%"), "{report}");
+    assert!(report.contains("light 0 reaches no face"), "{report}");
+    let down = "0.65,0.65,2;0.65,0.85,2;0.85,0.85,2;0.85,0.65,2";
+    let o = shadow(&[
+        "shadows",
+        input.to_str().unwrap(),
+        "--area-light",
+        down,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!stdout(&o).contains("reaches no face"), "{}", stdout(&o));
+}
+
 /// Soft shadows drawn: under a small square light, the floor's lit and
 /// umbra parts have the colours of the point light at its centre, lit
 /// and in shadow, and its penumbra shades lie between them.

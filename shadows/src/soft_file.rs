@@ -81,18 +81,31 @@ impl SoftFile {
 
     /// One line per light: the shares of the area lit, in penumbra (and
     /// of it undecided) and in umbra.
+    ///
+    /// A light that reaches no part of any face gets a second line saying
+    /// why that may be (an area light turned away from the scene).
     pub fn report(&self) -> String {
         let a = &self.written.areas;
         let pc = |x: f64| svbsp::percent(x, a.total);
         (0..a.lit.len())
             .map(|i| {
+                let dark = a.total > 0.0 && a.lit[i] + a.penumbra[i] == 0.0;
                 format!(
                     "light {i}: lit {:.1}%, penumbra {:.1}% (undecided {:.1}%), umbra {:.1}% \
-                     of the area\n",
+                     of the area\n{}",
                     pc(a.lit[i]),
                     pc(a.penumbra[i]),
                     pc(a.undecided[i]),
-                    pc(a.umbra[i])
+                    pc(a.umbra[i]),
+                    if dark {
+                        format!(
+                            "  light {i} reaches no face: is it behind them all? (an area \
+                             light shines on the side its corners turn counter-clockwise \
+                             about; list them the other way round to turn it over)\n"
+                        )
+                    } else {
+                        String::new()
+                    }
                 )
             })
             .collect()
