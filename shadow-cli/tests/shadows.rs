@@ -844,11 +844,14 @@ fn an_area_light_turned_away_is_named() {
 
 /// Soft shadows drawn: under a small square light, the floor's lit and
 /// umbra parts have the colours of the point light at its centre, lit
-/// and in shadow, and its penumbra shades lie between them.
+/// and in shadow, and its penumbra is drawn with gradients whose colours
+/// run between them.
 #[test]
 fn soft_shadows_are_drawn_between_lit_and_shadow() {
     let input = floor_and_occluder();
-    let fills = |args: &[&str], name: &str| -> BTreeSet<String> {
+    // the colours after `key` (`fill="` or `stop-color="`), but the
+    // background's and gradients' references
+    let colours = |args: &[&str], name: &str, key: &str| -> BTreeSet<String> {
         let out = scratch(name);
         let mut argv = vec!["shadows", input.to_str().unwrap(), "--eye", "1,-3,3"];
         argv.extend(args);
@@ -858,14 +861,15 @@ fn soft_shadows_are_drawn_between_lit_and_shadow() {
         assert!(stdout(&o).contains(" drawn, eye "), "{}", stdout(&o));
         let svg = std::fs::read_to_string(&out).unwrap();
         assert!(svg.trim_end().ends_with("</svg>"));
-        svg.split("fill=\"")
-            .skip(2) // the background
+        svg.split(key)
+            .skip(1)
             .map(|s| s[..7].to_string())
+            .filter(|c| c.starts_with('#') && c != "#e9ecf0")
             .collect()
     };
-    let hard = fills(&["--light", "0.75,0.75,2"], "hard_floor.svg");
+    let hard = colours(&["--light", "0.75,0.75,2"], "hard_floor.svg", "fill=\"");
     let light = "0.65,0.65,2;0.65,0.85,2;0.85,0.85,2;0.85,0.65,2";
-    let soft = fills(&["--area-light", light], "soft_floor.svg");
+    let soft = colours(&["--area-light", light], "soft_floor.svg", "fill=\"");
     assert!(hard.is_subset(&soft), "{hard:?} not in {soft:?}");
     let rgb = |f: &str| [1, 3, 5].map(|i| u8::from_str_radix(&f[i..i + 2], 16).unwrap());
     // the floor's lit and shadowed colours: the two of one hue
@@ -877,11 +881,12 @@ fn soft_shadows_are_drawn_between_lit_and_shadow() {
         .filter(|(a, b)| (0..3).all(|k| a[k] > b[k]))
         .max_by_key(|(a, b)| (0..3).map(|k| a[k] - b[k]).min())
         .unwrap();
-    let between = soft
-        .difference(&hard)
-        .map(|f| rgb(f))
-        .filter(|c| (0..3).all(|k| dark[k] < c[k] && c[k] < lit[k]))
-        .count();
-    // (the penumbra's four sides see the same share: one shade)
-    assert!(between >= 1, "no penumbra shade in {soft:?}");
+    let stops = colours(&["--area-light", light], "soft_floor.svg", "stop-color=\"");
+    assert!(!stops.is_empty(), "no gradient in the penumbra");
+    let within = |c: &[u8; 3]| (0..3).all(|k| dark[k] <= c[k] && c[k] <= lit[k]);
+    for s in &stops {
+        assert!(within(&rgb(s)), "{s} is not between {dark:?} and {lit:?}");
+    }
+    let strictly = |c: &[u8; 3]| (0..3).all(|k| dark[k] < c[k] && c[k] < lit[k]);
+    assert!(stops.iter().any(|s| strictly(&rgb(s))), "{stops:?}");
 }

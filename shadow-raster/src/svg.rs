@@ -11,7 +11,7 @@
 use std::fmt::Write;
 
 use bsp_core::{BspTree, Grid, Order, Plane, Polygon, Side, ViewPoint};
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use shadow_scene::Staging;
 use svbsp::{Light, PlacedLight};
 
@@ -354,6 +354,14 @@ impl SvgView {
             for &(poly, _) in &order[start..end] {
                 for &j in &per_polygon[poly] {
                     let f = &frags[j];
+                    if toward && !f.ramps.is_empty() {
+                        // a soft shade: each piece with its own gradient
+                        let at = |p: DVec3| ramped(f, p, centres[f.face], lights, to_viewer);
+                        for piece in &f.pieces {
+                            canvas.ramp(piece, colors[f.face], &at);
+                        }
+                        continue;
+                    }
                     let b = if toward {
                         brightness(f, centres[f.face], lights, to_viewer)
                     } else {
@@ -377,6 +385,29 @@ impl SvgView {
         }
         Ok(canvas.finish())
     }
+}
+
+/// [`brightness`] at point `p` of a fragment whose shares vary over it
+/// (its `ramps` in place of its `shares`).
+fn ramped(
+    f: &SvgFragment,
+    p: DVec3,
+    centre: DVec3,
+    lights: &[PlacedLight],
+    to_viewer: DVec3,
+) -> f64 {
+    let shares = f
+        .ramps
+        .iter()
+        .map(|&(j, [gx, gy, gz, d])| (j, (gx * p.x + gy * p.y + gz * p.z + d).clamp(0.0, 1.0)))
+        .collect();
+    let at = SvgFragment {
+        shares,
+        ramps: Vec::new(),
+        pieces: Vec::new(),
+        ..f.clone()
+    };
+    brightness(&at, centre, lights, to_viewer)
 }
 
 /// Brightness of a fragment seen from its front, lit by the lights of
@@ -412,6 +443,10 @@ pub struct SvgFragment {
     /// Lights of extent that reach part of it: the light's index and the
     /// share of its irradiance that arrives (soft shadows' penumbra).
     pub shares: Vec<(usize, f64)>,
+    /// Where given, the shares vary over it: per light of `shares`, the
+    /// share at a point `p` (input units) is `g · p + d` (`[g, d]`),
+    /// clamped to `[0, 1]`; the fragment is then drawn with a gradient.
+    pub ramps: Vec<(usize, [f64; 4])>,
     /// The unit normal of its front.
     pub normal: DVec3,
     /// Its convex pieces, in input units.
@@ -430,6 +465,7 @@ impl SvgFragment {
                 face: f.face() as usize,
                 lit: f.lit_mask(),
                 shares: Vec::new(),
+                ramps: Vec::new(),
                 normal: unit_normal(f.support()),
                 pieces: f
                     .pieces()
@@ -519,6 +555,47 @@ fn clip_to_outline(mut poly: Vec<DVec3>, outline: &[DVec3], n: DVec3) -> Option<
     (poly.len() >= 3).then_some(poly)
 }
 
+/// The linear gradient of values `b` at points `pts` (pixels): the
+/// affine function through the first corner and the two that span the
+/// largest triangle with it, from where it is least to where it is most
+/// over the corners, with those values; `None` where it is flat or the
+/// polygon covers less than a pixel.
+#[allow(clippy::type_complexity)]
+fn gradient(pts: &[(f64, f64)], b: &[f64]) -> Option<((f64, f64), (f64, f64), f64, f64)> {
+    let p = |i: usize| DVec2::new(pts[i].0, pts[i].1);
+    let n = pts.len();
+    let (mut best, mut pick) = (0.0, (1, 2));
+    for i in 1..n {
+        for k in i + 1..n {
+            let a = (p(i) - p(0)).perp_dot(p(k) - p(0)).abs();
+            if a > best {
+                (best, pick) = (a, (i, k));
+            }
+        }
+    }
+    let (e1, e2) = (p(pick.0) - p(0), p(pick.1) - p(0));
+    let det = e1.perp_dot(e2);
+    // under a square pixel: too small to show a gradient
+    if best < 1.0 {
+        return None;
+    }
+    // g · e1 = b1 − b0, g · e2 = b2 − b0
+    let (d1, d2) = (b[pick.0] - b[0], b[pick.1] - b[0]);
+    let g = DVec2::new(d1 * e2.y - d2 * e1.y, e1.x * d2 - e2.x * d1) / det;
+    let (lo, hi) = b
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
+    let g2 = g.length_squared();
+    if hi <= lo || g2 == 0.0 {
+        return None;
+    }
+    let from = p(0) + g * ((lo - b[0]) / g2);
+    let to = p(0) + g * ((hi - b[0]) / g2);
+    Some(((from.x, from.y), (to.x, to.y), lo, hi))
+}
+
 /// A finished SVG picture.
 #[derive(Clone, Debug)]
 pub struct SvgPicture {
@@ -576,6 +653,41 @@ impl<'v> Canvas<'v> {
     fn polygon(&mut self, world: impl IntoIterator<Item = DVec3>, fill: &str) {
         let Some(pts) = self.view.clip_project(world) else {
             return;
+        };
+        self.svg.push_str("<polygon points=\"");
+        for (i, (x, y)) in pts.iter().enumerate() {
+            let _ = write!(self.svg, "{}{x:.2},{y:.2}", if i > 0 { " " } else { "" });
+        }
+        let _ = writeln!(self.svg, "\" fill=\"{fill}\" stroke=\"{fill}\"/>");
+        self.drawn += 1;
+    }
+
+    /// Draws a convex polygon given in input units shaded from colour `c`
+    /// by the brightness `at` its points: a linear gradient through the
+    /// brightness at three of its corners as projected (exact for a
+    /// brightness affine in the picture's plane; a polygon cut by the
+    /// view's edges gets its corners' mean, flat).
+    fn ramp(&mut self, world: &[DVec3], c: DVec3, at: &dyn Fn(DVec3) -> f64) {
+        let Some(pts) = self.view.clip_project(world.iter().copied()) else {
+            return;
+        };
+        let b: Vec<f64> = world.iter().map(|&p| at(p)).collect();
+        let mean = b.iter().sum::<f64>() / b.len().max(1) as f64;
+        let fill = match (pts.len() == world.len())
+            .then(|| gradient(&pts, &b))
+            .flatten()
+        {
+            Some(((x1, y1), (x2, y2), lo, hi)) => {
+                let id = self.drawn;
+                let _ = writeln!(
+                    self.svg,
+                    r#"<linearGradient id="r{id}" gradientUnits="userSpaceOnUse" x1="{x1:.2}" y1="{y1:.2}" x2="{x2:.2}" y2="{y2:.2}"><stop offset="0" stop-color="{}"/><stop offset="1" stop-color="{}"/></linearGradient>"#,
+                    hex(c, lo),
+                    hex(c, hi)
+                );
+                format!("url(#r{id})")
+            }
+            None => hex(c, mean),
         };
         self.svg.push_str("<polygon points=\"");
         for (i, (x, y)) in pts.iter().enumerate() {
@@ -647,6 +759,27 @@ fn clip(poly: &[DVec3], n: DVec3, d: f64) -> Vec<DVec3> {
 mod tests {
     use super::*;
     use bsp_core::{BuildOptions, import_faces};
+
+    /// A gradient runs from the least value to the most, and the affine
+    /// function it draws takes the given values at the corners; flat or
+    /// sub-pixel polygons get none.
+    #[test]
+    fn gradients_reproduce_affine_values() {
+        let pts = [(10.0, 10.0), (110.0, 20.0), (90.0, 80.0), (20.0, 70.0)];
+        let f = |(x, y): (f64, f64)| 0.2 + 0.004 * x - 0.003 * y;
+        let b: Vec<f64> = pts.iter().map(|&p| f(p)).collect();
+        let ((x1, y1), (x2, y2), lo, hi) = gradient(&pts, &b).unwrap();
+        assert!((f((x1, y1)) - lo).abs() < 1e-12 && (f((x2, y2)) - hi).abs() < 1e-12);
+        let (min, max) = b
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                (l.min(v), h.max(v))
+            });
+        assert_eq!((lo, hi), (min, max));
+        assert!(gradient(&pts, &[0.5; 4]).is_none());
+        let tiny = [(0.0, 0.0), (0.5, 0.0), (0.0, 0.5)];
+        assert!(gradient(&tiny, &[0.0, 1.0, 0.5]).is_none());
+    }
 
     /// A mesh snapped to its own grid and built into a tree.
     fn prepared(mesh: &shadow_scene::Mesh) -> (Grid, BspTree) {

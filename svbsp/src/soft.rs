@@ -25,9 +25,9 @@ use crate::near::{CellGrid, near_lists};
 
 /// The share of a polygon light's irradiance that arrives on a penumbra
 /// fragment ([`crate::LightView::fraction`]): at the grid point nearest its
-/// centroid, and the least and most at the grid points nearest its
-/// corners.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// centroid, and at the grid points nearest its corners (each, and the
+/// least and most).
+#[derive(Clone, Debug, PartialEq)]
 pub struct Share {
     /// At the centroid.
     pub centroid: f64,
@@ -35,6 +35,8 @@ pub struct Share {
     pub min: f64,
     /// The most at a corner.
     pub max: f64,
+    /// At each corner, in the fragment's vertex order.
+    pub corners: Vec<f64>,
 }
 
 /// A piece of a face with one class per light.
@@ -112,7 +114,7 @@ impl Classes {
 /// assert!(ground.iter().any(|f| f.class(0) == AreaClass::Umbra && f.class(1) == AreaClass::Umbra));
 /// // the square light's penumbra, lit by the point
 /// let soft = ground.iter().find(|f| f.class(0) == AreaClass::Penumbra && f.class(1) == AreaClass::Lit);
-/// let share = soft.unwrap().visible[0].unwrap();
+/// let share = soft.unwrap().visible[0].as_ref().unwrap();
 /// assert!(0.0 <= share.min && share.min <= share.max && share.max <= 1.0);
 /// assert!(share.centroid > 0.0 && share.centroid < 1.0);
 /// ```
@@ -373,14 +375,17 @@ impl Probes {
             let i = viewed.points.binary_search(x).ok()?;
             viewed.fractions[i]
         };
-        let values = self.corners.iter().map(|x| at(x).unwrap_or(0.0));
-        let (min, max) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), f| {
-            (lo.min(f), hi.max(f))
-        });
+        let corners: Vec<f64> = self.corners.iter().map(|x| at(x).unwrap_or(0.0)).collect();
+        let (min, max) = corners
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &f| {
+                (lo.min(f), hi.max(f))
+            });
         Share {
             centroid: at(&self.centroid).unwrap_or(0.0),
             min,
             max,
+            corners,
         }
     }
 }

@@ -584,7 +584,7 @@ fn check_disc_shares(
             .filter(|s| !matches!(scene.verdict(s, 0, &hx), Verdict::Shadowed))
             .count();
         let want = open as f64 / lattice.len() as f64;
-        let got = f.visible[0].unwrap().centroid;
+        let got = f.visible[0].as_ref().unwrap().centroid;
         assert!(
             (got - want).abs() < 0.15,
             "{x:?}: share {got}, the lattice's {want}"
