@@ -217,6 +217,17 @@ fn bad_lights_are_refused() {
 }
 
 /// Whether the grid point `x` lies strictly inside the convex `piece`.
+/// Whether a fragment's class agrees with what the exact view at a point
+/// strictly inside it says (undecided: anything but all of the light).
+fn agrees(class: AreaClass, seen: Visibility) -> bool {
+    match class {
+        AreaClass::Lit => seen == Visibility::All,
+        AreaClass::Umbra => seen == Visibility::None,
+        AreaClass::Penumbra => seen == Visibility::Part,
+        AreaClass::Undecided => seen != Visibility::All,
+    }
+}
+
 fn strictly_inside(piece: &Polygon, x: [i32; 3]) -> bool {
     piece
         .edge_planes()
@@ -297,13 +308,11 @@ fn classified_faces_agree_with_the_view() {
                     continue;
                 }
                 let seen = light.view(x, Some(&plane), &faces).unwrap().visibility;
-                let ok = match f.class {
-                    AreaClass::Lit => seen == Visibility::All,
-                    AreaClass::Umbra => seen == Visibility::None,
-                    AreaClass::Penumbra => seen == Visibility::Part,
-                    AreaClass::Undecided => seen != Visibility::All,
-                };
-                assert!(ok, "{x:?}: class {:?}, the view says {seen:?}", f.class);
+                assert!(
+                    agrees(f.class, seen),
+                    "{x:?}: class {:?}, the view says {seen:?}",
+                    f.class
+                );
                 *met.entry(f.class).or_insert(0) += 1;
             }
         }
@@ -833,13 +842,11 @@ fn a_mesh_cut_both_ways_agrees_with_the_view() {
             continue;
         };
         let seen = light.view(x, Some(&plane), &faces).unwrap().visibility;
-        let ok = match f.class {
-            AreaClass::Lit => seen == Visibility::All,
-            AreaClass::Umbra => seen == Visibility::None,
-            AreaClass::Penumbra => seen == Visibility::Part,
-            AreaClass::Undecided => seen != Visibility::All,
-        };
-        assert!(ok, "{x:?}: class {:?}, the view says {seen:?}", f.class);
+        assert!(
+            agrees(f.class, seen),
+            "{x:?}: class {:?}, the view says {seen:?}",
+            f.class
+        );
         *met.entry(f.class).or_insert(0) += 1;
     }
     for class in [AreaClass::Lit, AreaClass::Penumbra, AreaClass::Undecided] {
