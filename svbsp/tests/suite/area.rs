@@ -6,7 +6,7 @@
 //! grazes an occluder, which the oracle calls degenerate), and the share
 //! of the irradiance that arrives must match the samples' weighted share.
 
-use bsp_core::Polygon;
+use bsp_core::{Plane, Polygon};
 use bsp_fixtures::Rng;
 use glam::DVec3;
 use svbsp::{AreaClass, AreaLight, Light, Occluder, Visibility};
@@ -217,15 +217,23 @@ fn bad_lights_are_refused() {
 }
 
 /// Whether the grid point `x` lies strictly inside the convex `piece`.
-/// Whether a fragment's class agrees with what the exact view at a point
-/// strictly inside it says (undecided: anything but all of the light).
-fn agrees(class: AreaClass, seen: Visibility) -> bool {
-    match class {
+/// Checks a fragment's class against what the exact view says at grid
+/// point `x` strictly inside it, on a face of plane `plane` (undecided:
+/// anything but all of the light).
+fn assert_agrees(
+    light: &AreaLight,
+    (x, plane): ([i32; 3], &Plane),
+    faces: &[Occluder],
+    class: AreaClass,
+) {
+    let seen = light.view(x, Some(plane), faces).unwrap().visibility;
+    let ok = match class {
         AreaClass::Lit => seen == Visibility::All,
         AreaClass::Umbra => seen == Visibility::None,
         AreaClass::Penumbra => seen == Visibility::Part,
         AreaClass::Undecided => seen != Visibility::All,
-    }
+    };
+    assert!(ok, "{x:?}: class {class:?}, the view says {seen:?}");
 }
 
 fn strictly_inside(piece: &Polygon, x: [i32; 3]) -> bool {
@@ -307,12 +315,7 @@ fn classified_faces_agree_with_the_view() {
                 if faces.iter().enumerate().any(|(i, o)| i != r && edge_on(o)) {
                     continue;
                 }
-                let seen = light.view(x, Some(&plane), &faces).unwrap().visibility;
-                assert!(
-                    agrees(f.class, seen),
-                    "{x:?}: class {:?}, the view says {seen:?}",
-                    f.class
-                );
+                assert_agrees(&light, (x, &plane), &faces, f.class);
                 *met.entry(f.class).or_insert(0) += 1;
             }
         }
@@ -841,12 +844,7 @@ fn a_mesh_cut_both_ways_agrees_with_the_view() {
         let Some(f) = fast[0].iter().find(|f| strictly_inside(&f.polygon, x)) else {
             continue;
         };
-        let seen = light.view(x, Some(&plane), &faces).unwrap().visibility;
-        assert!(
-            agrees(f.class, seen),
-            "{x:?}: class {:?}, the view says {seen:?}",
-            f.class
-        );
+        assert_agrees(&light, (x, &plane), &faces, f.class);
         *met.entry(f.class).or_insert(0) += 1;
     }
     for class in [AreaClass::Lit, AreaClass::Penumbra, AreaClass::Undecided] {
