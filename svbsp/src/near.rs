@@ -39,10 +39,13 @@ pub(crate) fn near_lists(
             [penumbra_box(lights, f.corners(), scene), umbra]
         })
         .collect();
-    let mut pairs: Vec<(u32, u32)> = regions
+    // per occluder the faces it may reach, then turned into per face the
+    // occluders (in index order): four bytes a pair in each form, and each
+    // occluder's list freed as it is turned
+    let hits: Vec<Vec<u32>> = regions
         .par_iter()
         .enumerate()
-        .flat_map_iter(|(j, r)| {
+        .map(|(j, r)| {
             let mut hit = Vec::new();
             if let Some(r) = r {
                 let reach = reaches[j][0];
@@ -58,14 +61,20 @@ pub(crate) fn near_lists(
                 });
                 hit.sort_unstable();
                 hit.dedup();
+                hit.shrink_to_fit();
             }
-            hit.into_iter().map(move |i| (i, j as u32))
+            hit
         })
         .collect();
-    pairs.par_sort_unstable();
-    let mut near = vec![Vec::new(); faces.len()];
-    for (i, j) in pairs {
-        near[i as usize].push(j);
+    let mut counts = vec![0usize; faces.len()];
+    for &i in hits.iter().flatten() {
+        counts[i as usize] += 1;
+    }
+    let mut near: Vec<Vec<u32>> = counts.into_iter().map(Vec::with_capacity).collect();
+    for (j, hit) in hits.into_iter().enumerate() {
+        for i in hit {
+            near[i as usize].push(j as u32);
+        }
     }
     (near, reaches)
 }
