@@ -356,7 +356,7 @@ impl SvgView {
                     let f = &frags[j];
                     if toward && !f.ramps.is_empty() {
                         // a soft shade: each piece with its own gradient
-                        let at = |p: DVec3| ramped(f, p, centres[f.face], lights, to_viewer);
+                        let at = |p| brightness_at(f, Some(p), centres[f.face], lights, to_viewer);
                         for piece in &f.pieces {
                             canvas.ramp(piece, colors[f.face], &at);
                         }
@@ -387,38 +387,29 @@ impl SvgView {
     }
 }
 
-/// [`brightness`] at point `p` of a fragment whose shares vary over it
-/// (its `ramps` in place of its `shares`).
-fn ramped(
+/// Brightness of a fragment seen from its front at point `p`, lit by the
+/// lights of its mask and by its lights of extent in the shares at `p`
+/// (a light's ramp where it has one, else its flat share):
+/// [`Lambert::SHADOWS`] at its face's centre `centre`.
+fn brightness_at(
     f: &SvgFragment,
-    p: DVec3,
+    p: Option<DVec3>,
     centre: DVec3,
     lights: &[PlacedLight],
     to_viewer: DVec3,
 ) -> f64 {
-    let shares = f
-        .ramps
-        .iter()
-        .map(|&(j, [gx, gy, gz, d])| (j, (gx * p.x + gy * p.y + gz * p.z + d).clamp(0.0, 1.0)))
-        .collect();
-    let at = SvgFragment {
-        shares,
-        ramps: Vec::new(),
-        pieces: Vec::new(),
-        ..f.clone()
-    };
-    brightness(&at, centre, lights, to_viewer)
-}
-
-/// Brightness of a fragment seen from its front, lit by the lights of
-/// its mask: [`Lambert::SHADOWS`] at its face's centre `centre`.
-fn brightness(f: &SvgFragment, centre: DVec3, lights: &[PlacedLight], to_viewer: DVec3) -> f64 {
     let weight = Lambert::weight(lights.len());
     let mut b = Lambert::SHADOWS.base(f.normal, to_viewer);
     let full = (0..lights.len())
         .filter(|j| f.lit >> j & 1 == 1)
         .map(|j| (j, 1.0));
-    for (j, share) in full.chain(f.shares.iter().copied()) {
+    let share = |&(j, flat): &(usize, f64)| {
+        let ramp = p.and_then(|p| Some((p, f.ramps.iter().find(|r| r.0 == j)?.1)));
+        let at =
+            ramp.map(|(p, [gx, gy, gz, d])| (gx * p.x + gy * p.y + gz * p.z + d).clamp(0.0, 1.0));
+        (j, at.unwrap_or(flat))
+    };
+    for (j, share) in full.chain(f.shares.iter().map(share)) {
         let Some(l) = lights.get(j) else { continue };
         let to_light = match l.light {
             Light::Point(_) => (l.world - centre).normalize_or_zero(),
@@ -427,6 +418,11 @@ fn brightness(f: &SvgFragment, centre: DVec3, lights: &[PlacedLight], to_viewer:
         b += share * Lambert::cosine(weight, f.normal, to_light);
     }
     b
+}
+
+/// [`brightness_at`] with every share flat.
+fn brightness(f: &SvgFragment, centre: DVec3, lights: &[PlacedLight], to_viewer: DVec3) -> f64 {
+    brightness_at(f, None, centre, lights, to_viewer)
 }
 
 /// A fragment to draw: a part of BSP polygon `polygon` (an index into
@@ -443,9 +439,10 @@ pub struct SvgFragment {
     /// Lights of extent that reach part of it: the light's index and the
     /// share of its irradiance that arrives (soft shadows' penumbra).
     pub shares: Vec<(usize, f64)>,
-    /// Where given, the shares vary over it: per light of `shares`, the
-    /// share at a point `p` (input units) is `g · p + d` (`[g, d]`),
-    /// clamped to `[0, 1]`; the fragment is then drawn with a gradient.
+    /// Where given, the shares vary over it: for a light of `shares`,
+    /// the share at a point `p` (input units) is `g · p + d` (`[g, d]`),
+    /// clamped to `[0, 1]` (a light of `shares` without one keeps its
+    /// flat share); the fragment is then drawn with a gradient.
     pub ramps: Vec<(usize, [f64; 4])>,
     /// The unit normal of its front.
     pub normal: DVec3,

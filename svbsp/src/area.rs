@@ -706,7 +706,9 @@ impl AreaLight {
 
     /// Convex `pieces` of `face`, each with a label, cut where this
     /// light's class changes (see the module docs); each part keeps its
-    /// piece's label. Not merged.
+    /// piece's label. Not merged. `occluders` are those whose penumbra
+    /// volume may meet the face (one that does not costs time, not
+    /// correctness: [`crate::near`] leaves them out).
     ///
     /// `corners`, where given, cuts a piece where the light's corners it
     /// sees change (bit `i` of each part's mask: corner `i` seen, as the
@@ -752,16 +754,7 @@ impl AreaLight {
                 }
             }
         }
-        // an occluder whose penumbra volume lies wholly beyond one of its
-        // planes from the face hides nothing from it
-        let whole = face.polygon.to_polygon(0);
-        let mut regions: Vec<(&Regions, Reach)> = occluders
-            .filter(|(r, _)| {
-                !r.penumbra
-                    .iter()
-                    .any(|(h, s)| wholly_outside(whole.classify(h), *s))
-            })
-            .collect();
+        let mut regions: Vec<(&Regions, Reach)> = occluders.collect();
         let n = self.corners().len();
         let all = u64::MAX >> (64 - n);
         let behind = (0..n).fold(0u64, |m, i| m | u64::from(behind_face[i]) << i);

@@ -81,7 +81,7 @@ pub(crate) fn near_lists(
 
 /// Whether grid points `corners` lie in the closed outside of one of the
 /// half-spaces `hs` (a face there has no area inside the volume).
-fn outside(corners: &[GridPoint], hs: &HalfSpaces) -> bool {
+pub(crate) fn outside(corners: &[GridPoint], hs: &HalfSpaces) -> bool {
     hs.iter()
         .any(|(h, inside)| corners.iter().all(|&c| h.classify_grid(c) != *inside))
 }

@@ -209,10 +209,12 @@ impl AreaLight {
     pub fn classify_face(&self, face: &Occluder, occluders: &[Occluder]) -> Vec<AreaFragment> {
         let own = plane_key(face.plane());
         let blockers = coplanar_blockers(occluders);
+        // those whose penumbra volume may meet the face
         let regions: Vec<Regions> = blockers
             .iter()
             .filter(|o| plane_key(o.plane()) != own)
             .filter_map(|o| self.regions(o))
+            .filter(|r| !crate::near::outside(face.corners(), &r.penumbra))
             .collect();
         self.classify_with(face, regions.iter().map(|r| (r, [EVERYWHERE; 2])), None)
     }
