@@ -11,36 +11,17 @@ use anyhow::{Result, bail};
 use clap::Args;
 use glam::DVec3;
 use shadow_raster::{
-    Camera, Hsr, Method, RasterScene, RenderOptions, ShadowOptions, compare, encode_pgm,
-    hidden_lines, render,
+    Camera, Hsr, Method, RasterScene, RenderOptions, ShadowOptions, compare, compare_soft,
+    encode_pgm, hidden_lines, render, render_soft,
 };
 use shadow_scene::face_colors;
-use svbsp::PlacedLight;
+use svbsp::{PlacedLight, SoftLight};
 
 use crate::args::{CameraArgs, LightArgs, SourceArgs, parse_fov, parse_size};
 use crate::input::Scene;
 use crate::lights::describe;
 use crate::output::{Phases, emit, ms, note, write_file, write_files};
 use crate::raster_error;
-
-/// `C` or `C,S`: constant and slope-scaled bias, not negative.
-fn parse_bias(s: &str) -> Result<(f64, f64), String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    let num = |v: &str| -> Result<f64, String> {
-        let x: f64 = v
-            .parse()
-            .map_err(|_| format!("`{v}` is not a number (expected C or C,S)"))?;
-        if !x.is_finite() || x < 0.0 {
-            return Err(format!("`{v}`: a bias must be finite and not negative"));
-        }
-        Ok(x)
-    };
-    match parts.as_slice() {
-        [c] => Ok((num(c)?, ShadowOptions::default().bias_slope)),
-        [c, k] => Ok((num(c)?, num(k)?)),
-        _ => Err(format!("`{s}`: expected C or C,S")),
-    }
-}
 
 /// Where the scene and camera come from.
 #[derive(Args, Debug)]
@@ -66,7 +47,7 @@ pub(crate) struct MethodArgs {
     pub(crate) map_size: u32,
     /// Shadow-map bias: C (input units) or C,S (S texel footprints times
     /// the tangent of the light's angle) [default: 0,1.5].
-    #[arg(long, value_name = "C[,S]", value_parser = parse_bias, allow_hyphen_values = true)]
+    #[arg(long, value_name = "C[,S]", value_parser = ShadowOptions::parse_bias, allow_hyphen_values = true)]
     pub(crate) bias: Option<(f64, f64)>,
     /// Percentage-closer filtering over K×K texels (odd K; 1: off).
     #[arg(long, value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=15))]
@@ -86,12 +67,15 @@ impl MethodArgs {
     fn unused_by(&self, method: Method) -> Option<String> {
         let d = ShadowOptions::default();
         let mut unused = Vec::new();
-        let map = matches!(method, Method::ShadowMap | Method::Texture);
-        if !map && self.map_size != d.map_size {
+        let map = matches!(method, Method::ShadowMap | Method::Pcss);
+        if !map && method != Method::Texture && self.map_size != d.map_size {
             unused.push("--map-size (shadow maps and textures)");
         }
-        if method != Method::ShadowMap && (self.bias.is_some() || self.pcf != d.pcf) {
-            unused.push("--bias and --pcf (shadow maps)");
+        if !map && self.bias.is_some() {
+            unused.push("--bias (shadow maps)");
+        }
+        if method != Method::ShadowMap && self.pcf != d.pcf {
+            unused.push("--pcf (shadow maps without pcss)");
         }
         let planar = self.no_clip || self.receivers as usize != d.planar_receivers;
         if method != Method::Planar && planar {
@@ -100,7 +84,7 @@ impl MethodArgs {
         (!unused.is_empty()).then(|| {
             format!(
                 "note: --method {} does not use {}",
-                method.name(),
+                method,
                 unused.join(", ")
             )
         })
@@ -132,7 +116,8 @@ pub(crate) struct RenderArgs {
     #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
     pub(crate) size: (u32, u32),
     /// Shadow method: exact, raycast, shadow-map, stencil-zpass,
-    /// stencil-zfail, planar or texture.
+    /// stencil-zfail, planar, texture, sampled:N (N exact point lights
+    /// over each light with extent) or pcss (soft shadow maps).
     #[arg(long, value_name = "M", default_value = "exact")]
     pub(crate) method: Method,
     /// Visible-surface method: zbuffer, scanline, warnock, raycast or bsp
@@ -166,7 +151,8 @@ pub(crate) struct CompareArgs {
     /// Size of each method's panel (`--size` is a hidden alias).
     #[arg(long = "panel", alias = "size", value_name = "WxH", default_value = "640x360", value_parser = parse_size)]
     pub(crate) size: (u32, u32),
-    /// The methods to compare with exact, comma-separated [default: all].
+    /// The methods to compare with exact, comma-separated [default: all;
+    /// with an area light or a sun disc, sampled:16,64,256 and pcss].
     #[arg(long, value_name = "M,M...", value_delimiter = ',')]
     pub(crate) methods: Vec<Method>,
     #[command(flatten)]
@@ -206,6 +192,8 @@ pub(crate) struct Prepared {
     pub(crate) faces: usize,
     pub(crate) scene: RasterScene,
     pub(crate) lights: Vec<PlacedLight>,
+    /// Every light, where some has extent.
+    pub(crate) soft: Vec<SoftLight>,
     pub(crate) light_notes: Vec<String>,
     pub(crate) camera: Camera,
     pub(crate) colors: Vec<DVec3>,
@@ -232,12 +220,10 @@ pub(crate) fn prepare(
 ) -> Result<Prepared> {
     let start = Instant::now();
     let specs = lights.map(LightArgs::specs).unwrap_or_default();
-    if lights.is_some_and(|l| !l.soft().is_empty()) {
-        bail!("--area-light and --sun-disc are for `shadow shadows` so far");
-    }
+    let soft = lights.map(LightArgs::soft).unwrap_or_default();
     let s = Scene::load(
         &args.source,
-        (specs, &[]),
+        (specs, &soft),
         lights.is_some(),
         args.quiet,
         &mut Phases::default(),
@@ -253,8 +239,15 @@ pub(crate) fn prepare(
         faces: s.mesh.faces.len(),
         colors: face_colors(&s.mesh),
         scene: RasterScene::new(&s.grid, s.polys)?,
-        light_notes: s.lights.iter().map(describe).collect(),
+        light_notes: (s.lights.iter().map(describe))
+            .chain(
+                s.soft[s.lights.len().min(s.soft.len())..]
+                    .iter()
+                    .map(|l| l.shape.to_string()),
+            )
+            .collect(),
         lights: s.lights,
+        soft: s.soft,
         name: s.name,
         camera,
         load_time: start.elapsed(),
@@ -278,7 +271,10 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
         .with_culling(args.cull)
         .with_method(args.method)
         .with_shadow(shadow);
-    let out = render(&p.scene, &p.lights, &p.camera, &p.colors, &opts)?;
+    let out = match &p.soft[..] {
+        [] => render(&p.scene, &p.lights, &p.camera, &p.colors, &opts)?,
+        soft => render_soft(&p.scene, soft, &p.camera, &p.colors, &opts)?,
+    };
     let t = Instant::now();
     let mask = out.mask();
     let png = out.image.encode_png();
@@ -297,7 +293,7 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
         args.size.1,
         p.name,
         p.faces,
-        args.method.name(),
+        args.method,
         args.hsr.name(),
         100.0 * lit as f64 / seen.max(1) as f64
     );
@@ -324,12 +320,16 @@ pub(crate) fn run_compare(args: &CompareArgs) -> Result<()> {
     }
     let shadow = args.opts.options()?;
     let p = prepare(&args.scene, Some(&args.lights), args.size)?;
-    let methods = if args.methods.is_empty() {
-        Method::ALL.to_vec()
-    } else {
-        args.methods.clone()
+    let methods = match (args.methods.is_empty(), p.soft.is_empty()) {
+        (false, _) => args.methods.clone(),
+        (true, true) => Method::ALL.to_vec(),
+        (true, false) => Method::SOFT.to_vec(),
     };
-    let cmp = compare(&p.scene, &p.lights, &p.camera, &p.colors, &shadow, &methods)?;
+    let (scene, cam, colors) = (&p.scene, &p.camera, &p.colors);
+    let cmp = match &p.soft[..] {
+        [] => compare(scene, &p.lights, cam, colors, &shadow, &methods)?,
+        soft => compare_soft(scene, soft, cam, colors, &shadow, &methods)?,
+    };
     let png = cmp
         .image(args.columns as usize, args.highlight)
         .encode_png();
@@ -375,9 +375,5 @@ mod tests {
         assert!(e.contains("available: exact, raycast"), "{e}");
         assert_eq!("warnock".parse(), Ok(Hsr::Warnock));
         assert!("painter".parse::<Hsr>().is_err());
-        assert_eq!(parse_bias("0.01"), Ok((0.01, 1.5)));
-        assert_eq!(parse_bias("0,2"), Ok((0.0, 2.0)));
-        assert!(parse_bias("-1").is_err());
-        assert!(parse_bias("1,2,3").is_err());
     }
 }

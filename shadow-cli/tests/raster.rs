@@ -112,7 +112,7 @@ fn compare_writes_the_panels_and_the_report() {
     let lines: Vec<&str> = report.lines().collect();
     assert_eq!(
         lines[0],
-        "method,disagree_pixels,visible_pixels,disagree_percent,ms"
+        "method,disagree_pixels,visible_pixels,disagree_percent,mean_error_percent,ms"
     );
     assert_eq!(lines.len(), 8, "{report}");
     assert!(lines[1].starts_with("exact,0,"), "{report}");
@@ -431,4 +431,100 @@ fn files_are_framed_without_camera_flags() {
         "{}",
         stderr(&o)
     );
+}
+
+/// A floor and a square over it, as OBJ.
+fn floor_and_square(name: &str) -> std::path::PathBuf {
+    let path = scratch(name);
+    std::fs::write(
+        &path,
+        "v -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\n\
+         v -0.5 -0.5 1\nv 0.5 -0.5 1\nv 0.5 0.5 1\nv -0.5 0.5 1\n\
+         f 1 2 3 4\nf 5 6 7 8\n",
+    )
+    .unwrap();
+    path
+}
+
+/// The square light over the floor and square, shining down.
+const SOFT_LIGHT: &str = "-0.4,-0.4,2.5;-0.4,0.4,2.5;0.4,0.4,2.5;0.4,-0.4,2.5";
+
+#[test]
+fn render_draws_soft_shadows_by_each_soft_method() {
+    let input = floor_and_square("soft_render.obj");
+    let input = input.to_str().unwrap();
+    let mut greys = Vec::new();
+    for method in ["exact", "sampled:8", "pcss"] {
+        let out = scratch(&format!("soft_{}.png", method.replace(':', "_")));
+        let o = shadow(&[
+            "render",
+            input,
+            "--area-light",
+            SOFT_LIGHT,
+            "--eye",
+            "0.2,-0.3,6",
+            "--size",
+            "120x90",
+            "--method",
+            method,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+        assert!(
+            stdout(&o).contains(&format!("{method} shadows")),
+            "{}",
+            stdout(&o)
+        );
+        // the floor's colours: lit, umbra, and many between
+        let (px, _) = rgb_of(&out);
+        let mut floor: Vec<[u8; 3]> = px.into_iter().filter(|p| p[0] > p[2] + 10).collect();
+        floor.sort_unstable();
+        floor.dedup();
+        greys.push((method, floor.len()));
+    }
+    for (method, n) in &greys {
+        assert!(*n > 8, "{method}: {n} floor colours ({greys:?})");
+    }
+    // a wrong count is refused with the choices
+    let o = shadow(&["render", input, "--method", "sampled:0", "-o", "x.png"]);
+    assert_usage_error(&o, &["unknown method `sampled:0`", "sampled:N", "pcss"]);
+}
+
+#[test]
+fn compare_measures_soft_methods_against_exact() {
+    let input = floor_and_square("soft_compare.obj");
+    let (out, csv) = (scratch("soft_compare.png"), scratch("soft_compare.csv"));
+    let o = shadow(&[
+        "compare",
+        input.to_str().unwrap(),
+        "--area-light",
+        SOFT_LIGHT,
+        "--eye",
+        "0.2,-0.3,6",
+        "--panel",
+        "96x72",
+        "-o",
+        out.to_str().unwrap(),
+        "--report",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<Vec<&str>> = report
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let methods: Vec<&str> = rows.iter().map(|r| r[0]).collect();
+    // by default the sampled lights and PCSS
+    assert_eq!(
+        methods,
+        ["exact", "sampled:16", "sampled:64", "sampled:256", "pcss"]
+    );
+    let error: Vec<f64> = rows.iter().map(|r| r[4].parse().unwrap()).collect();
+    assert_eq!(error[0], 0.0);
+    // more samples, closer to exact
+    assert!(error[1] > error[3] && error[3] < 0.2, "{report}");
+    assert!(error[4] > 0.0, "{report}");
 }

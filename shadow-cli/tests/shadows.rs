@@ -650,7 +650,7 @@ fn flags_that_do_not_apply_are_noted() {
     };
     let err = render(&[]);
     assert!(
-        err.contains("note: --method exact does not use --bias and --pcf"),
+        err.contains("note: --method exact does not use --pcf"),
         "{err}"
     );
     let err = render(&["--method", "shadow-map"]);

@@ -6,10 +6,10 @@ use glam::DVec3;
 
 use crate::hsr::{Frame, Hsr, NONE, visibility};
 use crate::image::{Image, composite, mask, shade};
-use svbsp::PlacedLight;
+use svbsp::{PlacedLight, SoftLight};
 
 use crate::lit::{Method, ShadowOptions};
-use crate::scene::RasterScene;
+use crate::scene::{RasterScene, SceneLight};
 use crate::shadow::shadows;
 use crate::{Camera, RasterError};
 
@@ -22,6 +22,10 @@ pub struct MethodReport {
     pub disagree: usize,
     /// Pixels with a visible surface (the same for every method).
     pub visible: usize,
+    /// The mean of `|amount − exact amount|` over the visible pixels and
+    /// the lights: how far the method's light is from the exact one, as
+    /// a share of a whole light.
+    pub mean_error: f64,
     /// Time of the method's shadow pass (the visibility pass is shared).
     pub time: Duration,
     /// The shaded image.
@@ -70,7 +74,12 @@ impl Comparison {
                         }
                     }
                 }
-                let label = format!("{}  {:.2}%", r.method.name(), r.disagree_percent());
+                let label = format!(
+                    "{}  {:.2}%  err {:.2}%",
+                    r.method,
+                    r.disagree_percent(),
+                    100.0 * r.mean_error
+                );
                 (label, img)
             })
             .collect();
@@ -78,30 +87,40 @@ impl Comparison {
     }
 
     /// The report as a table for people: method, the share of visible
-    /// pixels that disagree with the exact shadows, and the time.
+    /// pixels whose first light's mask disagrees with the exact one, the
+    /// mean error of the light's amount ([`MethodReport::mean_error`]),
+    /// and the time.
     pub fn table(&self) -> String {
-        let mut s = format!("{:<15} {:>12} {:>10}\n", "method", "disagree", "time");
+        let mut s = format!(
+            "{:<15} {:>12} {:>10} {:>10}\n",
+            "method", "disagree", "error", "time"
+        );
         for r in &self.reports {
             s += &format!(
-                "{:<15} {:>11.3}% {:>7.1} ms\n",
-                r.method.name(),
+                "{:<15} {:>11.3}% {:>9.3}% {:>7.1} ms\n",
+                r.method.to_string(),
                 r.disagree_percent(),
+                100.0 * r.mean_error,
                 r.time.as_secs_f64() * 1e3
             );
         }
         s
     }
 
-    /// The report as CSV: `method,disagree_pixels,visible_pixels,disagree_percent,ms`.
+    /// The report as CSV:
+    /// `method,disagree_pixels,visible_pixels,disagree_percent,mean_error_percent,ms`.
     pub fn csv(&self) -> String {
-        let mut s = String::from("method,disagree_pixels,visible_pixels,disagree_percent,ms\n");
+        let mut s = String::from(
+            "method,disagree_pixels,visible_pixels,disagree_percent,mean_error_percent,ms\n",
+        );
         for r in &self.reports {
             s += &format!(
-                "{},{},{},{:.4},{:.1}\n",
-                r.method.name(),
+                "{},{},{},{:.4},{:.4},{:.1}\n",
+                r.method,
                 r.disagree,
                 r.visible,
                 r.disagree_percent(),
+                100.0 * r.mean_error,
                 r.time.as_secs_f64() * 1e3
             );
         }
@@ -120,6 +139,31 @@ pub fn compare(
     methods: &[Method],
 ) -> Result<Comparison, RasterError> {
     let lights = &crate::scene_lights(lights)?;
+    compare_lights(scene, lights, camera, colors, opts, methods)
+}
+
+/// [`compare`] with lights of any kind (see [`crate::render_soft`]): for
+/// lights with extent, e.g. `exact` against [`Method::SOFT`].
+pub fn compare_soft(
+    scene: &RasterScene,
+    lights: &[SoftLight],
+    camera: &Camera,
+    colors: &[DVec3],
+    opts: &ShadowOptions,
+    methods: &[Method],
+) -> Result<Comparison, RasterError> {
+    let lights = &crate::soft_scene_lights(lights)?;
+    compare_lights(scene, lights, camera, colors, opts, methods)
+}
+
+fn compare_lights(
+    scene: &RasterScene,
+    lights: &[SceneLight],
+    camera: &Camera,
+    colors: &[DVec3],
+    opts: &ShadowOptions,
+    methods: &[Method],
+) -> Result<Comparison, RasterError> {
     opts.validate()?;
     let t = std::time::Instant::now();
     let frame = Frame::new(scene, camera, false)?;
@@ -129,6 +173,7 @@ pub fn compare(
     let mut list = vec![Method::Exact];
     list.extend(methods.iter().copied().filter(|&m| m != Method::Exact));
     let mut reports: Vec<MethodReport> = Vec::new();
+    let mut exact: Option<Vec<f32>> = None;
     for m in list {
         let (lit, fig) = shadows(&frame, &vis, lights, m, opts)?;
         let image = shade(&frame, &vis, &lit, lights, colors);
@@ -137,10 +182,17 @@ pub fn compare(
             Some(e) => e.mask.iter().zip(&mk).filter(|(a, b)| a != b).count(),
             None => 0,
         };
+        let e = exact.get_or_insert_with(|| lit.amount.clone());
+        let off: f64 = (vis.prim.iter().zip(lit.amount.chunks(lights.len().max(1))))
+            .zip(e.chunks(lights.len().max(1)))
+            .filter(|((p, _), _)| **p != NONE)
+            .flat_map(|((_, a), b)| a.iter().zip(b).map(|(&a, &b)| f64::from((a - b).abs())))
+            .sum();
         reports.push(MethodReport {
             method: m,
             disagree,
             visible,
+            mean_error: off / (visible * lights.len()).max(1) as f64,
             time: fig.time,
             image,
             mask: mk,

@@ -14,9 +14,14 @@
 
 use std::collections::HashMap;
 
+use bsp_core::GridPoint;
 use bsp_core::{Plane, Side};
 use glam::{DVec2, DVec3};
-use svbsp::{Batch, ShadeOptions, Shadows};
+use rayon::prelude::*;
+use svbsp::{
+    AreaClass, AreaLight, Batch, Light, LightError, Occluder, ShadeOptions, ShadowError, Shadows,
+    SoftFragment, SoftShadows,
+};
 
 use crate::RasterError;
 use crate::hsr::{Frame, NONE, Visibility};
@@ -56,6 +61,9 @@ pub(crate) fn exact(
     batch: Option<&Batch>,
     _facing: &[u64],
 ) -> Result<(LitBuffer, ShadowFigures), RasterError> {
+    if lights.iter().any(|l| l.extent.is_some()) {
+        return soft(frame, vis, lights);
+    }
     let own;
     let batch = match batch {
         Some(b) => b,
@@ -67,6 +75,193 @@ pub(crate) fn exact(
     Ok(draw_fragments(frame, vis, lights.len(), batch))
 }
 
+/// The exact method with lights of extent: the visible side of every
+/// prim cut where any light's class changes ([`svbsp::SoftShadows`], every
+/// prim an occluder), each pixel getting all of a light it sees whole,
+/// none of one it does not see, and in penumbra the share of the light's
+/// irradiance that reaches the grid point nearest its point
+/// ([`svbsp::SoftShadows::shares`]: exact visibility, the form factor in
+/// `f64`).
+fn soft(
+    frame: &Frame<'_>,
+    vis: &Visibility,
+    lights: &[SceneLight],
+) -> Result<(LitBuffer, ShadowFigures), RasterError> {
+    let scene = frame.scene;
+    let light = |(index, l): (usize, &SceneLight)| {
+        let made = match (&l.extent, l.exact) {
+            (Some(s), _) => Ok(s.light.clone()),
+            (None, Light::Point(p)) => AreaLight::point(p),
+            (None, Light::Directional(d)) => AreaLight::sun(d),
+        };
+        made.map_err(|cause| LightError::Extent { index, cause })
+    };
+    let area: Result<Vec<AreaLight>, _> = lights.iter().enumerate().map(light).collect();
+    let area = area.map_err(|e| RasterError::Shadows(ShadowError::Light(e)))?;
+    let (prims, occluders): (Vec<usize>, Vec<Occluder>) = scene
+        .polys
+        .iter()
+        .zip(&frame.side)
+        .enumerate()
+        .filter_map(|(i, (p, side))| {
+            let seen = if *side == Side::Back {
+                p.flipped()
+            } else {
+                p.clone()
+            };
+            Some((i, Occluder::of_polygon(&seen)?))
+        })
+        .unzip();
+    let run = SoftShadows::new(&area, &occluders)
+        .map_err(|e| RasterError::Shadows(ShadowError::Light(e)))?;
+    let grid = scene.grid;
+    let mut fragments = SoftFragments::default();
+    for (r, frags) in run.fragments().into_iter().enumerate() {
+        for f in frags {
+            let ring: Vec<DVec3> = f
+                .polygon
+                .vertices_f64()
+                .into_iter()
+                .map(|c| grid.to_world(c))
+                .collect();
+            fragments
+                .side
+                .push((scene.face[prims[r]], *occluders[r].plane()));
+            fragments.receiver.push(r as u32);
+            fragments.rings.push(ring);
+            fragments.cut.push(f);
+        }
+    }
+    let n = lights.len();
+    let (mut lit, fig, taken) = draw(frame, vis, n, &fragments);
+    // the penumbra pixels, by receiver and light
+    let mut wanted: Vec<(u32, u32, u32, GridPoint)> = Vec::new();
+    for (pix, &f) in taken.iter().enumerate() {
+        if f == NONE {
+            continue;
+        }
+        let frag = &fragments.cut[f as usize];
+        let soft = !(frag.lit | frag.umbra) & ((1u128 << n) - 1) as u64;
+        if soft == 0 {
+            continue;
+        }
+        let Ok(at) = grid.snap(pixel_point(frame, vis, pix)) else {
+            continue; // (a visible point lies on a face: in range)
+        };
+        for j in (0..n).filter(|&j| soft >> j & 1 == 1) {
+            wanted.push((fragments.receiver[f as usize], j as u32, pix as u32, at));
+        }
+    }
+    wanted.sort_unstable_by_key(|w| (w.0, w.1, w.2));
+    let groups: Vec<&[(u32, u32, u32, GridPoint)]> =
+        wanted.chunk_by(|a, b| (a.0, a.1) == (b.0, b.1)).collect();
+    let shares: Vec<Vec<Option<f64>>> = groups
+        .par_iter()
+        .map(|g| {
+            let points: Vec<GridPoint> = g.iter().map(|w| w.3).collect();
+            run.shares(g[0].1 as usize, g[0].0 as usize, &points)
+        })
+        .collect();
+    for (g, s) in groups.iter().zip(&shares) {
+        for (&(_, j, pix, _), share) in g.iter().zip(s) {
+            if let Some(v) = share {
+                lit.amount[pix as usize * n + j as usize] = v.clamp(0.0, 1.0) as f32;
+            }
+        }
+    }
+    Ok((lit, fig))
+}
+
+/// The fragments of [`soft`]: per fragment its face's side, the receiver
+/// it was cut from, its ring in input units, and the fragment.
+#[derive(Default)]
+struct SoftFragments {
+    side: Vec<(u32, Plane)>,
+    receiver: Vec<u32>,
+    rings: Vec<Vec<DVec3>>,
+    cut: Vec<SoftFragment>,
+}
+
+impl Drawable for SoftFragments {
+    fn count(&self) -> usize {
+        self.cut.len()
+    }
+
+    fn side(&self, i: usize) -> (u32, Plane) {
+        self.side[i]
+    }
+
+    fn rings(&self, i: usize) -> Vec<Vec<DVec3>> {
+        vec![self.rings[i].clone()]
+    }
+
+    /// All of a light seen whole, none of one not seen, and in penumbra
+    /// the share at the fragment's centroid (each penumbra pixel then gets
+    /// its own).
+    fn amounts(&self, i: usize, _: DVec3, out: &mut [f32]) {
+        let f = &self.cut[i];
+        for (j, cell) in out.iter_mut().enumerate() {
+            *cell = match f.class(j) {
+                AreaClass::Lit => 1.0,
+                AreaClass::Umbra => 0.0,
+                AreaClass::Penumbra | AreaClass::Undecided => {
+                    f.visible[j].as_ref().map_or(0.5, |s| s.centroid) as f32
+                }
+            };
+        }
+    }
+}
+
+/// Fragments of faces that can be scan-converted: each a region of one
+/// face's side (rings in input units), with how much of each light it
+/// gets at a point of it.
+pub(crate) trait Drawable: Sync {
+    /// How many fragments.
+    fn count(&self) -> usize;
+    /// The face of fragment `i` and the plane of the side it lies on.
+    fn side(&self, i: usize) -> (u32, Plane);
+    /// The rings of fragment `i` (outer first), in input units.
+    fn rings(&self, i: usize) -> Vec<Vec<DVec3>>;
+    /// How much of each light fragment `i` gets at its point `p`, into
+    /// `out` (one cell per light).
+    fn amounts(&self, i: usize, p: DVec3, out: &mut [f32]);
+}
+
+/// The fragments of a [`Batch`], their vertices in input units.
+struct BatchFragments<'b> {
+    batch: &'b Batch,
+    world: Vec<DVec3>,
+    lights: usize,
+}
+
+impl Drawable for BatchFragments<'_> {
+    fn count(&self) -> usize {
+        self.batch.len()
+    }
+
+    fn side(&self, i: usize) -> (u32, Plane) {
+        let f = self.batch.fragment(i);
+        (f.face(), *f.support())
+    }
+
+    fn rings(&self, i: usize) -> Vec<Vec<DVec3>> {
+        self.batch
+            .fragment(i)
+            .rings()
+            .map(|r| r.iter().map(|&v| self.world[v as usize]).collect())
+            .collect()
+    }
+
+    fn amounts(&self, i: usize, _: DVec3, out: &mut [f32]) {
+        let mask = self.batch.fragment(i).lit_mask();
+        for (j, cell) in out.iter_mut().enumerate().take(self.lights) {
+            if mask >> j & 1 == 1 {
+                *cell = 1.0;
+            }
+        }
+    }
+}
+
 /// Scan-converts the fragments of `batch` over the visible prims of their
 /// face and side.
 pub(crate) fn draw_fragments(
@@ -75,8 +270,29 @@ pub(crate) fn draw_fragments(
     lights: usize,
     batch: &Batch,
 ) -> (LitBuffer, ShadowFigures) {
+    let grid = frame.scene.grid;
+    let world = (0..batch.vertex_count() as u32)
+        .map(|v| grid.to_world(batch.rounded(v)))
+        .collect();
+    let fragments = BatchFragments {
+        batch,
+        world,
+        lights,
+    };
+    let (lit, fig, _) = draw(frame, vis, lights, &fragments);
+    (lit, fig)
+}
+
+/// Scan-converts `fragments` over the visible prims of their face and
+/// side: each pixel takes the amounts of the fragment that covers it at
+/// its point. Also returns that fragment per pixel ([`NONE`]: none).
+pub(crate) fn draw(
+    frame: &Frame<'_>,
+    vis: &Visibility,
+    lights: usize,
+    fragments: &impl Drawable,
+) -> (LitBuffer, ShadowFigures, Vec<u32>) {
     let scene = frame.scene;
-    let grid = scene.grid;
     // a group: one face seen from one side
     let mut groups: HashMap<(u32, Plane), u32> = HashMap::new();
     let prim_group: Vec<u32> = (0..scene.len())
@@ -88,28 +304,15 @@ pub(crate) fn draw_fragments(
             None => NONE,
         })
         .collect();
-    let frag_group: Vec<u32> = batch
-        .fragments()
-        .map(|f| {
-            groups
-                .get(&(f.face(), *f.support()))
-                .copied()
-                .unwrap_or(NONE)
-        })
-        .collect();
-    let world: Vec<DVec3> = (0..batch.vertex_count() as u32)
-        .map(|v| grid.to_world(batch.rounded(v)))
+    let frag_group: Vec<u32> = (0..fragments.count())
+        .map(|i| groups.get(&fragments.side(i)).copied().unwrap_or(NONE))
         .collect();
     let view = frame.view();
-    let screen = project_all(view, batch.len(), |i, proj, out, sc| {
+    let screen = project_all(view, fragments.count(), |i, proj, out, sc| {
         if frag_group[i] == NONE {
             return;
         }
-        let rings: Vec<Vec<DVec3>> = batch
-            .fragment(i)
-            .rings()
-            .map(|r| r.iter().map(|&v| world[v as usize]).collect())
-            .collect();
+        let rings = fragments.rings(i);
         proj.add(rings.iter().map(Vec::as_slice), [0.0; 3], i as u32, out, sc);
     });
     let (w, h) = (vis.width as usize, vis.height as usize);
@@ -142,11 +345,12 @@ pub(crate) fn draw_fragments(
     }
     let mut lit = LitBuffer::new(w * h, lights);
     let mut fallback = 0;
-    for (pix, (&prim, &took)) in vis.prim.iter().zip(&taken).enumerate() {
+    for (pix, (&prim, took)) in vis.prim.iter().zip(&mut taken).enumerate() {
         if prim == NONE {
             continue;
         }
-        let mut f = took;
+        let mut f = *took;
+        let p = pixel_point(frame, vis, pix);
         if f == NONE {
             let g = prim_group[prim as usize];
             let frags = &by_group[g as usize];
@@ -154,32 +358,31 @@ pub(crate) fn draw_fragments(
                 continue; // no fragment for this side: attached shadow
             }
             fallback += 1;
-            let p = pixel_point(frame, vis, pix);
             let n = scene.plane[prim as usize].0;
             f = frags
                 .iter()
                 .copied()
-                .find(|&f| inside_fragment(batch, f as usize, &world, n, p))
+                .find(|&f| inside_fragment(&fragments.rings(f as usize), n, p))
                 .unwrap_or(frags[0]);
+            *took = f;
         }
-        let mask = batch.fragment(f as usize).lit_mask();
-        for j in 0..lights {
-            if mask >> j & 1 == 1 {
-                lit.amount[pix * lights + j] = 1.0;
-            }
-        }
+        fragments.amounts(
+            f as usize,
+            p,
+            &mut lit.amount[pix * lights..(pix + 1) * lights],
+        );
     }
     let fig = ShadowFigures {
         primitives: screen.len(),
         fallback_pixels: fallback,
         ..ShadowFigures::default()
     };
-    (lit, fig)
+    (lit, fig, taken)
 }
 
-/// Even-odd test of `p` against fragment `f`'s rings, in the coordinate
+/// Even-odd test of `p` against a fragment's rings, in the coordinate
 /// plane that drops the normal's dominant axis.
-fn inside_fragment(batch: &Batch, f: usize, world: &[DVec3], n: DVec3, p: DVec3) -> bool {
+fn inside_fragment(rings: &[Vec<DVec3>], n: DVec3, p: DVec3) -> bool {
     let a = n.abs();
     let drop = if a.x >= a.y && a.x >= a.z {
         0
@@ -195,13 +398,10 @@ fn inside_fragment(batch: &Batch, f: usize, world: &[DVec3], n: DVec3, p: DVec3)
     };
     let q = flat(p);
     let mut inside = false;
-    for ring in batch.fragment(f).rings() {
+    for ring in rings {
         let k = ring.len();
         for i in 0..k {
-            let (a, b) = (
-                flat(world[ring[i] as usize]),
-                flat(world[ring[(i + 1) % k] as usize]),
-            );
+            let (a, b) = (flat(ring[i]), flat(ring[(i + 1) % k]));
             if (a.y > q.y) != (b.y > q.y) {
                 let x = a.x + (q.y - a.y) * (b.x - a.x) / (b.y - a.y);
                 if q.x < x {

@@ -67,6 +67,7 @@ mod lit;
 mod maps;
 mod planar;
 mod raster;
+mod sampled;
 mod scene;
 pub mod shading;
 mod shadow;
@@ -79,15 +80,16 @@ mod view;
 use std::time::{Duration, Instant};
 
 use glam::DVec3;
-use svbsp::PlacedLight;
+use svbsp::{PlacedLight, SoftLight};
 
 pub use bvh::TriangleBvh;
-pub use compare::{Comparison, MethodReport, compare};
+pub use compare::{Comparison, MethodReport, compare, compare_soft};
 pub use error::{RasterError, UnknownName};
 pub use hsr::{Hsr, NONE, Visibility, visible_surfaces};
 pub use image::{BACKGROUND, Image, composite, encode_pgm, mask, write_pgm};
 pub use lines::{HiddenLines, LINE_EPSILON, LineCheck, hidden_lines};
 pub use lit::{LitBuffer, Method, RAY_EPSILON, ShadowFigures, ShadowOptions};
+pub use maps::PCSS_MAX_RADIUS;
 pub use planar::{PLANAR_MARGIN, planar_matrix};
 pub use scene::RasterScene;
 use scene::SceneLight;
@@ -198,6 +200,18 @@ fn scene_lights(lights: &[PlacedLight]) -> Result<Vec<SceneLight>, RasterError> 
     Ok(lights.iter().map(SceneLight::from_placed).collect())
 }
 
+/// [`scene_lights`] of the lights of a soft-shadow run.
+fn soft_scene_lights(lights: &[SoftLight]) -> Result<Vec<SceneLight>, RasterError> {
+    if lights.len() > svbsp::MAX_LIGHTS {
+        return Err(RasterError::Option(format!(
+            "{} lights: at most {} are supported",
+            lights.len(),
+            svbsp::MAX_LIGHTS
+        )));
+    }
+    lights.iter().map(SceneLight::from_soft).collect()
+}
+
 /// Renders `scene` from `camera` with `lights`: visibility, shadows and
 /// Lambert shading. `colors` gives each face's base colour (RGB in
 /// `[0, 1]`, by face index; faces beyond it are grey).
@@ -213,6 +227,50 @@ pub fn render(
 ) -> Result<Rendered, RasterError> {
     let mut r = Renderer::new();
     r.render(scene, lights, camera, colors, opts)?;
+    Ok(r.into_rendered().expect("a frame was rendered"))
+}
+
+/// [`render`] with lights of any kind, from [`svbsp::place_soft_lights`]:
+/// area lights and sun discs as well as points and suns. With
+/// [`Method::Exact`] a pixel gets all of a light it sees whole, none of
+/// one it does not see, and in penumbra the share of the light's
+/// irradiance that reaches it (interpolated over its exact fragment);
+/// [`Method::Sampled`] spreads exact point lights over each light,
+/// [`Method::Pcss`] blurs a shadow map; the other methods take each
+/// light as its centre. With points and suns only, the image is
+/// [`render`]'s.
+///
+/// ```
+/// use glam::DVec3;
+/// use shadow_raster::{Camera, Method, RasterScene, RenderOptions, render_soft};
+/// use svbsp::{SoftSpec, place_soft_lights, shared_soft_grid};
+///
+/// let faces = vec![
+///     vec![DVec3::new(-4.0, -4.0, 0.0), DVec3::new(4.0, -4.0, 0.0), DVec3::new(4.0, 4.0, 0.0), DVec3::new(-4.0, 4.0, 0.0)],
+///     vec![DVec3::new(-1.0, -1.0, 2.0), DVec3::new(1.0, -1.0, 2.0), DVec3::new(1.0, 1.0, 2.0), DVec3::new(-1.0, 1.0, 2.0)],
+/// ];
+/// // a square light above, shining down (its corners turn clockwise seen from above)
+/// let light = SoftSpec::Area(vec![DVec3::new(-1.0, -1.0, 5.0), DVec3::new(-1.0, 1.0, 5.0), DVec3::new(1.0, 1.0, 5.0), DVec3::new(1.0, -1.0, 5.0)]);
+/// let grid = shared_soft_grid(&faces.concat(), &[], std::slice::from_ref(&light)).unwrap();
+/// let lights = place_soft_lights(&grid, &[], &[light]).unwrap();
+/// let (polys, _) = bsp_core::import_faces(&grid, faces.iter().map(Vec::as_slice)).unwrap();
+/// let scene = RasterScene::new(&grid, polys)?;
+/// let cam = Camera::look_at(DVec3::new(0.0, -8.0, 6.0), DVec3::ZERO, DVec3::Z, 50.0, 64, 48)?;
+/// let out = render_soft(&scene, &lights, &cam, &[], &RenderOptions::default())?;
+/// // lit floor, umbra under the square, and penumbra between
+/// let amounts = &out.lit.amount;
+/// assert!(amounts.contains(&1.0) && amounts.iter().any(|&a| a > 0.05 && a < 0.95));
+/// # Ok::<(), shadow_raster::RasterError>(())
+/// ```
+pub fn render_soft(
+    scene: &RasterScene,
+    lights: &[SoftLight],
+    camera: &Camera,
+    colors: &[DVec3],
+    opts: &RenderOptions,
+) -> Result<Rendered, RasterError> {
+    let mut r = Renderer::new();
+    r.render_soft(scene, lights, camera, colors, opts)?;
     Ok(r.into_rendered().expect("a frame was rendered"))
 }
 
@@ -294,6 +352,30 @@ impl Renderer {
         opts: &RenderOptions,
     ) -> Result<&Rendered, RasterError> {
         let lights = &scene_lights(lights)?;
+        self.render_lights(scene, lights, camera, colors, opts)
+    }
+
+    /// [`render_soft`] in this renderer's buffers.
+    pub fn render_soft(
+        &mut self,
+        scene: &RasterScene,
+        lights: &[SoftLight],
+        camera: &Camera,
+        colors: &[DVec3],
+        opts: &RenderOptions,
+    ) -> Result<&Rendered, RasterError> {
+        let lights = &soft_scene_lights(lights)?;
+        self.render_lights(scene, lights, camera, colors, opts)
+    }
+
+    fn render_lights(
+        &mut self,
+        scene: &RasterScene,
+        lights: &[SceneLight],
+        camera: &Camera,
+        colors: &[DVec3],
+        opts: &RenderOptions,
+    ) -> Result<&Rendered, RasterError> {
         opts.shadow.validate()?;
         let (method, shadow) = (opts.method, &opts.shadow);
         self.frame_with(

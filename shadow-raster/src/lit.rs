@@ -36,6 +36,14 @@ pub enum Method {
     /// Shadow texture: objects drawn from the light, projected on the
     /// objects behind them; no self-shadowing.
     Texture,
+    /// Each light with extent as `N` exact point lights spread over it
+    /// (suns over a sun disc), a pixel getting the share of their
+    /// irradiance that reaches it; a point light or a sun is itself.
+    Sampled(u32),
+    /// Percentage-closer soft shadows (Fernando 2005) on the shadow map
+    /// of each light's centre: a blocker search, then PCF over a kernel
+    /// as wide as the penumbra that the blockers' mean depth predicts.
+    Pcss,
 }
 
 impl Method {
@@ -50,7 +58,21 @@ impl Method {
         Method::Texture,
     ];
 
-    /// The name on the command line.
+    /// The methods compared by default when a light has extent: `exact`,
+    /// 16, 64 and 256 samples, and PCSS.
+    pub const SOFT: [Method; 5] = [
+        Method::Exact,
+        Method::Sampled(16),
+        Method::Sampled(64),
+        Method::Sampled(256),
+        Method::Pcss,
+    ];
+
+    /// The most samples [`Method::Sampled`] takes of a light.
+    pub const MAX_SAMPLES: u32 = 4096;
+
+    /// The name on the command line, without a sample count (see the
+    /// `Display` form for that: `sampled:16`).
     pub fn name(self) -> &'static str {
         match self {
             Method::Exact => "exact",
@@ -60,6 +82,19 @@ impl Method {
             Method::StencilZfail => "stencil-zfail",
             Method::Planar => "planar",
             Method::Texture => "texture",
+            Method::Sampled(_) => "sampled",
+            Method::Pcss => "pcss",
+        }
+    }
+}
+
+impl std::fmt::Display for Method {
+    /// The name on the command line: [`Method::name`], and for
+    /// [`Method::Sampled`] its count (`sampled:16`).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Method::Sampled(n) => write!(f, "sampled:{n}"),
+            m => f.write_str(m.name()),
         }
     }
 }
@@ -67,16 +102,27 @@ impl Method {
 impl std::str::FromStr for Method {
     type Err = crate::error::UnknownName;
 
-    /// The method of a name (see [`Method::name`]), spaces around it ignored.
+    /// The method of a name (its `Display` form: `sampled:N` with N from
+    /// 1 to [`Method::MAX_SAMPLES`]), spaces around it ignored.
     fn from_str(s: &str) -> Result<Method, Self::Err> {
         let s = s.trim();
-        Method::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
+        let sampled = s
+            .strip_prefix("sampled:")
+            .and_then(|n| n.trim().parse::<u32>().ok())
+            .filter(|n| (1..=Method::MAX_SAMPLES).contains(n))
+            .map(Method::Sampled);
+        let mut names = Method::ALL.map(Method::name).to_vec();
+        names.extend(["sampled:N (N from 1 to 4096)", "pcss"]);
+        sampled
+            .or_else(|| {
+                (Method::ALL.into_iter())
+                    .chain([Method::Pcss])
+                    .find(|m| m.name() == s)
+            })
             .ok_or_else(|| crate::error::UnknownName {
                 what: "method",
                 name: s.to_string(),
-                available: Method::ALL.map(Method::name).join(", "),
+                available: names.join(", "),
             })
     }
 }
@@ -116,6 +162,34 @@ impl Default for ShadowOptions {
 }
 
 impl ShadowOptions {
+    /// The biases of `C` or `C,S` (`(constant, slope)`; the default
+    /// slope when only `C` is given), neither negative.
+    ///
+    /// ```
+    /// use shadow_raster::ShadowOptions;
+    /// assert_eq!(ShadowOptions::parse_bias("0.01"), Ok((0.01, 1.5)));
+    /// assert_eq!(ShadowOptions::parse_bias("0,2"), Ok((0.0, 2.0)));
+    /// assert!(ShadowOptions::parse_bias("-1").is_err());
+    /// assert!(ShadowOptions::parse_bias("1,2,3").is_err());
+    /// ```
+    pub fn parse_bias(s: &str) -> Result<(f64, f64), String> {
+        let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+        let num = |v: &str| -> Result<f64, String> {
+            let x: f64 = v
+                .parse()
+                .map_err(|_| format!("`{v}` is not a number (expected C or C,S)"))?;
+            if !x.is_finite() || x < 0.0 {
+                return Err(format!("`{v}`: a bias must be finite and not negative"));
+            }
+            Ok(x)
+        };
+        match parts.as_slice() {
+            [c] => Ok((num(c)?, ShadowOptions::default().bias_slope)),
+            [c, k] => Ok((num(c)?, num(k)?)),
+            _ => Err(format!("`{s}`: expected C or C,S")),
+        }
+    }
+
     /// Sets [`ShadowOptions::map_size`].
     pub fn with_map_size(mut self, n: u32) -> Self {
         self.map_size = n;

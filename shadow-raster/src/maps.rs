@@ -640,6 +640,204 @@ fn shadow_map_in(
     (lit, fig)
 }
 
+/// The widest PCSS kernel, in texels from its centre (blocker search and
+/// filter alike): wider penumbrae are cut to it.
+pub const PCSS_MAX_RADIUS: f64 = 24.0;
+
+/// Taps of the PCSS blocker search and of its filter.
+const PCSS_SEARCH_TAPS: usize = 16;
+const PCSS_FILTER_TAPS: usize = 32;
+
+/// Tap `i` of `m` of a Vogel (golden-angle) disc of unit radius, turned
+/// by `turn` radians.
+#[inline]
+fn vogel(i: usize, m: usize, turn: f64) -> (f64, f64) {
+    let r = ((i as f64 + 0.5) / m as f64).sqrt();
+    let a = i as f64 * 2.399_963_229_728_653 + turn;
+    (r * a.cos(), r * a.sin())
+}
+
+/// A pixel's turn of the PCSS disc (interleaved gradient noise: the same
+/// on every run, and without the bands of one fixed pattern).
+#[inline]
+fn turn(x: usize, y: usize) -> f64 {
+    let f = |v: f64| v - v.floor();
+    std::f64::consts::TAU * f(52.982_918_9 * f(0.067_110_56 * x as f64 + 0.005_837_15 * y as f64))
+}
+
+/// Percentage-closer soft shadows (Fernando 2005) on the shadow map of
+/// each light's centre, with the light's spread
+/// ([`SceneLight::spread`]): a blocker search over the texels where the
+/// cone from the pixel to the light crosses the map half-way to it, the
+/// penumbra's half-width from the blockers' mean depth by similar
+/// triangles (`spread · (z − z_b) / z_b` for a point light at depth `z`,
+/// `(z − z_b) · tan r` for a disc), and the share of a Vogel disc of taps
+/// that pass the biased depth test within it. A point behind an area
+/// light's plane gets none of it. A point light or a sun is one tap, as
+/// [`shadow_map`] without PCF.
+pub(crate) fn pcss(
+    frame: &Frame<'_>,
+    vis: &Visibility,
+    (lights, facing): (&[SceneLight], &[u64]),
+    opts: &ShadowOptions,
+    spare: Option<LitBuffer>,
+    bufs: &mut MapBuffers,
+) -> (LitBuffer, ShadowFigures) {
+    let n = lights.len();
+    let mut lit = LitBuffer::reuse(spare, vis.prim.len(), n);
+    let mut fig = ShadowFigures::default();
+    let w = vis.width as usize;
+    // a sun's map starts this deep (see `light_views`)
+    let top = 0.5 * frame.scene.diagonal();
+    for (j, l) in lights.iter().enumerate() {
+        let spread = l.spread();
+        let views = light_views(frame.scene, l.world, opts.map_size);
+        let grow = if spread > 0.0 {
+            PCSS_MAX_RADIUS as u32 + 1
+        } else {
+            0
+        };
+        let need = locate(
+            frame,
+            vis,
+            (l.world, j),
+            facing,
+            &views,
+            opts,
+            &mut bufs.look,
+        )
+        .map(|r| {
+            if r.is_empty() {
+                r
+            } else {
+                r.grown(grow, opts.map_size)
+            }
+        });
+        fig.primitives += build_map(
+            frame.scene,
+            &views,
+            need,
+            f32::NEG_INFINITY,
+            |t, w, _| {
+                let w = w as f32;
+                *t = if w > *t { w } else { *t };
+            },
+            &mut bufs.texels,
+            &mut bufs.proj,
+        );
+        let blur = Blur {
+            persp: matches!(l.world, RasterLight::Point(_)),
+            // a texel's footprint per unit of depth (perspective) or in all
+            k: views[0].pixel_size(1.0),
+            size: opts.map_size as i64,
+            spread,
+            top,
+        };
+        let data: Vec<&[f32]> = bufs.texels.iter().map(Vec::as_slice).collect();
+        let (at, depth) = (&bufs.look.at, &bufs.look.depth);
+        // an area light shines on one side of its plane only
+        let emitter = l.emitter();
+        let rays = Rays::new(frame.view());
+        lit.amount
+            .par_chunks_mut(n * w)
+            .zip(at.par_chunks(w).zip(depth.par_chunks(w)))
+            .enumerate()
+            .for_each(|(y, (cells, (at, depth)))| {
+                let rt = rays.row(y);
+                for (x, cell) in cells.chunks_mut(n).enumerate() {
+                    let a = at[x];
+                    let behind = |(c, m): (DVec3, DVec3)| {
+                        m.dot(rays.point(x, y, rt, vis.w[y * w + x]) - c) <= 0.0
+                    };
+                    cell[j] = if a == NO_LOOKUP || emitter.is_some_and(behind) {
+                        0.0
+                    } else {
+                        let texels = data[(a >> (2 * TEXEL_BITS)) as usize];
+                        let mask = (1 << TEXEL_BITS) - 1;
+                        let texel = ((a & mask) as i64, (a >> TEXEL_BITS & mask) as i64);
+                        blur.amount(texels, texel, depth[x], turn(x, y))
+                    };
+                }
+            });
+    }
+    (lit, fig)
+}
+
+/// One light's map as PCSS reads it.
+struct Blur {
+    /// A point light's cube map (else a sun's orthographic map).
+    persp: bool,
+    /// A texel's footprint per unit of depth (perspective) or in all.
+    k: f64,
+    /// Texels on a side.
+    size: i64,
+    /// [`SceneLight::spread`].
+    spread: f64,
+    /// The depth where a sun's map meets the scene.
+    top: f64,
+}
+
+impl Blur {
+    /// Lit when `t − bias <= z_map`, with `z_map = 1/wm` (perspective)
+    /// or `−wm`, and nothing drawn (`wm = −∞`) lit.
+    #[inline]
+    fn passes(&self, wm: f64, t: f64) -> bool {
+        wm == f64::NEG_INFINITY || if self.persp { wm * t <= 1.0 } else { t <= -wm }
+    }
+
+    /// The light reaching a point that looks up `texel` of `texels` at
+    /// biased depth `t`, the disc turned by `rot`.
+    fn amount(&self, texels: &[f32], (tx, ty): (i64, i64), t: f64, rot: f64) -> f32 {
+        let (size, spread, k) = (self.size, self.spread, self.k);
+        let tap = |dx: f64, dy: f64| {
+            let sx = (tx + dx.round() as i64).clamp(0, size - 1);
+            let sy = (ty + dy.round() as i64).clamp(0, size - 1);
+            texels[(sy * size + sx) as usize] as f64
+        };
+        let hard = self.passes(tap(0.0, 0.0), t) as u8 as f32;
+        if spread == 0.0 {
+            return hard;
+        }
+        // the blockers: where the cone to the light is half-way there
+        let search = if self.persp {
+            spread / (k * t)
+        } else {
+            0.5 * (t - self.top).max(0.0) * spread / k
+        }
+        .min(PCSS_MAX_RADIUS);
+        let (mut sum, mut count) = (0.0, 0);
+        for i in 0..PCSS_SEARCH_TAPS {
+            let (dx, dy) = vogel(i, PCSS_SEARCH_TAPS, rot);
+            let wm = tap(dx * search, dy * search);
+            if !self.passes(wm, t) {
+                sum += if self.persp { 1.0 / wm } else { -wm };
+                count += 1;
+            }
+        }
+        if count == 0 {
+            return hard;
+        }
+        // the penumbra's half-width by similar triangles
+        let zb = sum / count as f64;
+        let radius = if self.persp {
+            spread * (t - zb) / (zb * k * t)
+        } else {
+            (t - zb) * spread / k
+        }
+        .clamp(0.0, PCSS_MAX_RADIUS);
+        if radius < 0.5 {
+            return hard;
+        }
+        let pass = (0..PCSS_FILTER_TAPS)
+            .filter(|&i| {
+                let (dx, dy) = vogel(i, PCSS_FILTER_TAPS, rot);
+                self.passes(tap(dx * radius, dy * radius), t)
+            })
+            .count();
+        pass as f32 / PCSS_FILTER_TAPS as f32
+    }
+}
+
 /// The scene's objects: prims connected through shared vertices. Returns
 /// each prim's object.
 pub(crate) fn objects(scene: &RasterScene) -> (Vec<u32>, usize) {

@@ -3,7 +3,7 @@
 
 use bsp_core::{Grid, Plane, Polygon, Side};
 use glam::DVec3;
-use svbsp::{Light, PlacedLight};
+use svbsp::{Light, PlacedLight, SoftLight, SoftShape};
 
 use crate::RasterError;
 
@@ -29,14 +29,21 @@ impl RasterLight {
 
 /// One light as the image-space methods use it: its exact form (on the
 /// scene's grid) and its form in input units (a sun's direction
-/// normalized once more). Made from the [`PlacedLight`]s the public
-/// functions take.
-#[derive(Clone, Copy, Debug)]
+/// normalized once more), and for a light with extent the light itself.
+/// Made from the [`PlacedLight`]s or [`SoftLight`]s the public functions
+/// take.
+#[derive(Clone, Debug)]
 pub(crate) struct SceneLight {
-    /// On the grid, as the exact shadows use it.
+    /// On the grid, as the exact shadows use it; for a light with extent,
+    /// its centre (the grid point nearest its corners' mean, or the
+    /// quantized direction of a disc's centre), which the methods that
+    /// take lights as points use.
     pub(crate) exact: Light,
-    /// In input units, as the image-space methods use it.
+    /// In input units, as the image-space methods use it: the centre of a
+    /// light with extent.
     pub(crate) world: RasterLight,
+    /// An area light or a sun disc; `None` for a point or a sun.
+    pub(crate) extent: Option<SoftLight>,
 }
 
 impl SceneLight {
@@ -49,6 +56,72 @@ impl SceneLight {
         SceneLight {
             exact: l.light,
             world,
+            extent: None,
+        }
+    }
+
+    /// From a light of a soft-shadow run ([`svbsp::place_soft_lights`]):
+    /// a point or a sun as [`SceneLight::from_placed`] makes it, a light
+    /// with extent with its centre.
+    pub(crate) fn from_soft(l: &SoftLight) -> Result<SceneLight, RasterError> {
+        let corners = l.light.corners();
+        let (exact, world) = match &l.shape {
+            SoftShape::Point(p) => (corners[0], RasterLight::Point(*p)),
+            SoftShape::Sun(d) => (corners[0], RasterLight::Sun(d.normalize())),
+            SoftShape::Area(world) => {
+                let mut sum = [0i64; 3];
+                for c in corners {
+                    if let Light::Point(g) = c {
+                        (0..3).for_each(|k| sum[k] += i64::from(g[k]));
+                    }
+                }
+                let n = corners.len() as f64;
+                let g = sum.map(|s| (s as f64 / n).round() as i32);
+                let centre = world.iter().sum::<DVec3>() / world.len() as f64;
+                (Light::Point(g), RasterLight::Point(centre))
+            }
+            SoftShape::SunDisc { direction, .. } => {
+                let q = svbsp::quantize_direction(*direction)
+                    .ok_or_else(|| RasterError::Option(format!("{}: no direction", l.shape)))?;
+                (
+                    Light::Directional(q),
+                    RasterLight::Sun(direction.normalize()),
+                )
+            }
+        };
+        let extended = matches!(l.shape, SoftShape::Area(_) | SoftShape::SunDisc { .. });
+        Ok(SceneLight {
+            exact,
+            world,
+            extent: extended.then(|| l.clone()),
+        })
+    }
+
+    /// An area light's centre and the unit normal of the side it shines
+    /// on (input units); `None` for other lights.
+    pub(crate) fn emitter(&self) -> Option<(DVec3, DVec3)> {
+        let Some(SoftShape::Area(c)) = self.extent.as_ref().map(|l| &l.shape) else {
+            return None;
+        };
+        let normal = (1..c.len() - 1)
+            .map(|i| (c[i] - c[0]).cross(c[i + 1] - c[0]))
+            .sum::<DVec3>()
+            .normalize_or_zero();
+        Some((c.iter().sum::<DVec3>() / c.len() as f64, normal))
+    }
+
+    /// How far the light spreads, for the methods that blur by it
+    /// (PCSS): an area light's largest distance from its centre to a
+    /// corner (input units), the tangent of a disc's angular radius, 0
+    /// for a point or a sun.
+    pub(crate) fn spread(&self) -> f64 {
+        match self.extent.as_ref().map(|l| &l.shape) {
+            Some(SoftShape::Area(c)) => {
+                let centre = c.iter().sum::<DVec3>() / c.len() as f64;
+                c.iter().map(|&p| p.distance(centre)).fold(0.0, f64::max)
+            }
+            Some(SoftShape::SunDisc { radius_deg, .. }) => radius_deg.to_radians().tan(),
+            _ => 0.0,
         }
     }
 }

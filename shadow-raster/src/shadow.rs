@@ -61,6 +61,11 @@ pub(crate) fn shadows_in(
         Method::StencilZpass => crate::stencil::stencil(frame, vis, lights, &facing, false),
         Method::StencilZfail => crate::stencil::stencil(frame, vis, lights, &facing, true),
         Method::Planar => crate::planar::planar(frame, vis, lights, &facing, opts),
+        Method::Sampled(n) => crate::sampled::sampled(frame, vis, lights, n)?,
+        Method::Pcss => {
+            let with = (lights, &facing[..]);
+            crate::maps::pcss(frame, vis, with, opts, spare, &mut bufs.maps)
+        }
     };
     fig.time = start.elapsed();
     Ok((lit, fig))

@@ -379,3 +379,82 @@ fn odd_cameras_and_lights_never_panic() {
         assert!(Camera::look_at(DVec3::ONE, DVec3::ZERO, DVec3::Z, 50.0, w, h).is_err());
     }
 }
+
+/// The room under a point light and a sun, as the lights of a soft run.
+fn room_soft(
+    extra: &[svbsp::SoftSpec],
+) -> (
+    shadow_raster::RasterScene,
+    Vec<svbsp::PlacedLight>,
+    Vec<svbsp::SoftLight>,
+) {
+    let mesh = shadow_scene::room();
+    let specs = [
+        LightSpec::Point(DVec3::new(0.9, 0.3, 2.45)),
+        LightSpec::Sun(DVec3::new(0.3, -0.2, 1.0)),
+    ];
+    let grid = svbsp::shared_soft_grid(&mesh.positions, &specs, extra).unwrap();
+    let placed = svbsp::place_lights(&grid, &specs).unwrap();
+    let soft = svbsp::place_soft_lights(&grid, &placed, extra).unwrap();
+    let loops = mesh.face_loops();
+    let (polys, _) = bsp_core::import_faces(&grid, loops.iter().map(Vec::as_slice)).unwrap();
+    (
+        shadow_raster::RasterScene::new(&grid, polys).unwrap(),
+        placed,
+        soft,
+    )
+}
+
+#[test]
+fn soft_methods_with_points_and_suns_only_are_the_hard_ones() {
+    let (scene, placed, soft) = room_soft(&[]);
+    let cam = room_camera(240, 135);
+    for (soft_method, hard) in [
+        (Method::Exact, Method::Exact),
+        (Method::Sampled(4), Method::Exact),
+        (Method::Pcss, Method::ShadowMap),
+    ] {
+        let a = shadow_raster::render_soft(&scene, &soft, &cam, &[], &with(soft_method)).unwrap();
+        let b = render(&scene, &placed, &cam, &[], &with(hard)).unwrap();
+        assert_eq!(a.lit, b.lit, "{soft_method}");
+        assert_eq!(a.image.rgb, b.image.rgb, "{soft_method}");
+    }
+}
+
+#[test]
+fn soft_pictures_do_not_depend_on_the_thread_count() {
+    let light = svbsp::SoftSpec::Area(
+        [[0.7, 0.1], [0.7, 0.5], [1.1, 0.5], [1.1, 0.1]]
+            .map(|[x, y]| DVec3::new(x, y, 2.45))
+            .to_vec(),
+    );
+    let disc = svbsp::SoftSpec::SunDisc {
+        direction: DVec3::new(0.3, -0.2, 1.0),
+        radius_deg: 3.0,
+    };
+    let (scene, _, soft) = room_soft(&[light, disc]);
+    let cam = room_camera(200, 112);
+    for m in [Method::Exact, Method::Sampled(8), Method::Pcss] {
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| shadow_raster::render_soft(&scene, &soft, &cam, &[], &with(m)).unwrap())
+        };
+        let (one, three) = (run(1), run(3));
+        assert_eq!(one.lit, three.lit, "{m}");
+        // the area light and the disc leave penumbra
+        let soft_px = |j: usize| {
+            (one.lit.amount.iter().skip(j).step_by(4))
+                .filter(|&&a| a > 0.0 && a < 1.0)
+                .count()
+        };
+        assert!(
+            soft_px(2) > 50 && soft_px(3) > 50,
+            "{m}: {} {}",
+            soft_px(2),
+            soft_px(3)
+        );
+    }
+}

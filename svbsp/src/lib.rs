@@ -70,8 +70,8 @@ pub use light::{
 };
 pub use psv::{ShadowVolumes, VolumeError, VolumeSanity};
 pub use soft::{
-    Share, SoftFragment, SoftLight, SoftShape, place_soft_lights, shared_soft_grid, soft_shadows,
-    soft_shadows_with,
+    Share, SoftFragment, SoftLight, SoftShadows, SoftShape, place_soft_lights, shared_soft_grid,
+    soft_shadows, soft_shadows_with,
 };
 pub use wide::{WPoint, WidePlane};
 

@@ -132,37 +132,130 @@ pub fn soft_shadows_with(
     faces: &[Occluder],
     on_faces: &(dyn Fn(usize) + Sync),
 ) -> Result<Vec<Vec<SoftFragment>>, LightError> {
-    if lights.len() > MAX_LIGHTS {
-        return Err(LightError::TooMany(lights.len()));
+    Ok(SoftShadows::new(lights, faces)?.fragments_with(on_faces))
+}
+
+/// A soft-shadow run of `lights` over `faces`, every face an occluder
+/// and a receiver (see [`soft_shadows`]): what it builds once (each
+/// occluder's volumes, the occluders near each face, the lights' corner
+/// trees), then the fragments of every face, and the share of a light
+/// at any point of a face.
+///
+/// ```
+/// use svbsp::{AreaClass, AreaLight, Occluder, SoftShadows};
+/// let lights = [AreaLight::new(&[[0, 0, 80], [0, 40, 80], [40, 40, 80], [40, 0, 80]]).unwrap()];
+/// let faces = [
+///     Occluder::new(&[[-200, -200, 0], [200, -200, 0], [200, 200, 0], [-200, 200, 0]]).unwrap(),
+///     Occluder::new(&[[0, 0, 40], [40, 0, 40], [40, 40, 40], [0, 40, 40]]).unwrap(),
+/// ];
+/// let run = SoftShadows::new(&lights, &faces).unwrap();
+/// let ground = &run.fragments()[0];
+/// assert!(ground.iter().any(|f| f.class(0) == AreaClass::Penumbra));
+/// // on the ground: under the roof's middle none, far away all; where
+/// // the roof hides the light's far half, more than half (the near half
+/// // shines stronger)
+/// let shares = run.shares(0, 0, &[[20, 20, 0], [190, 190, 0], [60, 20, 0]]);
+/// assert_eq!(&shares[..2], &[Some(0.0), Some(1.0)]);
+/// assert!(shares[2].unwrap() > 0.5 && shares[2].unwrap() < 1.0);
+/// ```
+pub struct SoftShadows<'a> {
+    lights: &'a [AreaLight],
+    faces: &'a [Occluder],
+    blockers: Vec<Occluder>,
+    /// Per light, per blocker: its volumes.
+    regions: Vec<Vec<Option<Regions>>>,
+    /// Per light, per face: the blockers that may hide some of the light.
+    near: Vec<Vec<Vec<u32>>>,
+    /// Per light, per blocker: the boxes its volumes reach.
+    reach: Vec<Vec<Reach>>,
+    corners: Vec<Option<Shadows>>,
+}
+
+impl std::fmt::Debug for SoftShadows<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SoftShadows")
+            .field("lights", &self.lights.len())
+            .field("faces", &self.faces.len())
+            .finish_non_exhaustive()
     }
-    let blockers = coplanar_blockers(faces);
-    let regions: Vec<Vec<Option<Regions>>> = lights
-        .iter()
-        .map(|l| blockers.par_iter().map(|o| l.regions(o)).collect())
-        .collect();
-    let (near, reach): (Vec<Vec<Vec<u32>>>, Vec<Vec<Reach>>) = lights
-        .iter()
-        .zip(&regions)
-        .map(|(l, r)| near_lists(l.corners(), faces, (&blockers, r)))
-        .unzip();
-    let corners = corner_shadows(lights, faces);
-    Ok(faces
-        .par_iter()
-        .enumerate()
-        .map_init(Scratch::default, |scratch, (i, face)| {
-            let near: Vec<&[u32]> = near.iter().map(|n| &n[i][..]).collect();
-            let scene = Scene {
-                lights,
-                blockers: &blockers,
-                regions: &regions,
-                reach: &reach,
-                corners: &corners,
-            };
-            let fragments = soft_face(&scene, &near, face, scratch);
-            on_faces(1);
-            fragments
+}
+
+impl<'a> SoftShadows<'a> {
+    /// The run's shared parts. At most [`MAX_LIGHTS`] lights (the classes
+    /// are bits of a `u64`): more are [`LightError::TooMany`].
+    pub fn new(lights: &'a [AreaLight], faces: &'a [Occluder]) -> Result<Self, LightError> {
+        if lights.len() > MAX_LIGHTS {
+            return Err(LightError::TooMany(lights.len()));
+        }
+        let blockers = coplanar_blockers(faces);
+        let regions: Vec<Vec<Option<Regions>>> = lights
+            .iter()
+            .map(|l| blockers.par_iter().map(|o| l.regions(o)).collect())
+            .collect();
+        let (near, reach) = lights
+            .iter()
+            .zip(&regions)
+            .map(|(l, r)| near_lists(l.corners(), faces, (&blockers, r)))
+            .unzip();
+        Ok(SoftShadows {
+            corners: corner_shadows(lights, faces),
+            lights,
+            faces,
+            blockers,
+            regions,
+            near,
+            reach,
         })
-        .collect())
+    }
+
+    /// Every face cut into fragments of one class per light, in face
+    /// order: [`soft_shadows`].
+    pub fn fragments(&self) -> Vec<Vec<SoftFragment>> {
+        self.fragments_with(&|_| {})
+    }
+
+    /// [`SoftShadows::fragments`], calling `on_faces(n)` as each `n` more
+    /// faces are done.
+    pub fn fragments_with(&self, on_faces: &(dyn Fn(usize) + Sync)) -> Vec<Vec<SoftFragment>> {
+        self.faces
+            .par_iter()
+            .enumerate()
+            .map_init(Scratch::default, |scratch, (i, face)| {
+                let fragments = soft_face(self, i, face, scratch);
+                on_faces(1);
+                fragments
+            })
+            .collect()
+    }
+
+    /// The share of light `light`'s irradiance arriving at each grid
+    /// point of `points`, taken as points of face `face` (on its front
+    /// side; see [`Share`]): `None` where nothing of the light is
+    /// reachable, and everywhere for a point light or a sun. The points
+    /// in parallel.
+    pub fn shares(&self, light: usize, face: usize, points: &[GridPoint]) -> Vec<Option<f64>> {
+        let l = &self.lights[light];
+        if !has_share(l) {
+            return vec![None; points.len()];
+        }
+        let f = &self.faces[face];
+        let hiders = self.hiders(light, face);
+        points
+            .par_iter()
+            .map(|&x| fraction_at(l, f, &hiders, x))
+            .collect()
+    }
+
+    /// The occluders near face `face` that may hide some of light
+    /// `light`, found by point.
+    fn hiders(&self, light: usize, face: usize) -> Hiders<'_> {
+        let near = self.near[light][face].iter().filter_map(|&j| {
+            let j = j as usize;
+            let r = self.regions[light][j].as_ref()?;
+            Some((&self.blockers[j], r, self.reach[light][j][0]))
+        });
+        Hiders::new(grid_box(self.faces[face].corners()), near.collect())
+    }
 }
 
 /// Per light, the point lights' shadow volumes of its corners over
@@ -175,15 +268,6 @@ fn corner_shadows(lights: &[AreaLight], faces: &[Occluder]) -> Vec<Option<Shadow
         .iter()
         .map(|l| Shadows::new(&polygons, l.corners()).ok())
         .collect()
-}
-
-/// What [`soft_face`] cuts a face with.
-struct Scene<'a> {
-    lights: &'a [AreaLight],
-    blockers: &'a [Occluder],
-    regions: &'a [Vec<Option<Regions>>],
-    reach: &'a [Vec<Reach>],
-    corners: &'a [Option<Shadows>],
 }
 
 impl AreaLight {
@@ -257,21 +341,21 @@ impl AreaLight {
     }
 }
 
-/// The fragments of `face`, with `near[k]` the occluders that may hide
-/// part of light `k` from it.
+/// The fragments of face `i` of `run`, `face`.
 fn soft_face(
-    scene: &Scene<'_>,
-    near: &[&[u32]],
+    run: &SoftShadows<'_>,
+    i: usize,
     face: &Occluder,
     scratch: &mut Scratch,
 ) -> Vec<SoftFragment> {
-    let Scene {
+    let SoftShadows {
         lights,
-        blockers,
         regions,
         reach,
         corners,
-    } = *scene;
+        ..
+    } = run;
+    let near: Vec<&[u32]> = run.near.iter().map(|n| &n[i][..]).collect();
     let mut pieces = vec![(face.to_polygon(), Classes::default())];
     for (k, light) in lights.iter().enumerate() {
         let occluders = near[k]
@@ -312,11 +396,7 @@ fn soft_face(
             }
             points.sort_unstable();
             points.dedup();
-            let near = near[k].iter().filter_map(|&j| {
-                let j = j as usize;
-                Some((&blockers[j], regions[k][j].as_ref()?, reach[k][j][0]))
-            });
-            let hiders = Hiders::new(grid_box(face.corners()), near.collect());
+            let hiders = run.hiders(k, i);
             let fractions = points
                 .par_iter()
                 .map(|&x| fraction_at(&lights[k], face, &hiders, x))
