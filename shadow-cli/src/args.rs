@@ -2,11 +2,14 @@
 
 use std::path::PathBuf;
 
+use bsp_shadows::soft_file::{parse_area_light, parse_sun_disc};
 use clap::Args;
 use glam::DVec3;
 use shadow_raster::svg::{SvgViewpoint, ViewRequest};
+pub(crate) use shadow_raster::{parse_fov, parse_size, parse_up};
+pub(crate) use shadow_scene::parse_vec3;
 use shadow_scene::{Mesh, Staging};
-use svbsp::{LightSpec, SUN_RADIUS_DEG, SoftSpec};
+use svbsp::{LightSpec, SoftSpec};
 
 /// Where the mesh comes from: a file or a built-in scene (exactly one).
 #[derive(Args, Debug)]
@@ -59,12 +62,12 @@ pub(crate) struct LightArgs {
     /// An area light: a planar convex polygon, its corners in order; it
     /// shines on the side they turn counter-clockwise about. Soft
     /// shadows: lit, penumbra and umbra (`shadows`: JSON, OBJ, SVG).
-    #[arg(long = "area-light", value_name = "X,Y,Z;X,Y,Z;X,Y,Z[;...]", value_parser = parse_area, allow_hyphen_values = true)]
+    #[arg(long = "area-light", value_name = "X,Y,Z;X,Y,Z;X,Y,Z[;...]", value_parser = parse_area_light, allow_hyphen_values = true)]
     pub(crate) areas: Vec<SoftSpec>,
     /// The sun as a disc toward DX,DY,DZ of angular radius DEG [default:
     /// 0.2666], bounded by an octagon that holds it: what is lit sees
     /// the whole disc, what is umbra none of it.
-    #[arg(long = "sun-disc", value_name = "DX,DY,DZ[:DEG]", value_parser = parse_disc, allow_hyphen_values = true)]
+    #[arg(long = "sun-disc", value_name = "DX,DY,DZ[:DEG]", value_parser = parse_sun_disc, allow_hyphen_values = true)]
     pub(crate) discs: Vec<SoftSpec>,
 }
 
@@ -80,34 +83,6 @@ impl LightArgs {
     pub(crate) fn soft(&self) -> Vec<SoftSpec> {
         self.areas.iter().chain(&self.discs).cloned().collect()
     }
-}
-
-/// Parses `X,Y,Z;X,Y,Z;X,Y,Z[;...]`, an area light's corners.
-fn parse_area(s: &str) -> Result<SoftSpec, String> {
-    let corners = s.split(';').map(parse_vec3).collect::<Result<Vec<_>, _>>();
-    let corners = corners.map_err(|e| format!("{e}; corners go as X,Y,Z;X,Y,Z;X,Y,Z"))?;
-    if corners.len() < 3 {
-        return Err(format!(
-            "{} corner(s): an area light takes at least three",
-            corners.len()
-        ));
-    }
-    Ok(SoftSpec::Area(corners))
-}
-
-/// Parses `DX,DY,DZ[:DEG]`, a sun disc.
-fn parse_disc(s: &str) -> Result<SoftSpec, String> {
-    let (d, deg) = s.split_once(':').unwrap_or((s, ""));
-    let radius_deg = match deg.trim() {
-        "" => SUN_RADIUS_DEG,
-        r => r
-            .parse()
-            .map_err(|_| format!("`{r}` is not an angle in degrees"))?,
-    };
-    Ok(SoftSpec::SunDisc {
-        direction: parse_vec3(d)?,
-        radius_deg,
-    })
 }
 
 /// Where a picture is seen from.
@@ -226,92 +201,6 @@ impl ImageArgs {
             self.height.unwrap_or(self.size.1),
         )
     }
-}
-
-/// Parses `X,Y,Z` into a finite vector.
-pub(crate) fn parse_vec3(s: &str) -> Result<DVec3, String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    if parts.len() != 3 {
-        return Err(format!(
-            "expected three comma-separated numbers X,Y,Z, got {} value(s)",
-            parts.len()
-        ));
-    }
-    let mut v = [0.0; 3];
-    for (out, p) in v.iter_mut().zip(&parts) {
-        *out = p
-            .parse::<f64>()
-            .map_err(|_| format!("`{p}` is not a number (expected X,Y,Z)"))?;
-        if !out.is_finite() {
-            return Err(format!("`{p}` is not a finite number"));
-        }
-    }
-    Ok(DVec3::from_array(v))
-}
-
-/// Parses an up direction: an axis (`x`, `y`, `z`, `-x`, `-y`, `-z`) or
-/// a non-zero `X,Y,Z`.
-pub(crate) fn parse_up(s: &str) -> Result<DVec3, String> {
-    let axis = match s.trim() {
-        "x" | "+x" => Some(DVec3::X),
-        "y" | "+y" => Some(DVec3::Y),
-        "z" | "+z" => Some(DVec3::Z),
-        "-x" => Some(DVec3::NEG_X),
-        "-y" => Some(DVec3::NEG_Y),
-        "-z" => Some(DVec3::NEG_Z),
-        _ => None,
-    };
-    match axis {
-        Some(a) => Ok(a),
-        None => {
-            let v = parse_vec3(s).map_err(|e| format!("{e}; or an axis: x, y, z, -x, -y, -z"))?;
-            if v == DVec3::ZERO {
-                return Err("the up direction must not be zero".to_string());
-            }
-            Ok(v)
-        }
-    }
-}
-
-/// Parses a field of view in degrees, between 1 and 170.
-pub(crate) fn parse_fov(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{s}` is not a number"))?;
-    if (1.0..=170.0).contains(&v) {
-        Ok(v)
-    } else {
-        Err(format!("{v} is outside 1..=170 degrees"))
-    }
-}
-
-/// `WxH`, each side between 1 and [`shadow_raster::MAX_SIZE`].
-pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("`{s}` is not a size: expected WxH, such as 1280x720"))?;
-    let side = |v: &str, what: &str| -> Result<u32, String> {
-        let n: u32 = v
-            .trim()
-            .parse()
-            .map_err(|_| format!("`{s}`: the {what} `{v}` is not a whole number (expected WxH)"))?;
-        if n == 0 || n > shadow_raster::MAX_SIZE {
-            return Err(format!(
-                "`{s}`: the {what} must lie between 1 and {} pixels",
-                shadow_raster::MAX_SIZE
-            ));
-        }
-        Ok(n)
-    };
-    let (w, h) = (side(w, "width")?, side(h, "height")?);
-    if w as u64 * h as u64 > shadow_raster::MAX_PIXELS {
-        return Err(format!(
-            "`{s}`: at most {} pixels in all",
-            shadow_raster::MAX_PIXELS
-        ));
-    }
-    Ok((w, h))
 }
 
 #[cfg(test)]

@@ -18,6 +18,7 @@ use shadow_raster::{CameraError, RasterError};
 
 mod animate;
 mod args;
+mod art;
 mod csg;
 mod input;
 mod lights;
@@ -88,6 +89,12 @@ enum Command {
     /// Hidden-line drawing of convex polyhedra (Roberts' algorithm) to SVG.
     #[command(after_help = "Examples:\n  shadow lines --scene room -o lines.svg --hidden")]
     Lines(Box<raster::LinesArgs>),
+    /// Shadow art: the exact hull whose shadows make several images, and
+    /// how much of each it gives.
+    #[command(
+        after_help = "Examples:\n  shadow art geb.json -o geb.obj --report geb.json --images views/"
+    )]
+    Art(art::ArtArgs),
     /// Print a shell completion script (bash, zsh, fish, elvish or
     /// powershell).
     #[command(
@@ -146,6 +153,7 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Render(a) => raster::run_render(a),
         Command::Compare(a) => raster::run_compare(a),
         Command::Lines(a) => raster::run_lines(a),
+        Command::Art(a) => art::run(a),
         Command::Completions { shell } => {
             let mut out = Vec::new();
             clap_complete::generate(*shell, &mut Cli::command(), "shadow", &mut out);

@@ -890,3 +890,55 @@ fn soft_shadows_are_drawn_between_lit_and_shadow() {
     let strictly = |c: &[u8; 3]| (0..3).all(|k| dark[k] < c[k] && c[k] < lit[k]);
     assert!(stops.iter().any(|s| strictly(&rgb(s))), "{stops:?}");
 }
+
+#[test]
+fn art_makes_the_hull_its_report_and_pictures() {
+    let dir = scratch("art");
+    std::fs::create_dir_all(&dir).unwrap();
+    // a 4 × 4 P2 image with its middle dark, under a sun straight down
+    let pgm = "P2\n4 4\n255\n255 255 255 255\n255 0 0 255\n255 0 0 255\n255 255 255 255\n";
+    std::fs::write(dir.join("sq.pgm"), pgm).unwrap();
+    let spec = r#"{"views": [{"image": "sq.pgm", "light": {"sun": [0, 0, 1]},
+        "plane": {"origin": [0, 0, 0], "u": [1, 0, 0], "v": [0, 1, 0]}}],
+        "bounds": [[0, 0, 0], [4, 4, 2]]}"#;
+    std::fs::write(dir.join("spec.json"), spec).unwrap();
+    let (hull, report, views) = (
+        dir.join("hull.stl"),
+        dir.join("report.json"),
+        dir.join("views"),
+    );
+    let o = shadow(&[
+        "art",
+        dir.join("spec.json").to_str().unwrap(),
+        "-o",
+        hull.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "--images",
+        views.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("volume 8"), "{}", stdout(&o));
+    let r: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["hull"]["volume"], 8.0);
+    assert_eq!(r["views"][0]["wanted_area"], 4.0);
+    assert_eq!(r["views"][0]["missing_area"], 0.0);
+    // the hull reads back as a closed mesh
+    let back = bsp_shadows::read_mesh(&hull).unwrap();
+    let loops: Vec<&[u32]> = back.faces.iter().map(|f| f.vertices.as_slice()).collect();
+    assert!(bsp_core::check_closed_manifold(loops).is_ok());
+    assert!(views.join("view0.png").exists());
+    // an all-white image is a clear error naming it
+    std::fs::write(
+        dir.join("sq.pgm"),
+        "P2\n4 4\n255\n".to_string() + &"255 ".repeat(16),
+    )
+    .unwrap();
+    let o = shadow(&[
+        "art",
+        dir.join("spec.json").to_str().unwrap(),
+        "-o",
+        hull.to_str().unwrap(),
+    ]);
+    crate::assert_failed_with(&o, &["view 0", "sq.pgm", "no wanted shadow"]);
+}

@@ -93,7 +93,9 @@ pub use maps::PCSS_MAX_RADIUS;
 pub use planar::{PLANAR_MARGIN, planar_matrix};
 pub use scene::RasterScene;
 use scene::SceneLight;
-pub use view::{Camera, CameraError, MAX_PIXELS, MAX_SIZE, default_up};
+pub use view::{
+    Camera, CameraError, MAX_PIXELS, MAX_SIZE, default_up, parse_fov, parse_size, parse_up,
+};
 
 /// Options of [`render`].
 #[derive(Clone, Debug, PartialEq)]

@@ -462,6 +462,69 @@ impl View {
     }
 }
 
+/// Parses an up direction: an axis (`x`, `y`, `z`, `-x`, `-y`, `-z`) or
+/// a non-zero `X,Y,Z`.
+pub fn parse_up(s: &str) -> Result<DVec3, String> {
+    let axis = match s.trim() {
+        "x" | "+x" => Some(DVec3::X),
+        "y" | "+y" => Some(DVec3::Y),
+        "z" | "+z" => Some(DVec3::Z),
+        "-x" => Some(DVec3::NEG_X),
+        "-y" => Some(DVec3::NEG_Y),
+        "-z" => Some(DVec3::NEG_Z),
+        _ => None,
+    };
+    match axis {
+        Some(a) => Ok(a),
+        None => {
+            let v = shadow_scene::parse_vec3(s)
+                .map_err(|e| format!("{e}; or an axis: x, y, z, -x, -y, -z"))?;
+            if v == DVec3::ZERO {
+                return Err("the up direction must not be zero".to_string());
+            }
+            Ok(v)
+        }
+    }
+}
+
+/// Parses a field of view in degrees, between 1 and 170.
+pub fn parse_fov(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    if (1.0..=170.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v} is outside 1..=170 degrees"))
+    }
+}
+
+/// `WxH`, each side between 1 and [`MAX_SIZE`].
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{s}` is not a size: expected WxH, such as 1280x720"))?;
+    let side = |v: &str, what: &str| -> Result<u32, String> {
+        let n: u32 = v
+            .trim()
+            .parse()
+            .map_err(|_| format!("`{s}`: the {what} `{v}` is not a whole number (expected WxH)"))?;
+        if n == 0 || n > MAX_SIZE {
+            return Err(format!(
+                "`{s}`: the {what} must lie between 1 and {} pixels",
+                MAX_SIZE
+            ));
+        }
+        Ok(n)
+    };
+    let (w, h) = (side(w, "width")?, side(h, "height")?);
+    if w as u64 * h as u64 > MAX_PIXELS {
+        return Err(format!("`{s}`: at most {} pixels in all", MAX_PIXELS));
+    }
+    Ok((w, h))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

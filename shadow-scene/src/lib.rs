@@ -159,6 +159,27 @@ pub fn save<M: MeshView + ?Sized>(path: &Path, mesh: &M) -> Result<(), SceneErro
 #[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;
 
+/// Parses `X,Y,Z` into a finite vector.
+pub fn parse_vec3(s: &str) -> Result<glam::DVec3, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "expected three comma-separated numbers X,Y,Z, got {} value(s)",
+            parts.len()
+        ));
+    }
+    let mut v = [0.0; 3];
+    for (out, p) in v.iter_mut().zip(&parts) {
+        *out = p
+            .parse::<f64>()
+            .map_err(|_| format!("`{p}` is not a number (expected X,Y,Z)"))?;
+        if !out.is_finite() {
+            return Err(format!("`{p}` is not a finite number"));
+        }
+    }
+    Ok(glam::DVec3::from_array(v))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -21,6 +21,7 @@
 //! parts of a face a light reaches. The results are rounded once to
 //! `f64`.
 
+pub mod art;
 pub mod frames;
 pub mod prepared;
 pub mod shadow_file;

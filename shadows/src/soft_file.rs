@@ -15,7 +15,7 @@ use shadow_scene::Mesh;
 use svbsp::export::{FragmentFormat, SoftWritten, soft_areas, write_soft};
 use svbsp::{
     AreaClass, AreaLight, LightSpec, Occluder, PlacedLight, Share, SoftFragment, SoftLight,
-    SoftShape,
+    SoftShape, SoftSpec,
 };
 
 use crate::Error;
@@ -251,5 +251,36 @@ pub fn write_soft_shadows(
         written,
         phases,
         drawn: None,
+    })
+}
+
+/// Parses `X,Y,Z;X,Y,Z;X,Y,Z[;...]`, an area light's corners.
+pub fn parse_area_light(s: &str) -> Result<SoftSpec, String> {
+    let corners = s
+        .split(';')
+        .map(shadow_scene::parse_vec3)
+        .collect::<Result<Vec<_>, _>>();
+    let corners = corners.map_err(|e| format!("{e}; corners go as X,Y,Z;X,Y,Z;X,Y,Z"))?;
+    if corners.len() < 3 {
+        return Err(format!(
+            "{} corner(s): an area light takes at least three",
+            corners.len()
+        ));
+    }
+    Ok(SoftSpec::Area(corners))
+}
+
+/// Parses `DX,DY,DZ[:DEG]`, a sun disc.
+pub fn parse_sun_disc(s: &str) -> Result<SoftSpec, String> {
+    let (d, deg) = s.split_once(':').unwrap_or((s, ""));
+    let radius_deg = match deg.trim() {
+        "" => svbsp::SUN_RADIUS_DEG,
+        r => r
+            .parse()
+            .map_err(|_| format!("`{r}` is not an angle in degrees"))?,
+    };
+    Ok(SoftSpec::SunDisc {
+        direction: shadow_scene::parse_vec3(d)?,
+        radius_deg,
     })
 }

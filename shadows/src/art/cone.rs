@@ -1,0 +1,186 @@
+//! A view's cone as a closed mesh: the wanted region's triangles on the
+//! receiving plane, the same triangles where the cone leaves the bounds
+//! toward the light, and a wall along every boundary segment between.
+
+use glam::DVec3;
+use shadow_scene::{Face, Mesh};
+
+use super::region::{RegionError, region};
+use super::{ArtLight, ArtView};
+
+/// A mesh of triangles and quads, one group.
+fn mesh(positions: Vec<DVec3>, faces: Vec<Vec<u32>>) -> Mesh {
+    Mesh {
+        positions,
+        faces: faces
+            .into_iter()
+            .map(|vertices| Face {
+                vertices,
+                line: 0,
+                group: 0,
+            })
+            .collect(),
+        groups: vec!["default".into()],
+    }
+}
+
+/// The box `[lo, hi]`, its faces turned outward.
+pub(crate) fn cuboid([lo, hi]: [DVec3; 2]) -> Mesh {
+    let p = |i: u32| {
+        DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    let faces = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    mesh((0..8).map(p).collect(), faces.map(|f| f.to_vec()).to_vec())
+}
+
+/// The corners of the box `[lo, hi]`.
+fn corners([lo, hi]: [DVec3; 2]) -> [DVec3; 8] {
+    std::array::from_fn(|i| {
+        DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
+}
+
+/// Where the cone of `view` ends toward the light, just beyond `bounds`:
+/// the map from a point of the plane to its end.
+fn far_end(view: &ArtView, bounds: [DVec3; 2]) -> Result<Box<dyn Fn(DVec3) -> DVec3>, String> {
+    let pl = view.plane;
+    let n = pl.normal();
+    if n.length_squared() == 0.0 || !n.is_finite() {
+        return Err("the plane's u and v are parallel (or zero): no pixel has an area".into());
+    }
+    let size = (bounds[1] - bounds[0]).length();
+    match view.light {
+        ArtLight::Sun(d) => {
+            let dn = d.dot(n);
+            if dn == 0.0 {
+                return Err("the sun shines along the receiving plane".into());
+            }
+            // each box corner is `p + t·d` for a point p of the plane
+            let t = corners(bounds)
+                .iter()
+                .map(|&c| (c - pl.origin).dot(n) / dn)
+                .fold(f64::NEG_INFINITY, f64::max);
+            if t <= 0.0 {
+                return Err("the bounds lie behind the receiving plane, away from the sun".into());
+            }
+            let t = t + 0.01 * size / d.length();
+            Ok(Box::new(move |p| p + d * t))
+        }
+        ArtLight::Point(l) => {
+            let h = (pl.origin - l).dot(n);
+            if h == 0.0 {
+                return Err("the point light lies on the receiving plane".into());
+            }
+            // each box corner at the fraction s of the way from the light
+            // to the plane
+            let s: Vec<f64> = corners(bounds)
+                .iter()
+                .map(|&c| (c - l).dot(n) / h)
+                .collect();
+            let (lo, hi) = s
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                    (a.min(x), b.max(x))
+                });
+            if lo <= 0.0 {
+                return Err(
+                    "the point light must lie beyond the bounds as seen from the plane (the \
+                     bounds reach the light, or the light is behind the plane)"
+                        .into(),
+                );
+            }
+            if hi <= 0.0 || lo >= 1.0 {
+                return Err(
+                    "the bounds lie behind the receiving plane, away from the light".into(),
+                );
+            }
+            let s = lo * 0.99;
+            Ok(Box::new(move |p| l + (p - l) * s))
+        }
+    }
+}
+
+/// The cone of `view` up to just beyond `bounds`, as a closed mesh (each
+/// component of the wanted region a closed part; its faces turned
+/// outward).
+pub(crate) fn cone(view: &ArtView, bounds: [DVec3; 2]) -> Result<Mesh, String> {
+    let end = far_end(view, bounds)?;
+    let parts = region(&view.mask).map_err(|e| match e {
+        RegionError::TooLarge => format!(
+            "{}: an image side above {} pixels",
+            super::spec::name(&view.image),
+            super::region::MAX_SIDE
+        ),
+        RegionError::Triangulation((c, r)) => format!(
+            "{}: the wanted region at pixel ({c}, {r}) could not be triangulated",
+            super::spec::name(&view.image)
+        ),
+    })?;
+    if parts.is_empty() {
+        return Err(format!(
+            "{}: no pixel is darker than the threshold (no wanted shadow)",
+            super::spec::name(&view.image)
+        ));
+    }
+    let (mut positions, mut faces) = (Vec::new(), Vec::new());
+    for part in &parts {
+        let base = positions.len() as u32;
+        let n = part.corners.len() as u32;
+        // the plane's corners, then their ends toward the light
+        let near: Vec<DVec3> = (part.corners.iter())
+            .map(|&[a, b]| view.plane.at(f64::from(a), f64::from(b)))
+            .collect();
+        positions.extend(near.iter().map(|&p| end(p)));
+        positions.extend(near);
+        let (far, near) = (|i: u32| base + i, |i: u32| base + n + i);
+        for t in &part.triangles {
+            // (counter-clockwise in the plane's (a, b) coordinates)
+            faces.push(vec![near(t[0]), near(t[2]), near(t[1])]);
+            faces.push(vec![far(t[0]), far(t[1]), far(t[2])]);
+        }
+        for range in part.loop_ranges() {
+            let (s, e) = (range.start as u32, range.end as u32);
+            for i in s..e {
+                let j = if i + 1 == e { s } else { i + 1 };
+                faces.push(vec![near(i), near(j), far(j)]);
+                faces.push(vec![near(i), far(j), far(i)]);
+            }
+        }
+    }
+    let mut m = mesh(positions, faces);
+    // turned outward: the plane's normal may face the light or away
+    if signed_volume(&m) < 0.0 {
+        for f in &mut m.faces {
+            f.vertices.reverse();
+        }
+    }
+    Ok(m)
+}
+
+/// The signed volume of a closed triangle mesh (`f64`: only its sign is
+/// read, and a cone is far from flat).
+fn signed_volume(m: &Mesh) -> f64 {
+    m.faces
+        .iter()
+        .map(|f| {
+            let [a, b, c] = [0, 1, 2].map(|k| m.positions[f.vertices[k] as usize]);
+            a.dot(b.cross(c))
+        })
+        .sum::<f64>()
+        / 6.0
+}

@@ -1,0 +1,289 @@
+//! Shadow art: known hulls by their exact volumes, the hull's shadows
+//! against the images, and bad input.
+
+use std::path::PathBuf;
+
+use bsp_shadows::DVec3;
+use bsp_shadows::art::{ArtError, ArtLight, ArtSpec, ArtView, Mask, ViewPlane, shadow_hull};
+
+/// A `n × n` mask wanting the pixels where `want(c, r)`.
+fn mask(n: u32, want: impl Fn(u32, u32) -> bool) -> Mask {
+    Mask {
+        width: n,
+        height: n,
+        wanted: (0..n * n).map(|p| want(p % n, p / n)).collect(),
+    }
+}
+
+/// A 4 × 4 image with its middle 2 × 2 wanted.
+fn square() -> Mask {
+    mask(4, |c, r| (1..3).contains(&c) && (1..3).contains(&r))
+}
+
+fn view(light: ArtLight, origin: DVec3, u: DVec3, v: DVec3, mask: Mask) -> ArtView {
+    ArtView {
+        image: PathBuf::from("test.pgm"),
+        light,
+        plane: ViewPlane { origin, u, v },
+        mask,
+    }
+}
+
+/// The floor `z = 0`, pixels of unit size along x and y.
+fn floor(light: ArtLight, mask: Mask) -> ArtView {
+    view(light, DVec3::ZERO, DVec3::X, DVec3::Y, mask)
+}
+
+fn spec(views: Vec<ArtView>, hi: DVec3) -> ArtSpec {
+    ArtSpec {
+        views,
+        bounds: [DVec3::ZERO, hi],
+    }
+}
+
+#[test]
+fn a_square_under_a_sun_is_a_prism() {
+    let s = spec(
+        vec![floor(ArtLight::Sun(DVec3::Z), square())],
+        DVec3::new(4.0, 4.0, 2.0),
+    );
+    let hull = shadow_hull(&s).unwrap();
+    assert_eq!(hull.hull.volume(), 8.0);
+    // its shadow is the wanted square, exactly where it is wanted
+    let check = &hull.check(&s).unwrap()[0];
+    assert_eq!(check.wanted_area, 4.0);
+    assert!((check.shadow_area - 4.0).abs() < 1e-9, "{check:?}");
+    assert!(
+        check.missing_area < 1e-9 && check.extra_area < 1e-9,
+        "{check:?}"
+    );
+}
+
+#[test]
+fn two_orthogonal_squares_give_a_box() {
+    // the floor under a sun overhead, and the wall x = 0 under a sun
+    // along +x
+    let wall = view(
+        ArtLight::Sun(DVec3::X),
+        DVec3::ZERO,
+        DVec3::Y,
+        DVec3::Z,
+        mask(4, |c, r| (1..3).contains(&c) && r < 1),
+    );
+    let s = spec(
+        vec![floor(ArtLight::Sun(DVec3::Z), square()), wall],
+        DVec3::new(4.0, 4.0, 4.0),
+    );
+    let hull = shadow_hull(&s).unwrap();
+    // x in [1, 3] (floor), y in [1, 3] (both), z in [0, 1] (wall)
+    assert_eq!(hull.hull.volume(), 4.0);
+    for c in hull.check(&s).unwrap() {
+        assert!(c.missing_area < 1e-9 && c.extra_area < 1e-9, "{c:?}");
+    }
+}
+
+#[test]
+fn a_point_light_gives_a_pyramid_frustum() {
+    let light = ArtLight::Point(DVec3::new(2.0, 2.0, 4.0));
+    let s = spec(vec![floor(light, square())], DVec3::new(4.0, 4.0, 2.0));
+    let hull = shadow_hull(&s).unwrap();
+    // from the side-2 square at z = 0 to the side-1 square at z = 2
+    let v = hull.hull.volume();
+    assert!((v - 14.0 / 3.0).abs() < 1e-12, "{v}");
+    let c = &hull.check(&s).unwrap()[0];
+    assert!(c.missing_area < 1e-9 && c.extra_area < 1e-9, "{c:?}");
+}
+
+#[test]
+fn conflicting_views_miss_shadow_and_never_cast_extra() {
+    // the floor wants a ring, the wall wants a bar the ring's hole cannot
+    // give: the hull casts less than the floor wants
+    let ring = mask(6, |c, r| {
+        (1..5).contains(&c) && (1..5).contains(&r) && !((2..4).contains(&c) && (2..4).contains(&r))
+    });
+    let wall = view(
+        ArtLight::Sun(DVec3::X),
+        DVec3::ZERO,
+        DVec3::Y,
+        DVec3::Z,
+        mask(6, |_, r| r == 0),
+    );
+    let s = spec(
+        vec![floor(ArtLight::Sun(DVec3::Z), ring), wall],
+        DVec3::new(6.0, 6.0, 3.0),
+    );
+    let hull = shadow_hull(&s).unwrap();
+    let checks = hull.check(&s).unwrap();
+    for c in &checks {
+        assert!(c.extra_area < 1e-9, "{c:?}");
+    }
+    // the wall's bar is wanted at rows y in [0, 1) and [5, 6) too, where
+    // the ring has nothing: missed
+    assert!(checks[1].missing_area > 1.0, "{:?}", checks[1]);
+    // the floor's ring is all there
+    assert!(checks[0].missing_area < 1e-9, "{:?}", checks[0]);
+}
+
+#[test]
+fn a_letter_shaped_region_with_holes_and_touching_corners() {
+    // a ring with an island, pixels touching at corners, a C whose tips
+    // touch: every cone is closed, and the prism's volume is the pixels'
+    let m = mask(9, |c, r| {
+        let ring = (1..8).contains(&c)
+            && (1..8).contains(&r)
+            && !((2..7).contains(&c) && (2..7).contains(&r));
+        let island = c == 4 && r == 4;
+        let diagonal = (c, r) == (0, 0) || (c, r) == (8, 8);
+        ring || island || diagonal || (c, r) == (3, 3)
+    });
+    let n = m.count() as f64;
+    let s = spec(
+        vec![floor(ArtLight::Sun(DVec3::Z), m)],
+        DVec3::new(9.0, 9.0, 1.0),
+    );
+    let hull = shadow_hull(&s).unwrap();
+    assert_eq!(hull.hull.volume(), n);
+}
+
+#[test]
+fn bad_views_are_named() {
+    let hi = DVec3::new(4.0, 4.0, 2.0);
+    let err = |s: ArtSpec| shadow_hull(&s).unwrap_err().to_string();
+    // a light on the receiving plane, and a sun along it
+    let e = err(spec(
+        vec![floor(ArtLight::Point(DVec3::new(9.0, 9.0, 0.0)), square())],
+        hi,
+    ));
+    assert!(
+        e.contains("view 0") && e.contains("lies on the receiving plane"),
+        "{e}"
+    );
+    let e = err(spec(vec![floor(ArtLight::Sun(DVec3::X), square())], hi));
+    assert!(e.contains("along the receiving plane"), "{e}");
+    // a point light inside the bounds, and one behind the plane
+    let e = err(spec(
+        vec![floor(ArtLight::Point(DVec3::new(2.0, 2.0, 1.0)), square())],
+        hi,
+    ));
+    assert!(e.contains("beyond the bounds"), "{e}");
+    let e = err(spec(
+        vec![floor(ArtLight::Point(DVec3::new(2.0, 2.0, -3.0)), square())],
+        hi,
+    ));
+    assert!(e.contains("view 0"), "{e}");
+    // degenerate u, v
+    let flat = view(
+        ArtLight::Sun(DVec3::Z),
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::X * 2.0,
+        square(),
+    );
+    let e = err(spec(vec![flat], hi));
+    assert!(e.contains("parallel"), "{e}");
+    // no wanted shadow
+    let e = err(spec(
+        vec![floor(ArtLight::Sun(DVec3::Z), mask(4, |_, _| false))],
+        hi,
+    ));
+    assert!(e.contains("no wanted shadow"), "{e}");
+    // cones that miss each other
+    let a = floor(ArtLight::Sun(DVec3::Z), mask(4, |c, _| c == 0));
+    let b = floor(ArtLight::Sun(DVec3::Z), mask(4, |c, _| c == 3));
+    let e = shadow_hull(&spec(vec![a, b], hi)).unwrap_err();
+    assert!(matches!(e, ArtError::Empty), "{e}");
+}
+
+#[test]
+fn specs_and_images_are_read_with_clear_errors() {
+    let dir = std::env::temp_dir().join(format!("bsp_art_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // a 4 × 4 P2 image with its middle dark
+    let pgm =
+        "P2\n# a square\n4 4\n255\n255 255 255 255\n255 0 0 255\n255 0 0 255\n255 255 255 255\n";
+    std::fs::write(dir.join("sq.pgm"), pgm).unwrap();
+    let text = r#"{"views": [{"image": "sq.pgm", "light": {"sun": [0, 0, 1]},
+        "plane": {"origin": [0, 0, 0], "u": [1, 0, 0], "v": [0, 1, 0]}}],
+        "bounds": [[0, 0, 0], [4, 4, 2]]}"#;
+    std::fs::write(dir.join("spec.json"), text).unwrap();
+    let s = ArtSpec::load(&dir.join("spec.json")).unwrap();
+    assert_eq!(s.views[0].mask, square());
+    assert_eq!(shadow_hull(&s).unwrap().hull.volume(), 8.0);
+    // a missing image names the file
+    std::fs::write(dir.join("bad.json"), text.replace("sq.pgm", "gone.pgm")).unwrap();
+    let e = ArtSpec::load(&dir.join("bad.json"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("gone.pgm"), "{e}");
+    // a spec without bounds
+    std::fs::write(dir.join("nb.json"), r#"{"views": []}"#).unwrap();
+    let e = ArtSpec::load(&dir.join("nb.json")).unwrap_err().to_string();
+    assert!(e.contains("nb.json") && e.contains("views"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn silhouettes_of_a_closed_mesh_come_back_but_for_boundary_pixels() {
+    use bsp_shadows::art::shadow_coverage;
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../data/meshes/pyvista_sphere.obj"
+    );
+    let sphere = bsp_shadows::read_mesh(path).unwrap();
+    let (lo, hi) = sphere.bounds().unwrap();
+    let n = 96u32;
+    let side = (hi - lo).max_element() * 1.2;
+    let px = side / f64::from(n);
+    let c = (lo + hi) * 0.5 - DVec3::splat(side / 2.0);
+    // three walls a little away from the sphere, each lit along an axis
+    let views: Vec<ArtView> = [
+        (
+            DVec3::X,
+            DVec3::new(lo.x - 1.0, c.y, c.z),
+            DVec3::Y,
+            DVec3::Z,
+        ),
+        (
+            DVec3::Y,
+            DVec3::new(c.x, lo.y - 1.0, c.z),
+            DVec3::Z,
+            DVec3::X,
+        ),
+        (
+            DVec3::Z,
+            DVec3::new(c.x, c.y, lo.z - 1.0),
+            DVec3::X,
+            DVec3::Y,
+        ),
+    ]
+    .into_iter()
+    .map(|(sun, origin, u, v)| {
+        let blank = mask(n, |_, _| false);
+        let mut view = view(ArtLight::Sun(sun), origin, u * px, v * px, blank);
+        // the silhouette: the pixels the sphere's shadow covers half of
+        let cov = shadow_coverage(&sphere, &view).unwrap();
+        view.mask.wanted = cov.iter().map(|&c| c >= 0.5).collect();
+        view
+    })
+    .collect();
+    let s = ArtSpec {
+        views: views.clone(),
+        bounds: [lo - DVec3::splat(0.5), hi + DVec3::splat(0.5)],
+    };
+    let hull = shadow_hull(&s).unwrap();
+    for (v, c) in views.iter().zip(hull.check(&s).unwrap()) {
+        let areas = (c.wanted_area, c.shadow_area, c.missing_area, c.extra_area);
+        // (the cones' corners, a non-dyadic pixel apart, round to the
+        // Booleans' grid, and the hull's to the shadows' grid)
+        assert!(c.extra_area < 1e-6 * c.wanted_area, "{areas:?}");
+        assert!(c.missing_area <= 0.02 * c.wanted_area, "{areas:?}");
+        // every pixel it misses lies on the wanted region's boundary
+        for (x, y) in c.missing_pixels(v, 1e-6) {
+            let (x, y) = (i64::from(x), i64::from(y));
+            let boundary = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+                .iter()
+                .any(|&(dx, dy)| !v.mask.at(x + dx, y + dy));
+            assert!(boundary, "pixel ({x}, {y}) missed inside the region");
+        }
+    }
+}
