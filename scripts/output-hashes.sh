@@ -51,6 +51,21 @@ done
 run compare --scene room --panel 320x180 -o cmp_room.png --report cmp_room.csv
 run compare --scene bunny --panel 320x180 -o cmp_bunny.png --report cmp_bunny.csv
 run lines --scene room -o lines.svg
+# soft lights in pictures, and shadow art
+SOFT="0.7,0.1,2.45;0.7,0.5,2.45;1.1,0.5,2.45;1.1,0.1,2.45"
+run render --scene room --size 320x180 --area-light "$SOFT" -o render_soft.png
+run render --scene room --size 320x180 --area-light "$SOFT" --sun-disc 0.3,-0.2,1:2 \
+  --method pcss -o render_pcss.png
+run compare --scene room --panel 160x90 --area-light "$SOFT" --methods sampled:4,pcss \
+  -o cmp_soft.png --report cmp_soft.csv
+printf 'P2\n4 4\n255\n255 255 255 255\n255 0 0 255\n255 0 255 255\n255 255 255 255\n' > sq.pgm
+printf 'P2\n4 4\n255\n255 0 0 255\n255 0 0 255\n255 255 255 255\n255 255 255 255\n' > bar.pgm
+printf '%s\n' '{"views": [' \
+  '{"image": "sq.pgm", "light": {"sun": [0, 0, 1]}, "plane": {"origin": [0, 0, 0], "u": [1, 0, 0], "v": [0, 1, 0]}},' \
+  '{"image": "bar.pgm", "light": {"point": [-9, 2, 1]}, "plane": {"origin": [5, 0, 0], "u": [0, 1, 0], "v": [0, 0, 1]}}' \
+  '], "bounds": [[0, 0, 0], [4, 4, 3]]}' > art.json
+run art art.json -o art.obj --report art_report.json --images art_views
+rm sq.pgm bar.pgm art.json
 run animate --scene room --frames 3 --format png --width 320 --height 180 -o anim_png \
   --report anim.csv
 run animate --scene room --frames 2 --format json -o anim_json --strategy paper

@@ -532,6 +532,44 @@ impl Row {
     }
 }
 
+/// Locates every pixel's lookup of light `j` (`l`), then draws the
+/// nearness of the light's map over each view's lookups as `widen` widens
+/// them (an empty view stays empty): the views and the texels drawn.
+fn depth_map(
+    frame: &Frame<'_>,
+    vis: &Visibility,
+    (l, j): (&SceneLight, usize),
+    facing: &[u64],
+    opts: &ShadowOptions,
+    bufs: &mut MapBuffers,
+    widen: impl Fn(Region) -> Region,
+) -> (Vec<View>, usize) {
+    let views = light_views(frame.scene, l.world, opts.map_size);
+    let need = locate(
+        frame,
+        vis,
+        (l.world, j),
+        facing,
+        &views,
+        opts,
+        &mut bufs.look,
+    )
+    .map(|r| if r.is_empty() { r } else { widen(r) });
+    let texels = build_map(
+        frame.scene,
+        &views,
+        need,
+        f32::NEG_INFINITY,
+        |t, w, _| {
+            let w = w as f32;
+            *t = if w > *t { w } else { *t };
+        },
+        &mut bufs.texels,
+        &mut bufs.proj,
+    );
+    (views, texels)
+}
+
 /// Williams' shadow map.
 pub(crate) fn shadow_map(
     frame: &Frame<'_>,
@@ -563,38 +601,15 @@ fn shadow_map_in(
     let taps = (opts.pcf * opts.pcf) as f32;
     let w = vis.width as usize;
     for (j, l) in lights.iter().enumerate() {
-        let views = light_views(frame.scene, l.world, opts.map_size);
-        let need = locate(
-            frame,
-            vis,
-            (l.world, j),
-            facing,
-            &views,
-            opts,
-            &mut bufs.look,
-        )
-        .map(|r| {
-            if r.is_empty() {
-                r
-            } else if scissor {
+        let (_, texels) = depth_map(frame, vis, (l, j), facing, opts, bufs, |r| {
+            if scissor {
                 // the texels of the lookups and of their PCF kernels
                 r.grown(half as u32, opts.map_size)
             } else {
                 Region::whole(opts.map_size)
             }
         });
-        fig.primitives += build_map(
-            frame.scene,
-            &views,
-            need,
-            f32::NEG_INFINITY,
-            |t, w, _| {
-                let w = w as f32;
-                *t = if w > *t { w } else { *t };
-            },
-            &mut bufs.texels,
-            &mut bufs.proj,
-        );
+        fig.primitives += texels;
         let persp = matches!(l.world, RasterLight::Point(_));
         let size = opts.map_size as i64;
         let data: Vec<&[f32]> = bufs.texels.iter().map(Vec::as_slice).collect();
@@ -691,40 +706,15 @@ pub(crate) fn pcss(
     let top = 0.5 * frame.scene.diagonal();
     for (j, l) in lights.iter().enumerate() {
         let spread = l.spread();
-        let views = light_views(frame.scene, l.world, opts.map_size);
         let grow = if spread > 0.0 {
             PCSS_MAX_RADIUS as u32 + 1
         } else {
             0
         };
-        let need = locate(
-            frame,
-            vis,
-            (l.world, j),
-            facing,
-            &views,
-            opts,
-            &mut bufs.look,
-        )
-        .map(|r| {
-            if r.is_empty() {
-                r
-            } else {
-                r.grown(grow, opts.map_size)
-            }
+        let (views, texels) = depth_map(frame, vis, (l, j), facing, opts, bufs, |r| {
+            r.grown(grow, opts.map_size)
         });
-        fig.primitives += build_map(
-            frame.scene,
-            &views,
-            need,
-            f32::NEG_INFINITY,
-            |t, w, _| {
-                let w = w as f32;
-                *t = if w > *t { w } else { *t };
-            },
-            &mut bufs.texels,
-            &mut bufs.proj,
-        );
+        fig.primitives += texels;
         let blur = Blur {
             persp: matches!(l.world, RasterLight::Point(_)),
             // a texel's footprint per unit of depth (perspective) or in all

@@ -25,14 +25,7 @@ fn mesh(positions: Vec<DVec3>, faces: Vec<Vec<u32>>) -> Mesh {
 }
 
 /// The box `[lo, hi]`, its faces turned outward.
-pub(crate) fn cuboid([lo, hi]: [DVec3; 2]) -> Mesh {
-    let p = |i: u32| {
-        DVec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        )
-    };
+pub(crate) fn cuboid(bounds: [DVec3; 2]) -> Mesh {
     let faces = [
         [0, 2, 3, 1],
         [4, 5, 7, 6],
@@ -41,10 +34,11 @@ pub(crate) fn cuboid([lo, hi]: [DVec3; 2]) -> Mesh {
         [0, 4, 6, 2],
         [1, 3, 7, 5],
     ];
-    mesh((0..8).map(p).collect(), faces.map(|f| f.to_vec()).to_vec())
+    mesh(corners(bounds).to_vec(), faces.map(|f| f.to_vec()).to_vec())
 }
 
-/// The corners of the box `[lo, hi]`.
+/// The corners of the box `[lo, hi]` (corner `i` takes `hi` along axis
+/// `k` where bit `k` of `i` is set).
 fn corners([lo, hi]: [DVec3; 2]) -> [DVec3; 8] {
     std::array::from_fn(|i| {
         DVec3::new(
