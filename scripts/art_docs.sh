@@ -37,8 +37,11 @@ with_walls "$WORK/geb.obj" -0.25 1.25 -0.25 -0.1 1.1 "$WORK/geb_scene.obj"
 "$BIN" render "$WORK/geb_scene.obj" --sun 1,0,0 --sun 0,-1,0 --sun 0,0,1 \
   --eye 1.9,-1.15,1.6 --target 0.35,0.6,0.3 --size 640x480 -o "$OUT/art_geb.png" > /dev/null
 
+"$BIN" art "$WORK/geb/spec.json" -o "$WORK/geb_grown.obj" --optimize --images "$WORK/geb/grown"
+cp "$WORK/geb/grown/view0.png" "$OUT/art_geb_g_grown.png"
+
 "$EX/art_silhouettes" "$ROOT/data/meshes/bunny.obj" "$WORK/bunny" 512 > /dev/null
 "$BIN" art "$WORK/bunny/spec.json" -o "$WORK/bunny.obj" --report "$WORK/bunny_report.json"
 cp "$WORK/geb/views/view2.png" "$OUT/art_geb_b.png"
-echo "wrote $OUT/art_geb.png and art_geb_b.png; the bunny's report:"
+echo "wrote $OUT/art_geb.png, art_geb_b.png and art_geb_g_grown.png; the bunny's report:"
 cat "$WORK/bunny_report.json"

@@ -65,6 +65,7 @@ printf '%s\n' '{"views": [' \
   '{"image": "bar.pgm", "light": {"point": [-9, 2, 1]}, "plane": {"origin": [5, 0, 0], "u": [0, 1, 0], "v": [0, 0, 1]}}' \
   '], "bounds": [[0, 0, 0], [4, 4, 3]]}' > art.json
 run art art.json -o art.obj --report art_report.json --images art_views
+run art art.json -o art_grown.obj --optimize --report art_grown.json
 rm sq.pgm bar.pgm art.json
 run animate --scene room --frames 3 --format png --width 320 --height 180 -o anim_png \
   --report anim.csv

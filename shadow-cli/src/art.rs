@@ -4,11 +4,11 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use bsp_shadows::art::{ArtSpec, shadow_hull};
+use bsp_shadows::art::{ArtSpec, optimize, shadow_hull};
 use clap::Args;
 use shadow_scene::MeshFormat;
 
-use crate::output::{emit, write_file};
+use crate::output::{emit, note, write_file};
 
 #[derive(Args, Debug)]
 pub(crate) struct ArtArgs {
@@ -25,14 +25,32 @@ pub(crate) struct ArtArgs {
     /// (missed in red, extra in blue) into DIR.
     #[arg(long, value_name = "DIR")]
     images: Option<PathBuf>,
+    /// Grow the images where the views conflict until each misses at
+    /// most 0.5% of its wanted shadow (the paper's inner loop).
+    #[arg(long)]
+    optimize: bool,
+    /// No notes on stderr (errors still go there).
+    #[arg(long, short)]
+    quiet: bool,
 }
 
 /// `shadow art`.
 pub(crate) fn run(args: &ArtArgs) -> Result<()> {
     let stl = MeshFormat::from_path(&args.output)? == MeshFormat::Stl;
-    let spec = ArtSpec::load(&args.spec)?;
-    let hull = shadow_hull(&spec)?;
-    let checks = hull.check(&spec)?;
+    let given = ArtSpec::load(&args.spec)?;
+    let (spec, hull, checks, grown) = if args.optimize {
+        let o = optimize(&given, 0.005, 16)?;
+        (
+            o.spec,
+            o.hull,
+            o.checks,
+            Some((o.growth, o.missing_before, o.rounds)),
+        )
+    } else {
+        let hull = shadow_hull(&given)?;
+        let checks = hull.check(&given)?;
+        (given, hull, checks, None)
+    };
     let mesh = hull.mesh(stl);
     shadow_scene::save(&args.output, &mesh)?;
     let mut text = format!(
@@ -51,9 +69,27 @@ pub(crate) fn run(args: &ArtArgs) -> Result<()> {
             100.0 * c.missing_area / c.wanted_area,
             c.extra_area
         );
+        if grown.is_none() && c.missing_area > 0.005 * c.wanted_area {
+            let why = "the views conflict (--optimize grows the images until they agree)";
+            note(
+                args.quiet,
+                &format!("note: view {i} misses part of its wanted shadow: {why}"),
+            );
+        }
+        if let Some((g, before, _)) = &grown {
+            let g = &g[i];
+            text += &format!(
+                "  grown by {} pixels, {:.2} px on average and {:.2} at most; missing before {:.6}\n",
+                g.pixels, g.mean_displacement, g.max_displacement, before[i]
+            );
+        }
+    }
+    if let Some((_, _, rounds)) = &grown {
+        text += &format!("{rounds} rounds of growing\n");
     }
     if let Some(r) = &args.report {
-        write_file(r, hull.report_json(&checks).as_bytes())?;
+        let grown = grown.as_ref().map(|(g, b, _)| (&g[..], &b[..]));
+        write_file(r, hull.report_json(&checks, grown).as_bytes())?;
         text += &format!("wrote {}\n", r.display());
     }
     if let Some(dir) = &args.images {

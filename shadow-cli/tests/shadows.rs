@@ -928,6 +928,20 @@ fn art_makes_the_hull_its_report_and_pictures() {
     let loops: Vec<&[u32]> = back.faces.iter().map(|f| f.vertices.as_slice()).collect();
     assert!(bsp_core::check_closed_manifold(loops).is_ok());
     assert!(views.join("view0.png").exists());
+    // views that agree need no growing
+    let o = shadow(&[
+        "art",
+        dir.join("spec.json").to_str().unwrap(),
+        "-o",
+        hull.to_str().unwrap(),
+        "--optimize",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("0 rounds of growing"), "{}", stdout(&o));
+    let r: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["views"][0]["pixels_added"], 0);
     // an all-white image is a clear error naming it
     std::fs::write(
         dir.join("sq.pgm"),

@@ -287,3 +287,51 @@ fn silhouettes_of_a_closed_mesh_come_back_but_for_boundary_pixels() {
         }
     }
 }
+
+#[test]
+fn conflicting_views_are_grown_until_they_agree() {
+    use bsp_shadows::art::optimize;
+    // the floor wants a ring, the wall a bar wider than the ring
+    let ring = mask(6, |c, r| {
+        (1..5).contains(&c) && (1..5).contains(&r) && !((2..4).contains(&c) && (2..4).contains(&r))
+    });
+    let wall = view(
+        ArtLight::Sun(DVec3::X),
+        DVec3::ZERO,
+        DVec3::Y,
+        DVec3::Z,
+        mask(6, |_, r| r == 0),
+    );
+    let s = spec(
+        vec![floor(ArtLight::Sun(DVec3::Z), ring.clone()), wall],
+        DVec3::new(6.0, 6.0, 3.0),
+    );
+    let o = optimize(&s, 0.005, 8).unwrap();
+    assert!(o.missing_before[1] > 1.0, "{:?}", o.missing_before);
+    for c in &o.checks {
+        assert!(
+            c.missing_area <= 0.005 * c.wanted_area,
+            "{:?}",
+            (c.wanted_area, c.missing_area)
+        );
+        assert!(c.extra_area < 1e-9);
+    }
+    // the floor's ring gained the pixels next to it that the bar needs,
+    // one pixel away; the wall's bar did not change
+    let g = &o.growth;
+    assert!(g[0].pixels >= 2 && g[0].max_displacement == 1.0, "{g:?}");
+    assert_eq!(g[1].pixels, 0);
+    assert!(
+        ring.wanted
+            .iter()
+            .zip(&o.spec.views[0].mask.wanted)
+            .all(|(a, b)| !a || *b)
+    );
+    // views that agree are left alone
+    let calm = spec(
+        vec![floor(ArtLight::Sun(DVec3::Z), square())],
+        DVec3::new(4.0, 4.0, 2.0),
+    );
+    let o = optimize(&calm, 0.005, 8).unwrap();
+    assert_eq!((o.rounds, o.growth[0].pixels), (0, 0));
+}

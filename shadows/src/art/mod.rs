@@ -20,6 +20,7 @@
 
 mod check;
 mod cone;
+mod grow;
 mod region;
 mod spec;
 
@@ -30,6 +31,7 @@ use bsp_csg::files::{FileBoolean, FileError, Operand};
 use glam::DVec3;
 
 pub use check::{ViewCheck, shadow_coverage};
+pub use grow::{Growth, Optimized, optimize};
 pub use region::Mask;
 pub use spec::read_mask;
 
@@ -206,17 +208,29 @@ pub fn shadow_hull(spec: &ArtSpec) -> Result<ShadowHull, ArtError> {
 
 impl ShadowHull {
     /// The report as JSON: per view (in the spec's order) its areas
-    /// ([`ViewCheck`]), and the hull's exact volume and its triangles.
-    pub fn report_json(&self, checks: &[ViewCheck]) -> String {
+    /// ([`ViewCheck`]) and, after [`optimize`], how its image grew
+    /// ([`Growth`]) and what it missed before (`grown`: per view); the
+    /// hull's exact volume
+    /// and its triangles.
+    pub fn report_json(&self, checks: &[ViewCheck], grown: Option<(&[Growth], &[f64])>) -> String {
         let views: Vec<serde_json::Value> = checks
             .iter()
-            .map(|c| {
-                serde_json::json!({
+            .enumerate()
+            .map(|(i, c)| {
+                let mut v = serde_json::json!({
                     "wanted_area": c.wanted_area,
                     "shadow_area": c.shadow_area,
                     "missing_area": c.missing_area,
                     "extra_area": c.extra_area,
-                })
+                });
+                if let Some((growth, before)) = grown {
+                    let g = &growth[i];
+                    v["missing_area_before"] = before[i].into();
+                    v["pixels_added"] = g.pixels.into();
+                    v["max_displacement_px"] = g.max_displacement.into();
+                    v["mean_displacement_px"] = g.mean_displacement.into();
+                }
+                v
             })
             .collect();
         let report = serde_json::json!({

@@ -1,0 +1,260 @@
+//! Making conflicting views agree (`--optimize`): the paper's inner loop.
+//!
+//! Where a view misses a wanted pixel, the hull must gain a point on the
+//! line from the light through that pixel. Of the points of that line in
+//! the bounds (sampled), the one whose shadows in the other views fall
+//! nearest to their wanted regions is chosen (the sum of its pixels'
+//! distances to them, from a distance transform), and each other view's
+//! image gains the pixel that point's shadow falls in. The images grow
+//! as little as that choice allows; the hull of the grown images is made
+//! exactly again, and the rounds go on until every view misses at most
+//! the target share of its (grown) wanted area, or nothing changes.
+//!
+//! Mitra & Pauly also deform the images as rigidly as possible (their
+//! outer loop); that is not done here: the images only grow.
+
+use glam::DVec3;
+
+use super::region::Mask;
+use super::{ArtError, ArtLight, ArtSpec, ArtView, ShadowHull, ViewCheck, shadow_hull};
+
+/// Points tried along each missed pixel's line.
+const SAMPLES: usize = 64;
+
+/// How one view's image grew.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Growth {
+    /// Pixels added.
+    pub pixels: usize,
+    /// The largest distance of an added pixel from the image's original
+    /// wanted region, in pixels.
+    pub max_displacement: f64,
+    /// Their mean distance, in pixels.
+    pub mean_displacement: f64,
+}
+
+/// What [`optimize`] made: the grown views, their exact hull and its
+/// check, and how each image grew, with the rounds run.
+#[derive(Debug)]
+pub struct Optimized {
+    /// The spec with the grown images.
+    pub spec: ArtSpec,
+    /// Their hull.
+    pub hull: ShadowHull,
+    /// Its check against the grown images.
+    pub checks: Vec<ViewCheck>,
+    /// Per view, how its image grew.
+    pub growth: Vec<Growth>,
+    /// Rounds of growing.
+    pub rounds: usize,
+    /// Per view, the missing area before growing (of the hull of the
+    /// images as given).
+    pub missing_before: Vec<f64>,
+}
+
+/// Per pixel, the distance (in pixels, by the 3-4 chamfer metric, /3) to
+/// the nearest wanted pixel; 0 on wanted pixels.
+fn distances(mask: &Mask) -> Vec<f64> {
+    let (w, h) = (mask.width as usize, mask.height as usize);
+    let big = u32::MAX / 4;
+    let mut d: Vec<u32> = mask
+        .wanted
+        .iter()
+        .map(|&x| if x { 0 } else { big })
+        .collect();
+    let at = |x: usize, y: usize| y * w + x;
+    for y in 0..h {
+        for x in 0..w {
+            let mut v = d[at(x, y)];
+            if x > 0 {
+                v = v.min(d[at(x - 1, y)] + 3);
+            }
+            if y > 0 {
+                v = v.min(d[at(x, y - 1)] + 3);
+                if x > 0 {
+                    v = v.min(d[at(x - 1, y - 1)] + 4);
+                }
+                if x + 1 < w {
+                    v = v.min(d[at(x + 1, y - 1)] + 4);
+                }
+            }
+            d[at(x, y)] = v;
+        }
+    }
+    for y in (0..h).rev() {
+        for x in (0..w).rev() {
+            let mut v = d[at(x, y)];
+            if x + 1 < w {
+                v = v.min(d[at(x + 1, y)] + 3);
+            }
+            if y + 1 < h {
+                v = v.min(d[at(x, y + 1)] + 3);
+                if x + 1 < w {
+                    v = v.min(d[at(x + 1, y + 1)] + 4);
+                }
+                if x > 0 {
+                    v = v.min(d[at(x - 1, y + 1)] + 4);
+                }
+            }
+            d[at(x, y)] = v;
+        }
+    }
+    d.into_iter().map(|v| f64::from(v) / 3.0).collect()
+}
+
+/// The pixel of `view`'s image that the shadow of point `x` falls in.
+fn pixel_of(view: &ArtView, x: DVec3) -> Option<(u32, u32)> {
+    let pl = view.plane;
+    let n = pl.normal();
+    let on_plane = match view.light {
+        ArtLight::Sun(d) => x - d * ((x - pl.origin).dot(n) / d.dot(n)),
+        ArtLight::Point(l) => {
+            let k = (x - l).dot(n);
+            if k == 0.0 {
+                return None;
+            }
+            l + (x - l) * ((pl.origin - l).dot(n) / k)
+        }
+    };
+    let (a, b) = pl.coords(on_plane);
+    let (c, r) = (a.floor(), b.floor());
+    let inside =
+        c >= 0.0 && r >= 0.0 && c < f64::from(view.mask.width) && r < f64::from(view.mask.height);
+    inside.then_some((c as u32, r as u32))
+}
+
+/// The points of the line from `view`'s light through the centre of
+/// pixel `(c, r)` that lie in `bounds`, between the light and the plane:
+/// [`SAMPLES`] of them, evenly spread.
+fn line_samples(view: &ArtView, (c, r): (u32, u32), [lo, hi]: [DVec3; 2]) -> Vec<DVec3> {
+    let p = view.plane.at(f64::from(c) + 0.5, f64::from(r) + 0.5);
+    // the line p + t·dir, t in (0, t_max]: toward the light
+    let (dir, t_max) = match view.light {
+        ArtLight::Sun(d) => (d, f64::INFINITY),
+        ArtLight::Point(l) => (l - p, 1.0),
+    };
+    let (mut t0, mut t1) = (0.0f64, t_max);
+    for k in 0..3 {
+        if dir[k] == 0.0 {
+            if p[k] < lo[k] || p[k] > hi[k] {
+                return Vec::new();
+            }
+            continue;
+        }
+        let (a, b) = ((lo[k] - p[k]) / dir[k], (hi[k] - p[k]) / dir[k]);
+        t0 = t0.max(a.min(b));
+        t1 = t1.min(a.max(b));
+    }
+    if t0 >= t1 {
+        return Vec::new();
+    }
+    (0..SAMPLES)
+        .map(|i| p + dir * (t0 + (t1 - t0) * (i as f64 + 0.5) / SAMPLES as f64))
+        .collect()
+}
+
+/// One round: for every pixel a view misses (its shadow covers less than
+/// half of it), the other views' images gain the pixels of the best point
+/// on its line. Returns how many pixels were added.
+fn grow_round(
+    spec: &mut ArtSpec,
+    checks: &[ViewCheck],
+    original: &[Vec<f64>],
+    growth: &mut [Growth],
+) -> usize {
+    let dist: Vec<Vec<f64>> = spec.views.iter().map(|v| distances(&v.mask)).collect();
+    let mut add: Vec<Vec<usize>> = vec![Vec::new(); spec.views.len()];
+    for (k, (view, check)) in spec.views.iter().zip(checks).enumerate() {
+        let w = view.mask.width;
+        for (p, (&wanted, &cov)) in view.mask.wanted.iter().zip(&check.coverage).enumerate() {
+            if !wanted || cov >= 0.5 {
+                continue;
+            }
+            let pixel = (p as u32 % w, p as u32 / w);
+            let mut best: Option<(f64, Vec<(usize, usize)>)> = None;
+            for x in line_samples(view, pixel, spec.bounds) {
+                let mut cost = 0.0;
+                let mut pixels = Vec::new();
+                for (j, other) in spec.views.iter().enumerate().filter(|&(j, _)| j != k) {
+                    let Some((c, r)) = pixel_of(other, x) else {
+                        cost = f64::INFINITY;
+                        break;
+                    };
+                    let q = (r * other.mask.width + c) as usize;
+                    cost += dist[j][q];
+                    pixels.push((j, q));
+                }
+                if cost.is_finite() && best.as_ref().is_none_or(|b| cost < b.0) {
+                    best = Some((cost, pixels));
+                }
+            }
+            for (j, q) in best.map(|b| b.1).unwrap_or_default() {
+                add[j].push(q);
+            }
+        }
+    }
+    let mut added = 0;
+    for (j, qs) in add.into_iter().enumerate() {
+        let mask = &mut spec.views[j].mask;
+        for q in qs {
+            if !mask.wanted[q] {
+                mask.wanted[q] = true;
+                added += 1;
+                let g = &mut growth[j];
+                let d = original[j][q];
+                g.mean_displacement =
+                    (g.mean_displacement * g.pixels as f64 + d) / (g.pixels + 1) as f64;
+                g.pixels += 1;
+                g.max_displacement = g.max_displacement.max(d);
+            }
+        }
+    }
+    added
+}
+
+/// Grows `spec`'s images until every view's hull shadow misses at most
+/// `target` of its wanted area (e.g. 0.005), in at most `rounds` rounds
+/// (see the module docs). The hull is exact in every round.
+pub fn optimize(spec: &ArtSpec, target: f64, rounds: usize) -> Result<Optimized, ArtError> {
+    let mut spec = spec.clone();
+    let original: Vec<Vec<f64>> = spec.views.iter().map(|v| distances(&v.mask)).collect();
+    let mut growth = vec![Growth::default(); spec.views.len()];
+    let mut hull = shadow_hull(&spec)?;
+    let mut checks = hull.check(&spec)?;
+    let missing_before = checks.iter().map(|c| c.missing_area).collect();
+    let mut done = 0;
+    while done < rounds {
+        let met = checks
+            .iter()
+            .all(|c| c.missing_area <= target * c.wanted_area);
+        if met || grow_round(&mut spec, &checks, &original, &mut growth) == 0 {
+            break;
+        }
+        hull = shadow_hull(&spec)?;
+        checks = hull.check(&spec)?;
+        done += 1;
+    }
+    Ok(Optimized {
+        spec,
+        hull,
+        checks,
+        growth,
+        rounds: done,
+        missing_before,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distances_are_chamfer_pixels() {
+        let m = Mask {
+            width: 4,
+            height: 1,
+            wanted: vec![true, false, false, false],
+        };
+        assert_eq!(distances(&m), [0.0, 1.0, 2.0, 3.0]);
+    }
+}
