@@ -335,3 +335,27 @@ fn conflicting_views_are_grown_until_they_agree() {
     let o = optimize(&calm, 0.005, 8).unwrap();
     assert_eq!((o.rounds, o.growth[0].pixels), (0, 0));
 }
+
+#[test]
+fn png_images_are_read_as_grey_over_white() {
+    let dir = std::env::temp_dir().join(format!("bsp_art_png_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // white, with a black pixel, a dark red one (luma 30: dark) and a
+    // light yellow one (luma 226: light)
+    let mut img = shadow_raster::Image::new(3, 2, [255, 255, 255]);
+    img.rgb[0..3].copy_from_slice(&[0, 0, 0]);
+    img.rgb[3..6].copy_from_slice(&[100, 0, 0]);
+    img.rgb[6..9].copy_from_slice(&[255, 255, 80]);
+    let path = dir.join("img.png");
+    std::fs::write(&path, img.encode_png()).unwrap();
+    let m = bsp_shadows::art::read_mask(&path, 128.0).unwrap();
+    assert_eq!((m.width, m.height), (3, 2));
+    assert_eq!(m.wanted, [true, true, false, false, false, false]);
+    // not an image
+    std::fs::write(&path, b"hello").unwrap();
+    let e = bsp_shadows::art::read_mask(&path, 128.0)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("img.png") && e.contains("not a PGM"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
