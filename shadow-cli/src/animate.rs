@@ -75,7 +75,7 @@ pub(crate) struct AnimateArgs {
     pub(crate) frames: u32,
     /// Rotation per frame: axis and degrees, AX,AY,AZ:DEGREES [default for
     /// --scene: the scene's; none for files].
-    #[arg(long, value_name = "AX,AY,AZ:DEG", value_parser = parse_spin, allow_hyphen_values = true)]
+    #[arg(long, value_name = "AX,AY,AZ:DEG", value_parser = shadow_scene::parse_spin, allow_hyphen_values = true)]
     pub(crate) spin: Option<(DVec3, f64)>,
     /// A point on the rotation axis [default: the centre of the moving
     /// object's bounding box, or the scene's].
@@ -118,25 +118,6 @@ pub(crate) struct AnimateArgs {
     /// No progress bar and no notes on stderr (errors still go there).
     #[arg(long, short)]
     pub(crate) quiet: bool,
-}
-
-/// Parses `AX,AY,AZ:DEGREES`.
-fn parse_spin(s: &str) -> Result<(DVec3, f64), String> {
-    let (axis, deg) = s
-        .rsplit_once(':')
-        .ok_or_else(|| format!("expected AX,AY,AZ:DEGREES, got `{s}`"))?;
-    let axis = parse_vec3(axis)?;
-    if axis.length_squared() == 0.0 {
-        return Err("the spin axis is zero".into());
-    }
-    let deg: f64 = deg
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{deg}` is not a number of degrees"))?;
-    if !deg.is_finite() {
-        return Err(format!("`{deg}` is not a finite number of degrees"));
-    }
-    Ok((axis, deg))
 }
 
 /// The static scene, the moving object and the defaults that come with a
@@ -478,6 +459,7 @@ fn frame_view(args: &AnimateArgs, s: &Setup) -> SvgViewpoint {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use shadow_scene::parse_spin;
 
     #[test]
     fn spins_parse_with_clear_errors() {

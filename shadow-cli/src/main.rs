@@ -26,6 +26,7 @@ mod output;
 mod progress;
 mod raster;
 mod shadows;
+mod sun;
 mod view;
 
 #[derive(Parser, Debug)]
@@ -95,6 +96,12 @@ enum Command {
         after_help = "Examples:\n  shadow art geb.json -o geb.obj --report geb.json --images views/"
     )]
     Art(art::ArtArgs),
+    /// Where the sun is at a place and time (NREL's SPA), in the scene's
+    /// axes: the light of a sun study.
+    #[command(
+        after_help = "Examples:\n  shadow sun --lat 51.5 --lon -0.12 --time 2026-03-21T12:00:00Z --json"
+    )]
+    Sun(sun::SunArgs),
     /// Print a shell completion script (bash, zsh, fish, elvish or
     /// powershell).
     #[command(
@@ -154,6 +161,7 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Compare(a) => raster::run_compare(a),
         Command::Lines(a) => raster::run_lines(a),
         Command::Art(a) => art::run(a),
+        Command::Sun(a) => sun::run(a),
         Command::Completions { shell } => {
             let mut out = Vec::new();
             clap_complete::generate(*shell, &mut Cli::command(), "shadow", &mut out);

@@ -956,3 +956,47 @@ fn art_makes_the_hull_its_report_and_pictures() {
     ]);
     crate::assert_failed_with(&o, &["view 0", "sq.pgm", "no wanted shadow"]);
 }
+
+#[test]
+fn sun_prints_where_the_sun_is() {
+    let o = shadow(&[
+        "sun",
+        "--lat",
+        "51.48",
+        "--lon",
+        "0",
+        "--time",
+        "2026-03-21T12:00:00Z",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let az = v["azimuth_deg"].as_f64().unwrap();
+    let el = v["elevation_deg"].as_f64().unwrap();
+    assert!((az - 180.0).abs() < 3.0 && (el - 38.9).abs() < 0.5, "{v}");
+    // south in the default axes (+y north), and with y up (-z north)
+    assert!(v["direction"][1].as_f64().unwrap() < -0.5, "{v}");
+    let o = shadow(&[
+        "sun",
+        "--lat",
+        "51.48",
+        "--lon",
+        "0",
+        "--time",
+        "2026-03-21T12:00:00+00:00",
+        "--up",
+        "y",
+    ]);
+    assert!(stdout(&o).starts_with("azimuth 177."), "{}", stdout(&o));
+    // a time without its offset is refused, naming the form
+    let o = shadow(&[
+        "sun",
+        "--lat",
+        "51.48",
+        "--lon",
+        "0",
+        "--time",
+        "2026-03-21 12:00",
+    ]);
+    crate::assert_failed_with(&o, &["2026-03-21 12:00", "offset"]);
+}

@@ -180,6 +180,26 @@ pub fn parse_vec3(s: &str) -> Result<glam::DVec3, String> {
     Ok(glam::DVec3::from_array(v))
 }
 
+/// Parses `AX,AY,AZ:DEGREES`: a rotation axis (not zero) and a finite
+/// angle in degrees.
+pub fn parse_spin(s: &str) -> Result<(glam::DVec3, f64), String> {
+    let (axis, deg) = s
+        .rsplit_once(':')
+        .ok_or_else(|| format!("expected AX,AY,AZ:DEGREES, got `{s}`"))?;
+    let axis = parse_vec3(axis)?;
+    if axis.length_squared() == 0.0 {
+        return Err("the spin axis is zero".into());
+    }
+    let deg: f64 = deg
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{deg}` is not a number of degrees"))?;
+    if !deg.is_finite() {
+        return Err(format!("`{deg}` is not a finite number of degrees"));
+    }
+    Ok((axis, deg))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -26,6 +26,7 @@ pub mod frames;
 pub mod prepared;
 pub mod shadow_file;
 pub mod soft_file;
+pub mod sun;
 
 use std::path::Path;
 

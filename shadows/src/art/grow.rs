@@ -33,23 +33,96 @@ pub struct Growth {
     pub mean_displacement: f64,
 }
 
-/// What [`optimize`] made: the grown views, their exact hull and its
-/// check, and how each image grew, with the rounds run.
+/// A shadow-art run: the views (grown, after [`optimize`]), their exact
+/// hull and its check, and how the images grew.
 #[derive(Debug)]
-pub struct Optimized {
-    /// The spec with the grown images.
+pub struct ArtRun {
+    /// The spec, with the grown images after [`optimize`].
     pub spec: ArtSpec,
-    /// Their hull.
+    /// The views' hull.
     pub hull: ShadowHull,
-    /// Its check against the grown images.
+    /// Its check against the (grown) images.
     pub checks: Vec<ViewCheck>,
+    /// After [`optimize`]: how the images grew.
+    pub grown: Option<Grown>,
+}
+
+/// How [`optimize`] grew the images.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Grown {
     /// Per view, how its image grew.
     pub growth: Vec<Growth>,
-    /// Rounds of growing.
-    pub rounds: usize,
     /// Per view, the missing area before growing (of the hull of the
     /// images as given).
     pub missing_before: Vec<f64>,
+    /// Rounds of growing.
+    pub rounds: usize,
+}
+
+/// The hull of `spec`'s views and its check, as given ([`ArtRun::grown`]
+/// `None`).
+pub fn run(spec: ArtSpec) -> Result<ArtRun, ArtError> {
+    let hull = shadow_hull(&spec)?;
+    let checks = hull.check(&spec)?;
+    Ok(ArtRun {
+        spec,
+        hull,
+        checks,
+        grown: None,
+    })
+}
+
+impl ArtRun {
+    /// The views a run as given leaves missing more than `share` of their
+    /// wanted area: the views that conflict.
+    pub fn conflicts(&self, share: f64) -> Vec<usize> {
+        (self.checks.iter().enumerate())
+            .filter(|(_, c)| c.missing_area > share * c.wanted_area)
+            .map(|(i, _)| i)
+            .collect()
+    }
+
+    /// For people, one line per view (its areas, and how it grew), then
+    /// the rounds of growing.
+    pub fn summary(&self) -> String {
+        let mut text = String::new();
+        for (i, c) in self.checks.iter().enumerate() {
+            text += &format!(
+                "view {i}: wanted {:.6}, shadow {:.6}, missing {:.6} ({:.3}%), extra {:.3e}\n",
+                c.wanted_area,
+                c.shadow_area,
+                c.missing_area,
+                100.0 * c.missing_area / c.wanted_area,
+                c.extra_area
+            );
+            if let Some(g) = &self.grown {
+                let (w, before) = (&g.growth[i], g.missing_before[i]);
+                text += &format!(
+                    "  grown by {} pixels, {:.2} px on average and {:.2} at most; missing \
+                     before {before:.6}\n",
+                    w.pixels, w.mean_displacement, w.max_displacement
+                );
+            }
+        }
+        match &self.grown {
+            Some(g) => text += &format!("{} rounds of growing\n", g.rounds),
+            None if !self.conflicts(0.005).is_empty() => {
+                text += "the views conflict: growing the images (optimizing) makes them agree\n"
+            }
+            None => {}
+        }
+        text
+    }
+
+    /// Writes each view's picture ([`ViewCheck::picture`]) as
+    /// `view{i}.png` into `dir` (made if need be).
+    pub fn write_pictures(&self, dir: &std::path::Path) -> std::io::Result<()> {
+        std::fs::create_dir_all(dir)?;
+        for (i, (v, c)) in self.spec.views.iter().zip(&self.checks).enumerate() {
+            std::fs::write(dir.join(format!("view{i}.png")), c.picture(v).encode_png())?;
+        }
+        Ok(())
+    }
 }
 
 /// Per pixel, the distance (in pixels, by the 3-4 chamfer metric, /3) to
@@ -215,7 +288,7 @@ fn grow_round(
 /// Grows `spec`'s images until every view's hull shadow misses at most
 /// `target` of its wanted area (e.g. 0.005), in at most `rounds` rounds
 /// (see the module docs). The hull is exact in every round.
-pub fn optimize(spec: &ArtSpec, target: f64, rounds: usize) -> Result<Optimized, ArtError> {
+pub fn optimize(spec: &ArtSpec, target: f64, rounds: usize) -> Result<ArtRun, ArtError> {
     let mut spec = spec.clone();
     let original: Vec<Vec<f64>> = spec.views.iter().map(|v| distances(&v.mask)).collect();
     let mut growth = vec![Growth::default(); spec.views.len()];
@@ -234,13 +307,15 @@ pub fn optimize(spec: &ArtSpec, target: f64, rounds: usize) -> Result<Optimized,
         checks = hull.check(&spec)?;
         done += 1;
     }
-    Ok(Optimized {
+    Ok(ArtRun {
         spec,
         hull,
         checks,
-        growth,
-        rounds: done,
-        missing_before,
+        grown: Some(Grown {
+            growth,
+            missing_before,
+            rounds: done,
+        }),
     })
 }
 

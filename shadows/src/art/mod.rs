@@ -31,7 +31,7 @@ use bsp_csg::files::{FileBoolean, FileError, Operand};
 use glam::DVec3;
 
 pub use check::{ViewCheck, shadow_coverage};
-pub use grow::{Growth, Optimized, optimize};
+pub use grow::{ArtRun, Grown, Growth, optimize, run};
 pub use region::Mask;
 pub use spec::read_mask;
 
@@ -207,13 +207,29 @@ pub fn shadow_hull(spec: &ArtSpec) -> Result<ShadowHull, ArtError> {
 }
 
 impl ShadowHull {
+    /// The hull as a file holds it (rounded to `f64`, or for `stl` to
+    /// `f32`, welded where rounding would pinch it; see
+    /// [`FileBoolean::rounded`]).
+    pub fn mesh(&self, stl: bool) -> shadow_scene::Mesh {
+        match self.hull.rounded(stl) {
+            Some(r) => r.mesh,
+            None => self.hull.mesh().to_mesh(),
+        }
+    }
+}
+
+impl ArtRun {
     /// The report as JSON: per view (in the spec's order) its areas
     /// ([`ViewCheck`]) and, after [`optimize`], how its image grew
-    /// ([`Growth`]) and what it missed before (`grown`: per view); the
-    /// hull's exact volume
+    /// ([`Growth`]) and what it missed before; the hull's exact volume
     /// and its triangles.
-    pub fn report_json(&self, checks: &[ViewCheck], grown: Option<(&[Growth], &[f64])>) -> String {
-        let views: Vec<serde_json::Value> = checks
+    pub fn report_json(&self) -> String {
+        let grown = self
+            .grown
+            .as_ref()
+            .map(|g| (&g.growth[..], &g.missing_before[..]));
+        let views: Vec<serde_json::Value> = self
+            .checks
             .iter()
             .enumerate()
             .map(|(i, c)| {
@@ -236,20 +252,10 @@ impl ShadowHull {
         let report = serde_json::json!({
             "views": views,
             "hull": {
-                "volume": self.hull.volume(),
-                "triangles": self.hull.exact.triangles.len(),
+                "volume": self.hull.hull.volume(),
+                "triangles": self.hull.hull.exact.triangles.len(),
             },
         });
         format!("{report:#}\n")
-    }
-
-    /// The hull as a file holds it (rounded to `f64`, or for `stl` to
-    /// `f32`, welded where rounding would pinch it; see
-    /// [`FileBoolean::rounded`]).
-    pub fn mesh(&self, stl: bool) -> shadow_scene::Mesh {
-        match self.hull.rounded(stl) {
-            Some(r) => r.mesh,
-            None => self.hull.mesh().to_mesh(),
-        }
     }
 }
