@@ -156,6 +156,202 @@ pub fn sun_position(site: &SunSite, time: &DateTime<FixedOffset>) -> Result<SunP
     })
 }
 
+/// The suns of a study: on each of `dates`, the midpoints of the day's
+/// `step_minutes`-long intervals from 00:00 to 24:00 at `utc_offset_hours`,
+/// those with the sun's centre above the horizon. The midpoint rule: a
+/// face's sun-hours are `step · Σ lit share` over these suns; the error
+/// against the day's true integral is at most `step² / 24 · |f''|` per
+/// interval for a lit share `f` smooth in time, and where a shadow edge
+/// crosses a point within an interval, at most half a step for that point
+/// (the sample is the interval's middle).
+pub fn study_suns(
+    site: &SunSite,
+    dates: &[chrono::NaiveDate],
+    step_minutes: f64,
+    utc_offset_hours: f64,
+) -> Result<Vec<SunPosition>, SunError> {
+    if !(step_minutes > 0.0 && step_minutes <= 1440.0) {
+        return Err(SunError(format!(
+            "a step of {step_minutes} minutes: from above 0 to 1440"
+        )));
+    }
+    let offset = FixedOffset::east_opt((utc_offset_hours * 3600.0).round() as i32)
+        .ok_or_else(|| SunError(format!("a UTC offset of {utc_offset_hours} hours")))?;
+    let steps = (1440.0 / step_minutes).floor() as i64;
+    let mut out = Vec::new();
+    for date in dates {
+        let midnight = date.and_hms_opt(0, 0, 0).expect("midnight exists");
+        let start = midnight
+            .and_local_timezone(offset)
+            .single()
+            .expect("a fixed offset has one local time");
+        for k in 0..steps {
+            let ms = ((k as f64 + 0.5) * step_minutes * 60_000.0).round() as i64;
+            let t = start + chrono::Duration::milliseconds(ms);
+            let p = sun_position(site, &t)?;
+            if p.is_up() {
+                out.push(p);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// A face's sun-hours over a study.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FaceHours {
+    /// The face's area.
+    pub area: f64,
+    /// `∫ lit area dt / area`: the mean of its points' hours.
+    pub sun_hours: f64,
+    /// The fewest hours a point of it gets.
+    pub min_hours: f64,
+    /// The most hours a point of it gets.
+    pub max_hours: f64,
+}
+
+/// A convex region of a face (in a frame of its plane) with the number
+/// of suns its points see.
+type Cell = (Vec<glam::DVec2>, u32);
+
+/// The sun-hours of every face of `mesh` (in face order) under `suns`
+/// (directions toward them), each sun standing for `step_hours`: the
+/// exact lit part of every face for every sun ([`crate::shadows`], at
+/// most [`svbsp::MAX_LIGHTS`] suns a run), its area summed over the suns
+/// (`sun_hours`), and the fewest and most hours over the face's points,
+/// from the runs' lit pieces overlaid (their hours added; the overlay is
+/// `f64`, and a cell below 10⁻¹² of the face's area, a rounding sliver
+/// where two runs' boundaries coincide, is left out).
+pub fn sun_hours(
+    mesh: &crate::Mesh,
+    suns: &[DVec3],
+    step_hours: f64,
+) -> Result<Vec<FaceHours>, crate::Error> {
+    let faces = mesh.faces.len();
+    let mut area = vec![0.0; faces];
+    let mut lit = vec![0.0; faces];
+    let mut cells: Vec<Option<Vec<Cell>>> = vec![None; faces];
+    let frames: Vec<(DVec3, DVec3, DVec3)> = (0..faces).map(|f| face_frame(mesh, f)).collect();
+    for batch in suns.chunks(svbsp::MAX_LIGHTS) {
+        let lights: Vec<crate::Light> = batch.iter().map(|&d| crate::Light::Sun(d)).collect();
+        let run = crate::shadows(mesh, &lights)?;
+        let mut pieces: Vec<Vec<Cell>> = vec![Vec::new(); faces];
+        for f in 0..faces {
+            area[f] = run.face_area(f);
+            lit[f] += (0..batch.len()).map(|l| run.lit_area(f, l)).sum::<f64>() * step_hours;
+        }
+        for frag in run.batch.fragments() {
+            let f = frag.face() as usize;
+            let seen = frag.lit_mask().count_ones();
+            let (o, u, v) = frames[f];
+            for piece in frag.pieces() {
+                let ring = piece
+                    .iter()
+                    .map(|&i| {
+                        let p = run.world[i as usize] - o;
+                        glam::DVec2::new(p.dot(u), p.dot(v))
+                    })
+                    .collect();
+                pieces[f].push((ring, seen));
+            }
+        }
+        for (f, new) in pieces.into_iter().enumerate() {
+            cells[f] = Some(match cells[f].take() {
+                None => new,
+                Some(old) => overlay(&old, &new, 1e-12 * area[f]),
+            });
+        }
+    }
+    Ok((0..faces)
+        .map(|f| {
+            let seen = cells[f].iter().flatten().map(|c| c.1);
+            let (min, max) = seen.fold((u32::MAX, 0), |(a, b), h| (a.min(h), b.max(h)));
+            let (min, max) = (f64::from(min) * step_hours, f64::from(max) * step_hours);
+            let none = suns.is_empty() || area[f] == 0.0;
+            FaceHours {
+                area: area[f],
+                sun_hours: if area[f] > 0.0 { lit[f] / area[f] } else { 0.0 },
+                min_hours: if none { 0.0 } else { min },
+                max_hours: if none { 0.0 } else { max },
+            }
+        })
+        .collect())
+}
+
+/// An origin and two unit axes of face `f`'s plane (Newell's normal).
+fn face_frame(mesh: &crate::Mesh, f: usize) -> (DVec3, DVec3, DVec3) {
+    let p: Vec<DVec3> = mesh.faces[f]
+        .vertices
+        .iter()
+        .map(|&i| mesh.positions[i as usize])
+        .collect();
+    let n = (0..p.len())
+        .map(|i| p[i].cross(p[(i + 1) % p.len()]))
+        .sum::<DVec3>()
+        .normalize_or_zero();
+    let u = n.any_orthonormal_vector();
+    (p.first().copied().unwrap_or(DVec3::ZERO), u, n.cross(u))
+}
+
+/// Every cell of `a` met with every cell of `b` (convex, by clipping),
+/// their suns added, keeping the meets of area above `least`.
+fn overlay(a: &[Cell], b: &[Cell], least: f64) -> Vec<Cell> {
+    let boxed = |c: &Cell| {
+        c.0.iter().fold(
+            (glam::DVec2::INFINITY, glam::DVec2::NEG_INFINITY),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        )
+    };
+    let bb: Vec<_> = b.iter().map(boxed).collect();
+    let mut out = Vec::new();
+    for ca in a {
+        let (lo, hi) = boxed(ca);
+        for (cb, &(blo, bhi)) in b.iter().zip(&bb) {
+            if hi.x < blo.x || bhi.x < lo.x || hi.y < blo.y || bhi.y < lo.y {
+                continue;
+            }
+            let meet = clip_convex(&ca.0, &cb.0);
+            if area2(&meet).abs() / 2.0 > least {
+                out.push((meet, ca.1 + cb.1));
+            }
+        }
+    }
+    out
+}
+
+/// Twice the signed area of a polygon.
+fn area2(p: &[glam::DVec2]) -> f64 {
+    (0..p.len())
+        .map(|i| p[i].perp_dot(p[(i + 1) % p.len()]))
+        .sum()
+}
+
+/// Convex polygon `a` clipped by convex polygon `b` (Sutherland–Hodgman
+/// over `b`'s edges, either turning).
+fn clip_convex(a: &[glam::DVec2], b: &[glam::DVec2]) -> Vec<glam::DVec2> {
+    let turn = area2(b).signum();
+    let mut out = a.to_vec();
+    for i in 0..b.len() {
+        if out.is_empty() {
+            break;
+        }
+        let (e0, e1) = (b[i], b[(i + 1) % b.len()]);
+        let side = |p: glam::DVec2| turn * (e1 - e0).perp_dot(p - e0);
+        let input = std::mem::take(&mut out);
+        for (k, &p) in input.iter().enumerate() {
+            let q = input[(k + 1) % input.len()];
+            let (sp, sq) = (side(p), side(q));
+            if sp >= 0.0 {
+                out.push(p);
+            }
+            if (sp >= 0.0) != (sq >= 0.0) {
+                out.push(p + (q - p) * (sp / (sp - sq)));
+            }
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -211,5 +407,117 @@ mod tests {
                 .to_string()
                 .contains("atitude")
         );
+    }
+
+    /// A ground with a box on it (the box's faces after the ground's).
+    fn yard() -> crate::Mesh {
+        let (b, h) = (1.0, 2.0);
+        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        let positions = vec![
+            p(-10.0, -10.0, 0.0),
+            p(10.0, -10.0, 0.0),
+            p(10.0, 10.0, 0.0),
+            p(-10.0, 10.0, 0.0),
+            p(-b, -b, 0.0),
+            p(b, -b, 0.0),
+            p(b, b, 0.0),
+            p(-b, b, 0.0),
+            p(-b, -b, h),
+            p(b, -b, h),
+            p(b, b, h),
+            p(-b, b, h),
+        ];
+        let faces = [
+            vec![0, 1, 2, 3],
+            vec![8, 9, 10, 11],
+            vec![4, 5, 9, 8],
+            vec![5, 6, 10, 9],
+            vec![6, 7, 11, 10],
+            vec![7, 4, 8, 11],
+        ];
+        crate::Mesh {
+            positions,
+            faces: faces
+                .into_iter()
+                .map(|vertices| crate::Face {
+                    vertices,
+                    line: 0,
+                    group: 0,
+                })
+                .collect(),
+            groups: vec!["default".into()],
+        }
+    }
+
+    /// Whether the ray from `p` toward `d` meets the box `[-1, 1]² × [0, 2]`
+    /// (slab test; `p` on the ground outside the box).
+    fn blocked(p: DVec3, d: DVec3) -> bool {
+        let (lo, hi) = (DVec3::new(-1.0, -1.0, 0.0), DVec3::new(1.0, 1.0, 2.0));
+        let (mut t0, mut t1) = (1e-9f64, f64::INFINITY);
+        for k in 0..3 {
+            if d[k] == 0.0 {
+                if p[k] < lo[k] || p[k] > hi[k] {
+                    return false;
+                }
+                continue;
+            }
+            let (a, b) = ((lo[k] - p[k]) / d[k], (hi[k] - p[k]) / d[k]);
+            t0 = t0.max(a.min(b));
+            t1 = t1.min(a.max(b));
+        }
+        t0 < t1
+    }
+
+    #[test]
+    fn a_day_of_suns_and_the_hours_of_a_yard() {
+        let site = SunSite::new(51.48, 0.0);
+        let day = [chrono::NaiveDate::from_ymd_opt(2026, 3, 21).unwrap()];
+        let hourly = study_suns(&site, &day, 60.0, 0.0).unwrap();
+        assert!((11..=13).contains(&hourly.len()), "{}", hourly.len());
+        assert!(study_suns(&site, &day, 0.0, 0.0).is_err());
+        // every 8 minutes: more suns than one run takes
+        let suns: Vec<DVec3> = study_suns(&site, &day, 8.0, 0.0)
+            .unwrap()
+            .iter()
+            .map(|s| s.direction)
+            .collect();
+        assert!(suns.len() > svbsp::MAX_LIGHTS, "{}", suns.len());
+        let step = 8.0 / 60.0;
+        let full = suns.len() as f64 * step;
+        let mesh = yard();
+        let hours = sun_hours(&mesh, &suns, step).unwrap();
+        // the roof sees every sun
+        let roof = &hours[1];
+        assert!(
+            (roof.sun_hours - full).abs() < 1e-9 && roof.min_hours == full,
+            "{roof:?}"
+        );
+        assert_eq!(roof.max_hours, full);
+        // the ground: its far corners see every sun, points by the box fewer
+        let g = &hours[0];
+        assert_eq!(g.max_hours, full);
+        assert!(g.min_hours < g.sun_hours && g.sun_hours < full, "{g:?}");
+        // every point's own count lies between the least and the most
+        for (x, y) in [
+            (0.0, -1.5),
+            (1.5, 1.5),
+            (-3.0, 2.0),
+            (0.2, 2.5),
+            (-1.2, -1.2),
+        ] {
+            let p = DVec3::new(x, y, 0.0);
+            let own = suns.iter().filter(|&&d| !blocked(p, d)).count() as f64 * step;
+            assert!(
+                g.min_hours - 1e-9 <= own && own <= g.max_hours + 1e-9,
+                "{own} at {p}"
+            );
+        }
+        // the suns in another order make other runs: the same hours
+        let back: Vec<DVec3> = suns.iter().rev().copied().collect();
+        for (a, b) in hours.iter().zip(sun_hours(&mesh, &back, step).unwrap()) {
+            assert!((a.sun_hours - b.sun_hours).abs() < 1e-9, "{a:?} {b:?}");
+            assert!((a.min_hours - b.min_hours).abs() < 1e-9, "{a:?} {b:?}");
+            assert!((a.max_hours - b.max_hours).abs() < 1e-9, "{a:?} {b:?}");
+        }
     }
 }
