@@ -12,14 +12,11 @@
 //! units. Areas and the SVG's projection and shading are plain `f64` on
 //! those vertices.
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use bsp_shadows::shadow_file::{
-    self, FileKind, LitScene, OutputFormat as Format, ShadowFile, write_shadows,
-};
+use bsp_shadows::shadow_file::{self, FileKind, LitScene, OutputFormat as Format, write_shadows};
 use bsp_shadows::soft_file::{SoftScene, draw_soft_shadows, write_soft_shadows};
 use clap::{Args, ValueEnum};
 use shadow_raster::svg::SvgViewpoint;
@@ -70,9 +67,6 @@ pub(crate) struct ShadowsArgs {
     #[arg(long, short)]
     pub(crate) quiet: bool,
 }
-
-/// How many faces `--stats` lists.
-const TOP_FACES: usize = 10;
 
 /// The output format, by the file's extension.
 fn format_of(path: &Path) -> Result<Format> {
@@ -215,7 +209,16 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
         );
     }
     if args.stats {
-        report += &stats_text(&scene, &fig, &phases, total);
+        let lights: Vec<(String, f64)> = scene
+            .lights
+            .iter()
+            .map(|l| (describe(l), l.angle))
+            .collect();
+        let import = scene.report.counts();
+        let group = |f| scene.mesh.group_name(f).to_string();
+        let faces = scene.mesh.faces.len();
+        let import = (faces, import.as_str(), &scene.grid);
+        report += &fig.stats_text(import, &lights, (&phases.0, total), group);
     }
     emit(&report)
 }
@@ -256,55 +259,6 @@ fn soft_shadows(
         report += &fig.stats_text(job.faces);
     }
     emit(&report)
-}
-
-/// The `--stats` report.
-fn stats_text(scene: &Scene, fig: &ShadowFile, phases: &Phases, total: Duration) -> String {
-    let faces = scene.mesh.faces.len();
-    let lights = &scene.lights;
-    let mut s = String::new();
-    let _ = writeln!(s, "faces:           {faces}; {}", scene.report.counts());
-    let _ = writeln!(s, "grid step:       {}", scene.grid.step_text());
-    if let Some(n) = fig.bsp_polygons {
-        let _ = writeln!(s, "bsp:             {n} polygons");
-    }
-    let _ = writeln!(
-        s,
-        "fragments:       {} ({:.3} per face; {} receivers, {} shadow-tree nodes over {} light{})",
-        fig.fragments,
-        fig.fragments as f64 / faces.max(1) as f64,
-        fig.receivers,
-        fig.shadow_nodes,
-        lights.len(),
-        if lights.len() == 1 { "" } else { "s" }
-    );
-    for (i, l) in lights.iter().enumerate() {
-        let _ = writeln!(s, "light {i}:         {}", describe(l));
-        if l.angle > 0.0 {
-            let _ = writeln!(
-                s,
-                "                 exact for the integer direction, {:.3e} degrees from the \
-                 given one",
-                l.angle.to_degrees()
-            );
-        }
-    }
-    let times: Vec<String> = phases
-        .0
-        .iter()
-        .map(|(n, d)| format!("{n} {:.2} ms", d.as_secs_f64() * 1e3))
-        .collect();
-    let _ = writeln!(
-        s,
-        "time:            {}; total {:.2} ms ({} threads)",
-        times.join(", "),
-        total.as_secs_f64() * 1e3,
-        rayon::current_num_threads()
-    );
-    s += &fig
-        .areas
-        .report(TOP_FACES, |f| scene.mesh.group_name(f).to_string());
-    s
 }
 
 #[cfg(test)]

@@ -114,6 +114,67 @@ pub struct ShadowFile {
     pub phases: Vec<(&'static str, Duration)>,
 }
 
+/// How many faces [`ShadowFile::stats_text`] lists.
+const TOP_FACES: usize = 10;
+
+impl ShadowFile {
+    /// The `--stats` report for people: the faces, what importing them
+    /// did (`import`: its counts) and the grid, the fragments, each
+    /// light (`lights`: its description, and how far its integer
+    /// direction is from the given one, radians), the phases' times and
+    /// the total, the threads, and the faces with the most shadow (named
+    /// by `group`).
+    pub fn stats_text(
+        &self,
+        (faces, import, grid): (usize, &str, &bsp_core::Grid),
+        lights: &[(String, f64)],
+        (phases, total): (&[(&'static str, Duration)], Duration),
+        group: impl Fn(usize) -> String,
+    ) -> String {
+        use std::fmt::Write as _;
+        let mut s = String::new();
+        let _ = writeln!(s, "faces:           {faces}; {import}");
+        let _ = writeln!(s, "grid step:       {}", grid.step_text());
+        if let Some(n) = self.bsp_polygons {
+            let _ = writeln!(s, "bsp:             {n} polygons");
+        }
+        let _ = writeln!(
+            s,
+            "fragments:       {} ({:.3} per face; {} receivers, {} shadow-tree nodes over {} light{})",
+            self.fragments,
+            self.fragments as f64 / faces.max(1) as f64,
+            self.receivers,
+            self.shadow_nodes,
+            lights.len(),
+            if lights.len() == 1 { "" } else { "s" }
+        );
+        for (i, (what, angle)) in lights.iter().enumerate() {
+            let _ = writeln!(s, "light {i}:         {what}");
+            if *angle > 0.0 {
+                let _ = writeln!(
+                    s,
+                    "                 exact for the integer direction, {:.3e} degrees from the \
+                     given one",
+                    angle.to_degrees()
+                );
+            }
+        }
+        let times: Vec<String> = phases
+            .iter()
+            .map(|(n, d)| format!("{n} {:.2} ms", d.as_secs_f64() * 1e3))
+            .collect();
+        let _ = writeln!(
+            s,
+            "time:            {}; total {:.2} ms ({} threads)",
+            times.join(", "),
+            total.as_secs_f64() * 1e3,
+            rayon::current_num_threads()
+        );
+        s += &self.areas.report(TOP_FACES, group);
+        s
+    }
+}
+
 /// Shades every face of `scene` by `algorithm` and writes `kind` to `out`.
 pub fn write_shadows(
     scene: &LitScene,
