@@ -66,6 +66,8 @@ printf '%s\n' '{"views": [' \
   '], "bounds": [[0, 0, 0], [4, 4, 3]]}' > art.json
 run art art.json -o art.obj --report art_report.json --images art_views
 run art art.json -o art_grown.obj --optimize --report art_grown.json
+run sunhours --scene room --lat 51.5 --lon -0.12 --date 2026-03-21 --to 2026-03-23 --every 2 \
+  --step 30 -o hours.csv
 rm sq.pgm bar.pgm art.json
 run animate --scene room --frames 3 --format png --width 320 --height 180 -o anim_png \
   --report anim.csv

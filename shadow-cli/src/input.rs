@@ -43,12 +43,7 @@ pub(crate) fn load_source_quiet(
         return Ok((load_mesh(path, quiet)?, path.display().to_string()));
     }
     let name = src.scene.as_deref().unwrap_or_default();
-    let mesh = shadow_scene::scene(name).with_context(|| {
-        format!(
-            "unknown scene `{name}` (available: {})",
-            shadow_scene::SCENE_NAMES.join(", ")
-        )
-    })?;
+    let mesh = shadow_scene::scene_named(name).map_err(anyhow::Error::msg)?;
     Ok((mesh, format!("scene {name}")))
 }
 

@@ -102,6 +102,12 @@ enum Command {
         after_help = "Examples:\n  shadow sun --lat 51.5 --lon -0.12 --time 2026-03-21T12:00:00Z --json"
     )]
     Sun(sun::SunArgs),
+    /// Every face's exact sun-hours over a day or days: the mean of its
+    /// points', the fewest and the most.
+    #[command(
+        after_help = "Examples:\n  shadow sunhours --scene room --lat 51.5 --lon -0.12 --date 2026-03-21 -o hours.csv"
+    )]
+    Sunhours(Box<sun::SunHoursArgs>),
     /// Print a shell completion script (bash, zsh, fish, elvish or
     /// powershell).
     #[command(
@@ -162,6 +168,7 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Lines(a) => raster::run_lines(a),
         Command::Art(a) => art::run(a),
         Command::Sun(a) => sun::run(a),
+        Command::Sunhours(a) => sun::run_hours(a),
         Command::Completions { shell } => {
             let mut out = Vec::new();
             clap_complete::generate(*shell, &mut Cli::command(), "shadow", &mut out);

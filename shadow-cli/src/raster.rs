@@ -65,29 +65,17 @@ pub(crate) struct MethodArgs {
 impl MethodArgs {
     /// The flags given that `method` does not use, as a note.
     fn unused_by(&self, method: Method) -> Option<String> {
-        let d = ShadowOptions::default();
-        let mut unused = Vec::new();
-        let map = matches!(method, Method::ShadowMap | Method::Pcss);
-        if !map && method != Method::Texture && self.map_size != d.map_size {
-            unused.push("--map-size (shadow maps and textures)");
-        }
-        if !map && self.bias.is_some() {
-            unused.push("--bias (shadow maps)");
-        }
-        if method != Method::ShadowMap && self.pcf != d.pcf {
-            unused.push("--pcf (shadow maps without pcss)");
-        }
-        let planar = self.no_clip || self.receivers as usize != d.planar_receivers;
-        if method != Method::Planar && planar {
-            unused.push("--no-clip and --receivers (planar shadows)");
-        }
-        (!unused.is_empty()).then(|| {
-            format!(
-                "note: --method {} does not use {}",
-                method,
-                unused.join(", ")
-            )
-        })
+        let opts = self.options().ok()?;
+        let flags: Vec<&str> = (opts.unused_by(method).into_iter())
+            .map(|o| match o {
+                "map_size" => "--map-size (shadow maps and textures)",
+                "bias" => "--bias (shadow maps)",
+                "pcf" => "--pcf (shadow maps without pcss)",
+                _ => "--no-clip and --receivers (planar shadows)",
+            })
+            .collect();
+        (!flags.is_empty())
+            .then(|| format!("note: --method {method} does not use {}", flags.join(", ")))
     }
 
     fn options(&self) -> Result<ShadowOptions> {

@@ -1,23 +1,27 @@
-//! `shadow sun`: where the sun is, in the scene's axes (the work is
+//! `shadow sun` and `shadow sunhours`: where the sun is, in the scene's
+//! axes, and every face's sun-hours over days (the work is
 //! `bsp_shadows::sun`'s).
 
-use anyhow::Result;
-use bsp_shadows::sun::{SunSite, Up, parse_time, sun_position};
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use bsp_shadows::sun::{self as sun, SunSite, Up};
 use clap::Args;
 
-use crate::output::emit;
+use crate::args::SourceArgs;
+use crate::facade_error;
+use crate::input::load_source_quiet;
+use crate::output::{emit, write_file};
 
+/// Where the study is, and how the scene sits there.
 #[derive(Args, Debug)]
-pub(crate) struct SunArgs {
+pub(crate) struct SiteArgs {
     /// Latitude, degrees north.
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     lat: f64,
     /// Longitude, degrees east.
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     lon: f64,
-    /// The time with its offset, such as 2026-03-21T12:00:00+01:00.
-    #[arg(long, value_name = "TIME")]
-    time: String,
     /// True north, degrees clockwise from the scene's north (+y; -z with --up y).
     #[arg(
         long,
@@ -27,8 +31,23 @@ pub(crate) struct SunArgs {
     )]
     north: f64,
     /// The scene's up axis: z (+y north) or y (-z north) [default: z].
-    #[arg(long, value_name = "AXIS", value_parser = ["z", "y"])]
-    up: Option<String>,
+    #[arg(long, value_name = "AXIS")]
+    up: Option<Up>,
+}
+
+impl SiteArgs {
+    fn site(&self) -> SunSite {
+        SunSite::new(self.lat, self.lon).with_axes(self.north, self.up.unwrap_or_default())
+    }
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct SunArgs {
+    #[command(flatten)]
+    site: SiteArgs,
+    /// The time with its offset, such as 2026-03-21T12:00:00+01:00.
+    #[arg(long, value_name = "TIME")]
+    time: String,
     /// Print one JSON object (azimuth, elevation, direction).
     #[arg(long)]
     json: bool,
@@ -39,16 +58,56 @@ pub(crate) struct SunArgs {
 
 /// `shadow sun`.
 pub(crate) fn run(a: &SunArgs) -> Result<()> {
-    let up = if a.up.as_deref() == Some("y") {
-        Up::Y
-    } else {
-        Up::Z
-    };
-    let site = SunSite {
-        north_deg: a.north,
-        up,
-        ..SunSite::new(a.lat, a.lon)
-    };
-    let p = sun_position(&site, &parse_time(&a.time)?)?;
+    let p = sun::sun_position(&a.site.site(), &sun::parse_time(&a.time)?)?;
     emit(&((if a.json { p.json() } else { p.text() }) + "\n"))
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct SunHoursArgs {
+    #[command(flatten)]
+    source: SourceArgs,
+    #[command(flatten)]
+    site: SiteArgs,
+    /// The (first) day, YYYY-MM-DD.
+    #[arg(long, value_name = "DATE")]
+    date: String,
+    /// The last day [default: --date].
+    #[arg(long, value_name = "DATE")]
+    to: Option<String>,
+    /// Days from one studied day to the next.
+    #[arg(long, value_name = "DAYS", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    every: u32,
+    /// Minutes between suns, each at its interval's midpoint [default: 10].
+    #[arg(long, value_name = "MIN")]
+    step: Option<f64>,
+    /// The days' clock, hours east of UTC [default: 0].
+    #[arg(long, value_name = "H", allow_hyphen_values = true)]
+    utc_offset: Option<f64>,
+    /// Output: CSV (one row per face) or JSON.
+    #[arg(short, long, value_name = "OUT.csv|OUT.json")]
+    output: PathBuf,
+    /// No notes on stderr (errors still go there).
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+/// `shadow sunhours`.
+pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
+    let Some(format) = sun::HoursFormat::of(&a.output) else {
+        bail!("{}: -o must name a .csv or .json file", a.output.display());
+    };
+    let (mesh, name) = load_source_quiet(&a.source, a.quiet)?;
+    let dates = sun::study_dates(&a.date, a.to.as_deref(), a.every)?;
+    let step = a.step.unwrap_or(10.0);
+    let suns = sun::study_suns(&a.site.site(), &dates, step, a.utc_offset.unwrap_or(0.0))?;
+    let dirs: Vec<_> = suns.iter().map(|s| s.direction).collect();
+    let hours = sun::sun_hours(&mesh, &dirs, step / 60.0).map_err(facade_error)?;
+    let text = format.text(&mesh, &hours, dirs.len());
+    write_file(&a.output, text.as_bytes())?;
+    let (n, out) = (dates.len(), a.output.display());
+    emit(&format!(
+        "wrote {out}: sun-hours of {} faces of {name} over {n} days, {} suns\n",
+        hours.len(),
+        dirs.len()
+    ))
 }

@@ -1000,3 +1000,70 @@ fn sun_prints_where_the_sun_is() {
     ]);
     crate::assert_failed_with(&o, &["2026-03-21 12:00", "offset"]);
 }
+
+#[test]
+fn sunhours_writes_every_faces_hours() {
+    let (csv, json) = (scratch("hours.csv"), scratch("hours.json"));
+    let args = |out: &Path| {
+        shadow(&[
+            "sunhours",
+            "--scene",
+            "cube",
+            "--lat",
+            "51.48",
+            "--lon",
+            "0",
+            "--date",
+            "2026-03-21",
+            "--step",
+            "60",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    let o = args(&csv);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("over 1 days"), "{}", stdout(&o));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(
+        text.lines().next(),
+        Some("face,group,area,sun_hours,min_hours,max_hours")
+    );
+    assert_eq!(rows.len(), 6);
+    // the cube's top sees every sun above the horizon (about 12 hours)
+    let top = rows
+        .iter()
+        .map(|r| r[3].parse::<f64>().unwrap())
+        .fold(0.0, f64::max);
+    assert!((11.0..=13.0).contains(&top), "{text}");
+    for r in &rows {
+        let h: Vec<f64> = r[3..].iter().map(|v| v.parse().unwrap()).collect();
+        assert!(h[1] <= h[0] + 1e-9 && h[0] <= h[2] + 1e-9, "{r:?}");
+    }
+    let o = args(&json);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["faces"].as_array().unwrap().len(), 6);
+    // bad names and dates are clear errors
+    let o = args(&scratch("hours.txt"));
+    crate::assert_failed_with(&o, &["hours.txt", ".csv or .json"]);
+    let o = shadow(&[
+        "sunhours",
+        "--scene",
+        "cube",
+        "--lat",
+        "51",
+        "--lon",
+        "0",
+        "--date",
+        "2026-02-30",
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    crate::assert_failed_with(&o, &["2026-02-30", "not a date"]);
+}

@@ -190,6 +190,39 @@ impl ShadowOptions {
         }
     }
 
+    /// The options set away from their defaults that `method` does not
+    /// use, by name: `map_size` (shadow maps, PCSS and textures), `bias`
+    /// (shadow maps and PCSS), `pcf` (shadow maps) and `planar` (the
+    /// planar method's clipping and receivers).
+    ///
+    /// ```
+    /// use shadow_raster::{Method, ShadowOptions};
+    /// let o = ShadowOptions::default().with_pcf(3).with_map_size(512);
+    /// assert_eq!(o.unused_by(Method::Exact), ["map_size", "pcf"]);
+    /// assert!(o.unused_by(Method::ShadowMap).is_empty());
+    /// assert_eq!(o.unused_by(Method::Pcss), ["pcf"]);
+    /// ```
+    pub fn unused_by(&self, method: Method) -> Vec<&'static str> {
+        let d = ShadowOptions::default();
+        let map = matches!(method, Method::ShadowMap | Method::Pcss);
+        let mut out = Vec::new();
+        if !map && method != Method::Texture && self.map_size != d.map_size {
+            out.push("map_size");
+        }
+        if !map && (self.bias_constant, self.bias_slope) != (d.bias_constant, d.bias_slope) {
+            out.push("bias");
+        }
+        if method != Method::ShadowMap && self.pcf != d.pcf {
+            out.push("pcf");
+        }
+        let planar =
+            (self.planar_clip, self.planar_receivers) != (d.planar_clip, d.planar_receivers);
+        if method != Method::Planar && planar {
+            out.push("planar");
+        }
+        out
+    }
+
     /// Sets [`ShadowOptions::map_size`].
     pub fn with_map_size(mut self, n: u32) -> Self {
         self.map_size = n;

@@ -23,6 +23,16 @@ pub const SCENE_NAMES: &[&str] = &[
     "bunny-893k",
 ];
 
+/// The built-in scene `name`, or an error naming the scenes there are.
+pub fn scene_named(name: &str) -> Result<Mesh, String> {
+    scene(name).ok_or_else(|| {
+        format!(
+            "unknown scene `{name}` (available: {})",
+            SCENE_NAMES.join(", ")
+        )
+    })
+}
+
 /// A built-in scene by name (see [`SCENE_NAMES`]): `"room"` is [`room`],
 /// `"chair"` one swivel chair of the room standing at the origin, `"cube"`
 /// the unit cube `[0, 1]³`, `"bunny"` the Stanford bunny (3 674 faces) on

@@ -22,6 +22,19 @@ pub enum Up {
     Y,
 }
 
+impl std::str::FromStr for Up {
+    type Err = String;
+
+    /// `z` or `y`.
+    fn from_str(s: &str) -> Result<Up, String> {
+        match s.trim() {
+            "z" => Ok(Up::Z),
+            "y" => Ok(Up::Y),
+            other => Err(format!("`{other}`: the up axis is z or y")),
+        }
+    }
+}
+
 /// A place on the earth and how the scene sits there.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SunSite {
@@ -55,6 +68,18 @@ impl SunSite {
             up: Up::Z,
             air: None,
             delta_t: None,
+        }
+    }
+}
+
+impl SunSite {
+    /// The site with the scene turned: true north `north_deg` clockwise
+    /// from its north axis, and `up` its up axis.
+    pub fn with_axes(self, north_deg: f64, up: Up) -> SunSite {
+        SunSite {
+            north_deg,
+            up,
+            ..self
         }
     }
 }
@@ -197,6 +222,31 @@ pub fn study_suns(
     Ok(out)
 }
 
+/// The days of a study: `from` to `to` (default: `from`), every `every`
+/// days, dates as `YYYY-MM-DD`.
+pub fn study_dates(
+    from: &str,
+    to: Option<&str>,
+    every: u32,
+) -> Result<Vec<chrono::NaiveDate>, SunError> {
+    let day = |s: &str| {
+        s.trim()
+            .parse::<chrono::NaiveDate>()
+            .map_err(|e| SunError(format!("`{s}` is not a date YYYY-MM-DD ({e})")))
+    };
+    let first = day(from)?;
+    let last = to.map_or(Ok(first), day)?;
+    if last < first || every == 0 {
+        return Err(SunError(format!(
+            "no days from {first} to {last} every {every} days"
+        )));
+    }
+    let days = (last - first).num_days() as u64;
+    Ok((0..=days / u64::from(every))
+        .map(|k| first + chrono::Duration::days((k * u64::from(every)) as i64))
+        .collect())
+}
+
 /// A face's sun-hours over a study.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FaceHours {
@@ -276,6 +326,63 @@ pub fn sun_hours(
             }
         })
         .collect())
+}
+
+/// A file of sun-hours.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HoursFormat {
+    /// [`hours_csv`].
+    Csv,
+    /// [`hours_json`].
+    Json,
+}
+
+impl HoursFormat {
+    /// The format a file name asks for (`.csv`, `.json`), if any.
+    pub fn of(path: &std::path::Path) -> Option<HoursFormat> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "json" => Some(HoursFormat::Json),
+            "csv" => Some(HoursFormat::Csv),
+            _ => None,
+        }
+    }
+
+    /// The hours of `mesh` in this format (`suns`: how many).
+    pub fn text(self, mesh: &crate::Mesh, hours: &[FaceHours], suns: usize) -> String {
+        match self {
+            HoursFormat::Json => hours_json(mesh, hours, suns),
+            HoursFormat::Csv => hours_csv(mesh, hours),
+        }
+    }
+}
+
+/// The hours as CSV: `face,group,area,sun_hours,min_hours,max_hours`.
+pub fn hours_csv(mesh: &crate::Mesh, hours: &[FaceHours]) -> String {
+    let mut s = String::from("face,group,area,sun_hours,min_hours,max_hours\n");
+    for (f, h) in hours.iter().enumerate() {
+        s += &format!(
+            "{f},{},{},{},{},{}\n",
+            mesh.group_name(f),
+            h.area,
+            h.sun_hours,
+            h.min_hours,
+            h.max_hours
+        );
+    }
+    s
+}
+
+/// The hours as JSON: `{"suns": n, "faces": [{"face", "group", "area",
+/// "sun_hours", "min_hours", "max_hours"}, …]}`.
+pub fn hours_json(mesh: &crate::Mesh, hours: &[FaceHours], suns: usize) -> String {
+    let faces: Vec<serde_json::Value> = (hours.iter().enumerate())
+        .map(|(f, h)| {
+            serde_json::json!({"face": f, "group": mesh.group_name(f), "area": h.area,
+                "sun_hours": h.sun_hours, "min_hours": h.min_hours, "max_hours": h.max_hours})
+        })
+        .collect();
+    format!("{:#}\n", serde_json::json!({"suns": suns, "faces": faces}))
 }
 
 /// An origin and two unit axes of face `f`'s plane (Newell's normal).
