@@ -9,7 +9,7 @@
 //! ```
 
 use bsp_shadows::DVec3;
-use bsp_shadows::art::{ArtLight, ArtView, Mask, ViewPlane, shadow_coverage};
+use bsp_shadows::art::{ArtLight, axis_silhouettes};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
@@ -20,71 +20,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = std::path::PathBuf::from(dir);
     std::fs::create_dir_all(&dir)?;
     let mesh = bsp_shadows::read_mesh(&mesh)?;
-    let (lo, hi) = mesh.bounds().ok_or("an empty mesh")?;
-    let side = (hi - lo).max_element() * 1.1;
-    let px = side / f64::from(n);
-    let c = (lo + hi) * 0.5 - DVec3::splat(side / 2.0);
-    let gap = 0.1 * side;
-    let walls = [
-        (
-            "x",
-            DVec3::X,
-            DVec3::new(lo.x - gap, c.y, c.z),
-            DVec3::Y,
-            DVec3::Z,
-        ),
-        (
-            "y",
-            DVec3::Y,
-            DVec3::new(c.x, lo.y - gap, c.z),
-            DVec3::Z,
-            DVec3::X,
-        ),
-        (
-            "z",
-            DVec3::Z,
-            DVec3::new(c.x, c.y, lo.z - gap),
-            DVec3::X,
-            DVec3::Y,
-        ),
-    ];
+    let views = axis_silhouettes(&mesh, n)?;
     let mut spec = String::from("{\"views\": [\n");
-    for (i, (name, sun, origin, u, v)) in walls.into_iter().enumerate() {
-        let plane = ViewPlane {
-            origin,
-            u: u * px,
-            v: v * px,
-        };
-        let blank = Mask {
-            width: n,
-            height: n,
-            wanted: vec![false; (n * n) as usize],
-        };
-        let view = ArtView {
-            image: dir.join(name),
-            light: ArtLight::Sun(sun),
-            plane,
-            mask: blank,
-        };
-        let cover = shadow_coverage(&mesh, &view)?;
+    let v3 = |v: DVec3| format!("[{}, {}, {}]", v.x, v.y, v.z);
+    for (i, view) in views.views.iter().enumerate() {
+        let name = view.image.display().to_string();
         let mut pgm = format!("P5\n{n} {n}\n255\n").into_bytes();
-        pgm.extend(cover.iter().map(|&c| if c >= 0.5 { 0u8 } else { 255 }));
-        std::fs::write(dir.join(format!("{name}.pgm")), pgm)?;
-        let v3 = |v: DVec3| format!("[{}, {}, {}]", v.x, v.y, v.z);
+        pgm.extend(view.mask.wanted.iter().map(|&w| if w { 0u8 } else { 255 }));
+        std::fs::write(dir.join(&name), pgm)?;
+        let (ArtLight::Sun(sun) | ArtLight::Point(sun)) = view.light;
+        let p = view.plane;
         spec += &format!(
-            "  {{\"image\": \"{name}.pgm\", \"light\": {{\"sun\": {}}},\n   \"plane\": {{\"origin\": {}, \"u\": {}, \"v\": {}}}}}{}\n",
+            "  {{\"image\": \"{name}\", \"light\": {{\"sun\": {}}},\n   \"plane\": {{\"origin\": {}, \"u\": {}, \"v\": {}}}}}{}\n",
             v3(sun),
-            v3(origin),
-            v3(plane.u),
-            v3(plane.v),
+            v3(p.origin),
+            v3(p.u),
+            v3(p.v),
             if i < 2 { "," } else { "" }
         );
     }
-    let (a, b) = (lo - DVec3::splat(gap / 2.0), hi + DVec3::splat(gap / 2.0));
-    spec += &format!(
-        " ],\n \"bounds\": [[{}, {}, {}], [{}, {}, {}]]}}\n",
-        a.x, a.y, a.z, b.x, b.y, b.z
-    );
+    let [a, b] = views.bounds;
+    spec += &format!(" ],\n \"bounds\": [{}, {}]}}\n", v3(a), v3(b));
     std::fs::write(dir.join("spec.json"), spec)?;
     println!(
         "wrote {}/spec.json and x.pgm, y.pgm, z.pgm ({n}x{n})",

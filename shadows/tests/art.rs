@@ -94,24 +94,30 @@ fn a_point_light_gives_a_pyramid_frustum() {
     assert!(c.missing_area < 1e-9 && c.extra_area < 1e-9, "{c:?}");
 }
 
-#[test]
-fn conflicting_views_miss_shadow_and_never_cast_extra() {
-    // the floor wants a ring, the wall wants a bar the ring's hole cannot
-    // give: the hull casts less than the floor wants
+/// The floor wants a ring, the wall (x = 0, sun along +x) a bar along its
+/// bottom row, wider than the ring.
+fn ring_and_bar() -> (Mask, ArtSpec) {
     let ring = mask(6, |c, r| {
-        (1..5).contains(&c) && (1..5).contains(&r) && !((2..4).contains(&c) && (2..4).contains(&r))
+        let hole = (2..4).contains(&c) && (2..4).contains(&r);
+        (1..5).contains(&c) && (1..5).contains(&r) && !hole
     });
+    let bar = mask(6, |_, r| r == 0);
     let wall = view(
         ArtLight::Sun(DVec3::X),
         DVec3::ZERO,
         DVec3::Y,
         DVec3::Z,
-        mask(6, |_, r| r == 0),
+        bar,
     );
-    let s = spec(
-        vec![floor(ArtLight::Sun(DVec3::Z), ring), wall],
-        DVec3::new(6.0, 6.0, 3.0),
-    );
+    let floor = floor(ArtLight::Sun(DVec3::Z), ring.clone());
+    (ring, spec(vec![floor, wall], DVec3::new(6.0, 6.0, 3.0)))
+}
+
+#[test]
+fn conflicting_views_miss_shadow_and_never_cast_extra() {
+    // the ring's hole cannot give the bar: the hull casts less than
+    // the wall wants
+    let (_, s) = ring_and_bar();
     let hull = shadow_hull(&s).unwrap();
     let checks = hull.check(&s).unwrap();
     for c in &checks {
@@ -224,52 +230,13 @@ fn specs_and_images_are_read_with_clear_errors() {
 
 #[test]
 fn silhouettes_of_a_closed_mesh_come_back_but_for_boundary_pixels() {
-    use bsp_shadows::art::shadow_coverage;
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../data/meshes/pyvista_sphere.obj"
     );
     let sphere = bsp_shadows::read_mesh(path).unwrap();
-    let (lo, hi) = sphere.bounds().unwrap();
-    let n = 96u32;
-    let side = (hi - lo).max_element() * 1.2;
-    let px = side / f64::from(n);
-    let c = (lo + hi) * 0.5 - DVec3::splat(side / 2.0);
-    // three walls a little away from the sphere, each lit along an axis
-    let views: Vec<ArtView> = [
-        (
-            DVec3::X,
-            DVec3::new(lo.x - 1.0, c.y, c.z),
-            DVec3::Y,
-            DVec3::Z,
-        ),
-        (
-            DVec3::Y,
-            DVec3::new(c.x, lo.y - 1.0, c.z),
-            DVec3::Z,
-            DVec3::X,
-        ),
-        (
-            DVec3::Z,
-            DVec3::new(c.x, c.y, lo.z - 1.0),
-            DVec3::X,
-            DVec3::Y,
-        ),
-    ]
-    .into_iter()
-    .map(|(sun, origin, u, v)| {
-        let blank = mask(n, |_, _| false);
-        let mut view = view(ArtLight::Sun(sun), origin, u * px, v * px, blank);
-        // the silhouette: the pixels the sphere's shadow covers half of
-        let cov = shadow_coverage(&sphere, &view).unwrap();
-        view.mask.wanted = cov.iter().map(|&c| c >= 0.5).collect();
-        view
-    })
-    .collect();
-    let s = ArtSpec {
-        views: views.clone(),
-        bounds: [lo - DVec3::splat(0.5), hi + DVec3::splat(0.5)],
-    };
+    let s = bsp_shadows::art::axis_silhouettes(&sphere, 96).unwrap();
+    let views = s.views.clone();
     let hull = shadow_hull(&s).unwrap();
     for (v, c) in views.iter().zip(hull.check(&s).unwrap()) {
         let areas = (c.wanted_area, c.shadow_area, c.missing_area, c.extra_area);
@@ -291,21 +258,7 @@ fn silhouettes_of_a_closed_mesh_come_back_but_for_boundary_pixels() {
 #[test]
 fn conflicting_views_are_grown_until_they_agree() {
     use bsp_shadows::art::optimize;
-    // the floor wants a ring, the wall a bar wider than the ring
-    let ring = mask(6, |c, r| {
-        (1..5).contains(&c) && (1..5).contains(&r) && !((2..4).contains(&c) && (2..4).contains(&r))
-    });
-    let wall = view(
-        ArtLight::Sun(DVec3::X),
-        DVec3::ZERO,
-        DVec3::Y,
-        DVec3::Z,
-        mask(6, |_, r| r == 0),
-    );
-    let s = spec(
-        vec![floor(ArtLight::Sun(DVec3::Z), ring.clone()), wall],
-        DVec3::new(6.0, 6.0, 3.0),
-    );
+    let (ring, s) = ring_and_bar();
     let o = optimize(&s, 0.005, 8).unwrap();
     let grown = o.grown.as_ref().unwrap();
     assert!(grown.missing_before[1] > 1.0, "{:?}", grown.missing_before);

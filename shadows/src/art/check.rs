@@ -134,6 +134,72 @@ pub fn shadow_coverage(mesh: &Mesh, view: &ArtView) -> Result<Vec<f64>, ArtError
     Ok(coverage)
 }
 
+/// The silhouettes of `mesh` under three suns along the axes, each an
+/// `n × n` image (the pixels its exact shadow covers at least half of,
+/// [`shadow_coverage`]) on a wall a tenth of the mesh's size away from
+/// it (`x`, `y`, `z` in that order), and bounds that much around the
+/// mesh: a spec whose views agree but for pixelization.
+pub fn axis_silhouettes(mesh: &Mesh, n: u32) -> Result<super::ArtSpec, ArtError> {
+    use glam::DVec3;
+    let (lo, hi) = mesh
+        .bounds()
+        .ok_or_else(|| ArtError::Spec("a mesh without faces has no silhouette".into()))?;
+    let side = (hi - lo).max_element() * 1.1;
+    let (px, gap) = (side / f64::from(n), 0.1 * side);
+    let c = (lo + hi) * 0.5 - DVec3::splat(side / 2.0);
+    let walls = [
+        (
+            DVec3::X,
+            DVec3::new(lo.x - gap, c.y, c.z),
+            DVec3::Y,
+            DVec3::Z,
+            "x",
+        ),
+        (
+            DVec3::Y,
+            DVec3::new(c.x, lo.y - gap, c.z),
+            DVec3::Z,
+            DVec3::X,
+            "y",
+        ),
+        (
+            DVec3::Z,
+            DVec3::new(c.x, c.y, lo.z - gap),
+            DVec3::X,
+            DVec3::Y,
+            "z",
+        ),
+    ];
+    let views = walls
+        .into_iter()
+        .map(|(sun, origin, u, v, name)| {
+            let wanted = vec![false; n as usize * n as usize];
+            let mut view = ArtView {
+                image: format!("{name}.pgm").into(),
+                light: ArtLight::Sun(sun),
+                plane: super::ViewPlane {
+                    origin,
+                    u: u * px,
+                    v: v * px,
+                },
+                mask: super::Mask {
+                    width: n,
+                    height: n,
+                    wanted,
+                },
+            };
+            let cover = shadow_coverage(mesh, &view)?;
+            view.mask.wanted = cover.iter().map(|&c| c >= 0.5).collect();
+            Ok(view)
+        })
+        .collect::<Result<_, ArtError>>()?;
+    let margin = DVec3::splat(gap / 2.0);
+    Ok(super::ArtSpec {
+        views,
+        bounds: [lo - margin, hi + margin],
+    })
+}
+
 /// Adds to `coverage` (per pixel of a `w × h` image) the area of each
 /// pixel square that the polygon of `rings` (pixel coordinates; holes
 /// turning against the outer ring) covers.

@@ -30,7 +30,7 @@ use bsp_core::BoolOp;
 use bsp_csg::files::{FileBoolean, FileError, Operand};
 use glam::DVec3;
 
-pub use check::{ViewCheck, shadow_coverage};
+pub use check::{ViewCheck, axis_silhouettes, shadow_coverage};
 pub use grow::{ArtRun, Grown, Growth, optimize, run};
 pub use region::Mask;
 pub use spec::read_mask;
