@@ -1,0 +1,33 @@
+//! Sun studies: every face's exact sun-hours over one day (the built-in
+//! room at 51.5° N on the equinox, a sun every 10 minutes: 73 suns above
+//! the horizon, two exact runs and their pieces overlaid), and the sun
+//! positions alone.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use bsp_shadows::sun::{SunSite, study_suns, sun_hours};
+use criterion::{Criterion, criterion_group, criterion_main};
+
+fn sun(cr: &mut Criterion) {
+    let mesh = shadow_scene::scene("room").expect("a built-in scene");
+    let site = SunSite::new(51.5, -0.12);
+    let day = [chrono::NaiveDate::from_ymd_opt(2026, 3, 21).unwrap()];
+    let suns: Vec<_> = study_suns(&site, &day, 10.0, 0.0)
+        .unwrap()
+        .iter()
+        .map(|s| s.direction)
+        .collect();
+    let mut g = cr.benchmark_group("sun/room equinox 10 min");
+    g.sample_size(10).measurement_time(Duration::from_secs(8));
+    g.bench_function("positions", |b| {
+        b.iter(|| black_box(study_suns(&site, &day, 10.0, 0.0).unwrap().len()))
+    });
+    g.bench_function("sun-hours", |b| {
+        b.iter(|| black_box(sun_hours(&mesh, &suns, 1.0 / 6.0).unwrap().len()))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, sun);
+criterion_main!(benches);
