@@ -83,6 +83,9 @@ pub(crate) struct SunHoursArgs {
     /// The days' clock, hours east of UTC [default: 0].
     #[arg(long, value_name = "H", allow_hyphen_values = true)]
     utc_offset: Option<f64>,
+    /// Also say how much of each group sees at least H hours.
+    #[arg(long, value_name = "H")]
+    min_hours: Option<f64>,
     /// Output: CSV (one row per face) or JSON.
     #[arg(short, long, value_name = "OUT.csv|OUT.json")]
     output: PathBuf,
@@ -104,10 +107,9 @@ pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
     let hours = sun::sun_hours(&mesh, &dirs, step / 60.0).map_err(facade_error)?;
     let text = format.text(&mesh, &hours, dirs.len());
     write_file(&a.output, text.as_bytes())?;
-    let (n, out) = (dates.len(), a.output.display());
-    emit(&format!(
-        "wrote {out}: sun-hours of {} faces of {name} over {n} days, {} suns\n",
-        hours.len(),
-        dirs.len()
-    ))
+    let (n, days, suns, out) = (hours.len(), dates.len(), dirs.len(), a.output.display());
+    let mut text =
+        format!("wrote {out}: sun-hours of {n} faces of {name}, {days} days, {suns} suns\n");
+    text += &sun::groups_in_sun_text(&mesh, &hours, a.min_hours);
+    emit(&text)
 }

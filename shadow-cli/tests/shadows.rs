@@ -1023,7 +1023,7 @@ fn sunhours_writes_every_faces_hours() {
     };
     let o = args(&csv);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stdout(&o).contains("over 1 days"), "{}", stdout(&o));
+    assert!(stdout(&o).contains(", 1 days"), "{}", stdout(&o));
     let text = std::fs::read_to_string(&csv).unwrap();
     let rows: Vec<Vec<&str>> = text
         .lines()
@@ -1048,6 +1048,34 @@ fn sunhours_writes_every_faces_hours() {
     let o = args(&json);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    // how much of each group sees at least some hours: the cube's top
+    // (a sixth of its area) sees every sun, its sides fewer
+    let o = shadow(&[
+        "sunhours",
+        "--scene",
+        "cube",
+        "--lat",
+        "51.48",
+        "--lon",
+        "0",
+        "--date",
+        "2026-03-21",
+        "--step",
+        "60",
+        "--min-hours",
+        "11",
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    let line = stdout(&o).lines().nth(1).unwrap_or_default().to_string();
+    assert!(
+        line.starts_with("cube: ") && line.ends_with("sees at least 11 hours of sun"),
+        "{line}"
+    );
+    let share: f64 = line["cube: ".len()..line.find('%').unwrap()]
+        .parse()
+        .unwrap();
+    assert!((16.0..50.0).contains(&share), "{line}");
     assert_eq!(v["faces"].as_array().unwrap().len(), 6);
     // bad names and dates are clear errors
     let o = args(&scratch("hours.txt"));

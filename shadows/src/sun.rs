@@ -258,6 +258,63 @@ pub struct FaceHours {
     pub min_hours: f64,
     /// The most hours a point of it gets.
     pub max_hours: f64,
+    /// How much of its area gets how many hours: `(hours, area)`, by
+    /// hours (the overlay's cells, `f64`).
+    pub hours_area: Vec<(f64, f64)>,
+}
+
+impl FaceHours {
+    /// The area of the face whose points get at least `hours` (within
+    /// 10⁻⁹ hours: the steps' sums in `f64`).
+    pub fn area_with_at_least(&self, hours: f64) -> f64 {
+        (self.hours_area.iter())
+            .filter(|(h, _)| *h >= hours - 1e-9)
+            .map(|(_, a)| a)
+            .sum()
+    }
+}
+
+/// Per group of `mesh` (in the order of first use), its area and the
+/// area of it whose points get at least `hours` of sun: the test of
+/// planning rules such as the BRE's "half of a garden in sun for at
+/// least two hours on 21 March". A face's share is measured on its
+/// overlay's cells, so the shares of the group's faces add up.
+pub fn groups_in_sun(
+    mesh: &crate::Mesh,
+    faces: &[FaceHours],
+    hours: f64,
+) -> Vec<(String, f64, f64)> {
+    let mut out: Vec<(String, f64, f64)> = Vec::new();
+    for (f, h) in faces.iter().enumerate() {
+        let name = mesh.group_name(f);
+        let total: f64 = h.hours_area.iter().map(|(_, a)| a).sum();
+        let sunny = h.area_with_at_least(hours);
+        match out.iter_mut().find(|g| g.0 == name) {
+            Some(g) => (g.1, g.2) = (g.1 + total, g.2 + sunny),
+            None => out.push((name.to_string(), total, sunny)),
+        }
+    }
+    out
+}
+
+/// [`groups_in_sun`] for people, one line per group (nothing without
+/// `hours`).
+pub fn groups_in_sun_text(mesh: &crate::Mesh, faces: &[FaceHours], hours: Option<f64>) -> String {
+    let Some(hours) = hours else {
+        return String::new();
+    };
+    (groups_in_sun(mesh, faces, hours).iter())
+        .map(|(name, total, sunny)| {
+            let share = if *total > 0.0 {
+                100.0 * sunny / total
+            } else {
+                0.0
+            };
+            format!(
+                "{name}: {share:.1}% of its {total:.6} units² sees at least {hours} hours of sun\n"
+            )
+        })
+        .collect()
 }
 
 /// A convex region of a face (in a frame of its plane) with the number
@@ -318,11 +375,17 @@ pub fn sun_hours(
             let (min, max) = seen.fold((u32::MAX, 0), |(a, b), h| (a.min(h), b.max(h)));
             let (min, max) = (f64::from(min) * step_hours, f64::from(max) * step_hours);
             let none = suns.is_empty() || area[f] == 0.0;
+            let mut by: std::collections::BTreeMap<u32, f64> = Default::default();
+            for (ring, n) in cells[f].iter().flatten() {
+                *by.entry(*n).or_default() += area2(ring).abs() / 2.0;
+            }
+            let hours_area = by.into_iter().map(|(n, a)| (f64::from(n) * step_hours, a));
             FaceHours {
                 area: area[f],
                 sun_hours: if area[f] > 0.0 { lit[f] / area[f] } else { 0.0 },
                 min_hours: if none { 0.0 } else { min },
                 max_hours: if none { 0.0 } else { max },
+                hours_area: hours_area.collect(),
             }
         })
         .collect())
@@ -619,6 +682,19 @@ mod tests {
                 "{own} at {p}"
             );
         }
+        // how much of the ground gets how many hours: all of it at least
+        // none, less and less as the hours grow, none beyond the day
+        let a = |h: f64| g.area_with_at_least(h);
+        assert!(
+            (a(0.0) - g.area).abs() < 1e-9 * g.area,
+            "{} {}",
+            a(0.0),
+            g.area
+        );
+        assert!(a(0.0) >= a(3.0) && a(3.0) >= a(full) && a(full) > 0.0 && a(full + 1.0) == 0.0);
+        assert!((roof.area_with_at_least(full) - roof.area).abs() < 1e-9);
+        let groups = groups_in_sun(&mesh, &hours, full);
+        assert_eq!(groups.len(), 1); // one group: the yard and the box
         // the suns in another order make other runs: the same hours
         let back: Vec<DVec3> = suns.iter().rev().copied().collect();
         for (a, b) in hours.iter().zip(sun_hours(&mesh, &back, step).unwrap()) {
