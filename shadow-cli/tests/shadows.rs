@@ -1004,8 +1004,8 @@ fn sun_prints_where_the_sun_is() {
 #[test]
 fn sunhours_writes_every_faces_hours() {
     let (csv, json) = (scratch("hours.csv"), scratch("hours.json"));
-    let args = |out: &Path| {
-        shadow(&[
+    let run = |out: &Path, extra: &[&str]| {
+        let mut argv = vec![
             "sunhours",
             "--scene",
             "cube",
@@ -1019,9 +1019,11 @@ fn sunhours_writes_every_faces_hours() {
             "60",
             "-o",
             out.to_str().unwrap(),
-        ])
+        ];
+        argv.extend(extra);
+        shadow(&argv)
     };
-    let o = args(&csv);
+    let o = run(&csv, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains(", 1 days"), "{}", stdout(&o));
     let text = std::fs::read_to_string(&csv).unwrap();
@@ -1045,28 +1047,13 @@ fn sunhours_writes_every_faces_hours() {
         let h: Vec<f64> = r[3..].iter().map(|v| v.parse().unwrap()).collect();
         assert!(h[1] <= h[0] + 1e-9 && h[0] <= h[2] + 1e-9, "{r:?}");
     }
-    let o = args(&json);
+    let o = run(&json, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    // how much of each group sees at least some hours: the cube's top
-    // (a sixth of its area) sees every sun, its sides fewer
-    let o = shadow(&[
-        "sunhours",
-        "--scene",
-        "cube",
-        "--lat",
-        "51.48",
-        "--lon",
-        "0",
-        "--date",
-        "2026-03-21",
-        "--step",
-        "60",
-        "--min-hours",
-        "11",
-        "-o",
-        csv.to_str().unwrap(),
-    ]);
+    assert_eq!(v["faces"].as_array().unwrap().len(), 6);
+    // how much of each group sees at least 11 hours: the cube's top (a
+    // sixth of its area) sees every sun, its sides fewer
+    let o = run(&csv, &["--min-hours", "11"]);
     let line = stdout(&o).lines().nth(1).unwrap_or_default().to_string();
     assert!(
         line.starts_with("cube: ") && line.ends_with("sees at least 11 hours of sun"),
@@ -1076,22 +1063,9 @@ fn sunhours_writes_every_faces_hours() {
         .parse()
         .unwrap();
     assert!((16.0..50.0).contains(&share), "{line}");
-    assert_eq!(v["faces"].as_array().unwrap().len(), 6);
     // bad names and dates are clear errors
-    let o = args(&scratch("hours.txt"));
+    let o = run(&scratch("hours.txt"), &[]);
     crate::assert_failed_with(&o, &["hours.txt", ".csv or .json"]);
-    let o = shadow(&[
-        "sunhours",
-        "--scene",
-        "cube",
-        "--lat",
-        "51",
-        "--lon",
-        "0",
-        "--date",
-        "2026-02-30",
-        "-o",
-        csv.to_str().unwrap(),
-    ]);
+    let o = run(&csv, &["--to", "2026-02-30"]);
     crate::assert_failed_with(&o, &["2026-02-30", "not a date"]);
 }
