@@ -64,6 +64,13 @@ pub enum Error {
     Raster(shadow_raster::RasterError),
     /// An output could not be written.
     Io(std::io::Error),
+    /// A sensor point does not fit the scene's grid.
+    Sensor {
+        /// Its index.
+        index: usize,
+        /// Why.
+        cause: bsp_core::SnapError,
+    },
 }
 
 impl std::fmt::Display for Error {
@@ -77,6 +84,7 @@ impl std::fmt::Display for Error {
             Error::Export(e) => e.fmt(f),
             Error::Raster(e) => e.fmt(f),
             Error::Io(e) => e.fmt(f),
+            Error::Sensor { index, cause } => write!(f, "sensor {index}: {cause}"),
         }
     }
 }
@@ -92,6 +100,7 @@ impl std::error::Error for Error {
             Error::Export(e) => e,
             Error::Raster(e) => e,
             Error::Io(e) => e,
+            Error::Sensor { cause, .. } => cause,
         })
     }
 }

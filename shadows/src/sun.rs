@@ -391,6 +391,42 @@ pub fn sun_hours(
         .collect())
 }
 
+/// The sun-hours at each point of `sensors` (input units) among the
+/// faces of `mesh`, each of `suns` (directions toward them) standing for
+/// `step_hours`: per sensor, the suns no face hides from its grid point,
+/// exactly ([`svbsp::Shadows::reaching`]; a point on a shadow's edge is
+/// reached), counted. A sensor on a face counts the suns in front of it
+/// and behind it alike: give sensors a little off their surface.
+pub fn sensor_hours(
+    mesh: &crate::Mesh,
+    sensors: &[DVec3],
+    suns: &[DVec3],
+    step_hours: f64,
+) -> Result<Vec<f64>, crate::Error> {
+    use crate::Error;
+    let all: Vec<crate::Light> = suns.iter().map(|&d| crate::Light::Sun(d)).collect();
+    let positions = [&mesh.positions[..], sensors].concat();
+    let grid = svbsp::shared_grid(&positions, &all).map_err(Error::Light)?;
+    let at: Vec<bsp_core::GridPoint> = (sensors.iter().enumerate())
+        .map(|(index, &p)| grid.snap(p).map_err(|cause| Error::Sensor { index, cause }))
+        .collect::<Result<_, _>>()?;
+    let (polys, _) =
+        bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(Error::Import)?;
+    let mut seen = vec![0u32; sensors.len()];
+    for batch in all.chunks(svbsp::MAX_LIGHTS) {
+        let placed = svbsp::place_lights(&grid, batch).map_err(Error::Light)?;
+        let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
+        let trees = svbsp::Shadows::new(&polys, &kernel).map_err(Error::Shadow)?;
+        for (n, &g) in seen.iter_mut().zip(&at) {
+            *n += trees.reaching(g).count_ones();
+        }
+    }
+    Ok(seen
+        .into_iter()
+        .map(|n| f64::from(n) * step_hours)
+        .collect())
+}
+
 /// A file of sun-hours.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HoursFormat {
@@ -695,6 +731,25 @@ mod tests {
         assert!((roof.area_with_at_least(full) - roof.area).abs() < 1e-9);
         let groups = groups_in_sun(&mesh, &hours, full);
         assert_eq!(groups.len(), 1); // one group: the yard and the box
+        // sensors: a point's own count, exactly (points off the shadows'
+        // edges), and the roof's middle sees every sun
+        let points: Vec<DVec3> = [
+            (0.0, -1.5),
+            (1.5, 1.5),
+            (-3.0, 2.0),
+            (0.2, 2.5),
+            (-1.2, -1.2),
+        ]
+        .iter()
+        .map(|&(x, y)| DVec3::new(x, y, 0.0))
+        .chain([DVec3::new(0.0, 0.0, 2.5)])
+        .collect();
+        let at = sensor_hours(&mesh, &points, &suns, step).unwrap();
+        for (p, h) in points.iter().zip(&at) {
+            let own = suns.iter().filter(|&&d| !blocked(*p, d)).count() as f64 * step;
+            assert_eq!(*h, own, "at {p}");
+        }
+        assert_eq!(at[5], full);
         // the suns in another order make other runs: the same hours
         let back: Vec<DVec3> = suns.iter().rev().copied().collect();
         for (a, b) in hours.iter().zip(sun_hours(&mesh, &back, step).unwrap()) {

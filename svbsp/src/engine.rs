@@ -125,6 +125,25 @@ pub fn receivers(polys: &[Polygon]) -> Vec<Range<usize>> {
 }
 
 impl Shadows {
+    /// Bit `j` set: light `j` reaches grid point `x`, no occluder hiding
+    /// it ([`ShadowVolumes::hides`]; a point on a shadow's boundary is
+    /// reached). For points apart from the faces, such as sensors; whether
+    /// a surface at `x` faces the light is the caller's to ask.
+    ///
+    /// ```
+    /// use svbsp::{Light, Shadows};
+    /// let roof = bsp_core::Polygon::from_grid_points(&[[0, 0, 10], [10, 0, 10], [10, 10, 10], [0, 10, 10]], 0).unwrap();
+    /// let s = Shadows::new(&[roof], &[Light::Directional([0, 0, 1])]).unwrap();
+    /// assert_eq!(s.reaching([5, 5, 0]), 0); // under the roof
+    /// assert_eq!(s.reaching([15, 5, 0]), 1); // beside it
+    /// assert_eq!(s.reaching([10, 5, 0]), 1); // on its shadow's edge
+    /// ```
+    pub fn reaching(&self, x: bsp_core::GridPoint) -> u64 {
+        (self.volumes.iter().enumerate())
+            .filter(|(_, v)| !v.hides(x))
+            .fold(0, |m, (j, _)| m | 1 << j)
+    }
+
     /// Builds one shadow-volume tree per light from `occluders` (polygons
     /// with grid vertices, e.g. from [`bsp_core::import_faces`]), each in
     /// parallel.

@@ -589,6 +589,30 @@ impl ShadowVolumes {
         })
     }
 
+    /// Whether the occluders hide the light from grid point `x`: `x` lies
+    /// strictly inside a shadow volume (a point on a volume's boundary,
+    /// e.g. on an occluder's own face or on a shadow's edge, is reached).
+    /// The tree is walked without recursion.
+    pub fn hides(&self, x: bsp_core::GridPoint) -> bool {
+        let mut todo = vec![self.root];
+        while let Some(link) = todo.pop() {
+            match link {
+                LIT => return false,
+                SHADOW => continue,
+                n => {
+                    let node = &self.nodes[n as usize];
+                    match node.plane.classify_grid(x) {
+                        Side::Front => todo.push(node.front),
+                        Side::Back => todo.push(node.back),
+                        // on a plane: hidden only if both sides are
+                        Side::On => todo.extend([node.front, node.back]),
+                    }
+                }
+            }
+        }
+        true
+    }
+
     /// The light.
     pub fn light(&self) -> Light {
         self.light
