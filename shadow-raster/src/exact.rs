@@ -198,7 +198,7 @@ impl Drawable for SoftFragments {
     /// All of a light seen whole, none of one not seen, and in penumbra
     /// the share at the fragment's centroid (each penumbra pixel then gets
     /// its own).
-    fn amounts(&self, i: usize, _: DVec3, out: &mut [f32]) {
+    fn amounts(&self, i: usize, out: &mut [f32]) {
         let f = &self.cut[i];
         for (j, cell) in out.iter_mut().enumerate() {
             *cell = match f.class(j) {
@@ -222,9 +222,9 @@ pub(crate) trait Drawable: Sync {
     fn side(&self, i: usize) -> (u32, Plane);
     /// The rings of fragment `i` (outer first), in input units.
     fn rings(&self, i: usize) -> Vec<Vec<DVec3>>;
-    /// How much of each light fragment `i` gets at its point `p`, into
-    /// `out` (one cell per light).
-    fn amounts(&self, i: usize, p: DVec3, out: &mut [f32]);
+    /// How much of each light fragment `i` gets, into `out` (one cell per
+    /// light).
+    fn amounts(&self, i: usize, out: &mut [f32]);
 }
 
 /// The fragments of a [`Batch`], their vertices in input units.
@@ -252,7 +252,7 @@ impl Drawable for BatchFragments<'_> {
             .collect()
     }
 
-    fn amounts(&self, i: usize, _: DVec3, out: &mut [f32]) {
+    fn amounts(&self, i: usize, out: &mut [f32]) {
         let mask = self.batch.fragment(i).lit_mask();
         for (j, cell) in out.iter_mut().enumerate().take(self.lights) {
             if mask >> j & 1 == 1 {
@@ -284,8 +284,7 @@ pub(crate) fn draw_fragments(
 }
 
 /// Scan-converts `fragments` over the visible prims of their face and
-/// side: each pixel takes the amounts of the fragment that covers it at
-/// its point. Also returns that fragment per pixel ([`NONE`]: none).
+/// side: each pixel takes the amounts of the fragment that covers it. Also returns that fragment per pixel ([`NONE`]: none).
 pub(crate) fn draw(
     frame: &Frame<'_>,
     vis: &Visibility,
@@ -350,7 +349,6 @@ pub(crate) fn draw(
             continue;
         }
         let mut f = *took;
-        let p = pixel_point(frame, vis, pix);
         if f == NONE {
             let g = prim_group[prim as usize];
             let frags = &by_group[g as usize];
@@ -358,7 +356,7 @@ pub(crate) fn draw(
                 continue; // no fragment for this side: attached shadow
             }
             fallback += 1;
-            let n = scene.plane[prim as usize].0;
+            let (n, p) = (scene.plane[prim as usize].0, pixel_point(frame, vis, pix));
             f = frags
                 .iter()
                 .copied()
@@ -368,7 +366,6 @@ pub(crate) fn draw(
         }
         fragments.amounts(
             f as usize,
-            p,
             &mut lit.amount[pix * lights..(pix + 1) * lights],
         );
     }
