@@ -329,24 +329,48 @@ type Cell = (Vec<glam::DVec2>, u32);
 /// from the runs' lit pieces overlaid (their hours added; the overlay is
 /// `f64`, and a cell below 10⁻¹² of the face's area, a rounding sliver
 /// where two runs' boundaries coincide, is left out).
+///
+/// The same as [`HoursRun::new`] over the suns in runs of
+/// [`svbsp::MAX_LIGHTS`], folded in order by [`HoursRun::fold`]: runs
+/// made elsewhere (on other processes or machines) and folded in the
+/// same order give the same bits.
 pub fn sun_hours(
     mesh: &crate::Mesh,
     suns: &[DVec3],
     step_hours: f64,
 ) -> Result<Vec<FaceHours>, crate::Error> {
-    let faces = mesh.faces.len();
-    let mut area = vec![0.0; faces];
-    let mut lit = vec![0.0; faces];
-    let mut cells: Vec<Option<Vec<Cell>>> = vec![None; faces];
-    let frames: Vec<(DVec3, DVec3, DVec3)> = (0..faces).map(|f| face_frame(mesh, f)).collect();
-    for batch in suns.chunks(svbsp::MAX_LIGHTS) {
-        let lights: Vec<crate::Light> = batch.iter().map(|&d| crate::Light::Sun(d)).collect();
+    let runs = (suns.chunks(svbsp::MAX_LIGHTS)).map(|batch| HoursRun::new(mesh, batch, step_hours));
+    HoursRun::fold(mesh.faces.len(), runs)
+}
+
+/// One run's share of a study's sun-hours: for at most
+/// [`svbsp::MAX_LIGHTS`] suns, every face's area, its lit area summed
+/// over the suns times the step, and its lit pieces with the number of
+/// suns each sees.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HoursRun {
+    step_hours: f64,
+    area: Vec<f64>,
+    lit: Vec<f64>,
+    cells: Vec<Vec<Cell>>,
+}
+
+impl HoursRun {
+    /// The run of `suns` (at most [`svbsp::MAX_LIGHTS`]) over `mesh`.
+    pub fn new(
+        mesh: &crate::Mesh,
+        suns: &[DVec3],
+        step_hours: f64,
+    ) -> Result<HoursRun, crate::Error> {
+        let faces = mesh.faces.len();
+        let lights: Vec<crate::Light> = suns.iter().map(|&d| crate::Light::Sun(d)).collect();
         let run = crate::shadows(mesh, &lights)?;
-        let mut pieces: Vec<Vec<Cell>> = vec![Vec::new(); faces];
-        for f in 0..faces {
-            area[f] = run.face_area(f);
-            lit[f] += (0..batch.len()).map(|l| run.lit_area(f, l)).sum::<f64>() * step_hours;
-        }
+        let area: Vec<f64> = (0..faces).map(|f| run.face_area(f)).collect();
+        let lit = (0..faces)
+            .map(|f| (0..suns.len()).map(|l| run.lit_area(f, l)).sum::<f64>() * step_hours)
+            .collect();
+        let frames: Vec<(DVec3, DVec3, DVec3)> = (0..faces).map(|f| face_frame(mesh, f)).collect();
+        let mut cells: Vec<Vec<Cell>> = vec![Vec::new(); faces];
         for frag in run.batch.fragments() {
             let f = frag.face() as usize;
             let seen = frag.lit_mask().count_ones();
@@ -359,36 +383,119 @@ pub fn sun_hours(
                         glam::DVec2::new(p.dot(u), p.dot(v))
                     })
                     .collect();
-                pieces[f].push((ring, seen));
+                cells[f].push((ring, seen));
             }
         }
-        for (f, new) in pieces.into_iter().enumerate() {
-            cells[f] = Some(match cells[f].take() {
-                None => new,
-                Some(old) => overlay(&old, &new, 1e-12 * area[f]),
-            });
-        }
-    }
-    Ok((0..faces)
-        .map(|f| {
-            let seen = cells[f].iter().flatten().map(|c| c.1);
-            let (min, max) = seen.fold((u32::MAX, 0), |(a, b), h| (a.min(h), b.max(h)));
-            let (min, max) = (f64::from(min) * step_hours, f64::from(max) * step_hours);
-            let none = suns.is_empty() || area[f] == 0.0;
-            let mut by: std::collections::BTreeMap<u32, f64> = Default::default();
-            for (ring, n) in cells[f].iter().flatten() {
-                *by.entry(*n).or_default() += area2(ring).abs() / 2.0;
-            }
-            let hours_area = by.into_iter().map(|(n, a)| (f64::from(n) * step_hours, a));
-            FaceHours {
-                area: area[f],
-                sun_hours: if area[f] > 0.0 { lit[f] / area[f] } else { 0.0 },
-                min_hours: if none { 0.0 } else { min },
-                max_hours: if none { 0.0 } else { max },
-                hours_area: hours_area.collect(),
-            }
+        Ok(HoursRun {
+            step_hours,
+            area,
+            lit,
+            cells,
         })
-        .collect())
+    }
+
+    /// The runs' faces' hours, the runs taken in order (`faces`: the
+    /// mesh's face count, for no runs at all).
+    pub fn fold(
+        faces: usize,
+        runs: impl IntoIterator<Item = Result<HoursRun, crate::Error>>,
+    ) -> Result<Vec<FaceHours>, crate::Error> {
+        let mut area = vec![0.0; faces];
+        let mut lit = vec![0.0; faces];
+        let mut cells: Vec<Option<Vec<Cell>>> = vec![None; faces];
+        let mut step_hours = 0.0;
+        for run in runs {
+            let run = run?;
+            step_hours = run.step_hours;
+            for (f, new) in run.cells.into_iter().enumerate() {
+                area[f] = run.area[f];
+                lit[f] += run.lit[f];
+                cells[f] = Some(match cells[f].take() {
+                    None => new,
+                    Some(old) => overlay(&old, &new, 1e-12 * area[f]),
+                });
+            }
+        }
+        Ok((0..faces)
+            .map(|f| face_hours(area[f], lit[f], cells[f].as_deref(), step_hours))
+            .collect())
+    }
+
+    /// The run as bytes (little-endian), for sending to another process.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut put = |x: f64| out.extend_from_slice(&x.to_le_bytes());
+        put(self.step_hours);
+        put(self.area.len() as f64);
+        for f in 0..self.area.len() {
+            put(self.area[f]);
+            put(self.lit[f]);
+            put(self.cells[f].len() as f64);
+            for (ring, seen) in &self.cells[f] {
+                put(f64::from(*seen));
+                put(ring.len() as f64);
+                for p in ring {
+                    put(p.x);
+                    put(p.y);
+                }
+            }
+        }
+        out
+    }
+
+    /// A run from [`HoursRun::to_bytes`]; `None` if `bytes` is not one.
+    pub fn from_bytes(bytes: &[u8]) -> Option<HoursRun> {
+        let mut words = bytes
+            .chunks_exact(8)
+            .map(|w| f64::from_le_bytes(w.try_into().expect("eight bytes")));
+        let mut next = || words.next();
+        let count = |x: f64| (x >= 0.0 && x.fract() == 0.0 && x < 1e15).then_some(x as usize);
+        let step_hours = next()?;
+        let faces = count(next()?)?;
+        let mut run = HoursRun {
+            step_hours,
+            area: Vec::new(),
+            lit: Vec::new(),
+            cells: Vec::new(),
+        };
+        for _ in 0..faces {
+            run.area.push(next()?);
+            run.lit.push(next()?);
+            let n = count(next()?)?;
+            let mut face = Vec::new();
+            for _ in 0..n {
+                let seen = u32::try_from(count(next()?)?).ok()?;
+                let len = count(next()?)?;
+                let ring = (0..len)
+                    .map(|_| Some(glam::DVec2::new(next()?, next()?)))
+                    .collect::<Option<Vec<_>>>()?;
+                face.push((ring, seen));
+            }
+            run.cells.push(face);
+        }
+        (bytes.len() % 8 == 0 && next().is_none()).then_some(run)
+    }
+}
+
+/// A face's hours from its area, its lit area times hours, and its
+/// overlaid cells (`None`: no suns).
+fn face_hours(area: f64, lit: f64, cells: Option<&[Cell]>, step_hours: f64) -> FaceHours {
+    let seen = cells.iter().copied().flatten().map(|c| c.1);
+    let (min, max) = seen.fold((u32::MAX, 0), |(a, b), h| (a.min(h), b.max(h)));
+    let (min, max) = (f64::from(min) * step_hours, f64::from(max) * step_hours);
+    let none = cells.is_none() || area == 0.0;
+    let mut by: std::collections::BTreeMap<u32, f64> = Default::default();
+    for (ring, n) in cells.iter().copied().flatten() {
+        *by.entry(*n).or_default() += area2(ring).abs() / 2.0;
+    }
+    let hours_area = by.into_iter().map(|(n, a)| (f64::from(n) * step_hours, a));
+    FaceHours {
+        area,
+        sun_hours: if area > 0.0 { lit / area } else { 0.0 },
+        min_hours: if none { 0.0 } else { min },
+        max_hours: if none { 0.0 } else { max },
+        hours_area: hours_area.collect(),
+    }
 }
 
 /// The sun-hours at each point of `sensors` (input units) among the
@@ -757,5 +864,16 @@ mod tests {
             assert!((a.min_hours - b.min_hours).abs() < 1e-9, "{a:?} {b:?}");
             assert!((a.max_hours - b.max_hours).abs() < 1e-9, "{a:?} {b:?}");
         }
+        // runs made apart, sent as bytes and folded in order: the same bits
+        let runs: Vec<Vec<u8>> = (suns.chunks(svbsp::MAX_LIGHTS))
+            .map(|c| HoursRun::new(&mesh, c, step).unwrap().to_bytes())
+            .collect();
+        let back = runs.iter().map(|b| Ok(HoursRun::from_bytes(b).unwrap()));
+        assert_eq!(HoursRun::fold(mesh.faces.len(), back).unwrap(), hours);
+        let cut = &runs[0][..runs[0].len() - 8];
+        assert!(HoursRun::from_bytes(cut).is_none());
+        assert!(HoursRun::from_bytes(&[runs[0].clone(), vec![0; 8]].concat()).is_none());
+        let none = HoursRun::fold(mesh.faces.len(), []).unwrap();
+        assert!(none.iter().all(|h| h.sun_hours == 0.0 && h.max_hours == 0.0));
     }
 }
