@@ -473,7 +473,7 @@ impl HoursRun {
             }
             run.cells.push(face);
         }
-        (bytes.len() % 8 == 0 && next().is_none()).then_some(run)
+        (bytes.len().is_multiple_of(8) && next().is_none()).then_some(run)
     }
 }
 
