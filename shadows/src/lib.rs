@@ -27,6 +27,7 @@ pub mod prepared;
 pub mod shadow_file;
 pub mod soft_file;
 pub mod sun;
+mod volume;
 
 use std::path::Path;
 
@@ -41,6 +42,7 @@ pub use shadow_scene::{Face, Mesh, MeshView};
 /// A point light at a position, or a sun in a direction (from the scene
 /// toward it), in the mesh's units.
 pub use svbsp::LightSpec as Light;
+pub use volume::volume;
 
 /// Why a job failed; [`std::error::Error::source`] gives the cause.
 #[derive(Debug)]
