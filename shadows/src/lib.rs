@@ -42,6 +42,8 @@ pub use shadow_scene::{Face, Mesh, MeshView};
 /// A point light at a position, or a sun in a direction (from the scene
 /// toward it), in the mesh's units.
 pub use svbsp::LightSpec as Light;
+/// The most lights one shadow run takes.
+pub use svbsp::MAX_LIGHTS;
 pub use volume::volume;
 
 /// Why a job failed; [`std::error::Error::source`] gives the cause.

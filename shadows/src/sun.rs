@@ -874,6 +874,9 @@ mod tests {
         assert!(HoursRun::from_bytes(cut).is_none());
         assert!(HoursRun::from_bytes(&[runs[0].clone(), vec![0; 8]].concat()).is_none());
         let none = HoursRun::fold(mesh.faces.len(), []).unwrap();
-        assert!(none.iter().all(|h| h.sun_hours == 0.0 && h.max_hours == 0.0));
+        assert!(
+            none.iter()
+                .all(|h| h.sun_hours == 0.0 && h.max_hours == 0.0)
+        );
     }
 }

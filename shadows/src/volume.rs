@@ -181,7 +181,18 @@ mod tests {
     #[test]
     fn rounds_once_to_nearest() {
         use num_rational::BigRational;
-        for n in [1u64, 2, 3, 5, 7, 9, 11, (1 << 53) + 1, (1 << 54) + 3, u64::MAX] {
+        for n in [
+            1u64,
+            2,
+            3,
+            5,
+            7,
+            9,
+            11,
+            (1 << 53) + 1,
+            (1 << 54) + 3,
+            u64::MAX,
+        ] {
             for e in [-60i64, 0, 33] {
                 let exact = BigRational::new(BigInt::from(n), BigInt::from(6))
                     * BigRational::from_integer(BigInt::from(2)).pow(e as i32);

@@ -1,0 +1,126 @@
+"""Exact mesh Booleans, shadows and sun-hours on numpy arrays.
+
+Every geometric decision is exact for the input snapped to a grid fitted
+to it (BSP trees, no epsilon); results are rounded once to float64.
+
+    >>> import numpy as np, bsp_shadows as bs
+    >>> cube = bs.box((0, 0, 0), (2, 2, 2))
+    >>> moved = cube.translated((1, 1, 1))
+    >>> (cube | moved).volume(), (cube & moved).volume(), (cube - moved).volume()
+    (15.0, 1.0, 7.0)
+    >>> s = bs.shadows(cube | bs.box((-5, -5, -1), (5, 5, 0)), [bs.Sun((0, 0, 1))])
+    >>> float(s.lit_area.sum())
+    100.0
+
+The work runs without the GIL on a pool of ``get_threads()`` threads
+(``set_threads(n)`` changes it; results do not depend on it).
+"""
+
+from __future__ import annotations
+
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from . import _native
+from ._native import (
+    MAX_SUNS_A_RUN,
+    BspError,
+    LightError,
+    Mesh,
+    MeshError,
+    PointLight,
+    Shadows,
+    Sun,
+    SunHours,
+    difference,
+    get_threads,
+    intersection,
+    set_threads,
+    shadows,
+    study_suns,
+    union,
+)
+
+__all__ = [
+    "BspError",
+    "LightError",
+    "MAX_SUNS_A_RUN",
+    "Mesh",
+    "MeshError",
+    "PointLight",
+    "Shadows",
+    "Sun",
+    "SunHours",
+    "box",
+    "difference",
+    "from_trimesh",
+    "get_threads",
+    "intersection",
+    "read_mesh",
+    "set_threads",
+    "shadows",
+    "study_suns",
+    "sun_hours",
+    "to_trimesh",
+    "union",
+]
+
+__version__ = "0.1.0"
+
+
+def read_mesh(path) -> Mesh:
+    """Reads an OBJ or STL file (by its extension)."""
+    return Mesh.read(path)
+
+
+def box(lo: Sequence[float], hi: Sequence[float]) -> Mesh:
+    """The axis-aligned box from corner ``lo`` to corner ``hi``, as six
+    outward-facing quads."""
+    (x0, y0, z0), (x1, y1, z1) = lo, hi
+    vertices = np.array(
+        [[x, y, z] for z in (z0, z1) for y in (y0, y1) for x in (x0, x1)],
+        dtype=np.float64,
+    )
+    faces = np.array(
+        [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]]
+    )
+    return Mesh(vertices, faces)
+
+
+def to_trimesh(mesh: Mesh):
+    """A ``trimesh.Trimesh`` of ``mesh`` (needs trimesh)."""
+    return mesh.to_trimesh()
+
+
+def from_trimesh(mesh) -> Mesh:
+    """The ``Mesh`` of a ``trimesh.Trimesh``."""
+    return Mesh.from_trimesh(mesh)
+
+
+def sun_hours(
+    scene: Mesh,
+    *,
+    lat: float,
+    lon: float,
+    dates: Iterable,
+    step_minutes: float = 10.0,
+    utc_offset: float = 0.0,
+    north: float = 0.0,
+    up: str = "z",
+    height: float = 0.0,
+) -> SunHours:
+    """The sun-hours of every face of ``scene`` over a study: on each of
+    ``dates`` (``datetime.date`` or ``"YYYY-MM-DD"``), a sun at the middle
+    of every ``step_minutes`` interval of the day (local time at
+    ``utc_offset`` hours) while it is above the horizon, at latitude
+    ``lat`` and longitude ``lon`` (degrees north and east). ``north``: true
+    north in degrees clockwise from the scene's north axis; ``up``: the
+    scene's up axis, ``"z"`` or ``"y"``.
+
+    The result's ``per_face`` is each face's mean hours (exact lit areas
+    for every sun), ``min_hours``/``max_hours`` the fewest and most a point
+    of it gets, and ``per_sensor(points)`` the exact hours at points.
+    """
+    suns = study_suns(lat, lon, list(dates), step_minutes, utc_offset, north, up, height)
+    return _native._hours_of_suns(scene, suns, step_minutes / 60.0)

@@ -1,0 +1,114 @@
+"""Types of the compiled module ``bsp_shadows._native``."""
+
+from os import PathLike
+from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+_Path = Union[str, PathLike]
+_Points = npt.ArrayLike
+_Faces = Union[npt.ArrayLike, Sequence[Sequence[int]]]
+_Light = Union["PointLight", "Sun"]
+
+MAX_SUNS_A_RUN: int
+
+class BspError(ValueError):
+    """The base of this package's errors: input it refuses, with the library's message."""
+
+class MeshError(BspError):
+    """A mesh that cannot be used (the message names the face, and the edge for an open operand)."""
+
+class LightError(BspError):
+    """A light that cannot be placed."""
+
+class Mesh:
+    """A polygon mesh: vertices ``(n, 3)`` float64, faces ``(m, k)`` ints or a list of polygons."""
+
+    def __init__(self, vertices: _Points, faces: _Faces) -> None: ...
+    @staticmethod
+    def read(path: _Path) -> "Mesh":
+        """Reads an OBJ or STL file."""
+    def write(self, path: _Path) -> None:
+        """Writes OBJ or STL, by the extension."""
+    @property
+    def vertices(self) -> npt.NDArray[np.float64]:
+        """``(n, 3)`` float64 (a copy)."""
+    @property
+    def faces(self) -> Union[npt.NDArray[np.int64], List[npt.NDArray[np.int64]]]:
+        """``(m, k)`` int64 when every face has k vertices, else a list of 1-D arrays."""
+    def volume(self) -> float:
+        """The enclosed volume, exact for the float64 positions and rounded once."""
+    def is_closed(self) -> bool:
+        """Whether every edge is met by two faces in opposite directions."""
+    def translated(self, offset: Tuple[float, float, float]) -> "Mesh": ...
+    def to_trimesh(self) -> Any:
+        """A ``trimesh.Trimesh`` (polygons fanned), without trimesh's processing."""
+    @staticmethod
+    def from_trimesh(mesh: Any) -> "Mesh": ...
+    def __or__(self, other: "Mesh") -> "Mesh": ...
+    def __and__(self, other: "Mesh") -> "Mesh": ...
+    def __sub__(self, other: "Mesh") -> "Mesh": ...
+
+class PointLight:
+    position: Tuple[float, float, float]
+    def __init__(self, position: Tuple[float, float, float]) -> None: ...
+
+class Sun:
+    """A light infinitely far in ``direction`` (from the scene toward it)."""
+
+    direction: Tuple[float, float, float]
+    def __init__(self, direction: Tuple[float, float, float]) -> None: ...
+
+class Shadows:
+    @property
+    def lit_area(self) -> npt.NDArray[np.float64]:
+        """``(faces, lights)``: the area of each face each light reaches."""
+    @property
+    def face_area(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def mesh(self) -> Mesh: ...
+    @property
+    def lights(self) -> List[_Light]: ...
+    def lit_fraction(self, light: int) -> float: ...
+    def fragments(self) -> Dict[str, npt.NDArray[Any]]:
+        """``face`` (F,), ``lit`` (F,) uint64 bits, ``rings`` (F+1,), ``ring_points`` (R+1,), ``points`` (P, 3)."""
+    def write(self, path: _Path) -> None:
+        """JSON or OBJ, by the extension (the CLI's files)."""
+
+class SunHours:
+    @property
+    def per_face(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def min_hours(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def max_hours(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def area(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def suns(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def step_hours(self) -> float: ...
+    def area_with_at_least(self, hours: float) -> npt.NDArray[np.float64]: ...
+    def per_sensor(self, points: _Points) -> npt.NDArray[np.float64]:
+        """The exact sun-hours at each point, among the mesh's faces."""
+
+def union(a: Mesh, b: Mesh) -> Mesh: ...
+def intersection(a: Mesh, b: Mesh) -> Mesh: ...
+def difference(a: Mesh, b: Mesh) -> Mesh: ...
+def shadows(mesh: Mesh, lights: Iterable[_Light]) -> Shadows: ...
+def study_suns(
+    lat: float,
+    lon: float,
+    dates: Iterable[Any],
+    step_minutes: float = ...,
+    utc_offset: float = ...,
+    north: float = ...,
+    up: str = ...,
+    height: float = ...,
+) -> npt.NDArray[np.float64]: ...
+def set_threads(n: Optional[int] = ...) -> None: ...
+def get_threads() -> int: ...
+def _hours_of_suns(mesh: Mesh, suns: _Points, step_hours: float) -> SunHours: ...
+def _hours_run(mesh: Mesh, suns: _Points, step_hours: float) -> bytes: ...
+def _fold_runs(mesh: Mesh, runs: List[bytes], suns: _Points, step_hours: float) -> SunHours: ...

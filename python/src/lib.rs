@@ -1,0 +1,824 @@
+//! `bsp_shadows._native`: the Python package's compiled half. Every
+//! function takes numpy arrays or this module's objects, releases the GIL
+//! while it works, and runs on the module's thread pool
+//! ([`set_threads`]). `python/bsp_shadows/__init__.py` is the face people
+//! use; `_native.pyi` types it.
+
+use std::sync::{Arc, Mutex};
+
+use bsp_shadows::sun::{HoursRun, SunSite, Up};
+use bsp_shadows::{DVec3, Error, Face, Light};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods,
+};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict, PyList};
+
+create_exception!(
+    bsp_shadows,
+    BspError,
+    PyValueError,
+    "The base of this package's errors: input it refuses, with the library's message."
+);
+create_exception!(
+    bsp_shadows,
+    MeshError,
+    BspError,
+    "A mesh that cannot be used: a face naming no vertex, an operand of a Boolean that is not closed (the message names the face and the edge), a face that does not fit the grid."
+);
+create_exception!(
+    bsp_shadows,
+    LightError,
+    BspError,
+    "A light that cannot be placed: too far from the scene, too many, a zero direction."
+);
+
+/// What `__reduce__` gives pickle: a callable and its arguments.
+type Reduced<'py, A> = PyResult<(Bound<'py, PyAny>, A)>;
+
+/// A Python exception for a library error, with its message.
+fn to_py(e: Error) -> PyErr {
+    match &e {
+        Error::File(shadow_scene::SceneError::Io { .. }) | Error::Io(_) => {
+            PyOSError::new_err(e.to_string())
+        }
+        Error::File(_) | Error::Boolean(_) | Error::Import(_) => MeshError::new_err(e.to_string()),
+        Error::Light(_) => LightError::new_err(e.to_string()),
+        _ => BspError::new_err(e.to_string()),
+    }
+}
+
+/// The pool every call runs on: `None` until [`set_threads`] sets one
+/// (then rayon's global pool: the CPUs the process may use).
+static POOL: Mutex<Option<Arc<rayon::ThreadPool>>> = Mutex::new(None);
+
+/// `work` without the GIL, on the module's pool.
+fn run<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> T {
+    let pool = POOL.lock().expect("the pool's lock").clone();
+    py.detach(|| match pool {
+        Some(pool) => pool.install(work),
+        None => work(),
+    })
+}
+
+/// Sets the number of threads the package's work runs on; `None` or 0:
+/// the CPUs the process may use. Results do not depend on it.
+#[pyfunction]
+#[pyo3(signature = (n=None))]
+fn set_threads(n: Option<usize>) -> PyResult<()> {
+    let pool = match n {
+        None | Some(0) => None,
+        Some(n) => Some(Arc::new(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| BspError::new_err(e.to_string()))?,
+        )),
+    };
+    *POOL.lock().expect("the pool's lock") = pool;
+    Ok(())
+}
+
+/// The number of threads the package's work runs on.
+#[pyfunction]
+fn get_threads() -> usize {
+    match &*POOL.lock().expect("the pool's lock") {
+        Some(pool) => pool.current_num_threads(),
+        None => rayon::current_num_threads(),
+    }
+}
+
+/// `array` as a C-contiguous, aligned numpy array of `dtype` (a copy only
+/// where it is not one already: arrays unpickled from out-of-band buffers
+/// may be misaligned).
+fn aligned<'py>(
+    np: &Bound<'py, PyModule>,
+    array: &Bound<'py, PyAny>,
+    dtype: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let kwargs = PyDict::new(np.py());
+    kwargs.set_item("requirements", ["C", "A"])?;
+    np.call_method("require", (array, dtype), Some(&kwargs))
+}
+
+/// `array` as points, `(n, 3)` float64.
+fn points<'py>(py: Python<'py>, array: &Bound<'py, PyAny>, what: &str) -> PyResult<Vec<DVec3>> {
+    let np = py.import("numpy")?;
+    let a = aligned(&np, array, "float64")?;
+    let a: PyReadonlyArray2<'py, f64> = a
+        .extract()
+        .map_err(|_| MeshError::new_err(format!("{what}: an array of shape (n, 3) of numbers")))?;
+    let shape = a.shape();
+    if shape[1] != 3 {
+        return Err(MeshError::new_err(format!(
+            "{what}: shape ({}, {}), not (n, 3)",
+            shape[0], shape[1]
+        )));
+    }
+    let flat = a.as_slice()?;
+    let out: Vec<DVec3> = flat
+        .chunks_exact(3)
+        .map(|p| DVec3::new(p[0], p[1], p[2]))
+        .collect();
+    if let Some(i) = out.iter().position(|p| !p.is_finite()) {
+        return Err(MeshError::new_err(format!(
+            "{what}: row {i} is not finite ({}, {}, {})",
+            out[i].x, out[i].y, out[i].z
+        )));
+    }
+    Ok(out)
+}
+
+/// Faces from an `(m, k)` integer array or a sequence of polygons.
+fn faces_of(py: Python<'_>, faces: &Bound<'_, PyAny>, vertices: usize) -> PyResult<Vec<Face>> {
+    let np = py.import("numpy")?;
+    let loops: Vec<Vec<i64>> =
+        if faces.hasattr("ndim")? && faces.getattr("ndim")?.extract::<usize>()? == 2 {
+            let a = aligned(&np, faces, "int64")?;
+            let a: PyReadonlyArray2<'_, i64> = a.extract()?;
+            let k = a.shape()[1];
+            a.as_slice()?
+                .chunks_exact(k.max(1))
+                .map(<[i64]>::to_vec)
+                .collect()
+        } else {
+            let mut out = Vec::new();
+            for (i, face) in faces.try_iter()?.enumerate() {
+                let face = face?;
+                let a = np.call_method1("asarray", (&face, "int64")).map_err(|_| {
+                    MeshError::new_err(format!("face {i}: a sequence of vertex indices"))
+                })?;
+                let v: Vec<i64> = a.call_method0("tolist")?.extract().map_err(|_| {
+                    MeshError::new_err(format!("face {i}: a flat sequence of vertex indices"))
+                })?;
+                out.push(v);
+            }
+            out
+        };
+    (loops.into_iter().enumerate())
+        .map(|(i, l)| {
+            if l.len() < 3 {
+                return Err(MeshError::new_err(format!(
+                    "face {i} has {} vertices, fewer than 3",
+                    l.len()
+                )));
+            }
+            let vertices = l
+                .iter()
+                .map(|&v| {
+                    u32::try_from(v)
+                        .ok()
+                        .filter(|&v| (v as usize) < vertices)
+                        .ok_or_else(|| {
+                            MeshError::new_err(format!(
+                                "face {i} names vertex {v}, but the vertices are 0 to {}",
+                                vertices as i64 - 1
+                            ))
+                        })
+                })
+                .collect::<PyResult<_>>()?;
+            Ok(Face {
+                vertices,
+                line: 0,
+                group: 0,
+            })
+        })
+        .collect()
+}
+
+/// A polygon mesh: `Mesh(vertices, faces)` with vertices an `(n, 3)`
+/// float64 array and faces an `(m, k)` integer array or a list of
+/// polygons (vertex index lists, counter-clockwise seen from outside).
+#[pyclass(module = "bsp_shadows", frozen)]
+#[derive(Clone)]
+struct Mesh {
+    mesh: Arc<bsp_shadows::Mesh>,
+}
+
+impl Mesh {
+    fn of(mesh: bsp_shadows::Mesh) -> Mesh {
+        Mesh {
+            mesh: Arc::new(mesh),
+        }
+    }
+}
+
+#[pymethods]
+impl Mesh {
+    #[new]
+    fn new(
+        py: Python<'_>,
+        vertices: &Bound<'_, PyAny>,
+        faces: &Bound<'_, PyAny>,
+    ) -> PyResult<Mesh> {
+        let positions = points(py, vertices, "vertices")?;
+        let faces = faces_of(py, faces, positions.len())?;
+        Ok(Mesh::of(bsp_shadows::Mesh {
+            positions,
+            faces,
+            groups: vec!["default".to_string()],
+        }))
+    }
+
+    /// Reads an OBJ or STL file.
+    #[staticmethod]
+    fn read(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Mesh> {
+        run(py, || bsp_shadows::read_mesh(&path))
+            .map(Mesh::of)
+            .map_err(to_py)
+    }
+
+    /// Writes the mesh as OBJ or STL, by the extension.
+    fn write(&self, py: Python<'_>, path: std::path::PathBuf) -> PyResult<()> {
+        run(py, || bsp_shadows::write_mesh(&path, &self.mesh)).map_err(to_py)
+    }
+
+    /// The vertex positions, `(n, 3)` float64 (a copy).
+    #[getter]
+    fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let flat: Vec<f64> = self
+            .mesh
+            .positions
+            .iter()
+            .flat_map(|p| p.to_array())
+            .collect();
+        flat.into_pyarray(py)
+            .reshape([self.mesh.positions.len(), 3])
+    }
+
+    /// The faces: an `(m, k)` int64 array when every face has `k`
+    /// vertices, else a list of 1-D int64 arrays.
+    #[getter]
+    fn faces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let faces = &self.mesh.faces;
+        let k = faces.first().map_or(3, |f| f.vertices.len());
+        if faces.iter().all(|f| f.vertices.len() == k) {
+            let flat: Vec<i64> = faces
+                .iter()
+                .flat_map(|f| f.vertices.iter().map(|&v| i64::from(v)))
+                .collect();
+            return Ok(flat.into_pyarray(py).reshape([faces.len(), k])?.into_any());
+        }
+        let list = PyList::empty(py);
+        for f in faces {
+            let v: Vec<i64> = f.vertices.iter().map(|&v| i64::from(v)).collect();
+            list.append(v.into_pyarray(py))?;
+        }
+        Ok(list.into_any())
+    }
+
+    /// The volume enclosed, exact for the `f64` positions and rounded once.
+    fn volume(&self, py: Python<'_>) -> f64 {
+        run(py, || bsp_shadows::volume(&self.mesh))
+    }
+
+    /// Whether every edge is met by exactly two faces in opposite
+    /// directions (a closed, oriented surface).
+    fn is_closed(&self) -> bool {
+        self.mesh.is_closed_oriented()
+    }
+
+    /// The mesh moved by `offset` (three numbers).
+    fn translated(&self, offset: [f64; 3]) -> Mesh {
+        Mesh::of(bsp_shadows::translated(
+            &self.mesh,
+            DVec3::from_array(offset),
+        ))
+    }
+
+    /// A `trimesh.Trimesh` of the same vertices and faces (polygons are
+    /// fanned), without trimesh's processing.
+    fn to_trimesh<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let trimesh = py.import("trimesh")?;
+        let flat: Vec<i64> = self
+            .mesh
+            .faces
+            .iter()
+            .flat_map(|f| {
+                (1..f.vertices.len() - 1).flat_map(move |k| {
+                    [f.vertices[0], f.vertices[k], f.vertices[k + 1]].map(i64::from)
+                })
+            })
+            .collect();
+        let n = flat.len() / 3;
+        let faces = flat.into_pyarray(py).reshape([n, 3])?;
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("process", false)?;
+        trimesh
+            .getattr("Trimesh")?
+            .call((self.vertices(py)?, faces), Some(&kwargs))
+    }
+
+    /// The mesh of a `trimesh.Trimesh` (its vertices and faces).
+    #[staticmethod]
+    fn from_trimesh(py: Python<'_>, mesh: &Bound<'_, PyAny>) -> PyResult<Mesh> {
+        Mesh::new(py, &mesh.getattr("vertices")?, &mesh.getattr("faces")?)
+    }
+
+    fn __or__(&self, py: Python<'_>, other: &Mesh) -> PyResult<Mesh> {
+        boolean(py, self, other, bsp_shadows::union)
+    }
+
+    fn __and__(&self, py: Python<'_>, other: &Mesh) -> PyResult<Mesh> {
+        boolean(py, self, other, bsp_shadows::intersection)
+    }
+
+    fn __sub__(&self, py: Python<'_>, other: &Mesh) -> PyResult<Mesh> {
+        boolean(py, self, other, bsp_shadows::difference)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Mesh(vertices={}, faces={})",
+            self.mesh.positions.len(),
+            self.mesh.faces.len()
+        )
+    }
+
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> Reduced<'py, (Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let py = slf.py();
+        let me = slf.get();
+        Ok((
+            slf.get_type().into_any(),
+            (me.vertices(py)?.into_any(), me.faces(py)?),
+        ))
+    }
+}
+
+fn boolean(
+    py: Python<'_>,
+    a: &Mesh,
+    b: &Mesh,
+    op: fn(&bsp_shadows::Mesh, &bsp_shadows::Mesh) -> Result<bsp_shadows::Mesh, Error>,
+) -> PyResult<Mesh> {
+    run(py, || op(&a.mesh, &b.mesh))
+        .map(Mesh::of)
+        .map_err(to_py)
+}
+
+/// The exact union of two closed meshes (also `a | b`).
+#[pyfunction]
+fn union(py: Python<'_>, a: &Mesh, b: &Mesh) -> PyResult<Mesh> {
+    boolean(py, a, b, bsp_shadows::union)
+}
+
+/// The exact intersection of two closed meshes (also `a & b`).
+#[pyfunction]
+fn intersection(py: Python<'_>, a: &Mesh, b: &Mesh) -> PyResult<Mesh> {
+    boolean(py, a, b, bsp_shadows::intersection)
+}
+
+/// The exact difference `a − b` of two closed meshes (also `a - b`).
+#[pyfunction]
+fn difference(py: Python<'_>, a: &Mesh, b: &Mesh) -> PyResult<Mesh> {
+    boolean(py, a, b, bsp_shadows::difference)
+}
+
+/// A point light at `position`.
+#[pyclass(module = "bsp_shadows", frozen)]
+#[derive(Clone)]
+struct PointLight {
+    #[pyo3(get)]
+    position: (f64, f64, f64),
+}
+
+#[pymethods]
+impl PointLight {
+    #[new]
+    fn new(position: (f64, f64, f64)) -> PointLight {
+        PointLight { position }
+    }
+
+    fn __repr__(&self) -> String {
+        format!("PointLight({:?})", self.position)
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> (Bound<'py, PyAny>, ((f64, f64, f64),)) {
+        (slf.get_type().into_any(), (slf.get().position,))
+    }
+}
+
+/// A sun: a light infinitely far in `direction` (from the scene toward it).
+#[pyclass(module = "bsp_shadows", frozen)]
+#[derive(Clone)]
+struct Sun {
+    #[pyo3(get)]
+    direction: (f64, f64, f64),
+}
+
+#[pymethods]
+impl Sun {
+    #[new]
+    fn new(direction: (f64, f64, f64)) -> Sun {
+        Sun { direction }
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Sun({:?})", self.direction)
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> (Bound<'py, PyAny>, ((f64, f64, f64),)) {
+        (slf.get_type().into_any(), (slf.get().direction,))
+    }
+}
+
+fn light_of(light: &Bound<'_, PyAny>, i: usize) -> PyResult<Light> {
+    if let Ok(p) = light.cast::<PointLight>() {
+        let (x, y, z) = p.get().position;
+        Ok(Light::Point(DVec3::new(x, y, z)))
+    } else if let Ok(s) = light.cast::<Sun>() {
+        let (x, y, z) = s.get().direction;
+        Ok(Light::Sun(DVec3::new(x, y, z)))
+    } else {
+        Err(LightError::new_err(format!(
+            "light {i} is neither a PointLight nor a Sun"
+        )))
+    }
+}
+
+/// The lit and shadowed parts of every face for some lights.
+#[pyclass(module = "bsp_shadows", frozen)]
+struct Shadows {
+    mesh: Mesh,
+    lights: Vec<Py<PyAny>>,
+    shadows: bsp_shadows::Shadows,
+}
+
+/// Shades every face of `mesh` for `lights` (at most 64 `PointLight` or
+/// `Sun`): exact lit and shadowed fragments.
+#[pyfunction]
+fn shadows(py: Python<'_>, mesh: &Mesh, lights: &Bound<'_, PyAny>) -> PyResult<Shadows> {
+    let given: Vec<Bound<'_, PyAny>> = lights.try_iter()?.collect::<PyResult<_>>()?;
+    let specs: Vec<Light> = (given.iter().enumerate())
+        .map(|(i, l)| light_of(l, i))
+        .collect::<PyResult<_>>()?;
+    let s = run(py, || bsp_shadows::shadows(&mesh.mesh, &specs)).map_err(to_py)?;
+    Ok(Shadows {
+        mesh: mesh.clone(),
+        lights: given.into_iter().map(Bound::unbind).collect(),
+        shadows: s,
+    })
+}
+
+#[pymethods]
+impl Shadows {
+    /// `(faces, lights)` float64: the area of each face each light reaches.
+    #[getter]
+    fn lit_area<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (faces, lights) = (self.mesh.mesh.faces.len(), self.lights.len());
+        let flat: Vec<f64> = (0..faces)
+            .flat_map(|f| (0..lights).map(move |l| (f, l)))
+            .map(|(f, l)| self.shadows.lit_area(f, l))
+            .collect();
+        flat.into_pyarray(py).reshape([faces, lights])
+    }
+
+    /// `(faces,)` float64: each face's area.
+    #[getter]
+    fn face_area<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let faces = self.mesh.mesh.faces.len();
+        (0..faces)
+            .map(|f| self.shadows.face_area(f))
+            .collect::<Vec<_>>()
+            .into_pyarray(py)
+    }
+
+    /// The share of the whole surface light `light` reaches.
+    fn lit_fraction(&self, light: usize) -> PyResult<f64> {
+        if light >= self.lights.len() {
+            return Err(LightError::new_err(format!(
+                "light {light} of {}",
+                self.lights.len()
+            )));
+        }
+        Ok(self.shadows.lit_fraction(light))
+    }
+
+    /// Every fragment as arrays: `face` (F,) int64; `lit` (F,) uint64,
+    /// bit i set where light i reaches it; `rings` (F+1,) int64, fragment
+    /// f's rings are `rings[f]:rings[f+1]` (outer first, then holes);
+    /// `ring_points` (R+1,) int64, ring r's points are
+    /// `points[ring_points[r]:ring_points[r+1]]`; `points` (P, 3) float64.
+    fn fragments<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let (mut face, mut lit, mut rings, mut ring_points, mut pts) =
+            (Vec::new(), Vec::new(), vec![0i64], vec![0i64], Vec::new());
+        for f in self.shadows.fragments() {
+            face.push(f.face as i64);
+            lit.push(f.lit);
+            for r in &f.rings {
+                pts.extend(r.iter().flat_map(|p| p.to_array()));
+                ring_points.push((pts.len() / 3) as i64);
+            }
+            rings.push(ring_points.len() as i64 - 1);
+        }
+        let d = PyDict::new(py);
+        let n = pts.len() / 3;
+        d.set_item("face", face.into_pyarray(py))?;
+        d.set_item("lit", lit.into_pyarray(py))?;
+        d.set_item("rings", rings.into_pyarray(py))?;
+        d.set_item("ring_points", ring_points.into_pyarray(py))?;
+        d.set_item("points", pts.into_pyarray(py).reshape([n, 3])?)?;
+        Ok(d)
+    }
+
+    /// Writes the fragments as JSON or OBJ, by the extension.
+    fn write(&self, py: Python<'_>, path: std::path::PathBuf) -> PyResult<()> {
+        run(py, || self.shadows.write(&path)).map_err(to_py)
+    }
+
+    /// The mesh shaded.
+    #[getter]
+    fn mesh(&self) -> Mesh {
+        self.mesh.clone()
+    }
+
+    /// The lights, as given.
+    #[getter]
+    fn lights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        PyList::new(py, self.lights.iter().map(|l| l.bind(py)))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Shadows(faces={}, lights={})",
+            self.mesh.mesh.faces.len(),
+            self.lights.len()
+        )
+    }
+
+    /// Pickled as its mesh and lights; unpickling shades again (the same
+    /// bits: the result is a function of them).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> Reduced<'py, (Mesh, Bound<'py, PyList>)> {
+        let py = slf.py();
+        let f = py.import("bsp_shadows._native")?.getattr("shadows")?;
+        Ok((f, (slf.get().mesh.clone(), slf.get().lights(py)?)))
+    }
+}
+
+/// The directions toward the suns of a study, `(s, 3)`: on each date, the
+/// midpoints of the day's `step_minutes` intervals with the sun above the
+/// horizon.
+#[pyfunction]
+#[pyo3(signature = (lat, lon, dates, step_minutes=10.0, utc_offset=0.0, north=0.0, up="z", height=0.0))]
+#[allow(clippy::too_many_arguments)] // (Python keywords, each with a default)
+fn study_suns<'py>(
+    py: Python<'py>,
+    lat: f64,
+    lon: f64,
+    dates: &Bound<'py, PyAny>,
+    step_minutes: f64,
+    utc_offset: f64,
+    north: f64,
+    up: &str,
+    height: f64,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let up: Up = up.parse().map_err(BspError::new_err)?;
+    let mut days = Vec::new();
+    for d in dates.try_iter()? {
+        let text = d?.str()?.to_string();
+        let day = text
+            .get(..10)
+            .unwrap_or(&text)
+            .parse::<chrono::NaiveDate>()
+            .map_err(|e| BspError::new_err(format!("`{text}` is not a date YYYY-MM-DD ({e})")))?;
+        days.push(day);
+    }
+    let site = SunSite {
+        height,
+        ..SunSite::new(lat, lon).with_axes(north, up)
+    };
+    let suns = bsp_shadows::sun::study_suns(&site, &days, step_minutes, utc_offset)
+        .map_err(|e| BspError::new_err(e.to_string()))?;
+    let flat: Vec<f64> = suns.iter().flat_map(|s| s.direction.to_array()).collect();
+    flat.into_pyarray(py).reshape([suns.len(), 3])
+}
+
+/// A study's hours per face.
+#[pyclass(module = "bsp_shadows", frozen)]
+struct SunHours {
+    mesh: Mesh,
+    suns: Vec<DVec3>,
+    step_hours: f64,
+    hours: Vec<bsp_shadows::sun::FaceHours>,
+}
+
+#[pymethods]
+impl SunHours {
+    /// `(faces,)`: each face's sun-hours (its points' mean).
+    #[getter]
+    fn per_face<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.hours
+            .iter()
+            .map(|h| h.sun_hours)
+            .collect::<Vec<_>>()
+            .into_pyarray(py)
+    }
+
+    /// `(faces,)`: the fewest hours a point of each face gets.
+    #[getter]
+    fn min_hours<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.hours
+            .iter()
+            .map(|h| h.min_hours)
+            .collect::<Vec<_>>()
+            .into_pyarray(py)
+    }
+
+    /// `(faces,)`: the most hours a point of each face gets.
+    #[getter]
+    fn max_hours<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.hours
+            .iter()
+            .map(|h| h.max_hours)
+            .collect::<Vec<_>>()
+            .into_pyarray(py)
+    }
+
+    /// `(faces,)`: each face's area.
+    #[getter]
+    fn area<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.hours
+            .iter()
+            .map(|h| h.area)
+            .collect::<Vec<_>>()
+            .into_pyarray(py)
+    }
+
+    /// `(s, 3)`: the directions toward the study's suns.
+    #[getter]
+    fn suns<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let flat: Vec<f64> = self.suns.iter().flat_map(|s| s.to_array()).collect();
+        flat.into_pyarray(py).reshape([self.suns.len(), 3])
+    }
+
+    /// The hours each sun stands for.
+    #[getter]
+    fn step_hours(&self) -> f64 {
+        self.step_hours
+    }
+
+    /// `(faces,)`: the area of each face whose points get at least `hours`.
+    fn area_with_at_least<'py>(&self, py: Python<'py>, hours: f64) -> Bound<'py, PyArray1<f64>> {
+        self.hours
+            .iter()
+            .map(|h| h.area_with_at_least(hours))
+            .collect::<Vec<_>>()
+            .into_pyarray(py)
+    }
+
+    /// `(p,)`: the exact sun-hours at each of `points` (`(p, 3)`), among
+    /// the mesh's faces.
+    fn per_sensor<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let at = crate::points(py, points, "points")?;
+        let h = run(py, || {
+            bsp_shadows::sun::sensor_hours(&self.mesh.mesh, &at, &self.suns, self.step_hours)
+        });
+        Ok(h.map_err(to_py)?.into_pyarray(py))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "SunHours(faces={}, suns={})",
+            self.hours.len(),
+            self.suns.len()
+        )
+    }
+
+    /// Pickled as the mesh, the suns, the step and the runs' bytes.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> Reduced<'py, (Mesh, Bound<'py, PyArray2<f64>>, f64)> {
+        let py = slf.py();
+        let me = slf.get();
+        let f = py
+            .import("bsp_shadows._native")?
+            .getattr("_hours_of_suns")?;
+        Ok((f, (me.mesh.clone(), me.suns(py)?, me.step_hours)))
+    }
+}
+
+/// The sun-hours of every face of `mesh` under the suns `suns` (`(s, 3)`,
+/// directions toward them), each standing for `step_hours`.
+#[pyfunction]
+fn _hours_of_suns(
+    py: Python<'_>,
+    mesh: &Mesh,
+    suns: &Bound<'_, PyAny>,
+    step_hours: f64,
+) -> PyResult<SunHours> {
+    let suns = points(py, suns, "suns")?;
+    let hours = run(py, || {
+        bsp_shadows::sun::sun_hours(&mesh.mesh, &suns, step_hours)
+    })
+    .map_err(to_py)?;
+    Ok(SunHours {
+        mesh: mesh.clone(),
+        suns,
+        step_hours,
+        hours,
+    })
+}
+
+/// One run of a study (at most 64 suns) as bytes: a task of the
+/// distributed study.
+#[pyfunction]
+fn _hours_run<'py>(
+    py: Python<'py>,
+    mesh: &Mesh,
+    suns: &Bound<'py, PyAny>,
+    step_hours: f64,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let suns = points(py, suns, "suns")?;
+    if suns.len() > MAX_SUNS_A_RUN {
+        return Err(LightError::new_err(format!(
+            "{} suns in one run; at most {MAX_SUNS_A_RUN}",
+            suns.len()
+        )));
+    }
+    let bytes = run(py, || {
+        HoursRun::new(&mesh.mesh, &suns, step_hours).map(|r| r.to_bytes())
+    })
+    .map_err(to_py)?;
+    Ok(PyBytes::new(py, &bytes))
+}
+
+/// The study's hours from its runs' bytes, folded in the order given.
+#[pyfunction]
+fn _fold_runs(
+    py: Python<'_>,
+    mesh: &Mesh,
+    runs: Vec<Vec<u8>>,
+    suns: &Bound<'_, PyAny>,
+    step_hours: f64,
+) -> PyResult<SunHours> {
+    let suns = points(py, suns, "suns")?;
+    let faces = mesh.mesh.faces.len();
+    let hours = run(py, || {
+        let runs = runs
+            .iter()
+            .enumerate()
+            .map(|(i, b)| HoursRun::from_bytes(b).ok_or(i));
+        let mut parsed = Vec::new();
+        for r in runs {
+            match r {
+                Ok(r) => parsed.push(Ok(r)),
+                Err(i) => return Err(Err(i)),
+            }
+        }
+        HoursRun::fold(faces, parsed).map_err(Ok)
+    });
+    let hours = match hours {
+        Ok(h) => h,
+        Err(Ok(e)) => return Err(to_py(e)),
+        Err(Err(i)) => return Err(BspError::new_err(format!("run {i} is not a run's bytes"))),
+    };
+    if hours.len() != faces {
+        return Err(BspError::new_err("the runs are of another mesh"));
+    }
+    Ok(SunHours {
+        mesh: mesh.clone(),
+        suns,
+        step_hours,
+        hours,
+    })
+}
+
+/// The number of suns one run takes (the shadow engine's lights a pass).
+const MAX_SUNS_A_RUN: usize = bsp_shadows::MAX_LIGHTS;
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("BspError", py.get_type::<BspError>())?;
+    m.add("MeshError", py.get_type::<MeshError>())?;
+    m.add("LightError", py.get_type::<LightError>())?;
+    m.add("MAX_SUNS_A_RUN", MAX_SUNS_A_RUN)?;
+    m.add_class::<Mesh>()?;
+    m.add_class::<PointLight>()?;
+    m.add_class::<Sun>()?;
+    m.add_class::<Shadows>()?;
+    m.add_class::<SunHours>()?;
+    for f in [
+        wrap_pyfunction!(union, m)?,
+        wrap_pyfunction!(intersection, m)?,
+        wrap_pyfunction!(difference, m)?,
+        wrap_pyfunction!(shadows, m)?,
+        wrap_pyfunction!(study_suns, m)?,
+        wrap_pyfunction!(_hours_of_suns, m)?,
+        wrap_pyfunction!(_hours_run, m)?,
+        wrap_pyfunction!(_fold_runs, m)?,
+        wrap_pyfunction!(set_threads, m)?,
+        wrap_pyfunction!(get_threads, m)?,
+    ] {
+        m.add_function(f)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,69 @@
+"""The package gives what the command line writes, for the same input."""
+
+import json
+
+import numpy as np
+import pytest
+
+import bsp_shadows as bs
+from conftest import MESHES, run_cli
+
+
+@pytest.mark.parametrize("op", ["union", "intersection", "difference"])
+def test_booleans_equal_the_cli_byte_for_byte(tmp_path, shadow_bin, sphere, op):
+    moved = sphere.translated((0.31, 0.17, -0.05))
+    a, b = tmp_path / "a.obj", tmp_path / "b.obj"
+    sphere.write(a)
+    moved.write(b)
+    run_cli(shadow_bin, "csg", op, a, b, "-o", tmp_path / "cli.obj")
+    ours = getattr(bs, op)(bs.read_mesh(a), bs.read_mesh(b))
+    ours.write(tmp_path / "py.obj")
+    assert (tmp_path / "py.obj").read_bytes() == (tmp_path / "cli.obj").read_bytes()
+    operator = {"union": "__or__", "intersection": "__and__", "difference": "__sub__"}[op]
+    again = getattr(bs.read_mesh(a), operator)(bs.read_mesh(b))
+    assert (again.vertices == ours.vertices).all() and (again.faces == ours.faces).all()
+    assert again.is_closed()
+
+
+def test_lit_areas_equal_the_cli_json(tmp_path, shadow_bin, teapot):
+    run_cli(
+        shadow_bin,
+        "shadows",
+        MESHES / "teapot.obj",
+        "--light", "2,3,5",
+        "--sun", "1,1,3",
+        "-o", tmp_path / "cli.json",
+    )
+    cli = json.loads((tmp_path / "cli.json").read_text())
+    s = bs.shadows(teapot, [bs.PointLight((2, 3, 5)), bs.Sun((1, 1, 3))])
+    lit = np.zeros_like(s.lit_area)
+    for frag in cli["fragments"]:
+        for i, on in enumerate(frag["lit"]):
+            if on:
+                lit[frag["face"], i] += frag["area"]
+    assert (lit == s.lit_area).all()
+    assert list(s.lit_area.sum(axis=0)) == cli["summary"]["lit_area"]
+    frags = s.fragments()
+    assert len(frags["face"]) == len(cli["fragments"])
+    assert (frags["face"] == [f["face"] for f in cli["fragments"]]).all()
+    # the outer rings' points are the JSON's vertices
+    first = cli["fragments"][0]["vertices"]
+    r0, r1 = frags["ring_points"][0], frags["ring_points"][1]
+    assert (frags["points"][r0:r1] == np.array(first)).all()
+    s.write(tmp_path / "py.json")
+    assert (tmp_path / "py.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+
+
+def test_sun_hours_equal_the_cli(tmp_path, shadow_bin, yard):
+    yard.write(tmp_path / "yard.obj")
+    run_cli(
+        shadow_bin, "sunhours", tmp_path / "yard.obj",
+        "--lat", "51.5", "--lon", "-0.1", "--date", "2026-03-21", "--step", "20",
+        "-o", tmp_path / "cli.csv",
+    )
+    rows = (tmp_path / "cli.csv").read_text().splitlines()[1:]
+    cli = np.array([[float(x) for x in r.split(",")[2:]] for r in rows])
+    h = bs.sun_hours(bs.read_mesh(tmp_path / "yard.obj"), lat=51.5, lon=-0.1,
+                     dates=["2026-03-21"], step_minutes=20)
+    ours = np.column_stack([h.area, h.per_face, h.min_hours, h.max_hours])
+    assert (ours == cli).all()

@@ -1,0 +1,59 @@
+"""Sun studies on Dask and Ray (on the loopback only) give one process's
+numbers, bit for bit."""
+
+import numpy as np
+import pytest
+
+import bsp_shadows as bs
+import bsp_shadows.distributed as bsd
+
+STUDY = dict(lat=51.5, lon=-0.1, dates=["2026-03-21", "2026-06-21"], step_minutes=10)
+
+
+@pytest.fixture(scope="module")
+def single(yard):
+    h = bs.sun_hours(yard, **STUDY)
+    # more suns than one run takes: several runs to fold
+    assert len(h.suns) > 2 * bs.MAX_SUNS_A_RUN
+    return h
+
+
+def same(a, b):
+    for name in ["per_face", "min_hours", "max_hours", "area", "suns"]:
+        x, y = getattr(a, name), getattr(b, name)
+        assert x.shape == y.shape and (x == y).all(), name
+
+
+def test_runs_folded_in_process(yard, single):
+    runs = [bs._native._hours_run(yard, r, single.step_hours) for r in bsd.runs_of(single.suns)]
+    same(bs._native._fold_runs(yard, runs, single.suns, single.step_hours), single)
+    with pytest.raises(bs.BspError, match="run 0"):
+        bs._native._fold_runs(yard, [runs[0][:-8]], single.suns, single.step_hours)
+
+
+def test_dask_local_cluster(yard, single):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+        dashboard_address=None, silence_logs=40,
+    ) as cluster, distributed.Client(cluster) as client:
+        h = bsd.sun_hours(yard, client, threads_per_task=1, **STUDY)
+    same(h, single)
+    points = np.array([[0.0, -3.0, 0.01], [6.0, 5.0, 0.01]])
+    assert (h.per_sensor(points) == single.per_sensor(points)).all()
+
+
+def test_ray_local(yard, single):
+    ray = pytest.importorskip("ray")
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False,
+             configure_logging=False, _node_ip_address="127.0.0.1")
+    try:
+        h = bsd.sun_hours(yard, "ray", threads_per_task=1, **STUDY)
+    finally:
+        ray.shutdown()
+    same(h, single)
+
+
+def test_bad_client(yard):
+    with pytest.raises(TypeError):
+        bsd.sun_hours(yard, object(), **STUDY)

@@ -1,0 +1,98 @@
+import pickle
+
+import numpy as np
+import pytest
+
+import bsp_shadows as bs
+from conftest import MESHES, tet
+
+
+def test_arrays_in_and_out():
+    v, f = tet()
+    m = bs.Mesh(v, f)
+    assert m.vertices.dtype == np.float64 and m.vertices.shape == (4, 3)
+    assert (m.vertices == v).all() and (m.faces == f).all()
+    assert m.is_closed()
+    assert m.volume() == 1 / 6
+    # other dtypes and lists convert; a list of polygons of mixed sizes too
+    assert (bs.Mesh(v.astype(np.float32), f.astype(np.uint32)).faces == f).all()
+    assert (bs.Mesh(v.tolist(), f.tolist()).vertices == v).all()
+    pyramid = bs.Mesh(
+        [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 1]],
+        [[0, 3, 2, 1], [0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]],
+    )
+    assert isinstance(pyramid.faces, list) and len(pyramid.faces) == 5
+    assert pyramid.volume() == 1 / 3
+    assert pyramid.is_closed()
+
+
+def test_exact_volume():
+    cube = bs.box((0, 0, 0), (0.1, 0.1, 0.1))
+    far = cube.translated((1e9, -3e9, 2e9))
+    v = far.vertices
+    sides = v.max(axis=0) - v.min(axis=0)
+    # the f64 sides as stored, multiplied exactly (few bits each)
+    assert far.volume() == sides[0] * sides[1] * sides[2]
+    assert bs.box((-1, -2, -3), (2, 2, 2)).volume() == 60.0
+
+
+def test_bad_input_raises_with_a_message(tmp_path):
+    v, f = tet()
+    with pytest.raises(bs.MeshError, match="face 1 names vertex 7"):
+        bs.Mesh(v, [[0, 2, 1], [0, 1, 7]])
+    with pytest.raises(bs.MeshError, match="fewer than 3"):
+        bs.Mesh(v, [[0, 2, 1], [0, 1]])
+    with pytest.raises(bs.MeshError, match="shape"):
+        bs.Mesh(v[:, :2], f)
+    bad = v.copy()
+    bad[2, 1] = np.nan
+    with pytest.raises(bs.MeshError, match="row 2 is not finite"):
+        bs.Mesh(bad, f)
+    # an open operand: the message names the face and the edge
+    open_tet = bs.Mesh(v, f[:3])
+    with pytest.raises(bs.MeshError, match=r"edge .* of face \d+ is a boundary edge"):
+        open_tet | bs.Mesh(v, f)
+    with pytest.raises(OSError):
+        bs.read_mesh(MESHES / "no such mesh.obj")
+    (tmp_path / "bad.obj").write_text("v 0 0 0\nv 1 0\nf 1 2 3\n")
+    with pytest.raises(bs.MeshError, match=r"bad.obj:2: vertex has 2"):
+        bs.read_mesh(tmp_path / "bad.obj")
+    with pytest.raises(bs.LightError, match="neither"):
+        bs.shadows(bs.Mesh(v, f), ["a lamp"])
+    with pytest.raises(bs.LightError):
+        bs.shadows(bs.Mesh(v, f), [bs.Sun((0, 0, 0))])
+    with pytest.raises(bs.LightError):
+        bs.shadows(bs.Mesh(v, f), [bs.Sun((0, 0, 1))] * 65)
+    assert issubclass(bs.MeshError, ValueError)
+
+
+def test_pickle_round_trips(sphere, yard):
+    for obj in [sphere, bs.PointLight((1.0, 2.0, 3.0)), bs.Sun((0.0, 0.5, 1.0))]:
+        back = pickle.loads(pickle.dumps(obj))
+        assert repr(back) == repr(obj)
+    back = pickle.loads(pickle.dumps(sphere))
+    assert (back.vertices == sphere.vertices).all() and (back.faces == sphere.faces).all()
+    s = bs.shadows(yard, [bs.PointLight((3, 4, 20)), bs.Sun((1, 2, 4))])
+    t = pickle.loads(pickle.dumps(s))
+    assert (t.lit_area == s.lit_area).all()
+    h = bs.sun_hours(yard, lat=51.5, lon=0.0, dates=["2026-06-21"], step_minutes=30)
+    g = pickle.loads(pickle.dumps(h))
+    assert (g.per_face == h.per_face).all() and (g.suns == h.suns).all()
+
+
+def test_trimesh_both_ways(sphere):
+    trimesh = pytest.importorskip("trimesh")
+    t = sphere.to_trimesh()
+    assert isinstance(t, trimesh.Trimesh) and t.is_watertight
+    assert abs(t.volume - sphere.volume()) < 1e-9 * abs(sphere.volume())
+    back = bs.from_trimesh(t)
+    assert (back.vertices == sphere.vertices).all()
+    u = bs.union(back, back.translated((0.3, 0.0, 0.0)))
+    assert bs.to_trimesh(u).is_watertight
+
+
+def test_the_package_docstring_examples():
+    import doctest
+
+    result = doctest.testmod(bs)
+    assert result.attempted >= 4 and result.failed == 0
