@@ -109,6 +109,7 @@ def sun_hours(
     north: float = 0.0,
     up: str = "z",
     height: float = 0.0,
+    extremes: bool = True,
 ) -> SunHours:
     """The sun-hours of every face of ``scene`` over a study: on each of
     ``dates`` (``datetime.date`` or ``"YYYY-MM-DD"``), a sun at the middle
@@ -121,6 +122,13 @@ def sun_hours(
     The result's ``per_face`` is each face's mean hours (exact lit areas
     for every sun), ``min_hours``/``max_hours`` the fewest and most a point
     of it gets, and ``per_sensor(points)`` the exact hours at points.
+
+    The extremes overlay every run's pieces of a face, which grows with the
+    arrangement of all the suns' shadow edges on it (quadratic in the suns
+    where many shadows cross one face, as on a ground under a detailed
+    object). ``extremes=False`` leaves them NaN and costs the shadows alone;
+    use it for long studies of large scenes, and ``per_sensor`` for hours
+    at points.
     """
     suns = study_suns(lat, lon, list(dates), step_minutes, utc_offset, north, up, height)
-    return _native._hours_of_suns(scene, suns, step_minutes / 60.0)
+    return _native._hours_of_suns(scene, suns, step_minutes / 60.0, extremes)

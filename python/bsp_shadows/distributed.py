@@ -35,10 +35,10 @@ def runs_of(suns: np.ndarray) -> List[np.ndarray]:
     return [suns[i : i + MAX_SUNS_A_RUN] for i in range(0, len(suns), MAX_SUNS_A_RUN)]
 
 
-def _run(mesh: Mesh, suns: np.ndarray, step_hours: float, threads: int | None) -> bytes:
+def _run(mesh: Mesh, suns: np.ndarray, step_hours: float, threads: int | None, extremes: bool) -> bytes:
     if threads is not None:
         _native.set_threads(threads)
-    return _native._hours_run(mesh, suns, step_hours)
+    return _native._hours_run(mesh, suns, step_hours, extremes)
 
 
 def sun_hours(
@@ -54,37 +54,39 @@ def sun_hours(
     up: str = "z",
     height: float = 0.0,
     threads_per_task: int | None = None,
+    extremes: bool = True,
 ) -> SunHours:
     """``bsp_shadows.sun_hours`` with the runs spread over ``client``: a
     ``dask.distributed.Client``, or ``"ray"`` for Ray's current cluster
     (``ray.init()`` first). ``threads_per_task`` caps the threads each task
     uses on its worker (default: the worker process's pool, which is the
     CPUs it may use; set it to the worker's CPUs when several workers share
-    a machine)."""
+    a machine). ``extremes``: as for ``bsp_shadows.sun_hours``."""
     suns = _native.study_suns(lat, lon, list(dates), step_minutes, utc_offset, north, up, height)
     step_hours = step_minutes / 60.0
     runs = runs_of(suns)
     if isinstance(client, str) and client == "ray":
-        parts = _on_ray(scene, runs, step_hours, threads_per_task)
+        parts = _on_ray(scene, runs, step_hours, threads_per_task, extremes)
     elif hasattr(client, "scatter") and hasattr(client, "gather"):
-        parts = _on_dask(client, scene, runs, step_hours, threads_per_task)
+        parts = _on_dask(client, scene, runs, step_hours, threads_per_task, extremes)
     else:
         raise TypeError("client: a dask.distributed.Client or the string 'ray'")
     return _native._fold_runs(scene, parts, suns, step_hours)
 
 
-def _on_dask(client, scene, runs, step_hours, threads):
+def _on_dask(client, scene, runs, step_hours, threads, extremes):
     mesh = client.scatter(scene, broadcast=True)
     futures = [
-        client.submit(_run, mesh, run, step_hours, threads, pure=False, key=f"bsp-sun-run-{i}-{id(runs)}")
+        client.submit(_run, mesh, run, step_hours, threads, extremes, pure=False,
+                      key=f"bsp-sun-run-{i}-{id(runs)}")
         for i, run in enumerate(runs)
     ]
     return client.gather(futures)
 
 
-def _on_ray(scene, runs, step_hours, threads):
+def _on_ray(scene, runs, step_hours, threads, extremes):
     import ray
 
     task = ray.remote(_run)
     mesh = ray.put(scene)
-    return ray.get([task.remote(mesh, run, step_hours, threads) for run in runs])
+    return ray.get([task.remote(mesh, run, step_hours, threads, extremes) for run in runs])

@@ -7,7 +7,7 @@
 use std::sync::{Arc, Mutex};
 
 use bsp_shadows::sun::{HoursRun, SunSite, Up};
-use bsp_shadows::{DVec3, Error, Face, Light};
+use bsp_shadows::{BoolOp, DVec3, Error, Face, Light};
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods,
 };
@@ -132,19 +132,18 @@ fn points<'py>(py: Python<'py>, array: &Bound<'py, PyAny>, what: &str) -> PyResu
 }
 
 /// Faces from an `(m, k)` integer array or a sequence of polygons.
-fn faces_of(py: Python<'_>, faces: &Bound<'_, PyAny>, vertices: usize) -> PyResult<Vec<Face>> {
+/// Faces from an `(m, k)` integer array or a sequence of polygons, checked.
+fn faces_of(py: Python<'_>, faces: &Bound<'_, PyAny>, vertices: usize) -> PyResult<FlatFaces> {
     let np = py.import("numpy")?;
-    let loops: Vec<Vec<i64>> =
+    // every index in one array, and where each face starts
+    let (flat, starts): (Vec<i64>, Vec<usize>) =
         if faces.hasattr("ndim")? && faces.getattr("ndim")?.extract::<usize>()? == 2 {
             let a = aligned(&np, faces, "int64")?;
             let a: PyReadonlyArray2<'_, i64> = a.extract()?;
-            let k = a.shape()[1];
-            a.as_slice()?
-                .chunks_exact(k.max(1))
-                .map(<[i64]>::to_vec)
-                .collect()
+            let (m, k) = (a.shape()[0], a.shape()[1]);
+            (a.as_slice()?.to_vec(), (0..=m).map(|i| i * k).collect())
         } else {
-            let mut out = Vec::new();
+            let (mut flat, mut starts) = (Vec::new(), vec![0]);
             for (i, face) in faces.try_iter()?.enumerate() {
                 let face = face?;
                 let a = np.call_method1("asarray", (&face, "int64")).map_err(|_| {
@@ -153,39 +152,69 @@ fn faces_of(py: Python<'_>, faces: &Bound<'_, PyAny>, vertices: usize) -> PyResu
                 let v: Vec<i64> = a.call_method0("tolist")?.extract().map_err(|_| {
                     MeshError::new_err(format!("face {i}: a flat sequence of vertex indices"))
                 })?;
-                out.push(v);
+                flat.extend(v);
+                starts.push(flat.len());
             }
-            out
+            (flat, starts)
         };
-    (loops.into_iter().enumerate())
-        .map(|(i, l)| {
-            if l.len() < 3 {
-                return Err(MeshError::new_err(format!(
-                    "face {i} has {} vertices, fewer than 3",
-                    l.len()
-                )));
-            }
-            let vertices = l
-                .iter()
-                .map(|&v| {
-                    u32::try_from(v)
-                        .ok()
-                        .filter(|&v| (v as usize) < vertices)
-                        .ok_or_else(|| {
-                            MeshError::new_err(format!(
-                                "face {i} names vertex {v}, but the vertices are 0 to {}",
-                                vertices as i64 - 1
-                            ))
-                        })
-                })
-                .collect::<PyResult<_>>()?;
-            Ok(Face {
-                vertices,
+    let bad = |i: usize| -> Option<String> {
+        let l = &flat[starts[i]..starts[i + 1]];
+        if l.len() < 3 {
+            return Some(format!("face {i} has {} vertices, fewer than 3", l.len()));
+        }
+        let v = *l.iter().find(|&&v| v < 0 || v as u64 >= vertices as u64)?;
+        Some(format!(
+            "face {i} names vertex {v}, but the vertices are 0 to {}",
+            vertices as i64 - 1
+        ))
+    };
+    run(py, || {
+        use rayon::prelude::*;
+        // (the first bad face, whatever the threads' order)
+        match (0..starts.len() - 1)
+            .into_par_iter()
+            .find_first(|&i| bad(i).is_some())
+        {
+            Some(i) => Err(bad(i).expect("found bad")),
+            None => Ok(flat.par_iter().map(|&v| v as u32).collect()),
+        }
+    })
+    .map(|indices| FlatFaces { indices, starts })
+    .map_err(MeshError::new_err)
+}
+
+/// Checked faces as given: every face's vertex indices in one array.
+struct FlatFaces {
+    indices: Vec<u32>,
+    /// Face `i` is `indices[starts[i]..starts[i + 1]]`.
+    starts: Vec<usize>,
+}
+
+/// A mesh as the package holds it: the arrays it was given, until a job
+/// needs the library's mesh (made once, in parallel, without the GIL).
+struct MeshData {
+    given: Option<(Vec<DVec3>, FlatFaces)>,
+    built: std::sync::OnceLock<bsp_shadows::Mesh>,
+}
+
+impl MeshData {
+    /// The library's mesh of the given arrays.
+    fn build(positions: &[DVec3], faces: &FlatFaces) -> bsp_shadows::Mesh {
+        use rayon::prelude::*;
+        let faces = (0..faces.starts.len() - 1)
+            .into_par_iter()
+            .map(|i| Face {
+                vertices: faces.indices[faces.starts[i]..faces.starts[i + 1]].to_vec(),
                 line: 0,
                 group: 0,
             })
-        })
-        .collect()
+            .collect();
+        bsp_shadows::Mesh {
+            positions: positions.to_vec(),
+            faces,
+            groups: vec!["default".to_string()],
+        }
+    }
 }
 
 /// A polygon mesh: `Mesh(vertices, faces)` with vertices an `(n, 3)`
@@ -194,13 +223,57 @@ fn faces_of(py: Python<'_>, faces: &Bound<'_, PyAny>, vertices: usize) -> PyResu
 #[pyclass(module = "bsp_shadows", frozen)]
 #[derive(Clone)]
 struct Mesh {
-    mesh: Arc<bsp_shadows::Mesh>,
+    data: Arc<MeshData>,
 }
 
 impl Mesh {
     fn of(mesh: bsp_shadows::Mesh) -> Mesh {
         Mesh {
-            mesh: Arc::new(mesh),
+            data: Arc::new(MeshData {
+                given: None,
+                built: mesh.into(),
+            }),
+        }
+    }
+
+    /// The library's mesh (made on first use; call without the GIL).
+    fn mesh(&self) -> &bsp_shadows::Mesh {
+        let d = &self.data;
+        d.built.get_or_init(|| {
+            let (positions, faces) = d.given.as_ref().expect("a mesh given or built");
+            MeshData::build(positions, faces)
+        })
+    }
+
+    /// A copy of the library's mesh, for a job that takes it (from the
+    /// arrays where they are kept: no mesh is made twice).
+    fn owned(&self) -> bsp_shadows::Mesh {
+        match (self.data.built.get(), &self.data.given) {
+            (Some(m), _) => m.clone(),
+            (None, Some((positions, faces))) => MeshData::build(positions, faces),
+            (None, None) => unreachable!("a mesh given or built"),
+        }
+    }
+
+    fn positions(&self) -> &[DVec3] {
+        match &self.data.given {
+            Some((p, _)) => p,
+            None => &self.mesh().positions,
+        }
+    }
+
+    fn face_count(&self) -> usize {
+        match &self.data.given {
+            Some((_, f)) => f.starts.len() - 1,
+            None => self.mesh().faces.len(),
+        }
+    }
+
+    /// Face `i`'s vertices.
+    fn face(&self, i: usize) -> &[u32] {
+        match &self.data.given {
+            Some((_, f)) => &f.indices[f.starts[i]..f.starts[i + 1]],
+            None => &self.mesh().faces[i].vertices,
         }
     }
 }
@@ -215,11 +288,12 @@ impl Mesh {
     ) -> PyResult<Mesh> {
         let positions = points(py, vertices, "vertices")?;
         let faces = faces_of(py, faces, positions.len())?;
-        Ok(Mesh::of(bsp_shadows::Mesh {
-            positions,
-            faces,
-            groups: vec!["default".to_string()],
-        }))
+        Ok(Mesh {
+            data: Arc::new(MeshData {
+                given: Some((positions, faces)),
+                built: std::sync::OnceLock::new(),
+            }),
+        })
     }
 
     /// Reads an OBJ or STL file.
@@ -230,40 +304,45 @@ impl Mesh {
             .map_err(to_py)
     }
 
+    /// A built-in scene: `"room"` (the core paper's test room), `"chair"`,
+    /// `"cube"`, `"bunny"` (the Stanford bunny on a ground) and
+    /// `"bunny-11k"` to `"bunny-893k"` (the same refined), as the CLI's
+    /// `--scene` gives them.
+    #[staticmethod]
+    fn scene(name: &str) -> PyResult<Mesh> {
+        shadow_scene::scene_named(name)
+            .map(Mesh::of)
+            .map_err(BspError::new_err)
+    }
+
     /// Writes the mesh as OBJ or STL, by the extension.
     fn write(&self, py: Python<'_>, path: std::path::PathBuf) -> PyResult<()> {
-        run(py, || bsp_shadows::write_mesh(&path, &self.mesh)).map_err(to_py)
+        run(py, || bsp_shadows::write_mesh(&path, self.mesh())).map_err(to_py)
     }
 
     /// The vertex positions, `(n, 3)` float64 (a copy).
     #[getter]
     fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let flat: Vec<f64> = self
-            .mesh
-            .positions
-            .iter()
-            .flat_map(|p| p.to_array())
-            .collect();
-        flat.into_pyarray(py)
-            .reshape([self.mesh.positions.len(), 3])
+        let positions = self.positions();
+        let flat: Vec<f64> = positions.iter().flat_map(|p| p.to_array()).collect();
+        flat.into_pyarray(py).reshape([positions.len(), 3])
     }
 
     /// The faces: an `(m, k)` int64 array when every face has `k`
     /// vertices, else a list of 1-D int64 arrays.
     #[getter]
     fn faces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let faces = &self.mesh.faces;
-        let k = faces.first().map_or(3, |f| f.vertices.len());
-        if faces.iter().all(|f| f.vertices.len() == k) {
-            let flat: Vec<i64> = faces
-                .iter()
-                .flat_map(|f| f.vertices.iter().map(|&v| i64::from(v)))
+        let m = self.face_count();
+        let k = if m == 0 { 3 } else { self.face(0).len() };
+        if (0..m).all(|i| self.face(i).len() == k) {
+            let flat: Vec<i64> = (0..m)
+                .flat_map(|i| self.face(i).iter().map(|&v| i64::from(v)))
                 .collect();
-            return Ok(flat.into_pyarray(py).reshape([faces.len(), k])?.into_any());
+            return Ok(flat.into_pyarray(py).reshape([m, k])?.into_any());
         }
         let list = PyList::empty(py);
-        for f in faces {
-            let v: Vec<i64> = f.vertices.iter().map(|&v| i64::from(v)).collect();
+        for i in 0..m {
+            let v: Vec<i64> = self.face(i).iter().map(|&v| i64::from(v)).collect();
             list.append(v.into_pyarray(py))?;
         }
         Ok(list.into_any())
@@ -271,36 +350,28 @@ impl Mesh {
 
     /// The volume enclosed, exact for the `f64` positions and rounded once.
     fn volume(&self, py: Python<'_>) -> f64 {
-        run(py, || bsp_shadows::volume(&self.mesh))
+        run(py, || bsp_shadows::volume(self.mesh()))
     }
 
     /// Whether every edge is met by exactly two faces in opposite
     /// directions (a closed, oriented surface).
-    fn is_closed(&self) -> bool {
-        self.mesh.is_closed_oriented()
+    fn is_closed(&self, py: Python<'_>) -> bool {
+        run(py, || self.mesh().is_closed_oriented())
     }
 
     /// The mesh moved by `offset` (three numbers).
-    fn translated(&self, offset: [f64; 3]) -> Mesh {
-        Mesh::of(bsp_shadows::translated(
-            &self.mesh,
-            DVec3::from_array(offset),
-        ))
+    fn translated(&self, py: Python<'_>, offset: [f64; 3]) -> Mesh {
+        let by = DVec3::from_array(offset);
+        Mesh::of(run(py, || bsp_shadows::translated(self.mesh(), by)))
     }
 
     /// A `trimesh.Trimesh` of the same vertices and faces (polygons are
     /// fanned), without trimesh's processing.
     fn to_trimesh<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let trimesh = py.import("trimesh")?;
-        let flat: Vec<i64> = self
-            .mesh
-            .faces
-            .iter()
-            .flat_map(|f| {
-                (1..f.vertices.len() - 1).flat_map(move |k| {
-                    [f.vertices[0], f.vertices[k], f.vertices[k + 1]].map(i64::from)
-                })
-            })
+        let flat: Vec<i64> = (0..self.face_count())
+            .map(|i| self.face(i))
+            .flat_map(|f| (1..f.len() - 1).flat_map(move |k| [f[0], f[k], f[k + 1]].map(i64::from)))
             .collect();
         let n = flat.len() / 3;
         let faces = flat.into_pyarray(py).reshape([n, 3])?;
@@ -318,22 +389,22 @@ impl Mesh {
     }
 
     fn __or__(&self, py: Python<'_>, other: &Mesh) -> PyResult<Mesh> {
-        boolean(py, self, other, bsp_shadows::union)
+        boolean(py, self, other, BoolOp::Union)
     }
 
     fn __and__(&self, py: Python<'_>, other: &Mesh) -> PyResult<Mesh> {
-        boolean(py, self, other, bsp_shadows::intersection)
+        boolean(py, self, other, BoolOp::Intersection)
     }
 
     fn __sub__(&self, py: Python<'_>, other: &Mesh) -> PyResult<Mesh> {
-        boolean(py, self, other, bsp_shadows::difference)
+        boolean(py, self, other, BoolOp::Difference)
     }
 
     fn __repr__(&self) -> String {
         format!(
             "Mesh(vertices={}, faces={})",
-            self.mesh.positions.len(),
-            self.mesh.faces.len()
+            self.positions().len(),
+            self.face_count()
         )
     }
 
@@ -349,13 +420,8 @@ impl Mesh {
     }
 }
 
-fn boolean(
-    py: Python<'_>,
-    a: &Mesh,
-    b: &Mesh,
-    op: fn(&bsp_shadows::Mesh, &bsp_shadows::Mesh) -> Result<bsp_shadows::Mesh, Error>,
-) -> PyResult<Mesh> {
-    run(py, || op(&a.mesh, &b.mesh))
+fn boolean(py: Python<'_>, a: &Mesh, b: &Mesh, op: BoolOp) -> PyResult<Mesh> {
+    run(py, || bsp_shadows::boolean_of(a.owned(), b.owned(), op))
         .map(Mesh::of)
         .map_err(to_py)
 }
@@ -363,19 +429,19 @@ fn boolean(
 /// The exact union of two closed meshes (also `a | b`).
 #[pyfunction]
 fn union(py: Python<'_>, a: &Mesh, b: &Mesh) -> PyResult<Mesh> {
-    boolean(py, a, b, bsp_shadows::union)
+    boolean(py, a, b, BoolOp::Union)
 }
 
 /// The exact intersection of two closed meshes (also `a & b`).
 #[pyfunction]
 fn intersection(py: Python<'_>, a: &Mesh, b: &Mesh) -> PyResult<Mesh> {
-    boolean(py, a, b, bsp_shadows::intersection)
+    boolean(py, a, b, BoolOp::Intersection)
 }
 
 /// The exact difference `a − b` of two closed meshes (also `a - b`).
 #[pyfunction]
 fn difference(py: Python<'_>, a: &Mesh, b: &Mesh) -> PyResult<Mesh> {
-    boolean(py, a, b, bsp_shadows::difference)
+    boolean(py, a, b, BoolOp::Difference)
 }
 
 /// A point light at `position`.
@@ -456,7 +522,7 @@ fn shadows(py: Python<'_>, mesh: &Mesh, lights: &Bound<'_, PyAny>) -> PyResult<S
     let specs: Vec<Light> = (given.iter().enumerate())
         .map(|(i, l)| light_of(l, i))
         .collect::<PyResult<_>>()?;
-    let s = run(py, || bsp_shadows::shadows(&mesh.mesh, &specs)).map_err(to_py)?;
+    let s = run(py, || bsp_shadows::shadows(mesh.mesh(), &specs)).map_err(to_py)?;
     Ok(Shadows {
         mesh: mesh.clone(),
         lights: given.into_iter().map(Bound::unbind).collect(),
@@ -469,7 +535,7 @@ impl Shadows {
     /// `(faces, lights)` float64: the area of each face each light reaches.
     #[getter]
     fn lit_area<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let (faces, lights) = (self.mesh.mesh.faces.len(), self.lights.len());
+        let (faces, lights) = (self.mesh.face_count(), self.lights.len());
         let flat: Vec<f64> = (0..faces)
             .flat_map(|f| (0..lights).map(move |l| (f, l)))
             .map(|(f, l)| self.shadows.lit_area(f, l))
@@ -480,7 +546,7 @@ impl Shadows {
     /// `(faces,)` float64: each face's area.
     #[getter]
     fn face_area<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        let faces = self.mesh.mesh.faces.len();
+        let faces = self.mesh.face_count();
         (0..faces)
             .map(|f| self.shadows.face_area(f))
             .collect::<Vec<_>>()
@@ -545,7 +611,7 @@ impl Shadows {
     fn __repr__(&self) -> String {
         format!(
             "Shadows(faces={}, lights={})",
-            self.mesh.mesh.faces.len(),
+            self.mesh.face_count(),
             self.lights.len()
         )
     }
@@ -606,6 +672,13 @@ struct SunHours {
     hours: Vec<bsp_shadows::sun::FaceHours>,
 }
 
+impl SunHours {
+    /// Whether the study kept the extremes (`min_hours`, `max_hours`).
+    fn extremes(&self) -> bool {
+        !self.hours.iter().any(|h| h.min_hours.is_nan())
+    }
+}
+
 #[pymethods]
 impl SunHours {
     /// `(faces,)`: each face's sun-hours (its points' mean).
@@ -618,7 +691,8 @@ impl SunHours {
             .into_pyarray(py)
     }
 
-    /// `(faces,)`: the fewest hours a point of each face gets.
+    /// `(faces,)`: the fewest hours a point of each face gets (NaN for a
+    /// study run with `extremes=False`).
     #[getter]
     fn min_hours<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.hours
@@ -628,7 +702,8 @@ impl SunHours {
             .into_pyarray(py)
     }
 
-    /// `(faces,)`: the most hours a point of each face gets.
+    /// `(faces,)`: the most hours a point of each face gets (NaN without
+    /// the extremes).
     #[getter]
     fn max_hours<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.hours
@@ -679,7 +754,7 @@ impl SunHours {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let at = crate::points(py, points, "points")?;
         let h = run(py, || {
-            bsp_shadows::sun::sensor_hours(&self.mesh.mesh, &at, &self.suns, self.step_hours)
+            bsp_shadows::sun::sensor_hours(self.mesh.mesh(), &at, &self.suns, self.step_hours)
         });
         Ok(h.map_err(to_py)?.into_pyarray(py))
     }
@@ -695,28 +770,32 @@ impl SunHours {
     /// Pickled as the mesh, the suns, the step and the runs' bytes.
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
-    ) -> Reduced<'py, (Mesh, Bound<'py, PyArray2<f64>>, f64)> {
+    ) -> Reduced<'py, (Mesh, Bound<'py, PyArray2<f64>>, f64, bool)> {
         let py = slf.py();
         let me = slf.get();
         let f = py
             .import("bsp_shadows._native")?
             .getattr("_hours_of_suns")?;
-        Ok((f, (me.mesh.clone(), me.suns(py)?, me.step_hours)))
+        let extremes = me.extremes();
+        Ok((f, (me.mesh.clone(), me.suns(py)?, me.step_hours, extremes)))
     }
 }
 
 /// The sun-hours of every face of `mesh` under the suns `suns` (`(s, 3)`,
 /// directions toward them), each standing for `step_hours`.
 #[pyfunction]
+#[pyo3(signature = (mesh, suns, step_hours, extremes=true))]
 fn _hours_of_suns(
     py: Python<'_>,
     mesh: &Mesh,
     suns: &Bound<'_, PyAny>,
     step_hours: f64,
+    extremes: bool,
 ) -> PyResult<SunHours> {
     let suns = points(py, suns, "suns")?;
-    let hours = run(py, || {
-        bsp_shadows::sun::sun_hours(&mesh.mesh, &suns, step_hours)
+    let hours = run(py, || match extremes {
+        true => bsp_shadows::sun::sun_hours(mesh.mesh(), &suns, step_hours),
+        false => bsp_shadows::sun::sun_hours_mean(mesh.mesh(), &suns, step_hours),
     })
     .map_err(to_py)?;
     Ok(SunHours {
@@ -730,11 +809,13 @@ fn _hours_of_suns(
 /// One run of a study (at most 64 suns) as bytes: a task of the
 /// distributed study.
 #[pyfunction]
+#[pyo3(signature = (mesh, suns, step_hours, extremes=true))]
 fn _hours_run<'py>(
     py: Python<'py>,
     mesh: &Mesh,
     suns: &Bound<'py, PyAny>,
     step_hours: f64,
+    extremes: bool,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let suns = points(py, suns, "suns")?;
     if suns.len() > MAX_SUNS_A_RUN {
@@ -744,7 +825,11 @@ fn _hours_run<'py>(
         )));
     }
     let bytes = run(py, || {
-        HoursRun::new(&mesh.mesh, &suns, step_hours).map(|r| r.to_bytes())
+        match extremes {
+            true => HoursRun::new(mesh.mesh(), &suns, step_hours),
+            false => HoursRun::mean_only(mesh.mesh(), &suns, step_hours),
+        }
+        .map(|r| r.to_bytes())
     })
     .map_err(to_py)?;
     Ok(PyBytes::new(py, &bytes))
@@ -760,7 +845,7 @@ fn _fold_runs(
     step_hours: f64,
 ) -> PyResult<SunHours> {
     let suns = points(py, suns, "suns")?;
-    let faces = mesh.mesh.faces.len();
+    let faces = mesh.face_count();
     let hours = run(py, || {
         let runs = runs
             .iter()

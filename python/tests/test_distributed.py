@@ -54,6 +54,22 @@ def test_ray_local(yard, single):
     same(h, single)
 
 
+def test_dask_without_extremes(yard, single):
+    distributed = pytest.importorskip("distributed")
+    mean = bs.sun_hours(yard, extremes=False, **STUDY)
+    assert (mean.per_face == single.per_face).all() and np.isnan(mean.min_hours).all()
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+        dashboard_address=None, silence_logs=40,
+    ) as cluster, distributed.Client(cluster) as client:
+        h = bsd.sun_hours(yard, client, extremes=False, **STUDY)
+    assert (h.per_face == single.per_face).all() and np.isnan(h.max_hours).all()
+    import pickle
+
+    back = pickle.loads(pickle.dumps(h))
+    assert (back.per_face == h.per_face).all() and np.isnan(back.min_hours).all()
+
+
 def test_bad_client(yard):
     with pytest.raises(TypeError):
         bsd.sun_hours(yard, object(), **STUDY)

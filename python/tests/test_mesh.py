@@ -26,6 +26,14 @@ def test_arrays_in_and_out():
     assert pyramid.is_closed()
 
 
+def test_built_in_scenes():
+    room = bs.Mesh.scene("room")
+    assert len(room.vertices) > 100 and not room.is_closed()
+    assert bs.Mesh.scene("cube").volume() == 1.0
+    with pytest.raises(bs.BspError, match="unknown scene `nope`"):
+        bs.Mesh.scene("nope")
+
+
 def test_exact_volume():
     cube = bs.box((0, 0, 0), (0.1, 0.1, 0.1))
     far = cube.translated((1e9, -3e9, 2e9))

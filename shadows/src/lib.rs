@@ -31,12 +31,12 @@ mod volume;
 
 use std::path::Path;
 
-use bsp_core::BoolOp;
 use bsp_csg::files::{FileBoolean, FileError, Operand};
 use shadow_scene::SceneError;
 use svbsp::export::{ExportError, FragmentFile, FragmentFormat, area_records, world_vertices};
 use svbsp::{Batch, LightError, PlacedLight, ShadeOptions, ShadowError};
 
+pub use bsp_core::BoolOp;
 pub use glam::DVec3;
 pub use shadow_scene::{Face, Mesh, MeshView};
 /// A point light at a position, or a sun in a direction (from the scene
@@ -158,7 +158,13 @@ pub fn difference(a: &Mesh, b: &Mesh) -> Result<Mesh, Error> {
 }
 
 fn boolean(a: &Mesh, b: &Mesh, op: BoolOp) -> Result<Mesh, Error> {
-    let mut operands = [Operand::new("a", a.clone()), Operand::new("b", b.clone())];
+    boolean_of(a.clone(), b.clone(), op)
+}
+
+/// [`union`], [`intersection`] or [`difference`] (by `op`) of meshes the
+/// caller gives away: no copy of them is made.
+pub fn boolean_of(a: Mesh, b: Mesh, op: BoolOp) -> Result<Mesh, Error> {
+    let mut operands = [Operand::new("a", a), Operand::new("b", b)];
     let checked = Operand::check_all(&mut operands).map_err(Error::Boolean)?;
     let out = FileBoolean::apply(checked, op, |_, _| {}).map_err(Error::Boolean)?;
     Ok(match out.rounded(false) {

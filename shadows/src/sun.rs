@@ -343,24 +343,60 @@ pub fn sun_hours(
     HoursRun::fold(mesh.faces.len(), runs)
 }
 
+/// [`sun_hours`] without the overlay: each face's exact `sun_hours` (and
+/// area), with `min_hours` and `max_hours` NaN and `hours_area` empty.
+/// The overlay of every run's pieces grows with the arrangement of all the
+/// suns' shadow edges on a face (quadratic in the suns where shadows of
+/// many suns cross one face, as on a ground under a detailed object);
+/// the mean needs none of it, so a long study of a large scene costs the
+/// shadows alone, run by run.
+pub fn sun_hours_mean(
+    mesh: &crate::Mesh,
+    suns: &[DVec3],
+    step_hours: f64,
+) -> Result<Vec<FaceHours>, crate::Error> {
+    let runs =
+        (suns.chunks(svbsp::MAX_LIGHTS)).map(|batch| HoursRun::mean_only(mesh, batch, step_hours));
+    HoursRun::fold(mesh.faces.len(), runs)
+}
+
 /// One run's share of a study's sun-hours: for at most
 /// [`svbsp::MAX_LIGHTS`] suns, every face's area, its lit area summed
-/// over the suns times the step, and its lit pieces with the number of
-/// suns each sees.
+/// over the suns times the step, and (for the extremes) its pieces with
+/// the number of suns each sees.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HoursRun {
     step_hours: f64,
     area: Vec<f64>,
     lit: Vec<f64>,
-    cells: Vec<Vec<Cell>>,
+    cells: Option<Vec<Vec<Cell>>>,
 }
 
 impl HoursRun {
-    /// The run of `suns` (at most [`svbsp::MAX_LIGHTS`]) over `mesh`.
+    /// The run of `suns` (at most [`svbsp::MAX_LIGHTS`]) over `mesh`, with
+    /// its pieces (for [`sun_hours`]).
     pub fn new(
         mesh: &crate::Mesh,
         suns: &[DVec3],
         step_hours: f64,
+    ) -> Result<HoursRun, crate::Error> {
+        HoursRun::make(mesh, suns, step_hours, true)
+    }
+
+    /// The run without its pieces (for [`sun_hours_mean`]).
+    pub fn mean_only(
+        mesh: &crate::Mesh,
+        suns: &[DVec3],
+        step_hours: f64,
+    ) -> Result<HoursRun, crate::Error> {
+        HoursRun::make(mesh, suns, step_hours, false)
+    }
+
+    fn make(
+        mesh: &crate::Mesh,
+        suns: &[DVec3],
+        step_hours: f64,
+        pieces: bool,
     ) -> Result<HoursRun, crate::Error> {
         let faces = mesh.faces.len();
         let lights: Vec<crate::Light> = suns.iter().map(|&d| crate::Light::Sun(d)).collect();
@@ -369,6 +405,14 @@ impl HoursRun {
         let lit = (0..faces)
             .map(|f| (0..suns.len()).map(|l| run.lit_area(f, l)).sum::<f64>() * step_hours)
             .collect();
+        if !pieces {
+            return Ok(HoursRun {
+                step_hours,
+                area,
+                lit,
+                cells: None,
+            });
+        }
         let frames: Vec<(DVec3, DVec3, DVec3)> = (0..faces).map(|f| face_frame(mesh, f)).collect();
         let mut cells: Vec<Vec<Cell>> = vec![Vec::new(); faces];
         for frag in run.batch.fragments() {
@@ -390,34 +434,53 @@ impl HoursRun {
             step_hours,
             area,
             lit,
-            cells,
+            cells: Some(cells),
         })
     }
 
     /// The runs' faces' hours, the runs taken in order (`faces`: the
-    /// mesh's face count, for no runs at all).
+    /// mesh's face count, for no runs at all). The extremes are NaN if a
+    /// run has no pieces. Faces are overlaid in parallel, each the same
+    /// whatever the thread count.
     pub fn fold(
         faces: usize,
         runs: impl IntoIterator<Item = Result<HoursRun, crate::Error>>,
     ) -> Result<Vec<FaceHours>, crate::Error> {
+        use rayon::prelude::*;
         let mut area = vec![0.0; faces];
         let mut lit = vec![0.0; faces];
         let mut cells: Vec<Option<Vec<Cell>>> = vec![None; faces];
-        let mut step_hours = 0.0;
+        let (mut step_hours, mut pieces) = (0.0, true);
         for run in runs {
             let run = run?;
             step_hours = run.step_hours;
-            for (f, new) in run.cells.into_iter().enumerate() {
-                area[f] = run.area[f];
-                lit[f] += run.lit[f];
-                cells[f] = Some(match cells[f].take() {
-                    None => new,
-                    Some(old) => overlay(&old, &new, 1e-12 * area[f]),
-                });
+            let n = faces.min(run.area.len());
+            area[..n].copy_from_slice(&run.area[..n]);
+            lit.iter_mut().zip(&run.lit).for_each(|(l, r)| *l += r);
+            match run.cells {
+                Some(new) if pieces => {
+                    (cells.par_iter_mut().zip(new).enumerate()).for_each(|(f, (old, new))| {
+                        *old = Some(match old.take() {
+                            None => new,
+                            Some(old) => overlay(&old, &new, 1e-12 * run.area[f]),
+                        });
+                    })
+                }
+                _ => {
+                    pieces = false;
+                    cells = vec![None; faces];
+                }
             }
         }
         Ok((0..faces)
-            .map(|f| face_hours(area[f], lit[f], cells[f].as_deref(), step_hours))
+            .map(|f| match pieces {
+                true => face_hours(area[f], lit[f], cells[f].as_deref(), step_hours),
+                false => FaceHours {
+                    min_hours: f64::NAN,
+                    max_hours: f64::NAN,
+                    ..face_hours(area[f], lit[f], None, step_hours)
+                },
+            })
             .collect())
     }
 
@@ -427,11 +490,15 @@ impl HoursRun {
         let mut put = |x: f64| out.extend_from_slice(&x.to_le_bytes());
         put(self.step_hours);
         put(self.area.len() as f64);
+        put(if self.cells.is_some() { 1.0 } else { 0.0 });
         for f in 0..self.area.len() {
             put(self.area[f]);
             put(self.lit[f]);
-            put(self.cells[f].len() as f64);
-            for (ring, seen) in &self.cells[f] {
+            let Some(cells) = &self.cells else {
+                continue;
+            };
+            put(cells[f].len() as f64);
+            for (ring, seen) in &cells[f] {
                 put(f64::from(*seen));
                 put(ring.len() as f64);
                 for p in ring {
@@ -452,15 +519,23 @@ impl HoursRun {
         let count = |x: f64| (x >= 0.0 && x.fract() == 0.0 && x < 1e15).then_some(x as usize);
         let step_hours = next()?;
         let faces = count(next()?)?;
+        let pieces = match next()? {
+            1.0 => true,
+            0.0 => false,
+            _ => return None,
+        };
         let mut run = HoursRun {
             step_hours,
             area: Vec::new(),
             lit: Vec::new(),
-            cells: Vec::new(),
+            cells: pieces.then(Vec::new),
         };
         for _ in 0..faces {
             run.area.push(next()?);
             run.lit.push(next()?);
+            let Some(cells) = &mut run.cells else {
+                continue;
+            };
             let n = count(next()?)?;
             let mut face = Vec::new();
             for _ in 0..n {
@@ -471,7 +546,7 @@ impl HoursRun {
                     .collect::<Option<Vec<_>>>()?;
                 face.push((ring, seen));
             }
-            run.cells.push(face);
+            cells.push(face);
         }
         (bytes.len().is_multiple_of(8) && next().is_none()).then_some(run)
     }
@@ -873,6 +948,14 @@ mod tests {
         let cut = &runs[0][..runs[0].len() - 8];
         assert!(HoursRun::from_bytes(cut).is_none());
         assert!(HoursRun::from_bytes(&[runs[0].clone(), vec![0; 8]].concat()).is_none());
+        // the mean alone: the same sun-hours, no extremes
+        let mean = sun_hours_mean(&mesh, &suns, step).unwrap();
+        for (a, b) in hours.iter().zip(&mean) {
+            assert_eq!((a.area, a.sun_hours), (b.area, b.sun_hours));
+            assert!(b.min_hours.is_nan() && b.max_hours.is_nan() && b.hours_area.is_empty());
+        }
+        let run = HoursRun::mean_only(&mesh, &suns[..10], step).unwrap();
+        assert_eq!(HoursRun::from_bytes(&run.to_bytes()), Some(run));
         let none = HoursRun::fold(mesh.faces.len(), []).unwrap();
         assert!(
             none.iter()

@@ -1,0 +1,160 @@
+#!/usr/bin/env python3
+"""The Python package's figures (docs/python.md), outside CI.
+
+1. Union of two ~100k-triangle UV spheres (the inputs of
+   scripts/manifold_compare.py: a copy rotated 5 degrees and shifted) from
+   numpy arrays, in paired rounds: `bs.union` with the arrays converted in
+   and out, manifold3d's Python call (`Manifold(Mesh(...))` for both, `+`,
+   `to_mesh()`), and the Rust library's `bsp_shadows::union` on the same
+   meshes in memory (`shadows/examples/union_time.rs`, its own timing).
+2. The package's import time.
+3. A year-long sun study (the 1st of each month, 15-minute steps) of a
+   built-in scene: one process (all CPUs) against a Dask LocalCluster of
+   2 workers x 1 thread, with each task's time, so the time on 100 workers
+   can be estimated from the measured costs.
+
+    python3 -m venv /tmp/pyv && /tmp/pyv/bin/pip install './python[test]' manifold3d
+    cargo build --release -p bsp-shadows --example union_time
+    /tmp/pyv/bin/python scripts/python_bench.py [--rounds 5] [--scene bunny-99k] [--skip-sun]
+"""
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from manifold_compare import SHIFT, rotate, uv_sphere, write_obj  # noqa: E402
+
+import bsp_shadows as bs  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def spheres(n):
+    va, tris = uv_sphere(n)
+    vb = rotate(va) + np.array(SHIFT)
+    return np.ascontiguousarray(va), np.ascontiguousarray(vb), np.ascontiguousarray(tris)
+
+
+def ours(va, vb, tris):
+    t = time.perf_counter()
+    u = bs.Mesh(va, tris) | bs.Mesh(vb, tris)
+    v, f = u.vertices, u.faces
+    return time.perf_counter() - t, len(f)
+
+
+def manifold(va, vb, tris):
+    from manifold3d import Manifold, Mesh
+
+    t = time.perf_counter()
+    a = Manifold(Mesh(vert_properties=va.astype(np.float32), tri_verts=tris.astype(np.uint32)))
+    b = Manifold(Mesh(vert_properties=vb.astype(np.float32), tri_verts=tris.astype(np.uint32)))
+    m = (a + b).to_mesh()
+    return time.perf_counter() - t, len(m.tri_verts)
+
+
+def rust(va, vb, tris, reps, example):
+    with tempfile.TemporaryDirectory() as d:
+        pa, pb = os.path.join(d, "a.obj"), os.path.join(d, "b.obj")
+        write_obj(pa, va, tris)
+        write_obj(pb, vb, tris)
+        out = subprocess.run([example, pa, pb, str(reps)], check=True, capture_output=True, text=True)
+    return [float(line.split()[0]) for line in out.stdout.split("\n") if line]
+
+
+def booleans(args):
+    va, vb, tris = spheres(args.triangles)
+    print(f"union of two UV spheres of {len(tris)} triangles, {args.rounds} paired rounds")
+    ours(va, vb, tris), manifold(va, vb, tris)  # warm both
+    ratios_m, t_ours, t_man = [], [], []
+    for _ in range(args.rounds):
+        (a, fa), (m, fm) = ours(va, vb, tris), manifold(va, vb, tris)
+        t_ours.append(a)
+        t_man.append(m)
+        ratios_m.append(a / m)
+    t_rust = rust(va, vb, tris, args.rounds, args.example)
+    mo, mm, mr = (statistics.median(x) for x in (t_ours, t_man, t_rust))
+    print(f"  bs.union (arrays in and out): median {mo:.3f} s, {fa} triangles")
+    print(f"  manifold3d (Manifold(Mesh) x2, +, to_mesh): median {mm:.3f} s, {fm} triangles")
+    print(f"  Rust bsp_shadows::union (meshes in memory): median {mr:.3f} s")
+    print(f"  ratio bs/manifold3d: median of rounds {statistics.median(ratios_m):.2f} "
+          f"(range {min(ratios_m):.2f}-{max(ratios_m):.2f})")
+    print(f"  overhead of Python over Rust: {100 * (mo / mr - 1):+.1f}% (medians)")
+
+
+def import_time():
+    code = "import time; t = time.perf_counter(); import bsp_shadows; print(time.perf_counter() - t)"
+    runs = [float(subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
+                                 text=True).stdout) for _ in range(5)]
+    print(f"import bsp_shadows: median {statistics.median(runs):.3f} s of 5 (with numpy)")
+
+
+def timed_run(mesh, suns, step):
+    t = time.perf_counter()
+    r = bs._native._hours_run(mesh, suns, step)
+    return time.perf_counter() - t, r
+
+
+def sun_study(args):
+    from distributed import Client, LocalCluster
+
+    import bsp_shadows.distributed as bsd
+
+    scene = bs.Mesh.scene(args.scene)
+    dates = [f"2026-{m:02d}-01" for m in range(1, 13)]
+    study = dict(lat=51.5, lon=-0.1, dates=dates, step_minutes=15)
+    suns = bs.study_suns(51.5, -0.1, dates, 15)
+    runs = bsd.runs_of(suns)
+    print(f"sun study: {args.scene} ({len(scene.faces)} faces), 12 days, 15-minute steps: "
+          f"{len(suns)} suns in {len(runs)} runs")
+    t = time.perf_counter()
+    single = bs.sun_hours(scene, **study)
+    t_single = time.perf_counter() - t
+    print(f"  one process ({bs.get_threads()} threads): {t_single:.1f} s")
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None, silence_logs=40) as cluster, Client(cluster) as client:
+        t = time.perf_counter()
+        h = bsd.sun_hours(scene, client, threads_per_task=1, **study)
+        t_dask = time.perf_counter() - t
+        # each task's own cost, one at a time on a worker (for the estimate)
+        mesh = client.scatter(scene, broadcast=True)
+        costs = client.gather([client.submit(lambda m, s: timed_run(m, s, 0.25)[0], mesh, r,
+                                             pure=False) for r in runs[:2]])
+    same = all((getattr(h, k) == getattr(single, k)).all() for k in ("per_face", "min_hours", "max_hours"))
+    print(f"  Dask LocalCluster 2 workers x 1 thread: {t_dask:.1f} s "
+          f"(ratio to one process {t_dask / t_single:.2f}); the same bits: {same}")
+    parts = [bs._native._hours_run(scene, r, 0.25) for r in runs[:2]]
+    t = time.perf_counter()
+    bs._native._fold_runs(scene, parts, suns[: sum(len(r) for r in runs[:2])], 0.25)
+    fold2 = time.perf_counter() - t
+    task = statistics.mean(costs)
+    fold = fold2 / 2 * len(runs)
+    est = task * -(-len(runs) // 100) + fold
+    print(f"  a task (one run of {bs.MAX_SUNS_A_RUN} suns, 1 thread): {task:.1f} s; "
+          f"folding on the driver: {fold2 / 2:.2f} s a run")
+    print(f"  100 workers: at most {len(runs)} tasks run at once, so about {est:.1f} s "
+          f"(a task's time plus the fold of {len(runs)} runs), before scheduling overheads")
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--rounds", type=int, default=5)
+    p.add_argument("--triangles", type=int, default=100_000)
+    p.add_argument("--scene", default="bunny-99k")
+    p.add_argument("--skip-sun", action="store_true")
+    p.add_argument("--example", default=os.path.join(ROOT, "target", "release", "examples", "union_time"))
+    args = p.parse_args()
+    print(f"load: {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} CPUs; threads {bs.get_threads()}")
+    booleans(args)
+    import_time()
+    if not args.skip_sun:
+        sun_study(args)
+
+
+if __name__ == "__main__":
+    main()
