@@ -50,8 +50,8 @@ fn to_py(e: Error) -> PyErr {
     }
 }
 
-/// The pool every call runs on: `None` until [`set_threads`] sets one
-/// (then rayon's global pool: the CPUs the process may use).
+/// The pool every call runs on, as [`set_threads`] set it; `None`:
+/// rayon's global pool, one thread per CPU the process may use.
 static POOL: Mutex<Option<Arc<rayon::ThreadPool>>> = Mutex::new(None);
 
 /// `work` without the GIL, on the module's pool.
