@@ -1,7 +1,7 @@
 //! `bsp_shadows._native`: the Python package's compiled half. Every
 //! function takes numpy arrays or this module's objects, releases the GIL
 //! while it works, and runs on the module's thread pool
-//! ([`set_threads`]). `python/bsp_shadows/__init__.py` is the face people
+//! (`set_threads`). `python/bsp_shadows/__init__.py` is the face people
 //! use; `_native.pyi` types it.
 
 use std::sync::{Arc, Mutex};
@@ -50,7 +50,7 @@ fn to_py(e: Error) -> PyErr {
     }
 }
 
-/// The pool every call runs on, as [`set_threads`] set it; `None`:
+/// The pool every call runs on, as `set_threads` set it; `None`:
 /// rayon's global pool, one thread per CPU the process may use.
 static POOL: Mutex<Option<Arc<rayon::ThreadPool>>> = Mutex::new(None);
 
