@@ -122,30 +122,7 @@ mod tests {
     use num_traits::ToPrimitive;
 
     fn cube(lo: DVec3, size: f64) -> Mesh {
-        let mut positions = Vec::new();
-        for i in 0..8 {
-            let c = DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2 & 1) as f64);
-            positions.push(lo + c * size);
-        }
-        let quads = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        Mesh {
-            positions,
-            faces: (quads.iter())
-                .map(|q| shadow_scene::Face {
-                    vertices: q.to_vec(),
-                    line: 0,
-                    group: 0,
-                })
-                .collect(),
-            groups: vec!["default".into()],
-        }
+        crate::art::cone::cuboid([lo, lo + DVec3::splat(size)])
     }
 
     #[test]

@@ -19,7 +19,7 @@
 //! integer predicates and checked to tile the region (`region`).
 
 mod check;
-mod cone;
+pub(crate) mod cone;
 mod grow;
 mod region;
 mod spec;
