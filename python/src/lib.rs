@@ -846,28 +846,20 @@ fn _fold_runs(
 ) -> PyResult<SunHours> {
     let suns = points(py, suns, "suns")?;
     let faces = mesh.face_count();
-    let hours = run(py, || {
-        let runs = runs
-            .iter()
-            .enumerate()
-            .map(|(i, b)| HoursRun::from_bytes(b).ok_or(i));
-        let mut parsed = Vec::new();
-        for r in runs {
-            match r {
-                Ok(r) => parsed.push(Ok(r)),
-                Err(i) => return Err(Err(i)),
-            }
-        }
-        HoursRun::fold(faces, parsed).map_err(Ok)
-    });
-    let hours = match hours {
-        Ok(h) => h,
-        Err(Ok(e)) => return Err(to_py(e)),
-        Err(Err(i)) => return Err(BspError::new_err(format!("run {i} is not a run's bytes"))),
-    };
-    if hours.len() != faces {
-        return Err(BspError::new_err("the runs are of another mesh"));
-    }
+    let parsed = run(py, || {
+        (runs.iter().enumerate())
+            .map(|(i, b)| match HoursRun::from_bytes(b) {
+                Some(r) if r.faces() == faces => Ok(r),
+                Some(r) => Err(format!(
+                    "run {i} is of a mesh of {} faces, not {faces}",
+                    r.faces()
+                )),
+                None => Err(format!("run {i} is not a run's bytes")),
+            })
+            .collect::<Result<Vec<_>, _>>()
+    })
+    .map_err(BspError::new_err)?;
+    let hours = run(py, || HoursRun::fold(faces, parsed.into_iter().map(Ok))).map_err(to_py)?;
     Ok(SunHours {
         mesh: mesh.clone(),
         suns,

@@ -27,8 +27,11 @@ def same(a, b):
 def test_runs_folded_in_process(yard, single):
     runs = [bs._native._hours_run(yard, r, single.step_hours) for r in bsd.runs_of(single.suns)]
     same(bs._native._fold_runs(yard, runs, single.suns, single.step_hours), single)
-    with pytest.raises(bs.BspError, match="run 0"):
+    with pytest.raises(bs.BspError, match="run 0 is not"):
         bs._native._fold_runs(yard, [runs[0][:-8]], single.suns, single.step_hours)
+    other = bs._native._hours_run(bs.box((0, 0, 0), (1, 1, 1)), single.suns[:3], single.step_hours)
+    with pytest.raises(bs.BspError, match="run 1 is of a mesh of 6 faces"):
+        bs._native._fold_runs(yard, [runs[0], other], single.suns, single.step_hours)
 
 
 def test_dask_local_cluster(yard, single):

@@ -438,8 +438,14 @@ impl HoursRun {
         })
     }
 
+    /// The number of faces of the run's mesh.
+    pub fn faces(&self) -> usize {
+        self.area.len()
+    }
+
     /// The runs' faces' hours, the runs taken in order (`faces`: the
-    /// mesh's face count, for no runs at all). The extremes are NaN if a
+    /// mesh's face count, for no runs at all; every run must be of a mesh
+    /// of as many faces, see [`HoursRun::faces`]). The extremes are NaN if a
     /// run has no pieces. Faces are overlaid in parallel, each the same
     /// whatever the thread count.
     pub fn fold(
