@@ -688,29 +688,111 @@ fn face_frame(mesh: &crate::Mesh, f: usize) -> (DVec3, DVec3, DVec3) {
 }
 
 /// Every cell of `a` met with every cell of `b` (convex, by clipping),
-/// their suns added, keeping the meets of area above `least`.
+/// their suns added, keeping the meets of area above `least`: in `a`'s
+/// order, and for each in `b`'s order. The cells of `b` whose boxes may
+/// meet a cell's box are found in a grid of buckets over `b`'s boxes, so
+/// the cost follows the meets, not `|a| · |b|`.
 fn overlay(a: &[Cell], b: &[Cell], least: f64) -> Vec<Cell> {
+    type Boxed = (glam::DVec2, glam::DVec2);
     let boxed = |c: &Cell| {
         c.0.iter().fold(
             (glam::DVec2::INFINITY, glam::DVec2::NEG_INFINITY),
             |(lo, hi), p| (lo.min(*p), hi.max(*p)),
         )
     };
-    let bb: Vec<_> = b.iter().map(boxed).collect();
+    let meet = |(lo, hi): Boxed, (blo, bhi): Boxed| {
+        !(hi.x < blo.x || bhi.x < lo.x || hi.y < blo.y || bhi.y < lo.y)
+    };
+    let bb: Vec<Boxed> = b.iter().map(boxed).collect();
+    let buckets = Buckets::new(&bb);
     let mut out = Vec::new();
-    for ca in a {
-        let (lo, hi) = boxed(ca);
-        for (cb, &(blo, bhi)) in b.iter().zip(&bb) {
-            if hi.x < blo.x || bhi.x < lo.x || hi.y < blo.y || bhi.y < lo.y {
+    let (mut seen, mut near) = (vec![usize::MAX; b.len()], Vec::new());
+    for (k, ca) in a.iter().enumerate() {
+        let abox = boxed(ca);
+        near.clear();
+        buckets.visit(abox, |j| {
+            if std::mem::replace(&mut seen[j], k) != k {
+                near.push(j);
+            }
+        });
+        near.sort_unstable();
+        for &j in &near {
+            if !meet(abox, bb[j]) {
                 continue;
             }
-            let meet = clip_convex(&ca.0, &cb.0);
-            if area2(&meet).abs() / 2.0 > least {
-                out.push((meet, ca.1 + cb.1));
+            let m = clip_convex(&ca.0, &b[j].0);
+            if area2(&m).abs() / 2.0 > least {
+                out.push((m, ca.1 + b[j].1));
             }
         }
     }
     out
+}
+
+/// A grid of buckets over boxes: each box is in every bucket its box
+/// covers, by a monotone map of coordinates to buckets, so two boxes
+/// that meet share a bucket.
+struct Buckets {
+    origin: glam::DVec2,
+    inverse: glam::DVec2,
+    side: usize,
+    cells: Vec<Vec<usize>>,
+}
+
+impl Buckets {
+    fn new(boxes: &[(glam::DVec2, glam::DVec2)]) -> Buckets {
+        let (lo, hi) = (boxes.iter()).fold(
+            (glam::DVec2::INFINITY, glam::DVec2::NEG_INFINITY),
+            |(lo, hi), b| (lo.min(b.0), hi.max(b.1)),
+        );
+        let side = ((boxes.len() as f64).sqrt().ceil() as usize).clamp(1, 1024);
+        let size = hi - lo;
+        let per = |s: f64| if s > 0.0 { side as f64 / s } else { 0.0 };
+        let mut buckets = Buckets {
+            origin: lo,
+            inverse: glam::DVec2::new(per(size.x), per(size.y)),
+            side,
+            cells: vec![Vec::new(); side * side],
+        };
+        for (i, &b) in boxes.iter().enumerate() {
+            let ([x0, x1], [y0, y1]) = buckets.range(b);
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    buckets.cells[y * side + x].push(i);
+                }
+            }
+        }
+        buckets
+    }
+
+    /// The buckets a box covers, along x and along y.
+    fn range(&self, (lo, hi): (glam::DVec2, glam::DVec2)) -> ([usize; 2], [usize; 2]) {
+        let index = |x: f64, origin: f64, inverse: f64| {
+            let i = ((x - origin) * inverse).floor();
+            // (NaN and below the grid to the first bucket; `as` saturates)
+            if i >= 0.0 {
+                (i as usize).min(self.side - 1)
+            } else {
+                0
+            }
+        };
+        let (o, v) = (self.origin, self.inverse);
+        (
+            [index(lo.x, o.x, v.x), index(hi.x, o.x, v.x)],
+            [index(lo.y, o.y, v.y), index(hi.y, o.y, v.y)],
+        )
+    }
+
+    /// Calls `f` with every box in the buckets `b` covers (once a
+    /// bucket, so possibly more than once in all).
+    fn visit(&self, b: (glam::DVec2, glam::DVec2), mut f: impl FnMut(usize)) {
+        let ([x0, x1], [y0, y1]) = self.range(b);
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                self.cells[y * self.side + x].iter().for_each(|&i| f(i));
+            }
+        }
+    }
 }
 
 /// Twice the signed area of a polygon.
