@@ -22,14 +22,9 @@ pub(crate) struct SiteArgs {
     /// Longitude, degrees east.
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     lon: f64,
-    /// True north, degrees clockwise from the scene's north (+y; -z with --up y).
-    #[arg(
-        long,
-        value_name = "DEG",
-        default_value_t = 0.0,
-        allow_hyphen_values = true
-    )]
-    north: f64,
+    /// True north, degrees clockwise from the scene's north (+y; -z with --up y) [default: 0].
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    north: Option<f64>,
     /// The scene's up axis: z (+y north) or y (-z north) [default: z].
     #[arg(long, value_name = "AXIS")]
     up: Option<Up>,
@@ -37,7 +32,8 @@ pub(crate) struct SiteArgs {
 
 impl SiteArgs {
     fn site(&self) -> SunSite {
-        SunSite::new(self.lat, self.lon).with_axes(self.north, self.up.unwrap_or_default())
+        let north = self.north.unwrap_or(0.0);
+        SunSite::new(self.lat, self.lon).with_axes(north, self.up.unwrap_or_default())
     }
 }
 
@@ -86,7 +82,10 @@ pub(crate) struct SunHoursArgs {
     /// Also say how much of each group sees at least H hours.
     #[arg(long, value_name = "H")]
     min_hours: Option<f64>,
-    /// Output: CSV (one row per face) or JSON.
+    /// Hours at points instead of faces: a file of x,y,z lines (a header line may lead).
+    #[arg(long, value_name = "FILE")]
+    sensors: Option<PathBuf>,
+    /// Output: CSV (one row per face, or per sensor) or JSON.
     #[arg(short, long, value_name = "OUT.csv|OUT.json")]
     output: PathBuf,
     /// No notes on stderr (errors still go there).
@@ -104,12 +103,11 @@ pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
     let step = a.step.unwrap_or(10.0);
     let suns = sun::study_suns(&a.site.site(), &dates, step, a.utc_offset.unwrap_or(0.0))?;
     let dirs: Vec<_> = suns.iter().map(|s| s.direction).collect();
-    let hours = sun::sun_hours(&mesh, &dirs, step / 60.0).map_err(facade_error)?;
-    let text = format.text(&mesh, &hours, dirs.len());
-    write_file(&a.output, text.as_bytes())?;
-    let (n, days, suns, out) = (hours.len(), dates.len(), dirs.len(), a.output.display());
-    let mut text =
-        format!("wrote {out}: sun-hours of {n} faces of {name}, {days} days, {suns} suns\n");
-    text += &sun::groups_in_sun_text(&mesh, &hours, a.min_hours);
-    emit(&text)
+    let (h, sensors) = (step / 60.0, a.sensors.as_deref());
+    let r = sun::hours_report(&mesh, &dirs, h, format, sensors, a.min_hours);
+    let r = r.map_err(facade_error)?;
+    write_file(&a.output, r.text.as_bytes())?;
+    let (days, suns, out, rows) = (dates.len(), dirs.len(), a.output.display(), &r.rows);
+    let said = format!("wrote {out}: sun-hours of {rows} of {name}, {days} days, {suns} suns\n");
+    emit(&(said + &r.groups))
 }

@@ -1063,6 +1063,26 @@ fn sunhours_writes_every_faces_hours() {
         .parse()
         .unwrap();
     assert!((16.0..50.0).contains(&share), "{line}");
+    // hours at sensors: above the cube every sun, inside it none; a bad
+    // sensors file names its line
+    let points = scratch("sensors.csv");
+    std::fs::write(&points, "x,y,z\n0.5,0.5,2\n0.5,0.5,0.5\n").unwrap();
+    let o = run(&csv, &["--sensors", points.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("sun-hours of 2 sensors among the faces of"),
+        "{}",
+        stdout(&o)
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let hours: Vec<f64> = (text.lines().skip(1))
+        .map(|l| l.rsplit(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(text.lines().next(), Some("sensor,x,y,z,sun_hours"));
+    assert!(hours[0] == top && hours[1] == 0.0, "{text}");
+    std::fs::write(&points, "0.5,0.5\n").unwrap();
+    let o = run(&json, &["--sensors", points.to_str().unwrap()]);
+    crate::assert_failed_with(&o, &["sensors.csv:1:", "a point is x,y,z"]);
     // bad names and dates are clear errors
     let o = run(&scratch("hours.txt"), &[]);
     crate::assert_failed_with(&o, &["hours.txt", ".csv or .json"]);

@@ -50,6 +50,7 @@ mod error;
 mod mesh;
 mod obj;
 mod palette;
+mod points;
 mod prim;
 mod scan;
 mod scenes;
@@ -67,6 +68,7 @@ pub use obj::{
     MAX_FACE_VERTICES, ObjNotes, parse_obj, parse_obj_notes, read_obj, read_obj_notes, write_obj,
 };
 pub use palette::{Rgb, face_colors};
+pub use points::{parse_points, read_points};
 pub use scan::{MAX_SUBDIVISIONS, bunny, sqrt3_subdivide};
 pub use scenes::{SCENE_NAMES, Staging, room, scene, scene_named};
 pub use stl::{parse_stl, read_stl, stl_collisions, write_stl};

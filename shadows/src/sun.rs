@@ -615,6 +615,90 @@ pub fn sensor_hours(
         .collect())
 }
 
+/// The sun-hours at the points of the file `path`
+/// ([`shadow_scene::read_points`]) among the faces of `mesh`
+/// ([`sensor_hours`]), as text in `format` ([`sensors_csv`],
+/// [`sensors_json`]); and how many points there are.
+pub fn sensor_hours_file(
+    mesh: &crate::Mesh,
+    path: &std::path::Path,
+    suns: &[DVec3],
+    step_hours: f64,
+    format: HoursFormat,
+) -> Result<(String, usize), crate::Error> {
+    let points = shadow_scene::read_points(path).map_err(crate::Error::File)?;
+    let hours = sensor_hours(mesh, &points, suns, step_hours)?;
+    let text = match format {
+        HoursFormat::Csv => sensors_csv(&points, &hours),
+        HoursFormat::Json => sensors_json(&points, &hours, suns.len()),
+    };
+    Ok((text, points.len()))
+}
+
+/// What `shadow sunhours` writes and says of a study.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HoursReport {
+    /// The file's text: one row per face, or per sensor.
+    pub text: String,
+    /// What the rows are, in words (`"6 faces"`, `"4 sensors among the
+    /// faces"`).
+    pub rows: String,
+    /// Per group, the share that sees at least the hours asked for, one
+    /// line each ([`groups_in_sun_text`]; empty for sensors or no hours).
+    pub groups: String,
+}
+
+/// The study's hours in `format`: every face's ([`sun_hours`]), or with
+/// `sensors` the hours at the points of that file
+/// ([`sensor_hours_file`]); with `min_hours`, the groups' shares that see
+/// at least that many hours.
+pub fn hours_report(
+    mesh: &crate::Mesh,
+    suns: &[DVec3],
+    step_hours: f64,
+    format: HoursFormat,
+    sensors: Option<&std::path::Path>,
+    min_hours: Option<f64>,
+) -> Result<HoursReport, crate::Error> {
+    if let Some(path) = sensors {
+        let (text, n) = sensor_hours_file(mesh, path, suns, step_hours, format)?;
+        let (rows, groups) = (format!("{n} sensors among the faces"), String::new());
+        return Ok(HoursReport { text, rows, groups });
+    }
+    let hours = sun_hours(mesh, suns, step_hours)?;
+    Ok(HoursReport {
+        text: format.text(mesh, &hours, suns.len()),
+        rows: format!("{} faces", hours.len()),
+        groups: groups_in_sun_text(mesh, &hours, min_hours),
+    })
+}
+
+/// Sensors' hours as CSV: `sensor,x,y,z,sun_hours`.
+pub fn sensors_csv(points: &[DVec3], hours: &[f64]) -> String {
+    let mut s = String::from(
+        "sensor,x,y,z,sun_hours
+",
+    );
+    for (i, (p, h)) in points.iter().zip(hours).enumerate() {
+        s += &format!("{i},{},{},{},{h}\n", p.x, p.y, p.z);
+    }
+    s
+}
+
+/// Sensors' hours as JSON: `{"suns": n, "sensors": [{"sensor",
+/// "position", "sun_hours"}, …]}`.
+pub fn sensors_json(points: &[DVec3], hours: &[f64], suns: usize) -> String {
+    let sensors: Vec<serde_json::Value> = (points.iter().zip(hours).enumerate())
+        .map(|(i, (p, h))| {
+            serde_json::json!({"sensor": i, "position": [p.x, p.y, p.z], "sun_hours": h})
+        })
+        .collect();
+    format!(
+        "{:#}\n",
+        serde_json::json!({"suns": suns, "sensors": sensors})
+    )
+}
+
 /// A file of sun-hours.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HoursFormat {
@@ -1020,6 +1104,33 @@ mod tests {
             assert_eq!(*h, own, "at {p}");
         }
         assert_eq!(at[5], full);
+        // the same points from a file, as CSV
+        let file = std::env::temp_dir().join(format!("sensors-{}.csv", std::process::id()));
+        let text: String = points
+            .iter()
+            .map(|p| format!("{} {} {}\n", p.x, p.y, p.z))
+            .collect();
+        std::fs::write(&file, format!("x y z\n{text}")).unwrap();
+        let (csv, n) = sensor_hours_file(&mesh, &file, &suns, step, HoursFormat::Csv).unwrap();
+        assert_eq!((n, csv.lines().count()), (6, 7));
+        let last: f64 = csv
+            .lines()
+            .last()
+            .unwrap()
+            .rsplit(',')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert_eq!(last, full);
+        std::fs::write(&file, "1 2\n").unwrap();
+        let e = sensor_hours_file(&mesh, &file, &suns, step, HoursFormat::Json).unwrap_err();
+        assert!(
+            e.to_string()
+                .ends_with(".csv:1: `1 2` has 2 numbers; a point is x,y,z"),
+            "{e}"
+        );
+        std::fs::remove_file(&file).unwrap();
         // the suns in another order make other runs: the same hours
         let back: Vec<DVec3> = suns.iter().rev().copied().collect();
         for (a, b) in hours.iter().zip(sun_hours(&mesh, &back, step).unwrap()) {
