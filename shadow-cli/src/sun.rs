@@ -85,8 +85,8 @@ pub(crate) struct SunHoursArgs {
     /// Hours at points instead of faces: a file of x,y,z lines (a header line may lead).
     #[arg(long, value_name = "FILE")]
     sensors: Option<PathBuf>,
-    /// Output: CSV (one row per face, or per sensor) or JSON.
-    #[arg(short, long, value_name = "OUT.csv|OUT.json")]
+    /// Output: CSV (one row per face, or per sensor), JSON, or OBJ (a heat map).
+    #[arg(short, long, value_name = "OUT.csv|OUT.json|OUT.obj")]
     output: PathBuf,
     /// No notes on stderr (errors still go there).
     #[arg(long, short)]
@@ -96,7 +96,10 @@ pub(crate) struct SunHoursArgs {
 /// `shadow sunhours`.
 pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
     let Some(format) = sun::HoursFormat::of(&a.output) else {
-        bail!("{}: -o must name a .csv or .json file", a.output.display());
+        bail!(
+            "{}: -o must name a .csv, .json or .obj file",
+            a.output.display()
+        );
     };
     let (mesh, name) = load_source_quiet(&a.source, a.quiet)?;
     let dates = sun::study_dates(&a.date, a.to.as_deref(), a.every)?;

@@ -1083,9 +1083,16 @@ fn sunhours_writes_every_faces_hours() {
     std::fs::write(&points, "0.5,0.5\n").unwrap();
     let o = run(&json, &["--sensors", points.to_str().unwrap()]);
     crate::assert_failed_with(&o, &["sensors.csv:1:", "a point is x,y,z"]);
+    // a heat map to look at: every face, its corners coloured
+    let heat = scratch("hours.obj");
+    let o = run(&heat, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&heat).unwrap();
+    assert!(text.starts_with("# sun-hours: viridis from 0"), "{text}");
+    assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 6);
     // bad names and dates are clear errors
     let o = run(&scratch("hours.txt"), &[]);
-    crate::assert_failed_with(&o, &["hours.txt", ".csv or .json"]);
+    crate::assert_failed_with(&o, &["hours.txt", ".csv, .json or .obj"]);
     let o = run(&csv, &["--to", "2026-02-30"]);
     crate::assert_failed_with(&o, &["2026-02-30", "not a date"]);
 }

@@ -631,6 +631,7 @@ pub fn sensor_hours_file(
     let text = match format {
         HoursFormat::Csv => sensors_csv(&points, &hours),
         HoursFormat::Json => sensors_json(&points, &hours, suns.len()),
+        HoursFormat::Obj => sensors_obj(&points, &hours),
     };
     Ok((text, points.len()))
 }
@@ -706,15 +707,18 @@ pub enum HoursFormat {
     Csv,
     /// [`hours_json`].
     Json,
+    /// [`hours_obj`]: a heat map to look at.
+    Obj,
 }
 
 impl HoursFormat {
-    /// The format a file name asks for (`.csv`, `.json`), if any.
+    /// The format a file name asks for (`.csv`, `.json`, `.obj`), if any.
     pub fn of(path: &std::path::Path) -> Option<HoursFormat> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
         match ext.as_str() {
             "json" => Some(HoursFormat::Json),
             "csv" => Some(HoursFormat::Csv),
+            "obj" => Some(HoursFormat::Obj),
             _ => None,
         }
     }
@@ -724,8 +728,64 @@ impl HoursFormat {
         match self {
             HoursFormat::Json => hours_json(mesh, hours, suns),
             HoursFormat::Csv => hours_csv(mesh, hours),
+            HoursFormat::Obj => hours_obj(mesh, hours),
         }
     }
+}
+
+/// The hours as a heat map in OBJ: every face with its own corners, each
+/// coloured (`v x y z r g b`) by the face's sun-hours on a viridis ramp
+/// from 0 hours (dark blue) to the most any face gets (yellow), named in
+/// the first line; groups as the mesh's.
+pub fn hours_obj(mesh: &crate::Mesh, hours: &[FaceHours]) -> String {
+    let most = hours.iter().map(|h| h.sun_hours).fold(0.0, f64::max);
+    let mut s = format!("# sun-hours: viridis from 0 (dark blue) to {most} hours (yellow)\n");
+    let (mut next, mut group) = (1, None);
+    for (f, (face, h)) in mesh.faces.iter().zip(hours).enumerate() {
+        if group != Some(face.group) {
+            group = Some(face.group);
+            s += &format!("g {}\n", mesh.group_name(f));
+        }
+        let [r, g, b] = viridis(if most > 0.0 { h.sun_hours / most } else { 0.0 });
+        for &v in &face.vertices {
+            let p = mesh.positions[v as usize];
+            s += &format!("v {} {} {} {r:.4} {g:.4} {b:.4}\n", p.x, p.y, p.z);
+        }
+        let corners: Vec<String> = (next..next + face.vertices.len())
+            .map(|i| i.to_string())
+            .collect();
+        s += &format!("f {}\n", corners.join(" "));
+        next += face.vertices.len();
+    }
+    s
+}
+
+/// Sensors' hours as coloured points in OBJ (`v x y z r g b`, the ramp
+/// of [`hours_obj`]).
+pub fn sensors_obj(points: &[DVec3], hours: &[f64]) -> String {
+    let most = hours.iter().copied().fold(0.0, f64::max);
+    let mut s = format!("# sun-hours: viridis from 0 (dark blue) to {most} hours (yellow)\n");
+    for (p, h) in points.iter().zip(hours) {
+        let [r, g, b] = viridis(if most > 0.0 { h / most } else { 0.0 });
+        s += &format!("v {} {} {} {r:.4} {g:.4} {b:.4}\n", p.x, p.y, p.z);
+    }
+    s
+}
+
+/// A colour of the viridis ramp at `t` in `[0, 1]` (five stops, linear
+/// between).
+fn viridis(t: f64) -> [f64; 3] {
+    const STOPS: [[f64; 3]; 5] = [
+        [68.0, 1.0, 84.0],
+        [59.0, 82.0, 139.0],
+        [33.0, 145.0, 140.0],
+        [94.0, 201.0, 98.0],
+        [253.0, 231.0, 37.0],
+    ];
+    let x = t.clamp(0.0, 1.0) * 4.0;
+    let i = (x.floor() as usize).min(3);
+    let w = x - i as f64;
+    std::array::from_fn(|k| ((1.0 - w) * STOPS[i][k] + w * STOPS[i + 1][k]) / 255.0)
 }
 
 /// The hours as CSV: `face,group,area,sun_hours,min_hours,max_hours`.
@@ -1028,14 +1088,11 @@ mod tests {
         t0 < t1
     }
 
-    #[test]
-    fn a_day_of_suns_and_the_hours_of_a_yard() {
+    /// The yard on the equinox at Greenwich, a sun every 8 minutes (more
+    /// than one run takes): the mesh, the suns, the step, all suns' hours.
+    fn equinox_study() -> (crate::Mesh, Vec<DVec3>, f64, f64) {
         let site = SunSite::new(51.48, 0.0);
         let day = [chrono::NaiveDate::from_ymd_opt(2026, 3, 21).unwrap()];
-        let hourly = study_suns(&site, &day, 60.0, 0.0).unwrap();
-        assert!((11..=13).contains(&hourly.len()), "{}", hourly.len());
-        assert!(study_suns(&site, &day, 0.0, 0.0).is_err());
-        // every 8 minutes: more suns than one run takes
         let suns: Vec<DVec3> = study_suns(&site, &day, 8.0, 0.0)
             .unwrap()
             .iter()
@@ -1044,7 +1101,17 @@ mod tests {
         assert!(suns.len() > svbsp::MAX_LIGHTS, "{}", suns.len());
         let step = 8.0 / 60.0;
         let full = suns.len() as f64 * step;
-        let mesh = yard();
+        (yard(), suns, step, full)
+    }
+
+    #[test]
+    fn a_day_of_suns_and_the_hours_of_a_yard() {
+        let site = SunSite::new(51.48, 0.0);
+        let day = [chrono::NaiveDate::from_ymd_opt(2026, 3, 21).unwrap()];
+        let hourly = study_suns(&site, &day, 60.0, 0.0).unwrap();
+        assert!((11..=13).contains(&hourly.len()), "{}", hourly.len());
+        assert!(study_suns(&site, &day, 0.0, 0.0).is_err());
+        let (mesh, suns, step, full) = equinox_study();
         let hours = sun_hours(&mesh, &suns, step).unwrap();
         // the roof sees every sun
         let roof = &hours[1];
@@ -1104,6 +1171,23 @@ mod tests {
             assert_eq!(*h, own, "at {p}");
         }
         assert_eq!(at[5], full);
+    }
+
+    #[test]
+    fn runs_files_and_heat_maps_of_a_yard() {
+        let (mesh, suns, step, full) = equinox_study();
+        let hours = sun_hours(&mesh, &suns, step).unwrap();
+        let points: Vec<DVec3> = [
+            (0.0, -1.5),
+            (1.5, 1.5),
+            (-3.0, 2.0),
+            (0.2, 2.5),
+            (-1.2, -1.2),
+        ]
+        .iter()
+        .map(|&(x, y)| DVec3::new(x, y, 0.0))
+        .chain([DVec3::new(0.0, 0.0, 2.5)])
+        .collect();
         // the same points from a file, as CSV
         let file = std::env::temp_dir().join(format!("sensors-{}.csv", std::process::id()));
         let text: String = points
@@ -1131,6 +1215,15 @@ mod tests {
             "{e}"
         );
         std::fs::remove_file(&file).unwrap();
+        // the heat map: a coloured corner per face corner, the roof yellow
+        let obj = HoursFormat::Obj.text(&mesh, &hours, suns.len());
+        let corners: usize = mesh.faces.iter().map(|f| f.vertices.len()).sum();
+        assert_eq!(obj.lines().filter(|l| l.starts_with("v ")).count(), corners);
+        let read = shadow_scene::parse_obj(&obj, "heat.obj").unwrap();
+        assert_eq!(read.faces.len(), mesh.faces.len());
+        let roof = obj.lines().filter(|l| l.starts_with("v ")).nth(4).unwrap();
+        assert!(roof.ends_with(" 0.9922 0.9059 0.1451"), "{roof}");
+        assert_eq!(viridis(0.0), [68.0 / 255.0, 1.0 / 255.0, 84.0 / 255.0]);
         // the suns in another order make other runs: the same hours
         let back: Vec<DVec3> = suns.iter().rev().copied().collect();
         for (a, b) in hours.iter().zip(sun_hours(&mesh, &back, step).unwrap()) {
