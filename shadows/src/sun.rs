@@ -1088,6 +1088,22 @@ mod tests {
         t0 < t1
     }
 
+    /// Points on the yard's ground off the shadows' edges, then one above
+    /// the roof's middle.
+    fn yard_sensors() -> Vec<DVec3> {
+        [
+            (0.0, -1.5),
+            (1.5, 1.5),
+            (-3.0, 2.0),
+            (0.2, 2.5),
+            (-1.2, -1.2),
+        ]
+        .iter()
+        .map(|&(x, y)| DVec3::new(x, y, 0.0))
+        .chain([DVec3::new(0.0, 0.0, 2.5)])
+        .collect()
+    }
+
     /// The yard on the equinox at Greenwich, a sun every 8 minutes (more
     /// than one run takes): the mesh, the suns, the step, all suns' hours.
     fn equinox_study() -> (crate::Mesh, Vec<DVec3>, f64, f64) {
@@ -1125,14 +1141,7 @@ mod tests {
         assert_eq!(g.max_hours, full);
         assert!(g.min_hours < g.sun_hours && g.sun_hours < full, "{g:?}");
         // every point's own count lies between the least and the most
-        for (x, y) in [
-            (0.0, -1.5),
-            (1.5, 1.5),
-            (-3.0, 2.0),
-            (0.2, 2.5),
-            (-1.2, -1.2),
-        ] {
-            let p = DVec3::new(x, y, 0.0);
+        for &p in &yard_sensors()[..5] {
             let own = suns.iter().filter(|&&d| !blocked(p, d)).count() as f64 * step;
             assert!(
                 g.min_hours - 1e-9 <= own && own <= g.max_hours + 1e-9,
@@ -1154,17 +1163,7 @@ mod tests {
         assert_eq!(groups.len(), 1); // one group: the yard and the box
         // sensors: a point's own count, exactly (points off the shadows'
         // edges), and the roof's middle sees every sun
-        let points: Vec<DVec3> = [
-            (0.0, -1.5),
-            (1.5, 1.5),
-            (-3.0, 2.0),
-            (0.2, 2.5),
-            (-1.2, -1.2),
-        ]
-        .iter()
-        .map(|&(x, y)| DVec3::new(x, y, 0.0))
-        .chain([DVec3::new(0.0, 0.0, 2.5)])
-        .collect();
+        let points = yard_sensors();
         let at = sensor_hours(&mesh, &points, &suns, step).unwrap();
         for (p, h) in points.iter().zip(&at) {
             let own = suns.iter().filter(|&&d| !blocked(*p, d)).count() as f64 * step;
@@ -1177,17 +1176,7 @@ mod tests {
     fn runs_files_and_heat_maps_of_a_yard() {
         let (mesh, suns, step, full) = equinox_study();
         let hours = sun_hours(&mesh, &suns, step).unwrap();
-        let points: Vec<DVec3> = [
-            (0.0, -1.5),
-            (1.5, 1.5),
-            (-3.0, 2.0),
-            (0.2, 2.5),
-            (-1.2, -1.2),
-        ]
-        .iter()
-        .map(|&(x, y)| DVec3::new(x, y, 0.0))
-        .chain([DVec3::new(0.0, 0.0, 2.5)])
-        .collect();
+        let points = yard_sensors();
         // the same points from a file, as CSV
         let file = std::env::temp_dir().join(format!("sensors-{}.csv", std::process::id()));
         let text: String = points
