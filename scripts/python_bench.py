@@ -111,8 +111,9 @@ def sun_study(args):
     dates = [f"2026-{m:02d}-01" for m in range(1, 13)]
     # each face's exact mean hours; the extremes' overlay grows quadratically
     # in the suns on the ground under the bunny (see bs.sun_hours)
-    study = dict(lat=51.5, lon=-0.1, dates=dates, step_minutes=15, extremes=False)
-    suns = bs.study_suns(51.5, -0.1, dates, 15)
+    up = "y" if args.scene.startswith("bunny") else "z"  # (the scans stand with y up)
+    study = dict(lat=51.5, lon=-0.1, dates=dates, step_minutes=15, extremes=False, up=up)
+    suns = bs.study_suns(51.5, -0.1, dates, 15, up=up)
     runs = bsd.runs_of(suns)
     print(f"sun study: {args.scene} ({len(scene.faces)} faces), 12 days, 15-minute steps: "
           f"{len(suns)} suns in {len(runs)} runs")

@@ -772,6 +772,14 @@ pub fn sensors_obj(points: &[DVec3], hours: &[f64]) -> String {
     s
 }
 
+/// Each face's colour in the heat maps ([`hours_obj`]): its sun-hours on
+/// the viridis ramp from 0 to `most` hours (RGB in `[0, 1]`).
+pub fn heat_colors(hours: &[FaceHours], most: f64) -> Vec<DVec3> {
+    (hours.iter())
+        .map(|h| DVec3::from_array(viridis(if most > 0.0 { h.sun_hours / most } else { 0.0 })))
+        .collect()
+}
+
 /// A colour of the viridis ramp at `t` in `[0, 1]` (five stops, linear
 /// between).
 fn viridis(t: f64) -> [f64; 3] {
