@@ -6,7 +6,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use bsp_shadows::sun::{HoursRun, SunSite, Up};
+use bsp_shadows::sun::{self, HoursRun, SunSite, Up};
 use bsp_shadows::{BoolOp, DVec3, Error, Face, Light};
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods,
@@ -646,11 +646,9 @@ fn study_suns<'py>(
     let mut days = Vec::new();
     for d in dates.try_iter()? {
         let text = d?.str()?.to_string();
-        let day = text
-            .get(..10)
-            .unwrap_or(&text)
-            .parse::<chrono::NaiveDate>()
-            .map_err(|e| BspError::new_err(format!("`{text}` is not a date YYYY-MM-DD ({e})")))?;
+        // (a datetime's text begins with its date)
+        let date = text.get(..10).unwrap_or(&text);
+        let day = sun::parse_date(date).map_err(|e| BspError::new_err(e.to_string()))?;
         days.push(day);
     }
     let site = SunSite {

@@ -222,6 +222,13 @@ pub fn study_suns(
     Ok(out)
 }
 
+/// A date `YYYY-MM-DD` (spaces around it ignored).
+pub fn parse_date(s: &str) -> Result<chrono::NaiveDate, SunError> {
+    s.trim()
+        .parse::<chrono::NaiveDate>()
+        .map_err(|e| SunError(format!("`{s}` is not a date YYYY-MM-DD ({e})")))
+}
+
 /// The days of a study: `from` to `to` (default: `from`), every `every`
 /// days, dates as `YYYY-MM-DD`.
 pub fn study_dates(
@@ -229,11 +236,7 @@ pub fn study_dates(
     to: Option<&str>,
     every: u32,
 ) -> Result<Vec<chrono::NaiveDate>, SunError> {
-    let day = |s: &str| {
-        s.trim()
-            .parse::<chrono::NaiveDate>()
-            .map_err(|e| SunError(format!("`{s}` is not a date YYYY-MM-DD ({e})")))
-    };
+    let day = parse_date;
     let first = day(from)?;
     let last = to.map_or(Ok(first), day)?;
     if last < first || every == 0 {
@@ -739,17 +742,16 @@ impl HoursFormat {
 /// the first line; groups as the mesh's.
 pub fn hours_obj(mesh: &crate::Mesh, hours: &[FaceHours]) -> String {
     let most = hours.iter().map(|h| h.sun_hours).fold(0.0, f64::max);
-    let mut s = format!("# sun-hours: viridis from 0 (dark blue) to {most} hours (yellow)\n");
+    let mut s = heat_header(most);
     let (mut next, mut group) = (1, None);
     for (f, (face, h)) in mesh.faces.iter().zip(hours).enumerate() {
         if group != Some(face.group) {
             group = Some(face.group);
             s += &format!("g {}\n", mesh.group_name(f));
         }
-        let [r, g, b] = viridis(if most > 0.0 { h.sun_hours / most } else { 0.0 });
+        let rgb = heat(h.sun_hours, most);
         for &v in &face.vertices {
-            let p = mesh.positions[v as usize];
-            s += &format!("v {} {} {} {r:.4} {g:.4} {b:.4}\n", p.x, p.y, p.z);
+            s += &colored_vertex(mesh.positions[v as usize], rgb);
         }
         let corners: Vec<String> = (next..next + face.vertices.len())
             .map(|i| i.to_string())
@@ -764,19 +766,33 @@ pub fn hours_obj(mesh: &crate::Mesh, hours: &[FaceHours]) -> String {
 /// of [`hours_obj`]).
 pub fn sensors_obj(points: &[DVec3], hours: &[f64]) -> String {
     let most = hours.iter().copied().fold(0.0, f64::max);
-    let mut s = format!("# sun-hours: viridis from 0 (dark blue) to {most} hours (yellow)\n");
+    let mut s = heat_header(most);
     for (p, h) in points.iter().zip(hours) {
-        let [r, g, b] = viridis(if most > 0.0 { h / most } else { 0.0 });
-        s += &format!("v {} {} {} {r:.4} {g:.4} {b:.4}\n", p.x, p.y, p.z);
+        s += &colored_vertex(*p, heat(*h, most));
     }
     s
+}
+
+/// The heat maps' first line: the ramp and its range.
+fn heat_header(most: f64) -> String {
+    format!("# sun-hours: viridis from 0 (dark blue) to {most} hours (yellow)\n")
+}
+
+/// An OBJ vertex with its colour.
+fn colored_vertex(p: DVec3, [r, g, b]: [f64; 3]) -> String {
+    format!("v {} {} {} {r:.4} {g:.4} {b:.4}\n", p.x, p.y, p.z)
+}
+
+/// The colour of `hours` on the ramp from 0 to `most` hours.
+fn heat(hours: f64, most: f64) -> [f64; 3] {
+    viridis(if most > 0.0 { hours / most } else { 0.0 })
 }
 
 /// Each face's colour in the heat maps ([`hours_obj`]): its sun-hours on
 /// the viridis ramp from 0 to `most` hours (RGB in `[0, 1]`).
 pub fn heat_colors(hours: &[FaceHours], most: f64) -> Vec<DVec3> {
     (hours.iter())
-        .map(|h| DVec3::from_array(viridis(if most > 0.0 { h.sun_hours / most } else { 0.0 })))
+        .map(|h| DVec3::from_array(heat(h.sun_hours, most)))
         .collect()
 }
 
