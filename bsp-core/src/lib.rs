@@ -23,7 +23,8 @@
 //! planes, points, polygons), `tree` (building, traversal, merging) and
 //! `solid` (import, meshes, topology and embedding checks). The crate
 //! root re-exports what a user needs; [`internals`] holds what the sibling
-//! crates of this workspace use besides.
+//! crates of this workspace use besides, and [`par`] the parallel loops
+//! they share (rayon's scheduling compiled once, results in index order).
 //!
 //! # Example
 //!
@@ -47,6 +48,7 @@
 //! None.
 
 mod kernel;
+pub mod par;
 mod solid;
 mod tree;
 mod union_find;

@@ -22,9 +22,9 @@
 
 use std::time::{Duration, Instant};
 
+use bsp_core::par;
 use bsp_core::{BoolOp, Grid, ImportReport, TopologyError, TriMesh};
 use glam::DVec3;
-use rayon::prelude::*;
 use shadow_scene::{Mesh, MeshView, Triangles};
 
 use crate::{CsgError, MeshBuf, MeshIn, SequenceError, Stage, Step, mesh_sequence_with};
@@ -181,7 +181,7 @@ impl Operand {
     /// in their order. The operands checked are what
     /// [`FileBoolean::apply`] takes.
     pub fn check_all(operands: &mut [Operand]) -> Result<Checked<'_>, FileError> {
-        let checked: Vec<Result<(), FileError>> = operands.par_iter().map(Operand::check).collect();
+        let checked: Vec<Result<(), FileError>> = par::map_slice(operands, Operand::check);
         checked.into_iter().collect::<Result<(), FileError>>()?;
         Ok(Checked(operands))
     }
@@ -399,11 +399,7 @@ impl FileBoolean {
             }
         })
         .map_err(|e| sequence_error(e, &names, op, &grid))?;
-        let positions = exact
-            .vertices_f64()
-            .into_par_iter()
-            .map(|v| grid.to_world(v))
-            .collect();
+        let positions = par::map_vec(exact.vertices_f64(), |v| grid.to_world(v));
         times.stop();
         Ok(FileBoolean {
             times,

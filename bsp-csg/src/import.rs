@@ -1,9 +1,9 @@
 //! From meshes to solids: the check, the grid, and the snap.
 
 use bsp_core::internals::GridPolygon;
+use bsp_core::par;
 use bsp_core::{Grid, ImportReport, check_closed_manifold};
 use glam::DVec3;
-use rayon::prelude::*;
 
 use crate::solid::SolidFace;
 use crate::{CsgError, Solid};
@@ -133,15 +133,13 @@ pub fn snap_one(
     const CHUNK: usize = 4096;
     let n = mesh.faces.len();
     let mut faces: Vec<Option<SolidFace>> = Vec::with_capacity(n);
-    faces.par_extend((0..n).into_par_iter().map(|_| None));
+    faces.resize_with(n, || None);
     // each vertex snapped once, not once per face around it
     let snapped = bsp_core::internals::snap_positions(grid, mesh.positions);
     type Run = (ImportReport, Vec<SolidFace>, i128);
-    let runs: Vec<Result<Run, bsp_core::Error>> = faces
-        .par_chunks_mut(CHUNK)
-        .zip(mesh.faces.par_chunks(CHUNK))
-        .enumerate()
-        .map(|(c, (slots, loops))| {
+    let runs: Vec<Result<Run, bsp_core::Error>> =
+        par::map_chunks_mut(&mut faces, CHUNK, |c, slots| {
+            let loops = &mesh.faces[c * CHUNK..];
             let mut imp = bsp_core::internals::FaceImporter::default();
             let (mut extra, mut six) = (Vec::new(), 0i128);
             for (i, (slot, face)) in slots.iter_mut().zip(loops).enumerate() {
@@ -155,8 +153,7 @@ pub fn snap_one(
                 })?;
             }
             Ok((imp.finish(), extra, six))
-        })
-        .collect();
+        });
     // the first error in face order, as a sequential import gives
     let mut report = ImportReport::default();
     let mut sign = 0i128;

@@ -67,6 +67,11 @@ pub(crate) fn union(a: &IBox, b: &IBox) -> IBox {
     )
 }
 
+/// The box spanning `boxes`; `None` for none.
+pub(crate) fn span(boxes: impl IntoIterator<Item = IBox>) -> Option<IBox> {
+    boxes.into_iter().reduce(|a, b| union(&a, &b))
+}
+
 /// Face ids bucketed by the grid cells their boxes overlap. Boxes beyond
 /// the grid fall in its border cells, so every query stays conservative.
 #[derive(Clone, Debug)]
@@ -116,29 +121,27 @@ impl FaceIndex {
     pub(crate) fn filled(
         bounds: IBox,
         count: usize,
-        faces: impl rayon::iter::IndexedParallelIterator<Item = Option<IBox>>,
+        faces: usize,
+        face_box: impl Fn(usize) -> Option<IBox> + Sync,
     ) -> FaceIndex {
-        use rayon::prelude::*;
         let mut ix = FaceIndex::new(bounds, count);
         let this = &ix;
         // (cell coordinates are below 256: `new` makes at most 256 cells
         // along an axis)
         debug_assert!(ix.dims.iter().all(|&d| d <= 256));
-        let ranges: Vec<Option<[u8; 6]>> = faces
-            .map(|b| {
-                b.map(|b| {
-                    let c = |k: usize, x: i64| this.coord(k, x) as u8;
-                    [
-                        c(0, b.0[0]),
-                        c(1, b.0[1]),
-                        c(2, b.0[2]),
-                        c(0, b.1[0]),
-                        c(1, b.1[1]),
-                        c(2, b.1[2]),
-                    ]
-                })
+        let ranges: Vec<Option<[u8; 6]>> = bsp_core::par::map(faces, |i| {
+            face_box(i).map(|b| {
+                let c = |k: usize, x: i64| this.coord(k, x) as u8;
+                [
+                    c(0, b.0[0]),
+                    c(1, b.0[1]),
+                    c(2, b.0[2]),
+                    c(0, b.1[0]),
+                    c(1, b.1[1]),
+                    c(2, b.1[2]),
+                ]
             })
-            .collect();
+        });
         let dims = ix.dims;
         let cells_in = move |r: [u8; 6]| {
             (r[0] as usize..=r[3] as usize).flat_map(move |x| {
@@ -196,10 +199,7 @@ impl FaceIndex {
 
     /// Keeps the ids `keep` accepts (every list in parallel, in order).
     pub(crate) fn retain(&mut self, keep: impl Fn(u32) -> bool + Sync) {
-        use rayon::prelude::*;
-        self.cells
-            .par_iter_mut()
-            .for_each(|list| list.retain(|&f| keep(f)));
+        bsp_core::par::for_each_mut(&mut self.cells, |_, list| list.retain(|&f| keep(f)));
     }
 
     /// How many ids [`FaceIndex::near`] would give (with repeats),
@@ -232,7 +232,6 @@ mod tests {
 
     #[test]
     fn a_filled_index_is_the_faces_inserted_in_turn() {
-        use rayon::prelude::*;
         let bounds = ([-50, 0, 10], [149, 99, 59]);
         // small and large boxes, some beyond the bounds, some slots empty
         let mut state = 7u64;
@@ -252,7 +251,7 @@ mod tests {
                 Some((lo, [0, 1, 2].map(|k| lo[k] + next(size))))
             })
             .collect();
-        let filled = FaceIndex::filled(bounds, 2000, boxes.par_iter().copied());
+        let filled = FaceIndex::filled(bounds, 2000, boxes.len(), |i| boxes[i]);
         let mut inserted = FaceIndex::new(bounds, 2000);
         for (i, b) in boxes.iter().enumerate() {
             if let Some(b) = b {

@@ -27,8 +27,8 @@ mod resolve;
 mod settle;
 
 use bsp_core::internals::ConvexFace;
+use bsp_core::par;
 use bsp_core::{BoolOp, Plane, TriMesh};
-use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
@@ -323,7 +323,10 @@ impl Cells {
         let mut leaves = grow_octree(solids, &near, root, opts.leaf_size);
         if opts.exact_cells {
             // the lists of the leaves holding both, by the exact test
-            leaves.par_iter_mut().filter(|l| l.mixed()).for_each(|l| {
+            par::for_each_mut(&mut leaves, |_, l| {
+                if !l.mixed() {
+                    return;
+                }
                 let bx = l.bx;
                 l.a.retain(|&f| octree::polygon_meets(solids.a.face(near.a[f as usize]), &bx));
                 l.b.retain(|&f| octree::polygon_meets(solids.b.face(near.b[f as usize]), &bx));
@@ -341,7 +344,7 @@ impl Cells {
             of
         });
         // the leaves' lists by face id
-        leaves.par_iter_mut().for_each(|l| {
+        par::for_each_mut(&mut leaves, |_, l| {
             l.a.iter_mut().for_each(|f| *f = near.a[*f as usize]);
             l.b.iter_mut().for_each(|f| *f = near.b[*f as usize]);
         });
@@ -367,8 +370,8 @@ fn grow_octree(
     // the faces' boxes and planes side by side, by their place in `near`
     // (a face slot is large: the build reads these often)
     let geometry = |s: &Solid, fs: &[u32]| -> (Vec<SmallBox>, Vec<Plane>) {
-        fs.par_iter()
-            .map(|&f| (s.face(f).small_box(), *s.face(f).support()))
+        par::map_slice(fs, |&f| (s.face(f).small_box(), *s.face(f).support()))
+            .into_iter()
             .unzip()
     };
     let (boxes_a, planes_a) = geometry(solids.a, &near.a);
@@ -543,14 +546,16 @@ impl<'s> Planning<'s> {
         touched: &Touched,
     ) -> Result<MixedCells, CsgError> {
         let leaves = &self.cells.leaves;
-        let first: Vec<(u32, CellRun)> = mixed
-            .par_iter()
-            .filter(|&&l| !touched.clean(l))
-            .map(|&l| {
-                work.run(&leaves[l as usize], self.easy_cells)
-                    .map(|r| (l, r))
-            })
-            .collect::<Result<_, _>>()?;
+        let unclean: Vec<u32> = mixed
+            .iter()
+            .copied()
+            .filter(|&l| !touched.clean(l))
+            .collect();
+        let first: Vec<(u32, CellRun)> = par::try_map(unclean.len(), |i| {
+            let l = unclean[i];
+            work.run(&leaves[l as usize], self.easy_cells)
+                .map(|r| (l, r))
+        })?;
         let mut done = MixedCells {
             fates: Both::default(),
             crossings: Both::default(),
@@ -616,10 +621,10 @@ impl<'s> Planning<'s> {
             }
         }
         let leaves = &self.cells.leaves;
-        let redone: Vec<(u32, CellRun)> = again
-            .into_par_iter()
-            .map(|l| work.run(&leaves[l as usize], false).map(|r| (l, r)))
-            .collect::<Result<_, _>>()?;
+        let redone: Vec<(u32, CellRun)> = par::try_map(again.len(), |i| {
+            let l = again[i];
+            work.run(&leaves[l as usize], false).map(|r| (l, r))
+        })?;
         for (l, run) in redone {
             match run {
                 CellRun::Built { outcome, .. } => done.built(l, outcome),
@@ -657,10 +662,10 @@ impl Planning<'_> {
                 touched,
             )
         };
-        let (settled_a, (kept_b, settled_b)) = rayon::join(
+        let (settled_a, (kept_b, settled_b)) = par::join(
             || settle_faces(Operand::A),
             || {
-                rayon::join(
+                par::join(
                     // the other solid's faces kept whole are listed, to be
                     // copied or moved over (turned around for a difference)
                     || self.whole_faces(Operand::B, &sorted.b, regions, true),
@@ -718,17 +723,14 @@ impl Planning<'_> {
     ) -> Vec<u32> {
         let (solid, other_regions) = (self.solids.get(o), regions.get(o.other()));
         let (near, leaves_of) = (self.cells.near.get(o), self.cells.leaves_of.get(o));
-        sorted
-            .whole
-            .par_iter()
-            .filter(|&&i| {
-                let face = solid.face(near[i as usize]);
-                let inside = meeting_leaf(face, &leaves_of[i as usize], &self.cells.leaves)
-                    .is_some_and(|l| other_regions.inside(l));
-                self.keep.piece(o, inside) == kept
-            })
-            .map(|&i| near[i as usize])
-            .collect()
+        let whole = &sorted.whole;
+        par::filter_map(whole.len(), |k| {
+            let i = whole[k] as usize;
+            let face = solid.face(near[i]);
+            let inside = meeting_leaf(face, &leaves_of[i], &self.cells.leaves)
+                .is_some_and(|l| other_regions.inside(l));
+            (self.keep.piece(o, inside) == kept).then_some(near[i])
+        })
     }
 
     /// What stays of each of operand `o`'s faces with pieces: by its
@@ -751,45 +753,41 @@ impl Planning<'_> {
             _ => keep(false),
         };
         let root_walls = walls(&self.cells.root);
-        pieced
-            .par_iter()
-            .map(|p| {
-                if let Some(inside) = labels[p.face as usize] {
-                    let remains = if keep(inside) {
-                        Remains::Whole
-                    } else {
-                        Remains::Parts(Vec::new())
-                    };
-                    return Ok(SettledFace {
-                        face: p.face,
-                        remains,
-                    });
-                }
-                // (an untouched face stays or goes whole by its label; a
-                // face the other surface may meet has no piece in a clean
-                // cell)
-                let in_clean_cell = |q: &FacePiece| {
-                    matches!(*q, FacePiece::InMixedLeaf { leaf, .. } if touched.clean(leaf))
+        par::try_map(pieced.len(), |i| {
+            let p = &pieced[i];
+            if let Some(inside) = labels[p.face as usize] {
+                let remains = if keep(inside) {
+                    Remains::Whole
+                } else {
+                    Remains::Parts(Vec::new())
                 };
-                if p.pieces.iter().any(in_clean_cell) {
-                    return Err(CsgError::Internal(
-                        "a face the other surface may meet has a piece in a clean cell".into(),
-                    ));
-                }
-                let remains = settle(
-                    solid.face(p.face),
-                    &p.pieces,
-                    &free_stays,
-                    fates,
-                    &self.cells.leaves,
-                    &root_walls,
-                );
-                Ok(SettledFace {
+                return Ok(SettledFace {
                     face: p.face,
                     remains,
-                })
+                });
+            }
+            // (an untouched face stays or goes whole by its label; a
+            // face the other surface may meet has no piece in a clean
+            // cell)
+            let in_clean_cell = |q: &FacePiece| matches!(*q, FacePiece::InMixedLeaf { leaf, .. } if touched.clean(leaf));
+            if p.pieces.iter().any(in_clean_cell) {
+                return Err(CsgError::Internal(
+                    "a face the other surface may meet has a piece in a clean cell".into(),
+                ));
+            }
+            let remains = settle(
+                solid.face(p.face),
+                &p.pieces,
+                &free_stays,
+                fates,
+                &self.cells.leaves,
+                &root_walls,
+            );
+            Ok(SettledFace {
+                face: p.face,
+                remains,
             })
-            .collect()
+        })
     }
 }
 

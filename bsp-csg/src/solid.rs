@@ -9,7 +9,7 @@ mod query;
 mod winding;
 
 use bsp_core::Polygon;
-use rayon::prelude::*;
+use bsp_core::par;
 use std::borrow::Cow;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -17,7 +17,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 pub(crate) use carry_out::{AddedFace, Additions, OtherFaces};
 pub(crate) use face::SolidFace;
 
-use crate::index::{FaceIndex, IBox, union};
+use crate::index::{FaceIndex, IBox, span, union};
 
 /// Faces removed or added at once from which the index is updated in
 /// parallel passes rather than face by face.
@@ -57,10 +57,7 @@ impl Solid {
     /// closed, outward-oriented polyhedron (not checked; see
     /// [`mesh_boolean`](crate::mesh_boolean) for checked input).
     pub fn from_polygons(polys: Vec<Polygon>) -> Solid {
-        let faces: Vec<Option<SolidFace>> = polys
-            .into_par_iter()
-            .map(|p| Some(SolidFace::made(Box::new(p))))
-            .collect();
+        let faces = par::map_vec(polys, |p| Some(SolidFace::made(Box::new(p))));
         Solid::from_faces(faces, Vec::new())
     }
 
@@ -85,10 +82,15 @@ impl Solid {
 
     /// The box of the live faces' boxes.
     fn faces_bounds(&self) -> Option<IBox> {
-        self.faces
-            .par_iter()
-            .filter_map(|f| f.as_ref().map(SolidFace::bx))
-            .reduce_with(|a, b| union(&a, &b))
+        let faces = &self.faces;
+        let spans = par::fold_runs(faces.len(), |r| {
+            span(
+                faces[r]
+                    .iter()
+                    .filter_map(|f| f.as_ref().map(SolidFace::bx)),
+            )
+        });
+        span(spans.into_iter().flatten())
     }
 
     /// An empty solid.
@@ -110,7 +112,8 @@ impl Solid {
         self.index = OnceLock::from(FaceIndex::filled(
             self.bounds.unwrap_or(([0; 3], [0; 3])),
             self.indexed,
-            self.faces.par_iter().map(|f| f.as_ref().map(SolidFace::bx)),
+            self.faces.len(),
+            |i| self.faces[i].as_ref().map(SolidFace::bx),
         ));
     }
 
@@ -202,11 +205,11 @@ impl Solid {
                 self.live -= 1;
             }
         }
-        self.faces
-            .par_iter_mut()
-            .zip(&gone)
-            .filter(|(_, g)| **g)
-            .for_each(|(f, _)| *f = None);
+        par::for_each_mut(&mut self.faces, |i, f| {
+            if gone[i] {
+                *f = None;
+            }
+        });
         if let Some(index) = self.index.get_mut() {
             index.retain(|f| !gone[f as usize]);
         }

@@ -16,7 +16,7 @@
 
 use bsp_core::GridPoint;
 use bsp_core::internals::{ConvexFace, UnionFind};
-use rayon::prelude::*;
+use bsp_core::par;
 use rustc_hash::{FxHashMap, FxHashSet};
 use smallvec::SmallVec;
 
@@ -165,10 +165,7 @@ impl Labeller<'_> {
         pieced: &[PiecedFace],
         touched: &Touched,
     ) -> Result<Vec<Option<bool>>, CsgError> {
-        let own: Vec<OwnLabel> = pieced
-            .par_iter()
-            .map(|p| self.own_label(p, touched))
-            .collect();
+        let own: Vec<OwnLabel> = par::map_slice(pieced, |p| self.own_label(p, touched));
         let by_id = |label: &dyn Fn(usize) -> Result<Option<bool>, CsgError>| {
             let mut out: Vec<Option<bool>> = vec![None; self.solid.slot_count()];
             for (i, p) in pieced.iter().enumerate() {
@@ -359,17 +356,14 @@ impl Labeller<'_> {
         nodes: &EasyNodes,
         crossings: &FxHashMap<u32, WallCrossings>,
     ) -> Vec<(u32, u32)> {
-        nodes
-            .cells
-            .par_iter()
-            .flat_map_iter(|&l| {
-                let mut out = Vec::new();
-                for &m in nodes.around.get(&l).map_or(&[][..], |v| &v[..]) {
-                    self.join_neighbours(nodes, crossings, l, m, &mut out);
-                }
-                out
-            })
-            .collect()
+        par::flat_map(nodes.cells.len(), |i| {
+            let l = nodes.cells[i];
+            let mut out = Vec::new();
+            for &m in nodes.around.get(&l).map_or(&[][..], |v| &v[..]) {
+                self.join_neighbours(nodes, crossings, l, m, &mut out);
+            }
+            out
+        })
     }
 
     /// The joins of the easy cell `l`'s pieces with the same faces'
@@ -495,7 +489,7 @@ fn answer(
     asked: &[(u32, GridPoint)],
     inside: &(dyn Fn(GridPoint) -> bool + Sync),
 ) {
-    let answers: Vec<(u32, bool)> = asked.par_iter().map(|&(r, g)| (r, inside(g))).collect();
+    let answers: Vec<(u32, bool)> = par::map_slice(asked, |&(r, g)| (r, inside(g)));
     for (r, x) in answers {
         groups.union(r, u32::from(x));
     }

@@ -12,8 +12,8 @@
 //! becomes of each listed face, or their merged boundary.
 
 use bsp_core::internals::ConvexFace;
+use bsp_core::par;
 use bsp_core::{BoolOp, GridPoint, Plane, Polygon};
-use rayon::prelude::*;
 use smallvec::SmallVec;
 
 use super::local::{self, CellResult, Fate};
@@ -265,10 +265,8 @@ impl Touched {
         solids: Both<&Solid>,
         easy_cells: bool,
     ) -> Touched {
-        let per_cell: Vec<Both<Vec<u32>>> = mixed
-            .par_iter()
-            .map(|&l| touched_in(&leaves[l as usize], solids))
-            .collect();
+        let per_cell: Vec<Both<Vec<u32>>> =
+            par::map_slice(mixed, |&l| touched_in(&leaves[l as usize], solids));
         let mut faces = Both {
             a: vec![false; solids.a.slot_count()],
             b: vec![false; solids.b.slot_count()],

@@ -10,7 +10,7 @@
 
 use bsp_core::Plane;
 use bsp_core::internals::ConvexFace;
-use rayon::prelude::*;
+use bsp_core::par;
 use smallvec::SmallVec;
 
 use super::operands::Operand;
@@ -198,7 +198,8 @@ fn grow<P: PlaneTest, Q: PlaneTest>(cell: Leaf, stalled: u8, o: &Build<'_, '_, P
             continue;
         };
         if cell.a.len() + cell.b.len() > PARALLEL_FACES {
-            let parts: Vec<Vec<Leaf>> = kids.into_par_iter().map(|k| grow(k, stalled, o)).collect();
+            let parts: Vec<Vec<Leaf>> =
+                par::map_vec(kids.into_iter().collect(), |k| grow(k, stalled, o));
             leaves.extend(parts.into_iter().flatten());
         } else {
             // children pushed in reverse so that they come out in order
@@ -305,22 +306,20 @@ fn split<P: PlaneTest, Q: PlaneTest>(
             deal_run(fs, bxs, meets, &mut lists);
             return lists;
         }
-        let runs: Vec<Vec<Vec<u32>>> = fs
-            .par_chunks(RUN)
-            .map(|run| {
-                let mut lists: Vec<Vec<u32>> = (0..boxes.len())
-                    .map(|_| Vec::with_capacity(room(run.len())))
-                    .collect();
-                deal_run(run, bxs, meets, &mut lists);
-                lists
-            })
-            .collect();
+        let runs: Vec<Vec<Vec<u32>>> = par::map(fs.len().div_ceil(RUN), |k| {
+            let run = &fs[k * RUN..((k + 1) * RUN).min(fs.len())];
+            let mut lists: Vec<Vec<u32>> = (0..boxes.len())
+                .map(|_| Vec::with_capacity(room(run.len())))
+                .collect();
+            deal_run(run, bxs, meets, &mut lists);
+            lists
+        });
         (0..boxes.len())
             .map(|c| runs.iter().flat_map(|r| r[c].iter().copied()).collect())
             .collect()
     };
     let (la, lb) = if cell.a.len() + cell.b.len() > PARALLEL_FACES {
-        rayon::join(
+        par::join(
             || deal(&cell.a, a.boxes, &a.plane_meets),
             || deal(&cell.b, b.boxes, &b.plane_meets),
         )
@@ -366,64 +365,61 @@ pub(crate) fn adjacent(leaves: &[Leaf]) -> Vec<(u32, u32)> {
     let side = |key: u128| (key >> 32) as u8 & 1;
     let leaf = |key: u128| key as u32;
     // the three axes in parallel, joined in order
-    let per_axis: Vec<Vec<(u32, u32)>> = (0..3usize)
-        .into_par_iter()
-        .map(|k| {
-            let mut out = Vec::new();
-            let (u, v) = ((k + 1) % 3, (k + 2) % 3);
-            // (wall coordinate, side, leaf): side 0 below the wall, 1 above
-            let mut by_wall: Vec<u128> = Vec::with_capacity(2 * boxes.len());
-            for (i, b) in boxes.iter().enumerate() {
-                by_wall.push(key(b.1[k], 0, i));
-                by_wall.push(key(b.0[k] - 1, 1, i));
+    let per_axis: Vec<Vec<(u32, u32)>> = par::map(3, |k| {
+        let mut out = Vec::new();
+        let (u, v) = ((k + 1) % 3, (k + 2) % 3);
+        // (wall coordinate, side, leaf): side 0 below the wall, 1 above
+        let mut by_wall: Vec<u128> = Vec::with_capacity(2 * boxes.len());
+        for (i, b) in boxes.iter().enumerate() {
+            by_wall.push(key(b.1[k], 0, i));
+            by_wall.push(key(b.0[k] - 1, 1, i));
+        }
+        by_wall.sort_unstable();
+        // (u coordinate, kind, side, leaf): removals (kind 0) before
+        // insertions (1) at a coordinate
+        let mut events: Vec<u128> = Vec::new();
+        // the leaves of each side the sweep line crosses, by their
+        // lower v: (lower v, upper v, leaf); their v ranges are
+        // disjoint (few at a time: sorted lists)
+        let mut active: [Vec<(i64, i64, u32)>; 2] = [Vec::new(), Vec::new()];
+        for group in by_wall.chunk_by(|x, y| coordinate(*x) == coordinate(*y)) {
+            if side(group[0]) == side(group[group.len() - 1]) {
+                continue; // leaves on one side of this wall only
             }
-            by_wall.sort_unstable();
-            // (u coordinate, kind, side, leaf): removals (kind 0) before
-            // insertions (1) at a coordinate
-            let mut events: Vec<u128> = Vec::new();
-            // the leaves of each side the sweep line crosses, by their
-            // lower v: (lower v, upper v, leaf); their v ranges are
-            // disjoint (few at a time: sorted lists)
-            let mut active: [Vec<(i64, i64, u32)>; 2] = [Vec::new(), Vec::new()];
-            for group in by_wall.chunk_by(|x, y| coordinate(*x) == coordinate(*y)) {
-                if side(group[0]) == side(group[group.len() - 1]) {
-                    continue; // leaves on one side of this wall only
-                }
-                // sweep along u
-                events.clear();
-                for &g in group {
-                    let (i, s) = (leaf(g) as usize, side(g) as u64);
-                    let b = &boxes[i];
-                    events.push(key(b.0[u], 2 | s, i));
-                    events.push(key(b.1[u] + 1, s, i));
-                }
-                events.sort_unstable();
-                for &e in &events {
-                    let i = leaf(e);
-                    let b = &boxes[i as usize];
-                    let (s, insert) = (side(e) as usize, (e >> 33) & 1 == 1);
-                    let at = active[s].partition_point(|x| x.0 < b.0[v]);
-                    if !insert {
-                        active[s].remove(at);
-                        continue;
-                    }
-                    let other = &active[1 - s];
-                    // the other side's leaves whose v range meets [lo, hi]:
-                    // the last starting below lo (if it reaches lo), then
-                    // those starting in [lo, hi]
-                    let from = other.partition_point(|x| x.0 < b.0[v]);
-                    let to = from + other[from..].partition_point(|x| x.0 <= b.1[v]);
-                    let before = from.checked_sub(1).filter(|&p| other[p].1 >= b.0[v]);
-                    for p in before.into_iter().chain(from..to) {
-                        let j = other[p].2;
-                        out.push(if s == 0 { (i, j) } else { (j, i) });
-                    }
-                    active[s].insert(at, (b.0[v], b.1[v], i));
-                }
+            // sweep along u
+            events.clear();
+            for &g in group {
+                let (i, s) = (leaf(g) as usize, side(g) as u64);
+                let b = &boxes[i];
+                events.push(key(b.0[u], 2 | s, i));
+                events.push(key(b.1[u] + 1, s, i));
             }
-            out
-        })
-        .collect();
+            events.sort_unstable();
+            for &e in &events {
+                let i = leaf(e);
+                let b = &boxes[i as usize];
+                let (s, insert) = (side(e) as usize, (e >> 33) & 1 == 1);
+                let at = active[s].partition_point(|x| x.0 < b.0[v]);
+                if !insert {
+                    active[s].remove(at);
+                    continue;
+                }
+                let other = &active[1 - s];
+                // the other side's leaves whose v range meets [lo, hi]:
+                // the last starting below lo (if it reaches lo), then
+                // those starting in [lo, hi]
+                let from = other.partition_point(|x| x.0 < b.0[v]);
+                let to = from + other[from..].partition_point(|x| x.0 <= b.1[v]);
+                let before = from.checked_sub(1).filter(|&p| other[p].1 >= b.0[v]);
+                for p in before.into_iter().chain(from..to) {
+                    let j = other[p].2;
+                    out.push(if s == 0 { (i, j) } else { (j, i) });
+                }
+                active[s].insert(at, (b.0[v], b.1[v], i));
+            }
+        }
+        out
+    });
     per_axis.concat()
 }
 

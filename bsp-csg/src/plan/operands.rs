@@ -41,7 +41,7 @@ impl<T> Both<T> {
 impl<T: Send> Both<T> {
     /// `make(A)` and `make(B)`, each operand's on its own thread.
     pub(super) fn join(make: impl Fn(Operand) -> T + Sync) -> Both<T> {
-        let (a, b) = rayon::join(|| make(Operand::A), || make(Operand::B));
+        let (a, b) = bsp_core::par::join(|| make(Operand::A), || make(Operand::B));
         Both { a, b }
     }
 }

@@ -26,8 +26,8 @@
 //! places where the surface meets itself, not with the whole surface.
 
 use bsp_core::internals::UnionFind;
+use bsp_core::par;
 use bsp_core::{GridPoint, Partition, Polygon, Split, meeting_pairs};
-use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use super::local::{cell_windings, positive_boundary, side_windings};
@@ -192,30 +192,24 @@ pub(crate) fn resolve_locally(solid: &Solid) -> Result<Resolved, CsgError> {
     let mut dirty: Vec<CellKey> = cells.dirty.iter().copied().collect();
     dirty.sort_unstable();
     // 2. the dirty cells, each on its own
-    let inside: Vec<Vec<Polygon>> = dirty
-        .par_iter()
-        .map(|&c| {
-            let (part, w) = windings_in(solid, &cells.cell_box(c))?;
-            Ok(positive_boundary(&part, &w))
-        })
-        .collect::<Result<_, CsgError>>()?;
+    let inside: Vec<Vec<Polygon>> = par::try_map(dirty.len(), |i| {
+        let (part, w) = windings_in(solid, &cells.cell_box(dirty[i]))?;
+        Ok::<_, CsgError>(positive_boundary(&part, &w))
+    })?;
     // 3. the clean parts: each face's pieces outside the dirty cells
     let loops: Vec<Vec<GridPoint>> = owned
         .iter()
         .map(|p| p.vertices().iter().filter_map(|v| v.as_grid()).collect())
         .collect();
-    let rest: Vec<Vec<Polygon>> = owned
-        .into_par_iter()
-        .zip(&boxes)
-        .map(|(p, b)| {
+    let rest: Vec<Vec<Polygon>> =
+        par::map_vec(owned.into_iter().zip(&boxes).collect(), |(p, b)| {
             let near = cells.dirty_near(b);
             if near.is_empty() {
                 vec![p]
             } else {
                 outside(p, &cells, &near)
             }
-        })
-        .collect();
+        });
     // the pieces numbered in face order
     let mut first_piece = Vec::with_capacity(rest.len() + 1);
     first_piece.push(0u32);
@@ -233,10 +227,12 @@ pub(crate) fn resolve_locally(solid: &Solid) -> Result<Resolved, CsgError> {
     }
     let mut probes: Vec<(u32, (usize, usize))> = first.into_iter().collect();
     probes.sort_unstable();
-    let keep: FxHashMap<u32, bool> = probes
-        .par_iter()
-        .map(|&(part, (f, k))| Ok((part, probe(solid, &rest[f][k])?)))
-        .collect::<Result<_, CsgError>>()?;
+    let keep: FxHashMap<u32, bool> = par::try_map(probes.len(), |i| {
+        let (part, (f, k)) = probes[i];
+        Ok::<_, CsgError>((part, probe(solid, &rest[f][k])?))
+    })?
+    .into_iter()
+    .collect();
     if pairs.is_empty() && keep.values().all(|&k| k) {
         return Ok(Resolved::Unchanged);
     }

@@ -3,7 +3,7 @@
 
 use bsp_core::Polygon;
 use bsp_core::internals::share_points;
-use rayon::prelude::*;
+use bsp_core::par;
 
 use super::{Solid, SolidFace};
 use crate::index::IBox;
@@ -122,13 +122,14 @@ impl Solid {
         let mut refill: Vec<(u32, Source<'_>)> = reused.iter().copied().zip(from).collect();
         refill.sort_unstable_by_key(|r| r.0);
         let (slots, sources): (Vec<u32>, Vec<Source<'_>>) = refill.into_iter().unzip();
-        borrow_sorted(&mut self.faces, &slots)
-            .into_par_iter()
+        let refills = borrow_sorted(&mut self.faces, &slots)
+            .into_iter()
             .zip(sources)
-            .for_each(|(slot, f)| *slot = Some(f.make(flip)));
+            .collect();
+        par::map_vec(refills, |(slot, f)| *slot = Some(f.make(flip)));
+        let rest = par::map_vec(rest, |f| Some(f.make(flip)));
         self.faces.reserve_exact(rest.len());
-        self.faces
-            .par_extend(rest.into_par_iter().map(|f| Some(f.make(flip))));
+        self.faces.extend(rest);
         let ids = reused
             .into_iter()
             .chain(first_new as u32..self.faces.len() as u32)
@@ -141,14 +142,14 @@ impl Solid {
     /// (`new_slots`) become one each: pieces cut along a shared edge
     /// computed them each for itself. The boxes stay as they are.
     fn index_added(&mut self, ids: &[u32], mut new_slots: Vec<u32>) {
-        let boxes: Vec<IBox> = ids.par_iter().map(|&f| self.face(f).bx()).collect();
+        let boxes: Vec<IBox> = par::map_slice(ids, |&f| self.face(f).bx());
         let Solid {
             faces,
             index,
             bounds,
             ..
         } = self;
-        rayon::join(
+        par::join(
             || {
                 // one borrow each, by slot (not a pass over all slots: a
                 // long sequence of operations adds few faces to many)

@@ -2,8 +2,8 @@
 //! operation meshed straight from the two solids' faces.
 
 use bsp_core::internals::share_points;
+use bsp_core::par;
 use bsp_core::{Polygon, TriMesh};
-use rayon::prelude::*;
 
 use super::carry_out::{borrow_sorted, reused_slots};
 use super::{AddedFace, Additions, Solid, SolidFace, drop_aside};
@@ -90,12 +90,10 @@ impl Solid {
         drop_aside((index, their_index));
         let (news, turned, added) = read_where_they_are(additions);
         // (in place, in parallel: no second copy of the faces kept)
-        borrow_sorted(&mut theirs, &turned)
-            .into_par_iter()
-            .for_each(|slot| {
-                let f = slot.as_mut().expect("a live face");
-                *f = f.flipped();
-            });
+        par::for_each_mut(&mut borrow_sorted(&mut theirs, &turned), |_, slot| {
+            let f = slot.as_mut().expect("a live face");
+            *f = f.flipped();
+        });
         let face = |a: &AddedAt| -> &SolidFace {
             match *a {
                 AddedAt::New(i) => &news[i as usize],
@@ -150,6 +148,6 @@ fn read_where_they_are(additions: Additions) -> (Vec<SolidFace>, Vec<u32>, Vec<A
     // then knows them equal at once
     let mut refs: Vec<&mut Polygon> = news.iter_mut().map(|p| &mut **p).collect();
     share_points(&mut refs);
-    let news = news.into_par_iter().map(SolidFace::made).collect();
+    let news = par::map_vec(news, SolidFace::made);
     (news, turned, added)
 }

@@ -2,11 +2,11 @@
 //! membership.
 
 use bsp_core::internals::ConvexFace;
+use bsp_core::par;
 use bsp_core::{GridPoint, Membership, Side};
-use rayon::prelude::*;
 
 use super::{Solid, SolidFace, winding};
-use crate::index::{IBox, overlaps, union};
+use crate::index::{IBox, overlaps, span};
 
 /// Face ids a query near a box handles in parallel.
 const MANY_NEAR: usize = 1 << 15;
@@ -15,14 +15,13 @@ impl Solid {
     /// The live faces whose box overlaps `b`.
     pub(crate) fn faces_near(&self, b: &IBox) -> Vec<u32> {
         match self.near_ids(b) {
-            None => (0..self.faces.len() as u32)
-                .into_par_iter()
-                .filter(|&i| self.near_face(i, b).is_some())
-                .collect(),
-            Some(ids) if ids.len() > MANY_NEAR => ids
-                .into_par_iter()
-                .filter(|&i| self.near_face(i, b).is_some())
-                .collect(),
+            None => par::filter_map(self.faces.len(), |i| {
+                let i = i as u32;
+                self.near_face(i, b).map(|_| i)
+            }),
+            Some(ids) if ids.len() > MANY_NEAR => {
+                par::filter_map(ids.len(), |k| self.near_face(ids[k], b).map(|_| ids[k]))
+            }
             Some(mut ids) => {
                 ids.retain(|&i| self.near_face(i, b).is_some());
                 // the ids came with repeats: the lists of a large box are
@@ -36,16 +35,11 @@ impl Solid {
     /// The box spanned by the live faces whose box overlaps `b`.
     pub(crate) fn near_span(&self, b: &IBox) -> Option<IBox> {
         let bx = |i: u32| self.near_face(i, b).map(SolidFace::bx);
-        match self.near_ids(b) {
-            None => (0..self.faces.len() as u32)
-                .into_par_iter()
-                .filter_map(bx)
-                .reduce_with(|x, y| union(&x, &y)),
-            Some(ids) => ids
-                .into_par_iter()
-                .filter_map(bx)
-                .reduce_with(|x, y| union(&x, &y)),
-        }
+        let spans = match self.near_ids(b) {
+            None => par::fold_runs(self.faces.len(), |r| span(r.filter_map(|i| bx(i as u32)))),
+            Some(ids) => par::fold_runs(ids.len(), |r| span(ids[r].iter().filter_map(|&i| bx(i)))),
+        };
+        span(spans.into_iter().flatten())
     }
 
     /// Face `i` if it is live and its box overlaps `b`.
@@ -69,7 +63,7 @@ impl Solid {
         let mut ids = Vec::with_capacity(listed);
         index.near(b, &mut ids);
         if ids.len() > MANY_NEAR {
-            ids.par_sort_unstable();
+            rayon::slice::ParallelSliceMut::par_sort_unstable(&mut ids[..]);
         } else {
             ids.sort_unstable();
         }
@@ -83,12 +77,15 @@ impl Solid {
     pub fn winding(&self, q: GridPoint) -> i32 {
         let q = q.map(i64::from);
         let Some(index) = self.query_index() else {
-            return self
-                .faces
-                .par_iter()
-                .filter_map(Option::as_ref)
-                .map(|f| ray_crossing(q, f))
-                .sum();
+            let faces = &self.faces;
+            let sums = par::fold_runs(faces.len(), |r| {
+                faces[r]
+                    .iter()
+                    .filter_map(Option::as_ref)
+                    .map(|f| ray_crossing(q, f))
+                    .sum::<i32>()
+            });
+            return sums.into_iter().sum();
         };
         let mut ids = Vec::new();
         index.along_x(q, &mut ids);
@@ -104,26 +101,27 @@ impl Solid {
     /// in one pass over the faces.
     pub(crate) fn windings(&self, qs: &[GridPoint]) -> Vec<i32> {
         if self.index.get().is_some() || qs.len() > FEW_WINDINGS {
-            return qs.par_iter().map(|&q| self.winding(q)).collect();
+            return par::map_slice(qs, |&q| self.winding(q));
         }
         let qs: Vec<[i64; 3]> = qs.iter().map(|q| q.map(i64::from)).collect();
-        let zero = || vec![0i32; qs.len()];
-        self.faces
-            .par_iter()
-            .filter_map(Option::as_ref)
-            .fold(zero, |mut sums, f| {
+        let faces = &self.faces;
+        let parts = par::fold_runs(faces.len(), |r| {
+            let mut sums = vec![0i32; qs.len()];
+            for f in faces[r].iter().filter_map(Option::as_ref) {
                 let bx = f.bx();
                 for (s, &q) in sums.iter_mut().zip(&qs) {
                     if ray_reaches(q, &bx) {
                         *s += winding::crossing(q, f);
                     }
                 }
-                sums
-            })
-            .reduce(zero, |mut a, b| {
-                a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
-                a
-            })
+            }
+            sums
+        });
+        let mut total = vec![0i32; qs.len()];
+        for p in parts {
+            total.iter_mut().zip(p).for_each(|(x, y)| *x += y);
+        }
+        total
     }
 
     /// Exact membership of a grid point.
