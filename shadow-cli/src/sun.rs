@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use bsp_shadows::sun::{self as sun, SunSite, Up};
 use clap::Args;
 
@@ -85,8 +85,8 @@ pub(crate) struct SunHoursArgs {
     /// Hours at points instead of faces: a file of x,y,z lines (a header line may lead).
     #[arg(long, value_name = "FILE")]
     sensors: Option<PathBuf>,
-    /// Output: CSV (one row per face, or per sensor), JSON, or OBJ (a heat map).
-    #[arg(short, long, value_name = "OUT.csv|OUT.json|OUT.obj")]
+    /// Output: CSV (one row per face, or per sensor), JSON, OBJ (a heat map) or PNG (its picture).
+    #[arg(short, long, value_name = "OUT.csv|OUT.json|OUT.obj|OUT.png")]
     output: PathBuf,
     /// No notes on stderr (errors still go there).
     #[arg(long, short)]
@@ -95,21 +95,21 @@ pub(crate) struct SunHoursArgs {
 
 /// `shadow sunhours`.
 pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
-    let Some(format) = sun::HoursFormat::of(&a.output) else {
-        bail!(
-            "{}: -o must name a .csv, .json or .obj file",
-            a.output.display()
-        );
-    };
+    let format = sun::HoursFormat::for_path(&a.output).map_err(facade_error)?;
     let (mesh, name) = load_source_quiet(&a.source, a.quiet)?;
+    let staging = mesh.bounds().and_then(|b| a.source.staging(b));
+    let view = sun::HeatView {
+        staging,
+        up: a.site.up.unwrap_or_default(),
+    };
     let dates = sun::study_dates(&a.date, a.to.as_deref(), a.every)?;
     let step = a.step.unwrap_or(10.0);
     let suns = sun::study_suns(&a.site.site(), &dates, step, a.utc_offset.unwrap_or(0.0))?;
     let dirs: Vec<_> = suns.iter().map(|s| s.direction).collect();
     let (h, sensors) = (step / 60.0, a.sensors.as_deref());
-    let r = sun::hours_report(&mesh, &dirs, h, format, sensors, a.min_hours);
+    let r = sun::hours_report(&mesh, &dirs, h, format, sensors, a.min_hours, view);
     let r = r.map_err(facade_error)?;
-    write_file(&a.output, r.text.as_bytes())?;
+    write_file(&a.output, &r.bytes)?;
     let (days, suns, out, rows) = (dates.len(), dirs.len(), a.output.display(), &r.rows);
     let said = format!("wrote {out}: sun-hours of {rows} of {name}, {days} days, {suns} suns\n");
     emit(&(said + &r.groups))

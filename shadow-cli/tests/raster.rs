@@ -3,7 +3,7 @@
 use crate::{scratch, shadow, stderr, stdout};
 
 /// Checks a PNG's signature and size.
-fn png_size(path: &std::path::Path) -> (u32, u32) {
+pub(crate) fn png_size(path: &std::path::Path) -> (u32, u32) {
     let b = std::fs::read(path).unwrap();
     assert_eq!(&b[..8], b"\x89PNG\r\n\x1a\n");
     let be = |i: usize| u32::from_be_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
@@ -11,7 +11,7 @@ fn png_size(path: &std::path::Path) -> (u32, u32) {
 }
 
 /// A PNG's pixels, RGB row by row, and its width.
-fn rgb_of(path: &std::path::Path) -> (Vec<[u8; 3]>, u32) {
+pub(crate) fn rgb_of(path: &std::path::Path) -> (Vec<[u8; 3]>, u32) {
     let file = std::fs::File::open(path).unwrap();
     let mut reader = png::Decoder::new(std::io::BufReader::new(file))
         .read_info()

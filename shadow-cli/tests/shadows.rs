@@ -1090,9 +1090,24 @@ fn sunhours_writes_every_faces_hours() {
     let text = std::fs::read_to_string(&heat).unwrap();
     assert!(text.starts_with("# sun-hours: viridis from 0"), "{text}");
     assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 6);
+    // its picture: the cube framed, its faces in the ramp's colours (the
+    // top, in every sun, yellow), the ramp itself along the bottom
+    let png = scratch("hours.png");
+    let o = run(&png, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(crate::raster::png_size(&png), (1280, 720));
+    let (px, w) = crate::raster::rgb_of(&png);
+    let at = |x: u32, y: u32| px[(y * w + x) as usize];
+    assert_eq!((at(52, 699), at(307, 699)), ([68, 1, 84], [253, 231, 37]));
+    let yellow = (px[..w as usize * 680].iter())
+        .filter(|p| p[0] > 100 && p[0] > 2 * p[2] && p[1] > 2 * p[2])
+        .count();
+    assert!(yellow > 5000, "{yellow} yellow pixels");
+    let o = run(&png, &["--sensors", points.to_str().unwrap()]);
+    crate::assert_failed_with(&o, &["sensors.csv", "not as a picture"]);
     // bad names and dates are clear errors
     let o = run(&scratch("hours.txt"), &[]);
-    crate::assert_failed_with(&o, &["hours.txt", ".csv, .json or .obj"]);
+    crate::assert_failed_with(&o, &["hours.txt", ".csv, .json, .obj or .png"]);
     let o = run(&csv, &["--to", "2026-02-30"]);
     crate::assert_failed_with(&o, &["2026-02-30", "not a date"]);
 }

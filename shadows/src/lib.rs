@@ -75,6 +75,13 @@ pub enum Error {
         /// Why.
         cause: bsp_core::SnapError,
     },
+    /// An output file's name asks for a format the job cannot write.
+    Format {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What the job writes.
+        why: &'static str,
+    },
 }
 
 impl std::fmt::Display for Error {
@@ -89,6 +96,7 @@ impl std::fmt::Display for Error {
             Error::Raster(e) => e.fmt(f),
             Error::Io(e) => e.fmt(f),
             Error::Sensor { index, cause } => write!(f, "sensor {index}: {cause}"),
+            Error::Format { path, why } => write!(f, "{}: {why}", path.display()),
         }
     }
 }
@@ -105,6 +113,7 @@ impl std::error::Error for Error {
             Error::Raster(e) => e,
             Error::Io(e) => e,
             Error::Sensor { cause, .. } => cause,
+            Error::Format { .. } => return None,
         })
     }
 }

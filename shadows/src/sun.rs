@@ -634,7 +634,7 @@ pub fn sensor_hours_file(
     let text = match format {
         HoursFormat::Csv => sensors_csv(&points, &hours),
         HoursFormat::Json => sensors_json(&points, &hours, suns.len()),
-        HoursFormat::Obj => sensors_obj(&points, &hours),
+        HoursFormat::Obj | HoursFormat::Png => sensors_obj(&points, &hours),
     };
     Ok((text, points.len()))
 }
@@ -642,8 +642,9 @@ pub fn sensor_hours_file(
 /// What `shadow sunhours` writes and says of a study.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HoursReport {
-    /// The file's text: one row per face, or per sensor.
-    pub text: String,
+    /// The file's contents: text with one row per face or per sensor, a
+    /// heat map in OBJ, or a picture in PNG.
+    pub bytes: Vec<u8>,
     /// What the rows are, in words (`"6 faces"`, `"4 sensors among the
     /// faces"`).
     pub rows: String,
@@ -654,8 +655,9 @@ pub struct HoursReport {
 
 /// The study's hours in `format`: every face's ([`sun_hours`]), or with
 /// `sensors` the hours at the points of that file
-/// ([`sensor_hours_file`]); with `min_hours`, the groups' shares that see
-/// at least that many hours.
+/// ([`sensor_hours_file`]; not as a picture); with `min_hours`, the
+/// groups' shares that see at least that many hours. A picture looks at
+/// the scene as `view` says.
 pub fn hours_report(
     mesh: &crate::Mesh,
     suns: &[DVec3],
@@ -663,18 +665,97 @@ pub fn hours_report(
     format: HoursFormat,
     sensors: Option<&std::path::Path>,
     min_hours: Option<f64>,
+    view: HeatView,
 ) -> Result<HoursReport, crate::Error> {
     if let Some(path) = sensors {
+        if format == HoursFormat::Png {
+            return Err(crate::Error::Format {
+                path: path.to_path_buf(),
+                why: "the hours at these sensors are written as .csv, .json or .obj, not as a picture",
+            });
+        }
         let (text, n) = sensor_hours_file(mesh, path, suns, step_hours, format)?;
         let (rows, groups) = (format!("{n} sensors among the faces"), String::new());
-        return Ok(HoursReport { text, rows, groups });
+        return Ok(HoursReport {
+            bytes: text.into_bytes(),
+            rows,
+            groups,
+        });
     }
     let hours = sun_hours(mesh, suns, step_hours)?;
+    let bytes = match format {
+        HoursFormat::Png => hours_png(mesh, &hours, suns.len(), view)?,
+        _ => format.text(mesh, &hours, suns.len()).into_bytes(),
+    };
     Ok(HoursReport {
-        text: format.text(mesh, &hours, suns.len()),
+        bytes,
         rows: format!("{} faces", hours.len()),
         groups: groups_in_sun_text(mesh, &hours, min_hours),
     })
+}
+
+/// How a picture of a study ([`hours_png`]) looks at the scene.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HeatView {
+    /// A built-in scene's camera ([`shadow_scene::Staging::of_scene`]);
+    /// `None`: a camera that frames every vertex.
+    pub staging: Option<shadow_scene::Staging>,
+    /// The scene's up axis, the framing camera's up.
+    pub up: Up,
+}
+
+/// The size of a study's picture, in pixels.
+pub const HEAT_PNG_SIZE: (u32, u32) = (1280, 720);
+
+/// A picture of the study (PNG, [`HEAT_PNG_SIZE`]): every face coloured
+/// by its sun-hours on the heat map's ramp ([`heat_colors`]: 0 hours dark
+/// blue, the most any face gets yellow), seen as `view` says, lit from
+/// the eye so the forms read, with the ramp, its range and the number of
+/// suns along the bottom.
+pub fn hours_png(
+    mesh: &crate::Mesh,
+    hours: &[FaceHours],
+    suns: usize,
+    view: HeatView,
+) -> Result<Vec<u8>, crate::Error> {
+    use shadow_raster::svg::{SvgViewpoint, ViewRequest};
+    let (w, h) = HEAT_PNG_SIZE;
+    let up = match view.up {
+        Up::Z => DVec3::Z,
+        Up::Y => DVec3::Y,
+    };
+    // (a built-in scene keeps its own camera's up)
+    let request = ViewRequest {
+        up: view.staging.is_none().then_some(up),
+        ..ViewRequest::default()
+    };
+    let (at, _) = SvgViewpoint::choose(request, &mesh.positions, view.staging, (w, h), 40.0);
+    let light = [svbsp::LightSpec::Point(at.eye)];
+    let grid = svbsp::shared_grid(&mesh.positions, &light).map_err(crate::Error::Light)?;
+    let lights = svbsp::place_lights(&grid, &light).map_err(crate::Error::Light)?;
+    let (polys, _) =
+        bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(crate::Error::Import)?;
+    let raster = |e| crate::Error::Raster(e);
+    let scene = shadow_raster::RasterScene::new(&grid, polys).map_err(raster)?;
+    let bounds =
+        (mesh.bounds()).ok_or(crate::Error::Raster(shadow_raster::RasterError::EmptyScene))?;
+    let camera = at.camera(bounds).map_err(raster)?;
+    let most = hours.iter().map(|h| h.sun_hours).fold(0.0, f64::max);
+    let colors = heat_colors(hours, most);
+    let options = shadow_raster::RenderOptions::default();
+    let mut picture = shadow_raster::render(&scene, &lights, &camera, &colors, &options)
+        .map_err(raster)?
+        .image;
+    // the ramp, between its ends' hours, along the bottom edge
+    let (ink, y) = ([40, 40, 40], h - 28);
+    picture.text("0 h", 10, y, 2, ink);
+    for i in 0..256 {
+        let rgb = viridis(f64::from(i) / 255.0).map(|c| (c * 255.0).round() as u8);
+        picture.blit(&shadow_raster::Image::new(1, 14, rgb), 52 + i, y);
+    }
+    let label = format!("{most:.1} h of sun ({suns} suns)");
+    picture.text(&label, 320, y, 2, ink);
+    Ok(picture.encode_png())
 }
 
 /// Sensors' hours as CSV: `sensor,x,y,z,sun_hours`.
@@ -712,26 +793,39 @@ pub enum HoursFormat {
     Json,
     /// [`hours_obj`]: a heat map to look at.
     Obj,
+    /// [`hours_png`]: a picture of the heat map.
+    Png,
 }
 
 impl HoursFormat {
-    /// The format a file name asks for (`.csv`, `.json`, `.obj`), if any.
+    /// The format a file name asks for (`.csv`, `.json`, `.obj`, `.png`),
+    /// if any.
     pub fn of(path: &std::path::Path) -> Option<HoursFormat> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
         match ext.as_str() {
             "json" => Some(HoursFormat::Json),
             "csv" => Some(HoursFormat::Csv),
             "obj" => Some(HoursFormat::Obj),
+            "png" => Some(HoursFormat::Png),
             _ => None,
         }
     }
 
-    /// The hours of `mesh` in this format (`suns`: how many).
+    /// [`HoursFormat::of`], or an error naming the file and the formats.
+    pub fn for_path(path: &std::path::Path) -> Result<HoursFormat, crate::Error> {
+        HoursFormat::of(path).ok_or_else(|| crate::Error::Format {
+            path: path.to_path_buf(),
+            why: "a sun study is written as .csv, .json, .obj or .png",
+        })
+    }
+
+    /// The hours of `mesh` in this format (`suns`: how many); a picture
+    /// ([`HoursFormat::Png`]) is not text: [`hours_png`].
     pub fn text(self, mesh: &crate::Mesh, hours: &[FaceHours], suns: usize) -> String {
         match self {
             HoursFormat::Json => hours_json(mesh, hours, suns),
             HoursFormat::Csv => hours_csv(mesh, hours),
-            HoursFormat::Obj => hours_obj(mesh, hours),
+            HoursFormat::Obj | HoursFormat::Png => hours_obj(mesh, hours),
         }
     }
 }
@@ -1237,6 +1331,26 @@ mod tests {
         let roof = obj.lines().filter(|l| l.starts_with("v ")).nth(4).unwrap();
         assert!(roof.ends_with(" 0.9922 0.9059 0.1451"), "{roof}");
         assert_eq!(viridis(0.0), [68.0 / 255.0, 1.0 / 255.0, 84.0 / 255.0]);
+        // its picture, by the file's name; no picture of sensors
+        let png = std::path::Path::new("study.PNG");
+        assert_eq!(HoursFormat::for_path(png).unwrap(), HoursFormat::Png);
+        let e = HoursFormat::for_path(std::path::Path::new("study.txt")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "study.txt: a sun study is written as .csv, .json, .obj or .png"
+        );
+        let bytes = hours_png(&mesh, &hours, suns.len(), HeatView::default()).unwrap();
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+        let e = hours_report(
+            &mesh,
+            &suns,
+            step,
+            HoursFormat::Png,
+            Some(&file),
+            None,
+            HeatView::default(),
+        );
+        assert!(e.unwrap_err().to_string().ends_with("not as a picture"));
         // the suns in another order make other runs: the same hours
         let back: Vec<DVec3> = suns.iter().rev().copied().collect();
         for (a, b) in hours.iter().zip(sun_hours(&mesh, &back, step).unwrap()) {
