@@ -10,6 +10,7 @@ _Path = Union[str, PathLike]
 _Points = npt.ArrayLike
 _Faces = Union[npt.ArrayLike, Sequence[Sequence[int]]]
 _Light = Union["PointLight", "Sun"]
+_AnyLight = Union["PointLight", "Sun", "AreaLight", "SunDisc"]
 
 MAX_SUNS_A_RUN: int
 
@@ -63,6 +64,45 @@ class Sun:
     direction: Tuple[float, float, float]
     def __init__(self, direction: Tuple[float, float, float]) -> None: ...
 
+class AreaLight:
+    """A planar convex polygon light; it shines on the side its corners turn counter-clockwise about."""
+
+    corners: List[Tuple[float, float, float]]
+    def __init__(self, corners: Sequence[Tuple[float, float, float]]) -> None: ...
+
+class SunDisc:
+    """The sun as a disc of angular radius ``radius_deg`` toward ``direction``."""
+
+    direction: Tuple[float, float, float]
+    radius_deg: float
+    def __init__(self, direction: Tuple[float, float, float], radius_deg: float = 0.2666) -> None: ...
+
+class SoftShadows:
+    """Lit, penumbra and umbra areas per face and light (columns in the order the lights were given)."""
+
+    @property
+    def lit_area(self) -> npt.NDArray[np.float64]:
+        """``(faces, lights)``: the area that sees all of each light."""
+    @property
+    def penumbra_area(self) -> npt.NDArray[np.float64]:
+        """``(faces, lights)``: the area that sees part of each light (undecided included)."""
+    @property
+    def umbra_area(self) -> npt.NDArray[np.float64]:
+        """``(faces, lights)``: the area that sees none of each light."""
+    @property
+    def undecided_area(self) -> npt.NDArray[np.float64]:
+        """``(faces, lights)``: penumbra that may be umbra (a quadric umbra boundary)."""
+    @property
+    def face_area(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def fragment_count(self) -> int: ...
+    @property
+    def mesh(self) -> Mesh: ...
+    @property
+    def lights(self) -> List[_AnyLight]: ...
+    def write(self, path: _Path) -> None:
+        """JSON or OBJ, by the extension (the CLI's files; lights numbered points and suns first)."""
+
 class Shadows:
     @property
     def lit_area(self) -> npt.NDArray[np.float64]:
@@ -100,6 +140,7 @@ def union(a: Mesh, b: Mesh) -> Mesh: ...
 def intersection(a: Mesh, b: Mesh) -> Mesh: ...
 def difference(a: Mesh, b: Mesh) -> Mesh: ...
 def shadows(mesh: Mesh, lights: Iterable[_Light]) -> Shadows: ...
+def soft_shadows(mesh: Mesh, lights: Iterable[_AnyLight]) -> SoftShadows: ...
 def study_suns(
     lat: float,
     lon: float,

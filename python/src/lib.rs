@@ -4,6 +4,8 @@
 //! (`set_threads`). `python/bsp_shadows/__init__.py` is the face people
 //! use; `_native.pyi` types it.
 
+mod soft;
+
 use std::sync::{Arc, Mutex};
 
 use bsp_shadows::sun::{self, HoursRun, SunSite, Up};
@@ -880,12 +882,16 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PointLight>()?;
     m.add_class::<Sun>()?;
     m.add_class::<Shadows>()?;
+    m.add_class::<soft::AreaLight>()?;
+    m.add_class::<soft::SunDisc>()?;
+    m.add_class::<soft::SoftShadows>()?;
     m.add_class::<SunHours>()?;
     for f in [
         wrap_pyfunction!(union, m)?,
         wrap_pyfunction!(intersection, m)?,
         wrap_pyfunction!(difference, m)?,
         wrap_pyfunction!(shadows, m)?,
+        wrap_pyfunction!(soft::soft_shadows, m)?,
         wrap_pyfunction!(study_suns, m)?,
         wrap_pyfunction!(_hours_of_suns, m)?,
         wrap_pyfunction!(_hours_run, m)?,

@@ -1,6 +1,7 @@
 """The package gives what the command line writes, for the same input."""
 
 import json
+import pickle
 
 import numpy as np
 import pytest
@@ -67,3 +68,39 @@ def test_sun_hours_equal_the_cli(tmp_path, shadow_bin, yard):
                      dates=["2026-03-21"], step_minutes=20)
     ours = np.column_stack([h.area, h.per_face, h.min_hours, h.max_hours])
     assert (ours == cli).all()
+
+
+def test_soft_shadows_equal_the_cli_json(tmp_path, shadow_bin, teapot):
+    lamp = [(1, -1, 6), (3, -1, 6), (3, 1, 6), (1, 1, 6)][::-1]
+    run_cli(
+        shadow_bin,
+        "shadows",
+        MESHES / "teapot.obj",
+        "--light", "2,3,5",
+        "--area-light", ";".join(",".join(map(str, c)) for c in lamp),
+        "--sun-disc", "1,1,3:2",
+        "-o", tmp_path / "cli.json",
+    )
+    cli = json.loads((tmp_path / "cli.json").read_text())
+    # given in another order than the CLI numbers them (points and suns
+    # first): the columns follow the order given
+    lights = [bs.AreaLight(lamp), bs.PointLight((2, 3, 5)), bs.SunDisc((1, 1, 3), 2.0)]
+    s = bs.soft_shadows(teapot, lights)
+    cols = [1, 0, 2]
+    summary = cli["summary"]
+    for name in ["lit_area", "penumbra_area", "umbra_area", "undecided_area"]:
+        ours = getattr(s, name).sum(axis=0)
+        assert np.allclose(ours, [summary[name][c] for c in cols], rtol=1e-12, atol=1e-12), name
+    assert s.penumbra_area[:, 0].sum() > 0 and s.umbra_area[:, 0].sum() > 0
+    assert s.penumbra_area[:, 1].sum() == 0  # a point light casts no penumbra
+    total = s.lit_area + s.penumbra_area + s.umbra_area
+    assert np.allclose(total, s.face_area[:, None], rtol=1e-9, atol=1e-12)
+    assert s.fragment_count == len(cli["fragments"])
+    s.write(tmp_path / "py.json")
+    assert (tmp_path / "py.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    again = pickle.loads(pickle.dumps(s))
+    assert (again.umbra_area == s.umbra_area).all()
+    with pytest.raises(bs.LightError, match="at least three"):
+        bs.AreaLight([(0, 0, 1), (1, 0, 1)])
+    with pytest.raises(bs.LightError, match="light 1 is not"):
+        bs.soft_shadows(teapot, [bs.PointLight((2, 3, 5)), "lamp"])

@@ -44,6 +44,11 @@ pub use shadow_scene::{Face, Mesh, MeshView};
 pub use svbsp::LightSpec as Light;
 /// The most lights one shadow run takes.
 pub use svbsp::MAX_LIGHTS;
+/// The sun's angular radius, degrees: a sun disc's by default.
+pub use svbsp::SUN_RADIUS_DEG;
+/// A light of extent: an area light's corners, or a sun disc
+/// ([`soft_file::soft_shadows`]).
+pub use svbsp::SoftSpec;
 pub use volume::volume;
 
 /// Why a job failed; [`std::error::Error::source`] gives the cause.

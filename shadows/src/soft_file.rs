@@ -284,3 +284,160 @@ pub fn parse_sun_disc(s: &str) -> Result<SoftSpec, String> {
         radius_deg,
     })
 }
+
+/// What reaches every face of a mesh from lights of extent: each face cut
+/// into fragments that see all of a light (lit), part of it (penumbra),
+/// none of it (umbra), or are undecided between the last two; see
+/// [`soft_shadows`].
+#[derive(Debug)]
+pub struct SoftShadows {
+    grid: Grid,
+    lights: Vec<SoftLight>,
+    faces: usize,
+    /// The face of each occluder's fragments.
+    faces_of: Vec<u32>,
+    fragments: Vec<Vec<SoftFragment>>,
+    /// `faces × lights`: lit, penumbra (undecided included), umbra and
+    /// undecided areas.
+    classes: Vec<[f64; 4]>,
+    area: Vec<f64>,
+}
+
+/// A face's area in one class of a light ([`SoftShadows::area_of`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SoftClass {
+    /// Sees all of the light.
+    Lit,
+    /// Sees part of it (the undecided area included).
+    Penumbra,
+    /// Sees none of it.
+    Umbra,
+    /// Penumbra or umbra, not decided: where an umbra boundary may be a
+    /// quadric surface of three occluders' edges.
+    Undecided,
+}
+
+/// Shades every face of `mesh` for point lights and suns (`lights`) and
+/// lights of extent (`soft`: area lights and sun discs), numbered in that
+/// order (at most [`crate::MAX_LIGHTS`] in all). Faces are receivers and
+/// occluders alike, lit on their front side only, as with
+/// [`crate::shadows`].
+///
+/// ```
+/// use bsp_shadows::{DVec3, SoftSpec, soft_file::SoftClass};
+/// let room = shadow_scene::room();
+/// let lamp = [(-0.2, -0.2), (0.2, -0.2), (0.2, 0.2), (-0.2, 0.2)]
+///     .map(|(x, y)| DVec3::new(x, y, 2.9));
+/// // (turned to face down: it shines on the side its corners turn
+/// // counter-clockwise about)
+/// let lamp = SoftSpec::Area(lamp.into_iter().rev().collect());
+/// let s = bsp_shadows::soft_file::soft_shadows(&room, &[], &[lamp])?;
+/// let total = |c| (0..s.faces()).map(|f| s.area_of(f, 0, c)).sum::<f64>();
+/// assert!(total(SoftClass::Penumbra) > 0.0 && total(SoftClass::Umbra) > 0.0);
+/// # Ok::<(), bsp_shadows::Error>(())
+/// ```
+pub fn soft_shadows(
+    mesh: &Mesh,
+    lights: &[LightSpec],
+    soft: &[SoftSpec],
+) -> Result<SoftShadows, Error> {
+    let grid = svbsp::shared_soft_grid(&mesh.positions, lights, soft).map_err(Error::Light)?;
+    let placed = svbsp::place_lights(&grid, lights).map_err(Error::Light)?;
+    let all = svbsp::place_soft_lights(&grid, &placed, soft).map_err(Error::Light)?;
+    let (polys, _) =
+        bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(Error::Import)?;
+    let faces = mesh.faces.len();
+    let scene = SoftScene {
+        name: "",
+        faces,
+        grid: &grid,
+        lights: &all,
+        polys: &polys,
+    };
+    let (_, faces_of, fragments) = shade(&scene, &Quiet)?;
+    let n = all.len();
+    let (mut classes, mut area) = (vec![[0.0; 4]; faces * n], vec![0.0; faces]);
+    for (frags, &face) in fragments.iter().zip(&faces_of) {
+        let face = face as usize;
+        let a = soft_areas(std::slice::from_ref(frags), n, &grid);
+        area[face] += a.total;
+        for (j, c) in classes[face * n..(face + 1) * n].iter_mut().enumerate() {
+            let add = [a.lit[j], a.penumbra[j], a.umbra[j], a.undecided[j]];
+            c.iter_mut().zip(add).for_each(|(x, y)| *x += y);
+        }
+    }
+    Ok(SoftShadows {
+        grid,
+        lights: all,
+        faces,
+        faces_of,
+        fragments,
+        classes,
+        area,
+    })
+}
+
+/// No progress to show.
+struct Quiet;
+
+impl Progress for Quiet {
+    fn phase(&self, _: &'static str, _: u64) {}
+    fn advance(&self, _: u64) {}
+}
+
+impl SoftShadows {
+    /// How many faces the mesh has.
+    pub fn faces(&self) -> usize {
+        self.faces
+    }
+
+    /// How many lights there are.
+    pub fn lights(&self) -> usize {
+        self.lights.len()
+    }
+
+    /// The area of `face` in `class` of light `light` (in the mesh's
+    /// units squared).
+    pub fn area_of(&self, face: usize, light: usize, class: SoftClass) -> f64 {
+        let c = &self.classes[face * self.lights.len() + light];
+        match class {
+            SoftClass::Lit => c[0],
+            SoftClass::Penumbra => c[1],
+            SoftClass::Umbra => c[2],
+            SoftClass::Undecided => c[3],
+        }
+    }
+
+    /// The area of `face`.
+    pub fn face_area(&self, face: usize) -> f64 {
+        self.area[face]
+    }
+
+    /// How many fragments the faces were cut into.
+    pub fn fragment_count(&self) -> usize {
+        self.fragments.iter().map(Vec::len).sum()
+    }
+
+    /// Writes the fragments as JSON or OBJ (groups `lit`, `penumbra`,
+    /// `umbra`), by the extension, as `shadow shadows` does, through a
+    /// temporary file renamed into place when complete.
+    pub fn write(&self, path: impl AsRef<std::path::Path>) -> Result<(), Error> {
+        let path = path.as_ref();
+        let format = match path.extension().and_then(|e| e.to_str()) {
+            Some(e) if e.eq_ignore_ascii_case("json") => FragmentFormat::Json,
+            _ => FragmentFormat::Obj,
+        };
+        let io = |source| {
+            Error::File(shadow_scene::SceneError::Io {
+                path: path.display().to_string(),
+                source,
+            })
+        };
+        let mut out = shadow_scene::AtomicFile::create(path).map_err(io)?;
+        let notes: Vec<String> = self.lights.iter().map(|l| l.shape.to_string()).collect();
+        let head = ("", &notes[..], self.faces);
+        let frags = (&self.fragments[..], &self.faces_of[..]);
+        write_soft(&mut out, format, &self.lights, head, frags, &self.grid).map_err(io)?;
+        out.commit().map_err(io)
+    }
+}

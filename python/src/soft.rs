@@ -1,0 +1,241 @@
+//! Soft shadows in Python: area lights and sun discs, and the lit,
+//! penumbra and umbra areas of every face (`bsp_shadows::soft_file`).
+
+use bsp_shadows::soft_file::{SoftClass, SoftShadows as Computed};
+use bsp_shadows::{DVec3, Light, SoftSpec};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyList;
+
+use crate::{LightError, Mesh, PointLight, Reduced, Sun, run, to_py};
+
+type Point = (f64, f64, f64);
+
+/// An area light: a planar convex polygon, its `corners` in order; it
+/// shines on the side they turn counter-clockwise about.
+#[pyclass(module = "bsp_shadows", frozen)]
+#[derive(Clone)]
+pub(crate) struct AreaLight {
+    #[pyo3(get)]
+    corners: Vec<(f64, f64, f64)>,
+}
+
+#[pymethods]
+impl AreaLight {
+    #[new]
+    fn new(corners: Vec<(f64, f64, f64)>) -> PyResult<AreaLight> {
+        if corners.len() < 3 {
+            return Err(LightError::new_err(format!(
+                "{} corner(s): an area light takes at least three",
+                corners.len()
+            )));
+        }
+        Ok(AreaLight { corners })
+    }
+
+    fn __repr__(&self) -> String {
+        format!("AreaLight({:?})", self.corners)
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> Reduced<'py, (Vec<Point>,)> {
+        Ok((slf.get_type().into_any(), (slf.get().corners.clone(),)))
+    }
+}
+
+/// The sun as a disc toward `direction` of angular radius `radius_deg`
+/// (the sun's own, 0.2666°, by default), bounded by an octagon that holds
+/// it: what is lit sees the whole disc, what is umbra none of it.
+#[pyclass(module = "bsp_shadows", frozen)]
+#[derive(Clone)]
+pub(crate) struct SunDisc {
+    #[pyo3(get)]
+    direction: (f64, f64, f64),
+    #[pyo3(get)]
+    radius_deg: f64,
+}
+
+#[pymethods]
+impl SunDisc {
+    #[new]
+    #[pyo3(signature = (direction, radius_deg=bsp_shadows::SUN_RADIUS_DEG))]
+    fn new(direction: (f64, f64, f64), radius_deg: f64) -> SunDisc {
+        SunDisc {
+            direction,
+            radius_deg,
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "SunDisc({:?}, radius_deg={})",
+            self.direction, self.radius_deg
+        )
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> Reduced<'py, (Point, f64)> {
+        let s = slf.get();
+        Ok((slf.get_type().into_any(), (s.direction, s.radius_deg)))
+    }
+}
+
+fn vec3((x, y, z): (f64, f64, f64)) -> DVec3 {
+    DVec3::new(x, y, z)
+}
+
+/// The lit, penumbra and umbra parts of every face for some lights, at
+/// least one of them with extent.
+#[pyclass(module = "bsp_shadows", frozen)]
+pub(crate) struct SoftShadows {
+    mesh: Mesh,
+    lights: Vec<Py<PyAny>>,
+    /// The library's number of each light as given (points and suns
+    /// first, then those with extent).
+    order: Vec<usize>,
+    shadows: Computed,
+}
+
+/// Shades every face of `mesh` for `lights` (at most 64 `PointLight`,
+/// `Sun`, `AreaLight` or `SunDisc`): fragments each lit, in penumbra or in
+/// umbra for each light, exact where their boundary is planar.
+#[pyfunction]
+pub(crate) fn soft_shadows(
+    py: Python<'_>,
+    mesh: &Mesh,
+    lights: &Bound<'_, PyAny>,
+) -> PyResult<SoftShadows> {
+    let given: Vec<Bound<'_, PyAny>> = lights.try_iter()?.collect::<PyResult<_>>()?;
+    let (mut hard, mut soft) = (Vec::new(), Vec::new());
+    // each light's place among its kind, then among all
+    let mut kinds = Vec::with_capacity(given.len());
+    for (i, l) in given.iter().enumerate() {
+        if let Ok(p) = l.cast::<PointLight>() {
+            kinds.push((false, hard.len()));
+            hard.push(Light::Point(vec3(p.get().position)));
+        } else if let Ok(s) = l.cast::<Sun>() {
+            kinds.push((false, hard.len()));
+            hard.push(Light::Sun(vec3(s.get().direction)));
+        } else if let Ok(a) = l.cast::<AreaLight>() {
+            kinds.push((true, soft.len()));
+            soft.push(SoftSpec::Area(
+                a.get().corners.iter().map(|&c| vec3(c)).collect(),
+            ));
+        } else if let Ok(d) = l.cast::<SunDisc>() {
+            kinds.push((true, soft.len()));
+            let d = d.get();
+            soft.push(SoftSpec::SunDisc {
+                direction: vec3(d.direction),
+                radius_deg: d.radius_deg,
+            });
+        } else {
+            return Err(LightError::new_err(format!(
+                "light {i} is not a PointLight, Sun, AreaLight or SunDisc"
+            )));
+        }
+    }
+    let order = (kinds.iter())
+        .map(|&(extent, k)| if extent { hard.len() + k } else { k })
+        .collect();
+    let computed = run(py, || {
+        bsp_shadows::soft_file::soft_shadows(mesh.mesh(), &hard, &soft)
+    });
+    Ok(SoftShadows {
+        mesh: mesh.clone(),
+        lights: given.into_iter().map(Bound::unbind).collect(),
+        order,
+        shadows: computed.map_err(to_py)?,
+    })
+}
+
+impl SoftShadows {
+    /// `(faces, lights)`: the area of each face in `class` of each light.
+    fn areas<'py>(&self, py: Python<'py>, class: SoftClass) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (faces, lights) = (self.mesh.face_count(), self.order.len());
+        let flat: Vec<f64> = (0..faces)
+            .flat_map(|f| self.order.iter().map(move |&l| (f, l)))
+            .map(|(f, l)| self.shadows.area_of(f, l, class))
+            .collect();
+        flat.into_pyarray(py).reshape([faces, lights])
+    }
+}
+
+#[pymethods]
+impl SoftShadows {
+    /// `(faces, lights)` float64: the area of each face that sees all of
+    /// each light.
+    #[getter]
+    fn lit_area<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.areas(py, SoftClass::Lit)
+    }
+
+    /// `(faces, lights)` float64: the area that sees part of each light
+    /// (`undecided_area` included).
+    #[getter]
+    fn penumbra_area<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.areas(py, SoftClass::Penumbra)
+    }
+
+    /// `(faces, lights)` float64: the area that sees none of each light.
+    #[getter]
+    fn umbra_area<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.areas(py, SoftClass::Umbra)
+    }
+
+    /// `(faces, lights)` float64: the penumbra area that may be umbra,
+    /// where an umbra boundary may be a quadric surface of three
+    /// occluders' edges.
+    #[getter]
+    fn undecided_area<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.areas(py, SoftClass::Undecided)
+    }
+
+    /// `(faces,)` float64: each face's area.
+    #[getter]
+    fn face_area<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        (0..self.mesh.face_count())
+            .map(|f| self.shadows.face_area(f))
+            .collect::<Vec<_>>()
+            .into_pyarray(py)
+    }
+
+    /// How many fragments the faces were cut into.
+    #[getter]
+    fn fragment_count(&self) -> usize {
+        self.shadows.fragment_count()
+    }
+
+    /// Writes the fragments as JSON or OBJ (groups `lit`, `penumbra`,
+    /// `umbra`), by the extension, as `shadow shadows` does: its lights
+    /// numbered points and suns first, then those with extent.
+    fn write(&self, py: Python<'_>, path: std::path::PathBuf) -> PyResult<()> {
+        run(py, || self.shadows.write(&path)).map_err(to_py)
+    }
+
+    /// The mesh shaded.
+    #[getter]
+    fn mesh(&self) -> Mesh {
+        self.mesh.clone()
+    }
+
+    /// The lights, as given.
+    #[getter]
+    fn lights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        PyList::new(py, self.lights.iter().map(|l| l.bind(py)))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "SoftShadows(faces={}, lights={}, fragments={})",
+            self.mesh.face_count(),
+            self.lights.len(),
+            self.shadows.fragment_count()
+        )
+    }
+
+    /// Pickled as its mesh and lights; unpickling shades again (the same
+    /// bits: the result is a function of them).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> Reduced<'py, (Mesh, Bound<'py, PyList>)> {
+        let py = slf.py();
+        let f = py.import("bsp_shadows._native")?.getattr("soft_shadows")?;
+        Ok((f, (slf.get().mesh.clone(), slf.get().lights(py)?)))
+    }
+}
