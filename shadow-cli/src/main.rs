@@ -105,7 +105,7 @@ enum Command {
     /// Every face's exact sun-hours over a day or days: the mean of its
     /// points', the fewest and the most.
     #[command(
-        after_help = "Examples:\n  shadow sunhours --scene room --lat 51.5 --lon -0.12 --date 2026-03-21 -o hours.csv\n  shadow sunhours city.obj --lat 40.4 --lon -3.7 --date 2026-12-21 --sensors windows.csv -o w.csv\n  shadow sunhours --scene bunny-11k --lat 51.5 --lon -0.1 --date 2026-03-21 --up y -o heat.png"
+        after_help = "Examples:\n  shadow sunhours --scene room --lat 51.5 --lon -0.12 --date 2026-03-21 -o hours.csv\n  shadow sunhours city.obj --lat 40.4 --lon -3.7 --date 2026-12-21 --sensors windows.csv -o w.csv\n  shadow sunhours --scene bunny-11k --lat 51.5 --lon -0.1 --date 2026-03-21 --up y -o heat.png\n  shadow sunhours site.obj --lat 51.5 --lon -0.1 --date 2026-03-21 --regions garden --bre209 -o garden.csv"
     )]
     Sunhours(Box<sun::SunHoursArgs>),
     /// Print a shell completion script (bash, zsh, fish, elvish or

@@ -79,12 +79,18 @@ pub(crate) struct SunHoursArgs {
     /// The days' clock, hours east of UTC [default: 0].
     #[arg(long, value_name = "H", allow_hyphen_values = true)]
     utc_offset: Option<f64>,
-    /// Also say how much of each group sees at least H hours.
+    /// Also say how much of each group (or of the regions) sees at least H hours.
     #[arg(long, value_name = "H")]
     min_hours: Option<f64>,
     /// Hours at points instead of faces: a file of x,y,z lines (a header line may lead).
     #[arg(long, value_name = "FILE")]
     sensors: Option<PathBuf>,
+    /// Hours of the cells of these faces instead (a group, or ids such as 1,4,7-9): every step's lit parts overlaid.
+    #[arg(long, value_name = "GROUP|IDS", conflicts_with = "sensors")]
+    regions: Option<sun::RegionFaces>,
+    /// Say whether the regions pass the BRE 209 garden test: half their area 2 hours in sun on 21 March.
+    #[arg(long, requires = "regions")]
+    bre209: bool,
     /// Output: CSV (one row per face, or per sensor), JSON, OBJ (a heat map) or PNG (its picture).
     #[arg(short, long, value_name = "OUT.csv|OUT.json|OUT.obj|OUT.png")]
     output: PathBuf,
@@ -95,22 +101,16 @@ pub(crate) struct SunHoursArgs {
 
 /// `shadow sunhours`.
 pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
-    let format = sun::HoursFormat::for_path(&a.output).map_err(facade_error)?;
     let (mesh, name) = load_source_quiet(&a.source, a.quiet)?;
-    let staging = mesh.bounds().and_then(|b| a.source.staging(b));
-    let view = sun::HeatView {
-        staging,
-        up: a.site.up.unwrap_or_default(),
-    };
+    let view = sun::HeatView::of(mesh.bounds().and_then(|b| a.source.staging(b)), a.site.up);
     let dates = sun::study_dates(&a.date, a.to.as_deref(), a.every)?;
+    sun::check_bre209(a.bre209, &dates).map_err(facade_error)?;
     let step = a.step.unwrap_or(10.0);
     let suns = sun::study_suns(&a.site.site(), &dates, step, a.utc_offset.unwrap_or(0.0))?;
     let dirs: Vec<_> = suns.iter().map(|s| s.direction).collect();
-    let (h, sensors) = (step / 60.0, a.sensors.as_deref());
-    let r = sun::hours_report(&mesh, &dirs, h, format, sensors, a.min_hours, view);
+    let of = sun::HoursOf::of(a.sensors.as_deref(), a.regions.as_ref(), a.bre209);
+    let r = sun::hours_report(&mesh, &dirs, step / 60.0, &a.output, of, a.min_hours, view);
     let r = r.map_err(facade_error)?;
     write_file(&a.output, &r.bytes)?;
-    let (days, suns, out, rows) = (dates.len(), dirs.len(), a.output.display(), &r.rows);
-    let said = format!("wrote {out}: sun-hours of {rows} of {name}, {days} days, {suns} suns\n");
-    emit(&(said + &r.groups))
+    emit(&r.said(&a.output, &name, dates.len(), dirs.len()))
 }

@@ -1001,28 +1001,32 @@ fn sun_prints_where_the_sun_is() {
     crate::assert_failed_with(&o, &["2026-03-21 12:00", "offset"]);
 }
 
+/// `shadow sunhours` of the cube on the equinox at Greenwich, hourly, to
+/// `out`, with `extra` flags.
+fn cube_sunhours(out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut argv = vec![
+        "sunhours",
+        "--scene",
+        "cube",
+        "--lat",
+        "51.48",
+        "--lon",
+        "0",
+        "--date",
+        "2026-03-21",
+        "--step",
+        "60",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    argv.extend(extra);
+    shadow(&argv)
+}
+
 #[test]
 fn sunhours_writes_every_faces_hours() {
     let (csv, json) = (scratch("hours.csv"), scratch("hours.json"));
-    let run = |out: &Path, extra: &[&str]| {
-        let mut argv = vec![
-            "sunhours",
-            "--scene",
-            "cube",
-            "--lat",
-            "51.48",
-            "--lon",
-            "0",
-            "--date",
-            "2026-03-21",
-            "--step",
-            "60",
-            "-o",
-            out.to_str().unwrap(),
-        ];
-        argv.extend(extra);
-        shadow(&argv)
-    };
+    let run = cube_sunhours;
     let o = run(&csv, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains(", 1 days"), "{}", stdout(&o));
@@ -1090,6 +1094,23 @@ fn sunhours_writes_every_faces_hours() {
     let text = std::fs::read_to_string(&heat).unwrap();
     assert!(text.starts_with("# sun-hours: viridis from 0"), "{text}");
     assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 6);
+    // bad names and dates are clear errors
+    let o = run(&scratch("hours.txt"), &[]);
+    crate::assert_failed_with(&o, &["hours.txt", ".csv, .json, .obj or .png"]);
+    let o = run(&csv, &["--to", "2026-02-30"]);
+    crate::assert_failed_with(&o, &["2026-02-30", "not a date"]);
+}
+#[test]
+fn sunhours_draws_pictures_and_overlays_regions() {
+    let run = cube_sunhours;
+    let points = scratch("sensors_for_png.csv");
+    std::fs::write(&points, "0.5,0.5,2\n").unwrap();
+    // the most hours a face gets, from the faces' study
+    let faces = scratch("faces_for_regions.csv");
+    assert!(run(&faces, &[]).status.success());
+    let top = (std::fs::read_to_string(&faces).unwrap().lines().skip(1))
+        .map(|l| l.split(',').nth(3).unwrap().parse::<f64>().unwrap())
+        .fold(0.0, f64::max);
     // its picture: the cube framed, its faces in the ramp's colours (the
     // top, in every sun, yellow), the ramp itself along the bottom
     let png = scratch("hours.png");
@@ -1104,10 +1125,46 @@ fn sunhours_writes_every_faces_hours() {
         .count();
     assert!(yellow > 5000, "{yellow} yellow pixels");
     let o = run(&png, &["--sensors", points.to_str().unwrap()]);
-    crate::assert_failed_with(&o, &["sensors.csv", "not as a picture"]);
-    // bad names and dates are clear errors
-    let o = run(&scratch("hours.txt"), &[]);
-    crate::assert_failed_with(&o, &["hours.txt", ".csv, .json, .obj or .png"]);
-    let o = run(&csv, &["--to", "2026-02-30"]);
-    crate::assert_failed_with(&o, &["2026-02-30", "not a date"]);
+    crate::assert_failed_with(&o, &["hours.png", "a picture shows the faces' hours"]);
+    // regions: the cube's faces as cells of exact hours, adding up to
+    // the faces' area; the BRE 209 verdict on 21 March only
+    let cells = scratch("cells.csv");
+    let o = run(
+        &cells,
+        &["--regions", "cube", "--min-hours", "11", "--bre209"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let said = stdout(&o);
+    assert!(said.contains("cells of 6 faces of scene cube"), "{said}");
+    assert!(
+        said.contains("region: ") && said.contains("sees at least 11 hours"),
+        "{said}"
+    );
+    assert!(said.contains("BRE 209: the region passes: "), "{said}");
+    let text = std::fs::read_to_string(&cells).unwrap();
+    assert_eq!(text.lines().next(), Some("cell,face,group,hours,area"));
+    // (a lone cube shades none of its own faces: a cell each, its area 1)
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 6, "{text}");
+    assert!(rows.iter().all(|r| r[4] == "1"), "{text}");
+    let most = rows
+        .iter()
+        .map(|r| r[3].parse::<f64>().unwrap())
+        .fold(0.0, f64::max);
+    assert_eq!(most, top, "{text}");
+    let o = run(
+        &cells,
+        &["--regions", "cube", "--bre209", "--to", "2026-03-22"],
+    );
+    crate::assert_failed_with(&o, &["BRE 209 test is of 21 March"]);
+    let o = run(&cells, &["--regions", "garden"]);
+    crate::assert_failed_with(&o, &["no face is in a group `garden`; the groups: cube"]);
+    let o = run(&cells, &["--regions", "0,9"]);
+    crate::assert_failed_with(&o, &["face 9: the mesh has 6 faces"]);
+    let o = run(&png, &["--regions", "0-2"]);
+    crate::assert_failed_with(&o, &["hours.png", "a picture shows the faces' hours"]);
 }

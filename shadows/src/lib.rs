@@ -80,6 +80,9 @@ pub enum Error {
         /// Why.
         cause: bsp_core::SnapError,
     },
+    /// The faces of a region study cannot be found, or its dates are not
+    /// the test's (the message says which).
+    Region(String),
     /// An output file's name asks for a format the job cannot write.
     Format {
         /// The file.
@@ -102,6 +105,7 @@ impl std::fmt::Display for Error {
             Error::Io(e) => e.fmt(f),
             Error::Sensor { index, cause } => write!(f, "sensor {index}: {cause}"),
             Error::Format { path, why } => write!(f, "{}: {why}", path.display()),
+            Error::Region(why) => f.write_str(why),
         }
     }
 }
@@ -118,7 +122,7 @@ impl std::error::Error for Error {
             Error::Raster(e) => e,
             Error::Io(e) => e,
             Error::Sensor { cause, .. } => cause,
-            Error::Format { .. } => return None,
+            Error::Format { .. } | Error::Region(_) => return None,
         })
     }
 }

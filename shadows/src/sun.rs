@@ -9,7 +9,13 @@
 //! above) from that axis.
 
 use chrono::{DateTime, FixedOffset};
+
+mod regions;
 use glam::DVec3;
+pub use regions::{
+    RegionCell, RegionFaces, area_in_sun, bre209_text, check_bre209, region_hours,
+    region_in_sun_text, regions_csv, regions_json, regions_obj,
+};
 use solar_positioning::{Location, RefractionCorrection, SolarPositions, delta_t};
 
 /// Which scene axis points up.
@@ -383,7 +389,7 @@ impl HoursRun {
         suns: &[DVec3],
         step_hours: f64,
     ) -> Result<HoursRun, crate::Error> {
-        HoursRun::make(mesh, suns, step_hours, true)
+        HoursRun::make(mesh, suns, step_hours, Some(None))
     }
 
     /// The run without its pieces (for [`sun_hours_mean`]).
@@ -392,14 +398,16 @@ impl HoursRun {
         suns: &[DVec3],
         step_hours: f64,
     ) -> Result<HoursRun, crate::Error> {
-        HoursRun::make(mesh, suns, step_hours, false)
+        HoursRun::make(mesh, suns, step_hours, None)
     }
 
+    /// The run; with `pieces`, the pieces of every face, or with
+    /// `Some(Some(keep))` of the faces `keep` marks.
     fn make(
         mesh: &crate::Mesh,
         suns: &[DVec3],
         step_hours: f64,
-        pieces: bool,
+        pieces: Option<Option<&[bool]>>,
     ) -> Result<HoursRun, crate::Error> {
         let faces = mesh.faces.len();
         let lights: Vec<crate::Light> = suns.iter().map(|&d| crate::Light::Sun(d)).collect();
@@ -408,18 +416,22 @@ impl HoursRun {
         let lit = (0..faces)
             .map(|f| (0..suns.len()).map(|l| run.lit_area(f, l)).sum::<f64>() * step_hours)
             .collect();
-        if !pieces {
+        let Some(keep) = pieces else {
             return Ok(HoursRun {
                 step_hours,
                 area,
                 lit,
                 cells: None,
             });
-        }
+        };
+        let kept = |f: usize| keep.is_none_or(|k| k[f]);
         let frames: Vec<(DVec3, DVec3, DVec3)> = (0..faces).map(|f| face_frame(mesh, f)).collect();
         let mut cells: Vec<Vec<Cell>> = vec![Vec::new(); faces];
         for frag in run.batch.fragments() {
             let f = frag.face() as usize;
+            if !kept(f) {
+                continue;
+            }
             let seen = frag.lit_mask().count_ones();
             let (o, u, v) = frames[f];
             for piece in frag.pieces() {
@@ -455,7 +467,27 @@ impl HoursRun {
         faces: usize,
         runs: impl IntoIterator<Item = Result<HoursRun, crate::Error>>,
     ) -> Result<Vec<FaceHours>, crate::Error> {
-        use rayon::prelude::*;
+        let (area, lit, cells, step_hours) = HoursRun::fold_cells(faces, runs)?;
+        Ok((0..faces)
+            .map(|f| match &cells {
+                Some(cells) => face_hours(area[f], lit[f], cells[f].as_deref(), step_hours),
+                None => FaceHours {
+                    min_hours: f64::NAN,
+                    max_hours: f64::NAN,
+                    ..face_hours(area[f], lit[f], None, step_hours)
+                },
+            })
+            .collect())
+    }
+
+    /// The runs folded in order: every face's area, its lit area times
+    /// hours, its overlaid cells (`None` if a run has no pieces; a face
+    /// `None` for no runs), and the step.
+    #[allow(clippy::type_complexity)] // (the fold's four results, named above)
+    fn fold_cells(
+        faces: usize,
+        runs: impl IntoIterator<Item = Result<HoursRun, crate::Error>>,
+    ) -> Result<(Vec<f64>, Vec<f64>, Option<Vec<Option<Vec<Cell>>>>, f64), crate::Error> {
         let mut area = vec![0.0; faces];
         let mut lit = vec![0.0; faces];
         let mut cells: Vec<Option<Vec<Cell>>> = vec![None; faces];
@@ -468,12 +500,15 @@ impl HoursRun {
             lit.iter_mut().zip(&run.lit).for_each(|(l, r)| *l += r);
             match run.cells {
                 Some(new) if pieces => {
-                    (cells.par_iter_mut().zip(new).enumerate()).for_each(|(f, (old, new))| {
+                    let mut both: Vec<_> = cells.into_iter().zip(new).collect();
+                    bsp_core::par::for_each_mut(&mut both, |f, (old, new)| {
                         *old = Some(match old.take() {
-                            None => new,
-                            Some(old) => overlay(&old, &new, 1e-12 * run.area[f]),
+                            None => std::mem::take(new),
+                            Some(old) => overlay(&old, new, 1e-12 * run.area[f]),
                         });
-                    })
+                    });
+                    cells = both.into_iter().map(|(c, _)| c).collect();
+                    cells.resize(faces, None);
                 }
                 _ => {
                     pieces = false;
@@ -481,16 +516,7 @@ impl HoursRun {
                 }
             }
         }
-        Ok((0..faces)
-            .map(|f| match pieces {
-                true => face_hours(area[f], lit[f], cells[f].as_deref(), step_hours),
-                false => FaceHours {
-                    min_hours: f64::NAN,
-                    max_hours: f64::NAN,
-                    ..face_hours(area[f], lit[f], None, step_hours)
-                },
-            })
-            .collect())
+        Ok((area, lit, pieces.then_some(cells), step_hours))
     }
 
     /// The run as bytes (little-endian), for sending to another process.
@@ -653,45 +679,114 @@ pub struct HoursReport {
     pub groups: String,
 }
 
-/// The study's hours in `format`: every face's ([`sun_hours`]), or with
-/// `sensors` the hours at the points of that file
-/// ([`sensor_hours_file`]; not as a picture); with `min_hours`, the
-/// groups' shares that see at least that many hours. A picture looks at
-/// the scene as `view` says.
+/// What a study reports the hours of.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum HoursOf<'a> {
+    /// Every face ([`sun_hours`]).
+    Faces,
+    /// The points of this file ([`sensor_hours_file`]).
+    Sensors(&'a std::path::Path),
+    /// The cells of these faces ([`region_hours`]), with the BRE 209
+    /// verdict if asked ([`bre209_text`]).
+    Regions {
+        /// The faces.
+        faces: &'a RegionFaces,
+        /// Whether to say the verdict.
+        bre209: bool,
+    },
+}
+
+impl<'a> HoursOf<'a> {
+    /// At `sensors` if given, else on the faces of `regions` if given
+    /// (with the BRE 209 verdict if `bre209`), else on every face.
+    pub fn of(
+        sensors: Option<&'a std::path::Path>,
+        regions: Option<&'a RegionFaces>,
+        bre209: bool,
+    ) -> HoursOf<'a> {
+        match (sensors, regions) {
+            (Some(path), _) => HoursOf::Sensors(path),
+            (None, Some(faces)) => HoursOf::Regions { faces, bre209 },
+            (None, None) => HoursOf::Faces,
+        }
+    }
+}
+
+impl HoursReport {
+    /// What `shadow sunhours` says when it has written the report to
+    /// `output`: the rows, the scene's `name`, the study's days and suns,
+    /// then the shares' lines.
+    pub fn said(&self, output: &std::path::Path, name: &str, days: usize, suns: usize) -> String {
+        let (out, rows) = (output.display(), &self.rows);
+        let said =
+            format!("wrote {out}: sun-hours of {rows} of {name}, {days} days, {suns} suns\n");
+        said + &self.groups
+    }
+}
+
+/// The study's hours of `of`, to be written to `output` in the format its
+/// name asks for ([`HoursFormat::for_path`]; a picture of the faces
+/// only); with `min_hours`, the shares of the groups (or of the region)
+/// that see at least that many hours. A picture looks at the scene as
+/// `view` says.
 pub fn hours_report(
     mesh: &crate::Mesh,
     suns: &[DVec3],
     step_hours: f64,
-    format: HoursFormat,
-    sensors: Option<&std::path::Path>,
+    output: &std::path::Path,
+    of: HoursOf<'_>,
     min_hours: Option<f64>,
     view: HeatView,
 ) -> Result<HoursReport, crate::Error> {
-    if let Some(path) = sensors {
-        if format == HoursFormat::Png {
-            return Err(crate::Error::Format {
-                path: path.to_path_buf(),
-                why: "the hours at these sensors are written as .csv, .json or .obj, not as a picture",
-            });
-        }
-        let (text, n) = sensor_hours_file(mesh, path, suns, step_hours, format)?;
-        let (rows, groups) = (format!("{n} sensors among the faces"), String::new());
-        return Ok(HoursReport {
-            bytes: text.into_bytes(),
-            rows,
-            groups,
+    let format = HoursFormat::for_path(output)?;
+    if format == HoursFormat::Png && of != HoursOf::Faces {
+        return Err(crate::Error::Format {
+            path: output.to_path_buf(),
+            why: "a picture shows the faces' hours: write sensors' or regions' hours as .csv, .json or .obj",
         });
     }
-    let hours = sun_hours(mesh, suns, step_hours)?;
-    let bytes = match format {
-        HoursFormat::Png => hours_png(mesh, &hours, suns.len(), view)?,
-        _ => format.text(mesh, &hours, suns.len()).into_bytes(),
+    let report = |text: String, rows: String, groups: String| HoursReport {
+        bytes: text.into_bytes(),
+        rows,
+        groups,
     };
-    Ok(HoursReport {
-        bytes,
-        rows: format!("{} faces", hours.len()),
-        groups: groups_in_sun_text(mesh, &hours, min_hours),
-    })
+    match of {
+        HoursOf::Sensors(path) => {
+            let (text, n) = sensor_hours_file(mesh, path, suns, step_hours, format)?;
+            Ok(report(
+                text,
+                format!("{n} sensors among the faces"),
+                String::new(),
+            ))
+        }
+        HoursOf::Regions { faces, bre209 } => {
+            let ids = faces.faces(mesh)?;
+            let cells = region_hours(mesh, suns, step_hours, &ids)?;
+            let text = match format {
+                HoursFormat::Csv => regions_csv(mesh, &cells),
+                HoursFormat::Json => regions_json(&cells, suns.len()),
+                HoursFormat::Obj | HoursFormat::Png => regions_obj(&cells),
+            };
+            let mut lines = min_hours.map_or(String::new(), |h| region_in_sun_text(&cells, h));
+            if bre209 {
+                lines += &bre209_text(&cells);
+            }
+            let rows = format!("{} cells of {} faces", cells.len(), ids.len());
+            Ok(report(text, rows, lines))
+        }
+        HoursOf::Faces => {
+            let hours = sun_hours(mesh, suns, step_hours)?;
+            let bytes = match format {
+                HoursFormat::Png => hours_png(mesh, &hours, suns.len(), view)?,
+                _ => format.text(mesh, &hours, suns.len()).into_bytes(),
+            };
+            Ok(HoursReport {
+                bytes,
+                rows: format!("{} faces", hours.len()),
+                groups: groups_in_sun_text(mesh, &hours, min_hours),
+            })
+        }
+    }
 }
 
 /// How a picture of a study ([`hours_png`]) looks at the scene.
@@ -702,6 +797,17 @@ pub struct HeatView {
     pub staging: Option<shadow_scene::Staging>,
     /// The scene's up axis, the framing camera's up.
     pub up: Up,
+}
+
+impl HeatView {
+    /// The view of a built-in scene's `staging`, or a framing one with
+    /// `up` (default `z`) as up.
+    pub fn of(staging: Option<shadow_scene::Staging>, up: Option<Up>) -> HeatView {
+        HeatView {
+            staging,
+            up: up.unwrap_or_default(),
+        }
+    }
 }
 
 /// The size of a study's picture, in pixels.
@@ -1341,16 +1447,13 @@ mod tests {
         );
         let bytes = hours_png(&mesh, &hours, suns.len(), HeatView::default()).unwrap();
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
-        let e = hours_report(
-            &mesh,
-            &suns,
-            step,
-            HoursFormat::Png,
-            Some(&file),
-            None,
-            HeatView::default(),
+        let of = HoursOf::Sensors(&file);
+        let e = hours_report(&mesh, &suns, step, png, of, None, HeatView::default());
+        let e = e.unwrap_err().to_string();
+        assert!(
+            e.starts_with("study.PNG: a picture shows the faces'"),
+            "{e}"
         );
-        assert!(e.unwrap_err().to_string().ends_with("not as a picture"));
         // the suns in another order make other runs: the same hours
         let back: Vec<DVec3> = suns.iter().rev().copied().collect();
         for (a, b) in hours.iter().zip(sun_hours(&mesh, &back, step).unwrap()) {
@@ -1379,6 +1482,84 @@ mod tests {
         assert!(
             none.iter()
                 .all(|h| h.sun_hours == 0.0 && h.max_hours == 0.0)
+        );
+    }
+
+    #[test]
+    fn regions_of_a_yard() {
+        let (mesh, suns, step, _) = equinox_study();
+        let hours = sun_hours(&mesh, &suns, step).unwrap();
+        // the ground's cells: their areas add up to the ground's, and the
+        // area in sun at least so long is the face's own
+        let ground: RegionFaces = "0".parse().unwrap();
+        let cells = region_hours(&mesh, &suns, step, &ground.faces(&mesh).unwrap()).unwrap();
+        assert!(cells.len() > 10 && cells.iter().all(|c| c.face == 0));
+        let g = &hours[0];
+        let (total, sunny) = area_in_sun(&cells, 6.0);
+        assert!((total - g.area).abs() < 1e-9 * g.area, "{total} {}", g.area);
+        assert!((sunny - g.area_with_at_least(6.0)).abs() < 1e-9 * g.area);
+        let (lo, hi) = (cells.iter().map(|c| c.hours))
+            .fold((f64::MAX, 0.0_f64), |(a, b), h| (a.min(h), b.max(h)));
+        assert_eq!((lo, hi), (g.min_hours, g.max_hours));
+        for c in &cells {
+            // each cell lies on the ground, counter-clockwise from above
+            assert!(
+                c.ring.iter().all(|p| p.z == 0.0 || p.z.abs() < 1e-12),
+                "{c:?}"
+            );
+            let turn: f64 = (0..c.ring.len())
+                .map(|i| {
+                    c.ring[i]
+                        .truncate()
+                        .perp_dot(c.ring[(i + 1) % c.ring.len()].truncate())
+                })
+                .sum();
+            assert!(turn > 0.0, "{c:?}");
+        }
+        let json: serde_json::Value =
+            serde_json::from_str(&regions_json(&cells, suns.len())).unwrap();
+        assert_eq!(json["cells"].as_array().unwrap().len(), cells.len());
+        assert_eq!(
+            regions_obj(&cells)
+                .lines()
+                .filter(|l| l.starts_with("f "))
+                .count(),
+            cells.len()
+        );
+        assert!(bre209_text(&cells).starts_with("BRE 209: the region passes: "));
+        let march = chrono::NaiveDate::from_ymd_opt(2026, 3, 21).unwrap();
+        assert!(check_bre209(true, &[march]).is_ok());
+        let next = [march.succ_opt().unwrap()];
+        assert!(check_bre209(true, &next).is_err() && check_bre209(false, &next).is_ok());
+        // faces by ids and ranges; unknown ones are errors that say why
+        assert_eq!(
+            "1,3-5,3"
+                .parse::<RegionFaces>()
+                .unwrap()
+                .faces(&mesh)
+                .unwrap(),
+            [1, 3, 4, 5]
+        );
+        assert!("3-1".parse::<RegionFaces>().is_err());
+        let e = "99"
+            .parse::<RegionFaces>()
+            .unwrap()
+            .faces(&mesh)
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "face 99: the mesh has {} faces (ids from 0)",
+                mesh.faces.len()
+            )
+        );
+        let e = RegionFaces::Group("garden".into())
+            .faces(&mesh)
+            .unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("no face is in a group `garden`; the groups: "),
+            "{e}"
         );
     }
 }

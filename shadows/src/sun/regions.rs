@@ -1,0 +1,226 @@
+//! Regions of a sun study: chosen faces overlaid, every step's lit
+//! fragments on them added up (the core paper's "+" overlay), so that
+//! each cell of a face has one number of suns; and the BRE 209 test of a
+//! garden.
+
+use glam::DVec3;
+
+use super::{Cell, HoursRun, area2, colored_vertex, face_frame, heat, heat_header};
+use crate::{Error, Mesh};
+
+/// The faces a region study overlays: a group's name, or face ids.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum RegionFaces {
+    /// The faces of the group of this name.
+    Group(String),
+    /// These faces (ids from 0, in the mesh's order).
+    Ids(Vec<usize>),
+}
+
+impl std::str::FromStr for RegionFaces {
+    type Err = String;
+
+    /// Face ids and inclusive ranges (`1,4,7-9`), else a group's name.
+    fn from_str(s: &str) -> Result<RegionFaces, String> {
+        let s = s.trim();
+        if s.is_empty() {
+            return Err("no faces: name a group, or give face ids such as 1,4,7-9".into());
+        }
+        if !s.starts_with(|c: char| c.is_ascii_digit()) {
+            return Ok(RegionFaces::Group(s.to_string()));
+        }
+        let mut ids = Vec::new();
+        for part in s.split(',').map(str::trim) {
+            let bad = || format!("`{part}` is not a face id or a range of them such as 7-9");
+            let id = |t: &str| t.trim().parse::<usize>().map_err(|_| bad());
+            match part.split_once('-') {
+                Some((a, b)) if id(a)? <= id(b)? => ids.extend(id(a)?..=id(b)?),
+                Some(_) => return Err(bad()),
+                None => ids.push(id(part)?),
+            }
+        }
+        Ok(RegionFaces::Ids(ids))
+    }
+}
+
+impl RegionFaces {
+    /// The ids of these faces of `mesh`, in order, each once.
+    pub fn faces(&self, mesh: &Mesh) -> Result<Vec<usize>, Error> {
+        let n = mesh.faces.len();
+        let mut ids: Vec<usize> = match self {
+            RegionFaces::Group(name) => (0..n).filter(|&f| mesh.group_name(f) == name).collect(),
+            RegionFaces::Ids(ids) => ids.clone(),
+        };
+        ids.sort_unstable();
+        ids.dedup();
+        if let RegionFaces::Group(name) = self
+            && ids.is_empty()
+        {
+            let mut groups: Vec<&str> = (0..n).map(|f| mesh.group_name(f)).collect();
+            groups.dedup();
+            let why = format!(
+                "no face is in a group `{name}`; the groups: {}",
+                groups.join(", ")
+            );
+            return Err(Error::Region(why));
+        }
+        match ids.last() {
+            Some(&f) if f >= n => Err(Error::Region(format!(
+                "face {f}: the mesh has {n} faces (ids from 0)"
+            ))),
+            _ => Ok(ids),
+        }
+    }
+}
+
+/// A cell of a region: a convex part of a face whose points all see the
+/// same number of the study's suns.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RegionCell {
+    /// The face.
+    pub face: usize,
+    /// The sun-hours of its points: its suns times the step, exact.
+    pub hours: f64,
+    /// Its area.
+    pub area: f64,
+    /// Its corners, counter-clockwise seen from the face's front, in the
+    /// mesh's units.
+    pub ring: Vec<DVec3>,
+}
+
+/// The cells of `faces` of `mesh` under `suns` (directions toward them),
+/// each sun standing for `step_hours`: every run's exact lit fragments of
+/// those faces, as pieces, overlaid (their suns added; the overlay's
+/// clipping is `f64`, and a cell below 10⁻¹² of its face's area, a
+/// rounding sliver where two runs' boundaries coincide, is left out). A
+/// face under no sun is one cell of 0 hours. Faces in the order given,
+/// each face's cells in the overlay's order; the same bits for any
+/// thread count.
+pub fn region_hours(
+    mesh: &Mesh,
+    suns: &[DVec3],
+    step_hours: f64,
+    faces: &[usize],
+) -> Result<Vec<RegionCell>, Error> {
+    let n = mesh.faces.len();
+    let mut keep = vec![false; n];
+    faces
+        .iter()
+        .filter(|&&f| f < n)
+        .for_each(|&f| keep[f] = true);
+    let runs = (suns.chunks(svbsp::MAX_LIGHTS))
+        .map(|batch| HoursRun::make(mesh, batch, step_hours, Some(Some(&keep))));
+    let (_, _, cells, _) = HoursRun::fold_cells(n, runs)?;
+    let cells = cells.unwrap_or_else(|| vec![None; n]);
+    let mut out = Vec::new();
+    for &f in faces.iter().filter(|&&f| f < n) {
+        let (o, u, v) = face_frame(mesh, f);
+        let whole = || {
+            let ring = mesh.faces[f].vertices.iter().map(|&i| {
+                let p = mesh.positions[i as usize] - o;
+                glam::DVec2::new(p.dot(u), p.dot(v))
+            });
+            vec![(ring.collect(), 0)]
+        };
+        let face_cells: Vec<Cell> = cells[f].clone().unwrap_or_else(whole);
+        for (ring, seen) in face_cells {
+            out.push(RegionCell {
+                face: f,
+                hours: f64::from(seen) * step_hours,
+                area: area2(&ring).abs() / 2.0,
+                ring: ring.iter().map(|p| o + u * p.x + v * p.y).collect(),
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// The area of `cells` and the area of those that see at least `hours`
+/// (within 10⁻⁹ hours: the steps' sums in `f64`).
+pub fn area_in_sun(cells: &[RegionCell], hours: f64) -> (f64, f64) {
+    let total = cells.iter().map(|c| c.area).sum();
+    let sunny = (cells.iter())
+        .filter(|c| c.hours >= hours - 1e-9)
+        .map(|c| c.area)
+        .sum();
+    (total, sunny)
+}
+
+/// The line that says how much of the region sees at least `hours`.
+pub fn region_in_sun_text(cells: &[RegionCell], hours: f64) -> String {
+    let (total, sunny) = area_in_sun(cells, hours);
+    let share = if total > 0.0 {
+        100.0 * sunny / total
+    } else {
+        0.0
+    };
+    format!("region: {share:.1}% of its {total:.6} units² sees at least {hours} hours of sun\n")
+}
+
+/// The BRE 209 test of a garden ("Site layout planning for daylight and
+/// sunlight", BRE 2022, 3.3.17): at least half of its area should see at
+/// least two hours of sun on 21 March; the verdict in a line.
+pub fn bre209_text(cells: &[RegionCell]) -> String {
+    let (total, sunny) = area_in_sun(cells, 2.0);
+    let share = if total > 0.0 { sunny / total } else { 0.0 };
+    let verdict = if share >= 0.5 { "passes" } else { "fails" };
+    format!(
+        "BRE 209: the region {verdict}: {:.1}% of it sees at least 2 hours of sun (at least 50% asked)\n",
+        100.0 * share
+    )
+}
+
+/// Fails if the BRE 209 test is `asked` for, and `dates` is not one 21
+/// March: the day the test is about.
+pub fn check_bre209(asked: bool, dates: &[chrono::NaiveDate]) -> Result<(), Error> {
+    use chrono::Datelike;
+    match dates {
+        _ if !asked => Ok(()),
+        [d] if d.month() == 3 && d.day() == 21 => Ok(()),
+        _ => Err(Error::Region(
+            "the BRE 209 test is of 21 March: study that one day (YYYY-03-21)".into(),
+        )),
+    }
+}
+
+/// The cells as CSV: `cell,face,group,hours,area`.
+pub fn regions_csv(mesh: &Mesh, cells: &[RegionCell]) -> String {
+    let mut s = String::from("cell,face,group,hours,area\n");
+    for (i, c) in cells.iter().enumerate() {
+        let group = mesh.group_name(c.face);
+        s += &format!("{i},{},{group},{},{}\n", c.face, c.hours, c.area);
+    }
+    s
+}
+
+/// The cells as JSON: `{"suns": n, "area": total, "cells": [{"face",
+/// "hours", "area", "ring": [[x, y, z], …]}, …]}`.
+pub fn regions_json(cells: &[RegionCell], suns: usize) -> String {
+    let list: Vec<serde_json::Value> = (cells.iter())
+        .map(|c| {
+            let ring: Vec<[f64; 3]> = c.ring.iter().map(|p| p.to_array()).collect();
+            serde_json::json!({"face": c.face, "hours": c.hours, "area": c.area, "ring": ring})
+        })
+        .collect();
+    let total: f64 = cells.iter().map(|c| c.area).sum();
+    let v = serde_json::json!({"suns": suns, "area": total, "cells": list});
+    format!("{v:#}\n")
+}
+
+/// The cells as an OBJ heat map: each cell its own face, its corners
+/// coloured by its hours on the ramp of [`super::hours_obj`].
+pub fn regions_obj(cells: &[RegionCell]) -> String {
+    let most = cells.iter().map(|c| c.hours).fold(0.0, f64::max);
+    let mut s = heat_header(most);
+    let mut next = 1;
+    for c in cells {
+        let rgb = heat(c.hours, most);
+        for &p in &c.ring {
+            s += &colored_vertex(p, rgb);
+        }
+        let corners: Vec<String> = (next..next + c.ring.len()).map(|i| i.to_string()).collect();
+        s += &format!("f {}\n", corners.join(" "));
+        next += c.ring.len();
+    }
+    s
+}
