@@ -65,6 +65,7 @@ __all__ = [
     "get_threads",
     "intersection",
     "read_mesh",
+    "region_hours",
     "set_threads",
     "shadows",
     "soft_shadows",
@@ -104,6 +105,36 @@ def to_trimesh(mesh: Mesh):
 def from_trimesh(mesh) -> Mesh:
     """The ``Mesh`` of a ``trimesh.Trimesh``."""
     return Mesh.from_trimesh(mesh)
+
+
+def region_hours(
+    scene: Mesh,
+    faces,
+    *,
+    lat: float,
+    lon: float,
+    dates: Iterable,
+    step_minutes: float = 10.0,
+    utc_offset: float = 0.0,
+    north: float = 0.0,
+    up: str = "z",
+    height: float = 0.0,
+) -> dict:
+    """The cells of some faces of ``scene`` over a study (the suns of
+    ``sun_hours``): every step's exact lit parts of those faces overlaid,
+    so that each cell's points see the same suns. ``faces``: a group's
+    name (a mesh read from a file or a built-in scene) or face ids.
+
+    A dict of arrays: ``face`` (C,), ``hours`` (C,), ``area`` (C,),
+    ``ring_points`` (C+1,) and ``points`` (P, 3), cell c's corners being
+    ``points[ring_points[c]:ring_points[c+1]]``, counter-clockwise from the
+    face's front. ``area[hours >= 2].sum() / area.sum()`` is the share of
+    the BRE 209 garden test on 21 March.
+    """
+    suns = study_suns(lat, lon, list(dates), step_minutes, utc_offset, north, up, height)
+    if not isinstance(faces, str):
+        faces = [int(f) for f in faces]
+    return _native._region_hours(scene, suns, step_minutes / 60.0, faces)
 
 
 def sun_hours(

@@ -806,6 +806,59 @@ fn _hours_of_suns(
     })
 }
 
+/// The cells of the faces `faces` (a group's name, or face ids) of
+/// `mesh` under the suns `suns` (`(s, 3)`), each standing for
+/// `step_hours`: a dict of `face` (C,) int64, `hours` (C,), `area` (C,),
+/// `ring_points` (C+1,) int64 (cell c's corners are
+/// `points[ring_points[c]:ring_points[c+1]]`) and `points` (P, 3).
+#[pyfunction]
+fn _region_hours<'py>(
+    py: Python<'py>,
+    mesh: &Mesh,
+    suns: &Bound<'py, PyAny>,
+    step_hours: f64,
+    faces: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let suns = points(py, suns, "suns")?;
+    let chosen = match faces.extract::<String>() {
+        Ok(group) => sun::RegionFaces::Group(group),
+        Err(_) => sun::RegionFaces::Ids(faces.extract::<Vec<usize>>()?),
+    };
+    let cells = run(py, || {
+        let ids = chosen.faces(mesh.mesh())?;
+        sun::region_hours(mesh.mesh(), &suns, step_hours, &ids)
+    })
+    .map_err(to_py)?;
+    let (mut ring_points, mut pts) = (vec![0i64], Vec::new());
+    for c in &cells {
+        pts.extend(c.ring.iter().flat_map(|p| p.to_array()));
+        ring_points.push((pts.len() / 3) as i64);
+    }
+    let d = PyDict::new(py);
+    let n = pts.len() / 3;
+    let face: Vec<i64> = cells.iter().map(|c| c.face as i64).collect();
+    d.set_item("face", face.into_pyarray(py))?;
+    d.set_item(
+        "hours",
+        cells
+            .iter()
+            .map(|c| c.hours)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
+    d.set_item(
+        "area",
+        cells
+            .iter()
+            .map(|c| c.area)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
+    d.set_item("ring_points", ring_points.into_pyarray(py))?;
+    d.set_item("points", pts.into_pyarray(py).reshape([n, 3])?)?;
+    Ok(d)
+}
+
 /// One run of a study (at most 64 suns) as bytes: a task of the
 /// distributed study.
 #[pyfunction]
@@ -895,6 +948,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(study_suns, m)?,
         wrap_pyfunction!(_hours_of_suns, m)?,
         wrap_pyfunction!(_hours_run, m)?,
+        wrap_pyfunction!(_region_hours, m)?,
         wrap_pyfunction!(_fold_runs, m)?,
         wrap_pyfunction!(set_threads, m)?,
         wrap_pyfunction!(get_threads, m)?,

@@ -104,3 +104,27 @@ def test_soft_shadows_equal_the_cli_json(tmp_path, shadow_bin, teapot):
         bs.AreaLight([(0, 0, 1), (1, 0, 1)])
     with pytest.raises(bs.LightError, match="light 1 is not"):
         bs.soft_shadows(teapot, [bs.PointLight((2, 3, 5)), "lamp"])
+
+
+def test_region_hours_equal_the_cli(tmp_path, shadow_bin, yard):
+    yard.write(tmp_path / "yard.obj")
+    run_cli(
+        shadow_bin, "sunhours", tmp_path / "yard.obj",
+        "--lat", "51.5", "--lon", "-0.1", "--date", "2026-03-21", "--step", "20",
+        "--regions", "0", "-o", tmp_path / "cli.csv",
+    )
+    rows = [r.split(",") for r in (tmp_path / "cli.csv").read_text().splitlines()[1:]]
+    cells = bs.region_hours(bs.read_mesh(tmp_path / "yard.obj"), [0], lat=51.5, lon=-0.1,
+                            dates=["2026-03-21"], step_minutes=20)
+    assert (cells["face"] == 0).all()
+    assert [float(r[3]) for r in rows] == list(cells["hours"])
+    assert [float(r[4]) for r in rows] == list(cells["area"])
+    assert len(cells["ring_points"]) == len(rows) + 1
+    assert cells["points"].shape == (cells["ring_points"][-1], 3)
+    h = bs.sun_hours(bs.read_mesh(tmp_path / "yard.obj"), lat=51.5, lon=-0.1,
+                     dates=["2026-03-21"], step_minutes=20)
+    assert abs(cells["area"].sum() - h.area[0]) < 1e-9 * h.area[0]
+    assert cells["hours"].min() == h.min_hours[0] and cells["hours"].max() == h.max_hours[0]
+    with pytest.raises(bs.BspError, match="no face is in a group `garden`"):
+        bs.region_hours(bs.read_mesh(tmp_path / "yard.obj"), "garden", lat=51.5, lon=-0.1,
+                        dates=["2026-03-21"])
