@@ -26,7 +26,13 @@ class LightError(BspError):
 class Mesh:
     """A polygon mesh: vertices ``(n, 3)`` float64, faces ``(m, k)`` ints or a list of polygons."""
 
-    def __init__(self, vertices: _Points, faces: _Faces) -> None: ...
+    def __init__(self, vertices: _Points, faces: _Faces, groups: Optional[Sequence[str]] = None) -> None: ...
+    @property
+    def groups(self) -> List[str]:
+        """Each face's group name."""
+    @property
+    def group_names(self) -> List[str]:
+        """The groups' names, in order of first use."""
     @staticmethod
     def read(path: _Path) -> "Mesh":
         """Reads an OBJ or STL file."""

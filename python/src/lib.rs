@@ -185,6 +185,23 @@ fn faces_of(py: Python<'_>, faces: &Bound<'_, PyAny>, vertices: usize) -> PyResu
     .map_err(MeshError::new_err)
 }
 
+/// Each face's group as an index into the distinct names, in order of
+/// first use.
+fn group_ids(per_face: Vec<String>) -> (Vec<u32>, Vec<String>) {
+    let mut names: Vec<String> = Vec::new();
+    let mut index: std::collections::HashMap<String, u32> = Default::default();
+    let ids = per_face
+        .into_iter()
+        .map(|g| {
+            *index.entry(g).or_insert_with_key(|g| {
+                names.push(g.clone());
+                names.len() as u32 - 1
+            })
+        })
+        .collect();
+    (ids, names)
+}
+
 /// Checked faces as given: every face's vertex indices in one array.
 struct FlatFaces {
     indices: Vec<u32>,
@@ -196,25 +213,32 @@ struct FlatFaces {
 /// needs the library's mesh (made once, in parallel, without the GIL).
 struct MeshData {
     given: Option<(Vec<DVec3>, FlatFaces)>,
+    /// With the arrays, each face's group (an index into the names) and
+    /// the names; `None`: one group, `default`.
+    groups: Option<(Vec<u32>, Vec<String>)>,
     built: std::sync::OnceLock<bsp_shadows::Mesh>,
 }
 
 impl MeshData {
     /// The library's mesh of the given arrays.
-    fn build(positions: &[DVec3], faces: &FlatFaces) -> bsp_shadows::Mesh {
+    fn build(
+        positions: &[DVec3],
+        faces: &FlatFaces,
+        groups: Option<&(Vec<u32>, Vec<String>)>,
+    ) -> bsp_shadows::Mesh {
         use rayon::prelude::*;
         let faces = (0..faces.starts.len() - 1)
             .into_par_iter()
             .map(|i| Face {
                 vertices: faces.indices[faces.starts[i]..faces.starts[i + 1]].to_vec(),
                 line: 0,
-                group: 0,
+                group: groups.map_or(0, |g| g.0[i]),
             })
             .collect();
         bsp_shadows::Mesh {
             positions: positions.to_vec(),
             faces,
-            groups: vec!["default".to_string()],
+            groups: groups.map_or_else(|| vec!["default".to_string()], |g| g.1.clone()),
         }
     }
 }
@@ -233,6 +257,7 @@ impl Mesh {
         Mesh {
             data: Arc::new(MeshData {
                 given: None,
+                groups: None,
                 built: mesh.into(),
             }),
         }
@@ -243,7 +268,7 @@ impl Mesh {
         let d = &self.data;
         d.built.get_or_init(|| {
             let (positions, faces) = d.given.as_ref().expect("a mesh given or built");
-            MeshData::build(positions, faces)
+            MeshData::build(positions, faces, d.groups.as_ref())
         })
     }
 
@@ -252,7 +277,9 @@ impl Mesh {
     fn owned(&self) -> bsp_shadows::Mesh {
         match (self.data.built.get(), &self.data.given) {
             (Some(m), _) => m.clone(),
-            (None, Some((positions, faces))) => MeshData::build(positions, faces),
+            (None, Some((positions, faces))) => {
+                MeshData::build(positions, faces, self.data.groups.as_ref())
+            }
             (None, None) => unreachable!("a mesh given or built"),
         }
     }
@@ -271,6 +298,15 @@ impl Mesh {
         }
     }
 
+    /// Face `i`'s group, an index into [`Mesh::group_names`].
+    fn group_of(&self, i: usize) -> usize {
+        match (&self.data.given, &self.data.groups) {
+            (Some(_), Some((ids, _))) => ids[i] as usize,
+            (Some(_), None) => 0,
+            (None, _) => self.mesh().faces[i].group as usize,
+        }
+    }
+
     /// Face `i`'s vertices.
     fn face(&self, i: usize) -> &[u32] {
         match &self.data.given {
@@ -282,20 +318,55 @@ impl Mesh {
 
 #[pymethods]
 impl Mesh {
+    /// `groups`: each face's group name (a sequence of `m` strings), or
+    /// `None` for one group, `default`.
     #[new]
+    #[pyo3(signature = (vertices, faces, groups=None))]
     fn new(
         py: Python<'_>,
         vertices: &Bound<'_, PyAny>,
         faces: &Bound<'_, PyAny>,
+        groups: Option<Vec<String>>,
     ) -> PyResult<Mesh> {
         let positions = points(py, vertices, "vertices")?;
         let faces = faces_of(py, faces, positions.len())?;
+        let m = faces.starts.len() - 1;
+        let groups = match groups {
+            Some(g) if g.len() != m => {
+                return Err(MeshError::new_err(format!(
+                    "{} group names for {m} faces: give one a face",
+                    g.len()
+                )));
+            }
+            Some(g) => Some(group_ids(g)),
+            None => None,
+        };
         Ok(Mesh {
             data: Arc::new(MeshData {
                 given: Some((positions, faces)),
+                groups,
                 built: std::sync::OnceLock::new(),
             }),
         })
+    }
+
+    /// Each face's group name, `(m,)` (a list).
+    #[getter]
+    fn groups(&self) -> Vec<String> {
+        let names = self.group_names();
+        (0..self.face_count())
+            .map(|i| names[self.group_of(i)].clone())
+            .collect()
+    }
+
+    /// The groups' names, in order of first use.
+    #[getter]
+    fn group_names(&self) -> Vec<String> {
+        match (&self.data.given, &self.data.groups) {
+            (Some(_), Some((_, names))) => names.clone(),
+            (Some(_), None) => vec!["default".to_string()],
+            (None, _) => self.mesh().groups.clone(),
+        }
     }
 
     /// Reads an OBJ or STL file.
@@ -387,7 +458,12 @@ impl Mesh {
     /// The mesh of a `trimesh.Trimesh` (its vertices and faces).
     #[staticmethod]
     fn from_trimesh(py: Python<'_>, mesh: &Bound<'_, PyAny>) -> PyResult<Mesh> {
-        Mesh::new(py, &mesh.getattr("vertices")?, &mesh.getattr("faces")?)
+        Mesh::new(
+            py,
+            &mesh.getattr("vertices")?,
+            &mesh.getattr("faces")?,
+            None,
+        )
     }
 
     fn __or__(&self, py: Python<'_>, other: &Mesh) -> PyResult<Mesh> {
@@ -410,14 +486,15 @@ impl Mesh {
         )
     }
 
+    /// Pickled as its arrays and its faces' group names.
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
-    ) -> Reduced<'py, (Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    ) -> Reduced<'py, (Bound<'py, PyAny>, Bound<'py, PyAny>, Vec<String>)> {
         let py = slf.py();
         let me = slf.get();
         Ok((
             slf.get_type().into_any(),
-            (me.vertices(py)?.into_any(), me.faces(py)?),
+            (me.vertices(py)?.into_any(), me.faces(py)?, me.groups()),
         ))
     }
 }

@@ -104,3 +104,26 @@ def test_the_package_docstring_examples():
 
     result = doctest.testmod(bs)
     assert result.attempted >= 4 and result.failed == 0
+
+
+def test_groups_name_faces_and_survive_pickling(tmp_path):
+    v, f = tet()
+    m = bs.Mesh(v, f, groups=["base", "side", "side", "top"])
+    assert m.group_names == ["base", "side", "top"]
+    assert m.groups == ["base", "side", "side", "top"]
+    back = pickle.loads(pickle.dumps(m))
+    assert back.groups == m.groups and (back.faces == m.faces).all()
+    # a mesh without names is one group; a file's groups come back
+    assert bs.Mesh(v, f).groups == ["default"] * 4
+    m.write(tmp_path / "t.obj")
+    read = bs.read_mesh(tmp_path / "t.obj")
+    assert read.groups == m.groups
+    assert pickle.loads(pickle.dumps(read)).groups == m.groups
+    room = bs.Mesh.scene("room")
+    assert "floor" in room.group_names
+    assert pickle.loads(pickle.dumps(room)).groups == room.groups
+    # a region study of a group by its name
+    cells = bs.region_hours(m, "base", lat=51.5, lon=0.0, dates=["2026-06-21"], step_minutes=60)
+    assert (cells["face"] == 0).all()
+    with pytest.raises(bs.MeshError, match="3 group names for 4 faces"):
+        bs.Mesh(v, f, groups=["a", "b", "c"])
