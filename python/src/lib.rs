@@ -998,8 +998,9 @@ fn _fold_runs(
     })
 }
 
-/// The number of suns one run takes (the shadow engine's lights a pass).
-const MAX_SUNS_A_RUN: usize = bsp_shadows::MAX_LIGHTS;
+/// The number of suns a run of a study takes, as one process cuts it
+/// (`sun::SUNS_A_RUN`).
+const MAX_SUNS_A_RUN: usize = sun::SUNS_A_RUN;
 
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -108,7 +108,7 @@ pub fn region_hours(
         .iter()
         .filter(|&&f| f < n)
         .for_each(|&f| keep[f] = true);
-    let runs = (suns.chunks(svbsp::MAX_LIGHTS))
+    let runs = (suns.chunks(super::SUNS_A_RUN))
         .map(|batch| HoursRun::make(mesh, batch, step_hours, Some(Some(&keep))));
     let (_, _, cells, _) = HoursRun::fold_cells(n, runs)?;
     let cells = cells.unwrap_or_else(|| vec![None; n]);
