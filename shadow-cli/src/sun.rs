@@ -91,6 +91,9 @@ pub(crate) struct SunHoursArgs {
     /// Say whether the regions pass the BRE 209 garden test: half their area 2 hours in sun on 21 March.
     #[arg(long, requires = "regions")]
     bre209: bool,
+    /// Faces' mean hours only, for the cost of the shadows: no least and most hours (empty in CSV).
+    #[arg(long, conflicts_with_all = ["min_hours", "regions"])]
+    no_extremes: bool,
     /// Output: CSV (one row per face, or per sensor), JSON, OBJ (a heat map) or PNG (its picture).
     #[arg(short, long, value_name = "OUT.csv|OUT.json|OUT.obj|OUT.png")]
     output: PathBuf,
@@ -108,7 +111,12 @@ pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
     let step = a.step.unwrap_or(10.0);
     let suns = sun::study_suns(&a.site.site(), &dates, step, a.utc_offset.unwrap_or(0.0))?;
     let dirs: Vec<_> = suns.iter().map(|s| s.direction).collect();
-    let of = sun::HoursOf::of(a.sensors.as_deref(), a.regions.as_ref(), a.bre209);
+    let of = sun::HoursOf::of(
+        a.sensors.as_deref(),
+        a.regions.as_ref(),
+        a.bre209,
+        !a.no_extremes,
+    );
     let r = sun::hours_report(&mesh, &dirs, step / 60.0, &a.output, of, a.min_hours, view);
     let r = r.map_err(facade_error)?;
     write_file(&a.output, &r.bytes)?;

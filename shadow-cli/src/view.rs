@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use shadow_raster::svg::SvgViewpoint;
-use shadow_scene::{ROOM_EYE, ROOM_TARGET};
+use shadow_scene::ROOM_STAGING;
 
 use crate::args::{CameraArgs, ImageArgs, SourceArgs};
 use crate::facade_error;
@@ -85,14 +85,7 @@ pub(crate) fn stats(args: &StatsArgs) -> Result<()> {
 /// `shadow demo`.
 pub(crate) fn demo(args: &DemoArgs) -> Result<()> {
     let prepared = prepare(shadow_scene::room(), "scene room", args.quiet)?;
-    let at = SvgViewpoint {
-        eye: ROOM_EYE,
-        target: Some(ROOM_TARGET),
-        up: None,
-        width: args.image.size().0,
-        height: args.image.size().1,
-        fov_deg: args.image.fov,
-    };
+    let at = SvgViewpoint::of_staging(ROOM_STAGING, args.image.size(), args.image.fov);
     let out = prepared.draw(&at).map_err(facade_error)?;
     write_file(&args.output, out.svg.as_bytes())?;
     emit(&format!(

@@ -1094,6 +1094,17 @@ fn sunhours_writes_every_faces_hours() {
     let text = std::fs::read_to_string(&heat).unwrap();
     assert!(text.starts_with("# sun-hours: viridis from 0"), "{text}");
     assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 6);
+    // the mean alone: the same hours, the extremes' fields empty
+    let mean = scratch("mean.csv");
+    let o = run(&mean, &["--no-extremes"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&mean).unwrap();
+    for (r, l) in rows.iter().zip(text.lines().skip(1)) {
+        let m: Vec<&str> = l.split(',').collect();
+        assert_eq!((&m[..4], &m[4..]), (&r[..4], &["", ""][..]), "{l}");
+    }
+    let o = run(&mean, &["--no-extremes", "--min-hours", "2"]);
+    crate::assert_failed_with(&o, &["--no-extremes", "--min-hours"]);
     // bad names and dates are clear errors
     let o = run(&scratch("hours.txt"), &[]);
     crate::assert_failed_with(&o, &["hours.txt", ".csv, .json, .obj or .png"]);

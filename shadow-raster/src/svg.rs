@@ -131,6 +131,20 @@ pub struct ViewRequest {
 }
 
 impl SvgViewpoint {
+    /// The viewpoint of a `width`×`height` picture from `staging`'s eye
+    /// toward its target, with its up, and a vertical field of view of
+    /// `fov_deg`.
+    pub fn of_staging(staging: Staging, (width, height): (u32, u32), fov_deg: f64) -> SvgViewpoint {
+        SvgViewpoint {
+            eye: staging.eye,
+            target: Some(staging.target),
+            up: staging.up,
+            width,
+            height,
+            fov_deg,
+        }
+    }
+
     /// The viewpoint of a `width`×`height` picture of `positions` with a
     /// vertical field of view of `fov_deg`, completing what was `given`:
     /// an eye given is kept (its up from `staging` unless given); else a

@@ -70,7 +70,7 @@ pub use obj::{
 pub use palette::{Rgb, face_colors};
 pub use points::{parse_points, read_points};
 pub use scan::{MAX_SUBDIVISIONS, bunny, sqrt3_subdivide};
-pub use scenes::{SCENE_NAMES, Staging, room, scene, scene_named};
+pub use scenes::{ROOM_STAGING, SCENE_NAMES, Staging, room, scene, scene_named};
 pub use stl::{parse_stl, read_stl, stl_collisions, write_stl};
 
 /// A mesh file format.

@@ -83,6 +83,15 @@ pub struct Staging {
     pub light: DVec3,
 }
 
+/// The room's staging: [`ROOM_EYE`] looking at [`ROOM_TARGET`], `+z` up,
+/// under [`ROOM_LIGHT`].
+pub const ROOM_STAGING: Staging = Staging {
+    eye: ROOM_EYE,
+    target: ROOM_TARGET,
+    up: None,
+    light: ROOM_LIGHT,
+};
+
 impl Staging {
     /// The staging of built-in scene `name` (see [`SCENE_NAMES`]) whose
     /// mesh spans `bounds` (`lo`, `hi`): for the room [`ROOM_EYE`] looking
@@ -99,12 +108,7 @@ impl Staging {
     pub fn of_scene(name: &str, (lo, hi): (DVec3, DVec3)) -> Option<Staging> {
         let (c, half) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
         match name {
-            "room" => Some(Staging {
-                eye: ROOM_EYE,
-                target: ROOM_TARGET,
-                up: None,
-                light: ROOM_LIGHT,
-            }),
+            "room" => Some(ROOM_STAGING),
             _ if name.starts_with("bunny") => Some(Staging {
                 eye: c + DVec3::new(0.75, 0.6, 1.7) * half,
                 target: c - DVec3::Y * 0.25 * half,

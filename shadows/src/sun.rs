@@ -692,8 +692,14 @@ pub struct HoursReport {
 /// What a study reports the hours of.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum HoursOf<'a> {
-    /// Every face ([`sun_hours`]).
-    Faces,
+    /// Every face: with the least and most hours of its points and the
+    /// area per hours ([`sun_hours`]), or without them, for the cost of
+    /// the shadows alone ([`sun_hours_mean`]: NaN in the data, empty in
+    /// CSV, `null` in JSON).
+    Faces {
+        /// Whether to overlay the runs for the extremes.
+        extremes: bool,
+    },
     /// The points of this file ([`sensor_hours_file`]).
     Sensors(&'a std::path::Path),
     /// The cells of these faces ([`region_hours`]), with the BRE 209
@@ -708,16 +714,18 @@ pub enum HoursOf<'a> {
 
 impl<'a> HoursOf<'a> {
     /// At `sensors` if given, else on the faces of `regions` if given
-    /// (with the BRE 209 verdict if `bre209`), else on every face.
+    /// (with the BRE 209 verdict if `bre209`), else on every face (with
+    /// their `extremes` if asked).
     pub fn of(
         sensors: Option<&'a std::path::Path>,
         regions: Option<&'a RegionFaces>,
         bre209: bool,
+        extremes: bool,
     ) -> HoursOf<'a> {
         match (sensors, regions) {
             (Some(path), _) => HoursOf::Sensors(path),
             (None, Some(faces)) => HoursOf::Regions { faces, bre209 },
-            (None, None) => HoursOf::Faces,
+            (None, None) => HoursOf::Faces { extremes },
         }
     }
 }
@@ -749,7 +757,7 @@ pub fn hours_report(
     view: HeatView,
 ) -> Result<HoursReport, crate::Error> {
     let format = HoursFormat::for_path(output)?;
-    if format == HoursFormat::Png && of != HoursOf::Faces {
+    if format == HoursFormat::Png && !matches!(of, HoursOf::Faces { .. }) {
         return Err(crate::Error::Format {
             path: output.to_path_buf(),
             why: "a picture shows the faces' hours: write sensors' or regions' hours as .csv, .json or .obj",
@@ -784,8 +792,16 @@ pub fn hours_report(
             let rows = format!("{} cells of {} faces", cells.len(), ids.len());
             Ok(report(text, rows, lines))
         }
-        HoursOf::Faces => {
-            let hours = sun_hours(mesh, suns, step_hours)?;
+        HoursOf::Faces { extremes } => {
+            if !extremes && min_hours.is_some() {
+                return Err(crate::Error::Region(
+                    "the area that sees at least so many hours needs the extremes' overlay".into(),
+                ));
+            }
+            let hours = match extremes {
+                true => sun_hours(mesh, suns, step_hours)?,
+                false => sun_hours_mean(mesh, suns, step_hours)?,
+            };
             let bytes = match format {
                 HoursFormat::Png => hours_png(mesh, &hours, suns.len(), view)?,
                 _ => format.text(mesh, &hours, suns.len()).into_bytes(),
@@ -1026,13 +1042,21 @@ fn viridis(t: f64) -> [f64; 3] {
 pub fn hours_csv(mesh: &crate::Mesh, hours: &[FaceHours]) -> String {
     let mut s = String::from("face,group,area,sun_hours,min_hours,max_hours\n");
     for (f, h) in hours.iter().enumerate() {
+        // (no extremes: empty fields)
+        let extreme = |x: f64| {
+            if x.is_nan() {
+                String::new()
+            } else {
+                x.to_string()
+            }
+        };
         s += &format!(
             "{f},{},{},{},{},{}\n",
             mesh.group_name(f),
             h.area,
             h.sun_hours,
-            h.min_hours,
-            h.max_hours
+            extreme(h.min_hours),
+            extreme(h.max_hours)
         );
     }
     s
