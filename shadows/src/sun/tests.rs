@@ -1,0 +1,365 @@
+//! The sun studies' tests: positions, a yard's hours, files, regions.
+
+use super::*;
+
+/// NREL's reference case (Reda & Andreas 2004, table A4.1): Golden,
+/// Colorado, 17 October 2003 12:30:30 local standard time (UTC−7),
+/// 1830.14 m, 820 hPa, 11 °C, ΔT 67 s: topocentric zenith 50.11162°,
+/// azimuth 194.34024°.
+#[test]
+fn nrels_reference_case() {
+    let site = SunSite {
+        height: 1830.14,
+        air: Some((820.0, 11.0)),
+        delta_t: Some(67.0),
+        ..SunSite::new(39.742476, -105.1786)
+    };
+    let time = parse_time("2003-10-17T12:30:30-07:00").unwrap();
+    let p = sun_position(&site, &time).unwrap();
+    assert!((p.azimuth_deg - 194.34024).abs() < 1e-4, "{p:?}");
+    assert!((90.0 - p.elevation_deg - 50.11162).abs() < 1e-4, "{p:?}");
+    // south-south-west and up, in the default axes
+    let d = p.direction;
+    assert!(d.y < 0.0 && d.x < 0.0 && d.z > 0.0 && (d.length() - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn axes_and_north() {
+    let time = parse_time("2026-03-21T12:00:00Z").unwrap();
+    // at noon on the equinox at Greenwich, the sun stands south, high
+    let p = sun_position(&SunSite::new(51.48, 0.0), &time).unwrap();
+    // (the equation of time: solar noon is at about 12:07)
+    assert!((p.azimuth_deg - 180.0).abs() < 3.0, "{p:?}");
+    assert!(p.direction.y < -0.5 && p.direction.x.abs() < 0.05, "{p:?}");
+    // y up: north is -z, so the southern sun is toward +z
+    let y_up = SunSite {
+        up: Up::Y,
+        ..SunSite::new(51.48, 0.0)
+    };
+    let q = sun_position(&y_up, &time).unwrap();
+    assert!(q.direction.z > 0.5 && q.direction.y > 0.5, "{q:?}");
+    // north turned by 90 degrees: south lies along -x
+    let turned = SunSite {
+        north_deg: 90.0,
+        ..SunSite::new(51.48, 0.0)
+    };
+    let r = sun_position(&turned, &time).unwrap();
+    assert!(r.direction.x < -0.5, "{r:?}");
+    assert!(parse_time("2026-03-21 12:00").is_err());
+    let far = SunSite::new(95.0, 0.0);
+    assert!(
+        sun_position(&far, &time)
+            .unwrap_err()
+            .to_string()
+            .contains("atitude")
+    );
+}
+
+/// A ground with a box on it (the box's faces after the ground's).
+fn yard() -> crate::Mesh {
+    let (b, h) = (1.0, 2.0);
+    let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    let positions = vec![
+        p(-10.0, -10.0, 0.0),
+        p(10.0, -10.0, 0.0),
+        p(10.0, 10.0, 0.0),
+        p(-10.0, 10.0, 0.0),
+        p(-b, -b, 0.0),
+        p(b, -b, 0.0),
+        p(b, b, 0.0),
+        p(-b, b, 0.0),
+        p(-b, -b, h),
+        p(b, -b, h),
+        p(b, b, h),
+        p(-b, b, h),
+    ];
+    let faces = [
+        vec![0, 1, 2, 3],
+        vec![8, 9, 10, 11],
+        vec![4, 5, 9, 8],
+        vec![5, 6, 10, 9],
+        vec![6, 7, 11, 10],
+        vec![7, 4, 8, 11],
+    ];
+    crate::Mesh {
+        positions,
+        faces: faces
+            .into_iter()
+            .map(|vertices| crate::Face {
+                vertices,
+                line: 0,
+                group: 0,
+            })
+            .collect(),
+        groups: vec!["default".into()],
+    }
+}
+
+/// Whether the ray from `p` toward `d` meets the box `[-1, 1]² × [0, 2]`
+/// (slab test; `p` on the ground outside the box).
+fn blocked(p: DVec3, d: DVec3) -> bool {
+    let (lo, hi) = (DVec3::new(-1.0, -1.0, 0.0), DVec3::new(1.0, 1.0, 2.0));
+    let (mut t0, mut t1) = (1e-9f64, f64::INFINITY);
+    for k in 0..3 {
+        if d[k] == 0.0 {
+            if p[k] < lo[k] || p[k] > hi[k] {
+                return false;
+            }
+            continue;
+        }
+        let (a, b) = ((lo[k] - p[k]) / d[k], (hi[k] - p[k]) / d[k]);
+        t0 = t0.max(a.min(b));
+        t1 = t1.min(a.max(b));
+    }
+    t0 < t1
+}
+
+/// Points on the yard's ground off the shadows' edges, then one above
+/// the roof's middle.
+fn yard_sensors() -> Vec<DVec3> {
+    [
+        (0.0, -1.5),
+        (1.5, 1.5),
+        (-3.0, 2.0),
+        (0.2, 2.5),
+        (-1.2, -1.2),
+    ]
+    .iter()
+    .map(|&(x, y)| DVec3::new(x, y, 0.0))
+    .chain([DVec3::new(0.0, 0.0, 2.5)])
+    .collect()
+}
+
+/// The yard on the equinox at Greenwich, a sun every 8 minutes (more
+/// than one run takes): the mesh, the suns, the step, all suns' hours.
+fn equinox_study() -> (crate::Mesh, Vec<DVec3>, f64, f64) {
+    let site = SunSite::new(51.48, 0.0);
+    let day = [chrono::NaiveDate::from_ymd_opt(2026, 3, 21).unwrap()];
+    let suns: Vec<DVec3> = study_suns(&site, &day, 8.0, 0.0)
+        .unwrap()
+        .iter()
+        .map(|s| s.direction)
+        .collect();
+    assert!(suns.len() > svbsp::MAX_LIGHTS, "{}", suns.len());
+    let step = 8.0 / 60.0;
+    let full = suns.len() as f64 * step;
+    (yard(), suns, step, full)
+}
+
+#[test]
+fn a_day_of_suns_and_the_hours_of_a_yard() {
+    let site = SunSite::new(51.48, 0.0);
+    let day = [chrono::NaiveDate::from_ymd_opt(2026, 3, 21).unwrap()];
+    let hourly = study_suns(&site, &day, 60.0, 0.0).unwrap();
+    assert!((11..=13).contains(&hourly.len()), "{}", hourly.len());
+    assert!(study_suns(&site, &day, 0.0, 0.0).is_err());
+    let (mesh, suns, step, full) = equinox_study();
+    let hours = sun_hours(&mesh, &suns, step).unwrap();
+    // the roof sees every sun
+    let roof = &hours[1];
+    assert!(
+        (roof.sun_hours - full).abs() < 1e-9 && roof.min_hours == full,
+        "{roof:?}"
+    );
+    assert_eq!(roof.max_hours, full);
+    // the ground: its far corners see every sun, points by the box fewer
+    let g = &hours[0];
+    assert_eq!(g.max_hours, full);
+    assert!(g.min_hours < g.sun_hours && g.sun_hours < full, "{g:?}");
+    // every point's own count lies between the least and the most
+    for &p in &yard_sensors()[..5] {
+        let own = suns.iter().filter(|&&d| !blocked(p, d)).count() as f64 * step;
+        assert!(
+            g.min_hours - 1e-9 <= own && own <= g.max_hours + 1e-9,
+            "{own} at {p}"
+        );
+    }
+    // how much of the ground gets how many hours: all of it at least
+    // none, less and less as the hours grow, none beyond the day
+    let a = |h: f64| g.area_with_at_least(h);
+    assert!(
+        (a(0.0) - g.area).abs() < 1e-9 * g.area,
+        "{} {}",
+        a(0.0),
+        g.area
+    );
+    assert!(a(0.0) >= a(3.0) && a(3.0) >= a(full) && a(full) > 0.0 && a(full + 1.0) == 0.0);
+    assert!((roof.area_with_at_least(full) - roof.area).abs() < 1e-9);
+    let groups = groups_in_sun(&mesh, &hours, full);
+    assert_eq!(groups.len(), 1); // one group: the yard and the box
+    // sensors: a point's own count, exactly (points off the shadows'
+    // edges), and the roof's middle sees every sun
+    let points = yard_sensors();
+    let at = sensor_hours(&mesh, &points, &suns, step).unwrap();
+    for (p, h) in points.iter().zip(&at) {
+        let own = suns.iter().filter(|&&d| !blocked(*p, d)).count() as f64 * step;
+        assert_eq!(*h, own, "at {p}");
+    }
+    assert_eq!(at[5], full);
+}
+
+#[test]
+fn runs_files_and_heat_maps_of_a_yard() {
+    let (mesh, suns, step, full) = equinox_study();
+    let hours = sun_hours(&mesh, &suns, step).unwrap();
+    let points = yard_sensors();
+    // the same points from a file, as CSV
+    let file = std::env::temp_dir().join(format!("sensors-{}.csv", std::process::id()));
+    let text: String = points
+        .iter()
+        .map(|p| format!("{} {} {}\n", p.x, p.y, p.z))
+        .collect();
+    std::fs::write(&file, format!("x y z\n{text}")).unwrap();
+    let (csv, n) = sensor_hours_file(&mesh, &file, &suns, step, HoursFormat::Csv).unwrap();
+    assert_eq!((n, csv.lines().count()), (6, 7));
+    let last: f64 = csv
+        .lines()
+        .last()
+        .unwrap()
+        .rsplit(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(last, full);
+    std::fs::write(&file, "1 2\n").unwrap();
+    let e = sensor_hours_file(&mesh, &file, &suns, step, HoursFormat::Json).unwrap_err();
+    assert!(
+        e.to_string()
+            .ends_with(".csv:1: `1 2` has 2 numbers; a point is x,y,z"),
+        "{e}"
+    );
+    std::fs::remove_file(&file).unwrap();
+    // the heat map: a coloured corner per face corner, the roof yellow
+    let obj = HoursFormat::Obj.text(&mesh, &hours, suns.len());
+    let corners: usize = mesh.faces.iter().map(|f| f.vertices.len()).sum();
+    assert_eq!(obj.lines().filter(|l| l.starts_with("v ")).count(), corners);
+    let read = shadow_scene::parse_obj(&obj, "heat.obj").unwrap();
+    assert_eq!(read.faces.len(), mesh.faces.len());
+    let roof = obj.lines().filter(|l| l.starts_with("v ")).nth(4).unwrap();
+    assert!(roof.ends_with(" 0.9922 0.9059 0.1451"), "{roof}");
+    assert_eq!(viridis(0.0), [68.0 / 255.0, 1.0 / 255.0, 84.0 / 255.0]);
+    // its picture, by the file's name; no picture of sensors
+    let png = std::path::Path::new("study.PNG");
+    assert_eq!(HoursFormat::for_path(png).unwrap(), HoursFormat::Png);
+    let e = HoursFormat::for_path(std::path::Path::new("study.txt")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "study.txt: a sun study is written as .csv, .json, .obj or .png"
+    );
+    let bytes = hours_png(&mesh, &hours, suns.len(), HeatView::default()).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    let of = HoursOf::Sensors(&file);
+    let e = hours_report(&mesh, &suns, step, png, of, None, HeatView::default());
+    let e = e.unwrap_err().to_string();
+    assert!(
+        e.starts_with("study.PNG: a picture shows the faces'"),
+        "{e}"
+    );
+    // the suns in another order make other runs: the same hours
+    let back: Vec<DVec3> = suns.iter().rev().copied().collect();
+    for (a, b) in hours.iter().zip(sun_hours(&mesh, &back, step).unwrap()) {
+        assert!((a.sun_hours - b.sun_hours).abs() < 1e-9, "{a:?} {b:?}");
+        assert!((a.min_hours - b.min_hours).abs() < 1e-9, "{a:?} {b:?}");
+        assert!((a.max_hours - b.max_hours).abs() < 1e-9, "{a:?} {b:?}");
+    }
+    // runs made apart, sent as bytes and folded in order: the same bits
+    let runs: Vec<Vec<u8>> = (suns.chunks(SUNS_A_RUN))
+        .map(|c| HoursRun::new(&mesh, c, step).unwrap().to_bytes())
+        .collect();
+    let back = runs.iter().map(|b| Ok(HoursRun::from_bytes(b).unwrap()));
+    assert_eq!(HoursRun::fold(mesh.faces.len(), back).unwrap(), hours);
+    let cut = &runs[0][..runs[0].len() - 8];
+    assert!(HoursRun::from_bytes(cut).is_none());
+    assert!(HoursRun::from_bytes(&[runs[0].clone(), vec![0; 8]].concat()).is_none());
+    // the mean alone: the same sun-hours, no extremes
+    let mean = sun_hours_mean(&mesh, &suns, step).unwrap();
+    for (a, b) in hours.iter().zip(&mean) {
+        assert_eq!((a.area, a.sun_hours), (b.area, b.sun_hours));
+        assert!(b.min_hours.is_nan() && b.max_hours.is_nan() && b.hours_area.is_empty());
+    }
+    let run = HoursRun::mean_only(&mesh, &suns[..10], step).unwrap();
+    assert_eq!(HoursRun::from_bytes(&run.to_bytes()), Some(run));
+    let none = HoursRun::fold(mesh.faces.len(), []).unwrap();
+    assert!(
+        none.iter()
+            .all(|h| h.sun_hours == 0.0 && h.max_hours == 0.0)
+    );
+}
+
+#[test]
+fn regions_of_a_yard() {
+    let (mesh, suns, step, _) = equinox_study();
+    let hours = sun_hours(&mesh, &suns, step).unwrap();
+    // the ground's cells: their areas add up to the ground's, and the
+    // area in sun at least so long is the face's own
+    let ground: RegionFaces = "0".parse().unwrap();
+    let cells = region_hours(&mesh, &suns, step, &ground.faces(&mesh).unwrap()).unwrap();
+    assert!(cells.len() > 10 && cells.iter().all(|c| c.face == 0));
+    let g = &hours[0];
+    let (total, sunny) = area_in_sun(&cells, 6.0);
+    assert!((total - g.area).abs() < 1e-9 * g.area, "{total} {}", g.area);
+    assert!((sunny - g.area_with_at_least(6.0)).abs() < 1e-9 * g.area);
+    let (lo, hi) =
+        (cells.iter().map(|c| c.hours)).fold((f64::MAX, 0.0_f64), |(a, b), h| (a.min(h), b.max(h)));
+    assert_eq!((lo, hi), (g.min_hours, g.max_hours));
+    for c in &cells {
+        // each cell lies on the ground, counter-clockwise from above
+        assert!(
+            c.ring.iter().all(|p| p.z == 0.0 || p.z.abs() < 1e-12),
+            "{c:?}"
+        );
+        let turn: f64 = (0..c.ring.len())
+            .map(|i| {
+                c.ring[i]
+                    .truncate()
+                    .perp_dot(c.ring[(i + 1) % c.ring.len()].truncate())
+            })
+            .sum();
+        assert!(turn > 0.0, "{c:?}");
+    }
+    let json: serde_json::Value = serde_json::from_str(&regions_json(&cells, suns.len())).unwrap();
+    assert_eq!(json["cells"].as_array().unwrap().len(), cells.len());
+    assert_eq!(
+        regions_obj(&cells)
+            .lines()
+            .filter(|l| l.starts_with("f "))
+            .count(),
+        cells.len()
+    );
+    assert!(bre209_text(&cells).starts_with("BRE 209: the region passes: "));
+    let march = chrono::NaiveDate::from_ymd_opt(2026, 3, 21).unwrap();
+    assert!(check_bre209(true, &[march]).is_ok());
+    let next = [march.succ_opt().unwrap()];
+    assert!(check_bre209(true, &next).is_err() && check_bre209(false, &next).is_ok());
+    // faces by ids and ranges; unknown ones are errors that say why
+    assert_eq!(
+        "1,3-5,3"
+            .parse::<RegionFaces>()
+            .unwrap()
+            .faces(&mesh)
+            .unwrap(),
+        [1, 3, 4, 5]
+    );
+    assert!("3-1".parse::<RegionFaces>().is_err());
+    let e = "99"
+        .parse::<RegionFaces>()
+        .unwrap()
+        .faces(&mesh)
+        .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "face 99: the mesh has {} faces (ids from 0)",
+            mesh.faces.len()
+        )
+    );
+    let e = RegionFaces::Group("garden".into())
+        .faces(&mesh)
+        .unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("no face is in a group `garden`; the groups: "),
+        "{e}"
+    );
+}
