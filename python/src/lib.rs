@@ -40,6 +40,23 @@ create_exception!(
 /// What `__reduce__` gives pickle: a callable and its arguments.
 type Reduced<'py, A> = PyResult<(Bound<'py, PyAny>, A)>;
 
+/// Lights as given, as a Python list.
+fn light_list<'py>(py: Python<'py>, lights: &[Py<PyAny>]) -> PyResult<Bound<'py, PyList>> {
+    PyList::new(py, lights.iter().map(|l| l.bind(py)))
+}
+
+/// What pickle needs to make a result of `mesh` and `lights` again: the
+/// native module's `function` and its arguments.
+fn remade<'py>(
+    py: Python<'py>,
+    function: &str,
+    mesh: &Mesh,
+    lights: &[Py<PyAny>],
+) -> Reduced<'py, (Mesh, Bound<'py, PyList>)> {
+    let f = py.import("bsp_shadows._native")?.getattr(function)?;
+    Ok((f, (mesh.clone(), light_list(py, lights)?)))
+}
+
 /// A Python exception for a library error, with its message.
 fn to_py(e: Error) -> PyErr {
     match &e {
@@ -684,7 +701,7 @@ impl Shadows {
     /// The lights, as given.
     #[getter]
     fn lights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        PyList::new(py, self.lights.iter().map(|l| l.bind(py)))
+        light_list(py, &self.lights)
     }
 
     fn __repr__(&self) -> String {
@@ -698,9 +715,7 @@ impl Shadows {
     /// Pickled as its mesh and lights; unpickling shades again (the same
     /// bits: the result is a function of them).
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> Reduced<'py, (Mesh, Bound<'py, PyList>)> {
-        let py = slf.py();
-        let f = py.import("bsp_shadows._native")?.getattr("shadows")?;
-        Ok((f, (slf.get().mesh.clone(), slf.get().lights(py)?)))
+        remade(slf.py(), "shadows", &slf.get().mesh, &slf.get().lights)
     }
 }
 

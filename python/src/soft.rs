@@ -7,7 +7,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyList;
 
-use crate::{LightError, Mesh, PointLight, Reduced, Sun, run, to_py};
+use crate::{LightError, Mesh, PointLight, Reduced, Sun, light_list, remade, run, to_py};
 
 type Point = (f64, f64, f64);
 
@@ -219,7 +219,7 @@ impl SoftShadows {
     /// The lights, as given.
     #[getter]
     fn lights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        PyList::new(py, self.lights.iter().map(|l| l.bind(py)))
+        light_list(py, &self.lights)
     }
 
     fn __repr__(&self) -> String {
@@ -234,8 +234,6 @@ impl SoftShadows {
     /// Pickled as its mesh and lights; unpickling shades again (the same
     /// bits: the result is a function of them).
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> Reduced<'py, (Mesh, Bound<'py, PyList>)> {
-        let py = slf.py();
-        let f = py.import("bsp_shadows._native")?.getattr("soft_shadows")?;
-        Ok((f, (slf.get().mesh.clone(), slf.get().lights(py)?)))
+        remade(slf.py(), "soft_shadows", &slf.get().mesh, &slf.get().lights)
     }
 }
