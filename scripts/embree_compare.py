@@ -1,0 +1,139 @@
+#!/usr/bin/env python3
+"""Exact shadows against Embree's shadow rays, on the same scene and light.
+
+Outside CI (it needs the package registry). The peer is Embree through
+the ``embreex`` package: its BVH built over the scene's triangles, then
+one shadow ray toward the point light from each of N points spread over
+the faces by area (``--rays``, default 1M; a fixed seed). Ours is
+``shadow shadows`` end to end (load, snap, shadows, JSON written), the
+binary given. Both run ``--runs`` times in turn; the medians and their
+ratio are printed, with the lit share each finds: the exact one (lit area
+over total area) and Embree's (the share of its points that see the
+light), which agree to within the sampling's error.
+
+    python3 -m venv /tmp/emb && /tmp/emb/bin/pip install embreex numpy ./python
+    cargo build --release -p shadow-cli
+    /tmp/emb/bin/python scripts/embree_compare.py --scene bunny-99k --runs 3
+
+The scene is a built-in one (``bsp_shadows.Mesh.scene``: its polygons
+fanned into triangles for Embree); the light defaults to the bunny scenes'
+own light (above and in front of the bunny), else give ``--light X,Y,Z``.
+A sample point is moved toward the light by 10⁻⁶ of the scene's size so
+that its ray does not hit its own face; a point on a face turned away from
+the light counts as shadowed, as the exact engine counts that face.
+"""
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def triangles_of(mesh):
+    """The faces fanned into triangles, ``(t, 3, 3)`` float64."""
+    v = mesh.vertices
+    faces = mesh.faces
+    if isinstance(faces, np.ndarray) and faces.shape[1] == 3:
+        return v[faces]
+    tris = []
+    for f in faces:
+        f = np.asarray(f)
+        for k in range(1, len(f) - 1):
+            tris.append([f[0], f[k], f[k + 1]])
+    return v[np.array(tris)]
+
+
+def default_light(tris):
+    """The bunny scenes' light: above and in front of the bounds' centre."""
+    lo, hi = tris.reshape(-1, 3).min(0), tris.reshape(-1, 3).max(0)
+    c, half = (lo + hi) / 2, (hi - lo).max() / 2
+    return c + np.array([0.4, 1.6, 0.6]) * half
+
+
+def samples(tris, n, seed=1):
+    """`n` points spread over the triangles by area, and each one's unit
+    normal."""
+    rng = np.random.default_rng(seed)
+    e1, e2 = tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]
+    cross = np.cross(e1, e2)
+    area = np.linalg.norm(cross, axis=1) / 2
+    pick = rng.choice(len(tris), size=n, p=area / area.sum())
+    u, v = rng.random(n), rng.random(n)
+    flip = u + v > 1
+    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+    pts = tris[pick, 0] + u[:, None] * e1[pick] + v[:, None] * e2[pick]
+    normal = cross[pick] / np.maximum(np.linalg.norm(cross[pick], axis=1), 1e-300)[:, None]
+    return pts, normal
+
+
+def embree_pass(tris, pts, normal, light):
+    """One Embree run: the BVH built, then a shadow ray per point. The
+    share of points lit, and the seconds it took."""
+    import embreex.mesh_construction as mc
+    import embreex.rtcore_scene as rtcs
+
+    size = np.ptp(tris.reshape(-1, 3), axis=0).max()
+    start = time.perf_counter()
+    scene = rtcs.EmbreeScene()
+    mc.TriangleMesh(scene=scene, vertices=tris.astype(np.float32))
+    to_light = light - pts
+    dist = np.linalg.norm(to_light, axis=1)
+    d = to_light / dist[:, None]
+    origin = pts + d * (1e-6 * size)
+    hit = scene.run(origin.astype(np.float32), d.astype(np.float32),
+                    query="OCCLUDED", dists=(dist * (1 - 1e-6)).astype(np.float32))
+    facing = (normal * d).sum(1) > 0
+    lit = facing & (hit == -1)
+    return lit.mean(), time.perf_counter() - start
+
+
+def ours_pass(binary, scene, light, out):
+    start = time.perf_counter()
+    subprocess.run([binary, "shadows", "--scene", scene, "--light", ",".join(repr(float(x)) for x in light),
+                    "-o", out, "--quiet"], check=True, stdout=subprocess.DEVNULL)
+    took = time.perf_counter() - start
+    summary = json.load(open(out))["summary"]
+    return summary["lit_area"][0] / summary["area"], took
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--scene", default="bunny-99k")
+    ap.add_argument("--light", help="X,Y,Z (default: the bunny scenes' light)")
+    ap.add_argument("--rays", type=int, default=1_000_000)
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--bin", default=os.path.join(ROOT, "target/release/shadow"))
+    args = ap.parse_args()
+    import bsp_shadows as bs
+
+    tris = triangles_of(bs.Mesh.scene(args.scene))
+    light = (np.array([float(x) for x in args.light.split(",")]) if args.light
+             else default_light(tris))
+    pts, normal = samples(tris, args.rays)
+    mine, theirs = [], []
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "shadows.json")
+        for _ in range(args.runs):
+            lit_exact, t = ours_pass(args.bin, args.scene, light, out)
+            mine.append(t)
+            lit_rays, t = embree_pass(tris, pts, normal, light)
+            theirs.append(t)
+    a, b = statistics.median(mine), statistics.median(theirs)
+    print(f"scene {args.scene}: {len(tris)} triangles, light {','.join(f'{x:.6g}' for x in light)}")
+    print(f"ours (shadow shadows, end to end): median {a:.3f} s of {args.runs}: {sorted(mine)}")
+    print(f"Embree (BVH + {args.rays} shadow rays): median {b:.3f} s: {sorted(theirs)}")
+    print(f"ratio ours/Embree: {a / b:.2f}")
+    print(f"lit share: exact {lit_exact:.5f}, Embree's points {lit_rays:.5f} "
+          f"(sampling error about {1 / np.sqrt(args.rays):.1e})")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
