@@ -17,7 +17,8 @@ light), which agree to within the sampling's error.
 
 The scene is a built-in one (``bsp_shadows.Mesh.scene``: its polygons
 fanned into triangles for Embree); the light defaults to the bunny scenes'
-own light (above and in front of the bunny), else give ``--light X,Y,Z``.
+own light (above and in front of the bunny); ``--light X,Y,Z`` and
+``--sun X,Y,Z`` (each repeatable) give others, one Embree pass each.
 A sample point is moved toward the light by 10⁻⁶ of the scene's size so
 that its ray does not hit its own face; a point on a face turned away from
 the light counts as shadowed, as the exact engine counts that face.
@@ -74,9 +75,10 @@ def samples(tris, n, seed=1):
     return pts, normal
 
 
-def embree_pass(tris, pts, normal, light):
-    """One Embree run: the BVH built, then a shadow ray per point. The
-    share of points lit, and the seconds it took."""
+def embree_pass(tris, pts, normal, lights):
+    """One Embree run: the BVH built, then a shadow ray per point and
+    light (`lights`: ("point", p) or ("sun", d)). Each light's share of
+    points lit, and the seconds it took."""
     import embreex.mesh_construction as mc
     import embreex.rtcore_scene as rtcs
 
@@ -84,30 +86,42 @@ def embree_pass(tris, pts, normal, light):
     start = time.perf_counter()
     scene = rtcs.EmbreeScene()
     mc.TriangleMesh(scene=scene, vertices=tris.astype(np.float32))
-    to_light = light - pts
-    dist = np.linalg.norm(to_light, axis=1)
-    d = to_light / dist[:, None]
-    origin = pts + d * (1e-6 * size)
-    hit = scene.run(origin.astype(np.float32), d.astype(np.float32),
-                    query="OCCLUDED", dists=(dist * (1 - 1e-6)).astype(np.float32))
-    facing = (normal * d).sum(1) > 0
-    lit = facing & (hit == -1)
-    return lit.mean(), time.perf_counter() - start
+    shares = []
+    for kind, x in lights:
+        if kind == "point":
+            to_light = x - pts
+            dist = np.linalg.norm(to_light, axis=1)
+            d = to_light / dist[:, None]
+            far = dist * (1 - 1e-6)
+        else:
+            d = np.broadcast_to(x / np.linalg.norm(x), pts.shape)
+            far = np.full(len(pts), np.inf)
+        origin = pts + d * (1e-6 * size)
+        hit = scene.run(origin.astype(np.float32), d.astype(np.float32),
+                        query="OCCLUDED", dists=far.astype(np.float32))
+        facing = (normal * d).sum(1) > 0
+        shares.append((facing & (hit == -1)).mean())
+    return shares, time.perf_counter() - start
 
 
-def ours_pass(binary, scene, light, out):
+def ours_pass(binary, scene, lights, out):
+    flags = []
+    for kind, x in lights:
+        flags += ["--light" if kind == "point" else "--sun", ",".join(repr(float(c)) for c in x)]
     start = time.perf_counter()
-    subprocess.run([binary, "shadows", "--scene", scene, "--light", ",".join(repr(float(x)) for x in light),
-                    "-o", out, "--quiet"], check=True, stdout=subprocess.DEVNULL)
+    subprocess.run([binary, "shadows", "--scene", scene, *flags, "-o", out, "--quiet"],
+                   check=True, stdout=subprocess.DEVNULL)
     took = time.perf_counter() - start
     summary = json.load(open(out))["summary"]
-    return summary["lit_area"][0] / summary["area"], took
+    return [lit / summary["area"] for lit in summary["lit_area"]], took
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scene", default="bunny-99k")
-    ap.add_argument("--light", help="X,Y,Z (default: the bunny scenes' light)")
+    ap.add_argument("--light", action="append", default=[],
+                    help="a point light X,Y,Z, repeatable (default, with no --sun: the bunny scenes' light)")
+    ap.add_argument("--sun", action="append", default=[], help="a sun's direction X,Y,Z, repeatable")
     ap.add_argument("--rays", type=int, default=1_000_000)
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--bin", default=os.path.join(ROOT, "target/release/shadow"))
@@ -115,24 +129,28 @@ def main():
     import bsp_shadows as bs
 
     tris = triangles_of(bs.Mesh.scene(args.scene))
-    light = (np.array([float(x) for x in args.light.split(",")]) if args.light
-             else default_light(tris))
+    vec = lambda t: np.array([float(x) for x in t.split(",")])
+    lights = [("point", vec(t)) for t in args.light] + [("sun", vec(t)) for t in args.sun]
+    if not lights:
+        lights = [("point", default_light(tris))]
     pts, normal = samples(tris, args.rays)
     mine, theirs = [], []
     with tempfile.TemporaryDirectory() as d:
         out = os.path.join(d, "shadows.json")
         for _ in range(args.runs):
-            lit_exact, t = ours_pass(args.bin, args.scene, light, out)
+            lit_exact, t = ours_pass(args.bin, args.scene, lights, out)
             mine.append(t)
-            lit_rays, t = embree_pass(tris, pts, normal, light)
+            lit_rays, t = embree_pass(tris, pts, normal, lights)
             theirs.append(t)
     a, b = statistics.median(mine), statistics.median(theirs)
-    print(f"scene {args.scene}: {len(tris)} triangles, light {','.join(f'{x:.6g}' for x in light)}")
+    said = "; ".join(f"{k} {','.join(f'{c:.6g}' for c in x)}" for k, x in lights)
+    print(f"scene {args.scene}: {len(tris)} triangles; lights: {said}")
     print(f"ours (shadow shadows, end to end): median {a:.3f} s of {args.runs}: {sorted(mine)}")
-    print(f"Embree (BVH + {args.rays} shadow rays): median {b:.3f} s: {sorted(theirs)}")
+    print(f"Embree (BVH + {args.rays} shadow rays a light): median {b:.3f} s: {sorted(theirs)}")
     print(f"ratio ours/Embree: {a / b:.2f}")
-    print(f"lit share: exact {lit_exact:.5f}, Embree's points {lit_rays:.5f} "
-          f"(sampling error about {1 / np.sqrt(args.rays):.1e})")
+    for i, (e, r) in enumerate(zip(lit_exact, lit_rays)):
+        print(f"light {i} lit share: exact {e:.5f}, Embree's points {r:.5f} "
+              f"(sampling error about {1 / np.sqrt(args.rays):.1e})")
 
 
 if __name__ == "__main__":
