@@ -232,17 +232,28 @@ pub struct Fragment {
 /// ```
 pub fn shadows(mesh: &Mesh, lights: &[Light]) -> Result<Shadows, Error> {
     let grid = svbsp::shared_grid(&mesh.positions, lights).map_err(Error::Light)?;
-    let placed = svbsp::place_lights(&grid, lights).map_err(Error::Light)?;
-    let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
     let (polys, _) =
         bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(Error::Import)?;
-    let trees = svbsp::Shadows::new(&polys, &kernel).map_err(Error::Shadow)?;
+    shadows_on(&grid, &polys, mesh.faces.len(), lights)
+}
+
+/// [`shadows`] of the `faces` faces of a mesh already snapped to `grid`
+/// (which must hold the point lights) and imported as `polys`: what a sun
+/// study shares between its runs.
+pub(crate) fn shadows_on(
+    grid: &bsp_core::Grid,
+    polys: &[bsp_core::Polygon],
+    faces: usize,
+    lights: &[Light],
+) -> Result<Shadows, Error> {
+    let placed = svbsp::place_lights(grid, lights).map_err(Error::Light)?;
+    let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
+    let trees = svbsp::Shadows::new(polys, &kernel).map_err(Error::Shadow)?;
     // (with convex pieces: the OBJ writer draws them)
     let batch = trees
         .set()
-        .shade_all(&polys, &ShadeOptions::default().with_pieces(true));
-    let world = world_vertices(&batch, &grid).map_err(Error::Export)?;
-    let faces = mesh.faces.len();
+        .shade_all(polys, &ShadeOptions::default().with_pieces(true));
+    let world = world_vertices(&batch, grid).map_err(Error::Export)?;
     let (mut lit, mut area) = (vec![0.0; faces * placed.len()], vec![0.0; faces]);
     for r in area_records(&batch, &world) {
         let f = r.face as usize;

@@ -359,8 +359,32 @@ pub fn sun_hours(
     suns: &[DVec3],
     step_hours: f64,
 ) -> Result<Vec<FaceHours>, crate::Error> {
-    let runs = (suns.chunks(SUNS_A_RUN)).map(|batch| HoursRun::new(mesh, batch, step_hours));
+    let snapped = Snapped::of(mesh, suns)?;
+    let runs = (suns.chunks(SUNS_A_RUN))
+        .map(|batch| HoursRun::make(mesh, batch, step_hours, Some(None), snapped.as_ref()));
     HoursRun::fold(mesh.faces.len(), runs)
+}
+
+/// A study's mesh snapped and imported once for all its runs: suns add
+/// no point to the grid ([`svbsp::shared_grid`]), so each run's own grid
+/// and faces would be these.
+pub(super) struct Snapped {
+    grid: bsp_core::Grid,
+    polys: Vec<bsp_core::Polygon>,
+}
+
+impl Snapped {
+    /// `mesh` snapped for a study of `suns` (`None` for none: nothing to
+    /// shade).
+    pub(super) fn of(mesh: &crate::Mesh, suns: &[DVec3]) -> Result<Option<Snapped>, crate::Error> {
+        if suns.is_empty() {
+            return Ok(None);
+        }
+        let grid = svbsp::shared_grid(&mesh.positions, &[]).map_err(crate::Error::Light)?;
+        let (polys, _) =
+            bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(crate::Error::Import)?;
+        Ok(Some(Snapped { grid, polys }))
+    }
 }
 
 /// [`sun_hours`] without the overlay: each face's exact `sun_hours` (and
@@ -375,7 +399,9 @@ pub fn sun_hours_mean(
     suns: &[DVec3],
     step_hours: f64,
 ) -> Result<Vec<FaceHours>, crate::Error> {
-    let runs = (suns.chunks(SUNS_A_RUN)).map(|batch| HoursRun::mean_only(mesh, batch, step_hours));
+    let snapped = Snapped::of(mesh, suns)?;
+    let runs = (suns.chunks(SUNS_A_RUN))
+        .map(|batch| HoursRun::make(mesh, batch, step_hours, None, snapped.as_ref()));
     HoursRun::fold(mesh.faces.len(), runs)
 }
 
@@ -399,7 +425,7 @@ impl HoursRun {
         suns: &[DVec3],
         step_hours: f64,
     ) -> Result<HoursRun, crate::Error> {
-        HoursRun::make(mesh, suns, step_hours, Some(None))
+        HoursRun::make(mesh, suns, step_hours, Some(None), None)
     }
 
     /// The run without its pieces (for [`sun_hours_mean`]).
@@ -408,20 +434,25 @@ impl HoursRun {
         suns: &[DVec3],
         step_hours: f64,
     ) -> Result<HoursRun, crate::Error> {
-        HoursRun::make(mesh, suns, step_hours, None)
+        HoursRun::make(mesh, suns, step_hours, None, None)
     }
 
     /// The run; with `pieces`, the pieces of every face, or with
-    /// `Some(Some(keep))` of the faces `keep` marks.
+    /// `Some(Some(keep))` of the faces `keep` marks; on the study's
+    /// `snapped` mesh if given (the same grid and faces as its own).
     fn make(
         mesh: &crate::Mesh,
         suns: &[DVec3],
         step_hours: f64,
         pieces: Option<Option<&[bool]>>,
+        snapped: Option<&Snapped>,
     ) -> Result<HoursRun, crate::Error> {
         let faces = mesh.faces.len();
         let lights: Vec<crate::Light> = suns.iter().map(|&d| crate::Light::Sun(d)).collect();
-        let run = crate::shadows(mesh, &lights)?;
+        let run = match snapped {
+            Some(s) => crate::shadows_on(&s.grid, &s.polys, faces, &lights)?,
+            None => crate::shadows(mesh, &lights)?,
+        };
         let area: Vec<f64> = (0..faces).map(|f| run.face_area(f)).collect();
         let lit = (0..faces)
             .map(|f| (0..suns.len()).map(|l| run.lit_area(f, l)).sum::<f64>() * step_hours)

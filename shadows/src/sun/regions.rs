@@ -5,7 +5,7 @@
 
 use glam::DVec3;
 
-use super::{Cell, HoursRun, area2, colored_vertex, face_frame, heat, heat_header};
+use super::{Cell, HoursRun, Snapped, area2, colored_vertex, face_frame, heat, heat_header};
 use crate::{Error, Mesh};
 
 /// The faces a region study overlays: a group's name, or face ids.
@@ -108,8 +108,9 @@ pub fn region_hours(
         .iter()
         .filter(|&&f| f < n)
         .for_each(|&f| keep[f] = true);
+    let snapped = Snapped::of(mesh, suns)?;
     let runs = (suns.chunks(super::SUNS_A_RUN))
-        .map(|batch| HoursRun::make(mesh, batch, step_hours, Some(Some(&keep))));
+        .map(|batch| HoursRun::make(mesh, batch, step_hours, Some(Some(&keep)), snapped.as_ref()));
     let (_, _, cells, _) = HoursRun::fold_cells(n, runs)?;
     let cells = cells.unwrap_or_else(|| vec![None; n]);
     let mut out = Vec::new();
