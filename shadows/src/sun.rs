@@ -14,7 +14,7 @@ mod regions;
 use glam::DVec3;
 pub use regions::{
     RegionCell, RegionFaces, area_in_sun, bre209_text, check_bre209, region_hours,
-    region_in_sun_text, regions_csv, regions_json, regions_obj,
+    region_in_sun_text, regions_csv, regions_json, regions_obj, regions_png,
 };
 use solar_positioning::{Location, RefractionCorrection, SolarPositions, delta_t};
 
@@ -788,10 +788,10 @@ pub fn hours_report(
     view: HeatView,
 ) -> Result<HoursReport, crate::Error> {
     let format = HoursFormat::for_path(output)?;
-    if format == HoursFormat::Png && !matches!(of, HoursOf::Faces { .. }) {
+    if format == HoursFormat::Png && matches!(of, HoursOf::Sensors(_)) {
         return Err(crate::Error::Format {
             path: output.to_path_buf(),
-            why: "a picture shows the faces' hours: write sensors' or regions' hours as .csv, .json or .obj",
+            why: "a picture shows faces' hours: write sensors' hours as .csv, .json or .obj",
         });
     }
     let report = |text: String, rows: String, groups: String| HoursReport {
@@ -811,17 +811,22 @@ pub fn hours_report(
         HoursOf::Regions { faces, bre209 } => {
             let ids = faces.faces(mesh)?;
             let cells = region_hours(mesh, suns, step_hours, &ids)?;
-            let text = match format {
-                HoursFormat::Csv => regions_csv(mesh, &cells),
-                HoursFormat::Json => regions_json(&cells, suns.len()),
-                HoursFormat::Obj | HoursFormat::Png => regions_obj(&cells),
+            let bytes = match format {
+                HoursFormat::Csv => regions_csv(mesh, &cells).into_bytes(),
+                HoursFormat::Json => regions_json(&cells, suns.len()).into_bytes(),
+                HoursFormat::Obj => regions_obj(&cells).into_bytes(),
+                HoursFormat::Png => regions_png(mesh, &ids, &cells, suns.len(), view)?,
             };
             let mut lines = min_hours.map_or(String::new(), |h| region_in_sun_text(&cells, h));
             if bre209 {
                 lines += &bre209_text(&cells);
             }
             let rows = format!("{} cells of {} faces", cells.len(), ids.len());
-            Ok(report(text, rows, lines))
+            Ok(HoursReport {
+                bytes,
+                rows,
+                groups: lines,
+            })
         }
         HoursOf::Faces { extremes } => {
             if !extremes && min_hours.is_some() {
@@ -881,6 +886,19 @@ pub fn hours_png(
     suns: usize,
     view: HeatView,
 ) -> Result<Vec<u8>, crate::Error> {
+    let most = hours.iter().map(|h| h.sun_hours).fold(0.0, f64::max);
+    heat_picture(mesh, &heat_colors(hours, most), most, suns, view)
+}
+
+/// The picture of [`hours_png`] of `mesh` with its faces in `colors`,
+/// the ramp's top at `most` hours.
+fn heat_picture(
+    mesh: &crate::Mesh,
+    colors: &[DVec3],
+    most: f64,
+    suns: usize,
+    view: HeatView,
+) -> Result<Vec<u8>, crate::Error> {
     use shadow_raster::svg::{SvgViewpoint, ViewRequest};
     let (w, h) = HEAT_PNG_SIZE;
     let up = match view.up {
@@ -903,10 +921,8 @@ pub fn hours_png(
     let bounds =
         (mesh.bounds()).ok_or(crate::Error::Raster(shadow_raster::RasterError::EmptyScene))?;
     let camera = at.camera(bounds).map_err(raster)?;
-    let most = hours.iter().map(|h| h.sun_hours).fold(0.0, f64::max);
-    let colors = heat_colors(hours, most);
     let options = shadow_raster::RenderOptions::default();
-    let mut picture = shadow_raster::render(&scene, &lights, &camera, &colors, &options)
+    let mut picture = shadow_raster::render(&scene, &lights, &camera, colors, &options)
         .map_err(raster)?
         .image;
     // the ramp, between its ends' hours, along the bottom edge

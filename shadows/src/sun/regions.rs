@@ -5,7 +5,10 @@
 
 use glam::DVec3;
 
-use super::{Cell, HoursRun, Snapped, area2, colored_vertex, face_frame, heat, heat_header};
+use super::{
+    Cell, HeatView, HoursRun, Snapped, area2, colored_vertex, face_frame, heat, heat_header,
+    heat_picture,
+};
 use crate::{Error, Mesh};
 
 /// The faces a region study overlays: a group's name, or face ids.
@@ -224,4 +227,55 @@ pub fn regions_obj(cells: &[RegionCell]) -> String {
         next += c.ring.len();
     }
     s
+}
+
+/// A picture of the region (PNG, [`super::HEAT_PNG_SIZE`]): its cells
+/// (`cells` of the faces `region`) in the heat map's colours, the scene's
+/// other faces grey, seen as `view` says, with the ramp along the bottom
+/// ([`super::hours_png`]). Cells that snapping to the picture's grid makes
+/// degenerate are not drawn.
+pub fn regions_png(
+    mesh: &Mesh,
+    region: &[usize],
+    cells: &[RegionCell],
+    suns: usize,
+    view: HeatView,
+) -> Result<Vec<u8>, Error> {
+    let n = mesh.faces.len();
+    let mut in_region = vec![false; n];
+    region
+        .iter()
+        .filter(|&&f| f < n)
+        .for_each(|&f| in_region[f] = true);
+    let mut scene = Mesh {
+        positions: mesh.positions.clone(),
+        faces: Vec::new(),
+        groups: vec!["scene".to_string()],
+    };
+    let mut colors = Vec::new();
+    for (face, _) in mesh
+        .faces
+        .iter()
+        .zip(&in_region)
+        .filter(|(_, inside)| !**inside)
+    {
+        scene.faces.push(shadow_scene::Face {
+            vertices: face.vertices.clone(),
+            line: 0,
+            group: 0,
+        });
+        colors.push(DVec3::splat(0.72));
+    }
+    let most = cells.iter().map(|c| c.hours).fold(0.0, f64::max);
+    for c in cells {
+        let first = scene.positions.len() as u32;
+        scene.positions.extend(&c.ring);
+        scene.faces.push(shadow_scene::Face {
+            vertices: (first..first + c.ring.len() as u32).collect(),
+            line: 0,
+            group: 0,
+        });
+        colors.push(DVec3::from_array(heat(c.hours, most)));
+    }
+    heat_picture(&scene, &colors, most, suns, view)
 }

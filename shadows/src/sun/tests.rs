@@ -253,7 +253,7 @@ fn runs_files_and_heat_maps_of_a_yard() {
     let e = hours_report(&mesh, &suns, step, png, of, None, HeatView::default());
     let e = e.unwrap_err().to_string();
     assert!(
-        e.starts_with("study.PNG: a picture shows the faces'"),
+        e.starts_with("study.PNG: a picture shows faces' hours"),
         "{e}"
     );
     // the suns in another order make other runs: the same hours
@@ -328,6 +328,8 @@ fn regions_of_a_yard() {
         cells.len()
     );
     assert!(bre209_text(&cells).starts_with("BRE 209: the region passes: "));
+    let png = regions_png(&mesh, &[0], &cells, suns.len(), HeatView::default()).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     let march = chrono::NaiveDate::from_ymd_opt(2026, 3, 21).unwrap();
     assert!(check_bre209(true, &[march]).is_ok());
     let next = [march.succ_opt().unwrap()];
