@@ -40,6 +40,42 @@ create_exception!(
 /// What `__reduce__` gives pickle: a callable and its arguments.
 type Reduced<'py, A> = PyResult<(Bound<'py, PyAny>, A)>;
 
+/// Rings of points as arrays: every point in `points` (`(P, 3)`), ring
+/// `r`'s at `points[ring_points[r]:ring_points[r + 1]]`.
+struct Rings {
+    ring_points: Vec<i64>,
+    points: Vec<f64>,
+}
+
+impl Default for Rings {
+    fn default() -> Rings {
+        Rings {
+            ring_points: vec![0],
+            points: Vec::new(),
+        }
+    }
+}
+
+impl Rings {
+    fn push(&mut self, ring: &[DVec3]) {
+        self.points.extend(ring.iter().flat_map(|p| p.to_array()));
+        self.ring_points.push((self.points.len() / 3) as i64);
+    }
+
+    /// How many rings there are.
+    fn count(&self) -> usize {
+        self.ring_points.len() - 1
+    }
+
+    /// Into `d` as `ring_points` and `points`.
+    fn put(self, d: &Bound<'_, PyDict>) -> PyResult<()> {
+        let py = d.py();
+        let n = self.points.len() / 3;
+        d.set_item("ring_points", self.ring_points.into_pyarray(py))?;
+        d.set_item("points", self.points.into_pyarray(py).reshape([n, 3])?)
+    }
+}
+
 /// Lights as given, as a Python list.
 fn light_list<'py>(py: Python<'py>, lights: &[Py<PyAny>]) -> PyResult<Bound<'py, PyList>> {
     PyList::new(py, lights.iter().map(|l| l.bind(py)))
@@ -666,24 +702,19 @@ impl Shadows {
     /// `ring_points` (R+1,) int64, ring r's points are
     /// `points[ring_points[r]:ring_points[r+1]]`; `points` (P, 3) float64.
     fn fragments<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let (mut face, mut lit, mut rings, mut ring_points, mut pts) =
-            (Vec::new(), Vec::new(), vec![0i64], vec![0i64], Vec::new());
+        let (mut face, mut lit, mut rings, mut packed) =
+            (Vec::new(), Vec::new(), vec![0i64], Rings::default());
         for f in self.shadows.fragments() {
             face.push(f.face as i64);
             lit.push(f.lit);
-            for r in &f.rings {
-                pts.extend(r.iter().flat_map(|p| p.to_array()));
-                ring_points.push((pts.len() / 3) as i64);
-            }
-            rings.push(ring_points.len() as i64 - 1);
+            f.rings.iter().for_each(|r| packed.push(r));
+            rings.push(packed.count() as i64);
         }
         let d = PyDict::new(py);
-        let n = pts.len() / 3;
         d.set_item("face", face.into_pyarray(py))?;
         d.set_item("lit", lit.into_pyarray(py))?;
         d.set_item("rings", rings.into_pyarray(py))?;
-        d.set_item("ring_points", ring_points.into_pyarray(py))?;
-        d.set_item("points", pts.into_pyarray(py).reshape([n, 3])?)?;
+        packed.put(&d)?;
         Ok(d)
     }
 
@@ -921,33 +952,15 @@ fn _region_hours<'py>(
         sun::region_hours(mesh.mesh(), &suns, step_hours, &ids)
     })
     .map_err(to_py)?;
-    let (mut ring_points, mut pts) = (vec![0i64], Vec::new());
-    for c in &cells {
-        pts.extend(c.ring.iter().flat_map(|p| p.to_array()));
-        ring_points.push((pts.len() / 3) as i64);
-    }
+    let mut packed = Rings::default();
+    cells.iter().for_each(|c| packed.push(&c.ring));
     let d = PyDict::new(py);
-    let n = pts.len() / 3;
+    let column = |f: fn(&sun::RegionCell) -> f64| cells.iter().map(f).collect::<Vec<_>>();
     let face: Vec<i64> = cells.iter().map(|c| c.face as i64).collect();
     d.set_item("face", face.into_pyarray(py))?;
-    d.set_item(
-        "hours",
-        cells
-            .iter()
-            .map(|c| c.hours)
-            .collect::<Vec<_>>()
-            .into_pyarray(py),
-    )?;
-    d.set_item(
-        "area",
-        cells
-            .iter()
-            .map(|c| c.area)
-            .collect::<Vec<_>>()
-            .into_pyarray(py),
-    )?;
-    d.set_item("ring_points", ring_points.into_pyarray(py))?;
-    d.set_item("points", pts.into_pyarray(py).reshape([n, 3])?)?;
+    d.set_item("hours", column(|c| c.hours).into_pyarray(py))?;
+    d.set_item("area", column(|c| c.area).into_pyarray(py))?;
+    packed.put(&d)?;
     Ok(d)
 }
 

@@ -359,16 +359,31 @@ pub fn sun_hours(
     suns: &[DVec3],
     step_hours: f64,
 ) -> Result<Vec<FaceHours>, crate::Error> {
+    study(mesh, suns, step_hours, Some(None), |runs| {
+        HoursRun::fold(mesh.faces.len(), runs)
+    })?
+}
+
+/// `fold` of a study's runs, in order: [`SUNS_A_RUN`] suns each, on the
+/// mesh snapped once ([`Snapped`]), with `pieces` as
+/// [`HoursRun::make`] takes them.
+fn study<T>(
+    mesh: &crate::Mesh,
+    suns: &[DVec3],
+    step_hours: f64,
+    pieces: Option<Option<&[bool]>>,
+    fold: impl FnOnce(&mut dyn Iterator<Item = Result<HoursRun, crate::Error>>) -> T,
+) -> Result<T, crate::Error> {
     let snapped = Snapped::of(mesh, suns)?;
-    let runs = (suns.chunks(SUNS_A_RUN))
-        .map(|batch| HoursRun::make(mesh, batch, step_hours, Some(None), snapped.as_ref()));
-    HoursRun::fold(mesh.faces.len(), runs)
+    let mut runs = (suns.chunks(SUNS_A_RUN))
+        .map(|batch| HoursRun::make(mesh, batch, step_hours, pieces, snapped.as_ref()));
+    Ok(fold(&mut runs))
 }
 
 /// A study's mesh snapped and imported once for all its runs: suns add
 /// no point to the grid ([`svbsp::shared_grid`]), so each run's own grid
 /// and faces would be these.
-pub(super) struct Snapped {
+struct Snapped {
     grid: bsp_core::Grid,
     polys: Vec<bsp_core::Polygon>,
 }
@@ -376,7 +391,7 @@ pub(super) struct Snapped {
 impl Snapped {
     /// `mesh` snapped for a study of `suns` (`None` for none: nothing to
     /// shade).
-    pub(super) fn of(mesh: &crate::Mesh, suns: &[DVec3]) -> Result<Option<Snapped>, crate::Error> {
+    fn of(mesh: &crate::Mesh, suns: &[DVec3]) -> Result<Option<Snapped>, crate::Error> {
         if suns.is_empty() {
             return Ok(None);
         }
@@ -399,10 +414,9 @@ pub fn sun_hours_mean(
     suns: &[DVec3],
     step_hours: f64,
 ) -> Result<Vec<FaceHours>, crate::Error> {
-    let snapped = Snapped::of(mesh, suns)?;
-    let runs = (suns.chunks(SUNS_A_RUN))
-        .map(|batch| HoursRun::make(mesh, batch, step_hours, None, snapped.as_ref()));
-    HoursRun::fold(mesh.faces.len(), runs)
+    study(mesh, suns, step_hours, None, |runs| {
+        HoursRun::fold(mesh.faces.len(), runs)
+    })?
 }
 
 /// One run's share of a study's sun-hours: for at most
@@ -688,7 +702,8 @@ pub fn sensor_hours(
 /// The sun-hours at the points of the file `path`
 /// ([`shadow_scene::read_points`]) among the faces of `mesh`
 /// ([`sensor_hours`]), as text in `format` ([`sensors_csv`],
-/// [`sensors_json`]); and how many points there are.
+/// [`sensors_json`], [`sensors_obj`]; not as a picture); and how many
+/// points there are.
 pub fn sensor_hours_file(
     mesh: &crate::Mesh,
     path: &std::path::Path,
@@ -696,12 +711,18 @@ pub fn sensor_hours_file(
     step_hours: f64,
     format: HoursFormat,
 ) -> Result<(String, usize), crate::Error> {
+    if format == HoursFormat::Png {
+        return Err(crate::Error::Format {
+            path: path.to_path_buf(),
+            why: SENSORS_NOT_A_PICTURE,
+        });
+    }
     let points = shadow_scene::read_points(path).map_err(crate::Error::File)?;
     let hours = sensor_hours(mesh, &points, suns, step_hours)?;
     let text = match format {
         HoursFormat::Csv => sensors_csv(&points, &hours),
         HoursFormat::Json => sensors_json(&points, &hours, suns.len()),
-        HoursFormat::Obj | HoursFormat::Png => sensors_obj(&points, &hours),
+        HoursFormat::Obj | HoursFormat::Png => sensors_obj(&points, &hours), // (Png refused above)
     };
     Ok((text, points.len()))
 }
@@ -719,6 +740,10 @@ pub struct HoursReport {
     /// line each ([`groups_in_sun_text`]; empty for sensors or no hours).
     pub groups: String,
 }
+
+/// Why sensors' hours are not drawn.
+const SENSORS_NOT_A_PICTURE: &str =
+    "a picture shows faces' hours: write sensors' hours as .csv, .json or .obj";
 
 /// What a study reports the hours of.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -791,7 +816,7 @@ pub fn hours_report(
     if format == HoursFormat::Png && matches!(of, HoursOf::Sensors(_)) {
         return Err(crate::Error::Format {
             path: output.to_path_buf(),
-            why: "a picture shows faces' hours: write sensors' hours as .csv, .json or .obj",
+            why: SENSORS_NOT_A_PICTURE,
         });
     }
     let report = |text: String, rows: String, groups: String| HoursReport {
@@ -838,10 +863,7 @@ pub fn hours_report(
                 true => sun_hours(mesh, suns, step_hours)?,
                 false => sun_hours_mean(mesh, suns, step_hours)?,
             };
-            let bytes = match format {
-                HoursFormat::Png => hours_png(mesh, &hours, suns.len(), view)?,
-                _ => format.text(mesh, &hours, suns.len()).into_bytes(),
-            };
+            let bytes = format.bytes(mesh, &hours, suns.len(), view)?;
             Ok(HoursReport {
                 bytes,
                 rows: format!("{} faces", hours.len()),
@@ -998,14 +1020,21 @@ impl HoursFormat {
         })
     }
 
-    /// The hours of `mesh` in this format (`suns`: how many); a picture
-    /// ([`HoursFormat::Png`]) is not text: [`hours_png`].
-    pub fn text(self, mesh: &crate::Mesh, hours: &[FaceHours], suns: usize) -> String {
-        match self {
-            HoursFormat::Json => hours_json(mesh, hours, suns),
-            HoursFormat::Csv => hours_csv(mesh, hours),
-            HoursFormat::Obj | HoursFormat::Png => hours_obj(mesh, hours),
-        }
+    /// The hours of `mesh` in this format (`suns`: how many; a picture
+    /// looks at the scene as `view` says).
+    pub fn bytes(
+        self,
+        mesh: &crate::Mesh,
+        hours: &[FaceHours],
+        suns: usize,
+        view: HeatView,
+    ) -> Result<Vec<u8>, crate::Error> {
+        Ok(match self {
+            HoursFormat::Json => hours_json(mesh, hours, suns).into_bytes(),
+            HoursFormat::Csv => hours_csv(mesh, hours).into_bytes(),
+            HoursFormat::Obj => hours_obj(mesh, hours).into_bytes(),
+            HoursFormat::Png => hours_png(mesh, hours, suns, view)?,
+        })
     }
 }
 

@@ -6,8 +6,8 @@
 use glam::DVec3;
 
 use super::{
-    Cell, HeatView, HoursRun, Snapped, area2, colored_vertex, face_frame, heat, heat_header,
-    heat_picture,
+    Cell, HeatView, HoursRun, area2, colored_vertex, face_frame, heat, heat_header, heat_picture,
+    study,
 };
 use crate::{Error, Mesh};
 
@@ -111,10 +111,10 @@ pub fn region_hours(
         .iter()
         .filter(|&&f| f < n)
         .for_each(|&f| keep[f] = true);
-    let snapped = Snapped::of(mesh, suns)?;
-    let runs = (suns.chunks(super::SUNS_A_RUN))
-        .map(|batch| HoursRun::make(mesh, batch, step_hours, Some(Some(&keep)), snapped.as_ref()));
-    let (_, _, cells, _) = HoursRun::fold_cells(n, runs)?;
+    let pieces = Some(Some(&keep[..]));
+    let (_, _, cells, _) = study(mesh, suns, step_hours, pieces, |runs| {
+        HoursRun::fold_cells(n, runs)
+    })??;
     let cells = cells.unwrap_or_else(|| vec![None; n]);
     let mut out = Vec::new();
     for &f in faces.iter().filter(|&&f| f < n) {

@@ -231,7 +231,8 @@ fn runs_files_and_heat_maps_of_a_yard() {
     );
     std::fs::remove_file(&file).unwrap();
     // the heat map: a coloured corner per face corner, the roof yellow
-    let obj = HoursFormat::Obj.text(&mesh, &hours, suns.len());
+    let obj = HoursFormat::Obj.bytes(&mesh, &hours, suns.len(), HeatView::default());
+    let obj = String::from_utf8(obj.unwrap()).unwrap();
     let corners: usize = mesh.faces.iter().map(|f| f.vertices.len()).sum();
     assert_eq!(obj.lines().filter(|l| l.starts_with("v ")).count(), corners);
     let read = shadow_scene::parse_obj(&obj, "heat.obj").unwrap();
