@@ -79,7 +79,7 @@ __version__ = "0.1.0"
 
 
 def read_mesh(path) -> Mesh:
-    """Reads an OBJ or STL file (by its extension)."""
+    """Reads an OBJ, STL or CityJSON file (by its extension; .json is CityJSON, one group per city object)."""
     return Mesh.read(path)
 
 

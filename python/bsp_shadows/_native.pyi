@@ -35,7 +35,7 @@ class Mesh:
         """The groups' names, in order of first use."""
     @staticmethod
     def read(path: _Path) -> "Mesh":
-        """Reads an OBJ or STL file."""
+        """Reads an OBJ, STL or CityJSON (.json) file."""
     @staticmethod
     def scene(name: str) -> "Mesh":
         """A built-in scene: room, chair, cube, bunny, bunny-11k ... bunny-893k."""

@@ -422,7 +422,7 @@ impl Mesh {
         }
     }
 
-    /// Reads an OBJ or STL file.
+    /// Reads an OBJ, STL or CityJSON (.json) file.
     #[staticmethod]
     fn read(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Mesh> {
         run(py, || bsp_shadows::read_mesh(&path))

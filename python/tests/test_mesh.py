@@ -127,3 +127,18 @@ def test_groups_name_faces_and_survive_pickling(tmp_path):
     assert (cells["face"] == 0).all()
     with pytest.raises(bs.MeshError, match="3 group names for 4 faces"):
         bs.Mesh(v, f, groups=["a", "b", "c"])
+
+
+def test_a_cityjson_block_reads_with_its_objects_as_groups(tmp_path):
+    block = MESHES.parent / "city" / "block.city.json"
+    m = bs.read_mesh(block)
+    assert m.group_names == ["house", "tower-part", "tree-1", "yard"]
+    # hours per face, each face in its building's group
+    hours = bs.sun_hours(m, lat=52.01, lon=4.36, dates=["2026-06-21"], step_minutes=60)
+    assert len(hours.per_face) == len(m.groups)
+    yard = [a for a, g in zip(hours.area, m.groups) if g == "yard"]
+    assert sum(yard) == pytest.approx(3500.0, abs=1e-6)
+    bad = tmp_path / "bad.city.json"
+    bad.write_text(block.read_text().replace('"CityObjects"', '"Objects"', 1))
+    with pytest.raises(bs.MeshError, match="bad.city.json: /CityObjects: missing"):
+        bs.read_mesh(bad)

@@ -57,7 +57,7 @@ pub(crate) enum StrategyArg {
 
 #[derive(Args, Debug)]
 pub(crate) struct AnimateArgs {
-    /// The static scene (.obj or .stl).
+    /// The static scene (.obj, .stl or CityJSON .json).
     pub(crate) input: Option<PathBuf>,
     /// A built-in animation instead of a file: room (the axis object
     /// spins) or bunny, bunny-11k ... bunny-893k (a torus circles the

@@ -14,7 +14,7 @@ use svbsp::{LightSpec, SoftSpec};
 /// Where the mesh comes from: a file or a built-in scene (exactly one).
 #[derive(Args, Debug)]
 pub(crate) struct SourceArgs {
-    /// Mesh file (.obj or .stl).
+    /// Mesh file (.obj, .stl, or CityJSON .json).
     pub(crate) input: Option<PathBuf>,
     /// Built-in scene instead of a file (room, chair, cube, bunny, or the
     /// bunny refined to bunny-11k ... bunny-893k faces).
@@ -30,7 +30,9 @@ impl SourceArgs {
                 anyhow::bail!("give either an INPUT file or --scene NAME, not both")
             }
             (None, None) => {
-                anyhow::bail!("no input: give a mesh file (.obj or .stl) or --scene NAME")
+                anyhow::bail!(
+                    "no input: give a mesh file (.obj, .stl or CityJSON .json) or --scene NAME"
+                )
             }
             _ => Ok(()),
         }

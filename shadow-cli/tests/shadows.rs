@@ -1181,3 +1181,40 @@ fn sunhours_draws_pictures_and_overlays_regions() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(crate::raster::png_size(&png), (1280, 720));
 }
+
+#[test]
+fn sunhours_reads_a_cityjson_block_and_keeps_the_objects_ids() {
+    let block = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/city/block.city.json");
+    let csv = scratch("block_hours.csv");
+    let (block, out) = (block.to_str().unwrap(), csv.to_str().unwrap());
+    let site = ["--lat", "52.01", "--lon", "4.36", "--date", "2026-06-21"];
+    let mut argv = vec!["sunhours", block, "--step", "60", "-o", out];
+    argv.extend(site);
+    let o = shadow(&argv);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut groups: Vec<&str> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap())
+        .collect();
+    groups.dedup();
+    assert_eq!(groups, ["house", "tower-part", "tree-1", "yard"]);
+    // the yard with its pond cut out, through the triangulation and the import
+    let yard: f64 = text
+        .lines()
+        .filter(|l| l.split(',').nth(1) == Some("yard"))
+        .map(|l| l.split(',').nth(2).unwrap().parse::<f64>().unwrap())
+        .sum();
+    assert!((yard - 3500.0).abs() < 1e-6, "{yard}");
+    // a broken file: the place in it named
+    let bad = scratch("bad.city.json");
+    let text = std::fs::read_to_string(block).unwrap();
+    std::fs::write(&bad, text.replacen("[0,1,2,3]", "[0,1,2,40]", 1)).unwrap();
+    argv[1] = bad.to_str().unwrap();
+    let o = shadow(&argv);
+    crate::assert_failed_with(
+        &o,
+        &["/CityObjects/yard/geometry/0/boundaries/0/0/3: vertex 40 out of range (0..=39)"],
+    );
+}

@@ -10,7 +10,10 @@
 //!   (1..=1839)`); no maintained crate does both,
 //! - binary or ASCII STL through `stl_io` ([`read_stl`], [`parse_stl`]),
 //!   welding exactly equal positions so triangles share vertices,
-//! - either, chosen by extension ([`load`]),
+//! - CityJSON city models ([`read_cityjson`], [`parse_cityjson`]), one
+//!   group per city object named by its id, errors placed by a JSON
+//!   pointer into the file,
+//! - any of them, chosen by extension ([`load`]),
 //!
 //! or generated in code ([`scene`], [`room`]), with a base colour for
 //! every face ([`face_colors`]): the test room of Liu & Wu's
@@ -46,6 +49,7 @@ use std::path::Path;
 
 mod animated;
 mod atomic;
+mod cityjson;
 mod error;
 mod mesh;
 mod obj;
@@ -60,6 +64,7 @@ pub use animated::{
     ANIMATED_NAMES, Animated, BUNNY_LIGHT, ROOM_EYE, ROOM_LIGHT, ROOM_TARGET, animated, torus,
 };
 pub use atomic::{AtomicFile, remove_unfinished};
+pub use cityjson::{parse_cityjson, read_cityjson};
 pub use error::SceneError;
 pub use mesh::{
     Face, FlatFix, Mesh, MeshView, Rounding, Triangles, collinear, f32_step, f64_step, to_f32,
@@ -108,8 +113,9 @@ impl MeshFormat {
     }
 }
 
-/// Reads an OBJ or STL file, chosen by its extension (`.obj` or `.stl`,
-/// in any case); other extensions give [`SceneError::UnknownFormat`].
+/// Reads an OBJ, STL or CityJSON file, chosen by its extension (`.obj`,
+/// `.stl` or `.json`, in any case); other extensions give
+/// [`SceneError::UnknownFormat`].
 ///
 /// ```
 /// use std::path::Path;
@@ -121,9 +127,15 @@ pub fn load(path: &Path) -> Result<Mesh, SceneError> {
     load_notes(path).map(|(m, _)| m)
 }
 
-/// [`load`], with what an OBJ reader skipped (see [`ObjNotes`]; STL has
-/// nothing to skip).
+/// [`load`], with what an OBJ reader skipped (see [`ObjNotes`]; STL and
+/// CityJSON have nothing to skip).
 pub fn load_notes(path: &Path) -> Result<(Mesh, ObjNotes), SceneError> {
+    let json = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    if json {
+        return Ok((read_cityjson(path)?, ObjNotes::default()));
+    }
     match MeshFormat::from_path(path)? {
         MeshFormat::Obj => read_obj_notes(path),
         MeshFormat::Stl => Ok((read_stl(path)?, ObjNotes::default())),

@@ -127,7 +127,8 @@ impl std::error::Error for Error {
     }
 }
 
-/// Reads an OBJ or STL file (by its extension).
+/// Reads an OBJ, STL or CityJSON file (by its extension: `.json` is
+/// CityJSON, one group per city object).
 pub fn read_mesh(path: impl AsRef<Path>) -> Result<Mesh, Error> {
     shadow_scene::load(path.as_ref()).map_err(Error::File)
 }
