@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use bsp_shadows::sun::{self as sun, SunSite, Up};
+use bsp_shadows::sun::{self as sun, HoursOf, SunSite, Up};
 use clap::Args;
 
 use crate::args::SourceArgs;
@@ -79,6 +79,9 @@ pub(crate) struct SunHoursArgs {
     /// The days' clock, hours east of UTC [default: 0].
     #[arg(long, value_name = "H", allow_hyphen_values = true)]
     utc_offset: Option<f64>,
+    /// Sensors' hours with no time sampling: each day's sun-on intervals in closed form (JSON lists them).
+    #[arg(long, requires = "sensors")]
+    exact_time: bool,
     /// Also say how much of each group (or of the regions) sees at least H hours.
     #[arg(long, value_name = "H")]
     min_hours: Option<f64>,
@@ -108,15 +111,10 @@ pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
     let view = sun::HeatView::of(mesh.bounds().and_then(|b| a.source.staging(b)), a.site.up);
     let dates = sun::study_dates(&a.date, a.to.as_deref(), a.every)?;
     sun::check_bre209(a.bre209, &dates).map_err(facade_error)?;
-    let step = a.step.unwrap_or(10.0);
-    let suns = sun::study_suns(&a.site.site(), &dates, step, a.utc_offset.unwrap_or(0.0))?;
-    let dirs: Vec<_> = suns.iter().map(|s| s.direction).collect();
-    let of = sun::HoursOf::of(
-        a.sensors.as_deref(),
-        a.regions.as_ref(),
-        a.bre209,
-        !a.no_extremes,
-    );
+    let (step, offset) = (a.step.unwrap_or(10.0), a.utc_offset.unwrap_or(0.0));
+    let (dirs, paths) = sun::study_plan(&a.site.site(), &dates, step, offset, a.exact_time)?;
+    let (sensors, regions) = (a.sensors.as_deref(), a.regions.as_ref());
+    let of = HoursOf::of(sensors, regions, a.bre209, !a.no_extremes).exact_time(paths.as_deref());
     let r = sun::hours_report(&mesh, &dirs, step / 60.0, &a.output, of, a.min_hours, view);
     let r = r.map_err(facade_error)?;
     write_file(&a.output, &r.bytes)?;

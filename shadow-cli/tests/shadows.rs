@@ -1218,3 +1218,84 @@ fn sunhours_reads_a_cityjson_block_and_keeps_the_objects_ids() {
         &["/CityObjects/yard/geometry/0/boundaries/0/0/3: vertex 40 out of range (0..=39)"],
     );
 }
+
+#[test]
+fn sunhours_exact_time_gives_sensors_intervals_in_closed_form() {
+    let block = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/city/block.city.json");
+    let sensors = scratch("yard_sensors.csv");
+    // in the yard: west of the house, just north of the tower, the open
+    // north-west corner
+    let points = "x,y,z\n85005,446015,0\n85034,446021,0\n85005,446055,0\n";
+    std::fs::write(&sensors, points).unwrap();
+    let (json, csv, sampled) = (
+        scratch("exact.json"),
+        scratch("exact.csv"),
+        scratch("sampled.csv"),
+    );
+    let run = |out: &Path, exact: bool| {
+        let mut argv = vec![
+            "sunhours",
+            block.to_str().unwrap(),
+            "--lat",
+            "52.01",
+            "--lon",
+            "4.36",
+            "--date",
+            "2026-06-21",
+            "--sensors",
+            sensors.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        if exact {
+            argv.push("--exact-time");
+        }
+        let o = shadow(&argv);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read_to_string(out).unwrap()
+    };
+    let v: Value = serde_json::from_str(&run(&json, true)).unwrap();
+    let column = |text: &str| -> Vec<f64> {
+        text.lines()
+            .skip(1)
+            .map(|l| l.rsplit(',').next().unwrap().parse().unwrap())
+            .collect()
+    };
+    let (exact, sampled) = (column(&run(&csv, true)), column(&run(&sampled, false)));
+    for (i, s) in v["sensors"].as_array().unwrap().iter().enumerate() {
+        let on = s["days"][0]["sun"].as_array().unwrap();
+        let mut total = 0.0;
+        let mut last = 0.0;
+        for pair in on {
+            let (a, b) = (pair[0].as_f64().unwrap(), pair[1].as_f64().unwrap());
+            assert!(last <= a && a < b && b <= 24.0, "{on:?}");
+            (total, last) = (total + b - a, b);
+        }
+        assert!((s["sun_hours"].as_f64().unwrap() - total).abs() < 1e-12);
+        assert!((exact[i] - total).abs() < 1e-9, "{exact:?}");
+        // the refraction the model leaves out (about 10 minutes a day in
+        // June at 52°) and the 10-minute steps' error at each shadow edge
+        // (the library's tests hold the model to a minute's sampling)
+        assert!(
+            (exact[i] - sampled[i]).abs() < 0.5,
+            "{exact:?} against {sampled:?}"
+        );
+    }
+    // the one by the tower's north face loses the midday sun
+    assert!(exact[1] < exact[2] - 2.0, "{exact:?}");
+    let o = shadow(&[
+        "sunhours",
+        "--scene",
+        "cube",
+        "--lat",
+        "0",
+        "--lon",
+        "0",
+        "--date",
+        "2026-01-01",
+        "--exact-time",
+        "-o",
+        "x.csv",
+    ]);
+    crate::assert_failed_with(&o, &["--sensors"]);
+}

@@ -10,7 +10,12 @@
 
 use chrono::{DateTime, FixedOffset};
 
+mod exact_time;
 mod regions;
+pub use exact_time::{
+    Interval, SunPath, day_paths, hides, interval_hours, intervals_json, sensor_intervals,
+    study_plan, triangles,
+};
 use glam::DVec3;
 pub use regions::{
     RegionCell, RegionFaces, area_in_sun, bre209_text, check_bre209, region_hours,
@@ -758,6 +763,14 @@ pub enum HoursOf<'a> {
     },
     /// The points of this file ([`sensor_hours_file`]).
     Sensors(&'a std::path::Path),
+    /// The points of this file, each day's sun-on intervals in closed
+    /// form on these paths ([`sensor_intervals`]; JSON lists them).
+    ExactSensors {
+        /// The file.
+        path: &'a std::path::Path,
+        /// The days.
+        paths: &'a [SunPath],
+    },
     /// The cells of these faces ([`region_hours`]), with the BRE 209
     /// verdict if asked ([`bre209_text`]).
     Regions {
@@ -782,6 +795,15 @@ impl<'a> HoursOf<'a> {
             (Some(path), _) => HoursOf::Sensors(path),
             (None, Some(faces)) => HoursOf::Regions { faces, bre209 },
             (None, None) => HoursOf::Faces { extremes },
+        }
+    }
+
+    /// Sensors' hours with no time sampling, on `paths`, if given (for
+    /// anything but sensors, `self`).
+    pub fn exact_time(self, paths: Option<&'a [SunPath]>) -> HoursOf<'a> {
+        match (self, paths) {
+            (HoursOf::Sensors(path), Some(paths)) => HoursOf::ExactSensors { path, paths },
+            _ => self,
         }
     }
 }
@@ -813,7 +835,8 @@ pub fn hours_report(
     view: HeatView,
 ) -> Result<HoursReport, crate::Error> {
     let format = HoursFormat::for_path(output)?;
-    if format == HoursFormat::Png && matches!(of, HoursOf::Sensors(_)) {
+    let sensors = matches!(of, HoursOf::Sensors(_) | HoursOf::ExactSensors { .. });
+    if format == HoursFormat::Png && sensors {
         return Err(crate::Error::Format {
             path: output.to_path_buf(),
             why: SENSORS_NOT_A_PICTURE,
@@ -832,6 +855,17 @@ pub fn hours_report(
                 format!("{n} sensors among the faces"),
                 String::new(),
             ))
+        }
+        HoursOf::ExactSensors { path, paths } => {
+            let points = shadow_scene::read_points(path).map_err(crate::Error::File)?;
+            let on = sensor_intervals(mesh, &points, paths);
+            let text = match format {
+                HoursFormat::Json => intervals_json(&points, paths, &on),
+                HoursFormat::Csv => sensors_csv(&points, &interval_hours(&on)),
+                _ => sensors_obj(&points, &interval_hours(&on)), // (Png refused above)
+            };
+            let rows = format!("{} sensors among the faces, exact time", points.len());
+            Ok(report(text, rows, String::new()))
         }
         HoursOf::Regions { faces, bre209 } => {
             let ids = faces.faces(mesh)?;

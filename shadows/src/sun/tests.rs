@@ -56,7 +56,7 @@ fn axes_and_north() {
 }
 
 /// A ground with a box on it (the box's faces after the ground's).
-fn yard() -> crate::Mesh {
+pub(super) fn yard() -> crate::Mesh {
     let (b, h) = (1.0, 2.0);
     let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
     let positions = vec![
@@ -97,7 +97,7 @@ fn yard() -> crate::Mesh {
 
 /// Whether the ray from `p` toward `d` meets the box `[-1, 1]² × [0, 2]`
 /// (slab test; `p` on the ground outside the box).
-fn blocked(p: DVec3, d: DVec3) -> bool {
+pub(super) fn blocked(p: DVec3, d: DVec3) -> bool {
     let (lo, hi) = (DVec3::new(-1.0, -1.0, 0.0), DVec3::new(1.0, 1.0, 2.0));
     let (mut t0, mut t1) = (1e-9f64, f64::INFINITY);
     for k in 0..3 {
@@ -116,7 +116,7 @@ fn blocked(p: DVec3, d: DVec3) -> bool {
 
 /// Points on the yard's ground off the shadows' edges, then one above
 /// the roof's middle.
-fn yard_sensors() -> Vec<DVec3> {
+pub(super) fn yard_sensors() -> Vec<DVec3> {
     [
         (0.0, -1.5),
         (1.5, 1.5),
