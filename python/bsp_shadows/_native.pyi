@@ -160,6 +160,22 @@ def study_suns(
     up: str = ...,
     height: float = ...,
 ) -> npt.NDArray[np.float64]: ...
+def sensor_intervals(
+    scene: Mesh,
+    points: _Points,
+    lat: float,
+    lon: float,
+    dates: Iterable[Any],
+    utc_offset: float = ...,
+    north: float = ...,
+    up: str = ...,
+    height: float = ...,
+) -> List[List[npt.NDArray[np.float64]]]:
+    """Each sensor's sun-on intervals on each day in closed form (no time
+    sampling): per sensor, per day, an (n, 2) array of hours of the day's
+    clock. Per hour the sun's arc from SPA at the hour's middle; no
+    refraction."""
+
 def set_threads(n: Optional[int] = ...) -> None: ...
 def get_threads() -> int: ...
 def _hours_of_suns(mesh: Mesh, suns: _Points, step_hours: float, extremes: bool = ...) -> SunHours: ...

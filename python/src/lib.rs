@@ -767,6 +767,22 @@ fn study_suns<'py>(
     up: &str,
     height: f64,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (site, days) = site_and_days(lat, lon, dates, north, up, height)?;
+    let suns = bsp_shadows::sun::study_suns(&site, &days, step_minutes, utc_offset)
+        .map_err(|e| BspError::new_err(e.to_string()))?;
+    let flat: Vec<f64> = suns.iter().flat_map(|s| s.direction.to_array()).collect();
+    flat.into_pyarray(py).reshape([suns.len(), 3])
+}
+
+/// The site of a study and its days, from Python's arguments.
+fn site_and_days(
+    lat: f64,
+    lon: f64,
+    dates: &Bound<'_, PyAny>,
+    north: f64,
+    up: &str,
+    height: f64,
+) -> PyResult<(SunSite, Vec<sun::NaiveDate>)> {
     let up: Up = up.parse().map_err(BspError::new_err)?;
     let mut days = Vec::new();
     for d in dates.try_iter()? {
@@ -780,10 +796,42 @@ fn study_suns<'py>(
         height,
         ..SunSite::new(lat, lon).with_axes(north, up)
     };
-    let suns = bsp_shadows::sun::study_suns(&site, &days, step_minutes, utc_offset)
-        .map_err(|e| BspError::new_err(e.to_string()))?;
-    let flat: Vec<f64> = suns.iter().flat_map(|s| s.direction.to_array()).collect();
-    flat.into_pyarray(py).reshape([suns.len(), 3])
+    Ok((site, days))
+}
+
+/// Each sensor's sun-on intervals on each day, in closed form (no time
+/// sampling: `bsp_shadows::sun::sensor_intervals`): per sensor, per day,
+/// an array of shape (n, 2) of hours of the day's clock.
+#[pyfunction]
+#[pyo3(signature = (scene, points, lat, lon, dates, utc_offset=0.0, north=0.0, up="z", height=0.0))]
+#[allow(clippy::too_many_arguments)] // (Python keywords, each with a default)
+fn sensor_intervals<'py>(
+    py: Python<'py>,
+    scene: &Mesh,
+    points: &Bound<'py, PyAny>,
+    lat: f64,
+    lon: f64,
+    dates: &Bound<'py, PyAny>,
+    utc_offset: f64,
+    north: f64,
+    up: &str,
+    height: f64,
+) -> PyResult<Vec<Vec<Bound<'py, PyArray2<f64>>>>> {
+    let (site, days) = site_and_days(lat, lon, dates, north, up, height)?;
+    let at = crate::points(py, points, "points")?;
+    let paths =
+        sun::day_paths(&site, &days, utc_offset).map_err(|e| BspError::new_err(e.to_string()))?;
+    let on = run(py, || sun::sensor_intervals(scene.mesh(), &at, &paths));
+    on.into_iter()
+        .map(|days| {
+            days.into_iter()
+                .map(|iv| {
+                    let flat: Vec<f64> = iv.iter().flat_map(|&(a, b)| [a, b]).collect();
+                    flat.into_pyarray(py).reshape([iv.len(), 2])
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// A study's hours per face.
@@ -1052,6 +1100,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(shadows, m)?,
         wrap_pyfunction!(soft::soft_shadows, m)?,
         wrap_pyfunction!(study_suns, m)?,
+        wrap_pyfunction!(sensor_intervals, m)?,
         wrap_pyfunction!(_hours_of_suns, m)?,
         wrap_pyfunction!(_hours_run, m)?,
         wrap_pyfunction!(_region_hours, m)?,

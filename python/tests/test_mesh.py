@@ -142,3 +142,21 @@ def test_a_cityjson_block_reads_with_its_objects_as_groups(tmp_path):
     bad.write_text(block.read_text().replace('"CityObjects"', '"Objects"', 1))
     with pytest.raises(bs.MeshError, match="bad.city.json: /CityObjects: missing"):
         bs.read_mesh(bad)
+
+
+def test_sensor_intervals_in_closed_form_agree_with_sampled_hours():
+    m = bs.read_mesh(MESHES.parent / "city" / "block.city.json")
+    points = np.array([[85005.0, 446015.0, 0.0], [85034.0, 446021.0, 0.0], [85005.0, 446055.0, 0.0]])
+    days = ["2026-03-21", "2026-06-21"]
+    on = bs.sensor_intervals(m, points, lat=52.01, lon=4.36, dates=days)
+    assert len(on) == 3 and all(len(d) == 2 for d in on)
+    exact = np.array([sum((iv[:, 1] - iv[:, 0]).sum() for iv in d) for d in on])
+    for d in on:
+        for iv in d:
+            assert iv.shape[1] == 2 and (iv[:, 0] < iv[:, 1]).all()
+            assert (iv[1:, 0] >= iv[:-1, 1]).all()  # sorted, disjoint
+    study = bs.sun_hours(m, lat=52.01, lon=4.36, dates=days, step_minutes=5, extremes=False)
+    sampled = study.per_sensor(points)
+    # the refraction left out and the steps at shadow edges, for two days
+    assert np.abs(exact - sampled).max() < 0.75, (exact, sampled)
+    assert exact[1] < exact[2] - 2.0

@@ -8,6 +8,8 @@
 //! east. [`SunSite::north_deg`] turns true north clockwise (seen from
 //! above) from that axis.
 
+/// A study's day ([`parse_date`], [`study_dates`]).
+pub use chrono::NaiveDate;
 use chrono::{DateTime, FixedOffset};
 
 mod exact_time;
