@@ -186,14 +186,10 @@ fn main() -> ExitCode {
     output::clean_up_on_interrupt();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
-        Err(e) if !e.use_stderr() => {
-            // --help and --version
-            let _ = e.print();
-            return ExitCode::SUCCESS;
-        }
         Err(e) => {
             let _ = e.print();
-            return ExitCode::FAILURE;
+            // status 1 for a usage error; 0 for --help and --version (stdout)
+            return ExitCode::from(u8::from(e.use_stderr()));
         }
     };
     match run(&cli) {

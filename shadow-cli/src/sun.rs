@@ -94,6 +94,9 @@ pub(crate) struct SunHoursArgs {
     /// Say whether the regions pass the BRE 209 garden test: half their area 2 hours in sun on 21 March.
     #[arg(long, requires = "regions")]
     bre209: bool,
+    /// The sun as a disc of DEG degrees [default: 0.2666]: faces' mean hours with its penumbra's share (slow).
+    #[arg(long, value_name = "DEG", num_args = 0..=1, default_missing_value = "0.2666", conflicts_with_all = ["sensors", "regions", "min_hours"])]
+    sun_disc: Option<f64>,
     /// Faces' mean hours only, for the cost of the shadows: no least and most hours (empty in CSV).
     #[arg(long, conflicts_with_all = ["min_hours", "regions"])]
     no_extremes: bool,
@@ -115,6 +118,7 @@ pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
     let (dirs, paths) = sun::study_plan(&a.site.site(), &dates, step, offset, a.exact_time)?;
     let (sensors, regions) = (a.sensors.as_deref(), a.regions.as_ref());
     let of = HoursOf::of(sensors, regions, a.bre209, !a.no_extremes).exact_time(paths.as_deref());
+    let of = of.sun_disc(a.sun_disc);
     let r = sun::hours_report(&mesh, &dirs, step / 60.0, &a.output, of, a.min_hours, view);
     let r = r.map_err(facade_error)?;
     write_file(&a.output, &r.bytes)?;

@@ -1299,3 +1299,30 @@ fn sunhours_exact_time_gives_sensors_intervals_in_closed_form() {
     ]);
     crate::assert_failed_with(&o, &["--sensors"]);
 }
+
+#[test]
+fn sunhours_with_a_sun_disc_counts_the_penumbras_share() {
+    let (point, disc) = (scratch("point_hours.csv"), scratch("disc_hours.csv"));
+    let hours = |out: &Path, extra: &[&str]| -> Vec<Vec<String>> {
+        let o = cube_sunhours(out, extra);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = std::fs::read_to_string(out).unwrap();
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').map(String::from).collect())
+            .collect()
+    };
+    let p = hours(&point, &["--no-extremes"]);
+    for extra in [&["--sun-disc"][..], &["--sun-disc", "2"]] {
+        let d = hours(&disc, extra);
+        assert_eq!(d.len(), p.len());
+        for (a, b) in p.iter().zip(&d) {
+            // a lone cube casts nothing on itself: a disc changes no face
+            let (x, y): (f64, f64) = (a[3].parse().unwrap(), b[3].parse().unwrap());
+            assert!((x - y).abs() < 1e-9, "{a:?} {b:?}");
+            assert_eq!((b[4].as_str(), b[5].as_str()), ("", ""), "no extremes");
+        }
+    }
+    let o = cube_sunhours(&disc, &["--sun-disc", "--regions", "0"]);
+    crate::assert_failed_with(&o, &["--sun-disc", "--regions"]);
+}

@@ -298,8 +298,9 @@ pub struct SoftShadows {
     faces_of: Vec<u32>,
     fragments: Vec<Vec<SoftFragment>>,
     /// `faces × lights`: lit, penumbra (undecided included), umbra and
-    /// undecided areas.
-    classes: Vec<[f64; 4]>,
+    /// undecided areas, and the area weighted by the share of the light
+    /// seen ([`SoftShadows::seen_area`]).
+    classes: Vec<[f64; 5]>,
     area: Vec<f64>,
 }
 
@@ -356,7 +357,7 @@ pub fn soft_shadows(
     };
     let (_, faces_of, fragments) = shade(&scene, &Quiet)?;
     let n = all.len();
-    let (mut classes, mut area) = (vec![[0.0; 4]; faces * n], vec![0.0; faces]);
+    let (mut classes, mut area) = (vec![[0.0; 5]; faces * n], vec![0.0; faces]);
     for (frags, &face) in fragments.iter().zip(&faces_of) {
         let face = face as usize;
         let a = soft_areas(std::slice::from_ref(frags), n, &grid);
@@ -364,6 +365,7 @@ pub fn soft_shadows(
         for (j, c) in classes[face * n..(face + 1) * n].iter_mut().enumerate() {
             let add = [a.lit[j], a.penumbra[j], a.umbra[j], a.undecided[j]];
             c.iter_mut().zip(add).for_each(|(x, y)| *x += y);
+            c[4] += seen_area(frags, j, &grid);
         }
     }
     Ok(SoftShadows {
@@ -375,6 +377,30 @@ pub fn soft_shadows(
         classes,
         area,
     })
+}
+
+/// The area of `fragments` weighted by the share of light `j` each sees:
+/// a lit one whole, a penumbra (or undecided) one by the share at its
+/// centroid, an umbra one not at all.
+fn seen_area(fragments: &[SoftFragment], j: usize, grid: &Grid) -> f64 {
+    let mut seen = 0.0;
+    for f in fragments {
+        let share = match f.class(j) {
+            AreaClass::Lit => 1.0,
+            AreaClass::Umbra => continue,
+            AreaClass::Penumbra | AreaClass::Undecided => {
+                f.visible[j].as_ref().map_or(0.0, |s| s.centroid)
+            }
+        };
+        let world: Vec<DVec3> = f
+            .polygon
+            .vertices_f64()
+            .iter()
+            .map(|&c| grid.to_world(c))
+            .collect();
+        seen += share * svbsp::polygon_area(&world);
+    }
+    seen
 }
 
 /// No progress to show.
@@ -406,6 +432,14 @@ impl SoftShadows {
             SoftClass::Umbra => c[2],
             SoftClass::Undecided => c[3],
         }
+    }
+
+    /// The area of `face` weighted by the share of light `light` it sees:
+    /// its lit area, and each penumbra fragment's area times the share of
+    /// the light seen at its centroid (the irradiance's share for an area
+    /// light, the disc's for a sun disc; exact back-projection, `f64`).
+    pub fn seen_area(&self, face: usize, light: usize) -> f64 {
+        self.classes[face * self.lights.len() + light][4]
     }
 
     /// The area of `face`.

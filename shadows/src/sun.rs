@@ -426,6 +426,71 @@ pub fn sun_hours_mean(
     })?
 }
 
+/// Every face's mean sun-hours with each of `suns` (directions toward
+/// their centres) a disc of `radius_deg` (the real sun's:
+/// [`crate::SUN_RADIUS_DEG`]): per sun, the face's lit area (seeing all
+/// of the disc) and each penumbra fragment's area times the share of the
+/// disc seen at its centroid ([`crate::soft_file::SoftShadows::seen_area`]),
+/// times the step. That share is of the disc's part in front of the face
+/// (the soft shadows' definition, for irradiance); for hours it is scaled
+/// to the whole disc by the share of a circle of the disc's radius in
+/// front of the face's plane (`f64`), so that a face the sun's centre is
+/// behind gets only the sliver it sees. No extremes (NaN). A sun at a
+/// time through the soft shadows' engine, which is far slower than
+/// [`sun_hours_mean`]'s point suns; a radius of 0 gives
+/// [`sun_hours_mean`]'s hours.
+pub fn sun_hours_disc(
+    mesh: &crate::Mesh,
+    suns: &[DVec3],
+    step_hours: f64,
+    radius_deg: f64,
+) -> Result<Vec<FaceHours>, crate::Error> {
+    let faces = mesh.faces.len();
+    let (mut area, mut seen) = (vec![0.0; faces], vec![0.0; faces]);
+    let normals: Vec<DVec3> = mesh.face_loops().iter().map(|p| newell(p)).collect();
+    for &direction in suns {
+        let disc = crate::SoftSpec::SunDisc {
+            direction,
+            radius_deg,
+        };
+        let s = crate::soft_file::soft_shadows(mesh, &[], &[disc])?;
+        let d = direction.normalize();
+        for f in 0..faces {
+            area[f] = s.face_area(f);
+            let front = disc_in_front(normals[f].dot(d).clamp(-1.0, 1.0).asin(), radius_deg);
+            seen[f] += s.seen_area(f, 0) * front * step_hours;
+        }
+    }
+    Ok((0..faces)
+        .map(|f| FaceHours {
+            min_hours: f64::NAN,
+            max_hours: f64::NAN,
+            ..face_hours(area[f], seen[f], None, step_hours)
+        })
+        .collect())
+}
+
+/// The share of a circle of angular radius `radius_deg` whose centre is
+/// `height` radians above a plane that lies in front of it: the circular
+/// segment's, `(acos(−h) + h √(1 − h²)) / π` for `h` the height in radii.
+fn disc_in_front(height: f64, radius_deg: f64) -> f64 {
+    let r = radius_deg.to_radians();
+    if height >= r {
+        return 1.0;
+    }
+    if height <= -r {
+        return 0.0;
+    }
+    let h = height / r;
+    ((-h).acos() + h * (1.0 - h * h).sqrt()) / std::f64::consts::PI
+}
+
+/// A polygon's unit normal by Newell's sum (zero for no area).
+fn newell(p: &[DVec3]) -> DVec3 {
+    let n: DVec3 = (0..p.len()).map(|i| p[i].cross(p[(i + 1) % p.len()])).sum();
+    n.normalize_or_zero()
+}
+
 /// One run's share of a study's sun-hours: for at most
 /// [`svbsp::MAX_LIGHTS`] suns, every face's area, its lit area summed
 /// over the suns times the step, and (for the extremes) its pieces with
@@ -763,6 +828,12 @@ pub enum HoursOf<'a> {
         /// Whether to overlay the runs for the extremes.
         extremes: bool,
     },
+    /// Every face's mean hours with the sun a disc of this radius in
+    /// degrees ([`sun_hours_disc`]; no extremes).
+    DiscFaces {
+        /// The disc's angular radius, degrees.
+        radius_deg: f64,
+    },
     /// The points of this file ([`sensor_hours_file`]).
     Sensors(&'a std::path::Path),
     /// The points of this file, each day's sun-on intervals in closed
@@ -805,6 +876,15 @@ impl<'a> HoursOf<'a> {
     pub fn exact_time(self, paths: Option<&'a [SunPath]>) -> HoursOf<'a> {
         match (self, paths) {
             (HoursOf::Sensors(path), Some(paths)) => HoursOf::ExactSensors { path, paths },
+            _ => self,
+        }
+    }
+
+    /// Faces' hours with the sun a disc of `radius_deg`, if given (for
+    /// anything but faces' hours, `self`).
+    pub fn sun_disc(self, radius_deg: Option<f64>) -> HoursOf<'a> {
+        match (self, radius_deg) {
+            (HoursOf::Faces { .. }, Some(radius_deg)) => HoursOf::DiscFaces { radius_deg },
             _ => self,
         }
     }
@@ -889,15 +969,19 @@ pub fn hours_report(
                 groups: lines,
             })
         }
-        HoursOf::Faces { extremes } => {
+        HoursOf::Faces { .. } | HoursOf::DiscFaces { .. } => {
+            let extremes = matches!(of, HoursOf::Faces { extremes: true });
             if !extremes && min_hours.is_some() {
                 return Err(crate::Error::Region(
                     "the area that sees at least so many hours needs the extremes' overlay".into(),
                 ));
             }
-            let hours = match extremes {
-                true => sun_hours(mesh, suns, step_hours)?,
-                false => sun_hours_mean(mesh, suns, step_hours)?,
+            let hours = match of {
+                HoursOf::DiscFaces { radius_deg } => {
+                    sun_hours_disc(mesh, suns, step_hours, radius_deg)?
+                }
+                _ if extremes => sun_hours(mesh, suns, step_hours)?,
+                _ => sun_hours_mean(mesh, suns, step_hours)?,
             };
             let bytes = format.bytes(mesh, &hours, suns.len(), view)?;
             Ok(HoursReport {

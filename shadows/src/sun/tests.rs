@@ -366,3 +366,54 @@ fn regions_of_a_yard() {
         "{e}"
     );
 }
+
+#[test]
+fn a_sun_disc_study_agrees_with_point_suns_and_blurs_the_edges() {
+    let site = SunSite::new(51.48, 0.0);
+    let day = [chrono::NaiveDate::from_ymd_opt(2026, 3, 21).unwrap()];
+    let suns: Vec<DVec3> = study_suns(&site, &day, 60.0, 0.0)
+        .unwrap()
+        .iter()
+        .map(|s| s.direction)
+        .collect();
+    let mesh = yard();
+    let point = sun_hours_mean(&mesh, &suns, 1.0).unwrap();
+    // a disc of no size is the point sun
+    let none = sun_hours_disc(&mesh, &suns, 1.0, 0.0).unwrap();
+    for (p, d) in point.iter().zip(&none) {
+        assert!((p.sun_hours - d.sun_hours).abs() < 1e-9, "{p:?} {d:?}");
+        assert!(d.min_hours.is_nan() && d.max_hours.is_nan());
+    }
+    // the real sun: the roof sees all of it, the ground loses a little of
+    // the penumbra's light on one side of each edge and gains it on the other
+    let real = sun_hours_disc(&mesh, &suns, 1.0, crate::SUN_RADIUS_DEG).unwrap();
+    assert_eq!(real[1].sun_hours, point[1].sun_hours);
+    let ground = (real[0].sun_hours - point[0].sun_hours).abs();
+    assert!(
+        ground > 0.0 && ground < 1e-3 * point[0].sun_hours,
+        "{ground}"
+    );
+    // a wide disc blurs more, and the hours stay within a day's suns
+    let wide = sun_hours_disc(&mesh, &suns, 1.0, 3.0).unwrap();
+    let blur = (wide[0].sun_hours - point[0].sun_hours).abs();
+    assert!(blur > ground, "{blur} against {ground}");
+    for f in &wide {
+        assert!(
+            f.sun_hours >= 0.0 && f.sun_hours <= suns.len() as f64 + 1e-9,
+            "{f:?}"
+        );
+    }
+}
+
+#[test]
+fn a_disc_straddling_a_plane_is_counted_by_its_part_in_front() {
+    let r = 0.5;
+    assert_eq!(disc_in_front(0.01, r), 1.0);
+    assert_eq!(disc_in_front(-0.01, r), 0.0);
+    assert!((disc_in_front(0.0, r) - 0.5).abs() < 1e-15);
+    // the segment beyond a chord at half the radius: 1/3 - √3/(4π)
+    let sliver = 1.0 / 3.0 - 3f64.sqrt() / (4.0 * std::f64::consts::PI);
+    let half_r = r.to_radians() / 2.0;
+    assert!((disc_in_front(-half_r, r) - sliver).abs() < 1e-12);
+    assert!((disc_in_front(half_r, r) - (1.0 - sliver)).abs() < 1e-12);
+}
