@@ -49,6 +49,7 @@ use std::path::Path;
 
 mod animated;
 mod atomic;
+mod city;
 mod cityjson;
 mod error;
 mod mesh;
@@ -64,6 +65,7 @@ pub use animated::{
     ANIMATED_NAMES, Animated, BUNNY_LIGHT, ROOM_EYE, ROOM_LIGHT, ROOM_TARGET, animated, torus,
 };
 pub use atomic::{AtomicFile, remove_unfinished};
+pub use city::{CITY_SIDE, city_block};
 pub use cityjson::{parse_cityjson, read_cityjson};
 pub use error::SceneError;
 pub use mesh::{

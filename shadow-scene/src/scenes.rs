@@ -21,6 +21,8 @@ pub const SCENE_NAMES: &[&str] = &[
     "bunny-99k",
     "bunny-298k",
     "bunny-893k",
+    "city",
+    "city-100k",
 ];
 
 /// The built-in scene `name`, or an error naming the scenes there are.
@@ -38,7 +40,9 @@ pub fn scene_named(name: &str) -> Result<Mesh, String> {
 /// the unit cube `[0, 1]³`, `"bunny"` the Stanford bunny (3 674 faces) on
 /// a ground quad, and `"bunny-11k"` to `"bunny-893k"` the same refined by
 /// one to five √3-subdivisions ([`crate::bunny`]) to 11 022 to 892 782
-/// faces.
+/// faces; `"city"` a block of sixteen buildings on a ground of 2 m tiles
+/// ([`crate::city_block`], 3,703 faces) and `"city-100k"` the same on
+/// 0.38 m tiles (99,959 faces), for sun studies.
 ///
 /// ```
 /// for name in ["room", "chair", "cube", "bunny"] {
@@ -66,6 +70,8 @@ pub fn scene(name: &str) -> Option<Mesh> {
         "bunny-99k" => crate::bunny(3),
         "bunny-298k" => crate::bunny(4),
         "bunny-893k" => crate::bunny(5),
+        "city" => Some(crate::city_block(60)),
+        "city-100k" => Some(crate::city_block(316)),
         _ => None,
     }
 }
