@@ -432,7 +432,8 @@ impl Mesh {
 
     /// A built-in scene: `"room"` (the core paper's test room), `"chair"`,
     /// `"cube"`, `"bunny"` (the Stanford bunny on a ground) and
-    /// `"bunny-11k"` to `"bunny-893k"` (the same refined), as the CLI's
+    /// `"bunny-11k"` to `"bunny-893k"` (the same refined), `"city"` and
+    /// `"city-100k"` (a block of buildings on a tiled ground), as the CLI's
     /// `--scene` gives them.
     #[staticmethod]
     fn scene(name: &str) -> PyResult<Mesh> {

@@ -195,7 +195,7 @@ mod tests {
         assert_eq!(
             load_source_quiet(&unknown, false).unwrap_err().to_string(),
             "unknown scene `kitchen` (available: room, chair, cube, bunny, bunny-11k, bunny-33k, \
-             bunny-99k, bunny-298k, bunny-893k)"
+             bunny-99k, bunny-298k, bunny-893k, city, city-100k)"
         );
     }
 }
