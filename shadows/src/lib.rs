@@ -249,7 +249,16 @@ pub(crate) fn shadows_on(
 ) -> Result<Shadows, Error> {
     let placed = svbsp::place_lights(grid, lights).map_err(Error::Light)?;
     let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
-    let trees = svbsp::Shadows::new(polys, &kernel).map_err(Error::Shadow)?;
+    // each light's tree from the faces that can hide it from some face
+    let bounds = grid_bounds(polys);
+    let volumes = bsp_core::par::try_map(kernel.len(), |j| {
+        let hiding: Vec<&bsp_core::Polygon> = (polys.iter())
+            .filter(|p| bounds.is_none_or(|b| may_hide(&kernel[j], p.support(), b)))
+            .collect();
+        svbsp::ShadowVolumes::build(kernel[j], &hiding)
+    });
+    let volumes = volumes.map_err(|e| Error::Shadow(e.into()))?;
+    let trees = svbsp::Shadows::from_volumes(&kernel, volumes).map_err(Error::Shadow)?;
     // (with convex pieces: the OBJ writer draws them)
     let batch = trees
         .set()
@@ -276,6 +285,50 @@ pub(crate) fn shadows_on(
         lit,
         area,
     })
+}
+
+/// The least and greatest grid coordinates of the polygons' vertices
+/// (which are grid points: imported faces), `None` for no polygon.
+fn grid_bounds(polys: &[bsp_core::Polygon]) -> Option<[[i32; 3]; 2]> {
+    let mut b: Option<[[i32; 3]; 2]> = None;
+    for v in polys.iter().flat_map(|p| p.vertices()) {
+        let bsp_core::Point::Grid(g) = v else {
+            return None; // (not an imported face: keep every occluder)
+        };
+        let [lo, hi] = b.get_or_insert([*g, *g]);
+        for k in 0..3 {
+            lo[k] = lo[k].min(g[k]);
+            hi[k] = hi[k].max(g[k]);
+        }
+    }
+    b
+}
+
+/// Whether a face of plane `support` may hide `light` from some point of
+/// the box `[lo, hi]`: its shadow lies strictly behind its plane seen from
+/// the light, so where no corner of the box is there (a ground under
+/// everything, a room's walls), it hides nothing from the faces in the
+/// box, and its volume can be left out of the light's tree with every
+/// fragment's class unchanged. Exact (`i128` on grid coordinates).
+fn may_hide(light: &svbsp::Light, support: &bsp_core::Plane, [lo, hi]: [[i32; 3]; 2]) -> bool {
+    let side = light.eval(support).signum();
+    if side == 0 {
+        return true; // (edge-on: the engine skips it anyway)
+    }
+    let n = support.normal();
+    // the corner farthest behind the plane, seen from the light
+    let corner: [i32; 3] = std::array::from_fn(|k| {
+        if (n[k] as i128) * side > 0 {
+            lo[k]
+        } else {
+            hi[k]
+        }
+    });
+    let at = (0..3)
+        .map(|k| n[k] as i128 * corner[k] as i128)
+        .sum::<i128>()
+        + support.offset();
+    at * side < 0
 }
 
 impl Shadows {
@@ -345,3 +398,53 @@ pub struct ReadmeDoctests;
 #[cfg(doctest)]
 #[doc = include_str!("../../README.md")]
 pub struct WorkspaceReadmeDoctests;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Leaving out the faces that hide nothing (here the city's ground
+    /// tiles, and for a light below the ground nothing) gives every face
+    /// the lit area of the trees of all faces.
+    #[test]
+    fn faces_that_hide_nothing_change_no_lit_area() {
+        let city = shadow_scene::city_block(6);
+        let lights = [
+            Light::Sun(DVec3::new(0.3, -0.5, 1.0)),
+            Light::Point(DVec3::new(50.0, 70.0, 80.0)),
+            Light::Sun(DVec3::new(0.2, 0.1, -1.0)),
+        ];
+        let grid = svbsp::shared_grid(&city.positions, &lights).unwrap();
+        let (polys, _) = bsp_core::import_faces_par(&grid, &city.face_loops()).unwrap();
+        let culled = shadows_on(&grid, &polys, city.faces.len(), &lights).unwrap();
+        let placed = svbsp::place_lights(&grid, &lights).unwrap();
+        let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
+        let all = svbsp::Shadows::new(&polys, &kernel).unwrap();
+        let batch = all.set().shade_all(&polys, &ShadeOptions::default());
+        let world = world_vertices(&batch, &grid).unwrap();
+        let mut lit = vec![0.0; city.faces.len() * 3];
+        for r in area_records(&batch, &world) {
+            for j in 0..3 {
+                if r.lit >> j & 1 == 1 {
+                    lit[r.face as usize * 3 + j] += r.area;
+                }
+            }
+        }
+        for f in 0..city.faces.len() {
+            for j in 0..3 {
+                let (a, b) = (culled.lit_area(f, j), lit[f * 3 + j]);
+                assert!(
+                    (a - b).abs() <= 1e-9 * culled.face_area(f).max(1.0),
+                    "{f} {j}: {a} {b}"
+                );
+            }
+        }
+        // the ground's tiles hide nothing from the suns above; from below, all may
+        let bounds = grid_bounds(&polys).unwrap();
+        let tile = polys.last().unwrap().support();
+        assert!(!may_hide(&kernel[0], tile, bounds) && !may_hide(&kernel[1], tile, bounds));
+        assert!(may_hide(&kernel[2], tile, bounds));
+        // a building's wall may hide a sun from the ground around it
+        assert!(may_hide(&kernel[0], polys[1].support(), bounds));
+    }
+}
