@@ -249,16 +249,7 @@ pub(crate) fn shadows_on(
 ) -> Result<Shadows, Error> {
     let placed = svbsp::place_lights(grid, lights).map_err(Error::Light)?;
     let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
-    // each light's tree from the faces that can hide it from some face
-    let bounds = grid_bounds(polys);
-    let volumes = bsp_core::par::try_map(kernel.len(), |j| {
-        let hiding: Vec<&bsp_core::Polygon> = (polys.iter())
-            .filter(|p| bounds.is_none_or(|b| may_hide(&kernel[j], p.support(), b)))
-            .collect();
-        svbsp::ShadowVolumes::build(kernel[j], &hiding)
-    });
-    let volumes = volumes.map_err(|e| Error::Shadow(e.into()))?;
-    let trees = svbsp::Shadows::from_volumes(&kernel, volumes).map_err(Error::Shadow)?;
+    let trees = face_trees(polys, &kernel).map_err(Error::Shadow)?;
     // (with convex pieces: the OBJ writer draws them)
     let batch = trees
         .set()
@@ -285,6 +276,23 @@ pub(crate) fn shadows_on(
         lit,
         area,
     })
+}
+
+/// One shadow-volume tree per light over the faces `polys`, for shading
+/// those faces: each light's tree holds only the faces that may hide it
+/// from some face ([`may_hide`]; the others change no fragment's class).
+pub(crate) fn face_trees(
+    polys: &[bsp_core::Polygon],
+    kernel: &[svbsp::Light],
+) -> Result<svbsp::Shadows, ShadowError> {
+    let bounds = grid_bounds(polys);
+    let volumes = bsp_core::par::try_map(kernel.len(), |j| {
+        let hiding: Vec<&bsp_core::Polygon> = (polys.iter())
+            .filter(|p| bounds.is_none_or(|b| may_hide(&kernel[j], p.support(), b)))
+            .collect();
+        svbsp::ShadowVolumes::build(kernel[j], &hiding)
+    })?;
+    svbsp::Shadows::from_volumes(kernel, volumes)
 }
 
 /// The least and greatest grid coordinates of the polygons' vertices
