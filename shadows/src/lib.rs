@@ -249,7 +249,7 @@ pub(crate) fn shadows_on(
 ) -> Result<Shadows, Error> {
     let placed = svbsp::place_lights(grid, lights).map_err(Error::Light)?;
     let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
-    let trees = face_trees(polys, &kernel).map_err(Error::Shadow)?;
+    let trees = face_trees(polys, &kernel, &[]).map_err(Error::Shadow)?;
     // (with convex pieces: the OBJ writer draws them)
     let batch = trees
         .set()
@@ -279,13 +279,24 @@ pub(crate) fn shadows_on(
 }
 
 /// One shadow-volume tree per light over the faces `polys`, for shading
-/// those faces: each light's tree holds only the faces that may hide it
-/// from some face ([`may_hide`]; the others change no fragment's class).
+/// those faces and asking at the grid points `also`: each light's tree
+/// holds only the faces that may hide it from some face or point
+/// ([`may_hide`]; the others change no fragment's class and no point's
+/// light).
 pub(crate) fn face_trees(
     polys: &[bsp_core::Polygon],
     kernel: &[svbsp::Light],
+    also: &[bsp_core::GridPoint],
 ) -> Result<svbsp::Shadows, ShadowError> {
-    let bounds = grid_bounds(polys);
+    let bounds = grid_bounds(polys).map(|[mut lo, mut hi]| {
+        for p in also {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        [lo, hi]
+    });
     let volumes = bsp_core::par::try_map(kernel.len(), |j| {
         let hiding: Vec<&bsp_core::Polygon> = (polys.iter())
             .filter(|p| bounds.is_none_or(|b| may_hide(&kernel[j], p.support(), b)))

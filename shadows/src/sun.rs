@@ -760,7 +760,7 @@ pub fn sensor_hours(
     for batch in all.chunks(svbsp::MAX_LIGHTS) {
         let placed = svbsp::place_lights(&grid, batch).map_err(Error::Light)?;
         let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
-        let trees = svbsp::Shadows::new(&polys, &kernel).map_err(Error::Shadow)?;
+        let trees = crate::face_trees(&polys, &kernel, &at).map_err(Error::Shadow)?;
         for (n, &g) in seen.iter_mut().zip(&at) {
             *n += trees.reaching(g).count_ones();
         }

@@ -417,3 +417,15 @@ fn a_disc_straddling_a_plane_is_counted_by_its_part_in_front() {
     assert!((disc_in_front(-half_r, r) - sliver).abs() < 1e-12);
     assert!((disc_in_front(half_r, r) - (1.0 - sliver)).abs() < 1e-12);
 }
+
+#[test]
+fn a_sensor_under_the_ground_keeps_the_ground_as_an_occluder() {
+    // the tiles hide nothing from the faces, all above them, but they do
+    // hide the sun from a point below
+    let city = shadow_scene::city_block(4);
+    let suns = [DVec3::new(0.2, -0.3, 1.0), DVec3::new(-0.4, -0.2, 0.8)];
+    let below = DVec3::new(2.0, 2.0, -1.0);
+    let open = DVec3::new(2.0, 2.0, 0.5);
+    let h = sensor_hours(&city, &[below, open], &suns, 1.0).unwrap();
+    assert_eq!(h, [0.0, 2.0]);
+}
