@@ -18,7 +18,7 @@ The work runs without the GIL on a pool of ``get_threads()`` threads
 
 from __future__ import annotations
 
-from typing import Iterable, Sequence
+from typing import Iterable, Optional, Sequence
 
 import numpy as np
 
@@ -151,6 +151,7 @@ def sun_hours(
     up: str = "z",
     height: float = 0.0,
     extremes: bool = True,
+    sun_disc: Optional[float] = None,
 ) -> SunHours:
     """The sun-hours of every face of ``scene`` over a study: on each of
     ``dates`` (``datetime.date`` or ``"YYYY-MM-DD"``), a sun at the middle
@@ -170,6 +171,10 @@ def sun_hours(
     object). ``extremes=False`` leaves them NaN and costs the shadows alone;
     use it for long studies of large scenes, and ``per_sensor`` for hours
     at points.
+
+    ``sun_disc`` (degrees; 0.2666 is the real sun's) counts each
+    sun as a disc of that radius: a face's penumbra by the share of the disc
+    it sees (mean hours only, the extremes NaN; far slower than point suns).
     """
     suns = study_suns(lat, lon, list(dates), step_minutes, utc_offset, north, up, height)
-    return _native._hours_of_suns(scene, suns, step_minutes / 60.0, extremes)
+    return _native._hours_of_suns(scene, suns, step_minutes / 60.0, extremes, sun_disc)

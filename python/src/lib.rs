@@ -954,20 +954,23 @@ impl SunHours {
 }
 
 /// The sun-hours of every face of `mesh` under the suns `suns` (`(s, 3)`,
-/// directions toward them), each standing for `step_hours`.
+/// directions toward them), each standing for `step_hours`; with
+/// `sun_disc` (degrees), each sun a disc of that radius (mean hours only).
 #[pyfunction]
-#[pyo3(signature = (mesh, suns, step_hours, extremes=true))]
+#[pyo3(signature = (mesh, suns, step_hours, extremes=true, sun_disc=None))]
 fn _hours_of_suns(
     py: Python<'_>,
     mesh: &Mesh,
     suns: &Bound<'_, PyAny>,
     step_hours: f64,
     extremes: bool,
+    sun_disc: Option<f64>,
 ) -> PyResult<SunHours> {
     let suns = points(py, suns, "suns")?;
-    let hours = run(py, || match extremes {
-        true => bsp_shadows::sun::sun_hours(mesh.mesh(), &suns, step_hours),
-        false => bsp_shadows::sun::sun_hours_mean(mesh.mesh(), &suns, step_hours),
+    let hours = run(py, || match (sun_disc, extremes) {
+        (Some(r), _) => bsp_shadows::sun::sun_hours_disc(mesh.mesh(), &suns, step_hours, r),
+        (None, true) => bsp_shadows::sun::sun_hours(mesh.mesh(), &suns, step_hours),
+        (None, false) => bsp_shadows::sun::sun_hours_mean(mesh.mesh(), &suns, step_hours),
     })
     .map_err(to_py)?;
     Ok(SunHours {

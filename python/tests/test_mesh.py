@@ -160,3 +160,13 @@ def test_sensor_intervals_in_closed_form_agree_with_sampled_hours():
     # the refraction left out and the steps at shadow edges, for two days
     assert np.abs(exact - sampled).max() < 0.75, (exact, sampled)
     assert exact[1] < exact[2] - 2.0
+
+
+def test_a_sun_disc_study_matches_point_suns_on_a_lone_box():
+    box = bs.box((0, 0, 0), (1, 2, 3))
+    kw = dict(lat=51.5, lon=0.0, dates=["2026-03-21"], step_minutes=60)
+    point = bs.sun_hours(box, extremes=False, **kw)
+    disc = bs.sun_hours(box, sun_disc=0.2666, **kw)
+    # nothing to cast a penumbra on: the same hours, no extremes
+    assert np.allclose(disc.per_face, point.per_face, rtol=0, atol=1e-9)
+    assert np.isnan(disc.min_hours).all()
