@@ -163,23 +163,7 @@ pub fn parse_time(s: &str) -> Result<DateTime<FixedOffset>, SunError> {
 
 /// Where the sun is seen from `site` at `time` (SPA, with refraction).
 pub fn sun_position(site: &SunSite, time: &DateTime<FixedOffset>) -> Result<SunPosition, SunError> {
-    let bad = |e: solar_positioning::Error| SunError(e.to_string());
-    let location = Location {
-        latitude: site.latitude,
-        longitude: site.longitude,
-    };
-    let dt = match site.delta_t {
-        Some(d) => d,
-        None => delta_t::estimate_from_date_like(time).map_err(bad)?,
-    };
-    let air = match site.air {
-        Some((p, t)) => RefractionCorrection::new(p, t).map_err(bad)?,
-        None => RefractionCorrection::standard(),
-    };
-    let p = SolarPositions::new()
-        .at(time, location, site.height, dt, Some(air))
-        .map_err(bad)?;
-    let (az, el) = (p.azimuth(), p.elevation_angle());
+    let (az, el) = spa(site, time, true)?;
     // the horizontal way to the sun, turned by the scene's north
     let (turn, tilt) = ((az + site.north_deg).to_radians(), el.to_radians());
     let (east, north, up) = (turn.sin() * tilt.cos(), turn.cos() * tilt.cos(), tilt.sin());
@@ -192,6 +176,34 @@ pub fn sun_position(site: &SunSite, time: &DateTime<FixedOffset>) -> Result<SunP
         elevation_deg: el,
         direction,
     })
+}
+
+/// SPA's topocentric azimuth and elevation (degrees) at `site` and
+/// `time`: apparent (with the site's air's refraction) if `refracted`,
+/// else geometric.
+fn spa(
+    site: &SunSite,
+    time: &DateTime<FixedOffset>,
+    refracted: bool,
+) -> Result<(f64, f64), SunError> {
+    let bad = |e: solar_positioning::Error| SunError(e.to_string());
+    let location = Location {
+        latitude: site.latitude,
+        longitude: site.longitude,
+    };
+    let dt = match site.delta_t {
+        Some(d) => d,
+        None => delta_t::estimate_from_date_like(time).map_err(bad)?,
+    };
+    let air = match (refracted, site.air) {
+        (false, _) => None,
+        (true, Some((p, t))) => Some(RefractionCorrection::new(p, t).map_err(bad)?),
+        (true, None) => Some(RefractionCorrection::standard()),
+    };
+    let p = SolarPositions::new()
+        .at(time, location, site.height, dt, air)
+        .map_err(bad)?;
+    Ok((p.azimuth(), p.elevation_angle()))
 }
 
 /// The suns of a study: on each of `dates`, the midpoints of the day's

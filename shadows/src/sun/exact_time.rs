@@ -81,11 +81,10 @@ impl SunPath {
         let pole = DVec3::new(0.0, phi.cos(), phi.sin());
         let top = DVec3::new(0.0, -phi.sin(), phi.cos());
         let west = DVec3::new(-1.0, 0.0, 0.0);
-        let geometric = SunSite { air: None, ..*site };
         let hours = (0..24)
             .map(|k| {
                 let t = midnight + chrono::Duration::minutes(60 * k + 30);
-                let (az, el) = geometric_position(&geometric, &t)?;
+                let (az, el) = geometric_position(site, &t)?;
                 let (az, el) = (az.to_radians(), el.to_radians());
                 let sun = DVec3::new(az.sin() * el.cos(), az.cos() * el.cos(), el.sin());
                 let declination = sun.dot(pole).clamp(-1.0, 1.0).asin();
@@ -328,20 +327,7 @@ pub(crate) fn geometric_position(
     site: &SunSite,
     time: &chrono::DateTime<chrono::FixedOffset>,
 ) -> Result<(f64, f64), SunError> {
-    use solar_positioning::{Location, SolarPositions, delta_t};
-    let bad = |e: solar_positioning::Error| SunError(e.to_string());
-    let location = Location {
-        latitude: site.latitude,
-        longitude: site.longitude,
-    };
-    let dt = match site.delta_t {
-        Some(d) => d,
-        None => delta_t::estimate_from_date_like(time).map_err(bad)?,
-    };
-    let p = SolarPositions::new()
-        .at(time, location, site.height, dt, None)
-        .map_err(bad)?;
-    Ok((p.azimuth(), p.elevation_angle()))
+    super::spa(site, time, false)
 }
 
 /// A vector in true east, north, up as the scene's axes have it.
