@@ -331,7 +331,7 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
     }
     let wall = loop_start.elapsed() / args.frames;
     files.finish()?;
-    progress.finish();
+    drop(progress);
     let mut out = String::new();
     let _ = writeln!(
         out,

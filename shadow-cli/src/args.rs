@@ -16,8 +16,8 @@ use svbsp::{LightSpec, SoftSpec};
 pub(crate) struct SourceArgs {
     /// Mesh file (.obj, .stl, or CityJSON .json).
     pub(crate) input: Option<PathBuf>,
-    /// Built-in scene instead of a file (room, chair, cube, bunny, or the
-    /// bunny refined to bunny-11k ... bunny-893k faces).
+    /// Built-in scene instead of a file (room, chair, cube, bunny, the
+    /// bunny refined to bunny-11k ... bunny-893k faces, city, city-100k).
     #[arg(long, value_name = "NAME")]
     pub(crate) scene: Option<String>,
 }
@@ -30,9 +30,7 @@ impl SourceArgs {
                 anyhow::bail!("give either an INPUT file or --scene NAME, not both")
             }
             (None, None) => {
-                anyhow::bail!(
-                    "no input: give a mesh file (.obj, .stl or CityJSON .json) or --scene NAME"
-                )
+                anyhow::bail!("no input: give a mesh file (.obj, .stl, .json) or --scene NAME")
             }
             _ => Ok(()),
         }

@@ -47,11 +47,6 @@ impl Progress {
     pub(crate) fn inc(&self, n: u64) {
         self.bar.inc(n);
     }
-
-    /// Removes the bar.
-    pub(crate) fn finish(&self) {
-        self.bar.finish_and_clear();
-    }
 }
 
 impl bsp_shadows::shadow_file::Progress for Progress {
@@ -63,6 +58,8 @@ impl bsp_shadows::shadow_file::Progress for Progress {
     }
 }
 
+/// Dropping the bar removes it (before the report is printed, where a
+/// command drops it on purpose).
 impl Drop for Progress {
     fn drop(&mut self) {
         self.bar.finish_and_clear();

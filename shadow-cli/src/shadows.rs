@@ -124,7 +124,7 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
             .pick(&scene.mesh, scene.staging, image, args.quiet)
     });
     if !scene.soft.is_empty() {
-        return soft_shadows(args, &scene, (format, view.as_ref()), &progress);
+        return soft_shadows(args, &scene, (format, view.as_ref()), progress);
     }
     let mut out = Output::create(&args.output)?;
     let kind = match (format, &view) {
@@ -156,7 +156,7 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
         })
     })?;
     out.commit()?;
-    progress.finish();
+    drop(progress);
     let total = total.elapsed();
     phases.0.extend(fig.phases.iter().copied());
     if fig.degenerate > 0 {
@@ -229,7 +229,7 @@ fn soft_shadows(
     args: &ShadowsArgs,
     scene: &Scene,
     (format, view): (Format, Option<&SvgViewpoint>),
-    progress: &Progress,
+    progress: Progress,
 ) -> Result<()> {
     let (name, faces, grid) = (&scene.name, scene.mesh.faces.len(), &scene.grid);
     let (lights, polys) = (&scene.soft, &scene.polys);
@@ -243,16 +243,16 @@ fn soft_shadows(
     let mut out = Output::create(&args.output)?;
     let fig = guarded("the input and the command line", || {
         match view {
-            Some(at) => draw_soft_shadows(&job, &scene.mesh, at, &mut out, progress),
+            Some(at) => draw_soft_shadows(&job, &scene.mesh, at, &mut out, &progress),
             None if format == Format::Obj => {
-                write_soft_shadows(&job, FragmentFormat::Obj, &mut out, progress)
+                write_soft_shadows(&job, FragmentFormat::Obj, &mut out, &progress)
             }
-            None => write_soft_shadows(&job, FragmentFormat::Json, &mut out, progress),
+            None => write_soft_shadows(&job, FragmentFormat::Json, &mut out, &progress),
         }
         .map_err(facade_error)
     })?;
     out.commit()?;
-    progress.finish();
+    drop(progress);
     let mut report = fig.wrote(&args.output, &job, &scene.light_count());
     report += &fig.report();
     if args.stats {

@@ -32,8 +32,8 @@ pub(crate) struct SiteArgs {
 
 impl SiteArgs {
     fn site(&self) -> SunSite {
-        let north = self.north.unwrap_or(0.0);
-        SunSite::new(self.lat, self.lon).with_axes(north, self.up.unwrap_or_default())
+        SunSite::new(self.lat, self.lon)
+            .with_axes(self.north.unwrap_or(0.0), self.up.unwrap_or_default())
     }
 }
 
@@ -91,6 +91,9 @@ pub(crate) struct SunHoursArgs {
     /// Hours of the cells of these faces instead (a group, or ids such as 1,4,7-9): every step's lit parts overlaid.
     #[arg(long, value_name = "GROUP|IDS", conflicts_with = "sensors")]
     regions: Option<sun::RegionFaces>,
+    /// Cut the regions to this outline seen from above (a file of x,y,z points, such as a garden's corners).
+    #[arg(long, value_name = "FILE", requires = "regions")]
+    outline: Option<PathBuf>,
     /// Say whether the regions pass the BRE 209 garden test: half their area 2 hours in sun on 21 March.
     #[arg(long, requires = "regions")]
     bre209: bool,
@@ -118,7 +121,7 @@ pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
     let (dirs, paths) = sun::study_plan(&a.site.site(), &dates, step, offset, a.exact_time)?;
     let (sensors, regions) = (a.sensors.as_deref(), a.regions.as_ref());
     let of = HoursOf::of(sensors, regions, a.bre209, !a.no_extremes).exact_time(paths.as_deref());
-    let of = of.sun_disc(a.sun_disc);
+    let of = of.sun_disc(a.sun_disc).outline(a.outline.as_deref());
     let r = sun::hours_report(&mesh, &dirs, step / 60.0, &a.output, of, a.min_hours, view);
     let r = r.map_err(facade_error)?;
     write_file(&a.output, &r.bytes)?;

@@ -1326,3 +1326,44 @@ fn sunhours_with_a_sun_disc_counts_the_penumbras_share() {
     let o = cube_sunhours(&disc, &["--sun-disc", "--regions", "0"]);
     crate::assert_failed_with(&o, &["--sun-disc", "--regions"]);
 }
+
+#[test]
+fn sunhours_regions_cut_to_a_garden_outline() {
+    let block = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/city/block.city.json");
+    let (garden, csv) = (scratch("garden.csv"), scratch("garden_cells.csv"));
+    // a 6 m square in the yard's south-west corner, heights left out
+    let corners = "x,y,z\n85002,446002,0\n85008,446002,0\n85008,446008,3\n85002,446008,0\n";
+    std::fs::write(&garden, corners).unwrap();
+    let argv = [
+        "sunhours",
+        block.to_str().unwrap(),
+        "--lat",
+        "52.01",
+        "--lon",
+        "4.36",
+        "--date",
+        "2026-03-21",
+        "--step",
+        "30",
+        "--regions",
+        "yard",
+        "--outline",
+        garden.to_str().unwrap(),
+        "--bre209",
+        "-o",
+        csv.to_str().unwrap(),
+    ];
+    let o = shadow(&argv);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("BRE 209"), "{}", stdout(&o));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let area: f64 = text
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().unwrap().parse::<f64>().unwrap())
+        .sum();
+    assert!((area - 36.0).abs() < 1e-6, "{area}");
+    // an outline without regions is refused
+    let o = shadow(&[&argv[..10], &argv[12..]].concat());
+    crate::assert_failed_with(&o, &["--outline", "--regions"]);
+}

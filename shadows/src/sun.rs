@@ -20,7 +20,7 @@ pub use exact_time::{
 };
 use glam::DVec3;
 pub use regions::{
-    RegionCell, RegionFaces, area_in_sun, bre209_text, check_bre209, region_hours,
+    RegionCell, RegionFaces, area_in_sun, bre209_text, check_bre209, clip_to_outline, region_hours,
     region_in_sun_text, regions_csv, regions_json, regions_obj, regions_png,
 };
 use solar_positioning::{Location, RefractionCorrection, SolarPositions, delta_t};
@@ -863,6 +863,10 @@ pub enum HoursOf<'a> {
         faces: &'a RegionFaces,
         /// Whether to say the verdict.
         bre209: bool,
+        /// A file of points outlining the region seen from above (such
+        /// as a garden across a ground face): the cells cut to it
+        /// ([`clip_to_outline`]).
+        outline: Option<&'a std::path::Path>,
     },
 }
 
@@ -878,7 +882,11 @@ impl<'a> HoursOf<'a> {
     ) -> HoursOf<'a> {
         match (sensors, regions) {
             (Some(path), _) => HoursOf::Sensors(path),
-            (None, Some(faces)) => HoursOf::Regions { faces, bre209 },
+            (None, Some(faces)) => HoursOf::Regions {
+                faces,
+                bre209,
+                outline: None,
+            },
             (None, None) => HoursOf::Faces { extremes },
         }
     }
@@ -888,6 +896,19 @@ impl<'a> HoursOf<'a> {
     pub fn exact_time(self, paths: Option<&'a [SunPath]>) -> HoursOf<'a> {
         match (self, paths) {
             (HoursOf::Sensors(path), Some(paths)) => HoursOf::ExactSensors { path, paths },
+            _ => self,
+        }
+    }
+
+    /// Regions' cells cut to the outline in the points file `path`, if
+    /// given (for anything but regions, `self`).
+    pub fn outline(self, path: Option<&'a std::path::Path>) -> HoursOf<'a> {
+        match self {
+            HoursOf::Regions { faces, bre209, .. } if path.is_some() => HoursOf::Regions {
+                faces,
+                bre209,
+                outline: path,
+            },
             _ => self,
         }
     }
@@ -961,9 +982,17 @@ pub fn hours_report(
             let rows = format!("{} sensors among the faces, exact time", points.len());
             Ok(report(text, rows, String::new()))
         }
-        HoursOf::Regions { faces, bre209 } => {
+        HoursOf::Regions {
+            faces,
+            bre209,
+            outline,
+        } => {
             let ids = faces.faces(mesh)?;
-            let cells = region_hours(mesh, suns, step_hours, &ids)?;
+            let mut cells = region_hours(mesh, suns, step_hours, &ids)?;
+            if let Some(path) = outline {
+                let points = shadow_scene::read_points(path).map_err(crate::Error::File)?;
+                cells = clip_to_outline(&cells, &points, view.up)?;
+            }
             let bytes = match format {
                 HoursFormat::Csv => regions_csv(mesh, &cells).into_bytes(),
                 HoursFormat::Json => regions_json(&cells, suns.len()).into_bytes(),

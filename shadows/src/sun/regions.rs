@@ -139,6 +139,95 @@ pub fn region_hours(
     Ok(out)
 }
 
+/// `cells` cut to the upright prism over `outline` (a closed polygon,
+/// such as a garden's boundary, given by points whose height along `up`
+/// is left out): each cell's parts whose plumb line meets the outline's
+/// inside, on the cell's own face, with their areas. A cell on a wall
+/// inside the outline stays whole. The outline is triangulated (earcut)
+/// and each cell clipped by each triangle's three upright planes, in
+/// `f64` (the cells' corners are); the parts keep their cell's face,
+/// hours and turning. An outline without area is an error.
+pub fn clip_to_outline(
+    cells: &[RegionCell],
+    outline: &[DVec3],
+    up: super::Up,
+) -> Result<Vec<RegionCell>, Error> {
+    // plan coordinates, counter-clockwise seen from above
+    let plan = |p: DVec3| match up {
+        super::Up::Z => [p.x, p.y],
+        super::Up::Y => [p.x, -p.z],
+    };
+    let flat: Vec<[f64; 2]> = outline.iter().map(|&p| plan(p)).collect();
+    let mut tri: Vec<u32> = Vec::new();
+    earcut::Earcut::new().earcut(flat.iter().copied(), &[] as &[u32], &mut tri);
+    let cross = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
+        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    };
+    let triangles: Vec<[[f64; 2]; 3]> = (tri.chunks(3))
+        .map(|t| t.iter().map(|&i| flat[i as usize]).collect::<Vec<_>>())
+        .filter_map(|t| match cross(t[0], t[1], t[2]) {
+            a if a > 0.0 => Some([t[0], t[1], t[2]]),
+            a if a < 0.0 => Some([t[0], t[2], t[1]]),
+            _ => None,
+        })
+        .collect();
+    if triangles.is_empty() {
+        return Err(Error::Region(format!(
+            "the outline of {} points encloses no area seen from above",
+            outline.len()
+        )));
+    }
+    let mut out = Vec::new();
+    for c in cells {
+        for t in &triangles {
+            let mut ring = c.ring.clone();
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                ring = clip_ring(&ring, |p| cross(a, b, plan(p)));
+                if ring.len() < 3 {
+                    break;
+                }
+            }
+            let area = ring_area(&ring);
+            if ring.len() >= 3 && area > 0.0 {
+                out.push(RegionCell {
+                    face: c.face,
+                    hours: c.hours,
+                    area,
+                    ring,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The part of the polygon `ring` where `side(p) >= 0` (Sutherland and
+/// Hodgman's step).
+fn clip_ring(ring: &[DVec3], side: impl Fn(DVec3) -> f64) -> Vec<DVec3> {
+    let mut out = Vec::with_capacity(ring.len() + 1);
+    for (i, &a) in ring.iter().enumerate() {
+        let b = ring[(i + 1) % ring.len()];
+        let (sa, sb) = (side(a), side(b));
+        if sa >= 0.0 {
+            out.push(a);
+        }
+        // (a corner on the line is kept once, not again as a crossing)
+        if (sa > 0.0 && sb < 0.0) || (sa < 0.0 && sb > 0.0) {
+            out.push(a + (b - a) * (sa / (sa - sb)));
+        }
+    }
+    out
+}
+
+/// A planar polygon's area.
+fn ring_area(ring: &[DVec3]) -> f64 {
+    let n: DVec3 = (1..ring.len().saturating_sub(1))
+        .map(|i| (ring[i] - ring[0]).cross(ring[i + 1] - ring[0]))
+        .sum();
+    n.length() / 2.0
+}
+
 /// The area of `cells` and the area of those that see at least `hours`
 /// (within 10⁻⁹ hours: the steps' sums in `f64`).
 pub fn area_in_sun(cells: &[RegionCell], hours: f64) -> (f64, f64) {

@@ -429,3 +429,62 @@ fn a_sensor_under_the_ground_keeps_the_ground_as_an_occluder() {
     let h = sensor_hours(&city, &[below, open], &suns, 1.0).unwrap();
     assert_eq!(h, [0.0, 2.0]);
 }
+
+#[test]
+fn a_region_cut_to_an_outline_keeps_its_hours_and_its_area() {
+    let (mesh, suns, step, _) = equinox_study();
+    let cells = region_hours(&mesh, &suns, step, &[0]).unwrap();
+    // an L-shaped garden north-east of the box, seen from above
+    let p = |x: f64, y: f64| DVec3::new(x, y, 7.0); // (its height is left out)
+    let garden = [
+        p(1.5, 1.5),
+        p(6.0, 1.5),
+        p(6.0, 3.0),
+        p(3.0, 3.0),
+        p(3.0, 6.0),
+        p(1.5, 6.0),
+    ];
+    let cut = clip_to_outline(&cells, &garden, Up::Z).unwrap();
+    let area: f64 = cut.iter().map(|c| c.area).sum();
+    assert!((area - (4.5 * 1.5 + 1.5 * 3.0)).abs() < 1e-9, "{area}");
+    // a point of the garden has its cell's hours: the exact count there
+    // (cells need not be convex: an even-odd test)
+    let inside = |c: &RegionCell, q: DVec3| {
+        let n = c.ring.len();
+        let crossings = (0..n).filter(|&i| {
+            let (a, b) = (c.ring[i], c.ring[(i + 1) % n]);
+            (a.y > q.y) != (b.y > q.y) && q.x < a.x + (q.y - a.y) / (b.y - a.y) * (b.x - a.x)
+        });
+        crossings.count() % 2 == 1
+    };
+    let points = [
+        DVec3::new(1.7, 1.7, 0.0),
+        DVec3::new(5.5, 2.2, 0.0),
+        DVec3::new(2.1, 5.3, 0.0),
+    ];
+    let exact = sensor_hours(&mesh, &points, &suns, step).unwrap();
+    for (q, h) in points.iter().zip(exact) {
+        let c = cut
+            .iter()
+            .find(|c| inside(c, *q))
+            .expect("a cell holds the point");
+        assert!((c.hours - h).abs() < 1e-9, "{q}: {} against {h}", c.hours);
+        assert_eq!(c.face, 0);
+    }
+    // y up: a ground cell of 4 × 4 in x and -z, a garden of 2 × 2 on it
+    let ground = RegionCell {
+        face: 0,
+        hours: 3.0,
+        area: 16.0,
+        ring: [(0.0, 0.0), (4.0, 0.0), (4.0, 4.0), (0.0, 4.0)]
+            .map(|(x, n)| DVec3::new(x, 0.0, -n))
+            .to_vec(),
+    };
+    let square =
+        [(1.0, 1.0), (3.0, 1.0), (3.0, 3.0), (1.0, 3.0)].map(|(x, n)| DVec3::new(x, 5.0, -n));
+    let part = clip_to_outline(&[ground], &square, Up::Y).unwrap();
+    assert_eq!(part.iter().map(|c| c.area).sum::<f64>(), 4.0);
+    assert!(part.iter().all(|c| c.hours == 3.0));
+    let flat = [p(0.0, 0.0), p(1.0, 1.0), p(2.0, 2.0)];
+    assert!(clip_to_outline(&cells, &flat, Up::Z).is_err());
+}
