@@ -2,12 +2,15 @@
 //! room at 51.5° N on the equinox, a sun every 10 minutes: 73 suns above
 //! the horizon, the runs' pieces overlaid), the sun positions alone, and
 //! the built-in city block's mean hours (3,703 faces: sixteen buildings on
-//! 2 m ground tiles) for the same day.
+//! 2 m ground tiles) for the same day, and its day at 100 sensors in
+//! closed form (`--exact-time`).
 
 use std::hint::black_box;
 use std::time::Duration;
 
-use bsp_shadows::sun::{SunSite, study_suns, sun_hours, sun_hours_mean};
+use bsp_shadows::sun::{
+    SunSite, day_paths, sensor_intervals, study_suns, sun_hours, sun_hours_mean,
+};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 fn sun(cr: &mut Criterion) {
@@ -33,6 +36,20 @@ fn sun(cr: &mut Criterion) {
     g.sample_size(10).measurement_time(Duration::from_secs(10));
     g.bench_function("mean sun-hours", |b| {
         b.iter(|| black_box(sun_hours_mean(&city, &suns, 1.0 / 6.0).unwrap().len()))
+    });
+    // 100 sensors on a 10 m lattice of the ground, the day in closed form
+    let sensors: Vec<glam::DVec3> = (0..100)
+        .map(|i| {
+            glam::DVec3::new(
+                5.0 + 10.0 * f64::from(i % 10),
+                5.0 + 10.0 * f64::from(i / 10),
+                0.0,
+            )
+        })
+        .collect();
+    let paths = day_paths(&site, &day, 0.0).unwrap();
+    g.bench_function("exact time, 100 sensors", |b| {
+        b.iter(|| black_box(sensor_intervals(&city, &sensors, &paths).len()))
     });
     g.finish();
 }
