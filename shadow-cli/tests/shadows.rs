@@ -1367,3 +1367,25 @@ fn sunhours_regions_cut_to_a_garden_outline() {
     let o = shadow(&[&argv[..10], &argv[12..]].concat());
     crate::assert_failed_with(&o, &["--outline", "--regions"]);
 }
+
+#[test]
+fn a_face_that_touches_itself_is_tiled_not_fanned() {
+    // two triangles meeting at (5, 1), one face whose loop passes there
+    // twice: area 2 (a fan over the loop covered 4, lit 3 of it)
+    let obj = scratch("pinched.obj");
+    let text = "v 4 0 0\nv 6 0 0\nv 5 1 0\nv 6 2 0\nv 4 2 0\nf 1 2 3 4 5 3\n";
+    std::fs::write(&obj, text).unwrap();
+    let json = scratch("pinched.json");
+    let o = shadow(&[
+        "shadows",
+        obj.to_str().unwrap(),
+        "--sun",
+        "0.3,-0.2,1",
+        "-o",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["summary"]["area"], 2.0);
+    assert_eq!(v["summary"]["lit_area"][0], 2.0);
+}

@@ -12,8 +12,11 @@ pub enum FaceDefect {
     ZeroArea,
     /// Not all vertices lie in one plane (after snapping).
     NonPlanar,
-    /// Planar but not convex (or not simple).
+    /// Planar but not convex.
     NonConvex,
+    /// Planar, but its loop touches or crosses itself (after snapping) so
+    /// that no triangles tile it.
+    NotSimple,
     /// A coordinate beyond `±MAX_COORD`, the range the exact arithmetic
     /// is proved for (snap input with a [`Grid`](crate::kernel::Grid) first).
     OutOfRange,
@@ -26,6 +29,7 @@ impl std::fmt::Display for FaceDefect {
             FaceDefect::ZeroArea => "zero area (collinear vertices)",
             FaceDefect::NonPlanar => "vertices not in one plane",
             FaceDefect::NonConvex => "not convex",
+            FaceDefect::NotSimple => "not simple: its boundary touches or crosses itself",
             FaceDefect::OutOfRange => "a grid coordinate beyond ±MAX_COORD (2^26 - 1)",
         })
     }

@@ -391,7 +391,10 @@ impl FaceImporter {
                 out(p);
             }
             Err(defect @ (FaceDefect::NonConvex | FaceDefect::NonPlanar)) => {
-                let tris = triangulate(pts, defect);
+                let Some(tris) = triangulate(pts, defect) else {
+                    report.dropped.push((fi, FaceDefect::NotSimple));
+                    return;
+                };
                 let before = report.polygons;
                 for t in tris.iter() {
                     if let Ok(p) = GridPolygon::from_grid_points(t) {
@@ -422,10 +425,11 @@ pub fn snap_positions(grid: &Grid, positions: &[DVec3]) -> Vec<Option<GridPoint>
     positions.par_iter().map(|&p| grid.snap(p).ok()).collect()
 }
 
-/// Triangles covering the loop: exact ear clipping for planar loops, a fan
-/// otherwise (or when ear clipping finds no ear, i.e. the loop is not
-/// simple).
-fn triangulate(pts: &[GridPoint], defect: FaceDefect) -> Vec<[GridPoint; 3]> {
+/// Triangles covering the loop: for a planar loop, triangles that tile it
+/// exactly (ear clipping, the loop split where a corner repeats if need
+/// be), or `None` where it touches or crosses itself so that none do; a
+/// fan for a loop out of one plane.
+fn triangulate(pts: &[GridPoint], defect: FaceDefect) -> Option<Vec<[GridPoint; 3]>> {
     let mut v: Vec<GridPoint> = Vec::with_capacity(pts.len());
     for p in pts {
         if v.last() != Some(p) {
@@ -437,28 +441,115 @@ fn triangulate(pts: &[GridPoint], defect: FaceDefect) -> Vec<[GridPoint; 3]> {
     }
     if defect == FaceDefect::NonConvex
         && let Ok(plane) = support_plane(&v)
-        && let Some(t) = ear_clip(&v, &plane)
     {
-        return t;
+        return tile(&v, &Projection::of(&plane));
     }
-    (1..v.len().saturating_sub(1))
-        .map(|i| [v[0], v[i], v[i + 1]])
-        .collect()
+    Some(
+        (1..v.len().saturating_sub(1))
+            .map(|i| [v[0], v[i], v[i + 1]])
+            .collect(),
+    )
 }
 
-/// Exact ear clipping of a planar loop, counter-clockwise about `plane`.
-fn ear_clip(v: &[GridPoint], plane: &Plane) -> Option<Vec<[GridPoint; 3]>> {
-    let ax = plane.dominant_axis();
-    let (a, b) = if plane.normal()[ax] > 0 {
-        ((ax + 1) % 3, (ax + 2) % 3)
-    } else {
-        ((ax + 2) % 3, (ax + 1) % 3)
-    };
-    let p2 = |p: GridPoint| (p[a] as i128, p[b] as i128);
-    let orient = |p: GridPoint, q: GridPoint, r: GridPoint| {
-        let (p, q, r) = (p2(p), p2(q), p2(r));
+/// Triangles that tile the planar loop `v` exactly, counter-clockwise in
+/// `proj`: the loop split at a corner it meets twice and each part tiled
+/// (a part turning the other way, a hole pinched off, cannot be); a loop
+/// of distinct corners only if it is simple (no two edges but neighbours
+/// meet), by ear clipping, checked (every triangle turns the loop's way
+/// and their areas add up to its area).
+fn tile(v: &[GridPoint], proj: &Projection) -> Option<Vec<[GridPoint; 3]>> {
+    for i in 0..v.len() {
+        if let Some(j) = (i + 1..v.len()).find(|&j| v[j] == v[i]) {
+            let inner = &v[i..j];
+            let outer: Vec<GridPoint> = v[j..].iter().chain(&v[..i]).copied().collect();
+            let mut t = tile(inner, proj)?;
+            t.extend(tile(&outer, proj)?);
+            return Some(t);
+        }
+    }
+    // corners all distinct: simple unless two edges not next to each
+    // other meet
+    let area = proj.area2(v);
+    if area <= 0 || !proj.simple(v) {
+        return None;
+    }
+    let t = ear_clip(v, proj)?;
+    (t.iter().map(|t| proj.area2(t)).sum::<i128>() == area).then_some(t)
+}
+
+/// A plane's loops seen along its dominant axis, counter-clockwise about
+/// its normal: exact `i128` orientation and area.
+struct Projection {
+    a: usize,
+    b: usize,
+}
+
+impl Projection {
+    fn of(plane: &Plane) -> Projection {
+        let ax = plane.dominant_axis();
+        let (a, b) = if plane.normal()[ax] > 0 {
+            ((ax + 1) % 3, (ax + 2) % 3)
+        } else {
+            ((ax + 2) % 3, (ax + 1) % 3)
+        };
+        Projection { a, b }
+    }
+
+    fn xy(&self, p: GridPoint) -> (i128, i128) {
+        (i128::from(p[self.a]), i128::from(p[self.b]))
+    }
+
+    /// The sign of the turn `p, q, r`.
+    fn orient(&self, p: GridPoint, q: GridPoint, r: GridPoint) -> i128 {
+        let (p, q, r) = (self.xy(p), self.xy(q), self.xy(r));
         ((q.0 - p.0) * (r.1 - p.1) - (q.1 - p.1) * (r.0 - p.0)).signum()
-    };
+    }
+
+    /// Whether segments `p`–`q` and `r`–`s` share a point.
+    fn meet(&self, (p, q): (GridPoint, GridPoint), (r, s): (GridPoint, GridPoint)) -> bool {
+        let (d1, d2) = (self.orient(p, q, r), self.orient(p, q, s));
+        let (d3, d4) = (self.orient(r, s, p), self.orient(r, s, q));
+        if d1 == 0 && d2 == 0 {
+            // on one line: do their extents overlap?
+            let (p, q, r, s) = (self.xy(p), self.xy(q), self.xy(r), self.xy(s));
+            let within = |lo: i128, hi: i128, a: i128, b: i128| {
+                lo.min(hi) <= a.max(b) && a.min(b) <= lo.max(hi)
+            };
+            return within(p.0, q.0, r.0, s.0) && within(p.1, q.1, r.1, s.1);
+        }
+        d1 * d2 <= 0 && d3 * d4 <= 0
+    }
+
+    /// Whether the loop's edges meet only their neighbours, at their
+    /// shared corners.
+    fn simple(&self, v: &[GridPoint]) -> bool {
+        let n = v.len();
+        let edge = |i: usize| (v[i], v[(i + 1) % n]);
+        (0..n).all(|i| {
+            // the edges after the next, up to the one before `i`
+            (i + 2..n)
+                .filter(|&j| (j + 1) % n != i)
+                .all(|j| !self.meet(edge(i), edge(j)))
+        })
+    }
+
+    /// Twice the loop's signed area (positive: counter-clockwise).
+    fn area2(&self, v: &[GridPoint]) -> i128 {
+        (0..v.len())
+            .map(|i| {
+                let (p, q) = (self.xy(v[i]), self.xy(v[(i + 1) % v.len()]));
+                p.0 * q.1 - q.0 * p.1
+            })
+            .sum()
+    }
+}
+
+/// Exact ear clipping of a planar loop, counter-clockwise in `proj`.
+fn ear_clip(v: &[GridPoint], proj: &Projection) -> Option<Vec<[GridPoint; 3]>> {
+    let orient = |p, q, r| proj.orient(p, q, r);
+    if v.len() < 3 {
+        return None;
+    }
     let mut idx: Vec<usize> = (0..v.len()).collect();
     let mut tris = Vec::with_capacity(v.len());
     while idx.len() > 3 {
@@ -664,5 +755,69 @@ mod tests {
             "{e}"
         );
         assert!(e.to_string().contains("face 0"));
+    }
+
+    /// Twice the area of polygons in the plane z = 0.
+    fn area2(polys: &[Polygon]) -> f64 {
+        polys
+            .iter()
+            .map(|p| {
+                let v = p.vertices_f64();
+                (1..v.len() - 1)
+                    .map(|i| {
+                        let (a, b, c) = (v[0], v[i], v[i + 1]);
+                        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+                    })
+                    .sum::<f64>()
+            })
+            .sum()
+    }
+
+    #[test]
+    fn a_loop_that_touches_itself_is_tiled_part_by_part_or_dropped() {
+        let at = |pts: &[(f64, f64)]| -> Vec<[f64; 3]> {
+            pts.iter().map(|&(x, y)| [x, y, 0.0]).collect()
+        };
+        // two triangles meeting at one corner, the loop through it twice:
+        // area 2, not the 4 that a fan over it covers (overlapping)
+        let pinched = at(&[
+            (4.0, 0.0),
+            (6.0, 0.0),
+            (5.0, 1.0),
+            (6.0, 2.0),
+            (4.0, 2.0),
+            (5.0, 1.0),
+        ]);
+        let (polys, r) = import(&pinched);
+        assert_eq!(area2(&polys), 4.0);
+        assert_eq!(r.triangulated, vec![(0, FaceDefect::NonConvex)]);
+        // a hole pinched off at a corner (its part turns the other way),
+        // and a star whose edges cross: no triangles tile them
+        let hole = at(&[
+            (0.0, 0.0),
+            (4.0, 0.0),
+            (4.0, 4.0),
+            (0.0, 4.0),
+            (0.0, 0.0),
+            (1.0, 2.0),
+            (2.0, 2.0),
+            (2.0, 1.0),
+        ]);
+        let star = at(&[
+            (0.0, 10.0),
+            (6.0, -8.0),
+            (-10.0, 3.0),
+            (10.0, 3.0),
+            (-6.0, -8.0),
+        ]);
+        for face in [hole, star] {
+            let (polys, r) = import(&face);
+            assert!(polys.is_empty());
+            assert_eq!(r.dropped, vec![(0, FaceDefect::NotSimple)]);
+        }
+        assert_eq!(
+            FaceDefect::NotSimple.to_string(),
+            "not simple: its boundary touches or crosses itself"
+        );
     }
 }
