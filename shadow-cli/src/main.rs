@@ -192,7 +192,8 @@ fn main() -> ExitCode {
             return ExitCode::from(u8::from(e.use_stderr()));
         }
     };
-    match run(&cli) {
+    // (every command: a panic of the libraries is reported as a bug)
+    match output::guarded("the input and the command line", || run(&cli)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {}", message(&e));
