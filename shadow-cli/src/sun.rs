@@ -103,8 +103,8 @@ pub(crate) struct SunHoursArgs {
     /// Faces' mean hours only, for the cost of the shadows: no least and most hours (empty in CSV).
     #[arg(long, conflicts_with_all = ["min_hours", "regions"])]
     no_extremes: bool,
-    /// Output: CSV (one row per face, or per sensor), JSON, OBJ (a heat map) or PNG (its picture).
-    #[arg(short, long, value_name = "OUT.csv|OUT.json|OUT.obj|OUT.png")]
+    /// Output: CSV (one row per face, or per sensor), JSON, OBJ or PLY (a heat map) or PNG (its picture).
+    #[arg(short, long, value_name = "OUT.csv|OUT.json|OUT.obj|OUT.ply|OUT.png")]
     output: PathBuf,
     /// No notes on stderr (errors still go there).
     #[arg(long, short)]

@@ -1107,7 +1107,7 @@ fn sunhours_writes_every_faces_hours() {
     crate::assert_failed_with(&o, &["--no-extremes", "--min-hours"]);
     // bad names and dates are clear errors
     let o = run(&scratch("hours.txt"), &[]);
-    crate::assert_failed_with(&o, &["hours.txt", ".csv, .json, .obj or .png"]);
+    crate::assert_failed_with(&o, &["hours.txt", ".csv, .json, .obj, .ply or .png"]);
     let o = run(&csv, &["--to", "2026-02-30"]);
     crate::assert_failed_with(&o, &["2026-02-30", "not a date"]);
 }

@@ -13,12 +13,14 @@ pub use chrono::NaiveDate;
 use chrono::{DateTime, FixedOffset};
 
 mod exact_time;
+mod ply;
 mod regions;
 pub use exact_time::{
     Interval, SunPath, day_paths, hides, interval_hours, intervals_json, sensor_intervals,
     study_plan, triangles,
 };
 use glam::DVec3;
+pub use ply::{hours_ply, regions_ply, sensors_ply};
 pub use regions::{
     RegionCell, RegionFaces, area_in_sun, bre209_text, check_bre209, clip_to_outline, region_hours,
     region_in_sun_text, regions_csv, regions_json, regions_obj, regions_png,
@@ -806,6 +808,7 @@ pub fn sensor_hours_file(
     let text = match format {
         HoursFormat::Csv => sensors_csv(&points, &hours),
         HoursFormat::Json => sensors_json(&points, &hours, suns.len()),
+        HoursFormat::Ply => sensors_ply(&points, &hours),
         HoursFormat::Obj | HoursFormat::Png => sensors_obj(&points, &hours), // (Png refused above)
     };
     Ok((text, points.len()))
@@ -977,6 +980,7 @@ pub fn hours_report(
             let text = match format {
                 HoursFormat::Json => intervals_json(&points, paths, &on),
                 HoursFormat::Csv => sensors_csv(&points, &interval_hours(&on)),
+                HoursFormat::Ply => sensors_ply(&points, &interval_hours(&on)),
                 _ => sensors_obj(&points, &interval_hours(&on)), // (Png refused above)
             };
             let rows = format!("{} sensors among the faces, exact time", points.len());
@@ -997,6 +1001,7 @@ pub fn hours_report(
                 HoursFormat::Csv => regions_csv(mesh, &cells).into_bytes(),
                 HoursFormat::Json => regions_json(&cells, suns.len()).into_bytes(),
                 HoursFormat::Obj => regions_obj(&cells).into_bytes(),
+                HoursFormat::Ply => regions_ply(&cells).into_bytes(),
                 HoursFormat::Png => regions_png(mesh, &ids, &cells, suns.len(), view)?,
             };
             let mut lines = min_hours.map_or(String::new(), |h| region_in_sun_text(&cells, h));
@@ -1155,12 +1160,14 @@ pub enum HoursFormat {
     Json,
     /// [`hours_obj`]: a heat map to look at.
     Obj,
+    /// [`hours_ply`]: the heat map with each face's hours.
+    Ply,
     /// [`hours_png`]: a picture of the heat map.
     Png,
 }
 
 impl HoursFormat {
-    /// The format a file name asks for (`.csv`, `.json`, `.obj`, `.png`),
+    /// The format a file name asks for (`.csv`, `.json`, `.obj`, `.ply`, `.png`),
     /// if any.
     pub fn of(path: &std::path::Path) -> Option<HoursFormat> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
@@ -1168,6 +1175,7 @@ impl HoursFormat {
             "json" => Some(HoursFormat::Json),
             "csv" => Some(HoursFormat::Csv),
             "obj" => Some(HoursFormat::Obj),
+            "ply" => Some(HoursFormat::Ply),
             "png" => Some(HoursFormat::Png),
             _ => None,
         }
@@ -1177,7 +1185,7 @@ impl HoursFormat {
     pub fn for_path(path: &std::path::Path) -> Result<HoursFormat, crate::Error> {
         HoursFormat::of(path).ok_or_else(|| crate::Error::Format {
             path: path.to_path_buf(),
-            why: "a sun study is written as .csv, .json, .obj or .png",
+            why: "a sun study is written as .csv, .json, .obj, .ply or .png",
         })
     }
 
@@ -1194,6 +1202,7 @@ impl HoursFormat {
             HoursFormat::Json => hours_json(mesh, hours, suns).into_bytes(),
             HoursFormat::Csv => hours_csv(mesh, hours).into_bytes(),
             HoursFormat::Obj => hours_obj(mesh, hours).into_bytes(),
+            HoursFormat::Ply => hours_ply(mesh, hours).into_bytes(),
             HoursFormat::Png => hours_png(mesh, hours, suns, view)?,
         })
     }

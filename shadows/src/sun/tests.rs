@@ -246,7 +246,7 @@ fn runs_files_and_heat_maps_of_a_yard() {
     let e = HoursFormat::for_path(std::path::Path::new("study.txt")).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "study.txt: a sun study is written as .csv, .json, .obj or .png"
+        "study.txt: a sun study is written as .csv, .json, .obj, .ply or .png"
     );
     let bytes = hours_png(&mesh, &hours, suns.len(), HeatView::default()).unwrap();
     assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
@@ -487,4 +487,35 @@ fn a_region_cut_to_an_outline_keeps_its_hours_and_its_area() {
     assert!(part.iter().all(|c| c.hours == 3.0));
     let flat = [p(0.0, 0.0), p(1.0, 1.0), p(2.0, 2.0)];
     assert!(clip_to_outline(&cells, &flat, Up::Z).is_err());
+}
+
+#[test]
+fn a_study_writes_ply_with_each_faces_hours() {
+    let (mesh, suns, step, _) = equinox_study();
+    let hours = sun_hours_mean(&mesh, &suns, step).unwrap();
+    let ply = String::from_utf8(
+        HoursFormat::Ply
+            .bytes(&mesh, &hours, suns.len(), HeatView::default())
+            .unwrap(),
+    )
+    .unwrap();
+    let (head, body) = ply.split_once("end_header\n").unwrap();
+    let corners: usize = mesh.faces.iter().map(|f| f.vertices.len()).sum();
+    assert!(head.starts_with("ply\nformat ascii 1.0\n"));
+    assert!(head.contains(&format!("element vertex {corners}\n")));
+    assert!(head.contains(&format!("element face {}\n", mesh.faces.len())));
+    let lines: Vec<&str> = body.lines().collect();
+    assert_eq!(lines.len(), corners + mesh.faces.len());
+    for (face, (line, h)) in lines[corners..].iter().zip(&hours).enumerate() {
+        let v: Vec<&str> = line.split(' ').collect();
+        let n = mesh.faces[face].vertices.len();
+        assert_eq!(v[0].parse::<usize>().unwrap(), n);
+        assert_eq!(v.last().unwrap().parse::<f64>().unwrap(), h.sun_hours);
+    }
+    // sensors as coloured points, regions as cells
+    let points = yard_sensors();
+    let s = sensors_ply(&points, &[1.0; 6]);
+    assert!(s.contains("element vertex 6\n") && !s.contains("element face"));
+    let cells = region_hours(&mesh, &suns, step, &[0]).unwrap();
+    assert!(regions_ply(&cells).contains(&format!("element face {}\n", cells.len())));
 }
