@@ -1,7 +1,7 @@
 //! Sun studies as PLY: the heat maps of [`super::hours_obj`],
 //! [`super::regions_obj`] and [`super::sensors_obj`] with the colour as
 //! `red`, `green`, `blue` and the hours as a `sun_hours` property of each
-//! face (or point), for tools that read PLY (MeshLab, Open3D, trimesh).
+//! face (or point), for tools that read PLY (`MeshLab`, `Open3D`, `trimesh`).
 
 use glam::DVec3;
 
