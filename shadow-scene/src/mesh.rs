@@ -371,6 +371,20 @@ impl Mesh {
             .collect()
     }
 
+    /// Each face's unit normal by Newell's sum over its loop (zero for a
+    /// face without area), turned as its loop turns counter-clockwise.
+    ///
+    /// ```
+    /// let cube = shadow_scene::scene("cube").unwrap();
+    /// let up = cube.face_normals().into_iter().filter(|n| n.z == 1.0).count();
+    /// assert_eq!(up, 1);
+    /// ```
+    pub fn face_normals(&self) -> Vec<DVec3> {
+        (0..self.faces.len())
+            .map(|f| newell(&self.face_points(f)).normalize_or_zero())
+            .collect()
+    }
+
     /// The connected parts of the faces (faces sharing a vertex are in one
     /// part), numbered in the order of their first face: each face's part.
     ///
@@ -961,6 +975,12 @@ impl Mesh {
             group: f.group + groups,
         }));
     }
+}
+
+/// Newell normal of a loop (twice its vector area).
+pub(crate) fn newell(ring: &[DVec3]) -> DVec3 {
+    let n = ring.len();
+    (0..n).fold(DVec3::ZERO, |acc, i| acc + ring[i].cross(ring[(i + 1) % n]))
 }
 
 #[cfg(test)]

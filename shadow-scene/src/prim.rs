@@ -13,6 +13,7 @@ use std::ops::Range;
 
 use glam::DVec3;
 
+use crate::mesh::newell;
 use crate::{Face, Mesh};
 
 /// The design grid of generated scenes: `2^-10` input units (about a
@@ -62,12 +63,6 @@ pub(crate) fn regular(n: usize, phase_deg: f64) -> Vec<[f64; 2]> {
             [q(a.cos()), q(a.sin())]
         })
         .collect()
-}
-
-/// Newell normal of a loop (twice the vector area).
-fn newell(ring: &[DVec3]) -> DVec3 {
-    let n = ring.len();
-    (0..n).fold(DVec3::ZERO, |acc, i| acc + ring[i].cross(ring[(i + 1) % n]))
 }
 
 /// Six times the signed volume bounded by `faces`.

@@ -463,7 +463,7 @@ pub fn sun_hours_disc(
 ) -> Result<Vec<FaceHours>, crate::Error> {
     let faces = mesh.faces.len();
     let (mut area, mut seen) = (vec![0.0; faces], vec![0.0; faces]);
-    let normals: Vec<DVec3> = mesh.face_loops().iter().map(|p| newell(p)).collect();
+    let normals = mesh.face_normals();
     for &direction in suns {
         let disc = crate::SoftSpec::SunDisc {
             direction,
@@ -499,12 +499,6 @@ fn disc_in_front(height: f64, radius_deg: f64) -> f64 {
     }
     let h = height / r;
     ((-h).acos() + h * (1.0 - h * h).sqrt()) / std::f64::consts::PI
-}
-
-/// A polygon's unit normal by Newell's sum (zero for no area).
-fn newell(p: &[DVec3]) -> DVec3 {
-    let n: DVec3 = (0..p.len()).map(|i| p[i].cross(p[(i + 1) % p.len()])).sum();
-    n.normalize_or_zero()
 }
 
 /// One run's share of a study's sun-hours: for at most

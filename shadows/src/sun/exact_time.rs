@@ -169,7 +169,14 @@ impl SunPath {
     /// `up` (whose sun is up): none where `x` is in its plane or the
     /// triangle is wholly below the horizon (then so is every direction
     /// into it), else, per hour, the intersection of its three arcs.
-    fn hidden_by(&self, x: DVec3, t: &[DVec3; 3], up: &[usize], out: &mut Vec<Interval>) {
+    fn hidden_by(
+        &self,
+        x: DVec3,
+        t: &[DVec3; 3],
+        up: &[usize],
+        out: &mut Vec<Interval>,
+        [hidden, arc, next]: &mut [Vec<Interval>; 3],
+    ) {
         let [a, b, c] = t.map(|p| p - x);
         let det = a.dot(b.cross(c));
         if det == 0.0 || [a, b, c].iter().all(|g| g.dot(self.up) <= 0.0) {
@@ -178,15 +185,18 @@ impl SunPath {
         let s = det.signum();
         let w = [b.cross(c), c.cross(a), a.cross(b)].map(|w| s * w);
         for &k in up {
-            let mut hidden: Vec<Interval> = self.arc(k, w[0], 0.0).collect();
+            hidden.clear();
+            hidden.extend(self.arc(k, w[0], 0.0));
             for w in &w[1..] {
                 if hidden.is_empty() {
                     break;
                 }
-                let arc: Vec<Interval> = self.arc(k, *w, 0.0).collect();
-                hidden = intersect(&hidden, &arc);
+                arc.clear();
+                arc.extend(self.arc(k, *w, 0.0));
+                intersect_into(hidden, arc, next);
+                std::mem::swap(hidden, next);
             }
-            out.extend(hidden);
+            out.extend_from_slice(hidden);
         }
     }
 }
@@ -236,25 +246,28 @@ pub fn sensor_intervals(
     paths: &[SunPath],
 ) -> Vec<Vec<Vec<Interval>>> {
     let tris = triangles(mesh);
+    // each day's hours of sun above the horizon, and the hours they touch
+    let days: Vec<(Vec<Interval>, Vec<usize>)> = paths
+        .iter()
+        .map(|path| {
+            let up_hours = path.up_hours();
+            let up = (0..24)
+                .filter(|&k| (up_hours.iter()).any(|&(a, b)| a < (k + 1) as f64 && b > k as f64))
+                .collect();
+            (up_hours, up)
+        })
+        .collect();
     bsp_core::par::map(sensors.len(), |i| {
         let x = sensors[i];
-        paths
-            .iter()
-            .map(|path| {
-                let up_hours = path.up_hours();
-                let up: Vec<usize> = (0..24)
-                    .filter(|&k| {
-                        up_hours
-                            .iter()
-                            .any(|&(a, b)| a < (k + 1) as f64 && b > k as f64)
-                    })
-                    .collect();
+        let mut scratch = Default::default();
+        (paths.iter().zip(&days))
+            .map(|(path, (up_hours, up))| {
                 let mut hidden = Vec::new();
                 for t in &tris {
-                    path.hidden_by(x, t, &up, &mut hidden);
+                    path.hidden_by(x, t, up, &mut hidden, &mut scratch);
                 }
                 hidden.sort_by(|p, q| p.0.total_cmp(&q.0));
-                subtract(&up_hours, &merged(hidden))
+                subtract(up_hours, &merged(hidden))
             })
             .collect()
     })
@@ -341,8 +354,16 @@ fn scene_axes(site: &SunSite, v: DVec3) -> DVec3 {
 }
 
 /// The intersection of two sorted, disjoint interval lists.
+#[cfg(test)]
 fn intersect(p: &[Interval], q: &[Interval]) -> Vec<Interval> {
     let mut out = Vec::new();
+    intersect_into(p, q, &mut out);
+    out
+}
+
+/// [`intersect`] written to `out` (cleared first).
+fn intersect_into(p: &[Interval], q: &[Interval], out: &mut Vec<Interval>) {
+    out.clear();
     let (mut i, mut j) = (0, 0);
     while i < p.len() && j < q.len() {
         let (a, b) = (p[i].0.max(q[j].0), p[i].1.min(q[j].1));
@@ -355,7 +376,6 @@ fn intersect(p: &[Interval], q: &[Interval]) -> Vec<Interval> {
             j += 1;
         }
     }
-    out
 }
 
 /// Pushes `i` (starting at or after the last interval's start) onto

@@ -188,7 +188,7 @@ pub fn clip_to_outline(
                     break;
                 }
             }
-            let area = ring_area(&ring);
+            let area = svbsp::polygon_area(&ring);
             if ring.len() >= 3 && area > 0.0 {
                 out.push(RegionCell {
                     face: c.face,
@@ -218,14 +218,6 @@ fn clip_ring(ring: &[DVec3], side: impl Fn(DVec3) -> f64) -> Vec<DVec3> {
         }
     }
     out
-}
-
-/// A planar polygon's area.
-fn ring_area(ring: &[DVec3]) -> f64 {
-    let n: DVec3 = (1..ring.len().saturating_sub(1))
-        .map(|i| (ring[i] - ring[0]).cross(ring[i + 1] - ring[0]))
-        .sum();
-    n.length() / 2.0
 }
 
 /// The area of `cells` and the area of those that see at least `hours`
