@@ -343,17 +343,29 @@ pub fn soft_shadows(
     soft: &[SoftSpec],
 ) -> Result<SoftShadows, Error> {
     let grid = svbsp::shared_soft_grid(&mesh.positions, lights, soft).map_err(Error::Light)?;
-    let placed = svbsp::place_lights(&grid, lights).map_err(Error::Light)?;
-    let all = svbsp::place_soft_lights(&grid, &placed, soft).map_err(Error::Light)?;
     let (polys, _) =
         bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(Error::Import)?;
-    let faces = mesh.faces.len();
+    soft_shadows_on(grid, &polys, mesh.faces.len(), lights, soft)
+}
+
+/// [`soft_shadows`] of the `faces` faces of a mesh already snapped to
+/// `grid` (which must hold the lights' points) and imported as `polys`:
+/// what a study of sun discs shares between its suns.
+pub(crate) fn soft_shadows_on(
+    grid: Grid,
+    polys: &[Polygon],
+    faces: usize,
+    lights: &[LightSpec],
+    soft: &[SoftSpec],
+) -> Result<SoftShadows, Error> {
+    let placed = svbsp::place_lights(&grid, lights).map_err(Error::Light)?;
+    let all = svbsp::place_soft_lights(&grid, &placed, soft).map_err(Error::Light)?;
     let scene = SoftScene {
         name: "",
         faces,
         grid: &grid,
         lights: &all,
-        polys: &polys,
+        polys,
     };
     let (_, faces_of, fragments) = shade(&scene, &Quiet)?;
     let n = all.len();

@@ -464,12 +464,16 @@ pub fn sun_hours_disc(
     let faces = mesh.faces.len();
     let (mut area, mut seen) = (vec![0.0; faces], vec![0.0; faces]);
     let normals = mesh.face_normals();
+    // (discs add no point to the grid: the mesh snapped and imported once)
+    let grid = svbsp::shared_soft_grid(&mesh.positions, &[], &[]).map_err(crate::Error::Light)?;
+    let (polys, _) =
+        bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(crate::Error::Import)?;
     for &direction in suns {
         let disc = crate::SoftSpec::SunDisc {
             direction,
             radius_deg,
         };
-        let s = crate::soft_file::soft_shadows(mesh, &[], &[disc])?;
+        let s = crate::soft_file::soft_shadows_on(grid.clone(), &polys, faces, &[], &[disc])?;
         let d = direction.normalize();
         for f in 0..faces {
             area[f] = s.face_area(f);
