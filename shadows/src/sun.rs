@@ -473,7 +473,7 @@ pub fn sun_hours_disc(
             direction,
             radius_deg,
         };
-        let s = crate::soft_file::soft_shadows_on(grid.clone(), &polys, faces, &[], &[disc])?;
+        let s = crate::soft_file::soft_shadows_on(grid, &polys, faces, &[], &[disc])?;
         let d = direction.normalize();
         for f in 0..faces {
             area[f] = s.face_area(f);
