@@ -29,6 +29,10 @@ pub(crate) struct ArtArgs {
     /// most 0.5% of its wanted shadow (the paper's inner loop).
     #[arg(long)]
     optimize: bool,
+    /// Simplify each image's wanted region within PX pixels: fewer
+    /// corners and a smaller hull, the region then no longer the pixels'.
+    #[arg(long, value_name = "PX")]
+    simplify: Option<f64>,
     /// (Nothing to quiet: the report is on stdout.)
     #[arg(long, short)]
     quiet: bool,
@@ -37,21 +41,15 @@ pub(crate) struct ArtArgs {
 /// `shadow art`.
 pub(crate) fn run(args: &ArtArgs) -> Result<()> {
     let stl = MeshFormat::from_path(&args.output)? == MeshFormat::Stl;
-    let given = ArtSpec::load(&args.spec)?;
+    let mut given = ArtSpec::load(&args.spec)?;
+    given.simplify = args.simplify;
     let run = match args.optimize {
         true => optimize(&given, 0.005, 16)?,
         false => art::run(given)?,
     };
     let mesh = run.hull.mesh(stl);
     shadow_scene::save(&args.output, &mesh)?;
-    let mut text = format!(
-        "wrote {}: the shadow hull of {} views, {} triangles, volume {}\n",
-        args.output.display(),
-        run.spec.views.len(),
-        mesh.faces.len(),
-        run.hull.hull.volume()
-    );
-    text += &run.summary();
+    let mut text = run.said(&args.output, mesh.faces.len());
     if let Some(r) = &args.report {
         write_file(r, run.report_json().as_bytes())?;
         text += &format!("wrote {}\n", r.display());

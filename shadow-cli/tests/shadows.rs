@@ -942,6 +942,46 @@ fn art_makes_the_hull_its_report_and_pictures() {
     assert!(stdout(&o).contains("0 rounds of growing"), "{}", stdout(&o));
     let r: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(r["views"][0]["pixels_added"], 0);
+    // a staircase triangle simplified: fewer triangles, no extra shadow
+    let stairs: String = (0..12)
+        .flat_map(|r| (0..12).map(move |c| if c + r < 12 { "0 " } else { "255 " }))
+        .collect();
+    std::fs::write(dir.join("sq.pgm"), format!("P2\n12 12\n255\n{stairs}")).unwrap();
+    let spec = spec.replace("[4, 4, 2]", "[12, 12, 2]");
+    std::fs::write(dir.join("spec.json"), spec).unwrap();
+    let spec_path = dir.join("spec.json");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "art",
+            spec_path.to_str().unwrap(),
+            "-o",
+            hull.to_str().unwrap(),
+        ];
+        args.extend(["--report", report.to_str().unwrap()]);
+        args.extend(extra);
+        shadow(&args)
+    };
+    let triangles = |extra: &[&str]| {
+        let o = run(extra);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let r: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        (
+            r["hull"]["triangles"].as_u64().unwrap(),
+            r["views"][0].clone(),
+            stdout(&o),
+        )
+    };
+    let (pixels, _, _) = triangles(&[]);
+    let (fewer, view, said) = triangles(&["--simplify", "1.5"]);
+    assert!(fewer < pixels, "{fewer} against {pixels} triangles");
+    assert!(said.contains("simplified within 1.5 px"), "{said}");
+    // (78 pixels; within 1.5 px of the steps, between their two chords)
+    let wanted = view["wanted_area"].as_f64().unwrap();
+    assert!((72.0..=84.0).contains(&wanted), "{view}");
+    assert!(view["extra_area"].as_f64().unwrap() < 1e-9, "{view}");
+    assert!(view["missing_area"].as_f64().unwrap() < 1e-9, "{view}");
+    let o = run(&["--simplify", "0"]);
+    crate::assert_failed_with(&o, &["simplify within 0 pixels", "positive"]);
     // an all-white image is a clear error naming it
     std::fs::write(
         dir.join("sq.pgm"),

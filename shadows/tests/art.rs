@@ -38,6 +38,7 @@ fn spec(views: Vec<ArtView>, hi: DVec3) -> ArtSpec {
     ArtSpec {
         views,
         bounds: [DVec3::ZERO, hi],
+        simplify: None,
     }
 }
 
@@ -253,6 +254,77 @@ fn silhouettes_of_a_closed_mesh_come_back_but_for_boundary_pixels() {
             assert!(boundary, "pixel ({x}, {y}) missed inside the region");
         }
     }
+}
+
+#[test]
+fn simplified_silhouettes_give_a_smaller_hull_whose_shadows_are_the_simplified_images() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../data/meshes/pyvista_sphere.obj"
+    );
+    let sphere = bsp_shadows::read_mesh(path).unwrap();
+    let mut s = bsp_shadows::art::axis_silhouettes(&sphere, 96).unwrap();
+    let pixels = shadow_hull(&s).unwrap();
+    s.simplify = Some(1.5);
+    let simple = shadow_hull(&s).unwrap();
+    let (before, after) = (
+        pixels.hull.exact.triangles.len(),
+        simple.hull.exact.triangles.len(),
+    );
+    assert!(3 * after < before, "{after} triangles against {before}");
+    for (v, c) in s.views.iter().zip(simple.check(&s).unwrap()) {
+        let areas = (c.wanted_area, c.shadow_area, c.missing_area, c.extra_area);
+        // the wanted region moved by at most 1.5 pixels along its
+        // boundary (about 3.5 · 96 pixels long here)
+        let px = v.plane.normal().length();
+        let image = v.mask.count() as f64 * px;
+        assert!(
+            (c.wanted_area - image).abs() < 1.5 * 400.0 * px,
+            "{areas:?} {image}"
+        );
+        assert!(c.wanted_area != image, "{areas:?}");
+        // the hull lies in every (simplified) cone: no extra shadow
+        assert!(c.extra_area < 1e-6 * c.wanted_area, "{areas:?}");
+        assert!(c.missing_area <= 0.02 * c.wanted_area, "{areas:?}");
+        // partly wanted pixels are the simplified region's boundary
+        assert!(c.wanted.iter().any(|&w| w > 0.0 && w < 1.0));
+    }
+}
+
+#[test]
+fn simplifying_keeps_holes_and_islands() {
+    // a ring (radii 12 and 18) around an island (radius 4), and a pixel
+    // touching the ring's outside at a corner: simplified by 3 pixels,
+    // every cone stays closed and the components and the hole stay
+    let m = mask(40, |c, r| {
+        let d2 = (f64::from(c) - 19.5).powi(2) + (f64::from(r) - 19.5).powi(2);
+        (144.0..=324.0).contains(&d2) || d2 <= 16.0 || (c, r) == (15, 1)
+    });
+    let pixels = m.count() as f64;
+    let mut s = spec(
+        vec![floor(ArtLight::Sun(DVec3::Z), m)],
+        DVec3::new(40.0, 40.0, 1.0),
+    );
+    s.simplify = Some(3.0);
+    let hull = shadow_hull(&s).unwrap();
+    let c = &hull.check(&s).unwrap()[0];
+    // a prism of height 1: its volume and its shadow are the simplified
+    // region's area, which is not the pixels'
+    let areas = (c.wanted_area, c.shadow_area, c.missing_area, c.extra_area);
+    assert!(
+        (hull.hull.volume() - c.wanted_area).abs() < 1e-9,
+        "{areas:?}"
+    );
+    // (the hull's corners round to the shadows' grid)
+    let tiny = 1e-6 * c.wanted_area;
+    assert!(c.missing_area < tiny && c.extra_area < tiny, "{areas:?}");
+    assert!(c.wanted_area != pixels && (c.wanted_area - pixels).abs() < 0.1 * pixels);
+    // the island, the gap around it, the ring, and the corner pixel
+    let at = |x: usize, y: usize| c.wanted[y * 40 + x];
+    assert_eq!(at(19, 19), 1.0);
+    assert_eq!(at(19 + 8, 19), 0.0);
+    assert_eq!(at(19 + 15, 19), 1.0);
+    assert_eq!(at(15, 1), 1.0);
 }
 
 #[test]

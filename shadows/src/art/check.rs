@@ -21,6 +21,9 @@ pub struct ViewCheck {
     pub extra_area: f64,
     /// Per pixel (row by row), the share of it in the hull's shadow.
     pub coverage: Vec<f32>,
+    /// Per pixel, the share of it wanted: 0 or 1, but for a simplified
+    /// region ([`ArtSpec::simplify`]), the share its polygons cover.
+    pub wanted: Vec<f32>,
 }
 
 impl ViewCheck {
@@ -28,7 +31,7 @@ impl ViewCheck {
     pub fn missing_pixels(&self, view: &ArtView, share: f32) -> Vec<(u32, u32)> {
         let w = view.mask.width;
         (0..self.coverage.len())
-            .filter(|&p| view.mask.wanted[p] && self.coverage[p] < 1.0 - share)
+            .filter(|&p| self.wanted[p] > 0.0 && self.coverage[p] < self.wanted[p] - share)
             .map(|p| (p as u32 % w, p as u32 / w))
             .collect()
     }
@@ -39,26 +42,45 @@ impl ShadowHull {
     /// (the exact fragments of [`crate::shadows`], the image's rectangle a
     /// receiver facing the light), measured per pixel in `f64`.
     pub fn check(&self, spec: &ArtSpec) -> Result<Vec<ViewCheck>, ArtError> {
-        spec.views.iter().map(|v| self.check_view(v)).collect()
+        (spec.views.iter())
+            .map(|v| self.check_view(v, spec.simplify))
+            .collect()
     }
 
-    fn check_view(&self, view: &ArtView) -> Result<ViewCheck, ArtError> {
+    fn check_view(&self, view: &ArtView, simplify: Option<f64>) -> Result<ViewCheck, ArtError> {
         let coverage = shadow_coverage(&self.hull.mesh().to_mesh(), view)?;
         let mask = &view.mask;
         let px = view.plane.normal().length();
-        let wanted = mask.count() as f64 * px;
+        let (wanted, overlap, wanted_share) = match simplify {
+            None => {
+                let overlap: f64 = (coverage.iter().zip(&mask.wanted))
+                    .filter(|(_, w)| **w)
+                    .map(|(c, _)| c.min(1.0))
+                    .sum::<f64>();
+                let share = mask.wanted.iter().map(|&w| f32::from(u8::from(w)));
+                (mask.count() as f64 * px, overlap * px, share.collect())
+            }
+            Some(tolerance) => {
+                // the simplified polygons' share of each pixel; the
+                // shadow overlaps it by at most the lesser of the two
+                let share = simplified_coverage(view, tolerance)?;
+                let overlap: f64 = (coverage.iter().zip(&share)).map(|(c, w)| c.min(*w)).sum();
+                let wanted = share.iter().sum::<f64>() * px;
+                (
+                    wanted,
+                    overlap * px,
+                    share.iter().map(|&w| w as f32).collect(),
+                )
+            }
+        };
         let shadow: f64 = coverage.iter().sum::<f64>() * px;
-        let overlap: f64 = (coverage.iter().zip(&mask.wanted))
-            .filter(|(_, w)| **w)
-            .map(|(c, _)| c.min(1.0))
-            .sum::<f64>()
-            * px;
         Ok(ViewCheck {
             wanted_area: wanted,
             shadow_area: shadow,
             missing_area: (wanted - overlap).max(0.0),
             extra_area: (shadow - overlap).max(0.0),
             coverage: coverage.into_iter().map(|c| c.min(1.0) as f32).collect(),
+            wanted: wanted_share,
         })
     }
 }
@@ -70,8 +92,8 @@ impl ViewCheck {
     pub fn picture(&self, view: &ArtView) -> shadow_raster::Image {
         let (w, h) = (view.mask.width, view.mask.height);
         let mut img = shadow_raster::Image::new(w, h, [255, 255, 255]);
-        for (p, (&c, &wanted)) in self.coverage.iter().zip(&view.mask.wanted).enumerate() {
-            let c = f64::from(c);
+        for (p, (&c, &wanted)) in self.coverage.iter().zip(&self.wanted).enumerate() {
+            let (c, wanted) = (f64::from(c), wanted >= 0.5);
             let mix = |a: [f64; 3], b: [f64; 3], t: f64| {
                 std::array::from_fn::<u8, 3, _>(|k| (a[k] * t + b[k] * (1.0 - t)).round() as u8)
             };
@@ -128,6 +150,25 @@ pub fn shadow_coverage(mesh: &Mesh, view: &ArtView) -> Result<Vec<f64>, ArtError
             .rings
             .iter()
             .map(|r| r.iter().map(|&p| DVec2::from(pl.coords(p))).collect())
+            .collect();
+        cover(&rings, (mask.width, mask.height), &mut coverage);
+    }
+    Ok(coverage)
+}
+
+/// How much of each pixel of `view`'s image its wanted region, simplified
+/// within `tolerance` pixels, covers.
+fn simplified_coverage(view: &ArtView, tolerance: f64) -> Result<Vec<f64>, ArtError> {
+    let mask = &view.mask;
+    let parts = super::cone::wanted_region(view, Some(tolerance)).map_err(ArtError::Spec)?;
+    let mut coverage = vec![0.0f64; mask.wanted.len()];
+    for part in &parts {
+        let rings: Vec<Vec<DVec2>> = (part.loop_ranges())
+            .map(|r| {
+                let ring = part.corners[r].iter();
+                ring.map(|&[a, b]| DVec2::new(f64::from(a), f64::from(b)))
+                    .collect()
+            })
             .collect();
         cover(&rings, (mask.width, mask.height), &mut coverage);
     }
@@ -197,6 +238,7 @@ pub fn axis_silhouettes(mesh: &Mesh, n: u32) -> Result<super::ArtSpec, ArtError>
     Ok(super::ArtSpec {
         views,
         bounds: [lo - margin, hi + margin],
+        simplify: None,
     })
 }
 

@@ -5,7 +5,7 @@
 use glam::DVec3;
 use shadow_scene::{Face, Mesh};
 
-use super::region::{RegionError, region};
+use super::region::{Component, RegionError, region};
 use super::{ArtLight, ArtView};
 
 /// A mesh of triangles and quads, one group.
@@ -109,12 +109,13 @@ fn far_end(view: &ArtView, bounds: [DVec3; 2]) -> Result<Box<dyn Fn(DVec3) -> DV
     }
 }
 
-/// The cone of `view` up to just beyond `bounds`, as a closed mesh (each
-/// component of the wanted region a closed part; its faces turned
-/// outward).
-pub(crate) fn cone(view: &ArtView, bounds: [DVec3; 2]) -> Result<Mesh, String> {
-    let end = far_end(view, bounds)?;
-    let parts = region(&view.mask).map_err(|e| match e {
+/// The components of `view`'s wanted region, simplified within
+/// `simplify` pixels if given; an error names the image.
+pub(crate) fn wanted_region(
+    view: &ArtView,
+    simplify: Option<f64>,
+) -> Result<Vec<Component>, String> {
+    let parts = region(&view.mask, simplify).map_err(|e| match e {
         RegionError::TooLarge => format!(
             "{}: an image side above {} pixels",
             super::spec::name(&view.image),
@@ -131,6 +132,19 @@ pub(crate) fn cone(view: &ArtView, bounds: [DVec3; 2]) -> Result<Mesh, String> {
             super::spec::name(&view.image)
         ));
     }
+    Ok(parts)
+}
+
+/// The cone of `view` up to just beyond `bounds`, as a closed mesh (each
+/// component of the wanted region a closed part; its faces turned
+/// outward), its region simplified within `simplify` pixels if given.
+pub(crate) fn cone(
+    view: &ArtView,
+    bounds: [DVec3; 2],
+    simplify: Option<f64>,
+) -> Result<Mesh, String> {
+    let end = far_end(view, bounds)?;
+    let parts = wanted_region(view, simplify)?;
     let (mut positions, mut faces) = (Vec::new(), Vec::new());
     for part in &parts {
         let base = positions.len() as u32;

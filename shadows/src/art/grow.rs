@@ -82,6 +82,24 @@ impl ArtRun {
             .collect()
     }
 
+    /// What `shadow art` says: the hull written to `output` (as
+    /// `triangles` triangles), whether the images were simplified, then
+    /// the [`summary`](Self::summary).
+    pub fn said(&self, output: &std::path::Path, triangles: usize) -> String {
+        let mut text = format!(
+            "wrote {}: the shadow hull of {} views, {triangles} triangles, volume {}\n",
+            output.display(),
+            self.spec.views.len(),
+            self.hull.hull.volume()
+        );
+        if let Some(px) = self.spec.simplify {
+            text += &format!(
+                "the wanted regions simplified within {px} px (the areas below are theirs)\n"
+            );
+        }
+        text + &self.summary()
+    }
+
     /// For people, one line per view (its areas, and how it grew), then
     /// the rounds of growing.
     pub fn summary(&self) -> String {

@@ -22,6 +22,7 @@ mod check;
 pub(crate) mod cone;
 mod grow;
 mod region;
+mod simplify;
 mod spec;
 
 use std::path::PathBuf;
@@ -97,6 +98,11 @@ pub struct ArtSpec {
     pub views: Vec<ArtView>,
     /// The box's least and greatest corners.
     pub bounds: [DVec3; 2],
+    /// Simplify each image's wanted region within this many pixels
+    /// (`shadow art --simplify PX`): fewer corners and a smaller hull,
+    /// the region kept in shape but no longer the pixels' (see
+    /// `docs/shadow-art.md`). `None`: the pixels as they are.
+    pub simplify: Option<f64>,
 }
 
 /// Why a shadow-art job failed; each names the view (from 0) or file.
@@ -186,11 +192,19 @@ pub struct ShadowHull {
 /// oriented, watertight mesh, exactly ([`ArtError::Empty`] when it has no
 /// volume).
 pub fn shadow_hull(spec: &ArtSpec) -> Result<ShadowHull, ArtError> {
+    // (NaN is not above 0 either)
+    if let Some(px) = spec.simplify
+        && px.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+    {
+        return Err(ArtError::Spec(format!(
+            "simplify within {px} pixels: the tolerance must be a positive number"
+        )));
+    }
     let mut operands = vec![Operand::new("bounds", cone::cuboid(spec.bounds))];
     let mut cone_triangles = Vec::new();
     for (i, v) in spec.views.iter().enumerate() {
-        let mesh =
-            cone::cone(v, spec.bounds).map_err(|message| ArtError::View { view: i, message })?;
+        let mesh = cone::cone(v, spec.bounds, spec.simplify)
+            .map_err(|message| ArtError::View { view: i, message })?;
         cone_triangles.push(mesh.faces.len());
         operands.push(Operand::new(format!("cone {i}"), mesh));
     }

@@ -194,8 +194,10 @@ pub(crate) enum RegionError {
 
 /// The components of `mask`'s wanted region, each triangulated and
 /// checked: its triangles turn counter-clockwise and their areas add up
-/// to its pixels exactly.
-pub(crate) fn region(mask: &Mask) -> Result<Vec<Component>, RegionError> {
+/// to its pixels exactly. With `simplify`, the loops are first simplified
+/// within that many pixels ([`super::simplify`]), and the triangles add
+/// up to the simplified loops' area.
+pub(crate) fn region(mask: &Mask, simplify: Option<f64>) -> Result<Vec<Component>, RegionError> {
     if mask.width > MAX_SIDE || mask.height > MAX_SIDE {
         return Err(RegionError::TooLarge);
     }
@@ -212,9 +214,18 @@ pub(crate) fn region(mask: &Mask) -> Result<Vec<Component>, RegionError> {
     // per component: its outer loop, then its holes
     let mut outer: Vec<Option<Vec<[i32; 2]>>> = vec![None; count];
     let mut holes: Vec<Vec<Vec<[i32; 2]>>> = vec![Vec::new(); count];
-    for l in loops(mask) {
-        let (c, r) = left_pixel(&l);
-        let k = label[(r * mask.width as i64 + c) as usize] as usize;
+    let mut all = loops(mask);
+    // each loop's component, from its pixels before any simplification
+    let of: Vec<usize> = (all.iter())
+        .map(|l| {
+            let (c, r) = left_pixel(l);
+            label[(r * mask.width as i64 + c) as usize] as usize
+        })
+        .collect();
+    if let Some(tolerance) = simplify {
+        super::simplify::simplify(&mut all, tolerance);
+    }
+    for (l, k) in all.into_iter().zip(of) {
         if area2(&l) > 0 {
             outer[k] = Some(l);
         } else {
@@ -248,7 +259,12 @@ pub(crate) fn region(mask: &Mask) -> Result<Vec<Component>, RegionError> {
                 _ => {} // no area: nothing to tile
             }
         }
-        if sum != 2 * pixels[k] {
+        let loops_area2: i64 = loops
+            .iter()
+            .zip(loops[1..].iter().chain([&corners.len()]))
+            .map(|(&s, &e)| area2(&corners[s..e]))
+            .sum();
+        if sum != loops_area2 || simplify.is_none() && sum != 2 * pixels[k] {
             return Err(RegionError::Triangulation(pixel));
         }
         out.push(Component {
@@ -278,7 +294,7 @@ mod tests {
     #[test]
     fn a_ring_is_one_component_with_a_hole() {
         let m = mask(&["#####", "#...#", "#.#.#", "#...#", "#####"]);
-        let r = region(&m).unwrap();
+        let r = region(&m, None).unwrap();
         assert_eq!(r.len(), 2); // the ring and the island in it
         let ring = r.iter().find(|c| c.loops.len() == 2).unwrap();
         assert_eq!(ring.corners.len(), 8);
@@ -290,14 +306,14 @@ mod tests {
     fn pixels_touching_at_a_corner_are_apart() {
         // a diagonal, and a C whose tips touch at a corner
         let m = mask(&["#..", ".#.", "..#"]);
-        let r = region(&m).unwrap();
+        let r = region(&m, None).unwrap();
         assert_eq!(r.len(), 3);
         assert!(
             r.iter()
                 .all(|c| c.loops.len() == 1 && c.triangles.len() == 2)
         );
         let c = mask(&["###.", "#...", "#..#", "####"]);
-        let r = region(&c).unwrap();
+        let r = region(&c, None).unwrap();
         assert_eq!(r.len(), 1);
         // the tips touch the body at corners: one loop, no hole
         assert_eq!(r[0].loops.len(), 1);
@@ -319,7 +335,7 @@ mod tests {
             .collect();
         let rows: Vec<&str> = rows.iter().map(String::as_str).collect();
         let m = mask(&rows);
-        let r = region(&m).unwrap();
+        let r = region(&m, None).unwrap();
         let tiled: i64 = r
             .iter()
             .flat_map(|c| {

@@ -56,6 +56,7 @@ impl ArtSpec {
         Ok(ArtSpec {
             views,
             bounds: [lo, hi],
+            simplify: None,
         })
     }
 }
