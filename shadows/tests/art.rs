@@ -153,6 +153,23 @@ fn a_letter_shaped_region_with_holes_and_touching_corners() {
 }
 
 #[test]
+fn a_dithered_image_makes_a_closed_cone() {
+    // pixels touching at corners all over (where earcut's triangles met
+    // the walls in T-junctions, and the Booleans refused the open cone)
+    let rows = [
+        ".#.#.#..", "..##.###", "...#.###", "##.#...#", "..#.###.", "..##.###", "#..###.#",
+        "##.#.###",
+    ];
+    let m = mask(8, |c, r| rows[r as usize].as_bytes()[c as usize] == b'#');
+    let n = m.count() as f64;
+    let s = spec(
+        vec![floor(ArtLight::Sun(DVec3::Z), m)],
+        DVec3::new(8.0, 8.0, 1.0),
+    );
+    assert_eq!(shadow_hull(&s).unwrap().hull.volume(), n);
+}
+
+#[test]
 fn bad_views_are_named() {
     let hi = DVec3::new(4.0, 4.0, 2.0);
     let err = |s: ArtSpec| shadow_hull(&s).unwrap_err().to_string();

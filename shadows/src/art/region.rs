@@ -248,17 +248,19 @@ pub(crate) fn region(mask: &Mask, simplify: Option<f64>) -> Result<Vec<Component
         earcut.earcut(corners.iter().copied(), &holes, &mut tri);
         let triangles: Vec<[u32; 3]> = tri.chunks(3).map(|t| [t[0], t[1], t[2]]).collect();
         // earcut's triangles may turn either way: counter-clockwise here
-        let mut sum = 0;
         let mut ccw = Vec::with_capacity(triangles.len());
         for t in triangles {
             let a = area2(&t.map(|i| corners[i as usize]));
-            sum += a.abs();
             match a.signum() {
                 1 => ccw.push(t),
                 -1 => ccw.push([t[0], t[2], t[1]]),
-                _ => {} // no area: nothing to tile
+                _ => {} // no area: nothing to tile (its sides are mended)
             }
         }
+        let ccw = mend_t_junctions(&corners, ccw);
+        let sum: i64 = (ccw.iter())
+            .map(|t| area2(&t.map(|i| corners[i as usize])))
+            .sum();
         let loops_area2: i64 = loops
             .iter()
             .zip(loops[1..].iter().chain([&corners.len()]))
@@ -274,6 +276,71 @@ pub(crate) fn region(mask: &Mask, simplify: Option<f64>) -> Result<Vec<Component
         });
     }
     Ok(out)
+}
+
+/// Earcut's triangles tile the component, but where corners lie in a
+/// line (a hole or another passage of the loop touching it, triangles of
+/// no area) a triangle's side may pass through a corner, which the walls
+/// along the loop have as a vertex (a T-junction: the cone would not be
+/// closed). Each triangle with corners inside its sides is cut into
+/// triangles between all its corners; those of no area are left out.
+fn mend_t_junctions(corners: &[[i32; 2]], triangles: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
+    use std::collections::HashMap;
+    let at = |i: u32| corners[i as usize];
+    // (the first of corners at one place)
+    let index: HashMap<[i32; 2], u32> = (corners.iter().enumerate().rev())
+        .map(|(i, &c)| (c, i as u32))
+        .collect();
+    let mut out = Vec::with_capacity(triangles.len());
+    for t in triangles {
+        let mut polygon = Vec::with_capacity(3);
+        for k in 0..3 {
+            let (a, b) = (at(t[k]), at(t[(k + 1) % 3]));
+            polygon.push(t[k]);
+            // the side's grid points, in order from a to b
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let g = gcd(d[0].unsigned_abs(), d[1].unsigned_abs()) as i32;
+            let step = [d[0] / g.max(1), d[1] / g.max(1)];
+            let on_side = (1..g).map(|s| [a[0] + s * step[0], a[1] + s * step[1]]);
+            polygon.extend(on_side.filter_map(|p| index.get(&p).copied()));
+        }
+        if polygon.len() == 3 {
+            if area2(&t.map(at)) > 0 {
+                out.push(t);
+            }
+            continue;
+        }
+        // a convex polygon with corners along its sides: clip ears at
+        // its turning corners whose chords hold no corner
+        while polygon.len() > 3 {
+            let n = polygon.len();
+            let ear = (0..n).find(|&k| {
+                let (u, v, w) = (polygon[(k + n - 1) % n], polygon[k], polygon[(k + 1) % n]);
+                area2(&[at(u), at(v), at(w)]) > 0
+                    && !(polygon.iter())
+                        .any(|&x| x != u && x != w && on_segment(at(u), at(x), at(w)))
+            });
+            let Some(k) = ear else { break };
+            out.push([polygon[(k + n - 1) % n], polygon[k], polygon[(k + 1) % n]]);
+            polygon.remove(k);
+        }
+        if let [a, b, c] = polygon[..]
+            && area2(&[at(a), at(b), at(c)]) > 0
+        {
+            out.push([a, b, c]);
+        }
+    }
+    out
+}
+
+/// The greatest common divisor.
+fn gcd(a: u32, b: u32) -> u32 {
+    if b == 0 { a } else { gcd(b, a % b) }
+}
+
+/// Whether `m` lies on the closed segment `ab`.
+fn on_segment(a: [i32; 2], m: [i32; 2], b: [i32; 2]) -> bool {
+    area2(&[a, m, b]) == 0 && (0..2).all(|k| a[k].min(b[k]) <= m[k] && m[k] <= a[k].max(b[k]))
 }
 
 #[cfg(test)]
@@ -317,6 +384,29 @@ mod tests {
         assert_eq!(r.len(), 1);
         // the tips touch the body at corners: one loop, no hole
         assert_eq!(r[0].loops.len(), 1);
+    }
+
+    #[test]
+    fn no_triangle_side_passes_through_a_corner() {
+        // earcut's triangles along y = 6 here spanned corners of the loop
+        // and of the hole (T-junctions: the cone was not closed)
+        let rows = [
+            ".#.#.#..", "..##.###", "...#.###", "##.#...#", "..#.###.", "..##.###", "#..###.#",
+            "##.#.###",
+        ];
+        let m = mask(&rows);
+        for simplify in [None, Some(1.5)] {
+            for c in region(&m, simplify).unwrap() {
+                for t in &c.triangles {
+                    for k in 0..3 {
+                        let (a, b) = (c.corners[t[k] as usize], c.corners[t[(k + 1) % 3] as usize]);
+                        let through =
+                            (c.corners.iter()).any(|&p| p != a && p != b && on_segment(a, p, b));
+                        assert!(!through, "{a:?}-{b:?} passes through a corner");
+                    }
+                }
+            }
+        }
     }
 
     #[test]
