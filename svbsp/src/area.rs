@@ -361,18 +361,23 @@ impl AreaLight {
         }
         let reachable = vec![light];
         let mut seen = reachable.clone();
-        let mut hidden = false;
+        let (mut hidden, mut merged) = (false, 0);
         for o in occluders {
             let Some(cone) = shadow_volume(Light::Point(x), &o.polygon) else {
                 continue;
             };
             let mut next = Vec::with_capacity(seen.len());
             for piece in seen {
-                hidden |= subtract(&cone, piece, &mut next).is_some();
+                hidden |= subtract_unmerged(&cone, piece, &mut next).is_some();
             }
             seen = next;
             if seen.is_empty() {
                 break;
+            }
+            // merged as they pile up (later cones then meet fewer)
+            if seen.len() > 16 && seen.len() > 2 * merged {
+                merge_run(&mut seen, 0);
+                merged = seen.len();
             }
         }
         let visibility = match (seen.is_empty(), hidden) {
@@ -505,6 +510,20 @@ fn subtract(
     piece: Polygon,
     out: &mut Vec<Polygon>,
 ) -> Option<Polygon> {
+    let start = out.len();
+    let inside = subtract_unmerged(halfspaces, piece, out);
+    if inside.is_some() {
+        merge_run(out, start);
+    }
+    inside
+}
+
+/// [`subtract`] without merging the parts outside.
+fn subtract_unmerged(
+    halfspaces: &[(Plane, Side)],
+    piece: Polygon,
+    out: &mut Vec<Polygon>,
+) -> Option<Polygon> {
     // wholly outside one half-space: nothing to cut (the common case)
     let outside_one = halfspaces
         .iter()
@@ -533,7 +552,6 @@ fn subtract(
         out.extend(outside);
         rest = within;
     }
-    merge_run(out, start);
     Some(rest)
 }
 

@@ -494,7 +494,19 @@ fn fraction_at(
 ) -> Option<f64> {
     let n = face.plane().normal().map(|c| c as f64);
     let normal = DVec3::from_array(n).normalize();
-    let hiding = hiders.at(x).into_iter();
+    let mut near = hiders.at(x);
+    // nearest first: they hide the most, and the cones of those behind
+    // them then often meet only what is hidden already
+    near.sort_by_cached_key(|o| {
+        (o.corners().iter())
+            .map(|c| {
+                (0..3)
+                    .map(|k| (i64::from(c[k]) - i64::from(x[k])).pow(2))
+                    .sum::<i64>()
+            })
+            .min()
+    });
+    let hiding = near.into_iter();
     let xf = DVec3::from_array(x.map(f64::from));
     if light.plane().is_none() {
         let sky: Vec<DVec3> = light
