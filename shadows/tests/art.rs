@@ -246,13 +246,18 @@ fn specs_and_images_are_read_with_clear_errors() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-#[test]
-fn silhouettes_of_a_closed_mesh_come_back_but_for_boundary_pixels() {
+/// The repository's UV sphere (a closed mesh).
+fn sphere() -> bsp_shadows::Mesh {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../data/meshes/pyvista_sphere.obj"
     );
-    let sphere = bsp_shadows::read_mesh(path).unwrap();
+    bsp_shadows::read_mesh(path).unwrap()
+}
+
+#[test]
+fn silhouettes_of_a_closed_mesh_come_back_but_for_boundary_pixels() {
+    let sphere = sphere();
     let s = bsp_shadows::art::axis_silhouettes(&sphere, 96).unwrap();
     let views = s.views.clone();
     let hull = shadow_hull(&s).unwrap();
@@ -275,11 +280,7 @@ fn silhouettes_of_a_closed_mesh_come_back_but_for_boundary_pixels() {
 
 #[test]
 fn simplified_silhouettes_give_a_smaller_hull_whose_shadows_are_the_simplified_images() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../data/meshes/pyvista_sphere.obj"
-    );
-    let sphere = bsp_shadows::read_mesh(path).unwrap();
+    let sphere = sphere();
     let mut s = bsp_shadows::art::axis_silhouettes(&sphere, 96).unwrap();
     let pixels = shadow_hull(&s).unwrap();
     s.simplify = Some(1.5);
