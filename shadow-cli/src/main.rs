@@ -93,7 +93,8 @@ enum Command {
     /// Shadow art: the exact hull whose shadows make several images, and
     /// how much of each it gives.
     #[command(
-        after_help = "Examples:\n  shadow art geb.json -o geb.obj --report geb.json --images views/"
+        after_help = "Examples:\n  shadow art geb.json -o geb.obj --report geb.json --images views/\n  \
+                      shadow art bunny/spec.json -o hull.stl --simplify 1.5"
     )]
     Art(art::ArtArgs),
     /// Where the sun is at a place and time (NREL's SPA), in the scene's
