@@ -136,14 +136,15 @@ pub fn snap_one(
     faces.resize_with(n, || None);
     // each vertex snapped once, not once per face around it
     let snapped = bsp_core::internals::snap_positions(grid, mesh.positions);
-    type Run = (ImportReport, Vec<SolidFace>, i128);
+    type Run = (ImportReport, Vec<SolidFace>, i128, bool);
     let runs: Vec<Result<Run, bsp_core::Error>> =
         par::map_chunks_mut(&mut faces, CHUNK, |c, slots| {
             let loops = &mesh.faces[c * CHUNK..];
             let mut imp = bsp_core::internals::FaceImporter::default();
-            let (mut extra, mut six) = (Vec::new(), 0i128);
+            let (mut extra, mut six, mut turned) = (Vec::new(), 0i128, false);
             for (i, (slot, face)) in slots.iter_mut().zip(loops).enumerate() {
                 imp.indexed_snapped(grid, mesh.positions, &snapped, face, c * CHUNK + i, |p| {
+                    turned |= turned_over(mesh.positions, face, &p);
                     six += six_volume(&p);
                     let face = SolidFace::grid(p);
                     match slot {
@@ -152,17 +153,18 @@ pub fn snap_one(
                     }
                 })?;
             }
-            Ok((imp.finish(), extra, six))
+            Ok((imp.finish(), extra, six, turned))
         });
     // the first error in face order, as a sequential import gives
     let mut report = ImportReport::default();
     let mut sign = 0i128;
-    let mut extra = Vec::new();
+    let (mut extra, mut turned) = (Vec::new(), false);
     for run in runs {
-        let (r, e, six) = run.map_err(CsgError::Grid)?;
+        let (r, e, six, t) = run.map_err(CsgError::Grid)?;
         report.add(r);
         extra.extend(e);
         sign += six;
+        turned |= t;
     }
     if sign < 0 {
         return Err(CsgError::Inward { operand });
@@ -180,13 +182,37 @@ pub fn snap_one(
     // closed cycle but no manifold may touch itself or fold: their solid
     // is where the winding number is positive (one manifold shell is
     // clean or crosses itself; see the crate docs)
-    let solid = match shells(mesh) > 1
+    // (a sliver triangle that snapping turned over folds the surface: a
+    // result read back on a coarser grid, say)
+    let solid = match turned
+        || shells(mesh) > 1
         || check_closed_manifold(mesh.faces.iter().map(Vec::as_slice)).is_err()
     {
         true => solid.resolved()?,
         false => solid,
     };
     Ok((solid, report))
+}
+
+/// Whether snapping turned the triangle `face` over: its snapped polygon
+/// `p` (the whole triangle) faces the other way along its normal's largest
+/// axis than the triangle's `f64` corners, or they have no area in that
+/// projection (exact: Shewchuk's orientation of the corners as given, the
+/// grid's integer normal). Faces of more corners are not checked.
+fn turned_over(positions: &[DVec3], face: &[u32], p: &GridPolygon) -> bool {
+    use bsp_core::internals::ConvexFace;
+    if face.len() != 3 || p.corner_count() != 3 {
+        return false;
+    }
+    let n = p.support().normal();
+    let k = (0..3).max_by_key(|&k| n[k].unsigned_abs()).unwrap_or(0);
+    let (u, v) = ((k + 1) % 3, (k + 2) % 3);
+    let at = |i: usize| {
+        let q = positions[face[i] as usize].to_array();
+        robust::Coord { x: q[u], y: q[v] }
+    };
+    let o = robust::orient2d(at(0), at(1), at(2));
+    o == 0.0 || (o > 0.0) != (n[k] > 0)
 }
 
 /// The number of vertex-connected shells of `mesh`'s faces (by vertex

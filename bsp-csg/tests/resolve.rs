@@ -250,6 +250,85 @@ fn results_written_and_read_back_are_inputs_again() {
     }
 }
 
+/// A sphere less a box over `x > 0.1`, written as OBJ and read back,
+/// united with the sphere: on the new run's grid (finer: the box is gone)
+/// some of the part's sliver triangles at the cut turn over, folding its
+/// surface where it nearly coincides with the sphere's. Such an operand is
+/// resolved (before, the union stopped with an internal error while it
+/// was meshed); the volumes then add up: the union is the sphere and the
+/// part less the sphere, exactly.
+#[test]
+fn a_part_read_back_with_turned_slivers_unites_with_its_whole() {
+    let (positions, faces) = shapes::uv_sphere(1500);
+    let read = |text: String, name: &str| {
+        Operand::new(name, shadow_scene::parse_obj(&text, name).unwrap())
+    };
+    let cube = |lo: [f64; 3], hi: [f64; 3]| {
+        let v: Vec<DVec3> = (0..8)
+            .map(|i| {
+                let pick = |k: usize| if i >> k & 1 == 0 { lo[k] } else { hi[k] };
+                DVec3::new(pick(0), pick(1), pick(2))
+            })
+            .collect();
+        let f = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        obj_text(&v, &f.map(|f| f.to_vec()))
+    };
+    let sphere = obj_text(&positions, &faces);
+    let run = |a: Operand, b: Operand, op| {
+        let mut pair = [a, b];
+        let checked = Operand::check_all(&mut pair).unwrap();
+        FileBoolean::apply(checked, op, |_, _| {}).unwrap()
+    };
+    let part = run(
+        read(sphere.clone(), "sphere.obj"),
+        read(cube([0.1, -2.0, -2.0], [2.0, 2.0, 2.0]), "box.obj"),
+        BoolOp::Difference,
+    );
+    let mut bytes = Vec::new();
+    match part.rounded(false) {
+        Some(r) => shadow_scene::write_obj(&r.mesh, &mut bytes),
+        None => shadow_scene::write_obj(&part.mesh(), &mut bytes),
+    }
+    .unwrap();
+    let part = String::from_utf8(bytes).unwrap();
+    let with = |op| {
+        run(
+            read(sphere.clone(), "sphere.obj"),
+            read(part.clone(), "part.obj"),
+            op,
+        )
+    };
+    let union = with(BoolOp::Union);
+    let whole = run(
+        read(sphere.clone(), "sphere.obj"),
+        read(sphere.clone(), "sphere.obj"),
+        BoolOp::Intersection,
+    );
+    let beyond = run(
+        read(part.clone(), "part.obj"),
+        read(sphere.clone(), "sphere.obj"),
+        BoolOp::Difference,
+    );
+    // (each volume exact, rounded once: their sum within an ulp or two)
+    let (u, sum) = (union.volume(), whole.volume() + beyond.volume());
+    assert!(
+        (u - sum).abs() <= 4.0 * f64::EPSILON * u,
+        "{u} against {sum}"
+    );
+    assert!(
+        beyond.volume() < 1e-6 * whole.volume(),
+        "{}",
+        beyond.volume()
+    );
+}
+
 /// The nut and a copy moved by a skew fraction of its size: their
 /// results rounded to `f32` put the three corners of some triangles on
 /// one line (and make some vertices equal); as written they have no flat
