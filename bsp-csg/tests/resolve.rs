@@ -264,21 +264,8 @@ fn a_part_read_back_with_turned_slivers_unites_with_its_whole() {
         Operand::new(name, shadow_scene::parse_obj(&text, name).unwrap())
     };
     let cube = |lo: [f64; 3], hi: [f64; 3]| {
-        let v: Vec<DVec3> = (0..8)
-            .map(|i| {
-                let pick = |k: usize| if i >> k & 1 == 0 { lo[k] } else { hi[k] };
-                DVec3::new(pick(0), pick(1), pick(2))
-            })
-            .collect();
-        let f = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        obj_text(&v, &f.map(|f| f.to_vec()))
+        let (v, f) = shapes::indexed_box(DVec3::from(lo), DVec3::from(hi));
+        obj_text(&v, &f)
     };
     let sphere = obj_text(&positions, &faces);
     let run = |a: Operand, b: Operand, op| {

@@ -1415,17 +1415,7 @@ fn a_face_that_touches_itself_is_tiled_not_fanned() {
     let obj = scratch("pinched.obj");
     let text = "v 4 0 0\nv 6 0 0\nv 5 1 0\nv 6 2 0\nv 4 2 0\nf 1 2 3 4 5 3\n";
     std::fs::write(&obj, text).unwrap();
-    let json = scratch("pinched.json");
-    let o = shadow(&[
-        "shadows",
-        obj.to_str().unwrap(),
-        "--sun",
-        "0.3,-0.2,1",
-        "-o",
-        json.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v = shadows_json(&obj, &["--sun", "0.3,-0.2,1"], "pinched.json");
     assert_eq!(v["summary"]["area"], 2.0);
     assert_eq!(v["summary"]["lit_area"][0], 2.0);
 }
