@@ -4,6 +4,7 @@
 //! garden.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::{
     Cell, HeatView, HoursRun, area2, colored_vertex, face_frame, heat, heat_header, heat_picture,
@@ -96,9 +97,11 @@ pub struct RegionCell {
 /// those faces, as pieces, overlaid (their suns added; the overlay's
 /// clipping is `f64`, and a cell below 10⁻¹² of its face's area, a
 /// rounding sliver where two runs' boundaries coincide, is left out). A
-/// face under no sun is one cell of 0 hours. Faces in the order given,
-/// each face's cells in the overlay's order; the same bits for any
-/// thread count.
+/// face under no sun is one cell of 0 hours. A face's cells of equal
+/// hours that share an edge are then merged where their union is convex
+/// (decided by exact turns of their corners).
+/// Faces in the order given, each face's cells in the overlay's order;
+/// the same bits for any thread count.
 pub fn region_hours(
     mesh: &Mesh,
     suns: &[DVec3],
@@ -115,28 +118,204 @@ pub fn region_hours(
     let (_, _, cells, _) = study(mesh, suns, step_hours, pieces, |runs| {
         HoursRun::fold_cells(n, runs)
     })??;
-    let cells = cells.unwrap_or_else(|| vec![None; n]);
-    let mut out = Vec::new();
-    for &f in faces.iter().filter(|&&f| f < n) {
-        let (o, u, v) = face_frame(mesh, f);
-        let whole = || {
-            let ring = mesh.faces[f].vertices.iter().map(|&i| {
-                let p = mesh.positions[i as usize] - o;
-                glam::DVec2::new(p.dot(u), p.dot(v))
-            });
-            vec![(ring.collect(), 0)]
-        };
-        let face_cells: Vec<Cell> = cells[f].clone().unwrap_or_else(whole);
-        for (ring, seen) in face_cells {
-            out.push(RegionCell {
-                face: f,
-                hours: f64::from(seen) * step_hours,
-                area: area2(&ring).abs() / 2.0,
-                ring: ring.iter().map(|p| o + u * p.x + v * p.y).collect(),
-            });
+    let mut cells = cells.unwrap_or_else(|| vec![None; n]);
+    // (a face given twice gets a copy the first time)
+    let mut uses = vec![0_usize; n];
+    faces.iter().filter(|&&f| f < n).for_each(|&f| uses[f] += 1);
+    let per_face: Vec<(usize, Option<Vec<Cell>>)> = (faces.iter())
+        .filter(|&&f| f < n)
+        .map(|&f| {
+            uses[f] -= 1;
+            let face_cells = if uses[f] == 0 {
+                cells[f].take()
+            } else {
+                cells[f].clone()
+            };
+            (f, face_cells)
+        })
+        .collect();
+    // the faces' cells made and merged in parallel, in the faces' order
+    let out: Vec<Vec<RegionCell>> = per_face
+        .into_par_iter()
+        .map(|(f, face_cells)| {
+            let (o, u, v) = face_frame(mesh, f);
+            let whole = || {
+                let ring = mesh.faces[f].vertices.iter().map(|&i| {
+                    let p = mesh.positions[i as usize] - o;
+                    glam::DVec2::new(p.dot(u), p.dot(v))
+                });
+                vec![(ring.collect(), 0)]
+            };
+            let face_cells =
+                (face_cells.unwrap_or_else(whole).into_iter()).map(|(ring, seen)| RegionCell {
+                    face: f,
+                    hours: f64::from(seen) * step_hours,
+                    area: area2(&ring).abs() / 2.0,
+                    ring: ring.iter().map(|p| o + u * p.x + v * p.y).collect(),
+                });
+            merge_cells(face_cells.collect(), u.cross(v))
+        })
+        .collect();
+    Ok(out.into_iter().flatten().collect())
+}
+
+/// The corner's coordinates as bits (`-0.0` as `0.0`): equal corners
+/// have equal keys.
+fn corner_key(p: DVec3) -> [u64; 3] {
+    p.to_array().map(|x| (x + 0.0).to_bits())
+}
+
+/// The directed edges of a ring of corner ids, each as one key.
+fn edges(ids: &[u32]) -> impl Iterator<Item = u64> + '_ {
+    let n = ids.len();
+    (0..n).map(move |k| edge_key(ids[k], ids[(k + 1) % n]))
+}
+
+/// The key of the directed edge from corner `a` to corner `b`.
+fn edge_key(a: u32, b: u32) -> u64 {
+    u64::from(a) << 32 | u64::from(b)
+}
+
+/// One face's cells (convex, counter-clockwise about `normal`) with those
+/// of equal hours merged pairwise where they share an edge (its two
+/// corners equal to the bit) and their union is convex, until none do.
+/// Convexity is the exact sign of the turn at the two shared corners
+/// (`robust::orient2d` of the corners as written, seen along the
+/// normal's largest axis), and a corner where the union runs straight on
+/// is dropped; a merged cell's area is its parts'. Corners repeated in a
+/// row (edges of no length, from the clipping) are dropped first.
+/// Deterministic: a merged cell takes the place of its first part.
+pub(super) fn merge_cells(cells: Vec<RegionCell>, normal: DVec3) -> Vec<RegionCell> {
+    let flat = flat_along(normal);
+    // each corner an id, equal corners one
+    let mut corners: rustc_hash::FxHashMap<[u64; 3], u32> = Default::default();
+    corners.reserve(cells.len() * 2);
+    let mut cells: Vec<Option<(RegionCell, Vec<u32>)>> = (cells.into_iter())
+        .map(|mut c| {
+            c.ring.dedup_by_key(|p| corner_key(*p));
+            while c.ring.len() > 3 && corner_key(c.ring[0]) == corner_key(c.ring[c.ring.len() - 1])
+            {
+                c.ring.pop();
+            }
+            let ids = (c.ring.iter())
+                .map(|p| {
+                    let next = corners.len() as u32;
+                    *corners.entry(corner_key(*p)).or_insert(next)
+                })
+                .collect();
+            Some((c, ids))
+        })
+        .collect();
+    // each directed edge's cell (stale entries are checked on use)
+    let mut at: rustc_hash::FxHashMap<u64, usize> = Default::default();
+    at.reserve(cells.len() * 5);
+    for (i, c) in cells.iter().enumerate() {
+        if let Some((_, ids)) = c {
+            at.extend(edges(ids).map(|e| (e, i)));
         }
     }
-    Ok(out)
+    for i in 0..cells.len() {
+        // grow cell i while a neighbour of equal hours keeps it convex
+        while let Some((cell, ids)) = &cells[i] {
+            let found = edges(ids).enumerate().find_map(|(k, e)| {
+                // the reverse edge: its two ids swapped
+                let &j = at.get(&e.rotate_right(32))?;
+                match &cells[j] {
+                    Some((other, other_ids)) if j != i && other.hours == cell.hours => {
+                        let p = (&cell.ring[..], &ids[..]);
+                        merge_pair(p, k, (&other.ring, other_ids), &flat).map(|m| (j, m))
+                    }
+                    _ => None,
+                }
+            });
+            let Some((j, (ring, ids))) = found else {
+                break;
+            };
+            // the partner's edges, and those new at the seams, are now i's
+            for e in edges(&ids) {
+                if at.get(&e) != Some(&i) {
+                    at.insert(e, i);
+                }
+            }
+            let part = cells[j].take().map_or(0.0, |(c, _)| c.area);
+            if let Some((cell, old)) = &mut cells[i] {
+                cell.ring = ring;
+                cell.area += part;
+                *old = ids;
+            }
+        }
+    }
+    cells.into_iter().flatten().map(|(c, _)| c).collect()
+}
+
+/// The projection along `normal`'s largest axis that keeps a ring
+/// counter-clockwise about `normal` counter-clockwise (coordinates
+/// dropped, not computed: exact).
+fn flat_along(normal: DVec3) -> impl Fn(DVec3) -> robust::Coord<f64> {
+    let a = normal.abs();
+    let axis = if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    };
+    let mirror = normal[axis] < 0.0;
+    move |p: DVec3| {
+        let (x, y) = (p[(axis + 1) % 3], p[(axis + 2) % 3]);
+        if mirror {
+            robust::Coord { x: y, y: x }
+        } else {
+            robust::Coord { x, y }
+        }
+    }
+}
+
+/// The union of convex counter-clockwise rings `p` and `q` (corners and
+/// their ids) where `p`'s edge from corner `k` is `q`'s edge reversed, if
+/// it is convex (seen through `flat`) and they share no other corner;
+/// `None` otherwise.
+#[allow(clippy::type_complexity)] // (a ring's corners and their ids)
+fn merge_pair(
+    (p, pi): (&[DVec3], &[u32]),
+    k: usize,
+    (q, qi): (&[DVec3], &[u32]),
+    flat: &impl Fn(DVec3) -> robust::Coord<f64>,
+) -> Option<(Vec<DVec3>, Vec<u32>)> {
+    let (np, nq) = (p.len(), q.len());
+    let (a, b) = (pi[k], pi[(k + 1) % np]);
+    let m = (0..nq).find(|&m| qi[m] == b && qi[(m + 1) % nq] == a)?;
+    let turn = |u: DVec3, v: DVec3, w: DVec3| robust::orient2d(flat(u), flat(v), flat(w));
+    // p from b round to a, then q after a up to before b
+    let at_a = turn(p[(k + np - 1) % np], p[k], q[(m + 2) % nq]);
+    let at_b = turn(q[(m + nq - 1) % nq], q[m], p[(k + 2) % np]);
+    if at_a < 0.0 || at_b < 0.0 {
+        return None;
+    }
+    if qi.iter().filter(|c| pi.contains(c)).count() != 2 {
+        return None;
+    }
+    let (mut ring, mut ids) = (
+        Vec::with_capacity(np + nq - 2),
+        Vec::with_capacity(np + nq - 2),
+    );
+    for t in 1..=np {
+        let i = (k + t) % np;
+        let straight = if i == k {
+            at_a == 0.0
+        } else {
+            i == (k + 1) % np && at_b == 0.0
+        };
+        if !straight {
+            ring.push(p[i]);
+            ids.push(pi[i]);
+        }
+    }
+    for t in 2..nq {
+        ring.push(q[(m + t) % nq]);
+        ids.push(qi[(m + t) % nq]);
+    }
+    Some((ring, ids))
 }
 
 /// `cells` cut to the upright prism over `outline` (a closed polygon,

@@ -288,6 +288,47 @@ fn runs_files_and_heat_maps_of_a_yard() {
     );
 }
 
+/// A face's cells of equal hours merge where their union is convex, and
+/// only there: four unit squares, three of one count in an L.
+#[test]
+fn equal_cells_merge_where_convex() {
+    let square = |x: f64, y: f64, hours: f64| RegionCell {
+        face: 0,
+        hours,
+        area: 1.0,
+        ring: [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+            .map(|(dx, dy)| DVec3::new(x + dx, y + dy, 0.0))
+            .to_vec(),
+    };
+    let cells = vec![
+        square(0.0, 0.0, 1.0),
+        square(1.0, 0.0, 1.0),
+        square(0.0, 1.0, 1.0),
+        square(1.0, 1.0, 2.0),
+    ];
+    let merged = regions::merge_cells(cells, DVec3::Z);
+    // the bottom row is one rectangle (its straight corners dropped); the
+    // L it would make with the square above is not convex
+    assert_eq!(merged.len(), 3, "{merged:?}");
+    let bottom = &merged[0];
+    assert_eq!((bottom.hours, bottom.area), (1.0, 2.0));
+    let mut corners: Vec<(f64, f64)> = bottom.ring.iter().map(|p| (p.x, p.y)).collect();
+    corners.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    assert_eq!(corners, [(0.0, 0.0), (0.0, 1.0), (2.0, 0.0), (2.0, 1.0)]);
+    assert_eq!((merged[1].hours, merged[2].hours), (1.0, 2.0));
+    // a column of equal squares is one cell, whatever their order
+    let column = || {
+        vec![
+            square(0.0, 2.0, 3.0),
+            square(0.0, 0.0, 3.0),
+            square(0.0, 1.0, 3.0),
+        ]
+    };
+    let one = regions::merge_cells(column(), DVec3::Z);
+    assert_eq!(one.len(), 1);
+    assert_eq!((one[0].ring.len(), one[0].area), (4, 3.0));
+}
+
 #[test]
 fn regions_of_a_yard() {
     let (mesh, suns, step, _) = equinox_study();
@@ -297,6 +338,37 @@ fn regions_of_a_yard() {
     let ground: RegionFaces = "0".parse().unwrap();
     let cells = region_hours(&mesh, &suns, step, &ground.faces(&mesh).unwrap()).unwrap();
     assert!(cells.len() > 10 && cells.iter().all(|c| c.face == 0));
+    // merged: no two cells of equal hours share an edge (corners equal to
+    // the bit) and no other corner where their union would be convex (no
+    // reflex turn at either end of the edge, by exact signs); no corner
+    // repeats
+    let turn = |a: DVec3, b: DVec3, c: DVec3| {
+        let p = |v: DVec3| robust::Coord { x: v.x, y: v.y };
+        robust::orient2d(p(a), p(b), p(c))
+    };
+    for (i, p) in cells.iter().enumerate() {
+        let n = p.ring.len();
+        assert!((0..n).all(|k| p.ring[k] != p.ring[(k + 1) % n]), "{p:?}");
+        for q in cells.iter().skip(i + 1).filter(|q| q.hours == p.hours) {
+            let (np, nq) = (p.ring.len(), q.ring.len());
+            for k in 0..np {
+                let (a, b) = (p.ring[k], p.ring[(k + 1) % np]);
+                let Some(m) = (0..nq).find(|&m| q.ring[m] == b && q.ring[(m + 1) % nq] == a) else {
+                    continue;
+                };
+                let common = (q.ring.iter()).filter(|c| p.ring.contains(c)).count();
+                if common > 2 {
+                    continue;
+                }
+                let at_a = turn(p.ring[(k + np - 1) % np], a, q.ring[(m + 2) % nq]);
+                let at_b = turn(q.ring[(m + nq - 1) % nq], b, p.ring[(k + 2) % np]);
+                assert!(
+                    at_a < 0.0 || at_b < 0.0,
+                    "{p:?} and {q:?} make a convex cell"
+                );
+            }
+        }
+    }
     let g = &hours[0];
     let (total, sunny) = area_in_sun(&cells, 6.0);
     assert!((total - g.area).abs() < 1e-9 * g.area, "{total} {}", g.area);
