@@ -2,12 +2,13 @@
 //! closed torus of 10k and 100k triangles.
 //!
 //! One million triangles are out of the default run: set `BSP_BENCH_1M`
-//! to `soup` (or `1`) for the soup, about 10 s per build, to `torus` for
-//! the torus, or to `all`. The torus's tree is a near-chain (an
-//! autopartition of a convex patch must be one: every face plane has the
-//! other faces behind it), so its build is quadratic: 33 s of CPU at 200k
-//! triangles, 330 s at 400k, well over half an hour at 1M, and criterion
-//! wants ten builds. See `docs/benchmarks.md`.
+//! to `soup` (or `1`) for the soup, about 13 s per build, to `torus` for
+//! the torus (about 26 s), or to `all`; criterion wants ten builds each.
+//! An autopartition of a convex patch is a chain (every face plane has
+//! the other faces behind it), so the torus is the case the default's
+//! balance cuts are for: without them (`with_cut_threshold(0)`) its build
+//! is quadratic, 10.6 s at 100k and well over half an hour at 1M. See
+//! `docs/benchmarks.md`.
 //!
 //! Criterion reports time only; the fragment count, node count and depth
 //! of each tree, and the time of one build, are printed to stderr before

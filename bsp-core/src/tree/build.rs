@@ -122,7 +122,7 @@ fn balance_cut(polys: &[Polygon]) -> Option<Plane> {
 }
 
 fn choose_plane(polys: &[Polygon], opts: &BuildOptions, rng: &mut SplitMix) -> Plane {
-    choose_plane_sides(polys, opts, rng, &mut Vec::new()).0
+    choose_plane_sides(polys, opts, rng, &mut Vec::new()).0.0
 }
 
 /// [`choose_plane`], and whether `sides` holds every polygon's side of
@@ -133,10 +133,10 @@ fn choose_plane_sides(
     opts: &BuildOptions,
     rng: &mut SplitMix,
     sides: &mut Vec<PolygonSide>,
-) -> (Plane, bool) {
+) -> ((Plane, bool), bool) {
     let n = polys.len();
     if n <= 2 {
-        return (*polys[0].support(), false);
+        return ((*polys[0].support(), false), false);
     }
     let k = opts.candidates.min(n);
     let s = opts.sample.min(n);
@@ -148,7 +148,7 @@ fn choose_plane_sides(
     // the best candidate's sides, and the current one's
     let mut these: Vec<PolygonSide> = Vec::with_capacity(s);
     sides.clear();
-    let mut best = (u64::MAX, *polys[0].support());
+    let mut best = (u64::MAX, *polys[0].support(), false);
     let mut tried: smallvec::SmallVec<[Plane; 8]> = smallvec::SmallVec::new();
     for c in 0..k {
         let plane = if k == n {
@@ -175,11 +175,14 @@ fn choose_plane_sides(
         }
         let score = opts.split_weight as u64 * sp + f.abs_diff(b);
         if score < best.0 {
-            best = (score, plane);
+            // lopsided: the smaller side and the plane itself each hold
+            // under an eighth of the sample
+            let on = s as u64 - f - b - sp;
+            best = (score, plane, 8 * f.min(b) < s as u64 && 8 * on < s as u64);
             std::mem::swap(sides, &mut these);
         }
     }
-    (best.1, s == n)
+    ((best.1, s == n), best.2)
 }
 
 /// A node's cut: its plane, the polygons in the plane, and the lists in
@@ -231,15 +234,19 @@ pub(super) fn grow<A>(
 }
 
 impl BspTree {
-    /// An autopartition of `polygons`: every partitioning plane is the
-    /// support plane of an input polygon; coplanar polygons of both
+    /// A tree of `polygons`: every partitioning plane is the support
+    /// plane of an input polygon, but for the balance cuts of long lists
+    /// whose best polygon plane is lopsided
+    /// ([`BuildOptions::cut_threshold`]; none with 0, a pure
+    /// autopartition); coplanar polygons of both
     /// orientations stay at their node. Uses an explicit stack, so any
     /// depth is fine.
     pub fn build(polygons: Vec<Polygon>, opts: &BuildOptions) -> BspTree {
         let mut rng = SplitMix(opts.seed);
         let mut sides = Vec::new();
         grow(polygons, (), |polys, ()| {
-            let cut = if opts.cut_threshold > 0 && polys.len() > opts.cut_threshold {
+            let ((plane, known), lopsided) = choose_plane_sides(&polys, opts, &mut rng, &mut sides);
+            let cut = if lopsided && opts.cut_threshold > 0 && polys.len() > opts.cut_threshold {
                 balance_cut(&polys)
             } else {
                 None
@@ -248,7 +255,6 @@ impl BspTree {
                 let (on, front, back) = partition_list(polys, &plane);
                 return ((plane, on, front, back), (), ());
             }
-            let (plane, known) = choose_plane_sides(&polys, opts, &mut rng, &mut sides);
             let (on, front, back) = if known {
                 partition_known(polys, &plane, &sides)
             } else {

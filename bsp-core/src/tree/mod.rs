@@ -78,7 +78,7 @@ pub enum Order {
 /// explicit stack.
 pub const RECURSION_LIMIT: usize = 2048;
 
-/// Options of the autopartition build.
+/// Options of the tree build: an autopartition with balance cuts.
 ///
 /// At every node, `candidates` polygons of the node's list are tried as
 /// the partitioning plane; each is scored on a sample of `sample` polygons
@@ -95,18 +95,23 @@ pub struct BuildOptions {
     pub split_weight: u32,
     /// Seed of the deterministic sampling.
     pub seed: u64,
-    /// Lists longer than this are first cut by an axis-aligned plane
-    /// through the median polygon position (a *balance cut*) instead of a
-    /// polygon's plane; 0 (the default) builds a pure autopartition.
+    /// Lists longer than this may be cut by an axis-aligned plane through
+    /// the median polygon position (a *balance cut*) instead of a
+    /// polygon's plane; 0 builds a pure autopartition. The default is 128.
     ///
     /// A convex mesh makes an autopartition a chain as deep as its face
-    /// count; balance cuts bound the depth by about `log2(n / threshold)`
-    /// plus the length of the chains inside cells of `threshold` polygons,
-    /// at the price of some extra fragments. A cut is only made when both
-    /// sides keep polygons and neither keeps more than three quarters of
-    /// them (spanning polygons count twice); otherwise the node is an
-    /// ordinary autopartition node. So every empty leaf still hangs below a
-    /// polygon's plane and the solid labelling stays valid.
+    /// count (every face's plane has the others behind it), and the build
+    /// quadratic; balance cuts bound the depth by about `log2(n /
+    /// threshold)` plus the length of the chains inside cells of
+    /// `threshold` polygons. A balance cut is tried only where the best
+    /// polygon plane found is lopsided (its smaller side and the plane
+    /// itself each hold under an eighth of the sampled polygons), and made
+    /// only when both sides keep polygons and neither keeps more than
+    /// three quarters of them (spanning polygons count twice); otherwise
+    /// the node is an ordinary autopartition node. So a scene the
+    /// autopartition splits well (a city's blocks, a room) keeps its tree,
+    /// and every empty leaf still hangs below a polygon's plane: the solid
+    /// labelling stays valid.
     pub cut_threshold: usize,
 }
 
@@ -117,7 +122,7 @@ impl Default for BuildOptions {
             sample: 48,
             split_weight: 4,
             seed: 0x5eed_b5b7,
-            cut_threshold: 0,
+            cut_threshold: 128,
         }
     }
 }
@@ -320,11 +325,12 @@ mod tests {
         assert!(!BspTree::build(faces, &BuildOptions::default()).faces_agree());
     }
 
+    /// The default build of a convex patch, which an autopartition makes a
+    /// chain as deep as its faces, is shallow: balance cuts keep at most
+    /// three quarters a side, so about `log(n / 128) / log(4/3)` of them
+    /// above chains of at most 128.
     #[test]
-    fn deep_chain_does_not_overflow() {
-        // the side faces of a convex prism over the parabola y = x^2: every
-        // face has all others behind it, so the tree is a chain as deep as
-        // the face count whatever the heuristic picks
+    fn default_build_of_a_convex_patch_is_shallow() {
         let n = 5_000;
         let polys: Vec<Polygon> = (-n..n)
             .map(|i: i32| {
@@ -334,6 +340,29 @@ mod tests {
             })
             .collect();
         let t = BspTree::build(polys, &BuildOptions::default());
+        t.sanity_check().unwrap();
+        let s = t.stats();
+        let levels = ((2 * n) as f64 / 128.0).ln() / (4.0_f64 / 3.0).ln();
+        assert!(s.depth <= 128 + levels.ceil() as usize + 2, "{s:?}");
+        // fragment growth at most 2.5 over the 2n faces
+        assert!(2 * s.polygons <= 5 * (2 * n as usize), "{s:?}");
+    }
+
+    #[test]
+    fn deep_chain_does_not_overflow() {
+        // the side faces of a convex prism over the parabola y = x^2: every
+        // face has all others behind it, so an autopartition is a chain
+        // as deep as the face count whatever the heuristic picks
+        let n = 5_000;
+        let polys: Vec<Polygon> = (-n..n)
+            .map(|i: i32| {
+                let (a, b) = ([i, i * i, 0], [i + 1, (i + 1) * (i + 1), 0]);
+                let up = |p: [i32; 3]| [p[0], p[1], 1];
+                Polygon::from_grid_points(&[a, b, up(b), up(a)], (i + n) as u32).unwrap()
+            })
+            .collect();
+        // (a pure autopartition: balance cuts would make it shallow)
+        let t = BspTree::build(polys, &BuildOptions::default().with_cut_threshold(0));
         assert_eq!(t.stats().depth, 2 * n as usize);
         let eye = ViewPoint::new([0, -10, 0]).unwrap();
         let (mut a, mut b) = (vec![], vec![]);
@@ -419,10 +448,12 @@ mod tests {
             }
         }
         let shown = |t: &BspTree| format!("{:?} {:?}", t.root, t.nodes);
+        // (the reference makes no balance cuts)
+        let pure = BuildOptions::default().with_cut_threshold(0);
         for opts in [
-            BuildOptions::default(),
-            BuildOptions::default().with_candidates(4).with_sample(16),
-            BuildOptions::default().with_candidates(3).with_sample(5000),
+            pure.clone(),
+            pure.clone().with_candidates(4).with_sample(16),
+            pure.with_candidates(3).with_sample(5000),
         ] {
             for part in [&polys[..25], &polys[300..340], &polys[..]] {
                 let built = BspTree::build(part.to_vec(), &opts);

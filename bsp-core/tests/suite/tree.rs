@@ -611,8 +611,8 @@ fn eyes_on_partition_planes() {
 }
 
 /// The side faces of a convex prism over the parabola `y = x^2`: every
-/// face has all others behind it, so the tree is a chain deeper than
-/// [`RECURSION_LIMIT`] whatever the heuristic picks. The recursive
+/// face has all others behind it, so an autopartition is a chain deeper
+/// than [`RECURSION_LIMIT`] whatever the heuristic picks. The recursive
 /// traversal hands over to the explicit stack and still agrees with the
 /// others, and the order is right along a few rays.
 #[test]
@@ -629,7 +629,8 @@ fn chain_deeper_than_the_recursion_limit() {
         .enumerate()
         .map(|(i, l)| Polygon::from_grid_points(l, i as u32).expect("planar convex quad"))
         .collect();
-    let opts = BuildOptions::default();
+    // a pure autopartition (balance cuts would make the tree shallow)
+    let opts = BuildOptions::default().with_cut_threshold(0);
     let depth = BspTree::build(polys, &opts).stats().depth;
     assert!(depth > RECURSION_LIMIT, "depth {depth}");
     let eyes = [[0, -10, 0], [3, 1 << 40, 1], [n as i64 + 5, 0, 7]];

@@ -69,7 +69,10 @@ pub(crate) fn solid(
 /// saves more time than its slightly larger trees cost
 /// (`docs/bench-csg.md`).
 fn local_build() -> BuildOptions {
-    BuildOptions::default().with_candidates(4).with_sample(16)
+    BuildOptions::default()
+        .with_candidates(4)
+        .with_sample(16)
+        .with_cut_threshold(0)
 }
 
 /// [`solid`] from the autopartition `tree` of the pieces.
@@ -215,7 +218,7 @@ pub(crate) fn positive_region(faces: Vec<Polygon>) -> Result<Vec<Polygon>, CsgEr
     };
     let corner = bx.0.map(|c| c - 1);
     let bx: IBox = (bx.0.map(|c| c - 2), bx.1.map(|c| c + 2));
-    let tree = BspTree::build(faces, &BuildOptions::default());
+    let tree = BspTree::build(faces, &BuildOptions::default().with_cut_threshold(0));
     let (part, leaves) = Partition::from_tree_in(&tree, &walls(&bx));
     let corner = bsp_core::Point::Grid(corner.map(|c| c as i32));
     let start = part.locate(&corner);
