@@ -242,16 +242,36 @@ impl BspTree {
     /// orientations stay at their node. Uses an explicit stack, so any
     /// depth is fine.
     pub fn build(polygons: Vec<Polygon>, opts: &BuildOptions) -> BspTree {
+        BspTree::build_cutting(polygons, opts, false)
+    }
+
+    /// [`BspTree::build`], trying a balance cut first on every list above
+    /// the threshold, lopsided or not (`always`), as [`crate::Partition`]'s
+    /// solids do: their set operations' results have fewer polygons so.
+    pub(crate) fn build_cutting(
+        polygons: Vec<Polygon>,
+        opts: &BuildOptions,
+        always: bool,
+    ) -> BspTree {
         let mut rng = SplitMix(opts.seed);
         let mut sides = Vec::new();
+        let long = |polys: &[Polygon]| opts.cut_threshold > 0 && polys.len() > opts.cut_threshold;
         grow(polygons, (), |polys, ()| {
+            let balanced =
+                |polys: &[Polygon]| balance_cut(polys).filter(|c| cut_balances(polys, c));
+            if always
+                && long(&polys)
+                && let Some(plane) = balanced(&polys)
+            {
+                let (on, front, back) = partition_list(polys, &plane);
+                return ((plane, on, front, back), (), ());
+            }
             let ((plane, known), lopsided) = choose_plane_sides(&polys, opts, &mut rng, &mut sides);
-            let cut = if lopsided && opts.cut_threshold > 0 && polys.len() > opts.cut_threshold {
-                balance_cut(&polys)
-            } else {
-                None
-            };
-            if let Some(plane) = cut.filter(|c| cut_balances(&polys, c)) {
+            if !always
+                && lopsided
+                && long(&polys)
+                && let Some(plane) = balanced(&polys)
+            {
                 let (on, front, back) = partition_list(polys, &plane);
                 return ((plane, on, front, back), (), ());
             }

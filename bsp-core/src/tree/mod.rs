@@ -325,6 +325,18 @@ mod tests {
         assert!(!BspTree::build(faces, &BuildOptions::default()).faces_agree());
     }
 
+    /// The `2 n` side faces of a convex prism over the parabola `y = x²`:
+    /// every face has all the others behind it.
+    fn parabola_prism(n: i32) -> Vec<Polygon> {
+        (-n..n)
+            .map(|i: i32| {
+                let (a, b) = ([i, i * i, 0], [i + 1, (i + 1) * (i + 1), 0]);
+                let up = |p: [i32; 3]| [p[0], p[1], 1];
+                Polygon::from_grid_points(&[a, b, up(b), up(a)], (i + n) as u32).unwrap()
+            })
+            .collect()
+    }
+
     /// The default build of a convex patch, which an autopartition makes a
     /// chain as deep as its faces, is shallow: balance cuts keep at most
     /// three quarters a side, so about `log(n / 128) / log(4/3)` of them
@@ -332,13 +344,7 @@ mod tests {
     #[test]
     fn default_build_of_a_convex_patch_is_shallow() {
         let n = 5_000;
-        let polys: Vec<Polygon> = (-n..n)
-            .map(|i: i32| {
-                let (a, b) = ([i, i * i, 0], [i + 1, (i + 1) * (i + 1), 0]);
-                let up = |p: [i32; 3]| [p[0], p[1], 1];
-                Polygon::from_grid_points(&[a, b, up(b), up(a)], (i + n) as u32).unwrap()
-            })
-            .collect();
+        let polys = parabola_prism(n);
         let t = BspTree::build(polys, &BuildOptions::default());
         t.sanity_check().unwrap();
         let s = t.stats();
@@ -354,13 +360,7 @@ mod tests {
         // face has all others behind it, so an autopartition is a chain
         // as deep as the face count whatever the heuristic picks
         let n = 5_000;
-        let polys: Vec<Polygon> = (-n..n)
-            .map(|i: i32| {
-                let (a, b) = ([i, i * i, 0], [i + 1, (i + 1) * (i + 1), 0]);
-                let up = |p: [i32; 3]| [p[0], p[1], 1];
-                Polygon::from_grid_points(&[a, b, up(b), up(a)], (i + n) as u32).unwrap()
-            })
-            .collect();
+        let polys = parabola_prism(n);
         // (a pure autopartition: balance cuts would make it shallow)
         let t = BspTree::build(polys, &BuildOptions::default().with_cut_threshold(0));
         assert_eq!(t.stats().depth, 2 * n as usize);
