@@ -66,23 +66,23 @@ impl BspTree {
         order: Order,
         visit: &mut impl FnMut(NodeId, &Node),
     ) {
-        enum Item {
-            Visit(Link),
-            Emit(NodeId),
-        }
-        let mut stack = vec![Item::Visit(start)];
-        while let Some(item) = stack.pop() {
-            match item {
-                Item::Visit(Link::Cell(_)) => {}
-                Item::Visit(Link::Node(id)) => {
-                    let n = &self.nodes[id as usize];
-                    let (first, second) = Self::children_in_order(n, in_front(&n.plane), order);
-                    stack.push(Item::Visit(second));
-                    stack.push(Item::Emit(id));
-                    stack.push(Item::Visit(first));
-                }
-                Item::Emit(id) => visit(id, &self.nodes[id as usize]),
+        // the nodes whose first subtree is being walked, each with its
+        // second subtree: a node is emitted when popped, then its second
+        // subtree walked (in order, no entry for a leaf)
+        let mut stack: Vec<(NodeId, Link)> = Vec::new();
+        let mut at = start;
+        loop {
+            while let Link::Node(id) = at {
+                let n = &self.nodes[id as usize];
+                let (first, second) = Self::children_in_order(n, in_front(&n.plane), order);
+                stack.push((id, second));
+                at = first;
             }
+            let Some((id, second)) = stack.pop() else {
+                return;
+            };
+            visit(id, &self.nodes[id as usize]);
+            at = second;
         }
     }
 
