@@ -242,39 +242,31 @@ impl BspTree {
     /// orientations stay at their node. Uses an explicit stack, so any
     /// depth is fine.
     pub fn build(polygons: Vec<Polygon>, opts: &BuildOptions) -> BspTree {
-        BspTree::build_cutting(polygons, opts, false)
-    }
-
-    /// [`BspTree::build`], trying a balance cut first on every list above
-    /// the threshold, lopsided or not (`always`), as [`crate::Partition`]'s
-    /// solids do: their set operations' results have fewer polygons so.
-    pub(crate) fn build_cutting(
-        polygons: Vec<Polygon>,
-        opts: &BuildOptions,
-        always: bool,
-    ) -> BspTree {
         let mut rng = SplitMix(opts.seed);
         let mut sides = Vec::new();
-        let long = |polys: &[Polygon]| opts.cut_threshold > 0 && polys.len() > opts.cut_threshold;
+        // a balance cut of a long list, where one balances
+        let balance = |polys: &[Polygon]| {
+            let long = opts.cut_threshold > 0 && polys.len() > opts.cut_threshold;
+            long.then(|| balance_cut(polys).filter(|c| cut_balances(polys, c)))
+                .flatten()
+        };
         grow(polygons, (), |polys, ()| {
-            let balanced =
-                |polys: &[Polygon]| balance_cut(polys).filter(|c| cut_balances(polys, c));
-            if always
-                && long(&polys)
-                && let Some(plane) = balanced(&polys)
-            {
-                let (on, front, back) = partition_list(polys, &plane);
-                return ((plane, on, front, back), (), ());
-            }
-            let ((plane, known), lopsided) = choose_plane_sides(&polys, opts, &mut rng, &mut sides);
-            if !always
-                && lopsided
-                && long(&polys)
-                && let Some(plane) = balanced(&polys)
-            {
-                let (on, front, back) = partition_list(polys, &plane);
-                return ((plane, on, front, back), (), ());
-            }
+            // tried first with `cut_always`, else where the best face plane
+            // is lopsided; `known`: `sides` hold every polygon's side of it
+            let (plane, known) = match opts.cut_always.then(|| balance(&polys)).flatten() {
+                Some(cut) => (cut, false),
+                None => {
+                    let ((plane, known), lopsided) =
+                        choose_plane_sides(&polys, opts, &mut rng, &mut sides);
+                    match (!opts.cut_always && lopsided)
+                        .then(|| balance(&polys))
+                        .flatten()
+                    {
+                        Some(cut) => (cut, false),
+                        None => (plane, known),
+                    }
+                }
+            };
             let (on, front, back) = if known {
                 partition_known(polys, &plane, &sides)
             } else {

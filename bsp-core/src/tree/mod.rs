@@ -113,6 +113,10 @@ pub struct BuildOptions {
     /// and every empty leaf still hangs below a polygon's plane: the solid
     /// labelling stays valid.
     pub cut_threshold: usize,
+    /// Try a balance cut first on every list above the threshold, lopsided
+    /// or not (`Partition::solid`'s builds: their set operations' results
+    /// have fewer polygons so).
+    pub(crate) cut_always: bool,
 }
 
 impl Default for BuildOptions {
@@ -123,6 +127,7 @@ impl Default for BuildOptions {
             split_weight: 4,
             seed: 0x5eed_b5b7,
             cut_threshold: 128,
+            cut_always: false,
         }
     }
 }

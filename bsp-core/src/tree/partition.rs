@@ -227,12 +227,14 @@ fn section_in(plane: &Plane, walls: &[Plane]) -> Option<Polygon> {
     Some(poly)
 }
 
-/// Options of [`Partition::solid`]: the BSP build with balance cuts of
-/// every list above 64 polygons where one balances
-/// ([`BspTree::build_cutting`]), which keep convex meshes from turning
-/// into chains.
+/// Options of [`Partition::solid`]: the BSP build with a balance cut
+/// tried first on every list above 64 polygons, which keeps convex meshes
+/// from turning into chains.
 pub(crate) fn solid_build_options() -> BuildOptions {
-    BuildOptions::default().with_cut_threshold(64)
+    BuildOptions {
+        cut_always: true,
+        ..BuildOptions::default().with_cut_threshold(64)
+    }
 }
 
 impl Partition<Cell> {
@@ -240,7 +242,7 @@ impl Partition<Cell> {
     /// closed, consistently oriented solid (outward normals). Node polygons
     /// are not kept: set operations only need cells and sub-hyperplanes.
     pub fn solid(polygons: Vec<Polygon>) -> Partition<Cell> {
-        let tree = BspTree::build_cutting(polygons, &solid_build_options(), true);
+        let tree = BspTree::build(polygons, &solid_build_options());
         let mut p = Partition::from_tree(&tree);
         p.clear_polygons();
         p

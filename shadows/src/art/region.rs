@@ -340,7 +340,8 @@ fn gcd(a: u32, b: u32) -> u32 {
 
 /// Whether `m` lies on the closed segment `ab`.
 fn on_segment(a: [i32; 2], m: [i32; 2], b: [i32; 2]) -> bool {
-    area2(&[a, m, b]) == 0 && (0..2).all(|k| a[k].min(b[k]) <= m[k] && m[k] <= a[k].max(b[k]))
+    use super::simplify::{orient, within};
+    orient(a, m, b) == 0 && within(a, b, m)
 }
 
 #[cfg(test)]

@@ -273,7 +273,7 @@ fn double(c: Corner) -> [i64; 2] {
 }
 
 /// Twice the signed area of the triangle `abc` (positive: counter-clockwise).
-fn orient(a: Corner, b: Corner, c: Corner) -> i64 {
+pub(super) fn orient(a: Corner, b: Corner, c: Corner) -> i64 {
     let [ax, ay] = a.map(i64::from);
     let [bx, by] = b.map(i64::from);
     let [cx, cy] = c.map(i64::from);
@@ -281,7 +281,7 @@ fn orient(a: Corner, b: Corner, c: Corner) -> i64 {
 }
 
 /// Whether `p` lies on the closed segment `ab` (given it is on its line).
-fn within(a: Corner, b: Corner, p: Corner) -> bool {
+pub(super) fn within(a: Corner, b: Corner, p: Corner) -> bool {
     (0..2).all(|k| a[k].min(b[k]) <= p[k] && p[k] <= a[k].max(b[k]))
 }
 
