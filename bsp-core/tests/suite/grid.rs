@@ -206,7 +206,11 @@ proptest! {
         } else {
             let plane = loop_plane(&snapped);
             let planar = snapped.iter().all(|g| plane.side_z(&grid_z(*g)) == bsp_core::Side::On);
-            if planar {
+            if planar && distinct == 4 && crosses_itself(&snapped) {
+                // snapping made a bow-tie: not simple, dropped
+                prop_assert!(polys.is_empty());
+                prop_assert_eq!(&report.dropped, &vec![(0, FaceDefect::NotSimple)]);
+            } else if planar {
                 // a loop like a, b, a, c has three points but no area
                 let q: Vec<Q3> = snapped.iter().map(|g| grid_q(*g)).collect();
                 let no_area = area_vector(&q).iter().all(Zero::is_zero);
@@ -218,6 +222,44 @@ proptest! {
             prop_assert_eq!(polys.is_empty(), !report.dropped.is_empty());
         }
     }
+}
+
+/// Whether a planar loop of four distinct grid points crosses itself: a
+/// side meets the side opposite it (closed segments), seen along the
+/// largest axis of the plane's normal.
+fn crosses_itself(q: &[GridPoint]) -> bool {
+    let w = |p: GridPoint| p.map(i128::from);
+    let d = |a: [i128; 3], b: [i128; 3]| [0, 1, 2].map(|k| b[k] - a[k]);
+    let (a, b, c) = (w(q[0]), w(q[1]), w(q[2]));
+    let (e, f) = (d(a, b), d(a, c));
+    let n = [
+        e[1] * f[2] - e[2] * f[1],
+        e[2] * f[0] - e[0] * f[2],
+        e[0] * f[1] - e[1] * f[0],
+    ];
+    let k = (0..3).max_by_key(|&k| n[k].abs()).unwrap_or(2);
+    let flat = |p: GridPoint| [w(p)[(k + 1) % 3], w(p)[(k + 2) % 3]];
+    let orient = |a: [i128; 2], b: [i128; 2], c: [i128; 2]| {
+        ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).signum()
+    };
+    let within = |a: [i128; 2], b: [i128; 2], p: [i128; 2]| {
+        (0..2).all(|i| a[i].min(b[i]) <= p[i] && p[i] <= a[i].max(b[i]))
+    };
+    let meet = |a, b, c, e| {
+        let (o1, o2, o3, o4) = (
+            orient(a, b, c),
+            orient(a, b, e),
+            orient(c, e, a),
+            orient(c, e, b),
+        );
+        (o1 * o2 < 0 && o3 * o4 < 0)
+            || (o1 == 0 && within(a, b, c))
+            || (o2 == 0 && within(a, b, e))
+            || (o3 == 0 && within(c, e, a))
+            || (o4 == 0 && within(c, e, b))
+    };
+    let p = [0, 1, 2, 3].map(|i| flat(q[i]));
+    meet(p[0], p[1], p[2], p[3]) || meet(p[1], p[2], p[3], p[0])
 }
 
 /// Far from its origin a box has coarse ulps: neighbouring inputs one ulp
