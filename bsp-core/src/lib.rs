@@ -58,9 +58,9 @@ pub use kernel::{
     Point, Polygon, PolygonSide, SanityError, Side, SnapError, Split, ViewPoint,
 };
 pub use solid::{
-    ImportReport, SolidBoundary, SurfaceDefect, TopologyError, TriMesh, certify_solid_boundary,
-    check_closed_manifold, import_faces, import_faces_par, import_indexed_par, is_closed_cycle,
-    meeting_pairs,
+    ImportReport, SolidBoundary, SolidParts, SurfaceDefect, TopologyError, TriMesh,
+    certify_solid_boundary, certify_solid_parts, check_closed_manifold, import_faces,
+    import_faces_par, import_indexed_par, is_closed_cycle, meeting_pairs,
 };
 pub use tree::{
     BoolOp, BspTree, BuildOptions, Cell, CellOp, FlatBsp, Link, Membership, Node, NodeId, Order,

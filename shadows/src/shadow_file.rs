@@ -100,6 +100,10 @@ pub struct ShadowFile {
     pub receivers: usize,
     /// Nodes of the shadow-volume trees.
     pub shadow_nodes: usize,
+    /// The occluders the trees were built from and those offered, summed
+    /// over the lights (faces turned away from a light, of closed meshes,
+    /// are left out), where the partitioned shadow volumes ran.
+    pub occluders: Option<(usize, usize)>,
     /// Polygons of the scene's BSP tree, where one was built.
     pub bsp_polygons: Option<usize>,
     /// The fragments' areas, added up.
@@ -140,13 +144,16 @@ impl ShadowFile {
         }
         let _ = writeln!(
             s,
-            "fragments:       {} ({:.3} per face; {} receivers, {} shadow-tree nodes over {} light{})",
+            "fragments:       {} ({:.3} per face; {} receivers, {} shadow-tree nodes over {} light{}{})",
             self.fragments,
             self.fragments as f64 / faces.max(1) as f64,
             self.receivers,
             self.shadow_nodes,
             lights.len(),
-            if lights.len() == 1 { "" } else { "s" }
+            if lights.len() == 1 { "" } else { "s" },
+            self.occluders.map_or(String::new(), |(n, of)| format!(
+                "; {n} of {of} occluders kept, faces of closed meshes turned away left out"
+            ))
         );
         for (i, (what, angle)) in lights.iter().enumerate() {
             let _ = writeln!(s, "light {i}:         {what}");
@@ -191,6 +198,7 @@ pub fn write_shadows(
             fragments: 0,
             receivers: 0,
             shadow_nodes: 0,
+            occluders: None,
             bsp_polygons: None,
             areas: Areas::new(scene.lights.len(), scene.mesh.faces.len()),
             vertices: None,
@@ -281,6 +289,8 @@ impl Job<'_> {
         })
         .map_err(Error::Shadow)?;
         self.fig.shadow_nodes = shadows.volumes().iter().map(|v| v.node_count()).sum();
+        let kept = shadows.volumes().iter().map(|v| v.occluder_count()).sum();
+        self.fig.occluders = Some((kept, polys.len() * kernel.len()));
         Ok(shadows)
     }
 

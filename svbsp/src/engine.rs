@@ -147,6 +147,14 @@ impl Shadows {
     /// Builds one shadow-volume tree per light from `occluders` (polygons
     /// with grid vertices, e.g. from [`bsp_core::import_faces`]), each in
     /// parallel.
+    ///
+    /// The polygons of an edge-connected part certified to bound a solid
+    /// ([`bsp_core::certify_solid_parts`]: closed, oriented, embedded,
+    /// outward) that a light outside the part's box does not face are left
+    /// out of that light's tree: the part's faces toward the light hide
+    /// all they hide ([`Light::culls_back_faces`]). Every lit area is the
+    /// same as with all of them; fragments may be cut differently only
+    /// inside shadow.
     pub fn new(occluders: &[Polygon], lights: &[Light]) -> Result<Shadows, ShadowError> {
         if lights.len() > MAX_LIGHTS {
             return Err(LightError::TooMany(lights.len()).into());
@@ -154,11 +162,25 @@ impl Shadows {
         for l in lights {
             l.validate()?;
         }
+        let solids = bsp_core::certify_solid_parts(occluders);
         // one light after the other: each build is parallel inside, and
         // only one build's working memory is alive at a time
         let volumes = lights
             .iter()
-            .map(|&l| ShadowVolumes::build(l, occluders))
+            .map(|&l| {
+                let turned_away = |(i, p): &(usize, &Polygon)| {
+                    solids.boundary(*i).is_some_and(|b| l.culls_back_faces(b))
+                        && !l.faces(p.support())
+                };
+                if !occluders.iter().enumerate().any(|ip| turned_away(&ip)) {
+                    return ShadowVolumes::build(l, occluders);
+                }
+                let kept: Vec<&Polygon> = (occluders.iter().enumerate())
+                    .filter(|ip| !turned_away(ip))
+                    .map(|(_, p)| p)
+                    .collect();
+                ShadowVolumes::build(l, &kept)
+            })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Shadows {
             lights: lights.to_vec(),

@@ -490,6 +490,7 @@ pub struct ShadowVolumes {
     pub(crate) root: u32,
     grafted: usize,
     skeleton: usize,
+    occluders: usize,
 }
 
 impl ShadowVolumes {
@@ -586,7 +587,14 @@ impl ShadowVolumes {
             root,
             grafted,
             skeleton,
+            occluders: occ.len(),
         })
+    }
+
+    /// The number of occluders the volumes were built from (those given,
+    /// less those in a plane through the light).
+    pub fn occluder_count(&self) -> usize {
+        self.occluders
     }
 
     /// Whether the occluders hide the light from grid point `x`: `x` lies

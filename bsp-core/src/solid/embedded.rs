@@ -207,6 +207,20 @@ fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefec
     Ok(SolidBoundary { lo, hi, parts })
 }
 
+/// The size of work (vertices, triangles) from which the certificate's
+/// loops run in parallel: below it, rayon's overhead is more than the work.
+const PARALLEL: usize = 4096;
+
+/// `f` over consecutive runs of `0..n`, in parallel when `size` (the work
+/// it stands for) is at least [`PARALLEL`]; the runs' values in order.
+fn runs<A: Send>(n: usize, size: usize, f: impl Fn(std::ops::Range<usize>) -> A + Sync) -> Vec<A> {
+    if size < PARALLEL {
+        vec![f(0..n)]
+    } else {
+        crate::par::fold_runs(n, f)
+    }
+}
+
 /// Every pair of polygons `[i, j]` (`i < j`, sorted, each once) whose
 /// fan triangles the test of step 2 of the module docs does not find
 /// apart: polygons that cross, overlap or touch other than in shared
@@ -227,6 +241,151 @@ pub fn meeting_pairs(polys: &[Polygon]) -> Result<Vec<[usize; 2]>, SurfaceDefect
     pairs.sort_unstable();
     pairs.dedup();
     Ok(pairs)
+}
+
+/// The edge-connected parts of a list of polygons, each certified to
+/// bound a solid or not ([`certify_solid_parts`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SolidParts {
+    /// Per polygon: its part.
+    part_of: Vec<u32>,
+    /// Per part: its certificate, where it bounds a solid on its own.
+    parts: Vec<Option<SolidBoundary>>,
+}
+
+impl SolidParts {
+    /// The certificate of the part holding polygon `i`, if that part is
+    /// certified to bound a solid on its own.
+    pub fn boundary(&self, i: usize) -> Option<&SolidBoundary> {
+        self.parts[self.part_of[i] as usize].as_ref()
+    }
+
+    /// The part holding polygon `i` (parts are numbered `0..` in the order
+    /// of their first polygons).
+    pub fn part(&self, i: usize) -> usize {
+        self.part_of[i] as usize
+    }
+
+    /// The number of parts.
+    pub fn len(&self) -> usize {
+        self.parts.len()
+    }
+
+    /// `true` for no polygons.
+    pub fn is_empty(&self) -> bool {
+        self.parts.is_empty()
+    }
+
+    /// The certified parts' certificates, by part.
+    pub fn certified(&self) -> impl Iterator<Item = &SolidBoundary> + '_ {
+        self.parts.iter().flatten()
+    }
+}
+
+/// [`certify_solid_boundary`] part by part: `polys` cut into their
+/// edge-connected parts (polygons sharing an edge, or a vertex where the
+/// surface is not closed and oriented), and each part certified on its
+/// own to bound a solid: closed, consistently oriented, embedded (its
+/// polygons meet one another only in shared vertices and edges; other
+/// parts may cross it) and turned outward. What the module docs say of a
+/// certified surface holds for each certified part alone: its winding
+/// number is `0` outside its box, so its polygons turned away from a
+/// light outside that box hide nothing its others do not, whatever the
+/// other parts are (a scan standing on a ground quad, several closed
+/// meshes crossing one another). A polygon off the grid leaves every part
+/// uncertified.
+///
+/// ```
+/// use bsp_core::{Polygon, certify_solid_parts};
+/// let cube: Vec<Polygon> = [
+///     [[0, 0, 0], [0, 1, 0], [1, 1, 0], [1, 0, 0]],
+///     [[0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],
+///     [[0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]],
+///     [[0, 1, 0], [0, 1, 1], [1, 1, 1], [1, 1, 0]],
+///     [[0, 0, 0], [0, 0, 1], [0, 1, 1], [0, 1, 0]],
+///     [[1, 0, 0], [1, 1, 0], [1, 1, 1], [1, 0, 1]],
+/// ]
+/// .iter()
+/// .map(|l| Polygon::from_grid_points(l, 0).unwrap())
+/// .collect();
+/// let ground = Polygon::from_grid_points(&[[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]], 0).unwrap();
+/// let scene: Vec<Polygon> = cube.into_iter().chain([ground]).collect();
+/// let parts = certify_solid_parts(&scene);
+/// assert_eq!(parts.len(), 2);
+/// assert_eq!(parts.boundary(0).unwrap().hi, [1, 1, 1]); // the cube
+/// assert!(parts.boundary(6).is_none()); // the ground is open
+/// ```
+pub fn certify_solid_parts(polys: &[Polygon]) -> SolidParts {
+    let Ok(loops) = Loops::new(polys) else {
+        return SolidParts {
+            part_of: (0..polys.len() as u32).collect(),
+            parts: vec![None; polys.len()],
+        };
+    };
+    let mut open = vec![false; polys.len()];
+    let (mut parts_of, certified) = loops
+        .pair_all(true, Some(&mut open))
+        .expect("lenient pairing reports no error");
+    let (tris, volume) = loops.fan_triangles(&mut parts_of);
+    // per root: still a candidate, and its box
+    let mut good: Vec<bool> = (0..polys.len())
+        .map(|i| volume[i] > 0 && parts_of.is_root(i as u32))
+        .collect();
+    for (i, &o) in open.iter().enumerate() {
+        if o {
+            good[parts_of.find(i as u32) as usize] = false;
+        }
+    }
+    let root: Vec<u32> = (0..polys.len() as u32).map(|i| parts_of.find(i)).collect();
+    let mut boxes = vec![([i32::MAX; 3], [i32::MIN; 3]); polys.len()];
+    for (g, p) in loops.pts.iter().enumerate() {
+        let (lo, hi) = &mut boxes[root[loops.corner_poly[g] as usize] as usize];
+        *lo = [0, 1, 2].map(|k| lo[k].min(p[k]));
+        *hi = [0, 1, 2].map(|k| hi[k].max(p[k]));
+    }
+    // embedded, each candidate part within itself
+    let candidate = |t: &Tri| good[root[t.poly as usize] as usize];
+    let settled = |s: &Tri, t: &Tri| {
+        s.id.iter()
+            .any(|&a| certified[a as usize] && t.id.contains(&a))
+    };
+    let (lo, hi) = loops.bounds();
+    if let Some(grid) = PairGrid::new(&tris, lo, hi, candidate) {
+        // the cells in runs, in parallel: the parts each run finds crossing
+        // themselves
+        let refused = runs(grid.cell_count(), grid.listed.len(), |cells| {
+            let mut refused: Vec<u32> = Vec::new();
+            grid.visit(cells, |s, t| {
+                let r = root[s.poly as usize];
+                if r == root[t.poly as usize] && !(s.poly == t.poly || settled(s, t) || apart(s, t))
+                {
+                    refused.push(r);
+                }
+                ControlFlow::Continue(())
+            });
+            refused
+        });
+        for r in refused.into_iter().flatten() {
+            good[r as usize] = false;
+        }
+    }
+    // parts numbered by their roots, which are their first polygons
+    let mut number = vec![u32::MAX; polys.len()];
+    let mut parts = Vec::new();
+    for (i, &r) in root.iter().enumerate() {
+        if r as usize == i {
+            number[i] = parts.len() as u32;
+            parts.push(good[i].then_some(SolidBoundary {
+                lo: boxes[i].0,
+                hi: boxes[i].1,
+                parts: 1,
+            }));
+        }
+    }
+    SolidParts {
+        part_of: root.iter().map(|&r| number[r as usize]).collect(),
+        parts,
+    }
 }
 
 /// The polygons' loops as grid points, every corner's point numbered by
@@ -311,6 +470,18 @@ impl Loops {
     /// across its outgoing edge. The polygons' edge-connected parts, and
     /// per vertex whether its star is certified embedded (with `stars`).
     fn closed_and_oriented(&self, stars: bool) -> Result<(UnionFind, Vec<bool>), SurfaceDefect> {
+        self.pair_all(stars, None)
+    }
+
+    /// [`Loops::closed_and_oriented`]; with `open`, a vertex whose edges
+    /// do not pair up is no error: its polygons are marked in `open` and
+    /// joined into one part (so that an open polygon's part is one with
+    /// every polygon it meets there), and the other vertices go on.
+    fn pair_all(
+        &self,
+        stars: bool,
+        mut open: Option<&mut Vec<bool>>,
+    ) -> Result<(UnionFind, Vec<bool>), SurfaceDefect> {
         let (ids, n_ids) = (&self.ids, self.n_ids);
         // the corners at each vertex, by a counting sort
         let mut first = vec![0u32; n_ids + 1];
@@ -327,43 +498,90 @@ impl Loops {
             fill[v as usize] += 1;
         }
         drop(fill);
-        let mut parts_of = UnionFind::new(self.start.len() - 1);
-        // per vertex: its star certified embedded (see `star_embedded`)
-        let mut certified = vec![false; n_ids];
-        let mut around: Vec<(u32, u32, u32)> = Vec::new();
-        let mut order: Vec<u32> = Vec::new();
-        for v in 0..n_ids {
-            let star = &corners[first[v] as usize..first[v + 1] as usize];
-            self.pair_edges(v as u32, star, &mut around)?;
-            // successor: the corner whose prev is this corner's next; the
-            // polygons across each edge are one part
-            let succ =
-                |c: &(u32, u32, u32)| around.binary_search_by_key(&c.1, |d| d.0).unwrap_or(0);
-            for c in &around {
-                let d = &around[succ(c)];
-                parts_of.union(
-                    self.corner_poly[c.2 as usize],
-                    self.corner_poly[d.2 as usize],
-                );
-            }
-            // one cycle around the vertex: its corners in order
-            order.clear();
-            let mut c = 0;
-            loop {
-                order.push(around[c].2);
-                c = succ(&around[c]);
-                if c == 0 || order.len() > around.len() {
-                    break;
+        // the vertices in runs, in parallel: each run's joins of polygons
+        // (across the edges at its vertices, or all of a star that does
+        // not pair up), its stars certified, and its first error
+        struct Run {
+            joins: Vec<[u32; 2]>,
+            certified: Vec<bool>,
+            open: Vec<u32>,
+            error: Option<SurfaceDefect>,
+        }
+        let lenient = open.is_some();
+        let runs = runs(n_ids, n_ids, |vs| {
+            let mut run = Run {
+                joins: Vec::with_capacity(3 * vs.len()),
+                certified: vec![false; vs.len()],
+                open: Vec::new(),
+                error: None,
+            };
+            let mut around: Vec<(u32, u32, u32)> = Vec::new();
+            let mut order: Vec<u32> = Vec::new();
+            for v in vs.clone() {
+                let star = &corners[first[v] as usize..first[v + 1] as usize];
+                if let Err(e) = self.pair_edges(v as u32, star, &mut around) {
+                    if !lenient {
+                        run.error = Some(e);
+                        break;
+                    }
+                    let p0 = self.corner_poly[star[0] as usize];
+                    for &g in star {
+                        let i = self.corner_poly[g as usize];
+                        run.open.push(i);
+                        run.joins.push([i, p0]);
+                    }
+                    continue;
+                }
+                // successor: the corner whose prev is this corner's next;
+                // the polygons across each edge are one part
+                let succ =
+                    |c: &(u32, u32, u32)| around.binary_search_by_key(&c.1, |d| d.0).unwrap_or(0);
+                for c in &around {
+                    let d = &around[succ(c)];
+                    run.joins.push([
+                        self.corner_poly[c.2 as usize],
+                        self.corner_poly[d.2 as usize],
+                    ]);
+                }
+                // one cycle around the vertex: its corners in order
+                order.clear();
+                let mut c = 0;
+                loop {
+                    order.push(around[c].2);
+                    c = succ(&around[c]);
+                    if c == 0 || order.len() > around.len() {
+                        break;
+                    }
+                }
+                if stars && order.len() == around.len() {
+                    run.certified[v - vs.start] =
+                        star_embedded(self.pts[order[0] as usize], &order, |g| {
+                            (
+                                self.pts[self.next_of(g as usize)],
+                                self.pts[self.prev_of(g as usize)],
+                            )
+                        });
                 }
             }
-            if stars && order.len() == around.len() {
-                certified[v] = star_embedded(self.pts[order[0] as usize], &order, |g| {
-                    (
-                        self.pts[self.next_of(g as usize)],
-                        self.pts[self.prev_of(g as usize)],
-                    )
-                });
+            run
+        });
+        // in the vertices' order: the first error is the sequential one
+        let mut parts_of = UnionFind::new(self.start.len() - 1);
+        // per vertex: its star certified embedded (see `star_embedded`)
+        let mut certified = Vec::with_capacity(n_ids);
+        for run in runs {
+            if let Some(e) = run.error {
+                return Err(e);
             }
+            for [a, b] in run.joins {
+                parts_of.union(a, b);
+            }
+            if let Some(open) = open.as_deref_mut() {
+                for i in run.open {
+                    open[i as usize] = true;
+                }
+            }
+            certified.extend(run.certified);
         }
         Ok((parts_of, certified))
     }
@@ -516,88 +734,154 @@ fn each_overlapping_pair(
     tris: &[Tri],
     lo: GridPoint,
     hi: GridPoint,
-    mut visit: impl FnMut(&Tri, &Tri) -> ControlFlow<()>,
+    visit: impl FnMut(&Tri, &Tri) -> ControlFlow<()>,
 ) {
-    if tris.len() < 2 {
-        return;
+    if let Some(grid) = PairGrid::new(tris, lo, hi, |_| true) {
+        grid.visit(0..grid.cell_count(), visit);
     }
-    // cells of the median of the triangles' largest box extents, grown
-    // until there are at most 8 cells a triangle
-    let mut ext: Vec<i64> = tris
-        .iter()
-        .map(|t| {
-            (0..3)
-                .map(|k| t.hi[k] as i64 - t.lo[k] as i64)
-                .max()
-                .unwrap_or(0)
-        })
-        .collect();
-    let mid = ext.len() / 2;
-    let mut size = (*ext.select_nth_unstable(mid).1).max(1);
-    let span = [0, 1, 2].map(|k| hi[k] as i64 - lo[k] as i64);
-    let dims = |size: i64| span.map(|s| (s / size + 1) as usize);
-    while dims(size).iter().product::<usize>() > 8 * tris.len() {
-        size *= 2;
-    }
-    let [nx, ny, _] = dims(size);
-    let cell = |p: GridPoint| [0, 1, 2].map(|k| ((p[k] as i64 - lo[k] as i64) / size) as usize);
-    let key = |c: [usize; 3]| (c[2] * ny + c[1]) * nx + c[0];
-    // the triangles of each cell, by a counting sort
-    let cells: Vec<([usize; 3], [usize; 3])> =
-        tris.iter().map(|t| (cell(t.lo), cell(t.hi))).collect();
-    let each = |(a, b): &([usize; 3], [usize; 3]), f: &mut dyn FnMut(usize)| {
-        for z in a[2]..=b[2] {
-            for y in a[1]..=b[1] {
-                for x in a[0]..=b[0] {
-                    f(key([x, y, z]));
+}
+
+/// The triangles listed in a uniform grid of cubic cells, of a typical
+/// triangle's size: each triangle in the cells its box meets, a pair of
+/// triangles whose boxes overlap visited in the cell that holds the low
+/// corner of the boxes' common part (so once). Only the cells that hold
+/// triangles are listed, in the order of their keys.
+struct PairGrid<'a> {
+    tris: &'a [Tri],
+    /// The listed triangles of the `k`-th cell that holds any:
+    /// `listed[first[k]..first[k + 1]]`, each with what the pair test
+    /// reads (so that a cell's are contiguous).
+    first: Vec<u32>,
+    listed: Vec<Listed>,
+    /// The grid's cells along x and y.
+    nx: u64,
+    ny: u64,
+}
+
+/// A triangle as listed in a cell: the cell's key, the triangle's box,
+/// the cell of its box's low corner, and its index.
+#[derive(Clone, Copy)]
+struct Listed {
+    key: u64,
+    lo: [i32; 3],
+    hi: [i32; 3],
+    low: [u32; 3],
+    tri: u32,
+}
+
+impl<'a> PairGrid<'a> {
+    /// `None` for fewer than two triangles.
+    /// The triangles `tris` that `keep` keeps.
+    fn new(
+        tris: &'a [Tri],
+        lo: GridPoint,
+        hi: GridPoint,
+        keep: impl Fn(&Tri) -> bool + Sync,
+    ) -> Option<PairGrid<'a>> {
+        if tris.len() < 2 {
+            return None;
+        }
+        // cells of the median of the triangles' largest box extents, grown
+        // until there are at most 8 cells a triangle
+        let mut ext: Vec<i64> = tris
+            .iter()
+            .map(|t| {
+                (0..3)
+                    .map(|k| t.hi[k] as i64 - t.lo[k] as i64)
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect();
+        let mid = ext.len() / 2;
+        let mut size = (*ext.select_nth_unstable(mid).1).max(1);
+        let span = [0, 1, 2].map(|k| hi[k] as i64 - lo[k] as i64);
+        let dims = |size: i64| span.map(|s| (s / size + 1) as u64);
+        while dims(size).iter().product::<u64>() > 8 * tris.len() as u64 {
+            size *= 2;
+        }
+        let [nx, ny, _] = dims(size);
+        let cell = |p: GridPoint| [0, 1, 2].map(|k| ((p[k] as i64 - lo[k] as i64) / size) as u64);
+        let key = |c: [u64; 3]| (c[2] * ny + c[1]) * nx + c[0];
+        // each triangle in every cell its box meets, sorted by cell
+        let runs = runs(tris.len(), tris.len(), |r| {
+            let mut out = Vec::with_capacity(2 * r.len());
+            for (i, t) in tris[r.clone()].iter().enumerate() {
+                if !keep(t) {
+                    continue;
+                }
+                let (a, b) = (cell(t.lo), cell(t.hi));
+                for z in a[2]..=b[2] {
+                    for y in a[1]..=b[1] {
+                        for x in a[0]..=b[0] {
+                            out.push(Listed {
+                                key: key([x, y, z]),
+                                lo: t.lo,
+                                hi: t.hi,
+                                low: a.map(|c| c as u32),
+                                tri: (r.start + i) as u32,
+                            });
+                        }
+                    }
                 }
             }
-        }
-    };
-    let mut first = vec![0u32; dims(size).iter().product::<usize>() + 1];
-    for c in &cells {
-        each(c, &mut |k| first[k + 1] += 1);
-    }
-    for k in 1..first.len() {
-        first[k] += first[k - 1];
-    }
-    let mut fill = first.clone();
-    let mut listed = vec![0u32; *first.last().unwrap_or(&0) as usize];
-    for (i, c) in cells.iter().enumerate() {
-        each(c, &mut |k| {
-            listed[fill[k] as usize] = i as u32;
-            fill[k] += 1;
+            out
         });
+        let mut listed: Vec<Listed> = runs.concat();
+        if tris.len() < PARALLEL {
+            listed.sort_unstable_by_key(|l| (l.key, l.tri));
+        } else {
+            rayon::slice::ParallelSliceMut::par_sort_unstable_by_key(&mut listed[..], |l| {
+                (l.key, l.tri)
+            });
+        }
+        let mut first: Vec<u32> = (0..listed.len())
+            .filter(|&i| i == 0 || listed[i].key != listed[i - 1].key)
+            .map(|i| i as u32)
+            .collect();
+        first.push(listed.len() as u32);
+        Some(PairGrid {
+            tris,
+            first,
+            listed,
+            nx,
+            ny,
+        })
     }
-    drop(fill);
-    let boxes: Vec<[i32; 6]> = tris
-        .iter()
-        .map(|t| [t.lo[0], t.lo[1], t.lo[2], t.hi[0], t.hi[1], t.hi[2]])
-        .collect();
-    for k in 0..first.len() - 1 {
-        let here = &listed[first[k] as usize..first[k + 1] as usize];
-        for (i, &si) in here.iter().enumerate() {
-            let si = si as usize;
-            let bs = boxes[si];
-            for &ti in &here[i + 1..] {
-                let ti = ti as usize;
-                let bt = boxes[ti];
-                // without branches: most pairs are near misses
-                let mut miss = false;
-                for k in 0..3 {
-                    miss |= (bt[k] > bs[k + 3]) | (bs[k] > bt[k + 3]);
-                }
-                if miss {
-                    continue;
-                }
-                // the cell of the common part's low corner: the larger of
-                // the two low cells
-                let (cs, ct) = (cells[si].0, cells[ti].0);
-                if key([0, 1, 2].map(|k| cs[k].max(ct[k]))) != k {
-                    continue;
-                }
-                if visit(&tris[si], &tris[ti]).is_break() {
-                    return;
+
+    /// The number of cells that hold triangles.
+    fn cell_count(&self) -> usize {
+        self.first.len() - 1
+    }
+
+    /// Calls `visit` on each pair of triangles whose boxes overlap and
+    /// that is visited in one of the listed cells `range`, until it breaks.
+    fn visit(
+        &self,
+        range: std::ops::Range<usize>,
+        mut visit: impl FnMut(&Tri, &Tri) -> ControlFlow<()>,
+    ) {
+        for k in range {
+            let here = &self.listed[self.first[k] as usize..self.first[k + 1] as usize];
+            for (i, s) in here.iter().enumerate() {
+                for t in &here[i + 1..] {
+                    // without branches: most pairs are near misses
+                    let mut miss = false;
+                    for k in 0..3 {
+                        miss |= (t.lo[k] > s.hi[k]) | (s.lo[k] > t.hi[k]);
+                    }
+                    if miss {
+                        continue;
+                    }
+                    // the cell of the common part's low corner (the larger
+                    // of the two low cells on each axis) must be this one
+                    let c = [0, 1, 2].map(|k| u64::from(s.low[k].max(t.low[k])));
+                    if (c[2] * self.ny + c[1]) * self.nx + c[0] != s.key {
+                        continue;
+                    }
+                    let (s, t) = (&self.tris[s.tri as usize], &self.tris[t.tri as usize]);
+                    if visit(s, t).is_break() {
+                        return;
+                    }
                 }
             }
         }
@@ -843,6 +1127,102 @@ mod tests {
         };
         assert!(certify_solid_boundary(&o(4)).is_ok());
         assert!(certify_solid_boundary(&o(-7)).is_err());
+    }
+
+    /// `certify_solid_parts`: which parts are certified, by their first
+    /// polygons.
+    fn certified_parts(polys: &[Polygon]) -> Vec<bool> {
+        let parts = certify_solid_parts(polys);
+        // parts numbered in the order of their first polygons, each
+        // polygon with its part's certificate
+        let mut firsts: Vec<usize> = Vec::new();
+        for i in 0..polys.len() {
+            if firsts.len() == parts.part(i) {
+                firsts.push(i);
+            }
+            assert!(parts.part(i) < firsts.len());
+            assert_eq!(parts.boundary(i), parts.boundary(firsts[parts.part(i)]));
+        }
+        assert_eq!(firsts.len(), parts.len());
+        assert_eq!(
+            parts.certified().count(),
+            firsts
+                .iter()
+                .filter(|&&i| parts.boundary(i).is_some())
+                .count()
+        );
+        firsts
+            .iter()
+            .map(|&i| parts.boundary(i).is_some())
+            .collect()
+    }
+
+    #[test]
+    fn parts_are_certified_each_on_its_own() {
+        let ground = || poly(&[[-9, -9, -1], [19, -9, -1], [19, 19, -1], [-9, 19, -1]]);
+        // a box over an open ground: the box certified, with its own box
+        let mut c = cube([0; 3], [4, 5, 6], false);
+        c.push(ground());
+        let parts = certify_solid_parts(&c);
+        assert_eq!(certified_parts(&c), [true, false]);
+        let b = parts.boundary(3).unwrap();
+        assert_eq!((b.lo, b.hi, b.parts), ([0; 3], [4, 5, 6], 1));
+        assert_eq!((parts.part(5), parts.part(6)), (0, 1));
+        // two boxes through each other: each part bounds a solid alone
+        let mut c = cube([0; 3], [4, 4, 4], false);
+        c.extend(cube([2, 1, 1], [6, 3, 3], false));
+        assert!(certify_solid_boundary(&c).is_err());
+        assert_eq!(certified_parts(&c), [true, true]);
+        // an inverted box, an open one, a folded octahedron, beside a
+        // good box: only the good one
+        let mut c = cube([0; 3], [4, 4, 4], true);
+        c.extend(cube([10; 3], [14; 3], false));
+        let mut open = cube([20; 3], [24; 3], false);
+        open.pop();
+        c.extend(open);
+        assert_eq!(certified_parts(&c), [false, true, false]);
+        // a surface crossing itself: the fold of `a_fold_is_refused`
+        let (e, n, w, s) = ([4, 0, 0], [0, 4, 0], [-4, 0, 0], [0, -4, 0]);
+        let (t, b) = ([1, 1, -7], [0, 0, -4]);
+        let ring = [e, n, w, s];
+        let mut fold: Vec<Polygon> = (0..4)
+            .flat_map(|k| {
+                let (p, q) = (ring[k], ring[(k + 1) % 4]);
+                [poly(&[p, q, t]), poly(&[q, p, b])]
+            })
+            .collect();
+        fold.extend(cube([10; 3], [14; 3], false));
+        assert_eq!(certified_parts(&fold), [false, true]);
+        // a vertex where three faces' edges do not pair up (a fin on a
+        // box's top edge): the box and the fin are one uncertified part
+        let mut c = cube([0; 3], [4, 4, 4], false);
+        c.push(poly(&[[0, 4, 4], [4, 4, 4], [2, 4, 8]]));
+        c.extend(cube([10; 3], [14; 3], false));
+        assert_eq!(certified_parts(&c), [false, true]);
+        // no polygons, no parts
+        assert!(certify_solid_parts(&[]).is_empty());
+    }
+
+    #[test]
+    fn one_part_is_certified_as_the_whole_surface_is() {
+        // the jittered spheres of `stars_agree_with_pairwise_tests`: one
+        // part each, certified exactly when the whole list is
+        let mut seen = [0; 2];
+        for seed in 0..200u64 {
+            let polys = polys(&bsp_fixtures::jittered_uv_sphere(
+                24,
+                8.0,
+                1 + (seed % 4) as i32,
+                &mut bsp_fixtures::Rng(seed),
+            ));
+            let whole = certify_solid_boundary(&polys);
+            let parts = certify_solid_parts(&polys);
+            assert_eq!(parts.len(), 1, "seed {seed}");
+            assert_eq!(parts.boundary(0).copied(), whole.ok(), "seed {seed}");
+            seen[usize::from(whole.is_ok())] += 1;
+        }
+        // both outcomes are exercised
+        assert!(seen.iter().all(|&n| n > 20), "{seen:?}");
     }
 
     #[test]

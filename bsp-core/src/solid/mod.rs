@@ -7,7 +7,10 @@ pub(crate) mod import;
 pub(crate) mod mesh;
 pub(crate) mod topology;
 
-pub use embedded::{SolidBoundary, SurfaceDefect, certify_solid_boundary, meeting_pairs};
+pub use embedded::{
+    SolidBoundary, SolidParts, SurfaceDefect, certify_solid_boundary, certify_solid_parts,
+    meeting_pairs,
+};
 pub use import::{
     FaceImporter, ImportReport, all_planar, import_faces, import_faces_par, import_indexed_par,
     snap_positions,

@@ -330,3 +330,32 @@ fn no_lights_and_bad_lights() {
         Some(LightError::ZeroDirection)
     );
 }
+
+/// `Shadows::new` leaves out the faces that a light does not face of an
+/// edge-connected part certified to bound a solid, and only of such a
+/// part: two closed boxes crossing each other over an open ground lose
+/// the faces turned away; an inverted box keeps all of them (left out,
+/// its floor would come out lit under its own roof). The oracle checks
+/// every fragment's flags, and the exact areas against Chin & Feiner's
+/// (which keeps every face), either way.
+#[test]
+fn back_faces_of_certified_solids_are_left_out() {
+    let light = Light::Point([3, 2, 40]);
+    let kept = |scene: &[Loop]| {
+        assert_loops(scene, &[light]);
+        let polys = crate::harness::polygons(scene).unwrap();
+        let s = svbsp::Shadows::new(&polys, &[light]).unwrap();
+        let facing = polys.iter().filter(|p| light.faces(p.support())).count();
+        (s.volumes()[0].occluder_count(), facing, polys.len())
+    };
+    let mut scene = vec![up(-30, -30, 30, 30, 0)];
+    scene.extend(cube([0, 0, 4], [4, 4, 8]));
+    scene.extend(cube([2, 1, 6], [7, 3, 10]));
+    let (count, facing, all) = kept(&scene);
+    assert_eq!((count, all), (facing, 13));
+    assert!(facing < 8, "{facing}");
+    let mut scene = vec![up(-30, -30, 30, 30, 0)];
+    scene.extend(cube([0, 0, 4], [4, 4, 8]).iter().map(flip));
+    let (count, _, all) = kept(&scene);
+    assert_eq!(count, all);
+}
