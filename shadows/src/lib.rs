@@ -235,7 +235,8 @@ pub fn shadows(mesh: &Mesh, lights: &[Light]) -> Result<Shadows, Error> {
     let grid = svbsp::shared_grid(&mesh.positions, lights).map_err(Error::Light)?;
     let (polys, _) =
         bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(Error::Import)?;
-    shadows_on(&grid, &polys, mesh.faces.len(), lights)
+    let solids = bsp_core::certify_solid_parts(&polys);
+    shadows_on(&grid, &polys, &solids, mesh.faces.len(), lights)
 }
 
 /// [`shadows`] of the `faces` faces of a mesh already snapped to `grid`
@@ -244,12 +245,13 @@ pub fn shadows(mesh: &Mesh, lights: &[Light]) -> Result<Shadows, Error> {
 pub(crate) fn shadows_on(
     grid: &bsp_core::Grid,
     polys: &[bsp_core::Polygon],
+    solids: &bsp_core::SolidParts,
     faces: usize,
     lights: &[Light],
 ) -> Result<Shadows, Error> {
     let placed = svbsp::place_lights(grid, lights).map_err(Error::Light)?;
     let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
-    let trees = face_trees(polys, &kernel, &[]).map_err(Error::Shadow)?;
+    let trees = face_trees(polys, &kernel, &[], solids).map_err(Error::Shadow)?;
     // (with convex pieces: the OBJ writer draws them)
     let batch = trees
         .set()
@@ -283,10 +285,16 @@ pub(crate) fn shadows_on(
 /// holds only the faces that may hide it from some face or point
 /// ([`may_hide`]; the others change no fragment's class and no point's
 /// light).
+///
+/// Nor the faces turned away from a light of the parts `solids` certifies
+/// to bound solids ([`svbsp::Light::leaves_out`]; `solids` is
+/// [`bsp_core::certify_solid_parts`] of `polys`): their other faces hide
+/// all they hide, from every face and point.
 pub(crate) fn face_trees(
     polys: &[bsp_core::Polygon],
     kernel: &[svbsp::Light],
     also: &[bsp_core::GridPoint],
+    solids: &bsp_core::SolidParts,
 ) -> Result<svbsp::Shadows, ShadowError> {
     let bounds = grid_bounds(polys).map(|[mut lo, mut hi]| {
         for p in also {
@@ -298,8 +306,12 @@ pub(crate) fn face_trees(
         [lo, hi]
     });
     let volumes = bsp_core::par::try_map(kernel.len(), |j| {
-        let hiding: Vec<&bsp_core::Polygon> = (polys.iter())
-            .filter(|p| bounds.is_none_or(|b| may_hide(&kernel[j], p.support(), b)))
+        let hiding: Vec<&bsp_core::Polygon> = (polys.iter().enumerate())
+            .filter(|(i, p)| {
+                bounds.is_none_or(|b| may_hide(&kernel[j], p.support(), b))
+                    && !kernel[j].leaves_out(solids, *i, p.support())
+            })
+            .map(|(_, p)| p)
             .collect();
         svbsp::ShadowVolumes::build(kernel[j], &hiding)
     })?;
@@ -423,8 +435,9 @@ mod tests {
     use super::*;
 
     /// Leaving out the faces that hide nothing (here the city's ground
-    /// tiles, and for a light below the ground nothing) gives every face
-    /// the lit area of the trees of all faces.
+    /// tiles, and for a light below the ground nothing; and the closed
+    /// buildings' faces turned away from a light) gives every face the
+    /// lit area of the trees of all faces.
     #[test]
     fn faces_that_hide_nothing_change_no_lit_area() {
         let city = shadow_scene::city_block(6);
@@ -435,10 +448,23 @@ mod tests {
         ];
         let grid = svbsp::shared_grid(&city.positions, &lights).unwrap();
         let (polys, _) = bsp_core::import_faces_par(&grid, &city.face_loops()).unwrap();
-        let culled = shadows_on(&grid, &polys, city.faces.len(), &lights).unwrap();
+        let solids = bsp_core::certify_solid_parts(&polys);
+        let culled = shadows_on(&grid, &polys, &solids, city.faces.len(), &lights).unwrap();
         let placed = svbsp::place_lights(&grid, &lights).unwrap();
         let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
-        let all = svbsp::Shadows::new(&polys, &kernel).unwrap();
+        // the buildings are closed: their faces turned away from a light
+        // are left out too
+        for l in &kernel {
+            let away = (polys.iter().enumerate())
+                .filter(|(i, p)| l.leaves_out(&solids, *i, p.support()))
+                .count();
+            assert!(away > polys.len() / 10, "{away} of {}", polys.len());
+        }
+        // the trees of every face
+        let volumes = (kernel.iter())
+            .map(|&l| svbsp::ShadowVolumes::build(l, &polys).unwrap())
+            .collect();
+        let all = svbsp::Shadows::from_volumes(&kernel, volumes).unwrap();
         let batch = all.set().shade_all(&polys, &ShadeOptions::default());
         let world = world_vertices(&batch, &grid).unwrap();
         let mut lit = vec![0.0; city.faces.len() * 3];

@@ -409,6 +409,8 @@ fn study<T>(
 struct Snapped {
     grid: bsp_core::Grid,
     polys: Vec<bsp_core::Polygon>,
+    /// The parts of `polys` certified to bound solids.
+    solids: bsp_core::SolidParts,
 }
 
 impl Snapped {
@@ -421,7 +423,12 @@ impl Snapped {
         let grid = svbsp::shared_grid(&mesh.positions, &[]).map_err(crate::Error::Light)?;
         let (polys, _) =
             bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(crate::Error::Import)?;
-        Ok(Some(Snapped { grid, polys }))
+        let solids = bsp_core::certify_solid_parts(&polys);
+        Ok(Some(Snapped {
+            grid,
+            polys,
+            solids,
+        }))
     }
 }
 
@@ -550,7 +557,7 @@ impl HoursRun {
         let faces = mesh.faces.len();
         let lights: Vec<crate::Light> = suns.iter().map(|&d| crate::Light::Sun(d)).collect();
         let run = match snapped {
-            Some(s) => crate::shadows_on(&s.grid, &s.polys, faces, &lights)?,
+            Some(s) => crate::shadows_on(&s.grid, &s.polys, &s.solids, faces, &lights)?,
             None => crate::shadows(mesh, &lights)?,
         };
         let area: Vec<f64> = (0..faces).map(|f| run.face_area(f)).collect();
@@ -770,11 +777,12 @@ pub fn sensor_hours(
         .collect::<Result<_, _>>()?;
     let (polys, _) =
         bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(Error::Import)?;
+    let solids = bsp_core::certify_solid_parts(&polys);
     let mut seen = vec![0u32; sensors.len()];
     for batch in all.chunks(svbsp::MAX_LIGHTS) {
         let placed = svbsp::place_lights(&grid, batch).map_err(Error::Light)?;
         let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
-        let trees = crate::face_trees(&polys, &kernel, &at).map_err(Error::Shadow)?;
+        let trees = crate::face_trees(&polys, &kernel, &at, &solids).map_err(Error::Shadow)?;
         for (n, &g) in seen.iter_mut().zip(&at) {
             *n += trees.reaching(g).count_ones();
         }

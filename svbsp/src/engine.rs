@@ -168,10 +168,8 @@ impl Shadows {
         let volumes = lights
             .iter()
             .map(|&l| {
-                let turned_away = |(i, p): &(usize, &Polygon)| {
-                    solids.boundary(*i).is_some_and(|b| l.culls_back_faces(b))
-                        && !l.faces(p.support())
-                };
+                let turned_away =
+                    |(i, p): &(usize, &Polygon)| l.leaves_out(&solids, *i, p.support());
                 if !occluders.iter().enumerate().any(|ip| turned_away(&ip)) {
                     return ShadowVolumes::build(l, occluders);
                 }

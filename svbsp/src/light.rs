@@ -155,6 +155,16 @@ impl Light {
         self.outside_box(solid.lo, solid.hi)
     }
 
+    /// `true` if polygon `i` of a list, whose plane is `support`, can be
+    /// left out of this light's shadow volumes: its edge-connected part is
+    /// certified to bound a solid (`solids`, from
+    /// [`bsp_core::certify_solid_parts`] of the list), the light is
+    /// outside the part's box ([`Light::culls_back_faces`]) and does not
+    /// face it. The part's faces toward the light hide all it hides.
+    pub fn leaves_out(&self, solids: &bsp_core::SolidParts, i: usize, support: &Plane) -> bool {
+        solids.boundary(i).is_some_and(|b| self.culls_back_faces(b)) && !self.faces(support)
+    }
+
     /// `true` for a sun, or a point light strictly outside the box `[lo,
     /// hi]`: where [`Light::culls_back_faces`] may answer `true` for
     /// solids with that box (so a caller can skip certifying them).
