@@ -152,9 +152,9 @@ impl Shadows {
     /// ([`bsp_core::certify_solid_parts`]: closed, oriented, embedded,
     /// outward) that a light outside the part's box does not face are left
     /// out of that light's tree: the part's faces toward the light hide
-    /// all they hide ([`Light::culls_back_faces`]). Every lit area is the
-    /// same as with all of them; fragments may be cut differently only
-    /// inside shadow.
+    /// all they hide ([`Light::leaves_out`]). Every lit area is the same
+    /// as with all of them; the fragments may come out cut or listed
+    /// differently.
     pub fn new(occluders: &[Polygon], lights: &[Light]) -> Result<Shadows, ShadowError> {
         if lights.len() > MAX_LIGHTS {
             return Err(LightError::TooMany(lights.len()).into());

@@ -144,7 +144,8 @@ impl Light {
     }
 
     /// `true` if, among occluders certified to bound solids
-    /// ([`bsp_core::certify_solid_boundary`]), those this light does not
+    /// ([`bsp_core::certify_solid_boundary`], or one part of them by
+    /// [`bsp_core::certify_solid_parts`]), those this light does not
     /// face ([`Light::faces`]) may be left out of its shadow volumes: the
     /// light is a sun, or a point outside the solids' box, so its winding
     /// number is 0. The others' volumes then cover theirs, except where a

@@ -770,8 +770,8 @@ struct Listed {
 }
 
 impl<'a> PairGrid<'a> {
-    /// `None` for fewer than two triangles.
-    /// The triangles `tris` that `keep` keeps.
+    /// The triangles of `tris` that `keep` keeps, in cells fitted to all
+    /// of `tris`; `None` for fewer than two triangles.
     fn new(
         tris: &'a [Tri],
         lo: GridPoint,
