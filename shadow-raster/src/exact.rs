@@ -31,19 +31,21 @@ use crate::scene::SceneLight;
 
 /// The fragments of the scene's prims for the side the eye sees of each:
 /// every prim is an occluder; each receiver is a prim turned toward the
-/// eye.
+/// eye whose face, seen from that side, has a pixel in `vis` ([`drawn`]:
+/// no other fragment can take a pixel).
 pub(crate) fn visible_side_fragments(
     frame: &Frame<'_>,
+    vis: &Visibility,
     lights: &[SceneLight],
 ) -> Result<Batch, RasterError> {
     let scene = frame.scene;
     let exact: Vec<svbsp::Light> = lights.iter().map(|l| l.exact).collect();
     let shadows = Shadows::new(&scene.polys, &exact).map_err(RasterError::Shadows)?;
-    let receivers: Vec<bsp_core::Polygon> = scene
-        .polys
-        .iter()
-        .zip(&frame.side)
-        .filter_map(|(p, v)| match v {
+    let drawn = drawn(frame, vis);
+    let receivers: Vec<bsp_core::Polygon> = (scene.polys.iter().zip(&frame.side))
+        .zip(drawn)
+        .filter_map(|((p, v), drawn)| match v {
+            _ if !drawn => None,
             Side::Front => Some(p.clone()),
             Side::Back => Some(p.flipped()),
             Side::On => None,
@@ -68,7 +70,7 @@ pub(crate) fn exact(
     let batch = match batch {
         Some(b) => b,
         None => {
-            own = visible_side_fragments(frame, lights)?;
+            own = visible_side_fragments(frame, vis, lights)?;
             &own
         }
     };
@@ -262,6 +264,31 @@ impl Drawable for BatchFragments<'_> {
     }
 }
 
+/// Per prim: whether a prim of its face, seen from the same side (a group
+/// of [`draw`]), is visible at some pixel of `vis`. A pixel takes only a
+/// fragment of its visible prim's group, so the fragments of the other
+/// prims are never drawn.
+fn drawn(frame: &Frame<'_>, vis: &Visibility) -> Vec<bool> {
+    let scene = frame.scene;
+    let mut seen = vec![false; scene.len()];
+    for &p in &vis.prim {
+        if p != NONE {
+            seen[p as usize] = true;
+        }
+    }
+    let groups: std::collections::HashSet<(u32, Plane)> = (0..scene.len())
+        .filter(|&i| seen[i])
+        .filter_map(|i| Some((scene.face[i], frame.vis_plane(i)?)))
+        .collect();
+    (0..scene.len())
+        .map(|i| {
+            frame
+                .vis_plane(i)
+                .is_some_and(|p| groups.contains(&(scene.face[i], p)))
+        })
+        .collect()
+}
+
 /// Scan-converts the fragments of `batch` over the visible prims of their
 /// face and side.
 pub(crate) fn draw_fragments(
@@ -408,4 +435,55 @@ fn inside_fragment(rings: &[Vec<DVec3>], n: DVec3, p: DVec3) -> bool {
         }
     }
     inside
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hsr::{Hsr, visibility};
+    use crate::{Camera, RasterScene};
+
+    /// Shading only the prims whose face is seen at some pixel draws the
+    /// same image as shading every prim: on the bunny over its ground,
+    /// seen from low and close, where most faces are hidden.
+    #[test]
+    fn only_the_drawn_faces_are_shaded_and_the_image_is_the_same() {
+        let mesh = shadow_scene::bunny(0).unwrap();
+        let lights = [svbsp::LightSpec::Point(DVec3::new(3.9, 20.6, 5.9))];
+        let grid = svbsp::shared_grid(&mesh.positions, &lights).unwrap();
+        let placed = svbsp::place_lights(&grid, &lights).unwrap();
+        let (polys, _) = bsp_core::import_faces_par(&grid, &mesh.face_loops()).unwrap();
+        let scene = RasterScene::new(&grid, polys).unwrap();
+        let (lo, hi) = mesh.bounds().unwrap();
+        let centre = (lo + hi) * 0.5;
+        let eye = centre + DVec3::new(0.3, 0.1, 1.0) * (hi - lo).length();
+        let cam = Camera::look_at(eye, centre, DVec3::Y, 40.0, 160, 120).unwrap();
+        let frame = Frame::new(&scene, &cam, false).unwrap();
+        let vis = visibility(&frame, Hsr::ZBuffer);
+        let sl: Vec<SceneLight> = placed.iter().map(SceneLight::from_placed).collect();
+        // every prim turned toward the eye, shaded
+        let exact_lights: Vec<svbsp::Light> = sl.iter().map(|l| l.exact).collect();
+        let shadows = Shadows::new(&scene.polys, &exact_lights).unwrap();
+        let every: Vec<bsp_core::Polygon> = (scene.polys.iter().zip(&frame.side))
+            .filter_map(|(p, v)| match v {
+                Side::Front => Some(p.clone()),
+                Side::Back => Some(p.flipped()),
+                Side::On => None,
+            })
+            .collect();
+        let all = shadows
+            .set()
+            .shade_all(&every, &ShadeOptions::default().with_pieces(false));
+        let (lit_all, _) = draw_fragments(&frame, &vis, sl.len(), &all);
+        let (lit, _) = exact(&frame, &vis, &sl, None, &[]).unwrap();
+        assert_eq!(lit.amount, lit_all.amount);
+        // most faces are left out, and the image has light and shadow
+        let drawn = drawn(&frame, &vis).iter().filter(|&&d| d).count();
+        assert!(drawn * 2 < every.len(), "{drawn} of {}", every.len());
+        let seen: Vec<f32> = (vis.prim.iter().zip(&lit.amount))
+            .filter(|(p, _)| **p != NONE)
+            .map(|(_, a)| *a)
+            .collect();
+        assert!(seen.contains(&1.0) && seen.contains(&0.0));
+    }
 }
