@@ -15,6 +15,12 @@ light), which agree to within the sampling's error.
     cargo build --release -p shadow-cli
     /tmp/emb/bin/python scripts/embree_compare.py --scene bunny-99k --runs 3
 
+``--image 1920x1080`` compares images instead: ``shadow render --method
+exact`` end to end (load, snap, shadows, PNG written) against Embree
+ray tracing the same view (BVH, a primary ray through each pixel, a
+shadow ray from each hit toward the light), with the share of the visible
+pixels each finds lit.
+
 The scene is a built-in one (``bsp_shadows.Mesh.scene``: its polygons
 fanned into triangles for Embree); the light defaults to the bunny scenes'
 own light (above and in front of the bunny); ``--light X,Y,Z`` and
@@ -116,6 +122,96 @@ def ours_pass(binary, scene, lights, out):
     return [lit / summary["area"] for lit in summary["lit_area"]], took
 
 
+def view_of(tris):
+    """A view of the scene: the eye in front, right and above the bounds'
+    centre, looking at it, `y` up (the bunny scenes' up)."""
+    lo, hi = tris.reshape(-1, 3).min(0), tris.reshape(-1, 3).max(0)
+    c, half = (lo + hi) / 2, (hi - lo).max() / 2
+    return c + np.array([1.2, 0.9, 2.2]) * half, c, np.array([0.0, 1.0, 0.0]), 50.0
+
+
+def embree_image(tris, view, size, light):
+    """Embree ray tracing an image: the BVH built, a primary ray through
+    each pixel's centre (pinhole, vertical field of view), and a shadow
+    ray toward the point light from each hit, lit where the hit face is
+    turned toward the light (as the exact engine counts it). The share of
+    the visible pixels lit, and the seconds it took."""
+    import embreex.mesh_construction as mc
+    import embreex.rtcore_scene as rtcs
+
+    eye, target, up, fov = view
+    w, h = size
+    start = time.perf_counter()
+    scene = rtcs.EmbreeScene()
+    mc.TriangleMesh(scene=scene, vertices=tris.astype(np.float32))
+    fwd = (target - eye) / np.linalg.norm(target - eye)
+    right = np.cross(fwd, up)
+    right /= np.linalg.norm(right)
+    upv = np.cross(right, fwd)
+    t = np.tan(np.radians(fov) / 2)
+    xs = (2 * (np.arange(w) + 0.5) / w - 1) * t * w / h
+    ys = (1 - 2 * (np.arange(h) + 0.5) / h) * t
+    d = fwd + xs[None, :, None] * right + ys[:, None, None] * upv
+    d = (d / np.linalg.norm(d, axis=2)[..., None]).reshape(-1, 3).astype(np.float32)
+    o = np.broadcast_to(eye.astype(np.float32), d.shape)
+    res = scene.run(o, d, output=1)
+    prim, dist = res["geomID"] >= 0, res["tfar"]
+    hit = np.nonzero(prim)[0]
+    pts = eye + d[hit].astype(np.float64) * dist[hit, None]
+    tri = tris[res["primID"][hit]]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    # the side of the face the eye sees
+    n *= np.where((n * d[hit]).sum(1) < 0, 1.0, -1.0)[:, None]
+    to_light = light - pts
+    dist_l = np.linalg.norm(to_light, axis=1)
+    dl = to_light / dist_l[:, None]
+    size_s = np.ptp(tris.reshape(-1, 3), axis=0).max()
+    origin = pts + dl * (1e-6 * size_s)
+    blocked = scene.run(origin.astype(np.float32), dl.astype(np.float32),
+                        query="OCCLUDED", dists=(dist_l * (1 - 1e-6)).astype(np.float32))
+    lit = ((n * dl).sum(1) > 0) & (blocked == -1)
+    return lit.mean(), time.perf_counter() - start
+
+
+def ours_image(binary, scene, view, size, light, out):
+    """`shadow render --method exact` of the same view: the share of the
+    visible pixels lit (from its report), and the seconds it took."""
+    eye, target, up, fov = view
+    flag = lambda x: ",".join(repr(float(c)) for c in x)
+    start = time.perf_counter()
+    said = subprocess.run(
+        [binary, "render", "--scene", scene, "--method", "exact", "--size", f"{size[0]}x{size[1]}",
+         "--eye", flag(eye), "--target", flag(target), "--up", flag(up), "--fov", str(fov),
+         "--light", flag(light), "-o", out],
+        check=True, capture_output=True, text=True).stdout
+    took = time.perf_counter() - start
+    share = float(said.split("% of the visible pixels lit")[0].split()[-1]) / 100
+    return share, took
+
+
+def image_main(args, tris, lights):
+    size = tuple(int(x) for x in args.image.split("x"))
+    (kind, light), = lights
+    if kind != "point":
+        raise SystemExit("--image takes one point light")
+    view = view_of(tris)
+    mine, theirs = [], []
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "image.png")
+        for _ in range(args.runs):
+            lit_exact, t = ours_image(args.bin, args.scene, view, size, light, out)
+            mine.append(t)
+            lit_rays, t = embree_image(tris, view, size, light)
+            theirs.append(t)
+    a, b = statistics.median(mine), statistics.median(theirs)
+    print(f"scene {args.scene}: {len(tris)} triangles; {size[0]}x{size[1]}, eye "
+          f"{','.join(f'{c:.4g}' for c in view[0])}")
+    print(f"ours (shadow render --method exact, end to end): median {a:.3f} s of {args.runs}: {sorted(mine)}")
+    print(f"Embree (BVH + a primary ray a pixel + a shadow ray a hit): median {b:.3f} s: {sorted(theirs)}")
+    print(f"ratio ours/Embree: {a / b:.2f}")
+    print(f"visible pixels lit: exact {lit_exact:.4f}, Embree {lit_rays:.4f}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scene", default="bunny-99k")
@@ -125,6 +221,9 @@ def main():
     ap.add_argument("--rays", type=int, default=1_000_000)
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--bin", default=os.path.join(ROOT, "target/release/shadow"))
+    ap.add_argument("--image", metavar="WxH",
+                    help="compare images instead: `shadow render --method exact` against Embree "
+                         "ray tracing the same view (one point light)")
     args = ap.parse_args()
     import bsp_shadows as bs
 
@@ -133,6 +232,8 @@ def main():
     lights = [("point", vec(t)) for t in args.light] + [("sun", vec(t)) for t in args.sun]
     if not lights:
         lights = [("point", default_light(tris))]
+    if args.image:
+        return image_main(args, tris, lights)
     pts, normal = samples(tris, args.rays)
     mine, theirs = [], []
     with tempfile.TemporaryDirectory() as d:
