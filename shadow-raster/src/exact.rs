@@ -278,15 +278,17 @@ fn drawn(frame: &Frame<'_>, vis: &Visibility) -> Vec<bool> {
     }
     let groups: std::collections::HashSet<(u32, Plane)> = (0..scene.len())
         .filter(|&i| seen[i])
-        .filter_map(|i| Some((scene.face[i], frame.vis_plane(i)?)))
+        .filter_map(|i| group_of(frame, i))
         .collect();
     (0..scene.len())
-        .map(|i| {
-            frame
-                .vis_plane(i)
-                .is_some_and(|p| groups.contains(&(scene.face[i], p)))
-        })
+        .map(|i| group_of(frame, i).is_some_and(|g| groups.contains(&g)))
         .collect()
+}
+
+/// The group of prim `i`: its face and the plane of the side the eye
+/// sees (`None` for a prim seen edge-on).
+fn group_of(frame: &Frame<'_>, i: usize) -> Option<(u32, Plane)> {
+    Some((frame.scene.face[i], frame.vis_plane(i)?))
 }
 
 /// Scan-converts the fragments of `batch` over the visible prims of their
@@ -322,10 +324,10 @@ pub(crate) fn draw(
     // a group: one face seen from one side
     let mut groups: HashMap<(u32, Plane), u32> = HashMap::new();
     let prim_group: Vec<u32> = (0..scene.len())
-        .map(|i| match frame.vis_plane(i) {
-            Some(p) => {
+        .map(|i| match group_of(frame, i) {
+            Some(g) => {
                 let next = groups.len() as u32;
-                *groups.entry((scene.face[i], p)).or_insert(next)
+                *groups.entry(g).or_insert(next)
             }
             None => NONE,
         })

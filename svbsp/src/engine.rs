@@ -156,25 +156,32 @@ impl Shadows {
     /// as with all of them; the fragments may come out cut or listed
     /// differently.
     pub fn new(occluders: &[Polygon], lights: &[Light]) -> Result<Shadows, ShadowError> {
+        Shadows::new_with(occluders, lights, &bsp_core::certify_solid_parts(occluders))
+    }
+
+    /// [`Shadows::new`] with the parts of `occluders` already certified
+    /// (`solids` is [`bsp_core::certify_solid_parts`] of `occluders`), for
+    /// callers that build several runs over the same polygons.
+    pub fn new_with(
+        occluders: &[Polygon],
+        lights: &[Light],
+        solids: &bsp_core::SolidParts,
+    ) -> Result<Shadows, ShadowError> {
         if lights.len() > MAX_LIGHTS {
             return Err(LightError::TooMany(lights.len()).into());
         }
         for l in lights {
             l.validate()?;
         }
-        let solids = bsp_core::certify_solid_parts(occluders);
         // one light after the other: each build is parallel inside, and
-        // only one build's working memory is alive at a time
+        // only one build's working memory is alive at a time (polygons
+        // off the grid leave no part certified, so nothing is left out
+        // and an error's index is the caller's)
         let volumes = lights
             .iter()
             .map(|&l| {
-                let turned_away =
-                    |(i, p): &(usize, &Polygon)| l.leaves_out(&solids, *i, p.support());
-                if !occluders.iter().enumerate().any(|ip| turned_away(&ip)) {
-                    return ShadowVolumes::build(l, occluders);
-                }
                 let kept: Vec<&Polygon> = (occluders.iter().enumerate())
-                    .filter(|ip| !turned_away(ip))
+                    .filter(|(i, p)| !l.leaves_out(solids, *i, p.support()))
                     .map(|(_, p)| p)
                     .collect();
                 ShadowVolumes::build(l, &kept)

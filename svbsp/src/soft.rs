@@ -264,9 +264,10 @@ impl<'a> SoftShadows<'a> {
 /// occluder's shadow volume from each corner instead).
 fn corner_shadows(lights: &[AreaLight], faces: &[Occluder]) -> Vec<Option<Shadows>> {
     let polygons: Vec<Polygon> = faces.iter().map(Occluder::to_polygon).collect();
+    let solids = bsp_core::certify_solid_parts(&polygons);
     lights
         .iter()
-        .map(|l| Shadows::new(&polygons, l.corners()).ok())
+        .map(|l| Shadows::new_with(&polygons, l.corners(), &solids).ok())
         .collect()
 }
 
