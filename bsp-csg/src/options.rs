@@ -63,8 +63,11 @@ pub struct Stats {
     pub cells: usize,
     /// Cells that hold faces of both operands (a local boolean each).
     pub mixed_cells: usize,
-    /// Mixed cells where faces of the two operands share a plane, merged
-    /// as whole partitions.
+    /// Mixed cells where faces of the two operands share a plane and one
+    /// operand is not a simple surface there (it touches itself, or
+    /// covers an area twice), merged as whole partitions. (Where both are
+    /// simple, pieces in a shared plane are sorted by the labels on both
+    /// sides of it, as other pieces are.)
     pub merged_cells: usize,
     /// Faces of either operand that the other surface cuts, so that only
     /// part of them stays (outside merged cells).
@@ -88,7 +91,8 @@ impl std::fmt::Display for Stats {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} cells, {} with both surfaces ({} with shared planes, {} where they do not meet: \
+            "{} cells, {} with both surfaces ({} with shared planes merged whole, {} where they do \
+             not meet: \
              {} with every face apart from the other surface, {} labelled from the cells \
              around); {} faces cut into {} pieces",
             self.cells,

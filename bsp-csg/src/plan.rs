@@ -28,7 +28,7 @@ mod settle;
 
 use bsp_core::internals::ConvexFace;
 use bsp_core::par;
-use bsp_core::{BoolOp, Plane, TriMesh};
+use bsp_core::{BoolOp, Plane, Polygon, TriMesh};
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
@@ -444,6 +444,35 @@ impl MixedCells {
     }
 }
 
+/// The new faces of an operation (cut faces' kept parts of both
+/// operands, merged cells' boundaries) put back together where two of one
+/// plane share a whole edge and their union is convex, across faces
+/// ([`settle::rejoined`]); in their order, faces kept whole untouched.
+fn rejoin_new_faces(add: &mut Vec<AddedFace>) {
+    // each new face's slot and polygon (the slot left holding a marker)
+    let (at, polygons): (Vec<usize>, Vec<Polygon>) = (add.iter_mut().enumerate())
+        .filter(|(_, f)| matches!(f, AddedFace::New(_)))
+        .filter_map(
+            |(i, f)| match std::mem::replace(f, AddedFace::Theirs(u32::MAX)) {
+                AddedFace::New(p) => Some((i, *p)),
+                AddedFace::Theirs(_) => None,
+            },
+        )
+        .unzip();
+    let mut gone = vec![false; add.len()];
+    for (&i, p) in at.iter().zip(settle::rejoined(polygons)) {
+        match p {
+            Some(p) => add[i] = AddedFace::New(Box::new(p)),
+            None => gone[i] = true,
+        }
+    }
+    let mut k = 0;
+    add.retain(|_| {
+        k += 1;
+        !gone[k - 1]
+    });
+}
+
 /// What an operation decided for the first solid.
 struct Decided {
     stats: Stats,
@@ -697,6 +726,7 @@ impl Planning<'_> {
                 }
             }
         }
+        rejoin_new_faces(add);
         // the faces away from the shared box: outside the other solid
         match self.op {
             BoolOp::Union => {

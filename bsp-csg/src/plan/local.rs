@@ -537,16 +537,23 @@ impl At {
 }
 
 /// The fate of `piece` against the labelled regions `other` of the other
-/// operand in the cell: a piece shares no plane with `other`'s faces, so
-/// every fragment lies strictly inside one region. `keep(c)` says whether
-/// a fragment in a region labelled `c` stays.
+/// operand in the cell. `keep(c)` says whether a fragment strictly inside
+/// a region labelled `c` stays; a part that lies in one of `other`'s
+/// planes is cut by the regions on both sides, and `coplanar(plane,
+/// ahead, behind)` says whether a fragment in `plane` with those labels
+/// just ahead of it and just behind it stays.
 ///
 /// The piece is split down the tree; where both parts of a split stay
 /// whole, the part they were cut from stays instead (it is their union),
 /// so a kept fragment is cut only by planes with something dropped on
 /// one side. The mesh puts into its edges the vertices its neighbours
 /// have there.
-fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate {
+fn fate(
+    piece: &Polygon,
+    other: &Labelled,
+    keep: impl Fn(Cell) -> bool,
+    coplanar: impl Fn(&Plane, Cell, Cell) -> bool,
+) -> Fate {
     /// A part: the piece itself (borrowed: most go down whole), or a
     /// part cut from it (boxed, so that the records stay small).
     enum Cow<'p> {
@@ -580,23 +587,39 @@ fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate 
         pieces: Option<[u32; 2]>,
         state: State,
     }
-    /// A part on its way down: where it goes, and its parent's record
-    /// and side.
+    /// Where a part in one of `other`'s planes is on its way: first down
+    /// the regions just ahead of it (then on to `behind`), then down those
+    /// just behind it with the label ahead found.
+    #[derive(Clone, Copy)]
+    enum Beside {
+        No,
+        Ahead { behind: At, node: u32 },
+        Behind { ahead: Cell, node: u32 },
+    }
+    /// A part on its way down: where it goes, its parent's record and
+    /// side, and whether it lies in a plane of `other`.
     /// (The piece itself is only borrowed: most go down whole.)
-    type Going<'p> = (Cow<'p>, At, Option<(u32, usize)>);
+    type Going<'p> = (Cow<'p>, At, Option<(u32, usize)>, Beside);
     // (small records in place: most pieces make one, and no allocation)
     let mut recs: smallvec::SmallVec<[Rec<'_>; 8]> = smallvec::SmallVec::new();
     let mut stack: smallvec::SmallVec<[Going<'_>; 8]> =
-        smallvec::smallvec![(Cow::Borrowed(piece), other.at_root(), None)];
-    while let Some((p, mut at, parent)) = stack.pop() {
+        smallvec::smallvec![(Cow::Borrowed(piece), other.at_root(), None, Beside::No)];
+    while let Some((p, mut at, parent, mut beside)) = stack.pop() {
         let me = recs.len() as u32;
         if let Some((r, k)) = parent {
             recs[r as usize].pieces.as_mut().expect("a split record")[k] = me;
         }
         loop {
-            match at {
-                At::Leaf(c) => {
-                    let state = if keep(c) { State::Kept } else { State::Dropped };
+            match (at, beside) {
+                (At::Leaf(c), Beside::Ahead { behind, node }) => {
+                    (at, beside) = (behind, Beside::Behind { ahead: c, node });
+                }
+                (At::Leaf(c), _) => {
+                    let kept = match beside {
+                        Beside::Behind { ahead, node } => coplanar(other.node(node).0, ahead, c),
+                        _ => keep(c),
+                    };
+                    let state = if kept { State::Kept } else { State::Dropped };
                     recs.push(Rec {
                         poly: Some(p),
                         pieces: None,
@@ -604,10 +627,23 @@ fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate 
                     });
                     break;
                 }
-                At::Node(i) => {
+                (At::Node(i), _) => {
                     let (plane, front, back) = other.node(i);
                     match p.get().parts(plane) {
                         Parts::Whole(PolygonSide::Back) => at = back,
+                        Parts::Whole(PolygonSide::Coplanar { same_orientation }) => {
+                            // the side the part's normal points to is the
+                            // plane's front if they agree
+                            let (ahead, behind) = match same_orientation {
+                                true => (front, back),
+                                false => (back, front),
+                            };
+                            (at, beside) = match beside {
+                                Beside::No => (ahead, Beside::Ahead { behind, node: i }),
+                                Beside::Ahead { .. } => (ahead, beside),
+                                Beside::Behind { .. } => (behind, beside),
+                            };
+                        }
                         Parts::Whole(_) => at = front,
                         Parts::Split { front: f, back: b } => {
                             recs.push(Rec {
@@ -615,8 +651,8 @@ fn fate(piece: &Polygon, other: &Labelled, keep: impl Fn(Cell) -> bool) -> Fate 
                                 pieces: Some([u32::MAX; 2]),
                                 state: State::Mixed,
                             });
-                            stack.push((Cow::Owned(Box::new(b)), back, Some((me, 1))));
-                            stack.push((Cow::Owned(Box::new(f)), front, Some((me, 0))));
+                            stack.push((Cow::Owned(Box::new(b)), back, Some((me, 1)), beside));
+                            stack.push((Cow::Owned(Box::new(f)), front, Some((me, 0)), beside));
                             break;
                         }
                     }
@@ -671,20 +707,158 @@ pub(crate) fn boolean_pieces(
     let shared = a
         .iter()
         .any(|p| b.iter().any(|q| p.support().is_coincident(q.support())));
-    if shared {
-        return boolean(bx, a, b, op, ref_a, ref_b).map(CellResult::Merged);
-    }
-    let pa = Labelled::new(bx, a.clone(), ref_a)?;
-    let pb = Labelled::new(bx, b.clone(), ref_b)?;
+    let (pa, pb) = if shared {
+        // pieces in a plane of the other surface are sorted by the labels
+        // on both sides of it, where each surface is simple there (see
+        // [`coplanar_keeps`]); else the cell is merged as a whole
+        match (simple_tree(&a), simple_tree(&b)) {
+            (Some(ta), Some(tb)) => (Labelled::Tree(ta), Labelled::Tree(tb)),
+            _ => return boolean(bx, a, b, op, ref_a, ref_b).map(CellResult::Merged),
+        }
+    } else {
+        (
+            Labelled::new(bx, a.clone(), ref_a)?,
+            Labelled::new(bx, b.clone(), ref_b)?,
+        )
+    };
+    let b_kept = if shared {
+        b_copies_kept(op, &a, &b)
+    } else {
+        Vec::new()
+    };
+    let on = |of_a: bool| {
+        let b_kept = &b_kept;
+        move |plane: &Plane, ahead: Cell, behind: Cell| {
+            let b_copy = b_kept
+                .iter()
+                .any(|(p, kept)| *kept && p.is_coincident(plane));
+            coplanar_keeps(op, of_a, b_copy, (ahead == Cell::In, behind == Cell::In))
+        }
+    };
+    let (on_a, on_b) = (on(true), on(false));
     let fa = a
         .iter()
-        .map(|p| fate(p, &pb, |c| keep.0(c == Cell::In)))
+        .map(|p| fate(p, &pb, |c| keep.0(c == Cell::In), on_a))
         .collect();
     let fb = b
         .iter()
-        .map(|p| fate(p, &pa, |c| keep.1(c == Cell::In)))
+        .map(|p| fate(p, &pa, |c| keep.1(c == Cell::In), on_b))
         .collect();
     Ok(CellResult::Pieces(fa, fb, a, b))
+}
+
+/// The autopartition of one operand's pieces in a cell where it is a
+/// simple surface: its tree's own labels are the winding numbers (as for
+/// [`Labelled::Tree`]), and no two of its pieces in one plane overlap (an
+/// area covered twice, where the labels on its two sides would not tell
+/// that two pieces lie there). `None` otherwise.
+fn simple_tree(pieces: &[Polygon]) -> Option<BspTree> {
+    let twice = pieces.iter().enumerate().any(|(i, p)| {
+        pieces[i + 1..]
+            .iter()
+            .any(|q| p.support().is_coincident(q.support()) && !apart_in_plane(p, q))
+    });
+    if twice {
+        return None;
+    }
+    let tree = BspTree::build(pieces.to_vec(), &local_build());
+    (tree.faces_agree() && faces_bound(&tree)).then_some(tree)
+}
+
+/// `true` if two convex polygons of one plane have no interior point in
+/// common: an edge line of one has the other wholly on its outer side or
+/// on it (for convex polygons in a plane, a separating line can be taken
+/// along an edge of one of them).
+fn apart_in_plane(p: &Polygon, q: &Polygon) -> bool {
+    let outside = |a: &Polygon, b: &Polygon| {
+        a.edge_planes()
+            .iter()
+            .any(|e| b.vertices().iter().all(|v| v.classify(e) != Side::Back))
+    };
+    outside(p, q) || outside(q, p)
+}
+
+/// Whether a fragment of a piece of operand A (`of_a`) or B that lies in
+/// a plane of the other operand's surface stays, from the other's labels
+/// just ahead of the piece (on the side its normal points to) and just
+/// behind it. Both surfaces are simple in the cell ([`simple_tree`]): the
+/// piece's own solid is outside ahead of it and inside behind it, and the
+/// other's labels differ across the plane exactly where one piece of the
+/// other's lies there, facing the way its labels change.
+///
+/// The result's boundary runs through the fragment, facing the way the
+/// kept piece is written (a piece of B turned around for `a − b`), where
+/// the result holds the point just behind that way and not the one ahead.
+/// Where a piece of the other operand would be written there facing the
+/// same way (a shared area), one copy is kept: B's where `b_copy` (see
+/// [`b_copies_kept`]), else A's.
+fn coplanar_keeps(op: BoolOp, of_a: bool, b_copy: bool, (ahead, behind): (bool, bool)) -> bool {
+    let holds = |own: bool, other: bool| {
+        let (a, b) = if of_a { (own, other) } else { (other, own) };
+        match op {
+            BoolOp::Union => a || b,
+            BoolOp::Intersection => a && b,
+            BoolOp::Difference => a && !b,
+        }
+    };
+    let (front, back) = (holds(false, ahead), holds(true, behind));
+    // whether the other's piece there is written facing the same way
+    let turned = op == BoolOp::Difference;
+    let twin = match turned {
+        true => ahead && !behind,
+        false => !ahead && behind,
+    };
+    // the result's boundary there, facing the way this piece is written
+    // (a piece of B turned around for a difference faces the other way)
+    let bounds = match !of_a && turned {
+        true => front && !back,
+        false => back && !front,
+    };
+    // the other operand's copy of it, where that is the one kept
+    let theirs = twin && b_copy == of_a;
+    bounds && !theirs
+}
+
+/// The planes where pieces of the two operands lie in a cell, each with
+/// whether B's copy of an area both cover is the one kept: the copy that
+/// can stay whole. For `a ∪ b` the result there covers both pieces, so
+/// B's where every piece of A in that plane lies within one of B's; for
+/// `a ∩ b` it covers what both do, so B's where every piece of B lies
+/// within one of A's (a box with a prism standing in it keeps the prism's
+/// faces whole and drops the box's); for `a − b`, where a piece of B
+/// would be written turned around onto one of A's, A's.
+fn b_copies_kept<'p>(op: BoolOp, a: &'p [Polygon], b: &'p [Polygon]) -> Vec<(&'p Plane, bool)> {
+    let (inner, outer) = match op {
+        BoolOp::Union => (a, b),
+        BoolOp::Intersection => (b, a),
+        BoolOp::Difference => return Vec::new(),
+    };
+    let mut planes: Vec<(&Plane, bool)> = Vec::new();
+    for q in inner {
+        let mut twins = (outer.iter())
+            .filter(|p| p.support().is_coincident(q.support()))
+            .peekable();
+        if twins.peek().is_none() {
+            continue;
+        }
+        let within = twins.any(|p| contains_in_plane(p, q));
+        match planes
+            .iter_mut()
+            .find(|(h, _)| h.is_coincident(q.support()))
+        {
+            Some((_, all)) => *all &= within,
+            None => planes.push((q.support(), within)),
+        }
+    }
+    planes
+}
+
+/// `true` if the convex polygon `q` lies within `p`, of the same plane:
+/// every corner of `q` on or behind every edge plane of `p`.
+fn contains_in_plane(p: &Polygon, q: &Polygon) -> bool {
+    p.edge_planes()
+        .iter()
+        .all(|e| q.vertices().iter().all(|v| v.classify(e) != Side::Front))
 }
 
 /// `true` if every vertex of `p` lies strictly on one side of `plane`.
@@ -992,7 +1166,8 @@ mod tests {
                     faces.extend(cuboid([dx, -1, dz], [dx + 2, h, dz + 3]));
                     let l = Labelled::new(&bx, pieces(&faces, &bx), || panic!("pieces decide"))
                         .unwrap();
-                    let Fate::Cut(kept) = fate(&sq, &l, out) else {
+                    let in_plane = |_: &Plane, _: Cell, _: Cell| panic!("no plane shared");
+                    let Fate::Cut(kept) = fate(&sq, &l, out, in_plane) else {
                         panic!("the first block cuts the square");
                     };
                     let leaves = l.push_down(sq.clone());
@@ -1003,8 +1178,8 @@ mod tests {
                     fewer += (kept.len() < kept_leaves) as u32;
                     cases += 1;
                     // everything kept, or everything dropped: the piece
-                    assert!(matches!(fate(&sq, &l, |_| true), Fate::Keep));
-                    assert!(matches!(fate(&sq, &l, |_| false), Fate::Drop));
+                    assert!(matches!(fate(&sq, &l, |_| true, in_plane), Fate::Keep));
+                    assert!(matches!(fate(&sq, &l, |_| false, in_plane), Fate::Drop));
                 }
             }
         }

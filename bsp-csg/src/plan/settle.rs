@@ -226,6 +226,16 @@ fn rejoin(pieces: Vec<Polygon>) -> Vec<Polygon> {
     if pieces.len() < 2 {
         return pieces;
     }
+    rejoined(pieces).into_iter().flatten().collect()
+}
+
+/// [`rejoin`] in place: each polygon's slot holds what it grew into, or
+/// `None` where it was merged into another (an earlier one, or a later
+/// one that then holds the union). Polygons of different planes never
+/// merge, so any polygons may be given: an operation passes every new
+/// face of its result, and the pieces of faces that one plane held (a
+/// quad written as two triangles, both cut) come together again.
+pub(super) fn rejoined(pieces: Vec<Polygon>) -> Vec<Option<Polygon>> {
     // the endpoints' approximate keys: a pair of equal points that gets
     // two keys is only a merge missed, and a merge is decided exactly
     let keys_of = |p: &Polygon| -> SmallVec<[u64; 8]> {
@@ -268,7 +278,7 @@ fn rejoin(pieces: Vec<Polygon>) -> Vec<Polygon> {
             work.push(i);
         }
     }
-    live.into_iter().flatten().collect()
+    live
 }
 
 #[cfg(test)]
