@@ -25,11 +25,12 @@ mod octree;
 mod operands;
 mod resolve;
 mod settle;
+mod twins;
 
 use bsp_core::internals::ConvexFace;
 use bsp_core::par;
 use bsp_core::{BoolOp, Plane, Polygon, TriMesh};
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 use smallvec::SmallVec;
 
 use crate::index::{IBox, SmallBox, intersect, union};
@@ -311,6 +312,9 @@ struct Cells {
     near: Both<Vec<u32>>,
     /// The leaves of each of those faces, by its place in `near`.
     leaves_of: Both<Vec<SmallVec<[u32; 4]>>>,
+    /// The faces (by id) that are the same polygon as one of the other
+    /// operand's ([`twins`]).
+    twinned: Both<FxHashSet<u32>>,
 }
 
 impl Cells {
@@ -320,7 +324,16 @@ impl Cells {
             a: solids.a.faces_near(&root),
             b: solids.b.faces_near(&root),
         };
-        let mut leaves = grow_octree(solids, &near, root, opts.leaf_size);
+        let twin = twins::twins(solids, &near);
+        // a cell where the two surfaces are one is not split
+        let settled = |l: &Leaf| {
+            let (ta, tb) = (&twin.a, &twin.b);
+            let twin_a = |f: u32| ta[f as usize] != twins::NONE;
+            let twin_b = |f: u32| tb[f as usize] != twins::NONE;
+            twins::one_set(solids, &l.bx, (&l.a, &l.b), twin_a, twin_b)
+        };
+        let mut leaves = grow_octree(solids, &near, root, opts.leaf_size, &settled);
+        let twinned = twins::twinned(&twin, &near);
         if opts.exact_cells {
             // the lists of the leaves holding both, by the exact test
             par::for_each_mut(&mut leaves, |_, l| {
@@ -355,6 +368,7 @@ impl Cells {
             adjacent,
             near,
             leaves_of,
+            twinned,
         }
     }
 }
@@ -366,6 +380,7 @@ fn grow_octree(
     near: &Both<Vec<u32>>,
     root: IBox,
     leaf_size: usize,
+    settled: &(dyn Fn(&Leaf) -> bool + Sync),
 ) -> Vec<Leaf> {
     // the faces' boxes and planes side by side, by their place in `near`
     // (a face slot is large: the build reads these often)
@@ -387,6 +402,7 @@ fn grow_octree(
             plane_meets: |f: u32, c: &IBox| octree::plane_meets(&planes_b[f as usize], c),
         },
         leaf_size,
+        settled,
     )
 }
 
@@ -525,6 +541,7 @@ impl<'s> Planning<'s> {
         let work = CellWork {
             solids: self.solids,
             touched: &touched,
+            twinned: &self.cells.twinned,
             op: self.op,
         };
         let mut done = self.run_mixed_cells(&work, &mixed, &touched)?;

@@ -14,11 +14,13 @@
 use bsp_core::internals::ConvexFace;
 use bsp_core::par;
 use bsp_core::{BoolOp, GridPoint, Plane, Polygon};
+use rustc_hash::FxHashSet;
 use smallvec::SmallVec;
 
 use super::local::{self, CellResult, Fate};
 use super::octree::{Leaf, walls};
 use super::operands::{Both, Keep, Operand};
+use super::twins;
 use crate::index::{IBox, holds};
 use crate::solid::SolidFace;
 use crate::{CsgError, Solid};
@@ -346,6 +348,8 @@ fn touched_in(leaf: &Leaf, solids: Both<&Solid>) -> Both<Vec<u32>> {
 pub(super) struct CellWork<'p> {
     pub(super) solids: Both<&'p Solid>,
     pub(super) touched: &'p Touched,
+    /// The faces that are the same polygon as one of the other's.
+    pub(super) twinned: &'p Both<FxHashSet<u32>>,
     pub(super) op: BoolOp,
 }
 
@@ -356,6 +360,11 @@ impl CellWork<'_> {
     /// faces' are known) and is easy if every piece is isolated; else it
     /// clips every face and builds its partitions.
     pub(super) fn run(&self, leaf: &Leaf, allow_easy: bool) -> Result<CellRun, CsgError> {
+        let (ta, tb) = (&self.twinned.a, &self.twinned.b);
+        let (twin_a, twin_b) = (|f| ta.contains(&f), |f| tb.contains(&f));
+        if twins::one_set(self.solids, &leaf.bx, (&leaf.a, &leaf.b), twin_a, twin_b) {
+            return Ok(self.one_set(leaf));
+        }
         let w = walls(&leaf.bx);
         let pieces = if allow_easy {
             let touched = Both {
@@ -383,6 +392,27 @@ impl CellWork<'_> {
             }
         };
         self.build(leaf, pieces, &w)
+    }
+
+    /// A cell where the two solids are one set ([`twins`]): `a ∪ b` and
+    /// `a ∩ b` keep `a`'s faces and drop `b`'s, `a − b` drops both; no
+    /// piece crosses a wall alone.
+    fn one_set(&self, leaf: &Leaf) -> CellRun {
+        let fate = |keep: bool| match keep {
+            true => PieceFate::Keep,
+            false => PieceFate::Drop,
+        };
+        let keep_a = self.op != BoolOp::Difference;
+        CellRun::Built {
+            outcome: CellOutcome::Sorted(Both {
+                a: leaf.a.iter().map(|_| fate(keep_a)).collect(),
+                b: leaf.b.iter().map(|_| fate(false)).collect(),
+            }),
+            crossings: Both {
+                a: vec![None; leaf.a.len()],
+                b: vec![None; leaf.b.len()],
+            },
+        }
     }
 
     /// Operand `o`'s listed faces of `leaf` that `which` accepts, clipped

@@ -162,18 +162,31 @@ pub(crate) struct Faces<'a, P> {
 /// nothing when faces pile up at one point (a vertex of high degree on the
 /// other surface), so the depth stays bounded there. Large cells' subtrees
 /// are built in parallel (the same leaves, in the same order).
+///
+/// `settled(cell)` says that a cell need not be split whatever it holds
+/// (its two surfaces are one there: see `plan::twins`).
 pub(crate) fn build<P: PlaneTest, Q: PlaneTest>(
     domain: IBox,
     a: &Faces<'_, P>,
     b: &Faces<'_, Q>,
     leaf_size: usize,
+    settled: &(dyn Fn(&Leaf) -> bool + Sync),
 ) -> Vec<Leaf> {
     let root = Leaf {
         bx: domain,
         a: (0..a.boxes.len() as u32).collect(),
         b: (0..b.boxes.len() as u32).collect(),
     };
-    grow(root, 0, &Build { a, b, leaf_size })
+    grow(
+        root,
+        0,
+        &Build {
+            a,
+            b,
+            leaf_size,
+            settled,
+        },
+    )
 }
 
 /// What the build works from.
@@ -181,6 +194,7 @@ struct Build<'f, 'a, P, Q> {
     a: &'f Faces<'a, P>,
     b: &'f Faces<'a, Q>,
     leaf_size: usize,
+    settled: &'f (dyn Fn(&Leaf) -> bool + Sync),
 }
 
 /// Cells with more faces than this build their children's subtrees in
@@ -225,6 +239,7 @@ fn split<P: PlaneTest, Q: PlaneTest>(
         || cell.a.len() + cell.b.len() <= leaf_size
         || axes.is_empty()
         || stalled >= MAX_STALLED
+        || (o.settled)(cell)
     {
         return None;
     }
@@ -502,7 +517,7 @@ mod tests {
             boxes: &boxes,
             plane_meets: |_, _: &IBox| true,
         };
-        let leaves = build(([0, 0, 0], [15, 15, 15]), &faces, &faces, 4);
+        let leaves = build(([0, 0, 0], [15, 15, 15]), &faces, &faces, 4, &|_| false);
         let volume: i64 = leaves
             .iter()
             .map(|l| (0..3).map(|k| l.bx.1[k] - l.bx.0[k] + 1).product::<i64>())
