@@ -78,6 +78,11 @@ pub struct Stats {
     /// labelled along their faces from the cells around, without local
     /// trees.
     pub easy_cells: usize,
+    /// Mixed cells where the two surfaces are one (every face has its
+    /// twin, the same polygon, in the other operand, and the two solids
+    /// wind alike there): each face kept or dropped whole, nothing
+    /// clipped, and the cell not split.
+    pub one_set_cells: usize,
     /// Mixed cells whose faces all lie apart from the other surface's
     /// (each whole face from each face of the other in every mixed cell
     /// that lists both): nothing was clipped or built there, and those
@@ -91,12 +96,12 @@ impl std::fmt::Display for Stats {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} cells, {} with both surfaces ({} with shared planes merged whole, {} where they do \
-             not meet: \
-             {} with every face apart from the other surface, {} labelled from the cells \
-             around); {} faces cut into {} pieces",
+            "{} cells, {} with both surfaces ({} where they are one, {} with shared planes merged \
+             whole, {} where they do not meet: {} with every face apart from the other surface, \
+             {} labelled from the cells around); {} faces cut into {} pieces",
             self.cells,
             self.mixed_cells,
+            self.one_set_cells,
             self.merged_cells,
             self.easy_cells + self.clean_cells,
             self.clean_cells,
@@ -118,6 +123,7 @@ impl<'a> std::iter::Sum<&'a Stats> for Stats {
             pieces: a.pieces + b.pieces,
             easy_cells: a.easy_cells + b.easy_cells,
             clean_cells: a.clean_cells + b.clean_cells,
+            one_set_cells: a.one_set_cells + b.one_set_cells,
         })
     }
 }

@@ -434,7 +434,7 @@ impl MixedCells {
                 self.easy_pieces.b.insert(l, pieces.b);
             }
             CellRun::Built { outcome, crossings } => {
-                if matches!(outcome, CellOutcome::Sorted(_)) {
+                if matches!(outcome, CellOutcome::Sorted(_) | CellOutcome::OneSet(_)) {
                     self.crossings.a.insert(l, crossings.a);
                     self.crossings.b.insert(l, crossings.b);
                 }
@@ -451,6 +451,11 @@ impl MixedCells {
                 self.stats.merged_cells += 1;
                 self.add
                     .extend(ps.into_iter().map(|p| AddedFace::New(Box::new(p))));
+            }
+            CellOutcome::OneSet(fates) => {
+                self.stats.one_set_cells += 1;
+                self.fates.a.insert(l, fates.a);
+                self.fates.b.insert(l, fates.b);
             }
             CellOutcome::Sorted(fates) => {
                 self.fates.a.insert(l, fates.a);

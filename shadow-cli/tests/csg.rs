@@ -117,9 +117,9 @@ fn stats_report_counts_volume_and_phases() {
     // the other surface
     assert_eq!(
         stat(&s, "octree:"),
-        "1 cells, 1 with both surfaces (0 with shared planes merged whole, 0 where they do not \
-         meet: 0 with every face apart from the other surface, 0 labelled from the cells \
-         around); 6 faces cut into 12 pieces"
+        "1 cells, 1 with both surfaces (0 where they are one, 0 with shared planes merged whole, \
+         0 where they do not meet: 0 with every face apart from the other surface, 0 labelled \
+         from the cells around); 6 faces cut into 12 pieces"
     );
     let m = closed_result(&out);
     assert_eq!(

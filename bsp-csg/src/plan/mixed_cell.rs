@@ -67,6 +67,9 @@ pub(super) enum CellOutcome {
     /// Faces of the two operands share a plane: the cell's merged
     /// boundary, which replaces every listed face's piece.
     Merged(Vec<Polygon>),
+    /// The two solids are one set in the cell ([`twins`]): each listed
+    /// face kept or dropped whole, nothing clipped.
+    OneSet(Both<Vec<PieceFate>>),
 }
 
 impl CellOutcome {
@@ -404,7 +407,7 @@ impl CellWork<'_> {
         };
         let keep_a = self.op != BoolOp::Difference;
         CellRun::Built {
-            outcome: CellOutcome::Sorted(Both {
+            outcome: CellOutcome::OneSet(Both {
                 a: leaf.a.iter().map(|_| fate(keep_a)).collect(),
                 b: leaf.b.iter().map(|_| fate(false)).collect(),
             }),
