@@ -122,3 +122,52 @@ fn same_polygon(p: &SolidFace, q: &SolidFace) -> bool {
                 .all(|i| (p.corner(i).to_point()).same_point(&q.corner((i + r) % n).to_point()))
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bsp_core::Polygon;
+
+    fn solid(quads: &[Vec<[i32; 3]>], turned: bool) -> Solid {
+        let polys = quads.iter().map(|q| {
+            let p = Polygon::from_grid_points(q, 0).unwrap();
+            if turned { p.flipped() } else { p }
+        });
+        Solid::from_polygons(polys.collect())
+    }
+
+    fn twins_of(a: &Solid, b: &Solid) -> Both<Vec<u32>> {
+        let all: IBox = ([-100; 3], [100; 3]);
+        let near = Both {
+            a: a.faces_near(&all),
+            b: b.faces_near(&all),
+        };
+        twins(Both { a, b }, &near)
+    }
+
+    /// The same box twice: every face has its twin, one to one; a face
+    /// repeated in one operand is nobody's twin; faces turned around, or
+    /// of another box, are not twins.
+    #[test]
+    fn twins_are_the_same_polygons_one_to_one() {
+        let cube = bsp_fixtures::grid_cuboid([0; 3], [2; 3]);
+        let a = solid(&cube, false);
+        let t = twins_of(&a, &solid(&cube, false));
+        assert!(t.a.iter().all(|&j| j != NONE) && t.b.iter().all(|&i| i != NONE));
+        for (i, &j) in t.a.iter().enumerate() {
+            assert_eq!(t.b[j as usize], i as u32);
+        }
+        let mut twice = cube.clone();
+        twice.push(cube[0].clone());
+        let t = twins_of(&a, &solid(&twice, false));
+        assert_eq!(t.a.iter().filter(|&&j| j == NONE).count(), 1);
+        assert_eq!(t.b.iter().filter(|&&i| i == NONE).count(), 2);
+        let t = twins_of(&a, &solid(&cube, true));
+        assert!(t.a.iter().all(|&j| j == NONE));
+        let other = bsp_fixtures::grid_cuboid([0; 3], [3, 2, 2]);
+        let t = twins_of(&a, &solid(&other, false));
+        // the faces at x = 0, y = 0 and z = 0 differ in size but for the
+        // one at x = 0, the same square
+        assert_eq!(t.a.iter().filter(|&&j| j != NONE).count(), 1);
+    }
+}
