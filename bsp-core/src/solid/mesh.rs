@@ -276,6 +276,34 @@ impl TriMesh {
             .collect();
         let near = Candidates::new(&coords);
         let twinned = twinned_edges(&corners, &start);
+        // the welded points inside each polygon's edges, in order along
+        // each (an edge used once each way needs no search:
+        // `twinned_edges`), as (edge, point)
+        let inside: Vec<Vec<(u32, u32)>> = (0..polys.len())
+            .into_par_iter()
+            .map(|p| {
+                let cs = &corners[start[p]..start[p + 1]];
+                let mut out = Vec::new();
+                for i in (0..cs.len()).filter(|&i| !twinned[start[p] + i]) {
+                    let (a, b) = (cs[i], cs[(i + 1) % cs.len()]);
+                    let mut on = edge_points(&polys[p], i, a, b, &vertices, &coords, &near);
+                    sort_along(&mut on, a, b, &vertices, &coords);
+                    out.extend(on.into_iter().map(|v| (i as u32, v)));
+                }
+                out
+            })
+            .collect();
+        // adjacent pieces of one plane meshed as one region where that
+        // drops corners (`flat_regions`)
+        let regions = super::flat_regions::flat_regions(
+            polys,
+            &super::flat_regions::Welded {
+                vertices: &vertices,
+                corners: &corners,
+                start: &start,
+                inside: &inside,
+            },
+        );
 
         // each polygon's triangles on its own, in parallel; chunks keep
         // the order of the polygons
@@ -288,7 +316,15 @@ impl TriMesh {
                 let mut of = Vec::new();
                 let first = c * RUN;
                 let cs_of = |i: usize| &corners[start[first + i]..start[first + i + 1]];
-                for (i, poly) in polys.iter().enumerate() {
+                for i in 0..polys.len() {
+                    let at = first + i;
+                    if regions.replaced[at] {
+                        if let Some(t) = regions.triangles.get(&(at as u32)) {
+                            triangles.extend_from_slice(t);
+                            of.extend(std::iter::repeat_n(at as u32, t.len()));
+                        }
+                        continue;
+                    }
                     let cs = cs_of(i);
                     // the place of the polygon's first edge in `twinned`
                     let edge0 = start[first + i];
@@ -302,45 +338,11 @@ impl TriMesh {
                     }
                     // boundary loop: (vertex, edge ids it lies on)
                     let mut ring: Vec<(u32, SmallVec<[u32; 3]>)> = Vec::with_capacity(k);
-                    for i in 0..k {
-                        let (a, b) = (cs[i], cs[(i + 1) % k]);
-                        ring.push((
-                            a,
-                            SmallVec::from_slice(&[((i + k - 1) % k) as u32, i as u32]),
-                        ));
-                        // an edge used once each way needs no search
-                        // (`twinned_edges`)
-                        let mut on_edge = if twinned[edge0 + i] {
-                            Vec::new()
-                        } else {
-                            edge_points(poly, i, a, b, &vertices, &coords, &near)
-                        };
-                        if on_edge.len() > 1 {
-                            let (pa, pb) = (&vertices[a as usize], &vertices[b as usize]);
-                            let axis = (0..3)
-                                .max_by(|&x, &y| {
-                                    let d = |c: usize| {
-                                        (coords[b as usize][c] - coords[a as usize][c]).abs()
-                                    };
-                                    d(x).total_cmp(&d(y))
-                                })
-                                .filter(|&ax| cmp_axis(pa, pb, ax) != Ordering::Equal)
-                                .or_else(|| {
-                                    (0..3).find(|&ax| cmp_axis(pa, pb, ax) != Ordering::Equal)
-                                })
-                                .expect("edge endpoints are distinct points");
-                            let rising = cmp_axis(pa, pb, axis) == Ordering::Less;
-                            on_edge.sort_by(|&x, &y| {
-                                let o =
-                                    cmp_axis(&vertices[x as usize], &vertices[y as usize], axis);
-                                if rising { o } else { o.reverse() }
-                            });
-                        }
-                        ring.extend(
-                            on_edge
-                                .into_iter()
-                                .map(|v| (v, SmallVec::from_slice(&[i as u32]))),
-                        );
+                    for (i, &c) in cs.iter().enumerate() {
+                        let e = i as u32;
+                        ring.push((c, SmallVec::from_slice(&[((i + k - 1) % k) as u32, e])));
+                        let on_edge = inside[at].iter().filter(|(f, _)| *f == e);
+                        ring.extend(on_edge.map(|&(_, v)| (v, SmallVec::from_slice(&[e]))));
                     }
                     let before = triangles.len();
                     clip_ears(ring, k as u32, &mut triangles);
@@ -352,7 +354,8 @@ impl TriMesh {
                 (triangles, of)
             })
             .collect();
-        drop((near, coords, corners, start, twinned));
+        let regions_dropped = !regions.triangles.is_empty();
+        drop((regions, inside, near, coords, corners, start, twinned));
         let n: usize = chunks.iter().map(|c| c.0.len()).sum();
         let mut triangles = Vec::with_capacity(n);
         let mut of = Vec::with_capacity(n);
@@ -360,6 +363,12 @@ impl TriMesh {
             triangles.extend(t);
             of.extend(p);
         }
+        // points a region left out of every loop are nobody's corner now
+        let (vertices, triangles) = if regions_dropped {
+            used_only(vertices, triangles)
+        } else {
+            (vertices, triangles)
+        };
         (vertices, triangles, of)
     }
 
@@ -824,6 +833,50 @@ fn twinned_edges(corners: &[u32], start: &[usize]) -> Vec<bool> {
     twinned
 }
 
+/// The vertices some triangle uses, in their order, and the triangles
+/// renumbered to them.
+fn used_only(vertices: Vec<Point>, mut triangles: Vec<[u32; 3]>) -> (Vec<Point>, Vec<[u32; 3]>) {
+    let mut new = vec![u32::MAX; vertices.len()];
+    for t in &triangles {
+        for &v in t {
+            new[v as usize] = 0;
+        }
+    }
+    let mut kept = Vec::with_capacity(vertices.len());
+    for (v, p) in vertices.into_iter().enumerate() {
+        if new[v] == 0 {
+            new[v] = kept.len() as u32;
+            kept.push(p);
+        }
+    }
+    triangles
+        .par_iter_mut()
+        .for_each(|t| *t = t.map(|v| new[v as usize]));
+    (kept, triangles)
+}
+
+/// Points of the segment from `a` to `b` sorted from `a` on (exactly,
+/// along the axis the segment spans most).
+fn sort_along(on: &mut [u32], a: u32, b: u32, vertices: &[Point], coords: &[[f32; 3]]) {
+    if on.len() < 2 {
+        return;
+    }
+    let (pa, pb) = (&vertices[a as usize], &vertices[b as usize]);
+    let axis = (0..3)
+        .max_by(|&x, &y| {
+            let d = |c: usize| (coords[b as usize][c] - coords[a as usize][c]).abs();
+            d(x).total_cmp(&d(y))
+        })
+        .filter(|&ax| cmp_axis(pa, pb, ax) != Ordering::Equal)
+        .or_else(|| (0..3).find(|&ax| cmp_axis(pa, pb, ax) != Ordering::Equal))
+        .expect("edge endpoints are distinct points");
+    let rising = cmp_axis(pa, pb, axis) == Ordering::Less;
+    on.sort_by(|&x, &y| {
+        let o = cmp_axis(&vertices[x as usize], &vertices[y as usize], axis);
+        if rising { o } else { o.reverse() }
+    });
+}
+
 /// Welded vertices lying strictly inside edge `i` (from `a` to `b`) of `poly`.
 #[allow(clippy::too_many_arguments)]
 fn edge_points(
@@ -976,7 +1029,7 @@ impl Candidates {
 /// other point of the loop, and `b` is not on it. A convex loop of positive
 /// area always has such an ear (at a corner next to a corner of another
 /// side). `next_edge` is the first free edge id for chords.
-fn clip_ears(
+pub(super) fn clip_ears(
     mut ring: Vec<(u32, SmallVec<[u32; 3]>)>,
     mut next_edge: u32,
     out: &mut Vec<[u32; 3]>,
@@ -1128,14 +1181,23 @@ mod tests {
 
     #[test]
     fn the_owned_mesh_is_the_borrowed_mesh() {
-        // a box cut by an oblique plane: implicit vertices, T-junctions
+        // a box cut by an oblique plane, all but one of the faces it
+        // crosses: implicit vertices, T-junctions on the face left whole
+        // (which keep them: the cut faces' pieces would otherwise mesh as
+        // their faces, `pieces_of_one_plane_mesh_as_one_region`)
         let cube = bsp_fixtures::cuboid(glam::DVec3::ZERO, glam::DVec3::splat(6.0));
         let cut = Plane::new([1, 2, 3], -17).unwrap();
         let mut polys = Vec::new();
+        let mut left_whole = false;
         for f in &cube {
             let g: Vec<crate::kernel::GridPoint> =
                 f.iter().map(|v| v.to_array().map(|c| c as i32)).collect();
-            match Polygon::from_grid_points(&g, 0).unwrap().split(&cut) {
+            let face = Polygon::from_grid_points(&g, 0).unwrap();
+            match face.clone().split(&cut) {
+                crate::Split::Spanning { .. } if !left_whole => {
+                    left_whole = true;
+                    polys.push(face);
+                }
                 crate::Split::Spanning { front, back } => polys.extend([front, back]),
                 crate::Split::Front(p) | crate::Split::Back(p) => polys.push(p),
                 crate::Split::Coplanar { polygon, .. } => polys.push(polygon),
@@ -1237,6 +1299,30 @@ mod tests {
             triangles: two,
         };
         assert_eq!(m.check_watertight(), Ok(()));
+    }
+
+    /// A box whose faces across the plane x = 1/2 are each cut in two
+    /// there (as a Boolean's cells cut them): the pieces of a face mesh as
+    /// one region, so the points where the plane crossed the edges go, and
+    /// the box comes out as a box (before: 12 vertices, 20 triangles).
+    #[test]
+    fn pieces_of_one_plane_mesh_as_one_region() {
+        let cube: Vec<Polygon> = bsp_fixtures::grid_cuboid([0; 3], [1; 3])
+            .iter()
+            .map(|q| Polygon::from_grid_points(q, 0).unwrap())
+            .collect();
+        let half = Plane::new([2, 0, 0], -1).unwrap();
+        let mut cut = Vec::new();
+        for p in &cube {
+            match p.parts(&half) {
+                crate::kernel::polygon::Parts::Split { front, back } => cut.extend([back, front]),
+                crate::kernel::polygon::Parts::Whole(_) => cut.push(p.clone()),
+            }
+        }
+        assert_eq!(cut.len(), 10);
+        let m = TriMesh::from_polygons_watertight(&cut).unwrap();
+        assert_eq!((m.vertices.len(), m.triangles.len()), (8, 12));
+        assert_eq!(m.volume_exact(), BigRational::from_integer(1.into()));
     }
 
     #[test]

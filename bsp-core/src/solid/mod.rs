@@ -3,6 +3,7 @@
 //! a surface is closed, oriented and embedded.
 
 pub(crate) mod embedded;
+mod flat_regions;
 pub(crate) mod import;
 pub(crate) mod mesh;
 pub(crate) mod topology;
