@@ -6,12 +6,10 @@
 use bsp_core::BoolOp;
 use bsp_csg::files::{FileBoolean, Operand};
 use bsp_csg::{MeshBuf, MeshIn, mesh_boolean, mesh_sequence};
+
+use crate::view;
 use bsp_fixtures as shapes;
 use glam::DVec3;
-
-fn view(m: &MeshBuf) -> MeshIn<'_> {
-    MeshIn::new(&m.positions, &m.faces)
-}
 
 /// The box `[lo, hi]` as one mesh (quads).
 fn cuboid(lo: [f64; 3], hi: [f64; 3]) -> MeshBuf {
@@ -39,8 +37,7 @@ fn cuboid(lo: [f64; 3], hi: [f64; 3]) -> MeshBuf {
 #[test]
 fn a_mesh_with_itself_comes_back_as_it_was() {
     for name in ["pyvista_nut.obj", "bunny.obj"] {
-        let path = format!("{}/../data/meshes/{name}", env!("CARGO_MANIFEST_DIR"));
-        let mesh = shadow_scene::load(std::path::Path::new(&path)).unwrap();
+        let mesh = crate::repo_mesh(name);
         let triangles: usize = mesh.faces.iter().map(|f| f.vertices.len() - 2).sum();
         let alone = {
             let mut one = [Operand::new(name, mesh.clone())];
@@ -119,11 +116,7 @@ fn of_two_faces_in_one_plane_the_one_that_stays_whole_is_kept() {
 /// 5,240 triangles for the copy's 1,146).
 #[test]
 fn a_mesh_with_an_edited_copy_of_itself_is_the_copy() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../data/meshes/pyvista_nut.obj"
-    );
-    let nut = shadow_scene::load(std::path::Path::new(path)).unwrap();
+    let nut = crate::repo_mesh("pyvista_nut.obj");
     let (lo, hi) = nut.bounds().unwrap();
     let (c, s) = ((lo + hi) / 2.0, hi - lo);
     let at = |x: f64, y: f64, z: f64| [x, c.y + y * s.y, c.z + z * s.z];

@@ -6,6 +6,8 @@
 use bsp_core::{BoolOp, Polygon};
 use bsp_csg::files::{FileBoolean, FileError, Operand, find_crossing};
 use bsp_csg::{MeshBuf, MeshIn, Solid, mesh_sequence};
+
+use crate::view;
 use bsp_fixtures::{self as shapes, GridPoint, Loop, Rng};
 use glam::DVec3;
 use shadow_scene::MeshView;
@@ -70,10 +72,6 @@ fn a_crossing_along_a_diagonal_resolves_to_the_outward_solid() {
         assert_eq!(after.winding(c.negative), 0);
         assert_eq!(after.winding(c.positive), 1);
     }
-}
-
-fn view(m: &MeshBuf) -> MeshIn<'_> {
-    MeshIn::new(&m.positions, &m.faces)
 }
 
 /// The boxes `[lo, hi]` (each turned inward if its flag says so) as one
@@ -322,11 +320,7 @@ fn a_part_read_back_with_turned_slivers_unites_with_its_whole() {
 /// face and are closed, and they are inputs again.
 #[test]
 fn results_that_round_flat_are_split_and_closed() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../data/meshes/pyvista_nut.obj"
-    );
-    let nut = shadow_scene::load(std::path::Path::new(path)).unwrap();
+    let nut = crate::repo_mesh("pyvista_nut.obj");
     let (lo, hi) = nut.bounds().unwrap();
     let moved = {
         let mut m = nut.clone();
