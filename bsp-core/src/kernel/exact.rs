@@ -216,6 +216,87 @@ fn cmp_scaled<const M: usize>(a: &BUint<M>, b: &BUint<M>, k: u64, e: i32) -> Opt
     Some(lhs.cmp(&rhs))
 }
 
+/// `x`'s top 126 bits as a double-double: `(hi, lo, s)` with
+/// `(hi + lo) 2^s` within `2^-104 x` of `x > 0`.
+fn double_double<const N: usize>(x: &BUint<N>) -> (f64, f64, i32) {
+    // the top 128 bits, read from the limbs (a wide shift is slower)
+    let d = x.digits();
+    let top = (0..N).rev().find(|&i| d[i] != 0).unwrap_or(0);
+    let (v, s) = if top < 2 {
+        let low = |i: usize| if i < N { d[i] as u128 } else { 0 };
+        (low(1) << 64 | low(0), 0)
+    } else {
+        // the three top limbs shifted up by `lz`, their top 128 bits:
+        // `x` truncated to `w 2^(64 (top - 1) - lz)`, within 2^-127 of it
+        let lz = d[top].leading_zeros();
+        let pair = (d[top] as u128) << 64 | d[top - 1] as u128;
+        let w = if lz == 0 {
+            pair
+        } else {
+            pair << lz | (d[top - 2] >> (64 - lz)) as u128
+        };
+        (w, 64 * (top as i32 - 1) - lz as i32)
+    };
+    // 126 bits at most, so that the residual below is an `i128`
+    let extra = (128 - v.leading_zeros() as i32 - 126).max(0);
+    let (v, s) = (v >> extra, s + extra);
+    let hi = v as f64;
+    // the residual of the rounding, below 2^73: its own rounding is below
+    // 2^-105 of `v`
+    let lo = (v as i128 - hi as i128) as f64;
+    (hi, lo, s)
+}
+
+/// `a b` exactly, as `p + e` (Dekker's product, no fused multiply-add):
+/// for `|a b|` well inside the exponent range.
+fn two_product(a: f64, b: f64) -> (f64, f64) {
+    let split = |v: f64| {
+        let c = 134_217_729.0 * v; // 2^27 + 1
+        let h = c - (c - v);
+        (h, v - h)
+    };
+    let p = a * b;
+    let ((ah, al), (bh, bl)) = (split(a), split(b));
+    (p, ((ah * bh - p) + ah * bl + al * bh) + al * bl)
+}
+
+/// The correctly rounded value of `a / b` (unsigned, `b > 0`) from a
+/// double-double quotient, when it is certain: `None` within `2^-90` of
+/// the quotient of a midpoint between two doubles (a possible tie or a
+/// rounding the approximation cannot decide), and outside the normal range.
+/// The quotient's error is below `2^-100` of it (the inputs' `2^-104` each,
+/// the division's steps a few `2^-106`), so the margin is wide.
+fn round_ratio_filtered<const M: usize>(a: &BUint<M>, b: &BUint<M>) -> Option<f64> {
+    let (xh, xl, sx) = double_double(a);
+    let (wh, wl, sw) = double_double(b);
+    let q = xh / wh;
+    // xh − q wh is a double, found exactly from the product's two parts
+    let (p, e) = two_product(q, wh);
+    let r = (xh - p) - e;
+    let q2 = (r + xl - q * wl) / wh;
+    let c = q + q2;
+    let tail = (q - c) + q2;
+    let bits = c.to_bits();
+    let exp = ((bits >> 52) & 0x7ff) as i32;
+    let m = bits & ((1u64 << 52) - 1);
+    // the distances to the midpoints above and below `c` (the one below is
+    // half as far at a power of two)
+    let ulp = pow2(exp - 1075);
+    let below = if m == 0 { ulp / 2.0 } else { ulp };
+    let margin = c.abs() * pow2(-90);
+    let scale = sx - sw;
+    let certain = (1..0x7fe).contains(&exp)
+        && ulp / 2.0 - tail > margin
+        && below / 2.0 + tail > margin
+        && (-1000..=1000).contains(&(exp - 1023 + scale));
+    // scaling by a power of two in the normal range is exact, and rounds
+    // as the quotient it scales
+    certain.then(|| {
+        let half = scale / 2;
+        c * pow2(half) * pow2(scale - half)
+    })
+}
+
 /// The correctly rounded (ties to even) value of `num / den`, `den > 0`,
 /// starting from an estimate `guess` within a few ulps: the estimate is
 /// accepted when the exact quotient lies between the midpoints to its
@@ -227,9 +308,13 @@ fn round_ratio<const N: usize, const M: usize>(num: &BInt<N>, den: &BInt<N>, gue
         return 0.0;
     }
     let neg = num.is_negative();
-    let a: BUint<M> = num.unsigned_abs().as_::<BUint<M>>();
-    let b: BUint<M> = den.unsigned_abs().as_::<BUint<M>>();
     let signed = |v: f64| if neg { -v } else { v };
+    let (a, b) = (num.unsigned_abs(), den.unsigned_abs());
+    if let Some(v) = round_ratio_filtered(&a, &b) {
+        return signed(v);
+    }
+    let a: BUint<M> = a.as_::<BUint<M>>();
+    let b: BUint<M> = b.as_::<BUint<M>>();
     let mut c = guess.abs();
     // normal numbers only: the bounds of every tier keep coordinates far
     // from the subnormal range, and anything else goes the slow way
@@ -390,6 +475,34 @@ impl<const N: usize> Homogeneous<N> {
         }
         let w = |x: &BInt<N>| (*x).as_::<BInt<M>>();
         (w(&self.h[k]) * w(&o.h[3])).cmp(&(w(&o.h[k]) * w(&self.h[3])))
+    }
+
+    /// `(⌊x_k / w⌋, ⌈x_k / w⌉)` for coordinate `k`, exactly: by the `f64`
+    /// approximations where no integer lies within their error bound,
+    /// else by one exact product with the one integer that does. `None`
+    /// when the quotient is beyond `2^40` in magnitude (divide instead).
+    #[inline]
+    pub fn floor_ceil(&self, k: usize) -> Option<(i64, i64)> {
+        let p = self.approx[k] / self.approx[3];
+        if !(p.abs() < (1u64 << 40) as f64) {
+            return None;
+        }
+        // the quotient is within 8u of the exact value (3u + 3u + u); its
+        // interval widened to 16u stays outside that after rounding, and
+        // is narrower than 2^-9: it holds one integer at most
+        let err = p.abs() * (16.0 / (1u64 << 53) as f64);
+        let (lo, hi) = (p - err, p + err);
+        let f = lo.floor();
+        if f != lo && hi < f + 1.0 {
+            return Some((f as i64, f as i64 + 1));
+        }
+        let n = if f == lo { f as i64 } else { f as i64 + 1 };
+        let nw = self.h[3].checked_mul(BInt::<N>::from(n))?;
+        Some(match self.h[k].cmp(&nw) {
+            Ordering::Equal => (n, n),
+            Ordering::Less => (n - 1, n),
+            Ordering::Greater => (n, n + 1),
+        })
     }
 
     /// [`Homogeneous::cmp_axis`] by the `f64` approximations alone:
@@ -585,6 +698,85 @@ mod tests {
             ];
             assert_eq!(got, want, "{num} / {den}");
         }
+    }
+
+    #[test]
+    fn floors_and_ceilings_are_exact() {
+        // quotients near integers (k w ± 1, k w, k w ± w / 2) and of every
+        // size: the answers are the exact ones, and come for every
+        // quotient below 2^40
+        let floor_ceil = |x: I256, w: I256| {
+            let (q, r) = (x / w, x % w);
+            let q = q.as_::<i64>();
+            match (r.is_zero(), x.is_negative()) {
+                (true, _) => (q, q),
+                (false, true) => (q - 1, q),
+                (false, false) => (q, q + 1),
+            }
+        };
+        let mut s = 0x0bad_cafe_f00d_1234u64;
+        let mut next = || crate::xorshift(&mut s);
+        let (mut small, mut answered) = (0, 0);
+        for _ in 0..20_000 {
+            let w = I256::from((next() >> 1) as i64 | 1) << (next() % 90) as u32;
+            let k = I256::from((next() as i64) >> (next() % 64));
+            let near = [I256::ZERO, I256::ONE, -I256::ONE][(next() % 3) as usize];
+            let x = k * w + near + I256::from((next() % 3) as i64 - 1) * (w >> 1u32);
+            let p = Homogeneous::<4>::new([x, -x, x + I256::ONE, w]).unwrap();
+            for (c, x) in [x, -x, x + I256::ONE].into_iter().enumerate() {
+                let exact = floor_ceil(x, w);
+                small += (exact.1.abs() < 1 << 39) as usize;
+                if let Some(got) = p.floor_ceil(c) {
+                    assert_eq!(got, exact, "{x} / {w}");
+                    answered += 1;
+                }
+            }
+        }
+        assert!(answered >= small, "{answered} of {small}");
+        let whole = Homogeneous::<4>::new([i(6), i(-9), i(7), i(3)]).unwrap();
+        assert_eq!(whole.floor_ceil(0), Some((2, 2)));
+        assert_eq!(whole.floor_ceil(1), Some((-3, -3)));
+        assert_eq!(whole.floor_ceil(2), Some((2, 3)));
+    }
+
+    #[test]
+    fn the_double_double_rounding_is_exact_or_declines() {
+        // random quotients, and ones within a hair of a midpoint between
+        // two doubles (2m + 1) 2^(e-1) ± d / den: the filter answers only
+        // with the correctly rounded value, and answers most
+        let mut s = 0x5eed_1234_abcd_9876u64;
+        let mut next = || crate::xorshift(&mut s);
+        let (mut answered, mut near_declined, total) = (0, 0, 30_000);
+        for t in 0..total {
+            let den = I256::from((next() >> 1) as i64 | 1) << (next() % 70) as u32;
+            let num = if t % 2 == 0 {
+                (I256::from(next() as i64).abs() * I256::from((next() >> 2) as i64))
+                    << (next() % 60) as u32
+            } else {
+                let mid = I256::from(((next() >> 11) | 1 << 53) as i64 | 1);
+                let d = [I256::ZERO, I256::ONE, -I256::ONE][(next() % 3) as usize];
+                (mid * den << (next() % 40) as u32) + d
+            };
+            if num <= I256::ZERO {
+                continue;
+            }
+            let (a, b) = (num.unsigned_abs(), den.unsigned_abs());
+            let want = ratio_to_f64_exact::<4, 9>(&num, &den);
+            match round_ratio_filtered::<4>(&a, &b) {
+                Some(got) => {
+                    assert_eq!(got, want, "{num} / {den}");
+                    answered += 1;
+                }
+                None if t % 2 == 1 => near_declined += 1,
+                None => {}
+            }
+        }
+        // nearly every random quotient is answered (one in 2^37 or so is
+        // near a midpoint)
+        assert!(answered > total / 2 - 10, "{answered}");
+        // the midpoints themselves and their nearest neighbours are left to
+        // the exact path
+        assert!(near_declined > total / 4, "{near_declined}");
     }
 
     #[test]
