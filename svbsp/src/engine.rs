@@ -830,7 +830,8 @@ fn filter(
                     break;
                 }
                 let n = &sv.nodes[link as usize];
-                let s = arena.sides(&p, &n.plane);
+                // every vertex's side, kept for a split (classified once)
+                let s = arena.classify_into(&p, &n.plane, sides);
                 let (front, back) = match (n.cap, s.front, s.back) {
                     // a cap: the part behind it is hidden
                     (true, _, false) => {
@@ -853,7 +854,6 @@ fn filter(
                     }
                     (false, true, true) => (n.front, n.back),
                 };
-                arena.classify_into(&p, &n.plane, sides);
                 let mark = arena.mark();
                 let cut = arena.add_plane(n.plane);
                 let (f, b) = arena.split(support, &p, cut, sides);

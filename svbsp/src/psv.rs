@@ -971,20 +971,19 @@ fn insert(
                 break;
             }
             let n = tree.nodes[link as usize];
-            let sd = arena.sides(&p, &n.plane);
+            // every vertex's side, kept for a split (classified once)
+            let sd = arena.classify_into(&p, &n.plane, &mut s.sides);
             let next = match (n.cap, sd.front, sd.back) {
                 // behind a cap (or in its plane): hidden already
                 (true, false, _) => break,
                 (true, true, false) | (false, true, false) | (false, false, false) => Side::Front,
                 (false, false, true) => Side::Back,
                 (true, true, true) => {
-                    arena.classify_into(&p, &n.plane, &mut s.sides);
                     let cut = arena.add_plane(n.plane);
                     p = arena.split(sup, &p, cut, &s.sides).0;
                     Side::Front
                 }
                 (false, true, true) => {
-                    arena.classify_into(&p, &n.plane, &mut s.sides);
                     let cut = arena.add_plane(n.plane);
                     let (f, b) = arena.split(sup, &p, cut, &s.sides);
                     s.stack
