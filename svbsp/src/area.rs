@@ -1268,17 +1268,14 @@ pub(crate) fn overlap(a: &Box3, b: &Box3) -> bool {
 pub(crate) const EVERYWHERE: Box3 = [[i64::MIN, i64::MAX]; 3];
 
 /// The smallest box of integers holding a polygon: each exact corner's
-/// coordinates rounded down and up (`x / w` with `w > 0`, in 256 bits).
+/// coordinates rounded down and up (`Homogeneous::floor_ceil`).
 pub(crate) fn polygon_box(p: &Polygon) -> Box3 {
     let mut b = [[i64::MAX, i64::MIN]; 3];
     for v in p.vertices() {
         let (lo, hi) = match v {
             bsp_core::Point::Grid(g) => (g.map(i64::from), g.map(i64::from)),
             bsp_core::Point::Implicit(i) => {
-                // without a division below 2^40
-                let h = i.coords();
-                let c =
-                    [0, 1, 2].map(|k| i.floor_ceil(k).unwrap_or_else(|| floor_ceil(h[k], h[3])));
+                let c = [0, 1, 2].map(|k| i.floor_ceil(k));
                 (c.map(|c| c.0), c.map(|c| c.1))
             }
         };
@@ -1287,16 +1284,4 @@ pub(crate) fn polygon_box(p: &Polygon) -> Box3 {
         }
     }
     b
-}
-
-/// `(⌊x / w⌋, ⌈x / w⌉)` in 256 bits (`w > 0`).
-fn floor_ceil(x: bnum::types::I256, w: bnum::types::I256) -> (i64, i64) {
-    use bnum::cast::As;
-    let (q, r) = (x / w, x % w);
-    let q: i64 = q.as_::<i64>();
-    match (r.is_zero(), x.is_negative()) {
-        (true, _) => (q, q),
-        (false, true) => (q - 1, q),
-        (false, false) => (q, q + 1),
-    }
 }

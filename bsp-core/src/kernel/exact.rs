@@ -216,6 +216,18 @@ fn cmp_scaled<const M: usize>(a: &BUint<M>, b: &BUint<M>, k: u64, e: i32) -> Opt
     Some(lhs.cmp(&rhs))
 }
 
+/// `(⌊x / w⌋, ⌈x / w⌉)` for `w > 0` by division (the `i64`s wrap beyond
+/// their range).
+fn floor_ceil_by_division<const N: usize>(x: &BInt<N>, w: &BInt<N>) -> (i64, i64) {
+    let (q, r) = (*x / *w, *x % *w);
+    let q = q.as_::<i64>();
+    match (r.is_zero(), x.is_negative()) {
+        (true, _) => (q, q),
+        (false, true) => (q - 1, q),
+        (false, false) => (q, q + 1),
+    }
+}
+
 /// `x`'s top 126 bits as a double-double: `(hi, lo, s)` with
 /// `(hi + lo) 2^s` within `2^-104 x` of `x > 0`.
 fn double_double<const N: usize>(x: &BUint<N>) -> (f64, f64, i32) {
@@ -477,14 +489,23 @@ impl<const N: usize> Homogeneous<N> {
         (w(&self.h[k]) * w(&o.h[3])).cmp(&(w(&o.h[k]) * w(&self.h[3])))
     }
 
-    /// `(⌊x_k / w⌋, ⌈x_k / w⌉)` for coordinate `k`, exactly: by the `f64`
-    /// approximations where no integer lies within their error bound,
-    /// else by one exact product with the one integer that does. `None`
-    /// when the quotient is beyond `2^40` in magnitude (divide instead).
+    /// `(⌊x_k / w⌋, ⌈x_k / w⌉)` for coordinate `k`, exactly (as `i64`s,
+    /// which a quotient beyond their range wraps): by the `f64`
+    /// approximations where no integer lies within their error bound, by
+    /// one exact product with the one integer that does, and by division
+    /// beyond `2^40`.
     #[inline]
-    pub fn floor_ceil(&self, k: usize) -> Option<(i64, i64)> {
+    pub fn floor_ceil(&self, k: usize) -> (i64, i64) {
+        self.floor_ceil_fast(k)
+            .unwrap_or_else(|| floor_ceil_by_division(&self.h[k], &self.h[3]))
+    }
+
+    /// [`Homogeneous::floor_ceil`] without a division: `None` when the
+    /// quotient is beyond `2^40` in magnitude.
+    #[inline]
+    fn floor_ceil_fast(&self, k: usize) -> Option<(i64, i64)> {
         let p = self.approx[k] / self.approx[3];
-        if !(p.abs() < (1u64 << 40) as f64) {
+        if p.is_nan() || p.abs() >= (1u64 << 40) as f64 {
             return None;
         }
         // the quotient is within 8u of the exact value (3u + 3u + u); its
@@ -705,15 +726,6 @@ mod tests {
         // quotients near integers (k w ± 1, k w, k w ± w / 2) and of every
         // size: the answers are the exact ones, and come for every
         // quotient below 2^40
-        let floor_ceil = |x: I256, w: I256| {
-            let (q, r) = (x / w, x % w);
-            let q = q.as_::<i64>();
-            match (r.is_zero(), x.is_negative()) {
-                (true, _) => (q, q),
-                (false, true) => (q - 1, q),
-                (false, false) => (q, q + 1),
-            }
-        };
         let mut s = 0x0bad_cafe_f00d_1234u64;
         let mut next = || crate::xorshift(&mut s);
         let (mut small, mut answered) = (0, 0);
@@ -724,19 +736,20 @@ mod tests {
             let x = k * w + near + I256::from((next() % 3) as i64 - 1) * (w >> 1u32);
             let p = Homogeneous::<4>::new([x, -x, x + I256::ONE, w]).unwrap();
             for (c, x) in [x, -x, x + I256::ONE].into_iter().enumerate() {
-                let exact = floor_ceil(x, w);
+                let exact = floor_ceil_by_division(&x, &w);
                 small += (exact.1.abs() < 1 << 39) as usize;
-                if let Some(got) = p.floor_ceil(c) {
+                if let Some(got) = p.floor_ceil_fast(c) {
                     assert_eq!(got, exact, "{x} / {w}");
                     answered += 1;
                 }
+                assert_eq!(p.floor_ceil(c), exact);
             }
         }
         assert!(answered >= small, "{answered} of {small}");
         let whole = Homogeneous::<4>::new([i(6), i(-9), i(7), i(3)]).unwrap();
-        assert_eq!(whole.floor_ceil(0), Some((2, 2)));
-        assert_eq!(whole.floor_ceil(1), Some((-3, -3)));
-        assert_eq!(whole.floor_ceil(2), Some((2, 3)));
+        assert_eq!(whole.floor_ceil_fast(0), Some((2, 2)));
+        assert_eq!(whole.floor_ceil_fast(1), Some((-3, -3)));
+        assert_eq!(whole.floor_ceil_fast(2), Some((2, 3)));
     }
 
     #[test]
@@ -755,7 +768,7 @@ mod tests {
             } else {
                 let mid = I256::from(((next() >> 11) | 1 << 53) as i64 | 1);
                 let d = [I256::ZERO, I256::ONE, -I256::ONE][(next() % 3) as usize];
-                (mid * den << (next() % 40) as u32) + d
+                ((mid * den) << (next() % 40) as u32) + d
             };
             if num <= I256::ZERO {
                 continue;
