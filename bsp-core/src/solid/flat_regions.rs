@@ -11,9 +11,10 @@
 //! before and after are the same plane) are dropped, unless another
 //! polygon still has them, and then they come back as points on the edge,
 //! as every such point does. A region with no reflex corner is clipped as
-//! a convex polygon is; one with a single reflex corner is fanned from it
-//! (the corner sees the whole region: the region is two convex parts
-//! that both have it as a corner); one with more keeps its polygons.
+//! a convex polygon is; one with reflex corners is fanned from the first
+//! that sees the whole region (strictly inside every edge but its own
+//! two: with a single reflex corner the region is two convex parts that
+//! both have it as a corner); one with none such keeps its polygons.
 //! Every decision is an exact side of a point, or exact equality.
 
 use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
@@ -281,24 +282,24 @@ fn plan<P: ConvexFace>(
     if turns.contains(&Side::On) {
         return None;
     }
-    let mut reflex = (0..m).filter(|&i| turns[i] == Side::Front);
-    let r = reflex.next();
-    if reflex.next().is_some() {
-        return None;
-    }
-    if let Some(r) = r {
-        // a fan from the reflex corner: no other edge's line runs through
-        // it (and its own two edges keep no point: checked once the points
-        // to drop are known)
+    // a fan from a reflex corner that is strictly inside every edge but
+    // its own two: each fan triangle then turns counter-clockwise, and
+    // triangles that all turn the same way over a simple loop cover its
+    // inside once, so they are its triangulation (with one reflex corner
+    // the region is two convex parts that both have it: only an edge
+    // running through it stops the fan); its own two edges must keep no
+    // point, checked once the points to drop are known
+    let reflex: Vec<usize> = (0..m).filter(|&i| turns[i] == Side::Front).collect();
+    let sees_all = |r: usize| {
         let apex = &w.vertices[lp[r].v as usize];
-        let far = (0..m).filter(|&k| k != r && k != (r + m - 1) % m);
-        if far
-            .into_iter()
-            .any(|k| apex.classify(&lp[k].plane) == Side::On)
-        {
-            return None;
-        }
-    }
+        (0..m)
+            .filter(|&k| k != r && k != (r + m - 1) % m)
+            .all(|k| apex.classify(&lp[k].plane) == Side::Back)
+    };
+    let r = match reflex.first() {
+        None => None,
+        Some(_) => Some(reflex.into_iter().find(|&r| sees_all(r))?),
+    };
     Some(Plan { lp, reflex: r, own })
 }
 

@@ -1325,6 +1325,50 @@ mod tests {
         assert_eq!(m.volume_exact(), BigRational::from_integer(1.into()));
     }
 
+    /// A flat region with two reflex corners, made of pieces cut at
+    /// `x = 5/2` and `x = 7/2` (so each has a made corner): it is fanned
+    /// from a reflex corner that sees every other edge from inside, its
+    /// ten corners and eight triangles (the pieces alone give more).
+    #[test]
+    fn a_region_with_two_reflex_corners_is_fanned() {
+        let outline: [[i32; 3]; 10] = [
+            [0, 0, 0],
+            [2, 0, 0],
+            [3, 1, 0],
+            [4, 0, 0],
+            [6, 0, 0],
+            [6, 6, 0],
+            [4, 6, 0],
+            [3, 3, 0],
+            [2, 6, 0],
+            [0, 6, 0],
+        ];
+        // the fan of the outline from (3, 3), each triangle cut in two
+        let apex = 7;
+        let mut pieces = Vec::new();
+        for i in (0..10).filter(|&i| i != apex && (i + 1) % 10 != apex) {
+            let (a, b) = (outline[i], outline[(i + 1) % 10]);
+            let t = Polygon::from_grid_points(&[outline[apex], a, b], 0).unwrap();
+            let x = if a[0].min(b[0]) < 3 { 5 } else { 7 };
+            match t.parts(&Plane::new([2, 0, 0], -x).unwrap()) {
+                crate::kernel::polygon::Parts::Split { front, back } => {
+                    pieces.extend([back, front])
+                }
+                crate::kernel::polygon::Parts::Whole(_) => panic!("every triangle is cut"),
+            }
+        }
+        let m = TriMesh::from_polygons(&pieces);
+        assert_eq!((m.vertices.len(), m.triangles.len()), (10, 8));
+        // its area: 36 less the notches' 1 and 3
+        assert_eq!(m.area_f64(), 32.0);
+        // every triangle turns counter-clockwise, seen from +z
+        for t in &m.triangles {
+            let [a, b, c] = t.map(|v| m.vertices[v as usize].to_f64());
+            let cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            assert!(cross > 0.0, "{t:?}");
+        }
+    }
+
     #[test]
     fn t_junction_is_resolved() {
         // a 2x1 rectangle next to two unit squares: the middle vertex of the
