@@ -423,7 +423,7 @@ impl Subtree {
 
 /// Nodes the quick test of [`reach`] may visit before the exact descent
 /// takes over.
-pub(crate) const REACH_BUDGET: usize = 256;
+pub(crate) const REACH_BUDGET: usize = 1024;
 
 /// The kinds of leaves a piece may reach below `root`, found without
 /// cutting it: at every node it goes to each side some vertex is on
