@@ -29,7 +29,7 @@ mod twins;
 
 use bsp_core::internals::ConvexFace;
 use bsp_core::par;
-use bsp_core::{BoolOp, Plane, Polygon, TriMesh};
+use bsp_core::{BoolOp, Plane, TriMesh};
 use rustc_hash::{FxHashMap, FxHashSet};
 use smallvec::SmallVec;
 
@@ -470,28 +470,23 @@ impl MixedCells {
 /// plane share a whole edge and their union is convex, across faces
 /// ([`settle::rejoined`]); in their order, faces kept whole untouched.
 fn rejoin_new_faces(add: &mut Vec<AddedFace>) {
-    // each new face's slot and polygon (the slot left holding a marker)
-    let (at, polygons): (Vec<usize>, Vec<Polygon>) = (add.iter_mut().enumerate())
-        .filter(|(_, f)| matches!(f, AddedFace::New(_)))
-        .filter_map(
-            |(i, f)| match std::mem::replace(f, AddedFace::Theirs(u32::MAX)) {
-                AddedFace::New(p) => Some((i, *p)),
-                AddedFace::Theirs(_) => None,
-            },
-        )
-        .unzip();
-    let mut gone = vec![false; add.len()];
-    for (&i, p) in at.iter().zip(settle::rejoined(polygons)) {
-        match p {
-            Some(p) => add[i] = AddedFace::New(Box::new(p)),
-            None => gone[i] = true,
+    // the new faces' polygons, and a gap in the list where each was
+    let (mut polygons, mut slots) = (Vec::new(), Vec::with_capacity(add.len()));
+    for f in std::mem::take(add) {
+        match f {
+            AddedFace::New(p) => {
+                polygons.push(*p);
+                slots.push(None);
+            }
+            theirs => slots.push(Some(theirs)),
         }
     }
-    let mut k = 0;
-    add.retain(|_| {
-        k += 1;
-        !gone[k - 1]
-    });
+    // each gap filled with what its polygon grew into, or closed
+    let mut joined = settle::rejoined(polygons).into_iter();
+    add.extend(slots.into_iter().filter_map(|slot| match slot {
+        Some(f) => Some(f),
+        None => (joined.next().expect("one per new face")).map(|p| AddedFace::New(Box::new(p))),
+    }));
 }
 
 /// What an operation decided for the first solid.

@@ -363,9 +363,11 @@ impl CellWork<'_> {
     /// faces' are known) and is easy if every piece is isolated; else it
     /// clips every face and builds its partitions.
     pub(super) fn run(&self, leaf: &Leaf, allow_easy: bool) -> Result<CellRun, CsgError> {
+        // (the octree's build asked already where it left the cell whole)
         let (ta, tb) = (&self.twinned.a, &self.twinned.b);
         let (twin_a, twin_b) = (|f| ta.contains(&f), |f| tb.contains(&f));
-        if twins::one_set(self.solids, &leaf.bx, (&leaf.a, &leaf.b), twin_a, twin_b) {
+        if leaf.settled || twins::one_set(self.solids, &leaf.bx, (&leaf.a, &leaf.b), twin_a, twin_b)
+        {
             return Ok(self.one_set(leaf));
         }
         let w = walls(&leaf.bx);

@@ -23,6 +23,9 @@ pub(crate) struct Leaf {
     pub(crate) bx: IBox,
     pub(crate) a: Vec<u32>,
     pub(crate) b: Vec<u32>,
+    /// The build's `settled` said so: the cell was left whole because its
+    /// two surfaces are one (a leaf without it was not asked).
+    pub(crate) settled: bool,
 }
 
 impl Leaf {
@@ -176,6 +179,7 @@ pub(crate) fn build<P: PlaneTest, Q: PlaneTest>(
         bx: domain,
         a: (0..a.boxes.len() as u32).collect(),
         b: (0..b.boxes.len() as u32).collect(),
+        settled: false,
     };
     grow(
         root,
@@ -206,8 +210,8 @@ const PARALLEL_FACES: usize = 2048;
 fn grow<P: PlaneTest, Q: PlaneTest>(cell: Leaf, stalled: u8, o: &Build<'_, '_, P, Q>) -> Vec<Leaf> {
     let mut leaves = Vec::new();
     let mut stack = vec![(cell, stalled)];
-    while let Some((cell, stalled)) = stack.pop() {
-        let Some((kids, stalled)) = split(&cell, stalled, o) else {
+    while let Some((mut cell, stalled)) = stack.pop() {
+        let Some((kids, stalled)) = split(&mut cell, stalled, o) else {
             leaves.push(cell);
             continue;
         };
@@ -226,9 +230,9 @@ fn grow<P: PlaneTest, Q: PlaneTest>(cell: Leaf, stalled: u8, o: &Build<'_, '_, P
 }
 
 /// The children of `cell` with their faces, and their count of stalled
-/// splits; `None` if the cell is a leaf.
+/// splits; `None` if the cell is a leaf (marked `settled` if that is why).
 fn split<P: PlaneTest, Q: PlaneTest>(
-    cell: &Leaf,
+    cell: &mut Leaf,
     stalled: u8,
     o: &Build<'_, '_, P, Q>,
 ) -> Option<(Vec<Leaf>, u8)> {
@@ -239,8 +243,11 @@ fn split<P: PlaneTest, Q: PlaneTest>(
         || cell.a.len() + cell.b.len() <= leaf_size
         || axes.is_empty()
         || stalled >= MAX_STALLED
-        || (o.settled)(cell)
     {
+        return None;
+    }
+    if (o.settled)(cell) {
+        cell.settled = true;
         return None;
     }
     let mid = [0, 1, 2].map(|k| lo[k] + (hi[k] - lo[k]) / 2);
@@ -266,6 +273,7 @@ fn split<P: PlaneTest, Q: PlaneTest>(
             bx,
             a: Vec::new(),
             b: Vec::new(),
+            settled: false,
         })
         .collect();
     // a face's box overlaps the cell, so along each split axis it
