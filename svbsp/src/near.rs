@@ -4,7 +4,7 @@
 //! not `n²` pairs. Boxes only ever let through more pairs than the exact
 //! tests keep: the exact signs decide (see [`crate::area`]).
 
-use bsp_core::GridPoint;
+use bsp_core::{GridPoint, Plane};
 use rayon::prelude::*;
 
 use crate::area::{Box3, HalfSpaces, Occluder, Reach, Regions, grid_box, overlap};
@@ -152,6 +152,110 @@ fn penumbra_box(lights: &[Light], o: &[GridPoint], scene: Box3) -> Box3 {
     [0, 1, 2].map(|k| [b[k][0].max(scene[k][0]), b[k][1].min(scene[k][1])])
 }
 
+/// What a slab holds of an occluder's penumbra volume ([`slab_box`]).
+pub(crate) enum InSlab {
+    /// None of it.
+    Nothing,
+    /// Its points there lie in this box.
+    Within(Box3),
+    /// It may hold points of the slab without bound (or the bound did
+    /// not fit the arithmetic): no box.
+    Unbounded,
+}
+
+/// A box holding the points of occluder `o`'s penumbra volume (see
+/// [`penumbra_box`]) in the slab `|n·x + d| ≤ |n|_1` around `plane`, in
+/// exact integers. The volume is `O + cone{o_i − l_j}` (occluder corners
+/// `o_i`, light corners `l_j`; a direction `v` gives `−v`): a midpoint of
+/// two of its points is one again, and `o' + t(o − l)` is
+/// `(1 + t)·(o' + t o)/(1 + t) − t l`. Where `n` has one strict sign on
+/// every `o_i − l_j`, the slab holds a bounded part of it, whose corners
+/// are corners `o_i` in the slab and points where the rays
+/// `o_i + t(o_i − l_j)` and the occluder's edges cross the slab's two
+/// planes: the box of those, rounded outward.
+pub(crate) fn slab_box(lights: &[Light], o: &[GridPoint], plane: &Plane) -> InSlab {
+    let wide = |p: &GridPoint| p.map(i128::from);
+    let n = plane.normal().map(i128::from);
+    let d = plane.offset();
+    let m: i128 = n.iter().map(|c| c.abs()).sum();
+    let dot = |v: [i128; 3]| -> Option<i128> {
+        n[0].checked_mul(v[0])?
+            .checked_add(n[1].checked_mul(v[1])?)?
+            .checked_add(n[2].checked_mul(v[2])?)
+    };
+    let mut rays = Vec::with_capacity(o.len() * lights.len());
+    let mut sign = 0;
+    for c in o {
+        let c = wide(c);
+        for l in lights {
+            let r = match l {
+                Light::Point(p) => [0, 1, 2].map(|k| c[k] - i128::from(p[k])),
+                Light::Directional(v) => v.map(|x| -i128::from(x)),
+            };
+            let Some(nr) = dot(r) else {
+                return InSlab::Unbounded;
+            };
+            if nr == 0 || (sign != 0 && nr.signum() != sign) {
+                return InSlab::Unbounded;
+            }
+            sign = nr.signum();
+            rays.push((c, r, nr));
+        }
+    }
+    let mut b = [[i64::MAX, i64::MIN]; 3];
+    let mut any = false;
+    // the point c + r·num/den (den ≠ 0), its coordinates rounded outward
+    let mut add = |c: [i128; 3], r: [i128; 3], num: i128, den: i128| -> Option<()> {
+        let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
+        for k in 0..3 {
+            let x = c[k].checked_mul(den)?.checked_add(r[k].checked_mul(num)?)?;
+            let lo = i64::try_from(x.div_euclid(den)).ok()?;
+            let hi = i64::try_from(-(-x).div_euclid(den)).ok()?;
+            b[k] = [b[k][0].min(lo), b[k][1].max(hi)];
+        }
+        any = true;
+        Some(())
+    };
+    let value = |c: [i128; 3]| dot(c).and_then(|v| v.checked_add(d));
+    for (i, c) in o.iter().enumerate() {
+        let c = wide(c);
+        let Some(vc) = value(c) else {
+            return InSlab::Unbounded;
+        };
+        if vc.abs() <= m && add(c, [0; 3], 0, 1).is_none() {
+            return InSlab::Unbounded;
+        }
+        let e = [0, 1, 2].map(|k| i128::from(o[(i + 1) % o.len()][k]) - c[k]);
+        for level in [-m, m] {
+            // the edge c + s·e, 0 ≤ s ≤ 1, and the level's plane
+            let (Some(ne), num) = (dot(e), level - vc) else {
+                return InSlab::Unbounded;
+            };
+            let on_edge = ne != 0 && num.signum() * ne.signum() >= 0 && num.abs() <= ne.abs();
+            if on_edge && add(c, e, num, ne).is_none() {
+                return InSlab::Unbounded;
+            }
+        }
+    }
+    for &(c, r, nr) in &rays {
+        let Some(vc) = value(c) else {
+            return InSlab::Unbounded;
+        };
+        for level in [-m, m] {
+            // the ray c + t·r, t ≥ 0, and the level's plane
+            let num = level - vc;
+            if num.signum() * nr.signum() >= 0 && add(c, r, num, nr).is_none() {
+                return InSlab::Unbounded;
+            }
+        }
+    }
+    if any {
+        InSlab::Within(b)
+    } else {
+        InSlab::Nothing
+    }
+}
+
 /// A uniform grid of cells over the scene, each listing the faces whose
 /// box meets it. A coordinate's cell is `(v − lo)·n / extent`, rounded
 /// down, in integers: it never decreases as `v` grows, so a box meets
@@ -222,6 +326,107 @@ impl CellGrid {
             for y in lo[1]..=hi[1] {
                 for z in lo[2]..=hi[2] {
                     self.cells[self.cell([x, y, z])].iter().for_each(|&i| f(i));
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn plane_z(z: i32) -> Plane {
+        Plane::through([0, 0, z], [1, 0, z], [0, 1, z]).unwrap()
+    }
+
+    #[test]
+    fn a_slab_under_a_square_holds_its_shadow() {
+        let square = [[-1, -1, 10], [1, -1, 10], [1, 1, 10], [-1, 1, 10]];
+        // the slab |z| <= 1: the shadow spreads from 2 (z = 0) to 2.1
+        // (z = -1) half-widths, rounded outward
+        let InSlab::Within(b) = slab_box(&[Light::Point([0, 0, 20])], &square, &plane_z(0)) else {
+            panic!("bounded");
+        };
+        assert_eq!(b, [[-3, 3], [-3, 3], [-1, 1]]);
+        // above the light's height nothing; a light level with the
+        // occluder's corners gives rays along the slab: no bound
+        let high = slab_box(&[Light::Point([0, 0, 20])], &square, &plane_z(30));
+        assert!(matches!(high, InSlab::Nothing));
+        let level = slab_box(&[Light::Point([5, 0, 10])], &square, &plane_z(0));
+        assert!(matches!(level, InSlab::Unbounded));
+        // a sun straight above: the square's prism
+        let InSlab::Within(b) = slab_box(&[Light::Directional([0, 0, 1])], &square, &plane_z(0))
+        else {
+            panic!("bounded");
+        };
+        assert_eq!(b, [[-1, 1], [-1, 1], [-1, 1]]);
+    }
+
+    fn point() -> impl Strategy<Value = GridPoint> {
+        prop::array::uniform3(-60i32..60)
+    }
+
+    proptest! {
+        /// Every point `o + t(o − l)` of the volume (rational `o`, `l`,
+        /// `t`) within the slab lies in its box.
+        #[test]
+        fn the_box_holds_the_volume_in_the_slab(
+            occluder in prop::array::uniform3(point()),
+            light in prop::collection::vec(point(), 1..4),
+            sun in any::<bool>(),
+            plane in prop::array::uniform3(point()),
+            samples in prop::collection::vec(
+                (prop::array::uniform3(0i128..4), prop::collection::vec(0i128..4, 4), 0i128..40, 1i128..8),
+                64,
+            ),
+        ) {
+            let Ok(plane) = Plane::through(plane[0], plane[1], plane[2]) else {
+                return Ok(());
+            };
+            let lights: Vec<Light> = light
+                .iter()
+                .map(|&p| if sun { Light::Directional(p) } else { Light::Point(p) })
+                .collect();
+            if sun && light.contains(&[0, 0, 0]) {
+                return Ok(());
+            }
+            let found = slab_box(&lights, &occluder, &plane);
+            let n = plane.normal().map(i128::from);
+            let m: i128 = n.iter().map(|c| c.abs()).sum();
+            for (a, b, t1, t2) in samples {
+                let b = &b[..lights.len()];
+                let (sa, sb): (i128, i128) = (a.iter().sum(), b.iter().sum());
+                if sa == 0 || sb == 0 {
+                    continue;
+                }
+                // p = ((t2 + t1)·o − t1·l) / t2, o = Σa·o_i / sa, l = Σb·l_j / sb
+                // (a direction v stands for the point at −∞·v: l = −v·sb / sb·∞;
+                // for a sun, p = o − (t1/t2)·Σb·v / sb)
+                let den = t2 * sa * sb;
+                let num = [0, 1, 2].map(|k| {
+                    let o: i128 = (0..3).map(|i| a[i] * i128::from(occluder[i][k])).sum();
+                    let l: i128 = (0..lights.len()).map(|j| b[j] * i128::from(light[j][k])).sum();
+                    if sun {
+                        t2 * sb * o - t1 * sa * l
+                    } else {
+                        (t2 + t1) * sb * o - t1 * sa * l
+                    }
+                });
+                let value = (0..3).map(|k| n[k] * num[k]).sum::<i128>() + plane.offset() * den;
+                if value.abs() > m * den {
+                    continue;
+                }
+                match &found {
+                    InSlab::Nothing => prop_assert!(false, "a point in the slab, none found"),
+                    InSlab::Unbounded => {}
+                    InSlab::Within(bx) => {
+                        for k in 0..3 {
+                            prop_assert!(i128::from(bx[k][0]) * den <= num[k]);
+                            prop_assert!(num[k] <= i128::from(bx[k][1]) * den);
+                        }
+                    }
                 }
             }
         }

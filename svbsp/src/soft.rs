@@ -10,18 +10,18 @@
 //! convex. Points and suns take part as the limits of area lights
 //! ([`AreaLight::point`], [`AreaLight::sun`]): lit or umbra.
 
-use bsp_core::{Grid, GridPoint, MAX_COORD, Polygon};
+use bsp_core::{Grid, GridPoint, MAX_COORD, Polygon, Side};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::area::{
-    AreaClass, AreaFragment, AreaLight, Box3, EVERYWHERE, Occluder, Reach, Regions, grid_box,
-    merge_convex,
+    AreaClass, AreaFragment, AreaLight, Box3, EVERYWHERE, HalfSpaces, Occluder, Reach, Regions,
+    grid_box, merge_convex,
 };
 use crate::blockers::{coplanar_blockers, plane_key};
 use crate::engine::{Scratch, Shadows};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
-use crate::near::{CellGrid, near_lists};
+use crate::near::{CellGrid, InSlab, near_lists, slab_box};
 
 /// The share of a polygon light's irradiance that arrives on a penumbra
 /// fragment ([`crate::LightView::fraction`]): at the grid point nearest its
@@ -254,7 +254,11 @@ impl<'a> SoftShadows<'a> {
             let r = self.regions[light][j].as_ref()?;
             Some((&self.blockers[j], r, self.reach[light][j][0]))
         });
-        Hiders::new(grid_box(self.faces[face].corners()), near.collect())
+        Hiders::new(
+            &self.faces[face],
+            self.lights[light].corners(),
+            near.collect(),
+        )
     }
 }
 
@@ -526,17 +530,44 @@ fn fraction_at(
 
 /// The occluders near a face that may hide part of one light from its
 /// points, found through a grid of cells over the face's box holding
-/// their penumbra volumes' boxes.
+/// their penumbra volumes' boxes. Each keeps only the half-spaces of its
+/// penumbra volume that the face's probe points may fall on either side
+/// of: one the whole face is outside drops the occluder, one the whole
+/// face is inside needs no test.
 struct Hiders<'a> {
-    occluders: Vec<(&'a Occluder, &'a Regions, Box3)>,
+    occluders: Vec<(&'a Occluder, HalfSpaces, Box3)>,
     grid: CellGrid,
 }
 
 impl<'a> Hiders<'a> {
-    fn new(face: Box3, occluders: Vec<(&'a Occluder, &'a Regions, Box3)>) -> Hiders<'a> {
+    /// The hiders of the face with corners `face` among `occluders`, for
+    /// probe points within 1 (a grid unit, per coordinate, strictly) of a
+    /// point of the face: the grid points nearest its fragments' corners
+    /// and centroids are (their `f64` coordinates are within `2^-26` of
+    /// exact points of the face, and rounding moves them by at most 1/2).
+    fn new(
+        face: &Occluder,
+        light: &[Light],
+        occluders: Vec<(&'a Occluder, &'a Regions, Box3)>,
+    ) -> Hiders<'a> {
+        // the probe points lie within 1 of the face's box, and in the slab
+        // of `slab_box` around its plane
+        let near = grid_box(face.corners()).map(|[lo, hi]| [lo - 1, hi + 1]);
+        let occluders: Vec<(&'a Occluder, HalfSpaces, Box3)> = occluders
+            .into_iter()
+            .filter_map(|(o, r, b)| {
+                let tests = face_tests(face.corners(), &r.penumbra)?;
+                let b = match slab_box(light, o.corners(), face.plane()) {
+                    InSlab::Nothing => return None,
+                    InSlab::Within(s) => meet(meet(b, s)?, near)?,
+                    InSlab::Unbounded => meet(b, near)?,
+                };
+                Some((o, tests, b))
+            })
+            .collect();
         let boxes: Vec<Box3> = occluders.iter().map(|o| o.2).collect();
         Hiders {
-            grid: CellGrid::new(face, &boxes),
+            grid: CellGrid::new(grid_box(face.corners()), &boxes),
             occluders,
         }
     }
@@ -548,9 +579,9 @@ impl<'a> Hiders<'a> {
         let at = x.map(i64::from);
         let mut found = Vec::new();
         self.grid.visit([0, 1, 2].map(|k| [at[k], at[k]]), |i| {
-            let (o, r, b) = &self.occluders[i as usize];
+            let (o, tests, b) = &self.occluders[i as usize];
             let in_box = (0..3).all(|k| b[k][0] <= at[k] && at[k] <= b[k][1]);
-            if in_box && r.penumbra.iter().all(|(h, s)| h.classify_grid(x) == *s) {
+            if in_box && tests.iter().all(|(h, s)| h.classify_grid(x) == *s) {
                 found.push((i, *o));
             }
         });
@@ -559,6 +590,54 @@ impl<'a> Hiders<'a> {
         found.dedup_by_key(|&mut (i, _)| i);
         found.into_iter().map(|(_, o)| o).collect()
     }
+}
+
+/// Of the convex region `volume` (each plane's side holding it strictly),
+/// the half-spaces a point within 1 per coordinate of the convex polygon
+/// `face` may be outside of; `None` where every such point is outside one.
+/// At `x = y + e` (`y` in the face, `|e_i| < 1`) a plane's value differs
+/// from its value at `y` by `n · e`, less than `|n|_1` in size; its value
+/// at `y` lies between its values at the face's corners. So corners all
+/// beyond `|n|_1` on the inner side put every such point inside, and all
+/// beyond it on the outer side put every one outside (exact, in `i128`:
+/// `|n_i| < 2^63`, corners within `2^31`).
+fn face_tests(face: &[GridPoint], volume: &HalfSpaces) -> Option<HalfSpaces> {
+    let mut tests = Vec::new();
+    for (h, s) in volume {
+        let inward = match s {
+            Side::Front => 1,
+            Side::Back => -1,
+            Side::On => {
+                tests.push((*h, *s));
+                continue;
+            }
+        };
+        let n = h.normal();
+        let margin: i128 = n.iter().map(|&c| i128::from(c).abs()).sum();
+        let (mut inner, mut outer) = (true, true);
+        for c in face {
+            let v = inward
+                * (0..3)
+                    .map(|k| i128::from(n[k]) * i128::from(c[k]))
+                    .sum::<i128>()
+                + inward * h.offset();
+            inner &= v > margin;
+            outer &= v < -margin;
+        }
+        if outer {
+            return None;
+        }
+        if !inner {
+            tests.push((*h, *s));
+        }
+    }
+    Some(tests)
+}
+
+/// The box two boxes share, if they meet.
+fn meet(a: Box3, b: Box3) -> Option<Box3> {
+    let m = [0, 1, 2].map(|k| [a[k][0].max(b[k][0]), a[k][1].min(b[k][1])]);
+    m.iter().all(|[lo, hi]| lo <= hi).then_some(m)
 }
 
 /// The share of a sun disc's polygon of directions `sky` that `x` (on a
