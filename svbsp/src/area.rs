@@ -947,7 +947,12 @@ impl Cutting<'_, '_> {
     /// occluder merged again as they pile up (so later occluders meet few).
     fn family<K: Copy + PartialEq>(&self, first: Piece<K>) -> Vec<Piece<K>> {
         let (all, known) = (self.all, self.known);
+        let scan = |p: &Piece<K>| Scan::of(p, known && p.hidden == all);
         let mut pieces = vec![first];
+        // beside the pieces, in step, what an occluder's boxes are tested
+        // against: a face's pieces times its occluders are the most
+        // pairs, and most are apart
+        let mut scans: Vec<Scan> = pieces.iter().map(scan).collect();
         let mut merged = 0;
         for &(r, reach) in self.regions {
             // pieces this occluder leaves as they are stay in place; the
@@ -955,34 +960,73 @@ impl Cutting<'_, '_> {
             let mut parts = Vec::new();
             let mut i = 0;
             while i < pieces.len() {
-                let piece = &pieces[i];
                 // a piece that hides every corner can only enter the umbra
-                let near = match known && piece.hidden == all {
-                    true => overlap(&piece.bbox, &reach[1]),
-                    false => overlap(&piece.bbox, &reach[0]),
-                };
-                if !near
+                if !scans[i].near(&reach)
                     || match known {
-                        true => untouched_known(r, piece, all),
-                        false => untouched(r, piece),
+                        true => untouched_known(r, &pieces[i], all),
+                        false => untouched(r, &pieces[i]),
                     }
                 {
                     i += 1;
                     continue;
                 }
+                scans.swap_remove(i);
                 let piece = pieces.swap_remove(i);
                 match known {
                     true => cut_piece_known(r, piece, all, &mut parts),
                     false => cut_piece(r, piece, all, &mut parts),
                 }
             }
+            scans.extend(parts.iter().map(scan));
             pieces.append(&mut parts);
             if pieces.len() > 16 && pieces.len() > 2 * merged {
                 pieces = merge_pieces(pieces);
+                scans = pieces.iter().map(scan).collect();
                 merged = pieces.len();
             }
         }
         pieces
+    }
+}
+
+/// What [`Cutting::family`] tests a piece against each occluder's boxes
+/// with: its box, and which box of the occluder's may meet it.
+struct Scan {
+    bbox: Box3,
+    kind: Near,
+}
+
+/// Which of an occluder's boxes ([`Reach`]) a piece must meet to be cut.
+#[derive(Clone, Copy, PartialEq)]
+enum Near {
+    /// None: a piece in an umbra is never cut again.
+    Never,
+    /// The penumbra volume's.
+    Penumbra,
+    /// The umbra's (a piece that hides every corner already).
+    Umbra,
+}
+
+impl Scan {
+    fn of<K>(p: &Piece<K>, deep: bool) -> Scan {
+        Scan {
+            bbox: p.bbox,
+            kind: match (p.umbra, deep) {
+                (true, _) => Near::Never,
+                (false, true) => Near::Umbra,
+                (false, false) => Near::Penumbra,
+            },
+        }
+    }
+
+    /// Whether the piece's box meets the occluder's box it must meet.
+    fn near(&self, reach: &Reach) -> bool {
+        let r = match self.kind {
+            Near::Never => return false,
+            Near::Penumbra => &reach[0],
+            Near::Umbra => &reach[1],
+        };
+        overlap(&self.bbox, r)
     }
 }
 
