@@ -10,7 +10,9 @@
 //! convex. Points and suns take part as the limits of area lights
 //! ([`AreaLight::point`], [`AreaLight::sun`]): lit or umbra.
 
-use bsp_core::{Grid, GridPoint, MAX_COORD, Polygon, Side};
+use std::borrow::Cow;
+
+use bsp_core::{Grid, GridPoint, MAX_COORD, Plane, Polygon, Side};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
@@ -239,7 +241,7 @@ impl<'a> SoftShadows<'a> {
             return vec![None; points.len()];
         }
         let f = &self.faces[face];
-        let hiders = self.hiders(light, face);
+        let hiders = self.hiders(light, face, Probing::Anywhere);
         points
             .par_iter()
             .map(|&x| fraction_at(l, f, &hiders, x))
@@ -247,8 +249,8 @@ impl<'a> SoftShadows<'a> {
     }
 
     /// The occluders near face `face` that may hide some of light
-    /// `light`, found by point.
-    fn hiders(&self, light: usize, face: usize) -> Hiders<'_> {
+    /// `light`, found by point, for points `probing` says where.
+    fn hiders(&self, light: usize, face: usize, probing: Probing) -> Hiders<'_> {
         let near = self.near[light][face].iter().filter_map(|&j| {
             let j = j as usize;
             let r = self.regions[light][j].as_ref()?;
@@ -258,6 +260,7 @@ impl<'a> SoftShadows<'a> {
             &self.faces[face],
             self.lights[light].corners(),
             near.collect(),
+            probing,
         )
     }
 }
@@ -401,7 +404,10 @@ fn soft_face(
             }
             points.sort_unstable();
             points.dedup();
-            let hiders = run.hiders(k, i);
+            // (a box of what each volume holds of the face's slab costs a
+            // few hundred operations; it pays where many points look)
+            let slab = points.len() >= 32;
+            let hiders = run.hiders(k, i, Probing::NearFace { slab });
             let fractions = points
                 .par_iter()
                 .map(|&x| fraction_at(&lights[k], face, &hiders, x))
@@ -528,41 +534,61 @@ fn fraction_at(
     view.fraction(xf, normal)
 }
 
+/// An occluder that may hide part of a light from a face's points, the
+/// half-spaces of its penumbra volume a point must be tested against, and
+/// a box holding every such point inside it.
+type Hider<'a> = (&'a Occluder, Cow<'a, [(Plane, Side)]>, Box3);
+
+/// Where the points a face's [`Hiders`] are asked about lie.
+#[derive(Clone, Copy)]
+enum Probing {
+    /// Anywhere (the exact tests decide everything).
+    Anywhere,
+    /// Within 1 (a grid unit, per coordinate, strictly) of a point of the
+    /// face, as the grid points nearest its fragments' corners and
+    /// centroids are (their `f64` coordinates are within `2^-26` of exact
+    /// points of the face, and rounding moves them by at most 1/2); with
+    /// `slab`, the occluders are also boxed by what their volumes hold
+    /// of the slab around the face's plane ([`slab_box`]).
+    NearFace { slab: bool },
+}
+
 /// The occluders near a face that may hide part of one light from its
 /// points, found through a grid of cells over the face's box holding
-/// their penumbra volumes' boxes. Each keeps only the half-spaces of its
-/// penumbra volume that the face's probe points may fall on either side
-/// of: one the whole face is outside drops the occluder, one the whole
-/// face is inside needs no test.
+/// their penumbra volumes' boxes. For points near the face, each keeps
+/// only the half-spaces of its penumbra volume that such points may fall
+/// on either side of: one the whole face is outside drops the occluder,
+/// one the whole face is inside needs no test.
 struct Hiders<'a> {
-    occluders: Vec<(&'a Occluder, HalfSpaces, Box3)>,
+    occluders: Vec<Hider<'a>>,
     grid: CellGrid,
 }
 
 impl<'a> Hiders<'a> {
-    /// The hiders of the face with corners `face` among `occluders`, for
-    /// probe points within 1 (a grid unit, per coordinate, strictly) of a
-    /// point of the face: the grid points nearest its fragments' corners
-    /// and centroids are (their `f64` coordinates are within `2^-26` of
-    /// exact points of the face, and rounding moves them by at most 1/2).
+    /// The hiders of `face` among `occluders`, for points `probing` says
+    /// where.
     fn new(
         face: &Occluder,
         light: &[Light],
         occluders: Vec<(&'a Occluder, &'a Regions, Box3)>,
+        probing: Probing,
     ) -> Hiders<'a> {
-        // the probe points lie within 1 of the face's box, and in the slab
+        // points near the face lie within 1 of its box, and in the slab
         // of `slab_box` around its plane
         let near = grid_box(face.corners()).map(|[lo, hi]| [lo - 1, hi + 1]);
-        let occluders: Vec<(&'a Occluder, HalfSpaces, Box3)> = occluders
+        let occluders: Vec<Hider<'a>> = occluders
             .into_iter()
             .filter_map(|(o, r, b)| {
-                let tests = face_tests(face.corners(), &r.penumbra)?;
-                let b = match slab_box(light, o.corners(), face.plane()) {
-                    InSlab::Nothing => return None,
-                    InSlab::Within(s) => meet(meet(b, s)?, near)?,
-                    InSlab::Unbounded => meet(b, near)?,
+                let Probing::NearFace { slab } = probing else {
+                    return Some((o, Cow::Borrowed(&r.penumbra[..]), b));
                 };
-                Some((o, tests, b))
+                let tests = face_tests(face.corners(), &r.penumbra)?;
+                let b = match slab.then(|| slab_box(light, o.corners(), face.plane())) {
+                    Some(InSlab::Nothing) => return None,
+                    Some(InSlab::Within(s)) => meet(meet(b, s)?, near)?,
+                    Some(InSlab::Unbounded) | None => meet(b, near)?,
+                };
+                Some((o, Cow::Owned(tests), b))
             })
             .collect();
         let boxes: Vec<Box3> = occluders.iter().map(|o| o.2).collect();
