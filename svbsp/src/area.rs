@@ -40,6 +40,7 @@ use bsp_core::{GridPoint, MAX_COORD, Plane, Polygon, PolygonSide, Side, Split};
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::boxes::{Box3, Near, Reach, Scan, Scans, polygon_box};
 use crate::light::{
     AreaLightError, Light, MAX_DISC_RADIUS, cross, plane_along, quantize_direction,
 };
@@ -698,14 +699,6 @@ pub(crate) struct Regions {
     pub(crate) umbra: Option<HalfSpaces>,
 }
 
-/// The box of grid points, per axis `[lo, hi]`.
-pub(crate) fn grid_box(points: &[GridPoint]) -> [[i64; 2]; 3] {
-    [0, 1, 2].map(|k| {
-        let c = points.iter().map(|p| i64::from(p[k]));
-        [c.clone().min().unwrap_or(0), c.max().unwrap_or(0)]
-    })
-}
-
 impl AreaLight {
     /// [`AreaLight::classify_face`] with the occluders' regions given.
     pub(crate) fn classify_with<'r>(
@@ -947,12 +940,12 @@ impl Cutting<'_, '_> {
     /// occluder merged again as they pile up (so later occluders meet few).
     fn family<K: Copy + PartialEq>(&self, first: Piece<K>) -> Vec<Piece<K>> {
         let (all, known) = (self.all, self.known);
-        let scan = |p: &Piece<K>| Scan::of(p, known && p.hidden == all);
+        let scan = |p: &Piece<K>| scan_of(p, known && p.hidden == all);
         let mut pieces = vec![first];
         // beside the pieces, in step, what an occluder's boxes are tested
         // against: a face's pieces times its occluders are the most
         // pairs, and most are apart
-        let mut scans: Vec<Scan> = pieces.iter().map(scan).collect();
+        let mut scans = Scans::new(pieces.iter().map(scan));
         let mut merged = 0;
         for &(r, reach) in self.regions {
             // pieces this occluder leaves as they are stay in place; the
@@ -960,8 +953,14 @@ impl Cutting<'_, '_> {
             let mut parts = Vec::new();
             let mut i = 0;
             while i < pieces.len() {
+                // a run of pieces none of which meets the occluder's boxes
+                // is passed over whole
+                if let Some(next) = scans.apart_until(i, &reach) {
+                    i = next;
+                    continue;
+                }
                 // a piece that hides every corner can only enter the umbra
-                if !scans[i].near(&reach)
+                if !scans.items[i].near(&reach)
                     || match known {
                         true => untouched_known(r, &pieces[i], all),
                         false => untouched(r, &pieces[i]),
@@ -977,11 +976,11 @@ impl Cutting<'_, '_> {
                     false => cut_piece(r, piece, all, &mut parts),
                 }
             }
-            scans.extend(parts.iter().map(scan));
+            parts.iter().for_each(|p| scans.push(scan(p)));
             pieces.append(&mut parts);
             if pieces.len() > 16 && pieces.len() > 2 * merged {
                 pieces = merge_pieces(pieces);
-                scans = pieces.iter().map(scan).collect();
+                scans = Scans::new(pieces.iter().map(scan));
                 merged = pieces.len();
             }
         }
@@ -989,44 +988,17 @@ impl Cutting<'_, '_> {
     }
 }
 
-/// What [`Cutting::family`] tests a piece against each occluder's boxes
-/// with: its box, and which box of the occluder's may meet it.
-struct Scan {
-    bbox: Box3,
-    kind: Near,
-}
-
-/// Which of an occluder's boxes ([`Reach`]) a piece must meet to be cut.
-#[derive(Clone, Copy, PartialEq)]
-enum Near {
-    /// None: a piece in an umbra is never cut again.
-    Never,
-    /// The penumbra volume's.
-    Penumbra,
-    /// The umbra's (a piece that hides every corner already).
-    Umbra,
-}
-
-impl Scan {
-    fn of<K>(p: &Piece<K>, deep: bool) -> Scan {
-        Scan {
-            bbox: p.bbox,
-            kind: match (p.umbra, deep) {
-                (true, _) => Near::Never,
-                (false, true) => Near::Umbra,
-                (false, false) => Near::Penumbra,
-            },
-        }
-    }
-
-    /// Whether the piece's box meets the occluder's box it must meet.
-    fn near(&self, reach: &Reach) -> bool {
-        let r = match self.kind {
-            Near::Never => return false,
-            Near::Penumbra => &reach[0],
-            Near::Umbra => &reach[1],
-        };
-        overlap(&self.bbox, r)
+/// A piece's [`Scan`]: its box, and which of an occluder's boxes it must
+/// meet to be cut (a piece in an umbra is never cut again; one that hides
+/// every corner already only by an umbra).
+fn scan_of<K>(p: &Piece<K>, deep: bool) -> Scan {
+    Scan {
+        bbox: p.bbox,
+        kind: match (p.umbra, deep) {
+            (true, _) => Near::Never,
+            (false, true) => Near::Umbra,
+            (false, false) => Near::Penumbra,
+        },
     }
 }
 
@@ -1295,37 +1267,3 @@ fn separating(h: &Plane, lv: &[Light], ov: &[GridPoint]) -> Option<Side> {
 /// The convex parts of a polygon with the light corners each sees (bit
 /// `i`: corner `i`), where that is known.
 pub(crate) type SeenCorners<'a> = dyn FnMut(&Polygon) -> Option<Vec<(Polygon, u64)>> + 'a;
-
-/// Boxes of an occluder's penumbra volume and of its umbra volume (empty
-/// where some `lo > hi`), within the scene.
-pub(crate) type Reach = [Box3; 2];
-
-/// A box per axis, `[lo, hi]`, in grid units (exact integers).
-pub(crate) type Box3 = [[i64; 2]; 3];
-
-/// Whether two boxes meet (touching counts).
-pub(crate) fn overlap(a: &Box3, b: &Box3) -> bool {
-    (0..3).all(|k| a[k][0] <= b[k][1] && b[k][0] <= a[k][1])
-}
-
-/// A box holding every point.
-pub(crate) const EVERYWHERE: Box3 = [[i64::MIN, i64::MAX]; 3];
-
-/// The smallest box of integers holding a polygon: each exact corner's
-/// coordinates rounded down and up (`Homogeneous::floor_ceil`).
-pub(crate) fn polygon_box(p: &Polygon) -> Box3 {
-    let mut b = [[i64::MAX, i64::MIN]; 3];
-    for v in p.vertices() {
-        let (lo, hi) = match v {
-            bsp_core::Point::Grid(g) => (g.map(i64::from), g.map(i64::from)),
-            bsp_core::Point::Implicit(i) => {
-                let c = [0, 1, 2].map(|k| i.floor_ceil(k));
-                (c.map(|c| c.0), c.map(|c| c.1))
-            }
-        };
-        for k in 0..3 {
-            b[k] = [b[k][0].min(lo[k]), b[k][1].max(hi[k])];
-        }
-    }
-    b
-}

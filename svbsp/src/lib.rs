@@ -44,6 +44,7 @@ mod area;
 mod areas;
 mod arena;
 mod blockers;
+mod boxes;
 mod chin_feiner;
 mod engine;
 pub mod export;

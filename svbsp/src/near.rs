@@ -7,8 +7,9 @@
 use bsp_core::{GridPoint, Plane};
 use rayon::prelude::*;
 
-use crate::area::{Box3, HalfSpaces, Occluder, Reach, Regions, grid_box, overlap};
+use crate::area::{HalfSpaces, Occluder, Regions};
 use crate::blockers::plane_key;
+use crate::boxes::{Box3, Reach, grid_box, overlap};
 use crate::light::Light;
 
 /// Per receiving face, the indices of the occluders not in its plane whose

@@ -17,10 +17,10 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::area::{
-    AreaClass, AreaFragment, AreaLight, Box3, EVERYWHERE, HalfSpaces, Occluder, Reach, Regions,
-    grid_box, merge_convex,
+    AreaClass, AreaFragment, AreaLight, HalfSpaces, Occluder, Regions, merge_convex,
 };
 use crate::blockers::{coplanar_blockers, plane_key};
+use crate::boxes::{Box3, EVERYWHERE, Reach, grid_box};
 use crate::engine::{Scratch, Shadows};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
 use crate::near::{CellGrid, InSlab, near_lists, slab_box};
