@@ -22,7 +22,6 @@ use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 use rayon::prelude::*;
 use smallvec::{SmallVec, smallvec};
 
-use super::mesh::clip_ears;
 use crate::kernel::Side;
 use crate::kernel::plane::Plane;
 use crate::kernel::point::Point;
@@ -339,4 +338,44 @@ fn finish(plan: &Plan, dropped: &HashSet<u32>) -> Vec<[u32; 3]> {
         }
     }
     tris
+}
+
+/// Triangulates a convex loop whose points may be collinear along edges.
+/// Every point knows the edges (original sides and chords made so far) it
+/// lies on. Three consecutive points `a, b, c` form an ear when `a` and `c`
+/// share no edge: the chord `ac` then crosses the interior and contains no
+/// other point of the loop, and `b` is not on it. A convex loop of positive
+/// area always has such an ear (at a corner next to a corner of another
+/// side). `next_edge` is the first free edge id for chords.
+pub(super) fn clip_ears(
+    mut ring: Vec<(u32, SmallVec<[u32; 3]>)>,
+    mut next_edge: u32,
+    out: &mut Vec<[u32; 3]>,
+) {
+    while ring.len() > 3 {
+        let m = ring.len();
+        let ear = (0..m).find(|&j| {
+            let (a, c) = (&ring[(j + m - 1) % m].1, &ring[(j + 1) % m].1);
+            !a.iter().any(|e| c.contains(e))
+        });
+        let Some(j) = ear else {
+            debug_assert!(false, "a convex loop with positive area has an ear");
+            return;
+        };
+        let (ia, ic) = ((j + m - 1) % m, (j + 1) % m);
+        out.push([ring[ia].0, ring[j].0, ring[ic].0]);
+        ring[ia].1.push(next_edge);
+        ring[ic].1.push(next_edge);
+        next_edge += 1;
+        ring.remove(j);
+    }
+    if ring.len() == 3 {
+        let all_on_one = ring[1]
+            .1
+            .iter()
+            .any(|e| ring[0].1.contains(e) && ring[2].1.contains(e));
+        if !all_on_one {
+            out.push([ring[0].0, ring[1].0, ring[2].0]);
+        }
+    }
 }
