@@ -402,9 +402,9 @@ mod tests {
                 if sa == 0 || sb == 0 {
                     continue;
                 }
-                // p = ((t2 + t1)·o − t1·l) / t2, o = Σa·o_i / sa, l = Σb·l_j / sb
-                // (a direction v stands for the point at −∞·v: l = −v·sb / sb·∞;
-                // for a sun, p = o − (t1/t2)·Σb·v / sb)
+                // o = Σa·o_i / sa and l = Σb·l_j / sb; for a point light
+                // p = ((t2 + t1)·o − t1·l) / t2, for a sun (l a direction
+                // toward it) p = o − (t1 / t2)·l
                 let den = t2 * sa * sb;
                 let num = [0, 1, 2].map(|k| {
                     let o: i128 = (0..3).map(|i| a[i] * i128::from(occluder[i][k])).sum();

@@ -407,7 +407,11 @@ fn soft_face(
             // (a box of what each volume holds of the face's slab costs a
             // few hundred operations; it pays where many points look)
             let slab = points.len() >= 32;
-            let hiders = run.hiders(k, i, Probing::NearFace { slab });
+            let probing = match fragments.iter().all(|(p, _)| p.len() < MAX_PROBED_CORNERS) {
+                true => Probing::NearFace { slab },
+                false => Probing::Anywhere,
+            };
+            let hiders = run.hiders(k, i, probing);
             let fractions = points
                 .par_iter()
                 .map(|&x| fraction_at(&lights[k], face, &hiders, x))
@@ -539,6 +543,11 @@ fn fraction_at(
 /// a box holding every such point inside it.
 type Hider<'a> = (&'a Occluder, Cow<'a, [(Plane, Side)]>, Box3);
 
+/// Fragments of fewer corners than this have their probe points near
+/// their face ([`Probing::NearFace`]); a face with a larger one is probed
+/// as if its points lay anywhere.
+const MAX_PROBED_CORNERS: usize = 2048;
+
 /// Where the points a face's [`Hiders`] are asked about lie.
 #[derive(Clone, Copy)]
 enum Probing {
@@ -546,10 +555,14 @@ enum Probing {
     Anywhere,
     /// Within 1 (a grid unit, per coordinate, strictly) of a point of the
     /// face, as the grid points nearest its fragments' corners and
-    /// centroids are (their `f64` coordinates are within `2^-26` of exact
-    /// points of the face, and rounding moves them by at most 1/2); with
-    /// `slab`, the occluders are also boxed by what their volumes hold
-    /// of the slab around the face's plane ([`slab_box`]).
+    /// centroids are: a corner's `f64` coordinates are its exact ones
+    /// correctly rounded (within `2^-27`: `|c| < 2^27`), a centroid of `n`
+    /// of them summed and divided in `f64` is within `n² 2^-26` of the
+    /// exact centroid of those (below 1/4 for fewer than
+    /// [`MAX_PROBED_CORNERS`]), which lies in the fragment, and rounding
+    /// to the grid moves a point by at most 1/2. With `slab`, the
+    /// occluders are also boxed by what their volumes hold of the slab
+    /// around the face's plane ([`slab_box`]).
     NearFace { slab: bool },
 }
 
