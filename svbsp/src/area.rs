@@ -989,8 +989,8 @@ impl Cutting<'_, '_> {
 }
 
 /// A piece's [`Scan`]: its box, and which of an occluder's boxes it must
-/// meet to be cut (a piece in an umbra is never cut again; one that hides
-/// every corner already only by an umbra).
+/// meet to be cut (a piece in an umbra is never cut again; one that
+/// already hides every corner is cut only by an occluder's umbra).
 fn scan_of<K>(p: &Piece<K>, deep: bool) -> Scan {
     Scan {
         bbox: p.bbox,
