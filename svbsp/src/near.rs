@@ -51,10 +51,14 @@ pub(crate) fn near_lists(
             if let Some(r) = r {
                 let reach = reaches[j][0];
                 let plane = plane_key(occluders[j].plane());
+                // the sweep in a few boxes: most faces in the whole box
+                // lie beside the volume where it is still narrow
+                let parts = penumbra_boxes(lights, occluders[j].corners(), scene, SWEEP_PARTS);
                 grid.visit(reach, |i| {
                     let i = i as usize;
                     if planes[i] != plane
                         && overlap(&boxes[i], &reach)
+                        && parts.iter().any(|p| overlap(&boxes[i], p))
                         && !outside(faces[i].corners(), &r.penumbra)
                     {
                         hit.push(i as u32);
@@ -80,6 +84,9 @@ pub(crate) fn near_lists(
     (near, reaches)
 }
 
+/// Into how many boxes [`near_lists`] cuts an occluder's sweep.
+const SWEEP_PARTS: usize = 4;
+
 /// Whether grid points `corners` lie in the closed outside of one of the
 /// half-spaces `hs` (a face there has no area inside the volume).
 pub(crate) fn outside(corners: &[GridPoint], hs: &HalfSpaces) -> bool {
@@ -100,6 +107,16 @@ fn union(a: Box3, b: Box3) -> Box3 {
 /// passes a bound `T = num / den` (the least over such axes), and the
 /// volume lies in `box(O) + [0, T]·D`, its bounds rounded outward.
 fn penumbra_box(lights: &[Light], o: &[GridPoint], scene: Box3) -> Box3 {
+    penumbra_boxes(lights, o, scene, 1)[0]
+}
+
+/// [`penumbra_box`] in `parts` boxes, one for each `t` in
+/// `[T·k/parts, T·(k+1)/parts]`: near the occluder the volume is narrow,
+/// and one box of the whole sweep is as wide there as the volume is where
+/// it leaves the scene. Over such a range the point lies in
+/// `box(O) + [t0, t1]·D`, whose bounds per axis are the least and most of
+/// `t·d` at the range's ends and `D`'s (`t ≥ 0`).
+fn penumbra_boxes(lights: &[Light], o: &[GridPoint], scene: Box3, parts: usize) -> Vec<Box3> {
     let ob = grid_box(o);
     let points: Vec<GridPoint> = lights
         .iter()
@@ -110,7 +127,7 @@ fn penumbra_box(lights: &[Light], o: &[GridPoint], scene: Box3) -> Box3 {
         .collect();
     // a light point on the occluder's box: the volume may be anywhere
     if !points.is_empty() && overlap(&grid_box(&points), &ob) {
-        return scene;
+        return vec![scene];
     }
     let mut d = [[i64::MAX, i64::MIN]; 3];
     for l in lights {
@@ -140,17 +157,32 @@ fn penumbra_box(lights: &[Light], o: &[GridPoint], scene: Box3) -> Box3 {
         }
     }
     let Some((num, den)) = t else {
-        return scene;
+        return vec![scene];
     };
-    let b = [0, 1, 2].map(|k| {
-        let lo = num * i128::from(d[k][0].min(0));
-        let hi = num * i128::from(d[k][1].max(0));
-        [
-            ob[k][0] + lo.div_euclid(den) as i64,
-            ob[k][1] - (-hi).div_euclid(den) as i64,
-        ]
-    });
-    [0, 1, 2].map(|k| [b[k][0].max(scene[k][0]), b[k][1].min(scene[k][1])])
+    // t from num·j / q to num·(j + 1) / q, q = den·parts
+    let q = den * parts as i128;
+    (0..parts as i128)
+        .map(|j| {
+            let b = [0, 1, 2].map(|k| {
+                let ends = [num * j, num * (j + 1)];
+                let lo = ends
+                    .map(|e| e * i128::from(d[k][0]))
+                    .into_iter()
+                    .min()
+                    .unwrap_or(0);
+                let hi = ends
+                    .map(|e| e * i128::from(d[k][1]))
+                    .into_iter()
+                    .max()
+                    .unwrap_or(0);
+                [
+                    ob[k][0] + lo.div_euclid(q) as i64,
+                    ob[k][1] - (-hi).div_euclid(q) as i64,
+                ]
+            });
+            [0, 1, 2].map(|k| [b[k][0].max(scene[k][0]), b[k][1].min(scene[k][1])])
+        })
+        .collect()
 }
 
 /// What a slab holds of an occluder's penumbra volume ([`slab_box`]).
@@ -370,6 +402,63 @@ mod tests {
     }
 
     proptest! {
+        /// Every point `o + t(o − l)` of the volume inside the scene lies
+        /// in one of the sweep's boxes, and they all in the whole sweep's.
+        #[test]
+        fn the_sweep_boxes_hold_the_volume(
+            occluder in prop::array::uniform3(point()),
+            light in prop::collection::vec(point(), 1..4),
+            sun in any::<bool>(),
+            parts in 1usize..6,
+            samples in prop::collection::vec(
+                (prop::array::uniform3(0i128..4), prop::collection::vec(0i128..4, 4), 0i128..400, 1i128..8),
+                64,
+            ),
+        ) {
+            let lights: Vec<Light> = light
+                .iter()
+                .map(|&p| if sun { Light::Directional(p) } else { Light::Point(p) })
+                .collect();
+            if sun && light.contains(&[0, 0, 0]) {
+                return Ok(());
+            }
+            let scene = [[-100, 100]; 3];
+            let boxes = penumbra_boxes(&lights, &occluder, scene, parts);
+            let whole = penumbra_box(&lights, &occluder, scene);
+            for b in &boxes {
+                for k in 0..3 {
+                    prop_assert!(b[k][0] > b[k][1] || (whole[k][0] <= b[k][0] && b[k][1] <= whole[k][1]));
+                }
+            }
+            for (a, b, t1, t2) in samples {
+                let b = &b[..lights.len()];
+                let (sa, sb): (i128, i128) = (a.iter().sum(), b.iter().sum());
+                if sa == 0 || sb == 0 {
+                    continue;
+                }
+                // as in the slab's test: p = num / den
+                let den = t2 * sa * sb;
+                let num = [0, 1, 2].map(|k| {
+                    let o: i128 = (0..3).map(|i| a[i] * i128::from(occluder[i][k])).sum();
+                    let l: i128 = (0..lights.len()).map(|j| b[j] * i128::from(light[j][k])).sum();
+                    if sun {
+                        t2 * sb * o - t1 * sa * l
+                    } else {
+                        (t2 + t1) * sb * o - t1 * sa * l
+                    }
+                });
+                let inside = |bx: &Box3| {
+                    (0..3).all(|k| {
+                        i128::from(bx[k][0]) * den <= num[k] && num[k] <= i128::from(bx[k][1]) * den
+                    })
+                };
+                if !inside(&scene) {
+                    continue;
+                }
+                prop_assert!(boxes.iter().any(inside), "{num:?} / {den} in none of {boxes:?}");
+            }
+        }
+
         /// Every point `o + t(o − l)` of the volume (rational `o`, `l`,
         /// `t`) within the slab lies in its box.
         #[test]
