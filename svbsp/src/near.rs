@@ -401,6 +401,52 @@ mod tests {
         prop::array::uniform3(-60i32..60)
     }
 
+    /// The points `light` as point lights, or (`sun`) as directions toward
+    /// suns; `None` where a direction is zero.
+    fn lights_of(light: &[GridPoint], sun: bool) -> Option<Vec<Light>> {
+        if sun && light.contains(&[0, 0, 0]) {
+            return None;
+        }
+        let kind = |p| {
+            if sun {
+                Light::Directional(p)
+            } else {
+                Light::Point(p)
+            }
+        };
+        Some(light.iter().map(|&p| kind(p)).collect())
+    }
+
+    /// A sample `(a, b, t1, t2)` of the volume of `occluder` under the
+    /// light points (or, `sun`, directions toward the light) `light`, as
+    /// `num / den`: `o = Σa·o_i / Σa` and `l = Σb·l_j / Σb`; for a point
+    /// light `p = ((t2 + t1)·o − t1·l) / t2`, for a sun `p = o − (t1 / t2)·l`.
+    /// `None` for zero weights.
+    fn volume_point(
+        occluder: &[GridPoint; 3],
+        light: &[GridPoint],
+        sun: bool,
+        (a, b, t1, t2): &([i128; 3], Vec<i128>, i128, i128),
+    ) -> Option<([i128; 3], i128)> {
+        let b = &b[..light.len()];
+        let (sa, sb): (i128, i128) = (a.iter().sum(), b.iter().sum());
+        if sa == 0 || sb == 0 {
+            return None;
+        }
+        let num = [0, 1, 2].map(|k| {
+            let o: i128 = (0..3).map(|i| a[i] * i128::from(occluder[i][k])).sum();
+            let l: i128 = (0..light.len())
+                .map(|j| b[j] * i128::from(light[j][k]))
+                .sum();
+            if sun {
+                t2 * sb * o - t1 * sa * l
+            } else {
+                (t2 + t1) * sb * o - t1 * sa * l
+            }
+        });
+        Some((num, t2 * sa * sb))
+    }
+
     proptest! {
         /// Every point `o + t(o − l)` of the volume inside the scene lies
         /// in one of the sweep's boxes, and they all in the whole sweep's.
@@ -415,13 +461,9 @@ mod tests {
                 64,
             ),
         ) {
-            let lights: Vec<Light> = light
-                .iter()
-                .map(|&p| if sun { Light::Directional(p) } else { Light::Point(p) })
-                .collect();
-            if sun && light.contains(&[0, 0, 0]) {
+            let Some(lights) = lights_of(&light, sun) else {
                 return Ok(());
-            }
+            };
             let scene = [[-100, 100]; 3];
             let boxes = penumbra_boxes(&lights, &occluder, scene, parts);
             let whole = penumbra_box(&lights, &occluder, scene);
@@ -430,23 +472,10 @@ mod tests {
                     prop_assert!(b[k][0] > b[k][1] || (whole[k][0] <= b[k][0] && b[k][1] <= whole[k][1]));
                 }
             }
-            for (a, b, t1, t2) in samples {
-                let b = &b[..lights.len()];
-                let (sa, sb): (i128, i128) = (a.iter().sum(), b.iter().sum());
-                if sa == 0 || sb == 0 {
+            for sample in &samples {
+                let Some((num, den)) = volume_point(&occluder, &light, sun, sample) else {
                     continue;
-                }
-                // as in the slab's test: p = num / den
-                let den = t2 * sa * sb;
-                let num = [0, 1, 2].map(|k| {
-                    let o: i128 = (0..3).map(|i| a[i] * i128::from(occluder[i][k])).sum();
-                    let l: i128 = (0..lights.len()).map(|j| b[j] * i128::from(light[j][k])).sum();
-                    if sun {
-                        t2 * sb * o - t1 * sa * l
-                    } else {
-                        (t2 + t1) * sb * o - t1 * sa * l
-                    }
-                });
+                };
                 let inside = |bx: &Box3| {
                     (0..3).all(|k| {
                         i128::from(bx[k][0]) * den <= num[k] && num[k] <= i128::from(bx[k][1]) * den
@@ -475,35 +504,16 @@ mod tests {
             let Ok(plane) = Plane::through(plane[0], plane[1], plane[2]) else {
                 return Ok(());
             };
-            let lights: Vec<Light> = light
-                .iter()
-                .map(|&p| if sun { Light::Directional(p) } else { Light::Point(p) })
-                .collect();
-            if sun && light.contains(&[0, 0, 0]) {
+            let Some(lights) = lights_of(&light, sun) else {
                 return Ok(());
-            }
+            };
             let found = slab_box(&lights, &occluder, &plane);
             let n = plane.normal().map(i128::from);
             let m: i128 = n.iter().map(|c| c.abs()).sum();
-            for (a, b, t1, t2) in samples {
-                let b = &b[..lights.len()];
-                let (sa, sb): (i128, i128) = (a.iter().sum(), b.iter().sum());
-                if sa == 0 || sb == 0 {
+            for sample in &samples {
+                let Some((num, den)) = volume_point(&occluder, &light, sun, sample) else {
                     continue;
-                }
-                // o = Σa·o_i / sa and l = Σb·l_j / sb; for a point light
-                // p = ((t2 + t1)·o − t1·l) / t2, for a sun (l a direction
-                // toward it) p = o − (t1 / t2)·l
-                let den = t2 * sa * sb;
-                let num = [0, 1, 2].map(|k| {
-                    let o: i128 = (0..3).map(|i| a[i] * i128::from(occluder[i][k])).sum();
-                    let l: i128 = (0..lights.len()).map(|j| b[j] * i128::from(light[j][k])).sum();
-                    if sun {
-                        t2 * sb * o - t1 * sa * l
-                    } else {
-                        (t2 + t1) * sb * o - t1 * sa * l
-                    }
-                });
+                };
                 let value = (0..3).map(|k| n[k] * num[k]).sum::<i128>() + plane.offset() * den;
                 if value.abs() > m * den {
                     continue;
