@@ -392,6 +392,8 @@ fn soft_face(
                 .collect()
         })
         .collect();
+    // (a probe point lies near the face when its fragment is not huge)
+    let near_face = fragments.iter().all(|(p, _)| p.len() < MAX_PROBED_CORNERS);
     let values: Vec<Option<Viewed>> = (0..lights.len())
         .map(|k| {
             let mut points: Vec<GridPoint> = probes
@@ -407,7 +409,7 @@ fn soft_face(
             // (a box of what each volume holds of the face's slab costs a
             // few hundred operations; it pays where many points look)
             let slab = points.len() >= 32;
-            let probing = match fragments.iter().all(|(p, _)| p.len() < MAX_PROBED_CORNERS) {
+            let probing = match near_face {
                 true => Probing::NearFace { slab },
                 false => Probing::Anywhere,
             };
@@ -588,7 +590,8 @@ impl<'a> Hiders<'a> {
     ) -> Hiders<'a> {
         // points near the face lie within 1 of its box, and in the slab
         // of `slab_box` around its plane
-        let near = grid_box(face.corners()).map(|[lo, hi]| [lo - 1, hi + 1]);
+        let face_box = grid_box(face.corners());
+        let near = face_box.map(|[lo, hi]| [lo - 1, hi + 1]);
         let occluders: Vec<Hider<'a>> = occluders
             .into_iter()
             .filter_map(|(o, r, b)| {
@@ -606,7 +609,7 @@ impl<'a> Hiders<'a> {
             .collect();
         let boxes: Vec<Box3> = occluders.iter().map(|o| o.2).collect();
         Hiders {
-            grid: CellGrid::new(grid_box(face.corners()), &boxes),
+            grid: CellGrid::new(face_box, &boxes),
             occluders,
         }
     }
