@@ -1247,6 +1247,26 @@ fn sunhours_reads_a_cityjson_block_and_keeps_the_objects_ids() {
         .map(|l| l.split(',').nth(2).unwrap().parse::<f64>().unwrap())
         .sum();
     assert!((yard - 3500.0).abs() < 1e-6, "{yard}");
+    // cut into 2 × 2 tiles: the same rows, ids and hours to the last bits
+    let tiled = scratch("block_hours_tiled.csv");
+    let mut cut = argv.clone();
+    cut[5] = tiled.to_str().unwrap();
+    cut.extend(["--tiles", "2"]);
+    let o = shadow(&cut);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let again = std::fs::read_to_string(&tiled).unwrap();
+    assert_eq!(again.lines().count(), text.lines().count());
+    for (a, b) in text.lines().zip(again.lines()).skip(1) {
+        let (a, b): (Vec<&str>, Vec<&str>) = (a.split(',').collect(), b.split(',').collect());
+        assert_eq!(a[..2], b[..2]);
+        for k in 2..6 {
+            let (x, y) = (a[k].parse::<f64>().unwrap(), b[k].parse::<f64>().unwrap());
+            assert!((x - y).abs() <= 1e-9 * x.abs().max(1.0), "{a:?} {b:?}");
+        }
+    }
+    *cut.last_mut().unwrap() = "0";
+    let o = shadow(&cut);
+    crate::assert_failed_with(&o, &["invalid value '0' for '--tiles <N>'"]);
     // a broken file: the place in it named
     let bad = scratch("bad.city.json");
     let text = std::fs::read_to_string(block).unwrap();

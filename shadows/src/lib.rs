@@ -83,6 +83,13 @@ pub enum Error {
     /// The faces of a region study cannot be found, or its dates are not
     /// the test's (the message says which).
     Region(String),
+    /// A study's tile that is not one of its tiles ([`sun::Tile`]).
+    Tile {
+        /// The tile asked for.
+        index: usize,
+        /// The study's tiles along each axis.
+        per_side: usize,
+    },
     /// An output file's name asks for a format the job cannot write.
     Format {
         /// The file.
@@ -106,6 +113,17 @@ impl std::fmt::Display for Error {
             Error::Sensor { index, cause } => write!(f, "sensor {index}: {cause}"),
             Error::Format { path, why } => write!(f, "{}: {why}", path.display()),
             Error::Region(why) => f.write_str(why),
+            Error::Tile { index, per_side: 0 } => {
+                write!(
+                    f,
+                    "tile {index} of a study cut into no tiles (tiles along each axis: at least 1)"
+                )
+            }
+            Error::Tile { index, per_side } => write!(
+                f,
+                "tile {index} of a study cut into {per_side} × {per_side} tiles (0 to {})",
+                per_side.saturating_mul(*per_side) - 1
+            ),
         }
     }
 }
@@ -122,7 +140,7 @@ impl std::error::Error for Error {
             Error::Raster(e) => e,
             Error::Io(e) => e,
             Error::Sensor { cause, .. } => cause,
-            Error::Format { .. } | Error::Region(_) => return None,
+            Error::Format { .. } | Error::Region(_) | Error::Tile { .. } => return None,
         })
     }
 }
@@ -236,26 +254,36 @@ pub fn shadows(mesh: &Mesh, lights: &[Light]) -> Result<Shadows, Error> {
     let (polys, _) =
         bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(Error::Import)?;
     let solids = bsp_core::certify_solid_parts(&polys);
-    shadows_on(&grid, &polys, &solids, mesh.faces.len(), lights)
+    shadows_on(&grid, &polys, &solids, mesh.faces.len(), lights, None)
 }
 
 /// [`shadows`] of the `faces` faces of a mesh already snapped to `grid`
 /// (which must hold the point lights) and imported as `polys`: what a sun
-/// study shares between its runs.
+/// study shares between its runs. With `tile`, of the tile's polygons
+/// only (indices into `polys`, within the grid box given), past the
+/// occluders that may hide a light from that box
+/// ([`sun::tiles`](crate::sun)); the other faces get no fragment.
 pub(crate) fn shadows_on(
     grid: &bsp_core::Grid,
     polys: &[bsp_core::Polygon],
     solids: &bsp_core::SolidParts,
     faces: usize,
     lights: &[Light],
+    tile: Option<(&[usize], [bsp_core::GridPoint; 2])>,
 ) -> Result<Shadows, Error> {
     let placed = svbsp::place_lights(grid, lights).map_err(Error::Light)?;
     let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
-    let trees = face_trees(polys, &kernel, &[], solids).map_err(Error::Shadow)?;
+    let reach = tile.map(|(_, b)| b);
+    let trees = face_trees(polys, &kernel, &[], solids, reach).map_err(Error::Shadow)?;
     // (with convex pieces: the OBJ writer draws them)
-    let batch = trees
-        .set()
-        .shade_all(polys, &ShadeOptions::default().with_pieces(true));
+    let opts = ShadeOptions::default().with_pieces(true);
+    let batch = match tile {
+        None => trees.set().shade_all(polys, &opts),
+        Some((own, _)) => {
+            let own: Vec<bsp_core::Polygon> = own.iter().map(|&i| polys[i].clone()).collect();
+            trees.set().shade_all(&own, &opts)
+        }
+    };
     let world = world_vertices(&batch, grid).map_err(Error::Export)?;
     let (mut lit, mut area) = (vec![0.0; faces * placed.len()], vec![0.0; faces]);
     for r in area_records(&batch, &world) {
@@ -290,26 +318,39 @@ pub(crate) fn shadows_on(
 /// to bound solids ([`svbsp::Light::leaves_out`]; `solids` is
 /// [`bsp_core::certify_solid_parts`] of `polys`): their other faces hide
 /// all they hide, from every face and point.
+///
+/// With `reach` (a grid box holding every face to be shaded and every
+/// point to be asked, in place of all of `polys` and `also`), nor the
+/// faces whose box no way from the box toward the light meets.
 pub(crate) fn face_trees(
     polys: &[bsp_core::Polygon],
     kernel: &[svbsp::Light],
     also: &[bsp_core::GridPoint],
     solids: &bsp_core::SolidParts,
+    reach: Option<[bsp_core::GridPoint; 2]>,
 ) -> Result<svbsp::Shadows, ShadowError> {
-    let bounds = grid_bounds(polys).map(|[mut lo, mut hi]| {
-        for p in also {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
+    let bounds = reach
+        .or_else(|| grid_bounds(polys))
+        .map(|[mut lo, mut hi]| {
+            for p in also {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
             }
-        }
-        [lo, hi]
-    });
+            [lo, hi]
+        });
+    let boxes: Option<Vec<[bsp_core::GridPoint; 2]>> =
+        reach.and_then(|_| polys.iter().map(sun::grid_box).collect::<Option<Vec<_>>>());
     let volumes = bsp_core::par::try_map(kernel.len(), |j| {
         let hiding: Vec<&bsp_core::Polygon> = (polys.iter().enumerate())
             .filter(|(i, p)| {
                 bounds.is_none_or(|b| may_hide(&kernel[j], p.support(), b))
                     && !kernel[j].leaves_out(solids, *i, p.support())
+                    && match (&boxes, bounds) {
+                        (Some(boxes), Some(b)) => sun::may_shade(&kernel[j], b, boxes[*i]),
+                        _ => true,
+                    }
             })
             .map(|(_, p)| p)
             .collect();
@@ -449,7 +490,7 @@ mod tests {
         let grid = svbsp::shared_grid(&city.positions, &lights).unwrap();
         let (polys, _) = bsp_core::import_faces_par(&grid, &city.face_loops()).unwrap();
         let solids = bsp_core::certify_solid_parts(&polys);
-        let culled = shadows_on(&grid, &polys, &solids, city.faces.len(), &lights).unwrap();
+        let culled = shadows_on(&grid, &polys, &solids, city.faces.len(), &lights, None).unwrap();
         let placed = svbsp::place_lights(&grid, &lights).unwrap();
         let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
         // the buildings are closed: their faces turned away from a light

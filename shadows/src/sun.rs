@@ -16,6 +16,8 @@ mod exact_time;
 mod ply;
 mod regions;
 mod report;
+mod runs;
+mod tiles;
 pub use exact_time::{
     Interval, SunPath, day_paths, hides, interval_hours, intervals_json, sensor_intervals,
     study_plan, triangles,
@@ -27,7 +29,11 @@ pub use regions::{
     region_in_sun_text, regions_csv, regions_json, regions_obj, regions_png,
 };
 pub use report::{HoursOf, HoursReport, hours_report};
+use runs::Snapped;
+pub use runs::{HoursRun, StudyScene};
 use solar_positioning::{Location, RefractionCorrection, SolarPositions, delta_t};
+pub use tiles::Tile;
+pub(crate) use tiles::{grid_box, may_shade};
 
 /// Which scene axis points up.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -399,37 +405,43 @@ fn study<T>(
 ) -> Result<T, crate::Error> {
     let snapped = Snapped::of(mesh, suns)?;
     let mut runs = (suns.chunks(SUNS_A_RUN))
-        .map(|batch| HoursRun::make(mesh, batch, step_hours, pieces, snapped.as_ref()));
+        .map(|batch| HoursRun::make(mesh, batch, step_hours, pieces, snapped.as_ref(), None));
     Ok(fold(&mut runs))
 }
 
-/// A study's mesh snapped and imported once for all its runs: suns add
-/// no point to the grid ([`svbsp::shared_grid`]), so each run's own grid
-/// and faces would be these.
-struct Snapped {
-    grid: bsp_core::Grid,
-    polys: Vec<bsp_core::Polygon>,
-    /// The parts of `polys` certified to bound solids.
-    solids: bsp_core::SolidParts,
-}
-
-impl Snapped {
-    /// `mesh` snapped for a study of `suns` (`None` for none: nothing to
-    /// shade).
-    fn of(mesh: &crate::Mesh, suns: &[DVec3]) -> Result<Option<Snapped>, crate::Error> {
-        if suns.is_empty() {
-            return Ok(None);
-        }
-        let grid = svbsp::shared_grid(&mesh.positions, &[]).map_err(crate::Error::Light)?;
-        let (polys, _) =
-            bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(crate::Error::Import)?;
-        let solids = bsp_core::certify_solid_parts(&polys);
-        Ok(Some(Snapped {
-            grid,
-            polys,
-            solids,
-        }))
+/// [`sun_hours`] (with `extremes`) or [`sun_hours_mean`] with the scene
+/// cut into `per_side × per_side` tiles ([`Tile`]): each run of suns
+/// shades one tile's faces past only the occluders that may hide the sun
+/// from them, in runs of [`SUNS_A_RUN`] suns, the tiles of a run in
+/// order ([`HoursRun::of_tile`]). Every fragment's class is the whole
+/// scene's; the areas may differ from the untiled study's in their last
+/// bits (the fragments are cut differently), and are the same, bit for
+/// bit, for runs made elsewhere and folded in this order. One tile a side
+/// is the untiled study.
+pub fn sun_hours_in_tiles(
+    mesh: &crate::Mesh,
+    suns: &[DVec3],
+    step_hours: f64,
+    per_side: usize,
+    extremes: bool,
+) -> Result<Vec<FaceHours>, crate::Error> {
+    if per_side == 1 {
+        return match extremes {
+            true => sun_hours(mesh, suns, step_hours),
+            false => sun_hours_mean(mesh, suns, step_hours),
+        };
     }
+    if per_side == 0 {
+        return Err(crate::Error::Tile { index: 0, per_side });
+    }
+    let pieces = extremes.then_some(None);
+    let snapped = Snapped::of(mesh, suns)?;
+    let mut runs = (suns.chunks(SUNS_A_RUN))
+        .flat_map(|batch| Tile::all(per_side).map(move |t| (batch, t)))
+        .map(|(batch, t)| {
+            HoursRun::make(mesh, batch, step_hours, pieces, snapped.as_ref(), Some(t))
+        });
+    HoursRun::fold(mesh.faces.len(), &mut runs)
 }
 
 /// [`sun_hours`] without the overlay: each face's exact `sun_hours` (and
@@ -512,229 +524,6 @@ fn disc_in_front(height: f64, radius_deg: f64) -> f64 {
     ((-h).acos() + h * (1.0 - h * h).sqrt()) / std::f64::consts::PI
 }
 
-/// One run's share of a study's sun-hours: for at most
-/// [`svbsp::MAX_LIGHTS`] suns, every face's area, its lit area summed
-/// over the suns times the step, and (for the extremes) its pieces with
-/// the number of suns each sees.
-#[derive(Clone, Debug, PartialEq)]
-pub struct HoursRun {
-    step_hours: f64,
-    area: Vec<f64>,
-    lit: Vec<f64>,
-    cells: Option<Vec<Vec<Cell>>>,
-}
-
-impl HoursRun {
-    /// The run of `suns` (at most [`svbsp::MAX_LIGHTS`]) over `mesh`, with
-    /// its pieces (for [`sun_hours`]).
-    pub fn new(
-        mesh: &crate::Mesh,
-        suns: &[DVec3],
-        step_hours: f64,
-    ) -> Result<HoursRun, crate::Error> {
-        HoursRun::make(mesh, suns, step_hours, Some(None), None)
-    }
-
-    /// The run without its pieces (for [`sun_hours_mean`]).
-    pub fn mean_only(
-        mesh: &crate::Mesh,
-        suns: &[DVec3],
-        step_hours: f64,
-    ) -> Result<HoursRun, crate::Error> {
-        HoursRun::make(mesh, suns, step_hours, None, None)
-    }
-
-    /// The run; with `pieces`, the pieces of every face, or with
-    /// `Some(Some(keep))` of the faces `keep` marks; on the study's
-    /// `snapped` mesh if given (the same grid and faces as its own).
-    fn make(
-        mesh: &crate::Mesh,
-        suns: &[DVec3],
-        step_hours: f64,
-        pieces: Option<Option<&[bool]>>,
-        snapped: Option<&Snapped>,
-    ) -> Result<HoursRun, crate::Error> {
-        let faces = mesh.faces.len();
-        let lights: Vec<crate::Light> = suns.iter().map(|&d| crate::Light::Sun(d)).collect();
-        let run = match snapped {
-            Some(s) => crate::shadows_on(&s.grid, &s.polys, &s.solids, faces, &lights)?,
-            None => crate::shadows(mesh, &lights)?,
-        };
-        let area: Vec<f64> = (0..faces).map(|f| run.face_area(f)).collect();
-        let lit = (0..faces)
-            .map(|f| (0..suns.len()).map(|l| run.lit_area(f, l)).sum::<f64>() * step_hours)
-            .collect();
-        let Some(keep) = pieces else {
-            return Ok(HoursRun {
-                step_hours,
-                area,
-                lit,
-                cells: None,
-            });
-        };
-        let kept = |f: usize| keep.is_none_or(|k| k[f]);
-        let frames: Vec<(DVec3, DVec3, DVec3)> = (0..faces).map(|f| face_frame(mesh, f)).collect();
-        let mut cells: Vec<Vec<Cell>> = vec![Vec::new(); faces];
-        for frag in run.batch.fragments() {
-            let f = frag.face() as usize;
-            if !kept(f) {
-                continue;
-            }
-            let seen = frag.lit_mask().count_ones();
-            let (o, u, v) = frames[f];
-            for piece in frag.pieces() {
-                let ring = piece
-                    .iter()
-                    .map(|&i| {
-                        let p = run.world[i as usize] - o;
-                        glam::DVec2::new(p.dot(u), p.dot(v))
-                    })
-                    .collect();
-                cells[f].push((ring, seen));
-            }
-        }
-        Ok(HoursRun {
-            step_hours,
-            area,
-            lit,
-            cells: Some(cells),
-        })
-    }
-
-    /// The number of faces of the run's mesh.
-    pub fn faces(&self) -> usize {
-        self.area.len()
-    }
-
-    /// The runs' faces' hours, the runs taken in order (`faces`: the
-    /// mesh's face count, for no runs at all; every run must be of a mesh
-    /// of as many faces, see [`HoursRun::faces`]). The extremes are NaN if a
-    /// run has no pieces. Faces are overlaid in parallel, each the same
-    /// whatever the thread count.
-    pub fn fold(
-        faces: usize,
-        runs: impl IntoIterator<Item = Result<HoursRun, crate::Error>>,
-    ) -> Result<Vec<FaceHours>, crate::Error> {
-        let (area, lit, cells, step_hours) = HoursRun::fold_cells(faces, runs)?;
-        Ok((0..faces)
-            .map(|f| match &cells {
-                Some(cells) => face_hours(area[f], lit[f], cells[f].as_deref(), step_hours),
-                None => FaceHours {
-                    min_hours: f64::NAN,
-                    max_hours: f64::NAN,
-                    ..face_hours(area[f], lit[f], None, step_hours)
-                },
-            })
-            .collect())
-    }
-
-    /// The runs folded in order: every face's area, its lit area times
-    /// hours, its overlaid cells (`None` if a run has no pieces; a face
-    /// `None` for no runs), and the step.
-    #[allow(clippy::type_complexity)] // (the fold's four results, named above)
-    fn fold_cells(
-        faces: usize,
-        runs: impl IntoIterator<Item = Result<HoursRun, crate::Error>>,
-    ) -> Result<(Vec<f64>, Vec<f64>, Option<Vec<Option<Vec<Cell>>>>, f64), crate::Error> {
-        let mut area = vec![0.0; faces];
-        let mut lit = vec![0.0; faces];
-        let mut cells: Vec<Option<Vec<Cell>>> = vec![None; faces];
-        let (mut step_hours, mut pieces) = (0.0, true);
-        for run in runs {
-            let run = run?;
-            step_hours = run.step_hours;
-            let n = faces.min(run.area.len());
-            area[..n].copy_from_slice(&run.area[..n]);
-            lit.iter_mut().zip(&run.lit).for_each(|(l, r)| *l += r);
-            match run.cells {
-                Some(new) if pieces => {
-                    let mut both: Vec<_> = cells.into_iter().zip(new).collect();
-                    bsp_core::par::for_each_mut(&mut both, |f, (old, new)| {
-                        *old = Some(match old.take() {
-                            None => std::mem::take(new),
-                            Some(old) => overlay(&old, new, 1e-12 * run.area[f]),
-                        });
-                    });
-                    cells = both.into_iter().map(|(c, _)| c).collect();
-                    cells.resize(faces, None);
-                }
-                _ => {
-                    pieces = false;
-                    cells = vec![None; faces];
-                }
-            }
-        }
-        Ok((area, lit, pieces.then_some(cells), step_hours))
-    }
-
-    /// The run as bytes (little-endian), for sending to another process.
-    pub fn to_bytes(&self) -> Vec<u8> {
-        let mut out = Vec::new();
-        let mut put = |x: f64| out.extend_from_slice(&x.to_le_bytes());
-        put(self.step_hours);
-        put(self.area.len() as f64);
-        put(if self.cells.is_some() { 1.0 } else { 0.0 });
-        for f in 0..self.area.len() {
-            put(self.area[f]);
-            put(self.lit[f]);
-            let Some(cells) = &self.cells else {
-                continue;
-            };
-            put(cells[f].len() as f64);
-            for (ring, seen) in &cells[f] {
-                put(f64::from(*seen));
-                put(ring.len() as f64);
-                for p in ring {
-                    put(p.x);
-                    put(p.y);
-                }
-            }
-        }
-        out
-    }
-
-    /// A run from [`HoursRun::to_bytes`]; `None` if `bytes` is not one.
-    pub fn from_bytes(bytes: &[u8]) -> Option<HoursRun> {
-        let mut words = bytes
-            .chunks_exact(8)
-            .map(|w| f64::from_le_bytes(w.try_into().expect("eight bytes")));
-        let mut next = || words.next();
-        let count = |x: f64| (x >= 0.0 && x.fract() == 0.0 && x < 1e15).then_some(x as usize);
-        let step_hours = next()?;
-        let faces = count(next()?)?;
-        let pieces = match next()? {
-            1.0 => true,
-            0.0 => false,
-            _ => return None,
-        };
-        let mut run = HoursRun {
-            step_hours,
-            area: Vec::new(),
-            lit: Vec::new(),
-            cells: pieces.then(Vec::new),
-        };
-        for _ in 0..faces {
-            run.area.push(next()?);
-            run.lit.push(next()?);
-            let Some(cells) = &mut run.cells else {
-                continue;
-            };
-            let n = count(next()?)?;
-            let mut face = Vec::new();
-            for _ in 0..n {
-                let seen = u32::try_from(count(next()?)?).ok()?;
-                let len = count(next()?)?;
-                let ring = (0..len)
-                    .map(|_| Some(glam::DVec2::new(next()?, next()?)))
-                    .collect::<Option<Vec<_>>>()?;
-                face.push((ring, seen));
-            }
-            cells.push(face);
-        }
-        (bytes.len().is_multiple_of(8) && next().is_none()).then_some(run)
-    }
-}
-
 /// A face's hours from its area, its lit area times hours, and its
 /// overlaid cells (`None`: no suns).
 fn face_hours(area: f64, lit: f64, cells: Option<&[Cell]>, step_hours: f64) -> FaceHours {
@@ -782,7 +571,8 @@ pub fn sensor_hours(
     for batch in all.chunks(svbsp::MAX_LIGHTS) {
         let placed = svbsp::place_lights(&grid, batch).map_err(Error::Light)?;
         let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
-        let trees = crate::face_trees(&polys, &kernel, &at, &solids).map_err(Error::Shadow)?;
+        let trees =
+            crate::face_trees(&polys, &kernel, &at, &solids, None).map_err(Error::Shadow)?;
         for (n, &g) in seen.iter_mut().zip(&at) {
             *n += trees.reaching(g).count_ones();
         }

@@ -9,7 +9,7 @@ use super::{
     clip_to_outline, groups_in_sun_text, interval_hours, intervals_json, region_hours,
     region_in_sun_text, regions_csv, regions_json, regions_obj, regions_ply, regions_png,
     sensor_hours_file, sensor_intervals, sensors_csv, sensors_obj, sensors_ply, sun_hours,
-    sun_hours_disc, sun_hours_mean,
+    sun_hours_disc, sun_hours_in_tiles, sun_hours_mean,
 };
 
 /// What `shadow sunhours` writes and says of a study.
@@ -36,6 +36,9 @@ pub enum HoursOf<'a> {
     Faces {
         /// Whether to overlay the runs for the extremes.
         extremes: bool,
+        /// The scene cut into this many tiles a side, each run shading
+        /// one tile ([`sun_hours_in_tiles`]; 1: not cut).
+        tiles: usize,
     },
     /// Every face's mean hours with the sun a disc of this radius in
     /// degrees ([`sun_hours_disc`]; no extremes).
@@ -84,7 +87,7 @@ impl<'a> HoursOf<'a> {
                 bre209,
                 outline: None,
             },
-            (None, None) => HoursOf::Faces { extremes },
+            (None, None) => HoursOf::Faces { extremes, tiles: 1 },
         }
     }
 
@@ -105,6 +108,18 @@ impl<'a> HoursOf<'a> {
                 faces,
                 bre209,
                 outline: path,
+            },
+            _ => self,
+        }
+    }
+
+    /// Faces' hours with the scene cut into `per_side × per_side` tiles
+    /// (for anything but faces' hours with point suns, `self`).
+    pub fn tiles(self, per_side: usize) -> HoursOf<'a> {
+        match self {
+            HoursOf::Faces { extremes, .. } => HoursOf::Faces {
+                extremes,
+                tiles: per_side,
             },
             _ => self,
         }
@@ -210,7 +225,7 @@ pub fn hours_report(
             })
         }
         HoursOf::Faces { .. } | HoursOf::DiscFaces { .. } => {
-            let extremes = matches!(of, HoursOf::Faces { extremes: true });
+            let extremes = matches!(of, HoursOf::Faces { extremes: true, .. });
             if !extremes && min_hours.is_some() {
                 return Err(crate::Error::Region(
                     "the area that sees at least so many hours needs the extremes' overlay".into(),
@@ -219,6 +234,9 @@ pub fn hours_report(
             let hours = match of {
                 HoursOf::DiscFaces { radius_deg } => {
                     sun_hours_disc(mesh, suns, step_hours, radius_deg)?
+                }
+                HoursOf::Faces { tiles, .. } if tiles != 1 => {
+                    sun_hours_in_tiles(mesh, suns, step_hours, tiles, extremes)?
                 }
                 _ if extremes => sun_hours(mesh, suns, step_hours)?,
                 _ => sun_hours_mean(mesh, suns, step_hours)?,

@@ -591,3 +591,69 @@ fn a_study_writes_ply_with_each_faces_hours() {
     let cells = region_hours(&mesh, &suns, step, &[0]).unwrap();
     assert!(regions_ply(&cells).contains(&format!("element face {}\n", cells.len())));
 }
+
+/// A study cut into tiles: every face's hours the uncut study's up to the
+/// last bits (each tile's trees hold every occluder that may hide the sun
+/// from it), the extremes too; its runs made apart and folded in order
+/// give the same bits; a tile that is not one is an error.
+#[test]
+fn a_study_cut_into_tiles_keeps_every_faces_hours() {
+    let (mesh, suns, step, _) = equinox_study();
+    let whole = sun_hours(&mesh, &suns, step).unwrap();
+    let cut = sun_hours_in_tiles(&mesh, &suns, step, 2, true).unwrap();
+    for (a, b) in whole.iter().zip(&cut) {
+        assert!((a.area - b.area).abs() <= 1e-12 * a.area, "{a:?} {b:?}");
+        for (x, y) in [
+            (a.sun_hours, b.sun_hours),
+            (a.min_hours, b.min_hours),
+            (a.max_hours, b.max_hours),
+        ] {
+            assert!((x - y).abs() < 1e-9, "{a:?} {b:?}");
+        }
+    }
+    let runs: Vec<Vec<u8>> = (suns.chunks(SUNS_A_RUN))
+        .flat_map(|c| Tile::all(2).map(move |t| (c, t)))
+        .map(|(c, t)| {
+            HoursRun::of_tile(&mesh, c, step, true, t)
+                .unwrap()
+                .to_bytes()
+        })
+        .collect();
+    let back = runs.iter().map(|b| Ok(HoursRun::from_bytes(b).unwrap()));
+    assert_eq!(HoursRun::fold(mesh.faces.len(), back).unwrap(), cut);
+    // a tile's face list must be ascending faces of the mesh
+    let mut words: Vec<f64> = (runs[0].chunks_exact(8))
+        .map(|w| f64::from_le_bytes(w.try_into().unwrap()))
+        .collect();
+    assert!(words[2] >= 2.0 && words[3] >= 1.0, "{:?}", &words[..4]);
+    words[4] = mesh.faces.len() as f64;
+    let bad: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    assert!(HoursRun::from_bytes(&bad).is_none());
+    let e = HoursRun::of_tile(
+        &mesh,
+        &suns[..3],
+        step,
+        true,
+        Tile {
+            index: 9,
+            per_side: 3,
+        },
+    );
+    assert_eq!(
+        e.unwrap_err().to_string(),
+        "tile 9 of a study cut into 3 × 3 tiles (0 to 8)"
+    );
+    assert!(sun_hours_in_tiles(&mesh, &suns, step, 0, false).is_err());
+
+    // a city block's mean hours in 3 × 3 tiles: the same to the last bits
+    let city = shadow_scene::city_block(6);
+    let suns = &suns[..40];
+    let whole = sun_hours_mean(&city, suns, step).unwrap();
+    let cut = sun_hours_in_tiles(&city, suns, step, 3, false).unwrap();
+    let most = whole.iter().map(|h| h.sun_hours).fold(0.0, f64::max);
+    assert!(most > 1.0, "{most}");
+    for (a, b) in whole.iter().zip(&cut) {
+        assert!((a.area - b.area).abs() <= 1e-12 * a.area, "{a:?} {b:?}");
+        assert!((a.sun_hours - b.sun_hours).abs() < 1e-9, "{a:?} {b:?}");
+    }
+}

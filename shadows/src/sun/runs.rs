@@ -1,0 +1,401 @@
+//! A study's runs: [`HoursRun`], one run of suns' share of the hours
+//! (made here or on another process, sent as bytes, folded in order), and
+//! the mesh snapped once for all of them ([`StudyScene`]).
+
+use glam::DVec3;
+
+use super::tiles::{self, Tile};
+use super::{Cell, FaceHours, face_frame, face_hours, overlay};
+
+/// A study's mesh snapped and imported once for all its runs: suns add
+/// no point to the grid ([`svbsp::shared_grid`]), so each run's own grid
+/// and faces would be these.
+pub(super) struct Snapped {
+    grid: bsp_core::Grid,
+    polys: Vec<bsp_core::Polygon>,
+    /// The parts of `polys` certified to bound solids.
+    solids: bsp_core::SolidParts,
+}
+
+/// A study's mesh snapped to its grid and imported once, for any number
+/// of runs ([`HoursRun::on`]): what the tasks of a distributed study on
+/// one worker can share.
+pub struct StudyScene(Snapped);
+
+impl StudyScene {
+    /// `mesh` snapped and imported.
+    pub fn new(mesh: &crate::Mesh) -> Result<StudyScene, crate::Error> {
+        Snapped::new(mesh).map(StudyScene)
+    }
+}
+
+impl Snapped {
+    /// `mesh` snapped for a study of `suns` (`None` for none: nothing to
+    /// shade).
+    pub(super) fn of(mesh: &crate::Mesh, suns: &[DVec3]) -> Result<Option<Snapped>, crate::Error> {
+        match suns.is_empty() {
+            true => Ok(None),
+            false => Snapped::new(mesh).map(Some),
+        }
+    }
+
+    /// `mesh` snapped and imported.
+    fn new(mesh: &crate::Mesh) -> Result<Snapped, crate::Error> {
+        let grid = svbsp::shared_grid(&mesh.positions, &[]).map_err(crate::Error::Light)?;
+        let (polys, _) =
+            bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(crate::Error::Import)?;
+        let solids = bsp_core::certify_solid_parts(&polys);
+        Ok(Snapped {
+            grid,
+            polys,
+            solids,
+        })
+    }
+}
+
+/// One run's share of a study's sun-hours: for at most
+/// [`svbsp::MAX_LIGHTS`] suns, every face's area, its lit area summed
+/// over the suns times the step, and (for the extremes) its pieces with
+/// the number of suns each sees.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HoursRun {
+    step_hours: f64,
+    /// The mesh's face count.
+    faces: usize,
+    /// The faces the run shades, ascending (a tile's), or `None` for all;
+    /// `area`, `lit` and `cells` are theirs, in this order.
+    ids: Option<Vec<u32>>,
+    area: Vec<f64>,
+    lit: Vec<f64>,
+    cells: Option<Vec<Vec<Cell>>>,
+}
+
+impl HoursRun {
+    /// The run of `suns` (at most [`svbsp::MAX_LIGHTS`]) over `mesh`, with
+    /// its pieces (for [`sun_hours`](super::sun_hours)).
+    pub fn new(
+        mesh: &crate::Mesh,
+        suns: &[DVec3],
+        step_hours: f64,
+    ) -> Result<HoursRun, crate::Error> {
+        HoursRun::make(mesh, suns, step_hours, Some(None), None, None)
+    }
+
+    /// The run without its pieces (for [`sun_hours_mean`](super::sun_hours_mean)).
+    pub fn mean_only(
+        mesh: &crate::Mesh,
+        suns: &[DVec3],
+        step_hours: f64,
+    ) -> Result<HoursRun, crate::Error> {
+        HoursRun::make(mesh, suns, step_hours, None, None, None)
+    }
+
+    /// The run of `suns` over the faces of `tile` only (see [`Tile`]),
+    /// with their pieces if `extremes`: the runs of every tile, folded in
+    /// order with [`HoursRun::fold`], are [`sun_hours_in_tiles`](super::sun_hours_in_tiles)'s study.
+    pub fn of_tile(
+        mesh: &crate::Mesh,
+        suns: &[DVec3],
+        step_hours: f64,
+        extremes: bool,
+        tile: Tile,
+    ) -> Result<HoursRun, crate::Error> {
+        let scene = StudyScene::new(mesh)?;
+        HoursRun::on(&scene, mesh, suns, step_hours, extremes, Some(tile))
+    }
+
+    /// The run of `suns` over `mesh` snapped once as `scene` (of this
+    /// mesh): [`HoursRun::new`] (or [`HoursRun::mean_only`] without
+    /// `extremes`), or [`HoursRun::of_tile`] with a tile, the same bits,
+    /// without snapping and importing the mesh again for every run.
+    pub fn on(
+        scene: &StudyScene,
+        mesh: &crate::Mesh,
+        suns: &[DVec3],
+        step_hours: f64,
+        extremes: bool,
+        tile: Option<Tile>,
+    ) -> Result<HoursRun, crate::Error> {
+        let pieces = extremes.then_some(None);
+        HoursRun::make(mesh, suns, step_hours, pieces, Some(&scene.0), tile)
+    }
+
+    /// The run; with `pieces`, the pieces of every face, or with
+    /// `Some(Some(keep))` of the faces `keep` marks; on the study's
+    /// `snapped` mesh if given (the same grid and faces as its own); of
+    /// `tile`'s faces only if given (which needs `snapped`).
+    pub(super) fn make(
+        mesh: &crate::Mesh,
+        suns: &[DVec3],
+        step_hours: f64,
+        pieces: Option<Option<&[bool]>>,
+        snapped: Option<&Snapped>,
+        tile: Option<Tile>,
+    ) -> Result<HoursRun, crate::Error> {
+        let faces = mesh.faces.len();
+        let lights: Vec<crate::Light> = suns.iter().map(|&d| crate::Light::Sun(d)).collect();
+        let (run, ids) = match (snapped, tile) {
+            (Some(s), Some(t)) => {
+                let own = tiles::tile_faces(&s.polys, t).ok_or(crate::Error::Tile {
+                    index: t.index,
+                    per_side: t.per_side,
+                })?;
+                let Some(b) = own.bounds else {
+                    return Ok(HoursRun::empty(
+                        faces,
+                        step_hours,
+                        pieces.is_some(),
+                        own.faces,
+                    ));
+                };
+                let shadows = crate::shadows_on(
+                    &s.grid,
+                    &s.polys,
+                    &s.solids,
+                    faces,
+                    &lights,
+                    Some((&own.polys, b)),
+                )?;
+                (shadows, Some(own.faces))
+            }
+            (Some(s), None) => {
+                let shadows =
+                    crate::shadows_on(&s.grid, &s.polys, &s.solids, faces, &lights, None)?;
+                (shadows, None)
+            }
+            (None, _) => (crate::shadows(mesh, &lights)?, None),
+        };
+        let order: Vec<usize> = match &ids {
+            Some(ids) => ids.iter().map(|&f| f as usize).collect(),
+            None => (0..faces).collect(),
+        };
+        let area: Vec<f64> = order.iter().map(|&f| run.face_area(f)).collect();
+        let lit = (order.iter())
+            .map(|&f| (0..suns.len()).map(|l| run.lit_area(f, l)).sum::<f64>() * step_hours)
+            .collect();
+        let mut out = HoursRun {
+            step_hours,
+            faces,
+            ids,
+            area,
+            lit,
+            cells: None,
+        };
+        let Some(keep) = pieces else {
+            return Ok(out);
+        };
+        // each face's place in the run's lists
+        let mut slot = vec![usize::MAX; faces];
+        for (k, &f) in order.iter().enumerate() {
+            slot[f] = k;
+        }
+        let kept = |f: usize| keep.is_none_or(|k| k[f]);
+        let frames: Vec<(DVec3, DVec3, DVec3)> =
+            order.iter().map(|&f| face_frame(mesh, f)).collect();
+        let mut cells: Vec<Vec<Cell>> = vec![Vec::new(); order.len()];
+        for frag in run.batch.fragments() {
+            let f = frag.face() as usize;
+            if !kept(f) {
+                continue;
+            }
+            let seen = frag.lit_mask().count_ones();
+            let k = slot[f];
+            let (o, u, v) = frames[k];
+            for piece in frag.pieces() {
+                let ring = piece
+                    .iter()
+                    .map(|&i| {
+                        let p = run.world[i as usize] - o;
+                        glam::DVec2::new(p.dot(u), p.dot(v))
+                    })
+                    .collect();
+                cells[k].push((ring, seen));
+            }
+        }
+        out.cells = Some(cells);
+        Ok(out)
+    }
+
+    /// The run of a tile with no face (`ids`: none, but kept as given).
+    fn empty(faces: usize, step_hours: f64, pieces: bool, ids: Vec<u32>) -> HoursRun {
+        let n = ids.len();
+        HoursRun {
+            step_hours,
+            faces,
+            ids: Some(ids),
+            area: vec![0.0; n],
+            lit: vec![0.0; n],
+            cells: pieces.then(|| vec![Vec::new(); n]),
+        }
+    }
+
+    /// The number of faces of the run's mesh.
+    pub fn faces(&self) -> usize {
+        self.faces
+    }
+
+    /// The runs' faces' hours, the runs taken in order (`faces`: the
+    /// mesh's face count, for no runs at all; every run must be of a mesh
+    /// of as many faces, see [`HoursRun::faces`]). The extremes are NaN if a
+    /// run has no pieces. Faces are overlaid in parallel, each the same
+    /// whatever the thread count.
+    pub fn fold(
+        faces: usize,
+        runs: impl IntoIterator<Item = Result<HoursRun, crate::Error>>,
+    ) -> Result<Vec<FaceHours>, crate::Error> {
+        let (area, lit, cells, step_hours) = HoursRun::fold_cells(faces, runs)?;
+        Ok((0..faces)
+            .map(|f| match &cells {
+                Some(cells) => face_hours(area[f], lit[f], cells[f].as_deref(), step_hours),
+                None => FaceHours {
+                    min_hours: f64::NAN,
+                    max_hours: f64::NAN,
+                    ..face_hours(area[f], lit[f], None, step_hours)
+                },
+            })
+            .collect())
+    }
+
+    /// The runs folded in order: every face's area, its lit area times
+    /// hours, its overlaid cells (`None` if a run has no pieces; a face
+    /// `None` for no runs), and the step.
+    #[allow(clippy::type_complexity)] // (the fold's four results, named above)
+    pub(super) fn fold_cells(
+        faces: usize,
+        runs: impl IntoIterator<Item = Result<HoursRun, crate::Error>>,
+    ) -> Result<(Vec<f64>, Vec<f64>, Option<Vec<Option<Vec<Cell>>>>, f64), crate::Error> {
+        let mut area = vec![0.0; faces];
+        let mut lit = vec![0.0; faces];
+        let mut cells: Vec<Option<Vec<Cell>>> = vec![None; faces];
+        let (mut step_hours, mut pieces) = (0.0, true);
+        for run in runs {
+            let run = run?;
+            step_hours = run.step_hours;
+            // the run's faces, in its lists' order, within the mesh's
+            let ids: Vec<usize> = match &run.ids {
+                Some(ids) => ids.iter().map(|&f| f as usize).collect(),
+                None => (0..run.area.len()).collect(),
+            };
+            let ids = &ids[..ids.partition_point(|&f| f < faces).min(run.area.len())];
+            for (k, &f) in ids.iter().enumerate() {
+                area[f] = run.area[k];
+                lit[f] += run.lit[k];
+            }
+            match run.cells {
+                Some(new) if pieces => {
+                    let mut both: Vec<_> = (ids.iter().zip(new))
+                        .map(|(&f, new)| (f, cells[f].take(), new))
+                        .collect();
+                    bsp_core::par::for_each_mut(&mut both, |_, (f, old, new)| {
+                        *old = Some(match old.take() {
+                            None => std::mem::take(new),
+                            Some(old) => overlay(&old, new, 1e-12 * area[*f]),
+                        });
+                    });
+                    for (f, c, _) in both {
+                        cells[f] = c;
+                    }
+                }
+                _ => {
+                    pieces = false;
+                    cells = vec![None; faces];
+                }
+            }
+        }
+        Ok((area, lit, pieces.then_some(cells), step_hours))
+    }
+
+    /// The run as bytes (little-endian), for sending to another process.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut put = |x: f64| out.extend_from_slice(&x.to_le_bytes());
+        put(self.step_hours);
+        put(self.faces as f64);
+        let pieces = if self.cells.is_some() { 1.0 } else { 0.0 };
+        match &self.ids {
+            None => put(pieces),
+            Some(ids) => {
+                put(pieces + 2.0);
+                put(ids.len() as f64);
+                ids.iter().for_each(|&f| put(f64::from(f)));
+            }
+        }
+        for f in 0..self.area.len() {
+            put(self.area[f]);
+            put(self.lit[f]);
+            let Some(cells) = &self.cells else {
+                continue;
+            };
+            put(cells[f].len() as f64);
+            for (ring, seen) in &cells[f] {
+                put(f64::from(*seen));
+                put(ring.len() as f64);
+                for p in ring {
+                    put(p.x);
+                    put(p.y);
+                }
+            }
+        }
+        out
+    }
+
+    /// A run from [`HoursRun::to_bytes`]; `None` if `bytes` is not one.
+    pub fn from_bytes(bytes: &[u8]) -> Option<HoursRun> {
+        let mut words = bytes
+            .chunks_exact(8)
+            .map(|w| f64::from_le_bytes(w.try_into().expect("eight bytes")));
+        let mut next = || words.next();
+        let count = |x: f64| (x >= 0.0 && x.fract() == 0.0 && x < 1e15).then_some(x as usize);
+        let step_hours = next()?;
+        let faces = count(next()?)?;
+        let (pieces, tiled) = match next()? {
+            0.0 => (false, false),
+            1.0 => (true, false),
+            2.0 => (false, true),
+            3.0 => (true, true),
+            _ => return None,
+        };
+        let ids = match tiled {
+            false => None,
+            true => {
+                let n = count(next()?)?;
+                let ids = (0..n)
+                    .map(|_| u32::try_from(count(next()?)?).ok())
+                    .collect::<Option<Vec<u32>>>()?;
+                // ascending, each once, faces of the mesh
+                let fits = ids.last().is_none_or(|&f| (f as usize) < faces);
+                (fits && ids.is_sorted_by(|a, b| a < b))
+                    .then_some(ids)?
+                    .into()
+            }
+        };
+        let listed = ids.as_ref().map_or(faces, Vec::len);
+        let mut run = HoursRun {
+            step_hours,
+            faces,
+            ids,
+            area: Vec::new(),
+            lit: Vec::new(),
+            cells: pieces.then(Vec::new),
+        };
+        for _ in 0..listed {
+            run.area.push(next()?);
+            run.lit.push(next()?);
+            let Some(cells) = &mut run.cells else {
+                continue;
+            };
+            let n = count(next()?)?;
+            let mut face = Vec::new();
+            for _ in 0..n {
+                let seen = u32::try_from(count(next()?)?).ok()?;
+                let len = count(next()?)?;
+                let ring = (0..len)
+                    .map(|_| Some(glam::DVec2::new(next()?, next()?)))
+                    .collect::<Option<Vec<_>>>()?;
+                face.push((ring, seen));
+            }
+            cells.push(face);
+        }
+        (bytes.len().is_multiple_of(8) && next().is_none()).then_some(run)
+    }
+}
