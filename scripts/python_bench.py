@@ -11,11 +11,14 @@
 3. A year-long sun study (the 1st of each month, 15-minute steps) of a
    built-in scene: one process (all CPUs) against a Dask LocalCluster of
    2 workers x 1 thread, with each task's time, so the time on 100 workers
-   can be estimated from the measured costs.
+   can be estimated from the measured costs; with --tiles N, the scene cut
+   into N x N tiles (a task a run and tile), each task's peak memory in a
+   process of its own.
 
     python3 -m venv /tmp/pyv && /tmp/pyv/bin/pip install './python[test]' manifold3d
     cargo build --release -p bsp-shadows --example union_time
     /tmp/pyv/bin/python scripts/python_bench.py [--rounds 5] [--scene bunny-99k] [--skip-sun]
+        [--skip-booleans] [--tiles N]
 """
 import argparse
 import os
@@ -95,11 +98,21 @@ def import_time():
     print(f"import bsp_shadows: median {statistics.median(runs):.3f} s of 5 (with numpy)")
 
 
-def timed_run(mesh, suns, step):
+def timed_run(mesh, suns, step, tile=None):
     bs.set_threads(1)
     t = time.perf_counter()
-    r = bs._native._hours_run(mesh, suns, step, False)
+    r = bs._native._hours_run(mesh, suns, step, False, tile)
     return time.perf_counter() - t, r
+
+
+def fresh_task(scene_name, suns, step, tile):
+    """One task in a process of its own: its time and the process's peak
+    memory (MiB; the scene, the package and the task)."""
+    import resource
+
+    scene = bs.Mesh.scene(scene_name)
+    t, _ = timed_run(scene, suns, step, tile)
+    return t, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
 def sun_study(args):
@@ -112,11 +125,24 @@ def sun_study(args):
     # each face's exact mean hours; the extremes' overlay grows quadratically
     # in the suns on the ground under the bunny (see bs.sun_hours)
     up = "y" if args.scene.startswith("bunny") else "z"  # (the scans stand with y up)
-    study = dict(lat=51.5, lon=-0.1, dates=dates, step_minutes=15, extremes=False, up=up)
+    study = dict(lat=51.5, lon=-0.1, dates=dates, step_minutes=15, extremes=False, up=up,
+                 tiles=args.tiles)
     suns = bs.study_suns(51.5, -0.1, dates, 15, up=up)
     runs = bsd.runs_of(suns)
+    tasks = bsd.tasks_of(suns, args.tiles)
     print(f"sun study: {args.scene} ({len(scene.faces)} faces), 12 days, 15-minute steps: "
-          f"{len(suns)} suns in {len(runs)} runs")
+          f"{len(suns)} suns in {len(runs)} runs, {args.tiles} x {args.tiles} tiles: "
+          f"{len(tasks)} tasks")
+    # one task at a time in a fresh process: its time and peak memory
+    import concurrent.futures
+    import multiprocessing
+
+    spawn = multiprocessing.get_context("spawn")
+    for task in tasks[:4]:
+        with concurrent.futures.ProcessPoolExecutor(1, mp_context=spawn) as pool:
+            t, peak = pool.submit(fresh_task, args.scene, *task[:1], 0.25, task[1]).result()
+        print(f"  task (run of {len(task[0])} suns, tile {task[1]}), fresh process, 1 thread: "
+              f"{t:.1f} s, peak {peak:.0f} MiB")
     t = time.perf_counter()
     single = bs.sun_hours(scene, **study)
     t_single = time.perf_counter() - t
@@ -128,22 +154,22 @@ def sun_study(args):
         t_dask = time.perf_counter() - t
         # each task's own cost, one at a time on a worker (for the estimate)
         mesh = client.scatter(scene, broadcast=True)
-        costs = client.gather([client.submit(lambda m, s: timed_run(m, s, 0.25)[0], mesh, r,
-                                             pure=False) for r in runs[:2]])
+        costs = client.gather([client.submit(lambda m, s, c: timed_run(m, s, 0.25, c)[0], mesh, r,
+                                             c, pure=False) for r, c in tasks[:2]])
     same = (h.per_face == single.per_face).all() and (h.area == single.area).all()
     print(f"  Dask LocalCluster 2 workers x 1 thread: {t_dask:.1f} s "
           f"(ratio to one process {t_dask / t_single:.2f}); the same bits: {same}")
-    parts = [bs._native._hours_run(scene, r, 0.25, False) for r in runs[:2]]
+    parts = [bs._native._hours_run(scene, r, 0.25, False, c) for r, c in tasks[:2]]
     t = time.perf_counter()
-    bs._native._fold_runs(scene, parts, suns[: sum(len(r) for r in runs[:2])], 0.25)
+    bs._native._fold_runs(scene, parts, suns[: sum(len(r) for r, _ in tasks[:2])], 0.25)
     fold2 = time.perf_counter() - t
     task = statistics.mean(costs)
-    fold = fold2 / 2 * len(runs)
-    est = task * -(-len(runs) // 100) + fold
-    print(f"  a task (one run of {bs.MAX_SUNS_A_RUN} suns, 1 thread): {task:.1f} s; "
-          f"folding on the driver: {fold2 / 2:.2f} s a run")
-    print(f"  100 workers: at most {len(runs)} tasks run at once, so about {est:.1f} s "
-          f"(a task's time plus the fold of {len(runs)} runs), before scheduling overheads")
+    fold = fold2 / 2 * len(tasks)
+    est = task * -(-len(tasks) // 100) + fold
+    print(f"  a task (one run of up to {bs.MAX_SUNS_A_RUN} suns, 1 thread): {task:.1f} s; "
+          f"folding on the driver: {fold2 / 2:.2f} s a task")
+    print(f"  100 workers: at most {len(tasks)} tasks run at once, so about {est:.1f} s "
+          f"(a task's time plus the fold of {len(tasks)} tasks), before scheduling overheads")
 
 
 def main():
@@ -152,10 +178,13 @@ def main():
     p.add_argument("--triangles", type=int, default=100_000)
     p.add_argument("--scene", default="bunny-99k")
     p.add_argument("--skip-sun", action="store_true")
+    p.add_argument("--skip-booleans", action="store_true")
+    p.add_argument("--tiles", type=int, default=1, help="the sun study cut into N x N tiles")
     p.add_argument("--example", default=os.path.join(ROOT, "target", "release", "examples", "union_time"))
     args = p.parse_args()
     print(f"load: {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} CPUs; threads {bs.get_threads()}")
-    booleans(args)
+    if not args.skip_booleans:
+        booleans(args)
     import_time()
     if not args.skip_sun:
         sun_study(args)

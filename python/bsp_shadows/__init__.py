@@ -152,6 +152,7 @@ def sun_hours(
     height: float = 0.0,
     extremes: bool = True,
     sun_disc: Optional[float] = None,
+    tiles: int = 1,
 ) -> SunHours:
     """The sun-hours of every face of ``scene`` over a study: on each of
     ``dates`` (``datetime.date`` or ``"YYYY-MM-DD"``), a sun at the middle
@@ -175,6 +176,12 @@ def sun_hours(
     ``sun_disc`` (degrees; 0.2666 is the real sun's) counts each
     sun as a disc of that radius: a face's penumbra by the share of the disc
     it sees (mean hours only, the extremes NaN; far slower than point suns).
+
+    ``tiles``: cut the scene into ``tiles × tiles`` tiles along its box's
+    two longest axes, each run of suns shading one tile's faces past only
+    what may shade them (less memory a run, and tasks to spread with
+    ``bsp_shadows.distributed``). Every fragment's class is the whole
+    scene's; the hours may differ from the uncut study's in their last bits.
     """
     suns = study_suns(lat, lon, list(dates), step_minutes, utc_offset, north, up, height)
-    return _native._hours_of_suns(scene, suns, step_minutes / 60.0, extremes, sun_disc)
+    return _native._hours_of_suns(scene, suns, step_minutes / 60.0, extremes, sun_disc, tiles)

@@ -270,6 +270,9 @@ struct MeshData {
     /// the names; `None`: one group, `default`.
     groups: Option<(Vec<u32>, Vec<String>)>,
     built: std::sync::OnceLock<bsp_shadows::Mesh>,
+    /// The mesh snapped and imported for sun studies' runs, made by the
+    /// first run that needs it (a worker's tasks share it).
+    study: std::sync::OnceLock<Arc<sun::StudyScene>>,
 }
 
 impl MeshData {
@@ -312,8 +315,19 @@ impl Mesh {
                 given: None,
                 groups: None,
                 built: mesh.into(),
+                study: std::sync::OnceLock::new(),
             }),
         }
+    }
+
+    /// The mesh snapped and imported for sun studies' runs, made once
+    /// (call without the GIL).
+    fn study_scene(&self) -> Result<Arc<sun::StudyScene>, Error> {
+        if let Some(s) = self.data.study.get() {
+            return Ok(s.clone());
+        }
+        let scene = Arc::new(sun::StudyScene::new(self.mesh())?);
+        Ok(self.data.study.get_or_init(|| scene).clone())
     }
 
     /// The library's mesh (made on first use; call without the GIL).
@@ -399,6 +413,7 @@ impl Mesh {
                 given: Some((positions, faces)),
                 groups,
                 built: std::sync::OnceLock::new(),
+                study: std::sync::OnceLock::new(),
             }),
         })
     }
@@ -841,6 +856,10 @@ struct SunHours {
     mesh: Mesh,
     suns: Vec<DVec3>,
     step_hours: f64,
+    /// The sun as a disc of this radius (degrees), if it was.
+    sun_disc: Option<f64>,
+    /// The tiles a side the study was cut into (1: not cut).
+    tiles: usize,
     hours: Vec<bsp_shadows::sun::FaceHours>,
 }
 
@@ -939,25 +958,42 @@ impl SunHours {
         )
     }
 
-    /// Pickled as the mesh, the suns, the step and the runs' bytes.
+    /// Pickled as the study that made it (the mesh, the suns, the step,
+    /// the extremes, the disc and the tiles), made again on unpickling.
+    #[allow(clippy::type_complexity)] // (the study's arguments, named above)
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
-    ) -> Reduced<'py, (Mesh, Bound<'py, PyArray2<f64>>, f64, bool)> {
+    ) -> Reduced<
+        'py,
+        (
+            Mesh,
+            Bound<'py, PyArray2<f64>>,
+            f64,
+            bool,
+            Option<f64>,
+            usize,
+        ),
+    > {
         let py = slf.py();
         let me = slf.get();
         let f = py
             .import("bsp_shadows._native")?
             .getattr("_hours_of_suns")?;
         let extremes = me.extremes();
-        Ok((f, (me.mesh.clone(), me.suns(py)?, me.step_hours, extremes)))
+        let study = (me.mesh.clone(), me.suns(py)?, me.step_hours, extremes);
+        Ok((
+            f,
+            (study.0, study.1, study.2, study.3, me.sun_disc, me.tiles),
+        ))
     }
 }
 
 /// The sun-hours of every face of `mesh` under the suns `suns` (`(s, 3)`,
 /// directions toward them), each standing for `step_hours`; with
-/// `sun_disc` (degrees), each sun a disc of that radius (mean hours only).
+/// `sun_disc` (degrees), each sun a disc of that radius (mean hours only);
+/// with `tiles` > 1, the scene cut into `tiles × tiles` tiles, a run each.
 #[pyfunction]
-#[pyo3(signature = (mesh, suns, step_hours, extremes=true, sun_disc=None))]
+#[pyo3(signature = (mesh, suns, step_hours, extremes=true, sun_disc=None, tiles=1))]
 fn _hours_of_suns(
     py: Python<'_>,
     mesh: &Mesh,
@@ -965,18 +1001,27 @@ fn _hours_of_suns(
     step_hours: f64,
     extremes: bool,
     sun_disc: Option<f64>,
+    tiles: usize,
 ) -> PyResult<SunHours> {
     let suns = points(py, suns, "suns")?;
-    let hours = run(py, || match (sun_disc, extremes) {
-        (Some(r), _) => bsp_shadows::sun::sun_hours_disc(mesh.mesh(), &suns, step_hours, r),
-        (None, true) => bsp_shadows::sun::sun_hours(mesh.mesh(), &suns, step_hours),
-        (None, false) => bsp_shadows::sun::sun_hours_mean(mesh.mesh(), &suns, step_hours),
+    if sun_disc.is_some() && tiles != 1 {
+        return Err(BspError::new_err(
+            "a study of the sun as a disc is not cut into tiles",
+        ));
+    }
+    let hours = run(py, || match sun_disc {
+        Some(r) => bsp_shadows::sun::sun_hours_disc(mesh.mesh(), &suns, step_hours, r),
+        None => {
+            bsp_shadows::sun::sun_hours_in_tiles(mesh.mesh(), &suns, step_hours, tiles, extremes)
+        }
     })
     .map_err(to_py)?;
     Ok(SunHours {
         mesh: mesh.clone(),
         suns,
         step_hours,
+        sun_disc,
+        tiles,
         hours,
     })
 }
@@ -1017,15 +1062,17 @@ fn _region_hours<'py>(
 }
 
 /// One run of a study (at most 64 suns) as bytes: a task of the
-/// distributed study.
+/// distributed study; with `tile` (`(index, per_side)`), of that tile's
+/// faces only.
 #[pyfunction]
-#[pyo3(signature = (mesh, suns, step_hours, extremes=true))]
+#[pyo3(signature = (mesh, suns, step_hours, extremes=true, tile=None))]
 fn _hours_run<'py>(
     py: Python<'py>,
     mesh: &Mesh,
     suns: &Bound<'py, PyAny>,
     step_hours: f64,
     extremes: bool,
+    tile: Option<(usize, usize)>,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let suns = points(py, suns, "suns")?;
     if suns.len() > MAX_SUNS_A_RUN {
@@ -1035,24 +1082,26 @@ fn _hours_run<'py>(
         )));
     }
     let bytes = run(py, || {
-        match extremes {
-            true => HoursRun::new(mesh.mesh(), &suns, step_hours),
-            false => HoursRun::mean_only(mesh.mesh(), &suns, step_hours),
-        }
-        .map(|r| r.to_bytes())
+        // (the mesh snapped once for all the runs made on this process)
+        let tile = tile.map(|(index, per_side)| sun::Tile { index, per_side });
+        let scene = mesh.study_scene()?;
+        HoursRun::on(&scene, mesh.mesh(), &suns, step_hours, extremes, tile).map(|r| r.to_bytes())
     })
     .map_err(to_py)?;
     Ok(PyBytes::new(py, &bytes))
 }
 
-/// The study's hours from its runs' bytes, folded in the order given.
+/// The study's hours from its runs' bytes, folded in the order given
+/// (`tiles`: the tiles a side its runs were cut into, for pickling).
 #[pyfunction]
+#[pyo3(signature = (mesh, runs, suns, step_hours, tiles=1))]
 fn _fold_runs(
     py: Python<'_>,
     mesh: &Mesh,
     runs: Vec<Vec<u8>>,
     suns: &Bound<'_, PyAny>,
     step_hours: f64,
+    tiles: usize,
 ) -> PyResult<SunHours> {
     let suns = points(py, suns, "suns")?;
     let faces = mesh.face_count();
@@ -1074,6 +1123,8 @@ fn _fold_runs(
         mesh: mesh.clone(),
         suns,
         step_hours,
+        sun_disc: None,
+        tiles,
         hours,
     })
 }

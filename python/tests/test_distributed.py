@@ -34,27 +34,61 @@ def test_runs_folded_in_process(yard, single):
         bs._native._fold_runs(yard, [runs[0], other], single.suns, single.step_hours)
 
 
-def test_dask_local_cluster(yard, single):
+@pytest.fixture(scope="module")
+def tiled(yard, single):
+    h = bs.sun_hours(yard, tiles=2, **STUDY)
+    # every fragment's class is the whole scene's: the hours agree to the
+    # last bits, and the cut is not the uncut study
+    for name in ["per_face", "min_hours", "max_hours"]:
+        assert np.abs(getattr(h, name) - getattr(single, name)).max() < 1e-9, name
+    assert (h.area == single.area).all()
+    return h
+
+
+def test_tiles_folded_in_process(yard, single, tiled):
+    tasks = bsd.tasks_of(single.suns, 2)
+    assert len(tasks) == 4 * len(bsd.runs_of(single.suns))
+    parts = [bs._native._hours_run(yard, run, single.step_hours, True, tile) for run, tile in tasks]
+    same(bs._native._fold_runs(yard, parts, single.suns, single.step_hours, 2), tiled)
+    # a tile's run is smaller than the whole run of its suns: only its
+    # faces' pieces
+    whole = bs._native._hours_run(yard, tasks[0][0], single.step_hours)
+    assert max(map(len, parts[:4])) < len(whole)
+    # pickled, the study is made again with its tiles
+    import pickle
+
+    same(pickle.loads(pickle.dumps(tiled)), tiled)
+    with pytest.raises(bs.BspError, match="tile 4 of a study cut into 2 × 2 tiles"):
+        bs._native._hours_run(yard, tasks[0][0], single.step_hours, True, (4, 2))
+    with pytest.raises(ValueError, match="tiles"):
+        bsd.tasks_of(single.suns, 0)
+
+
+def test_dask_local_cluster(yard, single, tiled):
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(
         n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
         dashboard_address=None, silence_logs=40,
     ) as cluster, distributed.Client(cluster) as client:
         h = bsd.sun_hours(yard, client, threads_per_task=1, **STUDY)
+        cut = bsd.sun_hours(yard, client, threads_per_task=1, tiles=2, **STUDY)
     same(h, single)
+    same(cut, tiled)
     points = np.array([[0.0, -3.0, 0.01], [6.0, 5.0, 0.01]])
     assert (h.per_sensor(points) == single.per_sensor(points)).all()
 
 
-def test_ray_local(yard, single):
+def test_ray_local(yard, single, tiled):
     ray = pytest.importorskip("ray")
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False,
              configure_logging=False, _node_ip_address="127.0.0.1")
     try:
         h = bsd.sun_hours(yard, "ray", threads_per_task=1, **STUDY)
+        cut = bsd.sun_hours(yard, "ray", threads_per_task=1, tiles=2, **STUDY)
     finally:
         ray.shutdown()
     same(h, single)
+    same(cut, tiled)
 
 
 def test_dask_without_extremes(yard, single):

@@ -170,3 +170,15 @@ def test_a_sun_disc_study_matches_point_suns_on_a_lone_box():
     # nothing to cast a penumbra on: the same hours, no extremes
     assert np.allclose(disc.per_face, point.per_face, rtol=0, atol=1e-9)
     assert np.isnan(disc.min_hours).all()
+
+
+def test_a_pickled_disc_study_stays_a_disc_study(yard):
+    kw = dict(lat=51.5, lon=0.0, dates=["2026-03-21"], step_minutes=120)
+    disc = bs.sun_hours(yard, sun_disc=2.0, **kw)
+    point = bs.sun_hours(yard, extremes=False, **kw)
+    # a wide disc's penumbrae change the ground's hours
+    assert np.abs(disc.per_face - point.per_face).max() > 1e-3
+    back = pickle.loads(pickle.dumps(disc))
+    assert (back.per_face == disc.per_face).all()
+    with pytest.raises(bs.BspError, match="not cut into tiles"):
+        bs.sun_hours(yard, sun_disc=2.0, tiles=2, **kw)
