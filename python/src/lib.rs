@@ -11,7 +11,8 @@ use std::sync::{Arc, Mutex};
 use bsp_shadows::sun::{self, HoursRun, SunSite, Up};
 use bsp_shadows::{BoolOp, DVec3, Error, Face, Light};
 use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods,
+    IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyUntypedArrayMethods,
 };
 use pyo3::create_exception;
 use pyo3::exceptions::{PyOSError, PyValueError};
@@ -555,17 +556,91 @@ impl Mesh {
         )
     }
 
-    /// Pickled as its arrays and its faces' group names.
+    /// Pickled as flat arrays: the vertices, every face's vertex indices
+    /// in one array and where each face starts, each face's group and the
+    /// groups' names. Arrays pickle (and Dask and Ray move them) as
+    /// buffers, with no Python object a face (a list of 100k faces took
+    /// seconds to scatter to a cluster).
+    #[allow(clippy::type_complexity)] // (the arrays, named above)
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
-    ) -> Reduced<'py, (Bound<'py, PyAny>, Bound<'py, PyAny>, Vec<String>)> {
+    ) -> Reduced<
+        'py,
+        (
+            Bound<'py, PyAny>,
+            Bound<'py, PyArray1<u32>>,
+            Bound<'py, PyArray1<u64>>,
+            Bound<'py, PyArray1<u32>>,
+            Vec<String>,
+        ),
+    > {
         let py = slf.py();
         let me = slf.get();
+        let m = me.face_count();
+        let (mut indices, mut starts) = (Vec::new(), vec![0u64]);
+        for i in 0..m {
+            indices.extend_from_slice(me.face(i));
+            starts.push(indices.len() as u64);
+        }
+        let groups: Vec<u32> = (0..m).map(|i| me.group_of(i) as u32).collect();
+        let f = py.import("bsp_shadows._native")?.getattr("_mesh_of_flat")?;
         Ok((
-            slf.get_type().into_any(),
-            (me.vertices(py)?.into_any(), me.faces(py)?, me.groups()),
+            f,
+            (
+                me.vertices(py)?.into_any(),
+                indices.into_pyarray(py),
+                starts.into_pyarray(py),
+                groups.into_pyarray(py),
+                me.group_names(),
+            ),
         ))
     }
+}
+
+/// A mesh from [`Mesh::__reduce__`]'s flat arrays, checked as
+/// `Mesh(...)` checks its arguments.
+#[pyfunction]
+fn _mesh_of_flat(
+    py: Python<'_>,
+    vertices: &Bound<'_, PyAny>,
+    indices: PyReadonlyArray1<'_, u32>,
+    starts: PyReadonlyArray1<'_, u64>,
+    groups: PyReadonlyArray1<'_, u32>,
+    names: Vec<String>,
+) -> PyResult<Mesh> {
+    let positions = points(py, vertices, "vertices")?;
+    let indices = indices.as_array().to_vec();
+    let groups = groups.as_array().to_vec();
+    let starts: Vec<usize> = starts.as_array().iter().map(|&s| s as usize).collect();
+    let m = starts.len().saturating_sub(1);
+    let ends = starts.first() == Some(&0) && starts.last() == Some(&indices.len());
+    if !ends || !starts.is_sorted() || groups.len() != m {
+        return Err(MeshError::new_err(
+            "a pickled mesh's arrays do not fit together",
+        ));
+    }
+    if let Some(i) = (0..m).find(|&i| starts[i + 1] - starts[i] < 3) {
+        return Err(MeshError::new_err(format!(
+            "face {i} has fewer than 3 vertices"
+        )));
+    }
+    if let Some(&v) = indices.iter().find(|&&v| v as usize >= positions.len()) {
+        return Err(MeshError::new_err(format!(
+            "a face names vertex {v} of {}",
+            positions.len()
+        )));
+    }
+    if groups.iter().any(|&g| g as usize >= names.len()) {
+        return Err(MeshError::new_err("a face's group is not among the names"));
+    }
+    Ok(Mesh {
+        data: Arc::new(MeshData {
+            given: Some((positions, FlatFaces { indices, starts })),
+            groups: Some((groups, names)),
+            built: std::sync::OnceLock::new(),
+            study: std::sync::OnceLock::new(),
+        }),
+    })
 }
 
 fn boolean(py: Python<'_>, a: &Mesh, b: &Mesh, op: BoolOp) -> PyResult<Mesh> {
@@ -1158,6 +1233,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(sensor_intervals, m)?,
         wrap_pyfunction!(_hours_of_suns, m)?,
         wrap_pyfunction!(_hours_run, m)?,
+        wrap_pyfunction!(_mesh_of_flat, m)?,
         wrap_pyfunction!(_region_hours, m)?,
         wrap_pyfunction!(_fold_runs, m)?,
         wrap_pyfunction!(set_threads, m)?,

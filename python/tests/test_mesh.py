@@ -122,6 +122,7 @@ def test_groups_name_faces_and_survive_pickling(tmp_path):
     room = bs.Mesh.scene("room")
     assert "floor" in room.group_names
     assert pickle.loads(pickle.dumps(room)).groups == room.groups
+
     # a region study of a group by its name
     cells = bs.region_hours(m, "base", lat=51.5, lon=0.0, dates=["2026-06-21"], step_minutes=60)
     assert (cells["face"] == 0).all()
@@ -182,3 +183,28 @@ def test_a_pickled_disc_study_stays_a_disc_study(yard):
     assert (back.per_face == disc.per_face).all()
     with pytest.raises(bs.BspError, match="not cut into tiles"):
         bs.sun_hours(yard, sun_disc=2.0, tiles=2, **kw)
+
+
+def test_meshes_of_mixed_faces_pickle_as_flat_arrays():
+    city = bs.Mesh.scene("city")
+    assert isinstance(city.faces, list)  # triangles and quads
+    corners = sum(len(f) for f in city.faces)
+    b = pickle.dumps(city)
+    # the buffers and little else: no Python object a face
+    arrays = city.vertices.nbytes + 4 * corners + 8 * (len(city.faces) + 1) + 4 * len(city.faces)
+    assert len(b) < arrays + 4096, (len(b), arrays)
+    back = pickle.loads(b)
+    assert (back.vertices == city.vertices).all() and back.groups == city.groups
+    assert all((np.asarray(x) == np.asarray(y)).all() for x, y in zip(back.faces, city.faces))
+    # arrays that do not make a mesh are refused
+    v = np.zeros((3, 3))
+    ids = lambda *a: np.array(a, dtype=np.uint32)  # noqa: E731
+    starts = lambda *a: np.array(a, dtype=np.uint64)  # noqa: E731
+    with pytest.raises(bs.MeshError, match="names vertex 5 of 3"):
+        bs._native._mesh_of_flat(v, ids(0, 1, 5), starts(0, 3), ids(0), ["a"])
+    with pytest.raises(bs.MeshError, match="do not fit"):
+        bs._native._mesh_of_flat(v, ids(0, 1, 2), starts(0, 4), ids(0), ["a"])
+    with pytest.raises(bs.MeshError, match="fewer than 3"):
+        bs._native._mesh_of_flat(v, ids(0, 1, 2), starts(0, 2, 3), ids(0, 0), ["a"])
+    with pytest.raises(bs.MeshError, match="group"):
+        bs._native._mesh_of_flat(v, ids(0, 1, 2), starts(0, 3), ids(1), ["a"])
