@@ -2,14 +2,15 @@
 //! room at 51.5° N on the equinox, a sun every 10 minutes: 73 suns above
 //! the horizon, the runs' pieces overlaid), the sun positions alone, and
 //! the built-in city block's mean hours (3,703 faces: sixteen buildings on
-//! 2 m ground tiles) for the same day, and its day at 100 sensors in
-//! closed form (`--exact-time`).
+//! 2 m ground tiles) for the same day, uncut and in 2 × 2 tiles
+//! (`--tiles 2`), and its day at 100 sensors in closed form
+//! (`--exact-time`).
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use bsp_shadows::sun::{
-    SunSite, day_paths, sensor_intervals, study_suns, sun_hours, sun_hours_mean,
+    SunSite, day_paths, sensor_intervals, study_suns, sun_hours, sun_hours_in_tiles, sun_hours_mean,
 };
 use criterion::{Criterion, criterion_group, criterion_main};
 
@@ -36,6 +37,13 @@ fn sun(cr: &mut Criterion) {
     g.sample_size(10).measurement_time(Duration::from_secs(10));
     g.bench_function("mean sun-hours", |b| {
         b.iter(|| black_box(sun_hours_mean(&city, &suns, 1.0 / 6.0).unwrap().len()))
+    });
+    // the same cut into 2 x 2 tiles, a run a tile (less memory a run)
+    g.bench_function("mean sun-hours, 2 x 2 tiles", |b| {
+        b.iter(|| {
+            let h = sun_hours_in_tiles(&city, &suns, 1.0 / 6.0, 2, false).unwrap();
+            black_box(h.len())
+        })
     });
     // 100 sensors on a 10 m lattice of the ground, the day in closed form
     let sensors: Vec<glam::DVec3> = (0..100)
