@@ -330,7 +330,7 @@ pub(crate) fn face_trees(
     reach: Option<[bsp_core::GridPoint; 2]>,
 ) -> Result<svbsp::Shadows, ShadowError> {
     let bounds = reach
-        .or_else(|| grid_bounds(polys))
+        .or_else(|| sun::grid_bounds(polys))
         .map(|[mut lo, mut hi]| {
             for p in also {
                 for k in 0..3 {
@@ -357,23 +357,6 @@ pub(crate) fn face_trees(
         svbsp::ShadowVolumes::build(kernel[j], &hiding)
     })?;
     svbsp::Shadows::from_volumes(kernel, volumes)
-}
-
-/// The least and greatest grid coordinates of the polygons' vertices
-/// (which are grid points: imported faces), `None` for no polygon.
-fn grid_bounds(polys: &[bsp_core::Polygon]) -> Option<[[i32; 3]; 2]> {
-    let mut b: Option<[[i32; 3]; 2]> = None;
-    for v in polys.iter().flat_map(|p| p.vertices()) {
-        let bsp_core::Point::Grid(g) = v else {
-            return None; // (not an imported face: keep every occluder)
-        };
-        let [lo, hi] = b.get_or_insert([*g, *g]);
-        for k in 0..3 {
-            lo[k] = lo[k].min(g[k]);
-            hi[k] = hi[k].max(g[k]);
-        }
-    }
-    b
 }
 
 /// Whether a face of plane `support` may hide `light` from some point of
@@ -526,7 +509,7 @@ mod tests {
             }
         }
         // the ground's tiles hide nothing from the suns above; from below, all may
-        let bounds = grid_bounds(&polys).unwrap();
+        let bounds = sun::grid_bounds(&polys).unwrap();
         let tile = polys.last().unwrap().support();
         assert!(!may_hide(&kernel[0], tile, bounds) && !may_hide(&kernel[1], tile, bounds));
         assert!(may_hide(&kernel[2], tile, bounds));

@@ -33,7 +33,7 @@ use runs::Snapped;
 pub use runs::{HoursRun, StudyScene};
 use solar_positioning::{Location, RefractionCorrection, SolarPositions, delta_t};
 pub use tiles::Tile;
-pub(crate) use tiles::{grid_box, may_shade};
+pub(crate) use tiles::{grid_bounds, grid_box, may_shade};
 
 /// Which scene axis points up.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

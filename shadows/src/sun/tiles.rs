@@ -60,6 +60,19 @@ pub(crate) fn grid_box(p: &Polygon) -> Option<[GridPoint; 2]> {
     b
 }
 
+/// The least and greatest grid coordinates of the polygons' vertices
+/// (which are grid points: imported faces), `None` for no polygon or a
+/// polygon with an implicit vertex.
+pub(crate) fn grid_bounds(polys: &[Polygon]) -> Option<[GridPoint; 2]> {
+    let boxes: Vec<[GridPoint; 2]> = polys.iter().map(grid_box).collect::<Option<_>>()?;
+    hull(&boxes)
+}
+
+/// The smallest box holding all of `boxes` (`None` for none).
+fn hull(boxes: &[[GridPoint; 2]]) -> Option<[GridPoint; 2]> {
+    boxes.iter().fold(None, |a, b| Some(join(a, *b)))
+}
+
 /// The smallest box holding both.
 fn join(a: Option<[GridPoint; 2]>, b: [GridPoint; 2]) -> [GridPoint; 2] {
     let Some([mut lo, mut hi]) = a else {
@@ -93,7 +106,7 @@ pub(crate) fn tile_faces(polys: &[Polygon], tile: Tile) -> Option<TileFaces> {
             _ => faces.push((p.tag(), *b, i..i + 1)),
         }
     }
-    let scene = boxes.iter().fold(None, |a, b| Some(join(a, *b)));
+    let scene = hull(&boxes);
     let mut out = TileFaces {
         polys: Vec::new(),
         faces: Vec::new(),
