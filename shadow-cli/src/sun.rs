@@ -103,9 +103,9 @@ pub(crate) struct SunHoursArgs {
     /// Faces' mean hours only, for the cost of the shadows: no least and most hours (empty in CSV).
     #[arg(long, conflicts_with_all = ["min_hours", "regions"])]
     no_extremes: bool,
-    /// Cut the scene into N × N tiles, each run shading one tile past only what may shade it (less memory a run; the areas' last bits may differ).
-    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1024), conflicts_with_all = ["sensors", "regions", "sun_disc"])]
-    tiles: u32,
+    /// Cut the scene into N × N tiles, each run shading one tile past only what may shade it (less memory a run; the areas' last bits may differ) [default: 1].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024), conflicts_with_all = ["sensors", "regions", "sun_disc"])]
+    tiles: Option<u32>,
     /// Output: CSV (one row per face, or per sensor), JSON, OBJ or PLY (a heat map) or PNG (its picture).
     #[arg(short, long, value_name = "OUT.csv|OUT.json|OUT.obj|OUT.ply|OUT.png")]
     output: PathBuf,
@@ -125,7 +125,7 @@ pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
     let (sensors, regions) = (a.sensors.as_deref(), a.regions.as_ref());
     let of = HoursOf::of(sensors, regions, a.bre209, !a.no_extremes).exact_time(paths.as_deref());
     let of = of.sun_disc(a.sun_disc).outline(a.outline.as_deref());
-    let of = of.tiles(a.tiles as usize);
+    let of = of.tiles(a.tiles.unwrap_or(1) as usize);
     let r = sun::hours_report(&mesh, &dirs, step / 60.0, &a.output, of, a.min_hours, view);
     let r = r.map_err(facade_error)?;
     write_file(&a.output, &r.bytes)?;
