@@ -106,6 +106,23 @@ fn to_py(e: Error) -> PyErr {
     }
 }
 
+/// The last study scene a run made on this process, with its mesh: a
+/// task that gets its own copy of the scene (as from Ray's object store)
+/// finds the scene here instead of snapping the mesh again. Only the
+/// last one is kept (a worker's memory holds one scene's), and only runs
+/// (`_hours_run`, the distributed studies' tasks) use it.
+static LAST_STUDY: Mutex<Option<(bsp_shadows::Mesh, Arc<sun::StudyScene>)>> = Mutex::new(None);
+
+/// How many study scenes runs have made on this process (for the tests).
+static STUDY_SCENES_MADE: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// How many study scenes `_hours_run` has made on this process: one per
+/// distinct scene, however many copies of it the tasks got.
+#[pyfunction]
+fn _study_scenes_made() -> usize {
+    STUDY_SCENES_MADE.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 /// The pool every call runs on, as `set_threads` set it; `None`:
 /// rayon's global pool, one thread per CPU the process may use.
 static POOL: Mutex<Option<Arc<rayon::ThreadPool>>> = Mutex::new(None);
@@ -322,12 +339,28 @@ impl Mesh {
     }
 
     /// The mesh snapped and imported for sun studies' runs, made once
-    /// (call without the GIL).
+    /// for this object, or found as the process's last one if that is of
+    /// an equal mesh ([`LAST_STUDY`]); call without the GIL.
     fn study_scene(&self) -> Result<Arc<sun::StudyScene>, Error> {
         if let Some(s) = self.data.study.get() {
             return Ok(s.clone());
         }
-        let scene = Arc::new(sun::StudyScene::new(self.mesh())?);
+        let mesh = self.mesh();
+        let last = LAST_STUDY.lock().expect("the last study's lock");
+        let found = (last.as_ref())
+            .filter(|(m, _)| m == mesh)
+            .map(|(_, s)| s.clone());
+        drop(last);
+        let scene = match found {
+            Some(s) => s,
+            None => {
+                let s = Arc::new(sun::StudyScene::new(mesh)?);
+                STUDY_SCENES_MADE.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                *LAST_STUDY.lock().expect("the last study's lock") =
+                    Some((mesh.clone(), s.clone()));
+                s
+            }
+        };
         Ok(self.data.study.get_or_init(|| scene).clone())
     }
 
@@ -1234,6 +1267,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(_hours_of_suns, m)?,
         wrap_pyfunction!(_hours_run, m)?,
         wrap_pyfunction!(_mesh_of_flat, m)?,
+        wrap_pyfunction!(_study_scenes_made, m)?,
         wrap_pyfunction!(_region_hours, m)?,
         wrap_pyfunction!(_fold_runs, m)?,
         wrap_pyfunction!(set_threads, m)?,

@@ -57,6 +57,19 @@ def test_tiles_folded_in_process(yard, single, tiled):
     # pickled, the study is made again with its tiles
     import pickle
 
+    # a copy of the scene (as each task on Ray gets) finds the scene the
+    # last copy's run snapped
+    def run_on_a_copy():
+        copy = pickle.loads(pickle.dumps(yard))
+        return bs._native._hours_run(copy, tasks[1][0], single.step_hours, True, tasks[1][1])
+
+    assert run_on_a_copy() == parts[1]
+    made = bs._native._study_scenes_made()
+    assert run_on_a_copy() == parts[1] and bs._native._study_scenes_made() == made
+    other = bs.box((0, 0, 0), (1, 1, 1))
+    bs._native._hours_run(other, tasks[0][0], single.step_hours)
+    assert bs._native._study_scenes_made() == made + 1
+
     same(pickle.loads(pickle.dumps(tiled)), tiled)
     with pytest.raises(bs.BspError, match="tile 4 of a study cut into 2 × 2 tiles"):
         bs._native._hours_run(yard, tasks[0][0], single.step_hours, True, (4, 2))
