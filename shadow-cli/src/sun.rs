@@ -12,6 +12,7 @@ use crate::args::SourceArgs;
 use crate::facade_error;
 use crate::input::load_source_quiet;
 use crate::output::{emit, write_file};
+use crate::progress::Progress;
 
 /// Where the study is, and how the scene sits there.
 #[derive(Args, Debug)]
@@ -126,8 +127,11 @@ pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
     let of = HoursOf::of(sensors, regions, a.bre209, !a.no_extremes).exact_time(paths.as_deref());
     let of = of.sun_disc(a.sun_disc).outline(a.outline.as_deref());
     let of = of.tiles(a.tiles.unwrap_or(1) as usize);
-    let r = sun::hours_report(&mesh, &dirs, step / 60.0, &a.output, of, a.min_hours, view);
+    let progress = Progress::new(!a.quiet);
+    let (out, hours) = (&a.output, a.min_hours);
+    let r = sun::hours_report(&mesh, &dirs, step / 60.0, out, of, hours, view, &progress);
     let r = r.map_err(facade_error)?;
+    drop(progress);
     write_file(&a.output, &r.bytes)?;
     emit(&r.said(&a.output, &name, dates.len(), dirs.len()))
 }

@@ -91,6 +91,15 @@ pub trait Progress: Sync {
     fn advance(&self, steps: u64);
 }
 
+/// No progress to hear of.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoProgress;
+
+impl Progress for NoProgress {
+    fn phase(&self, _: &'static str, _: u64) {}
+    fn advance(&self, _: u64) {}
+}
+
 /// What a job wrote, and what it took.
 #[derive(Debug)]
 pub struct ShadowFile {

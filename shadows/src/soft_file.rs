@@ -367,7 +367,7 @@ pub(crate) fn soft_shadows_on(
         lights: &all,
         polys,
     };
-    let (_, faces_of, fragments) = shade(&scene, &Quiet)?;
+    let (_, faces_of, fragments) = shade(&scene, &crate::shadow_file::NoProgress)?;
     let n = all.len();
     let (mut classes, mut area) = (vec![[0.0; 5]; faces * n], vec![0.0; faces]);
     for (frags, &face) in fragments.iter().zip(&faces_of) {
@@ -413,14 +413,6 @@ fn seen_area(fragments: &[SoftFragment], j: usize, grid: &Grid) -> f64 {
         seen += share * svbsp::polygon_area(&world);
     }
     seen
-}
-
-/// No progress to show.
-struct Quiet;
-
-impl Progress for Quiet {
-    fn phase(&self, _: &'static str, _: u64) {}
-    fn advance(&self, _: u64) {}
 }
 
 impl SoftShadows {

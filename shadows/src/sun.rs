@@ -23,7 +23,10 @@ pub use exact_time::{
     study_plan, triangles,
 };
 use glam::DVec3;
+
+use crate::shadow_file::{NoProgress, Progress};
 pub use ply::{hours_ply, regions_ply, sensors_ply};
+use regions::region_study;
 pub use regions::{
     RegionCell, RegionFaces, area_in_sun, bre209_text, check_bre209, clip_to_outline, region_hours,
     region_in_sun_text, regions_csv, regions_json, regions_obj, regions_png,
@@ -388,24 +391,59 @@ pub fn sun_hours(
     suns: &[DVec3],
     step_hours: f64,
 ) -> Result<Vec<FaceHours>, crate::Error> {
-    study(mesh, suns, step_hours, Some(None), |runs| {
+    faces_study(mesh, suns, step_hours, true, 1, &NoProgress)
+}
+
+/// Every face's hours, with the `extremes` or the mean only, the scene
+/// cut into `tiles × tiles` tiles (1: not cut), each run done told to
+/// `progress`.
+pub(crate) fn faces_study(
+    mesh: &crate::Mesh,
+    suns: &[DVec3],
+    step_hours: f64,
+    extremes: bool,
+    tiles: usize,
+    progress: &dyn Progress,
+) -> Result<Vec<FaceHours>, crate::Error> {
+    let pieces = extremes.then_some(None);
+    study(mesh, suns, step_hours, pieces, tiles, progress, |runs| {
         HoursRun::fold(mesh.faces.len(), runs)
     })?
 }
 
-/// `fold` of a study's runs, in order: [`SUNS_A_RUN`] suns each, on the
-/// mesh snapped once ([`Snapped`]), with `pieces` as
-/// [`HoursRun::make`] takes them.
+/// `fold` of a study's runs, in order: [`SUNS_A_RUN`] suns each, and of
+/// each run of suns each of `tiles × tiles` tiles in order (1: one run
+/// of every face), on the mesh snapped once ([`Snapped`]), with `pieces`
+/// as [`HoursRun::make`] takes them; every run done told to `progress`.
 fn study<T>(
     mesh: &crate::Mesh,
     suns: &[DVec3],
     step_hours: f64,
     pieces: Option<Option<&[bool]>>,
+    tiles: usize,
+    progress: &dyn Progress,
     fold: impl FnOnce(&mut dyn Iterator<Item = Result<HoursRun, crate::Error>>) -> T,
 ) -> Result<T, crate::Error> {
+    let cut: Vec<Option<Tile>> = match tiles {
+        0 => {
+            return Err(crate::Error::Tile {
+                index: 0,
+                per_side: 0,
+            });
+        }
+        1 => vec![None],
+        _ => Tile::all(tiles).map(Some).collect(),
+    };
     let snapped = Snapped::of(mesh, suns)?;
+    let count = suns.len().div_ceil(SUNS_A_RUN) * cut.len();
+    progress.phase("sun runs", count as u64);
     let mut runs = (suns.chunks(SUNS_A_RUN))
-        .map(|batch| HoursRun::make(mesh, batch, step_hours, pieces, snapped.as_ref(), None));
+        .flat_map(|batch| cut.iter().map(move |&t| (batch, t)))
+        .map(|(batch, t)| {
+            let run = HoursRun::make(mesh, batch, step_hours, pieces, snapped.as_ref(), t);
+            progress.advance(1);
+            run
+        });
     Ok(fold(&mut runs))
 }
 
@@ -425,23 +463,7 @@ pub fn sun_hours_in_tiles(
     per_side: usize,
     extremes: bool,
 ) -> Result<Vec<FaceHours>, crate::Error> {
-    if per_side == 1 {
-        return match extremes {
-            true => sun_hours(mesh, suns, step_hours),
-            false => sun_hours_mean(mesh, suns, step_hours),
-        };
-    }
-    if per_side == 0 {
-        return Err(crate::Error::Tile { index: 0, per_side });
-    }
-    let pieces = extremes.then_some(None);
-    let snapped = Snapped::of(mesh, suns)?;
-    let mut runs = (suns.chunks(SUNS_A_RUN))
-        .flat_map(|batch| Tile::all(per_side).map(move |t| (batch, t)))
-        .map(|(batch, t)| {
-            HoursRun::make(mesh, batch, step_hours, pieces, snapped.as_ref(), Some(t))
-        });
-    HoursRun::fold(mesh.faces.len(), &mut runs)
+    faces_study(mesh, suns, step_hours, extremes, per_side, &NoProgress)
 }
 
 /// [`sun_hours`] without the overlay: each face's exact `sun_hours` (and
@@ -456,9 +478,7 @@ pub fn sun_hours_mean(
     suns: &[DVec3],
     step_hours: f64,
 ) -> Result<Vec<FaceHours>, crate::Error> {
-    study(mesh, suns, step_hours, None, |runs| {
-        HoursRun::fold(mesh.faces.len(), runs)
-    })?
+    faces_study(mesh, suns, step_hours, false, 1, &NoProgress)
 }
 
 /// Every face's mean sun-hours with each of `suns` (directions toward
@@ -480,6 +500,17 @@ pub fn sun_hours_disc(
     step_hours: f64,
     radius_deg: f64,
 ) -> Result<Vec<FaceHours>, crate::Error> {
+    disc_study(mesh, suns, step_hours, radius_deg, &NoProgress)
+}
+
+/// [`sun_hours_disc`], every sun done told to `progress`.
+pub(crate) fn disc_study(
+    mesh: &crate::Mesh,
+    suns: &[DVec3],
+    step_hours: f64,
+    radius_deg: f64,
+    progress: &dyn Progress,
+) -> Result<Vec<FaceHours>, crate::Error> {
     let faces = mesh.faces.len();
     let (mut area, mut seen) = (vec![0.0; faces], vec![0.0; faces]);
     let normals = mesh.face_normals();
@@ -487,6 +518,7 @@ pub fn sun_hours_disc(
     let grid = svbsp::shared_soft_grid(&mesh.positions, &[], &[]).map_err(crate::Error::Light)?;
     let (polys, _) =
         bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(crate::Error::Import)?;
+    progress.phase("suns", suns.len() as u64);
     for &direction in suns {
         let disc = crate::SoftSpec::SunDisc {
             direction,
@@ -499,6 +531,7 @@ pub fn sun_hours_disc(
             let front = disc_in_front(normals[f].dot(d).clamp(-1.0, 1.0).asin(), radius_deg);
             seen[f] += s.seen_area(f, 0) * front * step_hours;
         }
+        progress.advance(1);
     }
     Ok((0..faces)
         .map(|f| FaceHours {

@@ -108,6 +108,23 @@ pub fn region_hours(
     step_hours: f64,
     faces: &[usize],
 ) -> Result<Vec<RegionCell>, Error> {
+    region_study(
+        mesh,
+        suns,
+        step_hours,
+        faces,
+        &crate::shadow_file::NoProgress,
+    )
+}
+
+/// [`region_hours`], every run of suns done told to `progress`.
+pub(crate) fn region_study(
+    mesh: &Mesh,
+    suns: &[DVec3],
+    step_hours: f64,
+    faces: &[usize],
+    progress: &dyn crate::shadow_file::Progress,
+) -> Result<Vec<RegionCell>, Error> {
     let n = mesh.faces.len();
     let mut keep = vec![false; n];
     faces
@@ -115,7 +132,7 @@ pub fn region_hours(
         .filter(|&&f| f < n)
         .for_each(|&f| keep[f] = true);
     let pieces = Some(Some(&keep[..]));
-    let (_, _, cells, _) = study(mesh, suns, step_hours, pieces, |runs| {
+    let (_, _, cells, _) = study(mesh, suns, step_hours, pieces, 1, progress, |runs| {
         HoursRun::fold_cells(n, runs)
     })??;
     let mut cells = cells.unwrap_or_else(|| vec![None; n]);

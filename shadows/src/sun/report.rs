@@ -6,10 +6,9 @@ use glam::DVec3;
 
 use super::{
     HeatView, HoursFormat, RegionFaces, SENSORS_NOT_A_PICTURE, SunPath, bre209_text,
-    clip_to_outline, groups_in_sun_text, interval_hours, intervals_json, region_hours,
-    region_in_sun_text, regions_csv, regions_json, regions_obj, regions_ply, regions_png,
-    sensor_hours_file, sensor_intervals, sensors_csv, sensors_obj, sensors_ply, sun_hours,
-    sun_hours_disc, sun_hours_in_tiles, sun_hours_mean,
+    clip_to_outline, disc_study, faces_study, groups_in_sun_text, interval_hours, intervals_json,
+    region_in_sun_text, region_study, regions_csv, regions_json, regions_obj, regions_ply,
+    regions_png, sensor_hours_file, sensor_intervals, sensors_csv, sensors_obj, sensors_ply,
 };
 
 /// What `shadow sunhours` writes and says of a study.
@@ -152,6 +151,7 @@ impl HoursReport {
 /// only); with `min_hours`, the shares of the groups (or of the region)
 /// that see at least that many hours. A picture looks at the scene as
 /// `view` says.
+#[allow(clippy::too_many_arguments)] // (the study, the output, and what to tell)
 pub fn hours_report(
     mesh: &crate::Mesh,
     suns: &[DVec3],
@@ -160,6 +160,7 @@ pub fn hours_report(
     of: HoursOf<'_>,
     min_hours: Option<f64>,
     view: HeatView,
+    progress: &dyn crate::shadow_file::Progress,
 ) -> Result<HoursReport, crate::Error> {
     let format = HoursFormat::for_path(output)?;
     let sensors = matches!(of, HoursOf::Sensors(_) | HoursOf::ExactSensors { .. });
@@ -201,7 +202,7 @@ pub fn hours_report(
             outline,
         } => {
             let ids = faces.faces(mesh)?;
-            let mut cells = region_hours(mesh, suns, step_hours, &ids)?;
+            let mut cells = region_study(mesh, suns, step_hours, &ids, progress)?;
             if let Some(path) = outline {
                 let points = shadow_scene::read_points(path).map_err(crate::Error::File)?;
                 cells = clip_to_outline(&cells, &points, view.up)?;
@@ -231,15 +232,14 @@ pub fn hours_report(
                     "the area that sees at least so many hours needs the extremes' overlay".into(),
                 ));
             }
-            let hours = match of {
-                HoursOf::DiscFaces { radius_deg } => {
-                    sun_hours_disc(mesh, suns, step_hours, radius_deg)?
-                }
-                HoursOf::Faces { tiles, .. } if tiles != 1 => {
-                    sun_hours_in_tiles(mesh, suns, step_hours, tiles, extremes)?
-                }
-                _ if extremes => sun_hours(mesh, suns, step_hours)?,
-                _ => sun_hours_mean(mesh, suns, step_hours)?,
+            let (disc, tiles) = match of {
+                HoursOf::DiscFaces { radius_deg } => (Some(radius_deg), 1),
+                HoursOf::Faces { tiles, .. } => (None, tiles),
+                _ => (None, 1),
+            };
+            let hours = match disc {
+                Some(r) => disc_study(mesh, suns, step_hours, r, progress)?,
+                None => faces_study(mesh, suns, step_hours, extremes, tiles, progress)?,
             };
             let bytes = format.bytes(mesh, &hours, suns.len(), view)?;
             Ok(HoursReport {

@@ -251,7 +251,17 @@ fn runs_files_and_heat_maps_of_a_yard() {
     let bytes = hours_png(&mesh, &hours, suns.len(), HeatView::default()).unwrap();
     assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
     let of = HoursOf::Sensors(&file);
-    let e = hours_report(&mesh, &suns, step, png, of, None, HeatView::default());
+    let quiet = &crate::shadow_file::NoProgress;
+    let e = hours_report(
+        &mesh,
+        &suns,
+        step,
+        png,
+        of,
+        None,
+        HeatView::default(),
+        quiet,
+    );
     let e = e.unwrap_err().to_string();
     assert!(
         e.starts_with("study.PNG: a picture shows faces' hours"),
@@ -644,6 +654,22 @@ fn a_study_cut_into_tiles_keeps_every_faces_hours() {
         "tile 9 of a study cut into 3 × 3 tiles (0 to 8)"
     );
     assert!(sun_hours_in_tiles(&mesh, &suns, step, 0, false).is_err());
+    // the study tells its progress: a step a run of suns and tile
+    #[derive(Default)]
+    struct Heard(std::sync::Mutex<(Vec<(&'static str, u64)>, u64)>);
+    impl crate::shadow_file::Progress for Heard {
+        fn phase(&self, name: &'static str, steps: u64) {
+            self.0.lock().unwrap().0.push((name, steps));
+        }
+        fn advance(&self, steps: u64) {
+            self.0.lock().unwrap().1 += steps;
+        }
+    }
+    let heard = Heard::default();
+    let again = faces_study(&mesh, &suns, step, true, 2, &heard).unwrap();
+    assert_eq!(again, cut);
+    let runs = suns.len().div_ceil(SUNS_A_RUN) as u64 * 4;
+    assert_eq!(*heard.0.lock().unwrap(), (vec![("sun runs", runs)], runs));
 
     // a city block's mean hours in 3 × 3 tiles: the same to the last bits
     let city = shadow_scene::city_block(6);
