@@ -29,18 +29,20 @@ pub struct HoursReport {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum HoursOf<'a> {
     /// Every face: with the least and most hours of its points and the
-    /// area per hours ([`sun_hours`]), or without them, for the cost of
-    /// the shadows alone ([`sun_hours_mean`]: NaN in the data, empty in
-    /// CSV, `null` in JSON).
+    /// area per hours ([`sun_hours`](super::sun_hours)), or without them,
+    /// for the cost of the shadows alone
+    /// ([`sun_hours_mean`](super::sun_hours_mean): NaN in the data, empty
+    /// in CSV, `null` in JSON).
     Faces {
         /// Whether to overlay the runs for the extremes.
         extremes: bool,
         /// The scene cut into this many tiles a side, each run shading
-        /// one tile ([`sun_hours_in_tiles`]; 1: not cut).
+        /// one tile ([`sun_hours_in_tiles`](super::sun_hours_in_tiles);
+        /// 1: not cut).
         tiles: usize,
     },
     /// Every face's mean hours with the sun a disc of this radius in
-    /// degrees ([`sun_hours_disc`]; no extremes).
+    /// degrees ([`sun_hours_disc`](super::sun_hours_disc); no extremes).
     DiscFaces {
         /// The disc's angular radius, degrees.
         radius_deg: f64,
@@ -55,8 +57,8 @@ pub enum HoursOf<'a> {
         /// The days.
         paths: &'a [SunPath],
     },
-    /// The cells of these faces ([`region_hours`]), with the BRE 209
-    /// verdict if asked ([`bre209_text`]).
+    /// The cells of these faces ([`region_hours`](super::region_hours)),
+    /// with the BRE 209 verdict if asked ([`bre209_text`]).
     Regions {
         /// The faces.
         faces: &'a RegionFaces,
