@@ -257,29 +257,38 @@ pub fn shadows(mesh: &Mesh, lights: &[Light]) -> Result<Shadows, Error> {
     shadows_on(&grid, &polys, &solids, mesh.faces.len(), lights, None)
 }
 
+/// A tile's part of a study's run ([`shadows_on`]): its polygons
+/// (indices into the scene's), the grid box they lie in, and the grid box
+/// of every polygon of the scene.
+pub(crate) type TilePart<'a> = (
+    &'a [usize],
+    [bsp_core::GridPoint; 2],
+    &'a [[bsp_core::GridPoint; 2]],
+);
+
 /// [`shadows`] of the `faces` faces of a mesh already snapped to `grid`
 /// (which must hold the point lights) and imported as `polys`: what a sun
-/// study shares between its runs. With `tile`, of the tile's polygons
-/// only (indices into `polys`, within the grid box given), past the
-/// occluders that may hide a light from that box
-/// ([`sun::tiles`](crate::sun)); the other faces get no fragment.
+/// study shares between its runs. With `tile`, of that tile's polygons
+/// only (indices into `polys`, within the box given), past the occluders
+/// that may hide a light from that box, by the boxes of `polys` given
+/// ([`sun::Tile`]); the other faces get no fragment.
 pub(crate) fn shadows_on(
     grid: &bsp_core::Grid,
     polys: &[bsp_core::Polygon],
     solids: &bsp_core::SolidParts,
     faces: usize,
     lights: &[Light],
-    tile: Option<(&[usize], [bsp_core::GridPoint; 2])>,
+    tile: Option<TilePart<'_>>,
 ) -> Result<Shadows, Error> {
     let placed = svbsp::place_lights(grid, lights).map_err(Error::Light)?;
     let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
-    let reach = tile.map(|(_, b)| b);
+    let reach = tile.map(|(_, b, boxes)| (b, boxes));
     let trees = face_trees(polys, &kernel, &[], solids, reach).map_err(Error::Shadow)?;
     // (with convex pieces: the OBJ writer draws them)
     let opts = ShadeOptions::default().with_pieces(true);
     let batch = match tile {
         None => trees.set().shade_all(polys, &opts),
-        Some((own, _)) => {
+        Some((own, _, _)) => {
             let own: Vec<bsp_core::Polygon> = own.iter().map(|&i| polys[i].clone()).collect();
             trees.set().shade_all(&own, &opts)
         }
@@ -320,16 +329,17 @@ pub(crate) fn shadows_on(
 /// all they hide, from every face and point.
 ///
 /// With `reach` (a grid box holding every face to be shaded and every
-/// point to be asked, in place of all of `polys` and `also`), nor the
-/// faces whose box no way from the box toward the light meets.
+/// point to be asked, in place of all of `polys` and `also`, and the grid
+/// box of each of `polys`), nor the faces whose box no way from the box
+/// toward the light meets.
 pub(crate) fn face_trees(
     polys: &[bsp_core::Polygon],
     kernel: &[svbsp::Light],
     also: &[bsp_core::GridPoint],
     solids: &bsp_core::SolidParts,
-    reach: Option<[bsp_core::GridPoint; 2]>,
+    reach: Option<([bsp_core::GridPoint; 2], &[[bsp_core::GridPoint; 2]])>,
 ) -> Result<svbsp::Shadows, ShadowError> {
-    let bounds = reach
+    let bounds = (reach.map(|(b, _)| b))
         .or_else(|| sun::grid_bounds(polys))
         .map(|[mut lo, mut hi]| {
             for p in also {
@@ -340,17 +350,14 @@ pub(crate) fn face_trees(
             }
             [lo, hi]
         });
-    let boxes: Option<Vec<[bsp_core::GridPoint; 2]>> =
-        reach.and_then(|_| polys.iter().map(sun::grid_box).collect::<Option<Vec<_>>>());
     let volumes = bsp_core::par::try_map(kernel.len(), |j| {
         let hiding: Vec<&bsp_core::Polygon> = (polys.iter().enumerate())
             .filter(|(i, p)| {
-                bounds.is_none_or(|b| may_hide(&kernel[j], p.support(), b))
+                // (the tile's sweep first: the cheapest test, and the one
+                // that leaves most faces out)
+                reach.is_none_or(|(b, boxes)| sun::may_shade(&kernel[j], b, boxes[*i]))
+                    && bounds.is_none_or(|b| may_hide(&kernel[j], p.support(), b))
                     && !kernel[j].leaves_out(solids, *i, p.support())
-                    && match (&boxes, bounds) {
-                        (Some(boxes), Some(b)) => sun::may_shade(&kernel[j], b, boxes[*i]),
-                        _ => true,
-                    }
             })
             .map(|(_, p)| p)
             .collect();

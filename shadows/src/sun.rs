@@ -36,7 +36,7 @@ use runs::Snapped;
 pub use runs::{HoursRun, StudyScene};
 use solar_positioning::{Location, RefractionCorrection, SolarPositions, delta_t};
 pub use tiles::Tile;
-pub(crate) use tiles::{grid_bounds, grid_box, may_shade};
+pub(crate) use tiles::{grid_bounds, may_shade};
 
 /// Which scene axis points up.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -434,13 +434,15 @@ fn study<T>(
         1 => vec![None],
         _ => Tile::all(tiles).map(Some).collect(),
     };
-    let snapped = Snapped::of(mesh, suns)?;
+    // (no suns: no runs, and nothing to snap)
+    let snapped = (!suns.is_empty()).then(|| Snapped::new(mesh)).transpose()?;
     let count = suns.len().div_ceil(SUNS_A_RUN) * cut.len();
     progress.phase("sun runs", count as u64);
-    let mut runs = (suns.chunks(SUNS_A_RUN))
-        .flat_map(|batch| cut.iter().map(move |&t| (batch, t)))
-        .map(|(batch, t)| {
-            let run = HoursRun::make(mesh, batch, step_hours, pieces, snapped.as_ref(), t);
+    let mut runs = (snapped.iter())
+        .flat_map(|s| suns.chunks(SUNS_A_RUN).map(move |batch| (s, batch)))
+        .flat_map(|(s, batch)| cut.iter().map(move |&t| (s, batch, t)))
+        .map(|(s, batch, t)| {
+            let run = HoursRun::make(mesh, batch, step_hours, pieces, s, t);
             progress.advance(1);
             run
         });

@@ -2,9 +2,11 @@
 //! (made here or on another process, sent as bytes, folded in order), and
 //! the mesh snapped once for all of them ([`StudyScene`]).
 
+use std::sync::{Arc, Mutex};
+
 use glam::DVec3;
 
-use super::tiles::{self, Tile};
+use super::tiles::{Tile, TileIndex};
 use super::{Cell, FaceHours, face_frame, face_hours, overlay};
 
 /// A study's mesh snapped and imported once for all its runs: suns add
@@ -15,6 +17,8 @@ pub(super) struct Snapped {
     polys: Vec<bsp_core::Polygon>,
     /// The parts of `polys` certified to bound solids.
     solids: bsp_core::SolidParts,
+    /// `polys` cut into tiles, for the last number of tiles asked.
+    tiles: Mutex<Option<Arc<TileIndex>>>,
 }
 
 /// A study's mesh snapped to its grid and imported once, for any number
@@ -30,17 +34,8 @@ impl StudyScene {
 }
 
 impl Snapped {
-    /// `mesh` snapped for a study of `suns` (`None` for none: nothing to
-    /// shade).
-    pub(super) fn of(mesh: &crate::Mesh, suns: &[DVec3]) -> Result<Option<Snapped>, crate::Error> {
-        match suns.is_empty() {
-            true => Ok(None),
-            false => Snapped::new(mesh).map(Some),
-        }
-    }
-
     /// `mesh` snapped and imported.
-    fn new(mesh: &crate::Mesh) -> Result<Snapped, crate::Error> {
+    pub(super) fn new(mesh: &crate::Mesh) -> Result<Snapped, crate::Error> {
         let grid = svbsp::shared_grid(&mesh.positions, &[]).map_err(crate::Error::Light)?;
         let (polys, _) =
             bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(crate::Error::Import)?;
@@ -49,7 +44,21 @@ impl Snapped {
             grid,
             polys,
             solids,
+            tiles: Mutex::new(None),
         })
+    }
+
+    /// The polygons cut into `per_side × per_side` tiles, made once for
+    /// as many runs as ask for that many; `None` where they cannot be
+    /// ([`TileIndex::new`]).
+    fn tile_index(&self, per_side: usize) -> Option<Arc<TileIndex>> {
+        let mut last = self.tiles.lock().expect("the tiles' lock");
+        if let Some(t) = last.as_ref().filter(|t| t.per_side == per_side) {
+            return Some(t.clone());
+        }
+        let index = Arc::new(TileIndex::new(&self.polys, per_side)?);
+        *last = Some(index.clone());
+        Some(index)
     }
 }
 
@@ -78,7 +87,14 @@ impl HoursRun {
         suns: &[DVec3],
         step_hours: f64,
     ) -> Result<HoursRun, crate::Error> {
-        HoursRun::make(mesh, suns, step_hours, Some(None), None, None)
+        HoursRun::make(
+            mesh,
+            suns,
+            step_hours,
+            Some(None),
+            &Snapped::new(mesh)?,
+            None,
+        )
     }
 
     /// The run without its pieces (for [`sun_hours_mean`](super::sun_hours_mean)).
@@ -87,7 +103,7 @@ impl HoursRun {
         suns: &[DVec3],
         step_hours: f64,
     ) -> Result<HoursRun, crate::Error> {
-        HoursRun::make(mesh, suns, step_hours, None, None, None)
+        HoursRun::make(mesh, suns, step_hours, None, &Snapped::new(mesh)?, None)
     }
 
     /// The run of `suns` over the faces of `tile` only (see [`Tile`]),
@@ -117,54 +133,46 @@ impl HoursRun {
         tile: Option<Tile>,
     ) -> Result<HoursRun, crate::Error> {
         let pieces = extremes.then_some(None);
-        HoursRun::make(mesh, suns, step_hours, pieces, Some(&scene.0), tile)
+        HoursRun::make(mesh, suns, step_hours, pieces, &scene.0, tile)
     }
 
-    /// The run; with `pieces`, the pieces of every face, or with
-    /// `Some(Some(keep))` of the faces `keep` marks; on the study's
-    /// `snapped` mesh if given (the same grid and faces as its own); of
-    /// `tile`'s faces only if given (which needs `snapped`).
+    /// The run on the study's `snapped` mesh; with `pieces`, the pieces
+    /// of every face, or with `Some(Some(keep))` of the faces `keep`
+    /// marks; of `tile`'s faces only if given.
     pub(super) fn make(
         mesh: &crate::Mesh,
         suns: &[DVec3],
         step_hours: f64,
         pieces: Option<Option<&[bool]>>,
-        snapped: Option<&Snapped>,
+        snapped: &Snapped,
         tile: Option<Tile>,
     ) -> Result<HoursRun, crate::Error> {
         let faces = mesh.faces.len();
         let lights: Vec<crate::Light> = suns.iter().map(|&d| crate::Light::Sun(d)).collect();
-        let (run, ids) = match (snapped, tile) {
-            (Some(s), Some(t)) => {
-                let own = tiles::tile_faces(&s.polys, t).ok_or(crate::Error::Tile {
+        // the tile's polygons, the box they lie in, and every polygon's box
+        let index = tile.map(|t| (t, snapped.tile_index(t.per_side)));
+        let part = match &index {
+            None => None,
+            Some((t, index)) => Some(
+                (index
+                    .as_deref()
+                    .and_then(|i| Some((i.get(*t)?, &i.boxes[..]))))
+                .ok_or(crate::Error::Tile {
                     index: t.index,
                     per_side: t.per_side,
-                })?;
-                let Some(b) = own.bounds else {
-                    return Ok(HoursRun::empty(
-                        faces,
-                        step_hours,
-                        pieces.is_some(),
-                        own.faces,
-                    ));
-                };
-                let shadows = crate::shadows_on(
-                    &s.grid,
-                    &s.polys,
-                    &s.solids,
-                    faces,
-                    &lights,
-                    Some((&own.polys, b)),
-                )?;
-                (shadows, Some(own.faces))
-            }
-            (Some(s), None) => {
-                let shadows =
-                    crate::shadows_on(&s.grid, &s.polys, &s.solids, faces, &lights, None)?;
-                (shadows, None)
-            }
-            (None, _) => (crate::shadows(mesh, &lights)?, None),
+                })?,
+            ),
         };
+        let shaded = match part {
+            None => None,
+            Some((own, boxes)) => match own.bounds {
+                Some(b) => Some((&own.polys[..], b, boxes)),
+                None => return Ok(HoursRun::empty(faces, step_hours, pieces, &own.faces)),
+            },
+        };
+        let s = snapped;
+        let run = crate::shadows_on(&s.grid, &s.polys, &s.solids, faces, &lights, shaded)?;
+        let ids = part.map(|(own, _)| own.faces.clone());
         let order: Vec<usize> = match &ids {
             Some(ids) => ids.iter().map(|&f| f as usize).collect(),
             None => (0..faces).collect(),
@@ -216,16 +224,22 @@ impl HoursRun {
         Ok(out)
     }
 
-    /// The run of a tile with no face (`ids`: none, but kept as given).
-    fn empty(faces: usize, step_hours: f64, pieces: bool, ids: Vec<u32>) -> HoursRun {
+    /// The run of a tile with no face (`ids`: none, but kept as given),
+    /// with pieces if asked.
+    fn empty(
+        faces: usize,
+        step_hours: f64,
+        pieces: Option<Option<&[bool]>>,
+        ids: &[u32],
+    ) -> HoursRun {
         let n = ids.len();
         HoursRun {
             step_hours,
             faces,
-            ids: Some(ids),
+            ids: Some(ids.to_vec()),
             area: vec![0.0; n],
             lit: vec![0.0; n],
-            cells: pieces.then(|| vec![Vec::new(); n]),
+            cells: pieces.map(|_| vec![Vec::new(); n]),
         }
     }
 

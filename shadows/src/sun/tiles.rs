@@ -45,7 +45,7 @@ pub(crate) struct TileFaces {
 
 /// The grid box of a polygon with grid vertices (an imported face's);
 /// `None` for a polygon with an implicit vertex.
-pub(crate) fn grid_box(p: &Polygon) -> Option<[GridPoint; 2]> {
+fn grid_box(p: &Polygon) -> Option<[GridPoint; 2]> {
     let mut b: Option<[GridPoint; 2]> = None;
     for v in p.vertices() {
         let Point::Grid(g) = v else {
@@ -85,56 +85,82 @@ fn join(a: Option<[GridPoint; 2]>, b: [GridPoint; 2]) -> [GridPoint; 2] {
     [lo, hi]
 }
 
-/// The polygons of `tile` among the scene's imported `polys` (grid
-/// vertices; polygons of one face consecutive, as imported). `None` if a
-/// polygon has an implicit vertex or `tile` is not one of its study's.
-pub(crate) fn tile_faces(polys: &[Polygon], tile: Tile) -> Option<TileFaces> {
-    let n = tile.per_side as i128;
-    let count = tile.per_side.checked_mul(tile.per_side);
-    if n == 0 || count.is_none_or(|c| tile.index >= c) {
-        return None;
-    }
-    let boxes: Vec<[GridPoint; 2]> = polys.iter().map(grid_box).collect::<Option<_>>()?;
-    // each face's box, over its consecutive polygons
-    let mut faces: Vec<(u32, [GridPoint; 2], std::ops::Range<usize>)> = Vec::new();
-    for (i, (p, b)) in polys.iter().zip(&boxes).enumerate() {
-        match faces.last_mut() {
-            Some((f, fb, r)) if *f == p.tag() => {
-                *fb = join(Some(*fb), *b);
-                r.end = i + 1;
-            }
-            _ => faces.push((p.tag(), *b, i..i + 1)),
+/// A scene's imported polygons cut into `per_side × per_side` tiles,
+/// once for all the runs of a study: each polygon's box and each tile's
+/// polygons.
+pub(crate) struct TileIndex {
+    /// The tiles along each axis.
+    pub per_side: usize,
+    /// Each polygon's grid box.
+    pub boxes: Vec<[GridPoint; 2]>,
+    /// The tiles, row after row.
+    pub tiles: Vec<TileFaces>,
+}
+
+impl TileIndex {
+    /// The tiles of the scene's imported `polys` (grid vertices; polygons
+    /// of one face consecutive, as imported). `None` if a polygon has an
+    /// implicit vertex, or for no tiles (`per_side` 0, or too many).
+    pub(crate) fn new(polys: &[Polygon], per_side: usize) -> Option<TileIndex> {
+        let count = per_side.checked_mul(per_side).filter(|&c| c > 0)?;
+        let boxes: Vec<[GridPoint; 2]> = polys.iter().map(grid_box).collect::<Option<_>>()?;
+        let empty = || TileFaces {
+            polys: Vec::new(),
+            faces: Vec::new(),
+            bounds: None,
+        };
+        let mut tiles: Vec<TileFaces> = (0..count).map(|_| empty()).collect();
+        let Some([lo, hi]) = hull(&boxes) else {
+            return Some(TileIndex {
+                per_side,
+                boxes,
+                tiles,
+            });
+        };
+        // the two longest axes, the lower first where equal
+        let mut axes = [0usize, 1, 2];
+        axes.sort_by_key(|&k| std::cmp::Reverse(hi[k] as i64 - lo[k] as i64));
+        let n = per_side as i128;
+        let tile_of = |[flo, fhi]: [GridPoint; 2]| {
+            let [a, b] = [axes[0], axes[1]].map(|k| {
+                // twice the centre, from twice the low corner, in cells of
+                // twice the extent (plus one: the top lies in the last cell)
+                let c2 = flo[k] as i128 + fhi[k] as i128 - 2 * lo[k] as i128;
+                c2 * n / (2 * (hi[k] as i128 - lo[k] as i128) + 1)
+            });
+            (a * n + b) as usize
+        };
+        // each face's box, over its consecutive polygons, then its tile
+        let mut start = 0;
+        while start < polys.len() {
+            let face = polys[start].tag();
+            let end = start
+                + polys[start..]
+                    .iter()
+                    .take_while(|p| p.tag() == face)
+                    .count();
+            let fb = hull(&boxes[start..end]).expect("a face's polygons");
+            let t = &mut tiles[tile_of(fb)];
+            t.polys.extend(start..end);
+            t.faces.push(face);
+            t.bounds = Some(join(t.bounds, fb));
+            start = end;
         }
-    }
-    let scene = hull(&boxes);
-    let mut out = TileFaces {
-        polys: Vec::new(),
-        faces: Vec::new(),
-        bounds: None,
-    };
-    let Some([lo, hi]) = scene else {
-        return Some(out);
-    };
-    // the two longest axes, the lower first where equal
-    let mut axes = [0usize, 1, 2];
-    axes.sort_by_key(|&k| std::cmp::Reverse(hi[k] as i64 - lo[k] as i64));
-    let want = [tile.index as i128 / n, tile.index as i128 % n];
-    for (face, [flo, fhi], range) in faces {
-        let cell = axes[..2].iter().map(|&k| {
-            // twice the centre, from twice the low corner, in cells of
-            // twice the extent (plus one: the top lies in the last cell)
-            let c2 = flo[k] as i128 + fhi[k] as i128 - 2 * lo[k] as i128;
-            c2 * n / (2 * (hi[k] as i128 - lo[k] as i128) + 1)
-        });
-        if cell.eq(want) {
-            out.polys.extend(range.clone());
-            out.faces.push(face);
-            out.bounds = Some(join(out.bounds, [flo, fhi]));
+        for t in &mut tiles {
+            t.faces.sort_unstable();
+            t.faces.dedup();
         }
+        Some(TileIndex {
+            per_side,
+            boxes,
+            tiles,
+        })
     }
-    out.faces.sort_unstable();
-    out.faces.dedup();
-    Some(out)
+
+    /// Tile `tile` of this index; `None` if it is not one of its tiles.
+    pub(crate) fn get(&self, tile: Tile) -> Option<&TileFaces> {
+        (tile.per_side == self.per_side).then(|| self.tiles.get(tile.index))?
+    }
 }
 
 /// Whether `light` may be hidden from a point of the box `reach` by
@@ -150,28 +176,28 @@ pub(crate) fn may_shade(light: &svbsp::Light, reach: [GridPoint; 2], face: [Grid
         }
         svbsp::Light::Directional(d) => {
             // per axis, fl - rh <= t d <= fh - rl: bounds on t as
-            // fractions with positive denominators
-            let (mut lower, mut upper) = (vec![(0i128, 1i128)], Vec::new());
+            // fractions with positive denominators (t >= 0 the first
+            // lower one; an axis along which the sun does not move gives
+            // none, or no t at all)
+            let (mut lower, mut upper) = ([(0i128, 1i128); 4], [(0i128, 1i128); 3]);
+            let (mut nl, mut nu) = (1, 0);
             for k in 0..3 {
                 let (a, b) = (fl[k] as i128 - rh[k] as i128, fh[k] as i128 - rl[k] as i128);
                 let dk = d[k] as i128;
-                match dk.signum() {
+                let (lo, hi) = match dk.signum() {
                     0 if a > 0 || b < 0 => return false,
-                    0 => {}
-                    1 => {
-                        lower.push((a, dk));
-                        upper.push((b, dk));
-                    }
-                    _ => {
-                        lower.push((-b, -dk));
-                        upper.push((-a, -dk));
-                    }
-                }
+                    0 => continue,
+                    1 => ((a, dk), (b, dk)),
+                    _ => ((-b, -dk), (-a, -dk)),
+                };
+                lower[nl] = lo;
+                upper[nu] = hi;
+                (nl, nu) = (nl + 1, nu + 1);
             }
             // |numerators| < 2^33, denominators < 2^31: no overflow
-            lower
+            lower[..nl]
                 .iter()
-                .all(|&(p, q)| upper.iter().all(|&(r, s)| p * s <= r * q))
+                .all(|&(p, q)| upper[..nu].iter().all(|&(r, s)| p * s <= r * q))
         }
     }
 }
@@ -194,8 +220,9 @@ mod tests {
             .collect();
         for per_side in 1..5 {
             let mut seen = vec![0; polys.len()];
+            let index = TileIndex::new(&polys, per_side).unwrap();
             for t in Tile::all(per_side) {
-                let tf = tile_faces(&polys, t).unwrap();
+                let tf = index.get(t).unwrap();
                 assert_eq!(tf.polys.len(), tf.faces.len());
                 for &f in &tf.faces {
                     seen[f as usize] += 1;
@@ -211,26 +238,32 @@ mod tests {
         }
         // x is the longest axis (36 + 2), then y (30 + 2): tile 1 of 2 × 2
         // is x low, y high
-        let t = tile_faces(
-            &polys,
-            Tile {
+        let index = TileIndex::new(&polys, 2).unwrap();
+        let t = index
+            .get(Tile {
                 index: 1,
                 per_side: 2,
-            },
-        )
-        .unwrap();
+            })
+            .unwrap();
         let [lo, hi] = t.bounds.unwrap();
         assert!(hi[0] <= 20 && lo[1] >= 15, "{lo:?} {hi:?}");
         assert!(
-            tile_faces(
-                &polys,
-                Tile {
+            index
+                .get(Tile {
                     index: 4,
                     per_side: 2
-                }
-            )
-            .is_none()
+                })
+                .is_none()
         );
+        assert!(
+            index
+                .get(Tile {
+                    index: 0,
+                    per_side: 3
+                })
+                .is_none()
+        );
+        assert!(TileIndex::new(&polys, 0).is_none());
     }
 
     /// The sweep test against sampling the sweep densely.
