@@ -39,9 +39,13 @@ with_walls "$WORK/geb.obj" -0.25 1.25 -0.25 -0.1 1.1 "$WORK/geb_scene.obj"
 
 "$BIN" art "$WORK/geb/spec.json" -o "$WORK/geb_grown.obj" --optimize --images "$WORK/geb/grown"
 cp "$WORK/geb/grown/view0.png" "$OUT/art_geb_g_grown.png"
+"$BIN" art "$WORK/geb/spec.json" -o "$WORK/geb_moved.obj" --optimize --deform --images "$WORK/geb/moved"
+cp "$WORK/geb/moved/view2.png" "$OUT/art_geb_b_deformed.png"
+cp "$WORK/geb/moved/view0.png" "$OUT/art_geb_g_after_deform.png"
 
 "$EX/art_silhouettes" "$ROOT/data/meshes/bunny.obj" "$WORK/bunny" 512 > /dev/null
 "$BIN" art "$WORK/bunny/spec.json" -o "$WORK/bunny.obj" --report "$WORK/bunny_report.json"
 cp "$WORK/geb/views/view2.png" "$OUT/art_geb_b.png"
-echo "wrote $OUT/art_geb.png, art_geb_b.png and art_geb_g_grown.png; the bunny's report:"
+echo "wrote $OUT/art_geb.png, art_geb_b.png, art_geb_g_grown.png, art_geb_b_deformed.png and"
+echo "art_geb_g_after_deform.png; the bunny's report:"
 cat "$WORK/bunny_report.json"

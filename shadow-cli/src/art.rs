@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use bsp_shadows::art::{self, ArtSpec, optimize};
+use bsp_shadows::art::{self, ArtSpec, Optimize, optimize_with};
 use clap::Args;
 use shadow_scene::MeshFormat;
 
@@ -29,6 +29,10 @@ pub(crate) struct ArtArgs {
     /// most 0.5% of its wanted shadow (the paper's inner loop).
     #[arg(long)]
     optimize: bool,
+    /// With --optimize: first deform the images that miss shadow as
+    /// rigidly as possible (the paper's outer loop), then grow them.
+    #[arg(long, requires = "optimize")]
+    deform: bool,
     /// Simplify each image's wanted region within PX pixels: fewer
     /// corners and a smaller hull, the region then no longer the pixels'.
     #[arg(long, value_name = "PX")]
@@ -44,7 +48,14 @@ pub(crate) fn run(args: &ArtArgs) -> Result<()> {
     let mut given = ArtSpec::load(&args.spec)?;
     given.simplify = args.simplify;
     let run = match args.optimize {
-        true => optimize(&given, 0.005, 16)?,
+        true => optimize_with(
+            &given,
+            Optimize {
+                target: 0.005,
+                rounds: 16,
+                deform_rounds: if args.deform { 8 } else { 0 },
+            },
+        )?,
         false => art::run(given)?,
     };
     let mesh = run.hull.mesh(stl);

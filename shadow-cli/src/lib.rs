@@ -94,7 +94,8 @@ enum Command {
     /// how much of each it gives.
     #[command(
         after_help = "Examples:\n  shadow art geb.json -o geb.obj --report geb.json --images views/\n  \
-                      shadow art bunny/spec.json -o hull.stl --simplify 1.5"
+                      shadow art bunny/spec.json -o hull.stl --simplify 1.5\n  \
+                      shadow art geb.json -o geb.obj --optimize --deform --images moved/"
     )]
     Art(art::ArtArgs),
     /// Where the sun is at a place and time (NREL's SPA), in the scene's

@@ -892,6 +892,78 @@ fn soft_shadows_are_drawn_between_lit_and_shadow() {
 }
 
 #[test]
+fn art_deform_moves_a_shifted_view() {
+    let dir = scratch("art_deform");
+    std::fs::create_dir_all(&dir).unwrap();
+    // three 16 × 16 views of an 8-cube, the third shifted by 2 pixels
+    let pgm = |c0: usize| {
+        let px: Vec<&str> = (0..256)
+            .map(|p| {
+                let (c, r) = (p % 16, p / 16);
+                if (c0..c0 + 8).contains(&c) && (4..12).contains(&r) {
+                    "0"
+                } else {
+                    "255"
+                }
+            })
+            .collect();
+        format!("P2\n16 16\n255\n{}\n", px.join(" "))
+    };
+    std::fs::write(dir.join("a.pgm"), pgm(4)).unwrap();
+    std::fs::write(dir.join("b.pgm"), pgm(6)).unwrap();
+    let spec = r#"{"views": [
+        {"image": "a.pgm", "light": {"sun": [0, 0, 1]},
+         "plane": {"origin": [0, 0, 0], "u": [1, 0, 0], "v": [0, 1, 0]}},
+        {"image": "a.pgm", "light": {"sun": [1, 0, 0]},
+         "plane": {"origin": [0, 0, 0], "u": [0, 1, 0], "v": [0, 0, 1]}},
+        {"image": "b.pgm", "light": {"sun": [0, 1, 0]},
+         "plane": {"origin": [0, 0, 0], "u": [1, 0, 0], "v": [0, 0, 1]}}],
+        "bounds": [[0, 0, 0], [16, 16, 16]]}"#;
+    let spec_path = dir.join("spec.json");
+    std::fs::write(&spec_path, spec).unwrap();
+    let (hull, report) = (dir.join("hull.obj"), dir.join("report.json"));
+    let args = [
+        "art",
+        spec_path.to_str().unwrap(),
+        "-o",
+        hull.to_str().unwrap(),
+    ];
+    let o = shadow(
+        &[
+            &args[..],
+            &[
+                "--optimize",
+                "--deform",
+                "--report",
+                report.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("rounds of deforming"), "{}", stdout(&o));
+    let r: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    for (k, v) in r["views"].as_array().unwrap().iter().enumerate() {
+        let moved = v["max_deformation_px"].as_f64().unwrap();
+        // the floor and the shifted wall moved, by about the shift
+        assert_eq!(moved > 0.0, k != 1, "{r}");
+        assert!(
+            moved <= 3.0 && v["mean_deformation_px"].as_f64().unwrap() <= moved,
+            "{r}"
+        );
+        let (missing, wanted) = (
+            v["missing_area"].as_f64().unwrap(),
+            v["wanted_area"].as_f64().unwrap(),
+        );
+        assert!(missing <= 0.005 * wanted, "{r}");
+    }
+    // --deform belongs to --optimize
+    let o = shadow(&[&args[..], &["--deform"]].concat());
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--optimize"), "{}", stderr(&o));
+}
+
+#[test]
 fn art_makes_the_hull_its_report_and_pictures() {
     let dir = scratch("art");
     std::fs::create_dir_all(&dir).unwrap();
@@ -942,6 +1014,7 @@ fn art_makes_the_hull_its_report_and_pictures() {
     assert!(stdout(&o).contains("0 rounds of growing"), "{}", stdout(&o));
     let r: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(r["views"][0]["pixels_added"], 0);
+    assert!(r["views"][0].get("mean_deformation_px").is_none());
     // a staircase triangle simplified: fewer triangles, no extra shadow
     let stairs: String = (0..12)
         .flat_map(|r| (0..12).map(move |c| if c + r < 12 { "0 " } else { "255 " }))

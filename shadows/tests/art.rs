@@ -95,6 +95,52 @@ fn a_point_light_gives_a_pyramid_frustum() {
     assert!(c.missing_area < 1e-9 && c.extra_area < 1e-9, "{c:?}");
 }
 
+#[test]
+fn a_point_light_in_the_bounds_is_the_apex() {
+    // the cone ends at the light: a pyramid on the square, 1 high
+    let light = ArtLight::Point(DVec3::new(2.0, 2.0, 1.0));
+    let s = spec(vec![floor(light, square())], DVec3::new(4.0, 4.0, 2.0));
+    let hull = shadow_hull(&s).unwrap();
+    assert_eq!(hull.hull.volume(), 4.0 / 3.0);
+    // the hull touches the light, and still gives the square back whole
+    let c = &hull.check(&s).unwrap()[0];
+    assert!(c.missing_area < 1e-9 && c.extra_area < 1e-9, "{c:?}");
+    assert_eq!(c.wanted_area, 4.0);
+    // a ring (a hole: two loops meeting at the light) and a second view
+    // whose sun cuts the pyramid at half its height: a frustum of a
+    // square ring
+    let ring = mask(8, |c, r| {
+        (2..6).contains(&c) && (2..6).contains(&r) && !((3..5).contains(&c) && (3..5).contains(&r))
+    });
+    let light = ArtLight::Point(DVec3::new(4.0, 4.0, 2.0));
+    let half = view(
+        ArtLight::Sun(DVec3::X),
+        DVec3::ZERO,
+        DVec3::Y,
+        DVec3::Z,
+        mask(8, |c, r| r < 1 && (2..6).contains(&c)),
+    );
+    let s = spec(vec![floor(light, ring), half], DVec3::new(8.0, 8.0, 4.0));
+    let hull = shadow_hull(&s).unwrap();
+    // the ring pyramid (outer 4 × 4, hole 2 × 2, 2 high) below z = 1:
+    // (16 − 4)·(2/3)·(1 − (1/2)³)
+    let v = hull.hull.volume();
+    assert!((v - 12.0 * 2.0 / 3.0 * 7.0 / 8.0).abs() < 1e-12, "{v}");
+    // the ring whole; on the wall a trapezoid, 4 wide at the bottom and
+    // 2 at the top, missing half of each end pixel
+    let c = hull.check(&s).unwrap();
+    assert!(
+        c[0].missing_area < 1e-9 && c[0].extra_area < 1e-9,
+        "{:?}",
+        c[0]
+    );
+    assert!(
+        (c[1].missing_area - 1.0).abs() < 1e-9 && c[1].extra_area < 1e-9,
+        "{:?}",
+        c[1]
+    );
+}
+
 /// The floor wants a ring, the wall (x = 0, sun along +x) a bar along its
 /// bottom row, wider than the ring.
 fn ring_and_bar() -> (Mask, ArtSpec) {
@@ -184,17 +230,16 @@ fn bad_views_are_named() {
     );
     let e = err(spec(vec![floor(ArtLight::Sun(DVec3::X), square())], hi));
     assert!(e.contains("along the receiving plane"), "{e}");
-    // a point light inside the bounds, and one behind the plane
-    let e = err(spec(
-        vec![floor(ArtLight::Point(DVec3::new(2.0, 2.0, 1.0)), square())],
-        hi,
-    ));
-    assert!(e.contains("beyond the bounds"), "{e}");
+    // a point light behind the plane (a light inside the bounds is fine:
+    // `a_point_light_in_the_bounds_is_the_apex`)
     let e = err(spec(
         vec![floor(ArtLight::Point(DVec3::new(2.0, 2.0, -3.0)), square())],
         hi,
     ));
-    assert!(e.contains("view 0"), "{e}");
+    assert!(
+        e.contains("view 0") && e.contains("behind the receiving plane"),
+        "{e}"
+    );
     // degenerate u, v
     let flat = view(
         ArtLight::Sun(DVec3::Z),
@@ -402,4 +447,75 @@ fn png_images_are_read_as_grey_over_white() {
         .to_string();
     assert!(e.contains("img.png") && e.contains("not a PGM"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn deforming_moves_a_shifted_view_back_instead_of_growing_the_others() {
+    use bsp_shadows::art::{Optimize, optimize_with};
+    // three views of a 16-cube in a 32-box, the third (on the wall y = 0)
+    // shifted by 4 pixels along x: the floor and it each miss a quarter
+    let sq = |c0: u32| {
+        mask(32, move |c, r| {
+            (c0..c0 + 16).contains(&c) && (8..24).contains(&r)
+        })
+    };
+    let floor_view = floor(ArtLight::Sun(DVec3::Z), sq(8));
+    let wall_x = view(
+        ArtLight::Sun(DVec3::X),
+        DVec3::ZERO,
+        DVec3::Y,
+        DVec3::Z,
+        sq(8),
+    );
+    let wall_y = view(
+        ArtLight::Sun(DVec3::Y),
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::Z,
+        sq(12),
+    );
+    let s = spec(vec![floor_view, wall_x, wall_y], DVec3::splat(32.0));
+    let how = |deform_rounds| Optimize {
+        target: 0.005,
+        rounds: 16,
+        deform_rounds,
+    };
+    let grown = optimize_with(&s, how(0)).unwrap();
+    let moved = optimize_with(&s, how(8)).unwrap();
+    for run in [&grown, &moved] {
+        let g = run.grown.as_ref().unwrap();
+        assert!(
+            (g.missing_before[0] - 64.0).abs() < 1e-9,
+            "{:?}",
+            g.missing_before
+        );
+        for c in &run.checks {
+            assert!(c.missing_area <= 0.005 * c.wanted_area, "{c:?}");
+            assert!(c.extra_area < 1e-9, "{c:?}");
+        }
+    }
+    let pixels = |run: &bsp_shadows::art::ArtRun| -> usize {
+        let g = run.grown.as_ref().unwrap();
+        g.growth.iter().map(|g| g.pixels).sum()
+    };
+    let g = moved.grown.as_ref().unwrap();
+    let d = g.deformed.as_ref().unwrap();
+    // the two views that missed moved, by at most the shift and a pixel;
+    // the one that did not stayed; fewer pixels were added
+    assert!(d.rounds >= 1, "{d:?}");
+    for k in [0, 2] {
+        let v = &d.views[k];
+        assert!(
+            v.max_displacement > 0.0 && v.max_displacement <= 5.0,
+            "{d:?}"
+        );
+    }
+    assert_eq!(d.views[1].max_displacement, 0.0);
+    assert!(
+        pixels(&moved) < pixels(&grown),
+        "{} {}",
+        pixels(&moved),
+        pixels(&grown)
+    );
+    assert!(grown.grown.as_ref().unwrap().deformed.is_none());
 }

@@ -43,12 +43,21 @@ impl ShadowHull {
     /// receiver facing the light), measured per pixel in `f64`.
     pub fn check(&self, spec: &ArtSpec) -> Result<Vec<ViewCheck>, ArtError> {
         (spec.views.iter())
-            .map(|v| self.check_view(v, spec.simplify))
+            .map(|v| self.check_view(v, spec))
             .collect()
     }
 
-    fn check_view(&self, view: &ArtView, simplify: Option<f64>) -> Result<ViewCheck, ArtError> {
-        let coverage = shadow_coverage(&self.hull.mesh().to_mesh(), view)?;
+    fn check_view(&self, view: &ArtView, spec: &ArtSpec) -> Result<ViewCheck, ArtError> {
+        let simplify = spec.simplify;
+        let coverage = match super::cone::reaches_light(view, spec.bounds) {
+            false => shadow_coverage(&self.hull.mesh().to_mesh(), view)?,
+            // the hull may touch the light, and a face through the light
+            // casts nothing (a cone's walls): its shadow is measured on
+            // the plane twice as far from the light, where every pixel is
+            // the same pixel scaled by 2 and the hull's faces on the view's
+            // plane cast too
+            true => shadow_coverage(&self.hull.mesh().to_mesh(), &doubled(view))?,
+        };
         let mask = &view.mask;
         let px = view.plane.normal().length();
         let (wanted, overlap, wanted_share) = match simplify {
@@ -106,6 +115,18 @@ impl ViewCheck {
         }
         img
     }
+}
+
+/// `view` (with a point light) on the plane twice as far from its light:
+/// pixel `(c, r)` is the scaled copy of pixel `(c, r)` of `view`.
+fn doubled(view: &ArtView) -> ArtView {
+    let ArtLight::Point(l) = view.light else {
+        return view.clone();
+    };
+    let mut v = view.clone();
+    v.plane.origin = l + (view.plane.origin - l) * 2.0;
+    (v.plane.u, v.plane.v) = (view.plane.u * 2.0, view.plane.v * 2.0);
+    v
 }
 
 /// How much of each pixel of `view`'s image the shadow of `mesh` (a

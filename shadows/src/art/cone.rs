@@ -49,9 +49,29 @@ fn corners([lo, hi]: [DVec3; 2]) -> [DVec3; 8] {
     })
 }
 
-/// Where the cone of `view` ends toward the light, just beyond `bounds`:
-/// the map from a point of the plane to its end.
-fn far_end(view: &ArtView, bounds: [DVec3; 2]) -> Result<Box<dyn Fn(DVec3) -> DVec3>, String> {
+/// Where the cone of `view` ends toward the light.
+enum End {
+    /// Just beyond `bounds`: the map from a point of the plane to its end.
+    Cap(Box<dyn Fn(DVec3) -> DVec3>),
+    /// At the point light itself, which the bounds reach.
+    Apex(DVec3),
+}
+
+/// Whether `view`'s light is a point light that `bounds` reach (a corner
+/// of the box as far from the plane as the light, or farther): its cone
+/// then ends at the light, and the hull may touch it.
+pub(crate) fn reaches_light(view: &ArtView, bounds: [DVec3; 2]) -> bool {
+    let ArtLight::Point(l) = view.light else {
+        return false;
+    };
+    let n = view.plane.normal();
+    let h = (view.plane.origin - l).dot(n);
+    h != 0.0 && corners(bounds).iter().any(|&c| (c - l).dot(n) / h <= 0.0)
+}
+
+/// Where the cone of `view` ends toward the light: just beyond `bounds`,
+/// or at a point light the bounds reach.
+fn far_end(view: &ArtView, bounds: [DVec3; 2]) -> Result<End, String> {
     let pl = view.plane;
     let n = pl.normal();
     if n.length_squared() == 0.0 || !n.is_finite() {
@@ -73,7 +93,7 @@ fn far_end(view: &ArtView, bounds: [DVec3; 2]) -> Result<Box<dyn Fn(DVec3) -> DV
                 return Err("the bounds lie behind the receiving plane, away from the sun".into());
             }
             let t = t + 0.01 * size / d.length();
-            Ok(Box::new(move |p| p + d * t))
+            Ok(End::Cap(Box::new(move |p| p + d * t)))
         }
         ArtLight::Point(l) => {
             let h = (pl.origin - l).dot(n);
@@ -91,20 +111,18 @@ fn far_end(view: &ArtView, bounds: [DVec3; 2]) -> Result<Box<dyn Fn(DVec3) -> DV
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
                     (a.min(x), b.max(x))
                 });
-            if lo <= 0.0 {
+            if hi <= 0.0 || lo >= 1.0 {
                 return Err(
-                    "the point light must lie beyond the bounds as seen from the plane (the \
-                     bounds reach the light, or the light is behind the plane)"
+                    "the bounds lie behind the receiving plane, away from the light, or \
+                     behind the light"
                         .into(),
                 );
             }
-            if hi <= 0.0 || lo >= 1.0 {
-                return Err(
-                    "the bounds lie behind the receiving plane, away from the light".into(),
-                );
+            if lo <= 0.0 {
+                return Ok(End::Apex(l));
             }
             let s = lo * 0.99;
-            Ok(Box::new(move |p| l + (p - l) * s))
+            Ok(End::Cap(Box::new(move |p| l + (p - l) * s)))
         }
     }
 }
@@ -135,9 +153,10 @@ pub(crate) fn wanted_region(
     Ok(parts)
 }
 
-/// The cone of `view` up to just beyond `bounds`, as a closed mesh (each
-/// component of the wanted region a closed part; its faces turned
-/// outward), its region simplified within `simplify` pixels if given.
+/// The cone of `view` up to just beyond `bounds` (or up to a point light
+/// the bounds reach), as a closed mesh (each component of the wanted
+/// region a closed part; its faces turned outward), its region
+/// simplified within `simplify` pixels if given.
 pub(crate) fn cone(
     view: &ArtView,
     bounds: [DVec3; 2],
@@ -149,24 +168,42 @@ pub(crate) fn cone(
     for part in &parts {
         let base = positions.len() as u32;
         let n = part.corners.len() as u32;
-        // the plane's corners, then their ends toward the light
         let near: Vec<DVec3> = (part.corners.iter())
             .map(|&[a, b]| view.plane.at(f64::from(a), f64::from(b)))
             .collect();
-        positions.extend(near.iter().map(|&p| end(p)));
-        positions.extend(near);
-        let (far, near) = (|i: u32| base + i, |i: u32| base + n + i);
-        for t in &part.triangles {
-            // (counter-clockwise in the plane's (a, b) coordinates)
-            faces.push(vec![near(t[0]), near(t[2]), near(t[1])]);
-            faces.push(vec![far(t[0]), far(t[1]), far(t[2])]);
-        }
-        for range in part.loop_ranges() {
-            let (s, e) = (range.start as u32, range.end as u32);
-            for i in s..e {
-                let j = if i + 1 == e { s } else { i + 1 };
-                faces.push(vec![near(i), near(j), far(j)]);
-                faces.push(vec![near(i), far(j), far(i)]);
+        match &end {
+            End::Cap(end) => {
+                // the ends toward the light, then the plane's corners
+                positions.extend(near.iter().map(|&p| end(p)));
+                positions.extend(near);
+                let (far, near) = (|i: u32| base + i, |i: u32| base + n + i);
+                for t in &part.triangles {
+                    // (counter-clockwise in the plane's (a, b) coordinates)
+                    faces.push(vec![near(t[0]), near(t[2]), near(t[1])]);
+                    faces.push(vec![far(t[0]), far(t[1]), far(t[2])]);
+                }
+                for (i, j) in loop_edges(part) {
+                    faces.push(vec![near(i), near(j), far(j)]);
+                    faces.push(vec![near(i), far(j), far(i)]);
+                }
+            }
+            End::Apex(light) => {
+                positions.extend(near);
+                let near = |i: u32| base + i;
+                for t in &part.triangles {
+                    faces.push(vec![near(t[0]), near(t[2]), near(t[1])]);
+                }
+                // each loop's walls meet at a copy of the light of their
+                // own, so the mesh stays a manifold where they touch
+                for range in part.loop_ranges() {
+                    let apex = positions.len() as u32;
+                    positions.push(*light);
+                    let (s, e) = (range.start as u32, range.end as u32);
+                    for i in s..e {
+                        let j = if i + 1 == e { s } else { i + 1 };
+                        faces.push(vec![near(i), near(j), apex]);
+                    }
+                }
             }
         }
     }
@@ -178,6 +215,15 @@ pub(crate) fn cone(
         }
     }
     Ok(m)
+}
+
+/// The boundary segments `(i, j)` of a component's loops, as corner
+/// indices.
+fn loop_edges(part: &Component) -> impl Iterator<Item = (u32, u32)> + '_ {
+    part.loop_ranges().flat_map(|range| {
+        let (s, e) = (range.start as u32, range.end as u32);
+        (s..e).map(move |i| (i, if i + 1 == e { s } else { i + 1 }))
+    })
 }
 
 /// The signed volume of a closed triangle mesh (`f64`: only its sign is

@@ -11,12 +11,16 @@
 //! the target share of its (grown) wanted area, or nothing changes.
 //!
 //! Mitra & Pauly also deform the images as rigidly as possible (their
-//! outer loop); that is not done here: the images only grow.
+//! outer loop): with [`Optimize::deform_rounds`] above 0 that comes
+//! first (`deform`), and growing then answers what is left.
 
 use glam::DVec3;
 
+use super::deform::{Deformation, Moved};
 use super::region::Mask;
-use super::{ArtError, ArtLight, ArtSpec, ArtView, ShadowHull, ViewCheck, shadow_hull};
+use super::{
+    ArtError, ArtLight, ArtSpec, ArtView, ShadowHull, ViewCheck, shadow_coverage, shadow_hull,
+};
 
 /// Points tried along each missed pixel's line.
 const SAMPLES: usize = 64;
@@ -57,6 +61,32 @@ pub struct Grown {
     pub missing_before: Vec<f64>,
     /// Rounds of growing.
     pub rounds: usize,
+    /// With [`Optimize::deform_rounds`] above 0: how the images were
+    /// deformed before they grew.
+    pub deformed: Option<Deformed>,
+}
+
+/// How [`optimize_with`] deformed the images.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Deformed {
+    /// Per view, how far its image moved (zero for a view that missed
+    /// nothing).
+    pub views: Vec<Deformation>,
+    /// Rounds of deforming kept (a round is kept only where it lowers the
+    /// views' summed missing shares).
+    pub rounds: usize,
+}
+
+/// How [`optimize_with`] makes the views agree.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Optimize {
+    /// Done when every view misses at most this share of its wanted area
+    /// (e.g. 0.005).
+    pub target: f64,
+    /// Rounds of growing, at most.
+    pub rounds: usize,
+    /// Rounds of deforming before the growing, at most: 0 grows only.
+    pub deform_rounds: usize,
 }
 
 /// The hull of `spec`'s views and its check, as given ([`ArtRun::grown`]
@@ -113,6 +143,13 @@ impl ArtRun {
                 100.0 * c.missing_area / c.wanted_area,
                 c.extra_area
             );
+            if let Some(d) = self.grown.as_ref().and_then(|g| g.deformed.as_ref()) {
+                let d = &d.views[i];
+                text += &format!(
+                    "  deformed by {:.2} px on average and {:.2} at most\n",
+                    d.mean_displacement, d.max_displacement
+                );
+            }
             if let Some(g) = &self.grown {
                 let (w, before) = (&g.growth[i], g.missing_before[i]);
                 text += &format!(
@@ -121,6 +158,9 @@ impl ArtRun {
                     w.pixels, w.mean_displacement, w.max_displacement
                 );
             }
+        }
+        if let Some(d) = self.grown.as_ref().and_then(|g| g.deformed.as_ref()) {
+            text += &format!("{} rounds of deforming\n", d.rounds);
         }
         match &self.grown {
             Some(g) => text += &format!("{} rounds of growing\n", g.rounds),
@@ -307,24 +347,100 @@ fn grow_round(
 /// `target` of its wanted area (e.g. 0.005), in at most `rounds` rounds
 /// (see the module docs). The hull is exact in every round.
 pub fn optimize(spec: &ArtSpec, target: f64, rounds: usize) -> Result<ArtRun, ArtError> {
+    optimize_with(
+        spec,
+        Optimize {
+            target,
+            rounds,
+            deform_rounds: 0,
+        },
+    )
+}
+
+/// Whether every view misses at most `target` of its wanted area.
+fn met(checks: &[ViewCheck], target: f64) -> bool {
+    (checks.iter()).all(|c| c.missing_area <= target * c.wanted_area)
+}
+
+/// The views' missing shares, summed.
+fn missing(checks: &[ViewCheck]) -> f64 {
+    checks.iter().map(|c| c.missing_area / c.wanted_area).sum()
+}
+
+/// The pixels of view `k`'s image that the other views allow: those the
+/// hull of their cones (and the bounds) shadows at least half of. `None`
+/// if that hull is empty.
+fn allowed(spec: &ArtSpec, k: usize) -> Result<Option<Vec<bool>>, ArtError> {
+    let mut others = spec.clone();
+    let view = others.views.remove(k);
+    let hull = match shadow_hull(&others) {
+        Ok(h) => h,
+        Err(ArtError::Empty) => return Ok(None),
+        Err(e) => return Err(e),
+    };
+    let coverage = shadow_coverage(&hull.hull.mesh().to_mesh(), &view)?;
+    Ok(Some(coverage.iter().map(|&c| c >= 0.5).collect()))
+}
+
+/// Makes `spec`'s views agree as `how` says: deforms the images that
+/// miss shadow as rigidly as possible (the paper's outer loop; a round
+/// kept only if the views then miss less), then grows them (the inner
+/// loop) until every view misses at most `how.target` of its wanted
+/// area. The hull is exact in every round.
+pub fn optimize_with(spec: &ArtSpec, how: Optimize) -> Result<ArtRun, ArtError> {
     let mut spec = spec.clone();
     let original: Vec<Vec<f64>> = spec.views.iter().map(|v| distances(&v.mask)).collect();
     let mut growth = vec![Growth::default(); spec.views.len()];
     let mut hull = shadow_hull(&spec)?;
     let mut checks = hull.check(&spec)?;
     let missing_before = checks.iter().map(|c| c.missing_area).collect();
+    let mut moved: Vec<Moved> = spec.views.iter().map(|v| Moved::new(&v.mask)).collect();
+    let mut deform_rounds = 0;
+    while deform_rounds < how.deform_rounds && !met(&checks, how.target) {
+        let mut trial = (spec.clone(), moved.clone());
+        let mut any = false;
+        for (k, c) in checks.iter().enumerate() {
+            if c.missing_area <= how.target * c.wanted_area {
+                continue;
+            }
+            let Some(allowed) = allowed(&spec, k)? else {
+                continue;
+            };
+            if let Some(m) = moved[k].deformed(&c.coverage, &allowed) {
+                trial.0.views[k].mask = m.mask.clone();
+                trial.1[k] = m;
+                any = true;
+            }
+        }
+        if !any {
+            break;
+        }
+        let made = match shadow_hull(&trial.0) {
+            Ok(h) => {
+                let c = h.check(&trial.0)?;
+                (missing(&c) < missing(&checks)).then_some((h, c))
+            }
+            Err(ArtError::Empty) => None,
+            Err(e) => return Err(e),
+        };
+        let Some((h, c)) = made else { break };
+        (spec, moved) = trial;
+        (hull, checks) = (h, c);
+        deform_rounds += 1;
+    }
     let mut done = 0;
-    while done < rounds {
-        let met = checks
-            .iter()
-            .all(|c| c.missing_area <= target * c.wanted_area);
-        if met || grow_round(&mut spec, &checks, &original, &mut growth) == 0 {
+    while done < how.rounds {
+        if met(&checks, how.target) || grow_round(&mut spec, &checks, &original, &mut growth) == 0 {
             break;
         }
         hull = shadow_hull(&spec)?;
         checks = hull.check(&spec)?;
         done += 1;
     }
+    let deformed = (how.deform_rounds > 0).then(|| Deformed {
+        views: moved.iter().map(Moved::deformation).collect(),
+        rounds: deform_rounds,
+    });
     Ok(ArtRun {
         spec,
         hull,
@@ -333,6 +449,7 @@ pub fn optimize(spec: &ArtSpec, target: f64, rounds: usize) -> Result<ArtRun, Ar
             growth,
             missing_before,
             rounds: done,
+            deformed,
         }),
     })
 }

@@ -20,6 +20,7 @@
 
 mod check;
 pub(crate) mod cone;
+mod deform;
 mod grow;
 mod region;
 mod simplify;
@@ -32,7 +33,8 @@ use bsp_csg::files::{FileBoolean, FileError, Operand};
 use glam::DVec3;
 
 pub use check::{ViewCheck, axis_silhouettes, shadow_coverage};
-pub use grow::{ArtRun, Grown, Growth, optimize, run};
+pub use deform::Deformation;
+pub use grow::{ArtRun, Deformed, Grown, Growth, Optimize, optimize, optimize_with, run};
 pub use region::Mask;
 pub use spec::read_mask;
 
@@ -235,7 +237,8 @@ impl ShadowHull {
 impl ArtRun {
     /// The report as JSON: per view (in the spec's order) its areas
     /// ([`ViewCheck`]) and, after [`optimize`], how its image grew
-    /// ([`Growth`]) and what it missed before; the hull's exact volume
+    /// ([`Growth`]) and what it missed before, and with deforming how far
+    /// its image moved ([`Deformation`]); the hull's exact volume
     /// and its triangles.
     pub fn report_json(&self) -> String {
         let grown = self
@@ -259,6 +262,10 @@ impl ArtRun {
                     v["pixels_added"] = g.pixels.into();
                     v["max_displacement_px"] = g.max_displacement.into();
                     v["mean_displacement_px"] = g.mean_displacement.into();
+                }
+                if let Some(d) = self.grown.as_ref().and_then(|g| g.deformed.as_ref()) {
+                    v["max_deformation_px"] = d.views[i].max_displacement.into();
+                    v["mean_deformation_px"] = d.views[i].mean_displacement.into();
                 }
                 v
             })
