@@ -49,15 +49,7 @@ impl ShadowHull {
 
     fn check_view(&self, view: &ArtView, spec: &ArtSpec) -> Result<ViewCheck, ArtError> {
         let simplify = spec.simplify;
-        let coverage = match super::cone::reaches_light(view, spec.bounds) {
-            false => shadow_coverage(&self.hull.mesh().to_mesh(), view)?,
-            // the hull may touch the light, and a face through the light
-            // casts nothing (a cone's walls): its shadow is measured on
-            // the plane twice as far from the light, where every pixel is
-            // the same pixel scaled by 2 and the hull's faces on the view's
-            // plane cast too
-            true => shadow_coverage(&self.hull.mesh().to_mesh(), &doubled(view))?,
-        };
+        let coverage = hull_coverage(&self.hull.mesh().to_mesh(), view, spec.bounds)?;
         let mask = &view.mask;
         let px = view.plane.normal().length();
         let (wanted, overlap, wanted_share) = match simplify {
@@ -114,6 +106,23 @@ impl ViewCheck {
             img.rgb[3 * p..3 * p + 3].copy_from_slice(&px);
         }
         img
+    }
+}
+
+/// [`shadow_coverage`] of a mesh within `bounds` (a hull): where the
+/// bounds reach the view's point light, the mesh may touch the light, and
+/// a face through the light casts nothing (a cone's walls), so its shadow
+/// is measured on the plane twice as far from the light, where every
+/// pixel is the same pixel scaled by 2 and the faces on the view's plane
+/// cast too.
+pub(crate) fn hull_coverage(
+    mesh: &Mesh,
+    view: &ArtView,
+    bounds: [glam::DVec3; 2],
+) -> Result<Vec<f64>, ArtError> {
+    match super::cone::reaches_light(view, bounds) {
+        false => shadow_coverage(mesh, view),
+        true => shadow_coverage(mesh, &doubled(view)),
     }
 }
 

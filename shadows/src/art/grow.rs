@@ -16,11 +16,10 @@
 
 use glam::DVec3;
 
+use super::check::hull_coverage;
 use super::deform::{Deformation, Moved};
 use super::region::Mask;
-use super::{
-    ArtError, ArtLight, ArtSpec, ArtView, ShadowHull, ViewCheck, shadow_coverage, shadow_hull,
-};
+use super::{ArtError, ArtLight, ArtSpec, ArtView, ShadowHull, ViewCheck, shadow_hull};
 
 /// Points tried along each missed pixel's line.
 const SAMPLES: usize = 64;
@@ -378,7 +377,7 @@ fn allowed(spec: &ArtSpec, k: usize) -> Result<Option<Vec<bool>>, ArtError> {
         Err(ArtError::Empty) => return Ok(None),
         Err(e) => return Err(e),
     };
-    let coverage = shadow_coverage(&hull.hull.mesh().to_mesh(), &view)?;
+    let coverage = hull_coverage(&hull.hull.mesh().to_mesh(), &view, spec.bounds)?;
     Ok(Some(coverage.iter().map(|&c| c >= 0.5).collect()))
 }
 
