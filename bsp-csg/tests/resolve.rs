@@ -336,27 +336,38 @@ fn results_that_round_flat_are_split_and_closed() {
         ];
         let checked = Operand::check_all(&mut pair).unwrap();
         let out = FileBoolean::apply(checked, op, |_, _| {}).unwrap();
-        let r = out
-            .rounded(true)
-            .expect("f32 rounding makes vertices equal");
-        assert!(r.closed, "{op:?}");
-        assert_eq!(r.mesh.flat_triangles(|p| p), 0, "{op:?}");
-        flattened += r.flattened;
+        // (`None`: rounding to f32 leaves every vertex apart and no
+        // triangle flat, so the result is written as it is)
+        if let Some(r) = out.rounded(true) {
+            assert!(r.closed, "{op:?}");
+            assert_eq!(r.mesh.flat_triangles(|p| p), 0, "{op:?}");
+            flattened += r.flattened;
+        }
         round_trip(&out, true);
         round_trip(&out, false);
     }
-    // (the case this test is for happens: 8, 11 and 10 triangles)
+    // (the case this test is for happens: 1 and 8 triangles)
     assert!(flattened > 0);
 }
 
-/// Two 8,000-triangle spheres, the second turned and moved a little:
-/// rounded to `f32`, their difference has vertices of two sheets closer
-/// than `f32` resolves, which welding would make one (an edge used four
-/// times). They are kept apart one step instead, and the file is closed
-/// as read back, and an input again.
+/// An 8,000-triangle sphere minus itself moved by 10⁻⁷: rounded to
+/// `f32`, the difference has vertices of two sheets closer than `f32`
+/// resolves, which welding would make one (an edge used four times). They
+/// are kept apart one step instead, and the file is closed as read back,
+/// and an input again.
 #[test]
 fn results_that_would_pinch_in_f32_keep_their_vertices_apart() {
-    let mut pair = sphere_pair_read(8_000);
+    let (a, _, faces) = shapes::sphere_pair(8_000);
+    let b: Vec<DVec3> = (a.iter())
+        .map(|p| *p + DVec3::new(1e-7, 0.5e-7, 0.0))
+        .collect();
+    let read = |p: &[DVec3], name: &str| {
+        Operand::new(
+            name,
+            shadow_scene::parse_obj(&obj_text(p, &faces), name).unwrap(),
+        )
+    };
+    let mut pair = [read(&a, "a.obj"), read(&b, "b.obj")];
     let checked = Operand::check_all(&mut pair).unwrap();
     let out = FileBoolean::apply(checked, BoolOp::Difference, |_, _| {}).unwrap();
     let mut welded = out.mesh().to_mesh();

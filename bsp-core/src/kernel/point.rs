@@ -350,6 +350,49 @@ impl Point {
     }
 }
 
+/// The turn `a → b → c` of three points seen along coordinate axis `k`
+/// (projected onto the axes `k + 1` and `k + 2`, mod 3, in that order):
+/// `1` counter-clockwise, `-1` clockwise, `0` collinear. The sign of the
+/// 3 × 3 determinant of their homogeneous `(·, ·, w)` rows (every `w >
+/// 0`), by the `f64` approximations when they certify it and exactly in
+/// 640 bits otherwise (each term below `2^561`, see [`Implicit`]).
+pub(crate) fn turn(a: &Point, b: &Point, c: &Point, k: usize) -> i32 {
+    let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+    let approx = |p: &Point| match p {
+        Point::Grid(g) => [g[i] as f64, g[j] as f64, 1.0],
+        Point::Implicit(h) => {
+            let x = h.approx();
+            [x[i], x[j], x[3]]
+        }
+    };
+    let [a1, b1, c1] = [approx(a), approx(b), approx(c)];
+    let terms = [
+        a1[0] * b1[1] * c1[2],
+        -a1[0] * b1[2] * c1[1],
+        -a1[1] * b1[0] * c1[2],
+        a1[1] * b1[2] * c1[0],
+        a1[2] * b1[0] * c1[1],
+        -a1[2] * b1[1] * c1[0],
+    ];
+    let det: f64 = terms.iter().sum();
+    // each input within 3u of its integer, each product two roundings
+    // more, the sum five: below 16u of the terms' magnitudes; 2^-47 is
+    // four times that
+    let bound = terms.iter().map(|t| t.abs()).sum::<f64>() * (1.0 / (1u64 << 47) as f64);
+    if det.abs() > bound {
+        return if det > 0.0 { 1 } else { -1 };
+    }
+    type W = bnum::BInt<10>;
+    let exact = |p: &Point| {
+        let h = p.homogeneous();
+        [h[i], h[j], h[3]].map(|x| x.as_::<W>())
+    };
+    let [a, b, c] = [exact(a), exact(b), exact(c)];
+    let det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+        + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    det.signum().as_::<i32>()
+}
+
 /// Whether the grid point `g` is the implicit point `i`, exactly.
 pub(crate) fn grid_is(g: &crate::kernel::GridPoint, i: &Implicit) -> bool {
     let h = i.coords();
@@ -384,6 +427,37 @@ mod tests {
     /// integer.
     fn mul_wide(a: i128, b: i128) -> I256 {
         Wide::product(a, b).to_i256()
+    }
+
+    #[test]
+    fn turns_are_exact_for_grid_and_implicit_points() {
+        let g = |x: i32, y: i32, z: i32| Point::Grid([x, y, z]);
+        let (o, x, y) = (g(0, 0, 0), g(1, 0, 0), g(0, 1, 0));
+        assert_eq!(turn(&o, &x, &y, 2), 1);
+        assert_eq!(turn(&o, &y, &x, 2), -1);
+        assert_eq!(turn(&o, &x, &g(5, 0, 9), 2), 0);
+        // seen along x: the axes y then z
+        assert_eq!(turn(&o, &y, &g(0, 0, 1), 0), 1);
+        // (1/3, 1/3, 0) and (2/3, 2/3, 0): on the diagonal through the
+        // origin exactly, and a step off it either way
+        let third = |k: i128, dy: i128| {
+            let p = |n: [i64; 3], d: i128| Plane::new(n, d).unwrap();
+            let z = p([0, 0, 1], 0);
+            Point::from_planes(&p([3, 0, 0], -k), &p([0, 3, 0], -k - dy), &z).unwrap()
+        };
+        let (a, b) = (third(1, 0), third(2, 0));
+        assert_eq!(turn(&o, &a, &b, 2), 0);
+        assert_eq!(turn(&a, &b, &g(1, 1, 0), 2), 0);
+        assert_eq!(turn(&o, &a, &third(2, 1), 2), 1);
+        assert_eq!(turn(&o, &a, &third(2, -1), 2), -1);
+        // far from the origin, where the filter cannot tell
+        let big = 1i32 << 30;
+        let far = |k: i128| {
+            let p = |n: [i64; 3], d: i128| Plane::new(n, d).unwrap();
+            let at = 3 * i128::from(big) + k;
+            Point::from_planes(&p([3, 0, 0], -at), &p([0, 3, 0], -at), &p([0, 0, 1], 0)).unwrap()
+        };
+        assert_eq!(turn(&g(big, big, 0), &far(1), &far(2), 2), 0);
     }
 
     #[test]

@@ -7,15 +7,20 @@
 //! Adjacent polygons of one support plane, each with a corner made by
 //! cutting (an implicit point), whose edges meet whole, are joined
 //! where the joined region's boundary is one loop and its inner corners
-//! are its own. Corners where the loop runs straight on (the edge planes
-//! before and after are the same plane) are dropped, unless another
-//! polygon still has them, and then they come back as points on the edge,
-//! as every such point does. A region with no reflex corner is clipped as
-//! a convex polygon is; one with reflex corners is fanned from the first
-//! that sees the whole region (strictly inside every edge but its own
-//! two: with a single reflex corner the region is two convex parts that
-//! both have it as a corner); one with none such keeps its polygons.
-//! Every decision is an exact side of a point, or exact equality.
+//! are its own. A point goes where every loop that has it agrees: a
+//! region's loop, where the point is a straight corner (the edge planes
+//! before and after are the same plane) or lies inside an edge, and any
+//! other polygon's, where the point lies inside one of its edges (a
+//! convex polygon is clipped as well without it); a point that stays is
+//! a point on the edges of every loop that has it. A region with no
+//! reflex corner is clipped as a convex polygon is; one with reflex
+//! corners is fanned from the first that sees the whole region (strictly
+//! inside every edge but its own two: with a single reflex corner the
+//! region is two convex parts that both have it as a corner), and where
+//! none does, or the fan's corner would keep a point on its edges, its
+//! corners are cut into ears by exact turns (`point::turn`) and each ear
+//! clipped with the points kept on its edges. Every decision is an exact
+//! side of a point, an exact turn, or exact equality.
 
 use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
@@ -24,7 +29,7 @@ use smallvec::{SmallVec, smallvec};
 
 use crate::kernel::Side;
 use crate::kernel::plane::Plane;
-use crate::kernel::point::Point;
+use crate::kernel::point::{Point, turn};
 use crate::kernel::polygon::ConvexFace;
 use crate::union_find::UnionFind;
 
@@ -33,6 +38,9 @@ use crate::union_find::UnionFind;
 pub(super) struct FlatRegions {
     pub(super) replaced: Vec<bool>,
     pub(super) triangles: HashMap<u32, Vec<[u32; 3]>>,
+    /// Points left out of every loop: the other polygons leave them out
+    /// of their edges too.
+    pub(super) dropped: HashSet<u32>,
 }
 
 /// What a triangulation reads of the welded polygons.
@@ -58,6 +66,7 @@ pub(super) fn flat_regions<P: ConvexFace + Sync>(polys: &[P], w: &Welded<'_>) ->
     let mut out = FlatRegions {
         replaced: vec![false; n],
         triangles: HashMap::default(),
+        dropped: HashSet::default(),
     };
     let made: Vec<usize> = (0..n)
         .into_par_iter()
@@ -125,17 +134,30 @@ pub(super) fn flat_regions<P: ConvexFace + Sync>(polys: &[P], w: &Welded<'_>) ->
         .par_iter()
         .map(|g| plan(polys, w, g, &rings, &uses))
         .collect();
-    // a point goes where every loop that has it belongs to a planned
-    // region: a straight corner of its loop, or a point inside it; a fan
-    // whose corner's edges would keep a point is given up, and its points
-    // counted again (each round gives up one region at least)
+    // a point goes where every loop that has it agrees: a planned
+    // region's, where it is a straight corner or a point inside an edge,
+    // or another polygon's, where it is a point inside an edge (a convex
+    // polygon is clipped as well without it). A fan whose corner's edges
+    // would keep a point is cut into ears instead, and given up where it
+    // cannot be (then its points are counted again: each round gives up
+    // one region at least)
     let dropped = loop {
         let mut votes: HashMap<u32, u32> = HashMap::default();
-        for plan in plans.iter().flatten() {
+        let mut planned = vec![false; n];
+        for (g, plan) in groups.iter().zip(&plans) {
+            let Some(plan) = plan else { continue };
+            g.iter().for_each(|&p| planned[p as usize] = true);
             let on_loop: HashSet<u32> = plan.lp.iter().map(|e| e.v).collect();
             for (&v, &k) in &plan.own {
                 if !on_loop.contains(&v) {
                     *votes.entry(v).or_default() += k;
+                }
+            }
+        }
+        for (p, inside) in w.inside.iter().enumerate() {
+            if !planned[p] {
+                for &(_, v) in inside {
+                    *votes.entry(v).or_default() += 1;
                 }
             }
         }
@@ -144,10 +166,17 @@ pub(super) fn flat_regions<P: ConvexFace + Sync>(polys: &[P], w: &Welded<'_>) ->
             .map(|(v, _)| v)
             .collect();
         let mut given_up = false;
-        for slot in plans.iter_mut() {
+        for (g, slot) in groups.iter().zip(plans.iter_mut()) {
             if slot.as_ref().is_some_and(|p| !fan_edges_clear(p, &dropped)) {
-                *slot = None;
-                given_up = true;
+                let mut plan = slot.take().expect("a plan");
+                let support = polys[g[0] as usize].support();
+                match ears(w, &plan.lp, support) {
+                    Some(e) => {
+                        (plan.reflex, plan.ears) = (None, Some(e));
+                        *slot = Some(plan);
+                    }
+                    None => given_up = true,
+                }
             }
         }
         if !given_up {
@@ -164,6 +193,7 @@ pub(super) fn flat_regions<P: ConvexFace + Sync>(polys: &[P], w: &Welded<'_>) ->
             out.triangles.insert(g[0], tris);
         }
     }
+    out.dropped = dropped;
     out
 }
 
@@ -200,6 +230,9 @@ struct LoopEdge {
 struct Plan {
     lp: Vec<LoopEdge>,
     reflex: Option<usize>,
+    /// Where no reflex corner sees the whole region: its loop's corners
+    /// cut into triangles (ears, as indices into `lp`).
+    ears: Option<Vec<[u32; 3]>>,
     own: HashMap<u32, u32>,
 }
 
@@ -295,11 +328,70 @@ fn plan<P: ConvexFace>(
             .filter(|&k| k != r && k != (r + m - 1) % m)
             .all(|k| apex.classify(&lp[k].plane) == Side::Back)
     };
-    let r = match reflex.first() {
-        None => None,
-        Some(_) => Some(reflex.into_iter().find(|&r| sees_all(r))?),
+    let (r, ears) = match reflex.first() {
+        None => (None, None),
+        Some(_) => match reflex.into_iter().find(|&r| sees_all(r)) {
+            Some(r) => (Some(r), None),
+            None => (
+                None,
+                Some(ears(w, &lp, polys[group[0] as usize].support())?),
+            ),
+        },
     };
-    Some(Plan { lp, reflex: r, own })
+    Some(Plan {
+        lp,
+        reflex: r,
+        ears,
+        own,
+    })
+}
+
+/// The most corners a loop is cut into ears at (each ear is tested
+/// against every corner left: cubic in the worst case).
+const MAX_EAR_CORNERS: usize = 256;
+
+/// A simple loop's corners (counter-clockwise on `support`, no straight
+/// corner) cut into triangles by clipping ears: a corner that turns
+/// counter-clockwise and whose triangle with its two neighbours holds no
+/// other corner left, on its edges included. Such a triangle's new side
+/// crosses the inside only, so the triangles tile the loop. Every turn is
+/// exact (`point::turn`, seen along the support normal's largest axis).
+/// `None` where no ear is found (the loop is not simple) or the loop has
+/// more than [`MAX_EAR_CORNERS`] corners.
+fn ears(w: &Welded<'_>, lp: &[LoopEdge], support: &Plane) -> Option<Vec<[u32; 3]>> {
+    let m = lp.len();
+    if m > MAX_EAR_CORNERS {
+        return None;
+    }
+    let n = support.normal();
+    let k = (0..3).max_by_key(|&k| n[k].unsigned_abs())?;
+    let sign = if n[k] > 0 { 1 } else { -1 };
+    let ccw = |a: u32, b: u32, c: u32| {
+        let at = |i: u32| &w.vertices[lp[i as usize].v as usize];
+        turn(at(a), at(b), at(c), k) * sign
+    };
+    let mut ring: Vec<u32> = (0..m as u32).collect();
+    let mut tris = Vec::with_capacity(m - 2);
+    while ring.len() > 3 {
+        let l = ring.len();
+        let j = (0..l).find(|&j| {
+            let (a, b, c) = (ring[(j + l - 1) % l], ring[j], ring[(j + 1) % l]);
+            ccw(a, b, c) > 0
+                && ring.iter().all(|&p| {
+                    p == a
+                        || p == b
+                        || p == c
+                        || ccw(a, b, p) < 0
+                        || ccw(b, c, p) < 0
+                        || ccw(c, a, p) < 0
+                })
+        })?;
+        tris.push([ring[(j + l - 1) % l], ring[j], ring[(j + 1) % l]]);
+        ring.remove(j);
+    }
+    (ccw(ring[0], ring[1], ring[2]) > 0).then_some(())?;
+    tris.push([ring[0], ring[1], ring[2]]);
+    Some(tris)
 }
 
 /// Whether the two edges at a planned fan's corner keep no point once
@@ -324,6 +416,25 @@ fn finish(plan: &Plan, dropped: &HashSet<u32>) -> Vec<[u32; 3]> {
         ring.extend(kept.map(|&t| (t, smallvec![k as u32])));
     }
     let mut tris = Vec::new();
+    if let Some(ears) = &plan.ears {
+        // each ear with the points kept on the loop's edges it has
+        for &[a, b, c] in ears {
+            let mut ring: Vec<(u32, SmallVec<[u32; 3]>)> = Vec::new();
+            for (e, (x, y)) in [(a, b), (b, c), (c, a)].into_iter().enumerate() {
+                let e = e as u32;
+                ring.push((lp[x as usize].v, smallvec![(e + 2) % 3, e]));
+                if y as usize == (x as usize + 1) % m {
+                    let kept = lp[x as usize]
+                        .inside
+                        .iter()
+                        .filter(|t| !dropped.contains(t));
+                    ring.extend(kept.map(|&t| (t, smallvec![e])));
+                }
+            }
+            clip_ears(ring, 3, &mut tris);
+        }
+        return tris;
+    }
     match plan.reflex {
         None => clip_ears(ring, m as u32, &mut tris),
         Some(r) => {

@@ -342,7 +342,8 @@ impl TriMesh {
                     for (i, &c) in cs.iter().enumerate() {
                         let e = i as u32;
                         ring.push((c, SmallVec::from_slice(&[((i + k - 1) % k) as u32, e])));
-                        let on_edge = inside[at].iter().filter(|(f, _)| *f == e);
+                        let on_edge = (inside[at].iter())
+                            .filter(|&&(f, v)| f == e && !regions.dropped.contains(&v));
                         ring.extend(on_edge.map(|&(_, v)| (v, SmallVec::from_slice(&[e]))));
                     }
                     let before = triangles.len();
@@ -1146,24 +1147,29 @@ mod tests {
         // crosses: implicit vertices, T-junctions on the face left whole
         // (which keep them: the cut faces' pieces would otherwise mesh as
         // their faces, `pieces_of_one_plane_mesh_as_one_region`)
+        // the cube [0, 6]³ less what lies in front of x + 2y + 3z = 17:
+        // its faces' back parts, and the cut's cap (a triangle of that
+        // plane clipped to the cube), whose corners are made points
         let cube = bsp_fixtures::cuboid(glam::DVec3::ZERO, glam::DVec3::splat(6.0));
         let cut = Plane::new([1, 2, 3], -17).unwrap();
         let mut polys = Vec::new();
-        let mut left_whole = false;
+        let mut cap =
+            Polygon::from_grid_points(&[[17, 0, 0], [-13, 15, 0], [-13, 0, 10]], 0).unwrap();
         for f in &cube {
             let g: Vec<crate::kernel::GridPoint> =
                 f.iter().map(|v| v.to_array().map(|c| c as i32)).collect();
             let face = Polygon::from_grid_points(&g, 0).unwrap();
-            match face.clone().split(&cut) {
-                crate::Split::Spanning { .. } if !left_whole => {
-                    left_whole = true;
-                    polys.push(face);
-                }
-                crate::Split::Spanning { front, back } => polys.extend([front, back]),
-                crate::Split::Front(p) | crate::Split::Back(p) => polys.push(p),
-                crate::Split::Coplanar { polygon, .. } => polys.push(polygon),
+            use crate::kernel::polygon::{Parts, PolygonSide};
+            match face.parts(&cut) {
+                Parts::Split { back, .. } => polys.push(back),
+                Parts::Whole(PolygonSide::Back) => polys.push(face.clone()),
+                Parts::Whole(_) => {}
+            }
+            if let Parts::Split { back, .. } = cap.parts(face.support()) {
+                cap = back;
             }
         }
+        polys.push(cap);
         let borrowed = TriMesh::from_polygons(&polys);
         let owned = TriMesh::from_polygons_owned(polys);
         assert_eq!(borrowed.triangles, owned.triangles);
@@ -1328,6 +1334,72 @@ mod tests {
             let cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
             assert!(cross > 0.0, "{t:?}");
         }
+    }
+
+    /// A flat region with two reflex corners, neither of which sees every
+    /// other edge from inside (two notches from opposite sides), made of
+    /// four convex pieces each cut at `x = 1/2` or `x = 11/2` (so each has
+    /// a made corner): its corners are cut into ears by exact turns, ten
+    /// corners and eight triangles (the pieces alone give more).
+    #[test]
+    fn a_region_no_corner_sees_whole_is_cut_into_ears() {
+        let parts: [&[[i32; 3]]; 4] = [
+            &[[0, 0, 0], [1, 0, 0], [2, 3, 0], [0, 3, 0]],
+            &[[2, 3, 0], [3, 0, 0], [6, 0, 0], [6, 3, 0], [4, 3, 0]],
+            &[[0, 3, 0], [2, 3, 0], [4, 3, 0], [3, 6, 0], [0, 6, 0]],
+            &[[4, 3, 0], [6, 3, 0], [6, 6, 0], [5, 6, 0]],
+        ];
+        let mut pieces = Vec::new();
+        for (i, part) in parts.iter().enumerate() {
+            let p = Polygon::from_grid_points(part, 0).unwrap();
+            let x = if i % 2 == 0 { 1 } else { 11 };
+            match p.parts(&Plane::new([2, 0, 0], -x).unwrap()) {
+                crate::kernel::polygon::Parts::Split { front, back } => {
+                    pieces.extend([back, front])
+                }
+                crate::kernel::polygon::Parts::Whole(_) => panic!("every part is cut"),
+            }
+        }
+        let m = TriMesh::from_polygons(&pieces);
+        assert_eq!((m.vertices.len(), m.triangles.len()), (10, 8));
+        // its area: 36 less the notches' 3 and 3
+        assert_eq!(m.area_f64(), 30.0);
+        for t in &m.triangles {
+            let [a, b, c] = t.map(|v| m.vertices[v as usize].to_f64());
+            let cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            assert!(cross > 0.0, "{t:?}");
+        }
+    }
+
+    /// A cube whose faces but one are cut by a plane: each cut face's
+    /// pieces make one region again, and the cut points on the whole
+    /// face's edges (points inside its edges, not corners) go from it
+    /// too, so the mesh is the cube's 8 corners and 12 triangles.
+    #[test]
+    fn points_inside_a_whole_face_s_edges_go_with_the_regions() {
+        let cube = bsp_fixtures::cuboid(glam::DVec3::ZERO, glam::DVec3::splat(6.0));
+        let cut = Plane::new([1, 2, 3], -17).unwrap();
+        let mut polys = Vec::new();
+        let mut left_whole = false;
+        for f in &cube {
+            let g: Vec<crate::kernel::GridPoint> =
+                f.iter().map(|v| v.to_array().map(|c| c as i32)).collect();
+            let face = Polygon::from_grid_points(&g, 0).unwrap();
+            match face.parts(&cut) {
+                crate::kernel::polygon::Parts::Split { front, back } if left_whole => {
+                    polys.extend([front, back])
+                }
+                crate::kernel::polygon::Parts::Split { .. } => {
+                    left_whole = true;
+                    polys.push(face);
+                }
+                crate::kernel::polygon::Parts::Whole(_) => polys.push(face),
+            }
+        }
+        assert!(left_whole && polys.len() > 6);
+        let m = TriMesh::from_polygons_watertight(&polys).unwrap();
+        assert_eq!((m.vertices.len(), m.triangles.len()), (8, 12));
+        assert_eq!(m.volume_exact(), BigRational::from_integer(216.into()));
     }
 
     #[test]
