@@ -87,31 +87,41 @@ impl FlatBsp {
         if self.planes.is_empty() {
             return;
         }
-        // entries: node << 1 to visit, node << 1 | 1 to emit
-        let mut stack: Vec<u32> = Vec::with_capacity(2 * self.depth + 2);
-        stack.push(0);
+        // the eye's side of every plane first, in one pass over the planes
+        // in memory order (exact, and free of the walk's branches); then
+        // the walk reads one bit a node
         let back_to_front = order == Order::BackToFront;
-        while let Some(e) = stack.pop() {
-            let i = (e >> 1) as usize;
-            if e & 1 == 1 {
-                let (a, b) = (self.first[i] as usize, self.first[i + 1] as usize);
-                self.polygons[a..b].iter().for_each(&mut visit);
-                continue;
+        let mut near_back = vec![0u64; self.planes.len().div_ceil(64)];
+        for (w, planes) in near_back.iter_mut().zip(self.planes.chunks(64)) {
+            for (k, plane) in planes.iter().enumerate() {
+                let eye_in_front = plane.classify_viewpoint(eye) != Side::Back;
+                *w |= u64::from(eye_in_front == back_to_front) << k;
             }
-            let [front, back] = self.children[i];
-            let eye_in_front = self.planes[i].classify_viewpoint(eye) != Side::Back;
-            let (first, second) = if eye_in_front == back_to_front {
-                (back, front)
-            } else {
-                (front, back)
+        }
+        // down each node's first subtree, keeping on the stack only the
+        // nodes still to emit, each with its second subtree
+        let mut stack: Vec<(u32, u32)> = Vec::with_capacity(self.depth + 1);
+        let mut at = 0u32;
+        loop {
+            while at < OUT {
+                let i = at as usize;
+                let [front, back] = self.children[i];
+                let (first, second) = match near_back[i / 64] >> (i % 64) & 1 == 1 {
+                    true => (back, front),
+                    false => (front, back),
+                };
+                stack.push((at, second));
+                at = first;
+            }
+            let Some((i, second)) = stack.pop() else {
+                break;
             };
-            if second < OUT {
-                stack.push(second << 1);
-            }
-            stack.push(e | 1);
-            if first < OUT {
-                stack.push(first << 1);
-            }
+            let (a, b) = (
+                self.first[i as usize] as usize,
+                self.first[i as usize + 1] as usize,
+            );
+            self.polygons[a..b].iter().for_each(&mut visit);
+            at = second;
         }
     }
 }
