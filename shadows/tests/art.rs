@@ -459,22 +459,15 @@ fn deforming_moves_a_shifted_view_back_instead_of_growing_the_others() {
             (c0..c0 + 16).contains(&c) && (8..24).contains(&r)
         })
     };
-    let floor_view = floor(ArtLight::Sun(DVec3::Z), sq(8));
-    let wall_x = view(
-        ArtLight::Sun(DVec3::X),
-        DVec3::ZERO,
-        DVec3::Y,
-        DVec3::Z,
-        sq(8),
-    );
-    let wall_y = view(
-        ArtLight::Sun(DVec3::Y),
-        DVec3::ZERO,
-        DVec3::X,
-        DVec3::Z,
-        sq(12),
-    );
-    let s = spec(vec![floor_view, wall_x, wall_y], DVec3::splat(32.0));
+    // (each wall through the origin, under a sun along its normal)
+    let wall =
+        |sun: DVec3, u: DVec3, v: DVec3, c0| view(ArtLight::Sun(sun), DVec3::ZERO, u, v, sq(c0));
+    let views = vec![
+        wall(DVec3::Z, DVec3::X, DVec3::Y, 8),
+        wall(DVec3::X, DVec3::Y, DVec3::Z, 8),
+        wall(DVec3::Y, DVec3::X, DVec3::Z, 12),
+    ];
+    let s = spec(views, DVec3::splat(32.0));
     let how = |deform_rounds| Optimize {
         target: 0.005,
         rounds: 16,

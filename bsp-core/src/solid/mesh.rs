@@ -1292,6 +1292,24 @@ mod tests {
         assert_eq!(m.volume_exact(), BigRational::from_integer(1.into()));
     }
 
+    /// `p` cut by the plane `x = x2 / 2`, which must cross it: its two
+    /// pieces, each with made corners.
+    fn cut_at_half_x(p: &Polygon, x2: i128) -> [Polygon; 2] {
+        match p.parts(&Plane::new([2, 0, 0], -x2).unwrap()) {
+            crate::kernel::polygon::Parts::Split { front, back } => [back, front],
+            crate::kernel::polygon::Parts::Whole(_) => panic!("the plane crosses the polygon"),
+        }
+    }
+
+    /// Every triangle of `m` turns counter-clockwise, seen from +z.
+    fn assert_ccw_from_z(m: &TriMesh) {
+        for t in &m.triangles {
+            let [a, b, c] = t.map(|v| m.vertices[v as usize].to_f64());
+            let cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            assert!(cross > 0.0, "{t:?}");
+        }
+    }
+
     /// A flat region with two reflex corners, made of pieces cut at
     /// `x = 5/2` and `x = 7/2` (so each has a made corner): it is fanned
     /// from a reflex corner that sees every other edge from inside, its
@@ -1317,23 +1335,13 @@ mod tests {
             let (a, b) = (outline[i], outline[(i + 1) % 10]);
             let t = Polygon::from_grid_points(&[outline[apex], a, b], 0).unwrap();
             let x = if a[0].min(b[0]) < 3 { 5 } else { 7 };
-            match t.parts(&Plane::new([2, 0, 0], -x).unwrap()) {
-                crate::kernel::polygon::Parts::Split { front, back } => {
-                    pieces.extend([back, front])
-                }
-                crate::kernel::polygon::Parts::Whole(_) => panic!("every triangle is cut"),
-            }
+            pieces.extend(cut_at_half_x(&t, x));
         }
         let m = TriMesh::from_polygons(&pieces);
         assert_eq!((m.vertices.len(), m.triangles.len()), (10, 8));
         // its area: 36 less the notches' 1 and 3
         assert_eq!(m.area_f64(), 32.0);
-        // every triangle turns counter-clockwise, seen from +z
-        for t in &m.triangles {
-            let [a, b, c] = t.map(|v| m.vertices[v as usize].to_f64());
-            let cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-            assert!(cross > 0.0, "{t:?}");
-        }
+        assert_ccw_from_z(&m);
     }
 
     /// A flat region with two reflex corners, neither of which sees every
@@ -1353,22 +1361,13 @@ mod tests {
         for (i, part) in parts.iter().enumerate() {
             let p = Polygon::from_grid_points(part, 0).unwrap();
             let x = if i % 2 == 0 { 1 } else { 11 };
-            match p.parts(&Plane::new([2, 0, 0], -x).unwrap()) {
-                crate::kernel::polygon::Parts::Split { front, back } => {
-                    pieces.extend([back, front])
-                }
-                crate::kernel::polygon::Parts::Whole(_) => panic!("every part is cut"),
-            }
+            pieces.extend(cut_at_half_x(&p, x));
         }
         let m = TriMesh::from_polygons(&pieces);
         assert_eq!((m.vertices.len(), m.triangles.len()), (10, 8));
         // its area: 36 less the notches' 3 and 3
         assert_eq!(m.area_f64(), 30.0);
-        for t in &m.triangles {
-            let [a, b, c] = t.map(|v| m.vertices[v as usize].to_f64());
-            let cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-            assert!(cross > 0.0, "{t:?}");
-        }
+        assert_ccw_from_z(&m);
     }
 
     /// A cube whose faces but one are cut by a plane: each cut face's
