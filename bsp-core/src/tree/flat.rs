@@ -2,10 +2,12 @@
 //!
 //! Seed 003 stores the tree level by level in an array padded to a full
 //! binary tree, which costs `2^depth` slots. Here the nodes are stored in
-//! pre-order in parallel arrays — planes, child indices, and one contiguous
-//! polygon array sliced by per-node offsets — so storage is linear in the
-//! node count, and traversal is a loop over a small explicit stack of
-//! `u32`s, without recursion.
+//! pre-order in parallel arrays — planes, child indices, subtree sizes, and
+//! one contiguous polygon array sliced by per-node offsets — so storage is
+//! linear in the node count. Traversal needs neither recursion nor a
+//! stack: one pass over the nodes in memory order places each node in the
+//! walk's order (after the subtree it puts first, which its size says how
+//! long is), and a second emits the polygons in that order.
 
 use crate::kernel::Side;
 use crate::kernel::grid::ViewPoint;
@@ -24,8 +26,10 @@ pub struct FlatBsp {
     children: Vec<[u32; 2]>,
     /// Node `i` holds `polygons[first[i]..first[i + 1]]`.
     first: Vec<u32>,
+    /// Nodes in each node's subtree, itself included, and a last 0 for
+    /// the cells (`IN`, `OUT` read as index `len`).
+    size: Vec<u32>,
     polygons: Vec<Polygon>,
-    depth: usize,
 }
 
 impl FlatBsp {
@@ -36,8 +40,8 @@ impl FlatBsp {
             planes: Vec::with_capacity(n),
             children: Vec::with_capacity(n),
             first: Vec::with_capacity(n + 1),
+            size: Vec::new(),
             polygons: Vec::with_capacity(tree.polygons().count()),
-            depth: tree.stats().depth,
         };
         // (link in `tree`, slot in `children` to patch: (index, 0 front / 1 back))
         let mut stack: Vec<(Link, Option<(usize, usize)>)> = vec![(tree.root(), None)];
@@ -63,6 +67,13 @@ impl FlatBsp {
             }
         }
         f.first.push(f.polygons.len() as u32);
+        // pre-order: a node's children come after it
+        let len = f.planes.len();
+        f.size = vec![0; len + 1];
+        for i in (0..len).rev() {
+            let [a, b] = f.children[i].map(|c| (c as usize).min(len));
+            f.size[i] = 1 + f.size[a] + f.size[b];
+        }
         f
     }
 
@@ -87,41 +98,32 @@ impl FlatBsp {
         if self.planes.is_empty() {
             return;
         }
-        // the eye's side of every plane first, in one pass over the planes
-        // in memory order (exact, and free of the walk's branches); then
-        // the walk reads one bit a node
+        // one pass over the nodes in memory order (pre-order: a node before
+        // its children) places each node in the walk's order: it comes
+        // after the whole subtree it puts first, and its second subtree
+        // right after it; the cells stand for index `len`. Then the
+        // polygons go out in that order. No stack, and no branch on the
+        // eye's side of a plane (which is as good as random).
         let back_to_front = order == Order::BackToFront;
-        let mut near_back = vec![0u64; self.planes.len().div_ceil(64)];
-        for (w, planes) in near_back.iter_mut().zip(self.planes.chunks(64)) {
-            for (k, plane) in planes.iter().enumerate() {
-                let eye_in_front = plane.classify_viewpoint(eye) != Side::Back;
-                *w |= u64::from(eye_in_front == back_to_front) << k;
-            }
+        let len = self.planes.len();
+        let mut base = vec![0u32; len + 1];
+        let mut at = vec![0u32; len + 1];
+        for i in 0..len {
+            let c = self.children[i].map(|c| (c as usize).min(len));
+            let eye_in_front = self.planes[i].classify_viewpoint(eye) != Side::Back;
+            let b = usize::from(eye_in_front == back_to_front);
+            let (first, second) = (c[b], c[1 - b]);
+            let place = base[i] + self.size[first];
+            at[place as usize] = i as u32;
+            base[first] = base[i];
+            base[second] = place + 1;
         }
-        // down each node's first subtree, keeping on the stack only the
-        // nodes still to emit, each with its second subtree
-        let mut stack: Vec<(u32, u32)> = Vec::with_capacity(self.depth + 1);
-        let mut at = 0u32;
-        loop {
-            while at < OUT {
-                let i = at as usize;
-                let [front, back] = self.children[i];
-                let (first, second) = match near_back[i / 64] >> (i % 64) & 1 == 1 {
-                    true => (back, front),
-                    false => (front, back),
-                };
-                stack.push((at, second));
-                at = first;
-            }
-            let Some((i, second)) = stack.pop() else {
-                break;
-            };
+        for &i in &at[..len] {
             let (a, b) = (
                 self.first[i as usize] as usize,
                 self.first[i as usize + 1] as usize,
             );
             self.polygons[a..b].iter().for_each(&mut visit);
-            at = second;
         }
     }
 }
