@@ -2,9 +2,9 @@
 //!
 //! Seed 003 stores the tree level by level in an array padded to a full
 //! binary tree, which costs `2^depth` slots. Here the nodes are stored in
-//! pre-order in parallel arrays — planes, child indices, subtree sizes, and
-//! one contiguous polygon array sliced by per-node offsets — so storage is
-//! linear in the node count. Traversal needs neither recursion nor a
+//! pre-order in parallel arrays — planes, child indices with their
+//! subtrees' sizes, and one contiguous polygon array sliced by per-node
+//! offsets — so storage is linear in the node count. Traversal needs neither recursion nor a
 //! stack: one pass over the nodes in memory order places each node in the
 //! walk's order (after the subtree it puts first, which its size says how
 //! long is), and a second emits the polygons in that order.
@@ -26,9 +26,9 @@ pub struct FlatBsp {
     children: Vec<[u32; 2]>,
     /// Node `i` holds `polygons[first[i]..first[i + 1]]`.
     first: Vec<u32>,
-    /// Nodes in each node's subtree, itself included, and a last 0 for
-    /// the cells (`IN`, `OUT` read as index `len`).
-    size: Vec<u32>,
+    /// The node counts of each node's `[front, back]` subtrees (0 for a
+    /// cell), beside its children so that the walk reads them in order.
+    child_size: Vec<[u32; 2]>,
     polygons: Vec<Polygon>,
 }
 
@@ -40,7 +40,7 @@ impl FlatBsp {
             planes: Vec::with_capacity(n),
             children: Vec::with_capacity(n),
             first: Vec::with_capacity(n + 1),
-            size: Vec::new(),
+            child_size: Vec::new(),
             polygons: Vec::with_capacity(tree.polygons().count()),
         };
         // (link in `tree`, slot in `children` to patch: (index, 0 front / 1 back))
@@ -67,13 +67,17 @@ impl FlatBsp {
             }
         }
         f.first.push(f.polygons.len() as u32);
-        // pre-order: a node's children come after it
+        // pre-order: a node's children come after it (the cells read as
+        // index `len`, of size 0)
         let len = f.planes.len();
-        f.size = vec![0; len + 1];
+        let mut size = vec![0u32; len + 1];
         for i in (0..len).rev() {
             let [a, b] = f.children[i].map(|c| (c as usize).min(len));
-            f.size[i] = 1 + f.size[a] + f.size[b];
+            size[i] = 1 + size[a] + size[b];
         }
+        f.child_size = (f.children.iter())
+            .map(|c| c.map(|c| size[(c as usize).min(len)]))
+            .collect();
         f
     }
 
@@ -113,7 +117,7 @@ impl FlatBsp {
             let eye_in_front = self.planes[i].classify_viewpoint(eye) != Side::Back;
             let b = usize::from(eye_in_front == back_to_front);
             let (first, second) = (c[b], c[1 - b]);
-            let place = base[i] + self.size[first];
+            let place = base[i] + self.child_size[i][b];
             at[place as usize] = i as u32;
             base[first] = base[i];
             base[second] = place + 1;
