@@ -4,10 +4,11 @@
 //! binary tree, which costs `2^depth` slots. Here the nodes are stored in
 //! pre-order in parallel arrays — planes, child indices with their
 //! subtrees' sizes, and one contiguous polygon array sliced by per-node
-//! offsets — so storage is linear in the node count. Traversal needs neither recursion nor a
-//! stack: one pass over the nodes in memory order places each node in the
-//! walk's order (after the subtree it puts first, which its size says how
-//! long is), and a second emits the polygons in that order.
+//! offsets — so storage is linear in the node count. Traversal needs
+//! neither recursion nor a stack: one pass over the nodes in memory order
+//! places each node in the walk's order (after the subtree it puts first,
+//! which its size says how long is), and a second emits the polygons in
+//! that order.
 
 use crate::kernel::Side;
 use crate::kernel::grid::ViewPoint;
