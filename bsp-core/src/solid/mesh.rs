@@ -1370,6 +1370,52 @@ mod tests {
         assert_ccw_from_z(&m);
     }
 
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+
+        /// A random star-shaped polygon (corners in increasing angle about
+        /// the origin, on the grid), fanned from the origin and each fan
+        /// triangle cut at `x = ±1/2` (so every piece has a made corner):
+        /// meshed as one region it keeps its area exactly, every triangle
+        /// turns counter-clockwise, and no point the cuts made is left.
+        #[test]
+        fn a_star_cut_into_pieces_comes_back_as_its_outline(
+            radii in proptest::collection::vec((5i32..60, 0.15f64..0.85), 5..14)
+        ) {
+            let k = radii.len();
+            let outline: Vec<[i32; 3]> = (radii.iter().enumerate())
+                .map(|(i, &(r, t))| {
+                    let a = std::f64::consts::TAU * (i as f64 + t) / k as f64;
+                    let (x, y) = ((r as f64 * a.cos()).round(), (r as f64 * a.sin()).round());
+                    // (away from the cut planes' strip, |x| >= 1)
+                    let x = if x.abs() < 1.0 { 1.0 } else { x };
+                    [x as i32, y as i32, 0]
+                })
+                .collect();
+            let turn = |a: [i32; 3], b: [i32; 3], c: [i32; 3]| {
+                let (a, b, c) = (a.map(i64::from), b.map(i64::from), c.map(i64::from));
+                (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+            };
+            // (rounding can make a corner's angle pass the next one's)
+            let star = (0..k).all(|i| turn([0; 3], outline[i], outline[(i + 1) % k]) > 0);
+            proptest::prop_assume!(star);
+            let mut pieces = Vec::new();
+            for i in 0..k {
+                let (a, b) = (outline[i], outline[(i + 1) % k]);
+                let t = Polygon::from_grid_points(&[[0; 3], a, b], 0).unwrap();
+                pieces.extend(cut_at_half_x(&t, if a[0].max(b[0]) >= 1 { 1 } else { -1 }));
+            }
+            let m = TriMesh::from_polygons(&pieces);
+            let twice: i64 = (0..k).map(|i| turn([0; 3], outline[i], outline[(i + 1) % k])).sum();
+            proptest::prop_assert_eq!(m.area_f64(), twice as f64 / 2.0);
+            assert_ccw_from_z(&m);
+            // only the outline's corners are left: no made point, and not
+            // the origin inside
+            proptest::prop_assert!(m.vertices.len() <= k, "{} of {k}", m.vertices.len());
+            proptest::prop_assert!(m.vertices.iter().all(|v| v.as_grid().is_some()));
+        }
+    }
+
     /// A cube whose faces but one are cut by a plane: each cut face's
     /// pieces make one region again, and the cut points on the whole
     /// face's edges (points inside its edges, not corners) go from it
