@@ -113,7 +113,7 @@ impl Moved {
         for t in &grid.triangles {
             let d = t.map(|v| moved[v]);
             let r = t.map(|v| grid.rest[v]);
-            let area = cross(d[1] - d[0], d[2] - d[0]);
+            let area = (d[1] - d[0]).perp_dot(d[2] - d[0]);
             if area == 0.0 {
                 continue;
             }
@@ -124,8 +124,8 @@ impl Moved {
             for row in r0..r1 {
                 for col in c0..c1 {
                     let q = centre(col, row);
-                    let b1 = cross(q - d[0], d[2] - d[0]) / area;
-                    let b2 = cross(d[1] - d[0], q - d[0]) / area;
+                    let b1 = (q - d[0]).perp_dot(d[2] - d[0]) / area;
+                    let b2 = (d[1] - d[0]).perp_dot(q - d[0]) / area;
                     let b0 = 1.0 - b1 - b2;
                     if b0 < 0.0 || b1 < 0.0 || b2 < 0.0 {
                         continue;
@@ -157,10 +157,6 @@ fn centre(c: usize, r: usize) -> DVec2 {
 /// 1)` holds every pixel whose centre lies in `[lo, hi]`.
 fn span(x: f64, n: usize) -> usize {
     (x.floor().max(0.0) as usize).min(n)
-}
-
-fn cross(a: DVec2, b: DVec2) -> f64 {
-    a.x * b.y - a.y * b.x
 }
 
 /// The pixel constraints: each wanted pixel's centre and where it should
@@ -285,9 +281,9 @@ impl Grid {
         let t = 2 * (j * cx + i) + usize::from(v > u);
         let tri = self.triangles[t];
         let [a, b, c] = tri.map(|k| self.rest[k]);
-        let area = cross(b - a, c - a);
-        let wb = cross(p - a, c - a) / area;
-        let wc = cross(b - a, p - a) / area;
+        let area = (b - a).perp_dot(c - a);
+        let wb = (p - a).perp_dot(c - a) / area;
+        let wc = (b - a).perp_dot(p - a) / area;
         (tri, [1.0 - wb - wc, wb, wc])
     }
 
@@ -339,7 +335,7 @@ impl Grid {
                 let (mut s, mut c) = (0.0, 0.0);
                 for &(i, j) in &edges {
                     let (e, f) = (self.rest[i] - self.rest[j], pos[i] - pos[j]);
-                    s += cross(e, f);
+                    s += e.perp_dot(f);
                     c += e.dot(f);
                 }
                 let turn = DVec2::new(c, s).try_normalize().unwrap_or(DVec2::X);

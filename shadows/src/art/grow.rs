@@ -395,23 +395,29 @@ pub fn optimize_with(spec: &ArtSpec, how: Optimize) -> Result<ArtRun, ArtError> 
     let missing_before = checks.iter().map(|c| c.missing_area).collect();
     let mut moved: Vec<Moved> = spec.views.iter().map(|v| Moved::new(&v.mask)).collect();
     let mut deform_rounds = 0;
+    // each view's allowed pixels, kept while no other view changes (a
+    // hull of the other views a view and round otherwise)
+    let mut allowed_of: Vec<Option<Option<Vec<bool>>>> = vec![None; spec.views.len()];
     while deform_rounds < how.deform_rounds && !met(&checks, how.target) {
         let mut trial = (spec.clone(), moved.clone());
-        let mut any = false;
+        let mut changed = vec![false; spec.views.len()];
         for (k, c) in checks.iter().enumerate() {
             if c.missing_area <= how.target * c.wanted_area {
                 continue;
             }
-            let Some(allowed) = allowed(&spec, k)? else {
+            if allowed_of[k].is_none() {
+                allowed_of[k] = Some(allowed(&spec, k)?);
+            }
+            let Some(Some(allowed)) = &allowed_of[k] else {
                 continue;
             };
-            if let Some(m) = moved[k].deformed(&c.coverage, &allowed) {
+            if let Some(m) = moved[k].deformed(&c.coverage, allowed) {
                 trial.0.views[k].mask = m.mask.clone();
                 trial.1[k] = m;
-                any = true;
+                changed[k] = true;
             }
         }
-        if !any {
+        if !changed.contains(&true) {
             break;
         }
         let made = match shadow_hull(&trial.0) {
@@ -426,6 +432,11 @@ pub fn optimize_with(spec: &ArtSpec, how: Optimize) -> Result<ArtRun, ArtError> 
         (spec, moved) = trial;
         (hull, checks) = (h, c);
         deform_rounds += 1;
+        for (k, slot) in allowed_of.iter_mut().enumerate() {
+            if (changed.iter().enumerate()).any(|(j, &c)| c && j != k) {
+                *slot = None;
+            }
+        }
     }
     let mut done = 0;
     while done < how.rounds {
