@@ -12,6 +12,7 @@
 
 use std::collections::HashMap;
 use std::io::{self, Write};
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 use bsp_core::{Grid, Polygon};
@@ -19,6 +20,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::engine::{is_one_of, large_receivers, runs};
 use crate::{
     AreaClass, Areas, Batch, CHUNK, Light, PlacedLight, ShadeOptions, ShadowSet, SoftFragment,
     SoftLight, SoftShape, polygon_area,
@@ -556,9 +558,23 @@ impl FragmentFile {
         &mut self,
         out: &mut impl Write,
         shadows: ShadowSet<'_>,
+        scene: (&[Polygon], &[std::ops::Range<usize>], &Grid),
+        opts: &ShadeOptions,
+        done: impl Fn(usize) + Sync,
+    ) -> io::Result<Streamed> {
+        self.stream_by(out, shadows, scene, opts, done, (ROUND, CHUNK))
+    }
+
+    /// [`FragmentFile::stream`] in rounds of `round` receivers, each
+    /// shaded in parallel in runs of at most `chunk`.
+    fn stream_by(
+        &mut self,
+        out: &mut impl Write,
+        shadows: ShadowSet<'_>,
         (polys, ranges, grid): (&[Polygon], &[std::ops::Range<usize>], &Grid),
         opts: &ShadeOptions,
         done: impl Fn(usize) + Sync,
+        (round, chunk): (usize, usize),
     ) -> io::Result<Streamed> {
         let json = matches!(self.kind, FileKind::Json { .. });
         let lights = self.lights;
@@ -566,34 +582,58 @@ impl FragmentFile {
             receivers: ranges.len(),
             ..Streamed::default()
         };
-        for (r, round) in ranges.chunks(ROUND).enumerate() {
-            let start = Instant::now();
-            let parts: Vec<Result<Shaded, ExportError>> = round
-                .par_chunks(CHUNK)
-                .enumerate()
-                .map(|(i, rs)| {
-                    let first_receiver = (r * ROUND + i * CHUNK) as u32;
-                    let b = shadows.shade_ranges(polys, rs, first_receiver, opts);
-                    let world = world_vertices(&b, grid)?;
-                    let records = area_records(&b, &world);
-                    let text = match json {
-                        true => json_fragments(&b, &world, &records, lights),
-                        false => Vec::new(),
-                    };
-                    done(rs.len());
-                    Ok((b, world, records, text))
+        // the large receivers (see `large_receivers`) are shaded from the
+        // start, beside the rounds, and kept until their round writes them;
+        // a round that comes to one not yet begun shades it itself
+        let large = large_receivers(polys, ranges);
+        let slots: Vec<OnceLock<Result<Shaded, ExportError>>> =
+            large.iter().map(|_| OnceLock::new()).collect();
+        let shade = |r: std::ops::Range<usize>| -> Result<Shaded, ExportError> {
+            let b = shadows.shade_ranges(polys, &ranges[r.clone()], r.start as u32, opts);
+            let world = world_vertices(&b, grid)?;
+            let records = area_records(&b, &world);
+            let text = match json {
+                true => json_fragments(&b, &world, &records, lights),
+                false => Vec::new(),
+            };
+            done(r.len());
+            Ok((b, world, records, text))
+        };
+        let large_part = |k: usize| slots[k].get_or_init(|| shade(large[k]..large[k] + 1));
+        rayon::in_place_scope(|scope| {
+            scope.spawn(|_| {
+                (0..large.len()).into_par_iter().for_each(|k| {
+                    large_part(k);
                 })
-                .collect();
-            s.shading += start.elapsed();
-            let start = Instant::now();
-            for part in parts {
-                let (b, world, records, text) =
-                    part.map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))?;
-                s.fragments += b.len();
-                self.write(out, (&b, &world, &records), json.then_some(&text[..]))?;
+            });
+            for start in (0..ranges.len()).step_by(round) {
+                let t = Instant::now();
+                let runs = runs(start..(start + round).min(ranges.len()), &large, chunk);
+                let todo: Vec<&std::ops::Range<usize>> =
+                    runs.iter().filter(|r| !is_one_of(r, &large)).collect();
+                let parts: Vec<Result<Shaded, ExportError>> =
+                    todo.par_iter().map(|r| shade((*r).clone())).collect();
+                let mut parts = parts.into_iter();
+                s.shading += t.elapsed();
+                let t = Instant::now();
+                for r in &runs {
+                    let own;
+                    let part = match large.iter().position(|&i| is_one_of(r, &[i])) {
+                        Some(k) => large_part(k).as_ref(),
+                        None => {
+                            own = parts.next().expect("a part a run");
+                            own.as_ref()
+                        }
+                    };
+                    let (b, world, records, text) =
+                        part.map_err(|e| io::Error::new(io::ErrorKind::InvalidData, *e))?;
+                    s.fragments += b.len();
+                    self.write(out, (b, world, records), json.then_some(&text[..]))?;
+                }
+                s.writing += t.elapsed();
             }
-            s.writing += start.elapsed();
-        }
+            Ok::<(), io::Error>(())
+        })?;
         Ok(s)
     }
 
@@ -690,6 +730,117 @@ mod tests {
         }
     }
 
+    /// A row of `n` small tiles at height 1 over three large faces at
+    /// heights 0, -1 and -2 (receivers 0, 21 and `n + 2`), under a point
+    /// light: its grid, light, polygons and shadow trees.
+    fn tiles_scene(n: usize) -> (Grid, Vec<PlacedLight>, Vec<Polygon>, crate::Shadows) {
+        let large = |z: f64| {
+            [
+                [-9., -9., z],
+                [n as f64 + 9., -9., z],
+                [n as f64 + 9., 9., z],
+                [-9., 9., z],
+            ]
+        };
+        let tile = |i: usize| {
+            let x = i as f64;
+            [
+                [x + 0.2, 0.2, 1.],
+                [x + 0.8, 0.2, 1.],
+                [x + 0.8, 0.8, 1.],
+                [x + 0.2, 0.8, 1.],
+            ]
+        };
+        let mut loops: Vec<[[f64; 3]; 4]> = (0..n).map(tile).collect();
+        loops.insert(0, large(0.0));
+        loops.insert(21, large(-1.0));
+        loops.push(large(-2.0));
+        let positions: Vec<DVec3> = loops.iter().flatten().map(|&p| DVec3::from(p)).collect();
+        let specs = [crate::LightSpec::Point(DVec3::new(
+            n as f64 / 2.0,
+            3.0,
+            9.0,
+        ))];
+        let grid = crate::shared_grid(&positions, &specs).unwrap();
+        let lights = crate::place_lights(&grid, &specs).unwrap();
+        let polys: Vec<bsp_core::Polygon> = (loops.iter().enumerate())
+            .map(|(i, l)| {
+                let pts: Vec<_> = l.iter().map(|&p| grid.snap(p.into()).unwrap()).collect();
+                bsp_core::Polygon::from_grid_points(&pts, i as u32).unwrap()
+            })
+            .collect();
+        let kernel: Vec<Light> = lights.iter().map(|l| l.light).collect();
+        let shadows = crate::Shadows::new(&polys, &kernel).unwrap();
+        (grid, lights, polys, shadows)
+    }
+
+    /// The large receivers are shaded first, beside the rounds, and the
+    /// file is still the receivers' in order: the same bytes as one batch
+    /// shaded receiver by receiver, for rounds and runs of every size and
+    /// on one thread or two.
+    #[test]
+    fn large_receivers_shaded_first_keep_the_file_in_order() {
+        let n = 40;
+        let (grid, lights, polys, shadows) = tiles_scene(n);
+        let ranges = crate::receivers(&polys);
+        let mut large = crate::engine::large_receivers(&polys, &ranges);
+        large.sort_unstable();
+        assert_eq!(large, [0, 21, n + 2]);
+        let opts = crate::ShadeOptions::default().with_pieces(true);
+        let whole = shadows.set().shade_ranges(&polys, &ranges, 0, &opts);
+        assert!(whole.len() > ranges.len(), "the large faces are cut");
+        for format in [FragmentFormat::Json, FragmentFormat::Obj] {
+            let (expected, _) =
+                file_of_faces(format, &grid, &lights, &[&whole], false, polys.len());
+            for (threads, round, chunk) in [(1, 8, 3), (2, 8, 3), (2, 64, 5), (2, 1, 1)] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let mut out = Vec::new();
+                let notes = ["a".to_string(), "b".to_string()];
+                let head = ("test", &notes[..]);
+                let faces = polys.len();
+                let mut file = FragmentFile::begin(&mut out, format, &lights, faces, head).unwrap();
+                let done = std::sync::atomic::AtomicUsize::new(0);
+                let count = |k: usize| {
+                    done.fetch_add(k, std::sync::atomic::Ordering::Relaxed);
+                };
+                let scene = (&polys[..], &ranges[..], &grid);
+                let s = pool
+                    .install(|| {
+                        file.stream_by(&mut out, shadows.set(), scene, &opts, count, (round, chunk))
+                    })
+                    .unwrap();
+                file.finish(&mut out).unwrap();
+                let why =
+                    format!("{format:?}, {threads} threads, rounds of {round}, runs of {chunk}");
+                assert!(out == expected, "{why}");
+                assert_eq!(
+                    (s.fragments, done.into_inner()),
+                    (whole.len(), ranges.len()),
+                    "{why}"
+                );
+            }
+            let all = shadows.set().shade_all(&polys, &opts);
+            let (by_chunks, _) = file_of_faces(format, &grid, &lights, &[&all], false, polys.len());
+            assert!(by_chunks == expected, "shade_all, {format:?}");
+        }
+    }
+
+    #[test]
+    fn runs_cover_the_receivers_in_order_with_each_large_one_alone() {
+        use crate::engine::runs;
+        assert_eq!(runs(0..10, &[], 4), [0..4, 4..8, 8..10]);
+        assert_eq!(
+            runs(0..10, &[9, 2, 3], 4),
+            [0..2, 2..3, 3..4, 4..8, 8..9, 9..10]
+        );
+        // large receivers of other rounds are not this round's
+        assert_eq!(runs(5..9, &[0, 6, 12], 8), [5..6, 6..7, 7..9]);
+        assert!(runs(3..3, &[3], 4).is_empty());
+    }
+
     /// The file written in `batches`, and what was written.
     fn file_of(
         format: FragmentFormat,
@@ -698,10 +849,22 @@ mod tests {
         batches: &[&Batch],
         preformat: bool,
     ) -> (Vec<u8>, Written) {
+        file_of_faces(format, grid, lights, batches, preformat, 2)
+    }
+
+    /// [`file_of`] for a scene of `faces` faces.
+    fn file_of_faces(
+        format: FragmentFormat,
+        grid: &Grid,
+        lights: &[PlacedLight],
+        batches: &[&Batch],
+        preformat: bool,
+        faces: usize,
+    ) -> (Vec<u8>, Written) {
         let mut out = Vec::new();
         let notes = ["a".to_string(), "b".to_string()];
         let mut file =
-            FragmentFile::begin(&mut out, format, lights, 2, ("test", &notes[..])).unwrap();
+            FragmentFile::begin(&mut out, format, lights, faces, ("test", &notes[..])).unwrap();
         for b in batches {
             let world = world_vertices(b, grid).unwrap();
             let records = area_records(b, &world);
