@@ -173,20 +173,31 @@ impl Shadows {
         for l in lights {
             l.validate()?;
         }
-        // one light after the other: each build is parallel inside, and
-        // only one build's working memory is alive at a time (polygons
-        // off the grid leave no part certified, so nothing is left out
-        // and an error's index is the caller's)
-        let volumes = lights
-            .iter()
-            .map(|&l| {
-                let kept: Vec<&Polygon> = (occluders.iter().enumerate())
-                    .filter(|(i, p)| !l.leaves_out(solids, *i, p.support()))
-                    .map(|(_, p)| p)
-                    .collect();
-                ShadowVolumes::build(l, &kept)
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        // (polygons off the grid leave no part certified, so nothing is
+        // left out and an error's index is the caller's)
+        let build = |l: Light| {
+            let kept: Vec<&Polygon> = (occluders.iter().enumerate())
+                .filter(|(i, p)| !l.leaves_out(solids, *i, p.support()))
+                .map(|(_, p)| p)
+                .collect();
+            ShadowVolumes::build(l, &kept)
+        };
+        // two lights at a time: each build is parallel inside but has
+        // parts on one thread (its start, and its last regions), which the
+        // other build fills; only two builds' working memory is alive at
+        // once
+        let mut volumes = Vec::with_capacity(lights.len());
+        for pair in lights.chunks(2) {
+            match *pair {
+                [a, b] => {
+                    let (a, b) = rayon::join(|| build(a), || build(b));
+                    volumes.push(a?);
+                    volumes.push(b?);
+                }
+                [a] => volumes.push(build(a)?),
+                _ => unreachable!("chunks of one or two"),
+            }
+        }
         Ok(Shadows {
             lights: lights.to_vec(),
             volumes,
