@@ -81,18 +81,19 @@ fn partition_known(
 /// fragments; without it, long parallel slivers would be cut again and
 /// again next to the previous cut.
 fn cut_balances(polys: &[Polygon], plane: &Plane) -> bool {
-    let (mut front, mut back) = (0usize, 0usize);
-    for p in polys {
-        match p.classify(plane) {
-            PolygonSide::Front => front += 1,
-            PolygonSide::Back => back += 1,
-            PolygonSide::Spanning => {
-                front += 1;
-                back += 1;
-            }
-            PolygonSide::Coplanar { .. } => {}
-        }
-    }
+    use rayon::prelude::*;
+    let count = |(front, back): (usize, usize), p: &Polygon| match p.classify(plane) {
+        PolygonSide::Front => (front + 1, back),
+        PolygonSide::Back => (front, back + 1),
+        PolygonSide::Spanning => (front + 1, back + 1),
+        PolygonSide::Coplanar { .. } => (front, back),
+    };
+    let (front, back) = match polys.len() > PARALLEL_LIST {
+        true => (polys.par_iter())
+            .fold(|| (0, 0), count)
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1)),
+        false => polys.iter().fold((0, 0), count),
+    };
     let limit = polys.len() * 3 / 4;
     front > 0 && back > 0 && front <= limit && back <= limit
 }
@@ -224,13 +225,77 @@ pub(super) fn grow<A>(
             stack.push((front, at_front, Slot::Front(id)));
             Link::Node(id)
         };
-        match slot {
-            Slot::Root => tree.root = link,
-            Slot::Front(id) => tree.nodes[id as usize].front = link,
-            Slot::Back(id) => tree.nodes[id as usize].back = link,
-        }
+        tree.hang(slot, link);
     }
     tree
+}
+
+/// Lists longer than this are cut first, one after the other, at the top
+/// of a [`BspTree::build`]; the shorter lists they leave are then grown in
+/// parallel.
+const PARALLEL_LIST: usize = 1 << 15;
+
+/// The cut [`BspTree::build`] makes of a list.
+fn cut(
+    polys: Vec<Polygon>,
+    opts: &BuildOptions,
+    rng: &mut SplitMix,
+    sides: &mut Vec<PolygonSide>,
+) -> Cut {
+    // a balance cut of a long list, where one balances
+    let balance = |polys: &[Polygon]| {
+        let long = opts.cut_threshold > 0 && polys.len() > opts.cut_threshold;
+        long.then(|| balance_cut(polys).filter(|c| cut_balances(polys, c)))
+            .flatten()
+    };
+    // tried first with `cut_always`, else where the best face plane is
+    // lopsided; `known`: `sides` hold every polygon's side of it
+    let (plane, known) = match opts.cut_always.then(|| balance(&polys)).flatten() {
+        Some(cut) => (cut, false),
+        None => {
+            let ((plane, known), lopsided) = choose_plane_sides(&polys, opts, rng, sides);
+            match (!opts.cut_always && lopsided)
+                .then(|| balance(&polys))
+                .flatten()
+            {
+                Some(cut) => (cut, false),
+                None => (plane, known),
+            }
+        }
+    };
+    let (on, front, back) = if known {
+        partition_known(polys, &plane, sides)
+    } else if polys.len() > PARALLEL_LIST {
+        // a long list's sides found in parallel
+        use rayon::prelude::*;
+        sides.clear();
+        polys
+            .par_iter()
+            .map(|p| p.classify(&plane))
+            .collect_into_vec(sides);
+        partition_known(polys, &plane, sides)
+    } else {
+        partition_list(polys, &plane)
+    };
+    (plane, on, front, back)
+}
+
+/// The tree of `polygons` grown on one thread from the random stream
+/// `seed`.
+fn build_one(polygons: Vec<Polygon>, opts: &BuildOptions, seed: u64) -> BspTree {
+    let mut rng = SplitMix(seed);
+    let mut sides = Vec::new();
+    grow(polygons, (), |polys, ()| {
+        (cut(polys, opts, &mut rng, &mut sides), (), ())
+    })
+}
+
+/// `link` of a tree whose nodes were moved `base` places on.
+fn shifted(link: Link, base: usize) -> Link {
+    match link {
+        Link::Node(id) => Link::Node(id + base as NodeId),
+        cell => cell,
+    }
 }
 
 impl BspTree {
@@ -241,39 +306,90 @@ impl BspTree {
     /// autopartition); coplanar polygons of both
     /// orientations stay at their node. Uses an explicit stack, so any
     /// depth is fine.
+    ///
+    /// Lists of more than 2^15 polygons are cut first, one after the
+    /// other; the shorter lists they leave are grown in parallel, each
+    /// from its own random stream (drawn from the seed and the list's
+    /// place), so the tree is the same for every thread count. A build of
+    /// fewer polygons is one list, grown from the seed alone.
     pub fn build(polygons: Vec<Polygon>, opts: &BuildOptions) -> BspTree {
-        let mut rng = SplitMix(opts.seed);
-        let mut sides = Vec::new();
-        // a balance cut of a long list, where one balances
-        let balance = |polys: &[Polygon]| {
-            let long = opts.cut_threshold > 0 && polys.len() > opts.cut_threshold;
-            long.then(|| balance_cut(polys).filter(|c| cut_balances(polys, c)))
-                .flatten()
+        use rayon::prelude::*;
+        if polygons.len() <= PARALLEL_LIST {
+            return build_one(polygons, opts, opts.seed);
+        }
+        let mut tree = BspTree {
+            nodes: Vec::new(),
+            root: Link::Cell(Cell::Out),
         };
-        grow(polygons, (), |polys, ()| {
-            // tried first with `cut_always`, else where the best face plane
-            // is lopsided; `known`: `sides` hold every polygon's side of it
-            let (plane, known) = match opts.cut_always.then(|| balance(&polys)).flatten() {
-                Some(cut) => (cut, false),
-                None => {
-                    let ((plane, known), lopsided) =
-                        choose_plane_sides(&polys, opts, &mut rng, &mut sides);
-                    match (!opts.cut_always && lopsided)
-                        .then(|| balance(&polys))
-                        .flatten()
-                    {
-                        Some(cut) => (cut, false),
-                        None => (plane, known),
-                    }
-                }
+        // the long lists cut level by level, those of a level in parallel,
+        // each from a random stream of its own (drawn from its parent's);
+        // the shorter lists left, with where they hang and their streams
+        let mut level = vec![(polygons, Slot::Root, opts.seed)];
+        let mut left: Vec<(Vec<Polygon>, Slot, u64)> = Vec::new();
+        while !level.is_empty() {
+            let (long, short): (Vec<_>, Vec<_>) =
+                level.into_iter().partition(|l| l.0.len() > PARALLEL_LIST);
+            left.extend(short);
+            let cuts: Vec<(Cut, Slot, [u64; 2])> = (long.into_par_iter())
+                .map(|(polys, slot, seed)| {
+                    let mut rng = SplitMix(seed);
+                    let cut = cut(polys, opts, &mut rng, &mut Vec::new());
+                    (cut, slot, [rng.next_u64(), rng.next_u64()])
+                })
+                .collect();
+            level = Vec::new();
+            for ((plane, on, front, back), slot, [f, b]) in cuts {
+                let id = tree.nodes.len() as NodeId;
+                tree.nodes.push(Node {
+                    plane,
+                    polygons: on,
+                    front: Link::Cell(Cell::Out),
+                    back: Link::Cell(Cell::In),
+                });
+                tree.hang(slot, Link::Node(id));
+                level.push((front, Slot::Front(id), f));
+                level.push((back, Slot::Back(id), b));
+            }
+        }
+        // the lists left grown in parallel, the longest started first;
+        // their nodes then follow the top's, in the lists' order
+        let mut jobs: Vec<(usize, Vec<Polygon>, u64)> = (left.iter_mut().enumerate())
+            .map(|(i, (polys, _, seed))| (i, std::mem::take(polys), *seed))
+            .collect();
+        jobs.sort_by_key(|j| std::cmp::Reverse(j.1.len()));
+        let mut grown: Vec<(usize, BspTree)> = (jobs.into_par_iter())
+            .map(|(i, polys, seed)| (i, build_one(polys, opts, seed)))
+            .collect();
+        grown.sort_by_key(|g| g.0);
+        tree.nodes
+            .reserve(grown.iter().map(|g| g.1.nodes.len()).sum());
+        for ((_, slot, _), (_, sub)) in left.into_iter().zip(grown) {
+            let base = tree.nodes.len();
+            let link = match sub.root {
+                // an empty list: the leaf `grow` makes of it
+                Link::Cell(_) => Link::Cell(match slot {
+                    Slot::Back(_) => Cell::In,
+                    Slot::Front(_) | Slot::Root => Cell::Out,
+                }),
+                root => shifted(root, base),
             };
-            let (on, front, back) = if known {
-                partition_known(polys, &plane, &sides)
-            } else {
-                partition_list(polys, &plane)
-            };
-            ((plane, on, front, back), (), ())
-        })
+            tree.nodes.extend(sub.nodes.into_iter().map(|mut n| {
+                n.front = shifted(n.front, base);
+                n.back = shifted(n.back, base);
+                n
+            }));
+            tree.hang(slot, link);
+        }
+        tree
+    }
+
+    /// Hangs `link` at `slot`.
+    fn hang(&mut self, slot: Slot, link: Link) {
+        match slot {
+            Slot::Root => self.root = link,
+            Slot::Front(id) => self.nodes[id as usize].front = link,
+            Slot::Back(id) => self.nodes[id as usize].back = link,
+        }
     }
 
     /// A tree from its nodes and root (indices into `nodes`; every node
