@@ -254,7 +254,7 @@ pub fn shadows(mesh: &Mesh, lights: &[Light]) -> Result<Shadows, Error> {
     let (polys, _) =
         bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(Error::Import)?;
     let solids = bsp_core::certify_solid_parts(&polys);
-    shadows_on(&grid, &polys, &solids, mesh.faces.len(), lights, None)
+    shadows_on(&grid, &polys, &solids, mesh.faces.len(), lights, None, true)
 }
 
 /// A tile's part of a study's run ([`shadows_on`]): its polygons
@@ -279,13 +279,15 @@ pub(crate) fn shadows_on(
     faces: usize,
     lights: &[Light],
     tile: Option<TilePart<'_>>,
+    pieces: bool,
 ) -> Result<Shadows, Error> {
     let placed = svbsp::place_lights(grid, lights).map_err(Error::Light)?;
     let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
     let reach = tile.map(|(_, b, boxes)| (b, boxes));
     let trees = face_trees(polys, &kernel, &[], solids, reach).map_err(Error::Shadow)?;
-    // (with convex pieces: the OBJ writer draws them)
-    let opts = ShadeOptions::default().with_pieces(true);
+    // with convex pieces where asked (the OBJ writer draws them, a sun
+    // study's extremes overlay them)
+    let opts = ShadeOptions::default().with_pieces(pieces);
     let batch = match tile {
         None => trees.set().shade_all(polys, &opts),
         Some((own, _, _)) => {
@@ -480,7 +482,16 @@ mod tests {
         let grid = svbsp::shared_grid(&city.positions, &lights).unwrap();
         let (polys, _) = bsp_core::import_faces_par(&grid, &city.face_loops()).unwrap();
         let solids = bsp_core::certify_solid_parts(&polys);
-        let culled = shadows_on(&grid, &polys, &solids, city.faces.len(), &lights, None).unwrap();
+        let culled = shadows_on(
+            &grid,
+            &polys,
+            &solids,
+            city.faces.len(),
+            &lights,
+            None,
+            true,
+        )
+        .unwrap();
         let placed = svbsp::place_lights(&grid, &lights).unwrap();
         let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
         // the buildings are closed: their faces turned away from a light

@@ -171,7 +171,15 @@ impl HoursRun {
             },
         };
         let s = snapped;
-        let run = crate::shadows_on(&s.grid, &s.polys, &s.solids, faces, &lights, shaded)?;
+        let run = crate::shadows_on(
+            &s.grid,
+            &s.polys,
+            &s.solids,
+            faces,
+            &lights,
+            shaded,
+            pieces.is_some(),
+        )?;
         let ids = part.map(|(own, _)| own.faces.clone());
         let order: Vec<usize> = match &ids {
             Some(ids) => ids.iter().map(|&f| f as usize).collect(),
