@@ -676,16 +676,24 @@ mod tests {
             [[0., 0., 0.], [8., 0., 0.], [8., 8., 0.], [0., 8., 0.]],
             [[2., 2., 4.], [4., 2., 4.], [4., 4., 4.], [2., 4., 4.]],
         ];
-        let positions: Vec<DVec3> = loops.iter().flatten().map(|&p| DVec3::from(p)).collect();
         let specs = [
             crate::LightSpec::Point(DVec3::new(3.0, 3.0, 8.0)),
             crate::LightSpec::Sun(DVec3::new(0.0, 0.0, 1.0)),
         ];
-        let grid = crate::shared_grid(&positions, &specs).unwrap();
-        let lights = crate::place_lights(&grid, &specs).unwrap();
-        let polys: Vec<bsp_core::Polygon> = loops
-            .iter()
-            .enumerate()
+        scene_of(&loops, &specs)
+    }
+
+    /// The quads `loops` (face `i`: `loops[i]`) snapped to a grid fitted
+    /// to them and `specs`: the grid, the lights placed on it, the
+    /// polygons and their shadow trees.
+    fn scene_of(
+        loops: &[[[f64; 3]; 4]],
+        specs: &[crate::LightSpec],
+    ) -> (Grid, Vec<PlacedLight>, Vec<Polygon>, crate::Shadows) {
+        let positions: Vec<DVec3> = loops.iter().flatten().map(|&p| DVec3::from(p)).collect();
+        let grid = crate::shared_grid(&positions, specs).unwrap();
+        let lights = crate::place_lights(&grid, specs).unwrap();
+        let polys: Vec<bsp_core::Polygon> = (loops.iter().enumerate())
             .map(|(i, l)| {
                 let pts: Vec<_> = l.iter().map(|&p| grid.snap(p.into()).unwrap()).collect();
                 bsp_core::Polygon::from_grid_points(&pts, i as u32).unwrap()
@@ -755,23 +763,12 @@ mod tests {
         loops.insert(0, large(0.0));
         loops.insert(21, large(-1.0));
         loops.push(large(-2.0));
-        let positions: Vec<DVec3> = loops.iter().flatten().map(|&p| DVec3::from(p)).collect();
         let specs = [crate::LightSpec::Point(DVec3::new(
             n as f64 / 2.0,
             3.0,
             9.0,
         ))];
-        let grid = crate::shared_grid(&positions, &specs).unwrap();
-        let lights = crate::place_lights(&grid, &specs).unwrap();
-        let polys: Vec<bsp_core::Polygon> = (loops.iter().enumerate())
-            .map(|(i, l)| {
-                let pts: Vec<_> = l.iter().map(|&p| grid.snap(p.into()).unwrap()).collect();
-                bsp_core::Polygon::from_grid_points(&pts, i as u32).unwrap()
-            })
-            .collect();
-        let kernel: Vec<Light> = lights.iter().map(|l| l.light).collect();
-        let shadows = crate::Shadows::new(&polys, &kernel).unwrap();
-        (grid, lights, polys, shadows)
+        scene_of(&loops, &specs)
     }
 
     /// The large receivers are shaded first, beside the rounds, and the

@@ -214,13 +214,7 @@ pub(super) fn grow<A>(
             })
         } else {
             let ((plane, on, front, back), at_front, at_back) = split(polys, at);
-            let id = tree.nodes.len() as NodeId;
-            tree.nodes.push(Node {
-                plane,
-                polygons: on,
-                front: Link::Cell(Cell::Out),
-                back: Link::Cell(Cell::In),
-            });
+            let id = tree.add_node(plane, on);
             stack.push((back, at_back, Slot::Back(id)));
             stack.push((front, at_front, Slot::Front(id)));
             Link::Node(id)
@@ -339,13 +333,7 @@ impl BspTree {
                 .collect();
             level = Vec::new();
             for ((plane, on, front, back), slot, [f, b]) in cuts {
-                let id = tree.nodes.len() as NodeId;
-                tree.nodes.push(Node {
-                    plane,
-                    polygons: on,
-                    front: Link::Cell(Cell::Out),
-                    back: Link::Cell(Cell::In),
-                });
+                let id = tree.add_node(plane, on);
                 tree.hang(slot, Link::Node(id));
                 level.push((front, Slot::Front(id), f));
                 level.push((back, Slot::Back(id), b));
@@ -381,6 +369,19 @@ impl BspTree {
             tree.hang(slot, link);
         }
         tree
+    }
+
+    /// A new node of `plane` holding `polygons`, its leaves as `grow`
+    /// makes them (outside in front, inside behind) until children hang
+    /// there.
+    fn add_node(&mut self, plane: Plane, polygons: Vec<Polygon>) -> NodeId {
+        self.nodes.push(Node {
+            plane,
+            polygons,
+            front: Link::Cell(Cell::Out),
+            back: Link::Cell(Cell::In),
+        });
+        (self.nodes.len() - 1) as NodeId
     }
 
     /// Hangs `link` at `slot`.
