@@ -656,8 +656,9 @@ impl<'a> ShadowSet<'a> {
     }
 
     /// [`ShadowSet::shade_ranges`] of the receivers `ranges` (receiver
-    /// `i`: `ranges[i]`), in parallel by [`CHUNK`] receivers, into one
-    /// batch in receiver order (the same for every thread count);
+    /// `i`: `ranges[i]`), in parallel by [`CHUNK`] receivers (the large
+    /// ones first and alone, see `large_receivers`), into one batch in
+    /// receiver order (the same for every thread count);
     /// `done(n)` is told of every `n` receivers shaded (for a progress
     /// bar).
     pub fn shade_par(

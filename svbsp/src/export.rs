@@ -397,8 +397,8 @@ impl ObjWriter {
 }
 
 /// Receivers shaded per round of [`FragmentFile::stream`]: each round is
-/// shaded and formatted in parallel (in chunks of [`CHUNK`]), then
-/// written.
+/// shaded and formatted in parallel (in chunks of [`CHUNK`]; the large
+/// receivers of every round from the start), then written.
 const ROUND: usize = CHUNK * 32;
 
 /// What [`FragmentFile::stream`] did.
