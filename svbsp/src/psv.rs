@@ -562,6 +562,7 @@ impl ShadowVolumes {
             .collect();
         drop(pool);
         let mut nodes = top.nodes;
+        nodes.reserve(parts.iter().map(|p| p.0.nodes.len()).sum());
         let mut grafted = top.grafted;
         let mut skeleton = skeleton_top;
         for (task, (sub, sub_root, sub_skeleton)) in ready.iter().zip(parts) {
