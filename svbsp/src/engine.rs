@@ -675,22 +675,19 @@ impl<'a> ShadowSet<'a> {
         let order: Vec<Range<usize>> = order
             .chain(runs.iter().filter(|&r| !is_one_of(r, &large)).cloned())
             .collect();
-        let batches: Vec<Batch> = order
+        let mut batches: Vec<(usize, Batch)> = order
             .par_iter()
             .map(|r| {
                 let b = self.shade_ranges(polys, &ranges[r.clone()], r.start as u32, opts);
                 done(r.len());
-                b
+                (r.start, b)
             })
             .collect();
-        let at: std::collections::HashMap<usize, usize> = order
-            .iter()
-            .enumerate()
-            .map(|(k, r)| (r.start, k))
-            .collect();
+        // back in receiver order: the runs' order
+        batches.sort_unstable_by_key(|b| b.0);
         let mut out = Batch::new();
-        for r in &runs {
-            out.append(&batches[at[&r.start]]);
+        for (_, b) in &batches {
+            out.append(b);
         }
         out
     }

@@ -618,7 +618,7 @@ impl FragmentFile {
                 let t = Instant::now();
                 for r in &runs {
                     let own;
-                    let part = match large.iter().position(|&i| is_one_of(r, &[i])) {
+                    let part = match large.iter().position(|&i| r.len() == 1 && r.start == i) {
                         Some(k) => large_part(k).as_ref(),
                         None => {
                             own = parts.next().expect("a part a run");

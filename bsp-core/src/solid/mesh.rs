@@ -1150,15 +1150,11 @@ mod tests {
         // the cube [0, 6]³ less what lies in front of x + 2y + 3z = 17:
         // its faces' back parts, and the cut's cap (a triangle of that
         // plane clipped to the cube), whose corners are made points
-        let cube = bsp_fixtures::cuboid(glam::DVec3::ZERO, glam::DVec3::splat(6.0));
         let cut = Plane::new([1, 2, 3], -17).unwrap();
         let mut polys = Vec::new();
         let mut cap =
             Polygon::from_grid_points(&[[17, 0, 0], [-13, 15, 0], [-13, 0, 10]], 0).unwrap();
-        for f in &cube {
-            let g: Vec<crate::kernel::GridPoint> =
-                f.iter().map(|v| v.to_array().map(|c| c as i32)).collect();
-            let face = Polygon::from_grid_points(&g, 0).unwrap();
+        for face in cube_faces(6) {
             use crate::kernel::polygon::{Parts, PolygonSide};
             match face.parts(&cut) {
                 Parts::Split { back, .. } => polys.push(back),
@@ -1292,6 +1288,13 @@ mod tests {
         assert_eq!(m.volume_exact(), BigRational::from_integer(1.into()));
     }
 
+    /// The faces of the cube `[0, side]³` as grid polygons, turned outward.
+    fn cube_faces(side: i32) -> Vec<Polygon> {
+        (bsp_fixtures::grid_cuboid([0; 3], [side; 3]).iter())
+            .map(|f| Polygon::from_grid_points(f, 0).unwrap())
+            .collect()
+    }
+
     /// `p` cut by the plane `x = x2 / 2`, which must cross it: its two
     /// pieces, each with made corners.
     fn cut_at_half_x(p: &Polygon, x2: i128) -> [Polygon; 2] {
@@ -1422,14 +1425,10 @@ mod tests {
     /// too, so the mesh is the cube's 8 corners and 12 triangles.
     #[test]
     fn points_inside_a_whole_face_s_edges_go_with_the_regions() {
-        let cube = bsp_fixtures::cuboid(glam::DVec3::ZERO, glam::DVec3::splat(6.0));
         let cut = Plane::new([1, 2, 3], -17).unwrap();
         let mut polys = Vec::new();
         let mut left_whole = false;
-        for f in &cube {
-            let g: Vec<crate::kernel::GridPoint> =
-                f.iter().map(|v| v.to_array().map(|c| c as i32)).collect();
-            let face = Polygon::from_grid_points(&g, 0).unwrap();
+        for face in cube_faces(6) {
             match face.parts(&cut) {
                 crate::kernel::polygon::Parts::Split { front, back } if left_whole => {
                     polys.extend([front, back])

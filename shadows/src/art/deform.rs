@@ -221,11 +221,8 @@ fn nearest(seed: &[bool], w: usize, h: usize) -> Vec<usize> {
             let q = nr as usize * w + nc as usize;
             let s = near[p];
             if near[q] == usize::MAX || d2(q, s) < d2(q, near[q]) {
-                let first = near[q] == usize::MAX;
                 near[q] = s;
-                if first || d2(q, s) > 0 {
-                    queue.push_back(q);
-                }
+                queue.push_back(q);
             }
         }
     }
