@@ -51,25 +51,7 @@ pub fn soup(n: usize, seed: u64) -> Vec<Polygon> {
 /// A closed torus (major radius 1, minor 0.4) of `2 u v` triangles,
 /// consistently oriented outwards.
 pub fn torus_faces(u: usize, v: usize) -> Vec<[DVec3; 3]> {
-    let (r0, r1) = (1.0, 0.4);
-    let p = |i: usize, j: usize| {
-        let a = (i % u) as f64 / u as f64 * std::f64::consts::TAU;
-        let b = (j % v) as f64 / v as f64 * std::f64::consts::TAU;
-        DVec3::new(
-            (r0 + r1 * b.cos()) * a.cos(),
-            (r0 + r1 * b.cos()) * a.sin(),
-            r1 * b.sin(),
-        )
-    };
-    let mut faces = Vec::with_capacity(2 * u * v);
-    for i in 0..u {
-        for j in 0..v {
-            let (a, b, c, d) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
-            faces.push([a, b, c]);
-            faces.push([a, c, d]);
-        }
-    }
-    faces
+    bsp_fixtures::torus(u, v, 1.0, 0.4)
 }
 
 /// A torus of about `n` triangles (`u = 2 v`).

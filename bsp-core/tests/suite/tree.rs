@@ -669,26 +669,12 @@ fn regress_balance_cuts_grow_with_extent() {
 /// `0.4 · 2^18`), rounded to grid points; triangles that rounding makes
 /// degenerate are left out.
 fn grid_torus(u: usize, v: usize) -> Vec<Polygon> {
-    let (r0, r1) = (262_144.0, 104_857.6);
-    let p = |i: usize, j: usize| -> GridPoint {
-        let a = (i % u) as f64 / u as f64 * std::f64::consts::TAU;
-        let b = (j % v) as f64 / v as f64 * std::f64::consts::TAU;
-        [
-            ((r0 + r1 * b.cos()) * a.cos()).round() as i32,
-            ((r0 + r1 * b.cos()) * a.sin()).round() as i32,
-            (r1 * b.sin()).round() as i32,
-        ]
-    };
-    let mut tris = Vec::with_capacity(2 * u * v);
-    for i in 0..u {
-        for j in 0..v {
-            let (a, b, c, d) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
-            tris.push([a, b, c]);
-            tris.push([a, c, d]);
-        }
-    }
+    let tris = bsp_fixtures::torus(u, v, 262_144.0, 104_857.6);
     (tris.iter().enumerate())
-        .filter_map(|(i, t)| Polygon::from_grid_points(t, i as u32).ok())
+        .filter_map(|(i, t)| {
+            let g = t.map(|p| p.to_array().map(|c| c.round() as i32));
+            Polygon::from_grid_points(&g, i as u32).ok()
+        })
         .collect()
 }
 
