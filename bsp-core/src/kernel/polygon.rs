@@ -900,20 +900,16 @@ impl Builder {
 /// exactly, so no vertex moves. The work is parallel: the corners are
 /// sharded by key.
 pub fn share_points(polys: &mut [&mut Polygon]) {
-    use rayon::prelude::*;
-    let keys: Vec<SmallVec<[(u64, u32); 6]>> = polys
-        .par_iter()
-        .map(|p| {
-            p.verts
-                .iter()
-                .enumerate()
-                .filter_map(|(v, pt)| match pt {
-                    Point::Implicit(i) => Some((point_key(i), v as u32)),
-                    Point::Grid(_) => None,
-                })
-                .collect()
-        })
-        .collect();
+    let keys: Vec<SmallVec<[(u64, u32); 6]>> = crate::par::map_slice(polys, |p| {
+        p.verts
+            .iter()
+            .enumerate()
+            .filter_map(|(v, pt)| match pt {
+                Point::Implicit(i) => Some((point_key(i), v as u32)),
+                Point::Grid(_) => None,
+            })
+            .collect()
+    });
     // the corners by shard of their keys, each shard in order
     let shards = 4 * rayon::current_num_threads().max(1);
     let mut by_shard: Vec<Vec<(u64, u32, u32)>> = vec![Vec::new(); shards];
@@ -925,34 +921,30 @@ pub fn share_points(polys: &mut [&mut Polygon]) {
     drop(keys);
     let view: &[&mut Polygon] = polys;
     // (corner, the first equal corner), shard by shard
-    let moves: Vec<Vec<(u32, u32, u32, u32)>> = by_shard
-        .par_iter()
-        .map(|corners| {
-            let mut firsts: rustc_hash::FxHashMap<u64, SmallVec<[(u32, u32); 1]>> =
-                Default::default();
-            let mut moves = Vec::new();
-            for &(k, p, v) in corners {
-                let Some(i) = implicit_at(view, p, v) else {
-                    continue;
-                };
-                let bucket = firsts.entry(k).or_default();
-                let first = bucket.iter().find_map(|&(q, w)| {
-                    implicit_at(view, q, w)
-                        .filter(|j| j.same_point(i))
-                        .map(|j| (q, w, j))
-                });
-                match first {
-                    Some((q, w, j)) => {
-                        if !Arc::ptr_eq(j, i) {
-                            moves.push((p, v, q, w));
-                        }
+    let moves: Vec<Vec<(u32, u32, u32, u32)>> = crate::par::map_slice(&by_shard, |corners| {
+        let mut firsts: rustc_hash::FxHashMap<u64, SmallVec<[(u32, u32); 1]>> = Default::default();
+        let mut moves = Vec::new();
+        for &(k, p, v) in corners {
+            let Some(i) = implicit_at(view, p, v) else {
+                continue;
+            };
+            let bucket = firsts.entry(k).or_default();
+            let first = bucket.iter().find_map(|&(q, w)| {
+                implicit_at(view, q, w)
+                    .filter(|j| j.same_point(i))
+                    .map(|j| (q, w, j))
+            });
+            match first {
+                Some((q, w, j)) => {
+                    if !Arc::ptr_eq(j, i) {
+                        moves.push((p, v, q, w));
                     }
-                    None => bucket.push((p, v)),
                 }
+                None => bucket.push((p, v)),
             }
-            moves
-        })
-        .collect();
+        }
+        moves
+    });
     // a first corner is never moved, so the order does not matter
     for (p, v, q, w) in moves.into_iter().flatten() {
         let first = implicit_at(polys, q, w).cloned();

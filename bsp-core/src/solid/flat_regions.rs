@@ -24,7 +24,6 @@
 
 use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
-use rayon::prelude::*;
 use smallvec::{SmallVec, smallvec};
 
 use crate::kernel::Side;
@@ -68,22 +67,21 @@ pub(super) fn flat_regions<P: ConvexFace + Sync>(polys: &[P], w: &Welded<'_>) ->
         triangles: HashMap::default(),
         dropped: HashSet::default(),
     };
-    let made: Vec<usize> = (0..n)
-        .into_par_iter()
-        .filter(|&p| {
-            (w.of(p).iter()).any(|&v| matches!(w.vertices[v as usize], Point::Implicit(_)))
-        })
-        .collect();
+    let made: Vec<usize> = crate::par::filter_map(n, |p| {
+        (w.of(p).iter())
+            .any(|&v| matches!(w.vertices[v as usize], Point::Implicit(_)))
+            .then_some(p)
+    });
     if made.len() < 2 {
         return out;
     }
     // their loops with the points on their edges (other polygons'
     // corners: where cells of different sizes meet, a piece's edge holds
     // its neighbours' corners), each point with the edge it is on
-    let rings: HashMap<u32, Vec<(u32, u32)>> = made
-        .par_iter()
-        .map(|&p| (p as u32, ring_of(p, w)))
-        .collect();
+    let rings: HashMap<u32, Vec<(u32, u32)>> =
+        crate::par::map_slice(&made, |&p| (p as u32, ring_of(p, w)))
+            .into_iter()
+            .collect();
     // their directed sub-edges; one used twice the same way joins nothing
     let mut edges: HashMap<(u32, u32), u32> =
         HashMap::with_capacity_and_hasher(made.len() * 6, Default::default());
@@ -130,10 +128,8 @@ pub(super) fn flat_regions<P: ConvexFace + Sync>(polys: &[P], w: &Welded<'_>) ->
     for &(_, v) in w.inside.iter().flatten() {
         uses[v as usize] += 1;
     }
-    let mut plans: Vec<Option<Plan>> = groups
-        .par_iter()
-        .map(|g| plan(polys, w, g, &rings, &uses))
-        .collect();
+    let mut plans: Vec<Option<Plan>> =
+        crate::par::map_slice(&groups, |g| plan(polys, w, g, &rings, &uses));
     // a point goes where every loop that has it agrees: a planned
     // region's, where it is a straight corner or a point inside an edge,
     // or another polygon's, where it is a point inside an edge (a convex
@@ -183,10 +179,8 @@ pub(super) fn flat_regions<P: ConvexFace + Sync>(polys: &[P], w: &Welded<'_>) ->
             break dropped;
         }
     };
-    let done: Vec<Option<Vec<[u32; 3]>>> = plans
-        .par_iter()
-        .map(|p| p.as_ref().map(|p| finish(p, &dropped)))
-        .collect();
+    let done: Vec<Option<Vec<[u32; 3]>>> =
+        crate::par::map_slice(&plans, |p| p.as_ref().map(|p| finish(p, &dropped)));
     for (g, tris) in groups.iter().zip(done) {
         if let Some(tris) = tris {
             g.iter().for_each(|&p| out.replaced[p as usize] = true);

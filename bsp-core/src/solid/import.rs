@@ -127,13 +127,11 @@ pub fn import_faces_par(
     grid: &Grid,
     faces: &[Vec<DVec3>],
 ) -> Result<(Vec<Polygon>, ImportReport), Error> {
-    use rayon::prelude::*;
     const CHUNK: usize = 4096;
-    let parts: Vec<Result<(Vec<Polygon>, ImportReport), Error>> = faces
-        .par_chunks(CHUNK)
-        .enumerate()
-        .map(|(i, chunk)| import_from(grid, chunk.iter().map(|f| &f[..]), i * CHUNK))
-        .collect();
+    let parts = crate::par::map(faces.len().div_ceil(CHUNK), |i| {
+        let chunk = &faces[i * CHUNK..faces.len().min((i + 1) * CHUNK)];
+        import_from(grid, chunk.iter().map(|f| &f[..]), i * CHUNK)
+    });
     let (runs, report) = gather(parts)?;
     let mut out = Vec::with_capacity(faces.len());
     for run in runs {
@@ -180,21 +178,17 @@ pub fn import_indexed_par(
     positions: &[DVec3],
     faces: &[Vec<u32>],
 ) -> Result<(Vec<Vec<Polygon>>, ImportReport), Error> {
-    use rayon::prelude::*;
     const CHUNK: usize = 4096;
-    let parts: Vec<Result<(Vec<Polygon>, ImportReport), Error>> = faces
-        .par_chunks(CHUNK)
-        .enumerate()
-        .map(|(c, chunk)| {
-            let mut run = Importer::new(chunk.len());
-            for (i, face) in chunk.iter().enumerate() {
-                let out = &mut run.out;
-                run.faces
-                    .indexed(grid, positions, face, c * CHUNK + i, |p| out.push(p))?;
-            }
-            Ok(run.finish())
-        })
-        .collect();
+    let parts = crate::par::map(faces.len().div_ceil(CHUNK), |c| {
+        let chunk = &faces[c * CHUNK..faces.len().min((c + 1) * CHUNK)];
+        let mut run = Importer::new(chunk.len());
+        for (i, face) in chunk.iter().enumerate() {
+            let out = &mut run.out;
+            run.faces
+                .indexed(grid, positions, face, c * CHUNK + i, |p| out.push(p))?;
+        }
+        Ok(run.finish())
+    });
     gather(parts)
 }
 
@@ -421,8 +415,7 @@ impl FaceImporter {
 /// Each position snapped to `grid` ([`Grid::snap`]), `None` where that
 /// fails, in parallel: for [`FaceImporter::indexed_snapped`].
 pub fn snap_positions(grid: &Grid, positions: &[DVec3]) -> Vec<Option<GridPoint>> {
-    use rayon::prelude::*;
-    positions.par_iter().map(|&p| grid.snap(p).ok()).collect()
+    crate::par::map_slice(positions, |&p| grid.snap(p).ok())
 }
 
 /// Triangles covering the loop: for a planar loop, triangles that tile it

@@ -133,39 +133,36 @@ fn weld<P: ConvexFace + Sync>(polys: &[P], start: &[usize]) -> (Vec<Point>, Vec<
     /// A shard's point of each item, and its points with their first
     /// corners.
     type Shard<'a> = (Vec<u32>, Vec<(Pt<'a>, u32)>);
-    let welded: Vec<Shard<'_>> = (0..SHARDS)
-        .into_par_iter()
-        .map(|s| {
-            let items = &items[at[s]..at[s + 1]];
-            // room for the points a closed triangle mesh's corners have
-            // (about one in six corners starts a point), so the map is
-            // seldom grown
-            let room = items.len() / 5 + 16;
-            let mut by_key: rustc_hash::FxHashMap<u64, u32> =
-                rustc_hash::FxHashMap::with_capacity_and_hasher(room, Default::default());
-            let mut points: Vec<(Pt<'_>, u32)> = Vec::with_capacity(room);
-            let mut next: Vec<u32> = Vec::with_capacity(room);
-            let ids = items
-                .iter()
-                .map(|&(pt, c)| {
-                    let head = by_key.entry(key_of(pt)).or_insert(END);
-                    let mut i = *head;
-                    while i != END {
-                        if same(points[i as usize].0, pt) {
-                            return i;
-                        }
-                        i = next[i as usize];
+    let welded: Vec<Shard<'_>> = crate::par::map(SHARDS, |s| {
+        let items = &items[at[s]..at[s + 1]];
+        // room for the points a closed triangle mesh's corners have
+        // (about one in six corners starts a point), so the map is
+        // seldom grown
+        let room = items.len() / 5 + 16;
+        let mut by_key: rustc_hash::FxHashMap<u64, u32> =
+            rustc_hash::FxHashMap::with_capacity_and_hasher(room, Default::default());
+        let mut points: Vec<(Pt<'_>, u32)> = Vec::with_capacity(room);
+        let mut next: Vec<u32> = Vec::with_capacity(room);
+        let ids = items
+            .iter()
+            .map(|&(pt, c)| {
+                let head = by_key.entry(key_of(pt)).or_insert(END);
+                let mut i = *head;
+                while i != END {
+                    if same(points[i as usize].0, pt) {
+                        return i;
                     }
-                    let id = points.len() as u32;
-                    points.push((pt, c));
-                    next.push(*head);
-                    *head = id;
-                    id
-                })
-                .collect();
-            (ids, points)
-        })
-        .collect();
+                    i = next[i as usize];
+                }
+                let id = points.len() as u32;
+                points.push((pt, c));
+                next.push(*head);
+                *head = id;
+                id
+            })
+            .collect();
+        (ids, points)
+    });
     // the points numbered by their first corners
     let mut order: Vec<(u32, u32, u32)> = welded
         .iter()
@@ -229,7 +226,7 @@ impl TriMesh {
         let (vertices, triangles, of) = Self::triangulate(&polys);
         // the polygons are dropped in parallel as their planes are taken
         // (the planes take a seventh of the polygons' room)
-        let supports: Vec<Plane> = polys.into_par_iter().map(|p| *p.support()).collect();
+        let supports: Vec<Plane> = crate::par::map_vec(polys, |p| *p.support());
         Self::assemble(vertices, triangles, of, |i| supports[i as usize]).0
     }
 
@@ -243,7 +240,7 @@ impl TriMesh {
         of: Vec<u32>,
         support: impl Fn(u32) -> Plane + Sync,
     ) -> (TriMesh, bool) {
-        let planes = of.par_iter().map(|&i| support(i)).collect();
+        let planes = crate::par::map_slice(&of, |&i| support(i));
         drop(of);
         let mut mesh = TriMesh {
             vertices,
@@ -261,7 +258,7 @@ impl TriMesh {
         // polygon `i`'s corners are `corners[start[i]..start[i + 1]]`, in
         // flat arrays (a list per polygon costs an allocation each)
         // (the counts read in parallel: a polygon read is a cache miss)
-        let counts: Vec<usize> = polys.par_iter().map(|p| p.corner_count()).collect();
+        let counts: Vec<usize> = crate::par::map_slice(polys, |p| p.corner_count());
         let mut start = Vec::with_capacity(polys.len() + 1);
         start.push(0usize);
         for n in counts {
@@ -271,29 +268,24 @@ impl TriMesh {
         // rounded once more to `f32` for the search of vertices on edges:
         // both roundings are monotone, so a point on a segment still has
         // its rounded coordinates in the segment's rounded box
-        let coords: Vec<[f32; 3]> = vertices
-            .par_iter()
-            .map(|v| v.to_f64().map(|c| c as f32))
-            .collect();
+        let coords: Vec<[f32; 3]> =
+            crate::par::map_slice(&vertices, |v| v.to_f64().map(|c| c as f32));
         let near = Candidates::new(&coords);
         let twinned = twinned_edges(&corners, &start);
         // the welded points inside each polygon's edges, in order along
         // each (an edge used once each way needs no search:
         // `twinned_edges`), as (edge, point)
-        let inside: Vec<Vec<(u32, u32)>> = (0..polys.len())
-            .into_par_iter()
-            .map(|p| {
-                let cs = &corners[start[p]..start[p + 1]];
-                let mut out = Vec::new();
-                for i in (0..cs.len()).filter(|&i| !twinned[start[p] + i]) {
-                    let (a, b) = (cs[i], cs[(i + 1) % cs.len()]);
-                    let mut on = edge_points(&polys[p], i, a, b, &vertices, &coords, &near);
-                    sort_along(&mut on, a, b, &vertices, &coords);
-                    out.extend(on.into_iter().map(|v| (i as u32, v)));
-                }
-                out
-            })
-            .collect();
+        let inside: Vec<Vec<(u32, u32)>> = crate::par::map(polys.len(), |p| {
+            let cs = &corners[start[p]..start[p + 1]];
+            let mut out = Vec::new();
+            for i in (0..cs.len()).filter(|&i| !twinned[start[p] + i]) {
+                let (a, b) = (cs[i], cs[(i + 1) % cs.len()]);
+                let mut on = edge_points(&polys[p], i, a, b, &vertices, &coords, &near);
+                sort_along(&mut on, a, b, &vertices, &coords);
+                out.extend(on.into_iter().map(|v| (i as u32, v)));
+            }
+            out
+        });
         // adjacent pieces of one plane meshed as one region where that
         // drops corners (`flat_regions`)
         let regions = super::flat_regions::flat_regions(
@@ -309,10 +301,9 @@ impl TriMesh {
         // each polygon's triangles on its own, in parallel; chunks keep
         // the order of the polygons
         const RUN: usize = 512;
-        let chunks: Vec<(Vec<[u32; 3]>, Vec<u32>)> = polys
-            .par_chunks(RUN)
-            .enumerate()
-            .map(|(c, polys)| {
+        let chunks: Vec<(Vec<[u32; 3]>, Vec<u32>)> =
+            crate::par::map(polys.len().div_ceil(RUN), |c| {
+                let polys = &polys[c * RUN..polys.len().min((c + 1) * RUN)];
                 let mut triangles = Vec::new();
                 let mut of = Vec::new();
                 let first = c * RUN;
@@ -354,8 +345,7 @@ impl TriMesh {
                     ));
                 }
                 (triangles, of)
-            })
-            .collect();
+            });
         let regions_dropped = !regions.triangles.is_empty();
         drop((regions, inside, near, coords, corners, start, twinned));
         let n: usize = chunks.iter().map(|c| c.0.len()).sum();
@@ -581,7 +571,7 @@ impl TriMesh {
     /// Vertex coordinates (grid units), correctly rounded (in parallel:
     /// an implicit vertex's rounding is an exact division).
     pub fn vertices_f64(&self) -> Vec<[f64; 3]> {
-        self.vertices.par_iter().map(Point::to_f64).collect()
+        crate::par::map_slice(&self.vertices, Point::to_f64)
     }
 
     /// Checks that every directed edge appears once and its reverse once
@@ -589,10 +579,14 @@ impl TriMesh {
     /// triangle repeats a vertex. Names the first bad edge.
     pub fn check_watertight(&self) -> Result<(), String> {
         // the common verdict by a parallel sort; a defect is named below
-        let distinct = self
-            .triangles
-            .par_iter()
-            .all(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
+        let tris = &self.triangles;
+        let distinct = crate::par::fold_runs(tris.len(), |r| {
+            tris[r]
+                .iter()
+                .all(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+        })
+        .into_iter()
+        .all(|ok| ok);
         if distinct {
             // every edge used once each way
             if crate::solid::topology::corners_close(&self.triangles, false) {
@@ -797,7 +791,11 @@ fn twinned_edges(corners: &[u32], start: &[usize]) -> Vec<bool> {
         return vec![false; corners.len()]; // places do not fit: search all
     }
     // each edge under its lower end: (upper end, place << 1 | direction)
-    let n = corners.par_iter().max().map_or(0, |&v| v as usize + 1);
+    let n = crate::par::fold_runs(corners.len(), |r| corners[r].iter().max().copied())
+        .into_iter()
+        .max()
+        .flatten()
+        .map_or(0, |v| v as usize + 1);
     let (at, edges) = crate::solid::topology::bucket(n, |emit| {
         for p in 0..start.len() - 1 {
             let cs = &corners[start[p]..start[p + 1]];
@@ -809,27 +807,25 @@ fn twinned_edges(corners: &[u32], start: &[usize]) -> Vec<bool> {
         }
     });
     // the edges used once each way, vertex by vertex in parallel
-    let places: Vec<u32> = (0..n)
-        .into_par_iter()
-        .with_min_len(4096)
-        .flat_map_iter(|v| {
+    let places: Vec<Vec<u32>> = crate::par::fold_runs(n, |vs| {
+        let mut places = Vec::new();
+        for v in vs {
             let mut g: SmallVec<[(u32, u32); 16]> =
                 edges[at[v]..at[v + 1]].iter().copied().collect();
             g.sort_unstable();
-            let mut out: SmallVec<[u32; 16]> = SmallVec::new();
             for run in g.chunk_by(|x, y| x.0 == y.0) {
                 if let [(_, e), (_, f)] = run
                     && (e ^ f) & 1 == 1
                 {
-                    out.extend([e >> 1, f >> 1]);
+                    places.extend([e >> 1, f >> 1]);
                 }
             }
-            out
-        })
-        .collect();
+        }
+        places
+    });
     drop(edges);
     let mut twinned = vec![false; corners.len()];
-    for e in places {
+    for e in places.into_iter().flatten() {
         twinned[e as usize] = true;
     }
     twinned
@@ -851,9 +847,7 @@ fn used_only(vertices: Vec<Point>, mut triangles: Vec<[u32; 3]>) -> (Vec<Point>,
             kept.push(p);
         }
     }
-    triangles
-        .par_iter_mut()
-        .for_each(|t| *t = t.map(|v| new[v as usize]));
+    crate::par::for_each_mut(&mut triangles, |_, t| *t = t.map(|v| new[v as usize]));
     (kept, triangles)
 }
 
@@ -942,11 +936,8 @@ impl Candidates {
     const LEAF: usize = 8;
 
     fn new(coords: &[[f32; 3]]) -> Candidates {
-        let mut pts: Vec<([f32; 3], u32)> = coords
-            .par_iter()
-            .enumerate()
-            .map(|(i, c)| (*c, i as u32))
-            .collect();
+        let mut pts: Vec<([f32; 3], u32)> =
+            crate::par::map(coords.len(), |i| (coords[i], i as u32));
         let mut axis = vec![0u8; pts.len()];
         Self::split(&mut pts, &mut axis);
         Candidates { pts, axis }
@@ -984,7 +975,7 @@ impl Candidates {
         let (high, high_axis) = (&mut high[1..], &mut high_axis[1..]);
         const PARALLEL: usize = 1 << 14;
         if low.len() > PARALLEL {
-            rayon::join(
+            crate::par::join(
                 || Self::split(low, low_axis),
                 || Self::split(high, high_axis),
             );

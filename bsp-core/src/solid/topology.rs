@@ -137,8 +137,7 @@ pub fn check_closed_manifold<'a>(
 /// face repeats a vertex, and the corners around every vertex close up
 /// ([`corners_close`], with the link cycles).
 fn is_closed_manifold(faces: &[&[u32]]) -> bool {
-    use rayon::prelude::*;
-    let ok_faces = faces.par_iter().all(|f| match **f {
+    let ok_face = |f: &&[u32]| match **f {
         // (most faces: three comparisons, no copy)
         [a, b, c] => a != b && b != c && c != a,
         _ => {
@@ -146,7 +145,10 @@ fn is_closed_manifold(faces: &[&[u32]]) -> bool {
             v.sort_unstable();
             f.len() >= 3 && v.windows(2).all(|w| w[0] != w[1])
         }
-    });
+    };
+    let ok_faces = crate::par::fold_runs(faces.len(), |r| faces[r].iter().all(ok_face))
+        .into_iter()
+        .all(|ok| ok);
     ok_faces && corners_close(faces, true)
 }
 
@@ -163,14 +165,18 @@ fn is_closed_manifold(faces: &[&[u32]]) -> bool {
 /// sort of all edges.
 pub(crate) fn corners_close<F: AsRef<[u32]> + Sync>(faces: &[F], cycles: bool) -> bool {
     use rayon::prelude::*;
-    let Some(last) = faces
-        .par_iter()
-        .filter_map(|f| f.as_ref().iter().max().copied())
-        .max()
-    else {
+    // (the largest id and the number of corners, run by run)
+    let runs = crate::par::fold_runs(faces.len(), |r| {
+        let faces = &faces[r];
+        let last = (faces.iter())
+            .filter_map(|f| f.as_ref().iter().max().copied())
+            .max();
+        (last, faces.iter().map(|f| f.as_ref().len()).sum::<usize>())
+    });
+    let Some(last) = runs.iter().filter_map(|r| r.0).max() else {
         return true;
     };
-    let corners: usize = faces.par_iter().map(|f| f.as_ref().len()).sum();
+    let corners: usize = runs.iter().map(|r| r.1).sum();
     // ids far beyond the corner count are numbered densely first, so that
     // the buckets stay as small as the faces
     let (n, dense): (usize, Option<Vec<u32>>) = if last as usize > 4 * corners + 1024 {
@@ -198,10 +204,12 @@ pub(crate) fn corners_close<F: AsRef<[u32]> + Sync>(faces: &[F], cycles: bool) -
             }
         }
     });
-    (0..n)
-        .into_par_iter()
-        .with_min_len(4096)
-        .all(|v| corners_close_at(&link[start[v]..start[v + 1]], cycles))
+    crate::par::fold_runs(n, |vs| {
+        vs.into_iter()
+            .all(|v| corners_close_at(&link[start[v]..start[v + 1]], cycles))
+    })
+    .into_iter()
+    .all(|ok| ok)
 }
 
 /// Items grouped by key: `each(emit)` calls `emit(key, item)` for every
@@ -249,22 +257,19 @@ pub(crate) fn bucket_par_corners<'f, F: Sync, T: Copy + Default + Send + Sync>(
     key: impl Fn(&'f F, usize) -> usize + Sync,
     make: impl Fn(usize, &'f F, usize) -> T + Sync,
 ) -> (Vec<usize>, Vec<T>) {
-    use rayon::prelude::*;
     const RUN: usize = 4096;
     let corners = |r: usize, j: usize| start[r * RUN + j]..start[r * RUN + j + 1];
-    let counts: Vec<Vec<usize>> = faces
-        .par_chunks(RUN)
-        .enumerate()
-        .map(|(r, run)| {
-            let mut c = vec![0usize; n];
-            for (j, f) in run.iter().enumerate() {
-                for i in 0..corners(r, j).len() {
-                    c[key(f, i)] += 1;
-                }
+    let run_of = |r: usize| &faces[r * RUN..faces.len().min((r + 1) * RUN)];
+    let counts: Vec<Vec<usize>> = crate::par::map(faces.len().div_ceil(RUN), |r| {
+        let run = run_of(r);
+        let mut c = vec![0usize; n];
+        for (j, f) in run.iter().enumerate() {
+            for i in 0..corners(r, j).len() {
+                c[key(f, i)] += 1;
             }
-            c
-        })
-        .collect();
+        }
+        c
+    });
     let mut at = vec![0usize; n + 1];
     for k in 0..n {
         at[k + 1] = at[k] + counts.iter().map(|c| c[k]).sum::<usize>();
@@ -280,20 +285,17 @@ pub(crate) fn bucket_par_corners<'f, F: Sync, T: Copy + Default + Send + Sync>(
             rest = tail;
         }
     }
-    ranges
-        .into_par_iter()
-        .zip(faces.par_chunks(RUN))
-        .enumerate()
-        .for_each(|(r, (mut out, run))| {
-            let mut fill = vec![0usize; n];
-            for (j, f) in run.iter().enumerate() {
-                for (i, c) in corners(r, j).enumerate() {
-                    let k = key(f, i);
-                    out[k][fill[k]] = make(c, f, i);
-                    fill[k] += 1;
-                }
+    crate::par::for_each_mut(&mut ranges, |r, out| {
+        let run = run_of(r);
+        let mut fill = vec![0usize; n];
+        for (j, f) in run.iter().enumerate() {
+            for (i, c) in corners(r, j).enumerate() {
+                let k = key(f, i);
+                out[k][fill[k]] = make(c, f, i);
+                fill[k] += 1;
             }
-        });
+        }
+    });
     (at, items)
 }
 

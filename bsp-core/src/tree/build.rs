@@ -81,7 +81,6 @@ fn partition_known(
 /// fragments; without it, long parallel slivers would be cut again and
 /// again next to the previous cut.
 fn cut_balances(polys: &[Polygon], plane: &Plane) -> bool {
-    use rayon::prelude::*;
     let count = |(front, back): (usize, usize), p: &Polygon| match p.classify(plane) {
         PolygonSide::Front => (front + 1, back),
         PolygonSide::Back => (front, back + 1),
@@ -89,9 +88,9 @@ fn cut_balances(polys: &[Polygon], plane: &Plane) -> bool {
         PolygonSide::Coplanar { .. } => (front, back),
     };
     let (front, back) = match polys.len() > PARALLEL_LIST {
-        true => (polys.par_iter())
-            .fold(|| (0, 0), count)
-            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1)),
+        true => crate::par::fold_runs(polys.len(), |r| polys[r].iter().fold((0, 0), count))
+            .into_iter()
+            .fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1)),
         false => polys.iter().fold((0, 0), count),
     };
     let limit = polys.len() * 3 / 4;
@@ -261,12 +260,9 @@ fn cut(
         partition_known(polys, &plane, sides)
     } else if polys.len() > PARALLEL_LIST {
         // a long list's sides found in parallel
-        use rayon::prelude::*;
         sides.clear();
-        polys
-            .par_iter()
-            .map(|p| p.classify(&plane))
-            .collect_into_vec(sides);
+        sides.resize(polys.len(), PolygonSide::Front);
+        crate::par::for_each_mut(sides, |i, s| *s = polys[i].classify(&plane));
         partition_known(polys, &plane, sides)
     } else {
         partition_list(polys, &plane)
@@ -307,7 +303,6 @@ impl BspTree {
     /// place), so the tree is the same for every thread count. A build of
     /// fewer polygons is one list, grown from the seed alone.
     pub fn build(polygons: Vec<Polygon>, opts: &BuildOptions) -> BspTree {
-        use rayon::prelude::*;
         if polygons.len() <= PARALLEL_LIST {
             return build_one(polygons, opts, opts.seed);
         }
@@ -324,13 +319,12 @@ impl BspTree {
             let (long, short): (Vec<_>, Vec<_>) =
                 level.into_iter().partition(|l| l.0.len() > PARALLEL_LIST);
             left.extend(short);
-            let cuts: Vec<(Cut, Slot, [u64; 2])> = (long.into_par_iter())
-                .map(|(polys, slot, seed)| {
+            let cuts: Vec<(Cut, Slot, [u64; 2])> =
+                crate::par::map_vec(long, |(polys, slot, seed)| {
                     let mut rng = SplitMix(seed);
                     let cut = cut(polys, opts, &mut rng, &mut Vec::new());
                     (cut, slot, [rng.next_u64(), rng.next_u64()])
-                })
-                .collect();
+                });
             level = Vec::new();
             for ((plane, on, front, back), slot, [f, b]) in cuts {
                 let id = tree.add_node(plane, on);
@@ -345,9 +339,8 @@ impl BspTree {
             .map(|(i, (polys, _, seed))| (i, std::mem::take(polys), *seed))
             .collect();
         jobs.sort_by_key(|j| std::cmp::Reverse(j.1.len()));
-        let mut grown: Vec<(usize, BspTree)> = (jobs.into_par_iter())
-            .map(|(i, polys, seed)| (i, build_one(polys, opts, seed)))
-            .collect();
+        let mut grown: Vec<(usize, BspTree)> =
+            crate::par::map_vec(jobs, |(i, polys, seed)| (i, build_one(polys, opts, seed)));
         grown.sort_by_key(|g| g.0);
         tree.nodes
             .reserve(grown.iter().map(|g| g.1.nodes.len()).sum());
