@@ -44,15 +44,25 @@ fn joined(a: &[GridPoint], b: &[GridPoint]) -> Option<Vec<GridPoint>> {
 /// result does not depend on the faces' order (each plane's faces are
 /// taken in the order of their corners).
 pub(crate) fn coplanar_blockers(faces: &[Occluder]) -> Vec<Occluder> {
-    let mut groups: HashMap<([i64; 3], i128), Vec<Vec<GridPoint>>> = HashMap::new();
-    for f in faces {
+    coplanar_blockers_of(faces).0
+}
+
+/// [`coplanar_blockers`], with each blocker's faces (their numbers in
+/// `faces`, ascending).
+pub(crate) fn coplanar_blockers_of(faces: &[Occluder]) -> (Vec<Occluder>, Vec<Vec<u32>>) {
+    type Group = Vec<(Vec<GridPoint>, Vec<u32>)>;
+    let mut groups: HashMap<([i64; 3], i128), Group> = HashMap::new();
+    for (i, f) in faces.iter().enumerate() {
         let key = plane_key(f.plane());
         let mut corners = f.corners().to_vec();
         // one orientation per plane: the key's
         if f.plane().normal() != key.0 {
             corners.reverse();
         }
-        groups.entry(key).or_default().push(corners);
+        groups
+            .entry(key)
+            .or_default()
+            .push((corners, vec![i as u32]));
     }
     let mut keys: Vec<_> = groups.keys().copied().collect();
     keys.sort_unstable();
@@ -64,17 +74,17 @@ pub(crate) fn coplanar_blockers(faces: &[Occluder]) -> Vec<Occluder> {
     }
     // in the order of their corners: every face meets its occluders in
     // that order (index order), whatever order the faces came in
-    out.sort_by(|a, b| a.corners().cmp(b.corners()));
-    out
+    out.sort_by(|a, b| a.0.corners().cmp(b.0.corners()));
+    out.into_iter().unzip()
 }
 
 /// One plane's polygons merged until no two that share an edge have a
 /// convex union.
-fn merge_group(mut polys: Vec<Vec<GridPoint>>) -> Vec<Occluder> {
+fn merge_group(mut polys: Vec<(Vec<GridPoint>, Vec<u32>)>) -> Vec<(Occluder, Vec<u32>)> {
     let mut alive = vec![true; polys.len()];
     loop {
         let mut edges: HashMap<(GridPoint, GridPoint), usize> = HashMap::new();
-        for (i, p) in polys.iter().enumerate().filter(|(i, _)| alive[*i]) {
+        for (i, (p, _)) in polys.iter().enumerate().filter(|(i, _)| alive[*i]) {
             for k in 0..p.len() {
                 edges.insert((p[k], p[(k + 1) % p.len()]), i);
             }
@@ -84,16 +94,19 @@ fn merge_group(mut polys: Vec<Vec<GridPoint>>) -> Vec<Occluder> {
             if !alive[i] {
                 continue;
             }
-            let n = polys[i].len();
+            let n = polys[i].0.len();
             let partner = (0..n).find_map(|k| {
-                let (p, q) = (polys[i][k], polys[i][(k + 1) % n]);
+                let (p, q) = (polys[i].0[k], polys[i].0[(k + 1) % n]);
                 let j = *edges.get(&(q, p))?;
-                let union = (j != i && alive[j]).then(|| joined(&polys[i], &polys[j]))??;
+                let union = (j != i && alive[j]).then(|| joined(&polys[i].0, &polys[j].0))??;
                 let o = Occluder::new(&union).ok()?;
                 Some((j, o.corners().to_vec()))
             });
             if let Some((j, union)) = partner {
-                polys[i] = union;
+                let mut from = std::mem::take(&mut polys[j].1);
+                from.extend_from_slice(&polys[i].1);
+                from.sort_unstable();
+                polys[i] = (union, from);
                 alive[j] = false;
                 changed = true;
             }
@@ -106,6 +119,6 @@ fn merge_group(mut polys: Vec<Vec<GridPoint>>) -> Vec<Occluder> {
         .into_iter()
         .zip(alive)
         .filter(|(_, a)| *a)
-        .filter_map(|(p, _)| Occluder::new(&p).ok())
+        .filter_map(|((p, from), _)| Some((Occluder::new(&p).ok()?, from)))
         .collect()
 }

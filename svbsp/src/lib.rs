@@ -43,6 +43,7 @@
 mod area;
 mod areas;
 mod arena;
+mod backs;
 mod blockers;
 mod boxes;
 mod chin_feiner;

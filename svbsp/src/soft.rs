@@ -19,7 +19,8 @@ use rayon::prelude::*;
 use crate::area::{
     AreaClass, AreaFragment, AreaLight, HalfSpaces, Occluder, Regions, merge_convex,
 };
-use crate::blockers::{coplanar_blockers, plane_key};
+use crate::backs::SolidBacks;
+use crate::blockers::{coplanar_blockers, coplanar_blockers_of, plane_key};
 use crate::boxes::{Box3, EVERYWHERE, Reach, grid_box};
 use crate::engine::{Scratch, Shadows};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
@@ -171,6 +172,8 @@ pub struct SoftShadows<'a> {
     /// Per light, per blocker: the boxes its volumes reach.
     reach: Vec<Vec<Reach>>,
     corners: Vec<Option<Shadows>>,
+    /// The blockers a point outside their solid may pass over.
+    backs: SolidBacks,
 }
 
 impl std::fmt::Debug for SoftShadows<'_> {
@@ -189,7 +192,9 @@ impl<'a> SoftShadows<'a> {
         if lights.len() > MAX_LIGHTS {
             return Err(LightError::TooMany(lights.len()));
         }
-        let blockers = coplanar_blockers(faces);
+        let (blockers, sources) = coplanar_blockers_of(faces);
+        let polygons: Vec<Polygon> = faces.iter().map(Occluder::to_polygon).collect();
+        let solids = bsp_core::certify_solid_parts(&polygons);
         let regions: Vec<Vec<Option<Regions>>> = lights
             .iter()
             .map(|l| blockers.par_iter().map(|o| l.regions(o)).collect())
@@ -200,7 +205,8 @@ impl<'a> SoftShadows<'a> {
             .map(|(l, r)| near_lists(l.corners(), faces, (&blockers, r)))
             .unzip();
         Ok(SoftShadows {
-            corners: corner_shadows(lights, faces),
+            corners: corner_shadows(lights, &polygons, &solids),
+            backs: SolidBacks::new(faces, &sources, &solids),
             lights,
             faces,
             blockers,
@@ -254,12 +260,17 @@ impl<'a> SoftShadows<'a> {
         let near = self.near[light][face].iter().filter_map(|&j| {
             let j = j as usize;
             let r = self.regions[light][j].as_ref()?;
-            Some((&self.blockers[j], r, self.reach[light][j][0]))
+            Some((
+                &self.blockers[j],
+                r,
+                self.reach[light][j][0],
+                self.backs.of(j),
+            ))
         });
         Hiders::new(
             &self.faces[face],
             self.lights[light].corners(),
-            near.collect(),
+            (near.collect(), &self.backs),
             probing,
         )
     }
@@ -269,12 +280,14 @@ impl<'a> SoftShadows<'a> {
 /// `faces` (which corners each point of a face sees); `None` for a light
 /// of more corners than the trees take (its pieces are then cut by each
 /// occluder's shadow volume from each corner instead).
-fn corner_shadows(lights: &[AreaLight], faces: &[Occluder]) -> Vec<Option<Shadows>> {
-    let polygons: Vec<Polygon> = faces.iter().map(Occluder::to_polygon).collect();
-    let solids = bsp_core::certify_solid_parts(&polygons);
+fn corner_shadows(
+    lights: &[AreaLight],
+    polygons: &[Polygon],
+    solids: &bsp_core::SolidParts,
+) -> Vec<Option<Shadows>> {
     lights
         .iter()
-        .map(|l| Shadows::new_with(&polygons, l.corners(), &solids).ok())
+        .map(|l| Shadows::new_with(polygons, l.corners(), solids).ok())
         .collect()
 }
 
@@ -331,7 +344,9 @@ impl AreaLight {
         let blockers = coplanar_blockers(faces);
         let regions: Vec<Option<Regions>> = blockers.par_iter().map(|o| self.regions(o)).collect();
         let (near, reach) = near_lists(self.corners(), faces, (&blockers, &regions));
-        let corners = corner_shadows(std::slice::from_ref(self), faces)
+        let polygons: Vec<Polygon> = faces.iter().map(Occluder::to_polygon).collect();
+        let solids = bsp_core::certify_solid_parts(&polygons);
+        let corners = corner_shadows(std::slice::from_ref(self), &polygons, &solids)
             .pop()
             .flatten();
         let set = corners.as_ref().map(Shadows::set);
@@ -543,7 +558,16 @@ fn fraction_at(
 /// An occluder that may hide part of a light from a face's points, the
 /// half-spaces of its penumbra volume a point must be tested against, and
 /// a box holding every such point inside it.
-type Hider<'a> = (&'a Occluder, Cow<'a, [(Plane, Side)]>, Box3);
+///
+/// With it, the part and outward plane of a closed solid's face that a
+/// point outside the solid may pass over where it lies behind the face
+/// ([`SolidBacks`]).
+type Hider<'a> = (
+    &'a Occluder,
+    Cow<'a, [(Plane, Side)]>,
+    Box3,
+    Option<(u32, Plane)>,
+);
 
 /// Fragments of fewer corners than this have their probe points near
 /// their face ([`Probing::NearFace`]); a face with a larger one is probed
@@ -577,7 +601,15 @@ enum Probing {
 struct Hiders<'a> {
     occluders: Vec<Hider<'a>>,
     grid: CellGrid,
+    backs: &'a SolidBacks,
 }
+
+/// A face's near occluders with their volumes, boxes and
+/// [`SolidBacks::of`], and the run's [`SolidBacks`].
+type Near<'a> = (
+    Vec<(&'a Occluder, &'a Regions, Box3, Option<(u32, Plane)>)>,
+    &'a SolidBacks,
+);
 
 impl<'a> Hiders<'a> {
     /// The hiders of `face` among `occluders`, for points `probing` says
@@ -585,7 +617,7 @@ impl<'a> Hiders<'a> {
     fn new(
         face: &Occluder,
         light: &[Light],
-        occluders: Vec<(&'a Occluder, &'a Regions, Box3)>,
+        (occluders, backs): Near<'a>,
         probing: Probing,
     ) -> Hiders<'a> {
         // points near the face lie within 1 of its box, and in the slab
@@ -594,9 +626,9 @@ impl<'a> Hiders<'a> {
         let near = face_box.map(|[lo, hi]| [lo - 1, hi + 1]);
         let occluders: Vec<Hider<'a>> = occluders
             .into_iter()
-            .filter_map(|(o, r, b)| {
+            .filter_map(|(o, r, b, back)| {
                 let Probing::NearFace { slab } = probing else {
-                    return Some((o, Cow::Borrowed(&r.penumbra[..]), b));
+                    return Some((o, Cow::Borrowed(&r.penumbra[..]), b, back));
                 };
                 let tests = face_tests(face.corners(), &r.penumbra)?;
                 let b = match slab.then(|| slab_box(light, o.corners(), face.plane())) {
@@ -604,28 +636,49 @@ impl<'a> Hiders<'a> {
                     Some(InSlab::Within(s)) => meet(meet(b, s)?, near)?,
                     Some(InSlab::Unbounded) | None => meet(b, near)?,
                 };
-                Some((o, Cow::Owned(tests), b))
+                Some((o, Cow::Owned(tests), b, back))
             })
             .collect();
         let boxes: Vec<Box3> = occluders.iter().map(|o| o.2).collect();
         Hiders {
             grid: CellGrid::new(face_box, &boxes),
             occluders,
+            backs,
         }
     }
 
     /// The occluders that hide some of the light from grid point `x`:
     /// those whose penumbra volume holds it strictly (and so their box
-    /// does), in the near list's order.
+    /// does), in the near list's order, less the faces of closed solids
+    /// `x` lies outside of and behind ([`SolidBacks`]): what `x` sees of
+    /// the light, by area, is the same without them.
     fn at(&self, x: GridPoint) -> Vec<&'a Occluder> {
         let at = x.map(i64::from);
         let mut found = Vec::new();
+        // per part met: whether `x` lies outside it
+        let mut outside: Vec<(u32, bool)> = Vec::new();
         self.grid.visit([0, 1, 2].map(|k| [at[k], at[k]]), |i| {
-            let (o, tests, b) = &self.occluders[i as usize];
+            let (o, tests, b, back) = &self.occluders[i as usize];
             let in_box = (0..3).all(|k| b[k][0] <= at[k] && at[k] <= b[k][1]);
-            if in_box && tests.iter().all(|(h, s)| h.classify_grid(x) == *s) {
-                found.push((i, *o));
+            if !in_box || !tests.iter().all(|(h, s)| h.classify_grid(x) == *s) {
+                return;
             }
+            if let Some((part, plane)) = back
+                && plane.classify_grid(x) != Side::Front
+            {
+                let out = match outside.iter().find(|p| p.0 == *part) {
+                    Some(&(_, out)) => out,
+                    None => {
+                        let out = self.backs.outside(*part, x);
+                        outside.push((*part, out));
+                        out
+                    }
+                };
+                if out {
+                    return;
+                }
+            }
+            found.push((i, *o));
         });
         // a point meets one cell, but keep the order whatever the grid
         found.sort_unstable_by_key(|&(i, _)| i);

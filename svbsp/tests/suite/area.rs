@@ -851,3 +851,82 @@ fn a_mesh_cut_both_ways_agrees_with_the_view() {
         assert!(met.contains_key(&class), "{class:?} never met: {met:?}");
     }
 }
+
+/// The six faces of the box `[lo, hi]`, turned outward.
+fn box_faces(lo: [i32; 3], hi: [i32; 3]) -> Vec<Vec<[i32; 3]>> {
+    let c = |i: usize| [0, 1, 2].map(|k| if i >> k & 1 == 1 { hi[k] } else { lo[k] });
+    [
+        [0, 2, 3, 1], // z low, seen from below
+        [4, 5, 7, 6], // z high
+        [0, 1, 5, 4], // y low
+        [2, 6, 7, 3], // y high
+        [0, 4, 6, 2], // x low
+        [1, 3, 7, 5], // x high
+    ]
+    .iter()
+    .map(|q| q.iter().map(|&i| c(i)).collect())
+    .collect()
+}
+
+/// A point outside a closed solid passes over the solid's faces it lies
+/// behind when it takes its share of the light (they hide nothing its
+/// others do not): the shares on the ground round a cube standing on it,
+/// a cube tipped onto one edge and a tetrahedron on one corner, are those
+/// of `AreaLight::view` with every face, at points far and near, on the
+/// solids' contact with the ground (which see none of the light through
+/// the solid above them) and just beside it.
+#[test]
+fn a_solids_far_side_hides_nothing_more() {
+    let cube = box_faces([-20, -20, 0], [20, 20, 40]);
+    // the cube turned 45° about x, resting on its edge along y = 0, z = 0
+    let tipped: Vec<Vec<[i32; 3]>> = box_faces([-20, -20, -20], [20, 20, 20])
+        .iter()
+        .map(|f| {
+            f.iter()
+                .map(|p| [p[0], p[1] - p[2], p[1] + p[2] + 40])
+                .collect()
+        })
+        .collect();
+    // a tetrahedron standing on its corner at the origin, turned outward
+    let (o, a, b, c) = ([0, 0, 0], [30, 0, 50], [-20, 30, 50], [-20, -30, 50]);
+    let tetra = vec![vec![o, b, a], vec![o, c, b], vec![o, a, c], vec![a, b, c]];
+    let light = AreaLight::new(&square_light(30, -20, 40, 140)).unwrap();
+    for solid in [cube, tipped, tetra] {
+        let mut faces = vec![ground(160)];
+        faces.extend(solid);
+        let occluders: Vec<Occluder> = faces.iter().map(|f| Occluder::new(f).unwrap()).collect();
+        let run = svbsp::SoftShadows::new(std::slice::from_ref(&light), &occluders).unwrap();
+        let mut points: Vec<[i32; 3]> = Vec::new();
+        for x in (-60..=60).step_by(5) {
+            for y in (-60..=60).step_by(5) {
+                points.push([x, y, 0]);
+            }
+        }
+        points.extend([
+            [0, 0, 0],
+            [1, 0, 0],
+            [0, 1, 0],
+            [20, 20, 0],
+            [21, 20, 0],
+            [7, 0, 0],
+        ]);
+        let normal = DVec3::Z;
+        let shares = run.shares(0, 0, &points);
+        let (mut hidden, mut partly) = (0, 0);
+        for (x, got) in points.iter().zip(shares) {
+            let want = light
+                .view(*x, Some(occluders[0].plane()), &occluders[1..])
+                .and_then(|v| v.fraction(DVec3::from_array(x.map(f64::from)), normal));
+            match (got, want) {
+                (Some(g), Some(w)) => assert!((g - w).abs() <= 1e-9, "{x:?}: {g} against {w}"),
+                _ => assert_eq!(got, want, "{x:?}"),
+            }
+            hidden += usize::from(want == Some(0.0));
+            partly += usize::from(want.is_some_and(|w| w > 0.0 && w < 1.0));
+        }
+        assert!(
+            hidden > 0 && partly > 10,
+            "{hidden} hidden, {partly} in part"
+        );
+    }
+}
