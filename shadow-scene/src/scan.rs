@@ -9,8 +9,6 @@
 //! to five steps. The ground is one quad under the mesh, perpendicular to
 //! `+y` (the bunny's up), twice as wide as the mesh.
 
-use std::collections::HashMap;
-
 use glam::DVec3;
 
 use crate::mesh::{Face, Mesh};
@@ -35,7 +33,9 @@ pub fn sqrt3_subdivide(mesh: &Mesh) -> Mesh {
     // neighbours of each old vertex, for the smoothing
     let mut sum = vec![DVec3::ZERO; n];
     let mut count = vec![0u32; n];
-    let mut edge_face: HashMap<(u32, u32), usize> = HashMap::with_capacity(tris.len() * 3);
+    // (keys are the mesh's own vertex numbers: a fast hash)
+    let mut edge_face: rustc_hash::FxHashMap<(u32, u32), usize> =
+        rustc_hash::FxHashMap::with_capacity_and_hasher(tris.len() * 3, Default::default());
     for (fi, t) in tris.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
