@@ -715,7 +715,12 @@ pub(crate) fn large_receivers(polys: &[Polygon], ranges: &[Range<usize>]) -> Vec
         .par_iter()
         .map(|r| polys[r.clone()].iter().map(approx_area).sum())
         .collect();
-    let mut sorted = area.clone();
+    large_first(&area)
+}
+
+/// Of receivers of areas `area`, those [`large_receivers`] starts first.
+pub(crate) fn large_first(area: &[f64]) -> Vec<usize> {
+    let mut sorted = area.to_vec();
     let Some((_, &mut median, _)) =
         (!sorted.is_empty()).then(|| sorted.select_nth_unstable_by(area.len() / 2, f64::total_cmp))
     else {

@@ -225,15 +225,27 @@ impl<'a> SoftShadows<'a> {
     /// [`SoftShadows::fragments`], calling `on_faces(n)` as each `n` more
     /// faces are done.
     pub fn fragments_with(&self, on_faces: &(dyn Fn(usize) + Sync)) -> Vec<Vec<SoftFragment>> {
-        self.faces
+        // the large faces first (a ground under a mesh: its pieces are
+        // cut on one thread, which must not be the last work left; see
+        // `large_receivers`), then the others in order; each face's
+        // fragments go back to its place
+        let area: Vec<f64> = self.faces.iter().map(|f| grid_area(f.corners())).collect();
+        let large = crate::engine::large_first(&area);
+        let mut order = large.clone();
+        order.extend((0..self.faces.len()).filter(|i| !large.contains(i)));
+        let done: Vec<Vec<SoftFragment>> = order
             .par_iter()
-            .enumerate()
-            .map_init(Scratch::default, |scratch, (i, face)| {
-                let fragments = soft_face(self, i, face, scratch);
+            .map_init(Scratch::default, |scratch, &i| {
+                let fragments = soft_face(self, i, &self.faces[i], scratch);
                 on_faces(1);
                 fragments
             })
-            .collect()
+            .collect();
+        let mut out: Vec<Vec<SoftFragment>> = vec![Vec::new(); self.faces.len()];
+        for (i, fragments) in order.into_iter().zip(done) {
+            out[i] = fragments;
+        }
+        out
     }
 
     /// The share of light `light`'s irradiance arriving at each grid
@@ -521,6 +533,17 @@ fn has_share(light: &AreaLight) -> bool {
 /// The grid point nearest `p` (grid units).
 fn nearest(p: [f64; 3]) -> GridPoint {
     p.map(|c| c.round() as i32)
+}
+
+/// A planar polygon's area from its grid corners, in `f64` (for
+/// scheduling only).
+fn grid_area(corners: &[GridPoint]) -> f64 {
+    let v: Vec<DVec3> = corners
+        .iter()
+        .map(|c| DVec3::from_array(c.map(f64::from)))
+        .collect();
+    let n = (0..v.len()).fold(DVec3::ZERO, |n, i| n + v[i].cross(v[(i + 1) % v.len()]));
+    n.length() / 2.0
 }
 
 /// The share of `light` (a polygon or a disc: [`has_share`]) arriving at
