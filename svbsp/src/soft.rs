@@ -446,8 +446,7 @@ fn soft_face(
             let hiders = run.hiders(k, i, probing);
             // (one point a task when stolen: the points are sorted, so the
             // dear ones, deep in a mesh's penumbra, lie together, and a
-            // run of them left to one thread kept the other idle for a
-            // quarter of bunny-99k's area light)
+            // run of them must not be left to one thread)
             let fractions = points
                 .par_iter()
                 .with_max_len(1)
