@@ -930,3 +930,56 @@ fn a_solids_far_side_hides_nothing_more() {
         );
     }
 }
+
+/// The same on meshes: a closed UV sphere floating over the ground and one
+/// standing on it on its pole, under a square light: every share on the
+/// ground (random points, and the point the standing sphere touches)
+/// equals `AreaLight::view` with every face.
+#[test]
+fn shares_past_closed_meshes_equal_the_view_with_every_face() {
+    let (v, tris) = bsp_fixtures::shapes::uv_sphere(200);
+    let lowest = v.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+    let mut world: Vec<Vec<DVec3>> = vec![vec![
+        DVec3::new(-6.0, -6.0, 0.0),
+        DVec3::new(6.0, -6.0, 0.0),
+        DVec3::new(6.0, 6.0, 0.0),
+        DVec3::new(-6.0, 6.0, 0.0),
+    ]];
+    for at in [DVec3::new(-1.1, 0.2, 2.0), DVec3::new(1.2, -0.3, -lowest)] {
+        world.extend(
+            tris.iter()
+                .map(|t| t.iter().map(|&i| v[i as usize] + at).collect()),
+        );
+    }
+    let corners =
+        [(-0.4, -0.6), (-0.4, 0.6), (0.8, 0.6), (0.8, -0.6)].map(|(x, y)| DVec3::new(x, y, 6.0));
+    let grid = bsp_core::Grid::fit_points(world.iter().flatten().chain(&corners)).unwrap();
+    let faces = snapped(&world, &grid);
+    let light = AreaLight::new(&corners.map(|c| grid.snap(c).unwrap())).unwrap();
+    let run = svbsp::SoftShadows::new(std::slice::from_ref(&light), &faces).unwrap();
+    let mut rng = Rng::new(0x0b5c_0e11);
+    let half = grid.snap(DVec3::new(3.0, 3.0, 0.0)).unwrap();
+    let z = grid.snap(DVec3::ZERO).unwrap()[2];
+    let touch = grid.snap(DVec3::new(1.2, -0.3, 0.0)).unwrap();
+    let mut points = vec![touch];
+    for _ in 0..300 {
+        points.push([
+            below(&mut rng, 2 * half[0] as u64) - half[0],
+            below(&mut rng, 2 * half[1] as u64) - half[1],
+            z,
+        ]);
+    }
+    let shares = run.shares(0, 0, &points);
+    let mut partly = 0;
+    for (x, got) in points.iter().zip(shares) {
+        let want = light
+            .view(*x, Some(faces[0].plane()), &faces[1..])
+            .and_then(|v| v.fraction(DVec3::from_array(x.map(f64::from)), DVec3::Z));
+        match (got, want) {
+            (Some(g), Some(w)) => assert!((g - w).abs() <= 1e-9, "{x:?}: {g} against {w}"),
+            _ => assert_eq!(got, want, "{x:?}"),
+        }
+        partly += usize::from(want.is_some_and(|w| w > 0.0 && w < 1.0));
+    }
+    assert!(partly > 20, "{partly} points in part");
+}
