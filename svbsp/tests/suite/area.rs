@@ -783,6 +783,36 @@ fn a_square_and_its_two_triangles_cast_the_same_umbra() {
     }
 }
 
+/// A 12 × 12 ground at height 0 (face 0), a copy of the mesh `v, tris`
+/// moved by each of `at`, and a 1.2 × 1.2 light at height 6 whose corners
+/// turn clockwise seen from above (it shines down), on the grid that fits
+/// them.
+fn spheres_under_a_light(
+    v: &[DVec3],
+    tris: &[Vec<u32>],
+    at: &[DVec3],
+) -> (bsp_core::Grid, Vec<Occluder>, AreaLight) {
+    let mut world: Vec<Vec<DVec3>> = vec![vec![
+        DVec3::new(-6.0, -6.0, 0.0),
+        DVec3::new(6.0, -6.0, 0.0),
+        DVec3::new(6.0, 6.0, 0.0),
+        DVec3::new(-6.0, 6.0, 0.0),
+    ]];
+    for &d in at {
+        world.extend(
+            tris.iter()
+                .map(|t| t.iter().map(|&i| v[i as usize] + d).collect()),
+        );
+    }
+    let corners =
+        [(-0.4, -0.6), (-0.4, 0.6), (0.8, 0.6), (0.8, -0.6)].map(|(x, y)| DVec3::new(x, y, 6.0));
+    let grid = bsp_core::Grid::fit_points(world.iter().flatten().chain(&corners)).unwrap();
+    let faces = snapped(&world, &grid);
+    assert_eq!(faces.len(), world.len());
+    let light = AreaLight::new(&corners.map(|c| grid.snap(c).unwrap())).unwrap();
+    (grid, faces, light)
+}
+
 /// A closed mesh (a UV sphere of 400 triangles) over the ground under a
 /// square light: its faces hide the light mostly together. The faces cut
 /// with the corners' point-light trees (`classify_faces`) have the same
@@ -792,25 +822,7 @@ fn a_square_and_its_two_triangles_cast_the_same_umbra() {
 #[test]
 fn a_mesh_cut_both_ways_agrees_with_the_view() {
     let (v, tris) = bsp_fixtures::shapes::uv_sphere(400);
-    let at = DVec3::new(0.2, -0.1, 2.0);
-    let mut world: Vec<Vec<DVec3>> = vec![vec![
-        DVec3::new(-6.0, -6.0, 0.0),
-        DVec3::new(6.0, -6.0, 0.0),
-        DVec3::new(6.0, 6.0, 0.0),
-        DVec3::new(-6.0, 6.0, 0.0),
-    ]];
-    world.extend(
-        tris.iter()
-            .map(|t| t.iter().map(|&i| v[i as usize] + at).collect()),
-    );
-    // a 1.2 × 1.2 light at height 6, its corners turning clockwise seen
-    // from above: it shines down
-    let corners =
-        [(-0.4, -0.6), (-0.4, 0.6), (0.8, 0.6), (0.8, -0.6)].map(|(x, y)| DVec3::new(x, y, 6.0));
-    let grid = bsp_core::Grid::fit_points(world.iter().flatten().chain(&corners)).unwrap();
-    let faces = snapped(&world, &grid);
-    assert_eq!(faces.len(), world.len());
-    let light = AreaLight::new(&corners.map(|c| grid.snap(c).unwrap())).unwrap();
+    let (grid, faces, light) = spheres_under_a_light(&v, &tris, &[DVec3::new(0.2, -0.1, 2.0)]);
     let fast = light.classify_faces(&faces);
     let areas = |fs: &[svbsp::AreaFragment]| -> [f64; 4] {
         let mut a = [0.0; 4];
@@ -939,23 +951,8 @@ fn a_solids_far_side_hides_nothing_more() {
 fn shares_past_closed_meshes_equal_the_view_with_every_face() {
     let (v, tris) = bsp_fixtures::shapes::uv_sphere(200);
     let lowest = v.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
-    let mut world: Vec<Vec<DVec3>> = vec![vec![
-        DVec3::new(-6.0, -6.0, 0.0),
-        DVec3::new(6.0, -6.0, 0.0),
-        DVec3::new(6.0, 6.0, 0.0),
-        DVec3::new(-6.0, 6.0, 0.0),
-    ]];
-    for at in [DVec3::new(-1.1, 0.2, 2.0), DVec3::new(1.2, -0.3, -lowest)] {
-        world.extend(
-            tris.iter()
-                .map(|t| t.iter().map(|&i| v[i as usize] + at).collect()),
-        );
-    }
-    let corners =
-        [(-0.4, -0.6), (-0.4, 0.6), (0.8, 0.6), (0.8, -0.6)].map(|(x, y)| DVec3::new(x, y, 6.0));
-    let grid = bsp_core::Grid::fit_points(world.iter().flatten().chain(&corners)).unwrap();
-    let faces = snapped(&world, &grid);
-    let light = AreaLight::new(&corners.map(|c| grid.snap(c).unwrap())).unwrap();
+    let at = [DVec3::new(-1.1, 0.2, 2.0), DVec3::new(1.2, -0.3, -lowest)];
+    let (grid, faces, light) = spheres_under_a_light(&v, &tris, &at);
     let run = svbsp::SoftShadows::new(std::slice::from_ref(&light), &faces).unwrap();
     let mut rng = Rng::new(0x0b5c_0e11);
     let half = grid.snap(DVec3::new(3.0, 3.0, 0.0)).unwrap();
