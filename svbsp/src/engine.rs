@@ -740,10 +740,7 @@ fn approx_area(p: &Polygon) -> f64 {
     let v: SmallVec<[glam::DVec3; 8]> = (p.vertices().iter())
         .map(|x| glam::DVec3::from(x.approx_f64()))
         .collect();
-    let n = (0..v.len()).fold(glam::DVec3::ZERO, |n, i| {
-        n + v[i].cross(v[(i + 1) % v.len()])
-    });
-    n.length() / 2.0
+    crate::polygon_area(&v)
 }
 
 /// Receivers `all` in order, cut into runs of at most `chunk`, each of

@@ -193,8 +193,7 @@ impl<'a> SoftShadows<'a> {
             return Err(LightError::TooMany(lights.len()));
         }
         let (blockers, sources) = coplanar_blockers_of(faces);
-        let polygons: Vec<Polygon> = faces.iter().map(Occluder::to_polygon).collect();
-        let solids = bsp_core::certify_solid_parts(&polygons);
+        let (polygons, solids) = certified(faces);
         let regions: Vec<Vec<Option<Regions>>> = lights
             .iter()
             .map(|l| blockers.par_iter().map(|o| l.regions(o)).collect())
@@ -291,6 +290,14 @@ impl<'a> SoftShadows<'a> {
     }
 }
 
+/// The faces as polygons, and their parts certified to bound solids
+/// ([`bsp_core::certify_solid_parts`]).
+fn certified(faces: &[Occluder]) -> (Vec<Polygon>, bsp_core::SolidParts) {
+    let polygons: Vec<Polygon> = faces.iter().map(Occluder::to_polygon).collect();
+    let solids = bsp_core::certify_solid_parts(&polygons);
+    (polygons, solids)
+}
+
 /// Per light, the point lights' shadow volumes of its corners over
 /// `faces` (which corners each point of a face sees); `None` for a light
 /// of more corners than the trees take (its pieces are then cut by each
@@ -359,8 +366,7 @@ impl AreaLight {
         let blockers = coplanar_blockers(faces);
         let regions: Vec<Option<Regions>> = blockers.par_iter().map(|o| self.regions(o)).collect();
         let (near, reach) = near_lists(self.corners(), faces, (&blockers, &regions));
-        let polygons: Vec<Polygon> = faces.iter().map(Occluder::to_polygon).collect();
-        let solids = bsp_core::certify_solid_parts(&polygons);
+        let (polygons, solids) = certified(faces);
         let corners = corner_shadows(std::slice::from_ref(self), &polygons, &solids)
             .pop()
             .flatten();
@@ -541,8 +547,7 @@ fn grid_area(corners: &[GridPoint]) -> f64 {
         .iter()
         .map(|c| DVec3::from_array(c.map(f64::from)))
         .collect();
-    let n = (0..v.len()).fold(DVec3::ZERO, |n, i| n + v[i].cross(v[(i + 1) % v.len()]));
-    n.length() / 2.0
+    crate::polygon_area(&v)
 }
 
 /// The share of `light` (a polygon or a disc: [`has_share`]) arriving at

@@ -75,25 +75,37 @@ fn partition_known(
     (on, front, back)
 }
 
-/// `true` if cutting by `plane` leaves each side with at most three
-/// quarters of the polygons (spanning ones count on both sides) and neither
-/// side empty. Decided before anything is split, so a rejected cut costs no
-/// fragments; without it, long parallel slivers would be cut again and
-/// again next to the previous cut.
-fn cut_balances(polys: &[Polygon], plane: &Plane) -> bool {
-    let count = |(front, back): (usize, usize), p: &Polygon| match p.classify(plane) {
-        PolygonSide::Front => (front + 1, back),
-        PolygonSide::Back => (front, back + 1),
-        PolygonSide::Spanning => (front + 1, back + 1),
-        PolygonSide::Coplanar { .. } => (front, back),
-    };
-    let (front, back) = match polys.len() > PARALLEL_LIST {
-        true => crate::par::fold_runs(polys.len(), |r| polys[r].iter().fold((0, 0), count))
-            .into_iter()
-            .fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1)),
-        false => polys.iter().fold((0, 0), count),
-    };
-    let limit = polys.len() * 3 / 4;
+/// Every polygon's side of `plane` written to `sides`, in parallel for a
+/// long list.
+fn sides_of(polys: &[Polygon], plane: &Plane, sides: &mut Vec<PolygonSide>) {
+    sides.clear();
+    if polys.len() > PARALLEL_LIST {
+        sides.resize(polys.len(), PolygonSide::Front);
+        crate::par::for_each_mut(sides, |i, s| *s = polys[i].classify(plane));
+    } else {
+        sides.extend(polys.iter().map(|p| p.classify(plane)));
+    }
+}
+
+/// `true` if cutting by a plane of which the polygons lie on `sides`
+/// leaves each side with at most three quarters of them (spanning ones
+/// count on both sides) and neither side empty. Decided before anything
+/// is split, so a rejected cut costs no fragments; without it, long
+/// parallel slivers would be cut again and again next to the previous cut.
+fn cut_balances(sides: &[PolygonSide]) -> bool {
+    let (mut front, mut back) = (0usize, 0usize);
+    for s in sides {
+        match s {
+            PolygonSide::Front => front += 1,
+            PolygonSide::Back => back += 1,
+            PolygonSide::Spanning => {
+                front += 1;
+                back += 1;
+            }
+            PolygonSide::Coplanar { .. } => {}
+        }
+    }
+    let limit = sides.len() * 3 / 4;
     front > 0 && back > 0 && front <= limit && back <= limit
 }
 
@@ -228,30 +240,47 @@ pub(super) fn grow<A>(
 /// parallel.
 const PARALLEL_LIST: usize = 1 << 15;
 
-/// The cut [`BspTree::build`] makes of a list.
+/// A balance cut of a list longer than the options' threshold, where one
+/// balances ([`cut_balances`]), with every polygon's side of it in
+/// `sides` (written whatever the answer).
+fn balance(polys: &[Polygon], opts: &BuildOptions, sides: &mut Vec<PolygonSide>) -> Option<Plane> {
+    if opts.cut_threshold == 0 || polys.len() <= opts.cut_threshold {
+        return None;
+    }
+    let cut = balance_cut(polys)?;
+    sides_of(polys, &cut, sides);
+    cut_balances(sides).then_some(cut)
+}
+
+/// The cut [`BspTree::build`] makes of a list (`scratch`: room for two
+/// planes' sides of every polygon).
 fn cut(
     polys: Vec<Polygon>,
     opts: &BuildOptions,
     rng: &mut SplitMix,
-    sides: &mut Vec<PolygonSide>,
+    scratch: &mut [Vec<PolygonSide>; 2],
 ) -> Cut {
-    // a balance cut of a long list, where one balances
-    let balance = |polys: &[Polygon]| {
-        let long = opts.cut_threshold > 0 && polys.len() > opts.cut_threshold;
-        long.then(|| balance_cut(polys).filter(|c| cut_balances(polys, c)))
-            .flatten()
-    };
-    // tried first with `cut_always`, else where the best face plane is
-    // lopsided; `known`: `sides` hold every polygon's side of it
-    let (plane, known) = match opts.cut_always.then(|| balance(&polys)).flatten() {
-        Some(cut) => (cut, false),
+    let [sides, spare] = scratch;
+    // a balance cut, tried first with `cut_always`, else where the best
+    // face plane is lopsided; `known`: `sides` hold every polygon's side
+    // of the plane (the balance cut's are found in `spare`, so that a
+    // rejected one leaves the face plane's)
+    let (plane, known) = match opts
+        .cut_always
+        .then(|| balance(&polys, opts, sides))
+        .flatten()
+    {
+        Some(cut) => (cut, true),
         None => {
             let ((plane, known), lopsided) = choose_plane_sides(&polys, opts, rng, sides);
             match (!opts.cut_always && lopsided)
-                .then(|| balance(&polys))
+                .then(|| balance(&polys, opts, spare))
                 .flatten()
             {
-                Some(cut) => (cut, false),
+                Some(cut) => {
+                    std::mem::swap(sides, spare);
+                    (cut, true)
+                }
                 None => (plane, known),
             }
         }
@@ -259,10 +288,7 @@ fn cut(
     let (on, front, back) = if known {
         partition_known(polys, &plane, sides)
     } else if polys.len() > PARALLEL_LIST {
-        // a long list's sides found in parallel
-        sides.clear();
-        sides.resize(polys.len(), PolygonSide::Front);
-        crate::par::for_each_mut(sides, |i, s| *s = polys[i].classify(&plane));
+        sides_of(&polys, &plane, sides);
         partition_known(polys, &plane, sides)
     } else {
         partition_list(polys, &plane)
@@ -274,9 +300,9 @@ fn cut(
 /// `seed`.
 fn build_one(polygons: Vec<Polygon>, opts: &BuildOptions, seed: u64) -> BspTree {
     let mut rng = SplitMix(seed);
-    let mut sides = Vec::new();
+    let mut scratch = [Vec::new(), Vec::new()];
     grow(polygons, (), |polys, ()| {
-        (cut(polys, opts, &mut rng, &mut sides), (), ())
+        (cut(polys, opts, &mut rng, &mut scratch), (), ())
     })
 }
 
@@ -322,7 +348,7 @@ impl BspTree {
             let cuts: Vec<(Cut, Slot, [u64; 2])> =
                 crate::par::map_vec(long, |(polys, slot, seed)| {
                     let mut rng = SplitMix(seed);
-                    let cut = cut(polys, opts, &mut rng, &mut Vec::new());
+                    let cut = cut(polys, opts, &mut rng, &mut Default::default());
                     (cut, slot, [rng.next_u64(), rng.next_u64()])
                 });
             level = Vec::new();
