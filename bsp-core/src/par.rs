@@ -87,6 +87,43 @@ pub fn map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
     out
 }
 
+/// [`map`] with each value written by its thread straight into its place
+/// in the output, where [`map`] gathers the runs' values and copies them
+/// on one thread: for large values, whose copy (and the first touch of the
+/// output's pages) would otherwise be a serial phase. Compiles rayon's
+/// collection once for each `T`.
+pub fn map_placed<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    placed(n, &f)
+}
+
+fn placed<T: Send>(n: usize, f: &(dyn Fn(usize) -> T + Sync)) -> Vec<T> {
+    let mut out = Vec::new();
+    let min = n.div_ceil(run_count(n).max(1)).max(1);
+    (0..n)
+        .into_par_iter()
+        .with_min_len(min)
+        .map(f)
+        .collect_into_vec(&mut out);
+    out
+}
+
+/// [`map_vec`] with each value written straight into its place (see
+/// [`map_placed`]).
+pub fn map_vec_placed<S: Send, T: Send>(items: Vec<S>, f: impl Fn(S) -> T + Sync) -> Vec<T> {
+    vec_placed(items, &f)
+}
+
+fn vec_placed<S: Send, T: Send>(items: Vec<S>, f: &(dyn Fn(S) -> T + Sync)) -> Vec<T> {
+    let mut out = Vec::new();
+    let min = items.len().div_ceil(run_count(items.len()).max(1)).max(1);
+    items
+        .into_par_iter()
+        .with_min_len(min)
+        .map(f)
+        .collect_into_vec(&mut out);
+    out
+}
+
 /// `[f(0)?, f(1)?, …]`, computed in parallel: the values, or the error of
 /// the first index that failed (the same error for every number of
 /// threads).

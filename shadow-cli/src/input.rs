@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use bsp_core::{Grid, ImportReport, Polygon, import_faces_par};
+use bsp_core::{Grid, ImportReport, Polygon};
 use bsp_shadows::prepared::Prepared;
 use glam::DVec3;
 use shadow_scene::{Mesh, Staging};
@@ -100,7 +100,7 @@ impl Scene {
         let scene = phases.run("snap/import", || -> Result<Scene> {
             let grid = shared_grid(&mesh.positions, &specs, soft).with_context(|| name.clone())?;
             let (lights, soft) = place_lights(&grid, &specs, soft)?;
-            let (polys, report) = import_faces_par(&grid, &mesh.face_loops())
+            let (polys, report) = bsp_shadows::import_mesh(&grid, &mesh)
                 .with_context(|| format!("{name}: cannot import the faces"))?;
             Ok(Scene {
                 mesh,

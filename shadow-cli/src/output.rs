@@ -122,6 +122,14 @@ pub(crate) fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
+/// Drops `value` on a thread of its own: a command's large structures (a
+/// 100k-face scene's polygons take milliseconds to free, one by one) need
+/// not hold up its exit, which returns the process's memory whole.
+pub(crate) fn drop_in_background<T: Send + 'static>(value: T) {
+    // (where no thread can be started, the value is dropped here)
+    let _ = std::thread::Builder::new().spawn(move || drop(value));
+}
+
 /// Writes to stdout; a closed pipe (`shadow csg ... --stats | head`) is
 /// not an error.
 pub(crate) fn emit(text: &str) -> Result<()> {

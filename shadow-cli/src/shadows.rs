@@ -220,6 +220,7 @@ pub(crate) fn run(args: &ShadowsArgs) -> Result<()> {
         let import = (faces, import.as_str(), &scene.grid);
         report += &fig.stats_text(import, &lights, (&phases.0, total), group);
     }
+    crate::output::drop_in_background(scene);
     emit(&report)
 }
 

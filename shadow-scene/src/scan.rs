@@ -30,18 +30,16 @@ pub fn sqrt3_subdivide(mesh: &Mesh) -> Mesh {
         .filter(|f| f.vertices.len() == 3)
         .map(|f| ([f.vertices[0], f.vertices[1], f.vertices[2]], f.group))
         .unzip();
-    // neighbours of each old vertex, for the smoothing
+    // neighbours of each old vertex, for the smoothing: each edge adds
+    // its ends once, when it is first seen from either side
+    let edges = Edges::new(n, &tris);
     let mut sum = vec![DVec3::ZERO; n];
     let mut count = vec![0u32; n];
-    // (keys are the mesh's own vertex numbers: a fast hash)
-    let mut edge_face: rustc_hash::FxHashMap<(u32, u32), usize> =
-        rustc_hash::FxHashMap::with_capacity_and_hasher(tris.len() * 3, Default::default());
     for (fi, t) in tris.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
-            edge_face.insert((a, b), fi);
-            // every edge seen from one side only adds both ends once
-            if !edge_face.contains_key(&(b, a)) {
+            let e = (3 * fi + k) as u32;
+            if edges.between(b, a).next().is_none_or(|f| f > e) {
                 sum[a as usize] += mesh.positions[b as usize];
                 sum[b as usize] += mesh.positions[a as usize];
                 count[a as usize] += 1;
@@ -81,9 +79,10 @@ pub fn sqrt3_subdivide(mesh: &Mesh) -> Mesh {
     for (fi, t) in tris.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
-            match edge_face.get(&(b, a)) {
+            // (the last triangle with the opposite edge, where several have it)
+            match edges.between(b, a).last().map(|e| e as usize / 3) {
                 // each interior edge once: the two triangles of the flip
-                Some(&g) if a < b => {
+                Some(g) if a < b => {
                     let (c, d) = (centre[fi], centre[g]);
                     push([a, d, c], groups[fi]);
                     push([b, c, d], groups[g]);
@@ -97,6 +96,50 @@ pub fn sqrt3_subdivide(mesh: &Mesh) -> Mesh {
         out.faces.push(f.clone());
     }
     out
+}
+
+/// A triangle list's directed edges `a → b`, edge `k` of triangle `t`
+/// numbered `3 t + k`, listed by their first vertex in their numbers'
+/// order (each vertex's few edges side by side: a lookup of an edge reads
+/// a handful of neighbours where a hash map's read its table at random).
+struct Edges {
+    /// Vertex `a`'s edges are `to[start[a]..start[a + 1]]`.
+    start: Vec<u32>,
+    /// Each edge's second vertex and number.
+    to: Vec<(u32, u32)>,
+}
+
+impl Edges {
+    fn new(vertices: usize, tris: &[[u32; 3]]) -> Edges {
+        let mut start = vec![0u32; vertices + 1];
+        for t in tris {
+            for &a in t {
+                start[a as usize + 1] += 1;
+            }
+        }
+        for v in 0..vertices {
+            start[v + 1] += start[v];
+        }
+        let mut next = start.clone();
+        let mut to = vec![(0, 0); 3 * tris.len()];
+        for (fi, t) in tris.iter().enumerate() {
+            for k in 0..3 {
+                let slot = &mut next[t[k] as usize];
+                to[*slot as usize] = (t[(k + 1) % 3], (3 * fi + k) as u32);
+                *slot += 1;
+            }
+        }
+        Edges { start, to }
+    }
+
+    /// The numbers of the edges `a → b`, in increasing order.
+    fn between(&self, a: u32, b: u32) -> impl Iterator<Item = u32> + '_ {
+        let r = self.start[a as usize] as usize..self.start[a as usize + 1] as usize;
+        self.to[r]
+            .iter()
+            .filter(move |&&(to, _)| to == b)
+            .map(|&(_, e)| e)
+    }
 }
 
 /// The Stanford bunny after `subdivisions` √3 steps (at most

@@ -251,10 +251,21 @@ pub struct Fragment {
 /// ```
 pub fn shadows(mesh: &Mesh, lights: &[Light]) -> Result<Shadows, Error> {
     let grid = svbsp::shared_grid(&mesh.positions, lights).map_err(Error::Light)?;
-    let (polys, _) =
-        bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(Error::Import)?;
+    let (polys, _) = crate::import_mesh(&grid, mesh).map_err(Error::Import)?;
     let solids = bsp_core::certify_solid_parts(&polys);
     shadows_on(&grid, &polys, &solids, mesh.faces.len(), lights, None, true)
+}
+
+/// The faces of `mesh` snapped to `grid` and imported, in parallel, as
+/// exact convex polygons tagged with their face numbers
+/// ([`bsp_core::import_mesh_par`]).
+pub fn import_mesh(
+    grid: &bsp_core::Grid,
+    mesh: &Mesh,
+) -> Result<(Vec<bsp_core::Polygon>, bsp_core::ImportReport), bsp_core::Error> {
+    bsp_core::import_mesh_par(grid, &mesh.positions, mesh.faces.len(), &|f| {
+        &mesh.faces[f].vertices[..]
+    })
 }
 
 /// A tile's part of a study's run ([`shadows_on`]): its polygons

@@ -343,8 +343,7 @@ pub fn soft_shadows(
     soft: &[SoftSpec],
 ) -> Result<SoftShadows, Error> {
     let grid = svbsp::shared_soft_grid(&mesh.positions, lights, soft).map_err(Error::Light)?;
-    let (polys, _) =
-        bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(Error::Import)?;
+    let (polys, _) = crate::import_mesh(&grid, mesh).map_err(Error::Import)?;
     soft_shadows_on(grid, &polys, mesh.faces.len(), lights, soft)
 }
 

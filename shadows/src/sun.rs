@@ -518,8 +518,7 @@ pub(crate) fn disc_study(
     let normals = mesh.face_normals();
     // (discs add no point to the grid: the mesh snapped and imported once)
     let grid = svbsp::shared_soft_grid(&mesh.positions, &[], &[]).map_err(crate::Error::Light)?;
-    let (polys, _) =
-        bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(crate::Error::Import)?;
+    let (polys, _) = crate::import_mesh(&grid, mesh).map_err(crate::Error::Import)?;
     progress.phase("suns", suns.len() as u64);
     for &direction in suns {
         let disc = crate::SoftSpec::SunDisc {
@@ -599,8 +598,7 @@ pub fn sensor_hours(
     let at: Vec<bsp_core::GridPoint> = (sensors.iter().enumerate())
         .map(|(index, &p)| grid.snap(p).map_err(|cause| Error::Sensor { index, cause }))
         .collect::<Result<_, _>>()?;
-    let (polys, _) =
-        bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(Error::Import)?;
+    let (polys, _) = crate::import_mesh(&grid, mesh).map_err(Error::Import)?;
     let solids = bsp_core::certify_solid_parts(&polys);
     let mut seen = vec![0u32; sensors.len()];
     for batch in all.chunks(svbsp::MAX_LIGHTS) {
@@ -714,8 +712,7 @@ fn heat_picture(
     let light = [svbsp::LightSpec::Point(at.eye)];
     let grid = svbsp::shared_grid(&mesh.positions, &light).map_err(crate::Error::Light)?;
     let lights = svbsp::place_lights(&grid, &light).map_err(crate::Error::Light)?;
-    let (polys, _) =
-        bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(crate::Error::Import)?;
+    let (polys, _) = crate::import_mesh(&grid, mesh).map_err(crate::Error::Import)?;
     let raster = |e| crate::Error::Raster(e);
     let scene = shadow_raster::RasterScene::new(&grid, polys).map_err(raster)?;
     let bounds =

@@ -506,6 +506,9 @@ impl ShadowVolumes {
     ) -> Result<ShadowVolumes, VolumeError> {
         let occ = Occluders::new(&light, occluders)?;
         let mut pool = Pool::default();
+        pool.arena
+            .reserve(occ.verts.len(), occ.verts.len() + occ.len());
+        pool.pieces.reserve(occ.len());
         let list: Vec<Entry> = (0..occ.len() as u32)
             .map(|o| pool.add_occluder(&occ, o))
             .collect();

@@ -402,14 +402,22 @@ struct Loops {
 
 impl Loops {
     fn new(polys: &[Polygon]) -> Result<Loops, SurfaceDefect> {
+        // each polygon's grid corners read in parallel (a pass over every
+        // polygon, which is large), then laid end to end
+        let corners = crate::par::map_placed(polys.len(), |i| {
+            polys[i]
+                .vertices()
+                .iter()
+                .map(|v| v.as_grid())
+                .collect::<Option<SmallVec<[GridPoint; 4]>>>()
+        });
         let mut start = Vec::with_capacity(polys.len() + 1);
         let mut pts: Vec<GridPoint> = Vec::with_capacity(polys.len() * 3);
-        for (i, p) in polys.iter().enumerate() {
+        for (i, c) in corners.iter().enumerate() {
             start.push(pts.len() as u32);
-            for v in p.vertices() {
-                pts.push(v.as_grid().ok_or(SurfaceDefect::NotGrid { polygon: i })?);
-            }
+            pts.extend_from_slice(c.as_ref().ok_or(SurfaceDefect::NotGrid { polygon: i })?);
         }
+        drop(corners);
         start.push(pts.len() as u32);
         let mut number: FxHashMap<GridPoint, u32> = FxHashMap::default();
         number.reserve(pts.len() / 2);

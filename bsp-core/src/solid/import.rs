@@ -127,17 +127,111 @@ pub fn import_faces_par(
     grid: &Grid,
     faces: &[Vec<DVec3>],
 ) -> Result<(Vec<Polygon>, ImportReport), Error> {
-    const CHUNK: usize = 4096;
-    let parts = crate::par::map(faces.len().div_ceil(CHUNK), |i| {
-        let chunk = &faces[i * CHUNK..faces.len().min((i + 1) * CHUNK)];
-        import_from(grid, chunk.iter().map(|f| &f[..]), i * CHUNK)
-    });
-    let (runs, report) = gather(parts)?;
-    let mut out = Vec::with_capacity(faces.len());
-    for run in runs {
-        out.extend(run);
+    import_placed(
+        faces.len(),
+        |fi| single_polygon(grid, faces[fi].iter().map(|&p| Some(p)), fi),
+        |importer, fi, out| importer.face(grid, &faces[fi], fi, out),
+    )
+}
+
+/// [`import_faces_par`] of an indexed mesh: `face(i)` is face `i`'s loop
+/// of indices into `positions` (an index out of range is an error naming
+/// the face and the corner). The same polygons and report as
+/// [`import_faces_par`] of the loops of positions, without making them.
+/// (`face` is a `dyn` closure so that the import is compiled here,
+/// optimised, whatever the caller's build settings.)
+///
+/// ```
+/// use bsp_core::{Grid, import_faces_par, import_mesh_par};
+/// use glam::DVec3;
+/// let p = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::ONE];
+/// let faces = [vec![0, 1, 2], vec![1, 3, 2], vec![0, 0, 1]];
+/// let grid = Grid::fit_points(&p).unwrap();
+/// let (polys, report) = import_mesh_par(&grid, &p, faces.len(), &|i| &faces[i][..]).unwrap();
+/// let loops: Vec<Vec<DVec3>> = faces.iter().map(|f| f.iter().map(|&v| p[v as usize]).collect()).collect();
+/// let (by_loops, by_loops_report) = import_faces_par(&grid, &loops).unwrap();
+/// assert_eq!(report, by_loops_report);
+/// let corners = |q: &[bsp_core::Polygon]| -> Vec<(u32, Vec<[f64; 3]>)> {
+///     q.iter().map(|q| (q.tag(), q.vertices_f64())).collect()
+/// };
+/// assert_eq!(corners(&polys), corners(&by_loops));
+/// assert_eq!((polys.len(), report.dropped.len()), (2, 1));
+/// assert!(import_mesh_par(&grid, &p, 1, &|_| &[0, 1, 7][..]).is_err());
+/// ```
+pub fn import_mesh_par<'a>(
+    grid: &Grid,
+    positions: &[DVec3],
+    faces: usize,
+    face: &(dyn Fn(usize) -> &'a [u32] + Sync),
+) -> Result<(Vec<Polygon>, ImportReport), Error> {
+    import_placed(
+        faces,
+        |fi| {
+            let corners = face(fi).iter().map(|&v| positions.get(v as usize).copied());
+            single_polygon(grid, corners, fi)
+        },
+        |importer, fi, out| importer.indexed(grid, positions, face(fi), fi, out),
+    )
+}
+
+/// The import of `n` faces in parallel: `single(i)` is face `i` as one
+/// polygon where it is one as it stands (the rule), and `import` imports
+/// any face with its notes and errors.
+///
+/// The rule's polygons go straight into their places in parallel (a
+/// gather and copy of large polygons on one thread afterwards was a tenth
+/// of a 100k-face scene's shadows); the other faces (triangulated,
+/// dropped, or in error) are imported again, in face order, with their
+/// notes: the same polygons, report and first error as one import of
+/// every face in order.
+fn import_placed(
+    n: usize,
+    single: impl Fn(usize) -> Option<Polygon> + Sync,
+    import: impl Fn(&mut FaceImporter, usize, &mut dyn FnMut(Polygon)) -> Result<(), Error>,
+) -> Result<(Vec<Polygon>, ImportReport), Error> {
+    let single = crate::par::map_placed(n, single);
+    let singles = single.iter().filter(|p| p.is_some()).count();
+    if singles == n {
+        let polys = crate::par::map_vec_placed(single, |p| match p {
+            Some(p) => p,
+            None => unreachable!("every face was counted as one polygon"),
+        });
+        let report = ImportReport {
+            faces: n,
+            polygons: n,
+            ..ImportReport::default()
+        };
+        return Ok((polys, report));
     }
-    Ok((out, report))
+    let mut run = Importer::new(n);
+    for (fi, p) in single.into_iter().enumerate() {
+        match p {
+            Some(p) => run.out.push(p),
+            None => {
+                let out = &mut run.out;
+                import(&mut run.faces, fi, &mut |q| out.push(q))?;
+            }
+        }
+    }
+    let (polys, mut report) = run.finish();
+    report.faces += singles;
+    report.polygons += singles;
+    Ok((polys, report))
+}
+
+/// Face `fi`, its corners' positions (`None` for a corner that does not
+/// exist), as one polygon where it is one as it stands: every corner
+/// snapped, and the loop planar, convex and with area on the grid (the
+/// import's rule, with nothing to note). Else `None`.
+fn single_polygon(
+    grid: &Grid,
+    corners: impl Iterator<Item = Option<DVec3>>,
+    fi: usize,
+) -> Option<Polygon> {
+    let pts: smallvec::SmallVec<[GridPoint; 8]> =
+        corners.map(|p| grid.snap(p?).ok()).collect::<Option<_>>()?;
+    let polygon = GridPolygon::from_grid_points(&pts).ok()?;
+    Some(polygon.to_polygon(fi as u32))
 }
 
 /// The runs of a parallel import in face order, with their report joined;
@@ -679,24 +773,52 @@ mod tests {
         let (runs, report) = import_indexed_par(&grid, &positions, &faces).unwrap();
         assert!(runs.len() > 1);
         let got: Vec<Polygon> = runs.into_iter().flatten().collect();
+        let same = |got: &[Polygon], want: &[Polygon]| {
+            assert_eq!(got.len(), want.len());
+            for (g, w) in got.iter().zip(want) {
+                assert_eq!(g.tag(), w.tag());
+                assert_eq!(g.support(), w.support());
+                assert_eq!(g.vertices_f64(), w.vertices_f64());
+            }
+        };
         assert_eq!(report, want_report);
-        assert_eq!(got.len(), want.len());
-        for (g, w) in got.iter().zip(&want) {
-            assert_eq!(g.tag(), w.tag());
-            assert_eq!(g.support(), w.support());
-            assert_eq!(g.vertices_f64(), w.vertices_f64());
-        }
+        same(&got, &want);
+        // the parallel imports that place each face's polygon: mixed faces
+        // (the others imported again in order), and faces that are all one
+        // polygon each (the triangles and quads alone)
+        let by_index = |faces: &[Vec<u32>]| {
+            import_mesh_par(&grid, &positions, faces.len(), &|f| &faces[f][..])
+        };
+        let (got, report) = import_faces_par(&grid, &loops).unwrap();
+        assert_eq!(report, want_report);
+        same(&got, &want);
+        let (got, report) = by_index(&faces).unwrap();
+        assert_eq!(report, want_report);
+        same(&got, &want);
+        let simple: Vec<Vec<u32>> = faces.iter().step_by(5).cloned().collect();
+        let simple_loops: Vec<Vec<DVec3>> = loops.iter().step_by(5).cloned().collect();
+        let (want, want_report) = import_faces(&grid, simple_loops.iter().map(|f| &f[..])).unwrap();
+        assert_eq!(want_report.polygons, simple.len());
+        let (got, report) = by_index(&simple).unwrap();
+        assert_eq!(report, want_report);
+        same(&got, &want);
+        let (got, report) = import_faces_par(&grid, &simple_loops).unwrap();
+        assert_eq!(report, want_report);
+        same(&got, &want);
         // a face naming a vertex the mesh does not have is an error, not
-        // a panic
+        // a panic; the first such face in order is named
         faces[7_000].push(positions.len() as u32);
+        faces[9_000].push(positions.len() as u32 + 1);
+        let error = Error::VertexIndex {
+            face: 7_000,
+            vertex: 3,
+            index: positions.len() as u32,
+        };
         assert_eq!(
             import_indexed_par(&grid, &positions, &faces).unwrap_err(),
-            Error::VertexIndex {
-                face: 7_000,
-                vertex: 3,
-                index: positions.len() as u32
-            }
+            error
         );
+        assert_eq!(by_index(&faces).unwrap_err(), error);
     }
 
     /// A non-convex planar face.

@@ -14,7 +14,7 @@ pub use embedded::{
 };
 pub use import::{
     FaceImporter, ImportReport, all_planar, import_faces, import_faces_par, import_indexed_par,
-    snap_positions,
+    import_mesh_par, snap_positions,
 };
 pub use mesh::TriMesh;
 pub use topology::{TopologyError, check_closed_manifold, is_closed_cycle};

@@ -37,8 +37,7 @@ impl Snapped {
     /// `mesh` snapped and imported.
     pub(super) fn new(mesh: &crate::Mesh) -> Result<Snapped, crate::Error> {
         let grid = svbsp::shared_grid(&mesh.positions, &[]).map_err(crate::Error::Light)?;
-        let (polys, _) =
-            bsp_core::import_faces_par(&grid, &mesh.face_loops()).map_err(crate::Error::Import)?;
+        let (polys, _) = crate::import_mesh(&grid, mesh).map_err(crate::Error::Import)?;
         let solids = bsp_core::certify_solid_parts(&polys);
         Ok(Snapped {
             grid,

@@ -436,6 +436,15 @@ impl PieceArena {
         self.anchors.truncate(mark.planes);
     }
 
+    /// Room for `grid` more grid vertices and `planes` more planes, so
+    /// that adding a known number of them (a tree's occluders) copies no
+    /// list as it grows.
+    pub(crate) fn reserve(&mut self, grid: usize, planes: usize) {
+        self.grid.reserve(grid);
+        self.planes.reserve(planes);
+        self.anchors.reserve(planes);
+    }
+
     /// Adds a plane, returning its index.
     #[inline]
     pub(crate) fn add_plane(&mut self, p: Plane) -> u32 {
