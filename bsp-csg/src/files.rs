@@ -121,7 +121,13 @@ impl Operand {
     /// that repeat, and is left out if fewer than three remain; their
     /// number is [`Operand::collapsed`]. The check that follows tells
     /// whether the surface is still closed.
-    pub fn welded(name: impl Into<String>, mut mesh: Mesh) -> Operand {
+    pub fn welded(name: impl Into<String>, mesh: Mesh) -> Operand {
+        Operand::welded_named(name.into(), mesh)
+    }
+
+    /// [`Operand::welded`], compiled here (a generic body would be
+    /// compiled, with its loops, in the caller's crate and build settings).
+    fn welded_named(name: String, mut mesh: Mesh) -> Operand {
         let counts = (mesh.triangle_count(), mesh.faces.len());
         let mut loops: Vec<Vec<u32>> = mesh.faces.iter().map(|f| f.vertices.clone()).collect();
         mesh.weld();
@@ -130,7 +136,7 @@ impl Operand {
             loops.remove(f);
         }
         Operand {
-            name: name.into(),
+            name,
             counts,
             mesh,
             file_loops: Some(loops),
@@ -369,6 +375,16 @@ impl FileBoolean {
         operands: Checked<'_>,
         op: BoolOp,
         mut on_step: impl FnMut(&Step, &Grid),
+    ) -> Result<FileBoolean, FileError> {
+        FileBoolean::apply_dyn(operands, op, &mut on_step)
+    }
+
+    /// [`FileBoolean::apply`], compiled here, optimised, whatever crate
+    /// calls it (a generic body is compiled in the caller's crate).
+    fn apply_dyn(
+        operands: Checked<'_>,
+        op: BoolOp,
+        on_step: &mut dyn FnMut(&Step, &Grid),
     ) -> Result<FileBoolean, FileError> {
         let operands = operands.0;
         let grid = {

@@ -155,7 +155,7 @@ pub fn load_notes(path: &Path) -> Result<(Mesh, ObjNotes), SceneError> {
 /// let err = save(Path::new("cube.ply"), &cube).unwrap_err();
 /// assert!(matches!(err, SceneError::UnknownFormat { .. }));
 /// ```
-pub fn save<M: MeshView + ?Sized>(path: &Path, mesh: &M) -> Result<(), SceneError> {
+pub fn save(path: &Path, mesh: &dyn MeshView) -> Result<(), SceneError> {
     let format = MeshFormat::from_path(path)?;
     let io = |source| SceneError::Io {
         path: path.display().to_string(),

@@ -41,7 +41,7 @@ pub fn frame_mesh(d: &Dynamic, statics: &Mesh, moving: &Mesh, m: &DMat4) -> Mesh
 /// Writes frame `k`'s scene ([`frame_mesh`]) as OBJ, after comments that
 /// say which faces are static and where the lights are.
 pub fn write_frame_obj(
-    out: &mut impl Write,
+    out: &mut dyn Write,
     d: &Dynamic,
     scene: &Mesh,
     k: u32,
@@ -67,14 +67,14 @@ pub fn write_frame_obj(
 
 /// Writes the frame's fragments as a JSON document.
 pub fn write_frame_json(
-    out: &mut impl Write,
+    out: &mut dyn Write,
     d: &Dynamic,
     frame: &Frame,
     lights: &[PlacedLight],
 ) -> io::Result<()> {
     let batch = d.fragments(frame);
     let (format, faces) = (FragmentFormat::Json, d.faces());
-    FragmentFile::of_batch(out, format, lights, faces, (&batch, d.grid()))?;
+    FragmentFile::of_batch(&mut &mut *out, format, lights, faces, (&batch, d.grid()))?;
     Ok(())
 }
 

@@ -196,7 +196,7 @@ pub fn write_shadows(
     scene: &LitScene,
     algorithm: Algorithm,
     kind: FileKind,
-    out: &mut impl Write,
+    out: &mut dyn Write,
     progress: &dyn Progress,
 ) -> Result<ShadowFile, Error> {
     let mut job = Job {
@@ -216,7 +216,7 @@ pub fn write_shadows(
             phases: Vec::new(),
         },
     };
-    job.run(algorithm, kind, out)?;
+    job.run(algorithm, kind, &mut &mut *out)?;
     Ok(job.fig)
 }
 

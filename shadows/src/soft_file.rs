@@ -229,7 +229,7 @@ fn shading_light(l: &SoftLight) -> PlacedLight {
 pub fn write_soft_shadows(
     scene: &SoftScene,
     format: FragmentFormat,
-    out: &mut impl Write,
+    out: &mut dyn Write,
     progress: &dyn Progress,
 ) -> Result<SoftFile, Error> {
     let (mut phases, faces_of, fragments) = shade(scene, progress)?;
@@ -238,7 +238,7 @@ pub fn write_soft_shadows(
     let notes: Vec<String> = scene.lights.iter().map(|l| l.shape.to_string()).collect();
     let head = (scene.name, &notes[..], scene.faces);
     let written = write_soft(
-        out,
+        &mut &mut *out,
         format,
         scene.lights,
         head,
