@@ -107,23 +107,6 @@ fn placed<T: Send>(n: usize, f: &(dyn Fn(usize) -> T + Sync)) -> Vec<T> {
     out
 }
 
-/// [`map_vec`] with each value written straight into its place (see
-/// [`map_placed`]).
-pub fn map_vec_placed<S: Send, T: Send>(items: Vec<S>, f: impl Fn(S) -> T + Sync) -> Vec<T> {
-    vec_placed(items, &f)
-}
-
-fn vec_placed<S: Send, T: Send>(items: Vec<S>, f: &(dyn Fn(S) -> T + Sync)) -> Vec<T> {
-    let mut out = Vec::new();
-    let min = items.len().div_ceil(run_count(items.len()).max(1)).max(1);
-    items
-        .into_par_iter()
-        .with_min_len(min)
-        .map(f)
-        .collect_into_vec(&mut out);
-    out
-}
-
 /// `[f(0)?, f(1)?, …]`, computed in parallel: the values, or the error of
 /// the first index that failed (the same error for every number of
 /// threads).

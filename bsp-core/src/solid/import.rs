@@ -180,22 +180,30 @@ pub fn import_mesh_par<'a>(
 ///
 /// The rule's polygons go straight into their places in parallel (a
 /// gather and copy of large polygons on one thread afterwards was a tenth
-/// of a 100k-face scene's shadows); the other faces (triangulated,
-/// dropped, or in error) are imported again, in face order, with their
-/// notes: the same polygons, report and first error as one import of
-/// every face in order.
+/// of a 100k-face scene's shadows), each other face holding its place
+/// with a stand-in tagged [`u32::MAX`] (no face's number: tags are face
+/// numbers, below `n`). Where there are stand-ins, the other faces
+/// (triangulated, dropped, or in error) are imported again, in face order,
+/// with their notes: the same polygons, report and first error as one
+/// import of every face in order.
 fn import_placed(
     n: usize,
     single: impl Fn(usize) -> Option<Polygon> + Sync,
     import: impl Fn(&mut FaceImporter, usize, &mut dyn FnMut(Polygon)) -> Result<(), Error>,
 ) -> Result<(Vec<Polygon>, ImportReport), Error> {
-    let single = crate::par::map_placed(n, single);
-    let singles = single.iter().filter(|p| p.is_some()).count();
-    if singles == n {
-        let polys = crate::par::map_vec_placed(single, |p| match p {
-            Some(p) => p,
-            None => unreachable!("every face was counted as one polygon"),
-        });
+    const STAND_IN: u32 = u32::MAX;
+    let stand_in = GridPolygon::from_grid_points(&[[0, 0, 0], [1, 0, 0], [0, 1, 0]])
+        .map(|g| g.to_polygon(STAND_IN))
+        .ok();
+    let polys = match stand_in {
+        Some(stand_in) if n < STAND_IN as usize => {
+            crate::par::map_placed(n, |fi| single(fi).unwrap_or_else(|| stand_in.clone()))
+        }
+        // (no stand-in: every face again in order)
+        _ => Vec::new(),
+    };
+    let singles = polys.iter().filter(|p| p.tag() != STAND_IN).count();
+    if polys.len() == n && singles == n {
         let report = ImportReport {
             faces: n,
             polygons: n,
@@ -204,10 +212,11 @@ fn import_placed(
         return Ok((polys, report));
     }
     let mut run = Importer::new(n);
-    for (fi, p) in single.into_iter().enumerate() {
-        match p {
-            Some(p) => run.out.push(p),
-            None => {
+    let mut placed = polys.into_iter();
+    for fi in 0..n {
+        match placed.next() {
+            Some(p) if p.tag() != STAND_IN => run.out.push(p),
+            _ => {
                 let out = &mut run.out;
                 import(&mut run.faces, fi, &mut |q| out.push(q))?;
             }
