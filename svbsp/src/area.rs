@@ -39,6 +39,7 @@ use bsp_core::internals::GridPolygon;
 use bsp_core::{GridPoint, MAX_COORD, Plane, Polygon, PolygonSide, Side, Split};
 use glam::DVec3;
 use rayon::prelude::*;
+use smallvec::SmallVec;
 
 use crate::boxes::{Box3, Near, Reach, Scan, Scans, polygon_box};
 use crate::light::{
@@ -609,29 +610,29 @@ fn merge_keyed<T: Copy + PartialEq, X>(
     join: impl Fn(&X, &X) -> X,
 ) -> Vec<Keyed<T, X>> {
     loop {
-        let mut at: rustc_hash::FxHashMap<[u64; 3], Vec<usize>> = Default::default();
+        // (a vertex is a corner of a few polygons: no list allocated for it)
+        let mut at: rustc_hash::FxHashMap<[u64; 3], SmallVec<[u32; 4]>> = Default::default();
+        at.reserve(items.len() * 2);
         for (i, item) in items.iter().enumerate() {
             for k in &item.keys {
-                at.entry(*k).or_default().push(i);
+                at.entry(*k).or_default().push(i as u32);
             }
         }
         let mut dead = vec![false; items.len()];
         let mut any = false;
+        let mut seen: SmallVec<[u32; 32]> = SmallVec::new();
         for i in 0..items.len() {
             if dead[i] {
                 continue;
             }
-            let mut seen: Vec<usize> = items[i]
-                .keys
-                .iter()
-                .flat_map(|k| at[k].iter().copied())
-                .collect();
+            seen.clear();
+            seen.extend(items[i].keys.iter().flat_map(|k| at[k].iter().copied()));
             seen.sort_unstable();
             let shared = seen
                 .windows(2)
-                .filter(|w| w[0] == w[1] && w[0] > i)
-                .map(|w| w[0]);
-            let mut candidates: Vec<usize> = shared.collect();
+                .filter(|w| w[0] == w[1] && w[0] as usize > i)
+                .map(|w| w[0] as usize);
+            let mut candidates: SmallVec<[usize; 8]> = shared.collect();
             candidates.dedup();
             for j in candidates {
                 if dead[j] || items[j].label != items[i].label {
