@@ -77,6 +77,28 @@ pub trait MeshView: Sync {
     }
 }
 
+/// Items grouped by vertex, by a counting sort: `each` calls `emit(v,
+/// item)` for every item, the same calls each time it runs (twice: to
+/// count, then to place); vertex `v`'s items are
+/// `items[start[v]..start[v + 1]]`, in the order they were emitted.
+pub(crate) fn by_vertex<T: Copy + Default>(
+    vertices: usize,
+    each: impl Fn(&mut dyn FnMut(u32, T)),
+) -> (Vec<usize>, Vec<T>) {
+    let mut start = vec![0usize; vertices + 1];
+    each(&mut |v, _| start[v as usize + 1] += 1);
+    for k in 1..start.len() {
+        start[k] += start[k - 1];
+    }
+    let mut next = start.clone();
+    let mut items = vec![T::default(); start[vertices]];
+    each(&mut |v, item| {
+        items[next[v as usize]] = item;
+        next[v as usize] += 1;
+    });
+    (start, items)
+}
+
 /// The positions some face uses, in order (each once).
 pub(crate) fn used_positions<M: MeshView + ?Sized>(mesh: &M) -> impl Iterator<Item = &DVec3> {
     let positions = mesh.positions();
@@ -400,24 +422,14 @@ impl Mesh {
     /// assert_eq!(m.parts(), vec![0, 1, 1]);
     /// ```
     pub fn parts(&self) -> Vec<usize> {
-        // the faces around each vertex, by a counting sort
-        let mut first = vec![0usize; self.positions.len() + 1];
-        for f in &self.faces {
-            for &v in &f.vertices {
-                first[v as usize + 1] += 1;
+        // the faces around each vertex
+        let (first, around) = by_vertex(self.positions.len(), |emit| {
+            for (i, f) in self.faces.iter().enumerate() {
+                for &v in &f.vertices {
+                    emit(v, i as u32);
+                }
             }
-        }
-        for k in 1..first.len() {
-            first[k] += first[k - 1];
-        }
-        let mut fill = first.clone();
-        let mut around = vec![0u32; first[self.positions.len()]];
-        for (i, f) in self.faces.iter().enumerate() {
-            for &v in &f.vertices {
-                around[fill[v as usize]] = i as u32;
-                fill[v as usize] += 1;
-            }
-        }
+        });
         // each part by a walk from its first face
         const UNSEEN: usize = usize::MAX;
         let mut part = vec![UNSEEN; self.faces.len()];

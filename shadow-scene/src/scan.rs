@@ -104,38 +104,26 @@ pub fn sqrt3_subdivide(mesh: &Mesh) -> Mesh {
 /// a handful of neighbours where a hash map's read its table at random).
 struct Edges {
     /// Vertex `a`'s edges are `to[start[a]..start[a + 1]]`.
-    start: Vec<u32>,
+    start: Vec<usize>,
     /// Each edge's second vertex and number.
     to: Vec<(u32, u32)>,
 }
 
 impl Edges {
     fn new(vertices: usize, tris: &[[u32; 3]]) -> Edges {
-        let mut start = vec![0u32; vertices + 1];
-        for t in tris {
-            for &a in t {
-                start[a as usize + 1] += 1;
+        let (start, to) = crate::mesh::by_vertex(vertices, |emit| {
+            for (fi, t) in tris.iter().enumerate() {
+                for k in 0..3 {
+                    emit(t[k], (t[(k + 1) % 3], (3 * fi + k) as u32));
+                }
             }
-        }
-        for v in 0..vertices {
-            start[v + 1] += start[v];
-        }
-        let mut next = start.clone();
-        let mut to = vec![(0, 0); 3 * tris.len()];
-        for (fi, t) in tris.iter().enumerate() {
-            for k in 0..3 {
-                let slot = &mut next[t[k] as usize];
-                to[*slot as usize] = (t[(k + 1) % 3], (3 * fi + k) as u32);
-                *slot += 1;
-            }
-        }
+        });
         Edges { start, to }
     }
 
     /// The numbers of the edges `a → b`, in increasing order.
     fn between(&self, a: u32, b: u32) -> impl Iterator<Item = u32> + '_ {
-        let r = self.start[a as usize] as usize..self.start[a as usize + 1] as usize;
-        self.to[r]
+        self.to[self.start[a as usize]..self.start[a as usize + 1]]
             .iter()
             .filter(move |&&(to, _)| to == b)
             .map(|&(_, e)| e)

@@ -74,7 +74,7 @@ pub fn write_frame_json(
 ) -> io::Result<()> {
     let batch = d.fragments(frame);
     let (format, faces) = (FragmentFormat::Json, d.faces());
-    FragmentFile::of_batch(&mut &mut *out, format, lights, faces, (&batch, d.grid()))?;
+    FragmentFile::of_batch(out, format, lights, faces, (&batch, d.grid()))?;
     Ok(())
 }
 

@@ -216,7 +216,7 @@ pub fn write_shadows(
             phases: Vec::new(),
         },
     };
-    job.run(algorithm, kind, &mut &mut *out)?;
+    job.run(algorithm, kind, out)?;
     Ok(job.fig)
 }
 
@@ -245,7 +245,7 @@ impl Job<'_> {
         &mut self,
         algorithm: Algorithm,
         kind: FileKind,
-        out: &mut impl Write,
+        out: &mut dyn Write,
     ) -> Result<(), Error> {
         let (batch, tree) = match (algorithm, kind) {
             (Algorithm::Psv, FileKind::Json | FileKind::Obj) => {
@@ -332,7 +332,7 @@ impl Job<'_> {
     }
 
     /// Starts the JSON or OBJ file.
-    fn begin(&self, kind: FileKind, out: &mut impl Write) -> Result<FragmentFile, Error> {
+    fn begin(&self, kind: FileKind, out: &mut dyn Write) -> Result<FragmentFile, Error> {
         let format = match kind {
             FileKind::Json => FragmentFormat::Json,
             _ => FragmentFormat::Obj,
@@ -347,7 +347,7 @@ impl Job<'_> {
         &mut self,
         file: FragmentFile,
         kind: FileKind,
-        out: &mut impl Write,
+        out: &mut dyn Write,
     ) -> Result<(), Error> {
         let w = file.finish(out).map_err(Error::Io)?;
         self.fig.areas = w.areas;
@@ -361,7 +361,7 @@ impl Job<'_> {
     /// Draws the fragments of the scene tree's polygons.
     fn write_svg(
         &mut self,
-        out: &mut impl Write,
+        out: &mut dyn Write,
         tree: &BspTree,
         view: &SvgViewpoint,
         batch: &Batch,
@@ -386,7 +386,7 @@ impl Job<'_> {
         &mut self,
         shadows: &svbsp::Shadows,
         kind: FileKind,
-        out: &mut impl Write,
+        out: &mut dyn Write,
     ) -> Result<(), Error> {
         let scene = self.scene;
         let opts = ShadeOptions::default().with_pieces(matches!(kind, FileKind::Obj));

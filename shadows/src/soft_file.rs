@@ -148,7 +148,7 @@ pub fn draw_soft_shadows(
     scene: &SoftScene,
     mesh: &Mesh,
     at: &SvgViewpoint,
-    out: &mut impl Write,
+    out: &mut dyn Write,
     progress: &dyn Progress,
 ) -> Result<SoftFile, Error> {
     let (mut phases, faces_of, fragments) = shade(scene, progress)?;
@@ -238,7 +238,7 @@ pub fn write_soft_shadows(
     let notes: Vec<String> = scene.lights.iter().map(|l| l.shape.to_string()).collect();
     let head = (scene.name, &notes[..], scene.faces);
     let written = write_soft(
-        &mut &mut *out,
+        out,
         format,
         scene.lights,
         head,

@@ -138,7 +138,11 @@ struct JsonSummary {
 
 /// The JSON document's head: the lights, the face count, and the
 /// opening of the fragment list.
-pub fn json_header(out: &mut impl Write, lights: &[PlacedLight], faces: usize) -> io::Result<()> {
+pub fn json_header(
+    out: &mut (impl Write + ?Sized),
+    lights: &[PlacedLight],
+    faces: usize,
+) -> io::Result<()> {
     let lights: Vec<JsonLight> = lights
         .iter()
         .map(|l| match l.light {
@@ -154,14 +158,23 @@ pub fn json_header(out: &mut impl Write, lights: &[PlacedLight], faces: usize) -
 }
 
 /// `{"lights":[...],"faces":N,"fragments":[`.
-fn json_head(out: &mut impl Write, lights: &[JsonLight], faces: usize) -> io::Result<()> {
+fn json_head(
+    out: &mut (impl Write + ?Sized),
+    lights: &[JsonLight],
+    faces: usize,
+) -> io::Result<()> {
     write!(out, "{{\"lights\":")?;
     serde_json::to_writer(&mut *out, lights)?;
     write!(out, ",\"faces\":{faces},\"fragments\":[")
 }
 
 /// An OBJ file's first comments: what it holds, and one line per light.
-fn obj_head(out: &mut impl Write, name: &str, lights: &[String], faces: usize) -> io::Result<()> {
+fn obj_head(
+    out: &mut (impl Write + ?Sized),
+    name: &str,
+    lights: &[String],
+    faces: usize,
+) -> io::Result<()> {
     writeln!(
         out,
         "# shadow shadows: the fragments of {faces} faces of {name}"
@@ -174,7 +187,7 @@ fn obj_head(out: &mut impl Write, name: &str, lights: &[String], faces: usize) -
 
 /// The JSON document's tail: the fragment list closed, and the summary
 /// of `areas`.
-pub fn json_footer(out: &mut impl Write, areas: &Areas) -> io::Result<()> {
+pub fn json_footer(out: &mut (impl Write + ?Sized), areas: &Areas) -> io::Result<()> {
     write!(out, "\n],\"summary\":")?;
     let summary = JsonSummary {
         area: areas.total,
@@ -299,7 +312,7 @@ impl ObjWriter {
     /// (`lights`, described by the caller), and the groups.
     pub fn header(
         &self,
-        out: &mut impl Write,
+        out: &mut (impl Write + ?Sized),
         name: &str,
         lights: &[String],
         faces: usize,
@@ -325,7 +338,7 @@ impl ObjWriter {
     /// vertices in input units).
     pub fn batch(
         &mut self,
-        out: &mut impl Write,
+        out: &mut (impl Write + ?Sized),
         b: &Batch,
         world: &[DVec3],
         lights: usize,
@@ -463,7 +476,7 @@ impl FragmentFile {
     /// `lights`. `name` (the scene) and `notes` (one line per light) are
     /// the OBJ's comments.
     pub fn begin(
-        out: &mut impl Write,
+        out: &mut (impl Write + ?Sized),
         format: FragmentFormat,
         lights: &[PlacedLight],
         faces: usize,
@@ -493,7 +506,7 @@ impl FragmentFile {
     /// formatted here.
     pub fn write(
         &mut self,
-        out: &mut impl Write,
+        out: &mut (impl Write + ?Sized),
         (b, world, records): (&Batch, &[DVec3], &[AreaRecord]),
         json: Option<&[u8]>,
     ) -> io::Result<()> {
@@ -532,7 +545,7 @@ impl FragmentFile {
     /// [`write`]: FragmentFile::write
     /// [`finish`]: FragmentFile::finish
     pub fn of_batch(
-        out: &mut impl Write,
+        out: &mut (impl Write + ?Sized),
         format: FragmentFormat,
         lights: &[PlacedLight],
         faces: usize,
@@ -556,7 +569,7 @@ impl FragmentFile {
     /// [`io::ErrorKind::InvalidData`] error carrying the [`ExportError`].
     pub fn stream(
         &mut self,
-        out: &mut impl Write,
+        out: &mut (impl Write + ?Sized),
         shadows: ShadowSet<'_>,
         scene: (&[Polygon], &[std::ops::Range<usize>], &Grid),
         opts: &ShadeOptions,
@@ -569,7 +582,7 @@ impl FragmentFile {
     /// shaded in parallel in runs of at most `chunk`.
     fn stream_by(
         &mut self,
-        out: &mut impl Write,
+        out: &mut (impl Write + ?Sized),
         shadows: ShadowSet<'_>,
         (polys, ranges, grid): (&[Polygon], &[std::ops::Range<usize>], &Grid),
         opts: &ShadeOptions,
@@ -638,7 +651,7 @@ impl FragmentFile {
     }
 
     /// Writes the file's tail (JSON: the summary of the areas).
-    pub fn finish(self, out: &mut impl Write) -> io::Result<Written> {
+    pub fn finish(self, out: &mut (impl Write + ?Sized)) -> io::Result<Written> {
         let (vertices, degenerate) = match &self.kind {
             FileKind::Json { .. } => {
                 json_footer(out, &self.areas)?;
@@ -1095,7 +1108,7 @@ fn soft_key(f: &SoftFragment) -> u64 {
 /// [`FragmentFormat`]). Vertices are rounded once to `f64` grid units and
 /// mapped to input units by `grid`.
 pub fn write_soft(
-    out: &mut impl Write,
+    out: &mut (impl Write + ?Sized),
     format: FragmentFormat,
     lights: &[SoftLight],
     (name, notes, faces): (&str, &[String], usize),
