@@ -5,6 +5,8 @@ use std::io::Write;
 use std::path::Path;
 
 use glam::DVec3;
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 
 use crate::{Face, Mesh, MeshView, SceneError};
 
@@ -156,75 +158,270 @@ pub fn parse_obj(text: &str, path_for_messages: &str) -> Result<Mesh, SceneError
 }
 
 /// [`parse_obj`], with the unknown statements it skipped.
+///
+/// A large text is read in parallel: cut at line ends into pieces of
+/// about [`PIECE_BYTES`] (never inside a statement that a `\\` continues),
+/// each piece's words and numbers read on its own, then the pieces joined
+/// in order. The mesh, the notes and the first error are those of reading
+/// it line by line.
 pub fn parse_obj_notes(
     text: &str,
     path_for_messages: &str,
 ) -> Result<(Mesh, ObjNotes), SceneError> {
-    let mut notes = ObjNotes::default();
+    parse_in_pieces(text, path_for_messages, PIECE_BYTES)
+}
+
+/// The size of the pieces a large OBJ text is read in, in parallel.
+const PIECE_BYTES: usize = 1 << 18;
+
+fn parse_in_pieces(
+    text: &str,
+    path_for_messages: &str,
+    piece_bytes: usize,
+) -> Result<(Mesh, ObjNotes), SceneError> {
+    let spans = pieces(text, piece_bytes);
+    let read: Vec<Piece> = match spans.len() {
+        1 => vec![Piece::read(text)],
+        _ => spans
+            .par_iter()
+            .map(|r| Piece::read(&text[r.clone()]))
+            .collect(),
+    };
+    join_pieces(read, path_for_messages)
+}
+
+/// Byte ranges that cut `text` at line ends into pieces of about `size`
+/// bytes; a piece never ends on a line that a `\\` continues.
+fn pieces(text: &str, size: usize) -> Vec<std::ops::Range<usize>> {
+    let bytes = text.as_bytes();
+    let mut out = Vec::new();
+    let mut start = 0;
+    while start < bytes.len() {
+        let mut end = (start + size.max(1)).min(bytes.len());
+        loop {
+            // the end of the line the cut falls in
+            end = match bytes[end.max(1) - 1..].iter().position(|&c| c == b'\n') {
+                Some(at) => end.max(1) + at,
+                None => bytes.len(),
+            };
+            let line_start = bytes[..end - 1]
+                .iter()
+                .rposition(|&c| c == b'\n')
+                .map_or(0, |at| at + 1);
+            let continued =
+                end < bytes.len() && text[line_start..end - 1].trim_end().ends_with('\\');
+            if !continued {
+                break;
+            }
+            end += 1;
+        }
+        out.push(start..end);
+        start = end;
+    }
+    if out.is_empty() {
+        out.push(0..0);
+    }
+    out
+}
+
+/// A face as a piece reads it: its vertex indices as written (the last
+/// `end` entries of the piece's list up to here), resolved when the
+/// vertices before the piece are counted.
+struct RawFace {
+    /// One past its last index in [`Piece::indices`].
+    end: usize,
+    /// Its line, counted from the piece's first (1-based).
+    line: usize,
+    /// The piece's `g`/`o` statement it follows, if any.
+    group: Option<u32>,
+    /// The vertices the piece read before it.
+    vertices_before: usize,
+}
+
+/// What one piece of an OBJ text holds, read on its own.
+#[derive(Default)]
+struct Piece {
+    positions: Vec<DVec3>,
+    indices: Vec<i64>,
+    faces: Vec<RawFace>,
+    /// The names of its `g` and `o` statements, in order.
+    groups: Vec<String>,
+    notes: ObjNotes,
+    /// The first statement that could not be read: its line, the message,
+    /// and for a face the indices read before it went wrong (resolved
+    /// first: an index out of range before the error is reported first).
+    error: Option<(usize, String, Option<RawFace>)>,
+    /// The lines it spans.
+    lines: usize,
+}
+
+impl Piece {
+    fn read(text: &str) -> Piece {
+        let mut piece = Piece {
+            lines: text.bytes().filter(|&c| c == b'\n').count()
+                + usize::from(!text.ends_with('\n')),
+            ..Piece::default()
+        };
+        let mut group = None;
+        let mut lines = Lines(text).enumerate();
+        let mut statement = String::new();
+        while let Some((i, first)) = lines.next() {
+            let line = i + 1;
+            // a line read as it is, unless it goes on to the next (copied then)
+            let mut current = first.trim_end();
+            let whole: &str = if current.ends_with('\\') {
+                statement.clear();
+                while let Some(head) = current.strip_suffix('\\') {
+                    statement.push_str(head);
+                    statement.push(' ');
+                    match lines.next() {
+                        Some((_, next)) => current = next.trim_end(),
+                        None => {
+                            current = "";
+                            break;
+                        }
+                    }
+                }
+                statement.push_str(current);
+                &statement
+            } else {
+                current
+            };
+            let mut tokens = Tokens::of(whole);
+            let Some(keyword) = tokens.next() else {
+                continue;
+            };
+            match keyword {
+                "v" => match parse_vertex(tokens) {
+                    Ok(p) => piece.positions.push(p),
+                    Err(message) => {
+                        piece.error = Some((line, message, None));
+                        break;
+                    }
+                },
+                "f" => {
+                    let read = parse_face(tokens, &mut piece.indices);
+                    let face = RawFace {
+                        end: piece.indices.len(),
+                        line,
+                        group,
+                        vertices_before: piece.positions.len(),
+                    };
+                    if let Err(message) = read {
+                        piece.error = Some((line, message, Some(face)));
+                        break;
+                    }
+                    piece.faces.push(face);
+                }
+                "g" | "o" => {
+                    let name = tokens.collect::<Vec<_>>().join(" ");
+                    group = Some(piece.groups.len() as u32);
+                    piece.groups.push(if name.is_empty() {
+                        "default".to_string()
+                    } else {
+                        name
+                    });
+                }
+                k if UNUSED.contains(&k) => {}
+                k => {
+                    piece.notes.unknown += 1;
+                    if piece.notes.first_unknown.is_none() {
+                        let shown: String = k.chars().take(24).collect();
+                        piece.notes.first_unknown = Some((line, shown));
+                    }
+                }
+            }
+        }
+        piece
+    }
+}
+
+/// The pieces joined in order: the vertices before each piece counted, its
+/// faces' indices resolved (in parallel) and its groups numbered as the
+/// file's `g` lines number them.
+fn join_pieces(read: Vec<Piece>, path: &str) -> Result<(Mesh, ObjNotes), SceneError> {
     let mut mesh = Mesh {
         groups: vec!["default".to_string()],
         ..Mesh::default()
     };
-    let mut group = 0u32;
-    let mut lines = Lines(text).enumerate();
-    let mut statement = String::new();
-    while let Some((i, first)) = lines.next() {
-        let line = i + 1;
-        // a line read as it is, unless it goes on to the next (copied then)
-        let mut current = first.trim_end();
-        let whole: &str = if current.ends_with('\\') {
-            statement.clear();
-            while let Some(head) = current.strip_suffix('\\') {
-                statement.push_str(head);
-                statement.push(' ');
-                match lines.next() {
-                    Some((_, next)) => current = next.trim_end(),
-                    None => {
-                        current = "";
-                        break;
-                    }
+    let mut notes = ObjNotes::default();
+    // (a map from names: a file may have a group a face)
+    let mut numbers: FxHashMap<String, u32> = FxHashMap::default();
+    numbers.insert("default".to_string(), 0);
+    let mut starts = Vec::with_capacity(read.len());
+    let (mut vertices, mut lines, mut group) = (0usize, 0usize, 0u32);
+    for piece in &read {
+        let named: Vec<u32> = (piece.groups.iter())
+            .map(|name| {
+                *numbers.entry(name.clone()).or_insert_with(|| {
+                    mesh.groups.push(name.clone());
+                    (mesh.groups.len() - 1) as u32
+                })
+            })
+            .collect();
+        starts.push((vertices, lines, group, named));
+        vertices += piece.positions.len();
+        lines += piece.lines;
+        group = starts
+            .last()
+            .and_then(|s| s.3.last().copied())
+            .unwrap_or(group);
+        notes.unknown += piece.notes.unknown;
+        if notes.first_unknown.is_none()
+            && let Some((line, keyword)) = &piece.notes.first_unknown
+        {
+            notes.first_unknown = Some((line + starts.last().map_or(0, |s| s.1), keyword.clone()));
+        }
+    }
+    let err = |line: usize, message: String| SceneError::Parse {
+        path: path.to_string(),
+        line,
+        message,
+    };
+    let faces: Vec<Result<Vec<Face>, SceneError>> = read
+        .par_iter()
+        .zip(&starts)
+        .map(|(piece, &(base, lines, group, ref named))| {
+            let mut faces = Vec::with_capacity(piece.faces.len());
+            let mut begin = 0;
+            let face_of = |raw: &RawFace, begin: usize| -> Result<Vec<u32>, String> {
+                piece.indices[begin..raw.end]
+                    .iter()
+                    .map(|&i| resolve_index(i, base + raw.vertices_before))
+                    .collect()
+            };
+            for raw in &piece.faces {
+                let vertices = face_of(raw, begin).map_err(|m| err(lines + raw.line, m))?;
+                begin = raw.end;
+                if vertices.len() < 3 {
+                    let message =
+                        format!("face has {} vertex(es), needs at least 3", vertices.len());
+                    return Err(err(lines + raw.line, message));
                 }
-            }
-            statement.push_str(current);
-            &statement
-        } else {
-            current
-        };
-        let mut tokens = Tokens::of(whole);
-        let Some(keyword) = tokens.next() else {
-            continue;
-        };
-        let err = |message: String| SceneError::Parse {
-            path: path_for_messages.to_string(),
-            line,
-            message,
-        };
-        match keyword {
-            "v" => {
-                let p = parse_vertex(tokens).map_err(err)?;
-                mesh.positions.push(p);
-            }
-            "f" => {
-                let vertices = parse_face(tokens, mesh.positions.len()).map_err(err)?;
-                mesh.faces.push(Face {
+                let group = raw.group.map_or(group, |g| named[g as usize]);
+                faces.push(Face {
                     vertices,
-                    line,
+                    line: lines + raw.line,
                     group,
                 });
             }
-            "g" | "o" => {
-                let name = tokens.collect::<Vec<_>>().join(" ");
-                group = mesh.add_group(if name.is_empty() { "default" } else { &name });
-            }
-            k if UNUSED.contains(&k) => {}
-            k => {
-                notes.unknown += 1;
-                if notes.first_unknown.is_none() {
-                    let shown: String = k.chars().take(24).collect();
-                    notes.first_unknown = Some((line, shown));
+            if let Some((line, message, raw)) = &piece.error {
+                if let Some(raw) = raw {
+                    face_of(raw, begin).map_err(|m| err(lines + raw.line, m))?;
                 }
+                return Err(err(lines + line, message.clone()));
             }
-        }
+            Ok(faces)
+        })
+        .collect();
+    mesh.positions.reserve_exact(vertices);
+    for piece in &read {
+        mesh.positions.extend_from_slice(&piece.positions);
+    }
+    mesh.faces
+        .reserve_exact(read.iter().map(|p| p.faces.len()).sum());
+    for f in faces {
+        mesh.faces.extend(f?);
     }
     Ok((mesh, notes))
 }
@@ -346,13 +543,15 @@ fn parse_vertex<'a>(tokens: impl Iterator<Item = &'a str>) -> Result<DVec3, Stri
 /// its text), far above any real face.
 pub const MAX_FACE_VERTICES: usize = 1 << 20;
 
+/// Reads a face's vertex indices as written onto `indices` (resolved, and
+/// counted, when the vertices before them are known).
 fn parse_face<'a>(
     tokens: impl Iterator<Item = &'a str>,
-    vertex_count: usize,
-) -> Result<Vec<u32>, String> {
-    let mut out = Vec::new();
+    indices: &mut Vec<i64>,
+) -> Result<(), String> {
+    let mut count = 0;
     for token in tokens {
-        if out.len() == MAX_FACE_VERTICES {
+        if count == MAX_FACE_VERTICES {
             return Err(format!(
                 "face has more than {MAX_FACE_VERTICES} vertices (the most a face may have)"
             ));
@@ -377,15 +576,10 @@ fn parse_face<'a>(
         let i = index
             .parse::<i64>()
             .map_err(|_| format!("could not parse `{index}` as a vertex index in `{token}`"))?;
-        out.push(resolve_index(i, vertex_count)?);
+        indices.push(i);
+        count += 1;
     }
-    if out.len() < 3 {
-        return Err(format!(
-            "face has {} vertex(es), needs at least 3",
-            out.len()
-        ));
-    }
-    Ok(out)
+    Ok(())
 }
 
 /// The 0-based vertex of a 1-based or negative (relative) OBJ index.
@@ -556,6 +750,122 @@ mod tests {
 
     fn parse(text: &str) -> Result<Mesh, SceneError> {
         parse_obj(text, "test.obj")
+    }
+
+    /// Read in pieces of any size (in parallel), a text gives the mesh,
+    /// notes and first error of reading it whole: statements continued
+    /// over lines, groups named in one piece and used in the next,
+    /// relative indices reaching back into earlier pieces, and errors of
+    /// every kind, in any piece.
+    #[test]
+    fn pieces_read_as_the_whole_text_reads() {
+        let mut seed = 0x3c6e_f372_fe94_f82bu64;
+        let mut next = |m: u64| xorshift(&mut seed) % m;
+        let statements = [
+            "v 0 0 0",
+            "v 1 0 0",
+            "v 0 1 0",
+            "v 1 1 1",
+            "f 1 2 3",
+            "f -1 -2 -3",
+            "f -3 -2 -1 -4",
+            "f 1/1 2//2 3/3/3",
+            "g a",
+            "g b c",
+            "g",
+            "o a",
+            "vt 0 0",
+            "# note",
+            "",
+            "  ",
+            "\r",
+            "f 1 2 \\",
+            "v 1 \\",
+            "V 1 2 3",
+            "foo",
+            "g b c",
+            "é 1",
+        ];
+        let wrong = [
+            "f 9 1 2",
+            "f 0 1 2",
+            "f 1 2",
+            "v 1 x 2",
+            "v 1 2 inf",
+            "f 1 2 -9",
+            "f 1/2/3/4 1 2",
+            "f -1 -2 z",
+            "f 1 99 z",
+        ];
+        let (mut read, mut failed) = (0, 0);
+        for round in 0..3_000 {
+            let n = next(40) as usize;
+            let mut text = "v 0 0 1\nv 0 1 1\nv 1 0 1\nv 1 1 2\n".to_string();
+            for _ in 0..n {
+                let s = match next(60) {
+                    0 => wrong[next(wrong.len() as u64) as usize],
+                    _ => statements[next(statements.len() as u64) as usize],
+                };
+                text.push_str(s);
+                text.push_str(if next(5) == 0 { "\r\n" } else { "\n" });
+            }
+            if round % 7 == 0 {
+                text.pop();
+            }
+            let whole = parse_in_pieces(&text, "t.obj", usize::MAX);
+            match &whole {
+                Ok(_) => read += 1,
+                Err(_) => failed += 1,
+            }
+            for size in [1, 2, 5, 9, 17, 40] {
+                let cut = parse_in_pieces(&text, "t.obj", size);
+                match (&whole, &cut) {
+                    (Ok(a), Ok(b)) => assert_eq!(a, b, "{text:?}, pieces of {size}"),
+                    (Err(a), Err(b)) => {
+                        assert_eq!(a.to_string(), b.to_string(), "{text:?}, pieces of {size}")
+                    }
+                    _ => panic!("{text:?}, pieces of {size}: {whole:?} against {cut:?}"),
+                }
+            }
+        }
+        // both kinds of outcome, often
+        assert!(read > 500 && failed > 500, "{read} read, {failed} failed");
+    }
+
+    /// A face's indices are resolved in order before a later word fails
+    /// to read: the first thing wrong on the line is reported.
+    #[test]
+    fn a_face_reports_its_first_fault() {
+        let err = |text: &str| parse(text).unwrap_err().to_string();
+        assert_eq!(
+            err("v 0 0 0\nf 1 5 z\n"),
+            "test.obj:2: face index 5 out of range (1..=1)"
+        );
+        assert_eq!(
+            err("v 0 0 0\nf 1 1 z\n"),
+            "test.obj:2: could not parse `z` as a vertex index in `z`"
+        );
+        assert_eq!(
+            err("v 0 0 0\nf 1 1\nv x\n"),
+            "test.obj:2: face has 2 vertex(es), needs at least 3"
+        );
+    }
+
+    /// The pieces cover the text, end at line ends, and never end on a
+    /// line that a backslash continues.
+    #[test]
+    fn pieces_end_at_statement_ends() {
+        let text = "v 1 \\\n2 3\nf 1 \\  \r\n2 \\\n3\n\ng a\n";
+        for size in 1..text.len() + 2 {
+            let spans = pieces(text, size);
+            assert_eq!(spans.first().unwrap().start, 0);
+            assert_eq!(spans.last().unwrap().end, text.len());
+            for w in spans.windows(2) {
+                assert_eq!(w[0].end, w[1].start);
+                let line = text[..w[0].end - 1].rsplit('\n').next().unwrap();
+                assert!(text.as_bytes()[w[0].end - 1] == b'\n' && !line.trim_end().ends_with('\\'));
+            }
+        }
     }
 
     /// The line and message of a parse error.
