@@ -448,9 +448,11 @@ fn every_command_writes_the_same_for_every_thread_count() {
 }
 
 /// Coordinates whose areas or volumes leave `f64`'s range, or a scene too
-/// small for the finest grid: a clear error, not a NaN or a coarse snap.
+/// small for the finest grid: a clear error, not a NaN or a coarse snap;
+/// and every scale the checks let through gives the areas and sun-hours
+/// of a sane scale.
 #[test]
-fn huge_and_tiny_coordinates_are_clear_errors() {
+fn huge_and_tiny_coordinates_are_clear_errors_or_exact() {
     let write = |name: &str, s: f64| {
         let p = scratch(name);
         let text = format!(
@@ -485,4 +487,50 @@ fn huge_and_tiny_coordinates_are_clear_errors() {
         out,
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // and so does every scale the checks let through: the areas are those
+    // of the tetrahedron, not an overflow to infinity or an underflow to 0
+    // (the normal's length is the fourth power of the size)
+    let csv = scratch("scaled_tetra.csv");
+    let csv = csv.to_str().unwrap();
+    let day = ["--lat", "50", "--lon", "0", "--date", "2026-06-21", "--step", "60", "-o", csv];
+    let hours = |p: &str| {
+        let o = shadow(&[&["sunhours", p][..], &day[..]].concat());
+        assert!(o.status.success(), "{p}: {}", stderr(&o));
+        let text = std::fs::read_to_string(csv).unwrap();
+        // each face's area, and its hours (mean, fewest, most)
+        let rows: Vec<(f64, String)> = (text.lines().skip(1))
+            .map(|l| {
+                let cells: Vec<&str> = l.split(',').collect();
+                let hours: Vec<f64> = cells[3..6].iter().map(|c| c.parse().unwrap()).collect();
+                let rounded: Vec<String> = hours.iter().map(|h| format!("{h:.9}")).collect();
+                (cells[2].parse().unwrap(), rounded.join(","))
+            })
+            .collect();
+        rows
+    };
+    let unit = hours(fine.to_str().unwrap());
+    for s in [1e-150, 1e-81, 1e77, 1e150] {
+        let p = write("scaled_tetra.obj", s);
+        // the sun-hours of each face are the same at every scale
+        let scaled = hours(p.to_str().unwrap());
+        for ((a, h), (b, g)) in scaled.iter().zip(&unit) {
+            assert_eq!(h, g, "{s:e}");
+            assert!((a / (b * s * s / 4.0) - 1.0).abs() < 1e-6, "{s:e}: area {a:e}");
+        }
+        let o = shadow(&["shadows", p.to_str().unwrap(), "--sun", "1,2,3", "-o", out]);
+        assert!(o.status.success(), "{s:e}: {}", stderr(&o));
+        assert!(
+            stdout(&o).contains("36.6% of the area lit"),
+            "{s:e}: {}",
+            stdout(&o)
+        );
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out).unwrap()).unwrap();
+        let area = json["summary"]["area"].as_f64().unwrap();
+        let want = (3.0 + 3f64.sqrt()) / 2.0 * s * s;
+        assert!(
+            (area / want - 1.0).abs() < 1e-6,
+            "{s:e}: area {area:e}, want {want:e}"
+        );
+    }
 }

@@ -81,7 +81,7 @@ fn samples(light: &SceneLight, grid: &bsp_core::Grid, n: u32) -> Result<Vec<Samp
         SoftShape::Area(c) => {
             let normal = light.emitter().map_or(DVec3::ZERO, |e| e.1);
             let areas: Vec<f64> = (1..c.len() - 1)
-                .map(|i| 0.5 * (c[i] - c[0]).cross(c[i + 1] - c[0]).length())
+                .map(|i| svbsp::polygon_area(&[c[0], c[i], c[i + 1]]))
                 .collect();
             let total: f64 = areas.iter().sum();
             hammersley

@@ -105,8 +105,8 @@ impl SceneLight {
         };
         let normal = (1..c.len() - 1)
             .map(|i| (c[i] - c[0]).cross(c[i + 1] - c[0]))
-            .sum::<DVec3>()
-            .normalize_or_zero();
+            .sum::<DVec3>();
+        let normal = shadow_scene::unit_or_zero(normal);
         Some((c.iter().sum::<DVec3>() / c.len() as f64, normal))
     }
 

@@ -403,7 +403,7 @@ impl Mesh {
     /// ```
     pub fn face_normals(&self) -> Vec<DVec3> {
         (0..self.faces.len())
-            .map(|f| newell(&self.face_points(f)).normalize_or_zero())
+            .map(|f| unit_or_zero(newell(&self.face_points(f))))
             .collect()
     }
 
@@ -990,6 +990,32 @@ impl Mesh {
 }
 
 /// Newell normal of a loop (twice its vector area).
+/// `v` scaled to unit length, or zero where it has none (as glam's
+/// `normalize_or_zero`), at any size: `v` is first scaled by a power of
+/// two that brings its largest component to about 1, so that squaring
+/// it neither overflows nor underflows (a face's normal from cross
+/// products is the square of its size: a face of size 1e77 has a normal
+/// whose squared length is not an `f64`). A power of two scales exactly,
+/// so the result is `normalize_or_zero`'s, bit for bit, wherever that one
+/// did not overflow or underflow.
+///
+/// ```
+/// use glam::DVec3;
+/// let n = shadow_scene::unit_or_zero(DVec3::new(3e160, 0.0, 4e160));
+/// assert_eq!(n, DVec3::new(0.6, 0.0, 0.8));
+/// assert_eq!(shadow_scene::unit_or_zero(DVec3::ZERO), DVec3::ZERO);
+/// ```
+pub fn unit_or_zero(v: DVec3) -> DVec3 {
+    let largest = v.abs().max_element();
+    if !(largest > 0.0 && largest.is_finite()) {
+        return v.normalize_or_zero();
+    }
+    // in two factors, each a normal number, to reach subnormal sizes too
+    let e = largest.log2().floor() as i32;
+    let (a, b) = (-e / 2, -e - (-e / 2));
+    (v * 2f64.powi(a) * 2f64.powi(b)).normalize_or_zero()
+}
+
 pub(crate) fn newell(ring: &[DVec3]) -> DVec3 {
     let n = ring.len();
     (0..n).fold(DVec3::ZERO, |acc, i| acc + ring[i].cross(ring[(i + 1) % n]))

@@ -125,7 +125,7 @@ pub fn write_stl<M: MeshView + ?Sized, W: Write>(mesh: &M, mut out: W) -> std::i
         let p = |i: usize| positions[f[i] as usize];
         for i in 1..f.len().saturating_sub(1) {
             let (a, b, c) = (p(0), p(i), p(i + 1));
-            let n = (b - a).cross(c - a).normalize_or_zero();
+            let n = crate::unit_or_zero((b - a).cross(c - a));
             triangles.push(stl_io::Triangle {
                 normal: to32(n),
                 vertices: [to32(a), to32(b), to32(c)],

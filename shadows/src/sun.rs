@@ -564,7 +564,9 @@ fn face_hours(area: f64, lit: f64, cells: Option<&[Cell]>, step_hours: f64) -> F
     let seen = cells.iter().copied().flatten().map(|c| c.1);
     let (min, max) = seen.fold((u32::MAX, 0), |(a, b), h| (a.min(h), b.max(h)));
     let (min, max) = (f64::from(min) * step_hours, f64::from(max) * step_hours);
-    let none = cells.is_none() || area == 0.0;
+    // (a face of area has cells, but none is no hours rather than a
+    // fewest of u32::MAX steps)
+    let none = cells.is_none_or(<[Cell]>::is_empty) || area == 0.0;
     let mut by: std::collections::BTreeMap<u32, f64> = Default::default();
     for (ring, n) in cells.iter().copied().flatten() {
         *by.entry(*n).or_default() += area2(ring).abs() / 2.0;
@@ -938,8 +940,8 @@ fn face_frame(mesh: &crate::Mesh, f: usize) -> (DVec3, DVec3, DVec3) {
         .collect();
     let n = (0..p.len())
         .map(|i| p[i].cross(p[(i + 1) % p.len()]))
-        .sum::<DVec3>()
-        .normalize_or_zero();
+        .sum::<DVec3>();
+    let n = shadow_scene::unit_or_zero(n);
     let u = n.any_orthonormal_vector();
     (p.first().copied().unwrap_or(DVec3::ZERO), u, n.cross(u))
 }

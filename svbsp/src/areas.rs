@@ -11,15 +11,48 @@ use glam::DVec3;
 use crate::engine::FragmentRef;
 
 /// The area of a planar polygon (any orientation).
+///
+/// Computed at unit scale: the corners' offsets from the first are scaled
+/// by a power of two that brings the largest to about 1, so that neither
+/// the cross products (the square of the size) nor the normal's length
+/// (the fourth power) overflow or underflow where the area itself is a
+/// normal `f64`; a power of two scales every step exactly, so the result
+/// is the unscaled formula's, bit for bit, wherever that one neither
+/// overflowed nor underflowed.
+///
+/// ```
+/// use glam::DVec3;
+/// for e in [1e-150, 1.0, 1e150] {
+///     let tri = [DVec3::ZERO, DVec3::new(e, 0.0, 0.0), DVec3::new(0.0, e, 0.0)];
+///     let area = svbsp::polygon_area(&tri);
+///     assert!((area / (0.5 * e * e) - 1.0).abs() < 1e-15);
+/// }
+/// ```
 pub fn polygon_area(pts: &[DVec3]) -> f64 {
     let Some(&o) = pts.first() else {
         return 0.0;
     };
+    let largest = pts
+        .iter()
+        .map(|&p| (p - o).abs().max_element())
+        .fold(0.0, f64::max);
+    // (no scale for no size, and none for a corner not finite)
+    let e = match largest {
+        0.0 => return 0.0,
+        l if l.is_finite() => l.log2().floor() as i32,
+        _ => 0,
+    };
+    // 2^-e brings the largest offset into [1/2, 4); applied in two halves,
+    // each a normal number, so that it reaches subnormal sizes too
+    let (a, b) = (-e / 2, -e - (-e / 2));
+    let (sa, sb) = (2f64.powi(a), 2f64.powi(b));
     let mut n = DVec3::ZERO;
     for w in pts[1..].windows(2) {
-        n += (w[0] - o).cross(w[1] - o);
+        n += ((w[0] - o) * sa * sb).cross((w[1] - o) * sa * sb);
     }
-    0.5 * n.length()
+    // the area scales back by 2^(2e), in four normal factors
+    let back = [2f64.powi(-a), 2f64.powi(-b)];
+    0.5 * n.length() * back[0] * back[0] * back[1] * back[1]
 }
 
 /// A fragment's area in input units: its outer ring's less its holes'.
