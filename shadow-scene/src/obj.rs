@@ -549,8 +549,7 @@ fn parse_face<'a>(
     tokens: impl Iterator<Item = &'a str>,
     indices: &mut Vec<i64>,
 ) -> Result<(), String> {
-    let mut count = 0;
-    for token in tokens {
+    for (count, token) in tokens.enumerate() {
         if count == MAX_FACE_VERTICES {
             return Err(format!(
                 "face has more than {MAX_FACE_VERTICES} vertices (the most a face may have)"
@@ -577,7 +576,6 @@ fn parse_face<'a>(
             .parse::<i64>()
             .map_err(|_| format!("could not parse `{index}` as a vertex index in `{token}`"))?;
         indices.push(i);
-        count += 1;
     }
     Ok(())
 }
