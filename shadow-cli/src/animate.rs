@@ -262,14 +262,35 @@ impl Plan {
     }
 
     /// One grid for every frame: the static scene, the lights and the box
-    /// of every position the object takes.
+    /// of every position the object takes. A path that would make it more
+    /// than `2^LIGHT_RANGE_BITS` times coarser than the grid of the scene
+    /// and the object as given is an error, as a point light that far
+    /// away is: the scene would lose its detail (a path of 10^9 over a
+    /// scene of 10 snaps the scene to a grid of step 32).
     fn grid(&self, frames: u32) -> Result<Grid> {
         let s = &self.setup;
         let (lo, hi) = self.motion.swept_bounds(&s.moving.positions, frames);
         let mut pts = s.statics.positions.clone();
+        pts.extend_from_slice(&s.moving.positions);
+        let own = shared_grid(&pts, &self.specs, &[]).with_context(|| s.name.clone())?;
         pts.push(lo);
         pts.push(hi);
-        shared_grid(&pts, &self.specs, &[]).with_context(|| s.name.clone())
+        let grid = shared_grid(&pts, &self.specs, &[]).with_context(|| s.name.clone())?;
+        let coarser = grid.step_log2() - own.step_log2();
+        if coarser > svbsp::LIGHT_RANGE_BITS {
+            bail!(
+                "{}: the object's path over {frames} frames spans {:.3e} units (from {lo} to {hi}), \
+                 which would snap the scene to a grid 2^{coarser} times coarser than its own \
+                 (a step of {} instead of {}) and cost it its detail; at most 2^{} is \
+                 allowed: give fewer frames, or a smaller --step or --spin",
+                s.name,
+                (hi - lo).max_element(),
+                grid.step_text(),
+                own.step_text(),
+                svbsp::LIGHT_RANGE_BITS,
+            );
+        }
+        Ok(grid)
     }
 }
 

@@ -265,6 +265,50 @@ fn files_need_a_moving_object_a_light_and_a_good_spin() {
         ]),
         &["no faces"],
     );
+    // a path so long that the shared grid would lose the scene's detail
+    // (a step of 2^5 under a scene of 8): an error, not frames of nothing;
+    // a path of 200 times the scene is fine
+    let far = [
+        "animate",
+        s,
+        "--dynamic",
+        t,
+        "--light",
+        "0,0,5",
+        "--frames",
+        "3",
+    ];
+    assert_failed_with(
+        &shadow(
+            &[
+                &far[..],
+                &["--step", "1e9,0,0", "-o", o, "--format", "none"],
+            ]
+            .concat(),
+        ),
+        &[
+            "anim_static.obj",
+            "path over 3 frames",
+            "2^27 times coarser",
+            "--step",
+        ],
+    );
+    let o2 = dir("anim_far_ok");
+    let o2 = o2.to_str().unwrap();
+    let fine = shadow(
+        &[
+            &far[..],
+            &["--step", "800,0,0", "-o", o2, "--format", "json"],
+        ]
+        .concat(),
+    );
+    assert!(fine.status.success(), "{}", stderr(&fine));
+    let frame0 = json(&Path::new(o2).join("frame_0000.json"));
+    let area = frame0["summary"]["area"].as_f64().unwrap();
+    assert!(
+        (area - (64.0 + 1.5 + 3f64.sqrt() / 2.0)).abs() < 1e-12,
+        "{area}"
+    );
     assert_failed_with(
         &shadow(&["animate", "--scene", "kitchen", "-o", o]),
         &["unknown animation `kitchen`", "room"],

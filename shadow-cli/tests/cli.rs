@@ -492,7 +492,18 @@ fn huge_and_tiny_coordinates_are_clear_errors_or_exact() {
     // (the normal's length is the fourth power of the size)
     let csv = scratch("scaled_tetra.csv");
     let csv = csv.to_str().unwrap();
-    let day = ["--lat", "50", "--lon", "0", "--date", "2026-06-21", "--step", "60", "-o", csv];
+    let day = [
+        "--lat",
+        "50",
+        "--lon",
+        "0",
+        "--date",
+        "2026-06-21",
+        "--step",
+        "60",
+        "-o",
+        csv,
+    ];
     let hours = |p: &str| {
         let o = shadow(&[&["sunhours", p][..], &day[..]].concat());
         assert!(o.status.success(), "{p}: {}", stderr(&o));
@@ -515,7 +526,10 @@ fn huge_and_tiny_coordinates_are_clear_errors_or_exact() {
         let scaled = hours(p.to_str().unwrap());
         for ((a, h), (b, g)) in scaled.iter().zip(&unit) {
             assert_eq!(h, g, "{s:e}");
-            assert!((a / (b * s * s / 4.0) - 1.0).abs() < 1e-6, "{s:e}: area {a:e}");
+            assert!(
+                (a / (b * s * s / 4.0) - 1.0).abs() < 1e-6,
+                "{s:e}: area {a:e}"
+            );
         }
         let o = shadow(&["shadows", p.to_str().unwrap(), "--sun", "1,2,3", "-o", out]);
         assert!(o.status.success(), "{s:e}: {}", stderr(&o));
