@@ -434,12 +434,18 @@ fn study<T>(
         1 => vec![None],
         _ => Tile::all(tiles).map(Some).collect(),
     };
-    // (no suns: no runs, and nothing to snap)
-    let snapped = (!suns.is_empty()).then(|| Snapped::new(mesh)).transpose()?;
-    let count = suns.len().div_ceil(SUNS_A_RUN) * cut.len();
+    // (no suns, as in a polar night: one run of none, which gives the
+    // faces' areas and no hours)
+    let snapped = Snapped::new(mesh)?;
+    let batches: Vec<&[DVec3]> = match suns.is_empty() {
+        true => vec![&[]],
+        false => suns.chunks(SUNS_A_RUN).collect(),
+    };
+    let count = batches.len() * cut.len();
     progress.phase("sun runs", count as u64);
-    let mut runs = (snapped.iter())
-        .flat_map(|s| suns.chunks(SUNS_A_RUN).map(move |batch| (s, batch)))
+    let s = &snapped;
+    let mut runs = (batches.into_iter())
+        .map(|batch| (s, batch))
         .flat_map(|(s, batch)| cut.iter().map(move |&t| (s, batch, t)))
         .map(|(s, batch, t)| {
             let run = HoursRun::make(mesh, batch, step_hours, pieces, s, t);

@@ -198,6 +198,28 @@ fn a_day_of_suns_and_the_hours_of_a_yard() {
     assert_eq!(at[5], full);
 }
 
+/// A day without sun (a polar night) still gives every face its area,
+/// and no hours: the same areas as a day of suns.
+#[test]
+fn a_day_without_sun_keeps_the_faces_areas() {
+    let (mesh, suns, step, _) = equinox_study();
+    let lit = sun_hours(&mesh, &suns, step).unwrap();
+    for hours in [
+        sun_hours(&mesh, &[], step).unwrap(),
+        sun_hours_mean(&mesh, &[], step).unwrap(),
+        sun_hours_in_tiles(&mesh, &[], step, 2, true).unwrap(),
+    ] {
+        for (night, day) in hours.iter().zip(&lit) {
+            assert!(day.area > 0.0 && (night.area - day.area).abs() < 1e-12 * day.area);
+            assert_eq!(night.sun_hours, 0.0);
+            assert!(
+                night.min_hours == 0.0 || night.min_hours.is_nan(),
+                "{night:?}"
+            );
+        }
+    }
+}
+
 #[test]
 fn runs_files_and_heat_maps_of_a_yard() {
     let (mesh, suns, step, full) = equinox_study();
