@@ -149,8 +149,9 @@ impl Operand {
     /// error names the file, line, face and edge (the check of
     /// [`crate::check_mesh`], on the faces as they are).
     ///
-    /// A mesh with no faces, or so large that its volume overflows `f64`,
-    /// is an error too.
+    /// A mesh so large that its volume overflows `f64` is an error too. A
+    /// mesh with no faces is the empty solid (a Boolean's empty result,
+    /// written and read back, is an operand again).
     pub fn check(&self) -> Result<(), FileError> {
         self.check_faces()?;
         let loops = || self.mesh.faces.iter().map(|f| f.vertices.as_slice());
@@ -166,11 +167,12 @@ impl Operand {
         })
     }
 
-    /// The part of [`Operand::check`] that needs no topology: the mesh
-    /// has faces, and its volume fits in `f64`.
+    /// The part of [`Operand::check`] that needs no topology: the mesh's
+    /// volume fits in `f64` (a mesh with no faces, the empty solid, has
+    /// none).
     pub fn check_faces(&self) -> Result<(), FileError> {
         let Some((lo, hi)) = self.mesh.bounds().filter(|_| !self.mesh.faces.is_empty()) else {
-            return Err(FileError::new(format!("{}: no faces", self.name)));
+            return Ok(());
         };
         let extent = (hi - lo).max_element();
         if !(extent * extent * extent).is_finite() {
@@ -390,7 +392,11 @@ impl FileBoolean {
         let grid = {
             let meshes: Vec<MeshIn<'_>> = operands
                 .iter()
-                .map(|o| MeshIn::new(&o.mesh.positions, &[]))
+                // (an empty solid's stray vertices are no part of it)
+                .map(|o| match o.mesh.faces.is_empty() {
+                    true => MeshIn::new(&[], &[]),
+                    false => MeshIn::new(&o.mesh.positions, &[]),
+                })
                 .collect();
             crate::fit_grid(&meshes)
                 .map_err(|e| FileError::new(format!("cannot snap the faces to one grid: {e}")))?
@@ -952,6 +958,42 @@ f 4 1 5 8
         assert_eq!(out.stats[0].cells, 0);
     }
 
+    /// A mesh with no faces is the empty solid: the union is the others',
+    /// the intersection empty, a difference takes nothing away or leaves
+    /// nothing; stray vertices of it do not widen the grid; the empty
+    /// result written and read back is an operand again.
+    #[test]
+    fn no_faces_is_the_empty_solid() {
+        let a = operand(&cube(4.0, [0.0; 3]), "a.obj", false);
+        let none = Operand::new("e.obj", Mesh::default());
+        let stray = operand("v 1e200 0 0\n", "stray.obj", false);
+        let alone = apply(&mut [a.clone()], BoolOp::Union).unwrap();
+        for empty in [none, stray] {
+            for (mut operands, op, vol) in [
+                (vec![empty.clone(), a.clone()], BoolOp::Union, 64.0),
+                (vec![a.clone(), empty.clone()], BoolOp::Union, 64.0),
+                (vec![a.clone(), empty.clone()], BoolOp::Intersection, 0.0),
+                (vec![empty.clone(), a.clone()], BoolOp::Intersection, 0.0),
+                (vec![a.clone(), empty.clone()], BoolOp::Difference, 64.0),
+                (vec![empty.clone(), a.clone()], BoolOp::Difference, 0.0),
+                (vec![empty.clone(), empty.clone()], BoolOp::Union, 0.0),
+            ] {
+                let out = apply(&mut operands, op).unwrap();
+                assert_eq!(out.volume(), vol, "{op:?} of {}", Operand::names(&operands));
+                if vol > 0.0 {
+                    assert_eq!(out.grid, alone.grid);
+                    assert_eq!(out.exact.triangles.len(), alone.exact.triangles.len());
+                }
+            }
+        }
+        let empty = apply(&mut [a.clone(), a.clone()], BoolOp::Difference).unwrap();
+        let mut text = Vec::new();
+        shadow_scene::write_obj(&empty.mesh(), &mut text).unwrap();
+        let back = operand(std::str::from_utf8(&text).unwrap(), "back.obj", false);
+        let out = apply(&mut [back, a], BoolOp::Union).unwrap();
+        assert_eq!(out.volume(), 64.0);
+    }
+
     /// Three operands: an import report for each, the stats of each
     /// operation, the library's three phases timed, and every operand's
     /// mesh let go (handed over to the library).
@@ -1014,8 +1056,9 @@ f 4 1 5 8
         let t = out.times;
         assert!(t.snap.is_some() && t.operations.is_some() && t.mesh.is_some());
 
+        // the empty solid: an operand like any other
         let empty = Operand::new("e.obj", Mesh::default());
-        assert_eq!(empty.check().unwrap_err().message, "e.obj: no faces");
+        assert!(empty.check().is_ok());
         let huge = operand(&cube(1e120, [0.0; 3]), "h.obj", false);
         let e = huge.check_faces().unwrap_err().message;
         assert!(

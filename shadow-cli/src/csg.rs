@@ -101,6 +101,10 @@ fn load_all(paths: &[PathBuf], weld: bool, quiet: bool) -> Result<Vec<Operand>> 
                 format!("{name}: welding left out {n} face(s) whose corners became one position");
             note(quiet, &format!("note: {what}"));
         }
+        if o.mesh.faces.is_empty() {
+            let name = &o.name;
+            note(quiet, &format!("note: {name}: no faces: the empty solid"));
+        }
         // (in the files' order, before a later file's read error)
         o.check_faces().map_err(file_error)?;
         operands.push(o);
