@@ -6,6 +6,7 @@ pub(crate) mod convex;
 pub(crate) mod error;
 pub(crate) mod exact;
 pub(crate) mod grid;
+mod grid_loop;
 pub(crate) mod plane;
 pub(crate) mod point;
 pub(crate) mod polygon;

@@ -4,10 +4,11 @@ use smallvec::SmallVec;
 
 use crate::kernel::grid::GridPoint;
 use crate::kernel::plane::FaceDefect;
-use crate::kernel::plane::{Plane, cross, in_range, sub};
+use crate::kernel::plane::{Plane, in_range};
 use std::sync::Arc;
 
 use crate::kernel::convex::{ConvexParts, SanityError, check_convex};
+use crate::kernel::grid_loop::{LINKED, dedupe_cyclic, remove_collinear};
 use crate::kernel::point::{Implicit, Point, PointRef, approx_key};
 
 /// Exact position of a polygon relative to a plane.
@@ -83,47 +84,6 @@ pub struct Polygon {
     edges: SmallVec<[Plane; 4]>,
     verts: SmallVec<[Point; 4]>,
     tag: u32,
-}
-
-/// A face's loop of grid points, on the stack for up to eight corners.
-type GridLoop = SmallVec<[GridPoint; 8]>;
-
-fn dedupe_cyclic(points: &[GridPoint]) -> GridLoop {
-    let mut v = GridLoop::with_capacity(points.len());
-    for p in points {
-        if v.last() != Some(p) {
-            v.push(*p);
-        }
-    }
-    while v.len() > 1 && v.first() == v.last() {
-        v.pop();
-    }
-    v
-}
-
-/// Removes vertices whose two edges are collinear (straight-through points
-/// and zero-area spikes); they do not change the enclosed region.
-fn remove_collinear(v: &mut GridLoop) {
-    let mut changed = true;
-    while changed && v.len() >= 3 {
-        changed = false;
-        let k = v.len();
-        for i in 0..k {
-            let prev = v[(i + k - 1) % k];
-            let next = v[(i + 1) % k];
-            if cross(sub(v[i], prev), sub(next, v[i])) == [0, 0, 0] {
-                v.remove(i);
-                changed = true;
-                break;
-            }
-        }
-        // removing a spike can make two neighbours equal
-        let d = dedupe_cyclic(v);
-        if d.len() != v.len() {
-            *v = d;
-            changed = true;
-        }
-    }
 }
 
 /// The support plane of a planar loop, oriented by its winding; `None` if
@@ -221,14 +181,9 @@ impl GridPolygon {
             support,
             verts: v.into_iter().collect(),
         };
-        let convex = || {
-            let k = g.verts.len();
-            (0..k).all(|i| {
-                let e = g.edge_plane(i);
-                g.verts.iter().enumerate().all(|(j, p)| {
-                    j == i || j == (i + 1) % k || e.classify_grid(*p) == crate::kernel::Side::Back
-                })
-            })
+        let convex = || match g.verts.len() >= LINKED {
+            true => g.convex_by_turns(),
+            false => g.convex_pairwise(),
         };
         if triangle {
             debug_assert!(convex(), "a triangle of nonzero area is convex");
@@ -241,6 +196,53 @@ impl GridPolygon {
     /// The support plane.
     pub fn support(&self) -> &Plane {
         &self.support
+    }
+
+    /// Whether every corner but an edge's own lies strictly behind the
+    /// edge's plane, edge by edge: strictly convex.
+    fn convex_pairwise(&self) -> bool {
+        let k = self.verts.len();
+        (0..k).all(|i| {
+            let e = self.edge_plane(i);
+            self.verts.iter().enumerate().all(|(j, p)| {
+                j == i || j == (i + 1) % k || e.classify_grid(*p) == crate::kernel::Side::Back
+            })
+        })
+    }
+
+    /// [`GridPolygon::convex_pairwise`]'s answer in linear time: strictly
+    /// convex if and only if every corner turns the loop's way (the corner
+    /// after the next lies strictly behind each edge's plane) and the loop
+    /// turns around once (a loop turning one way all along may go around
+    /// twice, as a pentagram does): its edges' directions, seen along the
+    /// support's dominant axis, pass a fixed direction once.
+    fn convex_by_turns(&self) -> bool {
+        let k = self.verts.len();
+        let v = &self.verts;
+        let turns = (0..k)
+            .all(|i| self.edge_plane(i).classify_grid(v[(i + 2) % k]) == crate::kernel::Side::Back);
+        if !turns {
+            return false;
+        }
+        let ax = self.support.dominant_axis();
+        let (a, b) = ((ax + 1) % 3, (ax + 2) % 3);
+        let d = |i: usize| {
+            let (p, q) = (v[i], v[(i + 1) % k]);
+            let c = |x: usize| i128::from(q[x]) - i128::from(p[x]);
+            (c(a), c(b))
+        };
+        let cross = |u: (i128, i128), w: (i128, i128)| u.0 * w.1 - u.1 * w.0;
+        // the way every edge turns into the next, seen so (none is straight)
+        let s = cross(d(0), d(1)).signum();
+        let r = (1, 0);
+        // the edges turning past `r` (from before it to it or beyond)
+        let passes = (0..k)
+            .filter(|&i| {
+                let (u, w) = (d(i), d((i + 1) % k));
+                s * cross(u, r) > 0 && (s * cross(r, w) > 0 || (cross(r, w) == 0 && w.0 > 0))
+            })
+            .count();
+        passes == 1
     }
 
     /// The corners, counter-clockwise.
@@ -972,6 +974,78 @@ fn point_key(i: &Implicit) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernel::grid_loop::GridLoop;
+
+    fn xorshift(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
+    /// A point of the plane `(x, y)` on one of a few integer planes of
+    /// space (each projected along a different axis, either way round).
+    fn embed(plane: usize, (x, y): (i32, i32)) -> GridPoint {
+        match plane % 4 {
+            0 => [x, y, 0],
+            1 => [y, 3, x],
+            2 => [x, y, x + 2 * y],
+            _ => [-2 * y + x, y, -x],
+        }
+    }
+
+    /// Regular polygons (convex), the same going round twice (turning one
+    /// way all along, not convex), with two corners swapped, with a corner
+    /// pushed in or out, each on a few planes of space and either way
+    /// round: convex by turns exactly when convex pair by pair.
+    #[test]
+    fn convex_by_turns_as_pair_by_pair() {
+        let mut seed = 0x3c6e_f372_fe94_f82bu64;
+        let mut next = |m: u64| xorshift(&mut seed) % m;
+        let (mut convex, mut not) = (0, 0);
+        for round in 0..800 {
+            let n = LINKED + next(200) as usize;
+            let turns = if round % 5 == 1 { 2.0 } else { 1.0 };
+            let r = 1e5 + next(1_000) as f64;
+            let mut xy: Vec<(i32, i32)> = (0..n)
+                .map(|k| {
+                    let a = turns * std::f64::consts::TAU * k as f64 / n as f64;
+                    ((r * a.cos()).round() as i32, (r * a.sin()).round() as i32)
+                })
+                .collect();
+            let k = next(n as u64 - 1) as usize;
+            match round % 5 {
+                2 => xy.swap(k, k + 1),
+                3 => xy[k] = (xy[k].0 / 2, xy[k].1 / 2),
+                4 => xy[k] = (xy[k].0 + xy[k].0 / 500, xy[k].1 + xy[k].1 / 500),
+                _ => {}
+            }
+            if round % 2 == 1 {
+                xy.reverse();
+            }
+            let mut v: GridLoop = xy.iter().map(|&p| embed(round / 2, p)).collect();
+            v = dedupe_cyclic(&v);
+            let Ok(support) = support_plane(&v) else {
+                continue;
+            };
+            remove_collinear(&mut v);
+            if v.len() < LINKED {
+                continue;
+            }
+            let g = GridPolygon {
+                support,
+                verts: v.into_iter().collect(),
+            };
+            let pairwise = g.convex_pairwise();
+            assert_eq!(g.convex_by_turns(), pairwise, "round {round}");
+            if pairwise {
+                convex += 1;
+            } else {
+                not += 1;
+            }
+        }
+        assert!(convex > 100 && not > 200, "{convex} convex, {not} not");
+    }
 
     proptest::proptest! {
         /// A triangle of three distinct corners takes a short path; it

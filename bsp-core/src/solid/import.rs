@@ -6,8 +6,9 @@ use crate::kernel::Error;
 use crate::kernel::Side;
 use crate::kernel::grid::{Grid, GridPoint};
 use crate::kernel::plane::FaceDefect;
-use crate::kernel::plane::Plane;
 use crate::kernel::polygon::{GridPolygon, Polygon, support_plane};
+
+use super::loops::{Projection, tile};
 
 /// What happened to the input faces on the way to convex polygons.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -545,141 +546,6 @@ fn triangulate(pts: &[GridPoint], defect: FaceDefect) -> Option<Vec<[GridPoint; 
             .map(|i| [v[0], v[i], v[i + 1]])
             .collect(),
     )
-}
-
-/// Triangles that tile the planar loop `v` exactly, counter-clockwise in
-/// `proj`: the loop split at a corner it meets twice and each part tiled
-/// (a part turning the other way, a hole pinched off, cannot be); a loop
-/// of distinct corners only if it is simple (no two edges but neighbours
-/// meet), by ear clipping, checked (every triangle turns the loop's way
-/// and their areas add up to its area).
-fn tile(v: &[GridPoint], proj: &Projection) -> Option<Vec<[GridPoint; 3]>> {
-    for i in 0..v.len() {
-        if let Some(j) = (i + 1..v.len()).find(|&j| v[j] == v[i]) {
-            let inner = &v[i..j];
-            let outer: Vec<GridPoint> = v[j..].iter().chain(&v[..i]).copied().collect();
-            let mut t = tile(inner, proj)?;
-            t.extend(tile(&outer, proj)?);
-            return Some(t);
-        }
-    }
-    // corners all distinct: simple unless two edges not next to each
-    // other meet
-    let area = proj.area2(v);
-    if area <= 0 || !proj.simple(v) {
-        return None;
-    }
-    let t = ear_clip(v, proj)?;
-    (t.iter().map(|t| proj.area2(t)).sum::<i128>() == area).then_some(t)
-}
-
-/// A plane's loops seen along its dominant axis, counter-clockwise about
-/// its normal: exact `i128` orientation and area.
-struct Projection {
-    a: usize,
-    b: usize,
-}
-
-impl Projection {
-    fn of(plane: &Plane) -> Projection {
-        let ax = plane.dominant_axis();
-        let (a, b) = if plane.normal()[ax] > 0 {
-            ((ax + 1) % 3, (ax + 2) % 3)
-        } else {
-            ((ax + 2) % 3, (ax + 1) % 3)
-        };
-        Projection { a, b }
-    }
-
-    fn xy(&self, p: GridPoint) -> (i128, i128) {
-        (i128::from(p[self.a]), i128::from(p[self.b]))
-    }
-
-    /// The sign of the turn `p, q, r`.
-    fn orient(&self, p: GridPoint, q: GridPoint, r: GridPoint) -> i128 {
-        let (p, q, r) = (self.xy(p), self.xy(q), self.xy(r));
-        ((q.0 - p.0) * (r.1 - p.1) - (q.1 - p.1) * (r.0 - p.0)).signum()
-    }
-
-    /// Whether segments `p`–`q` and `r`–`s` share a point.
-    fn meet(&self, (p, q): (GridPoint, GridPoint), (r, s): (GridPoint, GridPoint)) -> bool {
-        let (d1, d2) = (self.orient(p, q, r), self.orient(p, q, s));
-        let (d3, d4) = (self.orient(r, s, p), self.orient(r, s, q));
-        if d1 == 0 && d2 == 0 {
-            // on one line: do their extents overlap?
-            let (p, q, r, s) = (self.xy(p), self.xy(q), self.xy(r), self.xy(s));
-            let within = |lo: i128, hi: i128, a: i128, b: i128| {
-                lo.min(hi) <= a.max(b) && a.min(b) <= lo.max(hi)
-            };
-            return within(p.0, q.0, r.0, s.0) && within(p.1, q.1, r.1, s.1);
-        }
-        d1 * d2 <= 0 && d3 * d4 <= 0
-    }
-
-    /// Whether the loop's edges meet only their neighbours, at their
-    /// shared corners.
-    fn simple(&self, v: &[GridPoint]) -> bool {
-        let n = v.len();
-        let edge = |i: usize| (v[i], v[(i + 1) % n]);
-        (0..n).all(|i| {
-            // the edges after the next, up to the one before `i`
-            (i + 2..n)
-                .filter(|&j| (j + 1) % n != i)
-                .all(|j| !self.meet(edge(i), edge(j)))
-        })
-    }
-
-    /// Twice the loop's signed area (positive: counter-clockwise).
-    fn area2(&self, v: &[GridPoint]) -> i128 {
-        (0..v.len())
-            .map(|i| {
-                let (p, q) = (self.xy(v[i]), self.xy(v[(i + 1) % v.len()]));
-                p.0 * q.1 - q.0 * p.1
-            })
-            .sum()
-    }
-}
-
-/// Exact ear clipping of a planar loop, counter-clockwise in `proj`.
-fn ear_clip(v: &[GridPoint], proj: &Projection) -> Option<Vec<[GridPoint; 3]>> {
-    let orient = |p, q, r| proj.orient(p, q, r);
-    if v.len() < 3 {
-        return None;
-    }
-    let mut idx: Vec<usize> = (0..v.len()).collect();
-    let mut tris = Vec::with_capacity(v.len());
-    while idx.len() > 3 {
-        let m = idx.len();
-        let mut found = None;
-        for i in 0..m {
-            let (pa, pb, pc) = (v[idx[(i + m - 1) % m]], v[idx[i]], v[idx[(i + 1) % m]]);
-            if orient(pa, pb, pc) <= 0 {
-                continue;
-            }
-            let blocked = idx.iter().any(|&j| {
-                let p = v[j];
-                p != pa
-                    && p != pb
-                    && p != pc
-                    && orient(pa, pb, p) >= 0
-                    && orient(pb, pc, p) >= 0
-                    && orient(pc, pa, p) >= 0
-            });
-            if !blocked {
-                found = Some(i);
-                break;
-            }
-        }
-        let i = found?;
-        let m = idx.len();
-        tris.push([v[idx[(i + m - 1) % m]], v[idx[i]], v[idx[(i + 1) % m]]]);
-        idx.remove(i);
-    }
-    tris.push([v[idx[0]], v[idx[1]], v[idx[2]]]);
-    // every triangle must keep the loop's orientation
-    tris.iter()
-        .all(|t| orient(t[0], t[1], t[2]) >= 0)
-        .then_some(tris)
 }
 
 /// `true` if every vertex of every polygon lies exactly on its support plane

@@ -5,6 +5,7 @@
 pub(crate) mod embedded;
 mod flat_regions;
 pub(crate) mod import;
+mod loops;
 pub(crate) mod mesh;
 pub(crate) mod topology;
 

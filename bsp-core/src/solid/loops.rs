@@ -1,0 +1,521 @@
+//! Exact triangles of a non-convex planar face: its loop of grid points
+//! split where it meets itself at a corner, each part checked simple and
+//! ear-clipped, every decision an exact `i128` orientation in the face's
+//! projection along its dominant axis.
+//!
+//! A loop of [`BUCKETED`] corners or more is searched through buckets (a
+//! uniform grid of cells over the loop's box, each listing the corners or
+//! edges that may lie in it), so that a face of tens of thousands of
+//! corners is not a quadratic search; the buckets only pass over pairs
+//! that cannot meet, so the answers are those of the pairwise search,
+//! triangle for triangle.
+
+use rustc_hash::FxHashMap;
+
+use crate::kernel::grid::GridPoint;
+use crate::kernel::plane::Plane;
+
+/// Loops of at least this many corners are searched through buckets;
+/// smaller ones pair by pair.
+const BUCKETED: usize = 64;
+
+/// The most cells an item of [`Buckets`] may fill on average.
+const MAX_CELLS_AN_ITEM: usize = 16;
+
+/// Triangles that tile the planar loop `v` exactly, counter-clockwise in
+/// `proj`: the loop split at a corner it meets twice and each part tiled
+/// (a part turning the other way, a hole pinched off, cannot be); a loop
+/// of distinct corners only if it is simple (no two edges but neighbours
+/// meet), by ear clipping, checked (every triangle turns the loop's way
+/// and their areas add up to its area). The parts wait on a list, not on
+/// the stack: a loop may meet itself at thousands of corners.
+pub(super) fn tile(v: &[GridPoint], proj: &Projection) -> Option<Vec<[GridPoint; 3]>> {
+    let mut out = Vec::new();
+    let mut parts = vec![v.to_vec()];
+    while let Some(v) = parts.pop() {
+        if let Some((i, j)) = first_repeat(&v) {
+            // the part inside the repeated corner first, then the rest
+            parts.push(v[j..].iter().chain(&v[..i]).copied().collect());
+            parts.push(v[i..j].to_vec());
+            continue;
+        }
+        // corners all distinct: simple unless two edges not next to each
+        // other meet
+        let area = proj.area2(&v);
+        if area <= 0 || !proj.simple(&v) {
+            return None;
+        }
+        let t = ear_clip(&v, proj)?;
+        if t.iter().map(|t| proj.area2(t)).sum::<i128>() != area {
+            return None;
+        }
+        out.extend(t);
+    }
+    Some(out)
+}
+
+/// The first corner of `v` that it meets again, and where it first does.
+fn first_repeat(v: &[GridPoint]) -> Option<(usize, usize)> {
+    if v.len() < BUCKETED {
+        return (0..v.len()).find_map(|i| Some((i, (i + 1..v.len()).find(|&j| v[j] == v[i])?)));
+    }
+    // the first repeated corner is a first occurrence, and its first
+    // repeat the first one met after it
+    let mut first: FxHashMap<GridPoint, usize> = FxHashMap::default();
+    first.reserve(v.len());
+    let mut found: Option<(usize, usize)> = None;
+    for (k, p) in v.iter().enumerate() {
+        match first.get(p) {
+            Some(&i) => {
+                if found.is_none_or(|(f, _)| i < f) {
+                    found = Some((i, k));
+                }
+            }
+            None => {
+                first.insert(*p, k);
+            }
+        }
+    }
+    found
+}
+
+/// A plane's loops seen along its dominant axis, counter-clockwise about
+/// its normal: exact `i128` orientation and area.
+pub(super) struct Projection {
+    a: usize,
+    b: usize,
+}
+
+/// A point of a projected loop.
+type Xy = (i128, i128);
+
+impl Projection {
+    pub(super) fn of(plane: &Plane) -> Projection {
+        let ax = plane.dominant_axis();
+        let (a, b) = if plane.normal()[ax] > 0 {
+            ((ax + 1) % 3, (ax + 2) % 3)
+        } else {
+            ((ax + 2) % 3, (ax + 1) % 3)
+        };
+        Projection { a, b }
+    }
+
+    fn xy(&self, p: GridPoint) -> Xy {
+        (i128::from(p[self.a]), i128::from(p[self.b]))
+    }
+
+    /// The sign of the turn `p, q, r`.
+    fn orient(&self, p: GridPoint, q: GridPoint, r: GridPoint) -> i128 {
+        turn(self.xy(p), self.xy(q), self.xy(r))
+    }
+
+    /// Whether segments `p`–`q` and `r`–`s` share a point.
+    fn meet(&self, (p, q): (GridPoint, GridPoint), (r, s): (GridPoint, GridPoint)) -> bool {
+        let (d1, d2) = (self.orient(p, q, r), self.orient(p, q, s));
+        let (d3, d4) = (self.orient(r, s, p), self.orient(r, s, q));
+        if d1 == 0 && d2 == 0 {
+            // on one line: do their extents overlap?
+            let (p, q, r, s) = (self.xy(p), self.xy(q), self.xy(r), self.xy(s));
+            let within = |lo: i128, hi: i128, a: i128, b: i128| {
+                lo.min(hi) <= a.max(b) && a.min(b) <= lo.max(hi)
+            };
+            return within(p.0, q.0, r.0, s.0) && within(p.1, q.1, r.1, s.1);
+        }
+        d1 * d2 <= 0 && d3 * d4 <= 0
+    }
+
+    /// Whether the loop's edges meet only their neighbours, at their
+    /// shared corners.
+    fn simple(&self, v: &[GridPoint]) -> bool {
+        let n = v.len();
+        let edge = |i: usize| (v[i], v[(i + 1) % n]);
+        // (edges `i < j` next to each other: `j = i + 1`, and the last
+        // with the first)
+        let apart = |i: usize, j: usize| j > i + 1 && !(i == 0 && j == n - 1);
+        if n < BUCKETED {
+            return (0..n)
+                .all(|i| (i + 2..n).all(|j| !apart(i, j) || !self.meet(edge(i), edge(j))));
+        }
+        // edges that meet share a point, so they lie in a common cell
+        let boxes = (0..n).map(|i| {
+            let (p, q) = (self.xy(v[i]), self.xy(v[(i + 1) % n]));
+            ((p.0.min(q.0), p.1.min(q.1)), (p.0.max(q.0), p.1.max(q.1)))
+        });
+        let Some(cells) = Buckets::new(boxes.collect()) else {
+            return (0..n)
+                .all(|i| (i + 2..n).all(|j| !apart(i, j) || !self.meet(edge(i), edge(j))));
+        };
+        (0..cells.count()).all(|c| {
+            let edges = cells.cell(c);
+            edges.iter().enumerate().all(|(k, &i)| {
+                (edges[k + 1..].iter()).all(|&j| {
+                    let (i, j) = (i as usize, j as usize);
+                    !apart(i, j) || !self.meet(edge(i), edge(j))
+                })
+            })
+        })
+    }
+
+    /// Twice the loop's signed area (positive: counter-clockwise).
+    fn area2(&self, v: &[GridPoint]) -> i128 {
+        (0..v.len())
+            .map(|i| {
+                let (p, q) = (self.xy(v[i]), self.xy(v[(i + 1) % v.len()]));
+                p.0 * q.1 - q.0 * p.1
+            })
+            .sum()
+    }
+}
+
+/// The sign of the turn `p, q, r`.
+fn turn(p: Xy, q: Xy, r: Xy) -> i128 {
+    ((q.0 - p.0) * (r.1 - p.1) - (q.1 - p.1) * (r.0 - p.0)).signum()
+}
+
+/// A uniform grid of about as many square-ish cells as items over the
+/// items' boxes, each cell listing (in order) the items whose box meets
+/// it; none where the boxes would fill more than [`MAX_CELLS_AN_ITEM`]
+/// cells an item on average (long edges across the loop: the pairs are
+/// then searched pairwise).
+struct Buckets {
+    lo: Xy,
+    size: Xy,
+    side: usize,
+    /// Where each cell's items start in `items` (one more: the end).
+    start: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Buckets {
+    fn new(boxes: Vec<(Xy, Xy)>) -> Option<Buckets> {
+        let lo = boxes.iter().fold((i128::MAX, i128::MAX), |l, b| {
+            (l.0.min(b.0.0), l.1.min(b.0.1))
+        });
+        let hi = boxes.iter().fold((i128::MIN, i128::MIN), |h, b| {
+            (h.0.max(b.1.0), h.1.max(b.1.1))
+        });
+        let side = ((boxes.len() as f64).sqrt().ceil() as usize).max(1);
+        let size = (
+            (hi.0 - lo.0) / side as i128 + 1,
+            (hi.1 - lo.1) / side as i128 + 1,
+        );
+        let mut cells = Buckets {
+            lo,
+            size,
+            side,
+            start: vec![0; side * side + 1],
+            items: Vec::new(),
+        };
+        // a counting sort: how many a cell, where each starts, the items
+        for &(l, h) in &boxes {
+            let (xs, ys) = cells.span(l, h);
+            for y in ys {
+                for x in xs.clone() {
+                    cells.start[y * side + x + 1] += 1;
+                }
+            }
+        }
+        for c in 0..side * side {
+            cells.start[c + 1] += cells.start[c];
+        }
+        if cells.start[side * side] as usize > MAX_CELLS_AN_ITEM * boxes.len() {
+            return None;
+        }
+        let mut at: Vec<u32> = cells.start[..side * side].to_vec();
+        cells.items = vec![0; cells.start[side * side] as usize];
+        for (i, &(l, h)) in boxes.iter().enumerate() {
+            let (xs, ys) = cells.span(l, h);
+            for y in ys {
+                for x in xs.clone() {
+                    let c = &mut at[y * side + x];
+                    cells.items[*c as usize] = i as u32;
+                    *c += 1;
+                }
+            }
+        }
+        Some(cells)
+    }
+
+    /// The columns and rows of the cells that the box `l`–`h` meets.
+    fn span(
+        &self,
+        l: Xy,
+        h: Xy,
+    ) -> (
+        std::ops::RangeInclusive<usize>,
+        std::ops::RangeInclusive<usize>,
+    ) {
+        let col = |t: i128| (((t - self.lo.0).max(0) / self.size.0) as usize).min(self.side - 1);
+        let row = |t: i128| (((t - self.lo.1).max(0) / self.size.1) as usize).min(self.side - 1);
+        (col(l.0)..=col(h.0), row(l.1)..=row(h.1))
+    }
+
+    fn count(&self) -> usize {
+        self.side * self.side
+    }
+
+    fn cell(&self, c: usize) -> &[u32] {
+        &self.items[self.start[c] as usize..self.start[c + 1] as usize]
+    }
+
+    /// The cells that may hold a point of triangle `t`: row by row, the
+    /// columns of the triangle's extent in the row's band (found in `f64`
+    /// and widened by a cell each way, which the rounding of coordinates
+    /// below 2^64 cannot exceed).
+    fn under_triangle(&self, t: [Xy; 3], mut each: impl FnMut(usize) -> bool) -> bool {
+        let l = (
+            t.iter().map(|p| p.0).min().unwrap_or(0),
+            t.iter().map(|p| p.1).min().unwrap_or(0),
+        );
+        let h = (
+            t.iter().map(|p| p.0).max().unwrap_or(0),
+            t.iter().map(|p| p.1).max().unwrap_or(0),
+        );
+        let (xs, ys) = self.span(l, h);
+        let f = |p: Xy| (p.0 as f64, p.1 as f64);
+        for y in ys {
+            // the band's rows of points, within the triangle's
+            let y0 = (self.lo.1 + y as i128 * self.size.1).max(l.1) as f64;
+            let y1 = (self.lo.1 + (y as i128 + 1) * self.size.1 - 1).min(h.1) as f64;
+            // (the band's part of the triangle has its corners where the
+            // edges cross the band's lines, or at the triangle's own)
+            let (mut x0, mut x1) = (f64::INFINITY, f64::NEG_INFINITY);
+            for k in 0..3 {
+                let (p, q) = (f(t[k]), f(t[(k + 1) % 3]));
+                let (ylo, yhi) = (p.1.min(q.1), p.1.max(q.1));
+                if yhi < y0 || ylo > y1 {
+                    continue;
+                }
+                let xs: [f64; 2] = match q.1 == p.1 {
+                    true => [p.0, q.0],
+                    false => [y0.max(ylo), y1.min(yhi)]
+                        .map(|y| p.0 + (y - p.1) * (q.0 - p.0) / (q.1 - p.1)),
+                };
+                for x in xs {
+                    (x0, x1) = (x0.min(x), x1.max(x));
+                }
+            }
+            if x0 > x1 {
+                continue;
+            }
+            let col = |x: f64| ((x - self.lo.0 as f64) / self.size.0 as f64).floor();
+            let first = (col(x0) - 1.0).max(*xs.start() as f64) as usize;
+            let last = (col(x1) + 1.0).min(*xs.end() as f64) as usize;
+            for x in first..=last {
+                if !each(y * self.side + x) {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+}
+
+/// Exact ear clipping of a planar loop, counter-clockwise in `proj`: the
+/// first corner (in the loop's order, from its first remaining corner)
+/// that turns the loop's way and whose triangle holds no other remaining
+/// corner, again and again.
+fn ear_clip(v: &[GridPoint], proj: &Projection) -> Option<Vec<[GridPoint; 3]>> {
+    let orient = |p, q, r| proj.orient(p, q, r);
+    let n = v.len();
+    if n < 3 {
+        return None;
+    }
+    let xy: Vec<Xy> = v.iter().map(|&p| proj.xy(p)).collect();
+    // (a point fills one cell)
+    let cells = (n >= BUCKETED)
+        .then(|| Buckets::new(xy.iter().map(|&p| (p, p)).collect()))
+        .flatten();
+    // the remaining corners, a ring
+    let mut next: Vec<usize> = (1..=n).map(|i| i % n).collect();
+    let mut prev: Vec<usize> = (0..n).map(|i| (i + n - 1) % n).collect();
+    let mut gone = vec![false; n];
+    let (mut head, mut m) = (0, n);
+    let mut tris = Vec::with_capacity(n);
+    let inside = |gone: &[bool], j: usize, (pa, pb, pc): (GridPoint, GridPoint, GridPoint)| {
+        let p = v[j];
+        !gone[j]
+            && p != pa
+            && p != pb
+            && p != pc
+            && orient(pa, pb, p) >= 0
+            && orient(pb, pc, p) >= 0
+            && orient(pc, pa, p) >= 0
+    };
+    while m > 3 {
+        let mut i = head;
+        let mut found = None;
+        for _ in 0..m {
+            let (a, c) = (prev[i], next[i]);
+            let ear = (v[a], v[i], v[c]);
+            if orient(ear.0, ear.1, ear.2) > 0 {
+                let clear = match &cells {
+                    None => (0..n).all(|j| !inside(&gone, j, ear)),
+                    Some(cells) => cells.under_triangle([xy[a], xy[i], xy[c]], |cell| {
+                        cells
+                            .cell(cell)
+                            .iter()
+                            .all(|&j| !inside(&gone, j as usize, ear))
+                    }),
+                };
+                if clear {
+                    found = Some(i);
+                    break;
+                }
+            }
+            i = next[i];
+        }
+        let i = found?;
+        let (a, c) = (prev[i], next[i]);
+        tris.push([v[a], v[i], v[c]]);
+        (next[a], prev[c], gone[i]) = (c, a, true);
+        if head == i {
+            head = c;
+        }
+        m -= 1;
+    }
+    tris.push([v[head], v[next[head]], v[next[next[head]]]]);
+    // every triangle must keep the loop's orientation
+    tris.iter()
+        .all(|t| orient(t[0], t[1], t[2]) >= 0)
+        .then_some(tris)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The pairwise searches, as they were before the buckets: the
+    /// oracle of the bucketed ones.
+    fn simple_pairwise(proj: &Projection, v: &[GridPoint]) -> bool {
+        let n = v.len();
+        let edge = |i: usize| (v[i], v[(i + 1) % n]);
+        (0..n).all(|i| {
+            (i + 2..n)
+                .filter(|&j| (j + 1) % n != i)
+                .all(|j| !proj.meet(edge(i), edge(j)))
+        })
+    }
+
+    fn ear_clip_pairwise(v: &[GridPoint], proj: &Projection) -> Option<Vec<[GridPoint; 3]>> {
+        let orient = |p, q, r| proj.orient(p, q, r);
+        let mut idx: Vec<usize> = (0..v.len()).collect();
+        let mut tris = Vec::new();
+        while idx.len() > 3 {
+            let m = idx.len();
+            let i = (0..m).find(|&i| {
+                let (pa, pb, pc) = (v[idx[(i + m - 1) % m]], v[idx[i]], v[idx[(i + 1) % m]]);
+                orient(pa, pb, pc) > 0
+                    && !idx.iter().any(|&j| {
+                        let p = v[j];
+                        p != pa
+                            && p != pb
+                            && p != pc
+                            && orient(pa, pb, p) >= 0
+                            && orient(pb, pc, p) >= 0
+                            && orient(pc, pa, p) >= 0
+                    })
+            })?;
+            tris.push([v[idx[(i + m - 1) % m]], v[idx[i]], v[idx[(i + 1) % m]]]);
+            idx.remove(i);
+        }
+        tris.push([v[idx[0]], v[idx[1]], v[idx[2]]]);
+        tris.iter()
+            .all(|t| orient(t[0], t[1], t[2]) >= 0)
+            .then_some(tris)
+    }
+
+    fn xorshift(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
+    const XY: Projection = Projection { a: 0, b: 1 };
+
+    /// Loops of 64 to 300 corners on small lattices (collinear corners,
+    /// touching and crossing edges, spikes, long and short edges), star
+    /// shaped ones (mostly simple), and random walks (mostly not): the
+    /// bucketed searches answer as the pairwise ones, triangle for
+    /// triangle.
+    #[test]
+    fn buckets_answer_as_the_pairwise_search() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |m: u64| xorshift(&mut seed) % m;
+        let (mut simple, mut clipped, mut crossed) = (0, 0, 0);
+        for round in 0..1_200 {
+            let n = 64 + next(240) as usize;
+            let spread = [4, 50, 1 << 20][round % 3];
+            let star = |next: &mut dyn FnMut(u64) -> u64| -> Vec<GridPoint> {
+                (0..n)
+                    .map(|k| {
+                        let a = std::f64::consts::TAU * k as f64 / n as f64;
+                        let r = (spread + next(spread)) as f64;
+                        [
+                            (r * a.cos()).round() as i32,
+                            (r * a.sin()).round() as i32,
+                            0,
+                        ]
+                    })
+                    .collect()
+            };
+            let mut v: Vec<GridPoint> = match round % 4 {
+                // a star: corners in angle order at random radii
+                0 | 1 => star(&mut next),
+                // the same with two neighbours swapped: one crossing
+                // (mostly), anywhere
+                2 => {
+                    let mut v = star(&mut next);
+                    let k = next(n as u64 - 1) as usize;
+                    v.swap(k, k + 1);
+                    v
+                }
+                // a random walk
+                _ => (0..n)
+                    .map(|_| [next(spread) as i32, next(spread) as i32, 0])
+                    .collect(),
+            };
+            v.dedup();
+            if v.len() < BUCKETED || first_repeat(&v).is_some() {
+                assert_eq!(
+                    first_repeat(&v),
+                    (0..v.len()).find_map(|i| Some((i, (i + 1..v.len()).find(|&j| v[j] == v[i])?)))
+                );
+                continue;
+            }
+            let s = XY.simple(&v);
+            assert_eq!(s, simple_pairwise(&XY, &v), "round {round}");
+            crossed += usize::from(!s && round % 4 == 2);
+            if s && XY.area2(&v) > 0 {
+                simple += 1;
+                let t = ear_clip(&v, &XY);
+                assert_eq!(t, ear_clip_pairwise(&v, &XY), "round {round}");
+                clipped += usize::from(t.is_some());
+            }
+        }
+        assert!(
+            simple > 100 && clipped > 100 && crossed > 40,
+            "{simple} simple, {clipped} clipped, {crossed} crossed once"
+        );
+    }
+
+    /// A circle of 30,000 corners snapped to the grid (not convex any
+    /// more) is tiled, in much less than the pairwise search's seconds.
+    #[test]
+    fn a_face_of_many_corners_is_tiled() {
+        let n = 30_000;
+        let v: Vec<GridPoint> = (0..n)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / n as f64;
+                [
+                    (1e6 * a.cos()).round() as i32,
+                    (1e6 * a.sin()).round() as i32,
+                    0,
+                ]
+            })
+            .collect();
+        let t = tile(&v, &XY).unwrap();
+        assert_eq!(t.len(), n - 2);
+    }
+}
