@@ -20,7 +20,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::engine::{is_one_of, large_receivers, runs};
+use crate::schedule::{is_one_of, large_receivers, runs};
 use crate::{
     AreaClass, Areas, Batch, CHUNK, Light, PlacedLight, ShadeOptions, ShadowSet, SoftFragment,
     SoftLight, SoftShape, polygon_area,
@@ -793,7 +793,7 @@ mod tests {
         let n = 40;
         let (grid, lights, polys, shadows) = tiles_scene(n);
         let ranges = crate::receivers(&polys);
-        let mut large = crate::engine::large_receivers(&polys, &ranges);
+        let mut large = crate::schedule::large_receivers(&polys, &ranges);
         large.sort_unstable();
         assert_eq!(large, [0, 21, n + 2]);
         let opts = crate::ShadeOptions::default().with_pieces(true);
@@ -840,7 +840,7 @@ mod tests {
 
     #[test]
     fn runs_cover_the_receivers_in_order_with_each_large_one_alone() {
-        use crate::engine::runs;
+        use crate::schedule::runs;
         assert_eq!(runs(0..10, &[], 4), [0..4, 4..8, 8..10]);
         assert_eq!(
             runs(0..10, &[9, 2, 3], 4),

@@ -52,6 +52,7 @@ pub mod export;
 mod light;
 mod near;
 mod psv;
+mod schedule;
 mod soft;
 mod wide;
 

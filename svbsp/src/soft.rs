@@ -229,7 +229,7 @@ impl<'a> SoftShadows<'a> {
         // `large_receivers`), then the others in order; each face's
         // fragments go back to its place
         let area: Vec<f64> = self.faces.iter().map(|f| grid_area(f.corners())).collect();
-        let large = crate::engine::large_first(&area);
+        let large = crate::schedule::large_first(&area);
         let mut order = large.clone();
         order.extend((0..self.faces.len()).filter(|i| !large.contains(i)));
         let done: Vec<Vec<SoftFragment>> = order
