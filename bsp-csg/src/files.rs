@@ -519,6 +519,7 @@ impl FileBoolean {
             flattened: r.flattened,
             moved: r.moved,
             closed,
+            shared: coincide,
         })
     }
 
@@ -547,6 +548,10 @@ pub struct Rounded {
     /// with no flat triangle (where a collapsed edge's ends had other
     /// neighbours in common and no vertex could be kept apart, it is not).
     pub closed: bool,
+    /// Vertices of the result that shared their rounded position with
+    /// another before anything was done (where the solid touches itself,
+    /// as two cubes meeting at a corner, they share it exactly).
+    pub shared: usize,
 }
 
 impl Rounded {
@@ -574,6 +579,14 @@ impl Rounded {
                  kept apart, one {} step off)",
                 self.moved,
                 if stl { "f32" } else { "f64" }
+            ));
+        }
+        if did.is_empty() {
+            // (only positions shared where the solid touches itself)
+            did.push(format!(
+                "keeps {} vertex(es) that share a position with another (where the solid \
+                 touches itself), each a vertex of its own",
+                self.shared
             ));
         }
         let did = did.join(" and ");
@@ -931,6 +944,24 @@ f 4 1 5 8
         assert_eq!(
             o.check().unwrap_err().to_string(),
             "sliver.stl: face 0 (0, 0, 0) (0, 1, 0) (0, 0, 0) repeats a vertex"
+        );
+    }
+
+    /// Cubes meeting at one corner: the union's two corners there share
+    /// their position, and rounding has nothing else to do: the note says
+    /// so (it said "rounding to f64 ;" before).
+    #[test]
+    fn cubes_meeting_at_a_corner_note_their_shared_position() {
+        let a = operand(&cube(1.0, [0.0; 3]), "a.obj", false);
+        let b = operand(&cube(1.0, [1.0; 3]), "b.obj", false);
+        let out = apply(&mut [a, b], BoolOp::Union).unwrap();
+        let r = out.rounded(false).unwrap();
+        assert_eq!((r.collapsed, r.flattened, r.moved, r.shared), (0, 0, 0, 1));
+        assert_eq!(
+            r.message(false),
+            "note: rounding to f64 keeps 1 vertex(es) that share a position with another \
+             (where the solid touches itself), each a vertex of its own; the file is closed as \
+             read back"
         );
     }
 

@@ -131,6 +131,9 @@ pub(crate) fn raster_error(e: RasterError) -> anyhow::Error {
         RasterError::Camera(CameraError::EyeAtTarget) => {
             anyhow!("the eye and the target coincide; give a different --eye or --target")
         }
+        RasterError::Camera(CameraError::TooFar(d)) => anyhow!(
+            "the eye is {d:.3e} units from the target: too far for f64; give a nearer --eye"
+        ),
         RasterError::Camera(CameraError::UpAlongView) => {
             anyhow!("the up vector is parallel to the view direction; give another --up")
         }

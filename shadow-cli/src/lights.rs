@@ -9,7 +9,7 @@ use svbsp::{Light, LightError, LightSpec, PlacedLight, SoftLight, SoftSpec};
 
 /// `x,y,z` with the shortest representation of each coordinate.
 pub(crate) fn fmt_input(v: DVec3) -> String {
-    format!("{},{},{}", v.x, v.y, v.z)
+    svbsp::input_triple(v)
 }
 
 /// The flag that gives a light, as typed.

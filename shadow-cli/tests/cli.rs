@@ -482,6 +482,15 @@ fn huge_and_tiny_coordinates_are_clear_errors_or_exact() {
     assert_failed_with(&o, &["too small"]);
     // a sane scale of the same tetrahedron works
     let fine = write("fine_tetra.obj", 2.0);
+    // a number echoed in a message keeps its exponent
+    let f = fine.to_str().unwrap();
+    let o = shadow(&["shadows", f, "--light", "1e300,0,0", "-o", out]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("--light 1e300,0,0"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(stderr(&o).len() < 600, "{}", stderr(&o));
     let o = shadow(&[
         "shadows",
         fine.to_str().unwrap(),

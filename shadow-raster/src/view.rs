@@ -61,6 +61,9 @@ pub enum CameraError {
     FieldOfView(f64),
     /// The eye and the target are the same point.
     EyeAtTarget,
+    /// The eye is so far from the target (the largest coordinate of their
+    /// difference, given) that the square of the distance is not an `f64`.
+    TooFar(f64),
     /// The up vector is zero.
     ZeroUp,
     /// The up vector is parallel to the view direction.
@@ -76,6 +79,11 @@ impl std::fmt::Display for CameraError {
                 "field of view {deg} degrees: it must lie strictly between 0 and 180"
             ),
             CameraError::EyeAtTarget => f.write_str("the eye and the target coincide"),
+            CameraError::TooFar(d) => write!(
+                f,
+                "the eye is {d:.3e} units from the target: too far for f64 (its square \
+                 overflows)"
+            ),
             CameraError::ZeroUp => f.write_str("the up vector must not be zero"),
             CameraError::UpAlongView => {
                 f.write_str("the up vector is parallel to the view direction")
@@ -138,8 +146,12 @@ impl Camera {
         if !(fov_deg > 0.0 && fov_deg < 180.0) {
             return Err(bad(CameraError::FieldOfView(fov_deg)));
         }
-        let Some(f) = (target - eye).try_normalize() else {
-            return Err(bad(CameraError::EyeAtTarget));
+        let to_target = target - eye;
+        let Some(f) = to_target.try_normalize() else {
+            return Err(bad(match to_target == DVec3::ZERO {
+                true => CameraError::EyeAtTarget,
+                false => CameraError::TooFar(to_target.abs().max_element()),
+            }));
         };
         let Some(upn) = up.try_normalize() else {
             return Err(bad(CameraError::ZeroUp));
@@ -496,7 +508,10 @@ pub fn parse_fov(s: &str) -> Result<f64, String> {
     if (1.0..=170.0).contains(&v) {
         Ok(v)
     } else {
-        Err(format!("{v} is outside 1..=170 degrees"))
+        Err(format!(
+            "{} is outside 1..=170 degrees",
+            svbsp::input_number(v)
+        ))
     }
 }
 
@@ -598,6 +613,19 @@ mod tests {
     #[test]
     fn bad_cameras_are_errors() {
         let e = |r: Result<Camera, RasterError>| r.unwrap_err().to_string();
+        // an eye whose distance squared overflows is too far, not at the target
+        let far = e(Camera::look_at(
+            DVec3::new(1e300, 0.0, 0.0),
+            DVec3::ZERO,
+            DVec3::Z,
+            50.0,
+            10,
+            10,
+        ));
+        assert!(
+            far.contains("1.000e300 units from the target: too far"),
+            "{far}"
+        );
         assert!(
             e(Camera::look_at(
                 DVec3::ONE,

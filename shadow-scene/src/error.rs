@@ -79,7 +79,7 @@ impl fmt::Display for SceneError {
             } => write!(f, "{path}:{line}: {message}"),
             SceneError::UnknownFormat { path } => write!(
                 f,
-                "{path}: unknown mesh format (expected a .obj or .stl file, or CityJSON .json to read)"
+                "{path}: unknown mesh format (expected .obj or .stl; CityJSON .json is read, not written)"
             ),
         }
     }

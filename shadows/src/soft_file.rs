@@ -103,7 +103,8 @@ impl SoftFile {
                         format!(
                             "  light {i} reaches no face: is it behind them all? (an area \
                              light shines on the side its corners turn counter-clockwise \
-                             about; list them the other way round to turn it over)\n"
+                             about: list them the other way round to turn it over; a sun \
+                             shines from the direction given, toward the scene)\n"
                         )
                     } else {
                         String::new()

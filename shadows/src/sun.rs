@@ -238,8 +238,12 @@ pub fn study_suns(
             "a step of {step_minutes} minutes: from above 0 to 1440"
         )));
     }
-    let offset = FixedOffset::east_opt((utc_offset_hours * 3600.0).round() as i32)
-        .ok_or_else(|| SunError(format!("a UTC offset of {utc_offset_hours} hours")))?;
+    let offset =
+        FixedOffset::east_opt((utc_offset_hours * 3600.0).round() as i32).ok_or_else(|| {
+            SunError(format!(
+                "a UTC offset of {utc_offset_hours} hours: it must lie strictly between -24 and 24"
+            ))
+        })?;
     let steps = (1440.0 / step_minutes).floor() as i64;
     let mut out = Vec::new();
     for date in dates {

@@ -69,7 +69,7 @@ pub use engine::{
 pub use light::{
     AreaLightError, LIGHT_RANGE_BITS, Light, LightError, LightSpec, MAX_DISC_RADIUS,
     MAX_DISC_RADIUS_DEG, MAX_LIGHTS, PlacedLight, SUN_RADIUS_DEG, SoftSpec, angle_between,
-    place_lights, quantize_direction, shared_grid,
+    input_number, input_triple, place_lights, quantize_direction, shared_grid,
 };
 pub use psv::{ShadowVolumes, VolumeError, VolumeSanity};
 pub use soft::{

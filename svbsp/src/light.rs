@@ -238,6 +238,35 @@ pub struct PlacedLight {
     pub angle: f64,
 }
 
+/// A number as a person types it, for messages: plain decimals, or the
+/// exponent form beyond 10^16 and below 10^-5 (where Rust's `{:?}`
+/// switches to it), so that an echo of `1e300` is not 301 digits long.
+///
+/// ```
+/// assert_eq!(svbsp::input_number(2.5), "2.5");
+/// assert_eq!(svbsp::input_number(-3.0), "-3");
+/// assert_eq!(svbsp::input_number(1e300), "1e300");
+/// assert_eq!(svbsp::input_number(1e-300), "1e-300");
+/// ```
+pub fn input_number(x: f64) -> String {
+    let a = x.abs();
+    match a != 0.0 && a.is_finite() && !(1e-5..1e16).contains(&a) {
+        true => format!("{x:e}"),
+        false => format!("{x}"),
+    }
+}
+
+/// The three numbers of a point or direction, comma-separated, each as
+/// [`input_number`] gives it.
+pub fn input_triple(v: DVec3) -> String {
+    format!(
+        "{},{},{}",
+        input_number(v.x),
+        input_number(v.y),
+        input_number(v.z)
+    )
+}
+
 /// How many times coarser (as a power of two) than the scene's own grid
 /// the shared grid may become to take in the point lights. Beyond that, a
 /// light far away would cost the scene its resolution: such a light is

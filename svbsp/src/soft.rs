@@ -1007,7 +1007,7 @@ pub fn place_soft_lights(
 
 impl std::fmt::Display for SoftShape {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let v = |p: &DVec3| format!("{},{},{}", p.x, p.y, p.z);
+        let v = |p: &DVec3| crate::input_triple(*p);
         match self {
             SoftShape::Point(p) => write!(f, "point light at {}", v(p)),
             SoftShape::Sun(d) => write!(f, "sun toward {}", v(d)),
@@ -1020,8 +1020,9 @@ impl std::fmt::Display for SoftShape {
                 radius_deg,
             } => write!(
                 f,
-                "sun disc toward {}, radius {radius_deg} degrees",
-                v(direction)
+                "sun disc toward {}, radius {} degrees",
+                v(direction),
+                crate::input_number(*radius_deg)
             ),
         }
     }

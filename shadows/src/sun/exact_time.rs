@@ -69,7 +69,9 @@ impl SunPath {
         utc_offset_hours: f64,
     ) -> Result<SunPath, SunError> {
         let offset = chrono::FixedOffset::east_opt((utc_offset_hours * 3600.0).round() as i32)
-            .ok_or_else(|| SunError(format!("a UTC offset of {utc_offset_hours} hours")))?;
+            .ok_or_else(|| SunError(format!(
+            "a UTC offset of {utc_offset_hours} hours: it must lie strictly between -24 and 24"
+        )))?;
         let midnight = date
             .and_hms_opt(0, 0, 0)
             .expect("midnight exists")

@@ -153,6 +153,11 @@ fn a_day_of_suns_and_the_hours_of_a_yard() {
     let hourly = study_suns(&site, &day, 60.0, 0.0).unwrap();
     assert!((11..=13).contains(&hourly.len()), "{}", hourly.len());
     assert!(study_suns(&site, &day, 0.0, 0.0).is_err());
+    let offset = study_suns(&site, &day, 60.0, 30.0).unwrap_err().to_string();
+    assert!(
+        offset.contains("30 hours: it must lie strictly between -24 and 24"),
+        "{offset}"
+    );
     let (mesh, suns, step, full) = equinox_study();
     let hours = sun_hours(&mesh, &suns, step).unwrap();
     // the roof sees every sun
