@@ -22,7 +22,9 @@ shadow ray from each hit toward the light), with the share of the visible
 pixels each finds lit.
 
 The scene is a built-in one (``bsp_shadows.Mesh.scene``: its polygons
-fanned into triangles for Embree); the light defaults to the bunny scenes'
+fanned into triangles for Embree), or with ``--file PATH`` a mesh file
+(OBJ or STL, read by ``bsp_shadows.Mesh.read``, and by ``shadow shadows
+PATH``: the load is in our time, as a new user's run has it); the light defaults to the bunny scenes'
 own light (above and in front of the bunny); ``--light X,Y,Z`` and
 ``--sun X,Y,Z`` (each repeatable) give others, one Embree pass each.
 A sample point is moved toward the light by 10⁻⁶ of the scene's size so
@@ -111,11 +113,13 @@ def embree_pass(tris, pts, normal, lights):
 
 
 def ours_pass(binary, scene, lights, out):
+    """``scene``: the arguments naming the scene (``--scene NAME`` or a
+    file's path)."""
     flags = []
     for kind, x in lights:
         flags += ["--light" if kind == "point" else "--sun", ",".join(repr(float(c)) for c in x)]
     start = time.perf_counter()
-    subprocess.run([binary, "shadows", "--scene", scene, *flags, "-o", out, "--quiet"],
+    subprocess.run([binary, "shadows", *scene, *flags, "-o", out, "--quiet"],
                    check=True, stdout=subprocess.DEVNULL)
     took = time.perf_counter() - start
     summary = json.load(open(out))["summary"]
@@ -180,7 +184,7 @@ def ours_image(binary, scene, view, size, light, out):
     flag = lambda x: ",".join(repr(float(c)) for c in x)
     start = time.perf_counter()
     said = subprocess.run(
-        [binary, "render", "--scene", scene, "--method", "exact", "--size", f"{size[0]}x{size[1]}",
+        [binary, "render", *scene, "--method", "exact", "--size", f"{size[0]}x{size[1]}",
          "--eye", flag(eye), "--target", flag(target), "--up", flag(up), "--fov", str(fov),
          "--light", flag(light), "-o", out],
         check=True, capture_output=True, text=True).stdout
@@ -189,7 +193,7 @@ def ours_image(binary, scene, view, size, light, out):
     return share, took
 
 
-def image_main(args, tris, lights):
+def image_main(args, tris, lights, scene, name):
     size = tuple(int(x) for x in args.image.split("x"))
     (kind, light), = lights
     if kind != "point":
@@ -199,12 +203,12 @@ def image_main(args, tris, lights):
     with tempfile.TemporaryDirectory() as d:
         out = os.path.join(d, "image.png")
         for _ in range(args.runs):
-            lit_exact, t = ours_image(args.bin, args.scene, view, size, light, out)
+            lit_exact, t = ours_image(args.bin, scene, view, size, light, out)
             mine.append(t)
             lit_rays, t = embree_image(tris, view, size, light)
             theirs.append(t)
     a, b = statistics.median(mine), statistics.median(theirs)
-    print(f"scene {args.scene}: {len(tris)} triangles; {size[0]}x{size[1]}, eye "
+    print(f"scene {name}: {len(tris)} triangles; {size[0]}x{size[1]}, eye "
           f"{','.join(f'{c:.4g}' for c in view[0])}")
     print(f"ours (shadow render --method exact, end to end): median {a:.3f} s of {args.runs}: {sorted(mine)}")
     print(f"Embree (BVH + a primary ray a pixel + a shadow ray a hit): median {b:.3f} s: {sorted(theirs)}")
@@ -215,6 +219,7 @@ def image_main(args, tris, lights):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scene", default="bunny-99k")
+    ap.add_argument("--file", metavar="PATH", help="a mesh file (OBJ or STL) instead of --scene")
     ap.add_argument("--light", action="append", default=[],
                     help="a point light X,Y,Z, repeatable (default, with no --sun: the bunny scenes' light)")
     ap.add_argument("--sun", action="append", default=[], help="a sun's direction X,Y,Z, repeatable")
@@ -227,25 +232,28 @@ def main():
     args = ap.parse_args()
     import bsp_shadows as bs
 
-    tris = triangles_of(bs.Mesh.scene(args.scene))
+    mesh = bs.Mesh.read(args.file) if args.file else bs.Mesh.scene(args.scene)
+    scene = [args.file] if args.file else ["--scene", args.scene]
+    name = args.file or args.scene
+    tris = triangles_of(mesh)
     vec = lambda t: np.array([float(x) for x in t.split(",")])
     lights = [("point", vec(t)) for t in args.light] + [("sun", vec(t)) for t in args.sun]
     if not lights:
         lights = [("point", default_light(tris))]
     if args.image:
-        return image_main(args, tris, lights)
+        return image_main(args, tris, lights, scene, name)
     pts, normal = samples(tris, args.rays)
     mine, theirs = [], []
     with tempfile.TemporaryDirectory() as d:
         out = os.path.join(d, "shadows.json")
         for _ in range(args.runs):
-            lit_exact, t = ours_pass(args.bin, args.scene, lights, out)
+            lit_exact, t = ours_pass(args.bin, scene, lights, out)
             mine.append(t)
             lit_rays, t = embree_pass(tris, pts, normal, lights)
             theirs.append(t)
     a, b = statistics.median(mine), statistics.median(theirs)
     said = "; ".join(f"{k} {','.join(f'{c:.6g}' for c in x)}" for k, x in lights)
-    print(f"scene {args.scene}: {len(tris)} triangles; lights: {said}")
+    print(f"scene {name}: {len(tris)} triangles; lights: {said}")
     print(f"ours (shadow shadows, end to end): median {a:.3f} s of {args.runs}: {sorted(mine)}")
     print(f"Embree (BVH + {args.rays} shadow rays a light): median {b:.3f} s: {sorted(theirs)}")
     print(f"ratio ours/Embree: {a / b:.2f}")
