@@ -1006,6 +1006,10 @@ impl Mesh {
 /// assert_eq!(shadow_scene::unit_or_zero(DVec3::ZERO), DVec3::ZERO);
 /// ```
 pub fn unit_or_zero(v: DVec3) -> DVec3 {
+    // (near unit scale, as it stands: the same bits)
+    if v.length_squared().is_normal() {
+        return v.normalize_or_zero();
+    }
     let largest = v.abs().max_element();
     if !(largest > 0.0 && largest.is_finite()) {
         return v.normalize_or_zero();

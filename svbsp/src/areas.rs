@@ -12,13 +12,14 @@ use crate::engine::FragmentRef;
 
 /// The area of a planar polygon (any orientation).
 ///
-/// Computed at unit scale: the corners' offsets from the first are scaled
-/// by a power of two that brings the largest to about 1, so that neither
-/// the cross products (the square of the size) nor the normal's length
-/// (the fourth power) overflow or underflow where the area itself is a
-/// normal `f64`; a power of two scales every step exactly, so the result
-/// is the unscaled formula's, bit for bit, wherever that one neither
-/// overflowed nor underflowed.
+/// Half the length of the sum of the fan's cross products. Where that
+/// length's square is not a normal `f64` (a polygon larger than about
+/// 1e77 or smaller than about 1e-77: the square is the fourth power of the
+/// size), it is computed at unit scale: the corners' offsets from the
+/// first are scaled by a power of two that brings the largest to about 1,
+/// and the area scaled back. A power of two scales every step exactly, so
+/// both ways give the same bits wherever the plain one neither overflows
+/// nor underflows.
 ///
 /// ```
 /// use glam::DVec3;
@@ -32,6 +33,17 @@ pub fn polygon_area(pts: &[DVec3]) -> f64 {
     let Some(&o) = pts.first() else {
         return 0.0;
     };
+    // at unit scale or near it, the formula as it stands (the scaled one's
+    // bits, for less): a normal squared length neither overflowed nor
+    // lost its digits
+    let mut n = DVec3::ZERO;
+    for w in pts[1..].windows(2) {
+        n += (w[0] - o).cross(w[1] - o);
+    }
+    let square = n.length_squared();
+    if square.is_normal() {
+        return 0.5 * square.sqrt();
+    }
     let largest = pts
         .iter()
         .map(|&p| (p - o).abs().max_element())

@@ -326,16 +326,19 @@ pub fn certify_solid_parts(polys: &[Polygon]) -> SolidParts {
     let (mut parts_of, certified) = loops
         .pair_all(true, Some(&mut open))
         .expect("lenient pairing reports no error");
-    let (tris, volume) = loops.fan_triangles(&mut parts_of);
-    // per root: still a candidate, and its box
-    let mut good: Vec<bool> = (0..polys.len())
-        .map(|i| volume[i] > 0 && parts_of.is_root(i as u32))
-        .collect();
+    // an open part is no candidate: its triangles are not made (a scan
+    // with a hole has none to make)
+    let mut open_root = vec![false; polys.len()];
     for (i, &o) in open.iter().enumerate() {
         if o {
-            good[parts_of.find(i as u32) as usize] = false;
+            open_root[parts_of.find(i as u32) as usize] = true;
         }
     }
+    let (tris, volume) = loops.fan_triangles_of(&mut parts_of, |r| !open_root[r]);
+    // per root: still a candidate, and its box
+    let mut good: Vec<bool> = (0..polys.len())
+        .map(|i| volume[i] > 0 && parts_of.is_root(i as u32) && !open_root[i])
+        .collect();
     let root: Vec<u32> = (0..polys.len() as u32).map(|i| parts_of.find(i)).collect();
     let mut boxes = vec![([i32::MAX; 3], [i32::MIN; 3]); polys.len()];
     for (g, p) in loops.pts.iter().enumerate() {
@@ -631,13 +634,26 @@ impl Loops {
     /// Every polygon's fan triangles that have an area, and each part's
     /// six times signed volume (by its root in `parts_of`).
     fn fan_triangles(&self, parts_of: &mut UnionFind) -> (Vec<Tri>, Vec<i128>) {
+        self.fan_triangles_of(parts_of, |_| true)
+    }
+
+    /// [`Loops::fan_triangles`] of the polygons whose part's root `keep`
+    /// takes (the others' triangles left out, their volume 0).
+    fn fan_triangles_of(
+        &self,
+        parts_of: &mut UnionFind,
+        keep: impl Fn(usize) -> bool,
+    ) -> (Vec<Tri>, Vec<i128>) {
         let polys = self.start.len() - 1;
         let mut volume = vec![0i128; polys];
         let mut tris: Vec<Tri> = Vec::with_capacity(self.pts.len());
         for i in 0..polys {
+            let root = parts_of.find(i as u32) as usize;
+            if !keep(root) {
+                continue;
+            }
             let r = self.loop_of(i);
             let (l, id) = (&self.pts[r.clone()], &self.ids[r]);
-            let root = parts_of.find(i as u32) as usize;
             for j in 1..l.len() - 1 {
                 let t = [l[0], l[j], l[j + 1]];
                 let (a, b, c) = (sub(t[0], [0; 3]), sub(t[1], [0; 3]), sub(t[2], [0; 3]));
