@@ -157,20 +157,13 @@ impl Ring {
 mod tests {
     use super::*;
 
-    fn xorshift(state: &mut u64) -> u64 {
-        *state ^= *state << 13;
-        *state ^= *state >> 7;
-        *state ^= *state << 17;
-        *state
-    }
-
     /// Loops of 64 to 400 corners on small lattices (straight-through
     /// corners, spikes, corners met again, ends equal to starts): the
     /// linked cleaning leaves what the passes from the start leave.
     #[test]
     fn linked_cleaning_leaves_what_the_passes_leave() {
         let mut seed = 0xbb67_ae85_84ca_a73bu64;
-        let mut next = |m: u64| xorshift(&mut seed) % m;
+        let mut next = |m: u64| crate::xorshift(&mut seed) % m;
         let mut removed = 0;
         for round in 0..2_000 {
             let n = LINKED + next(340) as usize;

@@ -976,13 +976,6 @@ mod tests {
     use super::*;
     use crate::kernel::grid_loop::GridLoop;
 
-    fn xorshift(state: &mut u64) -> u64 {
-        *state ^= *state << 13;
-        *state ^= *state >> 7;
-        *state ^= *state << 17;
-        *state
-    }
-
     /// A point of the plane `(x, y)` on one of a few integer planes of
     /// space (each projected along a different axis, either way round).
     fn embed(plane: usize, (x, y): (i32, i32)) -> GridPoint {
@@ -1001,7 +994,7 @@ mod tests {
     #[test]
     fn convex_by_turns_as_pair_by_pair() {
         let mut seed = 0x3c6e_f372_fe94_f82bu64;
-        let mut next = |m: u64| xorshift(&mut seed) % m;
+        let mut next = |m: u64| crate::xorshift(&mut seed) % m;
         let (mut convex, mut not) = (0, 0);
         for round in 0..800 {
             let n = LINKED + next(200) as usize;

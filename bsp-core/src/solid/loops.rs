@@ -425,13 +425,6 @@ mod tests {
             .then_some(tris)
     }
 
-    fn xorshift(state: &mut u64) -> u64 {
-        *state ^= *state << 13;
-        *state ^= *state >> 7;
-        *state ^= *state << 17;
-        *state
-    }
-
     const XY: Projection = Projection { a: 0, b: 1 };
 
     /// Loops of 64 to 300 corners on small lattices (collinear corners,
@@ -442,7 +435,7 @@ mod tests {
     #[test]
     fn buckets_answer_as_the_pairwise_search() {
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = |m: u64| xorshift(&mut seed) % m;
+        let mut next = |m: u64| crate::xorshift(&mut seed) % m;
         let (mut simple, mut clipped, mut crossed) = (0, 0, 0);
         for round in 0..1_200 {
             let n = 64 + next(240) as usize;
