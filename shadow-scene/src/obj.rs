@@ -160,7 +160,7 @@ pub fn parse_obj(text: &str, path_for_messages: &str) -> Result<Mesh, SceneError
 /// [`parse_obj`], with the unknown statements it skipped.
 ///
 /// A large text is read in parallel: cut at line ends into pieces of
-/// about [`PIECE_BYTES`] (never inside a statement that a `\\` continues),
+/// about 256 KiB (never inside a statement that a `\` continues),
 /// each piece's words and numbers read on its own, then the pieces joined
 /// in order. The mesh, the notes and the first error are those of reading
 /// it line by line.
@@ -191,7 +191,7 @@ fn parse_in_pieces(
 }
 
 /// Byte ranges that cut `text` at line ends into pieces of about `size`
-/// bytes; a piece never ends on a line that a `\\` continues.
+/// bytes; a piece never ends on a line that a `\` continues.
 fn pieces(text: &str, size: usize) -> Vec<std::ops::Range<usize>> {
     let bytes = text.as_bytes();
     let mut out = Vec::new();
