@@ -224,9 +224,9 @@ fn pieces(text: &str, size: usize) -> Vec<std::ops::Range<usize>> {
     out
 }
 
-/// A face as a piece reads it: its vertex indices as written (the last
-/// `end` entries of the piece's list up to here), resolved when the
-/// vertices before the piece are counted.
+/// A face as a piece reads it: its vertex indices as written (the
+/// piece's list of them from the face before's `end` to its own),
+/// resolved when the vertices before the piece are counted.
 struct RawFace {
     /// One past its last index in [`Piece::indices`].
     end: usize,

@@ -439,17 +439,19 @@ fn study<T>(
         _ => Tile::all(tiles).map(Some).collect(),
     };
     // (no suns, as in a polar night: one run of none, which gives the
-    // faces' areas and no hours)
-    let snapped = Snapped::new(mesh)?;
-    let batches: Vec<&[DVec3]> = match suns.is_empty() {
-        true => vec![&[]],
-        false => suns.chunks(SUNS_A_RUN).collect(),
+    // faces' areas and no hours; no faces: no runs, nothing to snap)
+    let batches: Vec<&[DVec3]> = match (suns.is_empty(), mesh.faces.is_empty()) {
+        (true, true) => Vec::new(),
+        (true, false) => vec![&[]],
+        (false, _) => suns.chunks(SUNS_A_RUN).collect(),
     };
+    let snapped = (!batches.is_empty())
+        .then(|| Snapped::new(mesh))
+        .transpose()?;
     let count = batches.len() * cut.len();
     progress.phase("sun runs", count as u64);
-    let s = &snapped;
-    let mut runs = (batches.into_iter())
-        .map(|batch| (s, batch))
+    let mut runs = (snapped.iter())
+        .flat_map(|s| batches.iter().map(move |&batch| (s, batch)))
         .flat_map(|(s, batch)| cut.iter().map(move |&t| (s, batch, t)))
         .map(|(s, batch, t)| {
             let run = HoursRun::make(mesh, batch, step_hours, pieces, s, t);
