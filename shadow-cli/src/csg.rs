@@ -123,6 +123,10 @@ fn apply(
     quiet: bool,
 ) -> Result<FileBoolean> {
     let names: Vec<String> = operands.iter().map(|o| o.name.clone()).collect();
+    // each face's line, for the notes on faces snapping changed
+    let lines: Vec<Vec<usize>> = (operands.iter())
+        .map(|o| o.mesh.faces.iter().map(|f| f.line).collect())
+        .collect();
     let checked = phases
         .run("validate", || Operand::check_all(operands))
         .map_err(file_error)?;
@@ -130,7 +134,8 @@ fn apply(
         if let Step::Snapped { operand, report } = step
             && !quiet
         {
-            eprint!("{}", report.notes(&names[*operand], grid));
+            let line = |f: usize| lines[*operand].get(f).copied().unwrap_or(0);
+            eprint!("{}", report.notes_at(&names[*operand], grid, &line));
         }
     })
     .map_err(|e| match e.locate_crossing(&names) {

@@ -115,7 +115,7 @@ impl Scene {
                 report,
             })
         })?;
-        let summary = scene.report.summary();
+        let summary = (scene.report).summary_at(&|f| line_of(&scene.mesh, f));
         if !summary.is_empty() && !quiet {
             eprintln!("note: {}: {}", scene.name, summary.trim_end());
         }
@@ -140,11 +140,17 @@ impl Scene {
 /// import summary to stderr when faces were changed (unless `quiet`).
 pub(crate) fn prepare(mesh: Mesh, name: &str, quiet: bool) -> Result<Prepared> {
     let p = Prepared::new(mesh).map_err(|e| anyhow::anyhow!(e).context(name.to_string()))?;
-    let summary = p.report.summary();
+    let summary = p.report.summary_at(&|f| line_of(&p.mesh, f));
     if !summary.is_empty() && !quiet {
         eprint!("{name}: {summary}");
     }
     Ok(p)
+}
+
+/// The line of face `f` in its file (0: none, as in STL or a built-in
+/// scene).
+pub(crate) fn line_of(mesh: &Mesh, f: usize) -> usize {
+    mesh.faces.get(f).map_or(0, |face| face.line)
 }
 
 #[cfg(test)]

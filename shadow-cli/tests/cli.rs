@@ -285,6 +285,37 @@ fn files_without_faces_are_errors_but_empty_solids_for_csg() {
     }
 }
 
+/// A face that snapping changed is named with its line in the file, by
+/// `stats`, `shadows` and the other commands that import a scene.
+#[test]
+fn changed_faces_are_named_with_their_line() {
+    let l = file(
+        "l_shape.obj",
+        b"# an L\nv 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\n\nf 1 2 3 4 5 6\n",
+    );
+    let want = "1 face(s) triangulated: face 0 (line 9: not convex)";
+    let o = shadow(&["stats", &l]);
+    assert!(
+        o.status.success() && stderr(&o).contains(want),
+        "{}",
+        stderr(&o)
+    );
+    let out = scratch("l_shape.json");
+    let o = shadow(&[
+        "shadows",
+        &l,
+        "--light",
+        "0,0,5",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        o.status.success() && stderr(&o).contains(want),
+        "{}",
+        stderr(&o)
+    );
+}
+
 #[test]
 fn binary_files_are_errors_naming_the_file() {
     let png = file(

@@ -400,7 +400,7 @@ fn dropped_faces_are_reported() {
     assert_ok(&o);
     let err = stderr(&o);
     assert!(
-        err.contains("sliver.obj: 1 degenerate face(s) dropped: face 6"),
+        err.contains("sliver.obj: 1 degenerate face(s) dropped: face 6 (line 16: zero area"),
         "{err}"
     );
     assert!(err.contains("the solid may not be closed"), "{err}");

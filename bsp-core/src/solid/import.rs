@@ -27,11 +27,21 @@ pub struct ImportReport {
 impl ImportReport {
     /// A one-paragraph human summary, empty when every face was kept whole.
     pub fn summary(&self) -> String {
+        self.summary_at(&|_| 0)
+    }
+
+    /// [`ImportReport::summary`] with each face's line in its file
+    /// (`line(face)`; 0 where the format has none), so that a person finds
+    /// it: `face 6 (line 22: zero area (collinear vertices))`.
+    pub fn summary_at(&self, line: &dyn Fn(usize) -> usize) -> String {
         let mut s = String::new();
         let list = |v: &[(usize, FaceDefect)]| {
             v.iter()
                 .take(5)
-                .map(|(f, d)| format!("face {f} ({d})"))
+                .map(|&(f, d)| match line(f) {
+                    0 => format!("face {f} ({d})"),
+                    l => format!("face {f} (line {l}: {d})"),
+                })
                 .collect::<Vec<_>>()
                 .join(", ")
                 + if v.len() > 5 { ", ..." } else { "" }
@@ -58,8 +68,13 @@ impl ImportReport {
     /// that the solid may no longer be closed (`grid`: the grid they were
     /// snapped to). Empty when every face was kept whole.
     pub fn notes(&self, name: &str, grid: &Grid) -> String {
+        self.notes_at(name, grid, &|_| 0)
+    }
+
+    /// [`ImportReport::notes`] with each face's line ([`ImportReport::summary_at`]).
+    pub fn notes_at(&self, name: &str, grid: &Grid, line: &dyn Fn(usize) -> usize) -> String {
         let mut s = String::new();
-        let summary = self.summary();
+        let summary = self.summary_at(line);
         if !summary.is_empty() {
             s += &format!("{name}: {summary}");
         }
