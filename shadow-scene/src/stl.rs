@@ -57,6 +57,22 @@ pub fn parse_stl(bytes: &[u8], path_for_messages: &str) -> Result<Mesh, SceneErr
             bytes.len()
         )));
     }
+    // a binary file shorter than its count of triangles says: cut short
+    // (stl_io says only "failed to fill whole buffer")
+    let ascii = bytes.trim_ascii_start().starts_with(b"solid") && !looks_binary(bytes);
+    if !ascii {
+        let n = u64::from(u32::from_le_bytes([
+            bytes[80], bytes[81], bytes[82], bytes[83],
+        ]));
+        let (want, have) = (84 + 50 * n, bytes.len() as u64);
+        if have < want {
+            return Err(err(format!(
+                "invalid STL at triangle {}: the file is cut short: its header counts {n} \
+                 triangle(s), {want} bytes in all, and it has {have}",
+                (have - 84) / 50 + 1
+            )));
+        }
+    }
     let mut data = Cow::Borrowed(bytes);
     if looks_binary(bytes) && bytes.starts_with(b"solid") {
         // stl_io takes any file starting with "solid " for ASCII; the
@@ -294,10 +310,10 @@ mod tests {
         let mut bytes = binary(b"", &TETRA);
         bytes.truncate(bytes.len() - 10);
         let e = parse_stl(&bytes, "cut.stl").unwrap_err();
-        assert!(
-            e.to_string()
-                .starts_with("cut.stl: invalid STL at triangle 4"),
-            "{e}"
+        assert_eq!(
+            e.to_string(),
+            "cut.stl: invalid STL at triangle 4: the file is cut short: its header counts 4 \
+             triangle(s), 284 bytes in all, and it has 274"
         );
         let mut bad = TETRA;
         bad[2][1][0] = f32::NAN;
