@@ -238,9 +238,10 @@ pub struct PlacedLight {
     pub angle: f64,
 }
 
-/// A number as a person types it, for messages: plain decimals, or the
-/// exponent form beyond 10^16 and below 10^-5 (where Rust's `{:?}`
-/// switches to it), so that an echo of `1e300` is not 301 digits long.
+/// A number as a person types it, for messages: Rust's `{:?}` form
+/// (plain decimals, the exponent form for very large and very small
+/// magnitudes, which std chooses) without its `.0` on whole numbers, so
+/// that an echo of `1e300` is not 301 digits long and `3` stays `3`.
 ///
 /// ```
 /// assert_eq!(svbsp::input_number(2.5), "2.5");
@@ -249,10 +250,10 @@ pub struct PlacedLight {
 /// assert_eq!(svbsp::input_number(1e-300), "1e-300");
 /// ```
 pub fn input_number(x: f64) -> String {
-    let a = x.abs();
-    match a != 0.0 && a.is_finite() && !(1e-5..1e16).contains(&a) {
-        true => format!("{x:e}"),
-        false => format!("{x}"),
+    let s = format!("{x:?}");
+    match s.strip_suffix(".0") {
+        Some(whole) => whole.to_string(),
+        None => s,
     }
 }
 

@@ -258,10 +258,10 @@ impl Buckets {
         &self.items[self.start[c] as usize..self.start[c + 1] as usize]
     }
 
-    /// The cells that may hold a point of triangle `t`: row by row, the
-    /// columns of the triangle's extent in the row's band (found in `f64`
-    /// and widened by a cell each way, which the rounding of coordinates
-    /// below 2^64 cannot exceed).
+    /// The cells that may hold a lattice point of triangle `t`: row by
+    /// row, the columns of the triangle's extent in the row's band, its
+    /// ends rounded inward to the lattice exactly (the integer ceiling and
+    /// floor of where the edges cross the band's lines).
     fn under_triangle(&self, t: [Xy; 3], mut each: impl FnMut(usize) -> bool) -> bool {
         let l = (
             t.iter().map(|p| p.0).min().unwrap_or(0),
@@ -272,35 +272,39 @@ impl Buckets {
             t.iter().map(|p| p.1).max().unwrap_or(0),
         );
         let (xs, ys) = self.span(l, h);
-        let f = |p: Xy| (p.0 as f64, p.1 as f64);
         for y in ys {
             // the band's rows of points, within the triangle's
-            let y0 = (self.lo.1 + y as i128 * self.size.1).max(l.1) as f64;
-            let y1 = (self.lo.1 + (y as i128 + 1) * self.size.1 - 1).min(h.1) as f64;
+            let y0 = (self.lo.1 + y as i128 * self.size.1).max(l.1);
+            let y1 = (self.lo.1 + (y as i128 + 1) * self.size.1 - 1).min(h.1);
             // (the band's part of the triangle has its corners where the
             // edges cross the band's lines, or at the triangle's own)
-            let (mut x0, mut x1) = (f64::INFINITY, f64::NEG_INFINITY);
+            let (mut x0, mut x1) = (i128::MAX, i128::MIN);
             for k in 0..3 {
-                let (p, q) = (f(t[k]), f(t[(k + 1) % 3]));
+                let (p, q) = (t[k], t[(k + 1) % 3]);
                 let (ylo, yhi) = (p.1.min(q.1), p.1.max(q.1));
                 if yhi < y0 || ylo > y1 {
                     continue;
                 }
-                let xs: [f64; 2] = match q.1 == p.1 {
-                    true => [p.0, q.0],
-                    false => [y0.max(ylo), y1.min(yhi)]
-                        .map(|y| p.0 + (y - p.1) * (q.0 - p.0) / (q.1 - p.1)),
-                };
-                for x in xs {
-                    (x0, x1) = (x0.min(x), x1.max(x));
+                if q.1 == p.1 {
+                    (x0, x1) = (x0.min(p.0.min(q.0)), x1.max(p.0.max(q.0)));
+                    continue;
+                }
+                for y in [y0.max(ylo), y1.min(yhi)] {
+                    // x = p.x + (y - p.y)(q.x - p.x) / (q.y - p.y): the
+                    // lattice points on the band's side of it lie from its
+                    // ceiling (at the left end) to its floor (at the right)
+                    let (num, den) = ((y - p.1) * (q.0 - p.0), q.1 - p.1);
+                    let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
+                    let floor = p.0 + num.div_euclid(den);
+                    let ceil = floor + i128::from(num.rem_euclid(den) != 0);
+                    (x0, x1) = (x0.min(ceil), x1.max(floor));
                 }
             }
             if x0 > x1 {
                 continue;
             }
-            let col = |x: f64| ((x - self.lo.0 as f64) / self.size.0 as f64).floor();
-            let first = (col(x0) - 1.0).max(*xs.start() as f64) as usize;
-            let last = (col(x1) + 1.0).min(*xs.end() as f64) as usize;
+            let (first, last) = (self.span((x0, y0), (x1, y0)).0).into_inner();
+            let (first, last) = (first.max(*xs.start()), last.min(*xs.end()));
             for x in first..=last {
                 if !each(y * self.side + x) {
                     return false;
@@ -491,6 +495,43 @@ mod tests {
             simple > 100 && clipped > 100 && crossed > 40,
             "{simple} simple, {clipped} clipped, {crossed} crossed once"
         );
+    }
+
+    /// Every point of a triangle (its edges included) lies in a cell that
+    /// [`Buckets::under_triangle`] visits: small lattices, so that the
+    /// edges' crossings of the bands' lines fall between lattice points.
+    #[test]
+    fn a_triangle_s_cells_hold_all_its_points() {
+        let mut seed = 0x510e_527f_ade6_82d1u64;
+        let mut next = |m: u64| crate::xorshift(&mut seed) % m;
+        let mut inside = 0;
+        for _ in 0..400 {
+            let spread = 2 + next(40);
+            let pts: Vec<Xy> = (0..64 + next(200))
+                .map(|_| (next(spread) as i128, next(spread) as i128))
+                .collect();
+            let cells = Buckets::new(pts.iter().map(|&p| (p, p)).collect()).unwrap();
+            for _ in 0..20 {
+                let t = [0, 1, 2].map(|_| pts[next(pts.len() as u64) as usize]);
+                // (an ear turns the loop's way: no flat triangle)
+                let t = match turn(t[0], t[1], t[2]) {
+                    0 => continue,
+                    -1 => [t[0], t[2], t[1]],
+                    _ => t,
+                };
+                let mut seen = vec![false; pts.len()];
+                cells.under_triangle(t, |c| {
+                    cells.cell(c).iter().for_each(|&j| seen[j as usize] = true);
+                    true
+                });
+                for (j, &p) in pts.iter().enumerate() {
+                    let holds = (0..3).all(|k| turn(t[k], t[(k + 1) % 3], p) >= 0);
+                    assert!(!holds || seen[j], "{p:?} in {t:?}");
+                    inside += usize::from(holds);
+                }
+            }
+        }
+        assert!(inside > 10_000, "{inside}");
     }
 
     /// A circle of 30,000 corners snapped to the grid (not convex any
