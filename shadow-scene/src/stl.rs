@@ -24,8 +24,10 @@ pub fn read_stl(path: &Path) -> Result<Mesh, SceneError> {
 /// Every facet becomes a triangle face in group `"default"`; vertices with
 /// exactly equal positions (after the exact widening of `f32` to `f64`) are
 /// welded, so neighbouring triangles share them. A binary file whose header
-/// happens to start with `solid` is recognised by its size. Errors say
-/// which triangle is bad; the line is 0 as `stl_io` does not report lines.
+/// happens to start with `solid` is recognised by its size or its NUL
+/// bytes. A binary file's size must be what its triangle count says: a
+/// shorter or longer one is an error, not a guess. Errors say which
+/// triangle is bad; the line is 0 as `stl_io` does not report lines.
 ///
 /// ```
 /// use shadow_scene::parse_stl;
@@ -57,10 +59,17 @@ pub fn parse_stl(bytes: &[u8], path_for_messages: &str) -> Result<Mesh, SceneErr
             bytes.len()
         )));
     }
-    // a binary file shorter than its count of triangles says: cut short
-    // (stl_io says only "failed to fill whole buffer")
-    let ascii = bytes.trim_ascii_start().starts_with(b"solid") && !looks_binary(bytes);
-    if !ascii {
+    // A binary file's size must be what its count of triangles says:
+    // shorter, it was cut short (stl_io says only "failed to fill whole
+    // buffer"); longer, the count may be one a writer never filled in,
+    // and reading only what it counts would drop triangles unsaid. A
+    // NUL byte marks a binary file whose header starts with "solid":
+    // ASCII STL has none.
+    let binary = bytes.len() >= 84
+        && (!bytes.trim_ascii_start().starts_with(b"solid")
+            || looks_binary(bytes)
+            || bytes.contains(&0));
+    if binary {
         let n = u64::from(u32::from_le_bytes([
             bytes[80], bytes[81], bytes[82], bytes[83],
         ]));
@@ -72,9 +81,20 @@ pub fn parse_stl(bytes: &[u8], path_for_messages: &str) -> Result<Mesh, SceneErr
                 (have - 84) / 50 + 1
             )));
         }
+        if have > want {
+            let fits = match (have - 84) % 50 {
+                0 => format!(" (its size fits {} triangles)", (have - 84) / 50),
+                _ => String::new(),
+            };
+            return Err(err(format!(
+                "invalid binary STL: its header counts {n} triangle(s), {want} bytes in all, \
+                 but the file has {have}{fits}: {} byte(s) after the last counted triangle",
+                have - want
+            )));
+        }
     }
     let mut data = Cow::Borrowed(bytes);
-    if looks_binary(bytes) && bytes.starts_with(b"solid") {
+    if binary && bytes.starts_with(b"solid") {
         // stl_io takes any file starting with "solid " for ASCII; the
         // 80-byte header of a binary file is free text, so hide the word
         let mut owned = bytes.to_vec();
@@ -315,6 +335,27 @@ mod tests {
             "cut.stl: invalid STL at triangle 4: the file is cut short: its header counts 4 \
              triangle(s), 284 bytes in all, and it has 274"
         );
+        // bytes after the counted triangles: a count never filled in, or
+        // a damaged file; with a "solid" header too
+        for header in [&b""[..], b"solid but binary"] {
+            let mut bytes = binary(header, &TETRA);
+            bytes[80] = 2;
+            let e = parse_stl(&bytes, "long.stl").unwrap_err();
+            assert_eq!(
+                e.to_string(),
+                "long.stl: invalid binary STL: its header counts 2 triangle(s), 184 bytes in \
+                 all, but the file has 284 (its size fits 4 triangles): 100 byte(s) after the \
+                 last counted triangle"
+            );
+            let mut bytes = binary(header, &TETRA);
+            bytes.extend(b"pad");
+            let e = parse_stl(&bytes, "pad.stl").unwrap_err();
+            assert!(
+                e.to_string()
+                    .ends_with("has 287: 3 byte(s) after the last counted triangle"),
+                "{e}"
+            );
+        }
         let mut bad = TETRA;
         bad[2][1][0] = f32::NAN;
         let e = parse_stl(&binary(b"", &bad), "nan.stl").unwrap_err();
