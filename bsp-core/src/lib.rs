@@ -54,7 +54,7 @@ mod tree;
 mod union_find;
 
 pub use kernel::{
-    Error, FaceDefect, GRID_BITS, Grid, GridPoint, Implicit, MAX_COORD, MAX_VIEW_COORD, Plane,
+    FaceDefect, GRID_BITS, Grid, GridPoint, Implicit, InputError, MAX_COORD, MAX_VIEW_COORD, Plane,
     Point, Polygon, PolygonSide, SanityError, Side, SnapError, Split, ViewPoint,
 };
 pub use solid::{

@@ -21,7 +21,7 @@ pub enum CsgError {
         operand: usize,
     },
     /// A coordinate does not fit the grid (or is not finite).
-    Grid(bsp_core::Error),
+    Grid(bsp_core::InputError),
     /// A surface is closed and oriented as a mesh, but its winding
     /// numbers disagree within a cell (it crosses itself after snapping).
     /// [`Solid::plan_owned`](crate::Solid::plan_owned) meets it by

@@ -137,7 +137,7 @@ pub fn snap_one(
     // each vertex snapped once, not once per face around it
     let snapped = bsp_core::internals::snap_positions(grid, mesh.positions);
     type Run = (ImportReport, Vec<SolidFace>, i128, bool);
-    let runs: Vec<Result<Run, bsp_core::Error>> =
+    let runs: Vec<Result<Run, bsp_core::InputError>> =
         par::map_chunks_mut(&mut faces, CHUNK, |c, slots| {
             let loops = &mesh.faces[c * CHUNK..];
             let mut imp = bsp_core::internals::FaceImporter::default();

@@ -20,7 +20,7 @@ use std::time::Instant;
 
 use bsp_core::import_faces;
 use glam::DVec3;
-use svbsp::{LightSpec, ShadeOptions, Shadows, place_lights, shared_grid};
+use svbsp::{LightSpec, LightVolumes, ShadeOptions, place_lights, shared_grid};
 
 fn vec3(s: &str) -> DVec3 {
     let v: Vec<f64> = s.split(',').map(|x| x.parse().expect("X,Y,Z")).collect();
@@ -75,7 +75,7 @@ fn main() {
     let (polys, _) = import_faces(&grid, loops.iter().map(Vec::as_slice)).expect("import");
     let t_import = t.elapsed();
     let t = Instant::now();
-    let shadows = Shadows::new(&polys, &lights).expect("trees");
+    let shadows = LightVolumes::new(&polys, &lights).expect("trees");
     let t_trees = t.elapsed();
     let t = Instant::now();
     let batch = shadows

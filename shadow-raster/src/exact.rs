@@ -19,12 +19,12 @@ use bsp_core::{Plane, Side};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use svbsp::{
-    AreaClass, AreaLight, Batch, Light, LightError, Occluder, ShadeOptions, ShadowError, Shadows,
-    SoftFragment, SoftShadows,
+    AreaClass, AreaLight, Batch, Light, LightError, LightVolumes, Occluder, ShadeOptions,
+    ShadowError, SoftFragment, SoftVolumes,
 };
 
 use crate::RasterError;
-use crate::hsr::{Frame, NONE, Visibility};
+use crate::hsr::{Frame, NONE, VisibilityBuffer};
 use crate::lit::{LitBuffer, ShadowFigures, pixel_point};
 use crate::raster::{Bins, for_bands, project_all};
 use crate::scene::SceneLight;
@@ -35,12 +35,12 @@ use crate::scene::SceneLight;
 /// no other fragment can take a pixel).
 pub(crate) fn visible_side_fragments(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: &[SceneLight],
 ) -> Result<Batch, RasterError> {
     let scene = frame.scene;
     let exact: Vec<svbsp::Light> = lights.iter().map(|l| l.exact).collect();
-    let shadows = Shadows::new(&scene.polys, &exact).map_err(RasterError::Shadows)?;
+    let shadows = LightVolumes::new(&scene.polys, &exact).map_err(RasterError::Shadows)?;
     let drawn = drawn(frame, vis);
     let receivers: Vec<bsp_core::Polygon> = (scene.polys.iter().zip(&frame.side))
         .zip(drawn)
@@ -58,7 +58,7 @@ pub(crate) fn visible_side_fragments(
 
 pub(crate) fn exact(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: &[SceneLight],
     batch: Option<&Batch>,
     _facing: &[u64],
@@ -78,15 +78,15 @@ pub(crate) fn exact(
 }
 
 /// The exact method with lights of extent: the visible side of every
-/// prim cut where any light's class changes ([`svbsp::SoftShadows`], every
+/// prim cut where any light's class changes ([`svbsp::SoftVolumes`], every
 /// prim an occluder), each pixel getting all of a light it sees whole,
 /// none of one it does not see, and in penumbra the share of the light's
 /// irradiance that reaches the grid point nearest its point
-/// ([`svbsp::SoftShadows::shares`]: exact visibility, the form factor in
+/// ([`svbsp::SoftVolumes::shares`]: exact visibility, the form factor in
 /// `f64`).
 fn soft(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: &[SceneLight],
 ) -> Result<(LitBuffer, ShadowFigures), RasterError> {
     let scene = frame.scene;
@@ -114,7 +114,7 @@ fn soft(
             Some((i, Occluder::of_polygon(&seen)?))
         })
         .unzip();
-    let run = SoftShadows::new(&area, &occluders)
+    let run = SoftVolumes::new(&area, &occluders)
         .map_err(|e| RasterError::Shadows(ShadowError::Light(e)))?;
     let grid = scene.grid;
     let mut fragments = SoftFragments::default();
@@ -268,7 +268,7 @@ impl Drawable for BatchFragments<'_> {
 /// of [`draw`]), is visible at some pixel of `vis`. A pixel takes only a
 /// fragment of its visible prim's group, so the fragments of the other
 /// prims are never drawn.
-fn drawn(frame: &Frame<'_>, vis: &Visibility) -> Vec<bool> {
+fn drawn(frame: &Frame<'_>, vis: &VisibilityBuffer) -> Vec<bool> {
     let scene = frame.scene;
     let mut seen = vec![false; scene.len()];
     for &p in &vis.prim {
@@ -295,7 +295,7 @@ fn group_of(frame: &Frame<'_>, i: usize) -> Option<(u32, Plane)> {
 /// face and side.
 pub(crate) fn draw_fragments(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: usize,
     batch: &Batch,
 ) -> (LitBuffer, ShadowFigures) {
@@ -316,7 +316,7 @@ pub(crate) fn draw_fragments(
 /// side: each pixel takes the amounts of the fragment that covers it. Also returns that fragment per pixel ([`NONE`]: none).
 pub(crate) fn draw(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: usize,
     fragments: &impl Drawable,
 ) -> (LitBuffer, ShadowFigures, Vec<u32>) {
@@ -465,7 +465,7 @@ mod tests {
         let sl: Vec<SceneLight> = placed.iter().map(SceneLight::from_placed).collect();
         // every prim turned toward the eye, shaded
         let exact_lights: Vec<svbsp::Light> = sl.iter().map(|l| l.exact).collect();
-        let shadows = Shadows::new(&scene.polys, &exact_lights).unwrap();
+        let shadows = LightVolumes::new(&scene.polys, &exact_lights).unwrap();
         let every: Vec<bsp_core::Polygon> = (scene.polys.iter().zip(&frame.side))
             .filter_map(|(p, v)| match v {
                 Side::Front => Some(p.clone()),

@@ -99,7 +99,7 @@ impl std::str::FromStr for Hsr {
 /// The visible prim and its nearness per pixel, row-major from the
 /// top-left corner.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Visibility {
+pub struct VisibilityBuffer {
     /// Image width.
     pub width: u32,
     /// Image height.
@@ -111,9 +111,9 @@ pub struct Visibility {
     pub w: Vec<f64>,
 }
 
-impl Visibility {
+impl VisibilityBuffer {
     /// Number of pixels where `self` and `o` see different prims.
-    pub fn differences(&self, o: &Visibility) -> usize {
+    pub fn differences(&self, o: &VisibilityBuffer) -> usize {
         self.prim
             .iter()
             .zip(&o.prim)
@@ -267,13 +267,13 @@ fn better(w: f64, id: u32, cur: (f64, u32)) -> bool {
     w > cur.0 || (w == cur.0 && id < cur.1)
 }
 
-fn finish(width: usize, height: usize, buf: Vec<(f64, u32)>) -> Visibility {
+fn finish(width: usize, height: usize, buf: Vec<(f64, u32)>) -> VisibilityBuffer {
     let (w, prim) = buf
         .into_par_iter()
         .with_min_len(1 << 14)
         .map(|(w, p)| if p == NONE { (0.0, NONE) } else { (w, p) })
         .unzip();
-    Visibility {
+    VisibilityBuffer {
         width: width as u32,
         height: height as u32,
         prim,
@@ -284,7 +284,7 @@ fn finish(width: usize, height: usize, buf: Vec<(f64, u32)>) -> Visibility {
 const EMPTY: (f64, u32) = (f64::NEG_INFINITY, NONE);
 
 /// Computes the visibility of `frame` by `method`.
-pub(crate) fn visibility(frame: &Frame<'_>, method: Hsr) -> Visibility {
+pub(crate) fn visibility(frame: &Frame<'_>, method: Hsr) -> VisibilityBuffer {
     visibility_in(frame, method, None)
 }
 
@@ -292,8 +292,8 @@ pub(crate) fn visibility(frame: &Frame<'_>, method: Hsr) -> Visibility {
 pub(crate) fn visibility_in(
     frame: &Frame<'_>,
     method: Hsr,
-    spare: Option<Visibility>,
-) -> Visibility {
+    spare: Option<VisibilityBuffer>,
+) -> VisibilityBuffer {
     match method {
         Hsr::ZBuffer => zbuffer(frame, spare),
         Hsr::Scanline => scanline(frame),
@@ -303,7 +303,7 @@ pub(crate) fn visibility_in(
     }
 }
 
-fn zbuffer(frame: &Frame<'_>, spare: Option<Visibility>) -> Visibility {
+fn zbuffer(frame: &Frame<'_>, spare: Option<VisibilityBuffer>) -> VisibilityBuffer {
     let (w, h) = frame.size();
     let s = &frame.screen;
     let (mut near, mut prim) = spare.map(|v| (v.w, v.prim)).unwrap_or_default();
@@ -343,7 +343,7 @@ fn zbuffer(frame: &Frame<'_>, spare: Option<Visibility>) -> Visibility {
             }
         },
     );
-    Visibility {
+    VisibilityBuffer {
         width: w as u32,
         height: h as u32,
         prim,
@@ -351,7 +351,7 @@ fn zbuffer(frame: &Frame<'_>, spare: Option<Visibility>) -> Visibility {
     }
 }
 
-fn scanline(frame: &Frame<'_>) -> Visibility {
+fn scanline(frame: &Frame<'_>) -> VisibilityBuffer {
     let (w, h) = frame.size();
     let s = &frame.screen;
     // the polygon table: polygons by their first row
@@ -396,7 +396,7 @@ struct Window {
     list: Vec<u32>,
 }
 
-fn warnock(frame: &Frame<'_>) -> Visibility {
+fn warnock(frame: &Frame<'_>) -> VisibilityBuffer {
     let (w, h) = frame.size();
     let s = &frame.screen;
     let mut buf = crate::raster::filled(w * h, EMPTY);
@@ -528,7 +528,7 @@ fn surrounder(
     None
 }
 
-fn raycast(frame: &Frame<'_>) -> Visibility {
+fn raycast(frame: &Frame<'_>) -> VisibilityBuffer {
     let (w, h) = frame.size();
     let s = &frame.screen;
     let scene = frame.scene;
@@ -592,7 +592,7 @@ fn keeps_on(p: &Plane) -> bool {
 /// offset in grid units, and whether points on it are kept.
 type Cut = (DVec3, f64, bool);
 
-fn bsp(frame: &Frame<'_>) -> Visibility {
+fn bsp(frame: &Frame<'_>) -> VisibilityBuffer {
     let (w, h) = frame.size();
     let s = &frame.screen;
     let scene = frame.scene;
@@ -703,7 +703,7 @@ pub fn visible_surfaces(
     camera: &Camera,
     method: Hsr,
     cull_back_faces: bool,
-) -> Result<Visibility, RasterError> {
+) -> Result<VisibilityBuffer, RasterError> {
     let frame = Frame::new(scene, camera, cull_back_faces)?;
     Ok(visibility(&frame, method))
 }

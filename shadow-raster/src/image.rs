@@ -7,7 +7,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use crate::RasterError;
-use crate::hsr::{Frame, NONE, Visibility};
+use crate::hsr::{Frame, NONE, VisibilityBuffer};
 use crate::lit::{LitBuffer, visible_normal};
 use crate::scene::SceneLight;
 use crate::shading::Lambert;
@@ -104,7 +104,7 @@ pub(crate) fn write_file(path: &Path, bytes: &[u8]) -> Result<(), RasterError> {
 
 /// The mask of the first light: 0 where a pixel sees nothing, 255 where its
 /// visible surface is lit by the first light, 128 where it is not.
-pub fn mask(vis: &Visibility, lit: &LitBuffer) -> Vec<u8> {
+pub fn mask(vis: &VisibilityBuffer, lit: &LitBuffer) -> Vec<u8> {
     vis.prim
         .iter()
         .enumerate()
@@ -173,7 +173,7 @@ fn mix((c, mut b): (DVec3, f64), amount: &[f32], cosines: &[f64]) -> [u8; 3] {
 /// shadow boundaries show).
 pub(crate) fn shade(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lit: &LitBuffer,
     lights: &[SceneLight],
     colors: &[DVec3],
@@ -192,7 +192,7 @@ pub(crate) fn shade(
 /// [`shade`] into the memory of `spare` and `bufs`.
 pub(crate) fn shade_in(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lit: &LitBuffer,
     lights: &[SceneLight],
     colors: &[DVec3],

@@ -85,7 +85,7 @@ use svbsp::{PlacedLight, SoftLight};
 pub use bvh::TriangleBvh;
 pub use compare::{Comparison, MethodReport, compare, compare_soft};
 pub use error::{RasterError, UnknownName};
-pub use hsr::{Hsr, NONE, Visibility, visible_surfaces};
+pub use hsr::{Hsr, NONE, VisibilityBuffer, visible_surfaces};
 pub use image::{BACKGROUND, Image, composite, encode_pgm, mask, write_pgm};
 pub use lines::{HiddenLines, LINE_EPSILON, LineCheck, hidden_lines};
 pub use lit::{LitBuffer, Method, RAY_EPSILON, ShadowFigures, ShadowOptions};
@@ -149,7 +149,7 @@ impl RenderOptions {
 #[derive(Clone, Debug)]
 pub struct Rendered {
     /// The visible prim of every pixel.
-    pub visibility: Visibility,
+    pub visibility: VisibilityBuffer,
     /// How much of each light reaches every pixel.
     pub lit: LitBuffer,
     /// The shaded image.
@@ -277,7 +277,7 @@ pub fn render_soft(
 }
 
 /// Renders `scene` with the exact fragments of `batch` (from
-/// [`svbsp::Shadows`] over the same polygons, every face a receiver with
+/// [`svbsp::LightVolumes`] over the same polygons, every face a receiver with
 /// its front side; a face seen from the back is drawn in attached shadow
 /// unless the batch has fragments for its flipped plane). The hook for
 /// animations: one frame's polygons and fragments in, one image out.
@@ -427,7 +427,7 @@ impl Renderer {
         colors: &[DVec3],
         shadows: impl FnOnce(
             &hsr::Frame<'_>,
-            &hsr::Visibility,
+            &hsr::VisibilityBuffer,
             &mut shadow::ShadowBuffers,
         ) -> Result<(LitBuffer, ShadowFigures), RasterError>,
     ) -> Result<&Rendered, RasterError> {
@@ -472,7 +472,7 @@ impl Renderer {
     fn shaded(
         &mut self,
         frame: &hsr::Frame<'_>,
-        (visibility, visibility_time): (Visibility, Duration),
+        (visibility, visibility_time): (VisibilityBuffer, Duration),
         lit: LitBuffer,
         figures: ShadowFigures,
         lights: &[SceneLight],

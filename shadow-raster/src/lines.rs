@@ -421,7 +421,7 @@ fn hidden_by(solids: &[Solid], o: usize, qa: DVec3, qb: DVec3) -> Vec<(f64, f64)
 /// [`LineCheck`]).
 struct ZBufferCheck<'a> {
     space: &'a Perspective<'a>,
-    vis: &'a crate::hsr::Visibility,
+    vis: &'a crate::hsr::VisibilityBuffer,
     /// Each prim's polyhedron.
     obj: &'a [u32],
     solids: &'a [Solid],

@@ -12,7 +12,7 @@ use std::time::Duration;
 use glam::DVec3;
 
 use crate::RasterError;
-use crate::hsr::{Frame, NONE, Visibility};
+use crate::hsr::{Frame, NONE, VisibilityBuffer};
 use crate::scene::SceneLight;
 use crate::view::Rays;
 
@@ -357,7 +357,7 @@ pub(crate) fn visible_normal(frame: &Frame<'_>, i: usize) -> DVec3 {
 
 /// The world point of pixel `pix` (which has a visible prim).
 #[inline]
-pub(crate) fn pixel_point(frame: &Frame<'_>, vis: &Visibility, pix: usize) -> DVec3 {
+pub(crate) fn pixel_point(frame: &Frame<'_>, vis: &VisibilityBuffer, pix: usize) -> DVec3 {
     let w = vis.width as usize;
     let (x, y) = ((pix % w) as f64 + 0.5, (pix / w) as f64 + 0.5);
     frame.view().point(x, y, vis.w[pix])
@@ -365,7 +365,7 @@ pub(crate) fn pixel_point(frame: &Frame<'_>, vis: &Visibility, pix: usize) -> DV
 
 /// Sets the amount of every pixel to its facing bits alone (lit where the
 /// visible side faces the light); the methods then remove cast shadows.
-pub(crate) fn facing_only(vis: &Visibility, lights: usize, facing: &[u64]) -> LitBuffer {
+pub(crate) fn facing_only(vis: &VisibilityBuffer, lights: usize, facing: &[u64]) -> LitBuffer {
     let mut lit = LitBuffer::new(vis.prim.len(), lights);
     for (p, &prim) in vis.prim.iter().enumerate() {
         if prim == NONE {
@@ -390,7 +390,7 @@ pub const RAY_EPSILON: f64 = 1e-7;
 /// parallel by rows.
 pub(crate) fn set_amounts(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lit: &mut LitBuffer,
     j: usize,
     facing: &[u64],

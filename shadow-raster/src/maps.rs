@@ -21,7 +21,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::hsr::{Frame, NONE, Visibility};
+use crate::hsr::{Frame, NONE, VisibilityBuffer};
 use crate::lit::{LitBuffer, ShadowFigures, ShadowOptions, set_amounts, visible_normal};
 use crate::raster::{Bins, Corners, Projector, Screen, for_bands, project_all_into, row_term};
 use crate::scene::{RasterLight, RasterScene, SceneLight};
@@ -112,7 +112,7 @@ fn cube_face(v: DVec3) -> usize {
 /// The faces some visible pixel facing light `j` looks up.
 fn needed_faces(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     light: RasterLight,
     j: usize,
     facing: &[u64],
@@ -378,7 +378,7 @@ struct Lookups {
 /// pixel looks up.
 fn locate(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     (light, j): (RasterLight, usize),
     facing: &[u64],
     views: &[View],
@@ -537,7 +537,7 @@ impl Row {
 /// them (an empty view stays empty): the views and the texels drawn.
 fn depth_map(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     (l, j): (&SceneLight, usize),
     facing: &[u64],
     opts: &ShadowOptions,
@@ -573,7 +573,7 @@ fn depth_map(
 /// Williams' shadow map.
 pub(crate) fn shadow_map(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: &[SceneLight],
     facing: &[u64],
     opts: &ShadowOptions,
@@ -587,7 +587,7 @@ pub(crate) fn shadow_map(
 /// up (`scissor`) or whole.
 fn shadow_map_in(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     (lights, facing): (&[SceneLight], &[u64]),
     opts: &ShadowOptions,
     spare: Option<LitBuffer>,
@@ -692,7 +692,7 @@ fn turn(x: usize, y: usize) -> f64 {
 /// [`shadow_map`] without PCF.
 pub(crate) fn pcss(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     (lights, facing): (&[SceneLight], &[u64]),
     opts: &ShadowOptions,
     spare: Option<LitBuffer>,
@@ -845,7 +845,7 @@ pub(crate) fn objects(scene: &RasterScene) -> (Vec<u32>, usize) {
 /// The shadow texture.
 pub(crate) fn texture(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: &[SceneLight],
     facing: &[u64],
     opts: &ShadowOptions,

@@ -22,7 +22,7 @@ use std::collections::HashMap;
 use bsp_core::Plane;
 use glam::{DVec3, DVec4};
 
-use crate::hsr::{Frame, NONE, Visibility};
+use crate::hsr::{Frame, NONE, VisibilityBuffer};
 use crate::lit::{LitBuffer, ShadowFigures, ShadowOptions, facing_only};
 use crate::raster::{Bins, for_bands, project_all};
 use crate::scene::{RasterLight, SceneLight};
@@ -80,7 +80,7 @@ pub(crate) fn receivers(frame: &Frame<'_>, max: usize) -> Vec<Plane> {
 
 pub(crate) fn planar(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: &[SceneLight],
     facing: &[u64],
     opts: &ShadowOptions,

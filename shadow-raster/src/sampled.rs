@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use svbsp::{Light, SoftShape};
 
 use crate::RasterError;
-use crate::hsr::{Frame, NONE, Visibility};
+use crate::hsr::{Frame, NONE, VisibilityBuffer};
 use crate::lit::{LitBuffer, ShadowFigures, pixel_point, visible_normal};
 use crate::scene::{RasterLight, SceneLight};
 
@@ -142,7 +142,7 @@ fn samples(light: &SceneLight, grid: &bsp_core::Grid, n: u32) -> Result<Vec<Samp
 /// extent (see the module docs).
 pub(crate) fn sampled(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: &[SceneLight],
     n: u32,
 ) -> Result<(LitBuffer, ShadowFigures), RasterError> {

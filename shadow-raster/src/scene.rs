@@ -132,7 +132,7 @@ impl SceneLight {
 ///
 /// Built from the exact polygons of [`bsp_core::import_faces`] (or any
 /// polygons on the grid, such as a frame of a moving scene); the exact
-/// shadows of those polygons ([`svbsp::Shadows`]) are drawn by
+/// shadows of those polygons ([`svbsp::LightVolumes`]) are drawn by
 /// [`crate::render_fragments`].
 #[derive(Clone, Debug)]
 pub struct RasterScene {

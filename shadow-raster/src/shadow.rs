@@ -4,7 +4,7 @@
 //! ray casting is here).
 
 use crate::RasterError;
-use crate::hsr::{Frame, Visibility};
+use crate::hsr::{Frame, VisibilityBuffer};
 use crate::lit::{
     LitBuffer, Method, RAY_EPSILON, ShadowFigures, ShadowOptions, facing_bits, set_amounts,
 };
@@ -23,7 +23,7 @@ pub(crate) struct ShadowBuffers {
 /// Computes the lit buffer of `method`.
 pub(crate) fn shadows(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: &[SceneLight],
     method: Method,
     opts: &ShadowOptions,
@@ -41,7 +41,7 @@ pub(crate) fn shadows(
 /// [`shadows`] in the buffers of earlier frames.
 pub(crate) fn shadows_in(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: &[SceneLight],
     method: Method,
     opts: &ShadowOptions,
@@ -73,7 +73,7 @@ pub(crate) fn shadows_in(
 
 fn raycast(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: &[SceneLight],
     facing: &[u64],
     spare: Option<LitBuffer>,

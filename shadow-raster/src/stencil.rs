@@ -28,7 +28,7 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
-use crate::hsr::{Frame, NONE, Visibility};
+use crate::hsr::{Frame, NONE, VisibilityBuffer};
 use crate::lit::{LitBuffer, ShadowFigures, facing_only};
 use crate::raster::{Bins, for_bands, project_all, row_term};
 use crate::scene::{EdgeKey, RasterLight, SceneLight, point_key as key};
@@ -126,7 +126,7 @@ pub(crate) fn newell(pts: &[DVec3]) -> Option<(DVec3, f64)> {
 
 pub(crate) fn stencil(
     frame: &Frame<'_>,
-    vis: &Visibility,
+    vis: &VisibilityBuffer,
     lights: &[SceneLight],
     facing: &[u64],
     zfail: bool,

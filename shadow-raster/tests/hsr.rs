@@ -92,8 +92,9 @@ fn a_tiling_of_triangles_leaves_no_crack_and_no_double_cover() {
         let cam = Camera::look_at(eye, DVec3::ZERO, up, fov, 200, 150).unwrap();
         let a = visible_surfaces(&tiles.scene, &cam, Hsr::ZBuffer, false).unwrap();
         let b = visible_surfaces(&whole.scene, &cam, Hsr::ZBuffer, false).unwrap();
-        let covered =
-            |v: &shadow_raster::Visibility| v.prim.iter().map(|&p| p != NONE).collect::<Vec<_>>();
+        let covered = |v: &shadow_raster::VisibilityBuffer| {
+            v.prim.iter().map(|&p| p != NONE).collect::<Vec<_>>()
+        };
         assert_eq!(covered(&a), covered(&b));
         assert!(covered(&a).iter().filter(|&&c| c).count() > 5000);
     }

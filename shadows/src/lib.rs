@@ -63,7 +63,7 @@ pub enum Error {
     /// A light cannot be placed on the scene's grid.
     Light(LightError),
     /// A face does not fit the grid.
-    Import(bsp_core::Error),
+    Import(bsp_core::InputError),
     /// The shadow computation refused its input (too many lights).
     Shadow(ShadowError),
     /// A fragment's vertex leaves `f64` in the mesh's units.
@@ -262,7 +262,7 @@ pub fn shadows(mesh: &Mesh, lights: &[Light]) -> Result<Shadows, Error> {
 pub fn import_mesh(
     grid: &bsp_core::Grid,
     mesh: &Mesh,
-) -> Result<(Vec<bsp_core::Polygon>, bsp_core::ImportReport), bsp_core::Error> {
+) -> Result<(Vec<bsp_core::Polygon>, bsp_core::ImportReport), bsp_core::InputError> {
     bsp_core::import_mesh_par(grid, &mesh.positions, mesh.faces.len(), &|f| {
         &mesh.faces[f].vertices[..]
     })
@@ -351,7 +351,7 @@ pub(crate) fn face_trees(
     also: &[bsp_core::GridPoint],
     solids: &bsp_core::SolidParts,
     reach: Option<([bsp_core::GridPoint; 2], &[[bsp_core::GridPoint; 2]])>,
-) -> Result<svbsp::Shadows, ShadowError> {
+) -> Result<svbsp::LightVolumes, ShadowError> {
     let bounds = (reach.map(|(b, _)| b))
         .or_else(|| sun::grid_bounds(polys))
         .map(|[mut lo, mut hi]| {
@@ -376,7 +376,7 @@ pub(crate) fn face_trees(
             .collect();
         svbsp::ShadowVolumes::build(kernel[j], &hiding)
     })?;
-    svbsp::Shadows::from_volumes(kernel, volumes)
+    svbsp::LightVolumes::from_volumes(kernel, volumes)
 }
 
 /// Whether a face of plane `support` may hide `light` from some point of
@@ -517,7 +517,7 @@ mod tests {
         let volumes = (kernel.iter())
             .map(|&l| svbsp::ShadowVolumes::build(l, &polys).unwrap())
             .collect();
-        let all = svbsp::Shadows::from_volumes(&kernel, volumes).unwrap();
+        let all = svbsp::LightVolumes::from_volumes(&kernel, volumes).unwrap();
         let batch = all.set().shade_all(&polys, &ShadeOptions::default());
         let world = world_vertices(&batch, &grid).unwrap();
         let mut lit = vec![0.0; city.faces.len() * 3];

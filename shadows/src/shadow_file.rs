@@ -289,12 +289,12 @@ impl Job<'_> {
     }
 
     /// One shadow-volume tree per light.
-    fn shadow_trees(&mut self) -> Result<svbsp::Shadows, Error> {
+    fn shadow_trees(&mut self) -> Result<svbsp::LightVolumes, Error> {
         self.progress
             .phase("shadow trees", self.kernel.len() as u64);
         let (polys, kernel) = (self.scene.polys, &self.kernel);
         let shadows = timed(&mut self.fig.phases, "trees", || {
-            svbsp::Shadows::new(polys, kernel)
+            svbsp::LightVolumes::new(polys, kernel)
         })
         .map_err(Error::Shadow)?;
         self.fig.shadow_nodes = shadows.volumes().iter().map(|v| v.node_count()).sum();
@@ -317,7 +317,7 @@ impl Job<'_> {
 
     /// Every polygon of `tree` shaded as its own receiver (receiver =
     /// polygon index), in parallel.
-    fn shade_each(&mut self, shadows: &svbsp::Shadows, tree: &BspTree) -> Batch {
+    fn shade_each(&mut self, shadows: &svbsp::LightVolumes, tree: &BspTree) -> Batch {
         let polys: Vec<Polygon> = tree.polygons().cloned().collect();
         self.fig.receivers = polys.len();
         self.progress.phase("shading", polys.len() as u64);
@@ -384,7 +384,7 @@ impl Job<'_> {
     /// ([`FragmentFile::stream`]).
     fn stream(
         &mut self,
-        shadows: &svbsp::Shadows,
+        shadows: &svbsp::LightVolumes,
         kind: FileKind,
         out: &mut dyn Write,
     ) -> Result<(), Error> {

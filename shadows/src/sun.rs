@@ -596,7 +596,7 @@ fn face_hours(area: f64, lit: f64, cells: Option<&[Cell]>, step_hours: f64) -> F
 /// The sun-hours at each point of `sensors` (input units) among the
 /// faces of `mesh`, each of `suns` (directions toward them) standing for
 /// `step_hours`: per sensor, the suns no face hides from its grid point,
-/// exactly ([`svbsp::Shadows::reaching`]; a point on a shadow's edge is
+/// exactly ([`svbsp::LightVolumes::reaching`]; a point on a shadow's edge is
 /// reached), counted. A sensor on a face counts the suns in front of it
 /// and behind it alike: give sensors a little off their surface.
 pub fn sensor_hours(

@@ -9,7 +9,7 @@
 //! and for some scenes four lights (three points and a sun).
 //!
 //! Groups, per scene:
-//! - `psv/<scene>`: `Shadows::new` and `shade_all` (the default path:
+//! - `psv/<scene>`: `LightVolumes::new` and `shade_all` (the default path:
 //!   fragments per face, on every core);
 //! - `chin_feiner/<scene>`: the scene BSP (`BspTree::build`) and
 //!   `chin_feiner` (the baseline algorithm), up to 10 000 polygons;
@@ -32,7 +32,7 @@ use std::time::{Duration, Instant};
 
 use bsp_core::{BspTree, BuildOptions};
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
-use svbsp::{AreaClass, AreaLight, Occluder, ShadeOptions, Shadows, chin_feiner};
+use svbsp::{AreaClass, AreaLight, LightVolumes, Occluder, ShadeOptions, chin_feiner};
 
 mod common;
 
@@ -75,8 +75,8 @@ fn configure(g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallT
 }
 
 /// The exact shadows of `p` for its first `nl` lights.
-fn exact(p: &Prepared, nl: usize) -> (Shadows, svbsp::Batch) {
-    let shadows = Shadows::new(&p.polys, &p.lights[..nl]).expect("lights on the grid");
+fn exact(p: &Prepared, nl: usize) -> (LightVolumes, svbsp::Batch) {
+    let shadows = LightVolumes::new(&p.polys, &p.lights[..nl]).expect("lights on the grid");
     let b = shadows
         .set()
         .shade_all(&p.polys, &ShadeOptions::default().with_pieces(false));

@@ -20,7 +20,7 @@
 //! tier"). Fragments live in one arena of points and refer to them by
 //! index; a split makes each new vertex once. The split itself, the
 //! filter and the invariant check are `bsp-core`'s, shared with every
-//! other tier. [`crate::Shadows`] (partitioned shadow volumes) is the fast
+//! other tier. [`crate::LightVolumes`] (partitioned shadow volumes) is the fast
 //! path; this one is kept for the paper's pipeline and as an independent
 //! cross-check.
 

@@ -101,7 +101,7 @@ impl ShadeOptions {
 /// The shadow volumes of a scene for a list of lights, ready to shade
 /// receivers.
 #[derive(Clone, Debug)]
-pub struct Shadows {
+pub struct LightVolumes {
     lights: Vec<Light>,
     volumes: Vec<ShadowVolumes>,
 }
@@ -125,16 +125,16 @@ pub fn receivers(polys: &[Polygon]) -> Vec<Range<usize>> {
     out
 }
 
-impl Shadows {
+impl LightVolumes {
     /// Bit `j` set: light `j` reaches grid point `x`, no occluder hiding
     /// it ([`ShadowVolumes::hides`]; a point on a shadow's boundary is
     /// reached). For points apart from the faces, such as sensors; whether
     /// a surface at `x` faces the light is the caller's to ask.
     ///
     /// ```
-    /// use svbsp::{Light, Shadows};
+    /// use svbsp::{Light, LightVolumes};
     /// let roof = bsp_core::Polygon::from_grid_points(&[[0, 0, 10], [10, 0, 10], [10, 10, 10], [0, 10, 10]], 0).unwrap();
-    /// let s = Shadows::new(&[roof], &[Light::Directional([0, 0, 1])]).unwrap();
+    /// let s = LightVolumes::new(&[roof], &[Light::Directional([0, 0, 1])]).unwrap();
     /// assert_eq!(s.reaching([5, 5, 0]), 0); // under the roof
     /// assert_eq!(s.reaching([15, 5, 0]), 1); // beside it
     /// assert_eq!(s.reaching([10, 5, 0]), 1); // on its shadow's edge
@@ -156,18 +156,18 @@ impl Shadows {
     /// all they hide ([`Light::leaves_out`]). Every lit area is the same
     /// as with all of them; the fragments may come out cut or listed
     /// differently.
-    pub fn new(occluders: &[Polygon], lights: &[Light]) -> Result<Shadows, ShadowError> {
-        Shadows::new_with(occluders, lights, &bsp_core::certify_solid_parts(occluders))
+    pub fn new(occluders: &[Polygon], lights: &[Light]) -> Result<LightVolumes, ShadowError> {
+        LightVolumes::new_with(occluders, lights, &bsp_core::certify_solid_parts(occluders))
     }
 
-    /// [`Shadows::new`] with the parts of `occluders` already certified
+    /// [`LightVolumes::new`] with the parts of `occluders` already certified
     /// (`solids` is [`bsp_core::certify_solid_parts`] of `occluders`), for
     /// callers that build several runs over the same polygons.
     pub fn new_with(
         occluders: &[Polygon],
         lights: &[Light],
         solids: &bsp_core::SolidParts,
-    ) -> Result<Shadows, ShadowError> {
+    ) -> Result<LightVolumes, ShadowError> {
         if lights.len() > MAX_LIGHTS {
             return Err(LightError::TooMany(lights.len()).into());
         }
@@ -199,7 +199,7 @@ impl Shadows {
                 _ => unreachable!("chunks of one or two"),
             }
         }
-        Ok(Shadows {
+        Ok(LightVolumes {
             lights: lights.to_vec(),
             volumes,
         })
@@ -215,13 +215,13 @@ impl Shadows {
         &self.volumes
     }
 
-    /// Shadows from trees built elsewhere, one per light in order (for
+    /// The volumes of trees built elsewhere, one per light in order (for
     /// example over different occluders per light). Errors if a tree's
     /// light is not the light given for it.
     pub fn from_volumes(
         lights: &[Light],
         volumes: Vec<ShadowVolumes>,
-    ) -> Result<Shadows, ShadowError> {
+    ) -> Result<LightVolumes, ShadowError> {
         if lights.len() > MAX_LIGHTS {
             return Err(LightError::TooMany(lights.len()).into());
         }
@@ -229,7 +229,7 @@ impl Shadows {
         {
             return Err(ShadowError::Mismatch);
         }
-        Ok(Shadows {
+        Ok(LightVolumes {
             lights: lights.to_vec(),
             volumes,
         })
@@ -258,7 +258,7 @@ impl Shadows {
     /// other occluders) as one [`ShadowSet`]: a point is lit by a light
     /// when none of the light's trees blocks it. Errors if the lights
     /// differ.
-    pub fn with<'a>(&'a self, more: &'a Shadows) -> Result<ShadowSet<'a>, ShadowError> {
+    pub fn with<'a>(&'a self, more: &'a LightVolumes) -> Result<ShadowSet<'a>, ShadowError> {
         if more.lights != self.lights {
             return Err(ShadowError::Mismatch);
         }
@@ -278,8 +278,8 @@ fn facing(lights: &[Light], support: &Plane) -> u64 {
 }
 
 /// Shadow trees, borrowed, with the light each one is for: every shading
-/// method. Usually one tree per light ([`Shadows::set`]); a light's
-/// occluders may also be split among several trees ([`Shadows::with`]),
+/// method. Usually one tree per light ([`LightVolumes::set`]); a light's
+/// occluders may also be split among several trees ([`LightVolumes::with`]),
 /// and a point is then lit by the light when none of its trees blocks it.
 #[derive(Clone, Debug)]
 pub struct ShadowSet<'a> {
@@ -1364,12 +1364,12 @@ pub struct ShadowStats {
 /// Exact lit and shadowed fragments of every face of `polys` (imported
 /// polygons with grid vertices, tagged with their face) for each of
 /// `lights`: every face is both occluder and receiver. A convenience over
-/// [`Shadows`]; receivers are shaded in parallel.
+/// [`LightVolumes`]; receivers are shaded in parallel.
 pub fn shadow_fragments(
     polys: &[Polygon],
     lights: &[Light],
 ) -> Result<(Batch, ShadowStats), ShadowError> {
-    let shadows = Shadows::new(polys, lights)?;
+    let shadows = LightVolumes::new(polys, lights)?;
     let batch = shadows.set().shade_all(polys, &ShadeOptions::default());
     let stats = ShadowStats {
         receivers: receivers(polys).len(),

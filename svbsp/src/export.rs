@@ -684,7 +684,7 @@ mod tests {
 
     /// The scene of [`floor_and_roof`]: its grid, lights, polygons and
     /// shadow trees.
-    fn floor_and_roof_scene() -> (Grid, Vec<PlacedLight>, Vec<Polygon>, crate::Shadows) {
+    fn floor_and_roof_scene() -> (Grid, Vec<PlacedLight>, Vec<Polygon>, crate::LightVolumes) {
         let loops: [[[f64; 3]; 4]; 2] = [
             [[0., 0., 0.], [8., 0., 0.], [8., 8., 0.], [0., 8., 0.]],
             [[2., 2., 4.], [4., 2., 4.], [4., 4., 4.], [2., 4., 4.]],
@@ -702,7 +702,7 @@ mod tests {
     fn scene_of(
         loops: &[[[f64; 3]; 4]],
         specs: &[crate::LightSpec],
-    ) -> (Grid, Vec<PlacedLight>, Vec<Polygon>, crate::Shadows) {
+    ) -> (Grid, Vec<PlacedLight>, Vec<Polygon>, crate::LightVolumes) {
         let positions: Vec<DVec3> = loops.iter().flatten().map(|&p| DVec3::from(p)).collect();
         let grid = crate::shared_grid(&positions, specs).unwrap();
         let lights = crate::place_lights(&grid, specs).unwrap();
@@ -713,7 +713,7 @@ mod tests {
             })
             .collect();
         let kernel: Vec<Light> = lights.iter().map(|l| l.light).collect();
-        let shadows = crate::Shadows::new(&polys, &kernel).unwrap();
+        let shadows = crate::LightVolumes::new(&polys, &kernel).unwrap();
         (grid, lights, polys, shadows)
     }
 
@@ -754,7 +754,7 @@ mod tests {
     /// A row of `n` small tiles at height 1 over three large faces at
     /// heights 0, -1 and -2 (receivers 0, 21 and `n + 2`), under a point
     /// light: its grid, light, polygons and shadow trees.
-    fn tiles_scene(n: usize) -> (Grid, Vec<PlacedLight>, Vec<Polygon>, crate::Shadows) {
+    fn tiles_scene(n: usize) -> (Grid, Vec<PlacedLight>, Vec<Polygon>, crate::LightVolumes) {
         let large = |z: f64| {
             [
                 [-9., -9., z],

@@ -1,7 +1,7 @@
 //! Exact shadows: every face of a scene cut into fragments, each exactly
 //! lit or in shadow for every light (point lights and suns).
 //!
-//! [`Shadows`] builds one partitioned shadow-volume tree per light
+//! [`LightVolumes`] builds one partitioned shadow-volume tree per light
 //! (Gerhards et al. 2015: every occluder's volume, bounded by planes
 //! through the light and its edges and capped by its own plane) and
 //! filters every face through them. A face is cut only where a shadow
@@ -63,8 +63,8 @@ pub use areas::{Areas, fragment_area, percent, polygon_area};
 pub use arena::pieces::Vertex;
 pub use chin_feiner::{CfFragment, CfFragments, chin_feiner};
 pub use engine::{
-    Batch, CHUNK, Cells, FragmentRef, Refined, Scratch, ShadeOptions, ShadowError, ShadowSet,
-    ShadowStats, Shadows, Start, receivers, shadow_fragments,
+    Batch, CHUNK, Cells, FragmentRef, LightVolumes, Refined, Scratch, ShadeOptions, ShadowError,
+    ShadowSet, ShadowStats, Start, receivers, shadow_fragments,
 };
 pub use light::{
     AreaLightError, LIGHT_RANGE_BITS, Light, LightError, LightSpec, MAX_DISC_RADIUS,
@@ -73,7 +73,7 @@ pub use light::{
 };
 pub use psv::{ShadowVolumes, VolumeError, VolumeSanity};
 pub use soft::{
-    Share, SoftFragment, SoftLight, SoftShadows, SoftShape, place_soft_lights, shared_soft_grid,
+    Share, SoftFragment, SoftLight, SoftShape, SoftVolumes, place_soft_lights, shared_soft_grid,
     soft_shadows, soft_shadows_with,
 };
 pub use wide::{WPoint, WidePlane};

@@ -46,7 +46,7 @@ pub enum LightError {
         index: usize,
     },
     /// No grid fits the scene and its lights.
-    Grid(bsp_core::Error),
+    Grid(bsp_core::InputError),
     /// Placing lights given in input units: light `index`, an area light
     /// or a sun disc, is no light once on the grid.
     Extent {

@@ -22,7 +22,7 @@ use crate::area::{
 use crate::backs::SolidBacks;
 use crate::blockers::{coplanar_blockers, coplanar_blockers_of, plane_key};
 use crate::boxes::{Box3, EVERYWHERE, Reach, grid_box};
-use crate::engine::{Scratch, Shadows};
+use crate::engine::{LightVolumes, Scratch};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
 use crate::near::{CellGrid, InSlab, near_lists, slab_box};
 
@@ -135,7 +135,7 @@ pub fn soft_shadows_with(
     faces: &[Occluder],
     on_faces: &(dyn Fn(usize) + Sync),
 ) -> Result<Vec<Vec<SoftFragment>>, LightError> {
-    Ok(SoftShadows::new(lights, faces)?.fragments_with(on_faces))
+    Ok(SoftVolumes::new(lights, faces)?.fragments_with(on_faces))
 }
 
 /// A soft-shadow run of `lights` over `faces`, every face an occluder
@@ -145,13 +145,13 @@ pub fn soft_shadows_with(
 /// at any point of a face.
 ///
 /// ```
-/// use svbsp::{AreaClass, AreaLight, Occluder, SoftShadows};
+/// use svbsp::{AreaClass, AreaLight, Occluder, SoftVolumes};
 /// let lights = [AreaLight::new(&[[0, 0, 80], [0, 40, 80], [40, 40, 80], [40, 0, 80]]).unwrap()];
 /// let faces = [
 ///     Occluder::new(&[[-200, -200, 0], [200, -200, 0], [200, 200, 0], [-200, 200, 0]]).unwrap(),
 ///     Occluder::new(&[[0, 0, 40], [40, 0, 40], [40, 40, 40], [0, 40, 40]]).unwrap(),
 /// ];
-/// let run = SoftShadows::new(&lights, &faces).unwrap();
+/// let run = SoftVolumes::new(&lights, &faces).unwrap();
 /// let ground = &run.fragments()[0];
 /// assert!(ground.iter().any(|f| f.class(0) == AreaClass::Penumbra));
 /// // on the ground: under the roof's middle none, far away all; where
@@ -161,7 +161,7 @@ pub fn soft_shadows_with(
 /// assert_eq!(&shares[..2], &[Some(0.0), Some(1.0)]);
 /// assert!(shares[2].unwrap() > 0.5 && shares[2].unwrap() < 1.0);
 /// ```
-pub struct SoftShadows<'a> {
+pub struct SoftVolumes<'a> {
     lights: &'a [AreaLight],
     faces: &'a [Occluder],
     blockers: Vec<Occluder>,
@@ -171,21 +171,21 @@ pub struct SoftShadows<'a> {
     near: Vec<Vec<Vec<u32>>>,
     /// Per light, per blocker: the boxes its volumes reach.
     reach: Vec<Vec<Reach>>,
-    corners: Vec<Option<Shadows>>,
+    corners: Vec<Option<LightVolumes>>,
     /// The blockers a point outside their solid may pass over.
     backs: SolidBacks,
 }
 
-impl std::fmt::Debug for SoftShadows<'_> {
+impl std::fmt::Debug for SoftVolumes<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("SoftShadows")
+        f.debug_struct("SoftVolumes")
             .field("lights", &self.lights.len())
             .field("faces", &self.faces.len())
             .finish_non_exhaustive()
     }
 }
 
-impl<'a> SoftShadows<'a> {
+impl<'a> SoftVolumes<'a> {
     /// The run's shared parts. At most [`MAX_LIGHTS`] lights (the classes
     /// are bits of a `u64`): more are [`LightError::TooMany`].
     pub fn new(lights: &'a [AreaLight], faces: &'a [Occluder]) -> Result<Self, LightError> {
@@ -203,7 +203,7 @@ impl<'a> SoftShadows<'a> {
             .zip(&regions)
             .map(|(l, r)| near_lists(l.corners(), faces, (&blockers, r)))
             .unzip();
-        Ok(SoftShadows {
+        Ok(SoftVolumes {
             corners: corner_shadows(lights, &polygons, &solids),
             backs: SolidBacks::new(faces, &sources, &solids),
             lights,
@@ -221,7 +221,7 @@ impl<'a> SoftShadows<'a> {
         self.fragments_with(&|_| {})
     }
 
-    /// [`SoftShadows::fragments`], calling `on_faces(n)` as each `n` more
+    /// [`SoftVolumes::fragments`], calling `on_faces(n)` as each `n` more
     /// faces are done.
     pub fn fragments_with(&self, on_faces: &(dyn Fn(usize) + Sync)) -> Vec<Vec<SoftFragment>> {
         // the large faces first (a ground under a mesh: its pieces are
@@ -306,10 +306,10 @@ fn corner_shadows(
     lights: &[AreaLight],
     polygons: &[Polygon],
     solids: &bsp_core::SolidParts,
-) -> Vec<Option<Shadows>> {
+) -> Vec<Option<LightVolumes>> {
     lights
         .iter()
-        .map(|l| Shadows::new_with(polygons, l.corners(), solids).ok())
+        .map(|l| LightVolumes::new_with(polygons, l.corners(), solids).ok())
         .collect()
 }
 
@@ -370,7 +370,7 @@ impl AreaLight {
         let corners = corner_shadows(std::slice::from_ref(self), &polygons, &solids)
             .pop()
             .flatten();
-        let set = corners.as_ref().map(Shadows::set);
+        let set = corners.as_ref().map(LightVolumes::set);
         faces
             .par_iter()
             .zip(&near)
@@ -387,12 +387,12 @@ impl AreaLight {
 
 /// The fragments of face `i` of `run`, `face`.
 fn soft_face(
-    run: &SoftShadows<'_>,
+    run: &SoftVolumes<'_>,
     i: usize,
     face: &Occluder,
     scratch: &mut Scratch,
 ) -> Vec<SoftFragment> {
-    let SoftShadows {
+    let SoftVolumes {
         lights,
         regions,
         reach,
@@ -405,7 +405,7 @@ fn soft_face(
         let occluders = near[k]
             .iter()
             .filter_map(|&j| Some((regions[k][j as usize].as_ref()?, reach[k][j as usize])));
-        let set = corners[k].as_ref().map(Shadows::set);
+        let set = corners[k].as_ref().map(LightVolumes::set);
         let mut seen = |p: &Polygon| set.as_ref()?.cells(p, scratch);
         pieces = light
             .cut(face, pieces, occluders, Some(&mut seen))

@@ -38,6 +38,8 @@ mod bytes;
 mod certify;
 mod exact;
 mod files;
+#[cfg(test)]
+mod layout;
 mod merge;
 mod split;
 

@@ -44,7 +44,7 @@ pub use index::{
 };
 pub use pipeline::{
     Dynamic, FragmentView, Frame, FrameStats, FrameTally, Motion, PipelineError, PipelineOptions,
-    Prepared, Strategy,
+    PrepStats, Strategy,
 };
 
 /// The README's example, compiled and run as a doctest.

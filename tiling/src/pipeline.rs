@@ -26,7 +26,7 @@
 //!   shadow-volume tree over the moved faces and the related static
 //!   polygons (the tree does not depend on an order), through which the
 //!   moved faces are shaded; each related static face's static cells are
-//!   refined through the same tree ([`svbsp::Shadows::refine`]).
+//!   refined through the same tree ([`svbsp::LightVolumes::refine`]).
 //!
 //! Either way the frame's fragments are exact, and every face's lit area
 //! is exactly what [`svbsp::shadow_fragments`] computes from scratch on
@@ -43,8 +43,8 @@ use glam::{DMat4, DVec3};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use svbsp::{
-    Batch, CHUNK, Cells, CfFragments, Light, Refined, Scratch, ShadeOptions, ShadowError,
-    ShadowVolumes, Shadows, Start, chin_feiner, receivers,
+    Batch, CHUNK, Cells, CfFragments, Light, LightVolumes, Refined, Scratch, ShadeOptions,
+    ShadowError, ShadowVolumes, Start, chin_feiner, receivers,
 };
 
 use crate::{Query, TileIndex, TilingError};
@@ -96,10 +96,10 @@ impl PipelineOptions {
 #[non_exhaustive]
 pub enum PipelineError {
     /// A static face does not fit the grid.
-    Static(bsp_core::Error),
+    Static(bsp_core::InputError),
     /// A face of the moved object does not fit the grid in this frame
     /// (the error names the dynamic face).
-    Moved(bsp_core::Error),
+    Moved(bsp_core::InputError),
     /// The tiling of a light cannot be built.
     Tiling(TilingError),
     /// The shadows cannot be computed (a light or an occluder is unusable).
@@ -182,7 +182,7 @@ impl Motion {
 
 /// Figures of the preprocessing.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Prepared {
+pub struct PrepStats {
     /// Static faces.
     pub static_faces: usize,
     /// Static polygons (convex, as imported).
@@ -210,7 +210,7 @@ enum StaticShadows {
 /// The fast strategy's static data.
 struct FastStatics {
     /// The static scene's shadow trees.
-    shadows: Shadows,
+    shadows: LightVolumes,
     batch: Batch,
     /// Per static receiver, its fragments in `batch`.
     frags: Vec<Range<usize>>,
@@ -247,7 +247,7 @@ pub struct Dynamic {
     tilings: Vec<TileIndex>,
     moving: Vec<Vec<DVec3>>,
     shadows: StaticShadows,
-    prepared: Prepared,
+    prepared: PrepStats,
 }
 
 /// One frame's figures: the columns of the core paper's Table 2.
@@ -260,7 +260,7 @@ pub struct FrameStats {
     /// Dynamic polygons after the BSP's splits (`Bsp2`; the imported
     /// convex polygons with the fast strategy).
     pub dynamic_after_bsp: usize,
-    /// Static polygons after the static BSP's splits (see [`Prepared`]).
+    /// Static polygons after the static BSP's splits (see [`PrepStats`]).
     pub static_after_bsp: usize,
     /// Static fragments of the static shadows.
     pub static_after_shadow: usize,
@@ -514,9 +514,9 @@ impl FastStatics {
         ranges: &[Range<usize>],
         lights: &[Light],
         opts: &PipelineOptions,
-        prepared: &mut Prepared,
+        prepared: &mut PrepStats,
     ) -> Result<FastStatics, PipelineError> {
-        let sh = Shadows::new(polys, lights).map_err(PipelineError::Shadow)?;
+        let sh = LightVolumes::new(polys, lights).map_err(PipelineError::Shadow)?;
         let sopts = ShadeOptions::default().with_pieces(opts.pieces);
         let parts: Vec<(Batch, Vec<Option<Box<Cells>>>)> = ranges
             .par_chunks(CHUNK)
@@ -602,7 +602,7 @@ impl PaperStatics {
         faces: usize,
         moving: &[Vec<DVec3>],
         lights: &[Light],
-        prepared: &mut Prepared,
+        prepared: &mut PrepStats,
     ) -> Result<PaperStatics, PipelineError> {
         let bsp1 = BspTree::build(polys.to_vec(), &BuildOptions::default());
         let cf = chin_feiner(&bsp1, lights).map_err(|e| PipelineError::Shadow(e.into()))?;
@@ -648,9 +648,9 @@ impl Dynamic {
         lights: &[Light],
         opts: PipelineOptions,
     ) -> Result<Dynamic, PipelineError> {
-        let mut prepared = Prepared {
+        let mut prepared = PrepStats {
             static_faces: statics.len(),
-            ..Prepared::default()
+            ..PrepStats::default()
         };
         let t = Instant::now();
         let (polys, _) = import_faces_par(&grid, statics).map_err(PipelineError::Static)?;
@@ -707,7 +707,7 @@ impl Dynamic {
     }
 
     /// The preprocessing figures.
-    pub fn prepared(&self) -> &Prepared {
+    pub fn prepared(&self) -> &PrepStats {
         &self.prepared
     }
 
@@ -969,7 +969,7 @@ impl Dynamic {
         moved: &[Polygon],
         related: &Related,
         stats: &mut FrameStats,
-    ) -> Result<(Shadows, bool), PipelineError> {
+    ) -> Result<(LightVolumes, bool), PipelineError> {
         let (lo, hi) = (related.lo, related.hi);
         // per light, the related static polygons that may block
         // light on its way to the object: a polygon whose plane has
@@ -1024,7 +1024,8 @@ impl Dynamic {
             })
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| PipelineError::Shadow(e.into()))?;
-        let sh = Shadows::from_volumes(&self.lights, volumes).map_err(PipelineError::Shadow)?;
+        let sh =
+            LightVolumes::from_volumes(&self.lights, volumes).map_err(PipelineError::Shadow)?;
         Ok((sh, layered))
     }
 
@@ -1064,7 +1065,7 @@ impl Dynamic {
     /// keeps its static fragments.
     fn refine_receivers(
         &self,
-        sh: &Shadows,
+        sh: &LightVolumes,
         recs: &[u32],
         starts: &[Start<'_>],
         sopts: &ShadeOptions,

@@ -3,7 +3,7 @@
 /// Errors of this crate.
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
-pub enum Error {
+pub enum InputError {
     /// An input coordinate could not be snapped to the grid.
     Snap {
         /// Index of the face.
@@ -28,17 +28,17 @@ pub enum Error {
     },
 }
 
-impl std::fmt::Display for Error {
+impl std::fmt::Display for InputError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Error::Snap {
+            InputError::Snap {
                 face,
                 vertex,
                 value,
                 reason,
             } => write!(f, "face {face}, vertex {vertex} {value:?}: {reason}"),
-            Error::InvalidGrid(why) => write!(f, "invalid grid: {why}"),
-            Error::VertexIndex {
+            InputError::InvalidGrid(why) => write!(f, "invalid grid: {why}"),
+            InputError::VertexIndex {
                 face,
                 vertex,
                 index,
@@ -47,10 +47,10 @@ impl std::fmt::Display for Error {
     }
 }
 
-impl std::error::Error for Error {
+impl std::error::Error for InputError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            Error::Snap { reason, .. } => Some(reason),
+            InputError::Snap { reason, .. } => Some(reason),
             _ => None,
         }
     }

@@ -7,7 +7,7 @@
 
 use glam::DVec3;
 
-use crate::kernel::error::{Error, SnapError};
+use crate::kernel::error::{InputError, SnapError};
 
 /// Number of bits of an input grid coordinate: `|g| < 2^GRID_BITS`.
 pub const GRID_BITS: u32 = 26;
@@ -83,17 +83,17 @@ impl Grid {
     /// let g = Grid::new(DVec3::new(0.25, 0.0, 0.0), 0).unwrap();
     /// assert_eq!(g.origin(), DVec3::ZERO);
     /// ```
-    pub fn new(origin: DVec3, log2_scale: i32) -> Result<Grid, Error> {
+    pub fn new(origin: DVec3, log2_scale: i32) -> Result<Grid, InputError> {
         if !origin.is_finite() {
-            return Err(Error::InvalidGrid("origin is not finite"));
+            return Err(InputError::InvalidGrid("origin is not finite"));
         }
         if !(-1000..=1000).contains(&log2_scale) {
-            return Err(Error::InvalidGrid("log2_scale outside -1000..=1000"));
+            return Err(InputError::InvalidGrid("log2_scale outside -1000..=1000"));
         }
         let scale = 2f64.powi(log2_scale);
         let origin = (origin * scale).round() / scale;
         if !origin.is_finite() {
-            return Err(Error::InvalidGrid("origin too large for the scale"));
+            return Err(InputError::InvalidGrid("origin too large for the scale"));
         }
         Ok(Grid { origin, scale })
     }
@@ -109,9 +109,9 @@ impl Grid {
     /// let p = g.snap(DVec3::new(0.5, -1.0, 1.0)).unwrap();
     /// assert_eq!(g.to_world([p[0] as f64, p[1] as f64, p[2] as f64]), DVec3::new(0.5, -1.0, 1.0));
     /// ```
-    pub fn fit(min: DVec3, max: DVec3) -> Result<Grid, Error> {
+    pub fn fit(min: DVec3, max: DVec3) -> Result<Grid, InputError> {
         if !min.is_finite() || !max.is_finite() {
-            return Err(Error::InvalidGrid("bounding box is not finite"));
+            return Err(InputError::InvalidGrid("bounding box is not finite"));
         }
         let half = ((max - min) * 0.5).abs().max_element();
         let centre = (min + max) * 0.5;
@@ -123,7 +123,7 @@ impl Grid {
                 // the finest grid would still give the box only a few
                 // steps: snapping would move its points by a good part of
                 // its size
-                return Err(Error::InvalidGrid(
+                return Err(InputError::InvalidGrid(
                     "bounding box too small (under about 2^-975 units across)",
                 ));
             }
@@ -138,18 +138,18 @@ impl Grid {
         let scale = 2f64.powi(log2);
         let origin = (centre * scale).round() / scale;
         if !origin.is_finite() {
-            return Err(Error::InvalidGrid("bounding box too large"));
+            return Err(InputError::InvalidGrid("bounding box too large"));
         }
         Ok(Grid { origin, scale })
     }
 
     /// The grid that fits the bounding box of `points` (see [`Grid::fit`]).
-    pub fn fit_points<'a>(points: impl IntoIterator<Item = &'a DVec3>) -> Result<Grid, Error> {
+    pub fn fit_points<'a>(points: impl IntoIterator<Item = &'a DVec3>) -> Result<Grid, InputError> {
         let mut min = DVec3::splat(f64::INFINITY);
         let mut max = DVec3::splat(f64::NEG_INFINITY);
         for p in points {
             if !p.is_finite() {
-                return Err(Error::InvalidGrid("a point is not finite"));
+                return Err(InputError::InvalidGrid("a point is not finite"));
             }
             min = min.min(*p);
             max = max.max(*p);
@@ -272,7 +272,7 @@ mod tests {
         let tiny = DVec3::splat(2f64.powi(-1000));
         assert!(matches!(
             Grid::fit(DVec3::ZERO, tiny),
-            Err(Error::InvalidGrid(why)) if why.contains("too small")
+            Err(InputError::InvalidGrid(why)) if why.contains("too small")
         ));
         // a box a little larger still spans 2^24 steps and more (powers of
         // two: the product is exact)

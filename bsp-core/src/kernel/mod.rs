@@ -13,7 +13,7 @@ pub(crate) mod polygon;
 mod side;
 
 pub use convex::{ConvexParts, SanityError, check_convex};
-pub use error::{Error, SnapError};
+pub use error::{InputError, SnapError};
 pub use exact::{Homogeneous, approx, filter_ring_area, filter_side, filter_side_err};
 pub use grid::{GRID_BITS, Grid, GridPoint, MAX_COORD, MAX_VIEW_COORD, ViewPoint};
 pub use plane::{FaceDefect, MAX_NORMAL_BITS, MAX_OFFSET_BITS, Plane};

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use crate::kernel::Error;
+use crate::kernel::InputError;
 use crate::kernel::Side;
 use crate::kernel::grid::{Grid, GridPoint};
 use crate::kernel::plane::FaceDefect;
@@ -120,7 +120,7 @@ impl ImportReport {
 pub fn import_faces<'a>(
     grid: &Grid,
     faces: impl IntoIterator<Item = &'a [DVec3]>,
-) -> Result<(Vec<Polygon>, ImportReport), Error> {
+) -> Result<(Vec<Polygon>, ImportReport), InputError> {
     import_from(grid, faces, 0)
 }
 
@@ -142,7 +142,7 @@ pub fn import_faces<'a>(
 pub fn import_faces_par(
     grid: &Grid,
     faces: &[Vec<DVec3>],
-) -> Result<(Vec<Polygon>, ImportReport), Error> {
+) -> Result<(Vec<Polygon>, ImportReport), InputError> {
     import_placed(
         faces.len(),
         |fi| single_polygon(grid, faces[fi].iter().map(|&p| Some(p)), fi),
@@ -179,7 +179,7 @@ pub fn import_mesh_par<'a>(
     positions: &[DVec3],
     faces: usize,
     face: &(dyn Fn(usize) -> &'a [u32] + Sync),
-) -> Result<(Vec<Polygon>, ImportReport), Error> {
+) -> Result<(Vec<Polygon>, ImportReport), InputError> {
     import_placed(
         faces,
         |fi| {
@@ -205,8 +205,8 @@ pub fn import_mesh_par<'a>(
 fn import_placed(
     n: usize,
     single: impl Fn(usize) -> Option<Polygon> + Sync,
-    import: impl Fn(&mut FaceImporter, usize, &mut dyn FnMut(Polygon)) -> Result<(), Error>,
-) -> Result<(Vec<Polygon>, ImportReport), Error> {
+    import: impl Fn(&mut FaceImporter, usize, &mut dyn FnMut(Polygon)) -> Result<(), InputError>,
+) -> Result<(Vec<Polygon>, ImportReport), InputError> {
     const STAND_IN: u32 = u32::MAX;
     let stand_in = GridPolygon::from_grid_points(&[[0, 0, 0], [1, 0, 0], [0, 1, 0]])
         .map(|g| g.to_polygon(STAND_IN))
@@ -263,8 +263,8 @@ fn single_polygon(
 /// the first error in face order, as the sequential import gives.
 #[allow(clippy::type_complexity)]
 fn gather(
-    parts: Vec<Result<(Vec<Polygon>, ImportReport), Error>>,
-) -> Result<(Vec<Vec<Polygon>>, ImportReport), Error> {
+    parts: Vec<Result<(Vec<Polygon>, ImportReport), InputError>>,
+) -> Result<(Vec<Vec<Polygon>>, ImportReport), InputError> {
     let mut runs = Vec::with_capacity(parts.len());
     let mut report = ImportReport::default();
     for part in parts {
@@ -296,7 +296,7 @@ pub fn import_indexed_par(
     grid: &Grid,
     positions: &[DVec3],
     faces: &[Vec<u32>],
-) -> Result<(Vec<Vec<Polygon>>, ImportReport), Error> {
+) -> Result<(Vec<Vec<Polygon>>, ImportReport), InputError> {
     const CHUNK: usize = 4096;
     let parts = crate::par::map(faces.len().div_ceil(CHUNK), |c| {
         let chunk = &faces[c * CHUNK..faces.len().min((c + 1) * CHUNK)];
@@ -327,7 +327,7 @@ fn import_from<'a>(
     grid: &Grid,
     faces: impl IntoIterator<Item = &'a [DVec3]>,
     first: usize,
-) -> Result<(Vec<Polygon>, ImportReport), Error> {
+) -> Result<(Vec<Polygon>, ImportReport), InputError> {
     let faces = faces.into_iter();
     let mut run = Importer::new(faces.size_hint().0);
     for (fi, face) in faces.enumerate() {
@@ -397,7 +397,7 @@ impl FaceImporter {
         face: &[u32],
         fi: usize,
         mut out: impl FnMut(Polygon),
-    ) -> Result<(), Error> {
+    ) -> Result<(), InputError> {
         self.indexed_grid(grid, positions, face, fi, |g| out(g.to_polygon(fi as u32)))
     }
 
@@ -410,11 +410,11 @@ impl FaceImporter {
         face: &[u32],
         fi: usize,
         out: impl FnMut(GridPolygon),
-    ) -> Result<(), Error> {
+    ) -> Result<(), InputError> {
         let mut loop_ = std::mem::take(&mut self.loop_);
         loop_.clear();
         for (vertex, &v) in face.iter().enumerate() {
-            let p = positions.get(v as usize).ok_or(Error::VertexIndex {
+            let p = positions.get(v as usize).ok_or(InputError::VertexIndex {
                 face: fi,
                 vertex,
                 index: v,
@@ -433,7 +433,7 @@ impl FaceImporter {
         face: &[DVec3],
         fi: usize,
         mut out: impl FnMut(Polygon),
-    ) -> Result<(), Error> {
+    ) -> Result<(), InputError> {
         self.face_grid(grid, face, fi, |g| out(g.to_polygon(fi as u32)))
     }
 
@@ -445,12 +445,12 @@ impl FaceImporter {
         face: &[DVec3],
         fi: usize,
         out: impl FnMut(GridPolygon),
-    ) -> Result<(), Error> {
+    ) -> Result<(), InputError> {
         self.report.faces += 1;
         let mut pts = std::mem::take(&mut self.pts);
         pts.clear();
         for (vi, p) in face.iter().enumerate() {
-            let g = grid.snap(*p).map_err(|e| Error::Snap {
+            let g = grid.snap(*p).map_err(|e| InputError::Snap {
                 face: fi,
                 vertex: vi,
                 value: p.to_array(),
@@ -475,7 +475,7 @@ impl FaceImporter {
         face: &[u32],
         fi: usize,
         out: impl FnMut(GridPolygon),
-    ) -> Result<(), Error> {
+    ) -> Result<(), InputError> {
         let mut pts = std::mem::take(&mut self.pts);
         pts.clear();
         for &v in face {
@@ -610,7 +610,7 @@ mod tests {
         let run = |pre: bool| {
             let mut imp = FaceImporter::default();
             let mut polys = Vec::new();
-            let results: Vec<Result<(), Error>> = faces
+            let results: Vec<Result<(), InputError>> = faces
                 .iter()
                 .enumerate()
                 .map(|(fi, f)| {
@@ -699,7 +699,7 @@ mod tests {
         // a panic; the first such face in order is named
         faces[7_000].push(positions.len() as u32);
         faces[9_000].push(positions.len() as u32 + 1);
-        let error = Error::VertexIndex {
+        let error = InputError::VertexIndex {
             face: 7_000,
             vertex: 3,
             index: positions.len() as u32,
@@ -751,7 +751,7 @@ mod tests {
         assert!(
             matches!(
                 e,
-                Error::Snap {
+                InputError::Snap {
                     face: 0,
                     vertex: 2,
                     ..

@@ -149,7 +149,7 @@ proptest! {
             bsp_core::SnapError::NonFinite
         };
         match import_faces(&grid, faces.iter().map(|l| &l[..])) {
-            Err(bsp_core::Error::Snap { face, vertex, reason: r, .. }) => {
+            Err(bsp_core::InputError::Snap { face, vertex, reason: r, .. }) => {
                 prop_assert_eq!((face, vertex, r), (f, v, reason));
             }
             other => prop_assert!(false, "expected a snap error, got {:?}", other.map(|r| r.1)),

@@ -907,7 +907,7 @@ fn a_solids_far_side_hides_nothing_more() {
         let mut faces = vec![ground(160)];
         faces.extend(solid);
         let occluders: Vec<Occluder> = faces.iter().map(|f| Occluder::new(f).unwrap()).collect();
-        let run = svbsp::SoftShadows::new(std::slice::from_ref(&light), &occluders).unwrap();
+        let run = svbsp::SoftVolumes::new(std::slice::from_ref(&light), &occluders).unwrap();
         let mut points: Vec<[i32; 3]> = Vec::new();
         for x in (-60..=60).step_by(5) {
             for y in (-60..=60).step_by(5) {
@@ -953,7 +953,7 @@ fn shares_past_closed_meshes_equal_the_view_with_every_face() {
     let lowest = v.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
     let at = [DVec3::new(-1.1, 0.2, 2.0), DVec3::new(1.2, -0.3, -lowest)];
     let (grid, faces, light) = spheres_under_a_light(&v, &tris, &at);
-    let run = svbsp::SoftShadows::new(std::slice::from_ref(&light), &faces).unwrap();
+    let run = svbsp::SoftVolumes::new(std::slice::from_ref(&light), &faces).unwrap();
     let mut rng = Rng::new(0x0b5c_0e11);
     let half = grid.snap(DVec3::new(3.0, 3.0, 0.0)).unwrap();
     let z = grid.snap(DVec3::ZERO).unwrap()[2];

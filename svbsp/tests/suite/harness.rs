@@ -10,7 +10,7 @@ use std::collections::{BTreeSet, HashMap};
 
 use bsp_core::{BspTree, BuildOptions, Polygon};
 use num_traits::{ToPrimitive, Zero};
-use svbsp::{Batch, CfFragments, Light, ShadowStats, Shadows, chin_feiner, shadow_fragments};
+use svbsp::{Batch, CfFragments, Light, LightVolumes, ShadowStats, chin_feiner, shadow_fragments};
 
 use crate::oracle::{
     Face, FlagStats, HPoint, PieceRef, Q, Region, Scene, area_of, check_flags, check_regions,
@@ -247,7 +247,7 @@ pub(crate) fn check(
     opts: &Opts,
 ) -> Result<Checked, String> {
     let n = lights.len();
-    let shadows = Shadows::new(polys, lights).map_err(|e| e.to_string())?;
+    let shadows = LightVolumes::new(polys, lights).map_err(|e| e.to_string())?;
     for (j, v) in shadows.volumes().iter().enumerate() {
         v.sanity_check()
             .map_err(|e| format!("shadow volumes of light {j}: {e}"))?;

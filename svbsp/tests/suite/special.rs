@@ -331,7 +331,7 @@ fn no_lights_and_bad_lights() {
     );
 }
 
-/// `Shadows::new` leaves out the faces that a light does not face of an
+/// `LightVolumes::new` leaves out the faces that a light does not face of an
 /// edge-connected part certified to bound a solid, and only of such a
 /// part: two closed boxes crossing each other over an open ground lose
 /// the faces turned away; an inverted box keeps all of them (left out,
@@ -344,7 +344,7 @@ fn back_faces_of_certified_solids_are_left_out() {
     let kept = |scene: &[Loop]| {
         assert_loops(scene, &[light]);
         let polys = crate::harness::polygons(scene).unwrap();
-        let s = svbsp::Shadows::new(&polys, &[light]).unwrap();
+        let s = svbsp::LightVolumes::new(&polys, &[light]).unwrap();
         let facing = polys.iter().filter(|p| light.faces(p.support())).count();
         (s.volumes()[0].occluder_count(), facing, polys.len())
     };
