@@ -3,12 +3,19 @@
 //! ear-clipped, every decision an exact `i128` orientation in the face's
 //! projection along its dominant axis.
 //!
-//! A loop of [`BUCKETED`] corners or more is searched through buckets (a
-//! uniform grid of cells over the loop's box, each listing the corners or
-//! edges that may lie in it), so that a face of tens of thousands of
-//! corners is not a quadratic search; the buckets only pass over pairs
-//! that cannot meet, so the answers are those of the pairwise search,
-//! triangle for triangle.
+//! A loop of [`BUCKETED`] corners or more is not searched pair by pair:
+//! whether two of its edges meet is found by a sweep (Shamos and Hoey:
+//! the first place where two edges meet lies between edges next to each
+//! other along the sweep line, so each edge is tested against its
+//! neighbours there, `O(n log n)` whatever the edges' lengths), and its
+//! ears through buckets (a uniform grid of cells over the loop's box, each
+//! listing the corners that may lie in it). Both answer as the pairwise
+//! searches do, triangle for triangle.
+
+use std::cell::Cell;
+use std::cmp::Ordering;
+use std::collections::BTreeSet;
+use std::ops::Bound;
 
 use rustc_hash::FxHashMap;
 
@@ -111,17 +118,7 @@ impl Projection {
 
     /// Whether segments `p`–`q` and `r`–`s` share a point.
     fn meet(&self, (p, q): (GridPoint, GridPoint), (r, s): (GridPoint, GridPoint)) -> bool {
-        let (d1, d2) = (self.orient(p, q, r), self.orient(p, q, s));
-        let (d3, d4) = (self.orient(r, s, p), self.orient(r, s, q));
-        if d1 == 0 && d2 == 0 {
-            // on one line: do their extents overlap?
-            let (p, q, r, s) = (self.xy(p), self.xy(q), self.xy(r), self.xy(s));
-            let within = |lo: i128, hi: i128, a: i128, b: i128| {
-                lo.min(hi) <= a.max(b) && a.min(b) <= lo.max(hi)
-            };
-            return within(p.0, q.0, r.0, s.0) && within(p.1, q.1, r.1, s.1);
-        }
-        d1 * d2 <= 0 && d3 * d4 <= 0
+        meet((self.xy(p), self.xy(q)), (self.xy(r), self.xy(s)))
     }
 
     /// Whether the loop's edges meet only their neighbours, at their
@@ -136,24 +133,8 @@ impl Projection {
             return (0..n)
                 .all(|i| (i + 2..n).all(|j| !apart(i, j) || !self.meet(edge(i), edge(j))));
         }
-        // edges that meet share a point, so they lie in a common cell
-        let boxes = (0..n).map(|i| {
-            let (p, q) = (self.xy(v[i]), self.xy(v[(i + 1) % n]));
-            ((p.0.min(q.0), p.1.min(q.1)), (p.0.max(q.0), p.1.max(q.1)))
-        });
-        let Some(cells) = Buckets::new(boxes.collect()) else {
-            return (0..n)
-                .all(|i| (i + 2..n).all(|j| !apart(i, j) || !self.meet(edge(i), edge(j))));
-        };
-        (0..cells.count()).all(|c| {
-            let edges = cells.cell(c);
-            edges.iter().enumerate().all(|(k, &i)| {
-                (edges[k + 1..].iter()).all(|&j| {
-                    let (i, j) = (i as usize, j as usize);
-                    !apart(i, j) || !self.meet(edge(i), edge(j))
-                })
-            })
-        })
+        let xy: Vec<Xy> = v.iter().map(|&p| self.xy(p)).collect();
+        !Sweep::new(&xy).meets()
     }
 
     /// Twice the loop's signed area (positive: counter-clockwise).
@@ -170,6 +151,206 @@ impl Projection {
 /// The sign of the turn `p, q, r`.
 fn turn(p: Xy, q: Xy, r: Xy) -> i128 {
     ((q.0 - p.0) * (r.1 - p.1) - (q.1 - p.1) * (r.0 - p.0)).signum()
+}
+
+/// Whether segments `p`–`q` and `r`–`s` share a point.
+fn meet((p, q): (Xy, Xy), (r, s): (Xy, Xy)) -> bool {
+    let (d1, d2) = (turn(p, q, r), turn(p, q, s));
+    let (d3, d4) = (turn(r, s, p), turn(r, s, q));
+    if d1 == 0 && d2 == 0 {
+        // on one line: do their extents overlap?
+        let within =
+            |lo: i128, hi: i128, a: i128, b: i128| lo.min(hi) <= a.max(b) && a.min(b) <= lo.max(hi);
+        return within(p.0, q.0, r.0, s.0) && within(p.1, q.1, r.1, s.1);
+    }
+    d1 * d2 <= 0 && d3 * d4 <= 0
+}
+
+/// The sweep over a loop's edges (Shamos and Hoey): a line sweeps the
+/// plane in the order of points by `x`, then `y` (a vertical edge is met
+/// from its lower end up), holding the edges it crosses in their order
+/// along it, below to above; two edges are tested when they become
+/// neighbours there. Until the first place where two edges meet, the order
+/// does not change between events (the edges' ends), so the ordered set
+/// stays valid; and the two edges that meet first are neighbours just
+/// before that place, so they are tested.
+struct Sweep {
+    /// Each edge's ends, the lower first (by `x`, then `y`).
+    edges: Vec<(Xy, Xy)>,
+    loop_len: usize,
+    /// The event being handled, and whether the order asked for is the
+    /// one just after it (edges starting there) or just before (edges
+    /// ending there).
+    at: Cell<(Xy, bool)>,
+}
+
+/// An edge in the sweep's ordered set: compared along the sweep line.
+struct Crossing<'s> {
+    edge: u32,
+    sweep: &'s Sweep,
+}
+
+impl Sweep {
+    /// The sweep of the loop `xy`: distinct corners, at least three.
+    fn new(xy: &[Xy]) -> Sweep {
+        let n = xy.len();
+        let edges = (0..n)
+            .map(|i| {
+                let (p, q) = (xy[i], xy[(i + 1) % n]);
+                if p <= q { (p, q) } else { (q, p) }
+            })
+            .collect();
+        Sweep {
+            edges,
+            loop_len: n,
+            at: Cell::new(((0, 0), false)),
+        }
+    }
+
+    /// Where edge `e` crosses the sweep line through the event: its `y`
+    /// as a fraction (positive denominator); a vertical edge at the event
+    /// itself, kept within its ends.
+    fn y_at(&self, e: u32) -> (i128, i128) {
+        let ((lo, hi), (x, y)) = (self.edges[e as usize], self.at.get().0);
+        let dx = hi.0 - lo.0;
+        if dx == 0 {
+            return (y.clamp(lo.1, hi.1), 1);
+        }
+        (lo.1 * dx + (hi.1 - lo.1) * (x - lo.0), dx)
+    }
+
+    /// The order of edges `a` and `b` along the sweep line, below first:
+    /// where they cross it, then (crossing it at one point, the event)
+    /// by their slopes just after the event or just before it, then by
+    /// their numbers (edges on one line).
+    fn order(&self, a: u32, b: u32) -> Ordering {
+        if a == b {
+            return Ordering::Equal;
+        }
+        let ((ya, da), (yb, db)) = (self.y_at(a), self.y_at(b));
+        let slope = |e: u32| {
+            let (lo, hi) = self.edges[e as usize];
+            (hi.0 - lo.0, hi.1 - lo.1)
+        };
+        let ((ax, ay), (bx, by)) = (slope(a), slope(b));
+        // (a vertical edge, `dx = 0` and `dy > 0`, is steeper than all)
+        let slopes = (ay * bx).cmp(&(by * ax));
+        // where they cross the sweep line at one point, their order is the
+        // one just after it if the sweep has passed it (below the event,
+        // on its vertical), just before it if not (above), and at the
+        // event as asked
+        let ((_, y), after) = self.at.get();
+        let after = match ya.cmp(&(y * da)) {
+            Ordering::Less => true,
+            Ordering::Greater => false,
+            Ordering::Equal => after,
+        };
+        (ya * db)
+            .cmp(&(yb * da))
+            .then(if after { slopes } else { slopes.reverse() })
+            .then(a.cmp(&b))
+    }
+
+    /// Whether edges `a` and `b` lie on one line where the sweep line
+    /// crosses them: they overlap there (for a corner's two edges, one
+    /// holds the other: a spike).
+    fn tied(&self, a: u32, b: u32) -> bool {
+        let ((ya, da), (yb, db)) = (self.y_at(a), self.y_at(b));
+        let slope = |e: u32| {
+            let (lo, hi) = self.edges[e as usize];
+            (hi.0 - lo.0, hi.1 - lo.1)
+        };
+        let ((ax, ay), (bx, by)) = (slope(a), slope(b));
+        ya * db == yb * da && ay * bx == by * ax
+    }
+
+    /// The edges one way along the sweep line from edge `e` that `e`
+    /// must be tested against: the next one, and after it, while an edge
+    /// lies on one line with the one before it, the edges of that run and
+    /// the first one past it (overlapping edges, such as a spike's two,
+    /// must not hide what lies beyond them).
+    fn run(&self, e: u32, edges: impl Iterator<Item = u32>) -> Vec<u32> {
+        let mut out = Vec::new();
+        let (mut last, mut last_tied) = (e, false);
+        for o in edges {
+            let tied = self.tied(last, o);
+            if !out.is_empty() && !last_tied && !tied {
+                break;
+            }
+            out.push(o);
+            (last, last_tied) = (o, tied);
+        }
+        out
+    }
+
+    /// Whether edges `a` and `b` meet, unless they are the loop's
+    /// neighbours (which share a corner).
+    fn meet(&self, a: u32, b: u32) -> bool {
+        let n = self.loop_len as u32;
+        let neighbours = a.abs_diff(b) == 1 || a.abs_diff(b) == n - 1;
+        !neighbours && meet(self.edges[a as usize], self.edges[b as usize])
+    }
+
+    /// Whether any two edges of the loop that are not neighbours meet.
+    fn meets(&self) -> bool {
+        // the events: each edge's lower end (it enters) and upper end (it
+        // leaves); at one point, the edges that leave first
+        let mut events: Vec<(Xy, bool, u32)> = (0..self.edges.len() as u32)
+            .flat_map(|e| {
+                let (lo, hi) = self.edges[e as usize];
+                [(lo, true, e), (hi, false, e)]
+            })
+            .collect();
+        events.sort_unstable();
+        let key = |edge: u32| Crossing { edge, sweep: self };
+        // (the keys compare by the sweep's position, which moves; the
+        // order of the edges on the line does not, until two meet)
+        #[allow(clippy::mutable_key_type)]
+        let mut line: BTreeSet<Crossing<'_>> = BTreeSet::new();
+        for &(p, enters, e) in &events {
+            self.at.set((p, enters));
+            // the neighbours on each side, with the edges that overlap
+            // them (a spike's shorter edge must not hide its longer one)
+            let below = self.run(e, line.range(..key(e)).rev().map(|c| c.edge));
+            let after = line.range((Bound::Excluded(key(e)), Bound::Unbounded));
+            let above = self.run(e, after.map(|c| c.edge));
+            if enters {
+                line.insert(key(e));
+                if below.iter().chain(&above).any(|&o| self.meet(e, o)) {
+                    return true;
+                }
+            } else {
+                line.remove(&key(e));
+                if below
+                    .iter()
+                    .any(|&b| above.iter().any(|&a| self.meet(b, a)))
+                {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+impl PartialEq for Crossing<'_> {
+    fn eq(&self, o: &Self) -> bool {
+        self.edge == o.edge
+    }
+}
+
+impl Eq for Crossing<'_> {}
+
+impl PartialOrd for Crossing<'_> {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+impl Ord for Crossing<'_> {
+    fn cmp(&self, o: &Self) -> Ordering {
+        self.sweep.order(self.edge, o.edge)
+    }
 }
 
 /// A uniform grid of about as many square-ish cells as items over the
@@ -248,10 +429,6 @@ impl Buckets {
         let col = |t: i128| (((t - self.lo.0).max(0) / self.size.0) as usize).min(self.side - 1);
         let row = |t: i128| (((t - self.lo.1).max(0) / self.size.1) as usize).min(self.side - 1);
         (col(l.0)..=col(h.0), row(l.1)..=row(h.1))
-    }
-
-    fn count(&self) -> usize {
-        self.side * self.side
     }
 
     fn cell(&self, c: usize) -> &[u32] {
@@ -495,6 +672,81 @@ mod tests {
             simple > 100 && clipped > 100 && crossed > 40,
             "{simple} simple, {clipped} clipped, {crossed} crossed once"
         );
+    }
+
+    /// The sweep answers as the pairwise search on loops of distinct
+    /// corners of tiny lattices, where edges are vertical, collinear,
+    /// overlapping and touching everywhere: random corners in random order
+    /// (mostly crossing) and in the order of their angle about their
+    /// centre (mostly simple), some with a corner moved; on lattices
+    /// spread to the grid's range too.
+    #[test]
+    fn the_sweep_answers_as_the_pairwise_search() {
+        let mut seed = 0x6a09_e667_f3bc_c908u64;
+        let mut next = |m: u64| crate::xorshift(&mut seed) % m;
+        let (mut simple, mut not) = (0, 0);
+        for round in 0..20_000 {
+            let spread = 2 + next(6) as i32;
+            let mut lattice: Vec<GridPoint> = (0..spread * spread)
+                .map(|k| [k % spread, k / spread, 0])
+                .collect();
+            for i in (1..lattice.len()).rev() {
+                lattice.swap(i, next(i as u64 + 1) as usize);
+            }
+            let k = 4 + next((lattice.len() as u64 - 3).min(40)) as usize;
+            let mut v = lattice[..k].to_vec();
+            if round % 2 == 0 {
+                let c = v
+                    .iter()
+                    .fold([0.0, 0.0], |c, p| [c[0] + p[0] as f64, c[1] + p[1] as f64]);
+                let angle = |p: &GridPoint| {
+                    (p[1] as f64 - c[1] / k as f64).atan2(p[0] as f64 - c[0] / k as f64)
+                };
+                v.sort_by(|a, b| angle(a).total_cmp(&angle(b)));
+                if round % 4 == 2 {
+                    // a corner moved to a free lattice point
+                    let i = next(k as u64) as usize;
+                    v[i] = lattice[k + next((lattice.len() - k).max(1) as u64) as usize
+                        % (lattice.len() - k).max(1)..]
+                        .first()
+                        .copied()
+                        .unwrap_or(v[i]);
+                }
+            }
+            if round % 3 == 0 {
+                let s = 1 << (next(20) as i32);
+                v.iter_mut()
+                    .for_each(|p| *p = [p[0] * s - (1 << 25), p[1] * s + 7, 0]);
+            }
+            if first_repeat(&v).is_some() {
+                continue;
+            }
+            let xy: Vec<Xy> = v.iter().map(|&p| XY.xy(p)).collect();
+            let swept = !Sweep::new(&xy).meets();
+            assert_eq!(swept, simple_pairwise(&XY, &v), "round {round}: {v:?}");
+            (simple, not) = (simple + usize::from(swept), not + usize::from(!swept));
+        }
+        assert!(simple > 3_000 && not > 3_000, "{simple} simple, {not} not");
+    }
+
+    /// A star of 200,000 corners (long edges close together, which
+    /// buckets cannot tell apart) is tiled; its simplicity by the sweep.
+    #[test]
+    fn a_star_of_many_corners_is_tiled() {
+        let n = 200_000;
+        let v: Vec<GridPoint> = (0..n)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / n as f64;
+                let r = if k % 2 == 0 { 4e6 } else { 2e6 };
+                [
+                    (r * a.cos()).round() as i32,
+                    (r * a.sin()).round() as i32,
+                    0,
+                ]
+            })
+            .collect();
+        let t = tile(&v, &XY).unwrap();
+        assert_eq!(t.len(), n - 2);
     }
 
     /// Every point of a triangle (its edges included) lies in a cell that
