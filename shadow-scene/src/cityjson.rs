@@ -63,6 +63,8 @@ pub fn read_cityjson(path: &Path) -> Result<Mesh, SceneError> {
 /// );
 /// ```
 pub fn parse_cityjson(text: &str, path_for_messages: &str) -> Result<Mesh, SceneError> {
+    // (JSON has no byte-order mark, but some tools write one)
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let fail = |message: String| SceneError::Parse {
         path: path_for_messages.to_string(),
         line: 0,

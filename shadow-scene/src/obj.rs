@@ -168,6 +168,8 @@ pub fn parse_obj_notes(
     text: &str,
     path_for_messages: &str,
 ) -> Result<(Mesh, ObjNotes), SceneError> {
+    // (a byte-order mark some editors write is no statement)
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     parse_in_pieces(text, path_for_messages, PIECE_BYTES)
 }
 
@@ -702,6 +704,16 @@ mod tests {
         *state ^= *state >> 7;
         *state ^= *state << 17;
         *state
+    }
+
+    /// A byte-order mark before the first statement is not part of it
+    /// (it made `v` an unknown statement and every index one off).
+    #[test]
+    fn a_byte_order_mark_is_no_statement() {
+        let text = "v 0 0 0\nv 10 0 0\nv 10 10 0\nv 0 10 0\nf 1 2 3 4\n";
+        let (plain, _) = parse_obj_notes(text, "a.obj").unwrap();
+        let (bom, notes) = parse_obj_notes(&format!("\u{feff}{text}"), "a.obj").unwrap();
+        assert_eq!((bom, notes), (plain, ObjNotes::default()));
     }
 
     /// The lines are `str::lines`' once trailing whitespace is trimmed

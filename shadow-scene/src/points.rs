@@ -34,6 +34,8 @@ pub fn parse_points(text: &str, path_for_messages: &str) -> Result<Vec<DVec3>, S
         line,
         message,
     };
+    // (a byte-order mark some spreadsheets write is no number)
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut out = Vec::new();
     let mut first = true;
     for (i, raw) in text.lines().enumerate() {
@@ -69,6 +71,15 @@ pub fn parse_points(text: &str, path_for_messages: &str) -> Result<Vec<DVec3>, S
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_byte_order_mark_is_no_number() {
+        let p = super::parse_points("\u{feff}1,2,3\n4,5,6\n", "bom.csv").unwrap();
+        assert_eq!(
+            p,
+            [glam::DVec3::new(1., 2., 3.), glam::DVec3::new(4., 5., 6.)]
+        );
+    }
+
     use super::*;
 
     #[test]

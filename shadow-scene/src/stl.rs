@@ -52,6 +52,12 @@ pub fn parse_stl(bytes: &[u8], path_for_messages: &str) -> Result<Mesh, SceneErr
         line: 0,
         message,
     };
+    // an ASCII file may start with a byte-order mark (a binary one's
+    // header is free text, and its size tells it)
+    let bytes = match bytes.strip_prefix(b"\xEF\xBB\xBF") {
+        Some(text) if !looks_binary(bytes) && text.trim_ascii_start().starts_with(b"solid") => text,
+        _ => bytes,
+    };
     if !bytes.trim_ascii_start().starts_with(b"solid") && bytes.len() < 84 {
         return Err(err(format!(
             "invalid STL: a binary STL file has an 80-byte header and a 4-byte triangle count; this one \
@@ -274,6 +280,9 @@ mod tests {
         let m = parse_stl(text.as_bytes(), "t.stl").unwrap();
         assert_eq!((m.positions.len(), m.faces.len()), (4, 4));
         assert!(m.is_closed_oriented());
+        // a byte-order mark in front changes nothing
+        let bom = [&b"\xEF\xBB\xBF"[..], text.as_bytes()].concat();
+        assert_eq!(parse_stl(&bom, "bom.stl").unwrap(), m);
     }
 
     #[test]

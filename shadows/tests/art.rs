@@ -278,6 +278,10 @@ fn specs_and_images_are_read_with_clear_errors() {
     let s = ArtSpec::load(&dir.join("spec.json")).unwrap();
     assert_eq!(s.views[0].mask, square());
     assert_eq!(shadow_hull(&s).unwrap().hull.volume(), 8.0);
+    // a byte-order mark before the JSON is read past
+    std::fs::write(dir.join("bom.json"), format!("\u{feff}{text}")).unwrap();
+    let b = ArtSpec::load(&dir.join("bom.json")).unwrap();
+    assert_eq!(b.views[0].mask, square());
     // a missing image names the file
     std::fs::write(dir.join("bad.json"), text.replace("sq.pgm", "gone.pgm")).unwrap();
     let e = ArtSpec::load(&dir.join("bad.json"))

@@ -154,3 +154,9 @@ fn malformed_files_are_refused_with_the_place_in_the_file() {
     let e = parse_cityjson(none, "b.json").unwrap_err();
     assert_eq!(e.to_string(), "b.json: no city object has a surface");
 }
+
+#[test]
+fn a_byte_order_mark_is_read_past() {
+    let bom = format!("\u{feff}{BLOCK}");
+    assert_eq!(parse_cityjson(&bom, "block.city.json").unwrap(), block());
+}

@@ -25,6 +25,8 @@ impl ArtSpec {
 
     /// The spec of JSON `text`, its images' paths relative to `base`.
     pub fn from_json(text: &str, base: &Path) -> Result<ArtSpec, ArtError> {
+        // (JSON has no byte-order mark, but some tools write one)
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let json: Value =
             serde_json::from_str(text).map_err(|e| ArtError::Spec(format!("not JSON: {e}")))?;
         let views = json
