@@ -1150,7 +1150,11 @@ fn _region_hours<'py>(
     let suns = points(py, suns, "suns")?;
     let chosen = match faces.extract::<String>() {
         Ok(group) => sun::RegionFaces::Group(group),
-        Err(_) => sun::RegionFaces::Ids(faces.extract::<Vec<usize>>()?),
+        Err(_) => sun::RegionFaces::Ids(
+            (faces.extract::<Vec<usize>>()?.into_iter())
+                .map(|f| (f, f))
+                .collect(),
+        ),
     };
     let cells = run(py, || {
         let ids = chosen.faces(mesh.mesh())?;

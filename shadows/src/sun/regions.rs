@@ -17,8 +17,11 @@ use crate::{Error, Mesh};
 pub enum RegionFaces {
     /// The faces of the group of this name.
     Group(String),
-    /// These faces (ids from 0, in the mesh's order).
-    Ids(Vec<usize>),
+    /// These faces: inclusive ranges of ids (from 0, in the mesh's
+    /// order; one face is a range of one). A range is checked against the
+    /// mesh before it is listed, so `0-4294967295` is an error, not a
+    /// list of four billion ids.
+    Ids(Vec<(usize, usize)>),
 }
 
 impl std::str::FromStr for RegionFaces {
@@ -38,9 +41,9 @@ impl std::str::FromStr for RegionFaces {
             let bad = || format!("`{part}` is not a face id or a range of them such as 7-9");
             let id = |t: &str| t.trim().parse::<usize>().map_err(|_| bad());
             match part.split_once('-') {
-                Some((a, b)) if id(a)? <= id(b)? => ids.extend(id(a)?..=id(b)?),
+                Some((a, b)) if id(a)? <= id(b)? => ids.push((id(a)?, id(b)?)),
                 Some(_) => return Err(bad()),
-                None => ids.push(id(part)?),
+                None => ids.push((id(part)?, id(part)?)),
             }
         }
         Ok(RegionFaces::Ids(ids))
@@ -53,7 +56,16 @@ impl RegionFaces {
         let n = mesh.faces.len();
         let mut ids: Vec<usize> = match self {
             RegionFaces::Group(name) => (0..n).filter(|&f| mesh.group_name(f) == name).collect(),
-            RegionFaces::Ids(ids) => ids.clone(),
+            RegionFaces::Ids(ranges) => {
+                if let Some(&(_, f)) = ranges.iter().max_by_key(|r| r.1)
+                    && f >= n
+                {
+                    return Err(Error::Region(format!(
+                        "face {f}: the mesh has {n} faces (ids from 0)"
+                    )));
+                }
+                ranges.iter().flat_map(|&(a, b)| a..=b).collect()
+            }
         };
         ids.sort_unstable();
         ids.dedup();

@@ -454,6 +454,20 @@ fn regions_of_a_yard() {
         [1, 3, 4, 5]
     );
     assert!("3-1".parse::<RegionFaces>().is_err());
+    // a range far past the mesh is an error before it is listed (it was
+    // a failed allocation of 34 GB, or a panic)
+    for huge in [
+        "0-4294967295",
+        "0-18446744073709551615",
+        "5,2-18446744073709551615",
+    ] {
+        let e = huge
+            .parse::<RegionFaces>()
+            .unwrap()
+            .faces(&mesh)
+            .unwrap_err();
+        assert!(e.to_string().contains("faces (ids from 0)"), "{e}");
+    }
     let e = "99"
         .parse::<RegionFaces>()
         .unwrap()
