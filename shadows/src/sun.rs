@@ -176,6 +176,13 @@ pub fn parse_time(s: &str) -> Result<DateTime<FixedOffset>, SunError> {
 
 /// Where the sun is seen from `site` at `time` (SPA, with refraction).
 pub fn sun_position(site: &SunSite, time: &DateTime<FixedOffset>) -> Result<SunPosition, SunError> {
+    // (beyond a turn either way, an angle's degrees lose their precision)
+    if !(site.north_deg.abs() <= 360.0) {
+        return Err(SunError(format!(
+            "true north at {} degrees: give an angle from -360 to 360",
+            site.north_deg
+        )));
+    }
     let (az, el) = spa(site, time, true)?;
     // the horizontal way to the sun, turned by the scene's north
     let (turn, tilt) = ((az + site.north_deg).to_radians(), el.to_radians());
@@ -206,7 +213,8 @@ fn spa(
     };
     let dt = match site.delta_t {
         Some(d) => d,
-        None => delta_t::estimate_from_date_like(time).map_err(bad)?,
+        None => delta_t::estimate_from_date_like(time)
+            .map_err(|e| SunError(format!("{}: {e}", time.to_rfc3339())))?,
     };
     let air = match (refracted, site.air) {
         (false, _) => None,
@@ -238,12 +246,21 @@ pub fn study_suns(
             "a step of {step_minutes} minutes: from above 0 to 1440"
         )));
     }
-    let offset =
-        FixedOffset::east_opt((utc_offset_hours * 3600.0).round() as i32).ok_or_else(|| {
+    let offset = (utc_offset_hours.abs() < 24.0)
+        .then(|| FixedOffset::east_opt((utc_offset_hours * 3600.0).round() as i32))
+        .flatten()
+        .ok_or_else(|| {
             SunError(format!(
                 "a UTC offset of {utc_offset_hours} hours: it must lie strictly between -24 and 24"
             ))
         })?;
+    // the first and the last day at once: a date the sun's model does
+    // not reach fails before the days before it are worked out
+    for date in [dates.first(), dates.last()].into_iter().flatten() {
+        let noon = date.and_hms_opt(12, 0, 0).expect("noon exists");
+        let noon = noon.and_local_timezone(offset).single().expect("one local noon");
+        sun_position(site, &noon)?;
+    }
     let steps = (1440.0 / step_minutes).floor() as i64;
     let mut out = Vec::new();
     for date in dates {

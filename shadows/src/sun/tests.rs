@@ -158,6 +158,19 @@ fn a_day_of_suns_and_the_hours_of_a_yard() {
         offset.contains("30 hours: it must lie strictly between -24 and 24"),
         "{offset}"
     );
+    // (NaN was taken for 0)
+    let nan = study_suns(&site, &day, 60.0, f64::NAN).unwrap_err().to_string();
+    assert!(nan.contains("NaN hours: it must lie strictly"), "{nan}");
+    // true north must be an angle (NaN said "the sun direction is zero")
+    for north in [f64::NAN, 1e300, -361.0] {
+        let turned = site.with_axes(north, Up::Z);
+        let e = study_suns(&turned, &day, 60.0, 0.0).unwrap_err().to_string();
+        assert!(e.contains("give an angle from -360 to 360"), "{e}");
+    }
+    // a last day the sun's model does not reach fails at once, naming it
+    let far = [day[0], chrono::NaiveDate::from_ymd_opt(3001, 1, 1).unwrap()];
+    let e = study_suns(&site, &far, 60.0, 0.0).unwrap_err().to_string();
+    assert!(e.starts_with("3001-01-01T12:00:00+00:00: "), "{e}");
     let (mesh, suns, step, full) = equinox_study();
     let hours = sun_hours(&mesh, &suns, step).unwrap();
     // the roof sees every sun
