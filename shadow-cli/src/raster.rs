@@ -273,9 +273,15 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
     let write = t.elapsed();
     let seen = mask.iter().filter(|&&m| m != 0).count();
     let lit = mask.iter().filter(|&&m| m == 255).count();
+    let lit = match seen {
+        0 => "nothing of the scene in view (look at --eye, --target and --fov)".to_string(),
+        _ => format!(
+            "{:.1}% of the visible pixels lit by light 0",
+            100.0 * lit as f64 / seen as f64
+        ),
+    };
     let mut text = format!(
-        "wrote {}: {}x{} of {} ({} faces), {} shadows, {} visibility; {:.1}% of the visible \
-         pixels lit by light 0\n",
+        "wrote {}: {}x{} of {} ({} faces), {} shadows, {} visibility; {lit}\n",
         args.output.display(),
         args.size.0,
         args.size.1,
@@ -283,7 +289,6 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
         p.faces,
         args.method,
         args.hsr.name(),
-        100.0 * lit as f64 / seen.max(1) as f64
     );
     if let Some(m) = &args.mask {
         text += &format!("wrote {}: the mask of light 0\n", m.display());

@@ -59,6 +59,32 @@ fn render_the_room_with_a_mask() {
     assert!(body.contains(&0) && body.contains(&128) && body.contains(&255));
 }
 
+/// A camera looking away from the scene says so, rather than "0.0 % of
+/// the visible pixels lit".
+#[test]
+fn a_view_of_nothing_says_so() {
+    let out = scratch("away.png");
+    let o = shadow(&[
+        "render",
+        "--scene",
+        "room",
+        "--size",
+        "32x18",
+        "--eye",
+        "1,1,50",
+        "--target",
+        "1,1,100",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("nothing of the scene in view"),
+        "{}",
+        stdout(&o)
+    );
+}
+
 #[test]
 fn every_method_renders() {
     for m in [

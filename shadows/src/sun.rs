@@ -258,7 +258,10 @@ pub fn study_suns(
     // not reach fails before the days before it are worked out
     for date in [dates.first(), dates.last()].into_iter().flatten() {
         let noon = date.and_hms_opt(12, 0, 0).expect("noon exists");
-        let noon = noon.and_local_timezone(offset).single().expect("one local noon");
+        let noon = noon
+            .and_local_timezone(offset)
+            .single()
+            .expect("one local noon");
         sun_position(site, &noon)?;
     }
     let steps = (1440.0 / step_minutes).floor() as i64;
@@ -601,11 +604,15 @@ fn face_hours(area: f64, lit: f64, cells: Option<&[Cell]>, step_hours: f64) -> F
         *by.entry(*n).or_default() += area2(ring).abs() / 2.0;
     }
     let hours_area = by.into_iter().map(|(n, a)| (f64::from(n) * step_hours, a));
+    let (min, max) = if none { (0.0, 0.0) } else { (min, max) };
+    // the mean is a sum of rounded areas, the extremes exact counts: the
+    // mean kept between them (it fell an ulp below an equal least)
+    let mean = if area > 0.0 { lit / area } else { 0.0 };
     FaceHours {
         area,
-        sun_hours: if area > 0.0 { lit / area } else { 0.0 },
-        min_hours: if none { 0.0 } else { min },
-        max_hours: if none { 0.0 } else { max },
+        sun_hours: if none { mean } else { mean.clamp(min, max) },
+        min_hours: min,
+        max_hours: max,
         hours_area: hours_area.collect(),
     }
 }

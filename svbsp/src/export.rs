@@ -205,7 +205,8 @@ pub fn json_footer(out: &mut (impl Write + ?Sized), areas: &Areas) -> io::Result
 /// it.
 fn push_f64(s: &mut Vec<u8>, x: f64) {
     let mut b = zmij::Buffer::new();
-    s.extend_from_slice(b.format_finite(x).as_bytes());
+    // (`+ 0.0` writes a negative zero, such as an empty sum's, as 0)
+    s.extend_from_slice(b.format_finite(x + 0.0).as_bytes());
 }
 
 fn push_point(s: &mut Vec<u8>, p: DVec3) {
@@ -670,6 +671,16 @@ impl FragmentFile {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A negative zero (an empty sum's, a share's) is written as 0.
+    #[test]
+    fn negative_zero_is_written_as_zero() {
+        let (mut neg, mut pos) = (Vec::new(), Vec::new());
+        push_f64(&mut neg, -0.0);
+        push_f64(&mut pos, 0.0);
+        assert_eq!(neg, pos);
+        assert!(!neg.starts_with(b"-"));
+    }
 
     /// The floor `[0, 8]²` under the roof `[2, 4]²` at height 4, lit from
     /// above by one point light and one sun, shaded in two batches.

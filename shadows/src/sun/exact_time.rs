@@ -279,7 +279,8 @@ pub fn sensor_intervals(
 pub fn interval_hours(intervals: &[Vec<Vec<Interval>>]) -> Vec<f64> {
     intervals
         .iter()
-        .map(|days| days.iter().flatten().map(|(a, b)| b - a).sum())
+        // (`+ 0.0`: an empty sum is -0)
+        .map(|days| days.iter().flatten().map(|(a, b)| b - a).sum::<f64>() + 0.0)
         .collect()
 }
 

@@ -354,7 +354,8 @@ fn merge_pair(
 /// inside the outline stays whole. The outline is triangulated (earcut)
 /// and each cell clipped by each triangle's three upright planes, in
 /// `f64` (the cells' corners are); the parts keep their cell's face,
-/// hours and turning. An outline without area is an error.
+/// hours and turning. An outline without area, or one that meets none of
+/// the cells, is an error.
 pub fn clip_to_outline(
     cells: &[RegionCell],
     outline: &[DVec3],
@@ -407,6 +408,26 @@ pub fn clip_to_outline(
             }
         }
     }
+    if out.is_empty() && !cells.is_empty() {
+        // (a region of no area would say "0 % of its -0 units²")
+        let (lo, hi) =
+            flat.iter()
+                .fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(l, h), p| {
+                    (
+                        [l[0].min(p[0]), l[1].min(p[1])],
+                        [h[0].max(p[0]), h[1].max(p[1])],
+                    )
+                });
+        return Err(Error::Region(format!(
+            "the outline (seen from above, from {}, {} to {}, {}) meets none of the region's \
+             {} cells",
+            lo[0],
+            lo[1],
+            hi[0],
+            hi[1],
+            cells.len()
+        )));
+    }
     Ok(out)
 }
 
@@ -431,12 +452,13 @@ fn clip_ring(ring: &[DVec3], side: impl Fn(DVec3) -> f64) -> Vec<DVec3> {
 /// The area of `cells` and the area of those that see at least `hours`
 /// (within 10⁻⁹ hours: the steps' sums in `f64`).
 pub fn area_in_sun(cells: &[RegionCell], hours: f64) -> (f64, f64) {
-    let total = cells.iter().map(|c| c.area).sum();
+    let total = cells.iter().map(|c| c.area).sum::<f64>();
     let sunny = (cells.iter())
         .filter(|c| c.hours >= hours - 1e-9)
         .map(|c| c.area)
-        .sum();
-    (total, sunny)
+        .sum::<f64>();
+    // (`+ 0.0`: an empty sum is -0)
+    (total + 0.0, sunny + 0.0)
 }
 
 /// The line that says how much of the region sees at least `hours`.
