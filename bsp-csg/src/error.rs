@@ -37,6 +37,17 @@ pub enum CsgError {
         /// The surface's faces.
         faces: usize,
     },
+    /// Every face of operand `operand` has no area on the grid the
+    /// operands share (fitted to all of them together): the solid is
+    /// smaller than a step, and would be taken for the empty set.
+    Collapsed {
+        /// The operand.
+        operand: usize,
+        /// Its faces.
+        faces: usize,
+        /// The grid's step is `2^step_log2` input units.
+        step_log2: i32,
+    },
     /// The result is not watertight: a bug, not a problem of the input.
     Internal(String),
 }
@@ -61,9 +72,27 @@ impl std::fmt::Display for CsgError {
                  done for at most {} faces)",
                 crate::RESOLVE_LIMIT
             ),
+            CsgError::Collapsed {
+                operand,
+                faces,
+                step_log2,
+            } => write!(
+                f,
+                "operand {operand}: {}",
+                collapsed_text(*faces, *step_log2)
+            ),
             CsgError::Internal(e) => write!(f, "internal error: {e}"),
         }
     }
 }
 
 impl std::error::Error for CsgError {}
+
+/// Why a collapsed operand ([`CsgError::Collapsed`]) cannot be used.
+pub(crate) fn collapsed_text(faces: usize, step_log2: i32) -> String {
+    format!(
+        "all {faces} faces have no area on the grid the operands share (step 2^{step_log2} \
+         units, fitted to all of them together): the solid is smaller than a step, and would be \
+         taken for nothing; operate on operands closer in size and place"
+    )
+}

@@ -647,6 +647,18 @@ fn sequence_error(e: SequenceError, names: &[String], op: BoolOp, grid: &Grid) -
             names[i]
         ),
         (Stage::Snap(_), CsgError::Grid(e)) => format!("cannot snap the faces to one grid: {e}"),
+        (
+            Stage::Snap(i),
+            CsgError::Collapsed {
+                faces, step_log2, ..
+            },
+        ) => {
+            format!(
+                "{}: {}",
+                names[i],
+                crate::error::collapsed_text(faces, step_log2)
+            )
+        }
         (Stage::Operation(i), CsgError::NotASolid) => format!(
             "{} or the result before it: a surface crosses itself after snapping to the \
              grid (step 2^{}) and bounds no solid",
@@ -843,6 +855,25 @@ f 4 1 5 8
                 }
             })
             .collect()
+    }
+
+    /// A solid smaller than a step of the grid all the operands share is
+    /// an error, not the empty set (a unit cube beside one 10^15 away
+    /// gave an empty union).
+    #[test]
+    fn an_operand_the_grid_cannot_hold_is_an_error() {
+        let mut operands = [
+            operand(&cube(1.0, [0.0; 3]), "near.obj", false),
+            operand(&cube(1.0, [1e15; 3]), "far.obj", false),
+        ];
+        let e = apply(&mut operands, BoolOp::Union)
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            e.starts_with("near.obj: all 6 faces have no area on the grid the operands share"),
+            "{e}"
+        );
     }
 
     #[test]

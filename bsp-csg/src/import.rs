@@ -169,6 +169,13 @@ pub fn snap_one(
     if sign < 0 {
         return Err(CsgError::Inward { operand });
     }
+    if n > 0 && report.polygons == 0 {
+        return Err(CsgError::Collapsed {
+            operand,
+            faces: n,
+            step_log2: grid.step_log2(),
+        });
+    }
     faces.extend(extra.into_iter().map(Some));
     // a dropped face left its slot empty (the lowest is reused first)
     let free = report

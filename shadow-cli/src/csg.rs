@@ -184,6 +184,18 @@ pub(crate) fn run(args: &CsgArgs) -> Result<()> {
     })?;
     let stl = MeshFormat::from_path(&args.output)? == MeshFormat::Stl;
     let rounded = out.rounded(stl);
+    if let Some(r) = &rounded
+        && r.mesh.faces.is_empty()
+        && !out.exact.triangles.is_empty()
+    {
+        bail!(
+            "{}: the {} has {} triangles, but {}",
+            args.output.display(),
+            args.op.name(),
+            out.exact.triangles.len(),
+            bsp_shadows::STL_TOO_COARSE
+        );
+    }
     phases.run("write", || match &rounded {
         Some(r) => shadow_scene::save(&args.output, &r.mesh),
         None => shadow_scene::save(&args.output, &out.mesh()),

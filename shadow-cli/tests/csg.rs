@@ -144,6 +144,39 @@ fn stats_report_counts_volume_and_phases() {
     }
 }
 
+/// A result that STL's f32 cannot hold (every triangle collapses) is an
+/// error and no file, not an empty file and "the union is empty"; so is
+/// an operand smaller than a step of the grid the operands share.
+#[test]
+fn what_the_formats_or_the_grid_cannot_hold_is_an_error() {
+    let a = write("tiny_a.obj", &cube_obj([1e6; 3], 0.01));
+    let b = write("tiny_b.obj", &cube_obj([1e6 + 0.005; 3], 0.01));
+    let out = scratch("tiny_union.stl");
+    std::fs::remove_file(&out).ok();
+    let o = csg("union", &a, &b, &out, &[]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(
+        e.contains("rounding to f32 collapses every triangle"),
+        "{e}"
+    );
+    assert!(!out.exists());
+    // as OBJ the same union is written
+    let obj = scratch("tiny_union.obj");
+    assert_ok(&csg("union", &a, &b, &obj, &[]));
+    assert!(closed_result(&obj).faces.len() >= 12);
+    // a unit cube beside one 10^15 away
+    let far = write("far_cube.obj", &cube_obj([1e15; 3], 1.0));
+    let near = write("near_cube.obj", &cube_obj([0.0; 3], 1.0));
+    let o = csg("union", &near, &far, &scratch("far_union.obj"), &[]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("all 6 faces have no area on the grid"),
+        "{}",
+        stderr(&o)
+    );
+}
+
 #[test]
 fn stl_in_and_out_round_trip() {
     let cube = |lo, size| shadow_scene::parse_obj(&cube_obj(lo, size), "cube.obj").unwrap();

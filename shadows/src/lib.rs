@@ -164,10 +164,22 @@ pub fn write_mesh(path: impl AsRef<Path>, mesh: &Mesh) -> Result<(), Error> {
     if format == shadow_scene::MeshFormat::Stl {
         let mut rounded = mesh.clone();
         rounded.round_closed(shadow_scene::to_f32, shadow_scene::f32_step);
+        if rounded.faces.is_empty() && !mesh.faces.is_empty() {
+            return Err(Error::Format {
+                path: path.to_path_buf(),
+                why: STL_TOO_COARSE,
+            });
+        }
         return shadow_scene::save(path, &rounded).map_err(Error::File);
     }
     shadow_scene::save(path, mesh).map_err(Error::File)
 }
+
+/// Why a mesh is not written as STL when rounding to `f32` collapses
+/// every one of its triangles.
+pub const STL_TOO_COARSE: &str = "STL stores f32, and rounding to f32 collapses every triangle of \
+    this mesh (it is smaller than an f32 step where it lies); nothing was written: write .obj, \
+    which keeps f64";
 
 /// `mesh` moved by `by`.
 pub fn translated(mesh: &Mesh, by: DVec3) -> Mesh {

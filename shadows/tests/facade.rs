@@ -65,6 +65,21 @@ fn results_written_as_stl_are_closed_as_read_back() {
     assert_eq!(back.flat_triangles(|p| p), 0);
     assert!(back.is_closed_oriented());
     assert!((back.signed_volume() - u.signed_volume()).abs() < 1e-5 * u.signed_volume());
+    // a mesh smaller than an f32 step where it lies is not written as STL
+    let tiny = bsp_shadows::translated(&sphere(), DVec3::splat(1e9));
+    let tiny = bsp_shadows::Mesh {
+        positions: (tiny.positions.iter())
+            .map(|&p| DVec3::splat(1e9) + (p - DVec3::splat(1e9)) * 1e-3)
+            .collect(),
+        ..tiny
+    };
+    let e = bsp_shadows::write_mesh(&path, &tiny).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("rounding to f32 collapses every triangle"),
+        "{e}"
+    );
+    assert!(!path.exists());
 }
 
 #[test]
