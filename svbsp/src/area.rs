@@ -36,7 +36,7 @@
 //! together hide the light, which this first version does not resolve.
 
 use bsp_core::internals::GridPolygon;
-use bsp_core::{GridPoint, MAX_COORD, Plane, Polygon, PolygonSide, Side, Split};
+use bsp_core::{FaceDefect, GridPoint, MAX_COORD, Plane, Polygon, PolygonSide, Side, Split};
 use glam::DVec3;
 use rayon::prelude::*;
 use smallvec::SmallVec;
@@ -170,7 +170,20 @@ fn convex(corners: &[GridPoint]) -> Result<GridPolygon, AreaLightError> {
     if corners.len() < 3 {
         return Err(AreaLightError::TooFewCorners(corners.len()));
     }
-    GridPolygon::from_grid_points(corners).map_err(AreaLightError::Shape)
+    GridPolygon::from_grid_points(corners).map_err(|d| {
+        // corners not on one line whose loop has no area cross each other
+        // (a bow tie): say so, not "collinear"
+        let spread = || {
+            (1..corners.len()).any(|i| {
+                (i + 1..corners.len())
+                    .any(|j| Plane::through(corners[0], corners[i], corners[j]).is_ok())
+            })
+        };
+        match d {
+            FaceDefect::ZeroArea if spread() => AreaLightError::Shape(FaceDefect::NotSimple),
+            d => AreaLightError::Shape(d),
+        }
+    })
 }
 
 /// How much of a light a point sees, exactly (up to sets of zero area).
