@@ -147,7 +147,12 @@ impl Camera {
             return Err(bad(CameraError::FieldOfView(fov_deg)));
         }
         let to_target = target - eye;
-        let Some(f) = to_target.try_normalize() else {
+        // (a difference whose square underflows, the eye a hair from the
+        // target, still has a direction: scaled up first)
+        let m = to_target.abs().max_element();
+        let Some(f) = (to_target.try_normalize())
+            .or_else(|| (m > 0.0 && m < 1.0).then(|| (to_target / m).normalize()))
+        else {
             return Err(bad(match to_target == DVec3::ZERO {
                 true => CameraError::EyeAtTarget,
                 false => CameraError::TooFar(to_target.abs().max_element()),
@@ -543,6 +548,18 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An eye a hair from its target looks at it (it was "too far for
+    /// f64": the square of the distance underflowed); one whose square
+    /// overflows is too far, and says so.
+    #[test]
+    fn eyes_near_and_far() {
+        let look = |eye: DVec3| Camera::look_at(eye, DVec3::ZERO, DVec3::Y, 50.0, 8, 8);
+        let near = look(DVec3::new(0.0, 0.0, 1e-300)).unwrap();
+        assert_eq!(near.forward(), DVec3::NEG_Z);
+        let far = look(DVec3::new(0.0, 0.0, 1e300)).unwrap_err().to_string();
+        assert!(far.contains("too far for f64"), "{far}");
+    }
 
     #[test]
     fn contract_ray_and_projection_agree() {
