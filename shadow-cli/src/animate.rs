@@ -279,12 +279,12 @@ impl Plan {
         let coarser = grid.step_log2() - own.step_log2();
         if coarser > svbsp::LIGHT_RANGE_BITS {
             bail!(
-                "{}: the object's path over {frames} frames spans {:.3e} units (from {lo} to {hi}), \
-                 which would snap the scene to a grid 2^{coarser} times coarser than its own \
-                 (a step of {} instead of {}) and cost it its detail; at most 2^{} is \
-                 allowed: give fewer frames, or a smaller --step or --spin",
-                s.name,
+                "the moving object's path over {frames} frames spans {:.3e} units (from {lo} to \
+                 {hi}), which would snap the scene ({}) to a grid 2^{coarser} times coarser \
+                 than its own (a step of {} instead of {}) and cost it its detail; at most 2^{} \
+                 is allowed: give fewer frames, or a smaller --step or --spin",
                 (hi - lo).max_element(),
+                s.name,
                 grid.step_text(),
                 own.step_text(),
                 svbsp::LIGHT_RANGE_BITS,
