@@ -3,9 +3,9 @@
 //! ([`svbsp::place_lights`]).
 
 use anyhow::{Result, anyhow};
-use bsp_core::Grid;
+use bsp_core::{FaceDefect, Grid};
 use glam::DVec3;
-use svbsp::{Light, LightError, LightSpec, PlacedLight, SoftLight, SoftSpec};
+use svbsp::{AreaLightError, Light, LightError, LightSpec, PlacedLight, SoftLight, SoftSpec};
 
 /// `x,y,z` with the shortest representation of each coordinate.
 pub(crate) fn fmt_input(v: DVec3) -> String {
@@ -22,7 +22,13 @@ pub(crate) fn flag(spec: &LightSpec) -> String {
 
 /// An error about the lights, naming the light by its number and flag
 /// (`specs`, then `soft`).
-fn explain(e: LightError, specs: &[LightSpec], soft: &[SoftSpec]) -> anyhow::Error {
+/// (`grid`: the grid the lights were placed on, once there is one.)
+fn explain(
+    e: LightError,
+    grid: Option<&Grid>,
+    specs: &[LightSpec],
+    soft: &[SoftSpec],
+) -> anyhow::Error {
     let at = |i: usize| match specs.get(i) {
         Some(s) => format!("light {i} ({})", flag(s)),
         None => format!("light {i} ({})", soft[i - specs.len()]),
@@ -39,9 +45,49 @@ fn explain(e: LightError, specs: &[LightSpec], soft: &[SoftSpec]) -> anyhow::Err
             fmt_input(centre)
         ),
         LightError::ZeroSun { index } => anyhow!("{}: the sun direction is zero", at(index)),
+        LightError::Extent {
+            index,
+            cause: AreaLightError::Shape(FaceDefect::NonPlanar),
+        } if index >= specs.len()
+            && let Some(grid) = grid =>
+        {
+            // how far from flat, as given and as snapped: a tilted
+            // polygon's corners written in decimals seldom lie in one
+            // plane once snapped, even where they nearly do as given
+            let SoftSpec::Area(corners) = &soft[index - specs.len()] else {
+                unreachable!("only an area light has corners")
+            };
+            let snapped: Vec<DVec3> = (corners.iter())
+                .map(|&c| grid.snap(c).map_or(c, |g| grid.to_world(g.map(f64::from))))
+                .collect();
+            anyhow!(
+                "{}: its corners are not in one plane: they lie up to {:.3e} units off their \
+                 plane as given, {:.3e} once snapped to the grid (step {}); give a triangle, or \
+                 corners whose plane holds them exactly (an axis-aligned rectangle, say)",
+                at(index),
+                off_plane(corners),
+                off_plane(&snapped),
+                grid.step_text()
+            )
+        }
         LightError::Extent { index, cause } => anyhow!("{}: {cause}", at(index)),
         e => anyhow!(e),
     }
+}
+
+/// The farthest any of `corners` lies from their plane (Newell's normal
+/// through their centroid).
+fn off_plane(corners: &[DVec3]) -> f64 {
+    let k = corners.len();
+    let c = corners.iter().sum::<DVec3>() / k as f64;
+    let n = (0..k)
+        .map(|i| (corners[i] - c).cross(corners[(i + 1) % k] - c))
+        .sum::<DVec3>()
+        .normalize_or_zero();
+    corners
+        .iter()
+        .map(|&p| (p - c).dot(n).abs())
+        .fold(0.0, f64::max)
 }
 
 /// The grid shared by the scene and its point lights and area lights'
@@ -51,7 +97,7 @@ pub(crate) fn shared_grid(
     specs: &[LightSpec],
     soft: &[SoftSpec],
 ) -> Result<Grid> {
-    svbsp::shared_soft_grid(positions, specs, soft).map_err(|e| explain(e, specs, soft))
+    svbsp::shared_soft_grid(positions, specs, soft).map_err(|e| explain(e, None, specs, soft))
 }
 
 /// Every light on `grid`, errors naming the light and its flag: the
@@ -62,11 +108,13 @@ pub(crate) fn place_lights(
     specs: &[LightSpec],
     soft: &[SoftSpec],
 ) -> Result<(Vec<PlacedLight>, Vec<SoftLight>)> {
-    let placed = svbsp::place_lights(grid, specs).map_err(|e| explain(e, specs, soft))?;
+    let placed =
+        svbsp::place_lights(grid, specs).map_err(|e| explain(e, Some(grid), specs, soft))?;
     if soft.is_empty() {
         return Ok((placed, Vec::new()));
     }
-    let all = svbsp::place_soft_lights(grid, &placed, soft).map_err(|e| explain(e, specs, soft))?;
+    let all = svbsp::place_soft_lights(grid, &placed, soft)
+        .map_err(|e| explain(e, Some(grid), specs, soft))?;
     Ok((placed, all))
 }
 

@@ -790,7 +790,21 @@ fn bad_soft_lights_are_errors() {
         shadow(&argv)
     };
     let bent = run(&["--area-light", "0,0,3;1,0,3;1,1,3.5;0,1,3"], "bent.json");
-    assert_failed_with(&bent, &["light 0 (area light", "not in one plane"]);
+    assert_failed_with(
+        &bent,
+        &[
+            "light 0 (area light",
+            "not in one plane",
+            "up to 1.179e-1 units off",
+        ],
+    );
+    // a tilted square whose corners are decimals: nearly flat, and said so
+    let tilted = "0.7,0.1,2.45;0.7,0.5,2.5333333;1.1,0.5,2.6166667;1.1,0.1,2.5333333";
+    let nearly = run(&["--area-light", tilted], "tilted.json");
+    assert_failed_with(
+        &nearly,
+        &["not in one plane", "e-8 units off their plane as given"],
+    );
     let two = run(&["--area-light", "0,0,3;1,0,3"], "two.json");
     assert_failed_with(&two, &["at least three"]);
     let wide = run(&["--sun", "0,0,1", "--sun-disc", "0,0,1:45"], "wide.json");

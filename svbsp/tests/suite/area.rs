@@ -217,7 +217,10 @@ fn bad_lights_are_refused() {
     // a bow tie whose halves cancel has no area, but its corners are not
     // on one line: it crosses itself
     let tie = msg(&[[0, 0, 0], [0, 2, 0], [2, 0, 0], [2, 2, 0]]);
-    assert!(tie.contains("crosses itself") && !tie.contains("collinear"), "{tie}");
+    assert!(
+        tie.contains("crosses itself") && !tie.contains("collinear"),
+        "{tie}"
+    );
 }
 
 /// Whether the grid point `x` lies strictly inside the convex `piece`.
