@@ -502,6 +502,8 @@ pub fn sun_hours_in_tiles(
 
 /// [`sun_hours`] without the overlay: each face's exact `sun_hours` (and
 /// area), with `min_hours` and `max_hours` NaN and `hours_area` empty.
+/// (The same `sun_hours` as [`sun_hours`] gives, which keeps each between
+/// the face's extremes: a sum of rounded areas may fall an ulp outside.)
 /// The overlay of every run's pieces grows with the arrangement of all the
 /// suns' shadow edges on a face (quadratic in the suns where shadows of
 /// many suns cross one face, as on a ground under a detailed object);
