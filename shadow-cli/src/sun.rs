@@ -122,6 +122,18 @@ pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
     let dates = sun::study_dates(&a.date, a.to.as_deref(), a.every)?;
     sun::check_bre209(a.bre209, &dates).map_err(facade_error)?;
     let (step, offset) = (a.step.unwrap_or(10.0), a.utc_offset.unwrap_or(0.0));
+    // (a coarse step is allowed, but its error is not small: one sun a
+    // day at noon counts the whole day as sunny)
+    if step > 60.0 {
+        crate::output::note(
+            a.quiet,
+            &format!(
+                "note: each sun stands for {step} minutes: a point's hours may be off by up to \
+                 {} minutes wherever its sun begins or ends (sunrise, sunset, a shadow's edge)",
+                step / 2.0
+            ),
+        );
+    }
     let (dirs, paths) = sun::study_plan(&a.site.site(), &dates, step, offset, a.exact_time)?;
     let (sensors, regions) = (a.sensors.as_deref(), a.regions.as_ref());
     let of = HoursOf::of(sensors, regions, a.bre209, !a.no_extremes).exact_time(paths.as_deref());

@@ -1157,6 +1157,33 @@ fn sunhours_writes_every_faces_hours() {
     let o = run(&csv, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains(", 1 days"), "{}", stdout(&o));
+    // an hour a sun is a study's usual step; a day a sun is said to be coarse
+    assert!(
+        !stderr(&o).contains("each sun stands for"),
+        "{}",
+        stderr(&o)
+    );
+    let day_csv = scratch("day_step.csv");
+    let day = shadow(&[
+        "sunhours",
+        "--scene",
+        "cube",
+        "--lat",
+        "0",
+        "--lon",
+        "0",
+        "--date",
+        "2026-03-21",
+        "--step",
+        "1440",
+        "-o",
+        day_csv.to_str().unwrap(),
+    ]);
+    assert!(
+        stderr(&day).contains("each sun stands for 1440 minutes"),
+        "{}",
+        stderr(&day)
+    );
     let text = std::fs::read_to_string(&csv).unwrap();
     let rows: Vec<Vec<&str>> = text
         .lines()
