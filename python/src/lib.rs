@@ -141,6 +141,15 @@ fn run<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> T {
 #[pyfunction]
 #[pyo3(signature = (n=None))]
 fn set_threads(n: Option<usize>) -> PyResult<()> {
+    // (as the command line's --threads: thousands of threads took seconds
+    // to start, tens of thousands hung)
+    if let Some(n) = n
+        && n > 1024
+    {
+        return Err(BspError::new_err(format!(
+            "{n} threads: at most 1024 (0 or None: the CPUs this process may use)"
+        )));
+    }
     let pool = match n {
         None | Some(0) => None,
         Some(n) => Some(Arc::new(

@@ -32,3 +32,11 @@ def test_the_gil_is_released(yard):
     with ThreadPoolExecutor(2) as pool:
         a, b = pool.map(lambda _: bs.shadows(yard, lights).lit_area, range(2))
     assert (a == b).all()
+
+
+def test_too_many_threads_is_an_error():
+    import pytest
+
+    with pytest.raises(bs.BspError, match="at most 1024"):
+        bs.set_threads(100_000)
+    assert bs.get_threads() >= 1

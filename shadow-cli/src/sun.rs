@@ -122,6 +122,11 @@ pub(crate) fn run_hours(a: &SunHoursArgs) -> Result<()> {
     let dates = sun::study_dates(&a.date, a.to.as_deref(), a.every)?;
     sun::check_bre209(a.bre209, &dates).map_err(facade_error)?;
     let (step, offset) = (a.step.unwrap_or(10.0), a.utc_offset.unwrap_or(0.0));
+    if let Some(h) = a.min_hours
+        && !h.is_finite()
+    {
+        anyhow::bail!("--min-hours {h}: give a number of hours");
+    }
     // (a coarse step is allowed, but its error is not small: one sun a
     // day at noon counts the whole day as sunny)
     if step > 60.0 {

@@ -1259,6 +1259,8 @@ fn sunhours_writes_every_faces_hours() {
     }
     let o = run(&mean, &["--no-extremes", "--min-hours", "2"]);
     crate::assert_failed_with(&o, &["--no-extremes", "--min-hours"]);
+    let o = run(&mean, &["--min-hours", "nan"]);
+    crate::assert_failed_with(&o, &["--min-hours NaN: give a number of hours"]);
     // bad names and dates are clear errors
     let o = run(&scratch("hours.txt"), &[]);
     crate::assert_failed_with(&o, &["hours.txt", ".csv, .json, .obj, .ply or .png"]);
