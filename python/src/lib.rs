@@ -185,6 +185,40 @@ fn aligned<'py>(
     np.call_method("require", (array, dtype), Some(&kwargs))
 }
 
+/// `indices` (an array or a sequence) as vertex indices: integers, or
+/// numbers that are whole (numpy's cast would cut `2.9` to `2` and take
+/// `True` for `1`); `what` names them in the error.
+fn whole_indices<'py>(
+    np: &Bound<'py, PyModule>,
+    indices: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let a = np.call_method1("asarray", (indices,))?;
+    let kind: String = a.getattr("dtype")?.getattr("kind")?.extract()?;
+    let whole = match kind.as_str() {
+        "i" | "u" => true,
+        "f" => {
+            let finite = np.call_method1("isfinite", (&a,))?;
+            let floor = np.call_method1("floor", (&a,))?;
+            np.call_method1("all", (finite,))?.extract::<bool>()?
+                && np
+                    .call_method1("array_equal", (&a, floor))?
+                    .extract::<bool>()?
+        }
+        // (empty sequences are float; lists of lists of other lengths
+        // are objects, which the caller takes face by face)
+        "O" => return Ok(a),
+        _ => false,
+    };
+    if !whole {
+        return Err(MeshError::new_err(format!(
+            "{what}: vertex indices must be whole numbers (given {} values)",
+            a.getattr("dtype")?
+        )));
+    }
+    Ok(a)
+}
+
 /// `array` as points, `(n, 3)` float64.
 fn points<'py>(py: Python<'py>, array: &Bound<'py, PyAny>, what: &str) -> PyResult<Vec<DVec3>> {
     let np = py.import("numpy")?;
@@ -220,14 +254,15 @@ fn faces_of(py: Python<'_>, faces: &Bound<'_, PyAny>, vertices: usize) -> PyResu
     // every index in one array, and where each face starts
     let (flat, starts): (Vec<i64>, Vec<usize>) =
         if faces.hasattr("ndim")? && faces.getattr("ndim")?.extract::<usize>()? == 2 {
-            let a = aligned(&np, faces, "int64")?;
+            let a = whole_indices(&np, faces, "faces")?;
+            let a = aligned(&np, &a, "int64")?;
             let a: PyReadonlyArray2<'_, i64> = a.extract()?;
             let (m, k) = (a.shape()[0], a.shape()[1]);
             (a.as_slice()?.to_vec(), (0..=m).map(|i| i * k).collect())
         } else {
             let (mut flat, mut starts) = (Vec::new(), vec![0]);
             for (i, face) in faces.try_iter()?.enumerate() {
-                let face = face?;
+                let face = whole_indices(&np, &face?, &format!("face {i}"))?;
                 let a = np.call_method1("asarray", (&face, "int64")).map_err(|_| {
                     MeshError::new_err(format!("face {i}: a sequence of vertex indices"))
                 })?;

@@ -50,6 +50,12 @@ def test_bad_input_raises_with_a_message(tmp_path):
         bs.Mesh(v, [[0, 2, 1], [0, 1, 7]])
     with pytest.raises(bs.MeshError, match="fewer than 3"):
         bs.Mesh(v, [[0, 2, 1], [0, 1]])
+    # indices that are not whole numbers were cut (2.9 taken for 2, True
+    # for 1); whole floats are indices
+    for faces in [np.asarray(f) + 0.9, np.asarray(f) > 0, [[0, 2, 1.5]]]:
+        with pytest.raises(bs.MeshError, match="whole numbers"):
+            bs.Mesh(v, faces)
+    assert (bs.Mesh(v, np.asarray(f, dtype=float)).faces == bs.Mesh(v, f).faces).all()
     with pytest.raises(bs.MeshError, match="shape"):
         bs.Mesh(v[:, :2], f)
     bad = v.copy()
