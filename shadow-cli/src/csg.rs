@@ -112,6 +112,10 @@ fn load_all(paths: &[PathBuf], weld: bool, quiet: bool) -> Result<Vec<Operand>> 
     Ok(operands)
 }
 
+/// An operand spanning fewer steps of the shared grid than this is warned
+/// about: its vertices move by more than 0.05 % of its size.
+const COARSE_STEPS: f64 = 1024.0;
+
 /// The operation applied to the first operand with each of the others in
 /// turn ([`FileBoolean::apply`]): each import summary is printed to stderr
 /// as its operand is snapped, and the library's stages are timed as
@@ -127,6 +131,16 @@ fn apply(
     let lines: Vec<Vec<usize>> = (operands.iter())
         .map(|o| o.mesh.faces.iter().map(|f| f.line).collect())
         .collect();
+    // each operand's size, to say when the grid the operands share is
+    // coarse for it (a unit cube beside one 10^8 away snaps to a grid of
+    // step 2 and comes out 8 times its volume)
+    let sizes: Vec<f64> = (operands.iter())
+        .map(|o| {
+            o.mesh
+                .bounds()
+                .map_or(0.0, |(lo, hi)| (hi - lo).max_element())
+        })
+        .collect();
     let checked = phases
         .run("validate", || Operand::check_all(operands))
         .map_err(file_error)?;
@@ -136,6 +150,17 @@ fn apply(
         {
             let line = |f: usize| lines[*operand].get(f).copied().unwrap_or(0);
             eprint!("{}", report.notes_at(&names[*operand], grid, &line));
+            let steps = sizes[*operand] * grid.scale();
+            if steps > 0.0 && steps < COARSE_STEPS {
+                eprintln!(
+                    "warning: {} spans {steps:.3} steps of the grid the operands share (step {}): \
+                     snapping moves its vertices by up to half a step, {:.2}% of its size; \
+                     operate on operands closer in size and place",
+                    names[*operand],
+                    grid.step_text(),
+                    50.0 / steps
+                );
+            }
         }
     })
     .map_err(|e| match e.locate_crossing(&names) {

@@ -175,6 +175,20 @@ fn what_the_formats_or_the_grid_cannot_hold_is_an_error() {
         "{}",
         stderr(&o)
     );
+    // 10^8 away, the grid's step is 2: the cubes come out coarsened, and
+    // the command warns (it said nothing of a volume of 16 for 2)
+    let far8 = write("far8_cube.obj", &cube_obj([1e8, 0.0, 0.0], 1.0));
+    let o = csg("union", &near, &far8, &scratch("far8_union.obj"), &[]);
+    assert_ok(&o);
+    let e = stderr(&o);
+    assert!(
+        e.contains("near_cube.obj spans 0.500 steps of the grid"),
+        "{e}"
+    );
+    // operands of like size and place: no such warning
+    let near2 = write("near2_cube.obj", &cube_obj([0.5; 3], 1.0));
+    let o = csg("union", &near, &near2, &scratch("near2_union.obj"), &[]);
+    assert!(!stderr(&o).contains("steps of the grid"), "{}", stderr(&o));
 }
 
 #[test]
