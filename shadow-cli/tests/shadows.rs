@@ -1128,6 +1128,14 @@ fn sun_prints_where_the_sun_is() {
     crate::assert_failed_with(&o, &["2026-03-21 12:00", "offset"]);
 }
 
+/// `shadow sunhours` of the cube on the equator at `date`, with `extra`.
+fn equator_cube_sunhours(date: &str, extra: &[&str]) -> std::process::Output {
+    let at = [
+        "sunhours", "--scene", "cube", "--lat", "0", "--lon", "0", "--date", date,
+    ];
+    shadow(&[&at[..], extra].concat())
+}
+
 /// `shadow sunhours` of the cube on the equinox at Greenwich, hourly, to
 /// `out`, with `extra` flags.
 fn cube_sunhours(out: &Path, extra: &[&str]) -> std::process::Output {
@@ -1164,21 +1172,10 @@ fn sunhours_writes_every_faces_hours() {
         stderr(&o)
     );
     let day_csv = scratch("day_step.csv");
-    let day = shadow(&[
-        "sunhours",
-        "--scene",
-        "cube",
-        "--lat",
-        "0",
-        "--lon",
-        "0",
-        "--date",
+    let day = equator_cube_sunhours(
         "2026-03-21",
-        "--step",
-        "1440",
-        "-o",
-        day_csv.to_str().unwrap(),
-    ]);
+        &["--step", "1440", "-o", day_csv.to_str().unwrap()],
+    );
     assert!(
         stderr(&day).contains("each sun stands for 1440 minutes"),
         "{}",
@@ -1459,20 +1456,7 @@ fn sunhours_exact_time_gives_sensors_intervals_in_closed_form() {
     }
     // the one by the tower's north face loses the midday sun
     assert!(exact[1] < exact[2] - 2.0, "{exact:?}");
-    let o = shadow(&[
-        "sunhours",
-        "--scene",
-        "cube",
-        "--lat",
-        "0",
-        "--lon",
-        "0",
-        "--date",
-        "2026-01-01",
-        "--exact-time",
-        "-o",
-        "x.csv",
-    ]);
+    let o = equator_cube_sunhours("2026-01-01", &["--exact-time", "-o", "x.csv"]);
     crate::assert_failed_with(&o, &["--sensors"]);
 }
 

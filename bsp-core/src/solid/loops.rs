@@ -820,22 +820,27 @@ mod tests {
         assert_eq!(tile(&row, &XY).map(|t| t.len()), Some(100));
     }
 
-    /// A star of 200,000 corners (long edges close together, which
-    /// buckets cannot tell apart) is tiled; its simplicity by the sweep.
-    #[test]
-    fn a_star_of_many_corners_is_tiled() {
-        let n = 200_000;
-        let v: Vec<GridPoint> = (0..n)
+    /// `n` corners about the origin in angle order, corner `k` at radius
+    /// `radius(k)`, snapped to the grid.
+    fn ring(n: usize, radius: impl Fn(usize) -> f64) -> Vec<GridPoint> {
+        (0..n)
             .map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / n as f64;
-                let r = if k % 2 == 0 { 4e6 } else { 2e6 };
+                let (a, r) = (std::f64::consts::TAU * k as f64 / n as f64, radius(k));
                 [
                     (r * a.cos()).round() as i32,
                     (r * a.sin()).round() as i32,
                     0,
                 ]
             })
-            .collect();
+            .collect()
+    }
+
+    /// A star of 200,000 corners (long edges close together, which
+    /// buckets cannot tell apart) is tiled; its simplicity by the sweep.
+    #[test]
+    fn a_star_of_many_corners_is_tiled() {
+        let n = 200_000;
+        let v = ring(n, |k| if k % 2 == 0 { 4e6 } else { 2e6 });
         let t = tile(&v, &XY).unwrap();
         assert_eq!(t.len(), n - 2);
     }
@@ -882,16 +887,7 @@ mod tests {
     #[test]
     fn a_face_of_many_corners_is_tiled() {
         let n = 30_000;
-        let v: Vec<GridPoint> = (0..n)
-            .map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / n as f64;
-                [
-                    (1e6 * a.cos()).round() as i32,
-                    (1e6 * a.sin()).round() as i32,
-                    0,
-                ]
-            })
-            .collect();
+        let v = ring(n, |_| 1e6);
         let t = tile(&v, &XY).unwrap();
         assert_eq!(t.len(), n - 2);
     }
