@@ -70,7 +70,7 @@ pub(super) fn tile(v: &[GridPoint], proj: &Projection) -> Option<Vec<[GridPoint;
 }
 
 /// Whether triangles of different parts (`starts`: where each part's
-/// begin in `tris`) share an inner point: exactly, two triangles with area
+/// triangles begin in `tris`) share an inner point: exactly, two triangles with area
 /// are apart when the line of an edge of one has the other on its outer
 /// side or on it (convex sets are apart when some edge's line separates
 /// them). Triangles are visited in order of their least `x`, each against
