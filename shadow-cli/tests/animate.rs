@@ -288,7 +288,6 @@ fn files_need_a_moving_object_a_light_and_a_good_spin() {
         ),
         &[
             "the moving object's path over 3 frames",
-            "snap the scene (",
             "anim_static.obj)",
             "2^27 times coarser",
             "--step",

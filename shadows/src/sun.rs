@@ -177,7 +177,7 @@ pub fn parse_time(s: &str) -> Result<DateTime<FixedOffset>, SunError> {
 /// Where the sun is seen from `site` at `time` (SPA, with refraction).
 pub fn sun_position(site: &SunSite, time: &DateTime<FixedOffset>) -> Result<SunPosition, SunError> {
     // (beyond a turn either way, an angle's degrees lose their precision)
-    if !(site.north_deg.abs() <= 360.0) {
+    if site.north_deg.is_nan() || site.north_deg.abs() > 360.0 {
         return Err(SunError(format!(
             "true north at {} degrees: give an angle from -360 to 360",
             site.north_deg
