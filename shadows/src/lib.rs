@@ -151,6 +151,19 @@ pub fn read_mesh(path: impl AsRef<Path>) -> Result<Mesh, Error> {
     shadow_scene::load(path.as_ref()).map_err(Error::File)
 }
 
+/// The fragment file format `path`'s extension asks for: `.json` or
+/// `.obj` (any other was written as OBJ text, whatever its name).
+pub(crate) fn fragment_format(path: &Path) -> Result<FragmentFormat, Error> {
+    match path.extension().and_then(|e| e.to_str()) {
+        Some(e) if e.eq_ignore_ascii_case("json") => Ok(FragmentFormat::Json),
+        Some(e) if e.eq_ignore_ascii_case("obj") => Ok(FragmentFormat::Obj),
+        _ => Err(Error::Format {
+            path: path.to_path_buf(),
+            why: "fragments are written as .json or .obj",
+        }),
+    }
+}
+
 /// Writes `mesh` as OBJ or STL (by the extension), through a temporary
 /// file renamed into place when complete. For STL the positions are
 /// rounded to `f32` first and what that does to a closed surface is
@@ -450,14 +463,11 @@ impl Shadows {
     }
 
     /// Writes the fragments as JSON (the schema of `docs/shadows.md`) or
-    /// OBJ (groups `lit` and `shadow`), by the extension, through a
-    /// temporary file renamed into place when complete.
+    /// OBJ (groups `lit` and `shadow`), by the extension (another is an
+    /// error), through a temporary file renamed into place when complete.
     pub fn write(&self, path: impl AsRef<Path>) -> Result<(), Error> {
         let path = path.as_ref();
-        let format = match path.extension().and_then(|e| e.to_str()) {
-            Some(e) if e.eq_ignore_ascii_case("json") => FragmentFormat::Json,
-            _ => FragmentFormat::Obj,
-        };
+        let format = crate::fragment_format(path)?;
         let io = |source| {
             Error::File(SceneError::Io {
                 path: path.display().to_string(),

@@ -457,14 +457,12 @@ impl SoftShadows {
     }
 
     /// Writes the fragments as JSON or OBJ (groups `lit`, `penumbra`,
-    /// `umbra`), by the extension, as `shadow shadows` does, through a
+    /// `umbra`), by the extension (another is an error), as `shadow shadows`
+    /// does, through a
     /// temporary file renamed into place when complete.
     pub fn write(&self, path: impl AsRef<std::path::Path>) -> Result<(), Error> {
         let path = path.as_ref();
-        let format = match path.extension().and_then(|e| e.to_str()) {
-            Some(e) if e.eq_ignore_ascii_case("json") => FragmentFormat::Json,
-            _ => FragmentFormat::Obj,
-        };
+        let format = crate::fragment_format(path)?;
         let io = |source| {
             Error::File(shadow_scene::SceneError::Io {
                 path: path.display().to_string(),

@@ -124,6 +124,13 @@ fn shadow_areas_agree_with_the_fragments_and_files() {
     std::fs::create_dir_all(&dir).unwrap();
     s.write(dir.join("s.json")).unwrap();
     s.write(dir.join("s.obj")).unwrap();
+    // another name is an error, not OBJ text under it
+    let e = s.write(dir.join("s.svg")).unwrap_err().to_string();
+    assert!(
+        e.ends_with("s.svg: fragments are written as .json or .obj"),
+        "{e}"
+    );
+    assert!(!dir.join("s.svg").exists());
     let json = std::fs::read_to_string(dir.join("s.json")).unwrap();
     assert!(json.starts_with('{') && json.trim_end().ends_with('}'));
     let obj = std::fs::read_to_string(dir.join("s.obj")).unwrap();
