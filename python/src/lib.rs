@@ -823,6 +823,18 @@ fn shadows(py: Python<'_>, mesh: &Mesh, lights: &Bound<'_, PyAny>) -> PyResult<S
         .map(|(i, l)| light_of(l, i))
         .collect::<PyResult<_>>()?;
     let s = run(py, || bsp_shadows::shadows(mesh.mesh(), &specs)).map_err(to_py)?;
+    // (the command line notes faces left out; a Python user saw zeros)
+    let faces = mesh.mesh().faces.len();
+    let none = (0..faces).filter(|&f| s.face_area(f) == 0.0).count();
+    if none > 0 {
+        let message = format!(
+            "{none} of {faces} faces have no area on the grid the scene and its lights share, \
+             and were left out (faces without area, or smaller than a step of a grid fitted \
+             to a scene and lights that span a wide range)"
+        );
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        PyErr::warn(py, &category, &std::ffi::CString::new(message)?, 1)?;
+    }
     Ok(Shadows {
         mesh: mesh.clone(),
         lights: given.into_iter().map(Bound::unbind).collect(),

@@ -78,6 +78,11 @@ def test_bad_input_raises_with_a_message(tmp_path):
     with pytest.raises(bs.LightError):
         bs.shadows(bs.Mesh(v, f), [bs.Sun((0, 0, 1))] * 65)
     assert issubclass(bs.MeshError, ValueError)
+    # faces left out on the grid are said, not only zeros
+    far = np.vstack([v, v + 1e9])
+    with pytest.warns(UserWarning, match="have no area on the grid"):
+        s = bs.shadows(bs.Mesh(far, np.vstack([f, f + 4])), [bs.Sun((0, 0, 1))])
+    assert (s.face_area == 0).any()
 
 
 def test_pickle_round_trips(sphere, yard):
