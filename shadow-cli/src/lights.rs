@@ -78,12 +78,9 @@ fn explain(
 /// The farthest any of `corners` lies from their plane (Newell's normal
 /// through their centroid).
 fn off_plane(corners: &[DVec3]) -> f64 {
-    let k = corners.len();
-    let c = corners.iter().sum::<DVec3>() / k as f64;
-    let n = (0..k)
-        .map(|i| (corners[i] - c).cross(corners[(i + 1) % k] - c))
-        .sum::<DVec3>()
-        .normalize_or_zero();
+    let c = corners.iter().sum::<DVec3>() / corners.len() as f64;
+    let centred: Vec<DVec3> = corners.iter().map(|&p| p - c).collect();
+    let n = shadow_scene::unit_or_zero(shadow_scene::newell(&centred));
     corners
         .iter()
         .map(|&p| (p - c).dot(n).abs())

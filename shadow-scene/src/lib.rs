@@ -69,8 +69,8 @@ pub use city::{CITY_SIDE, city_block};
 pub use cityjson::{parse_cityjson, read_cityjson};
 pub use error::SceneError;
 pub use mesh::{
-    Face, FlatFix, Mesh, MeshView, Rounding, Triangles, collinear, f32_step, f64_step, to_f32,
-    unit_or_zero,
+    Face, FlatFix, Mesh, MeshView, Rounding, Triangles, collinear, f32_step, f64_step, newell,
+    to_f32, unit_or_zero,
 };
 pub use obj::{
     MAX_FACE_VERTICES, ObjNotes, parse_obj, parse_obj_notes, read_obj, read_obj_notes, write_obj,

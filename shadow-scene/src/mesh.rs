@@ -989,7 +989,6 @@ impl Mesh {
     }
 }
 
-/// Newell normal of a loop (twice its vector area).
 /// `v` scaled to unit length, or zero where it has none (as glam's
 /// `normalize_or_zero`), at any size: `v` is first scaled by a power of
 /// two that brings its largest component to about 1, so that squaring
@@ -1020,7 +1019,15 @@ pub fn unit_or_zero(v: DVec3) -> DVec3 {
     (v * 2f64.powi(a) * 2f64.powi(b)).normalize_or_zero()
 }
 
-pub(crate) fn newell(ring: &[DVec3]) -> DVec3 {
+/// Newell normal of a loop (twice its vector area; zero for a loop
+/// without area).
+///
+/// ```
+/// use glam::DVec3;
+/// let square = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+/// assert_eq!(shadow_scene::newell(&square), DVec3::new(0.0, 0.0, 2.0));
+/// ```
+pub fn newell(ring: &[DVec3]) -> DVec3 {
     let n = ring.len();
     (0..n).fold(DVec3::ZERO, |acc, i| acc + ring[i].cross(ring[(i + 1) % n]))
 }

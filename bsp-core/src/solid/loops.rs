@@ -81,21 +81,16 @@ fn parts_overlap(tris: &[[GridPoint; 3]], starts: &[usize], proj: &Projection) -
     let mut order: Vec<usize> = (0..tris.len())
         .filter(|&i| turn(xy[i][0], xy[i][1], xy[i][2]) != 0)
         .collect();
-    let x_range = |i: usize| {
-        let xs = xy[i].map(|p| p.0);
-        (
-            xs.into_iter().min().unwrap_or(0),
-            xs.into_iter().max().unwrap_or(0),
-        )
-    };
-    let y_range = |i: usize| {
-        let ys = xy[i].map(|p| p.1);
-        (
-            ys.into_iter().min().unwrap_or(0),
-            ys.into_iter().max().unwrap_or(0),
-        )
-    };
-    order.sort_unstable_by_key(|&i| x_range(i).0);
+    // each triangle's box, once: (least x, most x, least y, most y)
+    let boxes: Vec<[i128; 4]> = (xy.iter())
+        .map(|t| {
+            let (xs, ys) = (t.map(|p| p.0), t.map(|p| p.1));
+            let lo = |v: [i128; 3]| v[0].min(v[1]).min(v[2]);
+            let hi = |v: [i128; 3]| v[0].max(v[1]).max(v[2]);
+            [lo(xs), hi(xs), lo(ys), hi(ys)]
+        })
+        .collect();
+    order.sort_unstable_by_key(|&i| boxes[i][0]);
     // (a triangle kept counter-clockwise; an edge's line separates when
     // every corner of the other lies on it or to its right)
     let ccw = |i: usize| match turn(xy[i][0], xy[i][1], xy[i][2]) > 0 {
@@ -106,12 +101,12 @@ fn parts_overlap(tris: &[[GridPoint; 3]], starts: &[usize], proj: &Projection) -
         (0..3).any(|k| b.iter().all(|&p| turn(a[k], a[(k + 1) % 3], p) <= 0))
     };
     order.iter().enumerate().any(|(k, &i)| {
-        let (x1, (y0, y1)) = (x_range(i).1, y_range(i));
+        let [_, x1, y0, y1] = boxes[i];
         order[k + 1..]
             .iter()
-            .take_while(|&&j| x_range(j).0 < x1)
+            .take_while(|&&j| boxes[j][0] < x1)
             .any(|&j| {
-                let (b0, b1) = y_range(j);
+                let [_, _, b0, b1] = boxes[j];
                 part_of(i) != part_of(j) && b0 < y1 && y0 < b1 && {
                     let (a, b) = (ccw(i), ccw(j));
                     !separates(a, b) && !separates(b, a)
@@ -278,6 +273,13 @@ impl Sweep {
         (lo.1 * dx + (hi.1 - lo.1) * (x - lo.0), dx)
     }
 
+    /// Edge `e`'s direction, from its lower end (`dx >= 0`, and `dy > 0`
+    /// where `dx = 0`).
+    fn slope(&self, e: u32) -> Xy {
+        let (lo, hi) = self.edges[e as usize];
+        (hi.0 - lo.0, hi.1 - lo.1)
+    }
+
     /// The order of edges `a` and `b` along the sweep line, below first:
     /// where they cross it, then (crossing it at one point, the event)
     /// by their slopes just after the event or just before it, then by
@@ -287,11 +289,7 @@ impl Sweep {
             return Ordering::Equal;
         }
         let ((ya, da), (yb, db)) = (self.y_at(a), self.y_at(b));
-        let slope = |e: u32| {
-            let (lo, hi) = self.edges[e as usize];
-            (hi.0 - lo.0, hi.1 - lo.1)
-        };
-        let ((ax, ay), (bx, by)) = (slope(a), slope(b));
+        let ((ax, ay), (bx, by)) = (self.slope(a), self.slope(b));
         // (a vertical edge, `dx = 0` and `dy > 0`, is steeper than all)
         let slopes = (ay * bx).cmp(&(by * ax));
         // where they cross the sweep line at one point, their order is the
@@ -315,11 +313,7 @@ impl Sweep {
     /// holds the other: a spike).
     fn tied(&self, a: u32, b: u32) -> bool {
         let ((ya, da), (yb, db)) = (self.y_at(a), self.y_at(b));
-        let slope = |e: u32| {
-            let (lo, hi) = self.edges[e as usize];
-            (hi.0 - lo.0, hi.1 - lo.1)
-        };
-        let ((ax, ay), (bx, by)) = (slope(a), slope(b));
+        let ((ax, ay), (bx, by)) = (self.slope(a), self.slope(b));
         ya * db == yb * da && ay * bx == by * ax
     }
 
