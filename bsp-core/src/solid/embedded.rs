@@ -51,7 +51,7 @@ use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
 use crate::kernel::plane::{cross, cross_wide};
-use crate::kernel::{GridPoint, Polygon};
+use crate::kernel::{GridPoint, GridPolygon, Polygon};
 use crate::union_find::UnionFind;
 
 /// Why polygons are not certified as the boundary of solids (the first
@@ -172,18 +172,50 @@ pub fn certify_solid_boundary(polys: &[Polygon]) -> Result<SolidBoundary, Surfac
     certify(polys, true)
 }
 
+/// [`certify_solid_boundary`] of polygons with grid corners as they are
+/// imported (a solid's faces snapped from a mesh, say): the same
+/// certificate without making the [`Polygon`]s.
+pub fn certify_grid_polygons(polys: &[&GridPolygon]) -> Result<SolidBoundary, SurfaceDefect> {
+    let mut start = Vec::with_capacity(polys.len() + 1);
+    let mut pts: Vec<GridPoint> = Vec::with_capacity(polys.len() * 3);
+    for p in polys {
+        start.push(pts.len() as u32);
+        pts.extend_from_slice(p.vertices());
+    }
+    start.push(pts.len() as u32);
+    certify_loops(Loops::numbered(start, pts), true)
+}
+
 /// [`certify_solid_boundary`]; without `stars`, every pair of triangles
 /// with overlapping boxes is tested on its own (the reference the star
 /// tests are checked against).
 fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefect> {
-    let loops = Loops::new(polys)?;
+    certify_loops(Loops::new(polys)?, stars)
+}
+
+/// [`certify`] of the loops made.
+fn certify_loops(loops: Loops, stars: bool) -> Result<SolidBoundary, SurfaceDefect> {
     let (lo, hi) = loops.bounds();
-    // 1. closed and oriented, the parts, and the stars certified embedded
-    let (mut parts_of, certified) = loops.closed_and_oriented(stars)?;
+    let polys = loops.start.len() - 1;
+    // step 1 (closed and oriented, the parts, and the stars certified
+    // embedded) beside the fan triangles, each polygon's volume and the
+    // grid of step 2, which need no parts
+    let (paired, (tris, volume, grid)) = crate::par::join(
+        || loops.closed_and_oriented(stars),
+        || {
+            let (tris, volume) = loops.fan_triangles(&mut UnionFind::new(polys));
+            let grid = PairGrid::new(&tris, lo, hi, |_| true);
+            (tris, volume, grid)
+        },
+    );
+    let (mut parts_of, certified) = paired?;
     // 3. each part encloses a positive volume (6 × the signed volume)
-    let (tris, volume) = loops.fan_triangles(&mut parts_of);
+    let mut part_volume = vec![0i128; polys];
+    for (i, v) in volume.into_iter().enumerate() {
+        part_volume[parts_of.find(i as u32) as usize] += v;
+    }
     let mut parts = 0;
-    for (i, v) in volume.iter().enumerate() {
+    for (i, v) in part_volume.iter().enumerate() {
         if parts_of.is_root(i as u32) {
             parts += 1;
             if *v <= 0 {
@@ -197,8 +229,10 @@ fn certify(polys: &[Polygon], stars: bool) -> Result<SolidBoundary, SurfaceDefec
         s.id.iter()
             .any(|&a| certified[a as usize] && t.id.contains(&a))
     };
-    if let Some((a, b)) = overlapping_pairs(&tris, lo, hi, |s, t| {
-        s.poly == t.poly || settled(s, t) || apart(s, t)
+    if let Some((a, b)) = grid.and_then(|grid| {
+        first_refused(&grid, &tris, |s, t| {
+            s.poly == t.poly || settled(s, t) || apart(s, t)
+        })
     }) {
         return Err(SurfaceDefect::Intersecting {
             polygons: [a as usize, b as usize],
@@ -231,13 +265,20 @@ pub fn meeting_pairs(polys: &[Polygon]) -> Result<Vec<[usize; 2]>, SurfaceDefect
     let loops = Loops::new(polys)?;
     let (lo, hi) = loops.bounds();
     let (tris, _) = loops.fan_triangles(&mut UnionFind::new(polys.len()));
-    let mut pairs = Vec::new();
-    each_overlapping_pair(&tris, lo, hi, |s, t| {
-        if s.poly != t.poly && !apart(s, t) {
-            pairs.push([s.poly.min(t.poly) as usize, s.poly.max(t.poly) as usize]);
-        }
-        ControlFlow::Continue(())
-    });
+    let Some(grid) = PairGrid::new(&tris, lo, hi, |_| true) else {
+        return Ok(Vec::new());
+    };
+    let mut pairs = runs(grid.cell_count(), grid.listed.len(), |cells| {
+        let mut pairs = Vec::new();
+        grid.visit(&tris, cells, |s, t| {
+            if s.poly != t.poly && !apart(s, t) {
+                pairs.push([s.poly.min(t.poly) as usize, s.poly.max(t.poly) as usize]);
+            }
+            ControlFlow::Continue(())
+        });
+        pairs
+    })
+    .concat();
     pairs.sort_unstable();
     pairs.dedup();
     Ok(pairs)
@@ -358,7 +399,7 @@ pub fn certify_solid_parts(polys: &[Polygon]) -> SolidParts {
         // themselves
         let refused = runs(grid.cell_count(), grid.listed.len(), |cells| {
             let mut refused: Vec<u32> = Vec::new();
-            grid.visit(cells, |s, t| {
+            grid.visit(&tris, cells, |s, t| {
                 let r = root[s.poly as usize];
                 if r == root[t.poly as usize] && !(s.poly == t.poly || settled(s, t) || apart(s, t))
                 {
@@ -422,6 +463,13 @@ impl Loops {
         }
         drop(corners);
         start.push(pts.len() as u32);
+        Ok(Loops::numbered(start, pts))
+    }
+
+    /// The loops of polygon `i` at `pts[start[i]..start[i + 1]]`, their
+    /// points numbered.
+    fn numbered(start: Vec<u32>, pts: Vec<GridPoint>) -> Loops {
+        let polys = start.len() - 1;
         let mut number: FxHashMap<GridPoint, u32> = FxHashMap::default();
         number.reserve(pts.len() / 2);
         let ids: Vec<u32> = pts
@@ -434,16 +482,16 @@ impl Loops {
         drop(number);
         let n_ids = ids.iter().max().map_or(0, |&m| m as usize + 1);
         let mut corner_poly = vec![0u32; pts.len()];
-        for i in 0..polys.len() {
+        for i in 0..polys {
             corner_poly[start[i] as usize..start[i + 1] as usize].fill(i as u32);
         }
-        Ok(Loops {
+        Loops {
             start,
             pts,
             ids,
             corner_poly,
             n_ids,
-        })
+        }
     }
 
     /// The box of every corner: its low and high corners.
@@ -730,39 +778,27 @@ fn star_embedded(
     (2..k).all(|i| !(side[i] > 0 && side[i - 1] < 0))
 }
 
-/// Visits each pair of triangles whose closed boxes overlap once, until
-/// `fine` refuses one; returns the refused pair's polygons (smaller first).
-/// The pairs come from a uniform grid of cubic cells (each triangle listed
-/// in the cells its box meets, a pair visited in the cell holding the low
-/// corner of the boxes' common part), of a typical triangle's size.
-fn overlapping_pairs(
+/// The first pair of triangles of `grid` (made of `tris`) whose closed
+/// boxes overlap that `fine` refuses, in the order of the grid's cells,
+/// as its polygons (smaller first). Runs of cells are visited in
+/// parallel.
+fn first_refused(
+    grid: &PairGrid,
     tris: &[Tri],
-    lo: GridPoint,
-    hi: GridPoint,
-    mut fine: impl FnMut(&Tri, &Tri) -> bool,
+    fine: impl Fn(&Tri, &Tri) -> bool + Sync,
 ) -> Option<(u32, u32)> {
-    let mut refused = None;
-    each_overlapping_pair(tris, lo, hi, |s, t| {
-        if fine(s, t) {
-            return ControlFlow::Continue(());
-        }
-        refused = Some((s.poly.min(t.poly), s.poly.max(t.poly)));
-        ControlFlow::Break(())
+    let first = runs(grid.cell_count(), grid.listed.len(), |cells| {
+        let mut refused = None;
+        grid.visit(tris, cells, |s, t| {
+            if fine(s, t) {
+                return ControlFlow::Continue(());
+            }
+            refused = Some((s.poly.min(t.poly), s.poly.max(t.poly)));
+            ControlFlow::Break(())
+        });
+        refused
     });
-    refused
-}
-
-/// Calls `visit` on each pair of triangles whose closed boxes overlap,
-/// once, until it breaks (see [`overlapping_pairs`]).
-fn each_overlapping_pair(
-    tris: &[Tri],
-    lo: GridPoint,
-    hi: GridPoint,
-    visit: impl FnMut(&Tri, &Tri) -> ControlFlow<()>,
-) {
-    if let Some(grid) = PairGrid::new(tris, lo, hi, |_| true) {
-        grid.visit(0..grid.cell_count(), visit);
-    }
+    first.into_iter().flatten().next()
 }
 
 /// The triangles listed in a uniform grid of cubic cells, of a typical
@@ -770,8 +806,7 @@ fn each_overlapping_pair(
 /// triangles whose boxes overlap visited in the cell that holds the low
 /// corner of the boxes' common part (so once). Only the cells that hold
 /// triangles are listed, in the order of their keys.
-struct PairGrid<'a> {
-    tris: &'a [Tri],
+struct PairGrid {
     /// The listed triangles of the `k`-th cell that holds any:
     /// `listed[first[k]..first[k + 1]]`, each with what the pair test
     /// reads (so that a cell's are contiguous).
@@ -793,15 +828,15 @@ struct Listed {
     tri: u32,
 }
 
-impl<'a> PairGrid<'a> {
+impl PairGrid {
     /// The triangles of `tris` that `keep` keeps, in cells fitted to all
     /// of `tris`; `None` for fewer than two triangles.
     fn new(
-        tris: &'a [Tri],
+        tris: &[Tri],
         lo: GridPoint,
         hi: GridPoint,
         keep: impl Fn(&Tri) -> bool + Sync,
-    ) -> Option<PairGrid<'a>> {
+    ) -> Option<PairGrid> {
         if tris.len() < 2 {
             return None;
         }
@@ -826,45 +861,53 @@ impl<'a> PairGrid<'a> {
         let [nx, ny, _] = dims(size);
         let cell = |p: GridPoint| [0, 1, 2].map(|k| ((p[k] as i64 - lo[k] as i64) / size) as u64);
         let key = |c: [u64; 3]| (c[2] * ny + c[1]) * nx + c[0];
-        // each triangle in every cell its box meets, sorted by cell
-        let runs = runs(tris.len(), tris.len(), |r| {
-            let mut out = Vec::with_capacity(2 * r.len());
-            for (i, t) in tris[r.clone()].iter().enumerate() {
-                if !keep(t) {
-                    continue;
-                }
-                let (a, b) = (cell(t.lo), cell(t.hi));
-                for z in a[2]..=b[2] {
-                    for y in a[1]..=b[1] {
-                        for x in a[0]..=b[0] {
-                            out.push(Listed {
-                                key: key([x, y, z]),
-                                lo: t.lo,
-                                hi: t.hi,
-                                low: a.map(|c| c as u32),
-                                tri: (r.start + i) as u32,
-                            });
-                        }
-                    }
-                }
+        // each triangle in every cell its box meets, sorted by cell (a
+        // counting sort: the cells are at most 8 a triangle; within a
+        // cell the triangles keep their order)
+        let cells_of = |t: &Tri| {
+            let (a, b) = (cell(t.lo), cell(t.hi));
+            (a[2]..=b[2]).flat_map(move |z| {
+                (a[1]..=b[1]).flat_map(move |y| (a[0]..=b[0]).map(move |x| key([x, y, z])))
+            })
+        };
+        let n_cells = dims(size).iter().product::<u64>() as usize;
+        let mut at = vec![0u32; n_cells + 1];
+        for t in tris.iter().filter(|t| keep(t)) {
+            for k in cells_of(t) {
+                at[k as usize + 1] += 1;
             }
-            out
-        });
-        let mut listed: Vec<Listed> = runs.concat();
-        if tris.len() < PARALLEL {
-            listed.sort_unstable_by_key(|l| (l.key, l.tri));
-        } else {
-            rayon::slice::ParallelSliceMut::par_sort_unstable_by_key(&mut listed[..], |l| {
-                (l.key, l.tri)
-            });
         }
-        let mut first: Vec<u32> = (0..listed.len())
-            .filter(|&i| i == 0 || listed[i].key != listed[i - 1].key)
-            .map(|i| i as u32)
+        for k in 1..at.len() {
+            at[k] += at[k - 1];
+        }
+        let mut first: Vec<u32> = (0..n_cells)
+            .filter(|&k| at[k + 1] > at[k])
+            .map(|k| at[k])
             .collect();
-        first.push(listed.len() as u32);
+        first.push(at[n_cells]);
+        let blank = Listed {
+            key: 0,
+            lo: [0; 3],
+            hi: [0; 3],
+            low: [0; 3],
+            tri: 0,
+        };
+        let mut listed = vec![blank; at[n_cells] as usize];
+        for (i, t) in tris.iter().enumerate().filter(|(_, t)| keep(t)) {
+            let low = cell(t.lo).map(|c| c as u32);
+            for k in cells_of(t) {
+                let slot = &mut at[k as usize];
+                listed[*slot as usize] = Listed {
+                    key: k,
+                    lo: t.lo,
+                    hi: t.hi,
+                    low,
+                    tri: i as u32,
+                };
+                *slot += 1;
+            }
+        }
         Some(PairGrid {
-            tris,
             first,
             listed,
             nx,
@@ -877,10 +920,12 @@ impl<'a> PairGrid<'a> {
         self.first.len() - 1
     }
 
-    /// Calls `visit` on each pair of triangles whose boxes overlap and
-    /// that is visited in one of the listed cells `range`, until it breaks.
+    /// Calls `visit` on each pair of triangles of `tris` (those the grid
+    /// was made of) whose boxes overlap and that is visited in one of the
+    /// listed cells `range`, until it breaks.
     fn visit(
         &self,
+        tris: &[Tri],
         range: std::ops::Range<usize>,
         mut visit: impl FnMut(&Tri, &Tri) -> ControlFlow<()>,
     ) {
@@ -902,7 +947,7 @@ impl<'a> PairGrid<'a> {
                     if (c[2] * self.ny + c[1]) * self.nx + c[0] != s.key {
                         continue;
                     }
-                    let (s, t) = (&self.tris[s.tri as usize], &self.tris[t.tri as usize]);
+                    let (s, t) = (&tris[s.tri as usize], &tris[t.tri as usize]);
                     if visit(s, t).is_break() {
                         return;
                     }
@@ -1231,15 +1276,24 @@ mod tests {
     fn one_part_is_certified_as_the_whole_surface_is() {
         // the jittered spheres of `stars_agree_with_pairwise_tests`: one
         // part each, certified exactly when the whole list is
+        // (and the certificate of the loops as imported, without making
+        // polygons, is the same, error for error)
         let mut seen = [0; 2];
         for seed in 0..200u64 {
-            let polys = polys(&bsp_fixtures::jittered_uv_sphere(
+            let loops = bsp_fixtures::jittered_uv_sphere(
                 24,
                 8.0,
                 1 + (seed % 4) as i32,
                 &mut bsp_fixtures::Rng(seed),
-            ));
+            );
+            let polys = polys(&loops);
             let whole = certify_solid_boundary(&polys);
+            let grid: Vec<GridPolygon> = loops
+                .iter()
+                .map(|l| GridPolygon::from_grid_points(l).unwrap())
+                .collect();
+            let grid: Vec<&GridPolygon> = grid.iter().collect();
+            assert_eq!(certify_grid_polygons(&grid), whole, "seed {seed}");
             let parts = certify_solid_parts(&polys);
             assert_eq!(parts.len(), 1, "seed {seed}");
             assert_eq!(parts.boundary(0).copied(), whole.ok(), "seed {seed}");

@@ -10,8 +10,8 @@ pub(crate) mod mesh;
 pub(crate) mod topology;
 
 pub use embedded::{
-    SolidBoundary, SolidParts, SurfaceDefect, certify_solid_boundary, certify_solid_parts,
-    meeting_pairs,
+    SolidBoundary, SolidParts, SurfaceDefect, certify_grid_polygons, certify_solid_boundary,
+    certify_solid_parts, meeting_pairs,
 };
 pub use import::{
     FaceImporter, ImportReport, all_planar, import_faces, import_faces_par, import_indexed_par,
