@@ -184,6 +184,10 @@ pub fn snap_one(
         .rev()
         .map(|&(f, _)| f as u32)
         .collect();
+    let clean = !turned
+        && shells(mesh) <= 1
+        && check_closed_manifold(mesh.faces.iter().map(Vec::as_slice)).is_ok()
+        && embedded(&faces);
     let solid = Solid::from_faces(faces, free);
     // several shells may cross, overlap or nest, and a surface that is a
     // closed cycle but no manifold may touch itself or fold: their solid
@@ -191,12 +195,9 @@ pub fn snap_one(
     // clean or crosses itself; see the crate docs)
     // (a sliver triangle that snapping turned over folds the surface: a
     // result read back on a coarser grid, say)
-    let solid = match turned
-        || shells(mesh) > 1
-        || check_closed_manifold(mesh.faces.iter().map(Vec::as_slice)).is_err()
-    {
-        true => solid.resolved()?,
-        false => solid,
+    let solid = match clean {
+        true => solid,
+        false => solid.resolved()?,
     };
     Ok((solid, report))
 }
@@ -224,6 +225,16 @@ fn turned_over(positions: &[DVec3], face: &[u32], p: &GridPolygon) -> bool {
 
 /// The number of vertex-connected shells of `mesh`'s faces (by vertex
 /// index).
+/// Whether the faces (all with grid corners, as snapped) are certified
+/// to bound a solid: closed, oriented, outward, and meeting one another
+/// only in shared corners and edges ([`bsp_core::certify_solid_boundary`]).
+/// A closed 2-manifold by index may still cross itself once snapped, or
+/// as given; then it is resolved.
+fn embedded(faces: &[Option<SolidFace>]) -> bool {
+    let polys: Option<Vec<&GridPolygon>> = faces.iter().flatten().map(SolidFace::as_grid).collect();
+    polys.is_some_and(|p| bsp_core::internals::certify_grid_polygons(&p).is_ok())
+}
+
 fn shells(mesh: &MeshIn<'_>) -> usize {
     let mut uf = bsp_core::internals::UnionFind::new(mesh.positions.len());
     let mut used = vec![false; mesh.positions.len()];

@@ -482,3 +482,78 @@ fn coarse_faces_crossing_a_fine_shell_resolve_piece_by_piece() {
         assert_eq!(n1 * d2, n2 * d1, "the resolved volume is the union's");
     }
 }
+
+/// A single closed 2-manifold shell that crosses itself: a unit cube
+/// (scaled by 4) whose corner (4, 4, 4) is pulled through the bottom to
+/// (3, 3, −4). By index it is a clean solid, so only the certificate of
+/// its snapped faces (`certify_grid_polygons` at import) finds the
+/// crossing. As one of two operands it must count as the solid where its
+/// winding number is positive, as it does alone (checked here against
+/// exact winding numbers): before, `A ∪ A` and `A ∪ (a box apart)` kept
+/// its faces as they were, with the signed volume.
+#[test]
+fn a_single_shell_crossing_itself_is_resolved_as_any_operand() {
+    let corners: [[i32; 3]; 8] = [
+        [0, 0, 0],
+        [4, 0, 0],
+        [0, 4, 0],
+        [4, 4, 0],
+        [0, 0, 4],
+        [4, 0, 4],
+        [0, 4, 4],
+        [3, 3, -4],
+    ];
+    let tris: [[u32; 3]; 12] = [
+        [0, 2, 3],
+        [0, 3, 1],
+        [4, 5, 7],
+        [4, 7, 6],
+        [0, 1, 5],
+        [0, 5, 4],
+        [2, 6, 7],
+        [2, 7, 3],
+        [0, 4, 6],
+        [0, 6, 2],
+        [1, 3, 7],
+        [1, 7, 5],
+    ];
+    let loops: Vec<Loop> = tris
+        .iter()
+        .map(|t| t.iter().map(|&i| corners[i as usize]).collect())
+        .collect();
+    check_resolved(&loops, 4000, &[], &mut Rng::new(7));
+    let positions: Vec<DVec3> = corners
+        .iter()
+        .map(|c| DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64))
+        .collect();
+    let faces: Vec<Vec<u32>> = tris.iter().map(|t| t.to_vec()).collect();
+    let a = MeshBuf::new(positions, faces);
+    bsp_core::check_closed_manifold(a.faces.iter().map(Vec::as_slice)).unwrap();
+    let alone = mesh_sequence(&view(&a), &[]).unwrap().volume();
+    // the signed volume is less: part of the inside is turned out
+    let signed: f64 = a
+        .faces
+        .iter()
+        .map(|f| {
+            let [p, q, r] = [0, 1, 2].map(|k| a.positions[f[k] as usize]);
+            p.dot(q.cross(r)) / 6.0
+        })
+        .sum();
+    assert!(signed < alone - 1.0, "signed {signed}, resolved {alone}");
+    let far = boxes(&[([10.0; 3], [11.0; 3], false)]);
+    let around = boxes(&[([-10.0; 3], [10.0; 3], false)]);
+    let cases = [
+        (view(&a), BoolOp::Union, view(&a), alone),
+        (view(&a), BoolOp::Intersection, view(&a), alone),
+        (view(&a), BoolOp::Union, view(&far), alone + 1.0),
+        (view(&far), BoolOp::Union, view(&a), alone + 1.0),
+        (view(&a), BoolOp::Difference, view(&far), alone),
+        (view(&a), BoolOp::Intersection, view(&around), alone),
+        (view(&around), BoolOp::Difference, view(&a), 8000.0 - alone),
+    ];
+    for (i, (x, op, y, volume)) in cases.into_iter().enumerate() {
+        let out = mesh_sequence(&x, &[(op, y)]).unwrap();
+        out.mesh.check_watertight().unwrap();
+        assert_eq!(out.volume(), volume, "case {i}: {op:?}");
+    }
+}
