@@ -184,17 +184,13 @@ pub fn snap_one(
         .rev()
         .map(|&(f, _)| f as u32)
         .collect();
-    let clean = !turned
-        && shells(mesh) <= 1
-        && check_closed_manifold(mesh.faces.iter().map(Vec::as_slice)).is_ok()
-        && embedded(&faces);
+    // several shells may cross, overlap or nest, one shell may cross,
+    // touch or fold over itself (as given, or where snapping turned a
+    // sliver triangle over: a result read back on a coarser grid, say):
+    // their solid is where the winding number is positive (see the crate
+    // docs); a certified shell bounds it already
+    let clean = !turned && shells(mesh) <= 1 && embedded(&faces);
     let solid = Solid::from_faces(faces, free);
-    // several shells may cross, overlap or nest, and a surface that is a
-    // closed cycle but no manifold may touch itself or fold: their solid
-    // is where the winding number is positive (one manifold shell is
-    // clean or crosses itself; see the crate docs)
-    // (a sliver triangle that snapping turned over folds the surface: a
-    // result read back on a coarser grid, say)
     let solid = match clean {
         true => solid,
         false => solid.resolved()?,
@@ -223,18 +219,26 @@ fn turned_over(positions: &[DVec3], face: &[u32], p: &GridPolygon) -> bool {
     o == 0.0 || (o > 0.0) != (n[k] > 0)
 }
 
-/// The number of vertex-connected shells of `mesh`'s faces (by vertex
-/// index).
-/// Whether the faces (all with grid corners, as snapped) are certified
-/// to bound a solid: closed, oriented, outward, and meeting one another
-/// only in shared corners and edges ([`bsp_core::certify_solid_boundary`]).
-/// A closed 2-manifold by index may still cross itself once snapped, or
-/// as given; then it is resolved.
+/// Whether the faces (all with grid corners, as snapped) of a surface
+/// that is one shell by index bound the solid where its winding number
+/// is positive as they are: certified closed, oriented, outward, and
+/// meeting one another only in shared corners and edges (or touching at
+/// corners, cones apart: [`bsp_core::certify_solid_boundary`]), in one
+/// edge-connected part. Such a surface can be pulled apart at the corners
+/// where it touches into an embedded connected surface, which bounds
+/// winding number 1 inside and 0 outside. (Two parts would not do: a
+/// sphere inside another, touching it at a shared corner, passes the
+/// pair tests, and inside it the winding number is 2.) A shell that is a
+/// 2-manifold by index may still cross itself, as given or once snapped;
+/// then it is resolved.
 fn embedded(faces: &[Option<SolidFace>]) -> bool {
     let polys: Option<Vec<&GridPolygon>> = faces.iter().flatten().map(SolidFace::as_grid).collect();
-    polys.is_some_and(|p| bsp_core::internals::certify_grid_polygons(&p).is_ok())
+    polys
+        .is_some_and(|p| bsp_core::internals::certify_grid_polygons(&p).is_ok_and(|c| c.parts <= 1))
 }
 
+/// The number of vertex-connected shells of `mesh`'s faces (by vertex
+/// index).
 fn shells(mesh: &MeshIn<'_>) -> usize {
     let mut uf = bsp_core::internals::UnionFind::new(mesh.positions.len());
     let mut used = vec![false; mesh.positions.len()];

@@ -557,3 +557,44 @@ fn a_single_shell_crossing_itself_is_resolved_as_any_operand() {
         assert_eq!(out.volume(), volume, "case {i}: {op:?}");
     }
 }
+
+/// A box with a tetrahedron inside it that touches it at one shared
+/// corner (one shell by index, two edge-connected parts): every pair of
+/// faces at the corner is apart but for the corner, yet the winding
+/// number inside the tetrahedron is 2. The solid is the box alone, as an
+/// operand alone and with a box apart.
+#[test]
+fn a_shell_nested_in_another_at_a_shared_corner_counts_once() {
+    let mut mesh = boxes(&[([0.0; 3], [4.0; 3], false)]);
+    let corner = mesh
+        .positions
+        .iter()
+        .position(|&p| p == DVec3::ZERO)
+        .unwrap() as u32;
+    let first = mesh.positions.len() as u32;
+    mesh.positions.extend([
+        DVec3::new(1.0, 2.0, 2.0),
+        DVec3::new(2.0, 1.0, 2.0),
+        DVec3::new(2.0, 2.0, 1.0),
+    ]);
+    let [a, b, c] = [first, first + 1, first + 2];
+    // outward: the far face (a, b, c) faces away from the corner
+    mesh.faces.extend([
+        vec![a, b, c],
+        vec![corner, b, a],
+        vec![corner, c, b],
+        vec![corner, a, c],
+    ]);
+    let six: f64 = mesh.faces[6..]
+        .iter()
+        .map(|f| {
+            let [p, q, r] = [0, 1, 2].map(|k| mesh.positions[f[k] as usize]);
+            p.dot(q.cross(r))
+        })
+        .sum();
+    assert!(six > 0.0, "the tetrahedron is outward");
+    let far = boxes(&[([10.0; 3], [11.0; 3], false)]);
+    assert_eq!(mesh_sequence(&view(&mesh), &[]).unwrap().volume(), 64.0);
+    let with_far = mesh_sequence(&view(&mesh), &[(BoolOp::Union, view(&far))]).unwrap();
+    assert_eq!(with_far.volume(), 65.0);
+}
