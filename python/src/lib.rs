@@ -247,14 +247,50 @@ fn points<'py>(py: Python<'py>, array: &Bound<'py, PyAny>, what: &str) -> PyResu
     Ok(out)
 }
 
-/// Faces from an `(m, k)` integer array or a sequence of polygons.
+/// The first index of the whole-number array `a` (in C order) that
+/// numpy's cast to `int64` would not keep (a `uint64` above `2^63 - 1`, a
+/// float beyond `±2^63`): its flat position and its value as text.
+fn beyond_int64(
+    np: &Bound<'_, PyModule>,
+    a: &Bound<'_, PyAny>,
+) -> PyResult<Option<(usize, String)>> {
+    let kind: String = a.getattr("dtype")?.getattr("kind")?.extract()?;
+    let mask = match kind.as_str() {
+        "u" => a.call_method1("__gt__", (i64::MAX,))?,
+        "f" => np
+            .call_method1("abs", (a,))?
+            .call_method1("__ge__", (-(i64::MIN as f64),))?,
+        _ => return Ok(None),
+    };
+    let flat = mask.call_method0("ravel")?;
+    if !flat.call_method0("any")?.extract::<bool>()? {
+        return Ok(None);
+    }
+    let at: usize = np.call_method1("argmax", (&flat,))?.extract()?;
+    let value = a
+        .call_method0("ravel")?
+        .get_item(at)?
+        .call_method0("item")?;
+    Ok(Some((at, value.str()?.to_string())))
+}
+
 /// Faces from an `(m, k)` integer array or a sequence of polygons, checked.
 fn faces_of(py: Python<'_>, faces: &Bound<'_, PyAny>, vertices: usize) -> PyResult<FlatFaces> {
     let np = py.import("numpy")?;
+    let beyond = |face: usize, v: String| {
+        MeshError::new_err(format!(
+            "face {face} names vertex {v}, but the vertices are 0 to {}",
+            vertices as i64 - 1
+        ))
+    };
     // every index in one array, and where each face starts
     let (flat, starts): (Vec<i64>, Vec<usize>) =
         if faces.hasattr("ndim")? && faces.getattr("ndim")?.extract::<usize>()? == 2 {
             let a = whole_indices(&np, faces, "faces")?;
+            if let Some((at, v)) = beyond_int64(&np, &a)? {
+                let k: usize = a.getattr("shape")?.get_item(1)?.extract()?;
+                return Err(beyond(at / k.max(1), v));
+            }
             let a = aligned(&np, &a, "int64")?;
             let a: PyReadonlyArray2<'_, i64> = a.extract()?;
             let (m, k) = (a.shape()[0], a.shape()[1]);
@@ -263,6 +299,9 @@ fn faces_of(py: Python<'_>, faces: &Bound<'_, PyAny>, vertices: usize) -> PyResu
             let (mut flat, mut starts) = (Vec::new(), vec![0]);
             for (i, face) in faces.try_iter()?.enumerate() {
                 let face = whole_indices(&np, &face?, &format!("face {i}"))?;
+                if let Some((_, v)) = beyond_int64(&np, &face)? {
+                    return Err(beyond(i, v));
+                }
                 let a = np.call_method1("asarray", (&face, "int64")).map_err(|_| {
                     MeshError::new_err(format!("face {i}: a sequence of vertex indices"))
                 })?;

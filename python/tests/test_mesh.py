@@ -56,6 +56,18 @@ def test_bad_input_raises_with_a_message(tmp_path):
         with pytest.raises(bs.MeshError, match="whole numbers"):
             bs.Mesh(v, faces)
     assert (bs.Mesh(v, np.asarray(f, dtype=float)).faces == bs.Mesh(v, f).faces).all()
+    # indices numpy's cast to int64 would wrap to negative numbers are
+    # named as given
+    huge = np.asarray(f, dtype=np.uint64)
+    huge[2, 1] = np.iinfo(np.uint64).max
+    with pytest.raises(bs.MeshError, match="face 2 names vertex 18446744073709551615,"):
+        bs.Mesh(v, huge)
+    with pytest.raises(bs.MeshError, match="face 1 names vertex 18446744073709551615,"):
+        bs.Mesh(v, [f[0], list(huge[2])])
+    far = np.asarray(f, dtype=float)
+    far[3, 0] = 1e20
+    with pytest.raises(bs.MeshError, match="face 3 names vertex 1e\\+20,"):
+        bs.Mesh(v, far)
     with pytest.raises(bs.MeshError, match="shape"):
         bs.Mesh(v[:, :2], f)
     bad = v.copy()
