@@ -855,7 +855,9 @@ impl PairGrid {
         let mut size = (*ext.select_nth_unstable(mid).1).max(1);
         let span = [0, 1, 2].map(|k| hi[k] as i64 - lo[k] as i64);
         let dims = |size: i64| span.map(|s| (s / size + 1) as u64);
-        while dims(size).iter().product::<u64>() > 8 * tris.len() as u64 {
+        // (saturating: tiny triangles in a large scene would overflow)
+        let cells = |size: i64| dims(size).iter().fold(1u64, |n, &d| n.saturating_mul(d));
+        while cells(size) > 8 * tris.len() as u64 {
             size *= 2;
         }
         let [nx, ny, _] = dims(size);
@@ -870,7 +872,7 @@ impl PairGrid {
                 (a[1]..=b[1]).flat_map(move |y| (a[0]..=b[0]).map(move |x| key([x, y, z])))
             })
         };
-        let n_cells = dims(size).iter().product::<u64>() as usize;
+        let n_cells = cells(size) as usize;
         let mut at = vec![0u32; n_cells + 1];
         for t in tris.iter().filter(|t| keep(t)) {
             for k in cells_of(t) {
@@ -1270,6 +1272,28 @@ mod tests {
         assert_eq!(certified_parts(&c), [false, true]);
         // no polygons, no parts
         assert!(certify_solid_parts(&[]).is_empty());
+    }
+
+    /// Unit cubes at far corners of the grid: a grid of cells of their
+    /// size would have more cells than `u64` counts (the count saturates;
+    /// wrapped, 2^66 cells here were counted as none).
+    #[test]
+    fn tiny_parts_far_apart() {
+        let (far, edge) = ((1 << 25) - 10, (1 << 22) - 2);
+        // (the second: spanning 2^22 - 1 steps, 2^22 cells along each axis)
+        for corners in [
+            vec![[-far; 3], [0; 3], [far, -far, far]],
+            vec![[0; 3], [edge; 3]],
+        ] {
+            let cubes: Vec<Polygon> = corners
+                .iter()
+                .flat_map(|&lo| cube(lo, lo.map(|c| c + 1), false))
+                .collect();
+            let n = corners.len();
+            assert_eq!(certify_solid_boundary(&cubes).unwrap().parts, n);
+            assert_eq!(certify_solid_parts(&cubes).certified().count(), n);
+            assert!(meeting_pairs(&cubes).unwrap().is_empty());
+        }
     }
 
     #[test]
