@@ -65,8 +65,10 @@ impl ImportReport {
 
     /// The summary of operand `name` ([`ImportReport::summary`], each line
     /// prefixed with the name) and, where faces were dropped, a warning
-    /// that the solid may no longer be closed (`grid`: the grid they were
-    /// snapped to). Empty when every face was kept whole.
+    /// that says so (`grid`: the grid they were snapped to): a face with
+    /// no area on the grid leaves a seam of no area, where the other faces
+    /// do not pair up edge for edge (a solid made of them is resolved; see
+    /// `bsp-csg`). Empty when every face was kept whole.
     pub fn notes(&self, name: &str, grid: &Grid) -> String {
         self.notes_at(name, grid, &|_| 0)
     }
@@ -81,7 +83,7 @@ impl ImportReport {
         if !self.dropped.is_empty() {
             s += &format!(
                 "warning: {name}: {} face(s) have no area on the grid (step 2^{}) and were \
-                 dropped; the solid may not be closed\n",
+                 dropped; the seams they leave have no area either\n",
                 self.dropped.len(),
                 grid.step_log2()
             );
