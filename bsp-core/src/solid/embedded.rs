@@ -271,17 +271,14 @@ pub fn meeting_pairs(polys: &[Polygon]) -> Result<Vec<[usize; 2]>, SurfaceDefect
     let Some(grid) = PairGrid::new(&tris, lo, hi, |_| true) else {
         return Ok(Vec::new());
     };
-    let mut pairs = runs(grid.cell_count(), grid.listings(), |cells| {
-        let mut pairs = Vec::new();
-        grid.visit(&tris, cells, |s, t| {
+    let mut pairs = grid
+        .visit_runs(&tris, |pairs: &mut Vec<[usize; 2]>, s, t| {
             if s.poly != t.poly && !apart(s, t) {
                 pairs.push([s.poly.min(t.poly) as usize, s.poly.max(t.poly) as usize]);
             }
             ControlFlow::Continue(())
-        });
-        pairs
-    })
-    .concat();
+        })
+        .concat();
     pairs.sort_unstable();
     pairs.dedup();
     Ok(pairs)
@@ -400,17 +397,12 @@ pub fn certify_solid_parts(polys: &[Polygon]) -> SolidParts {
     if let Some(grid) = PairGrid::new(&tris, lo, hi, candidate) {
         // the cells in runs, in parallel: the parts each run finds crossing
         // themselves
-        let refused = runs(grid.cell_count(), grid.listings(), |cells| {
-            let mut refused: Vec<u32> = Vec::new();
-            grid.visit(&tris, cells, |s, t| {
-                let r = root[s.poly as usize];
-                if r == root[t.poly as usize] && !(s.poly == t.poly || settled(s, t) || apart(s, t))
-                {
-                    refused.push(r);
-                }
-                ControlFlow::Continue(())
-            });
-            refused
+        let refused = grid.visit_runs(&tris, |refused: &mut Vec<u32>, s, t| {
+            let r = root[s.poly as usize];
+            if r == root[t.poly as usize] && !(s.poly == t.poly || settled(s, t) || apart(s, t)) {
+                refused.push(r);
+            }
+            ControlFlow::Continue(())
         });
         for r in refused.into_iter().flatten() {
             good[r as usize] = false;
@@ -790,16 +782,12 @@ fn first_refused(
     tris: &[Tri],
     fine: impl Fn(&Tri, &Tri) -> bool + Sync,
 ) -> Option<(u32, u32)> {
-    let first = runs(grid.cell_count(), grid.listings(), |cells| {
-        let mut refused = None;
-        grid.visit(tris, cells, |s, t| {
-            if fine(s, t) {
-                return ControlFlow::Continue(());
-            }
-            refused = Some((s.poly.min(t.poly), s.poly.max(t.poly)));
-            ControlFlow::Break(())
-        });
-        refused
+    let first = grid.visit_runs(tris, |refused: &mut Option<(u32, u32)>, s, t| {
+        if fine(s, t) {
+            return ControlFlow::Continue(());
+        }
+        *refused = Some((s.poly.min(t.poly), s.poly.max(t.poly)));
+        ControlFlow::Break(())
     });
     first.into_iter().flatten().next()
 }

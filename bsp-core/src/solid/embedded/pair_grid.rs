@@ -124,20 +124,29 @@ impl PairGrid {
     }
 
     /// The number of cells that hold triangles.
-    pub(super) fn cell_count(&self) -> usize {
+    fn cell_count(&self) -> usize {
         self.first.len() - 1
     }
 
-    /// The number of listings (a triangle once for each cell it is in):
-    /// the size of the work of visiting the pairs.
-    pub(super) fn listings(&self) -> usize {
-        self.listed.len()
+    /// [`PairGrid::visit`] over runs of the listed cells, in parallel
+    /// when the listings are many: each run's value, filled by `visit`
+    /// from `A::default()` until it breaks, in the runs' order.
+    pub(super) fn visit_runs<A: Default + Send>(
+        &self,
+        tris: &[Tri],
+        visit: impl Fn(&mut A, &Tri, &Tri) -> ControlFlow<()> + Sync,
+    ) -> Vec<A> {
+        super::runs(self.cell_count(), self.listed.len(), |cells| {
+            let mut a = A::default();
+            self.visit(tris, cells, |s, t| visit(&mut a, s, t));
+            a
+        })
     }
 
     /// Calls `visit` on each pair of triangles of `tris` (those the grid
     /// was made of) whose boxes overlap and that is visited in one of the
     /// listed cells `range`, until it breaks.
-    pub(super) fn visit(
+    fn visit(
         &self,
         tris: &[Tri],
         range: std::ops::Range<usize>,
