@@ -858,7 +858,7 @@ impl AreaLight {
         };
         Some(Regions {
             penumbra,
-            umbra: umbra_volume(&from_corner),
+            umbra: umbra_volume(lv, &from_corner),
             from_corner,
         })
     }
@@ -896,9 +896,17 @@ impl AreaLight {
 }
 
 /// The intersection of the corners' shadow volumes (each the occluder's
-/// plane, far side first, then its edges' planes): one occluder plane and
-/// every edge plane; `None` where it is empty.
-fn umbra_volume(from_corner: &[Option<HalfSpaces>]) -> Option<HalfSpaces> {
+/// plane, far side first, then its edges' planes): the occluder's plane
+/// and, per edge, the plane through it and the light corner no other
+/// corner lies outside of; `None` where it is empty.
+///
+/// On the far side of the occluder's plane (every corner on the near
+/// side), the half-spaces through one edge `e` are, across `e`, wedges
+/// right of the rays from `e` away from each corner: they are nested, and
+/// the one through the outermost corner (every other corner inside it or
+/// on it) is their intersection. So the other planes through `e` are
+/// left out, exactly: the volume is the same set.
+fn umbra_volume(lights: &[Light], from_corner: &[Option<HalfSpaces>]) -> Option<HalfSpaces> {
     let volumes: Vec<&HalfSpaces> = from_corner
         .iter()
         .map(Option::as_ref)
@@ -908,7 +916,19 @@ fn umbra_volume(from_corner: &[Option<HalfSpaces>]) -> Option<HalfSpaces> {
         return None;
     }
     let mut u = vec![volumes[0][0]];
-    u.extend(volumes.iter().flat_map(|v| v[1..].iter().copied()));
+    for e in 1..volumes[0].len() {
+        let outermost = volumes.iter().find(|v| {
+            let (h, inside) = v[e];
+            lights.iter().all(|l| {
+                let side = sign(l.eval(&h));
+                side == Side::On || side == inside
+            })
+        });
+        match outermost {
+            Some(v) => u.push(v[e]),
+            None => u.extend(volumes.iter().map(|v| v[e])),
+        }
+    }
     Some(u)
 }
 
@@ -1281,3 +1301,58 @@ fn separating(h: &Plane, lv: &[Light], ov: &[GridPoint]) -> Option<Side> {
 /// The convex parts of a polygon with the light corners each sees (bit
 /// `i`: corner `i`), where that is known.
 pub(crate) type SeenCorners<'a> = dyn FnMut(&Polygon) -> Option<Vec<(Polygon, u64)>> + 'a;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Whether grid point `x` lies in the closed intersection of `hs`.
+    fn within(hs: &HalfSpaces, x: GridPoint) -> bool {
+        hs.iter().all(|(h, s)| {
+            let side = h.classify_grid(x);
+            side == *s || side == Side::On
+        })
+    }
+
+    /// The umbra volume with one plane per occluder edge holds exactly
+    /// the points in every corner's shadow volume: random triangles and
+    /// quads under a square light and a sun disc, at random grid points.
+    #[test]
+    fn the_umbra_keeps_one_plane_per_edge_and_the_same_points() {
+        let mut state = 0x0dd_ba11_u64;
+        let mut draw = |n: i32| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % (2 * n as u64 + 1)) as i32 - n
+        };
+        let square = AreaLight::new(&[[-8, -8, 90], [-8, 8, 90], [8, 8, 90], [8, -8, 90]]).unwrap();
+        let disc = AreaLight::sun_disc(DVec3::new(0.2, -0.1, 1.0), 0.05).unwrap();
+        let (mut kept, mut inside) = (0, 0);
+        for light in [square, disc] {
+            for _ in 0..60 {
+                let z = 30 + draw(10);
+                let c = [draw(20), draw(20)];
+                let tri: Vec<GridPoint> = (0..3)
+                    .map(|_| [c[0] + draw(15), c[1] + draw(15), z + draw(3)])
+                    .collect();
+                let Ok(o) = Occluder::new(&tri) else { continue };
+                let Some(r) = light.regions(&o) else { continue };
+                let Some(umbra) = &r.umbra else { continue };
+                let every: Vec<&HalfSpaces> = r.from_corner.iter().flatten().collect();
+                assert_eq!(umbra.len(), 1 + o.corners().len());
+                kept += 1;
+                for _ in 0..400 {
+                    let x = [c[0] + draw(30), c[1] + draw(30), draw(40)];
+                    let want = every.iter().all(|hs| within(hs, x));
+                    assert_eq!(within(umbra, x), want, "{x:?} under {tri:?}");
+                    inside += usize::from(want);
+                }
+            }
+        }
+        assert!(
+            kept > 20 && inside > 100,
+            "{kept} occluders with an umbra, {inside} points in one"
+        );
+    }
+}
