@@ -81,7 +81,9 @@ pub mod internals {
         PointRef, approx, check_convex, filter_ring_area, filter_side, filter_side_err,
         share_points, split_loop,
     };
-    pub use crate::solid::{FaceImporter, all_planar, certify_grid_polygons, snap_positions};
+    pub use crate::solid::{
+        FaceImporter, all_planar, certify_grid_polygons, snap_positions, triangles_disjoint,
+    };
     pub use crate::tree::{PLink, PNode, SplitMix, box_section, merge_smaller_into_larger};
     pub use crate::union_find::UnionFind;
     pub use bnum::types::I512;

@@ -30,14 +30,10 @@ pub(crate) fn near_lists(
     let reaches: Vec<Reach> = occluders
         .par_iter()
         .map(|f| {
-            // the umbra lies in the shadow volume from every corner
-            let umbra = lights
-                .iter()
-                .map(|l| penumbra_box(std::slice::from_ref(l), f.corners(), scene))
-                .fold(scene, |a, b| {
-                    [0, 1, 2].map(|k| [a[k][0].max(b[k][0]), a[k][1].min(b[k][1])])
-                });
-            [penumbra_box(lights, f.corners(), scene), umbra]
+            [
+                penumbra_box(lights, f.corners(), scene),
+                umbra_box(lights, f.corners(), scene),
+            ]
         })
         .collect();
     // per occluder the faces it may reach, then turned into per face the
@@ -82,6 +78,22 @@ pub(crate) fn near_lists(
         }
     }
     (near, reaches)
+}
+
+/// A box holding the part of occluder `o`'s umbra volume inside `scene`:
+/// the umbra lies in the shadow volume from every light corner.
+pub(crate) fn umbra_box(lights: &[Light], o: &[GridPoint], scene: Box3) -> Box3 {
+    lights
+        .iter()
+        .map(|l| penumbra_box(std::slice::from_ref(l), o, scene))
+        .fold(scene, |a, b| {
+            [0, 1, 2].map(|k| [a[k][0].max(b[k][0]), a[k][1].min(b[k][1])])
+        })
+}
+
+/// The box of every face's corners; `None` for no faces.
+pub(crate) fn scene_box(faces: &[Occluder]) -> Option<Box3> {
+    faces.iter().map(|f| grid_box(f.corners())).reduce(union)
 }
 
 /// Into how many boxes [`near_lists`] cuts an occluder's sweep.

@@ -174,6 +174,9 @@ pub struct SoftVolumes<'a> {
     corners: Vec<Option<LightVolumes>>,
     /// The blockers a point outside their solid may pass over.
     backs: SolidBacks,
+    /// Per light, the inner occluders that decide joint umbra
+    /// ([`crate::cores`]).
+    cores: Vec<Vec<(Regions, Reach)>>,
 }
 
 impl std::fmt::Debug for SoftVolumes<'_> {
@@ -204,6 +207,7 @@ impl<'a> SoftVolumes<'a> {
             .map(|(l, r)| near_lists(l.corners(), faces, (&blockers, r)))
             .unzip();
         Ok(SoftVolumes {
+            cores: crate::cores::cores_per_light(lights, faces, &solids),
             corners: corner_shadows(lights, &polygons, &solids),
             backs: SolidBacks::new(faces, &sources, &solids),
             lights,
@@ -371,13 +375,17 @@ impl AreaLight {
             .pop()
             .flatten();
         let set = corners.as_ref().map(LightVolumes::set);
+        let cores = crate::cores::cores_per_light(std::slice::from_ref(self), faces, &solids)
+            .pop()
+            .unwrap_or_default();
         faces
             .par_iter()
             .zip(&near)
             .map_init(Scratch::default, |scratch, (face, near)| {
                 let others = near
                     .iter()
-                    .filter_map(|&j| Some((regions[j as usize].as_ref()?, reach[j as usize])));
+                    .filter_map(|&j| Some((regions[j as usize].as_ref()?, reach[j as usize])))
+                    .chain(crate::cores::cores_at(&cores, face));
                 let mut seen = |p: &Polygon| set.as_ref()?.cells(p, scratch);
                 self.classify_with(face, others, Some(&mut seen))
             })
@@ -402,9 +410,11 @@ fn soft_face(
     let near: Vec<&[u32]> = run.near.iter().map(|n| &n[i][..]).collect();
     let mut pieces = vec![(face.to_polygon(), Classes::default())];
     for (k, light) in lights.iter().enumerate() {
+        // the inner occluders last: they cut only what stays undecided
         let occluders = near[k]
             .iter()
-            .filter_map(|&j| Some((regions[k][j as usize].as_ref()?, reach[k][j as usize])));
+            .filter_map(|&j| Some((regions[k][j as usize].as_ref()?, reach[k][j as usize])))
+            .chain(crate::cores::cores_at(&run.cores[k], face));
         let set = corners[k].as_ref().map(LightVolumes::set);
         let mut seen = |p: &Polygon| set.as_ref()?.cells(p, scratch);
         pieces = light

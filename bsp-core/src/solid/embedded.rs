@@ -846,6 +846,14 @@ fn apart(s: &Tri, t: &Tri) -> bool {
     }
 }
 
+/// Whether the closed triangles `s` and `t` (grid corners) certainly do
+/// not meet: a plane strictly separates them (the separating-axis test
+/// over every candidate axis, exact). `false` where they meet, and may
+/// be `false` for a triangle of no area that does not meet the other.
+pub fn triangles_disjoint(s: &[GridPoint; 3], t: &[GridPoint; 3]) -> bool {
+    disjoint(s, t)
+}
+
 /// Strict separation of two triangles without a shared vertex, by the
 /// separating-axis test over every candidate axis.
 fn disjoint(s: &[GridPoint; 3], t: &[GridPoint; 3]) -> bool {

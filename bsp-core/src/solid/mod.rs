@@ -11,7 +11,7 @@ pub(crate) mod topology;
 
 pub use embedded::{
     SolidBoundary, SolidParts, SurfaceDefect, certify_grid_polygons, certify_solid_boundary,
-    certify_solid_parts, meeting_pairs,
+    certify_solid_parts, meeting_pairs, triangles_disjoint,
 };
 pub use import::{
     FaceImporter, ImportReport, all_planar, import_faces, import_faces_par, import_indexed_par,

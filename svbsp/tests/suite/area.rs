@@ -822,10 +822,13 @@ fn spheres_under_a_light(
 
 /// A closed mesh (a UV sphere of 400 triangles) over the ground under a
 /// square light: its faces hide the light mostly together. The faces cut
-/// with the corners' point-light trees (`classify_faces`) have the same
-/// area of each class as when cut by every occluder's volume from each
-/// corner (`classify_face`), and at grid points strictly inside the
-/// ground's fragments the exact view agrees with their class.
+/// with the corners' point-light trees and the sphere's inner occluders
+/// (`classify_faces`) have the same lit and penumbra areas as when cut by
+/// every occluder's volume from each corner (`classify_face`, no inner
+/// occluders), and the same area hidden from every corner, of which the
+/// inner occluders decide most of what `classify_face` leaves undecided
+/// as umbra; at grid points strictly inside the ground's fragments the
+/// exact view agrees with their class.
 #[test]
 fn a_mesh_cut_both_ways_agrees_with_the_view() {
     let (v, tris) = bsp_fixtures::shapes::uv_sphere(400);
@@ -838,15 +841,32 @@ fn a_mesh_cut_both_ways_agrees_with_the_view() {
         }
         a
     };
-    for i in (0..faces.len()).step_by(10) {
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * (1.0 + b);
+    let (lit, penumbra, umbra, undecided) = (0, 1, 2, 3);
+    for i in (0..faces.len()).step_by(10).chain([0]) {
         let (a, b) = (
             areas(&fast[i]),
             areas(&light.classify_face(&faces[i], &faces)),
         );
-        for k in 0..4 {
+        assert!(close(a[lit], b[lit]), "face {i}: {a:?} against {b:?}");
+        assert!(
+            close(a[penumbra], b[penumbra]),
+            "face {i}: {a:?} against {b:?}"
+        );
+        assert!(
+            close(a[umbra] + a[undecided], b[umbra] + b[undecided]),
+            "face {i}: {a:?} against {b:?}"
+        );
+        assert!(
+            a[undecided] <= b[undecided] * (1.0 + 1e-9),
+            "face {i}: {a:?} against {b:?}"
+        );
+        if i == 0 {
+            // the ground: the sphere's joint umbra, undecided without
+            // the inner occluders, is mostly decided with them
             assert!(
-                (a[k] - b[k]).abs() <= 1e-9 * (1.0 + b[k]),
-                "face {i}: {a:?} against {b:?}"
+                b[undecided] > 0.05 * b[umbra] && a[undecided] < 0.5 * b[undecided],
+                "the ground: {a:?} against {b:?}"
             );
         }
     }
@@ -866,7 +886,12 @@ fn a_mesh_cut_both_ways_agrees_with_the_view() {
         assert_agrees(&light, (x, &plane), &faces, f.class);
         *met.entry(f.class).or_insert(0) += 1;
     }
-    for class in [AreaClass::Lit, AreaClass::Penumbra, AreaClass::Undecided] {
+    for class in [
+        AreaClass::Lit,
+        AreaClass::Penumbra,
+        AreaClass::Umbra,
+        AreaClass::Undecided,
+    ] {
         assert!(met.contains_key(&class), "{class:?} never met: {met:?}");
     }
 }
@@ -986,4 +1011,72 @@ fn shares_past_closed_meshes_equal_the_view_with_every_face() {
         partly += usize::from(want.is_some_and(|w| w > 0.0 && w < 1.0));
     }
     assert!(partly > 20, "{partly} points in part");
+}
+
+/// Inner occluders decide joint umbra only where it is: a torus (whose
+/// slices are rings round the hole the light shines through) and a UV
+/// sphere over the ground under a square light, through `soft_shadows`.
+/// At grid points strictly inside the ground's fragments the exact view
+/// agrees with their class, umbra is met under both meshes (where no one
+/// of their faces hides the light alone), and the light seen through the
+/// torus's hole is never called umbra.
+#[test]
+fn inner_occluders_decide_joint_umbra_only_where_it_is() {
+    let mut world: Vec<Vec<DVec3>> = vec![vec![
+        DVec3::new(-6.0, -6.0, 0.0),
+        DVec3::new(6.0, -6.0, 0.0),
+        DVec3::new(6.0, 6.0, 0.0),
+        DVec3::new(-6.0, 6.0, 0.0),
+    ]];
+    let lift = DVec3::new(0.0, 0.0, 1.5);
+    world.extend(
+        bsp_fixtures::shapes::torus(24, 12, 1.2, 0.45)
+            .iter()
+            .map(|t| t.iter().map(|&p| p + lift).collect()),
+    );
+    let (v, tris) = bsp_fixtures::shapes::uv_sphere(400);
+    let at = DVec3::new(3.0, 0.5, 1.2);
+    world.extend(
+        tris.iter()
+            .map(|t| t.iter().map(|&i| v[i as usize] * 0.8 + at).collect()),
+    );
+    let corners =
+        [(-0.6, -0.6), (-0.6, 0.6), (0.6, 0.6), (0.6, -0.6)].map(|(x, y)| DVec3::new(x, y, 6.0));
+    let grid = bsp_core::Grid::fit_points(world.iter().flatten().chain(&corners)).unwrap();
+    let faces = snapped(&world, &grid);
+    assert_eq!(faces.len(), world.len());
+    let light = AreaLight::new(&corners.map(|c| grid.snap(c).unwrap())).unwrap();
+    let all = svbsp::soft_shadows(std::slice::from_ref(&light), &faces).unwrap();
+    let plane = *faces[0].plane();
+    let mut rng = Rng::new(0x70_2e5);
+    let half = grid.snap(DVec3::new(4.2, 2.0, 0.0)).unwrap();
+    let z = grid.snap(DVec3::ZERO).unwrap()[2];
+    // where the ground sees the light through the hole, and under each mesh
+    let hole = grid.snap(DVec3::new(0.0, 0.0, 0.0)).unwrap();
+    let mut umbra = [0; 2];
+    for n in 0..1500 {
+        let x = match n {
+            0 => hole,
+            _ => [
+                below(&mut rng, 2 * half[0] as u64) - half[0] / 2,
+                below(&mut rng, 2 * half[1] as u64) - half[1],
+                z,
+            ],
+        };
+        let Some(f) = all[0].iter().find(|f| strictly_inside(&f.polygon, x)) else {
+            continue;
+        };
+        let class = f.class(0);
+        assert_agrees(&light, (x, &plane), &faces, class);
+        if n == 0 {
+            assert_ne!(class, AreaClass::Umbra, "the light seen through the hole");
+        }
+        if class == AreaClass::Umbra {
+            umbra[usize::from(x[0] > grid.snap(DVec3::new(2.0, 0.0, 0.0)).unwrap()[0])] += 1;
+        }
+    }
+    assert!(
+        umbra[0] > 0 && umbra[1] > 0,
+        "umbra met under the torus and the sphere: {umbra:?}"
+    );
 }
