@@ -56,24 +56,7 @@ pub(crate) fn inner_occluders(
     solids: &SolidParts,
     axis: usize,
 ) -> Vec<(Occluder, Box3)> {
-    let mut members: Vec<Vec<usize>> = vec![Vec::new(); solids.len()];
-    for i in 0..faces.len() {
-        if solids.boundary(i).is_some() {
-            members[solids.part(i)].push(i);
-        }
-    }
-    let parts: Vec<(Vec<usize>, Box3)> = members
-        .into_iter()
-        .filter(|m| m.len() >= MIN_FACES)
-        .map(|m| {
-            let corners: Vec<GridPoint> = m
-                .iter()
-                .flat_map(|&i| faces[i].corners().iter().copied())
-                .collect();
-            let b = grid_box(&corners);
-            (m, b)
-        })
-        .collect();
+    let parts = certified_parts(faces, solids, MIN_FACES);
     let jobs: Vec<(usize, i64)> = parts
         .iter()
         .enumerate()
@@ -133,6 +116,33 @@ pub(crate) fn cores_at<'r>(
         let umbra = r.umbra.as_ref()?;
         (overlap(&b, &reach[1]) && !crate::near::outside(&corners, umbra)).then_some((r, *reach))
     })
+}
+
+/// The certified closed parts of `faces` of at least `min_faces` faces:
+/// each its faces' indices and the box of their corners.
+pub(crate) fn certified_parts(
+    faces: &[Occluder],
+    solids: &SolidParts,
+    min_faces: usize,
+) -> Vec<(Vec<usize>, Box3)> {
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); solids.len()];
+    for i in 0..faces.len() {
+        if solids.boundary(i).is_some() {
+            members[solids.part(i)].push(i);
+        }
+    }
+    members
+        .into_iter()
+        .filter(|m| !m.is_empty() && m.len() >= min_faces)
+        .map(|m| {
+            let corners: Vec<GridPoint> = m
+                .iter()
+                .flat_map(|&i| faces[i].corners().iter().copied())
+                .collect();
+            let b = grid_box(&corners);
+            (m, b)
+        })
+        .collect()
 }
 
 /// The regions and reach of the inner occluders that can decide light
@@ -423,23 +433,34 @@ fn hull(points: &[[f64; 2]]) -> Option<Vec<[i32; 2]>> {
 
 /// Whether the convex polygon `q` (grid corners in the plane
 /// `x[axis] = k`) lies strictly inside the solid the closed, oriented,
-/// embedded part `part` bounds: no triangle of `q` meets a triangle of the
-/// part's faces, and the part winds once around a corner of `q`.
+/// embedded part `part` bounds ([`placed`] is 1).
 fn inside(part: &[&[GridPoint]], axis: usize, q: &[GridPoint]) -> bool {
+    placed(part, axis, q) == Some(1)
+}
+
+/// How many times the closed, oriented, embedded part `part` (its faces'
+/// grid corners) winds around the convex polygon `q` (grid corners, one
+/// plane; or a segment or a point) where no triangle of `q` meets a
+/// triangle of the part's faces: 1 strictly inside the solid it bounds, 0
+/// strictly outside. `None` where they meet or may meet, or where every
+/// corner of `q` is degenerate for the ray along `axis` ([`winding`]).
+pub(crate) fn placed(part: &[&[GridPoint]], axis: usize, q: &[GridPoint]) -> Option<i64> {
     let qb = grid_box(q);
-    let tris_q: Vec<[GridPoint; 3]> = (1..q.len() - 1).map(|j| [q[0], q[j], q[j + 1]]).collect();
-    let near: Vec<&[GridPoint]> = part
-        .iter()
-        .copied()
-        .filter(|f| overlap(&grid_box(f), &qb))
-        .collect();
-    let apart = near.iter().all(|f| {
+    let tris_q: Vec<[GridPoint; 3]> = match q.len() {
+        0 => return None,
+        1 | 2 => vec![[q[0], q[q.len() - 1], q[0]]],
+        _ => (1..q.len() - 1).map(|j| [q[0], q[j], q[j + 1]]).collect(),
+    };
+    let apart = part.iter().filter(|f| overlap(&grid_box(f), &qb)).all(|f| {
         (1..f.len() - 1).all(|j| {
             let t = [f[0], f[j], f[j + 1]];
             tris_q.iter().all(|s| triangles_disjoint(s, &t))
         })
     });
-    apart && q.iter().find_map(|&p| winding(part, axis, p)) == Some(1)
+    if !apart {
+        return None;
+    }
+    q.iter().find_map(|&p| winding(part, axis, p))
 }
 
 /// The number of times the closed, outward part `part` winds around grid

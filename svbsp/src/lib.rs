@@ -54,6 +54,7 @@ mod light;
 mod near;
 mod psv;
 mod schedule;
+mod sealed;
 mod soft;
 mod wide;
 

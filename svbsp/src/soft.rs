@@ -177,6 +177,9 @@ pub struct SoftVolumes<'a> {
     /// Per light, the inner occluders that decide joint umbra
     /// ([`crate::cores`]).
     cores: Vec<Vec<(Regions, Reach)>>,
+    /// Per light, per face: strictly outside a closed part that holds the
+    /// light (umbra, whole; [`crate::sealed`]); empty for none.
+    sealed: Vec<Vec<bool>>,
 }
 
 impl std::fmt::Debug for SoftVolumes<'_> {
@@ -208,6 +211,10 @@ impl<'a> SoftVolumes<'a> {
             .unzip();
         Ok(SoftVolumes {
             cores: crate::cores::cores_per_light(lights, faces, &solids),
+            sealed: lights
+                .iter()
+                .map(|l| crate::sealed::sealed_faces(l, faces, &solids))
+                .collect(),
             corners: corner_shadows(lights, &polygons, &solids),
             backs: SolidBacks::new(faces, &sources, &solids),
             lights,
@@ -378,10 +385,19 @@ impl AreaLight {
         let cores = crate::cores::cores_per_light(std::slice::from_ref(self), faces, &solids)
             .pop()
             .unwrap_or_default();
+        let sealed = crate::sealed::sealed_faces(self, faces, &solids);
         faces
             .par_iter()
             .zip(&near)
-            .map_init(Scratch::default, |scratch, (face, near)| {
+            .enumerate()
+            .map_init(Scratch::default, |scratch, (i, (face, near))| {
+                if sealed.get(i) == Some(&true) {
+                    let polygon = face.to_polygon();
+                    return vec![AreaFragment {
+                        polygon,
+                        class: AreaClass::Umbra,
+                    }];
+                }
                 let others = near
                     .iter()
                     .filter_map(|&j| Some((regions[j as usize].as_ref()?, reach[j as usize])))
@@ -410,6 +426,13 @@ fn soft_face(
     let near: Vec<&[u32]> = run.near.iter().map(|n| &n[i][..]).collect();
     let mut pieces = vec![(face.to_polygon(), Classes::default())];
     for (k, light) in lights.iter().enumerate() {
+        if run.sealed[k].get(i) == Some(&true) {
+            pieces = pieces
+                .into_iter()
+                .map(|(p, c)| (p, c.with(k, AreaClass::Umbra)))
+                .collect();
+            continue;
+        }
         // the inner occluders last: they cut only what stays undecided
         let occluders = near[k]
             .iter()

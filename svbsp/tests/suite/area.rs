@@ -1080,3 +1080,29 @@ fn inner_occluders_decide_joint_umbra_only_where_it_is() {
         "umbra met under the torus and the sphere: {umbra:?}"
     );
 }
+
+/// A light sealed inside a closed box over the ground: every ground point
+/// is umbra (the view agrees at points near and far), through
+/// `soft_shadows` and `classify_faces` both, where each occluder alone
+/// leaves the far ground undecided (its light corners hidden by
+/// different walls).
+#[test]
+fn a_light_sealed_in_a_closed_box_leaves_the_outside_in_umbra() {
+    let mut faces = vec![ground(400)];
+    faces.extend(box_faces([-40, -40, 40], [40, 40, 120]));
+    let occluders: Vec<Occluder> = faces.iter().map(|f| Occluder::new(f).unwrap()).collect();
+    // shining down from inside the box
+    let light = AreaLight::new(&[[-8, -8, 100], [-8, 8, 100], [8, 8, 100], [8, -8, 100]]).unwrap();
+    let soft = svbsp::soft_shadows(std::slice::from_ref(&light), &occluders).unwrap();
+    let classified = light.classify_faces(&occluders);
+    assert!(soft[0].iter().all(|f| f.class(0) == AreaClass::Umbra));
+    assert!(classified[0].iter().all(|f| f.class == AreaClass::Umbra));
+    let plane = *occluders[0].plane();
+    for x in [[0, 0, 0], [100, 0, 0], [300, -250, 0], [-390, 390, 0]] {
+        assert_agrees(&light, (x, &plane), &occluders, AreaClass::Umbra);
+    }
+    // the ground alone under each wall: some of it undecided
+    let alone = light.classify_face(&occluders[0], &occluders);
+    let classes: Vec<AreaClass> = alone.iter().map(|f| f.class).collect();
+    assert!(classes.contains(&AreaClass::Undecided), "{classes:?}");
+}
