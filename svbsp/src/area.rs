@@ -33,7 +33,10 @@
 //! which some light corner is seen is penumbra; a piece whose every light
 //! corner is hidden, by different occluders, is undecided: its umbra may
 //! end on a quadric (EEE) surface, or on a plane of occluders that only
-//! together hide the light, which this first version does not resolve.
+//! together hide the light. Under a closed mesh, convex polygons certified
+//! inside its solid decide much of it ([`crate::cores`]), and a light
+//! sealed inside one leaves everything outside in umbra
+//! ([`crate::sealed`]).
 
 use bsp_core::internals::GridPolygon;
 use bsp_core::{FaceDefect, GridPoint, MAX_COORD, Plane, Polygon, PolygonSide, Side, Split};

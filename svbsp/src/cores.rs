@@ -67,7 +67,8 @@ pub(crate) fn inner_occluders(
                 .filter(move |&(_, k)| lo < k && k < hi)
         })
         .collect();
-    jobs.par_iter()
+    let mut cores: Vec<(Occluder, Box3)> = jobs
+        .par_iter()
         .flat_map_iter(|&(p, k)| {
             let (members, b) = &parts[p];
             let part: Vec<&[GridPoint]> = members.iter().map(|&i| faces[i].corners()).collect();
@@ -76,7 +77,11 @@ pub(crate) fn inner_occluders(
                 .into_iter()
                 .filter_map(move |q| Some((Occluder::new(&q).ok()?, *b)))
         })
-        .collect()
+        .collect();
+    // in the order of their corners, not of the parts' first faces: the
+    // fragments do not depend on the faces' order
+    cores.sort_by(|a, b| a.0.corners().cmp(b.0.corners()));
+    cores
 }
 
 /// Per light, the regions and reach of the inner occluders that can

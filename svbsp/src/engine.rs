@@ -168,6 +168,18 @@ impl LightVolumes {
         lights: &[Light],
         solids: &bsp_core::SolidParts,
     ) -> Result<LightVolumes, ShadowError> {
+        let order: Vec<usize> = (0..occluders.len()).collect();
+        LightVolumes::new_ordered(occluders, &order, lights, solids)
+    }
+
+    /// [`LightVolumes::new_with`] with the occluders taken in the order of
+    /// the indices `order` (each tree is built in that order).
+    pub(crate) fn new_ordered(
+        occluders: &[Polygon],
+        order: &[usize],
+        lights: &[Light],
+        solids: &bsp_core::SolidParts,
+    ) -> Result<LightVolumes, ShadowError> {
         if lights.len() > MAX_LIGHTS {
             return Err(LightError::TooMany(lights.len()).into());
         }
@@ -177,7 +189,7 @@ impl LightVolumes {
         // (polygons off the grid leave no part certified, so nothing is
         // left out and an error's index is the caller's)
         let build = |l: Light| {
-            let kept: Vec<&Polygon> = (occluders.iter().enumerate())
+            let kept: Vec<&Polygon> = (order.iter().map(|&i| (i, &occluders[i])))
                 .filter(|(i, p)| !l.leaves_out(solids, *i, p.support()))
                 .map(|(_, p)| p)
                 .collect();

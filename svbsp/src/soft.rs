@@ -215,7 +215,7 @@ impl<'a> SoftVolumes<'a> {
                 .iter()
                 .map(|l| crate::sealed::sealed_faces(l, faces, &solids))
                 .collect(),
-            corners: corner_shadows(lights, &polygons, &solids),
+            corners: corner_shadows(lights, (faces, &polygons), &solids),
             backs: SolidBacks::new(faces, &sources, &solids),
             lights,
             faces,
@@ -312,15 +312,19 @@ fn certified(faces: &[Occluder]) -> (Vec<Polygon>, bsp_core::SolidParts) {
 /// Per light, the point lights' shadow volumes of its corners over
 /// `faces` (which corners each point of a face sees); `None` for a light
 /// of more corners than the trees take (its pieces are then cut by each
-/// occluder's shadow volume from each corner instead).
+/// occluder's shadow volume from each corner instead). Each tree is built
+/// with the faces in the order of their corners, so the cells, and with
+/// them the fragments, do not depend on the faces' order.
 fn corner_shadows(
     lights: &[AreaLight],
-    polygons: &[Polygon],
+    (faces, polygons): (&[Occluder], &[Polygon]),
     solids: &bsp_core::SolidParts,
 ) -> Vec<Option<LightVolumes>> {
+    let mut order: Vec<usize> = (0..faces.len()).collect();
+    order.sort_by(|&a, &b| faces[a].corners().cmp(faces[b].corners()));
     lights
         .iter()
-        .map(|l| LightVolumes::new_with(polygons, l.corners(), solids).ok())
+        .map(|l| LightVolumes::new_ordered(polygons, &order, l.corners(), solids).ok())
         .collect()
 }
 
@@ -378,7 +382,7 @@ impl AreaLight {
         let regions: Vec<Option<Regions>> = blockers.par_iter().map(|o| self.regions(o)).collect();
         let (near, reach) = near_lists(self.corners(), faces, (&blockers, &regions));
         let (polygons, solids) = certified(faces);
-        let corners = corner_shadows(std::slice::from_ref(self), &polygons, &solids)
+        let corners = corner_shadows(std::slice::from_ref(self), (faces, &polygons), &solids)
             .pop()
             .flatten();
         let set = corners.as_ref().map(LightVolumes::set);

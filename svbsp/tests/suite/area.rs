@@ -1079,6 +1079,25 @@ fn inner_occluders_decide_joint_umbra_only_where_it_is() {
         umbra[0] > 0 && umbra[1] > 0,
         "umbra met under the torus and the sphere: {umbra:?}"
     );
+    // the same fragments with the faces in another order, on one thread
+    let mut order: Vec<usize> = (0..faces.len()).collect();
+    order.reverse();
+    order.swap(0, faces.len() / 2);
+    let shuffled: Vec<Occluder> = order.iter().map(|&i| faces[i].clone()).collect();
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| svbsp::soft_shadows(std::slice::from_ref(&light), &shuffled))
+        .unwrap();
+    let key = |fs: &[svbsp::SoftFragment]| -> Vec<(Vec<[f64; 3]>, u64, u64, u64)> {
+        fs.iter()
+            .map(|f| (f.polygon.vertices_f64(), f.lit, f.umbra, f.undecided))
+            .collect()
+    };
+    for (s, &i) in order.iter().enumerate() {
+        assert_eq!(key(&one[s]), key(&all[i]), "face {i}");
+    }
 }
 
 /// A light sealed inside a closed box over the ground: every ground point
