@@ -160,13 +160,7 @@ pub(crate) fn core_regions(
     scene: Box3,
 ) -> Vec<(Regions, Reach)> {
     let corners = light.corners();
-    let points: Vec<GridPoint> = corners
-        .iter()
-        .filter_map(|l| match l {
-            Light::Point(p) => Some(*p),
-            Light::Directional(_) => None,
-        })
-        .collect();
+    let points: Vec<GridPoint> = corners.iter().filter_map(Light::point).collect();
     cores
         .par_iter()
         .filter(|(_, part)| points.is_empty() || !overlap(&grid_box(&points), part))

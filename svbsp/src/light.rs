@@ -110,6 +110,14 @@ pub(crate) fn cross(u: [i64; 3], v: [i64; 3]) -> [i64; 3] {
 }
 
 impl Light {
+    /// The point of a point light; `None` for a sun.
+    pub(crate) fn point(&self) -> Option<[i32; 3]> {
+        match self {
+            Light::Point(p) => Some(*p),
+            Light::Directional(_) => None,
+        }
+    }
+
     /// Checks the coordinate bounds the arithmetic budget relies on.
     pub fn validate(&self) -> Result<(), LightError> {
         let c = match self {

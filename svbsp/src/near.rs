@@ -130,13 +130,7 @@ fn penumbra_box(lights: &[Light], o: &[GridPoint], scene: Box3) -> Box3 {
 /// `t·d` at the range's ends and `D`'s (`t ≥ 0`).
 fn penumbra_boxes(lights: &[Light], o: &[GridPoint], scene: Box3, parts: usize) -> Vec<Box3> {
     let ob = grid_box(o);
-    let points: Vec<GridPoint> = lights
-        .iter()
-        .filter_map(|l| match l {
-            Light::Point(p) => Some(*p),
-            Light::Directional(_) => None,
-        })
-        .collect();
+    let points: Vec<GridPoint> = lights.iter().filter_map(Light::point).collect();
     // a light point on the occluder's box: the volume may be anywhere
     if !points.is_empty() && overlap(&grid_box(&points), &ob) {
         return vec![scene];

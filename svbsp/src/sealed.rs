@@ -34,14 +34,7 @@ pub(crate) fn sealed_faces(
     faces: &[Occluder],
     solids: &SolidParts,
 ) -> Vec<bool> {
-    let corners: Option<Vec<GridPoint>> = light
-        .corners()
-        .iter()
-        .map(|l| match l {
-            Light::Point(p) => Some(*p),
-            Light::Directional(_) => None,
-        })
-        .collect();
+    let corners: Option<Vec<GridPoint>> = light.corners().iter().map(Light::point).collect();
     let Some(corners) = corners.filter(|c| c.len() >= 3) else {
         return Vec::new();
     };
