@@ -32,6 +32,7 @@ use rayon::prelude::*;
 use crate::area::{AreaLight, Occluder, Regions};
 use crate::boxes::{Box3, Reach, grid_box, overlap};
 use crate::light::Light;
+use crate::near::CellGrid;
 
 /// Slices of a part at most, evenly spaced across its box along the axis.
 const SLICES: usize = 16;
@@ -113,35 +114,60 @@ pub(crate) fn cores_per_light(
     lights: &[AreaLight],
     faces: &[Occluder],
     solids: &SolidParts,
-) -> Vec<Vec<(Regions, Reach)>> {
+) -> Vec<LightCores> {
     let Some(scene) = crate::near::scene_box(faces) else {
-        return lights.iter().map(|_| Vec::new()).collect();
+        return lights.iter().map(|_| LightCores::default()).collect();
     };
     let mut by_axis: [Option<Vec<(Occluder, Box3)>>; 3] = [None, None, None];
     lights
         .iter()
         .map(|l| {
             let Some(axis) = light_axis(l) else {
-                return Vec::new();
+                return LightCores::default();
             };
             let cores = by_axis[axis].get_or_insert_with(|| inner_occluders(faces, solids, axis));
-            core_regions(l, cores, scene)
+            let cores = core_regions(l, cores, scene);
+            let boxes: Vec<Box3> = cores.iter().map(|(_, reach)| reach[1]).collect();
+            let grid = (!cores.is_empty()).then(|| CellGrid::new(scene, &boxes));
+            LightCores { cores, grid }
         })
         .collect()
+}
+
+/// One light's inner occluders ([`core_regions`]), and a grid of their
+/// umbrae's boxes to find those near a face.
+#[derive(Default)]
+pub(crate) struct LightCores {
+    cores: Vec<(Regions, Reach)>,
+    grid: Option<CellGrid>,
 }
 
 /// The inner occluders of `cores` that may cut face `face`'s undecided
 /// pieces: their umbra's box meets the face's, and the face is not
 /// wholly outside their umbra.
 pub(crate) fn cores_at<'r>(
-    cores: &'r [(Regions, Reach)],
+    cores: &'r LightCores,
     face: &Occluder,
 ) -> impl Iterator<Item = (&'r Regions, Reach)> + use<'r> {
-    let corners = face.corners().to_vec();
-    let b = grid_box(&corners);
-    cores.iter().filter_map(move |(r, reach)| {
-        let umbra = r.umbra.as_ref()?;
-        (overlap(&b, &reach[1]) && !crate::near::outside(&corners, umbra)).then_some((r, *reach))
+    let corners = face.corners();
+    let b = grid_box(corners);
+    // (in their order, whatever cells the face's box meets)
+    let mut near = Vec::new();
+    if let Some(grid) = &cores.grid {
+        grid.visit(b, |i| near.push(i));
+    }
+    near.sort_unstable();
+    near.dedup();
+    near.retain(|&i| {
+        let (r, reach) = &cores.cores[i as usize];
+        overlap(&b, &reach[1])
+            && r.umbra
+                .as_ref()
+                .is_some_and(|u| !crate::near::outside(corners, u))
+    });
+    near.into_iter().map(|i| {
+        let (r, reach) = &cores.cores[i as usize];
+        (r, *reach)
     })
 }
 
@@ -622,7 +648,11 @@ mod tests {
         assert_eq!(light_axis(&above), Some(2));
         let cores = inner_occluders(&faces, &solids, 2);
         // one per 16 of its 128 faces at most (a slice or two may find none)
-        assert!((6..=8).contains(&cores.len()), "{} inner occluders", cores.len());
+        assert!(
+            (6..=8).contains(&cores.len()),
+            "{} inner occluders",
+            cores.len()
+        );
         for (q, _) in &cores {
             let z = q.corners()[0][2];
             assert!(q.corners().iter().all(|c| c[2] == z));
@@ -635,7 +665,7 @@ mod tests {
             &faces,
             &solids,
         );
-        let counts: Vec<usize> = per_light.iter().map(Vec::len).collect();
+        let counts: Vec<usize> = per_light.iter().map(|l| l.cores.len()).collect();
         assert_eq!(counts, [cores.len(), 0, 0]);
     }
 }

@@ -176,7 +176,7 @@ pub struct SoftVolumes<'a> {
     backs: SolidBacks,
     /// Per light, the inner occluders that decide joint umbra
     /// ([`crate::cores`]).
-    cores: Vec<Vec<(Regions, Reach)>>,
+    cores: Vec<crate::cores::LightCores>,
     /// Per light, per face: strictly outside a closed part that holds the
     /// light (umbra, whole; [`crate::sealed`]); empty for none.
     sealed: Vec<Vec<bool>>,
