@@ -157,8 +157,9 @@ pub fn mesh_sequence(
 
 /// `((first op₁ m₁) op₂ m₂) ...` on `grid`, the last result made as a
 /// mesh only ([`Planned::into_watertight_mesh`]: no solid of its own),
-/// with each operand handed over when its turn comes and let go once
-/// snapped, and each step told to `on_step`.
+/// with each operand handed over when its turn comes (the first two at
+/// once: they are snapped side by side) and let go once snapped, and
+/// each step told to `on_step`.
 ///
 /// The meshes must be checked already ([`check_mesh`]), and `grid` must
 /// hold every position of every mesh ([`fit_grid`]). `rest` is read one
@@ -242,19 +243,19 @@ fn operate<M: AsMeshIn>(
     mut rest: impl ExactSizeIterator<Item = (BoolOp, M)>,
     on_step: &mut dyn FnMut(Step),
 ) -> Result<Last, SequenceError> {
-    let mut solid = snap_operand(grid, first, 0, on_step)?;
-    if rest.len() == 0 {
+    let Some((mut op, second)) = rest.next() else {
         // a sequence of one: its solid, cleaned (a shell that crosses
         // itself bounds where its winding number is positive)
+        let solid = snap_operand(grid, first, 0, on_step)?;
         let stage = Stage::Snap(0);
-        solid = solid
+        let solid = solid
             .resolved()
             .map_err(|error| SequenceError { stage, error })?;
-    }
-    let mut operand = 0;
-    while let Some((op, mesh)) = rest.next() {
-        operand += 1;
-        let other = snap_operand(grid, mesh, operand, on_step)?;
+        return Ok(Last::Solid(Box::new(solid)));
+    };
+    let (mut solid, mut other) = snap_two(grid, (first, second), on_step)?;
+    let mut operand = 1;
+    loop {
         let stage = Stage::Operation(operand);
         on_step(Step::Started(stage));
         let planned = solid
@@ -270,8 +271,43 @@ fn operate<M: AsMeshIn>(
         }
         solid = planned.into_solid();
         on_step(Step::Finished(stage));
+        let Some((next, mesh)) = rest.next() else {
+            return Ok(Last::Solid(Box::new(solid)));
+        };
+        operand += 1;
+        op = next;
+        other = snap_operand(grid, mesh, operand, on_step)?;
     }
-    Ok(Last::Solid(Box::new(solid)))
+}
+
+/// The solids of the first two operands, snapped side by side (each
+/// snap has parts on one thread: counting its shells, numbering the
+/// certificate's points, making the solid), their steps told in order as
+/// [`snap_operand`] tells them, and the first error in operand order.
+fn snap_two<M: AsMeshIn>(
+    grid: &Grid,
+    (first, second): (M, M),
+    on_step: &mut dyn FnMut(Step),
+) -> Result<(Solid, Solid), SequenceError> {
+    let (a, b) = (first.as_mesh_in(), second.as_mesh_in());
+    on_step(Step::Started(Stage::Snap(0)));
+    let (snapped_a, snapped_b) =
+        bsp_core::par::join(|| snap_one(grid, &a, 0), || snap_one(grid, &b, 1));
+    let told = |operand: usize,
+                snapped: Result<(Solid, ImportReport), CsgError>,
+                on_step: &mut dyn FnMut(Step)| {
+        let stage = Stage::Snap(operand);
+        let (solid, report) = snapped.map_err(|error| SequenceError { stage, error })?;
+        on_step(Step::Finished(stage));
+        on_step(Step::Snapped { operand, report });
+        Ok::<Solid, SequenceError>(solid)
+    };
+    let solid_a = told(0, snapped_a, on_step)?;
+    drop(first);
+    on_step(Step::Started(Stage::Snap(1)));
+    let solid_b = told(1, snapped_b, on_step)?;
+    drop(second);
+    Ok((solid_a, solid_b))
 }
 
 /// The solid of operand `operand`'s mesh, which is let go once the step
@@ -443,9 +479,11 @@ mod tests {
         }
     }
 
-    /// Each operand is taken from the iterator when its turn comes (after
-    /// the operation before is decided), and let go right after the step
-    /// that says it is snapped: a long sequence holds one operand's mesh.
+    /// The first two operands are taken at once (they are snapped side by
+    /// side), each later one when its turn comes (after the operation
+    /// before is decided), and each is let go right after the step that
+    /// says it is snapped: a long sequence holds one or two operands'
+    /// meshes.
     #[test]
     fn operands_are_taken_in_turn_and_let_go_once_snapped() {
         let meshes = three();
@@ -477,11 +515,11 @@ mod tests {
         assert_eq!(
             *log.borrow(),
             [
+                "take 1",
                 "snapping operand 0",
                 "end of snapping operand 0",
                 "snapped 0",
                 "drop 0",
-                "take 1",
                 "snapping operand 1",
                 "end of snapping operand 1",
                 "snapped 1",
