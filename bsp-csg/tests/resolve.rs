@@ -531,14 +531,7 @@ fn a_single_shell_crossing_itself_is_resolved_as_any_operand() {
     bsp_core::check_closed_manifold(a.faces.iter().map(Vec::as_slice)).unwrap();
     let alone = mesh_sequence(&view(&a), &[]).unwrap().volume();
     // the signed volume is less: part of the inside is turned out
-    let signed: f64 = a
-        .faces
-        .iter()
-        .map(|f| {
-            let [p, q, r] = [0, 1, 2].map(|k| a.positions[f[k] as usize]);
-            p.dot(q.cross(r)) / 6.0
-        })
-        .sum();
+    let signed = six_volume(&a, &a.faces) / 6.0;
     assert!(signed < alone - 1.0, "signed {signed}, resolved {alone}");
     let far = boxes(&[([10.0; 3], [11.0; 3], false)]);
     let around = boxes(&[([-10.0; 3], [10.0; 3], false)]);
@@ -585,16 +578,24 @@ fn a_shell_nested_in_another_at_a_shared_corner_counts_once() {
         vec![corner, c, b],
         vec![corner, a, c],
     ]);
-    let six: f64 = mesh.faces[6..]
+    assert!(
+        six_volume(&mesh, &mesh.faces[6..]) > 0.0,
+        "the tetrahedron is outward"
+    );
+    let far = boxes(&[([10.0; 3], [11.0; 3], false)]);
+    assert_eq!(mesh_sequence(&view(&mesh), &[]).unwrap().volume(), 64.0);
+    let with_far = mesh_sequence(&view(&mesh), &[(BoolOp::Union, view(&far))]).unwrap();
+    assert_eq!(with_far.volume(), 65.0);
+}
+
+/// Six times the signed volume the triangles `faces` of `mesh` enclose
+/// with the origin.
+fn six_volume(mesh: &MeshBuf, faces: &[Vec<u32>]) -> f64 {
+    faces
         .iter()
         .map(|f| {
             let [p, q, r] = [0, 1, 2].map(|k| mesh.positions[f[k] as usize]);
             p.dot(q.cross(r))
         })
-        .sum();
-    assert!(six > 0.0, "the tetrahedron is outward");
-    let far = boxes(&[([10.0; 3], [11.0; 3], false)]);
-    assert_eq!(mesh_sequence(&view(&mesh), &[]).unwrap().volume(), 64.0);
-    let with_far = mesh_sequence(&view(&mesh), &[(BoolOp::Union, view(&far))]).unwrap();
-    assert_eq!(with_far.volume(), 65.0);
+        .sum()
 }

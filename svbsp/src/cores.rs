@@ -187,13 +187,11 @@ pub(crate) fn certified_parts(
     members
         .into_iter()
         .filter(|m| !m.is_empty() && m.len() >= min_faces)
-        .map(|m| {
-            let corners: Vec<GridPoint> = m
-                .iter()
-                .flat_map(|&i| faces[i].corners().iter().copied())
-                .collect();
-            let b = grid_box(&corners);
-            (m, b)
+        .filter_map(|m| {
+            // the certificate's box is the box of the part's corners
+            let c = solids.boundary(m[0])?;
+            let b = [0, 1, 2].map(|k| [i64::from(c.lo[k]), i64::from(c.hi[k])]);
+            Some((m, b))
         })
         .collect()
 }
