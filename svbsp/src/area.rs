@@ -44,7 +44,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
-use crate::boxes::{Box3, Near, Reach, Scan, Scans, polygon_box};
+use crate::boxes::{Box3, Near, Reach, ReachIndex, Scan, Scans, grid_box, polygon_box};
 use crate::light::{
     AreaLightError, Light, MAX_DISC_RADIUS, cross, plane_along, quantize_direction,
 };
@@ -816,8 +816,13 @@ impl AreaLight {
         let (active, done): (Vec<Piece<K>>, Vec<Piece<K>>) = pieces
             .into_iter()
             .partition(|p| !known || !p.umbra && (p.hidden == 0 || p.hidden == all || flat));
+        // many pieces, each cut by many occluders: an index of the
+        // occluders' boxes spares each piece passing over all of them
+        let index = (active.len() > 1 && regions.len() > 128)
+            .then(|| ReachIndex::new(grid_box(face.corners()), regions.iter().map(|(_, r)| r)));
         let how = Cutting {
             regions: &regions,
+            index,
             all,
             known,
         };
@@ -968,6 +973,9 @@ struct Piece<K> {
 /// piece sees are known.
 struct Cutting<'a, 'r> {
     regions: &'a [(&'r Regions, Reach)],
+    /// Where a face has many pieces and occluders: which occluders may
+    /// meet the pieces within a box.
+    index: Option<ReachIndex>,
     all: u64,
     known: bool,
 }
@@ -978,13 +986,24 @@ impl Cutting<'_, '_> {
     fn family<K: Copy + PartialEq>(&self, first: Piece<K>) -> Vec<Piece<K>> {
         let (all, known) = (self.all, self.known);
         let scan = |p: &Piece<K>| scan_of(p, known && p.hidden == all);
+        // every part of `first` lies in its box: the occluders whose boxes
+        // miss it are passed over (in order: the parts are the same)
+        let picked: Vec<(&Regions, Reach)>;
+        let regions = match &self.index {
+            Some(index) => {
+                let near = index.near(&first.bbox).into_iter();
+                picked = near.map(|i| self.regions[i as usize]).collect();
+                &picked[..]
+            }
+            None => self.regions,
+        };
         let mut pieces = vec![first];
         // beside the pieces, in step, what an occluder's boxes are tested
         // against: a face's pieces times its occluders are the most
         // pairs, and most are apart
         let mut scans = Scans::new(pieces.iter().map(scan));
         let mut merged = 0;
-        for &(r, reach) in self.regions {
+        for &(r, reach) in regions {
             // pieces this occluder leaves as they are stay in place; the
             // others are cut and their parts appended
             let mut parts = Vec::new();

@@ -137,6 +137,177 @@ impl Scans {
     }
 }
 
+/// A uniform grid of cells over the scene, each listing the faces whose
+/// box meets it. A coordinate's cell is `(v − lo)·n / extent`, rounded
+/// down, in integers: it never decreases as `v` grows, so a box meets
+/// every cell of every face box it meets.
+pub(crate) struct CellGrid {
+    lo: [i64; 3],
+    extent: [i64; 3],
+    n: [usize; 3],
+    cells: Vec<Vec<u32>>,
+}
+
+impl CellGrid {
+    /// About one cell per face, cubes as far as the scene's shape allows.
+    pub(crate) fn new(scene: Box3, boxes: &[Box3]) -> CellGrid {
+        let mut grid = CellGrid::empty(scene, boxes.len());
+        for (i, b) in boxes.iter().enumerate() {
+            grid.insert(i as u32, *b);
+        }
+        grid
+    }
+
+    /// A grid of about one cell per face for `faces` faces, none listed.
+    fn empty(scene: Box3, faces: usize) -> CellGrid {
+        let extent = scene.map(|[lo, hi]| hi - lo + 1);
+        let volume: f64 = extent.iter().map(|&e| e as f64).product();
+        let side = (volume / faces.max(1) as f64).cbrt();
+        CellGrid::of_side(scene, [side; 3], faces)
+    }
+
+    /// A grid of cells about `side` long per axis (longer where that
+    /// would make more than about two cells per face), none listed.
+    fn of_side(scene: Box3, mut side: [f64; 3], faces: usize) -> CellGrid {
+        let extent = scene.map(|[lo, hi]| hi - lo + 1);
+        let target = faces.max(1) as f64;
+        // a flat scene (one face's box) would get too many thin cells
+        let n = loop {
+            let n = [0, 1, 2].map(|k| ((extent[k] as f64 / side[k]).ceil() as usize).clamp(1, 512));
+            if (n[0] * n[1] * n[2]) as f64 <= 2.0 * target + 8.0 {
+                break n;
+            }
+            side = side.map(|s| s * 1.25);
+        };
+        CellGrid {
+            lo: scene.map(|[lo, _]| lo),
+            extent,
+            n,
+            cells: vec![Vec::new(); n[0] * n[1] * n[2]],
+        }
+    }
+
+    /// Lists face `i` in every cell its box `b` meets.
+    fn insert(&mut self, i: u32, b: Box3) {
+        let (lo, hi) = self.range(b);
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    let c = self.cell([x, y, z]);
+                    self.cells[c].push(i);
+                }
+            }
+        }
+    }
+
+    fn cell(&self, c: [usize; 3]) -> usize {
+        (c[0] * self.n[1] + c[1]) * self.n[2] + c[2]
+    }
+
+    /// The cells a box meets, per axis from and to (inclusive).
+    fn range(&self, b: Box3) -> ([usize; 3], [usize; 3]) {
+        let at = |k: usize, v: i64| {
+            let off = i128::from(v.clamp(self.lo[k], self.lo[k] + self.extent[k] - 1) - self.lo[k]);
+            (off * self.n[k] as i128 / i128::from(self.extent[k])) as usize
+        };
+        (
+            [0, 1, 2].map(|k| at(k, b[k][0])),
+            [0, 1, 2].map(|k| at(k, b[k][1])),
+        )
+    }
+
+    /// How many cells box `b` meets.
+    fn cells_met(&self, b: Box3) -> usize {
+        let (lo, hi) = self.range(b);
+        (0..3).map(|k| hi[k] + 1 - lo[k]).product()
+    }
+
+    /// Calls `f` with every face listed in a cell that `b` meets (a face
+    /// may come more than once).
+    pub(crate) fn visit(&self, b: Box3, mut f: impl FnMut(u32)) {
+        let (lo, hi) = self.range(b);
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    self.cells[self.cell([x, y, z])].iter().for_each(|&i| f(i));
+                }
+            }
+        }
+    }
+}
+
+/// The occluders' [`Reach`]es near one face, indexed by a [`CellGrid`]
+/// over the face's box: for a box within the face, the occluders whose
+/// boxes may meet it, in their order (a superset of those that do). A
+/// face's pieces lie in its box, so an occluder whose boxes miss the
+/// face's box meets none of them.
+pub(crate) struct ReachIndex {
+    grid: CellGrid,
+    /// The occluder of each box in the grid.
+    of: Vec<u32>,
+    /// Occluders whose boxes span more than a quarter of the cells: met
+    /// by every box asked about.
+    wide: Vec<u32>,
+}
+
+impl ReachIndex {
+    pub(crate) fn new<'a>(face: Box3, reaches: impl Iterator<Item = &'a Reach>) -> ReachIndex {
+        let (mut boxes, mut of, mut wide) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, reach) in reaches.enumerate() {
+            // both boxes as one, within the face's (an empty box adds nothing)
+            let within = reach.iter().filter_map(|r| meet(r, &face));
+            if let Some(b) = within
+                .reduce(|a, b| [0, 1, 2].map(|k| [a[k][0].min(b[k][0]), a[k][1].max(b[k][1])]))
+            {
+                boxes.push(b);
+                of.push(i as u32);
+            }
+        }
+        // cells about as long as the boxes' median, per axis: a box meets a
+        // few cells, not thousands
+        let side = [0, 1, 2].map(|k| {
+            let mut e: Vec<i64> = boxes.iter().map(|b| b[k][1] - b[k][0] + 1).collect();
+            let mid = e.len() / 2;
+            if mid < e.len() {
+                e.select_nth_unstable(mid);
+            }
+            e.get(mid).map_or(1.0, |&m| m as f64)
+        });
+        let mut grid = CellGrid::of_side(face, side, boxes.len());
+        let cells = grid.cells.len();
+        let mut kept = Vec::with_capacity(boxes.len());
+        for (b, i) in boxes.into_iter().zip(of) {
+            if 4 * grid.cells_met(b) > cells {
+                wide.push(i);
+            } else {
+                grid.insert(kept.len() as u32, b);
+                kept.push(i);
+            }
+        }
+        ReachIndex {
+            grid,
+            of: kept,
+            wide,
+        }
+    }
+
+    /// The occluders whose boxes may meet `b`, ascending, each once.
+    pub(crate) fn near(&self, b: &Box3) -> Vec<u32> {
+        let mut ids = self.wide.clone();
+        self.grid.visit(*b, |g| ids.push(self.of[g as usize]));
+        ids.sort_unstable();
+        ids.dedup();
+        ids
+    }
+}
+
+/// The box two boxes share; `None` where they do not meet (or either is
+/// empty).
+fn meet(a: &Box3, b: &Box3) -> Option<Box3> {
+    let m = [0, 1, 2].map(|k| [a[k][0].max(b[k][0]), a[k][1].min(b[k][1])]);
+    m.iter().all(|[lo, hi]| lo <= hi).then_some(m)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -185,6 +356,39 @@ mod tests {
                             }
                             None => i += 1,
                         }
+                    }
+                }
+            }
+        }
+
+        /// For any box within a face's box, the index lists every
+        /// occluder one of whose boxes (possibly empty, or unbounded)
+        /// meets it, ascending and each once.
+        #[test]
+        fn the_index_lists_every_occluder_near_a_box(
+            reaches in prop::collection::vec((a_box(), a_box(), 0u8..8), 0..200),
+            face in a_box(),
+            asked in prop::collection::vec(a_box(), 1..20),
+        ) {
+            // some boxes empty (lo > hi), some everywhere, the rest as drawn
+            let reaches: Vec<Reach> = reaches
+                .into_iter()
+                .map(|(a, b, kind)| match kind {
+                    0 => [[[5, 4], [0, 0], [0, 0]], b],
+                    1 => [EVERYWHERE, a],
+                    _ => [a, b],
+                })
+                .collect();
+            // a flat face, as most are
+            let face = [face[0], [face[1][0], face[1][0]], face[2]];
+            let index = ReachIndex::new(face, reaches.iter());
+            for b in asked {
+                let Some(b) = meet(&b, &face) else { continue };
+                let listed = index.near(&b);
+                prop_assert!(listed.windows(2).all(|w| w[0] < w[1]));
+                for (i, r) in reaches.iter().enumerate() {
+                    if overlap(&r[0], &b) || overlap(&r[1], &b) {
+                        prop_assert!(listed.contains(&(i as u32)), "occluder {} missed", i);
                     }
                 }
             }

@@ -30,9 +30,8 @@ use bsp_core::{GridPoint, SolidParts};
 use rayon::prelude::*;
 
 use crate::area::{AreaLight, Occluder, Regions};
-use crate::boxes::{Box3, Reach, grid_box, overlap};
+use crate::boxes::{Box3, CellGrid, Reach, grid_box, overlap};
 use crate::light::Light;
-use crate::near::CellGrid;
 
 /// Slices of a part at most, evenly spaced across its box along the axis.
 const SLICES: usize = 16;

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use crate::area::{HalfSpaces, Occluder, Regions};
 use crate::blockers::plane_key;
-use crate::boxes::{Box3, Reach, grid_box, overlap};
+use crate::boxes::{Box3, CellGrid, Reach, grid_box, overlap};
 use crate::light::Light;
 
 /// Per receiving face, the indices of the occluders not in its plane whose
@@ -292,82 +292,6 @@ pub(crate) fn slab_box(lights: &[Light], o: &[GridPoint], plane: &Plane) -> InSl
         InSlab::Within(b)
     } else {
         InSlab::Nothing
-    }
-}
-
-/// A uniform grid of cells over the scene, each listing the faces whose
-/// box meets it. A coordinate's cell is `(v − lo)·n / extent`, rounded
-/// down, in integers: it never decreases as `v` grows, so a box meets
-/// every cell of every face box it meets.
-pub(crate) struct CellGrid {
-    lo: [i64; 3],
-    extent: [i64; 3],
-    n: [usize; 3],
-    cells: Vec<Vec<u32>>,
-}
-
-impl CellGrid {
-    /// About one cell per face, cubes as far as the scene's shape allows.
-    pub(crate) fn new(scene: Box3, boxes: &[Box3]) -> CellGrid {
-        let extent = scene.map(|[lo, hi]| hi - lo + 1);
-        let volume: f64 = extent.iter().map(|&e| e as f64).product();
-        let target = boxes.len().max(1) as f64;
-        let mut side = (volume / target).cbrt();
-        // a flat scene (one face's box) would get too many thin cells
-        let n = loop {
-            let n = extent.map(|e| ((e as f64 / side).ceil() as usize).clamp(1, 512));
-            if (n[0] * n[1] * n[2]) as f64 <= 2.0 * target + 8.0 {
-                break n;
-            }
-            side *= 1.25;
-        };
-        let mut grid = CellGrid {
-            lo: scene.map(|[lo, _]| lo),
-            extent,
-            n,
-            cells: vec![Vec::new(); n[0] * n[1] * n[2]],
-        };
-        for (i, b) in boxes.iter().enumerate() {
-            let (lo, hi) = grid.range(*b);
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        let c = grid.cell([x, y, z]);
-                        grid.cells[c].push(i as u32);
-                    }
-                }
-            }
-        }
-        grid
-    }
-
-    fn cell(&self, c: [usize; 3]) -> usize {
-        (c[0] * self.n[1] + c[1]) * self.n[2] + c[2]
-    }
-
-    /// The cells a box meets, per axis from and to (inclusive).
-    fn range(&self, b: Box3) -> ([usize; 3], [usize; 3]) {
-        let at = |k: usize, v: i64| {
-            let off = i128::from(v.clamp(self.lo[k], self.lo[k] + self.extent[k] - 1) - self.lo[k]);
-            (off * self.n[k] as i128 / i128::from(self.extent[k])) as usize
-        };
-        (
-            [0, 1, 2].map(|k| at(k, b[k][0])),
-            [0, 1, 2].map(|k| at(k, b[k][1])),
-        )
-    }
-
-    /// Calls `f` with every face listed in a cell that `b` meets (a face
-    /// may come more than once).
-    pub(crate) fn visit(&self, b: Box3, mut f: impl FnMut(u32)) {
-        let (lo, hi) = self.range(b);
-        for x in lo[0]..=hi[0] {
-            for y in lo[1]..=hi[1] {
-                for z in lo[2]..=hi[2] {
-                    self.cells[self.cell([x, y, z])].iter().for_each(|&i| f(i));
-                }
-            }
-        }
     }
 }
 

@@ -21,10 +21,10 @@ use crate::area::{
 };
 use crate::backs::SolidBacks;
 use crate::blockers::{coplanar_blockers, coplanar_blockers_of, plane_key};
-use crate::boxes::{Box3, EVERYWHERE, Reach, grid_box};
+use crate::boxes::{Box3, CellGrid, EVERYWHERE, Reach, grid_box};
 use crate::engine::{LightVolumes, Scratch};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
-use crate::near::{CellGrid, InSlab, near_lists, slab_box};
+use crate::near::{InSlab, near_lists, slab_box};
 
 /// The share of a polygon light's irradiance that arrives on a penumbra
 /// fragment ([`crate::LightView::fraction`]): at the grid point nearest its
