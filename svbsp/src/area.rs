@@ -322,6 +322,11 @@ impl AreaLight {
         &self.corners
     }
 
+    /// The corners of a polygon light at finite distance.
+    pub(crate) fn grid_corners(&self) -> Option<&[GridPoint]> {
+        self.polygon.as_ref().map(GridPolygon::vertices)
+    }
+
     /// The light's plane, for a polygon at finite distance; it emits on
     /// the front side.
     pub fn plane(&self) -> Option<&Plane> {

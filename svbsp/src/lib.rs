@@ -47,6 +47,7 @@ mod backs;
 mod blockers;
 mod boxes;
 mod chin_feiner;
+mod cones;
 mod cores;
 mod engine;
 pub mod export;

@@ -623,6 +623,12 @@ fn fraction_at(
             .collect();
         return sky_share(&sky, xf, normal, hiding);
     }
+    if let (Some(corners), Some(plane)) = (light.grid_corners(), light.plane())
+        && let Some(share) =
+            crate::cones::seen_share(corners, plane, face.plane(), x, normal, hiding.clone())
+    {
+        return share;
+    }
     let view = light.view_among(x, Some(face.plane()), hiding)?;
     view.fraction(xf, normal)
 }

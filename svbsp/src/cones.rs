@@ -1,0 +1,610 @@
+//! What a grid point sees of a polygon light, as cones of directions from
+//! it: the quick path of the visible share ([`seen_share`]).
+//!
+//! Every plane the share needs passes through the point `x`: the planes
+//! through `x` and a light edge bound the light's cone, and those through
+//! `x` and an occluder edge bound the occluder's. So with `x` as origin
+//! each is a normal vector alone, `(a − x) × (b − x)` of two grid points:
+//! below `2^55` per coordinate. A piece of the light is a convex cone,
+//! its boundary planes in turn (counter-clockwise seen from `x`, normals
+//! inward); its corner `i` is the ray `n_i × n_{i+1}`, never computed:
+//! the side of a plane `m` a corner lies on is the sign of
+//! `det(n_i, n_{i+1}, m)`, below `2^168`, exact (an `f64` filter, then
+//! 256-bit integers). Cutting makes no new numbers, only new lists.
+//!
+//! An occluder hides the light points `q` whose segment `x q` meets it.
+//! Where it lies strictly on `x`'s side of the light's plane, those are
+//! exactly the light points in its cone (the segment to `q` holds every
+//! point of the ray before the light's plane); where it lies on the light's
+//! plane or beyond, it hides none. An occluder crossing the light's plane,
+//! or a face plane cutting the light, is left to the general path
+//! (`AreaLight::view_among`), which cuts exact polygons in space.
+
+use bsp_core::{GridPoint, Plane, Side};
+use glam::DVec3;
+use rustc_hash::FxHashMap;
+use smallvec::SmallVec;
+
+use crate::area::Occluder;
+
+/// A plane through the viewing point, by its normal; inside: `n · d > 0`.
+type Line = [i64; 3];
+
+/// The boundary planes of a convex cone of directions, in turn.
+type Planes = SmallVec<[Line; 6]>;
+
+/// The ray `a × b` of two planes, exactly (below `2^111`) and rounded to
+/// `f64`.
+#[derive(Clone, Copy, Debug)]
+struct Ray {
+    exact: [i128; 3],
+    approx: [f64; 3],
+}
+
+impl Ray {
+    fn new(a: &Line, b: &Line) -> Ray {
+        let m = |p: i64, q: i64| i128::from(p) * i128::from(q);
+        let exact = [
+            m(a[1], b[2]) - m(a[2], b[1]),
+            m(a[2], b[0]) - m(a[0], b[2]),
+            m(a[0], b[1]) - m(a[1], b[0]),
+        ];
+        Ray {
+            exact,
+            approx: exact.map(|v| v as f64),
+        }
+    }
+}
+
+/// A convex piece of the light's cone: its planes in turn (counter-
+/// clockwise seen from the point), and its corners' rays rounded to `f64`
+/// (corner `i` between planes `i` and `i + 1`; the exact ray is made
+/// again where the rounded one does not decide).
+#[derive(Clone, Debug)]
+struct Piece {
+    planes: Planes,
+    rays: SmallVec<[[f64; 3]; 6]>,
+}
+
+impl Piece {
+    fn new(planes: Planes) -> Piece {
+        let n = planes.len();
+        let rays = (0..n)
+            .map(|i| Ray::new(&planes[i], &planes[(i + 1) % n]).approx)
+            .collect();
+        Piece { planes, rays }
+    }
+
+    /// The side of plane `m` corner `i` lies on.
+    fn side(&self, m: &Line, i: usize) -> i32 {
+        match filtered(m, &self.rays[i]) {
+            Some(s) => s,
+            None => {
+                let n = self.planes.len();
+                exact_side(m, &Ray::new(&self.planes[i], &self.planes[(i + 1) % n]))
+            }
+        }
+    }
+}
+
+/// The share of the light polygon with grid `corners` (strictly convex)
+/// that grid point `x` on a face with plane `face` and unit `normal`
+/// receives past `hiders` (in the order given), as
+/// [`crate::LightView::fraction`] gives it: `None` where this path does
+/// not apply (see the module docs), else that value (`Some(None)`:
+/// nothing arrives).
+pub(crate) fn seen_share<'o>(
+    corners: &[GridPoint],
+    light: &Plane,
+    face: &Plane,
+    x: GridPoint,
+    normal: DVec3,
+    hiders: impl Iterator<Item = &'o Occluder>,
+) -> Option<Option<f64>> {
+    let side = light.classify_grid(x);
+    if side != Side::Front
+        || corners
+            .iter()
+            .any(|&l| face.classify_grid(l) != Side::Front)
+    {
+        return None;
+    }
+    // every occluder wholly on `x`'s side of the light's plane, or on it
+    // or beyond (hiding nothing)
+    let mut cones: Vec<Planes> = Vec::new();
+    for o in hiders {
+        let sides = o.corners().iter().map(|&c| light.classify_grid(c));
+        // (a corner on the light's plane hides an area of it from
+        // neither side)
+        let (near, far) = sides.fold((0, 0), |(n, f), s| match s {
+            Side::Front => (n + 1, f),
+            Side::Back => (n, f + 1),
+            Side::On => (n, f),
+        });
+        if near > 0 && far > 0 {
+            return None;
+        }
+        if near > 0
+            && let Some(cone) = occluder_cone(o.corners(), x)
+        {
+            cones.push(cone);
+        }
+    }
+    let light_cone = Piece::new(light_cone(corners, x));
+    let all = form_factor(normal, &light_cone);
+    if all <= 0.0 {
+        return Some(None);
+    }
+    let mut seen = vec![light_cone];
+    let (mut hidden, mut merged) = (false, 0);
+    let mut parts = Vec::new();
+    for cone in &cones {
+        // pieces the cone leaves whole stay in place; the parts of those
+        // it cuts outside it are appended
+        let mut i = 0;
+        while i < seen.len() {
+            if cut(cone, &seen[i], &mut parts) {
+                hidden = true;
+                seen.swap_remove(i);
+            } else {
+                i += 1;
+            }
+        }
+        seen.append(&mut parts);
+        if seen.is_empty() {
+            break;
+        }
+        // merged as they pile up (later cones then meet fewer)
+        if seen.len() > 16 && seen.len() > 2 * merged {
+            seen = merge(seen);
+            merged = seen.len();
+        }
+    }
+    if !hidden {
+        return Some(Some(1.0));
+    }
+    let part: f64 = seen.iter().map(|c| form_factor(normal, c)).sum();
+    Some(Some((part / all).clamp(0.0, 1.0)))
+}
+
+/// `a × b` of grid differences (below `2^27`): below `2^55`.
+fn cross(a: [i64; 3], b: [i64; 3]) -> Line {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn from(x: GridPoint, p: GridPoint) -> [i64; 3] {
+    [0, 1, 2].map(|k| i64::from(p[k]) - i64::from(x[k]))
+}
+
+/// The light's cone from `x` (strictly in front of its plane): counter-
+/// clockwise seen from `x`, so that `n_i × n_{i+1}` points along corner
+/// `i + 1`.
+fn light_cone(corners: &[GridPoint], x: GridPoint) -> Planes {
+    let d: Vec<[i64; 3]> = corners.iter().map(|&c| from(x, c)).collect();
+    let n = d.len();
+    let turn = det_sign(&d[0], &d[1], &d[2]);
+    (0..n)
+        .map(|i| match turn {
+            1 => cross(d[i], d[(i + 1) % n]),
+            _ => cross(d[(n - i) % n], d[(2 * n - i - 1) % n]),
+        })
+        .collect()
+}
+
+/// The cone of directions from `x` that meet occluder `corners` (a convex
+/// polygon): inside the plane through `x` and each edge, on the side of
+/// the next corner; `None` where `x` lies in the occluder's plane.
+fn occluder_cone(corners: &[GridPoint], x: GridPoint) -> Option<Planes> {
+    let n = corners.len();
+    let mut cone = Planes::new();
+    for i in 0..n {
+        let (a, b, c) = (corners[i], corners[(i + 1) % n], corners[(i + 2) % n]);
+        let h = cross(from(x, a), from(x, b));
+        let s: i128 = (0..3)
+            .map(|k| i128::from(h[k]) * i128::from(from(x, c)[k]))
+            .sum();
+        match s.signum() {
+            1 => cone.push(h),
+            -1 => cone.push(h.map(|v| -v)),
+            _ => return None,
+        }
+    }
+    Some(cone)
+}
+
+/// The sign of `det(a, b, c) = a · (b × c)` for coordinates below `2^55`:
+/// the side of `a` that the ray `b × c` lies on.
+fn det_sign(a: &Line, b: &Line, c: &Line) -> i32 {
+    side(a, &Ray::new(b, c))
+}
+
+/// The side of plane `m` (below `2^55`) ray `r` lies on: the sign of
+/// `m · r`.
+fn side(m: &Line, r: &Ray) -> i32 {
+    filtered(m, &r.approx).unwrap_or_else(|| exact_side(m, r))
+}
+
+/// The sign of `m · r` from `r` correctly rounded, where the error bound
+/// decides (each of the three products within 3 roundings of `2^-53`,
+/// their sum within 2 more).
+fn filtered(m: &Line, r: &[f64; 3]) -> Option<i32> {
+    let t = [0, 1, 2].map(|k| m[k] as f64 * r[k]);
+    let sum = t[0] + t[1] + t[2];
+    let bound = (t[0].abs() + t[1].abs() + t[2].abs()) * (8.0 * f64::EPSILON);
+    if sum > bound {
+        Some(1)
+    } else if sum < -bound {
+        Some(-1)
+    } else {
+        None
+    }
+}
+
+/// The sign of `m · r` exactly: each `r_k = h_k 2^64 + l_k` with
+/// `0 ≤ l_k < 2^64`, so `m · r = A 2^64 + B` with `A = Σ m_k h_k` (below
+/// `2^104`) and `B = Σ m_k l_k` (below `2^121`).
+fn exact_side(m: &Line, r: &Ray) -> i32 {
+    let (mut a, mut b) = (0i128, 0i128);
+    for (&m, &c) in m.iter().zip(&r.exact) {
+        a += i128::from(m) * (c >> 64);
+        b += i128::from(m) * i128::from(c as u64);
+    }
+    // A 2^64 + B = (A + ⌊B / 2^64⌋) 2^64 + (B mod 2^64)
+    let high = a + (b >> 64);
+    match high.signum() {
+        0 => i32::from(b as u64 != 0),
+        s => s as i32,
+    }
+}
+
+/// The side of `m` each corner of `piece` lies on.
+fn sides(piece: &Piece, m: &Line) -> SmallVec<[i32; 6]> {
+    (0..piece.planes.len()).map(|i| piece.side(m, i)).collect()
+}
+
+/// The planes of `piece` whose edge has a corner strictly on side `on` of
+/// the cutting plane, then the cutting plane `m` (inward for that part).
+/// Some corner is strictly on each side.
+fn keep(piece: &Piece, s: &[i32], on: i32, m: Line) -> Piece {
+    let n = piece.planes.len();
+    // the corners on side `on` are a run (the cone is convex); edge i runs
+    // from corner i − 1 to corner i, so the edges ending at the run's
+    // first corner through the one leaving its last are kept
+    let first = (0..n)
+        .find(|&i| s[i] == on && s[(i + n - 1) % n] != on)
+        .unwrap_or(0);
+    let run = (0..n).take_while(|&k| s[(first + k) % n] == on).count();
+    let mut planes: Planes = (0..=run).map(|k| piece.planes[(first + k) % n]).collect();
+    // the kept corners, then the two where `m` cuts
+    let mut rays: SmallVec<[[f64; 3]; 6]> = (0..run).map(|k| piece.rays[(first + k) % n]).collect();
+    rays.push(Ray::new(&planes[run], &m).approx);
+    rays.push(Ray::new(&m, &planes[0]).approx);
+    planes.push(m);
+    Piece { planes, rays }
+}
+
+/// Cuts `piece` by `cone`: where some of it lies inside, its parts
+/// outside are pushed to `out` and `true` returned; a piece only touching
+/// the cone is left whole (`false`).
+fn cut(cone: &Planes, piece: &Piece, out: &mut Vec<Piece>) -> bool {
+    let n = piece.planes.len();
+    if cone.iter().any(|m| (0..n).all(|i| piece.side(m, i) <= 0)) {
+        return false;
+    }
+    let start = out.len();
+    let mut rest: Option<Piece> = None;
+    for m in cone {
+        let r = rest.as_ref().unwrap_or(piece);
+        let s = sides(r, m);
+        if s.iter().all(|&v| v >= 0) {
+            continue;
+        }
+        if s.iter().all(|&v| v <= 0) {
+            // the cone's planes each cross the piece, and yet it misses
+            // their meet: left whole
+            out.truncate(start);
+            return false;
+        }
+        out.push(keep(r, &s, -1, m.map(|v| -v)));
+        rest = Some(keep(r, &s, 1, *m));
+    }
+    true
+}
+
+/// Merges pieces pairwise where they share a whole edge and their union
+/// is convex, until none do. Deterministic: the input order decides.
+fn merge(mut pieces: Vec<Piece>) -> Vec<Piece> {
+    // each plane, up to sign, to the pieces bounded by it
+    let key = |l: &Line| match l.iter().find(|&&v| v != 0) {
+        Some(&v) if v < 0 => l.map(|c| -c),
+        _ => *l,
+    };
+    loop {
+        let mut at: FxHashMap<Line, SmallVec<[u32; 4]>> = FxHashMap::default();
+        for (i, p) in pieces.iter().enumerate() {
+            for l in &p.planes {
+                at.entry(key(l)).or_default().push(i as u32);
+            }
+        }
+        let mut dead = vec![false; pieces.len()];
+        let mut any = false;
+        for i in 0..pieces.len() {
+            if dead[i] {
+                continue;
+            }
+            let mut partners: SmallVec<[u32; 8]> = pieces[i]
+                .planes
+                .iter()
+                .flat_map(|l| at[&key(l)].iter().copied())
+                .filter(|&j| j as usize > i)
+                .collect();
+            partners.sort_unstable();
+            partners.dedup();
+            for j in partners {
+                let j = j as usize;
+                if dead[j] {
+                    continue;
+                }
+                if let Some(m) = union(&pieces[i], &pieces[j]) {
+                    pieces[i] = m;
+                    dead[j] = true;
+                    any = true;
+                }
+            }
+        }
+        if !any {
+            return pieces;
+        }
+        pieces = pieces
+            .into_iter()
+            .zip(dead)
+            .filter_map(|(p, d)| (!d).then_some(p))
+            .collect();
+    }
+}
+
+/// The union of two pieces that share a whole edge, where it is convex.
+fn union(p: &Piece, q: &Piece) -> Option<Piece> {
+    let (pl, ql) = (&p.planes, &q.planes);
+    let (k, j) = (pl.len(), ql.len());
+    let neg = |l: &Line| l.map(|v| -v);
+    let (a, b) = (0..k).find_map(|a| Some((a, ql.iter().position(|l| *l == neg(&pl[a]))?)))?;
+    let (pp, qp) = (&pl[(a + k - 1) % k], &ql[(b + j - 1) % j]);
+    // the shared edge's ends: p's start (its corner a − 1) on q's plane
+    // after the shared one, p's end (corner a) on q's plane before it
+    if p.side(&ql[(b + 1) % j], (a + k - 1) % k) != 0 || p.side(qp, a) != 0 {
+        return None;
+    }
+    // convex where the boundary passes from one to the other: the far
+    // corner of the edge leaving each junction inside the edge entering it
+    let one = q.side(pp, (b + 1) % j);
+    let two = p.side(qp, (a + 1) % k);
+    if one < 0 || two < 0 {
+        return None;
+    }
+    let mut planes = Planes::new();
+    // p from after the shared edge round to before it, then q likewise;
+    // a straight junction keeps one of its two (equal) planes
+    planes.extend((1..k).map(|t| pl[(a + t) % k]));
+    planes.extend(
+        (1..j)
+            .map(|t| ql[(b + t) % j])
+            .enumerate()
+            .filter_map(|(t, l)| {
+                let straight = (t == 0 && one == 0) || (t == j - 2 && two == 0);
+                (!straight).then_some(l)
+            }),
+    );
+    (planes.len() >= 3).then(|| Piece::new(planes))
+}
+
+/// The form factor from a point with unit `normal` to the piece's
+/// directions (Lambert's closed form on the corners' rays: it needs
+/// their directions only), in `f64`.
+fn form_factor(normal: DVec3, piece: &Piece) -> f64 {
+    let rays: SmallVec<[DVec3; 6]> = (piece.rays.iter())
+        .map(|r| DVec3::from_array(*r).normalize())
+        .collect();
+    let n = rays.len();
+    let mut sum = 0.0;
+    for i in 0..n {
+        let (a, b) = (rays[i], rays[(i + 1) % n]);
+        let c = a.cross(b);
+        let len = c.length();
+        if len == 0.0 {
+            continue;
+        }
+        sum += len.atan2(a.dot(b)) * normal.dot(c / len);
+    }
+    (sum / (2.0 * std::f64::consts::PI)).abs()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::AreaLight;
+    use bnum::cast::As;
+    use bnum::types::I256;
+    use proptest::prelude::*;
+
+    /// The general path's share: exact polygons in space.
+    fn general(
+        light: &AreaLight,
+        face: &Plane,
+        x: GridPoint,
+        normal: DVec3,
+        hiders: &[Occluder],
+    ) -> Option<f64> {
+        let view = light.view(x, Some(face), hiders)?;
+        view.fraction(DVec3::from_array(x.map(f64::from)), normal)
+    }
+
+    /// A height field of `k × k` cells at heights `z` (two triangles a
+    /// cell: shared edges and corners, fans round every inner corner),
+    /// then loose triangles.
+    fn scene(
+        scale: i32,
+        (ox, oy, s, k): (i32, i32, i32, usize),
+        z: &[i32],
+        loose: &[[(i32, i32, i32); 3]],
+    ) -> Vec<Occluder> {
+        let at = |i: usize, j: usize| {
+            let h = z[(i * 7 + j * 3) % z.len()];
+            [ox + s * i as i32, oy + s * j as i32, h].map(|c| c * scale)
+        };
+        let mut out = Vec::new();
+        for i in 0..k {
+            for j in 0..k {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                out.extend(Occluder::new(&[a, b, c]));
+                out.extend(Occluder::new(&[a, c, d]));
+            }
+        }
+        for t in loose {
+            out.extend(Occluder::new(
+                &t.map(|(x, y, z)| [x, y, z].map(|c| c * scale)),
+            ));
+        }
+        out
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(500))]
+        /// Where it applies, the cones' share is the general path's:
+        /// fully lit and nothing seen exactly alike, else within rounding.
+        /// It does not apply where an occluder crosses the light's plane.
+        #[test]
+        fn the_cones_see_what_the_general_path_sees(
+            scale in prop_oneof![Just(1), Just(3), Just(1 << 19)],
+            light in (-20i32..20, -20i32..20, 1i32..30, 90i32..100),
+            x in (-30i32..30, -30i32..30),
+            field in (-30i32..0, -30i32..0, 1i32..12, 1usize..6),
+            z in prop::collection::vec(10i32..80, 1..6),
+            loose in prop::collection::vec(prop::array::uniform3((-40i32..40, -40i32..40, 5i32..103)), 0..6),
+        ) {
+            let (lx, ly, size, lz) = light;
+            // clockwise seen from above: it shines down
+            let corners = [[lx, ly, lz], [lx, ly + size, lz], [lx + size, ly + size, lz], [lx + size, ly, lz]]
+                .map(|c| c.map(|v| v * scale));
+            let light = AreaLight::new(&corners).unwrap();
+            let ground = Plane::through([0, 0, 0], [1, 0, 0], [0, 1, 0]).unwrap();
+            let x = [x.0 * scale, x.1 * scale, 0];
+            let hiders = scene(scale, field, &z, &loose);
+            let crosses = hiders.iter().any(|o| {
+                let s = o.corners().iter().map(|&c| light.plane().unwrap().classify_grid(c));
+                let s: Vec<Side> = s.collect();
+                s.contains(&Side::Front) && s.contains(&Side::Back)
+            });
+            let quick = seen_share(light.grid_corners().unwrap(), light.plane().unwrap(), &ground, x, DVec3::Z, hiders.iter());
+            prop_assert_eq!(quick.is_none(), crosses);
+            if let Some(quick) = quick {
+                let slow = general(&light, &ground, x, DVec3::Z, &hiders);
+                match (quick, slow) {
+                    (Some(q), Some(s)) if q == 1.0 || s == 1.0 || q == 0.0 || s == 0.0 => prop_assert_eq!(q, s),
+                    (Some(q), Some(s)) => prop_assert!((q - s).abs() < 1e-9, "{} against {}", q, s),
+                    (q, s) => prop_assert_eq!(q, s),
+                }
+            }
+        }
+    }
+
+    /// The part of `cone` left of the line from `a` to `b` on the plane
+    /// `z = 10`, seen from above (from the origin: inside its plane).
+    fn left_of(cone: &Piece, a: [i32; 2], b: [i32; 2]) -> Piece {
+        let m = cross(
+            from([0; 3], [a[0], a[1], 10]),
+            from([0; 3], [b[0], b[1], 10]),
+        );
+        let s = sides(cone, &m);
+        assert!(
+            s.contains(&1) && s.contains(&-1),
+            "the line crosses the piece"
+        );
+        keep(cone, &s, 1, m)
+    }
+
+    /// Two cones sharing a whole edge merge where their union is convex
+    /// (a straight junction keeps one plane), not where it is not or
+    /// where they share part of an edge.
+    #[test]
+    fn pieces_merge_where_their_union_is_convex() {
+        let x = [0, 0, 0];
+        // the square light's cone cut in two along a diagonal, and merged
+        // back: the same four planes
+        let square = [[-2, -2, 10], [2, -2, 10], [2, 2, 10], [-2, 2, 10]];
+        let whole = Piece::new(light_cone(&square, x));
+        let (a, b) = (
+            left_of(&whole, [-2, -2], [2, 2]),
+            left_of(&whole, [2, 2], [-2, -2]),
+        );
+        assert_eq!((a.planes.len(), b.planes.len()), (3, 3));
+        let back = merge(vec![a, b]);
+        assert_eq!(back.len(), 1);
+        let (mut planes, mut want) = (back[0].planes.to_vec(), whole.planes.to_vec());
+        planes.sort_unstable();
+        want.sort_unstable();
+        assert_eq!(planes, want);
+        // a band [-2, 0] x [-1, 1] and, right of it, the same band: one
+        // rectangle of four planes (two straight junctions)
+        let band = left_of(&left_of(&whole, [-2, -1], [2, -1]), [2, 1], [-2, 1]);
+        let (west, east) = (
+            left_of(&band, [0, -2], [0, 2]),
+            left_of(&band, [0, 2], [0, -2]),
+        );
+        let joined = union(&west, &east).expect("the halves make the band");
+        assert_eq!(joined.planes.len(), 4);
+        let (halves, all) = (
+            form_factor(DVec3::Z, &west) + form_factor(DVec3::Z, &east),
+            form_factor(DVec3::Z, &joined),
+        );
+        assert!((halves - all).abs() < 1e-15 && all > 0.0);
+        // right of the west half, a piece widening from its edge: the
+        // union has reflex corners
+        let right = left_of(&whole, [0, 2], [0, -2]);
+        let fan = left_of(&left_of(&right, [0, -1], [2, -2]), [2, 2], [0, 1]);
+        assert!(union(&west, &fan).is_none() && union(&fan, &west).is_none());
+        // the east half and the west half of the whole square share part
+        // of an edge only
+        let tall_west = left_of(&whole, [0, -2], [0, 2]);
+        assert!(union(&tall_west, &east).is_none());
+    }
+
+    proptest! {
+        /// The filtered sign of a determinant is the exact one, also
+        /// where it is 0 or a unit from it at the largest coordinates.
+        #[test]
+        fn the_determinant_sign_is_exact(
+            a in prop::array::uniform3(-(1i64 << 55)..(1i64 << 55)),
+            b in prop::array::uniform3(-(1i64 << 55)..(1i64 << 55)),
+            (p, q) in (-3i64..4, -3i64..4),
+            nudge in prop::array::uniform3(-1i64..2),
+            shift in prop_oneof![Just(0u32), Just(37), Just(45)],
+        ) {
+            let exact = |a: &Line, b: &Line, c: &Line| {
+                let w = |v: i64| I256::from(v);
+                let det = w(a[0]) * (w(b[1]) * w(c[2]) - w(b[2]) * w(c[1]))
+                    + w(a[1]) * (w(b[2]) * w(c[0]) - w(b[0]) * w(c[2]))
+                    + w(a[2]) * (w(b[0]) * w(c[1]) - w(b[1]) * w(c[0]));
+                det.signum().as_::<i32>()
+            };
+            // c in the plane of a and b (within 2^55 after halving), then
+            // nudged off it by a unit
+            // (also small, where the product is below 2^64 and nonzero)
+            let (a, b) = match shift {
+                0 => (a, b),
+                s => (a.map(|v| v >> s), b.map(|v| v >> s)),
+            };
+            let c: Line = [0, 1, 2].map(|k| (p * (a[k] / 4) + q * (b[k] / 4)) + nudge[k]);
+            let a4 = a.map(|v| v / 4 * 4);
+            let b4 = b.map(|v| v / 4 * 4);
+            for (x, y, z) in [(&a, &b, &c), (&a4, &b4, &c), (&c, &a4, &b4)] {
+                prop_assert_eq!(det_sign(x, y, z), exact(x, y, z));
+                prop_assert_eq!(exact_side(x, &Ray::new(y, z)), exact(x, y, z));
+            }
+        }
+    }
+}
