@@ -438,9 +438,20 @@ fn soft_face(
             continue;
         }
         // the inner occluders last: they cut only what stays undecided
+        let light_corners = light.corners();
         let occluders = near[k]
             .iter()
-            .filter_map(|&j| Some((regions[k][j as usize].as_ref()?, reach[k][j as usize])))
+            .filter_map(|&j| {
+                let r = regions[k][j as usize].as_ref()?;
+                let reach = reach[k][j as usize];
+                match near[k].len() > TIGHTENED {
+                    true => Some((
+                        r,
+                        in_slab(reach, light_corners, &run.blockers[j as usize], face)?,
+                    )),
+                    false => Some((r, reach)),
+                }
+            })
             .chain(crate::cores::cores_at(&run.cores[k], face));
         let set = corners[k].as_ref().map(LightVolumes::set);
         let mut seen = |p: &Polygon| set.as_ref()?.cells(p, scratch);
@@ -516,6 +527,24 @@ fn soft_face(
             }
         })
         .collect()
+}
+
+/// A face with more occluders near it than this has their boxes
+/// ([`Reach`]) narrowed to what their volumes hold of the slab round its
+/// plane before its pieces are cut.
+const TIGHTENED: usize = 128;
+
+/// An occluder's boxes narrowed to what its penumbra volume holds of the
+/// slab round `face`'s plane (its umbra volume lies in that one), where
+/// its pieces lie; `None` where the volume holds none of it.
+fn in_slab(reach: Reach, lights: &[Light], o: &Occluder, face: &Occluder) -> Option<Reach> {
+    match slab_box(lights, o.corners(), face.plane()) {
+        InSlab::Nothing => None,
+        InSlab::Unbounded => Some(reach),
+        InSlab::Within(b) => {
+            Some(reach.map(|r| [0, 1, 2].map(|k| [r[k][0].max(b[k][0]), r[k][1].min(b[k][1])])))
+        }
+    }
 }
 
 /// The grid points nearest a fragment's centroid and corners, where its

@@ -870,6 +870,24 @@ fn a_mesh_cut_both_ways_agrees_with_the_view() {
             );
         }
     }
+    // the same through `soft_shadows` (whose faces with many occluders
+    // near have their boxes narrowed to the slab round their plane)
+    let soft = svbsp::soft_shadows(std::slice::from_ref(&light), &faces).unwrap();
+    for i in (0..faces.len()).step_by(10).chain([0]) {
+        let mut a = [0.0; 4];
+        for f in &soft[i] {
+            a[f.class(0) as usize] += area_of(&f.polygon);
+        }
+        let b = areas(&light.classify_face(&faces[i], &faces));
+        assert!(
+            close(a[lit], b[lit]) && close(a[penumbra], b[penumbra]),
+            "face {i}: {a:?} against {b:?}"
+        );
+        assert!(
+            close(a[umbra] + a[undecided], b[umbra] + b[undecided]),
+            "face {i}: {a:?} against {b:?}"
+        );
+    }
     let mut rng = Rng::new(0x005f_3e4e);
     let plane = *faces[0].plane();
     let half = grid.snap(DVec3::new(3.0, 3.0, 0.0)).unwrap();
