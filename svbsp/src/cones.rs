@@ -130,15 +130,79 @@ pub(crate) fn seen_share<'o>(
             cones.push(cone);
         }
     }
-    let light_cone = Piece::new(light_cone(corners, x));
+    let light_cone = Piece::new(light_cone(corners.iter().map(|&c| from(x, c))));
     let all = form_factor(normal, &light_cone);
     if all <= 0.0 {
         return Some(None);
     }
-    let mut seen = vec![light_cone];
+    let Some(seen) = visible(light_cone, &cones) else {
+        return Some(Some(1.0));
+    };
+    let part: f64 = seen.iter().map(|c| form_factor(normal, c)).sum();
+    Some(Some((part / all).clamp(0.0, 1.0)))
+}
+
+/// The share of a sun disc's polygon of directions `sky` (quantized, in
+/// order) that grid point `x` on a face with plane `face` sees past
+/// `hiders`, as `soft::sky_share` measures it: areas on the plane tangent
+/// to the sky at the directions' centre. `None` where this path does not
+/// apply: some direction is not strictly in front of the face.
+pub(crate) fn sky_seen_share<'o>(
+    sky: &[[i32; 3]],
+    face: &Plane,
+    x: GridPoint,
+    hiders: impl Iterator<Item = &'o Occluder>,
+) -> Option<f64> {
+    let n = face.normal();
+    let front = |d: &[i32; 3]| {
+        (0..3)
+            .map(|k| i128::from(n[k]) * i128::from(d[k]))
+            .sum::<i128>()
+            > 0
+    };
+    if !sky.iter().all(front) {
+        return None;
+    }
+    // a sun is beyond every occluder: each hides its whole cone
+    let cones: Vec<Planes> = hiders
+        .filter_map(|o| occluder_cone(o.corners(), x))
+        .collect();
+    let dirs = || sky.iter().map(|d| d.map(i64::from));
+    let light = Piece::new(light_cone(dirs()));
+    let c = dirs()
+        .map(|d| DVec3::from_array(d.map(|v| v as f64)))
+        .sum::<DVec3>()
+        .normalize();
+    let u = c.any_orthonormal_vector();
+    let v = c.cross(u);
+    let area = |p: &Piece| {
+        let q: SmallVec<[(f64, f64); 8]> = (p.rays.iter())
+            .map(|r| {
+                let r = DVec3::from_array(*r);
+                (r.dot(u) / r.dot(c), r.dot(v) / r.dot(c))
+            })
+            .collect();
+        let k = q.len();
+        let twice: f64 = (0..k)
+            .map(|i| q[i].0 * q[(i + 1) % k].1 - q[(i + 1) % k].0 * q[i].1)
+            .sum();
+        twice.abs() / 2.0
+    };
+    let all = area(&light);
+    let Some(seen) = visible(light, &cones) else {
+        return Some(1.0);
+    };
+    let left: f64 = seen.iter().map(area).sum();
+    Some((left / all).clamp(0.0, 1.0))
+}
+
+/// What of `light` lies outside every cone of `cones` (in their order),
+/// as convex pieces; `None` where no cone hid any of it.
+fn visible(light: Piece, cones: &[Planes]) -> Option<Vec<Piece>> {
+    let mut seen = vec![light];
     let (mut hidden, mut merged) = (false, 0);
     let mut parts = Vec::new();
-    for cone in &cones {
+    for cone in cones {
         // pieces the cone leaves whole stay in place; the parts of those
         // it cuts outside it are appended
         let mut i = 0;
@@ -160,11 +224,7 @@ pub(crate) fn seen_share<'o>(
             merged = seen.len();
         }
     }
-    if !hidden {
-        return Some(Some(1.0));
-    }
-    let part: f64 = seen.iter().map(|c| form_factor(normal, c)).sum();
-    Some(Some((part / all).clamp(0.0, 1.0)))
+    hidden.then_some(seen)
 }
 
 /// `a × b` of grid differences (below `2^27`): below `2^55`.
@@ -180,11 +240,12 @@ fn from(x: GridPoint, p: GridPoint) -> [i64; 3] {
     [0, 1, 2].map(|k| i64::from(p[k]) - i64::from(x[k]))
 }
 
-/// The light's cone from `x` (strictly in front of its plane): counter-
-/// clockwise seen from `x`, so that `n_i × n_{i+1}` points along corner
-/// `i + 1`.
-fn light_cone(corners: &[GridPoint], x: GridPoint) -> Planes {
-    let d: Vec<[i64; 3]> = corners.iter().map(|&c| from(x, c)).collect();
+/// The light's cone from a point, of the directions `d` to its corners
+/// (a strictly convex polygon's, the point off its plane; or a sun's
+/// directions): counter-clockwise seen from the point, so that
+/// `n_i × n_{i+1}` points along corner `i + 1`.
+fn light_cone(d: impl Iterator<Item = [i64; 3]>) -> Planes {
+    let d: Vec<[i64; 3]> = d.collect();
     let n = d.len();
     let turn = det_sign(&d[0], &d[1], &d[2]);
     (0..n)
@@ -512,6 +573,38 @@ mod tests {
         }
     }
 
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+        /// A sun disc's share on the cones is the `f64` chart's
+        /// (`soft::sky_share`), within that one's rounding.
+        #[test]
+        fn the_cones_see_a_sun_disc_as_the_chart_does(
+            toward in (-8i32..8, -8i32..8),
+            radius in prop_oneof![Just(0.01), Just(0.05), Just(0.2)],
+            x in (-30i32..30, -30i32..30),
+            field in (-30i32..0, -30i32..0, 1i32..12, 1usize..6),
+            z in prop::collection::vec(10i32..80, 1..6),
+            loose in prop::collection::vec(prop::array::uniform3((-40i32..40, -40i32..40, 5i32..103)), 0..6),
+        ) {
+            let d = DVec3::new(f64::from(toward.0) / 8.0, f64::from(toward.1) / 8.0, 1.0);
+            let disc = AreaLight::sun_disc(d, radius).unwrap();
+            let sky: Vec<[i32; 3]> = (disc.corners().iter())
+                .map(|l| match l {
+                    crate::Light::Directional(d) => *d,
+                    crate::Light::Point(_) => unreachable!("a disc of directions"),
+                })
+                .collect();
+            let ground = Plane::through([0, 0, 0], [1, 0, 0], [0, 1, 0]).unwrap();
+            let x = [x.0, x.1, 0];
+            let hiders = scene(1, field, &z, &loose);
+            let quick = sky_seen_share(&sky, &ground, x, hiders.iter()).unwrap();
+            let dirs: Vec<DVec3> = sky.iter().map(|d| DVec3::from_array(d.map(f64::from))).collect();
+            let xf = DVec3::from_array(x.map(f64::from));
+            let chart = crate::soft::sky_share(&dirs, xf, DVec3::Z, hiders.iter()).unwrap();
+            prop_assert!((quick - chart).abs() < 1e-9, "{} against {}", quick, chart);
+        }
+    }
+
     /// The part of `cone` left of the line from `a` to `b` on the plane
     /// `z = 10`, seen from above (from the origin: inside its plane).
     fn left_of(cone: &Piece, a: [i32; 2], b: [i32; 2]) -> Piece {
@@ -536,7 +629,7 @@ mod tests {
         // the square light's cone cut in two along a diagonal, and merged
         // back: the same four planes
         let square = [[-2, -2, 10], [2, -2, 10], [2, 2, 10], [-2, 2, 10]];
-        let whole = Piece::new(light_cone(&square, x));
+        let whole = Piece::new(light_cone(square.iter().map(|&c| from(x, c))));
         let (a, b) = (
             left_of(&whole, [-2, -2], [2, 2]),
             left_of(&whole, [2, 2], [-2, -2]),

@@ -642,6 +642,17 @@ fn fraction_at(
     let hiding = near.into_iter();
     let xf = DVec3::from_array(x.map(f64::from));
     if light.plane().is_none() {
+        let quantized: Vec<[i32; 3]> = (light.corners().iter())
+            .filter_map(|l| match l {
+                Light::Directional(d) => Some(*d),
+                Light::Point(_) => None,
+            })
+            .collect();
+        if let Some(share) =
+            crate::cones::sky_seen_share(&quantized, face.plane(), x, hiding.clone())
+        {
+            return Some(share);
+        }
         let sky: Vec<DVec3> = light
             .corners()
             .iter()
@@ -849,7 +860,7 @@ fn meet(a: Box3, b: Box3) -> Option<Box3> {
 /// face; the cosine at the face is taken as constant over the disc (it
 /// varies by less than its radius). `None` where no direction is in
 /// front of the face.
-fn sky_share<'o>(
+pub(crate) fn sky_share<'o>(
     sky: &[DVec3],
     x: DVec3,
     normal: DVec3,
