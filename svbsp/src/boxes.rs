@@ -28,6 +28,9 @@ pub(crate) fn overlap(a: &Box3, b: &Box3) -> bool {
 /// A box holding every point.
 pub(crate) const EVERYWHERE: Box3 = [[i64::MIN, i64::MAX]; 3];
 
+/// A box holding no point.
+pub(crate) const EMPTY: Box3 = [[i64::MAX, i64::MIN]; 3];
+
 /// The smallest box of integers holding a polygon: each exact corner's
 /// coordinates rounded down and up (`Homogeneous::floor_ceil`).
 pub(crate) fn polygon_box(p: &Polygon) -> Box3 {
@@ -88,7 +91,6 @@ pub(crate) struct Scans {
 
 impl Scans {
     const RUN: usize = 32;
-    const NONE: Box3 = [[i64::MAX, i64::MIN]; 3];
 
     pub(crate) fn new(items: impl Iterator<Item = Scan>) -> Scans {
         let mut s = Scans {
@@ -110,7 +112,7 @@ impl Scans {
 
     pub(crate) fn push(&mut self, x: Scan) {
         if self.items.len().is_multiple_of(Self::RUN) {
-            self.runs.push(Self::NONE);
+            self.runs.push(EMPTY);
         }
         self.items.push(x);
         self.cover(self.items.len() - 1);
@@ -255,7 +257,7 @@ impl ReachIndex {
         let (mut boxes, mut of, mut wide) = (Vec::new(), Vec::new(), Vec::new());
         for (i, reach) in reaches.enumerate() {
             // both boxes as one, within the face's (an empty box adds nothing)
-            let within = reach.iter().filter_map(|r| meet(r, &face));
+            let within = reach.iter().filter_map(|&r| meet(r, face));
             if let Some(b) = within
                 .reduce(|a, b| [0, 1, 2].map(|k| [a[k][0].min(b[k][0]), a[k][1].max(b[k][1])]))
             {
@@ -303,7 +305,7 @@ impl ReachIndex {
 
 /// The box two boxes share; `None` where they do not meet (or either is
 /// empty).
-fn meet(a: &Box3, b: &Box3) -> Option<Box3> {
+pub(crate) fn meet(a: Box3, b: Box3) -> Option<Box3> {
     let m = [0, 1, 2].map(|k| [a[k][0].max(b[k][0]), a[k][1].min(b[k][1])]);
     m.iter().all(|[lo, hi]| lo <= hi).then_some(m)
 }
@@ -383,7 +385,7 @@ mod tests {
             let face = [face[0], [face[1][0], face[1][0]], face[2]];
             let index = ReachIndex::new(face, reaches.iter());
             for b in asked {
-                let Some(b) = meet(&b, &face) else { continue };
+                let Some(b) = meet(b, face) else { continue };
                 let listed = index.near(&b);
                 prop_assert!(listed.windows(2).all(|w| w[0] < w[1]));
                 for (i, r) in reaches.iter().enumerate() {

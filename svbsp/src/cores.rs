@@ -30,7 +30,7 @@ use bsp_core::{GridPoint, SolidParts};
 use rayon::prelude::*;
 
 use crate::area::{AreaLight, Occluder, Regions};
-use crate::boxes::{Box3, CellGrid, Reach, grid_box, overlap};
+use crate::boxes::{Box3, CellGrid, EMPTY, Reach, grid_box, overlap};
 use crate::light::Light;
 
 /// Slices of a part at most, evenly spaced across its box along the axis.
@@ -217,9 +217,6 @@ pub(crate) fn core_regions(
         })
         .collect()
 }
-
-/// A box that meets nothing.
-const EMPTY: Box3 = [[i64::MAX, i64::MIN]; 3];
 
 /// The axis along which light `light`'s inner occluders are sliced (the
 /// largest component of its plane's normal, or of its first direction),

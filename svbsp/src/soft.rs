@@ -21,7 +21,7 @@ use crate::area::{
 };
 use crate::backs::SolidBacks;
 use crate::blockers::{coplanar_blockers, coplanar_blockers_of, plane_key};
-use crate::boxes::{Box3, CellGrid, EVERYWHERE, Reach, grid_box};
+use crate::boxes::{Box3, CellGrid, EMPTY, EVERYWHERE, Reach, grid_box, meet};
 use crate::engine::{LightVolumes, Scratch};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
 use crate::near::{InSlab, near_lists, slab_box};
@@ -541,9 +541,8 @@ fn in_slab(reach: Reach, lights: &[Light], o: &Occluder, face: &Occluder) -> Opt
     match slab_box(lights, o.corners(), face.plane()) {
         InSlab::Nothing => None,
         InSlab::Unbounded => Some(reach),
-        InSlab::Within(b) => {
-            Some(reach.map(|r| [0, 1, 2].map(|k| [r[k][0].max(b[k][0]), r[k][1].min(b[k][1])])))
-        }
+        // (the penumbra's box missing the slab's: the volume misses it)
+        InSlab::Within(b) => Some([meet(reach[0], b)?, meet(reach[1], b).unwrap_or(EMPTY)]),
     }
 }
 
@@ -653,13 +652,8 @@ fn fraction_at(
         {
             return Some(share);
         }
-        let sky: Vec<DVec3> = light
-            .corners()
-            .iter()
-            .filter_map(|l| match l {
-                Light::Directional(d) => Some(DVec3::from_array(d.map(f64::from))),
-                Light::Point(_) => None,
-            })
+        let sky: Vec<DVec3> = (quantized.iter())
+            .map(|d| DVec3::from_array(d.map(f64::from)))
             .collect();
         return sky_share(&sky, xf, normal, hiding);
     }
@@ -845,12 +839,6 @@ fn face_tests(face: &[GridPoint], volume: &HalfSpaces) -> Option<HalfSpaces> {
         }
     }
     Some(tests)
-}
-
-/// The box two boxes share, if they meet.
-fn meet(a: Box3, b: Box3) -> Option<Box3> {
-    let m = [0, 1, 2].map(|k| [a[k][0].max(b[k][0]), a[k][1].min(b[k][1])]);
-    m.iter().all(|[lo, hi]| lo <= hi).then_some(m)
 }
 
 /// The share of a sun disc's polygon of directions `sky` that `x` (on a
