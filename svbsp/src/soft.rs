@@ -650,7 +650,7 @@ fn fraction_at(
         if let Some(share) =
             crate::cones::sky_seen_share(&quantized, face.plane(), x, hiding.clone())
         {
-            return Some(share);
+            return share;
         }
         let sky: Vec<DVec3> = (quantized.iter())
             .map(|d| DVec3::from_array(d.map(f64::from)))
