@@ -50,18 +50,23 @@ pub(crate) fn near_lists(
                 // the sweep in a few boxes: most faces in the whole box
                 // lie beside the volume where it is still narrow
                 let parts = penumbra_boxes(lights, occluders[j].corners(), scene, SWEEP_PARTS);
-                grid.visit(reach, |i| {
-                    let i = i as usize;
-                    if planes[i] != plane
-                        && overlap(&boxes[i], &reach)
-                        && parts.iter().any(|p| overlap(&boxes[i], p))
-                        && !outside(faces[i].corners(), &r.penumbra)
-                    {
-                        hit.push(i as u32);
-                    }
-                });
+                // the cells of the parts only (not of their whole box),
+                // each face once before the exact test
+                for part in &parts {
+                    grid.visit(*part, |i| {
+                        if overlap(&boxes[i as usize], part) {
+                            hit.push(i);
+                        }
+                    });
+                }
                 hit.sort_unstable();
                 hit.dedup();
+                hit.retain(|&i| {
+                    let i = i as usize;
+                    planes[i] != plane
+                        && overlap(&boxes[i], &reach)
+                        && !outside(faces[i].corners(), &r.penumbra)
+                });
                 hit.shrink_to_fit();
             }
             hit
