@@ -16,7 +16,9 @@
 //! - `area/<scene>`: a 0.4 × 0.4 area light facing down, centred on the
 //!   key light, every face cut into lit, penumbra, umbra and undecided
 //!   fragments (`AreaLight::classify_faces`: every face against every
-//!   other, so up to 1 026 polygons), beside one point light's `1light`.
+//!   other, so up to 1 026 polygons), beside one point light's `1light`;
+//!   and `soft_shadows`, the same classes with the visible share at each
+//!   penumbra fragment's centroid and corners.
 //!
 //! Before each scene one timed run prints the counts criterion cannot
 //! report: fragments per face, shadow-tree nodes, and the peak memory of
@@ -217,6 +219,12 @@ fn bench_area(c: &mut Criterion, name: &str) {
     g.throughput(Throughput::Elements(faces.len() as u64));
     g.bench_function("area_light", |b| {
         b.iter(|| light.classify_faces(black_box(&faces)))
+    });
+    // the classes again, with the visible share at every penumbra
+    // fragment's centroid and corners (`soft_shadows`)
+    let lights = std::slice::from_ref(&light);
+    g.bench_function("soft_shadows", |b| {
+        b.iter(|| svbsp::soft_shadows(lights, black_box(&faces)).expect("one light"))
     });
     g.finish();
 }
