@@ -463,6 +463,7 @@ impl<'a> ShadowSet<'a> {
                     |p| cells.arena.sides_shared(piece, p),
                     crate::psv::REACH_BUDGET,
                     &mut s.links,
+                    &mut 0,
                 ) {
                     Some((true, false)) => {}
                     Some((false, true)) => now &= !bit,
@@ -838,19 +839,23 @@ fn filter(
     links: &mut Vec<u32>,
     sides: &mut SmallVec<[Side; 8]>,
 ) {
+    // (where the quick test cannot tell, the exact descent starts at the
+    // first node the piece straddles: the same walk, less its first part)
+    let mut fork = sv.root;
     match crate::psv::reach(
         &sv.nodes,
         sv.root,
         |p| arena.sides(&piece, p),
         crate::psv::REACH_BUDGET,
         links,
+        &mut fork,
     ) {
         Some((true, false)) => return out.push((piece, true)),
         Some((false, true)) => return out.push((piece, false)),
         _ => {}
     }
     stack.clear();
-    stack.push(Task::Visit(piece, sv.root));
+    stack.push(Task::Visit(piece, fork));
     while let Some(t) = stack.pop() {
         match t {
             Task::Visit(mut p, mut link) => loop {

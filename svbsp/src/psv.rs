@@ -430,15 +430,22 @@ pub(crate) const REACH_BUDGET: usize = 1024;
 /// (behind a cap counts as shadow). A superset of the leaves its points
 /// reach, so one kind alone is the exact answer for all of it. `None` when
 /// more than `budget` nodes would be visited.
+///
+/// `fork` is set to the first node with vertices strictly on both sides
+/// of its plane (left at `root` where there is none): above it the piece
+/// goes one way only, so an exact descent may start there.
 pub(crate) fn reach(
     nodes: &[Node],
     root: u32,
     mut sides: impl FnMut(&Plane) -> Sides,
     budget: usize,
     stack: &mut Vec<u32>,
+    fork: &mut u32,
 ) -> Option<(bool, bool)> {
     let (mut lit, mut shadow) = (false, false);
     let mut visits = 0;
+    let mut forked = false;
+    *fork = root;
     stack.clear();
     stack.push(root);
     while let Some(mut link) = stack.pop() {
@@ -457,6 +464,9 @@ pub(crate) fn reach(
             }
             let n = &nodes[link as usize];
             let s = sides(&n.plane);
+            if s.front && s.back && !forked {
+                (*fork, forked) = (link, true);
+            }
             match (n.cap, s.front, s.back) {
                 // a cap: behind it is hidden, in it or in front is not
                 (true, false, true) => {
@@ -947,6 +957,7 @@ fn insert(
         |p| pool.arena.sides(&piece, p),
         REACH_BUDGET,
         &mut s.links,
+        &mut 0,
     ) {
         return;
     }
