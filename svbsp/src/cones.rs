@@ -39,6 +39,14 @@ type Line = [i64; 3];
 /// The boundary planes of a convex cone of directions, in turn.
 type Planes = SmallVec<[Line; 6]>;
 
+/// An occluder's cone from the viewing point: its boundary planes, and
+/// the directions to its corners (grid differences, below `2^27`), whose
+/// positive hull it is.
+struct Cone {
+    planes: Planes,
+    corners: SmallVec<[[i64; 3]; 4]>,
+}
+
 /// The ray `a × b` of two planes, exactly (below `2^111`) and rounded to
 /// `f64`.
 #[derive(Clone, Copy, Debug)]
@@ -208,7 +216,7 @@ pub(crate) fn sky_seen_share<'o>(
 
 /// What of `light` lies outside every cone of `cones` (in their order),
 /// as convex pieces; `None` where no cone hid any of it.
-fn visible(light: Piece, cones: impl Iterator<Item = Planes>) -> Option<Vec<Piece>> {
+fn visible(light: Piece, cones: impl Iterator<Item = Cone>) -> Option<Vec<Piece>> {
     let mut seen = vec![light];
     let (mut hidden, mut merged) = (false, 0);
     let mut parts = Vec::new();
@@ -278,22 +286,27 @@ fn light_cone(d: impl Iterator<Item = [i64; 3]>) -> Option<Planes> {
 /// The cone of directions from `x` that meet occluder `corners` (a convex
 /// polygon): inside the plane through `x` and each edge, on the side of
 /// the next corner; `None` where `x` lies in the occluder's plane.
-fn occluder_cone(corners: &[GridPoint], x: GridPoint) -> Option<Planes> {
+fn occluder_cone(corners: &[GridPoint], x: GridPoint) -> Option<Cone> {
     let n = corners.len();
+    let d: SmallVec<[[i64; 3]; 4]> = corners.iter().map(|&c| from(x, c)).collect();
     let mut cone = Planes::new();
     for i in 0..n {
-        let (a, b, c) = (corners[i], corners[(i + 1) % n], corners[(i + 2) % n]);
-        let h = cross(from(x, a), from(x, b));
-        let s: i128 = (0..3)
-            .map(|k| i128::from(h[k]) * i128::from(from(x, c)[k]))
-            .sum();
-        match s.signum() {
+        let h = cross(d[i], d[(i + 1) % n]);
+        match dot(&h, &d[(i + 2) % n]).signum() {
             1 => cone.push(h),
             -1 => cone.push(h.map(|v| -v)),
             _ => return None,
         }
     }
-    Some(cone)
+    Some(Cone {
+        planes: cone,
+        corners: d,
+    })
+}
+
+/// `l · d` exactly, for `l` below `2^55` and `d` below `2^27`.
+fn dot(l: &Line, d: &[i64; 3]) -> i128 {
+    (0..3).map(|k| i128::from(l[k]) * i128::from(d[k])).sum()
 }
 
 /// The sign of `det(a, b, c) = a · (b × c)` for coordinates below `2^55`:
@@ -367,8 +380,15 @@ fn keep(piece: &Piece, s: &[i32], on: i32, m: Line) -> Piece {
 /// Cuts `piece` by `cone`: where some of it lies inside, its parts
 /// outside are pushed to `out` and `true` returned; a piece only touching
 /// the cone is left whole (`false`).
-fn cut(cone: &Planes, piece: &Piece, out: &mut Vec<Piece>) -> bool {
+fn cut(cone: &Cone, piece: &Piece, out: &mut Vec<Piece>) -> bool {
     let n = piece.planes.len();
+    // apart where a plane of either has the other wholly outside it
+    // (the piece's planes against the cone's corner directions: exact
+    // products of integers)
+    if (piece.planes.iter()).any(|l| cone.corners.iter().all(|c| dot(l, c) <= 0)) {
+        return false;
+    }
+    let cone = &cone.planes;
     if cone.iter().any(|m| (0..n).all(|i| piece.side(m, i) <= 0)) {
         return false;
     }
