@@ -576,11 +576,22 @@ impl PieceArena {
 
     /// The exact side of vertex `id` relative to `plane` (a lazy vertex
     /// keeps its exact coordinates if they had to be computed).
+    ///
+    /// A grid vertex, the common case, is classified inline; the others
+    /// out of line, so that the callers' loops carry no frame for them.
     #[inline]
     pub(crate) fn classify(&mut self, id: u32, plane: &Plane) -> Side {
+        match id & TAG {
+            0 => plane.classify_grid(self.grid[id as usize]),
+            _ => self.classify_implicit(id, plane),
+        }
+    }
+
+    /// [`PieceArena::classify`] of an implicit vertex.
+    #[inline(never)]
+    fn classify_implicit(&mut self, id: u32, plane: &Plane) -> Side {
         let i = (id & !TAG) as usize;
         match id & TAG {
-            0 => plane.classify_grid(self.grid[i]),
             EXACT => self.exact[i].classify(plane),
             _ => self.lazy[i].classify(&self.planes, &self.anchors, plane),
         }
