@@ -21,13 +21,17 @@ pub fn read_stl(path: &Path) -> Result<Mesh, SceneError> {
 /// Parses the bytes of a binary or ASCII STL file; `path_for_messages`
 /// names the file in errors.
 ///
-/// Every facet becomes a triangle face in group `"default"`; vertices with
-/// exactly equal positions (after the exact widening of `f32` to `f64`) are
-/// welded, so neighbouring triangles share them. A binary file whose header
-/// happens to start with `solid` is recognised by its size or its NUL
-/// bytes. A binary file's size must be what its triangle count says: a
-/// shorter or longer one is an error, not a guess. Errors say which
-/// triangle is bad; the line is 0 as `stl_io` does not report lines.
+/// Every facet becomes a face in group `"default"` (a triangle; an ASCII
+/// facet of more vertices, which some writers make, one polygon); vertices
+/// with exactly equal positions are welded, so neighbouring triangles share
+/// them. Binary STL is read through `stl_io`, its `f32` coordinates widened
+/// exactly to `f64`; ASCII STL by this crate, its decimal coordinates
+/// rounded once to `f64` (a coordinate outside `f32`'s range is not read as
+/// 0 or infinite). A binary file whose header happens to start with `solid`
+/// is recognised by its size or its NUL bytes. A binary file's size must be
+/// what its triangle count says: a shorter or longer one is an error, not a
+/// guess. Errors in a binary file say which triangle is bad (line 0); in an
+/// ASCII file, which line.
 ///
 /// ```
 /// use shadow_scene::parse_stl;
@@ -55,10 +59,23 @@ pub fn parse_stl(bytes: &[u8], path_for_messages: &str) -> Result<Mesh, SceneErr
     // an ASCII file may start with a byte-order mark (a binary one's
     // header is free text, and its size tells it)
     let bytes = match bytes.strip_prefix(b"\xEF\xBB\xBF") {
-        Some(text) if !looks_binary(bytes) && text.trim_ascii_start().starts_with(b"solid") => text,
+        Some(text)
+            if !looks_binary(bytes)
+                && text
+                    .trim_ascii_start()
+                    .get(..5)
+                    .is_some_and(|w| w.eq_ignore_ascii_case(b"solid")) =>
+        {
+            text
+        }
         _ => bytes,
     };
-    if !bytes.trim_ascii_start().starts_with(b"solid") && bytes.len() < 84 {
+    if !bytes
+        .trim_ascii_start()
+        .get(..5)
+        .is_some_and(|w| w.eq_ignore_ascii_case(b"solid"))
+        && bytes.len() < 84
+    {
         return Err(err(format!(
             "invalid STL: a binary STL file has an 80-byte header and a 4-byte triangle count; this one \
              has {} byte(s) in all",
@@ -72,7 +89,10 @@ pub fn parse_stl(bytes: &[u8], path_for_messages: &str) -> Result<Mesh, SceneErr
     // NUL byte marks a binary file whose header starts with "solid":
     // ASCII STL has none.
     let binary = bytes.len() >= 84
-        && (!bytes.trim_ascii_start().starts_with(b"solid")
+        && (!bytes
+            .trim_ascii_start()
+            .get(..5)
+            .is_some_and(|w| w.eq_ignore_ascii_case(b"solid"))
             || looks_binary(bytes)
             || bytes.contains(&0));
     if binary {
@@ -98,6 +118,9 @@ pub fn parse_stl(bytes: &[u8], path_for_messages: &str) -> Result<Mesh, SceneErr
                 have - want
             )));
         }
+    }
+    if !binary {
+        return parse_ascii(bytes, path_for_messages);
     }
     let mut data = Cow::Borrowed(bytes);
     if binary && bytes.starts_with(b"solid") {
@@ -219,6 +242,187 @@ pub fn stl_collisions<M: MeshView + ?Sized>(mesh: &M) -> usize {
 
 /// `true` if the size matches the binary layout: an 80-byte header, a
 /// triangle count, and 50 bytes per triangle.
+/// Reads ASCII STL: `solid [name]`, then facets (`facet normal NX NY NZ`,
+/// `outer loop`, `vertex X Y Z` three or more times, `endloop`,
+/// `endfacet`), then `endsolid [name]`; several solids may follow one
+/// another. Keywords in any case, tokens split by any white space.
+/// Coordinates are read as `f64` (correctly rounded from the decimal text),
+/// so a coordinate below `f32`'s range is not read as 0, nor one beyond it
+/// as infinite. A facet of more than three vertices is kept as one polygon
+/// face. Errors name the line.
+fn parse_ascii(bytes: &[u8], path: &str) -> Result<Mesh, SceneError> {
+    let err = |line: usize, message: String| SceneError::Parse {
+        path: path.to_string(),
+        line,
+        message,
+    };
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        let line = 1 + bytes[..e.valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count();
+        err(
+            line,
+            "invalid ASCII STL: a byte that is not text".to_string(),
+        )
+    })?;
+    let mut tokens = Tokens::new(text);
+    let mut mesh = Mesh {
+        groups: vec!["default".to_string()],
+        ..Mesh::default()
+    };
+    let mut solids = 0;
+    while let Some((word, line)) = tokens.next() {
+        if !word.eq_ignore_ascii_case("solid") {
+            return Err(err(line, format!("expected `solid`, found `{word}`")));
+        }
+        solids += 1;
+        tokens.skip_name(line);
+        loop {
+            let (word, line) = tokens.expect("`facet` or `endsolid`", &err)?;
+            if word.eq_ignore_ascii_case("endsolid") {
+                tokens.skip_name(line);
+                break;
+            }
+            if !word.eq_ignore_ascii_case("facet") {
+                return Err(err(
+                    line,
+                    format!("expected `facet` or `endsolid`, found `{word}`"),
+                ));
+            }
+            tokens.keyword("normal", &err)?;
+            for _ in 0..3 {
+                tokens.number("the facet's normal", &err)?;
+            }
+            tokens.keyword("outer", &err)?;
+            tokens.keyword("loop", &err)?;
+            let base = mesh.positions.len() as u32;
+            let end = loop {
+                let (word, at) = tokens.expect("`vertex` or `endloop`", &err)?;
+                if word.eq_ignore_ascii_case("endloop") {
+                    break at;
+                }
+                if !word.eq_ignore_ascii_case("vertex") {
+                    return Err(err(
+                        at,
+                        format!("expected `vertex` or `endloop`, found `{word}`"),
+                    ));
+                }
+                let mut p = [0.0; 3];
+                for c in &mut p {
+                    *c = tokens.number("a vertex", &err)?;
+                }
+                mesh.positions.push(DVec3::from_array(p));
+            };
+            let n = mesh.positions.len() as u32 - base;
+            if n < 3 {
+                return Err(err(
+                    end,
+                    format!("the facet of line {line} has {n} vertices (at least 3)"),
+                ));
+            }
+            tokens.keyword("endfacet", &err)?;
+            mesh.faces.push(Face {
+                vertices: (base..base + n).collect(),
+                line,
+                group: 0,
+            });
+        }
+    }
+    if solids == 0 {
+        return Err(err(1, "invalid ASCII STL: no `solid`".to_string()));
+    }
+    mesh.weld();
+    Ok(mesh)
+}
+
+/// The white-space separated words of a text, with their 1-based lines.
+struct Tokens<'a> {
+    words: std::iter::Peekable<Box<dyn Iterator<Item = (&'a str, usize)> + 'a>>,
+    /// The last line, for an error at the end of the text.
+    last: usize,
+}
+
+impl<'a> Tokens<'a> {
+    fn new(text: &'a str) -> Tokens<'a> {
+        let words: Box<dyn Iterator<Item = (&'a str, usize)> + 'a> = Box::new(
+            text.lines()
+                .enumerate()
+                .flat_map(|(i, l)| l.split_ascii_whitespace().map(move |w| (w, i + 1))),
+        );
+        Tokens {
+            words: words.peekable(),
+            last: text.lines().count().max(1),
+        }
+    }
+
+    fn next(&mut self) -> Option<(&'a str, usize)> {
+        self.words.next()
+    }
+
+    /// Passes over a solid's name: the words after `solid` or `endsolid`
+    /// on its line, up to a keyword that starts a facet or a solid.
+    fn skip_name(&mut self, line: usize) {
+        let keyword = |w: &str| {
+            ["facet", "endsolid", "solid"]
+                .iter()
+                .any(|k| w.eq_ignore_ascii_case(k))
+        };
+        while self
+            .words
+            .next_if(|&(w, l)| l == line && !keyword(w))
+            .is_some()
+        {}
+    }
+
+    /// The next word, or an error naming `what` was expected.
+    fn expect(
+        &mut self,
+        what: &str,
+        err: &impl Fn(usize, String) -> SceneError,
+    ) -> Result<(&'a str, usize), SceneError> {
+        self.next().ok_or_else(|| {
+            err(
+                self.last,
+                format!("the file ends where {what} was expected"),
+            )
+        })
+    }
+
+    /// The next word, which must be `keyword` (in any case).
+    fn keyword(
+        &mut self,
+        keyword: &str,
+        err: &impl Fn(usize, String) -> SceneError,
+    ) -> Result<(), SceneError> {
+        let (word, line) = self.expect(&format!("`{keyword}`"), err)?;
+        match word.eq_ignore_ascii_case(keyword) {
+            true => Ok(()),
+            false => Err(err(line, format!("expected `{keyword}`, found `{word}`"))),
+        }
+    }
+
+    /// The next word as a finite number, for `what`.
+    fn number(
+        &mut self,
+        what: &str,
+        err: &impl Fn(usize, String) -> SceneError,
+    ) -> Result<f64, SceneError> {
+        let (word, line) = self.expect(&format!("a number of {what}"), err)?;
+        match word.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            Ok(_) => Err(err(
+                line,
+                format!("{what} has a coordinate `{word}` that is not finite"),
+            )),
+            Err(_) => Err(err(
+                line,
+                format!("{what} has `{word}` where a number was expected"),
+            )),
+        }
+    }
+}
+
 fn looks_binary(bytes: &[u8]) -> bool {
     bytes.len() >= 84 && {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
@@ -283,6 +487,86 @@ mod tests {
         // a byte-order mark in front changes nothing
         let bom = [&b"\xEF\xBB\xBF"[..], text.as_bytes()].concat();
         assert_eq!(parse_stl(&bom, "bom.stl").unwrap(), m);
+    }
+
+    #[test]
+    fn ascii_coordinates_are_read_as_f64() {
+        // below f32's least subnormal, and beyond its largest value
+        let text = "solid tiny\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n\
+                    vertex 1e-50 0 0\nvertex 0 3e-50 0\nendloop\nendfacet\n\
+                    facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1e39 0 0\n\
+                    vertex 0 0.1 0\nendloop\nendfacet\nendsolid tiny\n";
+        let m = parse_stl(text.as_bytes(), "tiny.stl").unwrap();
+        assert_eq!(m.positions.len(), 5);
+        assert_eq!(m.positions[1], DVec3::new(1e-50, 0.0, 0.0));
+        assert_eq!(m.positions[2], DVec3::new(0.0, 3e-50, 0.0));
+        assert_eq!(m.positions[3], DVec3::new(1e39, 0.0, 0.0));
+        // the decimal text rounded once to f64, not through f32
+        assert_eq!(m.positions[4], DVec3::new(0.0, 0.1, 0.0));
+        assert_eq!((m.faces[0].line, m.faces[1].line), (2, 9));
+    }
+
+    #[test]
+    fn ascii_keywords_in_any_case_several_solids_and_polygons() {
+        let text = "SOLID a\nFACET NORMAL 0 0 1\n OUTER LOOP\n  VERTEX 0 0 0\n  VERTEX 1 0 0\n\
+                    VERTEX 1 1 0\n  VERTEX 0 1 0\n ENDLOOP\nENDFACET\nENDSOLID a\n\
+                    solid b facet normal 0 0 1 outer loop vertex 0 0 0 vertex 0 1 0 vertex \
+                    -1 0 0 endloop endfacet endsolid b";
+        let m = parse_stl(text.as_bytes(), "two.stl").unwrap();
+        assert_eq!(m.faces.len(), 2);
+        assert_eq!(m.faces[0].vertices.len(), 4);
+        assert_eq!(m.faces[1].vertices.len(), 3);
+        // the shared corners welded
+        assert_eq!(m.positions.len(), 5);
+    }
+
+    #[test]
+    fn ascii_errors_name_the_line() {
+        let good = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n\
+                    vertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+        let cases: [(&str, &str, &str); 7] = [
+            (
+                "vertex 1 0 0",
+                "vertex 1 x 0",
+                "t.stl:5: a vertex has `x` where a number",
+            ),
+            (
+                "vertex 1 0 0",
+                "vertex 1 1e999 0",
+                "t.stl:5: a vertex has a coordinate `1e999`",
+            ),
+            (
+                "vertex 1 0 0",
+                "vertex 1 inf 0",
+                "t.stl:5: a vertex has a coordinate `inf`",
+            ),
+            (
+                "outer loop",
+                "outer lop",
+                "t.stl:3: expected `loop`, found `lop`",
+            ),
+            (
+                "vertex 0 1 0\n",
+                "",
+                "t.stl:6: the facet of line 2 has 2 vertices (at least 3)",
+            ),
+            (
+                "endsolid t\n",
+                "",
+                "t.stl:8: the file ends where `facet` or `endsolid`",
+            ),
+            (
+                "endfacet",
+                "endfacet\nvertex",
+                "t.stl:9: expected `facet` or `endsolid`",
+            ),
+        ];
+        for (from, to, want) in cases {
+            let text = good.replacen(from, to, 1);
+            let e = parse_stl(text.as_bytes(), "t.stl").unwrap_err().to_string();
+            assert!(e.starts_with(want), "{text}: {e}");
+        }
+        assert!(parse_stl(good.as_bytes(), "t.stl").is_ok());
     }
 
     #[test]
@@ -377,10 +661,9 @@ mod tests {
             "a.stl",
         )
         .unwrap_err();
-        assert!(
-            e.to_string()
-                .starts_with("a.stl: invalid STL at triangle 1"),
-            "{e}"
+        assert_eq!(
+            e.to_string(),
+            "a.stl:4: a vertex has `zero` where a number was expected"
         );
     }
 }
