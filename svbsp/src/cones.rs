@@ -70,32 +70,54 @@ impl Ray {
     }
 }
 
-/// A convex piece of the light's cone: its planes in turn (counter-
-/// clockwise seen from the point), and its corners' rays rounded to `f64`
-/// (corner `i` between planes `i` and `i + 1`; the exact ray is made
-/// again where the rounded one does not decide).
-#[derive(Clone, Debug)]
-struct Piece {
-    planes: Planes,
-    rays: SmallVec<[[f64; 3]; 6]>,
+/// The pieces of one point's view: every piece's planes in turn
+/// (counter-clockwise seen from the point) and its corners' rays rounded
+/// to `f64` (corner `i` between planes `i` and `i + 1`; the exact ray is
+/// made again where the rounded one does not decide), a piece a range of
+/// both lists. Cutting appends its parts' lists and moves no piece.
+#[derive(Default)]
+struct Pool {
+    planes: Vec<Line>,
+    rays: Vec<[f64; 3]>,
 }
 
-impl Piece {
-    fn new(planes: Planes) -> Piece {
+/// A convex piece of the light's cone: the range `at..at + len` of its
+/// [`Pool`]'s lists.
+#[derive(Clone, Copy, Debug)]
+struct Piece {
+    at: u32,
+    len: u32,
+}
+
+impl Pool {
+    /// A piece bounded by `planes`, its rays made from them.
+    fn add(&mut self, planes: &[Line]) -> Piece {
         let n = planes.len();
-        let rays = (0..n)
-            .map(|i| Ray::new(&planes[i], &planes[(i + 1) % n]).approx)
-            .collect();
-        Piece { planes, rays }
+        let at = self.planes.len() as u32;
+        self.planes.extend_from_slice(planes);
+        self.rays
+            .extend((0..n).map(|i| Ray::new(&planes[i], &planes[(i + 1) % n]).approx));
+        Piece { at, len: n as u32 }
     }
 
-    /// The side of plane `m` corner `i` lies on.
-    fn side(&self, m: &Line, i: usize) -> i32 {
-        match filtered(m, &self.rays[i]) {
+    /// The planes of `p`, in turn.
+    fn planes(&self, p: Piece) -> &[Line] {
+        &self.planes[p.at as usize..(p.at + p.len) as usize]
+    }
+
+    /// The rays of `p`'s corners, rounded.
+    fn rays(&self, p: Piece) -> &[[f64; 3]] {
+        &self.rays[p.at as usize..(p.at + p.len) as usize]
+    }
+
+    /// The side of plane `m` corner `i` of `p` lies on.
+    fn side(&self, p: Piece, m: &Line, i: usize) -> i32 {
+        let at = p.at as usize;
+        match filtered(m, &self.rays[at + i]) {
             Some(s) => s,
             None => {
-                let n = self.planes.len();
-                exact_side(m, &Ray::new(&self.planes[i], &self.planes[(i + 1) % n]))
+                let next = at + (i + 1) % p.len as usize;
+                exact_side(m, &Ray::new(&self.planes[at + i], &self.planes[next]))
             }
         }
     }
@@ -142,18 +164,22 @@ pub(crate) fn seen_share<'o>(
             hiding.push(o);
         }
     }
-    let light_cone = Piece::new(light_cone(corners.iter().map(|&c| from(x, c)))?);
-    let all = form_factor(normal, &light_cone);
+    let mut pool = Pool::default();
+    let light_cone = pool.add(&light_cone(corners.iter().map(|&c| from(x, c)))?);
+    let all = form_factor(normal, pool.rays(light_cone));
     if all <= 0.0 {
         return Some(None);
     }
     // (each cone made as it is reached: a point that sees nothing stops
     // early)
     let cones = hiding.iter().filter_map(|o| occluder_cone(o.corners(), x));
-    let Some(seen) = visible(light_cone, cones) else {
+    let Some(seen) = visible(&mut pool, light_cone, cones) else {
         return Some(Some(1.0));
     };
-    let part: f64 = seen.iter().map(|c| form_factor(normal, c)).sum();
+    let part: f64 = seen
+        .iter()
+        .map(|&c| form_factor(normal, pool.rays(c)))
+        .sum();
     Some(Some((part / all).clamp(0.0, 1.0)))
 }
 
@@ -172,15 +198,16 @@ pub(crate) fn sky_seen_share<'o>(
     hiders: impl Iterator<Item = &'o Occluder>,
 ) -> Option<Option<f64>> {
     let dirs = || sky.iter().map(|d| d.map(i64::from));
-    let mut light = Piece::new(light_cone(dirs())?);
+    let mut pool = Pool::default();
+    let mut light = pool.add(&light_cone(dirs())?);
     // the directions in front of the face
     let front = face.normal();
-    let s = sides(&light, &front);
+    let s = sides(&pool, light, &front);
     if s.iter().all(|&v| v <= 0) {
         return Some(None);
     }
     if s.contains(&-1) {
-        light = keep(&light, &s, 1, front);
+        light = keep(&mut pool, light, &s, 1, front);
     }
     // a sun is beyond every occluder: each hides its whole cone
     let cones = hiders.filter_map(|o| occluder_cone(o.corners(), x));
@@ -190,8 +217,8 @@ pub(crate) fn sky_seen_share<'o>(
         .normalize();
     let u = c.any_orthonormal_vector();
     let v = c.cross(u);
-    let area = |p: &Piece| {
-        let q: SmallVec<[(f64, f64); 8]> = (p.rays.iter())
+    let area = |rays: &[[f64; 3]]| {
+        let q: SmallVec<[(f64, f64); 8]> = (rays.iter())
             .map(|r| {
                 let r = DVec3::from_array(*r);
                 (r.dot(u) / r.dot(c), r.dot(v) / r.dot(c))
@@ -203,20 +230,20 @@ pub(crate) fn sky_seen_share<'o>(
             .sum();
         twice.abs() / 2.0
     };
-    let all = area(&light);
+    let all = area(pool.rays(light));
     if all <= 0.0 {
         return Some(None);
     }
-    let Some(seen) = visible(light, cones) else {
+    let Some(seen) = visible(&mut pool, light, cones) else {
         return Some(Some(1.0));
     };
-    let left: f64 = seen.iter().map(area).sum();
+    let left: f64 = seen.iter().map(|&p| area(pool.rays(p))).sum();
     Some(Some((left / all).clamp(0.0, 1.0)))
 }
 
 /// What of `light` lies outside every cone of `cones` (in their order),
 /// as convex pieces; `None` where no cone hid any of it.
-fn visible(light: Piece, cones: impl Iterator<Item = Cone>) -> Option<Vec<Piece>> {
+fn visible(pool: &mut Pool, light: Piece, cones: impl Iterator<Item = Cone>) -> Option<Vec<Piece>> {
     let mut seen = vec![light];
     let (mut hidden, mut merged) = (false, 0);
     let mut parts = Vec::new();
@@ -225,7 +252,7 @@ fn visible(light: Piece, cones: impl Iterator<Item = Cone>) -> Option<Vec<Piece>
         // it cuts outside it are appended
         let mut i = 0;
         while i < seen.len() {
-            if cut(&cone, &seen[i], &mut parts) {
+            if cut(pool, &cone, seen[i], &mut parts) {
                 hidden = true;
                 seen.swap_remove(i);
             } else {
@@ -238,7 +265,7 @@ fn visible(light: Piece, cones: impl Iterator<Item = Cone>) -> Option<Vec<Piece>
         }
         // merged as they pile up (later cones then meet fewer)
         if seen.len() > 16 && seen.len() > 2 * merged {
-            seen = merge(seen);
+            seen = merge(pool, seen);
             merged = seen.len();
         }
     }
@@ -352,15 +379,17 @@ fn exact_side(m: &Line, r: &Ray) -> i32 {
 }
 
 /// The side of `m` each corner of `piece` lies on.
-fn sides(piece: &Piece, m: &Line) -> SmallVec<[i32; 6]> {
-    (0..piece.planes.len()).map(|i| piece.side(m, i)).collect()
+fn sides(pool: &Pool, piece: Piece, m: &Line) -> SmallVec<[i32; 6]> {
+    (0..piece.len as usize)
+        .map(|i| pool.side(piece, m, i))
+        .collect()
 }
 
 /// The planes of `piece` whose edge has a corner strictly on side `on` of
 /// the cutting plane, then the cutting plane `m` (inward for that part).
 /// Some corner is strictly on each side.
-fn keep(piece: &Piece, s: &[i32], on: i32, m: Line) -> Piece {
-    let n = piece.planes.len();
+fn keep(pool: &mut Pool, piece: Piece, s: &[i32], on: i32, m: Line) -> Piece {
+    let (at, n) = (piece.at as usize, piece.len as usize);
     // the corners on side `on` are a run (the cone is convex); edge i runs
     // from corner i − 1 to corner i, so the edges ending at the run's
     // first corner through the one leaving its last are kept
@@ -368,35 +397,48 @@ fn keep(piece: &Piece, s: &[i32], on: i32, m: Line) -> Piece {
         .find(|&i| s[i] == on && s[(i + n - 1) % n] != on)
         .unwrap_or(0);
     let run = (0..n).take_while(|&k| s[(first + k) % n] == on).count();
-    let mut planes: Planes = (0..=run).map(|k| piece.planes[(first + k) % n]).collect();
+    let start = pool.planes.len();
+    for k in 0..=run {
+        let l = pool.planes[at + (first + k) % n];
+        pool.planes.push(l);
+    }
     // the kept corners, then the two where `m` cuts
-    let mut rays: SmallVec<[[f64; 3]; 6]> = (0..run).map(|k| piece.rays[(first + k) % n]).collect();
-    rays.push(Ray::new(&planes[run], &m).approx);
-    rays.push(Ray::new(&m, &planes[0]).approx);
-    planes.push(m);
-    Piece { planes, rays }
+    for k in 0..run {
+        let r = pool.rays[at + (first + k) % n];
+        pool.rays.push(r);
+    }
+    let (last, head) = (pool.planes[start + run], pool.planes[start]);
+    pool.rays.push(Ray::new(&last, &m).approx);
+    pool.rays.push(Ray::new(&m, &head).approx);
+    pool.planes.push(m);
+    Piece {
+        at: start as u32,
+        len: (run + 2) as u32,
+    }
 }
 
 /// Cuts `piece` by `cone`: where some of it lies inside, its parts
 /// outside are pushed to `out` and `true` returned; a piece only touching
 /// the cone is left whole (`false`).
-fn cut(cone: &Cone, piece: &Piece, out: &mut Vec<Piece>) -> bool {
-    let n = piece.planes.len();
+fn cut(pool: &mut Pool, cone: &Cone, piece: Piece, out: &mut Vec<Piece>) -> bool {
+    let n = piece.len as usize;
     // apart where a plane of either has the other wholly outside it
     // (the piece's planes against the cone's corner directions: exact
     // products of integers)
-    if (piece.planes.iter()).any(|l| cone.corners.iter().all(|c| dot(l, c) <= 0)) {
+    if (pool.planes(piece).iter()).any(|l| cone.corners.iter().all(|c| dot(l, c) <= 0)) {
         return false;
     }
     let cone = &cone.planes;
-    if cone.iter().any(|m| (0..n).all(|i| piece.side(m, i) <= 0)) {
+    if cone
+        .iter()
+        .any(|m| (0..n).all(|i| pool.side(piece, m, i) <= 0))
+    {
         return false;
     }
     let start = out.len();
-    let mut rest: Option<Piece> = None;
+    let mut rest = piece;
     for m in cone {
-        let r = rest.as_ref().unwrap_or(piece);
-        let s = sides(r, m);
+        let s = sides(pool, rest, m);
         if s.iter().all(|&v| v >= 0) {
             continue;
         }
@@ -406,15 +448,16 @@ fn cut(cone: &Cone, piece: &Piece, out: &mut Vec<Piece>) -> bool {
             out.truncate(start);
             return false;
         }
-        out.push(keep(r, &s, -1, m.map(|v| -v)));
-        rest = Some(keep(r, &s, 1, *m));
+        let outside = keep(pool, rest, &s, -1, m.map(|v| -v));
+        out.push(outside);
+        rest = keep(pool, rest, &s, 1, *m);
     }
     true
 }
 
 /// Merges pieces pairwise where they share a whole edge and their union
 /// is convex, until none do. Deterministic: the input order decides.
-fn merge(mut pieces: Vec<Piece>) -> Vec<Piece> {
+fn merge(pool: &mut Pool, mut pieces: Vec<Piece>) -> Vec<Piece> {
     // each plane, up to sign, to the pieces bounded by it
     let key = |l: &Line| match l.iter().find(|&&v| v != 0) {
         Some(&v) if v < 0 => l.map(|c| -c),
@@ -422,8 +465,8 @@ fn merge(mut pieces: Vec<Piece>) -> Vec<Piece> {
     };
     loop {
         let mut at: FxHashMap<Line, SmallVec<[u32; 4]>> = FxHashMap::default();
-        for (i, p) in pieces.iter().enumerate() {
-            for l in &p.planes {
+        for (i, &p) in pieces.iter().enumerate() {
+            for l in pool.planes(p) {
                 at.entry(key(l)).or_default().push(i as u32);
             }
         }
@@ -433,9 +476,7 @@ fn merge(mut pieces: Vec<Piece>) -> Vec<Piece> {
             if dead[i] {
                 continue;
             }
-            let mut partners: SmallVec<[u32; 8]> = pieces[i]
-                .planes
-                .iter()
+            let mut partners: SmallVec<[u32; 8]> = (pool.planes(pieces[i]).iter())
                 .flat_map(|l| at[&key(l)].iter().copied())
                 .filter(|&j| j as usize > i)
                 .collect();
@@ -446,7 +487,7 @@ fn merge(mut pieces: Vec<Piece>) -> Vec<Piece> {
                 if dead[j] {
                     continue;
                 }
-                if let Some(m) = union(&pieces[i], &pieces[j]) {
+                if let Some(m) = union(pool, pieces[i], pieces[j]) {
                     pieces[i] = m;
                     dead[j] = true;
                     any = true;
@@ -465,21 +506,24 @@ fn merge(mut pieces: Vec<Piece>) -> Vec<Piece> {
 }
 
 /// The union of two pieces that share a whole edge, where it is convex.
-fn union(p: &Piece, q: &Piece) -> Option<Piece> {
-    let (pl, ql) = (&p.planes, &q.planes);
+fn union(pool: &mut Pool, p: Piece, q: Piece) -> Option<Piece> {
+    let (pl, ql): (Planes, Planes) = (
+        pool.planes(p).iter().copied().collect(),
+        pool.planes(q).iter().copied().collect(),
+    );
     let (k, j) = (pl.len(), ql.len());
     let neg = |l: &Line| l.map(|v| -v);
     let (a, b) = (0..k).find_map(|a| Some((a, ql.iter().position(|l| *l == neg(&pl[a]))?)))?;
     let (pp, qp) = (&pl[(a + k - 1) % k], &ql[(b + j - 1) % j]);
     // the shared edge's ends: p's start (its corner a − 1) on q's plane
     // after the shared one, p's end (corner a) on q's plane before it
-    if p.side(&ql[(b + 1) % j], (a + k - 1) % k) != 0 || p.side(qp, a) != 0 {
+    if pool.side(p, &ql[(b + 1) % j], (a + k - 1) % k) != 0 || pool.side(p, qp, a) != 0 {
         return None;
     }
     // convex where the boundary passes from one to the other: the far
     // corner of the edge leaving each junction inside the edge entering it
-    let one = q.side(pp, (b + 1) % j);
-    let two = p.side(qp, (a + 1) % k);
+    let one = pool.side(q, pp, (b + 1) % j);
+    let two = pool.side(p, qp, (a + 1) % k);
     if one < 0 || two < 0 {
         return None;
     }
@@ -496,14 +540,15 @@ fn union(p: &Piece, q: &Piece) -> Option<Piece> {
                 (!straight).then_some(l)
             }),
     );
-    (planes.len() >= 3).then(|| Piece::new(planes))
+    (planes.len() >= 3).then(|| pool.add(&planes))
 }
 
-/// The form factor from a point with unit `normal` to the piece's
-/// directions ([`crate::form_factor`] of its corners' rays from the
-/// origin: Lambert's closed form needs their directions only), in `f64`.
-fn form_factor(normal: DVec3, piece: &Piece) -> f64 {
-    crate::form_factor(DVec3::ZERO, normal, &piece.rays)
+/// The form factor from a point with unit `normal` to a piece's
+/// directions, its corners' `rays` ([`crate::form_factor`] of the rays
+/// from the origin: Lambert's closed form needs their directions only), in
+/// `f64`.
+fn form_factor(normal: DVec3, rays: &[[f64; 3]]) -> f64 {
+    crate::form_factor(DVec3::ZERO, normal, rays)
 }
 
 #[cfg(test)]
@@ -736,17 +781,17 @@ mod tests {
 
     /// The part of `cone` left of the line from `a` to `b` on the plane
     /// `z = 10`, seen from above (from the origin: inside its plane).
-    fn left_of(cone: &Piece, a: [i32; 2], b: [i32; 2]) -> Piece {
+    fn left_of(pool: &mut Pool, cone: Piece, a: [i32; 2], b: [i32; 2]) -> Piece {
         let m = cross(
             from([0; 3], [a[0], a[1], 10]),
             from([0; 3], [b[0], b[1], 10]),
         );
-        let s = sides(cone, &m);
+        let s = sides(pool, cone, &m);
         assert!(
             s.contains(&1) && s.contains(&-1),
             "the line crosses the piece"
         );
-        keep(cone, &s, 1, m)
+        keep(pool, cone, &s, 1, m)
     }
 
     /// Two cones sharing a whole edge merge where their union is convex
@@ -755,44 +800,48 @@ mod tests {
     #[test]
     fn pieces_merge_where_their_union_is_convex() {
         let x = [0, 0, 0];
+        let mut pool = Pool::default();
+        let p = &mut pool;
         // the square light's cone cut in two along a diagonal, and merged
         // back: the same four planes
         let square = [[-2, -2, 10], [2, -2, 10], [2, 2, 10], [-2, 2, 10]];
-        let whole = Piece::new(light_cone(square.iter().map(|&c| from(x, c))).unwrap());
+        let whole = p.add(&light_cone(square.iter().map(|&c| from(x, c))).unwrap());
         let (a, b) = (
-            left_of(&whole, [-2, -2], [2, 2]),
-            left_of(&whole, [2, 2], [-2, -2]),
+            left_of(p, whole, [-2, -2], [2, 2]),
+            left_of(p, whole, [2, 2], [-2, -2]),
         );
-        assert_eq!((a.planes.len(), b.planes.len()), (3, 3));
-        let back = merge(vec![a, b]);
+        assert_eq!((a.len, b.len), (3, 3));
+        let back = merge(p, vec![a, b]);
         assert_eq!(back.len(), 1);
-        let (mut planes, mut want) = (back[0].planes.to_vec(), whole.planes.to_vec());
+        let (mut planes, mut want) = (p.planes(back[0]).to_vec(), p.planes(whole).to_vec());
         planes.sort_unstable();
         want.sort_unstable();
         assert_eq!(planes, want);
         // a band [-2, 0] x [-1, 1] and, right of it, the same band: one
         // rectangle of four planes (two straight junctions)
-        let band = left_of(&left_of(&whole, [-2, -1], [2, -1]), [2, 1], [-2, 1]);
+        let low = left_of(p, whole, [-2, -1], [2, -1]);
+        let band = left_of(p, low, [2, 1], [-2, 1]);
         let (west, east) = (
-            left_of(&band, [0, -2], [0, 2]),
-            left_of(&band, [0, 2], [0, -2]),
+            left_of(p, band, [0, -2], [0, 2]),
+            left_of(p, band, [0, 2], [0, -2]),
         );
-        let joined = union(&west, &east).expect("the halves make the band");
-        assert_eq!(joined.planes.len(), 4);
+        let joined = union(p, west, east).expect("the halves make the band");
+        assert_eq!(joined.len, 4);
         let (halves, all) = (
-            form_factor(DVec3::Z, &west) + form_factor(DVec3::Z, &east),
-            form_factor(DVec3::Z, &joined),
+            form_factor(DVec3::Z, p.rays(west)) + form_factor(DVec3::Z, p.rays(east)),
+            form_factor(DVec3::Z, p.rays(joined)),
         );
         assert!((halves - all).abs() < 1e-15 && all > 0.0);
         // right of the west half, a piece widening from its edge: the
         // union has reflex corners
-        let right = left_of(&whole, [0, 2], [0, -2]);
-        let fan = left_of(&left_of(&right, [0, -1], [2, -2]), [2, 2], [0, 1]);
-        assert!(union(&west, &fan).is_none() && union(&fan, &west).is_none());
+        let right = left_of(p, whole, [0, 2], [0, -2]);
+        let narrow = left_of(p, right, [0, -1], [2, -2]);
+        let fan = left_of(p, narrow, [2, 2], [0, 1]);
+        assert!(union(p, west, fan).is_none() && union(p, fan, west).is_none());
         // the east half and the west half of the whole square share part
         // of an edge only
-        let tall_west = left_of(&whole, [0, -2], [0, 2]);
-        assert!(union(&tall_west, &east).is_none());
+        let tall_west = left_of(p, whole, [0, -2], [0, 2]);
+        assert!(union(p, tall_west, east).is_none());
     }
 
     proptest! {
