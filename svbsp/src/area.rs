@@ -42,12 +42,12 @@ use bsp_core::internals::GridPolygon;
 use bsp_core::{FaceDefect, GridPoint, MAX_COORD, Plane, Polygon, PolygonSide, Side, Split};
 use glam::DVec3;
 use rayon::prelude::*;
-use smallvec::SmallVec;
 
 use crate::boxes::{Box3, Near, Reach, ReachIndex, Scan, Scans, grid_box, polygon_box};
 use crate::light::{
     AreaLightError, Light, MAX_DISC_RADIUS, cross, plane_along, quantize_direction,
 };
+use crate::merging::{Keyed, merge_convex, merge_keyed, vertex_keys};
 
 /// A light with extent, or its limit, as a convex set of light points
 /// given by its corners ([`Light`]s, all of one kind):
@@ -584,102 +584,6 @@ fn merge_run(v: &mut Vec<Polygon>, start: usize) {
     let tail: Vec<Polygon> = v.drain(start..).collect();
     let merged = merge_convex(tail.into_iter().map(|p| (p, ())).collect());
     v.extend(merged.into_iter().map(|(p, ())| p));
-}
-
-/// The vertices' correctly rounded coordinates, as bits: equal exact
-/// points have equal keys, so two polygons that share an edge share two.
-fn vertex_keys(p: &Polygon) -> Vec<[u64; 3]> {
-    p.vertices_f64()
-        .iter()
-        .map(|c| c.map(|x| (x + 0.0).to_bits()))
-        .collect()
-}
-
-/// Merges polygons of equal labels pairwise where their union is convex
-/// (`Polygon::merge`, exact), until none do; only pairs that share two
-/// vertex keys are tried. Deterministic: the order of the input decides.
-pub(crate) fn merge_convex<T: Copy + PartialEq>(items: Vec<(Polygon, T)>) -> Vec<(Polygon, T)> {
-    let items = items
-        .into_iter()
-        .map(|(polygon, label)| Keyed {
-            keys: vertex_keys(&polygon),
-            polygon,
-            label,
-            extra: (),
-        })
-        .collect();
-    merge_keyed(items, |_, _| ())
-        .into_iter()
-        .map(|m| (m.polygon, m.label))
-        .collect()
-}
-
-/// A polygon to merge: its label, its vertex keys, and something that two
-/// merged polygons join.
-struct Keyed<T, X> {
-    polygon: Polygon,
-    label: T,
-    keys: Vec<[u64; 3]>,
-    extra: X,
-}
-
-/// [`merge_convex`] of polygons with their keys; `join` makes a merged
-/// polygon's `extra` of its two parts'. A polygon's keys are made again
-/// only when it grows.
-fn merge_keyed<T: Copy + PartialEq, X>(
-    mut items: Vec<Keyed<T, X>>,
-    join: impl Fn(&X, &X) -> X,
-) -> Vec<Keyed<T, X>> {
-    loop {
-        // (a vertex is a corner of a few polygons: no list allocated for it)
-        let mut at: rustc_hash::FxHashMap<[u64; 3], SmallVec<[u32; 4]>> = Default::default();
-        at.reserve(items.len() * 2);
-        for (i, item) in items.iter().enumerate() {
-            for k in &item.keys {
-                at.entry(*k).or_default().push(i as u32);
-            }
-        }
-        let mut dead = vec![false; items.len()];
-        let mut any = false;
-        let mut seen: SmallVec<[u32; 32]> = SmallVec::new();
-        for i in 0..items.len() {
-            if dead[i] {
-                continue;
-            }
-            seen.clear();
-            seen.extend(items[i].keys.iter().flat_map(|k| at[k].iter().copied()));
-            seen.sort_unstable();
-            let shared = seen
-                .windows(2)
-                .filter(|w| w[0] == w[1] && w[0] as usize > i)
-                .map(|w| w[0] as usize);
-            let mut candidates: SmallVec<[usize; 8]> = shared.collect();
-            candidates.dedup();
-            for j in candidates {
-                if dead[j] || items[j].label != items[i].label {
-                    continue;
-                }
-                if let Some(m) = items[i].polygon.merge(&items[j].polygon) {
-                    // later polygons of this pass look only for partners
-                    // after them: this one's new keys count from the next
-                    items[i].keys = vertex_keys(&m);
-                    items[i].polygon = m;
-                    items[i].extra = join(&items[i].extra, &items[j].extra);
-                    dead[j] = true;
-                    any = true;
-                    break;
-                }
-            }
-        }
-        let mut k = 0;
-        items.retain(|_| {
-            k += 1;
-            !dead[k - 1]
-        });
-        if !any {
-            return items;
-        }
-    }
 }
 
 /// What part of an area light the points of a fragment see.

@@ -52,6 +52,7 @@ mod cores;
 mod engine;
 pub mod export;
 mod light;
+mod merging;
 mod near;
 mod psv;
 mod schedule;

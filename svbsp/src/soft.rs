@@ -16,14 +16,13 @@ use bsp_core::{Grid, GridPoint, MAX_COORD, Plane, Polygon, Side};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use crate::area::{
-    AreaClass, AreaFragment, AreaLight, HalfSpaces, Occluder, Regions, merge_convex,
-};
+use crate::area::{AreaClass, AreaFragment, AreaLight, HalfSpaces, Occluder, Regions};
 use crate::backs::SolidBacks;
 use crate::blockers::{coplanar_blockers, coplanar_blockers_of, plane_key};
 use crate::boxes::{Box3, CellGrid, EMPTY, EVERYWHERE, Reach, grid_box, meet};
 use crate::engine::{LightVolumes, Scratch};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
+use crate::merging::merge_convex;
 use crate::near::{InSlab, near_lists, slab_box};
 
 /// The share of a polygon light's irradiance that arrives on a penumbra

@@ -1,0 +1,253 @@
+//! Merging convex polygons back where their union is convex: the pieces
+//! a face was cut into, once their classes are known, and what of a
+//! light a point sees ([`merge_convex`]).
+//!
+//! Two polygons that share an edge share two vertex keys (their
+//! vertices' correctly rounded coordinates), so candidates are found by
+//! hashing; whether they merge is decided exactly (`Polygon::merge`).
+
+use bsp_core::Polygon;
+use smallvec::SmallVec;
+
+/// The vertices' correctly rounded coordinates, as bits: equal exact
+/// points have equal keys, so two polygons that share an edge share two.
+pub(crate) fn vertex_keys(p: &Polygon) -> Vec<[u64; 3]> {
+    p.vertices_f64()
+        .iter()
+        .map(|c| c.map(|x| (x + 0.0).to_bits()))
+        .collect()
+}
+
+/// Merges polygons of equal labels pairwise where their union is convex
+/// (`Polygon::merge`, exact), until none do; only pairs that share two
+/// vertex keys are tried. Deterministic: the order of the input decides.
+pub(crate) fn merge_convex<T: Copy + PartialEq>(items: Vec<(Polygon, T)>) -> Vec<(Polygon, T)> {
+    let items = items
+        .into_iter()
+        .map(|(polygon, label)| Keyed {
+            keys: vertex_keys(&polygon),
+            polygon,
+            label,
+            extra: (),
+        })
+        .collect();
+    merge_keyed(items, |_, _| ())
+        .into_iter()
+        .map(|m| (m.polygon, m.label))
+        .collect()
+}
+
+/// A polygon to merge: its label, its vertex keys, and something that two
+/// merged polygons join.
+pub(crate) struct Keyed<T, X> {
+    pub(crate) polygon: Polygon,
+    pub(crate) label: T,
+    pub(crate) keys: Vec<[u64; 3]>,
+    pub(crate) extra: X,
+}
+
+/// [`merge_convex`] of polygons with their keys; `join` makes a merged
+/// polygon's `extra` of its two parts'. A polygon's keys are made again
+/// only when it grows.
+///
+/// In passes: each live polygon in turn tries, in index order, the later
+/// live ones of its label that share two vertex keys with it (as the
+/// pass found them) and takes the first it merges with; passes repeat
+/// until one merges nothing. A pass after the first visits only the
+/// polygons that grew in the one before and those sharing a key with
+/// them: any other polygon and all its partners are as they were when
+/// they last failed to merge, so it would fail again, and leaving it out
+/// changes nothing (a polygon's partners are always later ones, looked
+/// up as the pass began: the one that grows is never a partner of those
+/// after it, and the one it takes is dead).
+pub(crate) fn merge_keyed<T: Copy + PartialEq, X>(
+    mut items: Vec<Keyed<T, X>>,
+    join: impl Fn(&X, &X) -> X,
+) -> Vec<Keyed<T, X>> {
+    // each key to the live polygons with it, once for each time it is one
+    // of their keys (a vertex is a corner of a few polygons: no list
+    // allocated for it)
+    let mut at: rustc_hash::FxHashMap<[u64; 3], SmallVec<[u32; 4]>> = Default::default();
+    at.reserve(items.len() * 2);
+    for (i, item) in items.iter().enumerate() {
+        for k in &item.keys {
+            at.entry(*k).or_default().push(i as u32);
+        }
+    }
+    let mut dead = vec![false; items.len()];
+    let mut active: Vec<u32> = (0..items.len() as u32).collect();
+    let mut seen: SmallVec<[u32; 32]> = SmallVec::new();
+    while !active.is_empty() {
+        let mut grown: Vec<u32> = Vec::new();
+        for &i in &active {
+            let i = i as usize;
+            if dead[i] {
+                continue;
+            }
+            seen.clear();
+            seen.extend(items[i].keys.iter().flat_map(|k| at[k].iter().copied()));
+            seen.sort_unstable();
+            let shared = seen
+                .windows(2)
+                .filter(|w| w[0] == w[1] && w[0] as usize > i)
+                .map(|w| w[0] as usize);
+            let mut candidates: SmallVec<[usize; 8]> = shared.collect();
+            candidates.dedup();
+            for j in candidates {
+                if dead[j] || items[j].label != items[i].label {
+                    continue;
+                }
+                if let Some(m) = items[i].polygon.merge(&items[j].polygon) {
+                    // (the lists change for `i`, earlier than every
+                    // polygon after it in this pass, and for `j`, dead:
+                    // the later ones' partners are as the pass found them)
+                    let keys = vertex_keys(&m);
+                    unlist(&mut at, &items[i].keys, i as u32);
+                    unlist(&mut at, &items[j].keys, j as u32);
+                    for k in &keys {
+                        at.entry(*k).or_default().push(i as u32);
+                    }
+                    items[i].keys = keys;
+                    items[i].polygon = m;
+                    items[i].extra = join(&items[i].extra, &items[j].extra);
+                    dead[j] = true;
+                    grown.push(i as u32);
+                    break;
+                }
+            }
+        }
+        // the next pass: the polygons that grew and those sharing a key
+        // with them
+        active = grown
+            .iter()
+            .flat_map(|&i| {
+                items[i as usize]
+                    .keys
+                    .iter()
+                    .flat_map(|k| at[k].iter().copied())
+            })
+            .collect();
+        active.sort_unstable();
+        active.dedup();
+    }
+    let mut k = 0;
+    items.retain(|_| {
+        k += 1;
+        !dead[k - 1]
+    });
+    items
+}
+
+/// Takes polygon `i` off the lists of `keys`, once for each time a key
+/// is among them.
+fn unlist(at: &mut rustc_hash::FxHashMap<[u64; 3], SmallVec<[u32; 4]>>, keys: &[[u64; 3]], i: u32) {
+    for k in keys {
+        if let Some(list) = at.get_mut(k)
+            && let Some(p) = list.iter().position(|&x| x == i)
+        {
+            list.swap_remove(p);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The merge as it was before a pass visited only what the one before
+    /// changed: every pass visits every live polygon, with the lists made
+    /// again from all of them.
+    fn every_pass<T: Copy + PartialEq>(mut items: Vec<(Polygon, T)>) -> Vec<(Polygon, T)> {
+        loop {
+            let keys: Vec<Vec<[u64; 3]>> = items.iter().map(|(p, _)| vertex_keys(p)).collect();
+            let mut at: rustc_hash::FxHashMap<[u64; 3], Vec<usize>> = Default::default();
+            for (i, ks) in keys.iter().enumerate() {
+                for k in ks {
+                    at.entry(*k).or_default().push(i);
+                }
+            }
+            let mut dead = vec![false; items.len()];
+            let mut any = false;
+            for i in 0..items.len() {
+                if dead[i] {
+                    continue;
+                }
+                let mut seen: Vec<usize> = keys[i].iter().flat_map(|k| at[k].clone()).collect();
+                seen.sort_unstable();
+                let mut candidates: Vec<usize> = (seen.windows(2))
+                    .filter(|w| w[0] == w[1] && w[0] > i)
+                    .map(|w| w[0])
+                    .collect();
+                candidates.dedup();
+                for j in candidates {
+                    if dead[j] || items[j].1 != items[i].1 {
+                        continue;
+                    }
+                    if let Some(m) = items[i].0.merge(&items[j].0) {
+                        items[i].0 = m;
+                        dead[j] = true;
+                        any = true;
+                        break;
+                    }
+                }
+            }
+            let mut k = 0;
+            items.retain(|_| {
+                k += 1;
+                !dead[k - 1]
+            });
+            if !any {
+                return items;
+            }
+        }
+    }
+
+    /// A grid of unit squares, each cut into two triangles along a
+    /// random diagonal, with random labels of two kinds, in a random
+    /// order: the merge gives what passes over everything give, polygon
+    /// for polygon, and the labels' areas are kept.
+    #[test]
+    fn later_passes_visit_only_what_changed_and_give_the_same() {
+        let mut state = 0x5eed_u64;
+        let mut draw = |n: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % n
+        };
+        let mut merged_some = 0;
+        for round in 0..20 {
+            let side = 4 + round % 9;
+            let mut items: Vec<(Polygon, u8)> = Vec::new();
+            for x in 0..side {
+                for y in 0..side {
+                    let c = |dx: i32, dy: i32| [x + dx, y + dy, 0];
+                    let halves = match draw(2) {
+                        0 => [[c(0, 0), c(1, 0), c(1, 1)], [c(0, 0), c(1, 1), c(0, 1)]],
+                        _ => [[c(0, 0), c(1, 0), c(0, 1)], [c(1, 0), c(1, 1), c(0, 1)]],
+                    };
+                    // labels in patches, so that runs of equal ones merge
+                    let label = u8::from((x / 3 + y / 2 + draw(4) as i32 / 3) % 2 == 0);
+                    for t in halves {
+                        items.push((Polygon::from_grid_points(&t, 0).unwrap(), label));
+                    }
+                }
+            }
+            for i in (1..items.len()).rev() {
+                items.swap(i, draw(i as u64 + 1) as usize);
+            }
+            let want = every_pass(items.clone());
+            let got = merge_convex(items.clone());
+            assert_eq!(got.len(), want.len(), "round {round}");
+            for ((p, a), (q, b)) in got.iter().zip(&want) {
+                assert_eq!(a, b);
+                assert_eq!(p.vertices_f64(), q.vertices_f64(), "round {round}");
+            }
+            merged_some += usize::from(got.len() < items.len() / 2);
+        }
+        assert!(
+            merged_some > 10,
+            "{merged_some} rounds merged most triangles"
+        );
+    }
+}
