@@ -737,13 +737,7 @@ impl AreaLight {
         };
         // each piece and its parts on their own, in parallel where there
         // are several (in order: the same for every thread count)
-        let pieces = match active.len() {
-            0 | 1 => active.into_iter().flat_map(|p| how.family(p)).collect(),
-            _ => active
-                .into_par_iter()
-                .flat_map_iter(|p| how.family(p))
-                .collect::<Vec<_>>(),
-        };
+        let pieces = how.families(active);
         for piece in pieces.into_iter().chain(done) {
             let class = match piece {
                 Piece { not_lit: false, .. } if partly_behind => AreaClass::Penumbra,
@@ -890,6 +884,35 @@ struct Cutting<'a, 'r> {
 }
 
 impl Cutting<'_, '_> {
+    /// Every piece of `active` cut as its family ([`Cutting::family`]),
+    /// the families one after the other in `active`'s order: in parallel
+    /// where there are several (the same for every thread count), those
+    /// with the most occluders near them first where the index tells, so
+    /// that no large one is left to one thread at the end.
+    fn families<K: Copy + PartialEq + Send + Sync>(&self, active: Vec<Piece<K>>) -> Vec<Piece<K>> {
+        match (active.len(), &self.index) {
+            (0 | 1, _) => active.into_iter().flat_map(|p| self.family(p)).collect(),
+            (_, None) => active
+                .into_par_iter()
+                .flat_map_iter(|p| self.family(p))
+                .collect::<Vec<_>>(),
+            (_, Some(index)) => {
+                let mut jobs: Vec<(usize, usize, Piece<K>)> = (active.into_iter().enumerate())
+                    .map(|(i, p)| (index.near(&p.bbox).len(), i, p))
+                    .collect();
+                jobs.sort_by_key(|&(near, i, _)| (std::cmp::Reverse(near), i));
+                // one a task; then back in their order
+                let mut done: Vec<(usize, Vec<Piece<K>>)> = jobs
+                    .into_par_iter()
+                    .with_max_len(1)
+                    .map(|(_, i, p)| (i, self.family(p)))
+                    .collect();
+                done.sort_unstable_by_key(|&(i, _)| i);
+                done.into_iter().flat_map(|(_, f)| f).collect()
+            }
+        }
+    }
+
     /// `first` cut by every occluder in turn, its parts alike after an
     /// occluder merged again as they pile up (so later occluders meet few).
     fn family<K: Copy + PartialEq>(&self, first: Piece<K>) -> Vec<Piece<K>> {
@@ -1243,6 +1266,62 @@ mod tests {
             let side = h.classify_grid(x);
             side == *s || side == Side::On
         })
+    }
+
+    /// A ground cut in a row of squares under many small triangles,
+    /// crowded towards one end: the families, scheduled by how many
+    /// occluders lie near them, come back as cut one after the other, in
+    /// their order.
+    #[test]
+    fn families_come_back_in_their_order_whatever_runs_first() {
+        let light = AreaLight::new(&[[-8, -8, 90], [-8, 8, 90], [8, 8, 90], [8, -8, 90]]).unwrap();
+        let mut occluders = Vec::new();
+        for i in 0..200 {
+            // more of them over the row's far end
+            let x = i * i / 200;
+            let y = i * 7 % 11 - 5;
+            let tri = [[x, y, 30], [x + 3, y, 30], [x, y + 3, 31]];
+            occluders.push(Occluder::new(&tri).unwrap());
+        }
+        let regions: Vec<(Regions, Reach)> = (occluders.iter())
+            .filter_map(|o| {
+                let b = grid_box(o.corners());
+                let wide: Box3 = [
+                    [b[0][0] - 12, b[0][1] + 12],
+                    [b[1][0] - 12, b[1][1] + 12],
+                    [-1, 1],
+                ];
+                Some((light.regions(o)?, [wide, wide]))
+            })
+            .collect();
+        assert!(regions.len() > 128);
+        let refs: Vec<(&Regions, Reach)> = regions.iter().map(|(r, b)| (r, *b)).collect();
+        let squares: Vec<Polygon> = (0..12)
+            .map(|i| {
+                let x = -20 + 20 * i;
+                let q = [[x, -20, 0], [x + 20, -20, 0], [x + 20, 20, 0], [x, 20, 0]];
+                Polygon::from_grid_points(&q, 0).unwrap()
+            })
+            .collect();
+        let ground = grid_box(&[[-20, -20, 0], [220, 20, 0]]);
+        let how = Cutting {
+            regions: &refs,
+            index: Some(ReachIndex::new(ground, refs.iter().map(|(_, r)| r))),
+            all: 0b1111,
+            known: false,
+        };
+        let pieces = || squares.iter().map(|q| Piece::new(q.clone(), (), 0, false));
+        let want: Vec<Piece<()>> = pieces().flat_map(|p| how.family(p)).collect();
+        let got = how.families(pieces().collect());
+        assert!(want.len() > 2 * squares.len(), "{} pieces", want.len());
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            assert_eq!(g.polygon.vertices_f64(), w.polygon.vertices_f64());
+            assert_eq!(
+                (g.not_lit, g.hidden, g.umbra),
+                (w.not_lit, w.hidden, w.umbra)
+            );
+        }
     }
 
     /// The umbra volume with one plane per occluder edge holds exactly
