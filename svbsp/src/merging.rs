@@ -205,7 +205,7 @@ mod tests {
     /// A grid of unit squares, each cut into two triangles along a
     /// random diagonal, with random labels of two kinds, in a random
     /// order: the merge gives what passes over everything give, polygon
-    /// for polygon, and the labels' areas are kept.
+    /// for polygon and label for label, in the same order.
     #[test]
     fn later_passes_visit_only_what_changed_and_give_the_same() {
         let mut state = 0x5eed_u64;
