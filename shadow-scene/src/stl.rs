@@ -339,8 +339,8 @@ fn parse_ascii(bytes: &[u8], path: &str) -> Result<Mesh, SceneError> {
 /// The white-space separated words of a text, with their 1-based lines.
 struct Tokens<'a> {
     words: std::iter::Peekable<Box<dyn Iterator<Item = (&'a str, usize)> + 'a>>,
-    /// The last line, for an error at the end of the text.
-    last: usize,
+    /// The text, whose last line an error at its end names.
+    text: &'a str,
 }
 
 impl<'a> Tokens<'a> {
@@ -352,7 +352,7 @@ impl<'a> Tokens<'a> {
         );
         Tokens {
             words: words.peekable(),
-            last: text.lines().count().max(1),
+            text,
         }
     }
 
@@ -381,9 +381,11 @@ impl<'a> Tokens<'a> {
         what: &str,
         err: &impl Fn(usize, String) -> SceneError,
     ) -> Result<(&'a str, usize), SceneError> {
+        // (the lines counted only for the error)
+        let text = self.text;
         self.next().ok_or_else(|| {
             err(
-                self.last,
+                text.lines().count().max(1),
                 format!("the file ends where {what} was expected"),
             )
         })

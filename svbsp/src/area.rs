@@ -897,15 +897,17 @@ impl Cutting<'_, '_> {
                 .flat_map_iter(|p| self.family(p))
                 .collect::<Vec<_>>(),
             (_, Some(index)) => {
-                let mut jobs: Vec<(usize, usize, Piece<K>)> = (active.into_iter().enumerate())
-                    .map(|(i, p)| (index.near(&p.bbox).len(), i, p))
+                // (each family's near occluders found once: they order
+                // the families, then the family is cut by them)
+                let mut jobs: Vec<(Vec<u32>, usize, Piece<K>)> = (active.into_iter().enumerate())
+                    .map(|(i, p)| (index.near(&p.bbox), i, p))
                     .collect();
-                jobs.sort_by_key(|&(near, i, _)| (std::cmp::Reverse(near), i));
+                jobs.sort_by_key(|(near, i, _)| (std::cmp::Reverse(near.len()), *i));
                 // one a task; then back in their order
                 let mut done: Vec<(usize, Vec<Piece<K>>)> = jobs
                     .into_par_iter()
                     .with_max_len(1)
-                    .map(|(_, i, p)| (i, self.family(p)))
+                    .map(|(near, i, p)| (i, self.family_among(p, Some(&near))))
                     .collect();
                 done.sort_unstable_by_key(|&(i, _)| i);
                 done.into_iter().flat_map(|(_, f)| f).collect()
@@ -916,15 +918,25 @@ impl Cutting<'_, '_> {
     /// `first` cut by every occluder in turn, its parts alike after an
     /// occluder merged again as they pile up (so later occluders meet few).
     fn family<K: Copy + PartialEq>(&self, first: Piece<K>) -> Vec<Piece<K>> {
+        let near = self.index.as_ref().map(|index| index.near(&first.bbox));
+        self.family_among(first, near.as_deref())
+    }
+
+    /// [`Cutting::family`], with the index's answer for `first`'s box
+    /// (`near`) where there is an index.
+    fn family_among<K: Copy + PartialEq>(
+        &self,
+        first: Piece<K>,
+        near: Option<&[u32]>,
+    ) -> Vec<Piece<K>> {
         let (all, known) = (self.all, self.known);
         let scan = |p: &Piece<K>| scan_of(p, known && p.hidden == all);
         // every part of `first` lies in its box: the occluders whose boxes
         // miss it are passed over (in order: the parts are the same)
         let picked: Vec<(&Regions, Reach)>;
-        let regions = match &self.index {
-            Some(index) => {
-                let near = index.near(&first.bbox).into_iter();
-                picked = near.map(|i| self.regions[i as usize]).collect();
+        let regions = match near {
+            Some(near) => {
+                picked = near.iter().map(|&i| self.regions[i as usize]).collect();
                 &picked[..]
             }
             None => self.regions,

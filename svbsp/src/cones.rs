@@ -562,6 +562,7 @@ mod tests {
     /// How far two `f64` evaluations of one share may lie apart: a share
     /// is a value (Lambert's sum, or the chart's areas, over differently
     /// cut pieces), not a decision; every decision behind it is exact.
+    /// (Test-side only: nothing in the library compares with it.)
     const ROUNDING: f64 = 1e-9;
 
     /// How far the share of a 300 × 300 lattice of rays may lie from the
@@ -657,6 +658,8 @@ mod tests {
         #[test]
         fn the_cones_see_a_sun_disc_as_the_chart_does(
             toward in (-8i32..8, -8i32..8),
+            // (input radii in degrees, the first too small for a strictly
+            // convex quantized octagon: the chart's case)
             radius in prop_oneof![Just(1e-6), Just(0.01), Just(0.05), Just(0.2)],
             x in (-30i32..30, -30i32..30),
             field in (-30i32..0, -30i32..0, 1i32..12, 1usize..6),
@@ -831,6 +834,8 @@ mod tests {
             form_factor(DVec3::Z, p.rays(west)) + form_factor(DVec3::Z, p.rays(east)),
             form_factor(DVec3::Z, p.rays(joined)),
         );
+        // (two f64 Lambert sums of the same directions, which no decision
+        // reads: equal up to a few roundings)
         assert!((halves - all).abs() < 1e-15 && all > 0.0);
         // right of the west half, a piece widening from its edge: the
         // union has reflex corners
