@@ -82,11 +82,18 @@ pub struct ShadeOptions {
     /// Also record each fragment's convex pieces (for formats that need
     /// convex polygons, such as OBJ).
     pub pieces: bool,
+    /// Also record each convex piece's edge planes, so that the pieces
+    /// can be cut again exactly ([`FragmentRef::piece_planes`]; not kept
+    /// by [`ShadowSet::refine_cells`]).
+    pub planes: bool,
 }
 
 impl Default for ShadeOptions {
     fn default() -> ShadeOptions {
-        ShadeOptions { pieces: true }
+        ShadeOptions {
+            pieces: true,
+            planes: false,
+        }
     }
 }
 
@@ -94,6 +101,13 @@ impl ShadeOptions {
     /// Sets [`ShadeOptions::pieces`].
     pub fn with_pieces(mut self, pieces: bool) -> ShadeOptions {
         self.pieces = pieces;
+        self
+    }
+
+    /// Sets [`ShadeOptions::planes`] (and [`ShadeOptions::pieces`] with it).
+    pub fn with_planes(mut self, planes: bool) -> ShadeOptions {
+        self.planes = planes;
+        self.pieces |= planes;
         self
     }
 }
@@ -939,6 +953,10 @@ pub struct Batch {
     frag_piece: Vec<u32>,
     piece_start: Vec<u32>,
     piece_verts: Vec<u32>,
+    /// Per piece corner, the plane of the edge leaving it (the piece
+    /// behind it); valid while it is as long as `piece_verts` (every
+    /// piece recorded with [`ShadeOptions::planes`]).
+    piece_planes: Vec<Plane>,
     vertices: Vec<Vertex>,
     rounded: Vec<[f64; 3]>,
 }
@@ -1019,6 +1037,21 @@ impl<'a> FragmentRef<'a> {
         let r = b.frag_piece[self.index] as usize..b.frag_piece[self.index + 1] as usize;
         r.map(move |k| &b.piece_verts[b.piece_start[k] as usize..b.piece_start[k + 1] as usize])
     }
+
+    /// Per convex piece (as [`FragmentRef::pieces`]), its edge planes in
+    /// turn, exact: plane `i` bounds the edge from corner `i` to `i + 1`,
+    /// the piece behind it, so that with the fragment's support plane
+    /// they make the piece again ([`bsp_core::Polygon::from_planes`]).
+    /// `None` unless the batch was shaded with [`ShadeOptions::planes`].
+    pub fn piece_planes(self) -> Option<impl Iterator<Item = &'a [Plane]> + 'a> {
+        let b = self.batch;
+        (b.piece_planes.len() == b.piece_verts.len()).then(|| {
+            let r = b.frag_piece[self.index] as usize..b.frag_piece[self.index + 1] as usize;
+            r.map(move |k| {
+                &b.piece_planes[b.piece_start[k] as usize..b.piece_start[k + 1] as usize]
+            })
+        })
+    }
 }
 
 impl Batch {
@@ -1036,6 +1069,7 @@ impl Batch {
             frag_piece: vec![0],
             piece_start: vec![0],
             piece_verts: Vec::new(),
+            piece_planes: Vec::new(),
             vertices: Vec::new(),
             rounded: Vec::new(),
         }
@@ -1175,6 +1209,12 @@ impl Batch {
         );
         self.ring_verts
             .extend(o.ring_verts[rv].iter().map(|&v| shift(v)));
+        let planes = self.piece_planes.len() == self.piece_verts.len()
+            && o.piece_planes.len() == o.piece_verts.len();
+        if planes {
+            self.piece_planes
+                .extend_from_slice(&o.piece_planes[pv.clone()]);
+        }
         self.piece_verts
             .extend(o.piece_verts[pv].iter().map(|&v| shift(v)));
         if lo < hi {
@@ -1268,6 +1308,9 @@ impl Batch {
                 let copy: SmallVec<[u32; 8]> = self.ring_verts[start..].iter().copied().collect();
                 self.piece_verts.extend(copy);
                 self.piece_start.push(self.piece_verts.len() as u32);
+                if opts.planes {
+                    (self.piece_planes).extend(piece.edges.iter().map(|&e| s.arena.plane(e)));
+                }
             }
             self.close_fragment();
             return;
@@ -1316,6 +1359,10 @@ impl Batch {
                         self.piece_verts.push(id);
                     }
                     self.piece_start.push(self.piece_verts.len() as u32);
+                    if opts.planes {
+                        let edges = &s.pieces[c as usize].edges;
+                        (self.piece_planes).extend(edges.iter().map(|&e| s.arena.plane(e)));
+                    }
                 }
             }
             self.close_fragment();
@@ -1488,5 +1535,40 @@ mod tests {
         for f in b.fragments() {
             assert!(f.pieces().count() >= 1);
         }
+    }
+
+    /// With `planes`, each piece's edge planes make it again (the same
+    /// corners, in turn, as the support plane's meets with them), for
+    /// pieces that stayed whole and pieces of merged regions alike; and
+    /// appending batches keeps them. Without, there are none.
+    #[test]
+    fn piece_planes_make_the_pieces_again() {
+        let polys = [quad(0, 0, 8, 0), quad(4, 2, 4, 1), quad(6, -20, -10, 2)];
+        let lights = [Light::Point([3, 3, 8]), Light::Point([6, 1, 9])];
+        let shadows = LightVolumes::new(&polys, &lights).unwrap();
+        let opts = ShadeOptions::default().with_planes(true);
+        let whole = shadows.set().shade_all(&polys, &opts);
+        let mut b = Batch::new();
+        b.append_range(&whole, 0..1);
+        b.append_range(&whole, 1..whole.len());
+        let mut pieces = 0;
+        for f in b.fragments() {
+            let planes: Vec<&[Plane]> = f.piece_planes().unwrap().collect();
+            for (corners, planes) in f.pieces().zip(planes) {
+                let p = Polygon::from_planes(*f.support(), planes, 0).unwrap();
+                let made: Vec<[f64; 3]> = p.vertices_f64();
+                let kept: Vec<[f64; 3]> = corners.iter().map(|&v| b.rounded(v)).collect();
+                assert_eq!(made, kept);
+                // turned as the engine's pieces are: inside behind each plane
+                assert!(crate::Overlay::new(*f.support(), [(planes, 0)]).is_some());
+                pieces += 1;
+            }
+        }
+        assert!(pieces > b.len(), "some fragment of several pieces");
+        let plain = shadows.set().shade_all(&polys, &ShadeOptions::default());
+        assert!(plain.fragments().all(|f| f.piece_planes().is_none()));
+        let mut mixed = whole.clone();
+        mixed.append(&plain);
+        assert!(mixed.fragments().all(|f| f.piece_planes().is_none()));
     }
 }
