@@ -54,6 +54,7 @@ pub mod export;
 mod light;
 mod merging;
 mod near;
+mod overlay;
 mod psv;
 mod schedule;
 mod sealed;
@@ -75,6 +76,7 @@ pub use light::{
     MAX_DISC_RADIUS_DEG, MAX_LIGHTS, PlacedLight, SUN_RADIUS_DEG, SoftSpec, angle_between,
     input_number, input_triple, place_lights, quantize_direction, shared_grid,
 };
+pub use overlay::{Overlay, OverlayRegion};
 pub use psv::{ShadowVolumes, VolumeError, VolumeSanity};
 pub use soft::{
     Share, SoftFragment, SoftLight, SoftShape, SoftVolumes, place_soft_lights, shared_soft_grid,

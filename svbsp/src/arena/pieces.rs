@@ -350,6 +350,33 @@ impl VertexRef<'_> {
         }
     }
 
+    /// Per coordinate, an interval of `f64` values holding the exact one
+    /// but for a few units in the last place (a lazy point's from its
+    /// approximations and their error bounds, without its exact
+    /// coordinates where the denominator's interval is clear of zero);
+    /// for boxes that may be wider than the point, widened by the caller.
+    pub(crate) fn near_f64(self) -> [[f64; 2]; 3] {
+        match self {
+            VertexRef::Lazy(l, _) if l.exact.is_none() && l.approx[3] > 2.0 * l.err[3] => {
+                let (w, ew) = (l.approx[3], l.err[3]);
+                [0, 1, 2].map(|k| {
+                    let (x, ex) = (l.approx[k], l.err[k]);
+                    let q = [
+                        (x - ex) / (w - ew),
+                        (x - ex) / (w + ew),
+                        (x + ex) / (w - ew),
+                        (x + ex) / (w + ew),
+                    ];
+                    [
+                        q.iter().copied().fold(f64::INFINITY, f64::min),
+                        q.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                    ]
+                })
+            }
+            _ => self.to_f64().map(|c| [c, c]),
+        }
+    }
+
     /// The correctly rounded grid coordinates.
     pub(crate) fn to_f64(self) -> [f64; 3] {
         match self {

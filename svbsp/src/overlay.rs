@@ -1,0 +1,520 @@
+//! The exact overlay of partitions of one face (the core paper's "+"):
+//! cells with counts, each cell of one partition met with each cell of
+//! the other and their counts added, every cut an exact plane and every
+//! corner an exact point (no rounding decides anything, and no sliver is
+//! dropped for being small). A sun study overlays its runs' lit pieces
+//! of a face this way, so that each cell's points all see the same number
+//! of suns.
+
+use bsp_core::{Plane, Side};
+use smallvec::SmallVec;
+
+use crate::arena::pieces::{EdgeRef, Piece, PieceArena};
+use crate::arena::regions::merge_cells;
+use crate::boxes::{Box3, CellGrid, meet};
+
+/// How many cells [`Overlay::plus`] tries in turn rather than through a
+/// grid of their boxes.
+const FEW: usize = 8;
+
+/// Convex cells of one face with a count each, their corners exact.
+#[derive(Clone, Debug)]
+pub struct Overlay {
+    arena: PieceArena,
+    /// The support plane's index in the arena.
+    support: u32,
+    plane: Plane,
+    cells: Vec<(Piece, u32)>,
+    /// Per cell, a box of grid points holding it.
+    boxes: Vec<Box3>,
+}
+
+/// A region of an [`Overlay`]: cells of one count merged, as rings of
+/// correctly rounded grid coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OverlayRegion {
+    /// The cells' count.
+    pub count: u32,
+    /// The outer boundary, counter-clockwise seen from the front of the
+    /// support plane; no two consecutive edges collinear.
+    pub outer: Vec<[f64; 3]>,
+    /// The holes, each clockwise.
+    pub holes: Vec<Vec<[f64; 3]>>,
+}
+
+/// Equal where the support planes, and each cell's edge planes and
+/// count in turn, are (the same cells, however their corners were made).
+impl PartialEq for Overlay {
+    fn eq(&self, o: &Overlay) -> bool {
+        self.plane == o.plane
+            && self.len() == o.len()
+            && (0..self.len()).all(|i| self.count(i) == o.count(i) && self.planes(i) == o.planes(i))
+    }
+}
+
+impl Overlay {
+    /// The cells on plane `support` given by their edge planes in turn
+    /// (plane `i` bounds the edge from corner `i` to `i + 1`, the cell
+    /// behind it, as [`crate::FragmentRef::piece_planes`] gives them) and
+    /// their counts. `None` where a cell is not a strictly convex polygon
+    /// of at least three corners on `support` (checked exactly).
+    pub fn new<P: AsRef<[Plane]>>(
+        support: Plane,
+        cells: impl IntoIterator<Item = (P, u32)>,
+    ) -> Option<Overlay> {
+        let mut arena = PieceArena::default();
+        let s = arena.add_plane(support);
+        let mut out = Vec::new();
+        let mut sides = SmallVec::new();
+        for (planes, count) in cells {
+            let planes = planes.as_ref();
+            let k = planes.len();
+            if k < 3 {
+                return None;
+            }
+            let idx: SmallVec<[u32; 6]> = planes.iter().map(|&p| arena.add_plane(p)).collect();
+            let mut piece = Piece::default();
+            for i in 0..k {
+                piece
+                    .verts
+                    .push(arena.add_meet([s, idx[(i + k - 1) % k], idx[i]])?);
+                piece.edges.push(EdgeRef::new(idx[i], false));
+            }
+            // strictly convex: every corner strictly behind the planes of
+            // the edges it is not on
+            for (i, plane) in planes.iter().enumerate() {
+                arena.classify_into(&piece, plane, &mut sides);
+                let apart = (0..k).all(|v| match v == i || v == (i + 1) % k {
+                    true => sides[v] == Side::On,
+                    false => sides[v] == Side::Back,
+                });
+                if !apart {
+                    return None;
+                }
+            }
+            out.push((piece, count));
+        }
+        let mut o = Overlay {
+            arena,
+            support: s,
+            plane: support,
+            cells: out,
+            boxes: Vec::new(),
+        };
+        o.boxes = (o.cells.iter()).map(|c| o.bounds_of(&c.0)).collect();
+        Some(o)
+    }
+
+    /// The support plane.
+    pub fn support(&self) -> &Plane {
+        &self.plane
+    }
+
+    /// The number of cells.
+    pub fn len(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// `true` if there is no cell.
+    pub fn is_empty(&self) -> bool {
+        self.cells.is_empty()
+    }
+
+    /// Cell `i`'s count.
+    pub fn count(&self, i: usize) -> u32 {
+        self.cells[i].1
+    }
+
+    /// Cell `i`'s edge planes in turn (what [`Overlay::new`] takes).
+    pub fn planes(&self, i: usize) -> SmallVec<[Plane; 6]> {
+        let c = &self.cells[i].0;
+        c.edges.iter().map(|&e| self.arena.plane(e)).collect()
+    }
+
+    /// Cell `i`'s corners, counter-clockwise seen from the front of the
+    /// support plane, as correctly rounded grid coordinates (equal points
+    /// give equal coordinates, however they were made).
+    pub fn corners(&self, i: usize) -> Vec<[f64; 3]> {
+        let c = &self.cells[i].0;
+        c.verts
+            .iter()
+            .map(|&v| self.arena.vertex(v).to_f64())
+            .collect()
+    }
+
+    /// Every cell of `self` met with every cell of `other` (on the same
+    /// support plane), their counts added: the parts of a cell of `self`
+    /// inside each cell of `other`, cut off by that cell's edge planes
+    /// (exact sides, exact new corners). Where `other`'s cells leave part
+    /// of a cell uncovered, that part keeps its count alone. In the order
+    /// of `self`'s cells, then of the pieces as they are cut.
+    pub fn plus(mut self, other: &Overlay) -> Overlay {
+        debug_assert!(self.plane == other.plane, "overlays of one plane");
+        // one cell holding all of `other` (a face still whole): `other`'s
+        // cells, counted with it
+        if let [(cell, count)] = &self.cells[..]
+            && other.inside(cell, &self.arena)
+        {
+            let mut o = other.clone();
+            o.cells.iter_mut().for_each(|c| c.1 += count);
+            return o;
+        }
+        let boxes = &other.boxes;
+        let Some(scene) = boxes
+            .iter()
+            .copied()
+            .reduce(|a, b| [0, 1, 2].map(|k| [a[k][0].min(b[k][0]), a[k][1].max(b[k][1])]))
+        else {
+            return self;
+        };
+        // (a few cells are tried in turn, many through a grid of boxes)
+        let grid = (other.len() > FEW).then(|| CellGrid::new(scene, boxes));
+        // each of `other`'s planes copied in once (as oriented), when
+        // first needed
+        let mut copied: Vec<Option<u32>> = vec![None; 2 * other.arena.planes.len()];
+        // (and those copied while a cell is cut, forgotten if its cuts are
+        // undone)
+        let mut fresh = Vec::new();
+        let (mut seen, mut near) = (vec![usize::MAX; other.len()], Vec::new());
+        let mut sides = SmallVec::new();
+        let mut out = Vec::with_capacity(self.cells.len());
+        let mut out_boxes = Vec::with_capacity(self.cells.len());
+        let cells = std::mem::take(&mut self.cells);
+        let own = std::mem::take(&mut self.boxes);
+        for (i, ((cell, count), bounds)) in cells.into_iter().zip(own).enumerate() {
+            near.clear();
+            match &grid {
+                Some(grid) => {
+                    grid.visit(bounds, |j| {
+                        if std::mem::replace(&mut seen[j as usize], i) != i {
+                            near.push(j);
+                        }
+                    });
+                    near.sort_unstable();
+                }
+                None => near.extend(0..other.len() as u32),
+            }
+            let (first, mark) = (out.len(), self.arena.mark());
+            fresh.clear();
+            let mut rest = vec![cell.clone()];
+            for &j in &near {
+                let (theirs, more) = &other.cells[j as usize];
+                let mut next = Vec::new();
+                for piece in rest.drain(..) {
+                    let parts = next.len();
+                    let mut inside = Some(piece.clone());
+                    for &e in &theirs.edges {
+                        let Some(p) = inside.take() else { break };
+                        let plane = other.arena.plane(e);
+                        let s = self.arena.classify_into(&p, &plane, &mut sides);
+                        if !s.front {
+                            inside = Some(p);
+                        } else if s.back {
+                            let key = 2 * e.index() as usize + usize::from(e.flipped());
+                            let at = *copied[key].get_or_insert_with(|| {
+                                fresh.push(key);
+                                self.arena.add_plane(plane)
+                            });
+                            let (outside, kept) = self.arena.split(self.support, &p, at, &sides);
+                            next.push(outside);
+                            inside = Some(kept);
+                        }
+                    }
+                    match inside {
+                        Some(p) => {
+                            // in both cells: in both boxes
+                            out.push((p, count + more));
+                            out_boxes.push(meet(bounds, boxes[j as usize]).unwrap_or(bounds));
+                        }
+                        // apart from this cell: whole, not in parts
+                        None => {
+                            next.truncate(parts);
+                            next.push(piece);
+                        }
+                    }
+                }
+                rest = next;
+                if rest.is_empty() {
+                    break;
+                }
+            }
+            out_boxes.extend(rest.iter().map(|_| bounds));
+            out.extend(rest.into_iter().map(|p| (p, count)));
+            // parts that all came to one count: the cell whole, its cuts
+            // undone (the cuts made only other's cells, not other counts)
+            let mine = &out[first..];
+            if mine.len() > 1 && mine.iter().all(|c| c.1 == mine[0].1) {
+                let n = mine[0].1;
+                out.truncate(first);
+                out_boxes.truncate(first);
+                self.arena.rollback(mark);
+                fresh.iter().for_each(|&k| copied[k] = None);
+                out.push((cell, n));
+                out_boxes.push(bounds);
+            }
+        }
+        self.cells = out;
+        self.boxes = out_boxes;
+        self
+    }
+
+    /// Whether every cell lies in `cell` of `arena` (its corners behind or
+    /// on each of `cell`'s edge planes: the cells are convex).
+    fn inside(&self, cell: &Piece, arena: &PieceArena) -> bool {
+        cell.edges.iter().all(|&e| {
+            let plane = arena.plane(e);
+            (self.cells.iter()).all(|(c, _)| !self.arena.sides_shared(c, &plane).front)
+        })
+    }
+
+    /// The cells of equal counts merged into regions (maximal and
+    /// connected, with holes), in the order of their first cell.
+    pub fn regions(&self) -> Vec<OverlayRegion> {
+        let pieces: Vec<Piece> = self.cells.iter().map(|c| c.0.clone()).collect();
+        let labels: Vec<u64> = self.cells.iter().map(|c| u64::from(c.1)).collect();
+        let mut rounded = Vec::new();
+        let regions = merge_cells(&self.arena, &self.plane, &pieces, &labels, &mut rounded);
+        let at = |v: &u32| self.arena.vertex(*v).to_f64();
+        regions
+            .into_iter()
+            .map(|r| OverlayRegion {
+                count: r.label as u32,
+                outer: r.outer.iter().map(at).collect(),
+                holes: r.holes.iter().map(|h| h.iter().map(at).collect()).collect(),
+            })
+            .collect()
+    }
+
+    /// A box of grid points holding `cell`: the floor and ceiling of
+    /// intervals holding its corners' coordinates (but for a few units in
+    /// their last place, below `2^-20` of a grid step), widened by one.
+    fn bounds_of(&self, cell: &Piece) -> Box3 {
+        let mut b = [[i64::MAX, i64::MIN]; 3];
+        for &v in &cell.verts {
+            let p = self.arena.vertex(v).near_f64();
+            for k in 0..3 {
+                b[k][0] = b[k][0].min(p[k][0].floor() as i64 - 1);
+                b[k][1] = b[k][1].max(p[k][1].ceil() as i64 + 1);
+            }
+        }
+        b
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bsp_core::{GridPoint, Polygon, Split};
+    use proptest::prelude::*;
+
+    /// The square `[0, s]²` on the plane z = 0, facing +z.
+    fn square(s: i32) -> Polygon {
+        Polygon::from_grid_points(&[[0, 0, 0], [s, 0, 0], [s, s, 0], [0, s, 0]], 0).unwrap()
+    }
+
+    /// The upright plane through `a` and `b` (on z = 0).
+    fn upright(a: [i32; 2], b: [i32; 2]) -> Option<Plane> {
+        Plane::through([a[0], a[1], 0], [b[0], b[1], 0], [a[0], a[1], 1]).ok()
+    }
+
+    /// `face` cut by each of `cuts` in turn, each piece with a count.
+    fn partition(
+        face: Polygon,
+        cuts: &[Plane],
+        count: impl Fn(usize) -> u32,
+    ) -> Vec<(Polygon, u32)> {
+        let mut pieces = vec![face];
+        for c in cuts {
+            pieces = pieces
+                .into_iter()
+                .flat_map(|p| match p.split(c) {
+                    Split::Spanning { front, back } => vec![front, back],
+                    Split::Front(p) | Split::Back(p) => vec![p],
+                    Split::Coplanar { polygon, .. } => vec![polygon],
+                })
+                .collect();
+        }
+        pieces
+            .into_iter()
+            .enumerate()
+            .map(|(i, p)| (p, count(i)))
+            .collect()
+    }
+
+    fn overlay_of(cells: &[(Polygon, u32)]) -> Overlay {
+        let support = *cells[0].0.support();
+        Overlay::new(support, cells.iter().map(|(p, c)| (p.edge_planes(), *c))).unwrap()
+    }
+
+    /// The count of the cell of `o` that holds grid point `x` strictly
+    /// inside (`None` if none does: `x` lies on an edge).
+    fn count_at(o: &Overlay, x: GridPoint) -> Option<u32> {
+        let inside: Vec<u32> = (0..o.len())
+            .filter(|&i| o.planes(i).iter().all(|p| p.classify_grid(x) == Side::Back))
+            .map(|i| o.count(i))
+            .collect();
+        assert!(inside.len() <= 1, "cells overlap at {x:?}");
+        inside.first().copied()
+    }
+
+    fn count_in(cells: &[(Polygon, u32)], x: GridPoint) -> Option<u32> {
+        let inside: Vec<u32> = (cells.iter())
+            .filter(|(p, _)| {
+                p.edge_planes()
+                    .iter()
+                    .all(|e| e.classify_grid(x) == Side::Back)
+            })
+            .map(|c| c.1)
+            .collect();
+        inside.first().copied()
+    }
+
+    fn area(c: &[[f64; 3]]) -> f64 {
+        let n = c.len();
+        (0..n)
+            .map(|i| c[i][0] * c[(i + 1) % n][1] - c[(i + 1) % n][0] * c[i][1])
+            .sum::<f64>()
+            / 2.0
+    }
+
+    #[test]
+    fn two_crossing_cuts_give_four_cells_with_summed_counts() {
+        let a = partition(square(12), &[upright([4, 0], [4, 12]).unwrap()], |i| {
+            i as u32 + 1
+        });
+        let b = partition(square(12), &[upright([0, 3], [12, 9]).unwrap()], |i| {
+            10 * i as u32
+        });
+        let o = overlay_of(&a).plus(&overlay_of(&b));
+        assert_eq!(o.len(), 4);
+        let total: f64 = (0..o.len()).map(|i| area(&o.corners(i))).sum();
+        assert_eq!(total, 144.0);
+        for (x, y) in [(1, 1), (1, 11), (11, 1), (11, 11), (5, 8), (2, 5)] {
+            let want = count_in(&a, [x, y, 0]).unwrap() + count_in(&b, [x, y, 0]).unwrap();
+            assert_eq!(count_at(&o, [x, y, 0]), Some(want), "at {x}, {y}");
+        }
+    }
+
+    #[test]
+    fn a_cell_inside_another_is_kept_whole_and_regions_have_holes() {
+        // a square in the middle of the face, counted 1; around it 0
+        let cuts = [
+            upright([4, 0], [4, 12]).unwrap(),
+            upright([8, 12], [8, 0]).unwrap(),
+            upright([12, 4], [0, 4]).unwrap(),
+            upright([0, 8], [12, 8]).unwrap(),
+        ];
+        let middle = |p: &Polygon| {
+            p.vertices_f64()
+                .iter()
+                .all(|v| (4.0..=8.0).contains(&v[0]) && (4.0..=8.0).contains(&v[1]))
+        };
+        let a: Vec<(Polygon, u32)> = partition(square(12), &cuts, |_| 0)
+            .into_iter()
+            .map(|(p, _)| {
+                let c = u32::from(middle(&p));
+                (p, c)
+            })
+            .collect();
+        let whole = vec![(square(12), 2)];
+        let o = overlay_of(&whole).plus(&overlay_of(&a));
+        assert_eq!(o.len(), 9);
+        let r = o.regions();
+        assert_eq!(r.len(), 2);
+        let ring = r.iter().find(|r| r.count == 2).unwrap();
+        assert_eq!(ring.holes.len(), 1);
+        assert_eq!(area(&ring.outer), 144.0);
+        assert_eq!(area(&ring.holes[0]), -16.0);
+        let mid = r.iter().find(|r| r.count == 3).unwrap();
+        assert_eq!((area(&mid.outer), mid.holes.len()), (16.0, 0));
+    }
+
+    #[test]
+    fn one_cell_takes_the_others_cells_only_where_they_lie_in_it() {
+        let b = partition(square(12), &[upright([0, 3], [12, 9]).unwrap()], |i| {
+            10 * i as u32 + 1
+        });
+        // the whole face: b's cells as they are, counted with it
+        let whole = overlay_of(&[(square(12), 5)]).plus(&overlay_of(&b));
+        assert_eq!(
+            whole,
+            overlay_of(
+                &b.iter()
+                    .map(|(p, c)| (p.clone(), c + 5))
+                    .collect::<Vec<_>>()
+            )
+        );
+        // the face's left third only: b's cells cut to it
+        let left = partition(square(12), &[upright([4, 12], [4, 0]).unwrap()], |_| 2);
+        let third: Vec<(Polygon, u32)> = (left.into_iter())
+            .filter(|(p, _)| p.vertices_f64().iter().all(|v| v[0] <= 4.0))
+            .collect();
+        let o = overlay_of(&third).plus(&overlay_of(&b));
+        let total: f64 = (0..o.len()).map(|i| area(&o.corners(i))).sum();
+        assert_eq!((o.len(), total), (2, 48.0));
+        assert_eq!(
+            count_at(&o, [1, 1, 0]),
+            Some(2 + count_in(&b, [1, 1, 0]).unwrap())
+        );
+        assert_eq!(
+            count_at(&o, [1, 11, 0]),
+            Some(2 + count_in(&b, [1, 11, 0]).unwrap())
+        );
+    }
+
+    #[test]
+    fn cells_come_back_through_their_planes_and_bad_ones_are_refused() {
+        let a = partition(square(9), &[upright([2, 0], [7, 9]).unwrap()], |i| i as u32);
+        let o = overlay_of(&a);
+        let again = Overlay::new(
+            *o.support(),
+            (0..o.len()).map(|i| (o.planes(i), o.count(i))),
+        )
+        .unwrap();
+        for i in 0..o.len() {
+            assert_eq!(again.corners(i), o.corners(i));
+        }
+        // a cell whose planes make no convex polygon
+        let mut planes = a[0].0.edge_planes().to_vec();
+        planes.swap(0, 1);
+        assert!(Overlay::new(*o.support(), [(planes, 0)]).is_none());
+        // two planes are no cell
+        assert!(Overlay::new(*o.support(), [(&a[0].0.edge_planes()[..2], 0)]).is_none());
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+
+        /// Random partitions of a face by upright cuts through grid points:
+        /// at every grid point inside a cell of the overlay, its count is the
+        /// sum of the two partitions' counts there; the cells tile the face.
+        #[test]
+        fn the_overlay_counts_what_both_partitions_count(
+            cuts_a in prop::collection::vec(([0..=40i32, 0..=40i32], [0..=40i32, 0..=40i32]), 1..6),
+            cuts_b in prop::collection::vec(([0..=40i32, 0..=40i32], [0..=40i32, 0..=40i32]), 1..6),
+            seed in 0u32..1000,
+        ) {
+            let planes = |c: &[([i32; 2], [i32; 2])]| -> Vec<Plane> {
+                c.iter().filter_map(|&(a, b)| upright(a, b)).collect()
+            };
+            let a = partition(square(40), &planes(&cuts_a), |i| (i as u32 * 7 + seed) % 5);
+            let b = partition(square(40), &planes(&cuts_b), |i| (i as u32 * 3 + seed) % 4);
+            let o = overlay_of(&a).plus(&overlay_of(&b));
+            let total: f64 = (0..o.len()).map(|i| area(&o.corners(i))).sum();
+            prop_assert!((total - 1600.0).abs() < 1e-9, "area {total}");
+            for x in 0..=40 {
+                for y in (0..=40).step_by(3) {
+                    let p = [x, y, 0];
+                    // (a point on an edge of `a` or `b` lies in a cell of
+                    // the overlay where the two sides have one count)
+                    let (Some(ca), Some(cb)) = (count_in(&a, p), count_in(&b, p)) else {
+                        continue;
+                    };
+                    prop_assert_eq!(count_at(&o, p), Some(ca + cb), "at {:?}", p);
+                }
+            }
+            // and each cell is still a strictly convex polygon
+            prop_assert!(Overlay::new(*o.support(), (0..o.len()).map(|i| (o.planes(i), o.count(i)))).is_some());
+        }
+    }
+}
