@@ -124,14 +124,19 @@ def region_hours(
 ) -> dict:
     """The cells of some faces of ``scene`` over a study (the suns of
     ``sun_hours``): every step's exact lit parts of those faces overlaid,
-    so that each cell's points see the same suns. ``faces``: a group's
-    name (a mesh read from a file or a built-in scene) or face ids.
+    then merged where they see the same suns, so that each cell is a
+    largest connected part of a face whose points see the same suns (not
+    always convex, perhaps with holes). ``faces``: a group's name (a mesh
+    read from a file or a built-in scene) or face ids.
 
-    A dict of arrays: ``face`` (C,), ``hours`` (C,), ``area`` (C,),
-    ``ring_points`` (C+1,) and ``points`` (P, 3), cell c's corners being
-    ``points[ring_points[c]:ring_points[c+1]]``, counter-clockwise from the
-    face's front. ``area[hours >= 2].sum() / area.sum()`` is the share of
-    the BRE 209 garden test on 21 March.
+    A dict of arrays: ``face`` (C,), ``hours`` (C,), ``area`` (C,) (holes
+    taken out), ``rings`` (C+1,), ``ring_points`` (R+1,) and ``points``
+    (P, 3): cell c's rings are ``rings[c]:rings[c+1]``, its boundary
+    (counter-clockwise from the face's front) first, then its holes
+    (clockwise), and ring r's corners are
+    ``points[ring_points[r]:ring_points[r+1]]``.
+    ``area[hours >= 2].sum() / area.sum()`` is the share of the BRE 209
+    garden test on 21 March.
     """
     suns = study_suns(lat, lon, list(dates), step_minutes, utc_offset, north, up, height)
     if not isinstance(faces, str):

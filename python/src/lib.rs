@@ -1231,9 +1231,11 @@ fn _hours_of_suns(
 
 /// The cells of the faces `faces` (a group's name, or face ids) of
 /// `mesh` under the suns `suns` (`(s, 3)`), each standing for
-/// `step_hours`: a dict of `face` (C,) int64, `hours` (C,), `area` (C,),
-/// `ring_points` (C+1,) int64 (cell c's corners are
-/// `points[ring_points[c]:ring_points[c+1]]`) and `points` (P, 3).
+/// `step_hours`: a dict of `face` (C,) int64, `hours` (C,), `area` (C,)
+/// (holes taken out), `rings` (C+1,) int64 (cell c's rings are
+/// `rings[c]:rings[c+1]`, its boundary first, then its holes),
+/// `ring_points` (R+1,) int64 (ring r's corners are
+/// `points[ring_points[r]:ring_points[r+1]]`) and `points` (P, 3).
 #[pyfunction]
 fn _region_hours<'py>(
     py: Python<'py>,
@@ -1256,9 +1258,13 @@ fn _region_hours<'py>(
         sun::region_hours(mesh.mesh(), &suns, step_hours, &ids)
     })
     .map_err(to_py)?;
-    let mut packed = Rings::default();
-    cells.iter().for_each(|c| packed.push(&c.ring));
+    let (mut packed, mut rings) = (Rings::default(), vec![0i64]);
+    for c in &cells {
+        c.rings().for_each(|r| packed.push(r));
+        rings.push(packed.count() as i64);
+    }
     let d = PyDict::new(py);
+    d.set_item("rings", rings.into_pyarray(py))?;
     let column = |f: fn(&sun::RegionCell) -> f64| cells.iter().map(f).collect::<Vec<_>>();
     let face: Vec<i64> = cells.iter().map(|c| c.face as i64).collect();
     d.set_item("face", face.into_pyarray(py))?;

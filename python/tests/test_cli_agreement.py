@@ -119,7 +119,8 @@ def test_region_hours_equal_the_cli(tmp_path, shadow_bin, yard):
     assert (cells["face"] == 0).all()
     assert [float(r[3]) for r in rows] == list(cells["hours"])
     assert [float(r[4]) for r in rows] == list(cells["area"])
-    assert len(cells["ring_points"]) == len(rows) + 1
+    assert len(cells["rings"]) == len(rows) + 1
+    assert len(cells["ring_points"]) == cells["rings"][-1] + 1
     assert cells["points"].shape == (cells["ring_points"][-1], 3)
     h = bs.sun_hours(bs.read_mesh(tmp_path / "yard.obj"), lat=51.5, lon=-0.1,
                      dates=["2026-03-21"], step_minutes=20)

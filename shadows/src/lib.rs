@@ -83,6 +83,12 @@ pub enum Error {
     /// The faces of a region study cannot be found, or its dates are not
     /// the test's (the message says which).
     Region(String),
+    /// A study's runs whose pieces of a face lie in other planes (runs of
+    /// different meshes, folded together).
+    Runs {
+        /// The face.
+        face: usize,
+    },
     /// A study's tile that is not one of its tiles ([`sun::Tile`]).
     Tile {
         /// The tile asked for.
@@ -113,6 +119,11 @@ impl std::fmt::Display for Error {
             Error::Sensor { index, cause } => write!(f, "sensor {index}: {cause}"),
             Error::Format { path, why } => write!(f, "{}: {why}", path.display()),
             Error::Region(why) => f.write_str(why),
+            Error::Runs { face } => write!(
+                f,
+                "the study's runs do not fold together: face {face}'s parts lie in other planes \
+                 in one run than in another (runs of different meshes?)"
+            ),
             Error::Tile { index, per_side: 0 } => {
                 write!(
                     f,
@@ -140,7 +151,9 @@ impl std::error::Error for Error {
             Error::Raster(e) => e,
             Error::Io(e) => e,
             Error::Sensor { cause, .. } => cause,
-            Error::Format { .. } | Error::Region(_) | Error::Tile { .. } => return None,
+            Error::Format { .. } | Error::Region(_) | Error::Tile { .. } | Error::Runs { .. } => {
+                return None;
+            }
         })
     }
 }
@@ -278,7 +291,15 @@ pub fn shadows(mesh: &Mesh, lights: &[Light]) -> Result<Shadows, Error> {
     let grid = svbsp::shared_grid(&mesh.positions, lights).map_err(Error::Light)?;
     let (polys, _) = crate::import_mesh(&grid, mesh).map_err(Error::Import)?;
     let solids = bsp_core::certify_solid_parts(&polys);
-    shadows_on(&grid, &polys, &solids, mesh.faces.len(), lights, None, true)
+    shadows_on(
+        &grid,
+        &polys,
+        &solids,
+        mesh.faces.len(),
+        lights,
+        None,
+        &ShadeOptions::default(),
+    )
 }
 
 /// The faces of `mesh` snapped to `grid` and imported, in parallel, as
@@ -315,20 +336,19 @@ pub(crate) fn shadows_on(
     faces: usize,
     lights: &[Light],
     tile: Option<TilePart<'_>>,
-    pieces: bool,
+    opts: &ShadeOptions,
 ) -> Result<Shadows, Error> {
     let placed = svbsp::place_lights(grid, lights).map_err(Error::Light)?;
     let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
     let reach = tile.map(|(_, b, boxes)| (b, boxes));
     let trees = face_trees(polys, &kernel, &[], solids, reach).map_err(Error::Shadow)?;
-    // with convex pieces where asked (the OBJ writer draws them, a sun
-    // study's extremes overlay them)
-    let opts = ShadeOptions::default().with_pieces(pieces);
+    // with convex pieces where asked (the OBJ writer draws them), and
+    // their planes (a sun study's extremes overlay them)
     let batch = match tile {
-        None => trees.set().shade_all(polys, &opts),
+        None => trees.set().shade_all(polys, opts),
         Some((own, _, _)) => {
             let own: Vec<bsp_core::Polygon> = own.iter().map(|&i| polys[i].clone()).collect();
-            trees.set().shade_all(&own, &opts)
+            trees.set().shade_all(&own, opts)
         }
     };
     let world = world_vertices(&batch, grid).map_err(Error::Export)?;
@@ -522,7 +542,7 @@ mod tests {
             city.faces.len(),
             &lights,
             None,
-            true,
+            &ShadeOptions::default(),
         )
         .unwrap();
         let placed = svbsp::place_lights(&grid, &lights).unwrap();

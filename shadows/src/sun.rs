@@ -393,9 +393,10 @@ pub fn groups_in_sun_text(mesh: &crate::Mesh, faces: &[FaceHours], hours: Option
 /// 1.15 times.
 pub const SUNS_A_RUN: usize = 4;
 
-/// A convex region of a face (in a frame of its plane) with the number
-/// of suns its points see.
-type Cell = (Vec<glam::DVec2>, u32);
+/// A face's cells with the number of suns each one's points see: one
+/// exact overlay per support plane of the face's parts (one for a planar
+/// face).
+type FaceCells = Vec<svbsp::Overlay>;
 
 /// The sun-hours of every face of `mesh` (in face order) under `suns`
 /// (directions toward them), each sun standing for `step_hours`: the
@@ -403,8 +404,7 @@ type Cell = (Vec<glam::DVec2>, u32);
 /// [`SUNS_A_RUN`] suns a run), its area summed over the suns
 /// (`sun_hours`), and the fewest and most hours over the face's points,
 /// from the runs' lit pieces overlaid (their hours added; the overlay is
-/// `f64`, and a cell below 10⁻¹² of the face's area, a rounding sliver
-/// where two runs' boundaries coincide, is left out).
+/// exact: [`svbsp::Overlay`]).
 ///
 /// The same as [`HoursRun::new`] over the suns in runs of
 /// [`SUNS_A_RUN`], folded in order by [`HoursRun::fold`]: runs
@@ -593,17 +593,27 @@ fn disc_in_front(height: f64, radius_deg: f64) -> f64 {
 }
 
 /// A face's hours from its area, its lit area times hours, and its
-/// overlaid cells (`None`: no suns).
-fn face_hours(area: f64, lit: f64, cells: Option<&[Cell]>, step_hours: f64) -> FaceHours {
-    let seen = cells.iter().copied().flatten().map(|c| c.1);
+/// overlaid cells with the grid they are on (`None`: no suns).
+fn face_hours(
+    area: f64,
+    lit: f64,
+    cells: Option<(&[svbsp::Overlay], &bsp_core::Grid)>,
+    step_hours: f64,
+) -> FaceHours {
+    let parts = cells.map_or(&[][..], |c| c.0);
+    let seen = parts.iter().flat_map(|o| (0..o.len()).map(|i| o.count(i)));
     let (min, max) = seen.fold((u32::MAX, 0), |(a, b), h| (a.min(h), b.max(h)));
     let (min, max) = (f64::from(min) * step_hours, f64::from(max) * step_hours);
     // (a face of area has cells, but none is no hours rather than a
     // fewest of u32::MAX steps)
-    let none = cells.is_none_or(<[Cell]>::is_empty) || area == 0.0;
+    let none = parts.iter().all(svbsp::Overlay::is_empty) || area == 0.0;
     let mut by: std::collections::BTreeMap<u32, f64> = Default::default();
-    for (ring, n) in cells.iter().copied().flatten() {
-        *by.entry(*n).or_default() += area2(ring).abs() / 2.0;
+    if let Some((parts, grid)) = cells {
+        for o in parts {
+            for i in 0..o.len() {
+                *by.entry(o.count(i)).or_default() += cell_area(o, i, grid);
+            }
+        }
     }
     let hours_area = by.into_iter().map(|(n, a)| (f64::from(n) * step_hours, a));
     let (min, max) = if none { (0.0, 0.0) } else { (min, max) };
@@ -617,6 +627,13 @@ fn face_hours(area: f64, lit: f64, cells: Option<&[Cell]>, step_hours: f64) -> F
         max_hours: max,
         hours_area: hours_area.collect(),
     }
+}
+
+/// The area of cell `i` of `o` in the mesh's units (its corners
+/// correctly rounded on `grid`, then mapped back).
+fn cell_area(o: &svbsp::Overlay, i: usize, grid: &bsp_core::Grid) -> f64 {
+    let ring: Vec<DVec3> = o.corners(i).into_iter().map(|c| grid.to_world(c)).collect();
+    svbsp::polygon_area(&ring)
 }
 
 /// The sun-hours at each point of `sensors` (input units) among the
@@ -967,162 +984,6 @@ pub fn hours_json(mesh: &crate::Mesh, hours: &[FaceHours], suns: usize) -> Strin
         })
         .collect();
     format!("{:#}\n", serde_json::json!({"suns": suns, "faces": faces}))
-}
-
-/// An origin and two unit axes of face `f`'s plane (Newell's normal).
-fn face_frame(mesh: &crate::Mesh, f: usize) -> (DVec3, DVec3, DVec3) {
-    let p: Vec<DVec3> = mesh.faces[f]
-        .vertices
-        .iter()
-        .map(|&i| mesh.positions[i as usize])
-        .collect();
-    let n = (0..p.len())
-        .map(|i| p[i].cross(p[(i + 1) % p.len()]))
-        .sum::<DVec3>();
-    let n = shadow_scene::unit_or_zero(n);
-    let u = n.any_orthonormal_vector();
-    (p.first().copied().unwrap_or(DVec3::ZERO), u, n.cross(u))
-}
-
-/// Every cell of `a` met with every cell of `b` (convex, by clipping),
-/// their suns added, keeping the meets of area above `least`: in `a`'s
-/// order, and for each in `b`'s order. The cells of `b` whose boxes may
-/// meet a cell's box are found in a grid of buckets over `b`'s boxes, so
-/// the cost follows the meets, not `|a| · |b|`.
-fn overlay(a: &[Cell], b: &[Cell], least: f64) -> Vec<Cell> {
-    type Boxed = (glam::DVec2, glam::DVec2);
-    let boxed = |c: &Cell| {
-        c.0.iter().fold(
-            (glam::DVec2::INFINITY, glam::DVec2::NEG_INFINITY),
-            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-        )
-    };
-    let meet = |(lo, hi): Boxed, (blo, bhi): Boxed| {
-        !(hi.x < blo.x || bhi.x < lo.x || hi.y < blo.y || bhi.y < lo.y)
-    };
-    let bb: Vec<Boxed> = b.iter().map(boxed).collect();
-    let buckets = Buckets::new(&bb);
-    let mut out = Vec::new();
-    let (mut seen, mut near) = (vec![usize::MAX; b.len()], Vec::new());
-    for (k, ca) in a.iter().enumerate() {
-        let abox = boxed(ca);
-        near.clear();
-        buckets.visit(abox, |j| {
-            if std::mem::replace(&mut seen[j], k) != k {
-                near.push(j);
-            }
-        });
-        near.sort_unstable();
-        for &j in &near {
-            if !meet(abox, bb[j]) {
-                continue;
-            }
-            let m = clip_convex(&ca.0, &b[j].0);
-            if area2(&m).abs() / 2.0 > least {
-                out.push((m, ca.1 + b[j].1));
-            }
-        }
-    }
-    out
-}
-
-/// A grid of buckets over boxes: each box is in every bucket its box
-/// covers, by a monotone map of coordinates to buckets, so two boxes
-/// that meet share a bucket.
-struct Buckets {
-    origin: glam::DVec2,
-    inverse: glam::DVec2,
-    side: usize,
-    cells: Vec<Vec<usize>>,
-}
-
-impl Buckets {
-    fn new(boxes: &[(glam::DVec2, glam::DVec2)]) -> Buckets {
-        let (lo, hi) = (boxes.iter()).fold(
-            (glam::DVec2::INFINITY, glam::DVec2::NEG_INFINITY),
-            |(lo, hi), b| (lo.min(b.0), hi.max(b.1)),
-        );
-        let side = ((boxes.len() as f64).sqrt().ceil() as usize).clamp(1, 1024);
-        let size = hi - lo;
-        let per = |s: f64| if s > 0.0 { side as f64 / s } else { 0.0 };
-        let mut buckets = Buckets {
-            origin: lo,
-            inverse: glam::DVec2::new(per(size.x), per(size.y)),
-            side,
-            cells: vec![Vec::new(); side * side],
-        };
-        for (i, &b) in boxes.iter().enumerate() {
-            let ([x0, x1], [y0, y1]) = buckets.range(b);
-            for y in y0..=y1 {
-                for x in x0..=x1 {
-                    buckets.cells[y * side + x].push(i);
-                }
-            }
-        }
-        buckets
-    }
-
-    /// The buckets a box covers, along x and along y.
-    fn range(&self, (lo, hi): (glam::DVec2, glam::DVec2)) -> ([usize; 2], [usize; 2]) {
-        let index = |x: f64, origin: f64, inverse: f64| {
-            let i = ((x - origin) * inverse).floor();
-            // (NaN and below the grid to the first bucket; `as` saturates)
-            if i >= 0.0 {
-                (i as usize).min(self.side - 1)
-            } else {
-                0
-            }
-        };
-        let (o, v) = (self.origin, self.inverse);
-        (
-            [index(lo.x, o.x, v.x), index(hi.x, o.x, v.x)],
-            [index(lo.y, o.y, v.y), index(hi.y, o.y, v.y)],
-        )
-    }
-
-    /// Calls `f` with every box in the buckets `b` covers (once a
-    /// bucket, so possibly more than once in all).
-    fn visit(&self, b: (glam::DVec2, glam::DVec2), mut f: impl FnMut(usize)) {
-        let ([x0, x1], [y0, y1]) = self.range(b);
-        for y in y0..=y1 {
-            for x in x0..=x1 {
-                self.cells[y * self.side + x].iter().for_each(|&i| f(i));
-            }
-        }
-    }
-}
-
-/// Twice the signed area of a polygon.
-fn area2(p: &[glam::DVec2]) -> f64 {
-    (0..p.len())
-        .map(|i| p[i].perp_dot(p[(i + 1) % p.len()]))
-        .sum()
-}
-
-/// Convex polygon `a` clipped by convex polygon `b` (Sutherland–Hodgman
-/// over `b`'s edges, either turning).
-fn clip_convex(a: &[glam::DVec2], b: &[glam::DVec2]) -> Vec<glam::DVec2> {
-    let turn = area2(b).signum();
-    let mut out = a.to_vec();
-    for i in 0..b.len() {
-        if out.is_empty() {
-            break;
-        }
-        let (e0, e1) = (b[i], b[(i + 1) % b.len()]);
-        let side = |p: glam::DVec2| turn * (e1 - e0).perp_dot(p - e0);
-        let input = std::mem::take(&mut out);
-        for (k, &p) in input.iter().enumerate() {
-            let q = input[(k + 1) % input.len()];
-            let (sp, sq) = (side(p), side(q));
-            if sp >= 0.0 {
-                out.push(p);
-            }
-            if (sp >= 0.0) != (sq >= 0.0) {
-                out.push(p + (q - p) * (sp / (sp - sq)));
-            }
-        }
-    }
-    out
 }
 
 #[cfg(test)]

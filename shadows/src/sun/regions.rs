@@ -6,10 +6,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::{
-    Cell, HeatView, HoursRun, area2, colored_vertex, face_frame, heat, heat_header, heat_picture,
-    study,
-};
+use super::{HeatView, HoursRun, colored_vertex, heat, heat_header, heat_picture, study};
 use crate::{Error, Mesh};
 
 /// The faces a region study overlays: a group's name, or face ids.
@@ -89,29 +86,70 @@ impl RegionFaces {
     }
 }
 
-/// A cell of a region: a convex part of a face whose points all see the
-/// same number of the study's suns.
+/// A cell of a region: a connected part of a face whose points all see
+/// the same number of the study's suns, as large as it can be (its
+/// neighbours see other numbers), with holes where it surrounds others.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RegionCell {
     /// The face.
     pub face: usize,
     /// The sun-hours of its points: its suns times the step, exact.
     pub hours: f64,
-    /// Its area.
+    /// Its area (its holes' taken out).
     pub area: f64,
-    /// Its corners, counter-clockwise seen from the face's front, in the
-    /// mesh's units.
+    /// Its outer boundary, counter-clockwise seen from the face's front,
+    /// in the mesh's units.
     pub ring: Vec<DVec3>,
+    /// Its holes, each clockwise seen from the face's front.
+    pub holes: Vec<Vec<DVec3>>,
+}
+
+impl RegionCell {
+    /// The cell's outer boundary, then its holes.
+    pub fn rings(&self) -> impl Iterator<Item = &[DVec3]> {
+        std::iter::once(&self.ring[..]).chain(self.holes.iter().map(|h| &h[..]))
+    }
+
+    /// Triangles covering the cell (its holes left out), counter-clockwise
+    /// seen from the face's front as the cell is (earcut in the cell's
+    /// plane); none for a cell of no area.
+    pub fn triangles(&self) -> Vec<[DVec3; 3]> {
+        let corners: Vec<DVec3> = self.rings().flatten().copied().collect();
+        let normal = (0..self.ring.len())
+            .map(|i| self.ring[i].cross(self.ring[(i + 1) % self.ring.len()]))
+            .sum::<DVec3>();
+        let Some(n) = normal.try_normalize() else {
+            return Vec::new();
+        };
+        let u = n.any_orthonormal_vector();
+        let v = n.cross(u);
+        let flat = corners.iter().map(|p| [p.dot(u), p.dot(v)]);
+        let mut starts = Vec::new();
+        let mut at = self.ring.len() as u32;
+        for h in &self.holes {
+            starts.push(at);
+            at += h.len() as u32;
+        }
+        let mut tri: Vec<u32> = Vec::new();
+        earcut::Earcut::new().earcut(flat, &starts, &mut tri);
+        (tri.chunks(3))
+            .map(|t| t.iter().map(|&i| corners[i as usize]))
+            .map(|mut t| [t.next(), t.next(), t.next()].map(|p| p.expect("three corners")))
+            .map(|[a, b, c]| match (b - a).cross(c - a).dot(n) < 0.0 {
+                true => [a, c, b],
+                false => [a, b, c],
+            })
+            .collect()
+    }
 }
 
 /// The cells of `faces` of `mesh` under `suns` (directions toward them),
 /// each sun standing for `step_hours`: every run's exact lit fragments of
-/// those faces, as pieces, overlaid (their suns added; the overlay's
-/// clipping is `f64`, and a cell below 10⁻¹² of its face's area, a
-/// rounding sliver where two runs' boundaries coincide, is left out). A
-/// face under no sun is one cell of 0 hours. A face's cells of equal
-/// hours that share an edge are then merged where their union is convex
-/// (decided by exact turns of their corners).
+/// those faces, as pieces, overlaid exactly ([`svbsp::Overlay`]: their
+/// suns added, every corner an exact point, nothing dropped), then the
+/// pieces of equal hours merged into maximal connected cells with holes
+/// (exactly: [`svbsp::Overlay::regions`]), each corner correctly rounded
+/// on the study's grid. A face under no sun is one cell of 0 hours.
 /// Faces in the order given, each face's cells in the overlay's order;
 /// the same bits for any thread count.
 pub fn region_hours(
@@ -147,11 +185,14 @@ pub(crate) fn region_study(
     let (_, _, cells, _) = study(mesh, suns, step_hours, pieces, 1, progress, |runs| {
         HoursRun::fold_cells(n, runs)
     })??;
-    let mut cells = cells.unwrap_or_else(|| vec![None; n]);
+    let (mut cells, grid) = match cells {
+        Some((cells, grid)) => (cells, Some(grid)),
+        None => (vec![None; n], None),
+    };
     // (a face given twice gets a copy the first time)
     let mut uses = vec![0_usize; n];
     faces.iter().filter(|&&f| f < n).for_each(|&f| uses[f] += 1);
-    let per_face: Vec<(usize, Option<Vec<Cell>>)> = (faces.iter())
+    let per_face: Vec<(usize, Option<Vec<svbsp::Overlay>>)> = (faces.iter())
         .filter(|&&f| f < n)
         .map(|&f| {
             uses[f] -= 1;
@@ -163,188 +204,44 @@ pub(crate) fn region_study(
             (f, face_cells)
         })
         .collect();
-    // the faces' cells made and merged in parallel, in the faces' order
+    // the faces' regions made in parallel, in the faces' order
     let out: Vec<Vec<RegionCell>> = per_face
         .into_par_iter()
-        .map(|(f, face_cells)| {
-            let (o, u, v) = face_frame(mesh, f);
-            let whole = || {
-                let ring = mesh.faces[f].vertices.iter().map(|&i| {
-                    let p = mesh.positions[i as usize] - o;
-                    glam::DVec2::new(p.dot(u), p.dot(v))
-                });
-                vec![(ring.collect(), 0)]
-            };
-            let face_cells =
-                (face_cells.unwrap_or_else(whole).into_iter()).map(|(ring, seen)| RegionCell {
+        .map(|(f, parts)| match (parts, grid) {
+            (Some(parts), Some(grid)) if parts.iter().any(|o| !o.is_empty()) => (parts.iter())
+                .flat_map(|o| o.regions())
+                .map(|r| {
+                    let world = |ring: &[[f64; 3]]| -> Vec<DVec3> {
+                        ring.iter().map(|&c| grid.to_world(c)).collect()
+                    };
+                    let (ring, holes) = (world(&r.outer), r.holes.iter().map(|h| world(h)));
+                    let holes: Vec<Vec<DVec3>> = holes.collect();
+                    let area = svbsp::polygon_area(&ring)
+                        - holes.iter().map(|h| svbsp::polygon_area(h)).sum::<f64>();
+                    RegionCell {
+                        face: f,
+                        hours: f64::from(r.count) * step_hours,
+                        area,
+                        ring,
+                        holes,
+                    }
+                })
+                .collect(),
+            _ => {
+                let ring: Vec<DVec3> = (mesh.faces[f].vertices.iter())
+                    .map(|&i| mesh.positions[i as usize])
+                    .collect();
+                vec![RegionCell {
                     face: f,
-                    hours: f64::from(seen) * step_hours,
-                    area: area2(&ring).abs() / 2.0,
-                    ring: ring.iter().map(|p| o + u * p.x + v * p.y).collect(),
-                });
-            merge_cells(face_cells.collect(), u.cross(v))
+                    hours: 0.0,
+                    area: svbsp::polygon_area(&ring),
+                    ring,
+                    holes: Vec::new(),
+                }]
+            }
         })
         .collect();
     Ok(out.into_iter().flatten().collect())
-}
-
-/// The corner's coordinates as bits (`-0.0` as `0.0`): equal corners
-/// have equal keys.
-fn corner_key(p: DVec3) -> [u64; 3] {
-    p.to_array().map(|x| (x + 0.0).to_bits())
-}
-
-/// The directed edges of a ring of corner ids, each as one key.
-fn edges(ids: &[u32]) -> impl Iterator<Item = u64> + '_ {
-    let n = ids.len();
-    (0..n).map(move |k| edge_key(ids[k], ids[(k + 1) % n]))
-}
-
-/// The key of the directed edge from corner `a` to corner `b`.
-fn edge_key(a: u32, b: u32) -> u64 {
-    u64::from(a) << 32 | u64::from(b)
-}
-
-/// One face's cells (convex, counter-clockwise about `normal`) with those
-/// of equal hours merged pairwise where they share an edge (its two
-/// corners equal to the bit) and their union is convex, until none do.
-/// Convexity is the exact sign of the turn at the two shared corners
-/// (`robust::orient2d` of the corners as written, seen along the
-/// normal's largest axis), and a corner where the union runs straight on
-/// is dropped; a merged cell's area is its parts'. Corners repeated in a
-/// row (edges of no length, from the clipping) are dropped first.
-/// Deterministic: a merged cell takes the place of its first part.
-pub(super) fn merge_cells(cells: Vec<RegionCell>, normal: DVec3) -> Vec<RegionCell> {
-    let flat = flat_along(normal);
-    // each corner an id, equal corners one
-    let mut corners: rustc_hash::FxHashMap<[u64; 3], u32> = Default::default();
-    corners.reserve(cells.len() * 2);
-    let mut cells: Vec<Option<(RegionCell, Vec<u32>)>> = (cells.into_iter())
-        .map(|mut c| {
-            c.ring.dedup_by_key(|p| corner_key(*p));
-            while c.ring.len() > 3 && corner_key(c.ring[0]) == corner_key(c.ring[c.ring.len() - 1])
-            {
-                c.ring.pop();
-            }
-            let ids = (c.ring.iter())
-                .map(|p| {
-                    let next = corners.len() as u32;
-                    *corners.entry(corner_key(*p)).or_insert(next)
-                })
-                .collect();
-            Some((c, ids))
-        })
-        .collect();
-    // each directed edge's cell (stale entries are checked on use)
-    let mut at: rustc_hash::FxHashMap<u64, usize> = Default::default();
-    at.reserve(cells.len() * 5);
-    for (i, c) in cells.iter().enumerate() {
-        if let Some((_, ids)) = c {
-            at.extend(edges(ids).map(|e| (e, i)));
-        }
-    }
-    for i in 0..cells.len() {
-        // grow cell i while a neighbour of equal hours keeps it convex
-        while let Some((cell, ids)) = &cells[i] {
-            let found = edges(ids).enumerate().find_map(|(k, e)| {
-                // the reverse edge: its two ids swapped
-                let &j = at.get(&e.rotate_right(32))?;
-                match &cells[j] {
-                    Some((other, other_ids)) if j != i && other.hours == cell.hours => {
-                        let p = (&cell.ring[..], &ids[..]);
-                        merge_pair(p, k, (&other.ring, other_ids), &flat).map(|m| (j, m))
-                    }
-                    _ => None,
-                }
-            });
-            let Some((j, (ring, ids))) = found else {
-                break;
-            };
-            // the partner's edges, and those new at the seams, are now i's
-            for e in edges(&ids) {
-                if at.get(&e) != Some(&i) {
-                    at.insert(e, i);
-                }
-            }
-            let part = cells[j].take().map_or(0.0, |(c, _)| c.area);
-            if let Some((cell, old)) = &mut cells[i] {
-                cell.ring = ring;
-                cell.area += part;
-                *old = ids;
-            }
-        }
-    }
-    cells.into_iter().flatten().map(|(c, _)| c).collect()
-}
-
-/// The projection along `normal`'s largest axis that keeps a ring
-/// counter-clockwise about `normal` counter-clockwise (coordinates
-/// dropped, not computed: exact).
-fn flat_along(normal: DVec3) -> impl Fn(DVec3) -> robust::Coord<f64> {
-    let a = normal.abs();
-    let axis = if a.x >= a.y && a.x >= a.z {
-        0
-    } else if a.y >= a.z {
-        1
-    } else {
-        2
-    };
-    let mirror = normal[axis] < 0.0;
-    move |p: DVec3| {
-        let (x, y) = (p[(axis + 1) % 3], p[(axis + 2) % 3]);
-        if mirror {
-            robust::Coord { x: y, y: x }
-        } else {
-            robust::Coord { x, y }
-        }
-    }
-}
-
-/// The union of convex counter-clockwise rings `p` and `q` (corners and
-/// their ids) where `p`'s edge from corner `k` is `q`'s edge reversed, if
-/// it is convex (seen through `flat`) and they share no other corner;
-/// `None` otherwise.
-#[allow(clippy::type_complexity)] // (a ring's corners and their ids)
-fn merge_pair(
-    (p, pi): (&[DVec3], &[u32]),
-    k: usize,
-    (q, qi): (&[DVec3], &[u32]),
-    flat: &impl Fn(DVec3) -> robust::Coord<f64>,
-) -> Option<(Vec<DVec3>, Vec<u32>)> {
-    let (np, nq) = (p.len(), q.len());
-    let (a, b) = (pi[k], pi[(k + 1) % np]);
-    let m = (0..nq).find(|&m| qi[m] == b && qi[(m + 1) % nq] == a)?;
-    let turn = |u: DVec3, v: DVec3, w: DVec3| robust::orient2d(flat(u), flat(v), flat(w));
-    // p from b round to a, then q after a up to before b
-    let at_a = turn(p[(k + np - 1) % np], p[k], q[(m + 2) % nq]);
-    let at_b = turn(q[(m + nq - 1) % nq], q[m], p[(k + 2) % np]);
-    if at_a < 0.0 || at_b < 0.0 {
-        return None;
-    }
-    if qi.iter().filter(|c| pi.contains(c)).count() != 2 {
-        return None;
-    }
-    let (mut ring, mut ids) = (
-        Vec::with_capacity(np + nq - 2),
-        Vec::with_capacity(np + nq - 2),
-    );
-    for t in 1..=np {
-        let i = (k + t) % np;
-        let straight = if i == k {
-            at_a == 0.0
-        } else {
-            i == (k + 1) % np && at_b == 0.0
-        };
-        if !straight {
-            ring.push(p[i]);
-            ids.push(pi[i]);
-        }
-    }
-    for t in 2..nq {
-        ring.push(q[(m + t) % nq]);
-        ids.push(qi[(m + t) % nq]);
-    }
-    Some((ring, ids))
 }
 
 /// `cells` cut to the upright prism over `outline` (a closed polygon,
@@ -352,9 +249,11 @@ fn merge_pair(
 /// is left out): each cell's parts whose plumb line meets the outline's
 /// inside, on the cell's own face, with their areas. A cell on a wall
 /// inside the outline stays whole. The outline is triangulated (earcut)
-/// and each cell clipped by each triangle's three upright planes, in
-/// `f64` (the cells' corners are); the parts keep their cell's face,
-/// hours and turning. An outline without area, or one that meets none of
+/// and each cell's rings (its boundary and holes) clipped by each
+/// triangle's three upright planes, in `f64` (the cells' corners are, and
+/// the outline is the user's); the parts keep their cell's face, hours
+/// and turning (a part of a cell that is not convex may run along a
+/// triangle's side and back: its area is still the part's). An outline without area, or one that meets none of
 /// the cells, is an error.
 pub fn clip_to_outline(
     cells: &[RegionCell],
@@ -389,21 +288,30 @@ pub fn clip_to_outline(
     let mut out = Vec::new();
     for c in cells {
         for t in &triangles {
-            let mut ring = c.ring.clone();
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                ring = clip_ring(&ring, |p| cross(a, b, plan(p)));
-                if ring.len() < 3 {
-                    break;
+            let clip = |ring: &[DVec3]| {
+                let mut ring = ring.to_vec();
+                for k in 0..3 {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    ring = clip_ring(&ring, |p| cross(a, b, plan(p)));
+                    if ring.len() < 3 {
+                        return None;
+                    }
                 }
-            }
-            let area = svbsp::polygon_area(&ring);
-            if ring.len() >= 3 && area > 0.0 {
+                Some(ring)
+            };
+            let Some(ring) = clip(&c.ring) else {
+                continue;
+            };
+            let holes: Vec<Vec<DVec3>> = c.holes.iter().filter_map(|h| clip(h)).collect();
+            let area = svbsp::polygon_area(&ring)
+                - holes.iter().map(|h| svbsp::polygon_area(h)).sum::<f64>();
+            if area > 0.0 {
                 out.push(RegionCell {
                     face: c.face,
                     hours: c.hours,
                     area,
                     ring,
+                    holes,
                 });
             }
         }
@@ -509,12 +417,15 @@ pub fn regions_csv(mesh: &Mesh, cells: &[RegionCell]) -> String {
 }
 
 /// The cells as JSON: `{"suns": n, "area": total, "cells": [{"face",
-/// "hours", "area", "ring": [[x, y, z], …]}, …]}`.
+/// "hours", "area", "ring": [[x, y, z], …], "holes": [[[x, y, z], …],
+/// …]}, …]}`.
 pub fn regions_json(cells: &[RegionCell], suns: usize) -> String {
+    let points = |r: &[DVec3]| -> Vec<[f64; 3]> { r.iter().map(|p| p.to_array()).collect() };
     let list: Vec<serde_json::Value> = (cells.iter())
         .map(|c| {
-            let ring: Vec<[f64; 3]> = c.ring.iter().map(|p| p.to_array()).collect();
-            serde_json::json!({"face": c.face, "hours": c.hours, "area": c.area, "ring": ring})
+            let holes: Vec<Vec<[f64; 3]>> = c.holes.iter().map(|h| points(h)).collect();
+            serde_json::json!({"face": c.face, "hours": c.hours, "area": c.area,
+                "ring": points(&c.ring), "holes": holes})
         })
         .collect();
     let total: f64 = cells.iter().map(|c| c.area).sum();
@@ -522,20 +433,22 @@ pub fn regions_json(cells: &[RegionCell], suns: usize) -> String {
     format!("{v:#}\n")
 }
 
-/// The cells as an OBJ heat map: each cell its own face, its corners
-/// coloured by its hours on the ramp of [`super::hours_obj`].
+/// The cells as an OBJ heat map: each cell a group `cell<i>` of
+/// triangles ([`RegionCell::triangles`]: a cell need not be convex, and
+/// may have holes), its corners coloured by its hours on the ramp of
+/// [`super::hours_obj`].
 pub fn regions_obj(cells: &[RegionCell]) -> String {
     let most = cells.iter().map(|c| c.hours).fold(0.0, f64::max);
     let mut s = heat_header(most);
     let mut next = 1;
-    for c in cells {
+    for (i, c) in cells.iter().enumerate() {
         let rgb = heat(c.hours, most);
-        for &p in &c.ring {
-            s += &colored_vertex(p, rgb);
+        s += &format!("g cell{i}\n");
+        for t in c.triangles() {
+            t.iter().for_each(|&p| s += &colored_vertex(p, rgb));
+            s += &format!("f {} {} {}\n", next, next + 1, next + 2);
+            next += 3;
         }
-        let corners: Vec<String> = (next..next + c.ring.len()).map(|i| i.to_string()).collect();
-        s += &format!("f {}\n", corners.join(" "));
-        next += c.ring.len();
     }
     s
 }
@@ -579,14 +492,16 @@ pub fn regions_png(
     }
     let most = cells.iter().map(|c| c.hours).fold(0.0, f64::max);
     for c in cells {
-        let first = scene.positions.len() as u32;
-        scene.positions.extend(&c.ring);
-        scene.faces.push(shadow_scene::Face {
-            vertices: (first..first + c.ring.len() as u32).collect(),
-            line: 0,
-            group: 0,
-        });
-        colors.push(DVec3::from_array(heat(c.hours, most)));
+        for t in c.triangles() {
+            let first = scene.positions.len() as u32;
+            scene.positions.extend(t);
+            scene.faces.push(shadow_scene::Face {
+                vertices: (first..first + 3).collect(),
+                line: 0,
+                group: 0,
+            });
+            colors.push(DVec3::from_array(heat(c.hours, most)));
+        }
     }
     heat_picture(&scene, &colors, most, suns, view)
 }

@@ -5,9 +5,10 @@
 use std::sync::{Arc, Mutex};
 
 use glam::DVec3;
+use smallvec::SmallVec;
 
 use super::tiles::{Tile, TileIndex};
-use super::{Cell, FaceHours, face_frame, face_hours, overlay};
+use super::{FaceCells, FaceHours, face_hours};
 
 /// A study's mesh snapped and imported once for all its runs: suns add
 /// no point to the grid ([`svbsp::shared_grid`]), so each run's own grid
@@ -75,7 +76,9 @@ pub struct HoursRun {
     ids: Option<Vec<u32>>,
     area: Vec<f64>,
     lit: Vec<f64>,
-    cells: Option<Vec<Vec<Cell>>>,
+    cells: Option<Vec<FaceCells>>,
+    /// The grid the cells' corners are on.
+    grid: bsp_core::Grid,
 }
 
 impl HoursRun {
@@ -166,7 +169,15 @@ impl HoursRun {
             None => None,
             Some((own, boxes)) => match own.bounds {
                 Some(b) => Some((&own.polys[..], b, boxes)),
-                None => return Ok(HoursRun::empty(faces, step_hours, pieces, &own.faces)),
+                None => {
+                    return Ok(HoursRun::empty(
+                        faces,
+                        step_hours,
+                        pieces,
+                        &own.faces,
+                        snapped.grid,
+                    ));
+                }
             },
         };
         let s = snapped;
@@ -177,7 +188,9 @@ impl HoursRun {
             faces,
             &lights,
             shaded,
-            pieces.is_some(),
+            &svbsp::ShadeOptions::default()
+                .with_pieces(pieces.is_some())
+                .with_planes(pieces.is_some()),
         )?;
         let ids = part.map(|(own, _)| own.faces.clone());
         let order: Vec<usize> = match &ids {
@@ -195,6 +208,7 @@ impl HoursRun {
             area,
             lit,
             cells: None,
+            grid: s.grid,
         };
         let Some(keep) = pieces else {
             return Ok(out);
@@ -205,28 +219,43 @@ impl HoursRun {
             slot[f] = k;
         }
         let kept = |f: usize| keep.is_none_or(|k| k[f]);
-        let frames: Vec<(DVec3, DVec3, DVec3)> =
-            order.iter().map(|&f| face_frame(mesh, f)).collect();
-        let mut cells: Vec<Vec<Cell>> = vec![Vec::new(); order.len()];
+        // per face, per support plane of its parts: its pieces' planes
+        // and the suns each sees
+        type Parts = Vec<(bsp_core::Plane, Vec<(SmallVec<[bsp_core::Plane; 6]>, u32)>)>;
+        let mut parts: Vec<Parts> = vec![Vec::new(); order.len()];
         for frag in run.batch.fragments() {
             let f = frag.face() as usize;
             if !kept(f) {
                 continue;
             }
             let seen = frag.lit_mask().count_ones();
-            let k = slot[f];
-            let (o, u, v) = frames[k];
-            for piece in frag.pieces() {
-                let ring = piece
-                    .iter()
-                    .map(|&i| {
-                        let p = run.world[i as usize] - o;
-                        glam::DVec2::new(p.dot(u), p.dot(v))
-                    })
-                    .collect();
-                cells[k].push((ring, seen));
-            }
+            let support = *frag.support();
+            let face = &mut parts[slot[f]];
+            let at = match face.iter().position(|(s, _)| *s == support) {
+                Some(at) => at,
+                None => {
+                    face.push((support, Vec::new()));
+                    face.len() - 1
+                }
+            };
+            let planes = frag
+                .piece_planes()
+                .expect("a study's run is shaded with its pieces' planes");
+            face[at]
+                .1
+                .extend(planes.map(|p| (p.iter().copied().collect(), seen)));
         }
+        let cells: Vec<FaceCells> = parts
+            .into_iter()
+            .map(|face| {
+                (face.into_iter())
+                    .map(|(support, cells)| {
+                        svbsp::Overlay::new(support, cells)
+                            .expect("the engine's pieces are strictly convex")
+                    })
+                    .collect()
+            })
+            .collect();
         out.cells = Some(cells);
         Ok(out)
     }
@@ -238,6 +267,7 @@ impl HoursRun {
         step_hours: f64,
         pieces: Option<Option<&[bool]>>,
         ids: &[u32],
+        grid: bsp_core::Grid,
     ) -> HoursRun {
         let n = ids.len();
         HoursRun {
@@ -247,6 +277,7 @@ impl HoursRun {
             area: vec![0.0; n],
             lit: vec![0.0; n],
             cells: pieces.map(|_| vec![Vec::new(); n]),
+            grid,
         }
     }
 
@@ -267,7 +298,12 @@ impl HoursRun {
         let (area, lit, cells, step_hours) = HoursRun::fold_cells(faces, runs)?;
         Ok((0..faces)
             .map(|f| match &cells {
-                Some(cells) => face_hours(area[f], lit[f], cells[f].as_deref(), step_hours),
+                Some((cells, grid)) => face_hours(
+                    area[f],
+                    lit[f],
+                    cells[f].as_deref().map(|c| (c, grid)),
+                    step_hours,
+                ),
                 None => FaceHours {
                     min_hours: f64::NAN,
                     max_hours: f64::NAN,
@@ -278,20 +314,31 @@ impl HoursRun {
     }
 
     /// The runs folded in order: every face's area, its lit area times
-    /// hours, its overlaid cells (`None` if a run has no pieces; a face
-    /// `None` for no runs), and the step.
+    /// hours, its overlaid cells and their grid (`None` if a run has no
+    /// pieces; a face `None` for no runs), and the step. Each face's
+    /// parts (one a support plane) are overlaid exactly
+    /// ([`svbsp::Overlay::plus`]), faces in parallel.
     #[allow(clippy::type_complexity)] // (the fold's four results, named above)
     pub(super) fn fold_cells(
         faces: usize,
         runs: impl IntoIterator<Item = Result<HoursRun, crate::Error>>,
-    ) -> Result<(Vec<f64>, Vec<f64>, Option<Vec<Option<Vec<Cell>>>>, f64), crate::Error> {
+    ) -> Result<
+        (
+            Vec<f64>,
+            Vec<f64>,
+            Option<(Vec<Option<FaceCells>>, bsp_core::Grid)>,
+            f64,
+        ),
+        crate::Error,
+    > {
         let mut area = vec![0.0; faces];
         let mut lit = vec![0.0; faces];
-        let mut cells: Vec<Option<Vec<Cell>>> = vec![None; faces];
-        let (mut step_hours, mut pieces) = (0.0, true);
+        let mut cells: Vec<Option<FaceCells>> = vec![None; faces];
+        let (mut step_hours, mut pieces, mut grid) = (0.0, true, None);
         for run in runs {
             let run = run?;
             step_hours = run.step_hours;
+            grid = Some(run.grid);
             // the run's faces, in its lists' order, within the mesh's
             let ids: Vec<usize> = match &run.ids {
                 Some(ids) => ids.iter().map(|&f| f as usize).collect(),
@@ -305,16 +352,21 @@ impl HoursRun {
             match run.cells {
                 Some(new) if pieces => {
                     let mut both: Vec<_> = (ids.iter().zip(new))
-                        .map(|(&f, new)| (f, cells[f].take(), new))
+                        .map(|(&f, new)| (f, cells[f].take().map(Ok), new))
                         .collect();
-                    bsp_core::par::for_each_mut(&mut both, |_, (f, old, new)| {
+                    bsp_core::par::for_each_mut(&mut both, |_, (_, old, new)| {
+                        let new = std::mem::take(new);
                         *old = Some(match old.take() {
-                            None => std::mem::take(new),
-                            Some(old) => overlay(&old, new, 1e-12 * area[*f]),
+                            None => Ok(new),
+                            Some(old) => old.and_then(|old| overlay_parts(old, new)),
                         });
                     });
                     for (f, c, _) in both {
-                        cells[f] = c;
+                        cells[f] = match c {
+                            Some(Err(())) => return Err(crate::Error::Runs { face: f }),
+                            Some(Ok(c)) => Some(c),
+                            None => None,
+                        };
                     }
                 }
                 _ => {
@@ -323,13 +375,24 @@ impl HoursRun {
                 }
             }
         }
-        Ok((area, lit, pieces.then_some(cells), step_hours))
+        let cells = match (pieces, grid) {
+            (true, Some(grid)) => Some((cells, grid)),
+            (true, None) => Some((
+                cells,
+                bsp_core::Grid::new(DVec3::ZERO, 0).expect("a unit grid"),
+            )),
+            (false, _) => None,
+        };
+        Ok((area, lit, cells, step_hours))
     }
 
-    /// The run as bytes (little-endian), for sending to another process.
+    /// The run as bytes (little-endian words of 64 bits: numbers as
+    /// `f64`, a plane's integers as their bits), for sending to another
+    /// process.
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut out = Vec::new();
-        let mut put = |x: f64| out.extend_from_slice(&x.to_le_bytes());
+        let mut word = |x: u64| out.extend_from_slice(&x.to_le_bytes());
+        let mut put = |x: f64| word(x.to_bits());
         put(self.step_hours);
         put(self.faces as f64);
         let pieces = if self.cells.is_some() { 1.0 } else { 0.0 };
@@ -341,6 +404,16 @@ impl HoursRun {
                 ids.iter().for_each(|&f| put(f64::from(f)));
             }
         }
+        let o = self.grid.origin();
+        [o.x, o.y, o.z, f64::from(self.grid.step_log2())]
+            .into_iter()
+            .for_each(&mut put);
+        let plane = |p: &bsp_core::Plane, put: &mut dyn FnMut(f64)| {
+            let (n, d) = (p.normal(), p.offset());
+            n.iter().for_each(|&c| put(f64::from_bits(c as u64)));
+            put(f64::from_bits(d as u64));
+            put(f64::from_bits((d >> 64) as u64));
+        };
         for f in 0..self.area.len() {
             put(self.area[f]);
             put(self.lit[f]);
@@ -348,24 +421,28 @@ impl HoursRun {
                 continue;
             };
             put(cells[f].len() as f64);
-            for (ring, seen) in &cells[f] {
-                put(f64::from(*seen));
-                put(ring.len() as f64);
-                for p in ring {
-                    put(p.x);
-                    put(p.y);
+            for part in &cells[f] {
+                plane(part.support(), &mut put);
+                put(part.len() as f64);
+                for i in 0..part.len() {
+                    put(f64::from(part.count(i)));
+                    let planes = part.planes(i);
+                    put(planes.len() as f64);
+                    planes.iter().for_each(|p| plane(p, &mut put));
                 }
             }
         }
         out
     }
 
-    /// A run from [`HoursRun::to_bytes`]; `None` if `bytes` is not one.
+    /// A run from [`HoursRun::to_bytes`]; `None` if `bytes` is not one
+    /// (a cell that is not a strictly convex polygon included).
     pub fn from_bytes(bytes: &[u8]) -> Option<HoursRun> {
         let mut words = bytes
             .chunks_exact(8)
-            .map(|w| f64::from_le_bytes(w.try_into().expect("eight bytes")));
-        let mut next = || words.next();
+            .map(|w| u64::from_le_bytes(w.try_into().expect("eight bytes")));
+        let mut bits = || words.next();
+        let mut next = || bits().map(f64::from_bits);
         let count = |x: f64| (x >= 0.0 && x.fract() == 0.0 && x < 1e15).then_some(x as usize);
         let step_hours = next()?;
         let faces = count(next()?)?;
@@ -390,6 +467,10 @@ impl HoursRun {
                     .into()
             }
         };
+        let origin = DVec3::new(next()?, next()?, next()?);
+        let step = next()?;
+        let log2 = (step.fract() == 0.0 && step.abs() <= 1000.0).then_some(-step as i32)?;
+        let grid = bsp_core::Grid::new(origin, log2).ok()?;
         let listed = ids.as_ref().map_or(faces, Vec::len);
         let mut run = HoursRun {
             step_hours,
@@ -398,6 +479,13 @@ impl HoursRun {
             area: Vec::new(),
             lit: Vec::new(),
             cells: pieces.then(Vec::new),
+            grid,
+        };
+        let plane = |next: &mut dyn FnMut() -> Option<f64>| {
+            let mut w = || next().map(|x| x.to_bits());
+            let n = [w()? as i64, w()? as i64, w()? as i64];
+            let d = i128::from(w()?) | i128::from(w()? as i64) << 64;
+            bsp_core::Plane::new(n, d)
         };
         for _ in 0..listed {
             run.area.push(next()?);
@@ -405,18 +493,39 @@ impl HoursRun {
             let Some(cells) = &mut run.cells else {
                 continue;
             };
-            let n = count(next()?)?;
+            let parts = count(next()?)?;
             let mut face = Vec::new();
-            for _ in 0..n {
-                let seen = u32::try_from(count(next()?)?).ok()?;
-                let len = count(next()?)?;
-                let ring = (0..len)
-                    .map(|_| Some(glam::DVec2::new(next()?, next()?)))
-                    .collect::<Option<Vec<_>>>()?;
-                face.push((ring, seen));
+            for _ in 0..parts {
+                let support = plane(&mut next)?;
+                let n = count(next()?)?;
+                let mut part = Vec::new();
+                for _ in 0..n {
+                    let seen = u32::try_from(count(next()?)?).ok()?;
+                    let len = count(next()?)?;
+                    let planes = (0..len)
+                        .map(|_| plane(&mut next))
+                        .collect::<Option<SmallVec<[bsp_core::Plane; 6]>>>()?;
+                    part.push((planes, seen));
+                }
+                face.push(svbsp::Overlay::new(support, part)?);
             }
             cells.push(face);
         }
         (bytes.len().is_multiple_of(8) && next().is_none()).then_some(run)
     }
+}
+
+/// A face's parts (one overlay a support plane) overlaid with a later
+/// run's: part by part, in order; `Err` where the two runs' parts lie in
+/// other planes (runs of different meshes).
+fn overlay_parts(old: FaceCells, new: FaceCells) -> Result<FaceCells, ()> {
+    if old.len() != new.len()
+        || old
+            .iter()
+            .zip(&new)
+            .any(|(a, b)| a.support() != b.support())
+    {
+        return Err(());
+    }
+    Ok(old.into_iter().zip(&new).map(|(a, b)| a.plus(b)).collect())
 }

@@ -344,47 +344,6 @@ fn runs_files_and_heat_maps_of_a_yard() {
     );
 }
 
-/// A face's cells of equal hours merge where their union is convex, and
-/// only there: four unit squares, three of one count in an L.
-#[test]
-fn equal_cells_merge_where_convex() {
-    let square = |x: f64, y: f64, hours: f64| RegionCell {
-        face: 0,
-        hours,
-        area: 1.0,
-        ring: [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
-            .map(|(dx, dy)| DVec3::new(x + dx, y + dy, 0.0))
-            .to_vec(),
-    };
-    let cells = vec![
-        square(0.0, 0.0, 1.0),
-        square(1.0, 0.0, 1.0),
-        square(0.0, 1.0, 1.0),
-        square(1.0, 1.0, 2.0),
-    ];
-    let merged = regions::merge_cells(cells, DVec3::Z);
-    // the bottom row is one rectangle (its straight corners dropped); the
-    // L it would make with the square above is not convex
-    assert_eq!(merged.len(), 3, "{merged:?}");
-    let bottom = &merged[0];
-    assert_eq!((bottom.hours, bottom.area), (1.0, 2.0));
-    let mut corners: Vec<(f64, f64)> = bottom.ring.iter().map(|p| (p.x, p.y)).collect();
-    corners.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    assert_eq!(corners, [(0.0, 0.0), (0.0, 1.0), (2.0, 0.0), (2.0, 1.0)]);
-    assert_eq!((merged[1].hours, merged[2].hours), (1.0, 2.0));
-    // a column of equal squares is one cell, whatever their order
-    let column = || {
-        vec![
-            square(0.0, 2.0, 3.0),
-            square(0.0, 0.0, 3.0),
-            square(0.0, 1.0, 3.0),
-        ]
-    };
-    let one = regions::merge_cells(column(), DVec3::Z);
-    assert_eq!(one.len(), 1);
-    assert_eq!((one[0].ring.len(), one[0].area), (4, 3.0));
-}
-
 #[test]
 fn regions_of_a_yard() {
     let (mesh, suns, step, _) = equinox_study();
@@ -394,36 +353,45 @@ fn regions_of_a_yard() {
     let ground: RegionFaces = "0".parse().unwrap();
     let cells = region_hours(&mesh, &suns, step, &ground.faces(&mesh).unwrap()).unwrap();
     assert!(cells.len() > 10 && cells.iter().all(|c| c.face == 0));
-    // merged: no two cells of equal hours share an edge (corners equal to
-    // the bit) and no other corner where their union would be convex (no
-    // reflex turn at either end of the edge, by exact signs); no corner
-    // repeats
-    let turn = |a: DVec3, b: DVec3, c: DVec3| {
-        let p = |v: DVec3| robust::Coord { x: v.x, y: v.y };
-        robust::orient2d(p(a), p(b), p(c))
+    // merged: cells of equal hours are maximal, so no two of them share
+    // a piece of boundary (an edge of one whose corners lie on an edge of
+    // the other, at least one strictly inside it or both its ends: the
+    // corners are correctly rounded from exact points, equal to the bit
+    // where the points are equal); no corner repeats in a ring
+    let edges = |c: &RegionCell| -> Vec<(DVec3, DVec3)> {
+        c.rings()
+            .flat_map(|r| (0..r.len()).map(move |k| (r[k], r[(k + 1) % r.len()])))
+            .collect()
     };
     for (i, p) in cells.iter().enumerate() {
-        let n = p.ring.len();
-        assert!((0..n).all(|k| p.ring[k] != p.ring[(k + 1) % n]), "{p:?}");
-        for q in cells.iter().skip(i + 1).filter(|q| q.hours == p.hours) {
-            let (np, nq) = (p.ring.len(), q.ring.len());
-            for k in 0..np {
-                let (a, b) = (p.ring[k], p.ring[(k + 1) % np]);
-                let Some(m) = (0..nq).find(|&m| q.ring[m] == b && q.ring[(m + 1) % nq] == a) else {
-                    continue;
-                };
-                let common = (q.ring.iter()).filter(|c| p.ring.contains(c)).count();
-                if common > 2 {
-                    continue;
-                }
-                let at_a = turn(p.ring[(k + np - 1) % np], a, q.ring[(m + 2) % nq]);
-                let at_b = turn(q.ring[(m + nq - 1) % nq], b, p.ring[(k + 2) % np]);
-                assert!(
-                    at_a < 0.0 || at_b < 0.0,
-                    "{p:?} and {q:?} make a convex cell"
-                );
+        for r in p.rings() {
+            let n = r.len();
+            assert!((0..n).all(|k| r[k] != r[(k + 1) % n]), "{p:?}");
+        }
+        let mine = edges(p);
+        for q in cells
+            .iter()
+            .skip(i + 1)
+            .filter(|q| q.hours == p.hours && q.face == p.face)
+        {
+            for (a, b) in edges(q) {
+                assert!(!mine.contains(&(b, a)), "{p:?} and {q:?} share an edge");
             }
         }
+    }
+    // each cell's outer ring turns counter-clockwise from above, its
+    // holes clockwise, and its area is the rings' signed sum
+    let signed = |r: &[DVec3]| -> f64 {
+        (0..r.len())
+            .map(|i| r[i].truncate().perp_dot(r[(i + 1) % r.len()].truncate()))
+            .sum::<f64>()
+            / 2.0
+    };
+    for c in &cells {
+        assert!(signed(&c.ring) > 0.0, "{c:?}");
+        assert!(c.holes.iter().all(|h| signed(h) < 0.0), "{c:?}");
+        let sum: f64 = c.rings().map(signed).sum();
+        assert!((sum - c.area).abs() < 1e-9 * c.area.max(1.0), "{c:?}");
     }
     let g = &hours[0];
     let (total, sunny) = area_in_sun(&cells, 6.0);
@@ -433,28 +401,33 @@ fn regions_of_a_yard() {
         (cells.iter().map(|c| c.hours)).fold((f64::MAX, 0.0_f64), |(a, b), h| (a.min(h), b.max(h)));
     assert_eq!((lo, hi), (g.min_hours, g.max_hours));
     for c in &cells {
-        // each cell lies on the ground, counter-clockwise from above
+        // each cell lies on the ground
         assert!(
-            c.ring.iter().all(|p| p.z == 0.0 || p.z.abs() < 1e-12),
+            c.rings().flatten().all(|p| p.z == 0.0 || p.z.abs() < 1e-12),
             "{c:?}"
         );
-        let turn: f64 = (0..c.ring.len())
-            .map(|i| {
-                c.ring[i]
-                    .truncate()
-                    .perp_dot(c.ring[(i + 1) % c.ring.len()].truncate())
-            })
+        // its triangles cover its area
+        let tri: f64 = (c.triangles().iter())
+            .map(|t| (t[1] - t[0]).truncate().perp_dot((t[2] - t[0]).truncate()) / 2.0)
             .sum();
-        assert!(turn > 0.0, "{c:?}");
+        assert!((tri - c.area).abs() < 1e-9 * c.area.max(1.0), "{c:?}");
     }
     let json: serde_json::Value = serde_json::from_str(&regions_json(&cells, suns.len())).unwrap();
     assert_eq!(json["cells"].as_array().unwrap().len(), cells.len());
+    let holes: usize = cells.iter().map(|c| c.holes.len()).sum();
+    let listed: usize = (json["cells"].as_array().unwrap().iter())
+        .map(|c| c["holes"].as_array().unwrap().len())
+        .sum();
+    assert_eq!(listed, holes);
+    let obj = regions_obj(&cells);
     assert_eq!(
-        regions_obj(&cells)
-            .lines()
-            .filter(|l| l.starts_with("f "))
-            .count(),
+        obj.lines().filter(|l| l.starts_with("g ")).count(),
         cells.len()
+    );
+    let triangles: usize = cells.iter().map(|c| c.triangles().len()).sum();
+    assert_eq!(
+        obj.lines().filter(|l| l.starts_with("f ")).count(),
+        triangles
     );
     assert!(bre209_text(&cells).starts_with("BRE 209: the region passes: "));
     let png = regions_png(&mesh, &[0], &cells, suns.len(), HeatView::default()).unwrap();
@@ -590,12 +563,15 @@ fn a_region_cut_to_an_outline_keeps_its_hours_and_its_area() {
     let area: f64 = cut.iter().map(|c| c.area).sum();
     assert!((area - (4.5 * 1.5 + 1.5 * 3.0)).abs() < 1e-9, "{area}");
     // a point of the garden has its cell's hours: the exact count there
-    // (cells need not be convex: an even-odd test)
+    // (cells need not be convex, and may have holes: an even-odd test over
+    // all their rings)
     let inside = |c: &RegionCell, q: DVec3| {
-        let n = c.ring.len();
-        let crossings = (0..n).filter(|&i| {
-            let (a, b) = (c.ring[i], c.ring[(i + 1) % n]);
-            (a.y > q.y) != (b.y > q.y) && q.x < a.x + (q.y - a.y) / (b.y - a.y) * (b.x - a.x)
+        let crossings = c.rings().flat_map(|r| {
+            let n = r.len();
+            (0..n).filter(move |&i| {
+                let (a, b) = (r[i], r[(i + 1) % n]);
+                (a.y > q.y) != (b.y > q.y) && q.x < a.x + (q.y - a.y) / (b.y - a.y) * (b.x - a.x)
+            })
         });
         crossings.count() % 2 == 1
     };
@@ -621,6 +597,7 @@ fn a_region_cut_to_an_outline_keeps_its_hours_and_its_area() {
         ring: [(0.0, 0.0), (4.0, 0.0), (4.0, 4.0), (0.0, 4.0)]
             .map(|(x, n)| DVec3::new(x, 0.0, -n))
             .to_vec(),
+        holes: Vec::new(),
     };
     let square =
         [(1.0, 1.0), (3.0, 1.0), (3.0, 3.0), (1.0, 3.0)].map(|(x, n)| DVec3::new(x, 5.0, -n));
