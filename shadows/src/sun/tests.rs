@@ -748,3 +748,24 @@ fn the_mean_lies_between_the_extremes() {
     assert_eq!(outside, 0);
     assert!(hours.iter().any(|h| h.min_hours < h.max_hours));
 }
+
+/// Runs of two meshes whose faces lie in other planes do not fold: an
+/// error that names the face, not cells overlaid across planes.
+#[test]
+fn runs_of_different_meshes_do_not_fold() {
+    let (mesh, suns, step, _) = equinox_study();
+    let mut tilted = mesh.clone();
+    for p in &mut tilted.positions {
+        p.z += 0.1 * p.x;
+    }
+    let runs = [
+        HoursRun::new(&mesh, &suns[..4], step),
+        HoursRun::new(&tilted, &suns[4..8], step),
+    ];
+    let e = HoursRun::fold(mesh.faces.len(), runs).unwrap_err();
+    assert!(matches!(e, crate::Error::Runs { face: 0 }), "{e}");
+    assert!(
+        e.to_string().contains("face 0's parts lie in other planes"),
+        "{e}"
+    );
+}
