@@ -17,9 +17,15 @@ pub fn hours_ply(mesh: &crate::Mesh, hours: &[FaceHours]) -> String {
     heat_ply(faces.collect())
 }
 
-/// The region's cells, coloured by their hours, the hours a property.
+/// The region's cells, coloured by their hours, the hours a property:
+/// each cell as triangles ([`RegionCell::triangles`]: a cell need not be
+/// convex, and may have holes).
 pub fn regions_ply(cells: &[RegionCell]) -> String {
-    heat_ply(cells.iter().map(|c| (c.ring.clone(), c.hours)).collect())
+    heat_ply(
+        (cells.iter())
+            .flat_map(|c| c.triangles().into_iter().map(|t| (t.to_vec(), c.hours)))
+            .collect(),
+    )
 }
 
 /// Sensors as coloured points, their hours a property.
