@@ -147,9 +147,14 @@ impl Overlay {
     /// inside each cell of `other`, cut off by that cell's edge planes
     /// (exact sides, exact new corners). Where `other`'s cells leave part
     /// of a cell uncovered, that part keeps its count alone. In the order
-    /// of `self`'s cells, then of the pieces as they are cut.
-    pub fn plus(mut self, other: &Overlay) -> Overlay {
-        debug_assert!(self.plane == other.plane, "overlays of one plane");
+    /// of `self`'s cells, then of the pieces as they are cut. `None`
+    /// where the two lie on different support planes.
+    pub fn plus(self, other: &Overlay) -> Option<Overlay> {
+        (self.plane == other.plane).then(|| self.meet(other))
+    }
+
+    /// [`Overlay::plus`] of two overlays on one plane.
+    fn meet(mut self, other: &Overlay) -> Overlay {
         // one cell holding all of `other` (a face still whole): `other`'s
         // cells, counted with it
         if let [(cell, count)] = &self.cells[..]
@@ -385,7 +390,7 @@ mod tests {
         let b = partition(square(12), &[upright([0, 3], [12, 9]).unwrap()], |i| {
             10 * i as u32
         });
-        let o = overlay_of(&a).plus(&overlay_of(&b));
+        let o = overlay_of(&a).plus(&overlay_of(&b)).unwrap();
         assert_eq!(o.len(), 4);
         let total: f64 = (0..o.len()).map(|i| area(&o.corners(i))).sum();
         assert_eq!(total, 144.0);
@@ -417,7 +422,7 @@ mod tests {
             })
             .collect();
         let whole = vec![(square(12), 2)];
-        let o = overlay_of(&whole).plus(&overlay_of(&a));
+        let o = overlay_of(&whole).plus(&overlay_of(&a)).unwrap();
         assert_eq!(o.len(), 9);
         let r = o.regions();
         assert_eq!(r.len(), 2);
@@ -435,7 +440,9 @@ mod tests {
             10 * i as u32 + 1
         });
         // the whole face: b's cells as they are, counted with it
-        let whole = overlay_of(&[(square(12), 5)]).plus(&overlay_of(&b));
+        let whole = overlay_of(&[(square(12), 5)])
+            .plus(&overlay_of(&b))
+            .unwrap();
         assert_eq!(
             whole,
             overlay_of(
@@ -449,7 +456,7 @@ mod tests {
         let third: Vec<(Polygon, u32)> = (left.into_iter())
             .filter(|(p, _)| p.vertices_f64().iter().all(|v| v[0] <= 4.0))
             .collect();
-        let o = overlay_of(&third).plus(&overlay_of(&b));
+        let o = overlay_of(&third).plus(&overlay_of(&b)).unwrap();
         let total: f64 = (0..o.len()).map(|i| area(&o.corners(i))).sum();
         assert_eq!((o.len(), total), (2, 48.0));
         assert_eq!(
@@ -480,6 +487,10 @@ mod tests {
         assert!(Overlay::new(*o.support(), [(planes, 0)]).is_none());
         // two planes are no cell
         assert!(Overlay::new(*o.support(), [(&a[0].0.edge_planes()[..2], 0)]).is_none());
+        // overlays of two planes do not meet
+        let up =
+            Polygon::from_grid_points(&[[0, 0, 1], [9, 0, 1], [9, 9, 1], [0, 9, 1]], 0).unwrap();
+        assert!(o.clone().plus(&overlay_of(&[(up, 1)])).is_none());
     }
 
     proptest! {
@@ -499,7 +510,7 @@ mod tests {
             };
             let a = partition(square(40), &planes(&cuts_a), |i| (i as u32 * 7 + seed) % 5);
             let b = partition(square(40), &planes(&cuts_b), |i| (i as u32 * 3 + seed) % 4);
-            let o = overlay_of(&a).plus(&overlay_of(&b));
+            let o = overlay_of(&a).plus(&overlay_of(&b)).unwrap();
             let total: f64 = (0..o.len()).map(|i| area(&o.corners(i))).sum();
             prop_assert!((total - 1600.0).abs() < 1e-9, "area {total}");
             for x in 0..=40 {

@@ -519,13 +519,10 @@ impl HoursRun {
 /// run's: part by part, in order; `Err` where the two runs' parts lie in
 /// other planes (runs of different meshes).
 fn overlay_parts(old: FaceCells, new: FaceCells) -> Result<FaceCells, ()> {
-    if old.len() != new.len()
-        || old
-            .iter()
-            .zip(&new)
-            .any(|(a, b)| a.support() != b.support())
-    {
+    if old.len() != new.len() {
         return Err(());
     }
-    Ok(old.into_iter().zip(&new).map(|(a, b)| a.plus(b)).collect())
+    (old.into_iter().zip(&new))
+        .map(|(a, b)| a.plus(b).ok_or(()))
+        .collect()
 }
