@@ -446,7 +446,7 @@ fn study<T>(
     pieces: Option<Option<&[bool]>>,
     tiles: usize,
     progress: &dyn Progress,
-    fold: impl FnOnce(&mut dyn Iterator<Item = Result<HoursRun, crate::Error>>) -> T,
+    fold: impl FnOnce(&mut (dyn Iterator<Item = Result<HoursRun, crate::Error>> + Send)) -> T,
 ) -> Result<T, crate::Error> {
     let cut: Vec<Option<Tile>> = match tiles {
         0 => {
@@ -610,8 +610,9 @@ fn face_hours(
     let mut by: std::collections::BTreeMap<u32, f64> = Default::default();
     if let Some((parts, grid)) = cells {
         for o in parts {
-            for i in 0..o.len() {
-                *by.entry(o.count(i)).or_default() += cell_area(o, i, grid);
+            for (i, corners) in o.all_corners().into_iter().enumerate() {
+                let ring: Vec<DVec3> = corners.into_iter().map(|c| grid.to_world(c)).collect();
+                *by.entry(o.count(i)).or_default() += svbsp::polygon_area(&ring);
             }
         }
     }
@@ -627,13 +628,6 @@ fn face_hours(
         max_hours: max,
         hours_area: hours_area.collect(),
     }
-}
-
-/// The area of cell `i` of `o` in the mesh's units (its corners
-/// correctly rounded on `grid`, then mapped back).
-fn cell_area(o: &svbsp::Overlay, i: usize, grid: &bsp_core::Grid) -> f64 {
-    let ring: Vec<DVec3> = o.corners(i).into_iter().map(|c| grid.to_world(c)).collect();
-    svbsp::polygon_area(&ring)
 }
 
 /// The sun-hours at each point of `sensors` (input units) among the

@@ -7,6 +7,7 @@
 //! of suns.
 
 use bsp_core::{Plane, Side};
+use rayon::prelude::*;
 use smallvec::SmallVec;
 
 use crate::arena::pieces::{EdgeRef, Piece, PieceArena};
@@ -142,11 +143,34 @@ impl Overlay {
             .collect()
     }
 
+    /// Every cell's corners as [`Overlay::corners`] gives them, each
+    /// corner rounded once (in parallel for many) however many cells
+    /// share it.
+    pub fn all_corners(&self) -> Vec<Vec<[f64; 3]>> {
+        let mut used: Vec<u32> = self
+            .cells
+            .iter()
+            .flat_map(|c| c.0.verts.iter().copied())
+            .collect();
+        used.sort_unstable();
+        used.dedup();
+        let round = |&v: &u32| self.arena.vertex(v).to_f64();
+        let rounded: Vec<[f64; 3]> = match used.len() > 4096 {
+            true => used.par_iter().map(round).collect(),
+            false => used.iter().map(round).collect(),
+        };
+        let at = |v: u32| rounded[used.binary_search(&v).expect("a used corner")];
+        (self.cells.iter())
+            .map(|c| c.0.verts.iter().map(|&v| at(v)).collect())
+            .collect()
+    }
+
     /// Every cell of `self` met with every cell of `other` (on the same
-    /// support plane), their counts added: the parts of a cell of `self`
-    /// inside each cell of `other`, cut off by that cell's edge planes
-    /// (exact sides, exact new corners). Where `other`'s cells leave part
-    /// of a cell uncovered, that part keeps its count alone. In the order
+    /// support plane; the cells of each must not overlap, as a face's
+    /// partitions' do not), their counts added: the parts of a cell of
+    /// `self` inside each cell of `other`, cut off by that cell's edge
+    /// planes (exact sides, exact new corners). Where `other`'s cells
+    /// leave part of a cell uncovered, that part keeps its count alone. In the order
     /// of `self`'s cells, then of the pieces as they are cut. `None`
     /// where the two lie on different support planes.
     pub fn plus(self, other: &Overlay) -> Option<Overlay> {
@@ -180,7 +204,9 @@ impl Overlay {
         // (and those copied while a cell is cut, forgotten if its cuts are
         // undone)
         let mut fresh = Vec::new();
-        let (mut seen, mut near) = (vec![usize::MAX; other.len()], Vec::new());
+        let (mut seen, mut near, mut hits) =
+            (vec![usize::MAX; other.len()], Vec::new(), Vec::new());
+        let (mut rest, mut next) = (Vec::new(), Vec::new());
         let mut sides = SmallVec::new();
         let mut out = Vec::with_capacity(self.cells.len());
         let mut out_boxes = Vec::with_capacity(self.cells.len());
@@ -199,22 +225,42 @@ impl Overlay {
                 }
                 None => near.extend(0..other.len() as u32),
             }
+            // inside one cell of `other` (whose cells do not overlap): whole,
+            // with its count added
+            let holder = near
+                .iter()
+                .copied()
+                .find(|&j| other.holds(&other.cells[j as usize].0, &cell, &mut self.arena));
+            if let Some(j) = holder {
+                out.push((cell, count + other.cells[j as usize].1));
+                out_boxes.push(meet(bounds, boxes[j as usize]).unwrap_or(bounds));
+                continue;
+            }
+            // else the cells of `other` it overlaps (apart where a plane of
+            // either has the other in front or on it)
+            hits.clear();
+            hits.extend(near.iter().copied().filter(|&j| {
+                let theirs = &other.cells[j as usize].0;
+                !self.apart(&cell, other, theirs)
+            }));
             let (first, mark) = (out.len(), self.arena.mark());
             fresh.clear();
-            let mut rest = vec![cell.clone()];
-            for &j in &near {
+            rest.clear();
+            rest.push(cell.clone());
+            for &j in &hits {
                 let (theirs, more) = &other.cells[j as usize];
-                let mut next = Vec::new();
+                next.clear();
                 for piece in rest.drain(..) {
-                    let parts = next.len();
-                    let mut inside = Some(piece.clone());
+                    if self.apart(&piece, other, theirs) {
+                        next.push(piece);
+                        continue;
+                    }
+                    // they overlap: each cut leaves a part inside
+                    let mut p = piece;
                     for &e in &theirs.edges {
-                        let Some(p) = inside.take() else { break };
                         let plane = other.arena.plane(e);
                         let s = self.arena.classify_into(&p, &plane, &mut sides);
-                        if !s.front {
-                            inside = Some(p);
-                        } else if s.back {
+                        if s.front && s.back {
                             let key = 2 * e.index() as usize + usize::from(e.flipped());
                             let at = *copied[key].get_or_insert_with(|| {
                                 fresh.push(key);
@@ -222,29 +268,20 @@ impl Overlay {
                             });
                             let (outside, kept) = self.arena.split(self.support, &p, at, &sides);
                             next.push(outside);
-                            inside = Some(kept);
+                            p = kept;
                         }
                     }
-                    match inside {
-                        Some(p) => {
-                            // in both cells: in both boxes
-                            out.push((p, count + more));
-                            out_boxes.push(meet(bounds, boxes[j as usize]).unwrap_or(bounds));
-                        }
-                        // apart from this cell: whole, not in parts
-                        None => {
-                            next.truncate(parts);
-                            next.push(piece);
-                        }
-                    }
+                    // in both cells: in both boxes
+                    out.push((p, count + more));
+                    out_boxes.push(meet(bounds, boxes[j as usize]).unwrap_or(bounds));
                 }
-                rest = next;
+                std::mem::swap(&mut rest, &mut next);
                 if rest.is_empty() {
                     break;
                 }
             }
             out_boxes.extend(rest.iter().map(|_| bounds));
-            out.extend(rest.into_iter().map(|p| (p, count)));
+            out.extend(rest.drain(..).map(|p| (p, count)));
             // parts that all came to one count: the cell whole, its cuts
             // undone (the cuts made only other's cells, not other counts)
             let mine = &out[first..];
@@ -261,6 +298,25 @@ impl Overlay {
         self.cells = out;
         self.boxes = out_boxes;
         self
+    }
+
+    /// Whether `piece` (of this arena) and `theirs` (of `other`'s) are
+    /// apart: a plane of either has all of the other in front of it or on
+    /// it (two convex polygons that meet with area have no such plane).
+    fn apart(&self, piece: &Piece, other: &Overlay, theirs: &Piece) -> bool {
+        let front_of = |arena: &PieceArena, c: &Piece, plane: &Plane| {
+            c.verts
+                .iter()
+                .all(|&v| arena.vertex(v).classify(plane) != Side::Back)
+        };
+        (theirs.edges.iter()).any(|&e| front_of(&self.arena, piece, &other.arena.plane(e)))
+            || (piece.edges.iter()).any(|&e| front_of(&other.arena, theirs, &self.arena.plane(e)))
+    }
+
+    /// Whether cell `theirs` of this overlay holds `piece` of `arena`
+    /// (every corner behind or on each of its edge planes).
+    fn holds(&self, theirs: &Piece, piece: &Piece, arena: &mut PieceArena) -> bool {
+        (theirs.edges.iter()).all(|&e| !arena.sides(piece, &self.arena.plane(e)).front)
     }
 
     /// Whether every cell lies in `cell` of `arena` (its corners behind or

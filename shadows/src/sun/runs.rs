@@ -5,6 +5,7 @@
 use std::sync::{Arc, Mutex};
 
 use glam::DVec3;
+use rayon::prelude::*;
 use smallvec::SmallVec;
 
 use super::tiles::{Tile, TileIndex};
@@ -291,12 +292,14 @@ impl HoursRun {
     /// of as many faces, see [`HoursRun::faces`]). The extremes are NaN if a
     /// run has no pieces. Faces are overlaid in parallel, each the same
     /// whatever the thread count.
-    pub fn fold(
-        faces: usize,
-        runs: impl IntoIterator<Item = Result<HoursRun, crate::Error>>,
-    ) -> Result<Vec<FaceHours>, crate::Error> {
+    pub fn fold<I>(faces: usize, runs: I) -> Result<Vec<FaceHours>, crate::Error>
+    where
+        I: IntoIterator<Item = Result<HoursRun, crate::Error>>,
+        I::IntoIter: Send,
+    {
         let (area, lit, cells, step_hours) = HoursRun::fold_cells(faces, runs)?;
         Ok((0..faces)
+            .into_par_iter()
             .map(|f| match &cells {
                 Some((cells, grid)) => face_hours(
                     area[f],
@@ -319,9 +322,9 @@ impl HoursRun {
     /// parts (one a support plane) are overlaid exactly
     /// ([`svbsp::Overlay::plus`]), faces in parallel.
     #[allow(clippy::type_complexity)] // (the fold's four results, named above)
-    pub(super) fn fold_cells(
+    pub(super) fn fold_cells<I>(
         faces: usize,
-        runs: impl IntoIterator<Item = Result<HoursRun, crate::Error>>,
+        runs: I,
     ) -> Result<
         (
             Vec<f64>,
@@ -330,13 +333,16 @@ impl HoursRun {
             f64,
         ),
         crate::Error,
-    > {
+    >
+    where
+        I: IntoIterator<Item = Result<HoursRun, crate::Error>>,
+        I::IntoIter: Send,
+    {
         let mut area = vec![0.0; faces];
         let mut lit = vec![0.0; faces];
         let mut cells: Vec<Option<FaceCells>> = vec![None; faces];
         let (mut step_hours, mut pieces, mut grid) = (0.0, true, None);
-        for run in runs {
-            let run = run?;
+        let mut add = |run: HoursRun| -> Result<(), crate::Error> {
             step_hours = run.step_hours;
             grid = Some(run.grid);
             // the run's faces, in its lists' order, within the mesh's
@@ -374,6 +380,17 @@ impl HoursRun {
                     cells = vec![None; faces];
                 }
             }
+            Ok(())
+        };
+        // each run folded while the next is made (a large face's overlay
+        // is one task, which would leave the other threads idle)
+        let mut runs = runs.into_iter();
+        let mut pending = runs.next();
+        while let Some(run) = pending {
+            let run = run?;
+            let (done, next) = rayon::join(|| add(run), || runs.next());
+            done?;
+            pending = next;
         }
         let cells = match (pieces, grid) {
             (true, Some(grid)) => Some((cells, grid)),
