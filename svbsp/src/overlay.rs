@@ -170,8 +170,9 @@ impl Overlay {
     /// partitions' do not), their counts added: the parts of a cell of
     /// `self` inside each cell of `other`, cut off by that cell's edge
     /// planes (exact sides, exact new corners). Where `other`'s cells
-    /// leave part of a cell uncovered, that part keeps its count alone. In the order
-    /// of `self`'s cells, then of the pieces as they are cut. `None`
+    /// leave part of a cell uncovered, that part keeps its count alone.
+    /// A cell whose parts all come to one count is kept whole. In the
+    /// order of `self`'s cells, then of the parts as they are cut. `None`
     /// where the two lie on different support planes.
     pub fn plus(self, other: &Overlay) -> Option<Overlay> {
         (self.plane == other.plane).then(|| self.meet(other))
