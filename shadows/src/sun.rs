@@ -396,7 +396,7 @@ pub const SUNS_A_RUN: usize = 4;
 /// A face's cells with the number of suns each one's points see: one
 /// exact overlay per support plane of the face's parts (one for a planar
 /// face).
-type FaceCells = Vec<svbsp::Overlay>;
+type FaceCells = Vec<svbsp::FaceOverlay>;
 
 /// The sun-hours of every face of `mesh` (in face order) under `suns`
 /// (directions toward them), each sun standing for `step_hours`: the
@@ -404,7 +404,7 @@ type FaceCells = Vec<svbsp::Overlay>;
 /// [`SUNS_A_RUN`] suns a run), its area summed over the suns
 /// (`sun_hours`), and the fewest and most hours over the face's points,
 /// from the runs' lit pieces overlaid (their hours added; the overlay is
-/// exact: [`svbsp::Overlay`]).
+/// exact: [`svbsp::FaceOverlay`]).
 ///
 /// The same as [`HoursRun::new`] over the suns in runs of
 /// [`SUNS_A_RUN`], folded in order by [`HoursRun::fold`]: runs
@@ -597,7 +597,7 @@ fn disc_in_front(height: f64, radius_deg: f64) -> f64 {
 fn face_hours(
     area: f64,
     lit: f64,
-    cells: Option<(&[svbsp::Overlay], &bsp_core::Grid)>,
+    cells: Option<(&[svbsp::FaceOverlay], &bsp_core::Grid)>,
     step_hours: f64,
 ) -> FaceHours {
     let parts = cells.map_or(&[][..], |c| c.0);
@@ -606,7 +606,7 @@ fn face_hours(
     let (min, max) = (f64::from(min) * step_hours, f64::from(max) * step_hours);
     // (a face of area has cells, but none is no hours rather than a
     // fewest of u32::MAX steps)
-    let none = parts.iter().all(svbsp::Overlay::is_empty) || area == 0.0;
+    let none = parts.iter().all(svbsp::FaceOverlay::is_empty) || area == 0.0;
     let mut by: std::collections::BTreeMap<u32, f64> = Default::default();
     if let Some((parts, grid)) = cells {
         for o in parts {

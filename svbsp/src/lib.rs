@@ -76,7 +76,7 @@ pub use light::{
     MAX_DISC_RADIUS_DEG, MAX_LIGHTS, PlacedLight, SUN_RADIUS_DEG, SoftSpec, angle_between,
     input_number, input_triple, place_lights, quantize_direction, shared_grid,
 };
-pub use overlay::{Overlay, OverlayRegion};
+pub use overlay::{FaceOverlay, OverlayRegion};
 pub use psv::{ShadowVolumes, VolumeError, VolumeSanity};
 pub use soft::{
     Share, SoftFragment, SoftLight, SoftShape, SoftVolumes, place_soft_lights, shared_soft_grid,

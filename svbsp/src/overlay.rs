@@ -14,13 +14,13 @@ use crate::arena::pieces::{EdgeRef, Piece, PieceArena};
 use crate::arena::regions::merge_cells;
 use crate::boxes::{Box3, CellGrid, meet};
 
-/// How many cells [`Overlay::plus`] tries in turn rather than through a
+/// How many cells [`FaceOverlay::plus`] tries in turn rather than through a
 /// grid of their boxes.
 const FEW: usize = 8;
 
 /// Convex cells of one face with a count each, their corners exact.
 #[derive(Clone, Debug)]
-pub struct Overlay {
+pub struct FaceOverlay {
     arena: PieceArena,
     /// The support plane's index in the arena.
     support: u32,
@@ -30,7 +30,7 @@ pub struct Overlay {
     boxes: Vec<Box3>,
 }
 
-/// A region of an [`Overlay`]: cells of one count merged, as rings of
+/// A region of an [`FaceOverlay`]: cells of one count merged, as rings of
 /// correctly rounded grid coordinates.
 #[derive(Clone, Debug, PartialEq)]
 pub struct OverlayRegion {
@@ -45,15 +45,15 @@ pub struct OverlayRegion {
 
 /// Equal where the support planes, and each cell's edge planes and
 /// count in turn, are (the same cells, however their corners were made).
-impl PartialEq for Overlay {
-    fn eq(&self, o: &Overlay) -> bool {
+impl PartialEq for FaceOverlay {
+    fn eq(&self, o: &FaceOverlay) -> bool {
         self.plane == o.plane
             && self.len() == o.len()
             && (0..self.len()).all(|i| self.count(i) == o.count(i) && self.planes(i) == o.planes(i))
     }
 }
 
-impl Overlay {
+impl FaceOverlay {
     /// The cells on plane `support` given by their edge planes in turn
     /// (plane `i` bounds the edge from corner `i` to `i + 1`, the cell
     /// behind it, as [`crate::FragmentRef::piece_planes`] gives them) and
@@ -62,7 +62,7 @@ impl Overlay {
     pub fn new<P: AsRef<[Plane]>>(
         support: Plane,
         cells: impl IntoIterator<Item = (P, u32)>,
-    ) -> Option<Overlay> {
+    ) -> Option<FaceOverlay> {
         let mut arena = PieceArena::default();
         let s = arena.add_plane(support);
         let mut out = Vec::new();
@@ -95,7 +95,7 @@ impl Overlay {
             }
             out.push((piece, count));
         }
-        let mut o = Overlay {
+        let mut o = FaceOverlay {
             arena,
             support: s,
             plane: support,
@@ -126,7 +126,7 @@ impl Overlay {
         self.cells[i].1
     }
 
-    /// Cell `i`'s edge planes in turn (what [`Overlay::new`] takes).
+    /// Cell `i`'s edge planes in turn (what [`FaceOverlay::new`] takes).
     pub fn planes(&self, i: usize) -> SmallVec<[Plane; 6]> {
         let c = &self.cells[i].0;
         c.edges.iter().map(|&e| self.arena.plane(e)).collect()
@@ -143,7 +143,7 @@ impl Overlay {
             .collect()
     }
 
-    /// Every cell's corners as [`Overlay::corners`] gives them, each
+    /// Every cell's corners as [`FaceOverlay::corners`] gives them, each
     /// corner rounded once (in parallel for many) however many cells
     /// share it.
     pub fn all_corners(&self) -> Vec<Vec<[f64; 3]>> {
@@ -174,12 +174,12 @@ impl Overlay {
     /// A cell whose parts all come to one count is kept whole. In the
     /// order of `self`'s cells, then of the parts as they are cut. `None`
     /// where the two lie on different support planes.
-    pub fn plus(self, other: &Overlay) -> Option<Overlay> {
+    pub fn plus(self, other: &FaceOverlay) -> Option<FaceOverlay> {
         (self.plane == other.plane).then(|| self.meet(other))
     }
 
-    /// [`Overlay::plus`] of two overlays on one plane.
-    fn meet(mut self, other: &Overlay) -> Overlay {
+    /// [`FaceOverlay::plus`] of two overlays on one plane.
+    fn meet(mut self, other: &FaceOverlay) -> FaceOverlay {
         // one cell holding all of `other` (a face still whole): `other`'s
         // cells, counted with it
         if let [(cell, count)] = &self.cells[..]
@@ -304,7 +304,7 @@ impl Overlay {
     /// Whether `piece` (of this arena) and `theirs` (of `other`'s) are
     /// apart: a plane of either has all of the other in front of it or on
     /// it (two convex polygons that meet with area have no such plane).
-    fn apart(&self, piece: &Piece, other: &Overlay, theirs: &Piece) -> bool {
+    fn apart(&self, piece: &Piece, other: &FaceOverlay, theirs: &Piece) -> bool {
         let front_of = |arena: &PieceArena, c: &Piece, plane: &Plane| {
             c.verts
                 .iter()
@@ -403,14 +403,14 @@ mod tests {
             .collect()
     }
 
-    fn overlay_of(cells: &[(Polygon, u32)]) -> Overlay {
+    fn overlay_of(cells: &[(Polygon, u32)]) -> FaceOverlay {
         let support = *cells[0].0.support();
-        Overlay::new(support, cells.iter().map(|(p, c)| (p.edge_planes(), *c))).unwrap()
+        FaceOverlay::new(support, cells.iter().map(|(p, c)| (p.edge_planes(), *c))).unwrap()
     }
 
     /// The count of the cell of `o` that holds grid point `x` strictly
     /// inside (`None` if none does: `x` lies on an edge).
-    fn count_at(o: &Overlay, x: GridPoint) -> Option<u32> {
+    fn count_at(o: &FaceOverlay, x: GridPoint) -> Option<u32> {
         let inside: Vec<u32> = (0..o.len())
             .filter(|&i| o.planes(i).iter().all(|p| p.classify_grid(x) == Side::Back))
             .map(|i| o.count(i))
@@ -530,7 +530,7 @@ mod tests {
     fn cells_come_back_through_their_planes_and_bad_ones_are_refused() {
         let a = partition(square(9), &[upright([2, 0], [7, 9]).unwrap()], |i| i as u32);
         let o = overlay_of(&a);
-        let again = Overlay::new(
+        let again = FaceOverlay::new(
             *o.support(),
             (0..o.len()).map(|i| (o.planes(i), o.count(i))),
         )
@@ -541,9 +541,9 @@ mod tests {
         // a cell whose planes make no convex polygon
         let mut planes = a[0].0.edge_planes().to_vec();
         planes.swap(0, 1);
-        assert!(Overlay::new(*o.support(), [(planes, 0)]).is_none());
+        assert!(FaceOverlay::new(*o.support(), [(planes, 0)]).is_none());
         // two planes are no cell
-        assert!(Overlay::new(*o.support(), [(&a[0].0.edge_planes()[..2], 0)]).is_none());
+        assert!(FaceOverlay::new(*o.support(), [(&a[0].0.edge_planes()[..2], 0)]).is_none());
         // overlays of two planes do not meet
         let up =
             Polygon::from_grid_points(&[[0, 0, 1], [9, 0, 1], [9, 9, 1], [0, 9, 1]], 0).unwrap();
@@ -582,7 +582,7 @@ mod tests {
                 }
             }
             // and each cell is still a strictly convex polygon
-            prop_assert!(Overlay::new(*o.support(), (0..o.len()).map(|i| (o.planes(i), o.count(i)))).is_some());
+            prop_assert!(FaceOverlay::new(*o.support(), (0..o.len()).map(|i| (o.planes(i), o.count(i)))).is_some());
         }
     }
 }

@@ -145,10 +145,10 @@ impl RegionCell {
 
 /// The cells of `faces` of `mesh` under `suns` (directions toward them),
 /// each sun standing for `step_hours`: every run's exact lit fragments of
-/// those faces, as pieces, overlaid exactly ([`svbsp::Overlay`]: their
+/// those faces, as pieces, overlaid exactly ([`svbsp::FaceOverlay`]: their
 /// suns added, every corner an exact point, nothing dropped), then the
 /// pieces of equal hours merged into maximal connected cells with holes
-/// (exactly: [`svbsp::Overlay::regions`]), each corner correctly rounded
+/// (exactly: [`svbsp::FaceOverlay::regions`]), each corner correctly rounded
 /// on the study's grid. A face under no sun is one cell of 0 hours.
 /// Faces in the order given, each face's cells in the overlay's order;
 /// the same bits for any thread count.
@@ -192,7 +192,7 @@ pub(crate) fn region_study(
     // (a face given twice gets a copy the first time)
     let mut uses = vec![0_usize; n];
     faces.iter().filter(|&&f| f < n).for_each(|&f| uses[f] += 1);
-    let per_face: Vec<(usize, Option<Vec<svbsp::Overlay>>)> = (faces.iter())
+    let per_face: Vec<(usize, Option<Vec<svbsp::FaceOverlay>>)> = (faces.iter())
         .filter(|&&f| f < n)
         .map(|&f| {
             uses[f] -= 1;

@@ -251,7 +251,7 @@ impl HoursRun {
             .map(|face| {
                 (face.into_iter())
                     .map(|(support, cells)| {
-                        svbsp::Overlay::new(support, cells)
+                        svbsp::FaceOverlay::new(support, cells)
                             .expect("the engine's pieces are strictly convex")
                     })
                     .collect()
@@ -320,7 +320,7 @@ impl HoursRun {
     /// hours, its overlaid cells and their grid (`None` if a run has no
     /// pieces; a face `None` for no runs), and the step. Each face's
     /// parts (one a support plane) are overlaid exactly
-    /// ([`svbsp::Overlay::plus`]), faces in parallel.
+    /// ([`svbsp::FaceOverlay::plus`]), faces in parallel.
     #[allow(clippy::type_complexity)] // (the fold's four results, named above)
     pub(super) fn fold_cells<I>(
         faces: usize,
@@ -529,7 +529,7 @@ impl HoursRun {
                         .collect::<Option<SmallVec<[bsp_core::Plane; 6]>>>()?;
                     part.push((planes, seen));
                 }
-                face.push(svbsp::Overlay::new(support, part)?);
+                face.push(svbsp::FaceOverlay::new(support, part)?);
             }
             cells.push(face);
         }

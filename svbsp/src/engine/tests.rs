@@ -1,0 +1,127 @@
+//! The engine's unit tests.
+
+use super::*;
+
+fn quad(z: i32, lo: i32, hi: i32, tag: u32) -> Polygon {
+    Polygon::from_grid_points(&[[lo, lo, z], [hi, lo, z], [hi, hi, z], [lo, hi, z]], tag).unwrap()
+}
+
+fn ring_coords(b: &Batch, ring: &[u32]) -> Vec<[f64; 3]> {
+    let mut v: Vec<[f64; 3]> = ring.iter().map(|&i| b.rounded(i)).collect();
+    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    v
+}
+
+#[test]
+fn occluder_casts_an_exact_square_hole() {
+    // floor 0..8 at z = 0, occluder 2..4 at z = 4, light above at z = 8
+    let polys = [quad(0, 0, 8, 0), quad(4, 2, 4, 1)];
+    let (b, stats) = shadow_fragments(&polys, &[Light::Point([3, 3, 8])]).unwrap();
+    // the floor: one lit ring with a hole, one shadowed square; the
+    // occluder: lit, whole
+    assert_eq!((b.len(), stats.fragments), (3, 3));
+    let floor: Vec<_> = b.fragments().filter(|f| f.face() == 0).collect();
+    let lit = floor.iter().find(|f| f.lit(0)).unwrap();
+    let dark = floor.iter().find(|f| !f.lit(0)).unwrap();
+    assert_eq!(lit.hole_count(), 1);
+    assert_eq!(dark.hole_count(), 0);
+    // the shadow of [2,4]^2 at height 4 from (3,3,8) on z = 0 is [1,5]^2
+    let sq = vec![
+        [1.0, 1.0, 0.0],
+        [1.0, 5.0, 0.0],
+        [5.0, 1.0, 0.0],
+        [5.0, 5.0, 0.0],
+    ];
+    assert_eq!(ring_coords(&b, dark.outer()), sq);
+    assert_eq!(ring_coords(&b, lit.rings().nth(1).unwrap()), sq);
+    let occ: Vec<_> = b.fragments().filter(|f| f.face() == 1).collect();
+    assert_eq!(occ.len(), 1);
+    assert!(occ[0].lit(0));
+    assert_eq!(occ[0].outer().len(), 4);
+}
+
+#[test]
+fn sun_and_back_faces() {
+    let floor = quad(0, 0, 8, 0);
+    let occ = quad(4, 2, 4, 1).flipped(); // faces down, still blocks
+    let polys = [floor, occ];
+    let (b, _) = shadow_fragments(
+        &polys,
+        &[Light::Directional([0, 0, 1]), Light::Point([3, 3, -8])],
+    )
+    .unwrap();
+    let dark: Vec<_> = b
+        .fragments()
+        .filter(|f| f.face() == 0 && !f.lit(0))
+        .collect();
+    assert_eq!(dark.len(), 1);
+    assert_eq!(
+        ring_coords(&b, dark[0].outer()),
+        vec![
+            [2.0, 2.0, 0.0],
+            [2.0, 4.0, 0.0],
+            [4.0, 2.0, 0.0],
+            [4.0, 4.0, 0.0]
+        ]
+    );
+    // the occluder faces away from the sun and the light below is
+    // blocked by the floor
+    assert!(
+        b.fragments()
+            .filter(|f| f.face() == 1)
+            .all(|f| !f.lit(0) && !f.lit(1))
+    );
+    // the floor faces up: the light below leaves it in attached shadow
+    assert!(b.fragments().filter(|f| f.face() == 0).all(|f| !f.lit(1)));
+    assert!(
+        b.fragments()
+            .filter(|f| f.face() == 0)
+            .all(|f| f.facing_mask() == 1)
+    );
+}
+
+#[test]
+fn uniform_faces_stay_whole_and_pieces_cover_fragments() {
+    let polys = [quad(0, 0, 8, 0), quad(4, 2, 4, 1), quad(6, -20, -10, 2)];
+    let (b, _) = shadow_fragments(&polys, &[Light::Point([3, 3, 8])]).unwrap();
+    let far: Vec<_> = b.fragments().filter(|f| f.face() == 2).collect();
+    assert_eq!(far.len(), 1);
+    for f in b.fragments() {
+        assert!(f.pieces().count() >= 1);
+    }
+}
+
+/// With `planes`, each piece's edge planes make it again (the same
+/// corners, in turn, as the support plane's meets with them), for
+/// pieces that stayed whole and pieces of merged regions alike; and
+/// appending batches keeps them. Without, there are none.
+#[test]
+fn piece_planes_make_the_pieces_again() {
+    let polys = [quad(0, 0, 8, 0), quad(4, 2, 4, 1), quad(6, -20, -10, 2)];
+    let lights = [Light::Point([3, 3, 8]), Light::Point([6, 1, 9])];
+    let shadows = LightVolumes::new(&polys, &lights).unwrap();
+    let opts = ShadeOptions::default().with_planes(true);
+    let whole = shadows.set().shade_all(&polys, &opts);
+    let mut b = Batch::new();
+    b.append_range(&whole, 0..1);
+    b.append_range(&whole, 1..whole.len());
+    let mut pieces = 0;
+    for f in b.fragments() {
+        let planes: Vec<&[Plane]> = f.piece_planes().unwrap().collect();
+        for (corners, planes) in f.pieces().zip(planes) {
+            let p = Polygon::from_planes(*f.support(), planes, 0).unwrap();
+            let made: Vec<[f64; 3]> = p.vertices_f64();
+            let kept: Vec<[f64; 3]> = corners.iter().map(|&v| b.rounded(v)).collect();
+            assert_eq!(made, kept);
+            // turned as the engine's pieces are: inside behind each plane
+            assert!(crate::FaceOverlay::new(*f.support(), [(planes, 0)]).is_some());
+            pieces += 1;
+        }
+    }
+    assert!(pieces > b.len(), "some fragment of several pieces");
+    let plain = shadows.set().shade_all(&polys, &ShadeOptions::default());
+    assert!(plain.fragments().all(|f| f.piece_planes().is_none()));
+    let mut mixed = whole.clone();
+    mixed.append(&plain);
+    assert!(mixed.fragments().all(|f| f.piece_planes().is_none()));
+}
