@@ -23,6 +23,7 @@ pub use exact_time::{
     study_plan, triangles,
 };
 use glam::DVec3;
+use smallvec::SmallVec;
 
 use crate::shadow_file::{NoProgress, Progress};
 pub use ply::{hours_ply, regions_ply, sensors_ply};
@@ -394,9 +395,104 @@ pub fn groups_in_sun_text(mesh: &crate::Mesh, faces: &[FaceHours], hours: Option
 pub const SUNS_A_RUN: usize = 4;
 
 /// A face's cells with the number of suns each one's points see: one
-/// exact overlay per support plane of the face's parts (one for a planar
+/// [`Part`] per support plane of the face's polygons (one for a planar
 /// face).
-type FaceCells = Vec<svbsp::FaceOverlay>;
+type FaceCells = Vec<Part>;
+
+/// A part of a face (its polygons on one support plane) in a study's run
+/// or fold: whole, every point seeing the same suns (most faces in most
+/// runs: kept as its planes and count, not as an overlay), or its exact
+/// cells.
+#[derive(Clone, Debug, PartialEq)]
+enum Part {
+    /// The part whole: its support plane, its edge planes in turn, and
+    /// how many suns its points see.
+    Whole(bsp_core::Plane, SmallVec<[bsp_core::Plane; 6]>, u32),
+    /// Its cells.
+    Cells(svbsp::FaceOverlay),
+}
+
+impl Part {
+    /// The part of one cell, or of several; `None` if a cell is not a
+    /// strictly convex polygon on `support` ([`svbsp::FaceOverlay::new`]).
+    fn new(
+        support: bsp_core::Plane,
+        mut cells: Vec<(SmallVec<[bsp_core::Plane; 6]>, u32)>,
+    ) -> Option<Part> {
+        match cells.len() {
+            1 => {
+                // (checked as any cell is)
+                svbsp::FaceOverlay::new(support, cells.iter().map(|c| (&c.0[..], c.1)))?;
+                let (planes, count) = cells.pop()?;
+                Some(Part::Whole(support, planes, count))
+            }
+            _ => svbsp::FaceOverlay::new(support, cells).map(Part::Cells),
+        }
+    }
+
+    fn support(&self) -> &bsp_core::Plane {
+        match self {
+            Part::Whole(s, ..) => s,
+            Part::Cells(o) => o.support(),
+        }
+    }
+
+    /// The part as an overlay.
+    fn overlay(&self) -> svbsp::FaceOverlay {
+        match self {
+            Part::Whole(support, planes, count) => {
+                svbsp::FaceOverlay::new(*support, [(&planes[..], *count)])
+                    .expect("a whole part's planes make a convex polygon (checked)")
+            }
+            Part::Cells(o) => o.clone(),
+        }
+    }
+
+    /// This part overlaid with a later run's of the same polygons (a
+    /// whole part's count added to each of the other's cells, which cover
+    /// it); `None` where they lie on other planes.
+    fn plus(self, other: &Part) -> Option<Part> {
+        if self.support() != other.support() {
+            return None;
+        }
+        match (self, other) {
+            (Part::Whole(s, p, a), Part::Whole(_, _, b)) => Some(Part::Whole(s, p, a + b)),
+            (Part::Whole(_, _, a), Part::Cells(o)) => {
+                let mut o = o.clone();
+                o.add_count(a);
+                Some(Part::Cells(o))
+            }
+            (Part::Cells(mut o), Part::Whole(_, _, b)) => {
+                o.add_count(*b);
+                Some(Part::Cells(o))
+            }
+            (Part::Cells(a), Part::Cells(b)) => a.plus(b).map(Part::Cells),
+        }
+    }
+
+    /// Each cell's corners (correctly rounded grid coordinates) and count.
+    fn cells(&self) -> Vec<(Vec<[f64; 3]>, u32)> {
+        match self {
+            Part::Whole(support, planes, count) => {
+                let p = bsp_core::Polygon::from_planes(*support, planes, 0)
+                    .expect("a whole part's planes meet in turn (checked)");
+                vec![(p.vertices_f64(), *count)]
+            }
+            Part::Cells(o) => (o.all_corners().into_iter())
+                .enumerate()
+                .map(|(i, c)| (c, o.count(i)))
+                .collect(),
+        }
+    }
+
+    /// The counts of its cells.
+    fn counts(&self) -> Vec<u32> {
+        match self {
+            Part::Whole(.., count) => vec![*count],
+            Part::Cells(o) => (0..o.len()).map(|i| o.count(i)).collect(),
+        }
+    }
+}
 
 /// The sun-hours of every face of `mesh` (in face order) under `suns`
 /// (directions toward them), each sun standing for `step_hours`: the
@@ -597,23 +693,21 @@ fn disc_in_front(height: f64, radius_deg: f64) -> f64 {
 fn face_hours(
     area: f64,
     lit: f64,
-    cells: Option<(&[svbsp::FaceOverlay], &bsp_core::Grid)>,
+    cells: Option<(&[Part], &bsp_core::Grid)>,
     step_hours: f64,
 ) -> FaceHours {
     let parts = cells.map_or(&[][..], |c| c.0);
-    let seen = parts.iter().flat_map(|o| (0..o.len()).map(|i| o.count(i)));
+    let seen = parts.iter().flat_map(Part::counts);
     let (min, max) = seen.fold((u32::MAX, 0), |(a, b), h| (a.min(h), b.max(h)));
     let (min, max) = (f64::from(min) * step_hours, f64::from(max) * step_hours);
     // (a face of area has cells, but none is no hours rather than a
     // fewest of u32::MAX steps)
-    let none = parts.iter().all(svbsp::FaceOverlay::is_empty) || area == 0.0;
+    let none = parts.iter().all(|p| p.counts().is_empty()) || area == 0.0;
     let mut by: std::collections::BTreeMap<u32, f64> = Default::default();
     if let Some((parts, grid)) = cells {
-        for o in parts {
-            for (i, corners) in o.all_corners().into_iter().enumerate() {
-                let ring: Vec<DVec3> = corners.into_iter().map(|c| grid.to_world(c)).collect();
-                *by.entry(o.count(i)).or_default() += svbsp::polygon_area(&ring);
-            }
+        for (corners, count) in parts.iter().flat_map(Part::cells) {
+            let ring: Vec<DVec3> = corners.into_iter().map(|c| grid.to_world(c)).collect();
+            *by.entry(count).or_default() += svbsp::polygon_area(&ring);
         }
     }
     let hours_area = by.into_iter().map(|(n, a)| (f64::from(n) * step_hours, a));

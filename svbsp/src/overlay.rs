@@ -126,6 +126,11 @@ impl FaceOverlay {
         self.cells[i].1
     }
 
+    /// Adds `n` to every cell's count.
+    pub fn add_count(&mut self, n: u32) {
+        self.cells.iter_mut().for_each(|c| c.1 += n);
+    }
+
     /// Cell `i`'s edge planes in turn (what [`FaceOverlay::new`] takes).
     pub fn planes(&self, i: usize) -> SmallVec<[Plane; 6]> {
         let c = &self.cells[i].0;

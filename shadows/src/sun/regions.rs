@@ -192,7 +192,7 @@ pub(crate) fn region_study(
     // (a face given twice gets a copy the first time)
     let mut uses = vec![0_usize; n];
     faces.iter().filter(|&&f| f < n).for_each(|&f| uses[f] += 1);
-    let per_face: Vec<(usize, Option<Vec<svbsp::FaceOverlay>>)> = (faces.iter())
+    let per_face: Vec<(usize, Option<super::FaceCells>)> = (faces.iter())
         .filter(|&&f| f < n)
         .map(|&f| {
             uses[f] -= 1;
@@ -208,8 +208,8 @@ pub(crate) fn region_study(
     let out: Vec<Vec<RegionCell>> = per_face
         .into_par_iter()
         .map(|(f, parts)| match (parts, grid) {
-            (Some(parts), Some(grid)) if parts.iter().any(|o| !o.is_empty()) => (parts.iter())
-                .flat_map(|o| o.regions())
+            (Some(parts), Some(grid)) if !parts.is_empty() => (parts.iter())
+                .flat_map(|p| p.overlay().regions())
                 .map(|r| {
                     let world = |ring: &[[f64; 3]]| -> Vec<DVec3> {
                         ring.iter().map(|&c| grid.to_world(c)).collect()

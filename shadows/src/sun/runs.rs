@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use smallvec::SmallVec;
 
 use super::tiles::{Tile, TileIndex};
-use super::{FaceCells, FaceHours, face_hours};
+use super::{FaceCells, FaceHours, Part, face_hours};
 
 /// A study's mesh snapped and imported once for all its runs: suns add
 /// no point to the grid ([`svbsp::shared_grid`]), so each run's own grid
@@ -251,8 +251,7 @@ impl HoursRun {
             .map(|face| {
                 (face.into_iter())
                     .map(|(support, cells)| {
-                        svbsp::FaceOverlay::new(support, cells)
-                            .expect("the engine's pieces are strictly convex")
+                        Part::new(support, cells).expect("the engine's pieces are strictly convex")
                     })
                     .collect()
             })
@@ -444,6 +443,7 @@ impl HoursRun {
             };
             put(cells[f].len() as f64);
             for part in &cells[f] {
+                let part = part.overlay();
                 plane(part.support(), &mut put);
                 put(part.len() as f64);
                 for i in 0..part.len() {
@@ -529,7 +529,7 @@ impl HoursRun {
                         .collect::<Option<SmallVec<[bsp_core::Plane; 6]>>>()?;
                     part.push((planes, seen));
                 }
-                face.push(svbsp::FaceOverlay::new(support, part)?);
+                face.push(Part::new(support, part)?);
             }
             cells.push(face);
         }

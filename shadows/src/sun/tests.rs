@@ -771,3 +771,37 @@ fn runs_of_different_meshes_do_not_fold() {
         "{e}"
     );
 }
+
+/// A part whole in one run and cut in another: its count goes to each of
+/// the other's cells, in either order; two whole parts add up; parts of
+/// other planes do not fold.
+#[test]
+fn whole_parts_add_their_count_to_cut_ones() {
+    use super::Part;
+    use bsp_core::{Plane, Polygon, Split};
+    let square =
+        Polygon::from_grid_points(&[[0, 0, 0], [8, 0, 0], [8, 8, 0], [0, 8, 0]], 0).unwrap();
+    let cut = Plane::through([3, 0, 0], [3, 8, 0], [3, 0, 1]).unwrap();
+    let Split::Spanning { front, back } = square.clone().split(&cut) else {
+        panic!("the cut spans the square")
+    };
+    let planes = |p: &Polygon| -> smallvec::SmallVec<[Plane; 6]> {
+        p.edge_planes().iter().copied().collect()
+    };
+    let support = *square.support();
+    let whole = |n| Part::new(support, vec![(planes(&square), n)]).unwrap();
+    let cells = Part::new(support, vec![(planes(&front), 1), (planes(&back), 4)]).unwrap();
+    assert!(matches!(whole(3), Part::Whole(..)) && matches!(cells, Part::Cells(_)));
+    for sum in [
+        whole(3).plus(&cells).unwrap(),
+        cells.clone().plus(&whole(3)).unwrap(),
+    ] {
+        let mut counts = sum.counts();
+        counts.sort_unstable();
+        assert_eq!(counts, [4, 7]);
+    }
+    assert_eq!(whole(3).plus(&whole(5)).unwrap().counts(), [8]);
+    let up = Polygon::from_grid_points(&[[0, 0, 1], [8, 0, 1], [8, 8, 1], [0, 8, 1]], 0).unwrap();
+    let other = Part::new(*up.support(), vec![(planes(&up), 1)]).unwrap();
+    assert!(whole(3).plus(&other).is_none() && cells.plus(&other).is_none());
+}
