@@ -573,8 +573,15 @@ mod tests {
             let a = partition(square(40), &planes(&cuts_a), |i| (i as u32 * 7 + seed) % 5);
             let b = partition(square(40), &planes(&cuts_b), |i| (i as u32 * 3 + seed) % 4);
             let o = overlay_of(&a).plus(&overlay_of(&b)).unwrap();
-            let total: f64 = (0..o.len()).map(|i| area(&o.corners(i))).sum();
-            prop_assert!((total - 1600.0).abs() < 1e-9, "area {total}");
+            // the cells tile the face, exactly: all given one count, they
+            // merge into one region, the square, with no hole
+            let one = FaceOverlay::new(*o.support(), (0..o.len()).map(|i| (o.planes(i), 0))).unwrap();
+            let r = one.regions();
+            prop_assert_eq!(r.len(), 1);
+            prop_assert!(r[0].holes.is_empty());
+            let mut outer = r[0].outer.clone();
+            outer.sort_by(|a, b| a.partial_cmp(b).unwrap());
+            prop_assert_eq!(outer, vec![[0.0, 0.0, 0.0], [0.0, 40.0, 0.0], [40.0, 0.0, 0.0], [40.0, 40.0, 0.0]]);
             for x in 0..=40 {
                 for y in (0..=40).step_by(3) {
                     let p = [x, y, 0];
