@@ -284,36 +284,9 @@ impl<'a> Reader<'a> {
             .iter()
             .map(|&v| self.mesh.positions[v as usize].to_array())
             .collect();
-        let mut flat = Vec::new();
-        if !earcut::utils3d::project3d_to_2d(&points, rings[0].len(), &mut flat) {
-            return; // an outer ring with no area: nothing to cast
-        }
-        let mut holes = Vec::new();
-        let mut start = 0;
-        for r in &rings[..rings.len() - 1] {
-            start += r.len();
-            holes.push(start as u32);
-        }
-        let mut triangles: Vec<u32> = Vec::new();
-        earcut::Earcut::new().earcut(flat.iter().copied(), &holes, &mut triangles);
-        let area2 = |t: [usize; 3]| {
-            let [a, b, c] = t.map(|i| flat[i]);
-            (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-        };
-        let outer = rings[0].len();
-        let turn: f64 = (0..outer)
-            .map(|i| {
-                let (a, b) = (flat[i], flat[(i + 1) % outer]);
-                a[0] * b[1] - a[1] * b[0]
-            })
-            .sum();
-        for t in triangles.chunks(3) {
-            let t = [t[0] as usize, t[1] as usize, t[2] as usize];
-            let t = if (area2(t) > 0.0) == (turn > 0.0) {
-                t
-            } else {
-                [t[0], t[2], t[1]]
-            };
+        let lens: Vec<usize> = rings.iter().map(Vec::len).collect();
+        // (an outer ring with no area: nothing to cast)
+        for t in crate::triangulate_rings(&points, &lens) {
             self.mesh.faces.push(face(t.map(|i| corners[i]).to_vec()));
         }
     }

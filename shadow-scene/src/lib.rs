@@ -57,6 +57,7 @@ mod obj;
 mod palette;
 mod points;
 mod prim;
+mod rings;
 mod scan;
 mod scenes;
 mod stl;
@@ -77,6 +78,7 @@ pub use obj::{
 };
 pub use palette::{Rgb, face_colors};
 pub use points::{parse_points, read_points};
+pub use rings::triangulate_rings;
 pub use scan::{MAX_SUBDIVISIONS, bunny, sqrt3_subdivide};
 pub use scenes::{ROOM_STAGING, SCENE_NAMES, Staging, room, scene, scene_named};
 pub use stl::{parse_stl, read_stl, stl_collisions, write_stl};

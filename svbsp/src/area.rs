@@ -1205,9 +1205,7 @@ fn merge_pieces<K: Copy + PartialEq>(pieces: Vec<Piece<K>>) -> Vec<Piece<K>> {
             extra: p.bbox,
         })
         .collect();
-    let union =
-        |a: &Box3, b: &Box3| [0, 1, 2].map(|k| [a[k][0].min(b[k][0]), a[k][1].max(b[k][1])]);
-    merge_keyed(items, union)
+    merge_keyed(items, |a: &Box3, b: &Box3| crate::boxes::union(*a, *b))
         .into_iter()
         .map(|m| {
             let (label, not_lit, hidden, umbra) = m.label;

@@ -20,6 +20,11 @@ pub(crate) type Reach = [Box3; 2];
 /// A box per axis, `[lo, hi]`, in grid units (exact integers).
 pub(crate) type Box3 = [[i64; 2]; 3];
 
+/// The least box holding both.
+pub(crate) fn union(a: Box3, b: Box3) -> Box3 {
+    [0, 1, 2].map(|k| [a[k][0].min(b[k][0]), a[k][1].max(b[k][1])])
+}
+
 /// Whether two boxes meet (touching counts).
 pub(crate) fn overlap(a: &Box3, b: &Box3) -> bool {
     (0..3).all(|k| a[k][0] <= b[k][1] && b[k][0] <= a[k][1])
@@ -106,7 +111,7 @@ impl Scans {
         let x = &self.items[i];
         if x.kind != Near::Never {
             let b = &mut self.runs[i / Self::RUN];
-            *b = [0, 1, 2].map(|k| [b[k][0].min(x.bbox[k][0]), b[k][1].max(x.bbox[k][1])]);
+            *b = union(*b, x.bbox);
         }
     }
 
@@ -258,9 +263,7 @@ impl ReachIndex {
         for (i, reach) in reaches.enumerate() {
             // both boxes as one, within the face's (an empty box adds nothing)
             let within = reach.iter().filter_map(|&r| meet(r, face));
-            if let Some(b) = within
-                .reduce(|a, b| [0, 1, 2].map(|k| [a[k][0].min(b[k][0]), a[k][1].max(b[k][1])]))
-            {
+            if let Some(b) = within.reduce(union) {
                 boxes.push(b);
                 of.push(i as u32);
             }

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use crate::area::{HalfSpaces, Occluder, Regions};
 use crate::blockers::plane_key;
-use crate::boxes::{Box3, CellGrid, Reach, grid_box, overlap};
+use crate::boxes::{Box3, CellGrid, Reach, grid_box, overlap, union};
 use crate::light::Light;
 
 /// Per receiving face, the indices of the occluders not in its plane whose
@@ -109,10 +109,6 @@ const SWEEP_PARTS: usize = 4;
 pub(crate) fn outside(corners: &[GridPoint], hs: &HalfSpaces) -> bool {
     hs.iter()
         .any(|(h, inside)| corners.iter().all(|&c| h.classify_grid(c) != *inside))
-}
-
-fn union(a: Box3, b: Box3) -> Box3 {
-    [0, 1, 2].map(|k| [a[k][0].min(b[k][0]), a[k][1].max(b[k][1])])
 }
 
 /// A box holding the part of occluder `o`'s penumbra volume inside

@@ -12,7 +12,7 @@ use smallvec::SmallVec;
 
 use crate::arena::pieces::{EdgeRef, Piece, PieceArena};
 use crate::arena::regions::merge_cells;
-use crate::boxes::{Box3, CellGrid, meet};
+use crate::boxes::{Box3, CellGrid, meet, union};
 
 /// How many cells [`FaceOverlay::plus`] tries in turn rather than through a
 /// grid of their boxes.
@@ -195,11 +195,7 @@ impl FaceOverlay {
             return o;
         }
         let boxes = &other.boxes;
-        let Some(scene) = boxes
-            .iter()
-            .copied()
-            .reduce(|a, b| [0, 1, 2].map(|k| [a[k][0].min(b[k][0]), a[k][1].max(b[k][1])]))
-        else {
+        let Some(scene) = boxes.iter().copied().reduce(union) else {
             return self;
         };
         // (a few cells are tried in turn, many through a grid of boxes)

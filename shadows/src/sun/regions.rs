@@ -111,34 +111,14 @@ impl RegionCell {
     }
 
     /// Triangles covering the cell (its holes left out), counter-clockwise
-    /// seen from the face's front as the cell is (earcut in the cell's
-    /// plane); none for a cell of no area.
+    /// seen from the face's front as the cell is
+    /// ([`shadow_scene::triangulate_rings`]); none for a cell of no area.
     pub fn triangles(&self) -> Vec<[DVec3; 3]> {
         let corners: Vec<DVec3> = self.rings().flatten().copied().collect();
-        let normal = (0..self.ring.len())
-            .map(|i| self.ring[i].cross(self.ring[(i + 1) % self.ring.len()]))
-            .sum::<DVec3>();
-        let Some(n) = normal.try_normalize() else {
-            return Vec::new();
-        };
-        let u = n.any_orthonormal_vector();
-        let v = n.cross(u);
-        let flat = corners.iter().map(|p| [p.dot(u), p.dot(v)]);
-        let mut starts = Vec::new();
-        let mut at = self.ring.len() as u32;
-        for h in &self.holes {
-            starts.push(at);
-            at += h.len() as u32;
-        }
-        let mut tri: Vec<u32> = Vec::new();
-        earcut::Earcut::new().earcut(flat, &starts, &mut tri);
-        (tri.chunks(3))
-            .map(|t| t.iter().map(|&i| corners[i as usize]))
-            .map(|mut t| [t.next(), t.next(), t.next()].map(|p| p.expect("three corners")))
-            .map(|[a, b, c]| match (b - a).cross(c - a).dot(n) < 0.0 {
-                true => [a, c, b],
-                false => [a, b, c],
-            })
+        let points: Vec<[f64; 3]> = corners.iter().map(|p| p.to_array()).collect();
+        let lens: Vec<usize> = self.rings().map(<[DVec3]>::len).collect();
+        (shadow_scene::triangulate_rings(&points, &lens).into_iter())
+            .map(|t| t.map(|i| corners[i]))
             .collect()
     }
 }
