@@ -417,12 +417,23 @@ impl Part {
     /// strictly convex polygon on `support` ([`svbsp::FaceOverlay::new`]).
     fn new(
         support: bsp_core::Plane,
+        cells: Vec<(SmallVec<[bsp_core::Plane; 6]>, u32)>,
+    ) -> Option<Part> {
+        if let [(planes, count)] = &cells[..] {
+            // (checked as any cell is)
+            svbsp::FaceOverlay::new(support, [(&planes[..], *count)])?;
+        }
+        Part::of_pieces(support, cells)
+    }
+
+    /// [`Part::new`] of the engine's pieces of a face, strictly convex by
+    /// construction: a whole part is not checked again.
+    fn of_pieces(
+        support: bsp_core::Plane,
         mut cells: Vec<(SmallVec<[bsp_core::Plane; 6]>, u32)>,
     ) -> Option<Part> {
         match cells.len() {
             1 => {
-                // (checked as any cell is)
-                svbsp::FaceOverlay::new(support, cells.iter().map(|c| (&c.0[..], c.1)))?;
                 let (planes, count) = cells.pop()?;
                 Some(Part::Whole(support, planes, count))
             }

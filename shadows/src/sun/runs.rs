@@ -251,7 +251,8 @@ impl HoursRun {
             .map(|face| {
                 (face.into_iter())
                     .map(|(support, cells)| {
-                        Part::new(support, cells).expect("the engine's pieces are strictly convex")
+                        Part::of_pieces(support, cells)
+                            .expect("the engine's pieces are strictly convex")
                     })
                     .collect()
             })
