@@ -23,6 +23,7 @@
 
 pub mod art;
 pub mod frames;
+mod lit;
 pub mod prepared;
 pub mod shadow_file;
 pub mod soft_file;
@@ -409,19 +410,33 @@ pub(crate) fn face_trees(
             [lo, hi]
         });
     let volumes = bsp_core::par::try_map(kernel.len(), |j| {
-        let hiding: Vec<&bsp_core::Polygon> = (polys.iter().enumerate())
-            .filter(|(i, p)| {
-                // (the tile's sweep first: the cheapest test, and the one
-                // that leaves most faces out)
-                reach.is_none_or(|(b, boxes)| sun::may_shade(&kernel[j], b, boxes[*i]))
-                    && bounds.is_none_or(|b| may_hide(&kernel[j], p.support(), b))
-                    && !kernel[j].leaves_out(solids, *i, p.support())
-            })
-            .map(|(_, p)| p)
+        let hiding: Vec<&bsp_core::Polygon> = hiding(polys, &kernel[j], bounds, solids, reach)
+            .map(|i| &polys[i])
             .collect();
         svbsp::ShadowVolumes::build(kernel[j], &hiding)
     })?;
     svbsp::LightVolumes::from_volumes(kernel, volumes)
+}
+
+/// The indices of the faces of `polys` that [`face_trees`] puts in the
+/// tree of `light`, where `bounds` holds every face and point to be
+/// shaded (see there).
+fn hiding<'a>(
+    polys: &'a [bsp_core::Polygon],
+    light: &'a svbsp::Light,
+    bounds: Option<[bsp_core::GridPoint; 2]>,
+    solids: &'a bsp_core::SolidParts,
+    reach: Option<([bsp_core::GridPoint; 2], &'a [[bsp_core::GridPoint; 2]])>,
+) -> impl Iterator<Item = usize> + 'a {
+    (polys.iter().enumerate())
+        .filter(move |(i, p)| {
+            // (the tile's sweep first: the cheapest test, and the one
+            // that leaves most faces out)
+            reach.is_none_or(|(b, boxes)| sun::may_shade(light, b, boxes[*i]))
+                && bounds.is_none_or(|b| may_hide(light, p.support(), b))
+                && !light.leaves_out(solids, *i, p.support())
+        })
+        .map(|(i, _)| i)
 }
 
 /// Whether a face of plane `support` may hide `light` from some point of

@@ -44,11 +44,16 @@ use std::borrow::Borrow;
 
 use bsp_core::internals::SplitMix;
 use bsp_core::{GridPoint, Plane, Point, Polygon, SanityError, Side};
+
+use crate::arena::pieces::Vertex;
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
 use crate::arena::pieces::{EdgeRef, Piece, PieceArena, Sides};
 use crate::light::Light;
+
+mod rests;
+use rests::Rests;
 
 /// A leaf: lit.
 pub(crate) const LIT: u32 = u32::MAX;
@@ -105,6 +110,8 @@ struct Occluders {
     start: Vec<u32>,
     support: Vec<Plane>,
     cap: Vec<Plane>,
+    /// Each occluder's index in the input.
+    index: Vec<u32>,
 }
 
 impl Occluders {
@@ -204,6 +211,7 @@ impl Occluders {
             start: Vec::with_capacity(n + 1),
             support: Vec::with_capacity(n),
             cap: Vec::with_capacity(n),
+            index: order.iter().map(|o| o.1).collect(),
         };
         o.start.push(0);
         for c in chunks {
@@ -514,6 +522,66 @@ impl ShadowVolumes {
         light: Light,
         occluders: &[P],
     ) -> Result<ShadowVolumes, VolumeError> {
+        Ok(ShadowVolumes::build_inner::<P, ()>(light, occluders, None)?.0)
+    }
+
+    /// [`ShadowVolumes::build`], and the area of each occluder that the
+    /// light reaches, as its receiver would find it filtered through the
+    /// finished tree ([`crate::ShadowSet`]): the area of its parts that
+    /// are in front of no other occluder's volume, where it faces the
+    /// light (0 for an occluder turned away or edge-on), in grid units
+    /// squared, in the order of `occluders`.
+    ///
+    /// Found while the tree is built, without a second walk (each part
+    /// the insertion brings to a lit leaf is lit by the volumes so far,
+    /// and walks on when a later volume is grafted where it rests; see
+    /// `psv/rests.rs`). Every decision is the filter's exact sign; the
+    /// areas are measured in `f64` from the parts' corners (a cut corner
+    /// within `2^-20` grid units), so they agree with the filter's
+    /// fragments' areas to rounding.
+    ///
+    /// ```
+    /// use svbsp::{Light, ShadowVolumes};
+    /// let quad = |z: i32, lo: i32, hi: i32| {
+    ///     bsp_core::Polygon::from_grid_points(&[[lo, lo, z], [hi, lo, z], [hi, hi, z], [lo, hi, z]], 0).unwrap()
+    /// };
+    /// // a 2 x 2 roof over a 4 x 4 floor, the sun straight above
+    /// let (_, lit) = ShadowVolumes::build_lit(Light::Directional([0, 0, 1]), &[quad(10, 1, 3), quad(0, 0, 4)]).unwrap();
+    /// assert_eq!(lit, vec![4.0, 12.0]);
+    /// ```
+    pub fn build_lit<P: Borrow<Polygon> + Sync>(
+        light: Light,
+        occluders: &[P],
+    ) -> Result<(ShadowVolumes, Vec<f64>), VolumeError> {
+        let (v, parts) = ShadowVolumes::build_inner(light, occluders, Some(&Rests::areas))?;
+        let mut lit = vec![0.0; occluders.len()];
+        for (i, a) in parts {
+            lit[i as usize] += a;
+        }
+        Ok((v, lit))
+    }
+
+    /// [`ShadowVolumes::build_lit`] with the lit parts themselves: each a
+    /// convex polygon with exact corners (counter-clockwise seen from the
+    /// light's side) and the index of its occluder in `occluders`. The
+    /// parts of one occluder tile what of it the light reaches, but are
+    /// not merged (see [`crate::ShadowSet`] for maximal fragments).
+    pub fn lit_parts<P: Borrow<Polygon> + Sync>(
+        light: Light,
+        occluders: &[P],
+    ) -> Result<(ShadowVolumes, Vec<(usize, Vec<Vertex>)>), VolumeError> {
+        let (v, parts) = ShadowVolumes::build_inner(light, occluders, Some(&Rests::parts))?;
+        Ok((v, parts.into_iter().map(|(i, p)| (i as usize, p)).collect()))
+    }
+
+    /// [`ShadowVolumes::build`], and with `record` what it makes of each
+    /// region's lit parts, with their occluders' input indices (those
+    /// facing the light only), region by region in order.
+    fn build_inner<P: Borrow<Polygon> + Sync, T: Send>(
+        light: Light,
+        occluders: &[P],
+        record: Option<&Record<T>>,
+    ) -> Result<(ShadowVolumes, Vec<(u32, T)>), VolumeError> {
         let occ = Occluders::new(&light, occluders)?;
         let mut pool = Pool::default();
         pool.arena
@@ -555,7 +623,7 @@ impl ShadowVolumes {
         }
         let skeleton_top = top.nodes.len();
         // each pending region on its own pool, in parallel
-        let parts: Vec<(Subtree, u32, usize)> = ready
+        let parts: Vec<Region<T>> = ready
             .par_iter()
             .enumerate()
             .map(|(i, task)| {
@@ -570,7 +638,8 @@ impl ShadowVolumes {
                     path: task.path.clone(),
                     list,
                 };
-                build_region(&occ, &mut own, local, 0x5eed_5a0d ^ (i as u64 + 1))
+                let seed = 0x5eed_5a0d ^ (i as u64 + 1);
+                build_region(&occ, &mut own, local, seed, record)
             })
             .collect();
         drop(pool);
@@ -578,7 +647,15 @@ impl ShadowVolumes {
         nodes.reserve(parts.iter().map(|p| p.0.nodes.len()).sum());
         let mut grafted = top.grafted;
         let mut skeleton = skeleton_top;
-        for (task, (sub, sub_root, sub_skeleton)) in ready.iter().zip(parts) {
+        // region by region in order: the same for every thread count
+        let mut lit = Vec::new();
+        for (task, (sub, sub_root, sub_skeleton, found)) in ready.iter().zip(parts) {
+            for (o, a) in found {
+                // (turned away: a receiver in attached shadow)
+                if occ.cap[o as usize] == occ.support[o as usize] {
+                    lit.push((occ.index[o as usize], a));
+                }
+            }
             let off = nodes.len() as u32;
             let shift = |l: u32| if l >= SHADOW { l } else { l + off };
             nodes.extend(sub.nodes.into_iter().map(|mut n| {
@@ -595,14 +672,15 @@ impl ShadowVolumes {
             grafted += sub.grafted;
             skeleton += sub_skeleton;
         }
-        Ok(ShadowVolumes {
+        let volumes = ShadowVolumes {
             light,
             nodes,
             root,
             grafted,
             skeleton,
             occluders: occ.len(),
-        })
+        };
+        Ok((volumes, lit))
     }
 
     /// The number of occluders the volumes were built from (those given,
@@ -840,10 +918,25 @@ fn split_task(
     Ok((child(Side::Front, front), child(Side::Back, back)))
 }
 
+/// What [`build_region`] makes: the nodes, the root link, the number of
+/// skeleton nodes, and where asked the lit parts' areas with their
+/// occluders ([`Rests::areas`]).
+type Region<T> = (Subtree, u32, usize, Vec<(u32, T)>);
+
+/// What a build makes of a region's lit parts: [`Rests::areas`] or
+/// [`Rests::parts`].
+type Record<T> = dyn Fn(Rests, &PieceArena) -> Vec<(u32, T)> + Sync;
+
 /// The whole tree below one region, on its own pool: the rest of the
-/// skeleton, then each leaf's occluders inserted nearest first. Returns
-/// the nodes, the root link and the number of skeleton nodes.
-fn build_region(occ: &Occluders, pool: &mut Pool, task: Task, seed: u64) -> (Subtree, u32, usize) {
+/// skeleton, then each leaf's occluders inserted nearest first; with
+/// `record`, the lit parts of the occluders too (see [`rests`]).
+fn build_region<T>(
+    occ: &Occluders,
+    pool: &mut Pool,
+    task: Task,
+    seed: u64,
+    record: Option<&Record<T>>,
+) -> Region<T> {
     let mut tree = Subtree {
         nodes: Vec::new(),
         grafted: 0,
@@ -866,12 +959,18 @@ fn build_region(occ: &Occluders, pool: &mut Pool, task: Task, seed: u64) -> (Sub
     let entries: usize = leaves.iter().map(|l| l.list.len()).sum();
     tree.nodes.reserve(entries * 3);
     let mut scratch = InsertScratch::default();
+    let mut rests = record.map(|_| Rests::default());
     for leaf in &leaves {
         for &e in &leaf.list {
-            insert(&mut tree, &mut root, occ, pool, e, leaf, &mut scratch);
+            let r = rests.as_mut();
+            insert(&mut tree, &mut root, occ, pool, e, leaf, &mut scratch, r);
         }
     }
-    (tree, root, skeleton)
+    let found = match (rests, record) {
+        (Some(r), Some(make)) => make(r, &pool.arena),
+        _ => Vec::new(),
+    };
+    (tree, root, skeleton, found)
 }
 
 /// A plane through the light among the edge planes of a few occluders of
@@ -921,8 +1020,9 @@ fn choose_split(
 }
 
 /// Where a piece goes next: the piece, the link it reaches, the depth of
-/// its path and the slot it came through.
-type Visit = (Piece, u32, usize, Option<(u32, Side)>);
+/// its path, the slot it came through, and whether it goes on as a
+/// receiver only (see [`rests`]).
+type Visit = (Piece, u32, usize, Option<(u32, Side)>, bool);
 
 /// Work space of [`insert`].
 #[derive(Default)]
@@ -936,7 +1036,8 @@ struct InsertScratch {
 /// Inserts entry `e` (an occluder clipped to the region of `leaf`) below
 /// the leaf: it descends to the lit leaves its volume meets. The pieces it
 /// is cut into live in the pool's arena until it is grafted, then the
-/// arena is rolled back.
+/// arena is rolled back. With `rests`, its parts that reach lit leaves are
+/// kept there as lit (and the arena kept while they are; see [`rests`]).
 #[allow(clippy::too_many_arguments)]
 fn insert(
     tree: &mut Subtree,
@@ -946,6 +1047,7 @@ fn insert(
     e: Entry,
     leaf: &Task,
     s: &mut InsertScratch,
+    mut rests: Option<&mut Rests>,
 ) {
     let start_link = tree.link(leaf.slot, *root);
     let piece = pool.pieces[e.piece as usize].clone();
@@ -968,10 +1070,11 @@ fn insert(
     s.path.clear();
     s.path.extend_from_slice(&leaf.path);
     s.stack
-        .push((piece, start_link, leaf.path.len(), leaf.slot));
+        .push((piece, start_link, leaf.path.len(), leaf.slot, false));
     let arena = &mut pool.arena;
+    let changes = rests.as_ref().map(|r| r.changes);
     let mut first = true;
-    while let Some((mut p, mut link, depth, mut edge)) = s.stack.pop() {
+    while let Some((mut p, mut link, depth, mut edge, receiver)) = s.stack.pop() {
         s.path.truncate(depth);
         if !first && let Some((id, side)) = edge {
             s.path.push(Step::new(tree.nodes[id as usize].plane, side));
@@ -982,13 +1085,28 @@ fn insert(
                 break;
             }
             if link == LIT {
-                graft(tree, root, occ, e, &p, edge, &s.path);
+                if !receiver {
+                    graft(tree, root, occ, e, &p, edge, &s.path);
+                }
+                if let Some(r) = rests.as_deref_mut() {
+                    r.rest(edge, p, e.occ, sup);
+                    if !receiver {
+                        r.settle(tree, *root, edge, arena, &mut s.sides);
+                    }
+                }
                 break;
             }
             let n = tree.nodes[link as usize];
             // every vertex's side, kept for a split (classified once)
             let sd = arena.classify_into(&p, &n.plane, &mut s.sides);
             let next = match (n.cap, sd.front, sd.back) {
+                // in a cap's plane: its volume is hidden already, but as a
+                // receiver the part is not
+                (true, false, false) if rests.is_some() => {
+                    let slot = Some((link, Side::Front));
+                    s.stack.push((p, n.front, s.path.len(), slot, true));
+                    break;
+                }
                 // behind a cap (or in its plane): hidden already
                 (true, false, _) => break,
                 (true, true, false) | (false, true, false) | (false, false, false) => Side::Front,
@@ -1002,7 +1120,7 @@ fn insert(
                     let cut = arena.add_plane(n.plane);
                     let (f, b) = arena.split(sup, &p, cut, &s.sides);
                     s.stack
-                        .push((b, n.back, s.path.len(), Some((link, Side::Back))));
+                        .push((b, n.back, s.path.len(), Some((link, Side::Back)), receiver));
                     p = f;
                     Side::Front
                 }
@@ -1012,7 +1130,10 @@ fn insert(
             link = if next == Side::Front { n.front } else { n.back };
         }
     }
-    arena.rollback(mark);
+    // (pieces at rest keep what they were cut from)
+    if rests.map(|r| r.changes) == changes {
+        arena.rollback(mark);
+    }
 }
 
 /// Replaces the lit leaf below `slot` by the volume of `entry`'s

@@ -182,6 +182,23 @@ impl HoursRun {
             },
         };
         let s = snapped;
+        if pieces.is_none() && part.is_none() {
+            // mean hours alone: the lit areas, no fragments
+            let got = crate::lit::lit_areas_on(&s.grid, &s.polys, &s.solids, faces, &lights)?;
+            let n = suns.len();
+            let lit = (0..faces)
+                .map(|f| got.lit[f * n..(f + 1) * n].iter().sum::<f64>() * step_hours)
+                .collect();
+            return Ok(HoursRun {
+                step_hours,
+                faces,
+                ids: None,
+                area: got.area,
+                lit,
+                cells: None,
+                grid: s.grid,
+            });
+        }
         let run = crate::shadows_on(
             &s.grid,
             &s.polys,

@@ -327,12 +327,12 @@ fn runs_files_and_heat_maps_of_a_yard() {
     let cut = &runs[0][..runs[0].len() - 8];
     assert!(HoursRun::from_bytes(cut).is_none());
     assert!(HoursRun::from_bytes(&[runs[0].clone(), vec![0; 8]].concat()).is_none());
-    // the mean alone: the same sun-hours (but for the full study's
-    // keeping them between its extremes), no extremes
+    // the mean alone (its lit areas found as the trees are built, not
+    // from fragments: the same to rounding), no extremes
     let mean = sun_hours_mean(&mesh, &suns, step).unwrap();
     for (a, b) in hours.iter().zip(&mean) {
-        let kept = b.sun_hours.clamp(a.min_hours, a.max_hours);
-        assert_eq!((a.area, a.sun_hours), (b.area, kept));
+        assert!((a.area - b.area).abs() <= 1e-12 * a.area, "{a:?} {b:?}");
+        assert!((a.sun_hours - b.sun_hours).abs() < 1e-9, "{a:?} {b:?}");
         assert!(b.min_hours.is_nan() && b.max_hours.is_nan() && b.hours_area.is_empty());
     }
     let run = HoursRun::mean_only(&mesh, &suns[..10], step).unwrap();

@@ -184,6 +184,11 @@ pub(crate) struct Lazy {
 /// [`Lazy::new`] (at most `8.4 · 2^-53`; see `docs/architecture.md`).
 const LAZY_REL: f64 = 1.0 / (1u64 << 49) as f64;
 
+/// `2^-20`: how far from the exact coordinates [`VertexRef::approx`] may
+/// measure a lazy point (a bound on a measurement's input, not a
+/// tolerance any decision reads).
+pub(crate) const MEASURE_UNITS: f64 = 1.0 / (1u64 << 20) as f64;
+
 impl Lazy {
     /// The intersection of `planes[i]` for the three indices, or `None` if
     /// they do not meet in one point.
@@ -375,6 +380,27 @@ impl VertexRef<'_> {
             }
             _ => self.to_f64().map(|c| [c, c]),
         }
+    }
+
+    /// Grid coordinates in `f64` for measuring, not deciding: a lazy
+    /// point's approximations divided, without its exact coordinates,
+    /// where their error bounds put every coordinate within
+    /// [`MEASURE_UNITS`] grid units of the exact one; else, and for the
+    /// others, correctly rounded.
+    pub(crate) fn approx(self) -> [f64; 3] {
+        if let VertexRef::Lazy(l, _) = self
+            && l.exact.is_none()
+        {
+            let (w, ew) = (l.approx[3], l.err[3]);
+            // |x/w - X/W| <= (ex + |x/w| ew) / (w - ew) for |x - X| <= ex,
+            // |w - W| <= ew, w > ew
+            let q = [0, 1, 2].map(|k| l.approx[k] / w);
+            let room = (w - ew) * MEASURE_UNITS;
+            if w > ew && (0..3).all(|k| l.err[k] + q[k].abs() * ew <= room) {
+                return q;
+            }
+        }
+        self.to_f64()
     }
 
     /// The correctly rounded grid coordinates.

@@ -10,7 +10,10 @@ use std::collections::{BTreeSet, HashMap};
 
 use bsp_core::{BspTree, BuildOptions, Polygon};
 use num_traits::{ToPrimitive, Zero};
-use svbsp::{Batch, CfFragments, Light, LightVolumes, ShadowStats, chin_feiner, shadow_fragments};
+use svbsp::{
+    Batch, CfFragments, Light, LightVolumes, ShadowStats, ShadowVolumes, chin_feiner,
+    shadow_fragments,
+};
 
 use crate::oracle::{
     Face, FlagStats, HPoint, PieceRef, Q, Region, Scene, area_of, check_flags, check_regions,
@@ -287,6 +290,7 @@ pub(crate) fn check(
             .iter()
             .flat_map(|r| r.pieces.iter().map(move |p| (r.face, &r.lit[..], &p[..]))),
     );
+    check_lit_parts(polys, scene, lights, &areas)?;
     if opts.shuffled {
         let order = shuffle(polys.len());
         let moved: Vec<Polygon> = order.iter().map(|&i| polys[i].clone()).collect();
@@ -318,6 +322,48 @@ pub(crate) fn check(
         stats,
         flags: flag_stats,
     })
+}
+
+/// The lit parts found while each light's tree is built
+/// ([`ShadowVolumes::lit_parts`]) give every face exactly the fast path's
+/// lit area for that light.
+fn check_lit_parts(
+    polys: &[Polygon],
+    scene: &Scene,
+    lights: &[Light],
+    areas: &Areas,
+) -> Result<(), String> {
+    for (j, &light) in lights.iter().enumerate() {
+        let mut want: HashMap<usize, Q> = HashMap::new();
+        for ((face, lit), a) in areas {
+            if lit[j] {
+                *want.entry(*face).or_insert_with(Q::zero) += a;
+            }
+        }
+        let (_, parts) = ShadowVolumes::lit_parts(light, polys).map_err(|e| e.to_string())?;
+        let mut got: HashMap<usize, Q> = HashMap::new();
+        for (i, verts) in parts {
+            let face = polys[i].tag() as usize;
+            let pts: Vec<HPoint> = verts.iter().map(HPoint::of_vertex).collect();
+            *got.entry(face).or_insert_with(Q::zero) += area_of(&scene.faces[face], &pts);
+        }
+        let faces: BTreeSet<usize> = want.keys().chain(got.keys()).copied().collect();
+        for f in faces {
+            let (w, g) = (
+                want.get(&f).cloned().unwrap_or_else(Q::zero),
+                got.get(&f).cloned().unwrap_or_else(Q::zero),
+            );
+            if w != g {
+                return Err(format!(
+                    "light {j}: the parts lit as the tree was built give face {f} {} of its \
+                     area, the filter {}",
+                    g.to_f64().unwrap_or(f64::NAN),
+                    w.to_f64().unwrap_or(f64::NAN)
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Chin & Feiner's fragments: valid convex polygons that tile the faces,

@@ -1,0 +1,179 @@
+//! The lit parts of the occluders, found while their volumes are inserted
+//! ([`super::ShadowVolumes::build_lit`]).
+//!
+//! An occluder's part that reaches a lit leaf as it is inserted is lit by
+//! every volume in the tree so far. The finished tree is the tree of that
+//! moment with some lit leaves replaced by subtrees (a graft only ever
+//! replaces a lit leaf), so the walk a receiver would take through the
+//! finished tree is the insertion's walk continued into whatever replaced
+//! the leaf it reached. So each part rests at its lit leaf, and when a
+//! graft replaces that leaf, the parts resting there walk on into the new
+//! nodes, as [`crate::engine`]'s filter walks a receiver (behind a cap is
+//! shadow; in a cap's plane is not). Inserted nearest first, a later
+//! occluder rarely reaches a leaf an earlier part rests at (it would have
+//! to lie between the light and that part), so the rests mostly stay where
+//! they first came to: the lit parts of every occluder come with the tree,
+//! without a second walk of every face through it.
+//!
+//! An occluder part wholly in the plane of a cap it meets adds no volume
+//! (it hides nothing the cap's occluder does not), but as a receiver it is
+//! lit there: it walks on as a receiver only, resting without a graft.
+
+use std::collections::HashMap;
+
+use bsp_core::Side;
+use smallvec::SmallVec;
+
+use super::{LIT, SHADOW, Subtree};
+use crate::arena::pieces::{Piece, PieceArena, Vertex};
+
+/// A lit leaf's slot: the node whose child it is and the side (`None`:
+/// the root), as one key.
+fn key(slot: Option<(u32, Side)>) -> u64 {
+    match slot {
+        None => u64::MAX,
+        Some((id, Side::Front)) => 2 * id as u64,
+        Some((id, _)) => 2 * id as u64 + 1,
+    }
+}
+
+/// A part at rest: the piece, its occluder (sorted index) and its
+/// support plane in the arena.
+struct Rest {
+    piece: Piece,
+    occ: u32,
+    sup: u32,
+}
+
+/// The parts resting at each lit leaf of one region's subtree.
+#[derive(Default)]
+pub(super) struct Rests {
+    at: HashMap<u64, Vec<Rest>>,
+    /// Counts every change, so that an insertion that left nothing at
+    /// rest can roll its arena back.
+    pub(super) changes: u64,
+    stack: Vec<(Piece, u32, Option<(u32, Side)>)>,
+}
+
+impl Rests {
+    /// Puts `piece` of occluder `occ` (support plane `sup`) at rest at the
+    /// lit leaf of `slot`.
+    pub(super) fn rest(&mut self, slot: Option<(u32, Side)>, piece: Piece, occ: u32, sup: u32) {
+        let r = Rest { piece, occ, sup };
+        self.at.entry(key(slot)).or_default().push(r);
+        self.changes += 1;
+    }
+
+    /// After a graft at `slot`: the parts resting there walk on into the
+    /// new nodes, to the lit leaves they reach (the parts in shadow are
+    /// dropped).
+    pub(super) fn settle(
+        &mut self,
+        tree: &Subtree,
+        root: u32,
+        slot: Option<(u32, Side)>,
+        arena: &mut PieceArena,
+        sides: &mut SmallVec<[Side; 8]>,
+    ) {
+        let Some(list) = self.at.remove(&key(slot)) else {
+            return;
+        };
+        self.changes += 1;
+        let start = tree.link(slot, root);
+        let mut stack = std::mem::take(&mut self.stack);
+        for Rest { piece, occ, sup } in list {
+            stack.push((piece, start, slot));
+            while let Some((mut p, mut link, mut at)) = stack.pop() {
+                loop {
+                    if link == LIT {
+                        let r = Rest { piece: p, occ, sup };
+                        self.at.entry(key(at)).or_default().push(r);
+                        break;
+                    }
+                    if link == SHADOW {
+                        break;
+                    }
+                    let n = tree.nodes[link as usize];
+                    let sd = arena.classify_into(&p, &n.plane, sides);
+                    let next = match (n.cap, sd.front, sd.back) {
+                        // a cap: in its plane or in front is lit by it
+                        (true, _, false) => Side::Front,
+                        (true, false, true) => break,
+                        (true, true, true) => {
+                            let cut = arena.add_plane(n.plane);
+                            p = arena.split(sup, &p, cut, sides).0;
+                            Side::Front
+                        }
+                        (false, true, false) | (false, false, false) => Side::Front,
+                        (false, false, true) => Side::Back,
+                        (false, true, true) => {
+                            let cut = arena.add_plane(n.plane);
+                            let (f, b) = arena.split(sup, &p, cut, sides);
+                            stack.push((b, n.back, Some((link, Side::Back))));
+                            p = f;
+                            Side::Front
+                        }
+                    };
+                    at = Some((link, next));
+                    link = match next {
+                        Side::Front => n.front,
+                        _ => n.back,
+                    };
+                }
+            }
+        }
+        self.stack = stack;
+    }
+
+    /// The area of every part at rest (grid units squared, from `f64`
+    /// approximations of its corners), with its occluder: leaf by leaf in
+    /// the order of their slots, so the same for every thread count.
+    pub(super) fn areas(self, arena: &PieceArena) -> Vec<(u32, f64)> {
+        let mut pts: Vec<[f64; 3]> = Vec::new();
+        self.each(|r| {
+            pts.clear();
+            pts.extend(r.piece.verts.iter().map(|&v| arena.vertex(v).approx()));
+            area(&pts)
+        })
+    }
+
+    /// Every part at rest with exact corners, with its occluder, in the
+    /// order of [`Rests::areas`].
+    pub(super) fn parts(self, arena: &PieceArena) -> Vec<(u32, Vec<Vertex>)> {
+        self.each(|r| {
+            r.piece
+                .verts
+                .iter()
+                .map(|&v| arena.vertex(v).to_owned())
+                .collect()
+        })
+    }
+
+    /// `f` of every part at rest, with its occluder, leaf by leaf in the
+    /// order of their slots.
+    fn each<T>(self, mut f: impl FnMut(&Rest) -> T) -> Vec<(u32, T)> {
+        let mut slots: Vec<(u64, Vec<Rest>)> = self.at.into_iter().collect();
+        slots.sort_unstable_by_key(|s| s.0);
+        (slots.iter().flat_map(|s| &s.1))
+            .map(|r| (r.occ, f(r)))
+            .collect()
+    }
+}
+
+/// The area of a planar convex polygon (its corners turned either way):
+/// half the length of the sum of the cross products of its corners taken
+/// from the first.
+fn area(pts: &[[f64; 3]]) -> f64 {
+    let Some(&o) = pts.first() else {
+        return 0.0;
+    };
+    let d = |p: [f64; 3]| [p[0] - o[0], p[1] - o[1], p[2] - o[2]];
+    let mut n = [0.0; 3];
+    for w in pts[1..].windows(2) {
+        let (a, b) = (d(w[0]), d(w[1]));
+        n[0] += a[1] * b[2] - a[2] * b[1];
+        n[1] += a[2] * b[0] - a[0] * b[2];
+        n[2] += a[0] * b[1] - a[1] * b[0];
+    }
+    0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+}
