@@ -11,11 +11,8 @@
 //! `shadows_on`'s to rounding (the parts are measured unmerged, from `f64`
 //! approximations of their cut corners).
 
-use std::ops::Range;
-
 use bsp_core::{Grid, Point, Polygon, SolidParts};
-use svbsp::export::{area_records, world_vertices};
-use svbsp::{LightVolumes, ShadeOptions, ShadowVolumes};
+use svbsp::ShadowVolumes;
 
 use crate::{Error, Light, hiding, sun};
 
@@ -53,34 +50,15 @@ pub(crate) fn lit_areas_on(
         for (&i, a) in index.iter().zip(lit) {
             reached[i] = Some(a * unit);
         }
-        let mut out = vec![0.0; ranges.len()];
         // the receivers it faces that are not in its tree: filtered
-        let mut walk: Vec<Range<usize>> = Vec::new();
-        let mut slot: Vec<usize> = Vec::new();
-        for (k, r) in ranges.iter().enumerate() {
-            if !light.faces(polys[r.start].support()) {
-                continue;
-            }
-            match r.clone().map(|i| reached[i]).sum::<Option<f64>>() {
-                Some(a) => out[k] = a,
-                None => {
-                    walk.push(r.clone());
-                    slot.push(k);
-                }
-            }
-        }
-        if !walk.is_empty() {
-            let trees =
-                LightVolumes::from_volumes(&[light], vec![volumes]).map_err(Error::Shadow)?;
-            let opts = ShadeOptions::default().with_pieces(false);
-            let batch = trees.set().shade_par(polys, &walk, &opts, |_| {});
-            let world = world_vertices(&batch, grid).map_err(Error::Export)?;
-            for (f, r) in batch.fragments().zip(area_records(&batch, &world)) {
-                if r.lit & 1 == 1 {
-                    out[slot[f.receiver() as usize]] += r.area;
-                }
-            }
-        }
+        let out = (ranges.iter())
+            .map(
+                |r| match r.clone().map(|i| reached[i]).sum::<Option<f64>>() {
+                    Some(a) => a,
+                    None => volumes.lit_area(&polys[r.clone()]) * unit,
+                },
+            )
+            .collect::<Vec<f64>>();
         Ok::<_, Error>(out)
     })?;
     let n = kernel.len();

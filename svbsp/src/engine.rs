@@ -822,7 +822,7 @@ pub enum Start<'a> {
     Cells(&'a Cells),
 }
 
-enum Task {
+pub(crate) enum Task {
     Visit(Piece, u32),
     /// Both pieces of `parent`'s cut start at `out[mark]`; the arena held
     /// `arena` before the cut.
@@ -843,7 +843,7 @@ enum Task {
 /// same flag is undone (the parent piece is kept, the arena rolled back),
 /// so only cuts that separate lit from shadow survive.
 #[allow(clippy::too_many_arguments)]
-fn filter(
+pub(crate) fn filter(
     sv: &ShadowVolumes,
     arena: &mut PieceArena,
     support: u32,

@@ -24,7 +24,9 @@ use std::collections::HashMap;
 use bsp_core::Side;
 use smallvec::SmallVec;
 
-use super::{LIT, SHADOW, Subtree};
+use bsp_core::Polygon;
+
+use super::{LIT, SHADOW, ShadowVolumes, Subtree};
 use crate::arena::pieces::{Piece, PieceArena, Vertex};
 
 /// A lit leaf's slot: the node whose child it is and the side (`None`:
@@ -157,6 +159,43 @@ impl Rests {
         (slots.iter().flat_map(|s| &s.1))
             .map(|r| (r.occ, f(r)))
             .collect()
+    }
+}
+
+impl ShadowVolumes {
+    /// The area of a receiver that the light reaches, in grid units
+    /// squared: `polys` are convex polygons of one plane with grid
+    /// vertices (one face, as [`crate::receivers`] groups them), each
+    /// filtered through the tree as [`crate::ShadowSet`] filters it, its
+    /// lit pieces measured as [`ShadowVolumes::build_lit`] measures
+    /// (unmerged, from `f64` approximations of their cut corners). 0 if
+    /// the light does not face their plane (attached shadow).
+    pub fn lit_area(&self, polys: &[Polygon]) -> f64 {
+        let Some(first) = polys.first() else {
+            return 0.0;
+        };
+        if !self.light().faces(first.support()) {
+            return 0.0;
+        }
+        let mut arena = PieceArena::default();
+        let support = arena.add_plane(*first.support());
+        let (mut out, mut stack, mut links) = (Vec::new(), Vec::new(), Vec::new());
+        let mut sides = SmallVec::new();
+        let mut pts: Vec<[f64; 3]> = Vec::new();
+        let mut total = 0.0;
+        for p in polys {
+            let piece = arena.add_polygon(p);
+            out.clear();
+            crate::engine::filter(
+                self, &mut arena, support, piece, &mut out, &mut stack, &mut links, &mut sides,
+            );
+            for (piece, _) in out.iter().filter(|o| o.1) {
+                pts.clear();
+                pts.extend(piece.verts.iter().map(|&v| arena.vertex(v).approx()));
+                total += area(&pts);
+            }
+        }
+        total
     }
 }
 
