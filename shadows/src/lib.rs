@@ -342,11 +342,14 @@ pub(crate) fn shadows_on(
     let placed = svbsp::place_lights(grid, lights).map_err(Error::Light)?;
     let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
     let reach = tile.map(|(_, b, boxes)| (b, boxes));
-    let trees = face_trees(polys, &kernel, &[], solids, reach).map_err(Error::Shadow)?;
+    // (untiled, every face is shaded: what the trees' building found of
+    // each is kept)
+    let trees = face_trees_with(polys, &kernel, &[], solids, reach, tile.is_none())
+        .map_err(Error::Shadow)?;
     // with convex pieces where asked (the OBJ writer draws them), and
     // their planes (a sun study's extremes overlay them)
     let batch = match tile {
-        None => trees.set().shade_all(polys, opts),
+        None => trees.set_for_occluders().shade_all(polys, opts),
         Some((own, _, _)) => {
             let own: Vec<bsp_core::Polygon> = own.iter().map(|&i| polys[i].clone()).collect();
             trees.set().shade_all(&own, opts)
@@ -398,6 +401,20 @@ pub(crate) fn face_trees(
     solids: &bsp_core::SolidParts,
     reach: Option<([bsp_core::GridPoint; 2], &[[bsp_core::GridPoint; 2]])>,
 ) -> Result<svbsp::LightVolumes, ShadowError> {
+    face_trees_with(polys, kernel, also, solids, reach, false)
+}
+
+/// [`face_trees`], with `reaching` keeping what each tree's building
+/// found of the faces it holds, for shading `polys` themselves
+/// ([`svbsp::LightVolumes::set_for_occluders`]).
+fn face_trees_with(
+    polys: &[bsp_core::Polygon],
+    kernel: &[svbsp::Light],
+    also: &[bsp_core::GridPoint],
+    solids: &bsp_core::SolidParts,
+    reach: Option<([bsp_core::GridPoint; 2], &[[bsp_core::GridPoint; 2]])>,
+    reaching: bool,
+) -> Result<svbsp::LightVolumes, ShadowError> {
     let bounds = (reach.map(|(b, _)| b))
         .or_else(|| sun::grid_bounds(polys))
         .map(|[mut lo, mut hi]| {
@@ -409,13 +426,24 @@ pub(crate) fn face_trees(
             }
             [lo, hi]
         });
-    let volumes = bsp_core::par::try_map(kernel.len(), |j| {
-        let hiding: Vec<&bsp_core::Polygon> = hiding(polys, &kernel[j], bounds, solids, reach)
-            .map(|i| &polys[i])
-            .collect();
-        svbsp::ShadowVolumes::build(kernel[j], &hiding)
+    let built = bsp_core::par::try_map(kernel.len(), |j| {
+        let index: Vec<usize> = hiding(polys, &kernel[j], bounds, solids, reach).collect();
+        let tree: Vec<&bsp_core::Polygon> = index.iter().map(|&i| &polys[i]).collect();
+        if !reaching {
+            return svbsp::ShadowVolumes::build(kernel[j], &tree).map(|v| (v, Vec::new()));
+        }
+        let (v, found) = svbsp::ShadowVolumes::build_reached(kernel[j], &tree)?;
+        let mut reached = vec![None; polys.len()];
+        for (i, r) in index.into_iter().zip(found) {
+            reached[i] = r;
+        }
+        Ok((v, reached))
     })?;
-    svbsp::LightVolumes::from_volumes(kernel, volumes)
+    let (volumes, reached): (Vec<_>, Vec<_>) = built.into_iter().unzip();
+    match reaching {
+        true => svbsp::LightVolumes::from_volumes_reached(kernel, volumes, reached),
+        false => svbsp::LightVolumes::from_volumes(kernel, volumes),
+    }
 }
 
 /// The indices of the faces of `polys` that [`face_trees`] puts in the

@@ -249,12 +249,12 @@ impl Job<'_> {
     ) -> Result<(), Error> {
         let (batch, tree) = match (algorithm, kind) {
             (Algorithm::Psv, FileKind::Json | FileKind::Obj) => {
-                let shadows = self.shadow_trees()?;
+                let shadows = self.shadow_trees(true)?;
                 return self.stream(&shadows, kind, out);
             }
             (Algorithm::Psv, FileKind::Svg(_)) => {
                 let tree = self.scene_tree();
-                let shadows = self.shadow_trees()?;
+                let shadows = self.shadow_trees(false)?;
                 (self.shade_each(&shadows, &tree), tree)
             }
             (Algorithm::ChinFeiner, _) => {
@@ -288,13 +288,16 @@ impl Job<'_> {
         Ok(())
     }
 
-    /// One shadow-volume tree per light.
-    fn shadow_trees(&mut self) -> Result<svbsp::LightVolumes, Error> {
+    /// One shadow-volume tree per light; with `reaching`, knowing which
+    /// faces each light reaches all over or not at all, for shading the
+    /// scene's own polygons ([`svbsp::LightVolumes::set_for_occluders`]).
+    fn shadow_trees(&mut self, reaching: bool) -> Result<svbsp::LightVolumes, Error> {
         self.progress
             .phase("shadow trees", self.kernel.len() as u64);
         let (polys, kernel) = (self.scene.polys, &self.kernel);
-        let shadows = timed(&mut self.fig.phases, "trees", || {
-            svbsp::LightVolumes::new(polys, kernel)
+        let shadows = timed(&mut self.fig.phases, "trees", || match reaching {
+            true => svbsp::LightVolumes::new_reaching(polys, kernel),
+            false => svbsp::LightVolumes::new(polys, kernel),
         })
         .map_err(Error::Shadow)?;
         self.fig.shadow_nodes = shadows.volumes().iter().map(|v| v.node_count()).sum();
@@ -396,7 +399,7 @@ impl Job<'_> {
         progress.phase("shading", ranges.len() as u64);
         let polys = (scene.polys, &ranges[..], scene.grid);
         let s = file
-            .stream(out, shadows.set(), polys, &opts, |n| {
+            .stream(out, shadows.set_for_occluders(), polys, &opts, |n| {
                 progress.advance(n as u64)
             })
             .map_err(Error::Io)?;

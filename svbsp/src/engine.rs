@@ -118,6 +118,10 @@ impl ShadeOptions {
 pub struct LightVolumes {
     lights: Vec<Light>,
     volumes: Vec<ShadowVolumes>,
+    /// Per light, per occluder, whether its tree's building found the
+    /// light reaches all of it or none (see `engine/known.rs`); empty
+    /// where not asked.
+    reached: Vec<Vec<Option<bool>>>,
 }
 
 /// Consecutive polygons that form one receiver: the same face (tag) and
@@ -194,6 +198,19 @@ impl LightVolumes {
         lights: &[Light],
         solids: &bsp_core::SolidParts,
     ) -> Result<LightVolumes, ShadowError> {
+        LightVolumes::new_built(occluders, order, lights, solids, false)
+    }
+
+    /// [`LightVolumes::new_ordered`], and with `reach` what each tree's
+    /// building found of the occluders it holds
+    /// ([`ShadowVolumes::build_reached`]).
+    fn new_built(
+        occluders: &[Polygon],
+        order: &[usize],
+        lights: &[Light],
+        solids: &bsp_core::SolidParts,
+        reach: bool,
+    ) -> Result<LightVolumes, ShadowError> {
         if lights.len() > MAX_LIGHTS {
             return Err(LightError::TooMany(lights.len()).into());
         }
@@ -203,31 +220,42 @@ impl LightVolumes {
         // (polygons off the grid leave no part certified, so nothing is
         // left out and an error's index is the caller's)
         let build = |l: Light| {
-            let kept: Vec<&Polygon> = (order.iter().map(|&i| (i, &occluders[i])))
-                .filter(|(i, p)| !l.leaves_out(solids, *i, p.support()))
-                .map(|(_, p)| p)
-                .collect();
-            ShadowVolumes::build(l, &kept)
+            let (index, kept): (Vec<usize>, Vec<&Polygon>) =
+                (order.iter().map(|&i| (i, &occluders[i])))
+                    .filter(|(i, p)| !l.leaves_out(solids, *i, p.support()))
+                    .unzip();
+            if !reach {
+                return ShadowVolumes::build(l, &kept).map(|v| (v, Vec::new()));
+            }
+            let (v, found) = ShadowVolumes::build_reached(l, &kept)?;
+            let mut reached = vec![None; occluders.len()];
+            for (i, r) in index.into_iter().zip(found) {
+                reached[i] = r;
+            }
+            Ok((v, reached))
         };
         // two lights at a time: each build is parallel inside but has
         // parts on one thread (its start, and its last regions), which the
         // other build fills; only two builds' working memory is alive at
         // once
-        let mut volumes = Vec::with_capacity(lights.len());
+        let mut built = Vec::with_capacity(lights.len());
         for pair in lights.chunks(2) {
             match *pair {
                 [a, b] => {
                     let (a, b) = rayon::join(|| build(a), || build(b));
-                    volumes.push(a?);
-                    volumes.push(b?);
+                    built.push(a?);
+                    built.push(b?);
                 }
-                [a] => volumes.push(build(a)?),
+                [a] => built.push(build(a)?),
                 _ => unreachable!("chunks of one or two"),
             }
         }
+        let (volumes, reached): (Vec<ShadowVolumes>, Vec<Vec<Option<bool>>>) =
+            built.into_iter().unzip();
         Ok(LightVolumes {
             lights: lights.to_vec(),
             volumes,
+            reached: if reach { reached } else { Vec::new() },
         })
     }
 
@@ -258,6 +286,7 @@ impl LightVolumes {
         Ok(LightVolumes {
             lights: lights.to_vec(),
             volumes,
+            reached: Vec::new(),
         })
     }
 
@@ -277,6 +306,7 @@ impl LightVolumes {
                 .enumerate()
                 .map(|(j, v)| (v, j))
                 .collect(),
+            reached: &[],
         }
     }
 
@@ -311,6 +341,9 @@ fn facing(lights: &[Light], support: &Plane) -> u64 {
 pub struct ShadowSet<'a> {
     lights: &'a [Light],
     trees: SmallVec<[(&'a ShadowVolumes, usize); 4]>,
+    /// [`LightVolumes::set_for_occluders`]'s knowledge, per light and
+    /// occluder (empty: none).
+    reached: &'a [Vec<Option<bool>>],
 }
 
 impl<'a> ShadowSet<'a> {
@@ -565,6 +598,18 @@ impl<'a> ShadowSet<'a> {
     /// filters every cell lit by a light through that light's tree.
     /// Returns whether a cell was cut or changed its flags.
     fn filter_lights(&self, polys: &[Polygon], start: &Start<'_>, s: &mut Scratch) -> bool {
+        self.filter_lights_of(polys, start, s, u64::MAX)
+    }
+
+    /// [`ShadowSet::filter_lights`] through the trees of the lights in
+    /// `mask` only.
+    fn filter_lights_of(
+        &self,
+        polys: &[Polygon],
+        start: &Start<'_>,
+        s: &mut Scratch,
+        mask: u64,
+    ) -> bool {
         let support = *polys[0].support();
         let face = polys[0].tag();
         s.arena.clear();
@@ -589,7 +634,7 @@ impl<'a> ShadowSet<'a> {
         // lights the face turns its back to: attached shadow, the flag
         // stays 0
         let facing = self.facing(&support);
-        self.pass_lights(s, facing)
+        self.pass_lights(s, facing & mask)
     }
 
     /// Filters every cell of `s.cur` through the tree of each light in
@@ -665,14 +710,13 @@ impl<'a> ShadowSet<'a> {
     ) -> Batch {
         let mut scratch = Scratch::default();
         let mut out = Batch::new();
+        let known = self.knows(polys);
         for (i, r) in ranges.iter().enumerate() {
-            self.shade(
-                &polys[r.clone()],
-                first_receiver + i as u32,
-                opts,
-                &mut scratch,
-                &mut out,
-            );
+            let receiver = first_receiver + i as u32;
+            match known {
+                true => self.shade_known(polys, r.clone(), receiver, opts, &mut scratch, &mut out),
+                false => self.shade(&polys[r.clone()], receiver, opts, &mut scratch, &mut out),
+            }
         }
         out
     }
@@ -1433,8 +1477,8 @@ pub fn shadow_fragments(
     polys: &[Polygon],
     lights: &[Light],
 ) -> Result<(Batch, ShadowStats), ShadowError> {
-    let shadows = LightVolumes::new(polys, lights)?;
-    let batch = shadows.set().shade_all(polys, &ShadeOptions::default());
+    let shadows = LightVolumes::new_reaching(polys, lights)?;
+    let batch = (shadows.set_for_occluders()).shade_all(polys, &ShadeOptions::default());
     let stats = ShadowStats {
         receivers: receivers(polys).len(),
         fragments: batch.len(),
@@ -1445,3 +1489,5 @@ pub fn shadow_fragments(
 
 #[cfg(test)]
 mod tests;
+
+mod known;

@@ -579,6 +579,31 @@ impl ShadowVolumes {
         Ok((v, parts.into_iter().map(|(i, p)| (i as usize, p)).collect()))
     }
 
+    /// [`ShadowVolumes::build`], and per occluder that faces the light
+    /// whether the light reaches all of it (`Some(true)`), none of it
+    /// (`Some(false)`) or a part (`None`; also for an occluder turned away
+    /// or edge-on), as its receiver would find it filtered through the
+    /// finished tree, in the order of `occluders`: found as the tree is
+    /// built ([`ShadowVolumes::build_lit`]), so that a receiver known lit
+    /// or dark all over need not be filtered ([`crate::LightVolumes`]).
+    pub fn build_reached<P: Borrow<Polygon> + Sync>(
+        light: Light,
+        occluders: &[P],
+    ) -> Result<(ShadowVolumes, Vec<Option<bool>>), VolumeError> {
+        let (v, found) = ShadowVolumes::build_inner(light, occluders, Some(&Rests::reached))?;
+        // (an occluder the skeleton cut has parts in several regions)
+        let mut reached: Vec<Option<Option<bool>>> = vec![None; occluders.len()];
+        for (i, r) in found {
+            let at = &mut reached[i as usize];
+            *at = Some(match *at {
+                None => r,
+                Some(was) if was == r => r,
+                Some(_) => None,
+            });
+        }
+        Ok((v, reached.into_iter().map(Option::flatten).collect()))
+    }
+
     /// [`ShadowVolumes::build`], and with `record` what it makes of each
     /// region's lit parts, with their occluders' input indices (those
     /// facing the light only), region by region in order.
@@ -1066,6 +1091,9 @@ fn insert(
         &mut s.links,
         &mut 0,
     ) {
+        if let Some(r) = rests {
+            r.dark(e.occ);
+        }
         return;
     }
     let mark = pool.arena.mark();
@@ -1087,6 +1115,9 @@ fn insert(
         first = false;
         loop {
             if link == SHADOW {
+                if let Some(r) = rests.as_deref_mut() {
+                    r.dark(e.occ);
+                }
                 break;
             }
             if link == LIT {
@@ -1113,12 +1144,20 @@ fn insert(
                     break;
                 }
                 // behind a cap (or in its plane): hidden already
-                (true, false, _) => break,
+                (true, false, _) => {
+                    if let Some(r) = rests.as_deref_mut() {
+                        r.dark(e.occ);
+                    }
+                    break;
+                }
                 (true, true, false) | (false, true, false) | (false, false, false) => Side::Front,
                 (false, false, true) => Side::Back,
                 (true, true, true) => {
                     let cut = arena.add_plane(n.plane);
                     p = arena.split(sup, &p, cut, &s.sides).0;
+                    if let Some(r) = rests.as_deref_mut() {
+                        r.dark(e.occ);
+                    }
                     Side::Front
                 }
                 (false, true, true) => {

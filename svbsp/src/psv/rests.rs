@@ -55,6 +55,9 @@ pub(super) struct Rests {
     /// rest can roll its arena back.
     pub(super) changes: u64,
     stack: Vec<(Piece, u32, Option<(u32, Side)>)>,
+    /// The occluders (sorted indices) a part of which ended in shadow,
+    /// once or more.
+    dark: Vec<u32>,
 }
 
 impl Rests {
@@ -64,6 +67,11 @@ impl Rests {
         let r = Rest { piece, occ, sup };
         self.at.entry(key(slot)).or_default().push(r);
         self.changes += 1;
+    }
+
+    /// Notes that a part of occluder `occ` ended in shadow.
+    pub(super) fn dark(&mut self, occ: u32) {
+        self.dark.push(occ);
     }
 
     /// After a graft at `slot`: the parts resting there walk on into the
@@ -93,6 +101,7 @@ impl Rests {
                         break;
                     }
                     if link == SHADOW {
+                        self.dark.push(occ);
                         break;
                     }
                     let n = tree.nodes[link as usize];
@@ -100,10 +109,14 @@ impl Rests {
                     let next = match (n.cap, sd.front, sd.back) {
                         // a cap: in its plane or in front is lit by it
                         (true, _, false) => Side::Front,
-                        (true, false, true) => break,
+                        (true, false, true) => {
+                            self.dark.push(occ);
+                            break;
+                        }
                         (true, true, true) => {
                             let cut = arena.add_plane(n.plane);
                             p = arena.split(sup, &p, cut, sides).0;
+                            self.dark.push(occ);
                             Side::Front
                         }
                         (false, true, false) | (false, false, false) => Side::Front,
@@ -149,6 +162,26 @@ impl Rests {
                 .map(|&v| arena.vertex(v).to_owned())
                 .collect()
         })
+    }
+
+    /// Per occluder (sorted indices) with a part at rest or in shadow:
+    /// `Some(true)` if all of it rests lit, `Some(false)` if all of it
+    /// ended in shadow, `None` for both; in the order of the occluders.
+    pub(super) fn reached(self, _: &PieceArena) -> Vec<(u32, Option<bool>)> {
+        let mut marks: Vec<(u32, bool)> = (self.at.values().flatten())
+            .map(|r| (r.occ, true))
+            .chain(self.dark.iter().map(|&o| (o, false)))
+            .collect();
+        marks.sort_unstable();
+        marks.dedup();
+        let mut out: Vec<(u32, Option<bool>)> = Vec::with_capacity(marks.len());
+        for (o, lit) in marks {
+            match out.last_mut() {
+                Some(last) if last.0 == o => last.1 = None,
+                _ => out.push((o, Some(lit))),
+            }
+        }
+        out
     }
 
     /// `f` of every part at rest, with its occluder, leaf by leaf in the

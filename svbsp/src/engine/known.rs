@@ -1,0 +1,110 @@
+//! Receivers whose shadows the trees' building already found.
+//!
+//! Building a light's tree inserts every occluder, and each part of it
+//! that its insertion brings to a lit leaf is lit by every volume in the
+//! tree so far; kept there and walked on where a later volume is grafted,
+//! those parts are exactly what the occluder's receiver would find lit
+//! filtered through the finished tree ([`ShadowVolumes::build_reached`],
+//! `psv/rests.rs`). Most faces of a scene come out lit all over or dark
+//! all over: shading the occluders themselves, such a receiver takes its
+//! flag for that light as it is, and only the lights that light part of
+//! it are filtered. Its fragments are the ones the filter makes (for a
+//! receiver one light reaches all over, the filter's quick test keeps it
+//! whole too), so the output is the same, for less work.
+
+use std::ops::Range;
+
+use bsp_core::Polygon;
+
+use super::{Batch, LightVolumes, ShadeOptions, ShadowError, ShadowSet, Start};
+use crate::engine::Scratch;
+use crate::light::Light;
+use crate::psv::ShadowVolumes;
+
+impl LightVolumes {
+    /// [`LightVolumes::new`], keeping what each tree's building found of
+    /// the occluders it holds, for [`LightVolumes::set_for_occluders`].
+    pub fn new_reaching(
+        occluders: &[Polygon],
+        lights: &[Light],
+    ) -> Result<LightVolumes, ShadowError> {
+        let solids = bsp_core::certify_solid_parts(occluders);
+        let order: Vec<usize> = (0..occluders.len()).collect();
+        LightVolumes::new_built(occluders, &order, lights, &solids, true)
+    }
+
+    /// [`LightVolumes::from_volumes`] with what each tree's building found
+    /// of the occluders: `reached[j][i]` for light `j` and polygon `i` of
+    /// the receivers to be shaded by [`LightVolumes::set_for_occluders`]
+    /// (`Some(true)`: the tree lets the light reach all of it, as
+    /// [`ShadowVolumes::build_reached`] finds it; `Some(false)`: none of
+    /// it; `None`: not known). Errors as `from_volumes` does, or if
+    /// `reached` has not one list per light.
+    pub fn from_volumes_reached(
+        lights: &[Light],
+        volumes: Vec<ShadowVolumes>,
+        reached: Vec<Vec<Option<bool>>>,
+    ) -> Result<LightVolumes, ShadowError> {
+        if reached.len() != lights.len() {
+            return Err(ShadowError::Mismatch);
+        }
+        let mut v = LightVolumes::from_volumes(lights, volumes)?;
+        v.reached = reached;
+        Ok(v)
+    }
+
+    /// The trees as a [`ShadowSet`] for shading the occluders they were
+    /// built over, in their order (the same polygons, whole or as
+    /// [`crate::receivers`] groups them): a receiver the trees' building
+    /// found lit or dark all over for a light is not filtered through
+    /// that light's tree again. With other receivers it shades as
+    /// [`LightVolumes::set`] does but for a list of another length (not
+    /// checked beyond that: the caller's to keep).
+    pub fn set_for_occluders(&self) -> ShadowSet<'_> {
+        let mut set = self.set();
+        set.reached = &self.reached;
+        set
+    }
+}
+
+impl ShadowSet<'_> {
+    /// Whether this set knows the receivers of `polys` (what its trees'
+    /// building found, for a list of that length).
+    pub(super) fn knows(&self, polys: &[Polygon]) -> bool {
+        !self.reached.is_empty() && self.reached.iter().all(|r| r.len() == polys.len())
+    }
+
+    /// [`ShadowSet::shade`] of the receiver `polys[range]`, taking from
+    /// what the trees' building found each light that reaches all of it
+    /// or none of it.
+    pub(super) fn shade_known(
+        &self,
+        polys: &[Polygon],
+        range: Range<usize>,
+        receiver: u32,
+        opts: &ShadeOptions,
+        scratch: &mut Scratch,
+        out: &mut Batch,
+    ) {
+        let Some(first) = polys.get(range.start) else {
+            return;
+        };
+        let facing = self.facing(first.support());
+        let (mut flags, mut filter) = (facing, 0u64);
+        for (j, reached) in self.reached.iter().enumerate() {
+            let bit = 1u64 << j;
+            if facing & bit == 0 {
+                continue;
+            }
+            let all = |lit: bool| range.clone().all(|i| reached[i] == Some(lit));
+            if all(false) {
+                flags &= !bit;
+            } else if !all(true) {
+                filter |= bit;
+            }
+        }
+        let polys = &polys[range];
+        self.filter_lights_of(polys, &Start::Uniform(flags), scratch, filter);
+        self.finish(polys, receiver, opts, scratch, out);
+    }
+}
