@@ -1121,14 +1121,20 @@ fn insert(
                 break;
             }
             if link == LIT {
+                // (the part rests where its own volume leaves it: behind
+                // its edge planes, in its cap's plane, so in front of the
+                // cap; what rested at the leaf walks on into the volume)
+                let mut at = edge;
                 if !receiver {
-                    graft(tree, root, occ, e, &p, edge, &s.path);
-                }
-                if let Some(r) = rests.as_deref_mut() {
-                    r.rest(edge, p, e.occ, sup);
-                    if !receiver {
+                    let cap = graft(tree, root, occ, e, &p, edge, &s.path);
+                    if let Some(r) = rests.as_deref_mut() {
                         r.settle(tree, *root, edge, arena, &mut s.sides);
                     }
+                    at = Some((cap, Side::Front));
+                }
+                if let Some(r) = rests.as_deref_mut() {
+                    let new = arena.uses_since(&p, mark);
+                    r.rest(at, p, e.occ, sup, new);
                 }
                 break;
             }
@@ -1183,7 +1189,7 @@ fn insert(
 /// Replaces the lit leaf below `slot` by the volume of `entry`'s
 /// occluder, where `part` is what of it reaches the leaf: the occluder's
 /// edge planes that bound `part` and that the path does not already
-/// enforce, then the cap.
+/// enforce, then the cap. Returns the cap's node.
 fn graft(
     tree: &mut Subtree,
     root: &mut u32,
@@ -1192,7 +1198,7 @@ fn graft(
     part: &Piece,
     slot: Option<(u32, Side)>,
     path: &[Step],
-) {
+) -> u32 {
     let o = entry.occ;
     let mut keep: SmallVec<[Plane; 4]> = SmallVec::new();
     for (i, e) in occ.edges(o).iter().enumerate() {
@@ -1219,6 +1225,7 @@ fn graft(
     });
     tree.grafted += 1;
     tree.set_link(slot, root, first);
+    first + keep.len() as u32
 }
 
 #[cfg(test)]

@@ -591,6 +591,21 @@ impl PieceArena {
         self.grid.len() + self.exact.len() + self.lazy.len()
     }
 
+    /// Whether a vertex or an edge plane of `c` was added since `mark`
+    /// (so that rolling back to `mark` would take it away; a cut through
+    /// two of its corners makes a new edge and no new vertex).
+    pub(crate) fn uses_since(&self, c: &Piece, mark: ArenaMark) -> bool {
+        c.edges.iter().any(|e| e.index() as usize >= mark.planes)
+            || c.verts.iter().any(|&id| {
+                let i = (id & !TAG) as usize;
+                match id & TAG {
+                    0 => i >= mark.grid,
+                    EXACT => i >= mark.exact,
+                    _ => i >= mark.lazy,
+                }
+            })
+    }
+
     /// A dense index in `0..len()` for vertex `id`, valid until the next
     /// vertex is added.
     #[inline]

@@ -19,7 +19,7 @@
 //! (it hides nothing the cap's occluder does not), but as a receiver it is
 //! lit there: it walks on as a receiver only, resting without a graft.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 use bsp_core::Side;
 use smallvec::SmallVec;
@@ -50,9 +50,10 @@ struct Rest {
 /// The parts resting at each lit leaf of one region's subtree.
 #[derive(Default)]
 pub(super) struct Rests {
-    at: HashMap<u64, Vec<Rest>>,
-    /// Counts every change, so that an insertion that left nothing at
-    /// rest can roll its arena back.
+    at: FxHashMap<u64, Vec<Rest>>,
+    /// Counts every part put at rest with a vertex an insertion made, and
+    /// every cut of a part at rest, so that an insertion that kept none of
+    /// its arena's new vertices can roll them back.
     pub(super) changes: u64,
     stack: Vec<(Piece, u32, Option<(u32, Side)>)>,
     /// The occluders (sorted indices) a part of which ended in shadow,
@@ -62,11 +63,18 @@ pub(super) struct Rests {
 
 impl Rests {
     /// Puts `piece` of occluder `occ` (support plane `sup`) at rest at the
-    /// lit leaf of `slot`.
-    pub(super) fn rest(&mut self, slot: Option<(u32, Side)>, piece: Piece, occ: u32, sup: u32) {
+    /// lit leaf of `slot`; `new`: it has a vertex the arena must keep.
+    pub(super) fn rest(
+        &mut self,
+        slot: Option<(u32, Side)>,
+        piece: Piece,
+        occ: u32,
+        sup: u32,
+        new: bool,
+    ) {
         let r = Rest { piece, occ, sup };
         self.at.entry(key(slot)).or_default().push(r);
-        self.changes += 1;
+        self.changes += new as u64;
     }
 
     /// Notes that a part of occluder `occ` ended in shadow.
@@ -88,7 +96,6 @@ impl Rests {
         let Some(list) = self.at.remove(&key(slot)) else {
             return;
         };
-        self.changes += 1;
         let start = tree.link(slot, root);
         let mut stack = std::mem::take(&mut self.stack);
         for Rest { piece, occ, sup } in list {
@@ -117,6 +124,7 @@ impl Rests {
                             let cut = arena.add_plane(n.plane);
                             p = arena.split(sup, &p, cut, sides).0;
                             self.dark.push(occ);
+                            self.changes += 1;
                             Side::Front
                         }
                         (false, true, false) | (false, false, false) => Side::Front,
@@ -124,6 +132,7 @@ impl Rests {
                         (false, true, true) => {
                             let cut = arena.add_plane(n.plane);
                             let (f, b) = arena.split(sup, &p, cut, sides);
+                            self.changes += 1;
                             stack.push((b, n.back, Some((link, Side::Back))));
                             p = f;
                             Side::Front

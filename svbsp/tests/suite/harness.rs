@@ -342,10 +342,39 @@ fn check_lit_parts(
         }
         let (_, parts) = ShadowVolumes::lit_parts(light, polys).map_err(|e| e.to_string())?;
         let mut got: HashMap<usize, Q> = HashMap::new();
+        let mut per_poly: HashMap<usize, Q> = HashMap::new();
         for (i, verts) in parts {
             let face = polys[i].tag() as usize;
             let pts: Vec<HPoint> = verts.iter().map(HPoint::of_vertex).collect();
-            *got.entry(face).or_insert_with(Q::zero) += area_of(&scene.faces[face], &pts);
+            let a = area_of(&scene.faces[face], &pts);
+            *per_poly.entry(i).or_insert_with(Q::zero) += a.clone();
+            *got.entry(face).or_insert_with(Q::zero) += a;
+        }
+        // what the building says of each polygon: all of it, none, or part
+        let (_, reached) = ShadowVolumes::build_reached(light, polys).map_err(|e| e.to_string())?;
+        for (i, (p, r)) in polys.iter().zip(&reached).enumerate() {
+            if !light.faces(p.support()) {
+                continue;
+            }
+            let face = p.tag() as usize;
+            let pts: Vec<HPoint> = (p.vertices().iter())
+                .map(|v| match v {
+                    bsp_core::Point::Grid(g) => Ok(HPoint::grid(g.map(i64::from))),
+                    bsp_core::Point::Implicit(_) => Err("an occluder off the grid".to_string()),
+                })
+                .collect::<Result<_, _>>()?;
+            let whole = area_of(&scene.faces[face], &pts);
+            let lit = per_poly.get(&i).cloned().unwrap_or_else(Q::zero);
+            let found = match (lit.is_zero(), lit == whole) {
+                (true, _) => Some(false),
+                (_, true) => Some(true),
+                _ => None,
+            };
+            if *r != found {
+                return Err(format!(
+                    "light {j}: the building says {r:?} of polygon {i}, its lit parts {found:?}"
+                ));
+            }
         }
         let faces: BTreeSet<usize> = want.keys().chain(got.keys()).copied().collect();
         for f in faces {
