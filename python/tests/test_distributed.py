@@ -107,9 +107,10 @@ def test_ray_local(yard, single, tiled):
 def test_dask_without_extremes(yard, single):
     distributed = pytest.importorskip("distributed")
     mean = bs.sun_hours(yard, extremes=False, **STUDY)
-    # (the full study keeps each mean between the face's extremes)
-    kept = np.clip(mean.per_face, single.min_hours, single.max_hours)
-    assert (kept == single.per_face).all() and np.isnan(mean.min_hours).all()
+    # (the mean alone takes its lit areas from the trees' building, the
+    # full study from the fragments: the same to rounding)
+    assert np.abs(mean.per_face - single.per_face).max() < 1e-9
+    assert np.isnan(mean.min_hours).all()
     with distributed.LocalCluster(
         n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
         dashboard_address=None, silence_logs=40,
