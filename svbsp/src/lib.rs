@@ -77,7 +77,7 @@ pub use light::{
     input_number, input_triple, place_lights, quantize_direction, shared_grid,
 };
 pub use overlay::{FaceOverlay, OverlayRegion};
-pub use psv::{ShadowVolumes, VolumeError, VolumeSanity};
+pub use psv::{LitParts, ShadowVolumes, VolumeError, VolumeSanity};
 pub use soft::{
     Share, SoftFragment, SoftLight, SoftShape, SoftVolumes, place_soft_lights, shared_soft_grid,
     soft_shadows, soft_shadows_with,

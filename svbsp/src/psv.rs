@@ -574,7 +574,7 @@ impl ShadowVolumes {
     pub fn lit_parts<P: Borrow<Polygon> + Sync>(
         light: Light,
         occluders: &[P],
-    ) -> Result<(ShadowVolumes, Vec<(usize, Vec<Vertex>)>), VolumeError> {
+    ) -> Result<(ShadowVolumes, LitParts), VolumeError> {
         let (v, parts) = ShadowVolumes::build_inner(light, occluders, Some(&Rests::parts))?;
         Ok((v, parts.into_iter().map(|(i, p)| (i as usize, p)).collect()))
     }
@@ -947,6 +947,10 @@ fn split_task(
     };
     Ok((child(Side::Front, front), child(Side::Back, back)))
 }
+
+/// Lit parts of occluders: each a convex polygon's exact corners, with its
+/// occluder's index ([`ShadowVolumes::lit_parts`]).
+pub type LitParts = Vec<(usize, Vec<Vertex>)>;
 
 /// What [`build_region`] makes: the nodes, the root link, the number of
 /// skeleton nodes, and where asked the lit parts' areas with their

@@ -139,6 +139,30 @@ impl HoursRun {
         HoursRun::make(mesh, suns, step_hours, pieces, &scene.0, tile)
     }
 
+    /// The run of `lights` (suns) over every face, mean hours alone: the
+    /// lit areas, no fragments (`crate::lit`).
+    fn mean_of(
+        faces: usize,
+        lights: &[crate::Light],
+        step_hours: f64,
+        s: &Snapped,
+    ) -> Result<HoursRun, crate::Error> {
+        let got = crate::lit::lit_areas_on(&s.grid, &s.polys, &s.solids, faces, lights)?;
+        let n = lights.len();
+        let lit = (0..faces)
+            .map(|f| got.lit[f * n..(f + 1) * n].iter().sum::<f64>() * step_hours)
+            .collect();
+        Ok(HoursRun {
+            step_hours,
+            faces,
+            ids: None,
+            area: got.area,
+            lit,
+            cells: None,
+            grid: s.grid,
+        })
+    }
+
     /// The run on the study's `snapped` mesh; with `pieces`, the pieces
     /// of every face, or with `Some(Some(keep))` of the faces `keep`
     /// marks; of `tile`'s faces only if given.
@@ -183,21 +207,7 @@ impl HoursRun {
         };
         let s = snapped;
         if pieces.is_none() && part.is_none() {
-            // mean hours alone: the lit areas, no fragments
-            let got = crate::lit::lit_areas_on(&s.grid, &s.polys, &s.solids, faces, &lights)?;
-            let n = suns.len();
-            let lit = (0..faces)
-                .map(|f| got.lit[f * n..(f + 1) * n].iter().sum::<f64>() * step_hours)
-                .collect();
-            return Ok(HoursRun {
-                step_hours,
-                faces,
-                ids: None,
-                area: got.area,
-                lit,
-                cells: None,
-                grid: s.grid,
-            });
+            return HoursRun::mean_of(faces, &lights, step_hours, s);
         }
         let run = crate::shadows_on(
             &s.grid,

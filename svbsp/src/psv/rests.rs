@@ -29,9 +29,12 @@ use bsp_core::Polygon;
 use super::{LIT, SHADOW, ShadowVolumes, Subtree};
 use crate::arena::pieces::{Piece, PieceArena, Vertex};
 
-/// A lit leaf's slot: the node whose child it is and the side (`None`:
-/// the root), as one key.
-fn key(slot: Option<(u32, Side)>) -> u64 {
+/// Where a leaf hangs: the node whose child it is and the side (`None`:
+/// the root).
+type Slot = Option<(u32, Side)>;
+
+/// A lit leaf's slot as one key.
+fn key(slot: Slot) -> u64 {
     match slot {
         None => u64::MAX,
         Some((id, Side::Front)) => 2 * id as u64,
@@ -55,7 +58,7 @@ pub(super) struct Rests {
     /// every cut of a part at rest, so that an insertion that kept none of
     /// its arena's new vertices can roll them back.
     pub(super) changes: u64,
-    stack: Vec<(Piece, u32, Option<(u32, Side)>)>,
+    stack: Vec<(Piece, u32, Slot)>,
     /// The occluders (sorted indices) a part of which ended in shadow,
     /// once or more.
     dark: Vec<u32>,
@@ -63,15 +66,9 @@ pub(super) struct Rests {
 
 impl Rests {
     /// Puts `piece` of occluder `occ` (support plane `sup`) at rest at the
-    /// lit leaf of `slot`; `new`: it has a vertex the arena must keep.
-    pub(super) fn rest(
-        &mut self,
-        slot: Option<(u32, Side)>,
-        piece: Piece,
-        occ: u32,
-        sup: u32,
-        new: bool,
-    ) {
+    /// lit leaf of `slot`; `new`: it has a vertex or an edge plane the
+    /// arena must keep.
+    pub(super) fn rest(&mut self, slot: Slot, piece: Piece, occ: u32, sup: u32, new: bool) {
         let r = Rest { piece, occ, sup };
         self.at.entry(key(slot)).or_default().push(r);
         self.changes += new as u64;
@@ -89,7 +86,7 @@ impl Rests {
         &mut self,
         tree: &Subtree,
         root: u32,
-        slot: Option<(u32, Side)>,
+        slot: Slot,
         arena: &mut PieceArena,
         sides: &mut SmallVec<[Side; 8]>,
     ) {
