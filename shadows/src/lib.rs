@@ -428,16 +428,11 @@ fn face_trees_with(
         });
     let built = bsp_core::par::try_map(kernel.len(), |j| {
         let index: Vec<usize> = hiding(polys, &kernel[j], bounds, solids, reach).collect();
+        if reaching {
+            return svbsp::ShadowVolumes::build_reached_among(kernel[j], polys, &index);
+        }
         let tree: Vec<&bsp_core::Polygon> = index.iter().map(|&i| &polys[i]).collect();
-        if !reaching {
-            return svbsp::ShadowVolumes::build(kernel[j], &tree).map(|v| (v, Vec::new()));
-        }
-        let (v, found) = svbsp::ShadowVolumes::build_reached(kernel[j], &tree)?;
-        let mut reached = vec![None; polys.len()];
-        for (i, r) in index.into_iter().zip(found) {
-            reached[i] = r;
-        }
-        Ok((v, reached))
+        svbsp::ShadowVolumes::build(kernel[j], &tree).map(|v| (v, Vec::new()))
     })?;
     let (volumes, reached): (Vec<_>, Vec<_>) = built.into_iter().unzip();
     match reaching {

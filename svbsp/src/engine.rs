@@ -224,15 +224,10 @@ impl LightVolumes {
                 (order.iter().map(|&i| (i, &occluders[i])))
                     .filter(|(i, p)| !l.leaves_out(solids, *i, p.support()))
                     .unzip();
-            if !reach {
-                return ShadowVolumes::build(l, &kept).map(|v| (v, Vec::new()));
+            match reach {
+                true => ShadowVolumes::build_reached_among(l, occluders, &index),
+                false => ShadowVolumes::build(l, &kept).map(|v| (v, Vec::new())),
             }
-            let (v, found) = ShadowVolumes::build_reached(l, &kept)?;
-            let mut reached = vec![None; occluders.len()];
-            for (i, r) in index.into_iter().zip(found) {
-                reached[i] = r;
-            }
-            Ok((v, reached))
         };
         // two lights at a time: each build is parallel inside but has
         // parts on one thread (its start, and its last regions), which the

@@ -44,12 +44,10 @@ use std::borrow::Borrow;
 
 use bsp_core::internals::SplitMix;
 use bsp_core::{GridPoint, Plane, Point, Polygon, SanityError, Side};
-
-use crate::arena::pieces::Vertex;
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
-use crate::arena::pieces::{EdgeRef, Piece, PieceArena, Sides};
+use crate::arena::pieces::{EdgeRef, Piece, PieceArena, Sides, Vertex};
 use crate::light::Light;
 
 mod rests;
@@ -604,6 +602,23 @@ impl ShadowVolumes {
         Ok((v, reached.into_iter().map(Option::flatten).collect()))
     }
 
+    /// [`ShadowVolumes::build_reached`] of the polygons `index` picks from
+    /// `polys` (in that order), what it found given per polygon of
+    /// `polys` (`None` for those not picked).
+    pub fn build_reached_among(
+        light: Light,
+        polys: &[Polygon],
+        index: &[usize],
+    ) -> Result<(ShadowVolumes, Vec<Option<bool>>), VolumeError> {
+        let picked: Vec<&Polygon> = index.iter().map(|&i| &polys[i]).collect();
+        let (v, found) = ShadowVolumes::build_reached(light, &picked)?;
+        let mut reached = vec![None; polys.len()];
+        for (&i, r) in index.iter().zip(found) {
+            reached[i] = r;
+        }
+        Ok((v, reached))
+    }
+
     /// [`ShadowVolumes::build`], and with `record` what it makes of each
     /// region's lit parts, with their occluders' input indices (those
     /// facing the light only), region by region in order.
@@ -953,12 +968,12 @@ fn split_task(
 pub type LitParts = Vec<(usize, Vec<Vertex>)>;
 
 /// What [`build_region`] makes: the nodes, the root link, the number of
-/// skeleton nodes, and where asked the lit parts' areas with their
-/// occluders ([`Rests::areas`]).
+/// skeleton nodes, and what its `record` makes of the lit parts, with
+/// their occluders.
 type Region<T> = (Subtree, u32, usize, Vec<(u32, T)>);
 
-/// What a build makes of a region's lit parts: [`Rests::areas`] or
-/// [`Rests::parts`].
+/// What a build makes of a region's lit parts: [`Rests::areas`],
+/// [`Rests::parts`] or [`Rests::reached`].
 type Record<T> = dyn Fn(Rests, &PieceArena) -> Vec<(u32, T)> + Sync;
 
 /// The whole tree below one region, on its own pool: the rest of the

@@ -15,16 +15,19 @@
 //! they first came to: the lit parts of every occluder come with the tree,
 //! without a second walk of every face through it.
 //!
-//! An occluder part wholly in the plane of a cap it meets adds no volume
-//! (it hides nothing the cap's occluder does not), but as a receiver it is
-//! lit there: it walks on as a receiver only, resting without a graft.
+//! The part that brings its own volume to a leaf rests in front of that
+//! volume's cap at once (it lies behind its own edge planes and in its
+//! cap's plane: the walk would take it there). An occluder part wholly in
+//! the plane of a cap it meets adds no volume (it hides nothing the cap's
+//! occluder does not), but as a receiver it is lit there: it walks on as a
+//! receiver only, resting without a graft. Which occluders had a part end
+//! in shadow is noted too, so that the building can tell the occluders the
+//! light reaches all over, not at all, or in part
+//! ([`super::ShadowVolumes::build_reached`]).
 
+use bsp_core::{Polygon, Side};
 use rustc_hash::FxHashMap;
-
-use bsp_core::Side;
 use smallvec::SmallVec;
-
-use bsp_core::Polygon;
 
 use super::{LIT, SHADOW, ShadowVolumes, Subtree};
 use crate::arena::pieces::{Piece, PieceArena, Vertex};
@@ -54,9 +57,10 @@ struct Rest {
 #[derive(Default)]
 pub(super) struct Rests {
     at: FxHashMap<u64, Vec<Rest>>,
-    /// Counts every part put at rest with a vertex an insertion made, and
-    /// every cut of a part at rest, so that an insertion that kept none of
-    /// its arena's new vertices can roll them back.
+    /// Counts every part put at rest with a vertex or an edge plane an
+    /// insertion made, and every cut of a part at rest, so that an
+    /// insertion that kept none of its arena's new vertices and planes can
+    /// roll them back.
     pub(super) changes: u64,
     stack: Vec<(Piece, u32, Slot)>,
     /// The occluders (sorted indices) a part of which ended in shadow,
