@@ -574,7 +574,19 @@ impl<'a> ShadowSet<'a> {
         scratch: &mut Scratch,
     ) -> Option<Vec<(Polygon, u64)>> {
         let start = Start::Uniform(self.facing(poly.support()));
-        self.filter_lights(std::slice::from_ref(poly), &start, scratch);
+        self.cells_from(poly, &start, u64::MAX, scratch)
+    }
+
+    /// [`ShadowSet::cells`] from `start`, filtered through the trees of
+    /// the lights in `mask` only.
+    fn cells_from(
+        &self,
+        poly: &Polygon,
+        start: &Start<'_>,
+        mask: u64,
+        scratch: &mut Scratch,
+    ) -> Option<Vec<(Polygon, u64)>> {
+        self.filter_lights_of(std::slice::from_ref(poly), start, scratch, mask);
         let s = &*scratch;
         s.cur
             .iter()

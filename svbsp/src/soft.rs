@@ -323,7 +323,7 @@ fn corner_shadows(
     order.sort_by(|&a, &b| faces[a].corners().cmp(faces[b].corners()));
     lights
         .iter()
-        .map(|l| LightVolumes::new_ordered(polygons, &order, l.corners(), solids).ok())
+        .map(|l| LightVolumes::new_ordered_reaching(polygons, &order, l.corners(), solids).ok())
         .collect()
 }
 
@@ -384,7 +384,7 @@ impl AreaLight {
         let corners = corner_shadows(std::slice::from_ref(self), (faces, &polygons), &solids)
             .pop()
             .flatten();
-        let set = corners.as_ref().map(LightVolumes::set);
+        let set = corners.as_ref().map(LightVolumes::set_for_occluders);
         let cores = crate::cores::cores_per_light(std::slice::from_ref(self), faces, &solids)
             .pop()
             .unwrap_or_default();
@@ -405,11 +405,22 @@ impl AreaLight {
                     .iter()
                     .filter_map(|&j| Some((regions[j as usize].as_ref()?, reach[j as usize])))
                     .chain(crate::cores::cores_at(&cores, face));
-                let mut seen = |p: &Polygon| set.as_ref()?.cells(p, scratch);
+                let mut seen = |p: &Polygon| {
+                    let whole = is_face(p, face).then_some(i);
+                    set.as_ref()?.cells_known(p, whole, faces.len(), scratch)
+                };
                 self.classify_with(face, others, Some(&mut seen))
             })
             .collect()
     }
+}
+
+/// Whether `p` is `face` whole: its corners, in order.
+fn is_face(p: &Polygon, face: &Occluder) -> bool {
+    let c = face.corners();
+    p.vertices().len() == c.len()
+        && (p.vertices().iter().zip(c))
+            .all(|(v, g)| matches!(v, bsp_core::Point::Grid(v) if v == g))
 }
 
 /// The fragments of face `i` of `run`, `face`.
@@ -452,8 +463,15 @@ fn soft_face(
                 }
             })
             .chain(crate::cores::cores_at(&run.cores[k], face));
-        let set = corners[k].as_ref().map(LightVolumes::set);
-        let mut seen = |p: &Polygon| set.as_ref()?.cells(p, scratch);
+        // (the face whole is occluder `i` of the corners' trees: what
+        // their building found of it spares filtering it where they
+        // light all of it or none)
+        let set = corners[k].as_ref().map(LightVolumes::set_for_occluders);
+        let faces = run.faces.len();
+        let mut seen = |p: &Polygon| {
+            let whole = is_face(p, face).then_some(i);
+            set.as_ref()?.cells_known(p, whole, faces, scratch)
+        };
         pieces = light
             .cut(face, pieces, occluders, Some(&mut seen))
             .into_iter()

@@ -22,6 +22,17 @@ use crate::light::Light;
 use crate::psv::ShadowVolumes;
 
 impl LightVolumes {
+    /// [`LightVolumes::new_ordered`], keeping what each tree's building
+    /// found of the occluders, for [`LightVolumes::set_for_occluders`].
+    pub(crate) fn new_ordered_reaching(
+        occluders: &[Polygon],
+        order: &[usize],
+        lights: &[Light],
+        solids: &bsp_core::SolidParts,
+    ) -> Result<LightVolumes, ShadowError> {
+        LightVolumes::new_built(occluders, order, lights, solids, true)
+    }
+
     /// [`LightVolumes::new`], keeping what each tree's building found of
     /// the occluders it holds, for [`LightVolumes::set_for_occluders`].
     pub fn new_reaching(
@@ -89,6 +100,37 @@ impl ShadowSet<'_> {
         let Some(first) = polys.get(range.start) else {
             return;
         };
+        let (flags, filter) = self.known_flags(first, range.clone());
+        let polys = &polys[range];
+        self.filter_lights_of(polys, &Start::Uniform(flags), scratch, filter);
+        self.finish(polys, receiver, opts, scratch, out);
+    }
+
+    /// [`ShadowSet::cells`] of `poly`, which is occluder `index` of those
+    /// the trees were built over, whole, where given and this set knows
+    /// them ([`LightVolumes::set_for_occluders`] over `occluders`
+    /// polygons): the same cells, filtered only through the trees of the
+    /// lights that reach part of it.
+    pub(crate) fn cells_known(
+        &self,
+        poly: &Polygon,
+        index: Option<usize>,
+        occluders: usize,
+        scratch: &mut Scratch,
+    ) -> Option<Vec<(Polygon, u64)>> {
+        let known = !self.reached.is_empty() && self.reached.iter().all(|r| r.len() == occluders);
+        let Some(i) = index.filter(|_| known) else {
+            return self.cells(poly, scratch);
+        };
+        let (flags, filter) = self.known_flags(poly, i..i + 1);
+        self.cells_from(poly, &Start::Uniform(flags), filter, scratch)
+    }
+
+    /// For a receiver of the polygons `range` (the first `first`): the
+    /// flags of the lights facing it, less those its trees' building found
+    /// reach none of it, and the lights to filter it through (those that
+    /// reach part of it, or are not known).
+    fn known_flags(&self, first: &Polygon, range: Range<usize>) -> (u64, u64) {
         let facing = self.facing(first.support());
         let (mut flags, mut filter) = (facing, 0u64);
         for (j, reached) in self.reached.iter().enumerate() {
@@ -103,8 +145,6 @@ impl ShadowSet<'_> {
                 filter |= bit;
             }
         }
-        let polys = &polys[range];
-        self.filter_lights_of(polys, &Start::Uniform(flags), scratch, filter);
-        self.finish(polys, receiver, opts, scratch, out);
+        (flags, filter)
     }
 }
