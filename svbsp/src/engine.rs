@@ -564,43 +564,6 @@ impl<'a> ShadowSet<'a> {
         }
     }
 
-    /// The convex cells of receiver polygon `poly` with their flags (bit
-    /// `j`: lit by light `j`), as polygons: the cells [`ShadowSet::shade`]
-    /// merges into fragments. `None` where a cell's vertices cannot be
-    /// made from its planes.
-    pub(crate) fn cells(
-        &self,
-        poly: &Polygon,
-        scratch: &mut Scratch,
-    ) -> Option<Vec<(Polygon, u64)>> {
-        let start = Start::Uniform(self.facing(poly.support()));
-        self.cells_from(poly, &start, u64::MAX, scratch)
-    }
-
-    /// [`ShadowSet::cells`] from `start`, filtered through the trees of
-    /// the lights in `mask` only.
-    fn cells_from(
-        &self,
-        poly: &Polygon,
-        start: &Start<'_>,
-        mask: u64,
-        scratch: &mut Scratch,
-    ) -> Option<Vec<(Polygon, u64)>> {
-        self.filter_lights_of(std::slice::from_ref(poly), start, scratch, mask);
-        let s = &*scratch;
-        s.cur
-            .iter()
-            .map(|(c, flags)| {
-                let edges: SmallVec<[Plane; 6]> =
-                    c.edges.iter().map(|&e| s.arena.plane(e)).collect();
-                Some((
-                    Polygon::from_planes(*poly.support(), &edges, poly.tag())?,
-                    *flags,
-                ))
-            })
-            .collect()
-    }
-
     /// Sets the scratch up with the receiver's cells as `start` says, and
     /// filters every cell lit by a light through that light's tree.
     /// Returns whether a cell was cut or changed its flags.

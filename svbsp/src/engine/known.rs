@@ -10,11 +10,14 @@
 //! flag for that light as it is, and only the lights that light part of
 //! it are filtered. Its fragments are the ones the filter makes (for a
 //! receiver one light reaches all over, the filter's quick test keeps it
-//! whole too), so the output is the same, for less work.
+//! whole too), so the output is the same, for less work. The same holds
+//! for the cells an area light's corner trees cut a whole face into
+//! ([`ShadowSet::cells_known`]), which is why those live here too.
 
 use std::ops::Range;
 
-use bsp_core::Polygon;
+use bsp_core::{Plane, Polygon};
+use smallvec::SmallVec;
 
 use super::{Batch, LightVolumes, ShadeOptions, ShadowError, ShadowSet, Start};
 use crate::engine::Scratch;
@@ -79,6 +82,43 @@ impl LightVolumes {
 }
 
 impl ShadowSet<'_> {
+    /// The convex cells of receiver polygon `poly` with their flags (bit
+    /// `j`: lit by light `j`), as polygons: the cells [`ShadowSet::shade`]
+    /// merges into fragments. `None` where a cell's vertices cannot be
+    /// made from its planes.
+    pub(crate) fn cells(
+        &self,
+        poly: &Polygon,
+        scratch: &mut Scratch,
+    ) -> Option<Vec<(Polygon, u64)>> {
+        let start = Start::Uniform(self.facing(poly.support()));
+        self.cells_from(poly, &start, u64::MAX, scratch)
+    }
+
+    /// [`ShadowSet::cells`] from `start`, filtered through the trees of
+    /// the lights in `mask` only.
+    fn cells_from(
+        &self,
+        poly: &Polygon,
+        start: &Start<'_>,
+        mask: u64,
+        scratch: &mut Scratch,
+    ) -> Option<Vec<(Polygon, u64)>> {
+        self.filter_lights_of(std::slice::from_ref(poly), start, scratch, mask);
+        let s = &*scratch;
+        s.cur
+            .iter()
+            .map(|(c, flags)| {
+                let edges: SmallVec<[Plane; 6]> =
+                    c.edges.iter().map(|&e| s.arena.plane(e)).collect();
+                Some((
+                    Polygon::from_planes(*poly.support(), &edges, poly.tag())?,
+                    *flags,
+                ))
+            })
+            .collect()
+    }
+
     /// Whether this set knows the receivers of `polys` (what its trees'
     /// building found, for a list of that length).
     pub(super) fn knows(&self, polys: &[Polygon]) -> bool {
