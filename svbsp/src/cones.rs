@@ -176,11 +176,22 @@ pub(crate) fn seen_share<'o>(
     let Some(seen) = visible(&mut pool, light_cone, cones) else {
         return Some(Some(1.0));
     };
+    #[cfg(test)]
+    tests::SEEN.with(|s| *s.borrow_mut() = cones_of(&pool, &seen));
     let part: f64 = seen
         .iter()
         .map(|&c| form_factor(normal, pool.rays(c)))
         .sum();
     Some(Some((part / all).clamp(0.0, 1.0)))
+}
+
+/// The planes of `pieces`, each in turn (for tests that measure them
+/// exactly).
+#[cfg(test)]
+fn cones_of(pool: &Pool, pieces: &[Piece]) -> Vec<Planes> {
+    (pieces.iter())
+        .map(|&p| pool.planes(p).iter().copied().collect())
+        .collect()
 }
 
 /// The share of a sun disc's polygon of directions `sky` (quantized, in
@@ -237,6 +248,8 @@ pub(crate) fn sky_seen_share<'o>(
     let Some(seen) = visible(&mut pool, light, cones) else {
         return Some(Some(1.0));
     };
+    #[cfg(test)]
+    tests::SEEN.with(|s| *s.borrow_mut() = cones_of(&pool, &seen));
     let left: f64 = seen.iter().map(|&p| area(pool.rays(p))).sum();
     Some(Some((left / all).clamp(0.0, 1.0)))
 }
@@ -554,32 +567,112 @@ fn form_factor(normal: DVec3, rays: &[[f64; 3]]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::AreaLight;
+    use crate::{AreaLight, LightView, Visibility};
     use bnum::cast::As;
     use bnum::types::I256;
+    use bsp_core::Polygon;
+    use num_bigint::BigInt;
+    use num_rational::BigRational;
+    use num_traits::{Signed, Zero};
     use proptest::prelude::*;
 
-    /// How far two `f64` evaluations of one share may lie apart: a share
-    /// is a value (Lambert's sum, or the chart's areas, over differently
-    /// cut pieces), not a decision; every decision behind it is exact.
-    /// (Test-side only: nothing in the library compares with it.)
-    const ROUNDING: f64 = 1e-9;
+    thread_local! {
+        /// The seen pieces' planes of the last share taken on this
+        /// thread (set by [`seen_share`] and [`sky_seen_share`] in tests).
+        pub(super) static SEEN: std::cell::RefCell<Vec<Planes>> =
+            const { std::cell::RefCell::new(Vec::new()) };
+    }
 
-    /// How far the share of a 300 × 300 lattice of rays may lie from the
-    /// true one on these scenes (a lattice cell's share of the disc is
-    /// about 1/70,000; an occluder's edge crosses a few hundred).
-    const LATTICE: f64 = 0.01;
+    /// An input radius in degrees too small for a strictly convex
+    /// quantized octagon: the disc is left to the `f64` chart.
+    const TINY_DISC_DEG: f64 = 1e-6;
 
-    /// The general path's share: exact polygons in space.
+    /// An exact `BigInt` of an `I256`.
+    fn big(v: I256) -> BigInt {
+        BigInt::parse_bytes(v.to_str_radix(16).as_bytes(), 16).expect("I256 prints in hexadecimal")
+    }
+
+    /// Twice the area, exactly, of convex polygons (corners in turn, as
+    /// exact points relative to one origin) drawn on the two coordinates
+    /// other than `k`: each polygon's area taken unsigned, then summed.
+    fn twice_area(rings: &[Vec<[BigRational; 3]>], k: usize) -> BigRational {
+        let (u, v) = ((k + 1) % 3, (k + 2) % 3);
+        let mut sum = BigRational::zero();
+        for ring in rings {
+            let n = ring.len();
+            let mut a = BigRational::zero();
+            for i in 0..n {
+                let (p, q) = (&ring[i], &ring[(i + 1) % n]);
+                a += &p[u] * &q[v] - &q[u] * &p[v];
+            }
+            sum += a.abs();
+        }
+        sum
+    }
+
+    /// Where the seen cones (their planes through `x`) meet the plane
+    /// `plane`, relative to `x`, exactly: corner `i` on the ray of planes
+    /// `i` and `i + 1`.
+    fn cones_on(cones: &[Planes], plane: &Plane, x: GridPoint) -> Vec<Vec<[BigRational; 3]>> {
+        let n = plane.normal().map(BigInt::from);
+        let at_x = (0..3).fold(BigInt::from(plane.offset()), |a, k| {
+            a + &n[k] * BigInt::from(x[k])
+        });
+        (cones.iter())
+            .map(|planes| {
+                let m = planes.len();
+                (0..m)
+                    .map(|i| {
+                        let r = Ray::new(&planes[i], &planes[(i + 1) % m])
+                            .exact
+                            .map(BigInt::from);
+                        let along = (0..3).fold(BigInt::zero(), |a, k| a + &n[k] * &r[k]);
+                        // x + t r on the plane: t = -(n · x + d) / (n · r)
+                        let t = BigRational::new(-at_x.clone(), along);
+                        r.map(|c| &t * BigRational::from_integer(c))
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Exact polygons, relative to `x`.
+    fn polygons_at(polys: &[Polygon], x: GridPoint) -> Vec<Vec<[BigRational; 3]>> {
+        (polys.iter())
+            .map(|p| {
+                (p.vertices().iter())
+                    .map(|v| {
+                        let h = v.homogeneous();
+                        let w = big(h[3]);
+                        [0, 1, 2].map(|k| {
+                            BigRational::new(big(h[k]), w.clone())
+                                - BigRational::from_integer(BigInt::from(x[k]))
+                        })
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Whether the cones [`SEEN`] last found from `x` cut the plane of the
+    /// light `view` was taken of in exactly the area of `view.seen`.
+    fn same_seen(view: &LightView, light: &Plane, x: GridPoint) -> bool {
+        let k = light.dominant_axis();
+        let cones = SEEN.with(|s| s.borrow().clone());
+        twice_area(&cones_on(&cones, light, x), k) == twice_area(&polygons_at(&view.seen, x), k)
+    }
+
+    /// The general path's view (exact polygons in space) and share.
     fn general(
         light: &AreaLight,
         face: &Plane,
         x: GridPoint,
         normal: DVec3,
         hiders: &[Occluder],
-    ) -> Option<f64> {
+    ) -> Option<(LightView, Option<f64>)> {
         let view = light.view(x, Some(face), hiders)?;
-        view.fraction(DVec3::from_array(x.map(f64::from)), normal)
+        let share = view.fraction(DVec3::from_array(x.map(f64::from)), normal);
+        Some((view, share))
     }
 
     /// A height field of `k × k` cells at heights `z` (two triangles a
@@ -613,9 +706,11 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(500))]
-        /// Where it applies, the cones' share is the general path's:
-        /// fully lit and nothing seen exactly alike, else within rounding.
-        /// It does not apply where an occluder crosses the light's plane.
+        /// Where it applies, the cones see what the general path sees:
+        /// fully lit and nothing seen alike, else a seen part of exactly
+        /// the same area on the light's plane (exact rationals; the two
+        /// shares are `f64` sums over differently cut pieces). It does not
+        /// apply where an occluder crosses the light's plane.
         #[test]
         fn the_cones_see_what_the_general_path_sees(
             scale in prop_oneof![Just(1), Just(3), Just(1 << 19)],
@@ -641,10 +736,14 @@ mod tests {
             let quick = seen_share(light.grid_corners().unwrap(), light.plane().unwrap(), &ground, x, DVec3::Z, hiders.iter());
             prop_assert_eq!(quick.is_none(), crosses);
             if let Some(quick) = quick {
-                let slow = general(&light, &ground, x, DVec3::Z, &hiders);
+                let (view, slow) = general(&light, &ground, x, DVec3::Z, &hiders).unzip();
+                let slow = slow.flatten();
                 match (quick, slow) {
                     (Some(q), Some(s)) if q == 1.0 || s == 1.0 || q == 0.0 || s == 0.0 => prop_assert_eq!(q, s),
-                    (Some(q), Some(s)) => prop_assert!((q - s).abs() < ROUNDING, "{} against {}", q, s),
+                    (Some(_), Some(_)) => prop_assert!(
+                        same_seen(view.as_ref().unwrap(), light.plane().unwrap(), x),
+                        "the cones' seen part has another area than the general path's"
+                    ),
                     (q, s) => prop_assert_eq!(q, s),
                 }
             }
@@ -653,133 +752,87 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(300))]
-        /// A sun disc's share on the cones is the `f64` chart's
-        /// (`soft::sky_share`), within that one's rounding.
+        /// A sun's polygon of directions on the cones sees what the
+        /// general path sees of the polygon light those directions reach
+        /// far beyond every occluder (a sun is beyond every occluder; the
+        /// light at height `2^20` is beyond these): nothing, all, or a
+        /// part of exactly the same area on the light's plane, with the
+        /// face cutting the directions or not.
         #[test]
-        fn the_cones_see_a_sun_disc_as_the_chart_does(
+        fn the_cones_see_a_sun_as_the_general_path_sees_a_far_light(
             toward in (-8i32..8, -8i32..8),
-            // (input radii in degrees, the first too small for a strictly
-            // convex quantized octagon: the chart's case)
-            radius in prop_oneof![Just(1e-6), Just(0.01), Just(0.05), Just(0.2)],
+            size in prop_oneof![Just(3i32), Just(1000), Just(30000)],
             x in (-30i32..30, -30i32..30),
             field in (-30i32..0, -30i32..0, 1i32..12, 1usize..6),
             z in prop::collection::vec(10i32..80, 1..6),
             loose in prop::collection::vec(prop::array::uniform3((-40i32..40, -40i32..40, 5i32..103)), 0..6),
             tilt in prop_oneof![Just((0, 1)), Just((8, 7)), Just((8, 6)), Just((8, 8)), Just((1, 0)), Just((-8, -7))],
         ) {
-            let d = DVec3::new(f64::from(toward.0) / 8.0, f64::from(toward.1) / 8.0, 1.0);
-            let disc = AreaLight::sun_disc(d, radius).unwrap();
-            let sky: Vec<[i32; 3]> = (disc.corners().iter())
-                .map(|l| match l {
-                    crate::Light::Directional(d) => *d,
-                    crate::Light::Point(_) => unreachable!("a disc of directions"),
-                })
-                .collect();
+            const H: i32 = 1 << 20;
             let x = [x.0, x.1, 0];
-            // the face through x with normal (0, -a, b): the ground, or
-            // tilted so that it cuts the disc, holds it whole or hides it
-            let (a, b) = tilt;
-            let ground = Plane::through(x, [x[0] + 1, x[1], x[2]], [x[0], x[1] + b, x[2] + a]).unwrap();
-            let normal = DVec3::from_array(ground.normal().map(|v| v as f64)).normalize();
+            // an octagon at height H round a point the directions lean
+            // toward, clockwise seen from above: it shines down
+            let (cx, cy) = (toward.0 * (H / 8), toward.1 * (H / 8));
+            let (a, b) = (size, size / 2);
+            let corners: Vec<GridPoint> = [(a, b), (b, a), (-b, a), (-a, b), (-a, -b), (-b, -a), (b, -a), (a, -b)]
+                .iter()
+                .rev()
+                .map(|&(u, v)| [cx + u, cy + v, H])
+                .collect();
+            let light = AreaLight::new(&corners).unwrap();
+            let sky: Vec<[i32; 3]> = (corners.iter())
+                .map(|c| [c[0] - x[0], c[1] - x[1], c[2] - x[2]])
+                .collect();
+            let (p, q) = tilt;
+            let face = Plane::through(x, [x[0] + 1, x[1], x[2]], [x[0], x[1] + q, x[2] + p]).unwrap();
             let hiders = scene(1, field, &z, &loose);
-            // (a disc so small that its quantized octagon is no strictly
-            // convex cone is left to the chart)
-            let Some(quick) = sky_seen_share(&sky, &ground, x, hiders.iter()) else {
-                let octagon = light_cone(sky.iter().map(|d| d.map(i64::from)));
-                prop_assert!(octagon.is_none(), "radius {}: a cone, yet left to the chart", radius);
-                return Ok(());
-            };
-            let chart = crate::soft::sky_share(
-                &sky.iter().map(|d| DVec3::from_array(d.map(f64::from))).collect::<Vec<_>>(),
-                DVec3::from_array(x.map(f64::from)),
-                normal,
-                hiders.iter(),
-            );
-            let Some(quick) = quick else {
-                // no direction in front of the face: none either way
-                prop_assert!(chart.is_none() || chart == Some(0.0), "the chart's {:?}", chart);
-                return Ok(());
-            };
-            let dirs: Vec<DVec3> = sky.iter().map(|d| DVec3::from_array(d.map(f64::from))).collect();
-            let xf = DVec3::from_array(x.map(f64::from));
-            let chart = chart.unwrap_or(0.0);
-            // where they differ, rays through a lattice of the chart say
-            // which is right (the chart's clipping in f64 is not robust
-            // where an occluder's edge runs through the disc's centre)
-            if (quick - chart).abs() >= ROUNDING {
-                let rays = sampled(&dirs, (xf, normal), &hiders);
-                prop_assert!(
-                    (quick - rays).abs() < LATTICE && (quick - rays).abs() < (chart - rays).abs(),
-                    "{} against the chart's {} and the rays' {}", quick, chart, rays
-                );
+            let quick = sky_seen_share(&sky, &face, x, hiders.iter())
+                .expect("a strictly convex octagon of directions");
+            let view = light.view(x, Some(&face), &hiders);
+            match (quick, view) {
+                (None, view) => prop_assert!(
+                    view.is_none_or(|v| v.reachable.is_empty()),
+                    "no direction in front of the face, yet the light is"
+                ),
+                (Some(_), None) => prop_assert!(false, "directions in front of the face, but no light"),
+                (Some(share), Some(view)) => match view.visibility {
+                    Visibility::All => prop_assert_eq!(share, 1.0),
+                    Visibility::None => prop_assert_eq!(share, 0.0),
+                    Visibility::Part => prop_assert!(
+                        share < 1.0 && same_seen(&view, light.plane().unwrap(), x),
+                        "the cones' seen part has another area than the general path's"
+                    ),
+                },
             }
         }
     }
 
-    /// The share of sun directions `dirs` (a convex polygon of them, in
-    /// order) in front of a face with `normal` at `x` that rays from `x`
-    /// through a 300 × 300 lattice of the chart
-    /// of [`sky_seen_share`] find past the `hiders` (Möller–Trumbore, in
-    /// `f64`).
-    fn sampled(dirs: &[DVec3], (x, normal): (DVec3, DVec3), hiders: &[Occluder]) -> f64 {
-        let c = dirs.iter().sum::<DVec3>().normalize();
-        let (u, v) = (
-            c.any_orthonormal_vector(),
-            c.cross(c.any_orthonormal_vector()),
-        );
-        let chart: Vec<(f64, f64)> = (dirs.iter())
-            .map(|r| (r.dot(u) / r.dot(c), r.dot(v) / r.dot(c)))
-            .collect();
-        let n = chart.len();
-        let inside = |q: (f64, f64)| {
-            let turns = (0..n).map(|i| {
-                let (a, b) = (chart[i], chart[(i + 1) % n]);
-                ((b.0 - a.0) * (q.1 - a.1) - (b.1 - a.1) * (q.0 - a.0)).signum()
-            });
-            let t: Vec<f64> = turns.collect();
-            t.iter().all(|&s| s >= 0.0) || t.iter().all(|&s| s <= 0.0)
-        };
-        let hits = |dir: DVec3| {
-            hiders.iter().any(|o| {
-                let p: Vec<DVec3> = (o.corners().iter())
-                    .map(|q| DVec3::from_array(q.map(f64::from)))
+    /// The cones decline a sun disc (leaving it to the `f64` chart) where,
+    /// and only where, its quantized octagon is no strictly convex cone;
+    /// a disc of the sun's size they take.
+    #[test]
+    fn the_cones_decline_only_discs_that_are_no_cone() {
+        let hiders = scene(1, (-10, -10, 4, 3), &[20, 30], &[]);
+        let ground = Plane::through([0, 0, 0], [1, 0, 0], [0, 1, 0]).unwrap();
+        for toward in [
+            DVec3::new(0.1, -0.2, 1.0),
+            DVec3::Z,
+            DVec3::new(-0.7, 0.4, 1.0),
+        ] {
+            for radius in [TINY_DISC_DEG, 0.01, 0.2666] {
+                let disc = AreaLight::sun_disc(toward, radius).unwrap();
+                let sky: Vec<[i32; 3]> = (disc.corners().iter())
+                    .map(|l| match l {
+                        crate::Light::Directional(d) => *d,
+                        crate::Light::Point(_) => unreachable!("a disc of directions"),
+                    })
                     .collect();
-                (1..p.len() - 1).any(|k| {
-                    let (e1, e2) = (p[k] - p[0], p[k + 1] - p[0]);
-                    let h = dir.cross(e2);
-                    let a = e1.dot(h);
-                    let s = x - p[0];
-                    let (b, q) = (s.dot(h) / a, s.cross(e1));
-                    let w = dir.dot(q) / a;
-                    a != 0.0
-                        && (0.0..=1.0).contains(&b)
-                        && w >= 0.0
-                        && b + w <= 1.0
-                        && e2.dot(q) / a > 0.0
-                })
-            })
-        };
-        let lo = chart
-            .iter()
-            .fold((f64::MAX, f64::MAX), |m, p| (m.0.min(p.0), m.1.min(p.1)));
-        let hi = chart
-            .iter()
-            .fold((f64::MIN, f64::MIN), |m, p| (m.0.max(p.0), m.1.max(p.1)));
-        let (mut all, mut seen) = (0, 0);
-        for i in 0..300 {
-            for j in 0..300 {
-                let q = (
-                    lo.0 + (hi.0 - lo.0) * (f64::from(i) + 0.5) / 300.0,
-                    lo.1 + (hi.1 - lo.1) * (f64::from(j) + 0.5) / 300.0,
-                );
-                let dir = c + u * q.0 + v * q.1;
-                if inside(q) && normal.dot(dir) > 0.0 {
-                    all += 1;
-                    seen += usize::from(!hits(dir));
-                }
+                let quick = sky_seen_share(&sky, &ground, [0, 0, 0], hiders.iter());
+                let octagon = light_cone(sky.iter().map(|d| d.map(i64::from)));
+                assert_eq!(quick.is_none(), octagon.is_none(), "radius {radius}");
+                assert!(radius < 0.01 || quick.is_some(), "radius {radius} declined");
             }
         }
-        seen as f64 / all as f64
     }
 
     /// The part of `cone` left of the line from `a` to `b` on the plane
