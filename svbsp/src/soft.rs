@@ -20,7 +20,7 @@ use crate::area::{AreaClass, AreaFragment, AreaLight, HalfSpaces, Occluder, Regi
 use crate::backs::SolidBacks;
 use crate::blockers::{coplanar_blockers, coplanar_blockers_of, plane_key};
 use crate::boxes::{Box3, CellGrid, EMPTY, EVERYWHERE, Reach, grid_box, meet};
-use crate::engine::{LightVolumes, Scratch};
+use crate::engine::{LightVolumes, Scratch, ShadowSet};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
 use crate::merging::merge_convex;
 use crate::near::{InSlab, near_lists, slab_box};
@@ -405,22 +405,30 @@ impl AreaLight {
                     .iter()
                     .filter_map(|&j| Some((regions[j as usize].as_ref()?, reach[j as usize])))
                     .chain(crate::cores::cores_at(&cores, face));
-                let mut seen = |p: &Polygon| {
-                    let whole = is_face(p, face).then_some(i);
-                    set.as_ref()?.cells_known(p, whole, faces.len(), scratch)
-                };
+                let mut seen = corner_cells(set.as_ref(), (face, i, faces.len()), scratch);
                 self.classify_with(face, others, Some(&mut seen))
             })
             .collect()
     }
 }
 
-/// Whether `p` is `face` whole: its corners, in order.
-fn is_face(p: &Polygon, face: &Occluder) -> bool {
-    let c = face.corners();
-    p.vertices().len() == c.len()
-        && (p.vertices().iter().zip(c))
-            .all(|(v, g)| matches!(v, bsp_core::Point::Grid(v) if v == g))
+/// The cells of a piece of `face` (face `i` of `faces`) by the corners'
+/// trees `set` (see [`ShadowSet::cells`]): the face whole is occluder
+/// `i` of those trees, so what their building found of it spares
+/// filtering it where they light all of it or none
+/// ([`ShadowSet::cells_known`]).
+fn corner_cells<'a, 't: 'a>(
+    set: Option<&'a ShadowSet<'t>>,
+    (face, i, faces): (&'a Occluder, usize, usize),
+    scratch: &'a mut Scratch,
+) -> impl FnMut(&Polygon) -> Option<Vec<(Polygon, u64)>> + 'a {
+    move |p: &Polygon| {
+        let c = face.corners();
+        let whole = p.vertices().len() == c.len()
+            && (p.vertices().iter().zip(c))
+                .all(|(v, g)| matches!(v, bsp_core::Point::Grid(v) if v == g));
+        set?.cells_known(p, whole.then_some(i), faces, scratch)
+    }
 }
 
 /// The fragments of face `i` of `run`, `face`.
@@ -463,15 +471,8 @@ fn soft_face(
                 }
             })
             .chain(crate::cores::cores_at(&run.cores[k], face));
-        // (the face whole is occluder `i` of the corners' trees: what
-        // their building found of it spares filtering it where they
-        // light all of it or none)
         let set = corners[k].as_ref().map(LightVolumes::set_for_occluders);
-        let faces = run.faces.len();
-        let mut seen = |p: &Polygon| {
-            let whole = is_face(p, face).then_some(i);
-            set.as_ref()?.cells_known(p, whole, faces, scratch)
-        };
+        let mut seen = corner_cells(set.as_ref(), (face, i, run.faces.len()), scratch);
         pieces = light
             .cut(face, pieces, occluders, Some(&mut seen))
             .into_iter()
