@@ -175,7 +175,8 @@ impl LightVolumes {
     /// as with all of them; the fragments may come out cut or listed
     /// differently.
     pub fn new(occluders: &[Polygon], lights: &[Light]) -> Result<LightVolumes, ShadowError> {
-        LightVolumes::new_with(occluders, lights, &bsp_core::certify_solid_parts(occluders))
+        let order: Vec<usize> = (0..occluders.len()).collect();
+        LightVolumes::new_built(occluders, &order, lights, None, false)
     }
 
     /// [`LightVolumes::new`] with the parts of `occluders` already certified
@@ -198,60 +199,7 @@ impl LightVolumes {
         lights: &[Light],
         solids: &bsp_core::SolidParts,
     ) -> Result<LightVolumes, ShadowError> {
-        LightVolumes::new_built(occluders, order, lights, solids, false)
-    }
-
-    /// [`LightVolumes::new_ordered`], and with `reach` what each tree's
-    /// building found of the occluders it holds
-    /// ([`ShadowVolumes::build_reached`]).
-    fn new_built(
-        occluders: &[Polygon],
-        order: &[usize],
-        lights: &[Light],
-        solids: &bsp_core::SolidParts,
-        reach: bool,
-    ) -> Result<LightVolumes, ShadowError> {
-        if lights.len() > MAX_LIGHTS {
-            return Err(LightError::TooMany(lights.len()).into());
-        }
-        for l in lights {
-            l.validate()?;
-        }
-        // (polygons off the grid leave no part certified, so nothing is
-        // left out and an error's index is the caller's)
-        let build = |l: Light| {
-            let (index, kept): (Vec<usize>, Vec<&Polygon>) =
-                (order.iter().map(|&i| (i, &occluders[i])))
-                    .filter(|(i, p)| !l.leaves_out(solids, *i, p.support()))
-                    .unzip();
-            match reach {
-                true => ShadowVolumes::build_reached_among(l, occluders, &index),
-                false => ShadowVolumes::build(l, &kept).map(|v| (v, Vec::new())),
-            }
-        };
-        // two lights at a time: each build is parallel inside but has
-        // parts on one thread (its start, and its last regions), which the
-        // other build fills; only two builds' working memory is alive at
-        // once
-        let mut built = Vec::with_capacity(lights.len());
-        for pair in lights.chunks(2) {
-            match *pair {
-                [a, b] => {
-                    let (a, b) = rayon::join(|| build(a), || build(b));
-                    built.push(a?);
-                    built.push(b?);
-                }
-                [a] => built.push(build(a)?),
-                _ => unreachable!("chunks of one or two"),
-            }
-        }
-        let (volumes, reached): (Vec<ShadowVolumes>, Vec<Vec<Option<bool>>>) =
-            built.into_iter().unzip();
-        Ok(LightVolumes {
-            lights: lights.to_vec(),
-            volumes,
-            reached: if reach { reached } else { Vec::new() },
-        })
+        LightVolumes::new_built(occluders, order, lights, Some(solids), false)
     }
 
     /// The lights, in order: bit `i` of a fragment's flags is light `i`.
@@ -1460,4 +1408,5 @@ pub fn shadow_fragments(
 #[cfg(test)]
 mod tests;
 
+mod building;
 mod known;

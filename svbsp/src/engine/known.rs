@@ -33,7 +33,7 @@ impl LightVolumes {
         lights: &[Light],
         solids: &bsp_core::SolidParts,
     ) -> Result<LightVolumes, ShadowError> {
-        LightVolumes::new_built(occluders, order, lights, solids, true)
+        LightVolumes::new_built(occluders, order, lights, Some(solids), true)
     }
 
     /// [`LightVolumes::new`], keeping what each tree's building found of
@@ -42,9 +42,8 @@ impl LightVolumes {
         occluders: &[Polygon],
         lights: &[Light],
     ) -> Result<LightVolumes, ShadowError> {
-        let solids = bsp_core::certify_solid_parts(occluders);
         let order: Vec<usize> = (0..occluders.len()).collect();
-        LightVolumes::new_built(occluders, &order, lights, &solids, true)
+        LightVolumes::new_built(occluders, &order, lights, None, true)
     }
 
     /// [`LightVolumes::from_volumes`] with what each tree's building found

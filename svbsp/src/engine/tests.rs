@@ -125,3 +125,69 @@ fn piece_planes_make_the_pieces_again() {
     mixed.append(&plain);
     assert!(mixed.fragments().all(|f| f.piece_planes().is_none()));
 }
+
+/// The trees built while the parts are certified (over the faces each
+/// light faces, kept where the certified parts leave out every other
+/// face) are the trees built after certifying: where the guess holds
+/// (closed boxes lit from outside, an open floor facing the lights) and
+/// where it does not (an open face turned away, a light inside a box).
+#[test]
+fn trees_built_while_certifying_are_those_built_after() {
+    let poly = |l: &Vec<[i32; 3]>, tag: u32| Polygon::from_grid_points(l, tag).unwrap();
+    let mut closed: Vec<Polygon> = bsp_fixtures::grid_cuboid([2, 2, 2], [5, 5, 5])
+        .iter()
+        .chain(&bsp_fixtures::grid_cuboid([6, 1, 1], [7, 3, 4]))
+        .enumerate()
+        .map(|(i, l)| poly(l, i as u32))
+        .collect();
+    closed.push(quad(0, -4, 12, 12));
+    let mut open = closed.clone();
+    open.push(quad(9, 0, 3, 13).flipped()); // faces down, away from lights above
+    let above = [
+        Light::Point([3, 4, 20]),
+        Light::Point([10, 9, 14]),
+        Light::Directional([1, 2, 5]),
+    ];
+    let inside = [Light::Point([3, 3, 3]), Light::Directional([-1, 2, 7])];
+    let solids_of = |p: &[Polygon]| bsp_core::certify_solid_parts(p);
+    // whether the guess holds for a light: every face it does not face
+    // is left out
+    let holds = |p: &[Polygon], l: &Light| {
+        let s = solids_of(p);
+        (0..p.len()).all(|i| l.faces(p[i].support()) || l.leaves_out(&s, i, p[i].support()))
+    };
+    assert!(holds(&closed, &above[0]) && holds(&closed, &above[1]));
+    assert!(!holds(&open, &above[0]) && !holds(&closed, &inside[0]));
+    for (polys, lights) in [
+        (&closed, &above[..]),
+        (&open, &above[..]),
+        (&closed, &inside[..]),
+    ] {
+        let solids = solids_of(polys);
+        let order: Vec<usize> = (0..polys.len()).collect();
+        let pairs = [
+            (
+                LightVolumes::new(polys, lights).unwrap(),
+                LightVolumes::new_with(polys, lights, &solids).unwrap(),
+            ),
+            (
+                LightVolumes::new_reaching(polys, lights).unwrap(),
+                LightVolumes::new_ordered_reaching(polys, &order, lights, &solids).unwrap(),
+            ),
+        ];
+        for (a, b) in pairs {
+            assert_eq!(a.reached, b.reached);
+            for (ta, tb) in a.volumes().iter().zip(b.volumes()) {
+                assert_eq!(ta.node_count(), tb.node_count());
+                assert_eq!(ta.occluder_count(), tb.occluder_count());
+                for x in -4..=12 {
+                    for y in -4..=12 {
+                        for z in -1..=10 {
+                            assert_eq!(ta.hides([x, y, z]), tb.hides([x, y, z]));
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
