@@ -558,38 +558,20 @@ impl<'a> ShadowSet<'a> {
     /// Filters every cell of `s.cur` through the tree of each light in
     /// `mask` for which the cell's flag is set, light after light; a cell
     /// may come back cut, or shadowed for that light. Returns whether a
-    /// cell was cut or lost a light.
+    /// cell was cut or lost a light. Once the cells are many (a large
+    /// face, such as a ground, cut by its first light), the rest of the
+    /// lights pass over runs of them in parallel (`engine/passes.rs`).
     fn pass_lights(&self, s: &mut Scratch, mask: u64) -> bool {
+        let trees: SmallVec<[(&ShadowVolumes, usize); 4]> = (self.trees.iter())
+            .filter(|(_, j)| mask & 1 << j != 0)
+            .copied()
+            .collect();
         let mut changed = false;
-        for &(sv, j) in &self.trees {
-            let bit = 1u64 << j;
-            if mask & bit == 0 {
-                continue;
+        for (k, &tree) in trees.iter().enumerate() {
+            if k > 0 && s.cur.len() >= passes::PARALLEL_CELLS {
+                return passes::pass_runs(s, &trees[k..]) | changed;
             }
-            s.next.clear();
-            for (piece, flags) in s.cur.drain(..) {
-                if flags & bit == 0 {
-                    s.next.push((piece, flags));
-                    continue;
-                }
-                s.out.clear();
-                filter(
-                    sv,
-                    &mut s.arena,
-                    s.support,
-                    piece,
-                    &mut s.out,
-                    &mut s.stack,
-                    &mut s.links,
-                    &mut s.sides,
-                );
-                // one piece back, still lit: the cell as it was
-                changed |= s.out.len() != 1 || !s.out[0].1;
-                for (p, lit) in s.out.drain(..) {
-                    s.next.push((p, flags & !bit | (lit as u64) << j));
-                }
-            }
-            std::mem::swap(&mut s.cur, &mut s.next);
+            changed |= passes::pass(s, tree);
         }
         changed
     }
@@ -1410,3 +1392,4 @@ mod tests;
 
 mod building;
 mod known;
+mod passes;

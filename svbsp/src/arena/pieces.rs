@@ -478,6 +478,60 @@ impl PieceArena {
         }
     }
 
+    /// Appends what `other` (a copy of this arena when it was at `mark`,
+    /// since grown on its own) added after `mark`, and renumbers `pieces`
+    /// (of `other`) into this arena: the vertices and planes `other` had
+    /// at `mark` keep their ids, the later ones follow this arena's own.
+    /// With several copies appended in turn, each renumbered piece refers
+    /// to the same points and planes as in its copy.
+    pub(crate) fn append_since(
+        &mut self,
+        other: &PieceArena,
+        mark: ArenaMark,
+        pieces: &mut [Piece],
+    ) {
+        let shift = [
+            self.grid.len() - mark.grid,
+            self.exact.len() - mark.exact,
+            self.lazy.len() - mark.lazy,
+        ];
+        let planes = self.planes.len() - mark.planes;
+        let plane = |i: u32| match i as usize >= mark.planes {
+            true => i + planes as u32,
+            false => i,
+        };
+        let vertex = |id: u32| {
+            let (tag, i) = (id & TAG, (id & !TAG) as usize);
+            let (base, k) = match tag {
+                EXACT => (mark.exact, 1),
+                LAZY => (mark.lazy, 2),
+                _ => (mark.grid, 0),
+            };
+            match i >= base {
+                true => (i + shift[k]) as u32 | tag,
+                false => id,
+            }
+        };
+        self.grid.extend_from_slice(&other.grid[mark.grid..]);
+        self.exact.extend_from_slice(&other.exact[mark.exact..]);
+        self.lazy
+            .extend(other.lazy[mark.lazy..].iter().map(|l| Lazy {
+                planes: l.planes.map(plane),
+                ..l.clone()
+            }));
+        self.planes.extend_from_slice(&other.planes[mark.planes..]);
+        self.anchors
+            .extend_from_slice(&other.anchors[mark.planes..]);
+        for c in pieces {
+            for v in &mut c.verts {
+                *v = vertex(*v);
+            }
+            for e in &mut c.edges {
+                *e = EdgeRef::new(plane(e.index()), e.flipped());
+            }
+        }
+    }
+
     /// Drops every vertex and plane added since `mark`. Pieces that refer
     /// to them must be dropped too.
     #[inline]

@@ -191,3 +191,86 @@ fn trees_built_while_certifying_are_those_built_after() {
         }
     }
 }
+
+/// A ground under a grid of small roofs, lit by three lights: cut by the
+/// first into more cells than [`passes::PARALLEL_CELLS`], its cells go
+/// through the other two trees in parallel runs
+/// ([`passes::pass_runs`]) and come out as the one-by-one passes make
+/// them: the same cells in the same order, the same exact corners, the
+/// same flags, on one thread and on three.
+#[test]
+fn a_large_face_passes_its_cells_in_runs_as_one_by_one() {
+    let mut polys = vec![quad(0, -40, 104, 0)];
+    for i in 0..12 {
+        for j in 0..12 {
+            let (x, y) = (i * 6, j * 6);
+            let roof = [[x, y, 5], [x + 3, y, 5], [x + 3, y + 2, 5], [x, y + 2, 5]];
+            polys.push(Polygon::from_grid_points(&roof, (1 + i * 12 + j) as u32).unwrap());
+        }
+    }
+    let lights = [
+        Light::Point([31, 29, 40]),
+        Light::Point([50, 10, 33]),
+        Light::Directional([2, -1, 9]),
+    ];
+    let shadows = LightVolumes::new(&polys, &lights).unwrap();
+    let set = shadows.set();
+    let ground = &polys[..1];
+    let first = |s: &mut Scratch| {
+        set.filter_lights_of(ground, &Start::Uniform(0b111), s, 0b001);
+    };
+    let rest: Vec<_> = set.trees[1..].to_vec();
+    let corners = |s: &Scratch| -> Vec<(Vec<Vertex>, u64)> {
+        (s.cur.iter())
+            .map(|(p, f)| {
+                let v = p
+                    .verts
+                    .iter()
+                    .map(|&v| s.arena.vertex(v).to_owned())
+                    .collect();
+                (v, *f)
+            })
+            .collect()
+    };
+    let mut one = Scratch::default();
+    first(&mut one);
+    assert!(
+        one.cur.len() >= passes::PARALLEL_CELLS,
+        "{} cells",
+        one.cur.len()
+    );
+    let changed_one = rest
+        .iter()
+        .fold(false, |c, &t| passes::pass(&mut one, t) | c);
+    let expected = corners(&one);
+    for threads in [1, 3] {
+        let mut runs = Scratch::default();
+        let changed = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                first(&mut runs);
+                passes::pass_runs(&mut runs, &rest)
+            });
+        assert_eq!(changed, changed_one);
+        let got = corners(&runs);
+        assert_eq!(got.len(), expected.len());
+        for ((a, fa), (b, fb)) in got.iter().zip(&expected) {
+            assert_eq!(fa, fb);
+            assert_eq!(a.len(), b.len());
+            assert!(a.iter().zip(b).all(|(x, y)| x.same_point(y)));
+        }
+        // the renumbered cells keep their planes: each edge's plane holds
+        // both of its corners
+        for (p, _) in &runs.cur {
+            let k = p.verts.len();
+            for i in 0..k {
+                let e = runs.arena.plane(p.edges[i]);
+                for v in [p.verts[i], p.verts[(i + 1) % k]] {
+                    assert_eq!(runs.arena.vertex(v).classify(&e), Side::On);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,98 @@
+//! A receiver's cells through the lights' trees, light after light; the
+//! cells of a large receiver in runs, in parallel.
+//!
+//! A ground under a scanned mesh is cut by its first light into
+//! thousands of cells, and with several lights each of them goes through
+//! every other tree: one face's work, on one thread, while the rest of
+//! the scene is done. Past the first light, each cell's walk through a
+//! tree is its own: runs of cells go through the remaining trees on
+//! copies of the arena, whose additions are then appended in the runs'
+//! order ([`PieceArena::append_since`]). The cells come out in the same
+//! order, each the same polygon with the same flags, for any number of
+//! threads.
+
+use rayon::prelude::*;
+
+use super::{Scratch, filter};
+use crate::psv::ShadowVolumes;
+
+/// Cells from which the lights after the first pass over runs in
+/// parallel.
+pub(super) const PARALLEL_CELLS: usize = 256;
+
+/// At most this many runs (each copies the arena).
+const MAX_RUNS: usize = 8;
+
+/// Cells a run holds at least.
+const MIN_RUN: usize = 64;
+
+/// The cells of `s.cur` whose flag for light `j` is set through `sv`,
+/// the tree of light `j`; whether a cell was cut or lost the light.
+pub(super) fn pass(s: &mut Scratch, (sv, j): (&ShadowVolumes, usize)) -> bool {
+    let bit = 1u64 << j;
+    let mut changed = false;
+    s.next.clear();
+    for (piece, flags) in s.cur.drain(..) {
+        if flags & bit == 0 {
+            s.next.push((piece, flags));
+            continue;
+        }
+        s.out.clear();
+        filter(
+            sv,
+            &mut s.arena,
+            s.support,
+            piece,
+            &mut s.out,
+            &mut s.stack,
+            &mut s.links,
+            &mut s.sides,
+        );
+        // one piece back, still lit: the cell as it was
+        changed |= s.out.len() != 1 || !s.out[0].1;
+        for (p, lit) in s.out.drain(..) {
+            s.next.push((p, flags & !bit | (lit as u64) << j));
+        }
+    }
+    std::mem::swap(&mut s.cur, &mut s.next);
+    changed
+}
+
+/// [`pass`] of every tree of `trees` in turn, over runs of `s.cur` in
+/// parallel, each on its own copy of the arena; the cells and the
+/// arena's additions put back in the runs' order.
+pub(super) fn pass_runs(s: &mut Scratch, trees: &[(&ShadowVolumes, usize)]) -> bool {
+    let n = s.cur.len();
+    let runs = (n / MIN_RUN).clamp(1, MAX_RUNS);
+    let size = n.div_ceil(runs);
+    let mark = s.arena.mark();
+    let (arena, support) = (&s.arena, s.support);
+    let done: Vec<(Scratch, bool)> = s
+        .cur
+        .par_chunks(size)
+        .map(|cells| {
+            let mut own = Scratch {
+                arena: arena.clone(),
+                support,
+                cur: cells.to_vec(),
+                ..Scratch::default()
+            };
+            let changed = trees.iter().fold(false, |c, &t| pass(&mut own, t) | c);
+            (own, changed)
+        })
+        .collect();
+    s.cur.clear();
+    let mut changed = false;
+    for (mut own, c) in done {
+        let mut pieces: Vec<_> = own.cur.iter().map(|(p, _)| p.clone()).collect();
+        s.arena.append_since(&own.arena, mark, &mut pieces);
+        s.cur.extend(
+            pieces
+                .into_iter()
+                .zip(own.cur.drain(..))
+                .map(|(p, (_, f))| (p, f)),
+        );
+        changed |= c;
+    }
+    changed
+}
