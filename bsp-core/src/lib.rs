@@ -58,9 +58,10 @@ pub use kernel::{
     Point, Polygon, PolygonSide, SanityError, Side, SnapError, Split, ViewPoint,
 };
 pub use solid::{
-    ImportReport, SolidBoundary, SolidParts, SurfaceDefect, TopologyError, TriMesh,
+    ImportReport, PairedParts, SolidBoundary, SolidParts, SurfaceDefect, TopologyError, TriMesh,
     certify_solid_boundary, certify_solid_parts, check_closed_manifold, import_faces,
     import_faces_par, import_indexed_par, import_mesh_par, is_closed_cycle, meeting_pairs,
+    pair_solid_parts,
 };
 pub use tree::{
     BoolOp, BspTree, BuildOptions, Cell, CellOp, FlatBsp, Link, Membership, Node, NodeId, Order,

@@ -46,6 +46,7 @@ use bsp_core::internals::SplitMix;
 use bsp_core::{GridPoint, Plane, Point, Polygon, SanityError, Side};
 use rayon::prelude::*;
 use smallvec::SmallVec;
+use std::sync::atomic::Ordering;
 
 use crate::arena::pieces::{EdgeRef, Piece, PieceArena, Sides, Vertex};
 use crate::light::Light;
@@ -525,7 +526,17 @@ impl ShadowVolumes {
         light: Light,
         occluders: &[P],
     ) -> Result<ShadowVolumes, VolumeError> {
-        Ok(ShadowVolumes::build_inner::<P, ()>(light, occluders, None)?.0)
+        Ok(ShadowVolumes::build_until(light, occluders, None)?.expect("no stop"))
+    }
+
+    /// [`ShadowVolumes::build`], given up (`None`) once `stop` is raised.
+    pub(crate) fn build_until<P: Borrow<Polygon> + Sync>(
+        light: Light,
+        occluders: &[P],
+        stop: Option<&Stop>,
+    ) -> Result<Option<ShadowVolumes>, VolumeError> {
+        let built = ShadowVolumes::build_inner::<P, ()>(light, occluders, None, stop)?;
+        Ok(built.map(|b| b.0))
     }
 
     /// [`ShadowVolumes::build`], and the area of each occluder that the
@@ -556,7 +567,8 @@ impl ShadowVolumes {
         light: Light,
         occluders: &[P],
     ) -> Result<(ShadowVolumes, Vec<f64>), VolumeError> {
-        let (v, parts) = ShadowVolumes::build_inner(light, occluders, Some(&Rests::areas))?;
+        let (v, parts) = ShadowVolumes::build_inner(light, occluders, Some(&Rests::areas), None)?
+            .expect("no stop");
         let mut lit = vec![0.0; occluders.len()];
         for (i, a) in parts {
             lit[i as usize] += a;
@@ -573,7 +585,8 @@ impl ShadowVolumes {
         light: Light,
         occluders: &[P],
     ) -> Result<(ShadowVolumes, LitParts), VolumeError> {
-        let (v, parts) = ShadowVolumes::build_inner(light, occluders, Some(&Rests::parts))?;
+        let (v, parts) = ShadowVolumes::build_inner(light, occluders, Some(&Rests::parts), None)?
+            .expect("no stop");
         Ok((v, parts.into_iter().map(|(i, p)| (i as usize, p)).collect()))
     }
 
@@ -588,7 +601,20 @@ impl ShadowVolumes {
         light: Light,
         occluders: &[P],
     ) -> Result<(ShadowVolumes, Vec<Option<bool>>), VolumeError> {
-        let (v, found) = ShadowVolumes::build_inner(light, occluders, Some(&Rests::reached))?;
+        Ok(ShadowVolumes::build_reached_until(light, occluders, None)?.expect("no stop"))
+    }
+
+    /// [`ShadowVolumes::build_reached`], given up (`None`) once `stop` is
+    /// raised.
+    fn build_reached_until<P: Borrow<Polygon> + Sync>(
+        light: Light,
+        occluders: &[P],
+        stop: Option<&Stop>,
+    ) -> Result<Option<Reached>, VolumeError> {
+        let built = ShadowVolumes::build_inner(light, occluders, Some(&Rests::reached), stop)?;
+        let Some((v, found)) = built else {
+            return Ok(None);
+        };
         // (an occluder the skeleton cut has parts in several regions)
         let mut reached: Vec<Option<Option<bool>>> = vec![None; occluders.len()];
         for (i, r) in found {
@@ -599,7 +625,10 @@ impl ShadowVolumes {
                 Some(_) => None,
             });
         }
-        Ok((v, reached.into_iter().map(Option::flatten).collect()))
+        Ok(Some((
+            v,
+            reached.into_iter().map(Option::flatten).collect(),
+        )))
     }
 
     /// [`ShadowVolumes::build_reached`] of the polygons `index` picks from
@@ -610,13 +639,27 @@ impl ShadowVolumes {
         polys: &[Polygon],
         index: &[usize],
     ) -> Result<(ShadowVolumes, Vec<Option<bool>>), VolumeError> {
+        let built = ShadowVolumes::build_reached_among_until(light, polys, index, None)?;
+        Ok(built.expect("no stop"))
+    }
+
+    /// [`ShadowVolumes::build_reached_among`], given up (`None`) once
+    /// `stop` is raised.
+    pub(crate) fn build_reached_among_until(
+        light: Light,
+        polys: &[Polygon],
+        index: &[usize],
+        stop: Option<&Stop>,
+    ) -> Result<Option<Reached>, VolumeError> {
         let picked: Vec<&Polygon> = index.iter().map(|&i| &polys[i]).collect();
-        let (v, found) = ShadowVolumes::build_reached(light, &picked)?;
+        let Some((v, found)) = ShadowVolumes::build_reached_until(light, &picked, stop)? else {
+            return Ok(None);
+        };
         let mut reached = vec![None; polys.len()];
         for (&i, r) in index.iter().zip(found) {
             reached[i] = r;
         }
-        Ok((v, reached))
+        Ok(Some((v, reached)))
     }
 
     /// [`ShadowVolumes::build`], and with `record` what it makes of each
@@ -626,7 +669,9 @@ impl ShadowVolumes {
         light: Light,
         occluders: &[P],
         record: Option<&Record<T>>,
-    ) -> Result<(ShadowVolumes, Vec<(u32, T)>), VolumeError> {
+        stop: Option<&Stop>,
+    ) -> Result<Option<Built<T>>, VolumeError> {
+        let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
         let occ = Occluders::new(&light, occluders)?;
         let mut pool = Pool::default();
         pool.arena
@@ -652,6 +697,9 @@ impl ShadowVolumes {
             list,
         }]);
         while let Some(task) = queue.pop_front() {
+            if stopped() {
+                return Ok(None);
+            }
             if queue.len() + ready.len() + 1 >= PARALLEL_TASKS {
                 ready.push(task);
                 continue;
@@ -684,10 +732,13 @@ impl ShadowVolumes {
                     list,
                 };
                 let seed = 0x5eed_5a0d ^ (i as u64 + 1);
-                build_region(&occ, &mut own, local, seed, record)
+                build_region(&occ, &mut own, local, seed, record, stop)
             })
             .collect();
         drop(pool);
+        if stopped() {
+            return Ok(None);
+        }
         let mut nodes = top.nodes;
         nodes.reserve(parts.iter().map(|p| p.0.nodes.len()).sum());
         let mut grafted = top.grafted;
@@ -725,7 +776,7 @@ impl ShadowVolumes {
             skeleton,
             occluders: occ.len(),
         };
-        Ok((volumes, lit))
+        Ok(Some((volumes, lit)))
     }
 
     /// The number of occluders the volumes were built from (those given,
@@ -967,6 +1018,18 @@ fn split_task(
 /// occluder's index ([`ShadowVolumes::lit_parts`]).
 pub type LitParts = Vec<(usize, Vec<Vertex>)>;
 
+/// A flag another thread raises to give up a build whose tree is no
+/// longer wanted.
+pub(crate) type Stop = std::sync::atomic::AtomicBool;
+
+/// What a build makes: the tree, and what its `record` made of the lit
+/// parts, with their occluders.
+type Built<T> = (ShadowVolumes, Vec<(u32, T)>);
+
+/// A tree, and per occluder whether the light reaches all of it
+/// (`Some(true)`), none (`Some(false)`) or part ([`ShadowVolumes::build_reached`]).
+pub(crate) type Reached = (ShadowVolumes, Vec<Option<bool>>);
+
 /// What [`build_region`] makes: the nodes, the root link, the number of
 /// skeleton nodes, and what its `record` makes of the lit parts, with
 /// their occluders.
@@ -985,6 +1048,7 @@ fn build_region<T>(
     task: Task,
     seed: u64,
     record: Option<&Record<T>>,
+    stop: Option<&Stop>,
 ) -> Region<T> {
     let mut tree = Subtree {
         nodes: Vec::new(),
@@ -1010,6 +1074,10 @@ fn build_region<T>(
     let mut scratch = InsertScratch::default();
     let mut rests = record.map(|_| Rests::default());
     for leaf in &leaves {
+        // (a stopped build's regions are thrown away whole)
+        if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            break;
+        }
         for &e in &leaf.list {
             let r = rests.as_mut();
             insert(&mut tree, &mut root, occ, pool, e, leaf, &mut scratch, r);

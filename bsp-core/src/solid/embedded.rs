@@ -357,10 +357,18 @@ impl SolidParts {
 /// assert!(parts.boundary(6).is_none()); // the ground is open
 /// ```
 pub fn certify_solid_parts(polys: &[Polygon]) -> SolidParts {
+    pair_solid_parts(polys).certify()
+}
+
+/// The first step of [`certify_solid_parts`]: the polygons' edges paired
+/// up into parts, which tells the parts that are open (or off the grid)
+/// and so cannot be certified, before the costlier test that the others
+/// are embedded ([`PairedParts::certify`]).
+pub fn pair_solid_parts(polys: &[Polygon]) -> PairedParts {
     let Ok(loops) = Loops::new(polys) else {
-        return SolidParts {
-            part_of: (0..polys.len() as u32).collect(),
-            parts: vec![None; polys.len()],
+        return PairedParts {
+            n: polys.len(),
+            paired: None,
         };
     };
     let mut open = vec![false; polys.len()];
@@ -375,13 +383,82 @@ pub fn certify_solid_parts(polys: &[Polygon]) -> SolidParts {
             open_root[parts_of.find(i as u32) as usize] = true;
         }
     }
-    let (tris, volume) = loops.fan_triangles_of(&mut parts_of, |r| !open_root[r]);
+    for (i, o) in open.iter_mut().enumerate() {
+        *o = open_root[parts_of.find(i as u32) as usize];
+    }
+    PairedParts {
+        n: polys.len(),
+        paired: Some(Paired {
+            loops,
+            parts_of,
+            certified,
+            open_root,
+            open,
+        }),
+    }
+}
+
+/// Polygons paired up into parts ([`pair_solid_parts`]), to be certified.
+pub struct PairedParts {
+    n: usize,
+    /// `None` for a polygon off the grid: no part is certified.
+    paired: Option<Paired>,
+}
+
+/// What the pairing found.
+struct Paired {
+    loops: Loops,
+    parts_of: UnionFind,
+    /// Per point: its star certified embedded.
+    certified: Vec<bool>,
+    /// Per root: its part is open.
+    open_root: Vec<bool>,
+    /// Per polygon: its part is open.
+    open: Vec<bool>,
+}
+
+impl PairedParts {
+    /// `true` if polygon `i` lies in a part that no certificate can hold:
+    /// an open one (or any, with a polygon off the grid). The others may
+    /// still fail to be embedded.
+    pub fn open(&self, i: usize) -> bool {
+        self.paired.as_ref().is_none_or(|p| p.open[i])
+    }
+
+    /// The parts, each certified or not ([`certify_solid_parts`]).
+    pub fn certify(self) -> SolidParts {
+        let Some(Paired {
+            loops,
+            mut parts_of,
+            certified,
+            open_root,
+            ..
+        }) = self.paired
+        else {
+            return SolidParts {
+                part_of: (0..self.n as u32).collect(),
+                parts: vec![None; self.n],
+            };
+        };
+        certify_paired(self.n, &loops, &mut parts_of, &certified, &open_root)
+    }
+}
+
+/// [`PairedParts::certify`] of `n` polygons paired up.
+fn certify_paired(
+    n: usize,
+    loops: &Loops,
+    parts_of: &mut UnionFind,
+    certified: &[bool],
+    open_root: &[bool],
+) -> SolidParts {
+    let (tris, volume) = loops.fan_triangles_of(parts_of, |r| !open_root[r]);
     // per root: still a candidate, and its box
-    let mut good: Vec<bool> = (0..polys.len())
+    let mut good: Vec<bool> = (0..n)
         .map(|i| volume[i] > 0 && parts_of.is_root(i as u32) && !open_root[i])
         .collect();
-    let root: Vec<u32> = (0..polys.len() as u32).map(|i| parts_of.find(i)).collect();
-    let mut boxes = vec![([i32::MAX; 3], [i32::MIN; 3]); polys.len()];
+    let root: Vec<u32> = (0..n as u32).map(|i| parts_of.find(i)).collect();
+    let mut boxes = vec![([i32::MAX; 3], [i32::MIN; 3]); n];
     for (g, p) in loops.pts.iter().enumerate() {
         let (lo, hi) = &mut boxes[root[loops.corner_poly[g] as usize] as usize];
         *lo = [0, 1, 2].map(|k| lo[k].min(p[k]));
@@ -409,7 +486,7 @@ pub fn certify_solid_parts(polys: &[Polygon]) -> SolidParts {
         }
     }
     // parts numbered by their roots, which are their first polygons
-    let mut number = vec![u32::MAX; polys.len()];
+    let mut number = vec![u32::MAX; n];
     let mut parts = Vec::new();
     for (i, &r) in root.iter().enumerate() {
         if r as usize == i {

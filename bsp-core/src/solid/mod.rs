@@ -10,8 +10,9 @@ pub(crate) mod mesh;
 pub(crate) mod topology;
 
 pub use embedded::{
-    SolidBoundary, SolidParts, SurfaceDefect, certify_grid_polygons, certify_solid_boundary,
-    certify_solid_parts, meeting_pairs, triangles_disjoint,
+    PairedParts, SolidBoundary, SolidParts, SurfaceDefect, certify_grid_polygons,
+    certify_solid_boundary, certify_solid_parts, meeting_pairs, pair_solid_parts,
+    triangles_disjoint,
 };
 pub use import::{
     FaceImporter, ImportReport, all_planar, import_faces, import_faces_par, import_indexed_par,

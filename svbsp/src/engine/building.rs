@@ -7,18 +7,16 @@ use bsp_core::Polygon;
 use super::LightVolumes;
 use crate::engine::ShadowError;
 use crate::light::{Light, LightError, MAX_LIGHTS};
-use crate::psv::{ShadowVolumes, VolumeError};
-
-/// A light's tree, and per occluder what its building found of it (empty
-/// where not asked).
-type Built = (ShadowVolumes, Vec<Option<bool>>);
+use crate::psv::{Reached, ShadowVolumes, Stop, VolumeError};
 
 /// Per light, the faces a tree was built over while certifying, and the
-/// tree.
-type Guessed = Vec<(Vec<usize>, Result<Built, VolumeError>)>;
+/// tree (`None`: given up).
+type Guessed = Vec<(Vec<usize>, Result<Option<Reached>, VolumeError>)>;
 
-/// How a light's tree is built over the occluders of the given indices.
-type Build<'a> = dyn Fn(Light, Vec<usize>) -> Result<Built, VolumeError> + Sync + 'a;
+/// How a light's tree is built over the occluders of the given indices,
+/// given up (`None`) once the stop is raised.
+type Build<'a> =
+    dyn Fn(Light, Vec<usize>, Option<&Stop>) -> Result<Option<Reached>, VolumeError> + Sync + 'a;
 
 impl LightVolumes {
     /// [`LightVolumes::new_ordered`], and with `reach` what each tree's
@@ -42,12 +40,16 @@ impl LightVolumes {
         }
         // (polygons off the grid leave no part certified, so nothing is
         // left out and an error's index is the caller's)
-        let build = |l: Light, index: Vec<usize>| match reach {
-            true => ShadowVolumes::build_reached_among(l, occluders, &index),
+        let build_until = |l: Light, index: Vec<usize>, stop: Option<&Stop>| match reach {
+            true => ShadowVolumes::build_reached_among_until(l, occluders, &index, stop),
             false => {
                 let kept: Vec<&Polygon> = index.iter().map(|&i| &occluders[i]).collect();
-                ShadowVolumes::build(l, &kept).map(|v| (v, Vec::new()))
+                let built = ShadowVolumes::build_until(l, &kept, stop)?;
+                Ok(built.map(|v| (v, Vec::new())))
             }
+        };
+        let build = |l: Light, index: Vec<usize>| -> Result<Reached, VolumeError> {
+            Ok(build_until(l, index, None)?.expect("no stop"))
         };
         let kept = |l: Light, solids: &bsp_core::SolidParts| -> Vec<usize> {
             (order.iter().copied())
@@ -58,7 +60,7 @@ impl LightVolumes {
             Some(_) => (None, Vec::new()),
             None => {
                 let (solids, first) =
-                    LightVolumes::new_certifying(occluders, order, lights, &build);
+                    LightVolumes::new_certifying(occluders, order, lights, &build_until);
                 (Some(solids), first)
             }
         };
@@ -69,7 +71,7 @@ impl LightVolumes {
         for (l, (faced, tree)) in lights.iter().zip(first) {
             let index = kept(*l, solids);
             match tree {
-                Ok(t) if index == faced => built.push(t),
+                Ok(Some(t)) if index == faced => built.push(t),
                 _ => built.push(build(*l, index)?),
             }
         }
@@ -105,35 +107,61 @@ impl LightVolumes {
     /// parts leave out every other face (a scene of closed meshes lit
     /// from outside, and open faces toward the light), such a tree is the
     /// one the parts ask for, and is kept; otherwise it is built again.
-    /// The parts, and per light the faces its tree was built over with
-    /// the tree.
+    /// A light is not guessed for where the pairing of the parts' edges
+    /// (the certificate's first step) finds a face it does not face in an
+    /// open part (an open scan), and a guess is given up as soon as the
+    /// parts say it fails. The parts, and per light the faces its tree
+    /// was built over with the tree.
     fn new_certifying(
         occluders: &[Polygon],
         order: &[usize],
         lights: &[Light],
         build: &Build,
     ) -> (bsp_core::SolidParts, Guessed) {
-        let faced = |l: &Light| -> Vec<usize> {
-            (order.iter().copied())
-                .filter(|&i| l.faces(occluders[i].support()))
-                .collect()
+        let paired = bsp_core::pair_solid_parts(occluders);
+        // per light: the faces it faces, if every other face may be left out
+        let guess = |l: &Light| -> Option<Vec<usize>> {
+            let mut faced = Vec::with_capacity(order.len());
+            for &i in order {
+                match l.faces(occluders[i].support()) {
+                    true => faced.push(i),
+                    false if paired.open(i) => return None,
+                    false => {}
+                }
+            }
+            Some(faced)
         };
-        let first = &lights[..lights.len().min(2)];
-        rayon::join(
-            || bsp_core::certify_solid_parts(occluders),
-            || match *first {
-                [a, b] => {
-                    let (fa, fb) = (faced(&a), faced(&b));
-                    let (ta, tb) = rayon::join(|| build(a, fa.clone()), || build(b, fb.clone()));
-                    vec![(fa, ta), (fb, tb)]
+        let first: Vec<(Light, Vec<usize>)> = (lights.iter().take(2))
+            .map_while(|l| guess(l).map(|f| (*l, f)))
+            .collect();
+        if first.is_empty() {
+            return (paired.certify(), Vec::new());
+        }
+        let stops = [Stop::new(false), Stop::new(false)];
+        let certify = || {
+            let solids = paired.certify();
+            for ((l, _), stop) in first.iter().zip(&stops) {
+                let holds = (order.iter()).all(|&i| {
+                    let s = occluders[i].support();
+                    l.faces(s) || l.leaves_out(&solids, i, s)
+                });
+                if !holds {
+                    stop.store(true, std::sync::atomic::Ordering::Relaxed);
                 }
-                [a] => {
-                    let fa = faced(&a);
-                    let ta = build(a, fa.clone());
-                    vec![(fa, ta)]
-                }
-                _ => Vec::new(),
-            },
-        )
+            }
+            solids
+        };
+        let guessed = || match &first[..] {
+            [(a, fa), (b, fb)] => {
+                let (ta, tb) = rayon::join(
+                    || build(*a, fa.clone(), Some(&stops[0])),
+                    || build(*b, fb.clone(), Some(&stops[1])),
+                );
+                vec![(fa.clone(), ta), (fb.clone(), tb)]
+            }
+            [(a, fa)] => vec![(fa.clone(), build(*a, fa.clone(), Some(&stops[0])))],
+            _ => unreachable!("one or two lights"),
+        };
+        rayon::join(certify, guessed)
     }
 }

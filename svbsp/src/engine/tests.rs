@@ -274,3 +274,51 @@ fn a_large_face_passes_its_cells_in_runs_as_one_by_one() {
         }
     }
 }
+
+/// A build whose stop is raised gives up (`None`), and one whose stop
+/// stays down is the build without one.
+#[test]
+fn a_stopped_build_gives_up() {
+    use crate::psv::Stop;
+    let polys = [quad(0, 0, 8, 0), quad(4, 2, 4, 1)];
+    let light = Light::Point([3, 3, 8]);
+    let up = Stop::new(true);
+    assert!(
+        ShadowVolumes::build_until(light, &polys, Some(&up))
+            .unwrap()
+            .is_none()
+    );
+    let index = [0, 1];
+    let stopped = ShadowVolumes::build_reached_among_until(light, &polys, &index, Some(&up));
+    assert!(stopped.unwrap().is_none());
+    let down = Stop::new(false);
+    let (v, reached) = ShadowVolumes::build_reached_among_until(light, &polys, &index, Some(&down))
+        .unwrap()
+        .expect("not stopped");
+    let (w, reached_w) = ShadowVolumes::build_reached_among(light, &polys, &index).unwrap();
+    assert_eq!((v.node_count(), reached), (w.node_count(), reached_w));
+}
+
+/// The pairing of the certificate's first step finds the open parts:
+/// an open floor and a box with a face missing, not a closed box.
+#[test]
+fn the_pairing_finds_open_parts() {
+    let poly = |l: &Vec<[i32; 3]>| Polygon::from_grid_points(l, 0).unwrap();
+    let closed: Vec<Polygon> = bsp_fixtures::grid_cuboid([2, 2, 2], [5, 5, 5])
+        .iter()
+        .map(poly)
+        .collect();
+    let holed: Vec<Polygon> = bsp_fixtures::grid_cuboid([7, 2, 2], [9, 5, 5])
+        .iter()
+        .skip(1)
+        .map(poly)
+        .collect();
+    let mut scene = closed.clone();
+    scene.extend(holed.iter().cloned());
+    scene.push(quad(0, -4, 12, 0));
+    let paired = bsp_core::pair_solid_parts(&scene);
+    let open: Vec<bool> = (0..scene.len()).map(|i| paired.open(i)).collect();
+    assert!(open[..6].iter().all(|o| !o));
+    assert!(open[6..].iter().all(|&o| o));
+    assert_eq!(paired.certify(), bsp_core::certify_solid_parts(&scene));
+}
