@@ -84,14 +84,9 @@ pub(super) fn pass_runs(s: &mut Scratch, trees: &[(&ShadowVolumes, usize)]) -> b
     s.cur.clear();
     let mut changed = false;
     for (mut own, c) in done {
-        let mut pieces: Vec<_> = own.cur.iter().map(|(p, _)| p.clone()).collect();
+        let (mut pieces, flags): (Vec<_>, Vec<_>) = own.cur.drain(..).unzip();
         s.arena.append_since(&own.arena, mark, &mut pieces);
-        s.cur.extend(
-            pieces
-                .into_iter()
-                .zip(own.cur.drain(..))
-                .map(|(p, (_, f))| (p, f)),
-        );
+        s.cur.extend(pieces.into_iter().zip(flags));
         changed |= c;
     }
     changed
