@@ -14,7 +14,8 @@
 use bsp_core::{Grid, Point, Polygon, SolidParts};
 use svbsp::ShadowVolumes;
 
-use crate::{Error, Light, hiding, sun};
+use crate::sun::tiles::grid_bounds;
+use crate::{Error, Light, hiding};
 
 /// Per face the area each light reaches (`lit[face * lights + light]`),
 /// and per face its area, in the mesh's units squared.
@@ -36,7 +37,7 @@ pub(crate) fn lit_areas_on(
     let unit = grid.step() * grid.step();
     let placed = svbsp::place_lights(grid, lights).map_err(Error::Light)?;
     let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
-    let bounds = sun::grid_bounds(polys);
+    let bounds = grid_bounds(polys);
     let ranges = svbsp::receivers(polys);
     // per light (in parallel, each tree dropped when done), per receiver
     // the area it reaches

@@ -17,7 +17,7 @@ mod ply;
 mod regions;
 mod report;
 mod runs;
-mod tiles;
+pub(crate) mod tiles;
 pub use exact_time::{
     Interval, SunPath, day_paths, hides, interval_hours, intervals_json, sensor_intervals,
     study_plan, triangles,

@@ -24,10 +24,11 @@ use bsp_core::{Plane, Polygon, Side};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
-use crate::arena::pieces::{ArenaMark, EdgeRef, Piece, PieceArena, Vertex};
+use crate::arena::pieces::{EdgeRef, Piece, PieceArena, Vertex};
 use crate::arena::regions::{MergeCache, Region, Remerged, merge_cells};
 use crate::light::{Light, LightError, MAX_LIGHTS};
-use crate::psv::{LIT, SHADOW, ShadowVolumes, VolumeError};
+use crate::psv::filter::Walk;
+use crate::psv::{ShadowVolumes, VolumeError};
 
 /// Why shadows cannot be computed.
 #[derive(Clone, Debug, PartialEq)]
@@ -555,27 +556,6 @@ impl<'a> ShadowSet<'a> {
         self.pass_lights(s, facing & mask)
     }
 
-    /// Filters every cell of `s.cur` through the tree of each light in
-    /// `mask` for which the cell's flag is set, light after light; a cell
-    /// may come back cut, or shadowed for that light. Returns whether a
-    /// cell was cut or lost a light. Once the cells are many (a large
-    /// face, such as a ground, cut by its first light), the rest of the
-    /// lights pass over runs of them in parallel (`engine/passes.rs`).
-    fn pass_lights(&self, s: &mut Scratch, mask: u64) -> bool {
-        let trees: SmallVec<[(&ShadowVolumes, usize); 4]> = (self.trees.iter())
-            .filter(|(_, j)| mask & 1 << j != 0)
-            .copied()
-            .collect();
-        let mut changed = false;
-        for (k, &tree) in trees.iter().enumerate() {
-            if k > 0 && s.cur.len() >= passes::PARALLEL_CELLS {
-                return passes::pass_runs(s, &trees[k..]) | changed;
-            }
-            changed |= passes::pass(s, tree);
-        }
-        changed
-    }
-
     /// Merges the scratch's cells into regions and appends them.
     fn finish(
         &self,
@@ -678,7 +658,7 @@ pub struct Scratch {
     cur: Vec<(Piece, u64)>,
     next: Vec<(Piece, u64)>,
     out: Vec<(Piece, bool)>,
-    stack: Vec<Task>,
+    stack: Vec<Walk>,
     links: Vec<u32>,
     /// The receiver's first polygon, as it was added.
     whole: Piece,
@@ -764,118 +744,6 @@ pub enum Start<'a> {
     Uniform(u64),
     /// Cells kept by [`ShadowSet::shade_keeping`].
     Cells(&'a Cells),
-}
-
-pub(crate) enum Task {
-    Visit(Piece, u32),
-    /// Both pieces of `parent`'s cut start at `out[mark]`; the arena held
-    /// `arena` before the cut.
-    Merge {
-        parent: Piece,
-        mark: usize,
-        arena: ArenaMark,
-    },
-}
-
-/// Filters `piece` through a shadow-volume tree: the lit and shadowed
-/// pieces go to `out`.
-///
-/// First a quick test without cuts ([`crate::psv::reach`]): a piece that
-/// can only reach leaves of one kind is all lit or all in shadow, and
-/// stays whole. Otherwise the piece descends cut by every plane it
-/// straddles; a cut whose two sides come back as single pieces with the
-/// same flag is undone (the parent piece is kept, the arena rolled back),
-/// so only cuts that separate lit from shadow survive.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn filter(
-    sv: &ShadowVolumes,
-    arena: &mut PieceArena,
-    support: u32,
-    piece: Piece,
-    out: &mut Vec<(Piece, bool)>,
-    stack: &mut Vec<Task>,
-    links: &mut Vec<u32>,
-    sides: &mut SmallVec<[Side; 8]>,
-) {
-    // (where the quick test cannot tell, the exact descent starts at the
-    // first node the piece straddles: the same walk, less its first part)
-    let mut fork = sv.root;
-    match crate::psv::reach(
-        &sv.nodes,
-        sv.root,
-        |p| arena.sides(&piece, p),
-        crate::psv::REACH_BUDGET,
-        links,
-        &mut fork,
-    ) {
-        Some((true, false)) => return out.push((piece, true)),
-        Some((false, true)) => return out.push((piece, false)),
-        _ => {}
-    }
-    stack.clear();
-    stack.push(Task::Visit(piece, fork));
-    while let Some(t) = stack.pop() {
-        match t {
-            Task::Visit(mut p, mut link) => loop {
-                if link == LIT {
-                    out.push((p, true));
-                    break;
-                }
-                if link == SHADOW {
-                    out.push((p, false));
-                    break;
-                }
-                let n = &sv.nodes[link as usize];
-                // every vertex's side, kept for a split (classified once)
-                let s = arena.classify_into(&p, &n.plane, sides);
-                let (front, back) = match (n.cap, s.front, s.back) {
-                    // a cap: the part behind it is hidden
-                    (true, _, false) => {
-                        link = n.front;
-                        continue;
-                    }
-                    (true, false, true) => {
-                        out.push((p, false));
-                        break;
-                    }
-                    (true, true, true) => (n.front, SHADOW),
-                    // a plane through the light
-                    (false, true, false) | (false, false, false) => {
-                        link = n.front;
-                        continue;
-                    }
-                    (false, false, true) => {
-                        link = n.back;
-                        continue;
-                    }
-                    (false, true, true) => (n.front, n.back),
-                };
-                let mark = arena.mark();
-                let cut = arena.add_plane(n.plane);
-                let (f, b) = arena.split(support, &p, cut, sides);
-                stack.push(Task::Merge {
-                    parent: p,
-                    mark: out.len(),
-                    arena: mark,
-                });
-                stack.push(Task::Visit(b, back));
-                p = f;
-                link = front;
-            },
-            Task::Merge {
-                parent,
-                mark,
-                arena: am,
-            } => {
-                if out.len() == mark + 2 && out[mark].1 == out[mark + 1].1 {
-                    let lit = out[mark].1;
-                    out.truncate(mark);
-                    arena.rollback(am);
-                    out.push((parent, lit));
-                }
-            }
-        }
-    }
 }
 
 /// Fragments of many receivers in flat arrays: per fragment its face,

@@ -51,6 +51,7 @@ use std::sync::atomic::Ordering;
 use crate::arena::pieces::{EdgeRef, Piece, PieceArena, Sides, Vertex};
 use crate::light::Light;
 
+pub(crate) mod filter;
 mod rests;
 use rests::Rests;
 

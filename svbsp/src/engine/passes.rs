@@ -12,9 +12,11 @@
 //! threads.
 
 use rayon::prelude::*;
+use smallvec::SmallVec;
 
-use super::{Scratch, filter};
+use super::{Scratch, ShadowSet};
 use crate::psv::ShadowVolumes;
+use crate::psv::filter::filter;
 
 /// Cells from which the lights after the first pass over runs in
 /// parallel.
@@ -25,6 +27,29 @@ const MAX_RUNS: usize = 8;
 
 /// Cells a run holds at least.
 const MIN_RUN: usize = 64;
+
+impl ShadowSet<'_> {
+    /// Filters every cell of `s.cur` through the tree of each light in
+    /// `mask` for which the cell's flag is set, light after light; a cell
+    /// may come back cut, or shadowed for that light. Returns whether a
+    /// cell was cut or lost a light. Once the cells are many (a large
+    /// face, such as a ground, cut by its first light), the rest of the
+    /// lights pass over runs of them in parallel (`engine/passes.rs`).
+    pub(super) fn pass_lights(&self, s: &mut Scratch, mask: u64) -> bool {
+        let trees: SmallVec<[(&ShadowVolumes, usize); 4]> = (self.trees.iter())
+            .filter(|(_, j)| mask & 1 << j != 0)
+            .copied()
+            .collect();
+        let mut changed = false;
+        for (k, &tree) in trees.iter().enumerate() {
+            if k > 0 && s.cur.len() >= PARALLEL_CELLS {
+                return pass_runs(s, &trees[k..]) | changed;
+            }
+            changed |= pass(s, tree);
+        }
+        changed
+    }
+}
 
 /// The cells of `s.cur` whose flag for light `j` is set through `sv`,
 /// the tree of light `j`; whether a cell was cut or lost the light.

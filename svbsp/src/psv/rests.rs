@@ -229,7 +229,7 @@ impl ShadowVolumes {
         for p in polys {
             let piece = arena.add_polygon(p);
             out.clear();
-            crate::engine::filter(
+            super::filter::filter(
                 self, &mut arena, support, piece, &mut out, &mut stack, &mut links, &mut sides,
             );
             for (piece, _) in out.iter().filter(|o| o.1) {
