@@ -364,6 +364,27 @@ pub fn certify_solid_parts(polys: &[Polygon]) -> SolidParts {
 /// up into parts, which tells the parts that are open (or off the grid)
 /// and so cannot be certified, before the costlier test that the others
 /// are embedded ([`PairedParts::certify`]).
+///
+/// ```
+/// use bsp_core::{Polygon, certify_solid_parts, pair_solid_parts};
+/// let quad = |l: &[[i32; 3]; 4]| Polygon::from_grid_points(l, 0).unwrap();
+/// let mut scene: Vec<Polygon> = [
+///     [[0, 0, 0], [0, 1, 0], [1, 1, 0], [1, 0, 0]],
+///     [[0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],
+///     [[0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]],
+///     [[0, 1, 0], [0, 1, 1], [1, 1, 1], [1, 1, 0]],
+///     [[0, 0, 0], [0, 0, 1], [0, 1, 1], [0, 1, 0]],
+///     [[1, 0, 0], [1, 1, 0], [1, 1, 1], [1, 0, 1]],
+/// ]
+/// .iter()
+/// .map(quad)
+/// .collect();
+/// scene.push(quad(&[[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]]));
+/// let paired = pair_solid_parts(&scene);
+/// assert!(!paired.open(0)); // the cube is closed
+/// assert!(paired.open(6)); // the ground is not
+/// assert_eq!(paired.certify(), certify_solid_parts(&scene));
+/// ```
 pub fn pair_solid_parts(polys: &[Polygon]) -> PairedParts {
     let Ok(loops) = Loops::new(polys) else {
         return PairedParts {
@@ -399,6 +420,7 @@ pub fn pair_solid_parts(polys: &[Polygon]) -> PairedParts {
 }
 
 /// Polygons paired up into parts ([`pair_solid_parts`]), to be certified.
+#[derive(Debug)]
 pub struct PairedParts {
     n: usize,
     /// `None` for a polygon off the grid: no part is certified.
@@ -406,6 +428,7 @@ pub struct PairedParts {
 }
 
 /// What the pairing found.
+#[derive(Debug)]
 struct Paired {
     loops: Loops,
     parts_of: UnionFind,
@@ -506,6 +529,7 @@ fn certify_paired(
 
 /// The polygons' loops as grid points, every corner's point numbered by
 /// the point's first occurrence, and each corner's polygon.
+#[derive(Debug)]
 struct Loops {
     /// Polygon `i`'s corners are `start[i]..start[i + 1]`.
     start: Vec<u32>,
