@@ -454,9 +454,13 @@ impl LightView {
 ///
 /// ```
 /// use glam::DVec3;
-/// // a huge square right above: the whole hemisphere
-/// let big = [[-1e6, -1e6, 1.0], [1e6, -1e6, 1.0], [1e6, 1e6, 1.0], [-1e6, 1e6, 1.0]];
-/// assert!((svbsp::form_factor(DVec3::ZERO, DVec3::Z, &big) - 1.0).abs() < 1e-5);
+/// let square = |s: f64| [[-s, -s, 1.0], [s, -s, 1.0], [s, s, 1.0], [-s, s, 1.0]];
+/// let f = |s: f64| svbsp::form_factor(DVec3::ZERO, DVec3::Z, &square(s));
+/// // a wider square right above sends more, and all of the hemisphere
+/// // sends 1: a huge one nearly that
+/// assert!(0.0 < f(0.5) && f(0.5) < f(1.0) && f(1.0) < f(1e6) && f(1e6) <= 1.0);
+/// // seen from beside the square's plane, nothing
+/// assert_eq!(svbsp::form_factor(DVec3::new(0.0, 0.0, 1.0), DVec3::X, &square(1.0)), 0.0);
 /// ```
 pub fn form_factor(x: DVec3, normal: DVec3, polygon: &[[f64; 3]]) -> f64 {
     let n = polygon.len();

@@ -583,9 +583,11 @@ mod tests {
             const { std::cell::RefCell::new(Vec::new()) };
     }
 
-    /// An input radius in degrees too small for a strictly convex
-    /// quantized octagon: the disc is left to the `f64` chart.
-    const TINY_DISC_DEG: f64 = 1e-6;
+    /// A disc's radius of one quantization step of a direction (`1 /
+    /// MAX_COORD` radians): about the least a quantized octagon can hold,
+    /// where it may be no strictly convex cone and the disc is left to
+    /// the `f64` chart.
+    const TINY_DISC: f64 = 1.0 / bsp_core::MAX_COORD as f64;
 
     /// An exact `BigInt` of an `I256`.
     fn big(v: I256) -> BigInt {
@@ -819,7 +821,7 @@ mod tests {
             DVec3::Z,
             DVec3::new(-0.7, 0.4, 1.0),
         ] {
-            for radius in [TINY_DISC_DEG, 0.01, 0.2666] {
+            for radius in [TINY_DISC, 0.01, 0.2666] {
                 let disc = AreaLight::sun_disc(toward, radius).unwrap();
                 let sky: Vec<[i32; 3]> = (disc.corners().iter())
                     .map(|l| match l {

@@ -11,11 +11,61 @@ use bsp_fixtures::Rng;
 use glam::DVec3;
 use svbsp::{AreaClass, AreaLight, Light, Occluder, Visibility};
 
-use crate::oracle::{HPoint, Scene, Verdict};
+use num_traits::{Signed, Zero};
+
+use crate::oracle::{HPoint, Q, Scene, Verdict, twice_area_vector};
 
 /// A number in `0..n`.
 fn below(rng: &mut Rng, n: u64) -> i32 {
     (rng.next_u64() % n) as i32
+}
+
+/// Whether `fragments` tile the face of grid corners `corners` by area,
+/// exactly: their area vectors (twice, exact rationals) add up to the
+/// face's (each fragment turning as the face does, none with area the
+/// face lacks).
+fn tile_by_area<'a>(
+    corners: &[[i32; 3]],
+    fragments: impl IntoIterator<Item = &'a Polygon>,
+) -> bool {
+    let face: Vec<HPoint> = corners
+        .iter()
+        .map(|c| HPoint::grid(c.map(i64::from)))
+        .collect();
+    let mut sum: [Q; 3] = std::array::from_fn(|_| Q::zero());
+    for f in fragments {
+        let a = twice_area_vector(&exact_corners(f));
+        for k in 0..3 {
+            sum[k] += &a[k];
+        }
+    }
+    sum == twice_area_vector(&face)
+}
+
+/// The corners of a polygon with exact corners, as exact points.
+fn exact_corners(p: &Polygon) -> Vec<HPoint> {
+    (p.vertices().iter())
+        .map(|v| HPoint::of_vertex(&svbsp::Vertex::from_point(v)))
+        .collect()
+}
+
+/// Per class (`AreaClass as usize`), twice the fragments' area, exactly:
+/// their area vectors summed (fragments of one face are parallel and turn
+/// alike), measured by the largest component's size.
+fn class_areas(fs: &[svbsp::AreaFragment]) -> [Q; 4] {
+    class_areas_of(fs.iter().map(|f| (&f.polygon, f.class as usize)))
+}
+
+/// [`class_areas`] of polygons given with their classes.
+fn class_areas_of<'a>(fs: impl IntoIterator<Item = (&'a Polygon, usize)>) -> [Q; 4] {
+    let mut sums: [[Q; 3]; 4] = std::array::from_fn(|_| std::array::from_fn(|_| Q::zero()));
+    for (polygon, class) in fs {
+        let a = twice_area_vector(&exact_corners(polygon));
+        for k in 0..3 {
+            sums[class][k] += &a[k];
+        }
+    }
+    sums.map(|v| v.iter().map(Signed::abs).max().expect("three components"))
 }
 
 /// A convex polygon's area, from its correctly rounded corners.
@@ -300,15 +350,12 @@ fn classified_faces_agree_with_the_view() {
         // every face with the corners' point-light shadow volumes
         let together = light.classify_faces(&faces);
         let ways = [(0, false), (1, false), (0, true), (1, true)];
-        for (r, total, fragments) in ways.map(|(r, all)| {
-            let total = [240.0 * 240.0, 240.0 * 120.0][r];
-            match all {
-                true => (r, total, together[r].clone()),
-                false => (r, total, light.classify_face(&faces[r], &faces)),
-            }
+        for (r, fragments) in ways.map(|(r, all)| match all {
+            true => (r, together[r].clone()),
+            false => (r, light.classify_face(&faces[r], &faces)),
         }) {
-            let area: f64 = fragments.iter().map(|f| area_of(&f.polygon)).sum();
-            assert!((area - total).abs() < 1e-6 * total, "{area}");
+            let polygons = fragments.iter().map(|f| &f.polygon);
+            assert!(tile_by_area(faces[r].corners(), polygons), "face {r}");
             let plane = *faces[r].plane();
             for _ in 0..96 {
                 let (u, v) = (below(&mut rng, 240) - 120, below(&mut rng, 120));
@@ -408,24 +455,12 @@ fn classified_scenes_tile_their_faces_on_any_thread_count() {
     };
     let one = run(1);
     assert_eq!(key(&one), key(&run(3)));
-    let area = |p: &[[f64; 3]]| {
-        let v: Vec<DVec3> = p.iter().map(|&c| DVec3::from_array(c)).collect();
-        svbsp::polygon_area(&v)
-    };
     let mut classes = std::collections::HashSet::new();
     for (face, fragments) in faces.iter().zip(&one) {
-        let whole = area(
-            &face
-                .corners()
-                .iter()
-                .map(|c| c.map(f64::from))
-                .collect::<Vec<_>>(),
-        );
-        let parts: f64 = fragments
-            .iter()
-            .map(|f| area(&f.polygon.vertices_f64()))
-            .sum();
-        assert!((parts - whole).abs() <= 1e-9 * whole, "{parts} of {whole}");
+        assert!(tile_by_area(
+            face.corners(),
+            fragments.iter().map(|f| &f.polygon)
+        ));
         classes.extend(fragments.iter().map(|f| f.class));
     }
     assert!(classes.contains(&AreaClass::Penumbra) && classes.contains(&AreaClass::Umbra));
@@ -434,9 +469,20 @@ fn classified_scenes_tile_their_faces_on_any_thread_count() {
 /// Per face, the area classified lit by `light` in the area engine, and
 /// the lit area of the same faces under `point` by the partitioned
 /// shadow volumes.
-fn lit_areas(light: &AreaLight, point: Light, faces: &[Vec<[i32; 3]>]) -> (Vec<f64>, Vec<f64>) {
+fn lit_areas(
+    light: &AreaLight,
+    point: Light,
+    faces: &[Vec<[i32; 3]>],
+) -> (Vec<[Q; 3]>, Vec<[Q; 3]>) {
     let occluders: Vec<Occluder> = faces.iter().map(|f| Occluder::new(f).unwrap()).collect();
     let polys = polygons(faces);
+    let zero = || -> [Q; 3] { std::array::from_fn(|_| Q::zero()) };
+    let add = |sum: &mut [Q; 3], corners: Vec<HPoint>| {
+        let a = twice_area_vector(&corners);
+        for k in 0..3 {
+            sum[k] += &a[k];
+        }
+    };
     let area = light
         .classify_faces(&occluders)
         .iter()
@@ -446,18 +492,21 @@ fn lit_areas(light: &AreaLight, point: Light, faces: &[Vec<[i32; 3]>]) -> (Vec<f
                     .all(|f| matches!(f.class, AreaClass::Lit | AreaClass::Umbra)),
                 "a light of no extent makes no penumbra"
             );
-            fs.iter()
-                .filter(|f| f.class == AreaClass::Lit)
-                .map(|f| area_of(&f.polygon))
-                .sum()
+            let mut sum = zero();
+            for f in fs.iter().filter(|f| f.class == AreaClass::Lit) {
+                let corners = (f.polygon.vertices().iter())
+                    .map(|v| HPoint::of_vertex(&svbsp::Vertex::from_point(v)))
+                    .collect();
+                add(&mut sum, corners);
+            }
+            sum
         })
         .collect();
-    let (batch, _) = svbsp::shadow_fragments(&polys, &[point]).unwrap();
-    let grid = bsp_core::Grid::new(DVec3::ZERO, 0).unwrap();
-    let mut psv = vec![0.0; faces.len()];
-    let mut buf = Vec::new();
-    for f in batch.fragments().filter(|f| f.lit(0)) {
-        psv[f.face() as usize] += svbsp::fragment_area(&f, &grid, &mut buf);
+    // the lit parts the point light's tree finds of every face, exactly
+    let (_, parts) = svbsp::ShadowVolumes::lit_parts(point, &polys).unwrap();
+    let mut psv: Vec<[Q; 3]> = (0..faces.len()).map(|_| zero()).collect();
+    for (i, corners) in parts {
+        add(&mut psv[i], corners.iter().map(HPoint::of_vertex).collect());
     }
     (area, psv)
 }
@@ -491,12 +540,12 @@ fn lights_of_no_extent_equal_the_point_light_and_the_sun() {
         for (light, point) in cases {
             let (area, psv) = lit_areas(&light, point, &faces);
             for (i, (a, p)) in area.iter().zip(&psv).enumerate() {
-                assert!(
-                    (a - p).abs() <= 1e-9 * 240.0 * 240.0,
-                    "round {round}, face {i}: {a} lit by the limit, {p} by {point:?}"
+                assert_eq!(
+                    a, p,
+                    "round {round}, face {i}: lit by the limit, and by {point:?}"
                 );
             }
-            assert!(area.iter().sum::<f64>() > 0.0);
+            assert!(area.iter().any(|a| a.iter().any(|c| !c.is_zero())));
         }
     }
 }
@@ -654,8 +703,10 @@ fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
         .map(|l| l.classify_face(&faces[0], &faces))
         .collect();
     let ground_fragments = &all[0];
-    let area: f64 = ground_fragments.iter().map(|f| area_of(&f.polygon)).sum();
-    assert!((area - 240.0 * 240.0).abs() < 1e-6 * area, "{area}");
+    assert!(tile_by_area(
+        faces[0].corners(),
+        ground_fragments.iter().map(|f| &f.polygon)
+    ));
     let mut checked = 0;
     let mut kinds = std::collections::HashSet::new();
     for _ in 0..2000 {
@@ -728,24 +779,15 @@ fn the_near_occluders_are_all_that_matter() {
         AreaLight::new(&square_light(cx - side, cy - side, 2 * side, top + side)).unwrap(),
         AreaLight::sun_disc(glam::DVec3::new(0.3, -0.2, 1.0), 2f64.to_radians()).unwrap(),
     ];
-    let areas = |fs: &[svbsp::AreaFragment]| -> [f64; 4] {
-        let mut a = [0.0; 4];
-        for f in fs {
-            a[f.class as usize] += area_of(&f.polygon);
-        }
-        a
-    };
     for light in &lights {
         let fast = light.classify_faces(&faces);
         let mut classes = std::collections::HashSet::new();
         for (i, face) in faces.iter().enumerate() {
-            let (a, b) = (areas(&fast[i]), areas(&light.classify_face(face, &faces)));
-            for k in 0..4 {
-                assert!(
-                    (a[k] - b[k]).abs() <= 1e-9 * (1.0 + b[k]),
-                    "face {i}: {a:?} against {b:?}"
-                );
-            }
+            let (a, b) = (
+                class_areas(&fast[i]),
+                class_areas(&light.classify_face(face, &faces)),
+            );
+            assert_eq!(a, b, "face {i}");
             classes.extend(fast[i].iter().map(|f| f.class));
         }
         assert!(classes.len() >= 3, "{classes:?}");
@@ -771,22 +813,15 @@ fn a_square_and_its_two_triangles_cast_the_same_umbra() {
         Occluder::new(&[q[0], q[1], q[2]]).unwrap(),
         Occluder::new(&[q[0], q[2], q[3]]).unwrap(),
     ];
-    let areas = |faces: &[Occluder]| -> [f64; 4] {
-        let mut a = [0.0; 4];
-        for f in light.classify_face(&ground, faces) {
-            a[f.class as usize] += area_of(&f.polygon);
-        }
-        a
-    };
-    let total = 400.0 * 400.0;
-    let mut want = [0.0; 4];
-    want[AreaClass::Lit as usize] = total - 14_400.0;
-    want[AreaClass::Penumbra as usize] = 14_400.0 - 1_600.0;
-    want[AreaClass::Umbra as usize] = 1_600.0;
+    let areas = |faces: &[Occluder]| class_areas(&light.classify_face(&ground, faces));
+    // (twice the areas)
+    let total = 2 * 400 * 400;
+    let mut want: [Q; 4] = std::array::from_fn(|_| Q::zero());
+    want[AreaClass::Lit as usize] = Q::from_integer((total - 2 * 14_400).into());
+    want[AreaClass::Penumbra as usize] = Q::from_integer((2 * (14_400 - 1_600)).into());
+    want[AreaClass::Umbra as usize] = Q::from_integer((2 * 1_600).into());
     for got in [areas(&whole), areas(&halves)] {
-        for k in 0..4 {
-            assert!((got[k] - want[k]).abs() < 1e-6, "{got:?} against {want:?}");
-        }
+        assert_eq!(got, want);
     }
 }
 
@@ -834,38 +869,29 @@ fn a_mesh_cut_both_ways_agrees_with_the_view() {
     let (v, tris) = bsp_fixtures::shapes::uv_sphere(400);
     let (grid, faces, light) = spheres_under_a_light(&v, &tris, &[DVec3::new(0.2, -0.1, 2.0)]);
     let fast = light.classify_faces(&faces);
-    let areas = |fs: &[svbsp::AreaFragment]| -> [f64; 4] {
-        let mut a = [0.0; 4];
-        for f in fs {
-            a[f.class as usize] += area_of(&f.polygon);
-        }
-        a
-    };
-    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * (1.0 + b);
     let (lit, penumbra, umbra, undecided) = (0, 1, 2, 3);
     for i in (0..faces.len()).step_by(10).chain([0]) {
         let (a, b) = (
-            areas(&fast[i]),
-            areas(&light.classify_face(&faces[i], &faces)),
+            class_areas(&fast[i]),
+            class_areas(&light.classify_face(&faces[i], &faces)),
         );
-        assert!(close(a[lit], b[lit]), "face {i}: {a:?} against {b:?}");
-        assert!(
-            close(a[penumbra], b[penumbra]),
+        assert_eq!(a[lit], b[lit], "face {i}: {a:?} against {b:?}");
+        assert_eq!(a[penumbra], b[penumbra], "face {i}: {a:?} against {b:?}");
+        assert_eq!(
+            &a[umbra] + &a[undecided],
+            &b[umbra] + &b[undecided],
             "face {i}: {a:?} against {b:?}"
         );
         assert!(
-            close(a[umbra] + a[undecided], b[umbra] + b[undecided]),
-            "face {i}: {a:?} against {b:?}"
-        );
-        assert!(
-            a[undecided] <= b[undecided] * (1.0 + 1e-9),
+            a[undecided] <= b[undecided],
             "face {i}: {a:?} against {b:?}"
         );
         if i == 0 {
             // the ground: the sphere's joint umbra, undecided without
             // the inner occluders, is mostly decided with them
             assert!(
-                b[undecided] > 0.05 * b[umbra] && a[undecided] < 0.5 * b[undecided],
+                &b[undecided] * Q::from_integer(20.into()) > b[umbra]
+                    && &a[undecided] * Q::from_integer(2.into()) < b[undecided],
                 "the ground: {a:?} against {b:?}"
             );
         }
@@ -874,17 +900,15 @@ fn a_mesh_cut_both_ways_agrees_with_the_view() {
     // near have their boxes narrowed to the slab round their plane)
     let soft = svbsp::soft_shadows(std::slice::from_ref(&light), &faces).unwrap();
     for i in (0..faces.len()).step_by(10).chain([0]) {
-        let mut a = [0.0; 4];
-        for f in &soft[i] {
-            a[f.class(0) as usize] += area_of(&f.polygon);
-        }
-        let b = areas(&light.classify_face(&faces[i], &faces));
+        let a = class_areas_of(soft[i].iter().map(|f| (&f.polygon, f.class(0) as usize)));
+        let b = class_areas(&light.classify_face(&faces[i], &faces));
         assert!(
-            close(a[lit], b[lit]) && close(a[penumbra], b[penumbra]),
+            a[lit] == b[lit] && a[penumbra] == b[penumbra],
             "face {i}: {a:?} against {b:?}"
         );
-        assert!(
-            close(a[umbra] + a[undecided], b[umbra] + b[undecided]),
+        assert_eq!(
+            &a[umbra] + &a[undecided],
+            &b[umbra] + &b[undecided],
             "face {i}: {a:?} against {b:?}"
         );
     }

@@ -678,6 +678,13 @@ pub(crate) fn check_flags(
 
 /// Twice the area vector of a polygon, `Σ v_i × v_{i+1}`, as an integer
 /// vector over the positive denominator `Π w_i`.
+/// Twice a polygon's area vector, exactly: the sum of its edges' cross
+/// products (pointing where the polygon turns counter-clockwise).
+pub(crate) fn twice_area_vector(verts: &[HPoint]) -> [Q; 3] {
+    let (a, den) = area2(verts);
+    a.map(|c| Q::new(c, den.clone()))
+}
+
 fn area2(verts: &[HPoint]) -> (Z3, BigInt) {
     let k = verts.len();
     let mut a = z3([0, 0, 0]);
@@ -720,25 +727,24 @@ fn separated(a: &[HPoint], b: &[HPoint], ax: usize, ccw: bool) -> bool {
     })
 }
 
-/// A fragment's exact vertices and a float box around them, stored as
+/// A fragment's exact vertices and an integer box around them, stored as
 /// `[min; -max]`.
-type Boxed = (Vec<HPoint>, [f64; 6]);
+type Boxed = (Vec<HPoint>, [i64; 6]);
 
-fn boxed(verts: &[HPoint]) -> [f64; 6] {
-    // a box around the exact vertices (the margin dwarfs the float error),
-    // to skip exact tests on far pairs
-    let mut bb = [f64::INFINITY; 6];
+/// The least integer box holding the exact vertices (to skip exact tests
+/// on pairs whose boxes are apart).
+fn boxed(verts: &[HPoint]) -> [i64; 6] {
+    let mut bb = [i64::MAX; 6];
     for v in verts {
-        for (k, x) in v.f64().into_iter().enumerate() {
-            let m = 1e-9 * (x.abs() + 1.0);
-            bb[k] = bb[k].min(x - m);
-            bb[k + 3] = bb[k + 3].min(-(x + m));
+        for (k, (lo, hi)) in v.int_box().into_iter().enumerate() {
+            bb[k] = bb[k].min(lo);
+            bb[k + 3] = bb[k + 3].min(-hi);
         }
     }
     bb
 }
 
-fn boxes_apart(a: &[f64; 6], b: &[f64; 6]) -> bool {
+fn boxes_apart(a: &[i64; 6], b: &[i64; 6]) -> bool {
     (0..3).any(|k| -a[k + 3] < b[k] || -b[k + 3] < a[k])
 }
 
@@ -933,7 +939,7 @@ pub(crate) fn check_regions(scene: &Scene, regions: &[Region]) -> Result<(), Str
     // share a stretch of edge
     for (face, list) in &by_face {
         let (ax, _) = projection(&scene.faces[*face]);
-        let items: Vec<(usize, &Vec<HPoint>, [f64; 6])> = list
+        let items: Vec<(usize, &Vec<HPoint>, [i64; 6])> = list
             .iter()
             .flat_map(|&i| regions[i].pieces.iter().map(move |p| (i, p, boxed(p))))
             .collect();
