@@ -189,18 +189,7 @@ impl LightVolumes {
         solids: &bsp_core::SolidParts,
     ) -> Result<LightVolumes, ShadowError> {
         let order: Vec<usize> = (0..occluders.len()).collect();
-        LightVolumes::new_ordered(occluders, &order, lights, solids)
-    }
-
-    /// [`LightVolumes::new_with`] with the occluders taken in the order of
-    /// the indices `order` (each tree is built in that order).
-    pub(crate) fn new_ordered(
-        occluders: &[Polygon],
-        order: &[usize],
-        lights: &[Light],
-        solids: &bsp_core::SolidParts,
-    ) -> Result<LightVolumes, ShadowError> {
-        LightVolumes::new_built(occluders, order, lights, Some(solids), false)
+        LightVolumes::new_built(occluders, &order, lights, Some(solids), false)
     }
 
     /// The lights, in order: bit `i` of a fragment's flags is light `i`.

@@ -19,8 +19,9 @@ type Build<'a> =
     dyn Fn(Light, Vec<usize>, Option<&Stop>) -> Result<Option<Reached>, VolumeError> + Sync + 'a;
 
 impl LightVolumes {
-    /// [`LightVolumes::new_ordered`], and with `reach` what each tree's
-    /// building found of the occluders it holds
+    /// The trees of `lights` over `occluders` taken in the order of the
+    /// indices `order` ([`LightVolumes::new_with`]), and with `reach`
+    /// what each tree's building found of the occluders it holds
     /// ([`ShadowVolumes::build_reached`]). With `solids` `None`, the
     /// occluders' parts are certified here, while the first two lights'
     /// trees are built over the faces they face (see

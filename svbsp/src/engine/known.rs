@@ -25,8 +25,10 @@ use crate::light::Light;
 use crate::psv::ShadowVolumes;
 
 impl LightVolumes {
-    /// [`LightVolumes::new_ordered`], keeping what each tree's building
-    /// found of the occluders, for [`LightVolumes::set_for_occluders`].
+    /// [`LightVolumes::new_with`] with the occluders taken in the order of
+    /// the indices `order` (each tree is built in that order), keeping
+    /// what each tree's building found of the occluders, for
+    /// [`LightVolumes::set_for_occluders`].
     pub(crate) fn new_ordered_reaching(
         occluders: &[Polygon],
         order: &[usize],
