@@ -7,12 +7,14 @@
 
 use std::collections::HashMap;
 
+use rayon::prelude::*;
+
 use bsp_core::{GridPoint, Plane};
 
 use crate::area::Occluder;
 
 /// The faces' plane up to orientation: the same key for both sides.
-pub(crate) fn plane_key(p: &Plane) -> ([i64; 3], i128) {
+pub(crate) fn plane_key(p: &Plane) -> PlaneKey {
     let (n, d) = (p.normal(), p.offset());
     let first = n.iter().find(|&&c| c != 0).copied().unwrap_or(0);
     if first < 0 {
@@ -50,37 +52,53 @@ pub(crate) fn coplanar_blockers(faces: &[Occluder]) -> Vec<Occluder> {
 /// [`coplanar_blockers`], with each blocker's faces (their numbers in
 /// `faces`, ascending).
 pub(crate) fn coplanar_blockers_of(faces: &[Occluder]) -> (Vec<Occluder>, Vec<Vec<u32>>) {
-    type Group = Vec<(Vec<GridPoint>, Vec<u32>)>;
-    let mut groups: HashMap<([i64; 3], i128), Group> = HashMap::new();
-    for (i, f) in faces.iter().enumerate() {
-        let key = plane_key(f.plane());
-        let mut corners = f.corners().to_vec();
-        // one orientation per plane: the key's
-        if f.plane().normal() != key.0 {
-            corners.reverse();
-        }
-        groups
-            .entry(key)
-            .or_default()
-            .push((corners, vec![i as u32]));
-    }
-    let mut keys: Vec<_> = groups.keys().copied().collect();
-    keys.sort_unstable();
-    let mut out = Vec::new();
-    for key in keys {
-        let mut polys = groups.remove(&key).unwrap_or_default();
-        polys.sort();
-        out.extend(merge_group(polys));
-    }
+    // each face by its plane's key, in the key's orientation (one per
+    // plane), then by its corners and number: each plane's faces are one
+    // run, in the order of their corners
+    let mut keyed: Vec<(PlaneKey, Vec<GridPoint>, u32)> = faces
+        .par_iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let key = plane_key(f.plane());
+            let mut corners = f.corners().to_vec();
+            if f.plane().normal() != key.0 {
+                corners.reverse();
+            }
+            (key, corners, i as u32)
+        })
+        .collect();
+    keyed.par_sort_unstable();
+    let runs: Vec<_> = keyed.chunk_by_mut(|a, b| a.0 == b.0).collect();
+    let mut out: Vec<(Occluder, Vec<u32>)> = runs
+        .into_par_iter()
+        .flat_map_iter(|run| {
+            let polys = run
+                .iter_mut()
+                .map(|(_, corners, i)| (std::mem::take(corners), vec![*i]))
+                .collect();
+            merge_group(polys)
+        })
+        .collect();
     // in the order of their corners: every face meets its occluders in
     // that order (index order), whatever order the faces came in
-    out.sort_by(|a, b| a.0.corners().cmp(b.0.corners()));
+    out.par_sort_by(|a, b| a.0.corners().cmp(b.0.corners()));
     out.into_iter().unzip()
 }
+
+/// A plane up to orientation ([`plane_key`]).
+type PlaneKey = ([i64; 3], i128);
 
 /// One plane's polygons merged until no two that share an edge have a
 /// convex union.
 fn merge_group(mut polys: Vec<(Vec<GridPoint>, Vec<u32>)>) -> Vec<(Occluder, Vec<u32>)> {
+    if let [(p, from)] = &mut polys[..] {
+        let from = std::mem::take(from);
+        return Occluder::new(p)
+            .ok()
+            .map(|o| (o, from))
+            .into_iter()
+            .collect();
+    }
     let mut alive = vec![true; polys.len()];
     loop {
         let mut edges: HashMap<(GridPoint, GridPoint), usize> = HashMap::new();

@@ -197,24 +197,38 @@ impl<'a> SoftVolumes<'a> {
         if lights.len() > MAX_LIGHTS {
             return Err(LightError::TooMany(lights.len()));
         }
-        let (blockers, sources) = coplanar_blockers_of(faces);
-        let (polygons, solids) = certified(faces);
-        let regions: Vec<Vec<Option<Regions>>> = lights
-            .iter()
-            .map(|l| blockers.par_iter().map(|o| l.regions(o)).collect())
-            .collect();
-        let (near, reach) = lights
-            .iter()
-            .zip(&regions)
-            .map(|(l, r)| near_lists(l.corners(), faces, (&blockers, r)))
-            .unzip();
+        // the occluders' volumes and near lists beside the certificate
+        // and what hangs on it (both sides use every core in parts)
+        let ((blockers, sources, regions, (near, reach)), (solids, cores, sealed, corners)) =
+            rayon::join(
+                || {
+                    let (blockers, sources) = coplanar_blockers_of(faces);
+                    let regions: Vec<Vec<Option<Regions>>> = lights
+                        .iter()
+                        .map(|l| blockers.par_iter().map(|o| l.regions(o)).collect())
+                        .collect();
+                    let near: (Vec<_>, Vec<_>) = lights
+                        .iter()
+                        .zip(&regions)
+                        .map(|(l, r)| near_lists(l.corners(), faces, (&blockers, r)))
+                        .unzip();
+                    (blockers, sources, regions, near)
+                },
+                || {
+                    let (polygons, solids) = certified(faces);
+                    let cores = crate::cores::cores_per_light(lights, faces, &solids);
+                    let sealed: Vec<Vec<bool>> = lights
+                        .iter()
+                        .map(|l| crate::sealed::sealed_faces(l, faces, &solids))
+                        .collect();
+                    let corners = corner_shadows(lights, (faces, &polygons), &solids);
+                    (solids, cores, sealed, corners)
+                },
+            );
         Ok(SoftVolumes {
-            cores: crate::cores::cores_per_light(lights, faces, &solids),
-            sealed: lights
-                .iter()
-                .map(|l| crate::sealed::sealed_faces(l, faces, &solids))
-                .collect(),
-            corners: corner_shadows(lights, (faces, &polygons), &solids),
+            cores,
+            sealed,
+            corners,
             backs: SolidBacks::new(faces, &sources, &solids),
             lights,
             faces,
@@ -457,19 +471,24 @@ fn soft_face(
         }
         // the inner occluders last: they cut only what stays undecided
         let light_corners = light.corners();
-        let occluders = near[k]
-            .iter()
-            .filter_map(|&j| {
-                let r = regions[k][j as usize].as_ref()?;
-                let reach = reach[k][j as usize];
-                match near[k].len() > TIGHTENED {
-                    true => Some((
-                        r,
-                        in_slab(reach, light_corners, &run.blockers[j as usize], face)?,
-                    )),
-                    false => Some((r, reach)),
-                }
-            })
+        let occluder = |&j: &u32| {
+            let r = regions[k][j as usize].as_ref()?;
+            let reach = reach[k][j as usize];
+            match near[k].len() > TIGHTENED {
+                true => Some((
+                    r,
+                    in_slab(reach, light_corners, &run.blockers[j as usize], face)?,
+                )),
+                false => Some((r, reach)),
+            }
+        };
+        // (a ground under a mesh has them all: in parallel, in order)
+        let occluders: Vec<(&Regions, Reach)> = match near[k].len() > PARALLEL_OCCLUDERS {
+            true => near[k].par_iter().filter_map(occluder).collect(),
+            false => near[k].iter().filter_map(occluder).collect(),
+        };
+        let occluders = occluders
+            .into_iter()
             .chain(crate::cores::cores_at(&run.cores[k], face));
         let set = corners[k].as_ref().map(LightVolumes::set_for_occluders);
         let mut seen = corner_cells(set.as_ref(), (face, i, run.faces.len()), scratch);
@@ -546,6 +565,10 @@ fn soft_face(
         })
         .collect()
 }
+
+/// A face with more occluders near it than this has them prepared in
+/// parallel (their boxes narrowed, their tests for its points).
+const PARALLEL_OCCLUDERS: usize = 1024;
 
 /// A face with more occluders near it than this has their boxes
 /// ([`Reach`]) narrowed to what their volumes hold of the slab round its
@@ -754,21 +777,23 @@ impl<'a> Hiders<'a> {
         // of `slab_box` around its plane
         let face_box = grid_box(face.corners());
         let near = face_box.map(|[lo, hi]| [lo - 1, hi + 1]);
-        let occluders: Vec<Hider<'a>> = occluders
-            .into_iter()
-            .filter_map(|(o, r, b, back)| {
-                let Probing::NearFace { slab } = probing else {
-                    return Some((o, Cow::Borrowed(&r.penumbra[..]), b, back));
-                };
-                let tests = face_tests(face.corners(), &r.penumbra)?;
-                let b = match slab.then(|| slab_box(light, o.corners(), face.plane())) {
-                    Some(InSlab::Nothing) => return None,
-                    Some(InSlab::Within(s)) => meet(meet(b, s)?, near)?,
-                    Some(InSlab::Unbounded) | None => meet(b, near)?,
-                };
-                Some((o, Cow::Owned(tests), b, back))
-            })
-            .collect();
+        let hider = |(o, r, b, back): (&'a Occluder, &'a Regions, Box3, _)| {
+            let Probing::NearFace { slab } = probing else {
+                return Some((o, Cow::Borrowed(&r.penumbra[..]), b, back));
+            };
+            let tests = face_tests(face.corners(), &r.penumbra)?;
+            let b = match slab.then(|| slab_box(light, o.corners(), face.plane())) {
+                Some(InSlab::Nothing) => return None,
+                Some(InSlab::Within(s)) => meet(meet(b, s)?, near)?,
+                Some(InSlab::Unbounded) | None => meet(b, near)?,
+            };
+            Some((o, Cow::Owned(tests), b, back))
+        };
+        // (a ground under a mesh has them all: in parallel, in order)
+        let occluders: Vec<Hider<'a>> = match occluders.len() > PARALLEL_OCCLUDERS {
+            true => occluders.into_par_iter().filter_map(hider).collect(),
+            false => occluders.into_iter().filter_map(hider).collect(),
+        };
         let boxes: Vec<Box3> = occluders.iter().map(|o| o.2).collect();
         Hiders {
             grid: CellGrid::new(face_box, &boxes),
