@@ -101,8 +101,12 @@ pub(crate) fn scene_box(faces: &[Occluder]) -> Option<Box3> {
     faces.iter().map(|f| grid_box(f.corners())).reduce(union)
 }
 
-/// Into how many boxes [`near_lists`] cuts an occluder's sweep.
-const SWEEP_PARTS: usize = 4;
+/// Into how many boxes [`near_lists`] cuts an occluder's sweep. A slanted
+/// sweep's box is as wide as its slope times its length: at bunny-99k
+/// under a 1 × 1 light, 4 boxes let 28.1M face boxes through to the
+/// exact test for 3.4M pairs kept, 16 boxes 10.2M (12, 16 and 24 gave
+/// the same time; more boxes cost more cell visits than they save).
+const SWEEP_PARTS: usize = 16;
 
 /// Whether grid points `corners` lie in the closed outside of one of the
 /// half-spaces `hs` (a face there has no area inside the volume).
