@@ -248,6 +248,8 @@ pub fn write_soft_shadows(
     )
     .map_err(Error::Io)?;
     phases.push(("write", start.elapsed()));
+    // (freed by the pool: a caller about to exit need not wait for it)
+    rayon::spawn(move || drop(fragments));
     Ok(SoftFile {
         written,
         phases,

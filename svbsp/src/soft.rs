@@ -134,7 +134,10 @@ pub fn soft_shadows_with(
     faces: &[Occluder],
     on_faces: &(dyn Fn(usize) + Sync),
 ) -> Result<Vec<Vec<SoftFragment>>, LightError> {
-    Ok(SoftVolumes::new(lights, faces)?.fragments_with(on_faces))
+    let run = SoftVolumes::new(lights, faces)?;
+    let fragments = run.fragments_with(on_faces);
+    run.free_later();
+    Ok(fragments)
 }
 
 /// A soft-shadow run of `lights` over `faces`, every face an occluder
@@ -237,6 +240,28 @@ impl<'a> SoftVolumes<'a> {
             near,
             reach,
         })
+    }
+
+    /// Hands what the run built to the thread pool to free, so that the
+    /// caller goes on (to write the fragments, on one thread) while its
+    /// millions of small lists are given back.
+    fn free_later(self) {
+        let SoftVolumes {
+            blockers,
+            regions,
+            near,
+            reach,
+            corners,
+            backs,
+            cores,
+            sealed,
+            ..
+        } = self;
+        rayon::spawn(move || {
+            drop((
+                blockers, regions, near, reach, corners, backs, cores, sealed,
+            ))
+        });
     }
 
     /// Every face cut into fragments of one class per light, in face
