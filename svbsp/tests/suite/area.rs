@@ -1167,3 +1167,106 @@ fn a_light_sealed_in_a_closed_box_leaves_the_outside_in_umbra() {
     let classes: Vec<AreaClass> = alone.iter().map(|f| f.class).collect();
     assert!(classes.contains(&AreaClass::Undecided), "{classes:?}");
 }
+
+/// A ground under more occluders than a face prepares one by one (a
+/// field of 34 × 34 small triangles, every one's penumbra on the ground;
+/// they are prepared in parallel): the ground's fragments tile it, none
+/// is undecided (the gaps between the triangles are too wide for any
+/// joint umbra), they agree with the exact view at grid points inside
+/// them, carry at their centroids the share that
+/// `SoftVolumes::shares` finds there (0 exactly where the view sees
+/// nothing), and are the same on one thread and on three.
+#[test]
+fn a_ground_under_a_field_of_occluders_agrees_with_the_view() {
+    let light = AreaLight::new(&square_light(-2, -2, 4, 96)).unwrap();
+    let mut faces = vec![Occluder::new(&ground(240)).unwrap()];
+    for i in -17..17 {
+        for j in -17..17 {
+            let (x, y) = (i * 10, j * 10);
+            faces.push(Occluder::new(&[[x, y, 20], [x + 7, y, 20], [x, y + 7, 21]]).unwrap());
+        }
+    }
+    assert!(faces.len() > 1100);
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| svbsp::soft_shadows(std::slice::from_ref(&light), &faces))
+            .unwrap()
+    };
+    // each fragment's corners, classes and centroid share's bits
+    type Key = (Vec<[f64; 3]>, u64, u64, Option<u64>);
+    let key = |fs: &[svbsp::SoftFragment]| -> Vec<Key> {
+        fs.iter()
+            .map(|f| {
+                let share = f.visible[0].as_ref().map(|s| s.centroid.to_bits());
+                (f.polygon.vertices_f64(), f.lit, f.umbra, share)
+            })
+            .collect()
+    };
+    let one = run(1);
+    let three = run(3);
+    for (a, b) in one.iter().zip(&three) {
+        assert_eq!(key(a), key(b));
+    }
+    let ground_fragments = &one[0];
+    assert!(tile_by_area(
+        faces[0].corners(),
+        ground_fragments.iter().map(|f| &f.polygon)
+    ));
+    // the gaps between the triangles, seen from the ground, are wider
+    // than the light: every corner hidden means hidden by one triangle,
+    // whose umbra it is (nothing jointly hidden, nothing undecided)
+    assert!(
+        ground_fragments
+            .iter()
+            .all(|f| f.class(0) != AreaClass::Undecided)
+    );
+    let plane = *faces[0].plane();
+    let mut rng = Rng::new(0x00f1_e1d5);
+    let mut met = std::collections::HashMap::new();
+    for _ in 0..100 {
+        let x = [below(&mut rng, 480) - 240, below(&mut rng, 480) - 240, 0];
+        let Some(f) = ground_fragments
+            .iter()
+            .find(|f| strictly_inside(&f.polygon, x))
+        else {
+            continue;
+        };
+        assert_agrees(&light, (x, &plane), &faces, f.class(0));
+        *met.entry(f.class(0)).or_insert(0) += 1;
+    }
+    for class in [AreaClass::Lit, AreaClass::Penumbra, AreaClass::Umbra] {
+        assert!(met.contains_key(&class), "{class:?} never met: {met:?}");
+    }
+    // the shares at the penumbra fragments' centroids, asked of the run
+    let volumes = svbsp::SoftVolumes::new(std::slice::from_ref(&light), &faces).unwrap();
+    let (mut asked, mut dark) = (0, 0);
+    for f in ground_fragments
+        .iter()
+        .filter(|f| f.visible[0].is_some())
+        .step_by(16)
+    {
+        let c = f.polygon.vertices_f64();
+        let n = c.len() as f64;
+        let centroid = [0, 1, 2].map(|k| (c.iter().map(|p| p[k]).sum::<f64>() / n).round() as i32);
+        let share = volumes.shares(0, 0, &[centroid])[0].unwrap_or(0.0);
+        assert_eq!(
+            share,
+            f.visible[0].as_ref().unwrap().centroid,
+            "at {centroid:?}"
+        );
+        let seen = light
+            .view(centroid, Some(&plane), &faces)
+            .unwrap()
+            .visibility;
+        assert_eq!(seen == Visibility::None, share == 0.0, "at {centroid:?}");
+        asked += 1;
+        dark += usize::from(share == 0.0);
+    }
+    assert!(
+        asked > 20 && dark > 0,
+        "{asked} penumbra fragments asked, {dark} dark"
+    );
+}
