@@ -7,9 +7,8 @@
 
 use std::collections::HashMap;
 
-use rayon::prelude::*;
-
 use bsp_core::{GridPoint, Plane};
+use rayon::prelude::*;
 
 use crate::area::Occluder;
 
