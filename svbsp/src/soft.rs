@@ -440,10 +440,10 @@ impl AreaLight {
                         class: AreaClass::Umbra,
                     }];
                 }
-                let others = near
-                    .iter()
-                    .filter_map(|&j| Some((regions[j as usize].as_ref()?, reach[j as usize])))
-                    .chain(crate::cores::cores_at(&cores, face));
+                let others =
+                    near_occluders(near, (&regions, &reach, &blockers), self.corners(), face)
+                        .into_iter()
+                        .chain(crate::cores::cores_at(&cores, face));
                 let mut seen = corner_cells(set.as_ref(), (face, i, faces.len()), scratch);
                 self.classify_with(face, others, Some(&mut seen))
             })
@@ -495,23 +495,12 @@ fn soft_face(
             continue;
         }
         // the inner occluders last: they cut only what stays undecided
-        let light_corners = light.corners();
-        let occluder = |&j: &u32| {
-            let r = regions[k][j as usize].as_ref()?;
-            let reach = reach[k][j as usize];
-            match near[k].len() > TIGHTENED {
-                true => Some((
-                    r,
-                    in_slab(reach, light_corners, &run.blockers[j as usize], face)?,
-                )),
-                false => Some((r, reach)),
-            }
-        };
-        // (a ground under a mesh has them all: in parallel, in order)
-        let occluders: Vec<(&Regions, Reach)> = match near[k].len() > PARALLEL_OCCLUDERS {
-            true => near[k].par_iter().filter_map(occluder).collect(),
-            false => near[k].iter().filter_map(occluder).collect(),
-        };
+        let occluders = near_occluders(
+            near[k],
+            (&regions[k], &reach[k], &run.blockers),
+            light.corners(),
+            face,
+        );
         let occluders = occluders
             .into_iter()
             .chain(crate::cores::cores_at(&run.cores[k], face));
@@ -589,6 +578,31 @@ fn soft_face(
             }
         })
         .collect()
+}
+
+/// The occluders near `face` (numbers `near` into `regions`, `reach` and
+/// `blockers`) with their volumes and boxes: for a face with many, the
+/// boxes narrowed to what the volumes hold of the slab round its plane
+/// ([`in_slab`]; one that holds none is left out), in parallel for a
+/// face with very many (a ground under a mesh). In `near`'s order.
+fn near_occluders<'r>(
+    near: &[u32],
+    (regions, reach, blockers): (&'r [Option<Regions>], &[Reach], &[Occluder]),
+    light: &[Light],
+    face: &Occluder,
+) -> Vec<(&'r Regions, Reach)> {
+    let occluder = |&j: &u32| {
+        let r = regions[j as usize].as_ref()?;
+        let reach = reach[j as usize];
+        match near.len() > TIGHTENED {
+            true => Some((r, in_slab(reach, light, &blockers[j as usize], face)?)),
+            false => Some((r, reach)),
+        }
+    };
+    match near.len() > PARALLEL_OCCLUDERS {
+        true => near.par_iter().filter_map(occluder).collect(),
+        false => near.iter().filter_map(occluder).collect(),
+    }
 }
 
 /// A face with more occluders near it than this has them prepared in
