@@ -707,12 +707,17 @@ impl AreaLight {
                 pieces.push(Piece::new(polygon, label, behind, false));
                 continue;
             };
-            for (polygon, seen) in cells {
+            let piece = |(polygon, seen): (Polygon, u64)| {
                 let hidden = behind | (all & !seen);
                 let mut piece = Piece::new(polygon, label, hidden, hidden != 0);
                 // a point (or a sun) hidden is umbra
                 piece.umbra = n == 1 && hidden == all;
-                pieces.push(piece);
+                piece
+            };
+            // (a ground's many cells: their boxes in parallel, in order)
+            match cells.len() > PARALLEL_CELLS {
+                true => pieces.par_extend(cells.into_par_iter().map(piece)),
+                false => pieces.extend(cells.into_iter().map(piece)),
             }
         }
         if known {
@@ -1049,6 +1054,10 @@ fn outside<K>(piece: &Piece<K>, hs: &HalfSpaces) -> bool {
             .iter()
             .any(|(h, s)| wholly_outside(piece.polygon.classify(h), *s))
 }
+
+/// A piece cut into more cells than this by the corners' trees has them
+/// made into pieces in parallel ([`AreaLight::cut`]).
+const PARALLEL_CELLS: usize = 1024;
 
 /// Whether box `b` lies in the closed half-space opposite `inside` of
 /// `h`: the extreme value of `n · x + d` over its corners, in `i128`

@@ -17,12 +17,17 @@
 use std::ops::Range;
 
 use bsp_core::{Plane, Polygon};
+use rayon::prelude::*;
 use smallvec::SmallVec;
 
 use super::{Batch, LightVolumes, ShadeOptions, ShadowError, ShadowSet, Start};
 use crate::engine::Scratch;
 use crate::light::Light;
 use crate::psv::ShadowVolumes;
+
+/// A face cut into more cells than this by [`ShadowSet::cells`] has them
+/// made into polygons in parallel.
+const PARALLEL_CELLS: usize = 1024;
 
 impl LightVolumes {
     /// [`LightVolumes::new_with`] with the occluders taken in the order of
@@ -107,17 +112,18 @@ impl ShadowSet<'_> {
     ) -> Option<Vec<(Polygon, u64)>> {
         self.filter_lights_of(std::slice::from_ref(poly), start, scratch, mask);
         let s = &*scratch;
-        s.cur
-            .iter()
-            .map(|(c, flags)| {
-                let edges: SmallVec<[Plane; 6]> =
-                    c.edges.iter().map(|&e| s.arena.plane(e)).collect();
-                Some((
-                    Polygon::from_planes(*poly.support(), &edges, poly.tag())?,
-                    *flags,
-                ))
-            })
-            .collect()
+        let cell = |(c, flags): &(crate::arena::pieces::Piece, u64)| {
+            let edges: SmallVec<[Plane; 6]> = c.edges.iter().map(|&e| s.arena.plane(e)).collect();
+            Some((
+                Polygon::from_planes(*poly.support(), &edges, poly.tag())?,
+                *flags,
+            ))
+        };
+        // (a ground's many cells in parallel, in order)
+        match s.cur.len() > PARALLEL_CELLS {
+            true => s.cur.par_iter().map(cell).collect(),
+            false => s.cur.iter().map(cell).collect(),
+        }
     }
 
     /// Whether this set knows the receivers of `polys` (what its trees'

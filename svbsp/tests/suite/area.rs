@@ -1170,7 +1170,8 @@ fn a_light_sealed_in_a_closed_box_leaves_the_outside_in_umbra() {
 
 /// A ground under more occluders than a face prepares one by one (a
 /// field of 34 × 34 small triangles, every one's penumbra on the ground;
-/// they are prepared in parallel): the ground's fragments tile it, none
+/// they are prepared, and the ground's many corner cells made, in
+/// parallel): the ground's fragments tile it, none
 /// is undecided (the gaps between the triangles are too wide for any
 /// joint umbra), they agree with the exact view at grid points inside
 /// them, carry at their centroids the share that
