@@ -293,6 +293,28 @@ fn assert_agrees(
     assert!(ok, "{x:?}: class {class:?}, the view says {seen:?}");
 }
 
+/// A random grid point of the ground (`z = 0`, `|x|, |y| < r`) and the
+/// fragment of `fragments` it lies strictly inside, if any.
+fn on_the_ground<'a>(
+    rng: &mut Rng,
+    r: i32,
+    fragments: &'a [svbsp::SoftFragment],
+) -> Option<([i32; 3], &'a svbsp::SoftFragment)> {
+    let w = 2 * r as u64;
+    let x = [below(rng, w) - r, below(rng, w) - r, 0];
+    let f = fragments.iter().find(|f| strictly_inside(&f.polygon, x))?;
+    Some((x, f))
+}
+
+/// `f` on a pool of its own of `threads` threads.
+fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
 fn strictly_inside(piece: &Polygon, x: [i32; 3]) -> bool {
     piece
         .edge_planes()
@@ -440,13 +462,7 @@ fn classified_scenes_tile_their_faces_on_any_thread_count() {
     .unwrap();
     let faces = snapped(&spec.faces, &grid);
     assert!(faces.len() > 200);
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| light.classify_faces(&faces))
-    };
+    let run = |threads: usize| on_threads(threads, || light.classify_faces(&faces));
     let key = |all: &Vec<Vec<svbsp::AreaFragment>>| -> Vec<(Vec<[f64; 3]>, AreaClass)> {
         all.iter()
             .flatten()
@@ -710,11 +726,7 @@ fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
     let mut checked = 0;
     let mut kinds = std::collections::HashSet::new();
     for _ in 0..2000 {
-        let x = [below(&mut rng, 240) - 120, below(&mut rng, 240) - 120, 0];
-        let Some(f) = ground_fragments
-            .iter()
-            .find(|f| strictly_inside(&f.polygon, x))
-        else {
+        let Some((x, f)) = on_the_ground(&mut rng, 120, ground_fragments) else {
             continue;
         };
         for (k, frags) in alone.iter().enumerate() {
@@ -743,12 +755,7 @@ fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
     order.reverse();
     order.swap(0, 2);
     let shuffled: Vec<Occluder> = order.iter().map(|&i| faces[i].clone()).collect();
-    let one = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap()
-        .install(|| svbsp::soft_shadows(&lights, &shuffled))
-        .unwrap();
+    let one = on_threads(1, || svbsp::soft_shadows(&lights, &shuffled)).unwrap();
     for (s, &i) in order.iter().enumerate() {
         assert_eq!(key(&one[s]), key(&all[i]), "face {i}");
     }
@@ -1126,12 +1133,10 @@ fn inner_occluders_decide_joint_umbra_only_where_it_is() {
     order.reverse();
     order.swap(0, faces.len() / 2);
     let shuffled: Vec<Occluder> = order.iter().map(|&i| faces[i].clone()).collect();
-    let one = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap()
-        .install(|| svbsp::soft_shadows(std::slice::from_ref(&light), &shuffled))
-        .unwrap();
+    let one = on_threads(1, || {
+        svbsp::soft_shadows(std::slice::from_ref(&light), &shuffled)
+    })
+    .unwrap();
     let key = |fs: &[svbsp::SoftFragment]| -> Vec<(Vec<[f64; 3]>, u64, u64, u64)> {
         fs.iter()
             .map(|f| (f.polygon.vertices_f64(), f.lit, f.umbra, f.undecided))
@@ -1189,12 +1194,10 @@ fn a_ground_under_a_field_of_occluders_agrees_with_the_view() {
     }
     assert!(faces.len() > 1100);
     let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| svbsp::soft_shadows(std::slice::from_ref(&light), &faces))
-            .unwrap()
+        on_threads(threads, || {
+            svbsp::soft_shadows(std::slice::from_ref(&light), &faces)
+        })
+        .unwrap()
     };
     // each fragment's corners, classes and centroid share's bits
     type Key = (Vec<[f64; 3]>, u64, u64, Option<u64>);
@@ -1228,11 +1231,7 @@ fn a_ground_under_a_field_of_occluders_agrees_with_the_view() {
     let mut rng = Rng::new(0x00f1_e1d5);
     let mut met = std::collections::HashMap::new();
     for _ in 0..100 {
-        let x = [below(&mut rng, 480) - 240, below(&mut rng, 480) - 240, 0];
-        let Some(f) = ground_fragments
-            .iter()
-            .find(|f| strictly_inside(&f.polygon, x))
-        else {
+        let Some((x, f)) = on_the_ground(&mut rng, 240, ground_fragments) else {
             continue;
         };
         assert_agrees(&light, (x, &plane), &faces, f.class(0));
