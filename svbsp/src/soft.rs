@@ -200,6 +200,11 @@ impl<'a> SoftVolumes<'a> {
         if lights.len() > MAX_LIGHTS {
             return Err(LightError::TooMany(lights.len()));
         }
+        Ok(SoftVolumes::build(lights, faces))
+    }
+
+    /// [`SoftVolumes::new`] for at most [`MAX_LIGHTS`] lights.
+    fn build(lights: &'a [AreaLight], faces: &'a [Occluder]) -> Self {
         // the occluders' volumes and near lists beside the certificate
         // and what hangs on it (both sides use every core in parts)
         let ((blockers, sources, regions, (near, reach)), (solids, cores, sealed, corners)) =
@@ -228,7 +233,7 @@ impl<'a> SoftVolumes<'a> {
                     (solids, cores, sealed, corners)
                 },
             );
-        Ok(SoftVolumes {
+        SoftVolumes {
             cores,
             sealed,
             corners,
@@ -239,7 +244,7 @@ impl<'a> SoftVolumes<'a> {
             regions,
             near,
             reach,
-        })
+        }
     }
 
     /// Hands what the run built to the thread pool to free, so that the
@@ -416,21 +421,18 @@ impl AreaLight {
     /// assert!(all[1].iter().all(|f| f.class == AreaClass::Lit)); // the roof
     /// ```
     pub fn classify_faces(&self, faces: &[Occluder]) -> Vec<Vec<AreaFragment>> {
-        let blockers = coplanar_blockers(faces);
-        let regions: Vec<Option<Regions>> = blockers.par_iter().map(|o| self.regions(o)).collect();
-        let (near, reach) = near_lists(self.corners(), faces, (&blockers, &regions));
-        let (polygons, solids) = certified(faces);
-        let corners = corner_shadows(std::slice::from_ref(self), (faces, &polygons), &solids)
-            .pop()
-            .flatten();
-        let set = corners.as_ref().map(LightVolumes::set_for_occluders);
-        let cores = crate::cores::cores_per_light(std::slice::from_ref(self), faces, &solids)
-            .pop()
-            .unwrap_or_default();
-        let sealed = crate::sealed::sealed_faces(self, faces, &solids);
-        faces
+        // the run's shared parts for this one light, built as for several
+        let run = SoftVolumes::build(std::slice::from_ref(self), faces);
+        let set = run.corners[0].as_ref().map(LightVolumes::set_for_occluders);
+        let (regions, reach, cores, sealed) = (
+            &run.regions[0],
+            &run.reach[0],
+            &run.cores[0],
+            &run.sealed[0],
+        );
+        let fragments = faces
             .par_iter()
-            .zip(&near)
+            .zip(&run.near[0])
             .enumerate()
             .map_init(Scratch::default, |scratch, (i, (face, near))| {
                 if sealed.get(i) == Some(&true) {
@@ -441,13 +443,16 @@ impl AreaLight {
                     }];
                 }
                 let others =
-                    near_occluders(near, (&regions, &reach, &blockers), self.corners(), face)
+                    near_occluders(near, (regions, reach, &run.blockers), self.corners(), face)
                         .into_iter()
-                        .chain(crate::cores::cores_at(&cores, face));
+                        .chain(crate::cores::cores_at(cores, face));
                 let mut seen = corner_cells(set.as_ref(), (face, i, faces.len()), scratch);
                 self.classify_with(face, others, Some(&mut seen))
             })
-            .collect()
+            .collect();
+        drop(set);
+        run.free_later();
+        fragments
     }
 }
 
