@@ -20,14 +20,11 @@ use bsp_core::{Plane, Polygon};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
+use super::passes::PARALLEL_CELLS;
 use super::{Batch, LightVolumes, ShadeOptions, ShadowError, ShadowSet, Start};
 use crate::engine::Scratch;
 use crate::light::Light;
 use crate::psv::ShadowVolumes;
-
-/// A face cut into more cells than this by [`ShadowSet::cells`] has them
-/// made into polygons in parallel.
-const PARALLEL_CELLS: usize = 1024;
 
 impl LightVolumes {
     /// [`LightVolumes::new_with`] with the occluders taken in the order of
@@ -120,7 +117,7 @@ impl ShadowSet<'_> {
             ))
         };
         // (a ground's many cells in parallel, in order)
-        match s.cur.len() > PARALLEL_CELLS {
+        match s.cur.len() >= PARALLEL_CELLS {
             true => s.cur.par_iter().map(cell).collect(),
             false => s.cur.iter().map(cell).collect(),
         }

@@ -19,7 +19,8 @@ use crate::psv::ShadowVolumes;
 use crate::psv::filter::filter;
 
 /// Cells from which the lights after the first pass over runs in
-/// parallel.
+/// parallel (and [`ShadowSet::cells`] makes them into polygons in
+/// parallel).
 pub(super) const PARALLEL_CELLS: usize = 256;
 
 /// At most this many runs (each copies the arena).
