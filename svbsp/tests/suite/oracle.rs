@@ -676,8 +676,6 @@ pub(crate) fn check_flags(
     Ok(())
 }
 
-/// Twice the area vector of a polygon, `Σ v_i × v_{i+1}`, as an integer
-/// vector over the positive denominator `Π w_i`.
 /// Twice a polygon's area vector, exactly: the sum of its edges' cross
 /// products (pointing where the polygon turns counter-clockwise).
 pub(crate) fn twice_area_vector(verts: &[HPoint]) -> [Q; 3] {
@@ -685,6 +683,8 @@ pub(crate) fn twice_area_vector(verts: &[HPoint]) -> [Q; 3] {
     a.map(|c| Q::new(c, den.clone()))
 }
 
+/// Twice the area vector of a polygon, `Σ v_i × v_{i+1}`, as an integer
+/// vector over the positive denominator `Π w_i`.
 fn area2(verts: &[HPoint]) -> (Z3, BigInt) {
     let k = verts.len();
     let mut a = z3([0, 0, 0]);
