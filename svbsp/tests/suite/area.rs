@@ -273,7 +273,6 @@ fn bad_lights_are_refused() {
     );
 }
 
-/// Whether the grid point `x` lies strictly inside the convex `piece`.
 /// Checks a fragment's class against what the exact view says at grid
 /// point `x` strictly inside it, on a face of plane `plane` (undecided:
 /// anything but all of the light).
@@ -315,6 +314,7 @@ fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
         .install(f)
 }
 
+/// Whether the grid point `x` lies strictly inside the convex `piece`.
 fn strictly_inside(piece: &Polygon, x: [i32; 3]) -> bool {
     piece
         .edge_planes()
