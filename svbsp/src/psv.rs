@@ -100,9 +100,22 @@ impl std::fmt::Display for VolumeError {
 impl std::error::Error for VolumeError {}
 
 /// The occluders that face or back onto the light, nearest first, as
-/// flat arrays.
+/// flat arrays in chunks of [`OCCLUDER_CHUNK`] occluders (each chunk made
+/// on its own thread; joining them into one list took a serial pass over
+/// a scene's every plane).
 struct Occluders {
-    /// Vertices of occluder `i`: `verts[start[i]..start[i + 1]]`.
+    chunks: Vec<OccluderChunk>,
+    /// Each occluder's index in the input.
+    index: Vec<u32>,
+}
+
+/// Occluders per chunk of [`Occluders`] (a power of two).
+const OCCLUDER_CHUNK: usize = 1 << OCCLUDER_CHUNK_BITS;
+const OCCLUDER_CHUNK_BITS: u32 = 12;
+
+/// [`OCCLUDER_CHUNK`] consecutive occluders (fewer in the last chunk).
+struct OccluderChunk {
+    /// Vertices of the chunk's occluder `i`: `verts[start[i]..start[i + 1]]`.
     verts: Vec<GridPoint>,
     /// The shadow plane of each edge (edge `j` from vertex `j` to `j + 1`),
     /// interior behind: also the occluder's edge planes as a polygon.
@@ -110,25 +123,50 @@ struct Occluders {
     start: Vec<u32>,
     support: Vec<Plane>,
     cap: Vec<Plane>,
-    /// Each occluder's index in the input.
-    index: Vec<u32>,
 }
 
 impl Occluders {
     fn len(&self) -> usize {
-        self.support.len()
+        self.index.len()
     }
 
-    fn range(&self, i: u32) -> std::ops::Range<usize> {
-        self.start[i as usize] as usize..self.start[i as usize + 1] as usize
+    /// Occluder `i`'s chunk and its index there.
+    #[inline]
+    fn at(&self, i: u32) -> (&OccluderChunk, usize) {
+        (
+            &self.chunks[(i >> OCCLUDER_CHUNK_BITS) as usize],
+            i as usize & (OCCLUDER_CHUNK - 1),
+        )
+    }
+
+    fn range(&self, i: u32) -> (&OccluderChunk, std::ops::Range<usize>) {
+        let (c, j) = self.at(i);
+        (c, c.start[j] as usize..c.start[j + 1] as usize)
+    }
+
+    /// The number of occluder `i`'s corners (and edges).
+    fn corners(&self, i: u32) -> usize {
+        self.range(i).1.len()
     }
 
     fn verts(&self, i: u32) -> &[GridPoint] {
-        &self.verts[self.range(i)]
+        let (c, r) = self.range(i);
+        &c.verts[r]
     }
 
     fn edges(&self, i: u32) -> &[Plane] {
-        &self.edges[self.range(i)]
+        let (c, r) = self.range(i);
+        &c.edges[r]
+    }
+
+    fn support(&self, i: u32) -> &Plane {
+        let (c, j) = self.at(i);
+        &c.support[j]
+    }
+
+    fn cap(&self, i: u32) -> &Plane {
+        let (c, j) = self.at(i);
+        &c.cap[j]
     }
 
     /// Prepares every polygon (in parallel) and orders them nearest
@@ -164,23 +202,17 @@ impl Occluders {
         let mut order: Vec<(f64, u32)> = keyed.into_iter().flatten().collect();
         order.par_sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         // then the planes, chunk by chunk in parallel
-        struct Chunk {
-            verts: Vec<GridPoint>,
-            edges: Vec<Plane>,
-            counts: Vec<u32>,
-            support: Vec<Plane>,
-            cap: Vec<Plane>,
-        }
-        let chunks: Vec<Chunk> = order
-            .par_chunks(4096)
+        let chunks: Vec<OccluderChunk> = order
+            .par_chunks(OCCLUDER_CHUNK)
             .map(|part| {
-                let mut c = Chunk {
+                let mut c = OccluderChunk {
                     verts: Vec::with_capacity(part.len() * 3),
                     edges: Vec::with_capacity(part.len() * 3),
-                    counts: Vec::with_capacity(part.len()),
+                    start: Vec::with_capacity(part.len() + 1),
                     support: Vec::with_capacity(part.len()),
                     cap: Vec::with_capacity(part.len()),
                 };
+                c.start.push(0);
                 for &(_, i) in part {
                     let p = polys[i as usize].borrow();
                     let verts = grid(p);
@@ -192,7 +224,7 @@ impl Occluders {
                         c.edges.push(e);
                     }
                     c.verts.extend_from_slice(&verts);
-                    c.counts.push(k as u32);
+                    c.start.push(c.verts.len() as u32);
                     let support = *p.support();
                     c.support.push(support);
                     c.cap.push(if light.eval(&support) > 0 {
@@ -204,27 +236,10 @@ impl Occluders {
                 c
             })
             .collect();
-        let n = order.len();
-        let mut o = Occluders {
-            verts: Vec::with_capacity(chunks.iter().map(|c| c.verts.len()).sum()),
-            edges: Vec::with_capacity(chunks.iter().map(|c| c.edges.len()).sum()),
-            start: Vec::with_capacity(n + 1),
-            support: Vec::with_capacity(n),
-            cap: Vec::with_capacity(n),
+        Ok(Occluders {
+            chunks,
             index: order.iter().map(|o| o.1).collect(),
-        };
-        o.start.push(0);
-        for c in chunks {
-            for k in c.counts {
-                let last = *o.start.last().expect("starts at 0");
-                o.start.push(last + k);
-            }
-            o.verts.extend_from_slice(&c.verts);
-            o.edges.extend_from_slice(&c.edges);
-            o.support.extend_from_slice(&c.support);
-            o.cap.extend_from_slice(&c.cap);
-        }
-        Ok(o)
+        })
     }
 }
 
@@ -331,12 +346,29 @@ const PARALLEL_LIST: usize = 8192;
 
 /// An occluder's part in a region: the occluder, the part (a piece of the
 /// pool), and where the occluder's edge planes start in the pool's arena
-/// (its support plane follows them).
+/// (its support plane follows them); or, with `piece` [`WHOLE`], the
+/// occluder whole, not yet in the pool (the skeleton's first levels cut
+/// few occluders, so only those are added to its pool, and the regions'
+/// pools, filled in parallel, add the others from [`Occluders`]).
 #[derive(Clone, Copy, Debug)]
 struct Entry {
     occ: u32,
     piece: u32,
     base: u32,
+}
+
+/// [`Entry::piece`] of an occluder whole, not in the pool.
+const WHOLE: u32 = u32::MAX;
+
+impl Entry {
+    /// Occluder `o` whole, not in any pool.
+    fn whole(o: u32) -> Entry {
+        Entry {
+            occ: o,
+            piece: WHOLE,
+            base: WHOLE,
+        }
+    }
 }
 
 /// Pieces of occluders and their vertices and planes.
@@ -358,7 +390,7 @@ impl Pool {
             let plane = self.arena.add_edge_plane(*e, v, verts[(j + 1) % k]);
             piece.edges.push(EdgeRef::new(plane, false));
         }
-        self.arena.add_plane(occ.support[o as usize]);
+        self.arena.add_plane(*occ.support(o));
         self.pieces.push(piece);
         Entry {
             occ: o,
@@ -367,10 +399,42 @@ impl Pool {
         }
     }
 
+    /// The sides of entry `e`'s part relative to `plane` (an occluder
+    /// whole by its grid points).
+    fn sides_shared(&self, occ: &Occluders, e: Entry, plane: &Plane) -> Sides {
+        if e.piece == WHOLE {
+            Sides::of_grid(occ.verts(e.occ), plane)
+        } else {
+            self.arena
+                .sides_shared(&self.pieces[e.piece as usize], plane)
+        }
+    }
+
+    /// [`Pool::sides_shared`], keeping what a lazy vertex computes.
+    fn sides(&mut self, occ: &Occluders, e: Entry, plane: &Plane) -> Sides {
+        if e.piece == WHOLE {
+            Sides::of_grid(occ.verts(e.occ), plane)
+        } else {
+            self.arena.sides(&self.pieces[e.piece as usize], plane)
+        }
+    }
+
+    /// Entry `e` in this pool: an occluder whole is added.
+    fn own(&mut self, occ: &Occluders, e: Entry) -> Entry {
+        if e.piece == WHOLE {
+            self.add_occluder(occ, e.occ)
+        } else {
+            e
+        }
+    }
+
     /// Copies an entry of another pool: the occluder's planes, then the
-    /// part's vertices and cut planes.
+    /// part's vertices and cut planes; an occluder whole is added.
     fn copy_entry(&mut self, from: &Pool, occ: &Occluders, e: Entry) -> Entry {
-        let k = occ.range(e.occ).len() as u32;
+        if e.piece == WHOLE {
+            return self.add_occluder(occ, e.occ);
+        }
+        let k = occ.corners(e.occ) as u32;
         let base = self.arena.planes.len() as u32;
         for i in 0..=k {
             let plane = from.arena.planes[(e.base + i) as usize];
@@ -675,12 +739,7 @@ impl ShadowVolumes {
         let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
         let occ = Occluders::new(&light, occluders)?;
         let mut pool = Pool::default();
-        pool.arena
-            .reserve(occ.verts.len(), occ.verts.len() + occ.len());
-        pool.pieces.reserve(occ.len());
-        let list: Vec<Entry> = (0..occ.len() as u32)
-            .map(|o| pool.add_occluder(&occ, o))
-            .collect();
+        let list: Vec<Entry> = (0..occ.len() as u32).map(Entry::whole).collect();
         // the first levels one after the other, on one pool
         let mut top = Subtree {
             nodes: Vec::new(),
@@ -740,34 +799,36 @@ impl ShadowVolumes {
         if stopped() {
             return Ok(None);
         }
-        let mut nodes = top.nodes;
-        nodes.reserve(parts.iter().map(|p| p.0.nodes.len()).sum());
-        let mut grafted = top.grafted;
-        let mut skeleton = skeleton_top;
         // region by region in order: the same for every thread count
         let mut lit = Vec::new();
-        for (task, (sub, sub_root, sub_skeleton, found)) in ready.iter().zip(parts) {
+        let mut grafted = top.grafted;
+        let mut skeleton = skeleton_top;
+        let mut starts = vec![0, top.nodes.len()];
+        let mut subs = vec![top.nodes];
+        let mut roots = Vec::with_capacity(parts.len());
+        for (sub, sub_root, sub_skeleton, found) in parts {
             for (o, a) in found {
                 // (turned away: a receiver in attached shadow)
-                if occ.cap[o as usize] == occ.support[o as usize] {
+                if occ.cap(o) == occ.support(o) {
                     lit.push((occ.index[o as usize], a));
                 }
             }
-            let off = nodes.len() as u32;
-            let shift = |l: u32| if l >= SHADOW { l } else { l + off };
-            nodes.extend(sub.nodes.into_iter().map(|mut n| {
-                n.front = shift(n.front);
-                n.back = shift(n.back);
-                n
-            }));
-            let r = shift(sub_root);
+            let off = *starts.last().expect("the skeleton's top first");
+            roots.push(shift(sub_root, off as u32));
+            starts.push(off + sub.nodes.len());
+            subs.push(sub.nodes);
+            grafted += sub.grafted;
+            skeleton += sub_skeleton;
+        }
+        let mut nodes = Vec::new();
+        joined(&subs, &starts, &mut nodes);
+        drop(subs);
+        for (task, r) in ready.iter().zip(roots) {
             match task.slot {
                 None => root = r,
                 Some((id, Side::Front)) => nodes[id as usize].front = r,
                 Some((id, _)) => nodes[id as usize].back = r,
             }
-            grafted += sub.grafted;
-            skeleton += sub_skeleton;
         }
         let volumes = ShadowVolumes {
             light,
@@ -948,7 +1009,7 @@ fn split_task(
     if task.list.len() <= LEAF_SIZE || task.path.len() >= MAX_SKELETON_DEPTH {
         return Err(task);
     }
-    let Some(plane) = choose_split(occ, pool, &task, rng, sides) else {
+    let Some(plane) = choose_split(occ, pool, &task, rng) else {
         return Err(task);
     };
     // the sides of every part, in parallel for long lists
@@ -956,15 +1017,12 @@ fn split_task(
         let pool = &*pool;
         task.list
             .par_iter()
-            .map(|e| {
-                pool.arena
-                    .sides_shared(&pool.pieces[e.piece as usize], &plane)
-            })
+            .map(|&e| pool.sides_shared(occ, e, &plane))
             .collect()
     } else {
         task.list
             .iter()
-            .map(|e| pool.arena.sides(&pool.pieces[e.piece as usize], &plane))
+            .map(|&e| pool.sides(occ, e, &plane))
             .collect()
     };
     let cut = pool.arena.add_plane(plane);
@@ -973,9 +1031,10 @@ fn split_task(
         match (sd.front, sd.back) {
             (false, true) => back.push(e),
             (true, true) => {
+                let e = pool.own(occ, e);
                 pool.arena
                     .classify_into(&pool.pieces[e.piece as usize], &plane, sides);
-                let sup = e.base + occ.range(e.occ).len() as u32;
+                let sup = e.base + occ.corners(e.occ) as u32;
                 let (f, b) = pool
                     .arena
                     .split(sup, &pool.pieces[e.piece as usize], cut, sides);
@@ -1013,6 +1072,33 @@ fn split_task(
         }
     };
     Ok((child(Side::Front, front), child(Side::Back, back)))
+}
+
+/// Link `l` of a subtree whose nodes start at `off` in the whole tree.
+#[inline]
+fn shift(l: u32, off: u32) -> u32 {
+    if l >= SHADOW { l } else { l + off }
+}
+
+/// The subtrees' nodes one after the other in `out`, each subtree's links
+/// shifted to where it starts (`starts[i]`, and the end last), written
+/// in parallel: a scene's tree is tens of megabytes, which one thread
+/// took a tenth of a light's build to copy.
+fn joined(subs: &[Vec<Node>], starts: &[usize], out: &mut Vec<Node>) {
+    let total = *starts.last().expect("an end");
+    (0..total)
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|i| {
+            // the last subtree starting at or before node `i`
+            let k = starts.partition_point(|&s| s <= i) - 1;
+            let off = starts[k];
+            let mut n = subs[k][i - off];
+            n.front = shift(n.front, off as u32);
+            n.back = shift(n.back, off as u32);
+            n
+        })
+        .collect_into_vec(out);
 }
 
 /// Lit parts of occluders: each a convex polygon's exact corners, with its
@@ -1099,7 +1185,6 @@ fn choose_split(
     pool: &mut Pool,
     task: &Task,
     rng: &mut SplitMix,
-    sides: &mut SmallVec<[Side; 8]>,
 ) -> Option<Plane> {
     let n = task.list.len();
     let sample: SmallVec<[usize; SAMPLE]> = if n <= SAMPLE {
@@ -1116,8 +1201,7 @@ fn choose_split(
             }
             let (mut f, mut b, mut both) = (0u64, 0u64, 0u64);
             for &i in &sample {
-                let p = &pool.pieces[task.list[i].piece as usize];
-                let sd = pool.arena.classify_into(p, e, sides);
+                let sd = pool.sides(occ, task.list[i], e);
                 match (sd.front, sd.back) {
                     (true, true) => both += 1,
                     (true, false) => f += 1,
@@ -1185,7 +1269,7 @@ fn insert(
         return;
     }
     let mark = pool.arena.mark();
-    let k = occ.range(e.occ).len() as u32;
+    let k = occ.corners(e.occ) as u32;
     let sup = e.base + k;
     s.stack.clear();
     s.path.clear();
@@ -1306,7 +1390,7 @@ fn graft(
         });
     }
     tree.nodes.push(Node {
-        plane: occ.cap[o as usize],
+        plane: *occ.cap(o),
         front: LIT,
         back: SHADOW,
         cap: true,

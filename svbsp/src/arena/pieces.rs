@@ -449,6 +449,24 @@ impl Sides {
         }
         Sides { front, back }
     }
+
+    /// The sides some grid point of `verts` is strictly on (a polygon not
+    /// yet in an arena), as [`Sides::of`] gives for a piece of them.
+    #[inline]
+    pub(crate) fn of_grid(verts: &[GridPoint], plane: &Plane) -> Sides {
+        let (mut front, mut back) = (false, false);
+        for &g in verts {
+            match plane.classify_grid(g) {
+                Side::Front => front = true,
+                Side::Back => back = true,
+                Side::On => {}
+            }
+            if front && back {
+                break;
+            }
+        }
+        Sides { front, back }
+    }
 }
 
 impl PieceArena {
@@ -541,15 +559,6 @@ impl PieceArena {
         self.lazy.truncate(mark.lazy);
         self.planes.truncate(mark.planes);
         self.anchors.truncate(mark.planes);
-    }
-
-    /// Room for `grid` more grid vertices and `planes` more planes, so
-    /// that adding a known number of them (a tree's occluders) copies no
-    /// list as it grows.
-    pub(crate) fn reserve(&mut self, grid: usize, planes: usize) {
-        self.grid.reserve(grid);
-        self.planes.reserve(planes);
-        self.anchors.reserve(planes);
     }
 
     /// Adds a plane, returning its index.
