@@ -1009,7 +1009,7 @@ fn split_task(
     if task.list.len() <= LEAF_SIZE || task.path.len() >= MAX_SKELETON_DEPTH {
         return Err(task);
     }
-    let Some(plane) = choose_split(occ, pool, &task, rng) else {
+    let Some(plane) = choose_split(occ, pool, &task, rng, sides) else {
         return Err(task);
     };
     // the sides of every part, in parallel for long lists
@@ -1185,6 +1185,7 @@ fn choose_split(
     pool: &mut Pool,
     task: &Task,
     rng: &mut SplitMix,
+    sides: &mut SmallVec<[Side; 8]>,
 ) -> Option<Plane> {
     let n = task.list.len();
     let sample: SmallVec<[usize; SAMPLE]> = if n <= SAMPLE {
@@ -1201,7 +1202,14 @@ fn choose_split(
             }
             let (mut f, mut b, mut both) = (0u64, 0u64, 0u64);
             for &i in &sample {
-                let sd = pool.sides(occ, task.list[i], e);
+                // every vertex classified (a lazy vertex keeps its exact
+                // coordinates, which its measures then use)
+                let sd = match task.list[i] {
+                    w if w.piece == WHOLE => Sides::of_grid(occ.verts(w.occ), e),
+                    p => pool
+                        .arena
+                        .classify_into(&pool.pieces[p.piece as usize], e, sides),
+                };
                 match (sd.front, sd.back) {
                     (true, true) => both += 1,
                     (true, false) => f += 1,
