@@ -223,10 +223,15 @@ pub(crate) fn prepare(
     if s.polys.is_empty() {
         bail!("{}: nothing to draw: no face has an area", s.name);
     }
+    // (the colours walk the mesh's parts on one thread, beside the prims)
+    let (colors, scene) = rayon::join(
+        || face_colors(&s.mesh),
+        || RasterScene::new(&s.grid, s.polys),
+    );
     Ok(Prepared {
         faces: s.mesh.faces.len(),
-        colors: face_colors(&s.mesh),
-        scene: RasterScene::new(&s.grid, s.polys)?,
+        colors,
+        scene: scene?,
         light_notes: (s.lights.iter().map(describe))
             .chain(
                 s.soft[s.lights.len().min(s.soft.len())..]
@@ -240,6 +245,19 @@ pub(crate) fn prepare(
         camera,
         load_time: start.elapsed(),
     })
+}
+
+/// The pixels of a mask that see the scene (not 0), and those lit (255),
+/// counted in parallel.
+fn seen_and_lit(mask: &[u8]) -> (usize, usize) {
+    use rayon::prelude::*;
+    mask.par_chunks(1 << 16)
+        .map(|c| {
+            let seen: usize = c.iter().map(|&m| usize::from(m != 0)).sum();
+            let lit: usize = c.iter().map(|&m| usize::from(m == 255)).sum();
+            (seen, lit)
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
 }
 
 /// `shadow render`.
@@ -271,8 +289,7 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
     files.extend(args.mask.as_deref().map(|m| (m, &pgm[..])));
     write_files(&files)?;
     let write = t.elapsed();
-    let seen = mask.iter().filter(|&&m| m != 0).count();
-    let lit = mask.iter().filter(|&&m| m == 255).count();
+    let (seen, lit) = seen_and_lit(&mask);
     let lit = match seen {
         0 => "nothing of the scene in view (look at --eye, --target and --fov)".to_string(),
         _ => format!(

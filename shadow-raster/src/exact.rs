@@ -12,7 +12,7 @@
 //! surface point against the face's fragments (even-odd in the face's
 //! plane).
 
-use std::collections::HashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 use bsp_core::GridPoint;
 use bsp_core::{Plane, Side};
@@ -276,7 +276,7 @@ fn drawn(frame: &Frame<'_>, vis: &VisibilityBuffer) -> Vec<bool> {
             seen[p as usize] = true;
         }
     }
-    let groups: std::collections::HashSet<(u32, Plane)> = (0..scene.len())
+    let groups: FxHashSet<(u32, Plane)> = (0..scene.len())
         .filter(|&i| seen[i])
         .filter_map(|i| group_of(frame, i))
         .collect();
@@ -322,7 +322,7 @@ pub(crate) fn draw(
 ) -> (LitBuffer, ShadowFigures, Vec<u32>) {
     let scene = frame.scene;
     // a group: one face seen from one side
-    let mut groups: HashMap<(u32, Plane), u32> = HashMap::new();
+    let mut groups: FxHashMap<(u32, Plane), u32> = FxHashMap::default();
     let prim_group: Vec<u32> = (0..scene.len())
         .map(|i| match group_of(frame, i) {
             Some(g) => {

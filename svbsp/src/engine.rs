@@ -626,11 +626,8 @@ impl<'a> ShadowSet<'a> {
             .collect();
         // back in receiver order: the runs' order
         batches.sort_unstable_by_key(|b| b.0);
-        let mut out = Batch::new();
-        for (_, b) in &batches {
-            out.append(b);
-        }
-        out
+        let parts: Vec<&Batch> = batches.iter().map(|b| &b.1).collect();
+        Batch::concat(&parts)
     }
 }
 
@@ -952,6 +949,32 @@ impl Batch {
         b.piece_verts.extend(first..last);
         b.piece_start.push(b.piece_verts.len() as u32);
         b.frag_piece.push((b.piece_start.len() - 1) as u32);
+    }
+
+    /// The fragments of `parts` one after the other (as [`Batch::append`]
+    /// of each in turn), every list allocated once at its final length
+    /// rather than grown (and copied) batch by batch.
+    pub fn concat(parts: &[&Batch]) -> Batch {
+        let mut out = Batch::new();
+        let total = |len: fn(&Batch) -> usize| parts.iter().map(|b| len(b)).sum::<usize>();
+        out.face.reserve(total(|b| b.face.len()));
+        out.receiver.reserve(total(|b| b.receiver.len()));
+        out.lit.reserve(total(|b| b.lit.len()));
+        out.facing.reserve(total(|b| b.facing.len()));
+        out.support.reserve(total(|b| b.support.len()));
+        out.frag_ring.reserve(total(|b| b.frag_ring.len()));
+        out.ring_start.reserve(total(|b| b.ring_start.len()));
+        out.ring_verts.reserve(total(|b| b.ring_verts.len()));
+        out.frag_piece.reserve(total(|b| b.frag_piece.len()));
+        out.piece_start.reserve(total(|b| b.piece_start.len()));
+        out.piece_verts.reserve(total(|b| b.piece_verts.len()));
+        out.piece_planes.reserve(total(|b| b.piece_planes.len()));
+        out.vertices.reserve(total(|b| b.vertices.len()));
+        out.rounded.reserve(total(|b| b.rounded.len()));
+        for b in parts {
+            out.append(b);
+        }
+        out
     }
 
     /// Appends another batch's fragments.
