@@ -12,7 +12,7 @@ use clap::Args;
 use glam::DVec3;
 use shadow_raster::{
     Camera, Hsr, Method, RasterScene, RenderOptions, ShadowOptions, compare, compare_soft,
-    encode_pgm, hidden_lines, render, render_soft,
+    encode_pgm, hidden_lines, mask_counts, render, render_soft,
 };
 use shadow_scene::face_colors;
 use svbsp::{PlacedLight, SoftLight};
@@ -247,19 +247,6 @@ pub(crate) fn prepare(
     })
 }
 
-/// The pixels of a mask that see the scene (not 0), and those lit (255),
-/// counted in parallel.
-fn seen_and_lit(mask: &[u8]) -> (usize, usize) {
-    use rayon::prelude::*;
-    mask.par_chunks(1 << 16)
-        .map(|c| {
-            let seen: usize = c.iter().map(|&m| usize::from(m != 0)).sum();
-            let lit: usize = c.iter().map(|&m| usize::from(m == 255)).sum();
-            (seen, lit)
-        })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
-}
-
 /// `shadow render`.
 pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
     check_ext(&args.output, "png", "-o")?;
@@ -289,7 +276,7 @@ pub(crate) fn run_render(args: &RenderArgs) -> Result<()> {
     files.extend(args.mask.as_deref().map(|m| (m, &pgm[..])));
     write_files(&files)?;
     let write = t.elapsed();
-    let (seen, lit) = seen_and_lit(&mask);
+    let (seen, lit) = mask_counts(&mask);
     let lit = match seen {
         0 => "nothing of the scene in view (look at --eye, --target and --fov)".to_string(),
         _ => format!(

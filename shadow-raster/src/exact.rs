@@ -42,7 +42,7 @@ pub(crate) fn visible_side_fragments(
     let exact: Vec<svbsp::Light> = lights.iter().map(|l| l.exact).collect();
     let shadows = LightVolumes::new(&scene.polys, &exact).map_err(RasterError::Shadows)?;
     let drawn = drawn(frame, vis);
-    let receivers: Vec<bsp_core::Polygon> = (scene.polys.iter().zip(&frame.side))
+    let receivers: Vec<bsp_core::Polygon> = (scene.polys.par_iter().zip(&frame.side))
         .zip(drawn)
         .filter_map(|((p, v), drawn)| match v {
             _ if !drawn => None,
@@ -51,9 +51,12 @@ pub(crate) fn visible_side_fragments(
             Side::On => None,
         })
         .collect();
-    Ok(shadows
-        .set()
-        .shade_all(&receivers, &ShadeOptions::default().with_pieces(false)))
+    Ok(shadows.set().shade_all(
+        &receivers,
+        &ShadeOptions::default()
+            .with_pieces(false)
+            .with_vertices(false),
+    ))
 }
 
 pub(crate) fn exact(
@@ -301,6 +304,7 @@ pub(crate) fn draw_fragments(
 ) -> (LitBuffer, ShadowFigures) {
     let grid = frame.scene.grid;
     let world = (0..batch.vertex_count() as u32)
+        .into_par_iter()
         .map(|v| grid.to_world(batch.rounded(v)))
         .collect();
     let fragments = BatchFragments {
@@ -333,6 +337,7 @@ pub(crate) fn draw(
         })
         .collect();
     let frag_group: Vec<u32> = (0..fragments.count())
+        .into_par_iter()
         .map(|i| groups.get(&fragments.side(i)).copied().unwrap_or(NONE))
         .collect();
     let view = frame.view();
@@ -473,9 +478,12 @@ mod tests {
                 Side::On => None,
             })
             .collect();
-        let all = shadows
-            .set()
-            .shade_all(&every, &ShadeOptions::default().with_pieces(false));
+        let all = shadows.set().shade_all(
+            &every,
+            &ShadeOptions::default()
+                .with_pieces(false)
+                .with_vertices(false),
+        );
         let (lit_all, _) = draw_fragments(&frame, &vis, sl.len(), &all);
         let (lit, _) = exact(&frame, &vis, &sl, None, &[]).unwrap();
         assert_eq!(lit.amount, lit_all.amount);

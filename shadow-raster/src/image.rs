@@ -116,6 +116,23 @@ pub fn mask(vis: &VisibilityBuffer, lit: &LitBuffer) -> Vec<u8> {
         .collect()
 }
 
+/// The pixels of a [`mask`] that see the scene (not 0) and those lit by
+/// light 0 (255), counted in parallel.
+///
+/// ```
+/// assert_eq!(shadow_raster::mask_counts(&[0, 128, 255, 255]), (3, 2));
+/// ```
+pub fn mask_counts(mask: &[u8]) -> (usize, usize) {
+    use rayon::prelude::*;
+    mask.par_chunks(1 << 16)
+        .map(|c| {
+            let seen: usize = c.iter().map(|&m| usize::from(m != 0)).sum();
+            let lit: usize = c.iter().map(|&m| usize::from(m == 255)).sum();
+            (seen, lit)
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+}
+
 /// A binary PGM (P5) of a mask.
 pub fn encode_pgm(width: u32, height: u32, mask: &[u8]) -> Vec<u8> {
     let mut out = format!("P5\n{width} {height}\n255\n").into_bytes();

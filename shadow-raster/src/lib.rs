@@ -86,7 +86,7 @@ pub use bvh::TriangleBvh;
 pub use compare::{Comparison, MethodReport, compare, compare_soft};
 pub use error::{RasterError, UnknownName};
 pub use hsr::{Hsr, NONE, VisibilityBuffer, visible_surfaces};
-pub use image::{BACKGROUND, Image, composite, encode_pgm, mask, write_pgm};
+pub use image::{BACKGROUND, Image, composite, encode_pgm, mask, mask_counts, write_pgm};
 pub use lines::{HiddenLines, LINE_EPSILON, LineCheck, hidden_lines};
 pub use lit::{LitBuffer, Method, RAY_EPSILON, ShadowFigures, ShadowOptions};
 pub use maps::PCSS_MAX_RADIUS;

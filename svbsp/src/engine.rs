@@ -87,6 +87,10 @@ pub struct ShadeOptions {
     /// can be cut again exactly ([`FragmentRef::piece_planes`]; not kept
     /// by [`ShadowSet::refine_cells`]).
     pub planes: bool,
+    /// Keep each vertex's exact coordinates ([`Batch::vertex`]), not only
+    /// their correct rounding ([`Batch::rounded`]); a picture needs only
+    /// the rounding.
+    pub vertices: bool,
 }
 
 impl Default for ShadeOptions {
@@ -94,6 +98,7 @@ impl Default for ShadeOptions {
         ShadeOptions {
             pieces: true,
             planes: false,
+            vertices: true,
         }
     }
 }
@@ -102,6 +107,12 @@ impl ShadeOptions {
     /// Sets [`ShadeOptions::pieces`].
     pub fn with_pieces(mut self, pieces: bool) -> ShadeOptions {
         self.pieces = pieces;
+        self
+    }
+
+    /// Sets [`ShadeOptions::vertices`].
+    pub fn with_vertices(mut self, vertices: bool) -> ShadeOptions {
+        self.vertices = vertices;
         self
     }
 
@@ -579,6 +590,7 @@ impl<'a> ShadowSet<'a> {
     ) -> Batch {
         let mut scratch = Scratch::default();
         let mut out = Batch::new();
+        out.exact = opts.vertices;
         let known = self.knows(polys);
         for (i, r) in ranges.iter().enumerate() {
             let receiver = first_receiver + i as u32;
@@ -757,6 +769,9 @@ pub struct Batch {
     piece_planes: Vec<Plane>,
     vertices: Vec<Vertex>,
     rounded: Vec<[f64; 3]>,
+    /// Whether new vertices keep their exact coordinates in `vertices`
+    /// ([`ShadeOptions::vertices`]).
+    exact: bool,
 }
 
 impl Default for Batch {
@@ -870,6 +885,7 @@ impl Batch {
             piece_planes: Vec::new(),
             vertices: Vec::new(),
             rounded: Vec::new(),
+            exact: true,
         }
     }
 
@@ -899,7 +915,7 @@ impl Batch {
 
     /// The exact vertex `v`; `None` in a batch made from (or with) Chin &
     /// Feiner's fragments ([`Batch::from_chin_feiner`]), whose vertices are
-    /// wider than [`Vertex`].
+    /// wider than [`Vertex`], or shaded without [`ShadeOptions::vertices`].
     pub fn vertex(&self, v: u32) -> Option<&Vertex> {
         self.vertices.get(v as usize)
     }
@@ -1078,9 +1094,11 @@ impl Batch {
                 .copied()
                 .flatten()
                 .unwrap_or_else(|| vert.to_f64());
-            self.vertices.push(vert.to_owned());
+            if self.exact {
+                self.vertices.push(vert.to_owned());
+            }
             self.rounded.push(r);
-            *slot = (self.vertices.len() - 1) as u32;
+            *slot = (self.rounded.len() - 1) as u32;
         }
         *slot
     }
@@ -1210,7 +1228,9 @@ impl Batch {
         let mut take = |b: &mut Batch, p: u32| {
             *ids.entry(p).or_insert_with(|| {
                 let (v, r) = m.point(cache, p);
-                b.vertices.push(v.clone());
+                if b.exact {
+                    b.vertices.push(v.clone());
+                }
                 b.rounded.push(r);
                 (b.rounded.len() - 1) as u32
             })
