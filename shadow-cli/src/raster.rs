@@ -223,13 +223,16 @@ pub(crate) fn prepare(
     if s.polys.is_empty() {
         bail!("{}: nothing to draw: no face has an area", s.name);
     }
-    // (the colours walk the mesh's parts on one thread, beside the prims)
+    // (the colours walk the mesh's parts on one thread, beside the prims;
+    // the mesh, a list a face, is freed there too)
+    let faces = s.mesh.faces.len();
+    let mesh = s.mesh;
     let (colors, scene) = rayon::join(
-        || face_colors(&s.mesh),
+        move || face_colors(&mesh),
         || RasterScene::new(&s.grid, s.polys),
     );
     Ok(Prepared {
-        faces: s.mesh.faces.len(),
+        faces,
         colors,
         scene: scene?,
         light_notes: (s.lights.iter().map(describe))

@@ -284,6 +284,7 @@ fn drawn(frame: &Frame<'_>, vis: &VisibilityBuffer) -> Vec<bool> {
         .filter_map(|i| group_of(frame, i))
         .collect();
     (0..scene.len())
+        .into_par_iter()
         .map(|i| group_of(frame, i).is_some_and(|g| groups.contains(&g)))
         .collect()
 }
@@ -326,7 +327,8 @@ pub(crate) fn draw(
 ) -> (LitBuffer, ShadowFigures, Vec<u32>) {
     let scene = frame.scene;
     // a group: one face seen from one side
-    let mut groups: FxHashMap<(u32, Plane), u32> = FxHashMap::default();
+    let mut groups: FxHashMap<(u32, Plane), u32> =
+        FxHashMap::with_capacity_and_hasher(scene.len(), Default::default());
     let prim_group: Vec<u32> = (0..scene.len())
         .map(|i| match group_of(frame, i) {
             Some(g) => {
