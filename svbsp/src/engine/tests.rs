@@ -126,6 +126,41 @@ fn piece_planes_make_the_pieces_again() {
     assert!(mixed.fragments().all(|f| f.piece_planes().is_none()));
 }
 
+/// Without [`ShadeOptions::vertices`] a batch keeps no exact vertex, and
+/// everything else the same: the fragments, their rings' vertex numbers,
+/// the roundings; `Batch::concat` of its parts is its `append`s'.
+#[test]
+fn rounding_only_batches_drop_nothing_else() {
+    let polys = [quad(0, 0, 8, 0), quad(4, 2, 4, 1), quad(6, 1, 3, 2)];
+    let lights = [Light::Point([3, 3, 8]), Light::Point([6, 1, 9])];
+    let shadows = LightVolumes::new(&polys, &lights).unwrap();
+    let exact = shadows.set().shade_all(&polys, &ShadeOptions::default());
+    let opts = ShadeOptions::default().with_vertices(false);
+    let rounded = shadows.set().shade_all(&polys, &opts);
+    assert!(exact.vertex_count() > 0);
+    assert!((0..exact.vertex_count() as u32).all(|v| exact.vertex(v).is_some()));
+    assert!(rounded.vertex(0).is_none());
+    assert_eq!(exact.len(), rounded.len());
+    assert_eq!(exact.vertex_count(), rounded.vertex_count());
+    for (a, b) in exact.fragments().zip(rounded.fragments()) {
+        assert_eq!((a.face(), a.lit_mask()), (b.face(), b.lit_mask()));
+        let (ra, rb): (Vec<&[u32]>, Vec<&[u32]>) = (a.rings().collect(), b.rings().collect());
+        assert_eq!(ra, rb);
+    }
+    for v in 0..exact.vertex_count() as u32 {
+        assert_eq!(exact.rounded(v), rounded.rounded(v));
+    }
+    // joined in one go or batch by batch: the same lists
+    let parts = [&exact, &rounded, &exact];
+    let joined = Batch::concat(&parts);
+    let mut appended = Batch::new();
+    for b in parts {
+        appended.append(b);
+    }
+    assert_eq!(joined.len(), 3 * exact.len());
+    assert_eq!(format!("{joined:?}"), format!("{appended:?}"));
+}
+
 /// The trees built while the parts are certified (over the faces each
 /// light faces, kept where the certified parts leave out every other
 /// face) are the trees built after certifying: where the guess holds
