@@ -436,27 +436,23 @@ impl Sides {
     /// side; stops at the first vertex that makes both.
     #[inline]
     fn of(c: &Piece, mut side: impl FnMut(u32) -> Side) -> Sides {
-        let (mut front, mut back) = (false, false);
-        for &v in &c.verts {
-            match side(v) {
-                Side::Front => front = true,
-                Side::Back => back = true,
-                Side::On => {}
-            }
-            if front && back {
-                break;
-            }
-        }
-        Sides { front, back }
+        Sides::first_both(c.verts.iter().map(|&v| side(v)))
     }
 
     /// The sides some grid point of `verts` is strictly on (a polygon not
     /// yet in an arena), as [`Sides::of`] gives for a piece of them.
     #[inline]
     pub(crate) fn of_grid(verts: &[GridPoint], plane: &Plane) -> Sides {
+        Sides::first_both(verts.iter().map(|&g| plane.classify_grid(g)))
+    }
+
+    /// The sides some of `sides` is strictly on, taken no further than
+    /// the first that makes both.
+    #[inline]
+    fn first_both(sides: impl Iterator<Item = Side>) -> Sides {
         let (mut front, mut back) = (false, false);
-        for &g in verts {
-            match plane.classify_grid(g) {
+        for s in sides {
+            match s {
                 Side::Front => front = true,
                 Side::Back => back = true,
                 Side::On => {}
