@@ -1082,8 +1082,8 @@ fn shift(l: u32, off: u32) -> u32 {
 
 /// The subtrees' nodes one after the other in `out`, each subtree's links
 /// shifted to where it starts (`starts[i]`, and the end last), written
-/// in parallel: a scene's tree is tens of megabytes, which one thread
-/// took a tenth of a light's build to copy.
+/// in parallel (the copy was one thread's work at the end of every
+/// build, with the other core idle).
 fn joined(subs: &[Vec<Node>], starts: &[usize], out: &mut Vec<Node>) {
     let total = *starts.last().expect("an end");
     (0..total)
