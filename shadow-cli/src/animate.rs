@@ -309,7 +309,8 @@ pub(crate) fn run(args: &AnimateArgs) -> Result<()> {
     let opts = PipelineOptions::default()
         .with_strategy(plan.strategy)
         .with_tiles(args.tiles)
-        .with_pieces(args.format == FrameFormat::Svg);
+        .with_pieces(args.format == FrameFormat::Svg)
+        .with_rounded_only(true);
 
     let progress = Progress::new(!args.quiet);
     progress.phase("preprocessing", 1);

@@ -392,7 +392,10 @@ impl Job<'_> {
         out: &mut dyn Write,
     ) -> Result<(), Error> {
         let scene = self.scene;
-        let opts = ShadeOptions::default().with_pieces(matches!(kind, FileKind::Obj));
+        // (a file holds the vertices' rounding only)
+        let opts = ShadeOptions::default()
+            .with_pieces(matches!(kind, FileKind::Obj))
+            .with_vertices(false);
         let mut file = self.begin(kind, out)?;
         let progress = self.progress;
         let ranges = receivers(scene.polys);

@@ -590,7 +590,6 @@ impl<'a> ShadowSet<'a> {
     ) -> Batch {
         let mut scratch = Scratch::default();
         let mut out = Batch::new();
-        out.exact = opts.vertices;
         let known = self.knows(polys);
         for (i, r) in ranges.iter().enumerate() {
             let receiver = first_receiver + i as u32;
@@ -769,9 +768,6 @@ pub struct Batch {
     piece_planes: Vec<Plane>,
     vertices: Vec<Vertex>,
     rounded: Vec<[f64; 3]>,
-    /// Whether new vertices keep their exact coordinates in `vertices`
-    /// ([`ShadeOptions::vertices`]).
-    exact: bool,
 }
 
 impl Default for Batch {
@@ -885,7 +881,6 @@ impl Batch {
             piece_planes: Vec::new(),
             vertices: Vec::new(),
             rounded: Vec::new(),
-            exact: true,
         }
     }
 
@@ -1082,8 +1077,9 @@ impl Batch {
         out
     }
 
-    /// A vertex of the scratch arena, added once per receiver.
-    fn take_vertex(&mut self, s: &mut Scratch, v: u32) -> u32 {
+    /// A vertex of the scratch arena, added once per receiver (with
+    /// `exact`, its exact coordinates kept too).
+    fn take_vertex(&mut self, s: &mut Scratch, v: u32, exact: bool) -> u32 {
         let d = s.arena.dense(v);
         let slot = &mut s.remap[d];
         if *slot == u32::MAX {
@@ -1094,7 +1090,7 @@ impl Batch {
                 .copied()
                 .flatten()
                 .unwrap_or_else(|| vert.to_f64());
-            if self.exact {
+            if exact {
                 self.vertices.push(vert.to_owned());
             }
             self.rounded.push(r);
@@ -1140,7 +1136,7 @@ impl Batch {
             let piece = std::mem::take(&mut s.whole);
             self.push_meta(face, receiver, lit, facing, support);
             for &v in &piece.verts {
-                let id = self.take_vertex(s, v);
+                let id = self.take_vertex(s, v, opts.vertices);
                 self.ring_verts.push(id);
             }
             self.ring_start.push(self.ring_verts.len() as u32);
@@ -1188,7 +1184,7 @@ impl Batch {
             self.push_meta(face, receiver, r.label, facing, support);
             for ring in std::iter::once(&r.outer).chain(&r.holes) {
                 for &v in ring {
-                    let id = self.take_vertex(s, v);
+                    let id = self.take_vertex(s, v, opts.vertices);
                     self.ring_verts.push(id);
                 }
                 self.ring_start.push(self.ring_verts.len() as u32);
@@ -1197,7 +1193,7 @@ impl Batch {
                 for &c in &r.cells {
                     let verts = s.pieces[c as usize].verts.clone();
                     for v in verts {
-                        let id = self.take_vertex(s, v);
+                        let id = self.take_vertex(s, v, opts.vertices);
                         self.piece_verts.push(id);
                     }
                     self.piece_start.push(self.piece_verts.len() as u32);
@@ -1228,7 +1224,7 @@ impl Batch {
         let mut take = |b: &mut Batch, p: u32| {
             *ids.entry(p).or_insert_with(|| {
                 let (v, r) = m.point(cache, p);
-                if b.exact {
+                if opts.vertices {
                     b.vertices.push(v.clone());
                 }
                 b.rounded.push(r);

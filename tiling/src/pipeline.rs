@@ -71,6 +71,10 @@ pub struct PipelineOptions {
     pub tiles: Option<u32>,
     /// Record each fragment's convex pieces (for OBJ output).
     pub pieces: bool,
+    /// Keep only the rounding of the fragments' vertices, not their exact
+    /// coordinates ([`svbsp::Batch::vertex`]): a picture or a file needs
+    /// only the rounding, and a frame is then about 7% quicker.
+    pub rounded_only: bool,
 }
 
 impl PipelineOptions {
@@ -88,6 +92,17 @@ impl PipelineOptions {
     pub fn with_pieces(mut self, p: bool) -> Self {
         self.pieces = p;
         self
+    }
+    /// Sets [`PipelineOptions::rounded_only`].
+    pub fn with_rounded_only(mut self, r: bool) -> Self {
+        self.rounded_only = r;
+        self
+    }
+    /// The shading options these ask for.
+    fn shading(&self) -> ShadeOptions {
+        ShadeOptions::default()
+            .with_pieces(self.pieces)
+            .with_vertices(!self.rounded_only)
     }
 }
 
@@ -517,7 +532,7 @@ impl FastStatics {
         prepared: &mut PrepStats,
     ) -> Result<FastStatics, PipelineError> {
         let sh = LightVolumes::new(polys, lights).map_err(PipelineError::Shadow)?;
-        let sopts = ShadeOptions::default().with_pieces(opts.pieces);
+        let sopts = opts.shading();
         let parts: Vec<(Batch, Vec<Option<Box<Cells>>>)> = ranges
             .par_chunks(CHUNK)
             .enumerate()
@@ -900,7 +915,7 @@ impl Dynamic {
         };
         stats.t_merge = t.elapsed();
         let t = Instant::now();
-        let sopts = ShadeOptions::default().with_pieces(self.opts.pieces);
+        let sopts = self.opts.shading();
         let (lights_of, recs) = self.changing_receivers(fast, related);
         let starts: Vec<Start<'_>> = recs
             .iter()

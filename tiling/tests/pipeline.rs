@@ -346,3 +346,49 @@ fn regress_quads_crossing_along_a_diagonal_keep_every_face() {
     let f = check_motion(&wall, &object, &light, &still, 1, Strategy::Fast, None);
     assert_eq!(f[0].culled, 0);
 }
+
+/// Frames made keeping only the rounding of their vertices
+/// (`PipelineOptions::rounded_only`, as `shadow animate` runs) have the
+/// same fragments, rings and rounded points as frames that keep the exact
+/// points, and no exact point.
+#[test]
+fn rounded_only_frames_are_the_same_frames() {
+    let (st, dy) = room_parts();
+    let spin = Motion {
+        axis: DVec3::new(0.2, 0.1, 1.0),
+        degrees: 29.0,
+        centre: DVec3::ZERO,
+        step: DVec3::new(-0.2, 0.1, 0.0),
+    };
+    let lights = [LightSpec::Point(ROOM_LIGHT)];
+    let mut pts: Vec<DVec3> = st.iter().flatten().copied().collect();
+    for k in 0..3 {
+        let m = spin.matrix(k);
+        pts.extend(dy.iter().flatten().map(|&p| m.transform_point3(p)));
+    }
+    let grid = shared_grid(&pts, &lights).unwrap();
+    let placed: Vec<svbsp::Light> = (place_lights(&grid, &lights).unwrap().iter())
+        .map(|l| l.light)
+        .collect();
+    let exact = Dynamic::new(&st, &dy, grid, &placed, PipelineOptions::default()).unwrap();
+    let opts = PipelineOptions::default().with_rounded_only(true);
+    let rounded = Dynamic::new(&st, &dy, grid, &placed, opts).unwrap();
+    for k in 0..3 {
+        let m = spin.matrix(k);
+        let (a, b) = (exact.frame(&m).unwrap(), rounded.frame(&m).unwrap());
+        let (a, b) = (exact.fragments(&a), rounded.fragments(&b));
+        assert!(a.len() > st.len(), "frame {k}: some face cut");
+        assert_eq!(a.len(), b.len());
+        for (fa, fb) in a.fragments().zip(b.fragments()) {
+            assert_eq!((fa.face(), fa.lit_mask()), (fb.face(), fb.lit_mask()));
+            let ring = |x: &svbsp::Batch, r: &[u32]| -> Vec<[f64; 3]> {
+                r.iter().map(|&v| x.rounded(v)).collect()
+            };
+            for (ra, rb) in fa.rings().zip(fb.rings()) {
+                assert_eq!(ring(&a, ra), ring(&b, rb), "frame {k}");
+            }
+        }
+        assert!((0..a.vertex_count() as u32).all(|v| a.vertex(v).is_some()));
+        assert!(b.vertex(0).is_none(), "frame {k}: no exact point kept");
+    }
+}

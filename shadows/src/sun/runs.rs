@@ -218,7 +218,8 @@ impl HoursRun {
             shaded,
             &svbsp::ShadeOptions::default()
                 .with_pieces(pieces.is_some())
-                .with_planes(pieces.is_some()),
+                .with_planes(pieces.is_some())
+                .with_vertices(false),
         )?;
         let ids = part.map(|(own, _)| own.faces.clone());
         let order: Vec<usize> = match &ids {
