@@ -521,17 +521,21 @@ fn soft_face(
     // per light, the grid points nearest the penumbra fragments' centroids
     // and corners (neighbours share corners), each viewed once, in
     // parallel; then each fragment's share from its points
-    let probes: Vec<Vec<Option<Probes>>> = fragments
-        .iter()
-        .map(|(polygon, c)| {
-            (0..lights.len())
-                .map(|k| {
-                    let penumbra = (c.lit | c.umbra) >> k & 1 == 0;
-                    (penumbra && has_share(&lights[k])).then(|| Probes::of(polygon))
-                })
-                .collect()
-        })
-        .collect();
+    let probes_of = |(polygon, c): &(Polygon, Classes)| -> Vec<Option<Probes>> {
+        (0..lights.len())
+            .map(|k| {
+                let penumbra = (c.lit | c.umbra) >> k & 1 == 0;
+                (penumbra && has_share(&lights[k])).then(|| Probes::of(polygon))
+            })
+            .collect()
+    };
+    // (a face of many fragments, such as a ground, rounds their corners
+    // on every thread)
+    let many = fragments.len() >= PARALLEL_FRAGMENTS;
+    let probes: Vec<Vec<Option<Probes>>> = match many {
+        true => fragments.par_iter().map(probes_of).collect(),
+        false => fragments.iter().map(probes_of).collect(),
+    };
     // (a probe point lies near the face when its fragment is not huge)
     let near_face = fragments.iter().all(|(p, _)| p.len() < MAX_PROBED_CORNERS);
     let values: Vec<Option<Viewed>> = (0..lights.len())
@@ -565,25 +569,33 @@ fn soft_face(
             Some(Viewed { points, fractions })
         })
         .collect();
-    fragments
-        .into_iter()
-        .zip(probes)
-        .map(|((polygon, c), probes)| {
-            let visible = probes
-                .iter()
-                .zip(&values)
-                .map(|(p, v)| Some(p.as_ref()?.share(v.as_ref()?)))
-                .collect();
-            SoftFragment {
-                polygon,
-                lit: c.lit,
-                umbra: c.umbra,
-                undecided: c.undecided,
-                visible,
-            }
-        })
-        .collect()
+    let fragment = |((polygon, c), probes): ((Polygon, Classes), Vec<Option<Probes>>)| {
+        let visible = probes
+            .iter()
+            .zip(&values)
+            .map(|(p, v)| Some(p.as_ref()?.share(v.as_ref()?)))
+            .collect();
+        SoftFragment {
+            polygon,
+            lit: c.lit,
+            umbra: c.umbra,
+            undecided: c.undecided,
+            visible,
+        }
+    };
+    match many {
+        true => fragments
+            .into_par_iter()
+            .zip(probes)
+            .map(fragment)
+            .collect(),
+        false => fragments.into_iter().zip(probes).map(fragment).collect(),
+    }
 }
+
+/// Fragments of one face from which their probe points and shares are
+/// made in parallel.
+const PARALLEL_FRAGMENTS: usize = 256;
 
 /// The occluders near `face` (numbers `near` into `regions`, `reach` and
 /// `blockers`) with their volumes and boxes: for a face with many, the
