@@ -15,7 +15,7 @@ use proptest::prelude::*;
 use svbsp::{LightSpec, place_lights, shared_grid};
 use tiling::{Dynamic, Motion, PipelineOptions, Strategy};
 
-use crate::scratch::{check_motion, crossing, ground, tetra};
+use crate::scratch::{check_motion, crossing, grid_and_lights, ground, tetra};
 
 /// The number of static polygons the faces import to.
 fn d_polygons(st: &[Vec<DVec3>]) -> usize {
@@ -361,15 +361,7 @@ fn rounded_only_frames_are_the_same_frames() {
         step: DVec3::new(-0.2, 0.1, 0.0),
     };
     let lights = [LightSpec::Point(ROOM_LIGHT)];
-    let mut pts: Vec<DVec3> = st.iter().flatten().copied().collect();
-    for k in 0..3 {
-        let m = spin.matrix(k);
-        pts.extend(dy.iter().flatten().map(|&p| m.transform_point3(p)));
-    }
-    let grid = shared_grid(&pts, &lights).unwrap();
-    let placed: Vec<svbsp::Light> = (place_lights(&grid, &lights).unwrap().iter())
-        .map(|l| l.light)
-        .collect();
+    let (grid, placed) = grid_and_lights(&st, &dy, &lights, &spin, 3);
     let exact = Dynamic::new(&st, &dy, grid, &placed, PipelineOptions::default()).unwrap();
     let opts = PipelineOptions::default().with_rounded_only(true);
     let rounded = Dynamic::new(&st, &dy, grid, &placed, opts).unwrap();

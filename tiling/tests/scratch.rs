@@ -106,19 +106,16 @@ pub(crate) fn nonzero(a: Areas) -> Areas {
     a.into_iter().filter(|(_, v)| !v.is_zero()).collect()
 }
 
-/// Runs `frames` of `motion` with `strategy` and checks each against the
-/// computation from scratch. Returns the frames' figures.
-pub(crate) fn check_motion(
+/// One grid for every frame (the static scene, the lights and every
+/// position the object takes in `frames` of `motion`), and the lights
+/// placed on it.
+pub(crate) fn grid_and_lights(
     statics: &[Vec<DVec3>],
     moving: &[Vec<DVec3>],
     lights: &[LightSpec],
     motion: &Motion,
     frames: u32,
-    strategy: Strategy,
-    tiles: Option<u32>,
-) -> Vec<tiling::FrameStats> {
-    // one grid for every frame: the static scene, the lights and every
-    // position the object takes
+) -> (Grid, Vec<Light>) {
     let mut pts: Vec<DVec3> = statics.iter().flatten().copied().collect();
     for k in 0..frames {
         let m = motion.matrix(k);
@@ -130,6 +127,21 @@ pub(crate) fn check_motion(
         .iter()
         .map(|l| l.light)
         .collect();
+    (grid, placed)
+}
+
+/// Runs `frames` of `motion` with `strategy` and checks each against the
+/// computation from scratch. Returns the frames' figures.
+pub(crate) fn check_motion(
+    statics: &[Vec<DVec3>],
+    moving: &[Vec<DVec3>],
+    lights: &[LightSpec],
+    motion: &Motion,
+    frames: u32,
+    strategy: Strategy,
+    tiles: Option<u32>,
+) -> Vec<tiling::FrameStats> {
+    let (grid, placed) = grid_and_lights(statics, moving, lights, motion, frames);
     let opts = PipelineOptions::default()
         .with_strategy(strategy)
         .with_tiles(tiles);
