@@ -820,8 +820,7 @@ impl ShadowVolumes {
             grafted += sub.grafted;
             skeleton += sub_skeleton;
         }
-        let mut nodes = Vec::new();
-        joined(&subs, &starts, &mut nodes);
+        let mut nodes = joined(&subs, &starts);
         drop(subs);
         for (task, r) in ready.iter().zip(roots) {
             match task.slot {
@@ -1080,25 +1079,22 @@ fn shift(l: u32, off: u32) -> u32 {
     if l >= SHADOW { l } else { l + off }
 }
 
-/// The subtrees' nodes one after the other in `out`, each subtree's links
-/// shifted to where it starts (`starts[i]`, and the end last), written
-/// in parallel (the copy was one thread's work at the end of every
-/// build, with the other core idle).
-fn joined(subs: &[Vec<Node>], starts: &[usize], out: &mut Vec<Node>) {
+/// The subtrees' nodes one after the other, each subtree's links shifted
+/// to where it starts (`starts[i]`, and the end last), each node written
+/// by its thread in its place (`bsp_core::par::map_placed`: the copy was
+/// one thread's work at the end of every build, with the other core
+/// idle).
+fn joined(subs: &[Vec<Node>], starts: &[usize]) -> Vec<Node> {
     let total = *starts.last().expect("an end");
-    (0..total)
-        .into_par_iter()
-        .with_min_len(4096)
-        .map(|i| {
-            // the last subtree starting at or before node `i`
-            let k = starts.partition_point(|&s| s <= i) - 1;
-            let off = starts[k];
-            let mut n = subs[k][i - off];
-            n.front = shift(n.front, off as u32);
-            n.back = shift(n.back, off as u32);
-            n
-        })
-        .collect_into_vec(out);
+    bsp_core::par::map_placed(total, |i| {
+        // the last subtree starting at or before node `i`
+        let k = starts.partition_point(|&s| s <= i) - 1;
+        let off = starts[k];
+        let mut n = subs[k][i - off];
+        n.front = shift(n.front, off as u32);
+        n.back = shift(n.back, off as u32);
+        n
+    })
 }
 
 /// Lit parts of occluders: each a convex polygon's exact corners, with its
