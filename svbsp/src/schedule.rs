@@ -7,6 +7,12 @@ use bsp_core::Polygon;
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
+/// A face's cells, pieces or fragments from this many on (a ground under
+/// a mesh, cut by its lights) are worked on in parallel, in order: the
+/// lights after the first pass over runs of them, and they are made into
+/// polygons, pieces, probe points and shares.
+pub(crate) const PARALLEL_CELLS: usize = 256;
+
 /// A receiver of this many times the median receiver's area counts as
 /// large.
 const LARGE_AREA: f64 = 64.0;

@@ -531,7 +531,7 @@ fn soft_face(
     };
     // (a face of many fragments, such as a ground, rounds their corners
     // on every thread)
-    let many = fragments.len() >= PARALLEL_FRAGMENTS;
+    let many = fragments.len() >= crate::schedule::PARALLEL_CELLS;
     let probes: Vec<Vec<Option<Probes>>> = match many {
         true => fragments.par_iter().map(probes_of).collect(),
         false => fragments.iter().map(probes_of).collect(),
@@ -592,10 +592,6 @@ fn soft_face(
         false => fragments.into_iter().zip(probes).map(fragment).collect(),
     }
 }
-
-/// Fragments of one face from which their probe points and shares are
-/// made in parallel.
-const PARALLEL_FRAGMENTS: usize = 256;
 
 /// The occluders near `face` (numbers `near` into `regions`, `reach` and
 /// `blockers`) with their volumes and boxes: for a face with many, the

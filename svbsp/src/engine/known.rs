@@ -20,11 +20,11 @@ use bsp_core::{Plane, Polygon};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
-use super::passes::PARALLEL_CELLS;
 use super::{Batch, LightVolumes, ShadeOptions, ShadowError, ShadowSet, Start};
 use crate::engine::Scratch;
 use crate::light::Light;
 use crate::psv::ShadowVolumes;
+use crate::schedule::PARALLEL_CELLS;
 
 impl LightVolumes {
     /// [`LightVolumes::new_with`] with the occluders taken in the order of

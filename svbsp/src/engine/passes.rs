@@ -17,11 +17,7 @@ use smallvec::SmallVec;
 use super::{Scratch, ShadowSet};
 use crate::psv::ShadowVolumes;
 use crate::psv::filter::filter;
-
-/// Cells from which the lights after the first pass over runs in
-/// parallel (and [`ShadowSet::cells`] makes them into polygons in
-/// parallel).
-pub(super) const PARALLEL_CELLS: usize = 256;
+use crate::schedule::PARALLEL_CELLS;
 
 /// At most this many runs (each copies the arena).
 const MAX_RUNS: usize = 8;

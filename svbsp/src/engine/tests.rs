@@ -270,7 +270,7 @@ fn a_large_face_passes_its_cells_in_runs_as_one_by_one() {
     let mut one = Scratch::default();
     first(&mut one);
     assert!(
-        one.cur.len() >= passes::PARALLEL_CELLS,
+        one.cur.len() >= crate::schedule::PARALLEL_CELLS,
         "{} cells",
         one.cur.len()
     );
