@@ -419,6 +419,25 @@ impl Pool {
         }
     }
 
+    /// [`Pool::sides`] from every vertex's side, written to `out`: a lazy
+    /// vertex keeps the exact coordinates this computes, and its measures
+    /// then use them, so a skeleton's scoring classifies every vertex
+    /// (an occluder whole leaves `out` as it was: its grid points keep
+    /// nothing).
+    fn classify_into(
+        &mut self,
+        occ: &Occluders,
+        e: Entry,
+        plane: &Plane,
+        out: &mut SmallVec<[Side; 8]>,
+    ) -> Sides {
+        if e.piece == WHOLE {
+            Sides::of_grid(occ.verts(e.occ), plane)
+        } else {
+            (self.arena).classify_into(&self.pieces[e.piece as usize], plane, out)
+        }
+    }
+
     /// Entry `e` in this pool: an occluder whole is added.
     fn own(&mut self, occ: &Occluders, e: Entry) -> Entry {
         if e.piece == WHOLE {
@@ -1198,14 +1217,7 @@ fn choose_split(
             }
             let (mut f, mut b, mut both) = (0u64, 0u64, 0u64);
             for &i in &sample {
-                // every vertex classified (a lazy vertex keeps its exact
-                // coordinates, which its measures then use)
-                let sd = match task.list[i] {
-                    w if w.piece == WHOLE => Sides::of_grid(occ.verts(w.occ), e),
-                    p => pool
-                        .arena
-                        .classify_into(&pool.pieces[p.piece as usize], e, sides),
-                };
+                let sd = pool.classify_into(occ, task.list[i], e, sides);
                 match (sd.front, sd.back) {
                     (true, true) => both += 1,
                     (true, false) => f += 1,
