@@ -434,7 +434,8 @@ impl Pool {
         if e.piece == WHOLE {
             Sides::of_grid(occ.verts(e.occ), plane)
         } else {
-            (self.arena).classify_into(&self.pieces[e.piece as usize], plane, out)
+            self.arena
+                .classify_into(&self.pieces[e.piece as usize], plane, out)
         }
     }
 
