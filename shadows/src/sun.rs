@@ -461,7 +461,9 @@ impl Part {
 
     /// This part overlaid with a later run's of the same polygons (a
     /// whole part's count added to each of the other's cells, which cover
-    /// it); `None` where they lie on other planes.
+    /// it; two parts' cells, which cover each other, overlaid as such:
+    /// [`svbsp::FaceOverlay::plus_covering`]); `None` where they lie on
+    /// other planes.
     fn plus(self, other: &Part) -> Option<Part> {
         if self.support() != other.support() {
             return None;
@@ -477,7 +479,7 @@ impl Part {
                 o.add_count(*b);
                 Some(Part::Cells(o))
             }
-            (Part::Cells(a), Part::Cells(b)) => a.plus(b).map(Part::Cells),
+            (Part::Cells(a), Part::Cells(b)) => a.plus_covering(b).map(Part::Cells),
         }
     }
 
