@@ -277,17 +277,22 @@ impl FaceOverlay {
                     continue;
                 }
             }
+            // (the cells whose boxes miss its box are apart from it)
             near.clear();
             match &grid {
                 Some(grid) => {
                     grid.visit(bounds, |j| {
-                        if std::mem::replace(&mut seen[j as usize], i) != i {
+                        if std::mem::replace(&mut seen[j as usize], i) != i
+                            && overlap(&bounds, &boxes[j as usize])
+                        {
                             near.push(j);
                         }
                     });
                     near.sort_unstable();
                 }
-                None => near.extend(0..other.len() as u32),
+                None => near.extend(
+                    (0..other.len() as u32).filter(|&j| overlap(&bounds, &boxes[j as usize])),
+                ),
             }
             // inside one cell of `other` (whose cells do not overlap): whole,
             // with its count added
