@@ -295,23 +295,31 @@ impl FaceOverlay {
                 ),
             }
             // inside one cell of `other` (whose cells do not overlap): whole,
-            // with its count added
-            let holder = near
-                .iter()
-                .copied()
-                .find(|&j| other.holds(&other.cells[j as usize].0, &cell, &mut self.arena));
+            // with its count added; else the cells of `other` it overlaps
+            // (apart where a plane of either has the other in front or on
+            // it); each cell's planes against its corners once for both
+            hits.clear();
+            let mut holder = None;
+            for &j in &near {
+                let theirs = &other.cells[j as usize].0;
+                match other.relate(theirs, &cell, &mut self.arena) {
+                    Relation::Holds => {
+                        holder = Some(j);
+                        break;
+                    }
+                    Relation::Apart => {}
+                    Relation::Unknown => {
+                        if !self.apart_by_own(&cell, other, theirs) {
+                            hits.push(j);
+                        }
+                    }
+                }
+            }
             if let Some(j) = holder {
                 out.push((cell, count + other.cells[j as usize].1));
                 out_boxes.push(meet(bounds, boxes[j as usize]).unwrap_or(bounds));
                 continue;
             }
-            // else the cells of `other` it overlaps (apart where a plane of
-            // either has the other in front or on it)
-            hits.clear();
-            hits.extend(near.iter().copied().filter(|&j| {
-                let theirs = &other.cells[j as usize].0;
-                !self.apart(&cell, other, theirs)
-            }));
             let (first, mark) = (out.len(), self.arena.mark());
             fresh.clear();
             rest.clear();
@@ -375,19 +383,38 @@ impl FaceOverlay {
     /// apart: a plane of either has all of the other in front of it or on
     /// it (two convex polygons that meet with area have no such plane).
     fn apart(&self, piece: &Piece, other: &FaceOverlay, theirs: &Piece) -> bool {
-        let front_of = |arena: &PieceArena, c: &Piece, plane: &Plane| {
-            c.verts
-                .iter()
-                .all(|&v| arena.vertex(v).classify(plane) != Side::Back)
-        };
-        (theirs.edges.iter()).any(|&e| front_of(&self.arena, piece, &other.arena.plane(e)))
-            || (piece.edges.iter()).any(|&e| front_of(&other.arena, theirs, &self.arena.plane(e)))
+        (theirs.edges.iter()).any(|&e| {
+            let plane = other.arena.plane(e);
+            (piece.verts.iter()).all(|&v| self.arena.vertex(v).classify(&plane) != Side::Back)
+        }) || self.apart_by_own(piece, other, theirs)
     }
 
     /// Whether cell `theirs` of this overlay holds `piece` of `arena`
-    /// (every corner behind or on each of its edge planes).
-    fn holds(&self, theirs: &Piece, piece: &Piece, arena: &mut PieceArena) -> bool {
-        (theirs.edges.iter()).all(|&e| !arena.sides(piece, &self.arena.plane(e)).front)
+    /// (every corner behind or on each of its edge planes), or is apart
+    /// from it by one of its edge planes (every corner in front or on it).
+    fn relate(&self, theirs: &Piece, piece: &Piece, arena: &mut PieceArena) -> Relation {
+        let mut holds = true;
+        for &e in &theirs.edges {
+            let s = arena.sides(piece, &self.arena.plane(e));
+            if !s.back {
+                return Relation::Apart;
+            }
+            holds &= !s.front;
+        }
+        match holds {
+            true => Relation::Holds,
+            false => Relation::Unknown,
+        }
+    }
+
+    /// Whether a plane of `piece` (of this arena) has all of `theirs` (of
+    /// `other`'s) in front of it or on it: [`FaceOverlay::apart`] by
+    /// `piece`'s planes alone.
+    fn apart_by_own(&self, piece: &Piece, other: &FaceOverlay, theirs: &Piece) -> bool {
+        (piece.edges.iter()).any(|&e| {
+            let plane = self.arena.plane(e);
+            (theirs.verts.iter()).all(|&v| other.arena.vertex(v).classify(&plane) != Side::Back)
+        })
     }
 
     /// Whether every cell lies in `cell` of `arena` (its corners behind or
@@ -431,6 +458,17 @@ impl FaceOverlay {
         }
         b
     }
+}
+
+/// How a cell of one overlay lies to a convex piece of another, by the
+/// cell's edge planes ([`FaceOverlay::relate`]).
+enum Relation {
+    /// It holds the piece.
+    Holds,
+    /// One of its planes has the piece in front or on it.
+    Apart,
+    /// Neither, by its planes.
+    Unknown,
 }
 
 /// At most how many parts of one cell [`rejoin`] tries to put together
