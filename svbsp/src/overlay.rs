@@ -189,13 +189,14 @@ impl FaceOverlay {
     /// that share a whole edge, have one count and make a convex union are
     /// joined (the cuts between `other`'s cells of one count are undone
     /// where that leaves convex cells; the points keep their counts). A
-    /// cell of `self` whose box
-    /// meets no box of `other`'s cells of other counts than the one
-    /// whose cells' boxes cover the most (the count of most of the face,
-    /// as a rule) lies in cells of that count, so it takes that count
-    /// whole without a test of its corners. Where `other` does not cover
-    /// `self`, such a cell takes that count where [`FaceOverlay::plus`]
-    /// would keep a part of it uncounted.
+    /// cell of `self` whose box meets the boxes of `other`'s cells of one
+    /// count only lies in those (they cover it) and takes that count whole
+    /// without a test of its corners; so does, found without listing the
+    /// cells near it, a cell whose box meets no box of `other`'s cells of
+    /// other counts than the one whose cells' boxes cover the most (the
+    /// count of most of the face, as a rule). Where `other` does not
+    /// cover `self`, such a cell takes that count where
+    /// [`FaceOverlay::plus`] would keep a part of it uncounted.
     pub fn plus_covering(self, other: &FaceOverlay) -> Option<FaceOverlay> {
         (self.plane == other.plane).then(|| self.meet(other, true))
     }
@@ -293,6 +294,17 @@ impl FaceOverlay {
                 None => near.extend(
                     (0..other.len() as u32).filter(|&j| overlap(&bounds, &boxes[j as usize])),
                 ),
+            }
+            // (covering: the cells near it cover it; of one count, it
+            // takes that count whole)
+            if covering
+                && let Some((&j, more)) = near.split_first()
+                && let c = other.cells[j as usize].1
+                && more.iter().all(|&k| other.cells[k as usize].1 == c)
+            {
+                out.push((cell, count + c));
+                out_boxes.push(bounds);
+                continue;
             }
             // inside one cell of `other` (whose cells do not overlap): whole,
             // with its count added; else the cells of `other` it overlaps
