@@ -242,67 +242,23 @@ impl FaceOverlay {
         let Some(scene) = boxes.iter().copied().reduce(union) else {
             return self;
         };
-        // (a few cells are tried in turn, many through a grid of boxes)
-        let grid = (other.len() > FEW).then(|| CellGrid::new(scene, boxes));
+        let mut look = Near::new(other, scene, covering);
         // each of `other`'s planes copied in once (as oriented), when
         // first needed
         let mut copied: Vec<Option<u32>> = vec![None; 2 * other.arena.planes.len()];
         // (and those copied while a cell is cut, forgotten if its cuts are
         // undone)
         let mut fresh = Vec::new();
-        let (mut seen, mut near, mut hits) =
-            (vec![usize::MAX; other.len()], Vec::new(), Vec::new());
+        let mut hits = Vec::new();
         let (mut rest, mut next) = (Vec::new(), Vec::new());
         let mut sides = SmallVec::new();
         let mut out = Vec::with_capacity(self.cells.len());
         let mut out_boxes = Vec::with_capacity(self.cells.len());
         let cells = std::mem::take(&mut self.cells);
         let own = std::mem::take(&mut self.boxes);
-        let common = covering.then(|| other.common_count()).flatten();
         for (i, ((cell, count), bounds)) in cells.into_iter().zip(own).enumerate() {
-            // away from every cell of another count than the common one:
-            // in cells of that count (which cover it), whole
-            if let Some((n, others, grid)) = &common {
-                let mut met = false;
-                match grid {
-                    Some(grid) => grid.visit(bounds, |j| {
-                        met |= overlap(&bounds, &boxes[others[j as usize] as usize]);
-                    }),
-                    None => {
-                        met = (others.iter()).any(|&j| overlap(&bounds, &boxes[j as usize]));
-                    }
-                }
-                if !met {
-                    out.push((cell, count + n));
-                    out_boxes.push(bounds);
-                    continue;
-                }
-            }
-            // (the cells whose boxes miss its box are apart from it)
-            near.clear();
-            match &grid {
-                Some(grid) => {
-                    grid.visit(bounds, |j| {
-                        if std::mem::replace(&mut seen[j as usize], i) != i
-                            && overlap(&bounds, &boxes[j as usize])
-                        {
-                            near.push(j);
-                        }
-                    });
-                    near.sort_unstable();
-                }
-                None => near.extend(
-                    (0..other.len() as u32).filter(|&j| overlap(&bounds, &boxes[j as usize])),
-                ),
-            }
-            // (covering: the cells near it cover it; of one count, it
-            // takes that count whole)
-            if covering
-                && let Some((&j, more)) = near.split_first()
-                && let c = other.cells[j as usize].1
-                && more.iter().all(|&k| other.cells[k as usize].1 == c)
-            {
-                out.push((cell, count + c));
+            if let Some(n) = look.find(i, bounds) {
+                out.push((cell, count + n));
                 out_boxes.push(bounds);
                 continue;
             }
@@ -312,7 +268,7 @@ impl FaceOverlay {
             // it); each cell's planes against its corners once for both
             hits.clear();
             let mut holder = None;
-            for &j in &near {
+            for &j in &look.list {
                 let theirs = &other.cells[j as usize].0;
                 match other.relate(theirs, &cell, &mut self.arena) {
                     Relation::Holds => {
@@ -469,6 +425,78 @@ impl FaceOverlay {
             }
         }
         b
+    }
+}
+
+/// How [`FaceOverlay::meet`] finds the cells of `other` near a cell: a
+/// few tried in turn, many through a grid of their boxes; with
+/// `covering`, the common count's cells apart.
+struct Near<'a> {
+    other: &'a FaceOverlay,
+    grid: Option<CellGrid>,
+    covering: bool,
+    /// The common count, the cells of other counts and a grid of their
+    /// boxes ([`FaceOverlay::common_count`]).
+    common: Option<(u32, Vec<u32>, Option<CellGrid>)>,
+    /// Per cell of `other`, the last cell it was listed for.
+    seen: Vec<usize>,
+    /// The cells near the last cell asked about, in their order.
+    list: Vec<u32>,
+}
+
+impl<'a> Near<'a> {
+    /// The lookup of `other`'s cells, which lie in box `scene`.
+    fn new(other: &'a FaceOverlay, scene: Box3, covering: bool) -> Near<'a> {
+        Near {
+            other,
+            grid: (other.len() > FEW).then(|| CellGrid::new(scene, &other.boxes)),
+            covering,
+            common: covering.then(|| other.common_count()).flatten(),
+            seen: vec![usize::MAX; other.len()],
+            list: Vec::new(),
+        }
+    }
+
+    /// For cell `i` of box `bounds`: with `covering`, the count it takes
+    /// whole if the boxes alone tell (the cells of `other` whose boxes
+    /// meet its box cover it: of one count, it lies in that count);
+    /// else `None`, and [`Near::list`] holds those cells (the others are
+    /// apart from it).
+    fn find(&mut self, i: usize, bounds: Box3) -> Option<u32> {
+        let (other, boxes) = (self.other, &self.other.boxes);
+        // away from every cell of another count than the common one
+        if let Some((n, others, grid)) = &self.common {
+            let mut met = false;
+            match grid {
+                Some(grid) => grid.visit(bounds, |j| {
+                    met |= overlap(&bounds, &boxes[others[j as usize] as usize]);
+                }),
+                None => met = (others.iter()).any(|&j| overlap(&bounds, &boxes[j as usize])),
+            }
+            if !met {
+                return Some(*n);
+            }
+        }
+        self.list.clear();
+        match &self.grid {
+            Some(grid) => {
+                let (seen, list) = (&mut self.seen, &mut self.list);
+                grid.visit(bounds, |j| {
+                    if std::mem::replace(&mut seen[j as usize], i) != i
+                        && overlap(&bounds, &boxes[j as usize])
+                    {
+                        list.push(j);
+                    }
+                });
+                self.list.sort_unstable();
+            }
+            None => self
+                .list
+                .extend((0..other.len() as u32).filter(|&j| overlap(&bounds, &boxes[j as usize]))),
+        }
+        let (&j, more) = self.list.split_first()?;
+        let c = other.cells[j as usize].1;
+        (self.covering && more.iter().all(|&k| other.cells[k as usize].1 == c)).then_some(c)
     }
 }
 
