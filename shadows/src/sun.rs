@@ -483,7 +483,8 @@ impl Part {
         }
     }
 
-    /// Each cell's corners (correctly rounded grid coordinates) and count.
+    /// Each cell's corners (grid coordinates for measuring: correctly
+    /// rounded, or within `2^-20` grid units of the exact points) and count.
     fn cells(&self) -> Vec<(Vec<[f64; 3]>, u32)> {
         match self {
             Part::Whole(support, planes, count) => {
@@ -491,7 +492,7 @@ impl Part {
                     .expect("a whole part's planes meet in turn (checked)");
                 vec![(p.vertices_f64(), *count)]
             }
-            Part::Cells(o) => (o.all_corners().into_iter())
+            Part::Cells(o) => (o.measured_corners().into_iter())
                 .enumerate()
                 .map(|(i, c)| (c, o.count(i)))
                 .collect(),

@@ -10,7 +10,7 @@ use bsp_core::{Plane, Side};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
-use crate::arena::pieces::{EdgeRef, Piece, PieceArena};
+use crate::arena::pieces::{EdgeRef, Piece, PieceArena, VertexRef};
 use crate::arena::regions::merge_cells;
 use crate::boxes::{Box3, CellGrid, meet, overlap, union};
 
@@ -152,6 +152,20 @@ impl FaceOverlay {
     /// corner rounded once (in parallel for many) however many cells
     /// share it.
     pub fn all_corners(&self) -> Vec<Vec<[f64; 3]>> {
+        self.corners_by(|v| v.to_f64())
+    }
+
+    /// Every cell's corners for measuring (its area, say): grid
+    /// coordinates within `2^-20` grid units of the exact ones, found
+    /// without exact arithmetic where the `f64` approximations of a cut
+    /// corner are that close (the same bits however the overlay was
+    /// made), each corner once however many cells share it.
+    pub fn measured_corners(&self) -> Vec<Vec<[f64; 3]>> {
+        self.corners_by(|v| v.measure())
+    }
+
+    /// Every cell's corners, each found once by `at`.
+    fn corners_by(&self, at: impl Fn(VertexRef<'_>) -> [f64; 3] + Sync) -> Vec<Vec<[f64; 3]>> {
         let mut used: Vec<u32> = self
             .cells
             .iter()
@@ -159,7 +173,7 @@ impl FaceOverlay {
             .collect();
         used.sort_unstable();
         used.dedup();
-        let round = |&v: &u32| self.arena.vertex(v).to_f64();
+        let round = |&v: &u32| at(self.arena.vertex(v));
         let rounded: Vec<[f64; 3]> = match used.len() > 4096 {
             true => used.par_iter().map(round).collect(),
             false => used.iter().map(round).collect(),
@@ -605,6 +619,7 @@ fn joined(arena: &mut PieceArena, p: &Piece, q: &Piece) -> Option<Piece> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::arena::pieces::MEASURE_UNITS;
     use bsp_core::{GridPoint, Polygon, Split};
     use proptest::prelude::*;
 
@@ -812,6 +827,16 @@ mod tests {
             let c = overlay_of(&a).plus_covering(&overlay_of(&b)).unwrap();
             tiles_with_summed_counts(&c, &a, &b, 40)?;
             prop_assert!(c.len() <= o.len());
+            // corners for measuring: within 2^-20 grid units of the
+            // correctly rounded ones, cell by cell
+            let (exact, measured) = (c.all_corners(), c.measured_corners());
+            prop_assert_eq!(exact.len(), measured.len());
+            for (e, m) in exact.iter().zip(&measured) {
+                prop_assert_eq!(e.len(), m.len());
+                for (p, q) in e.iter().zip(m) {
+                    prop_assert!((0..3).all(|k| (p[k] - q[k]).abs() <= MEASURE_UNITS), "{:?} {:?}", p, q);
+                }
+            }
         }
 
         /// Two fine partitions of a face, one mostly of one count (as a

@@ -305,6 +305,17 @@ impl Lazy {
             })
     }
 
+    /// Grid coordinates from the approximations, if they are within
+    /// [`MEASURE_UNITS`] of the exact ones.
+    fn measure(&self) -> Option<[f64; 3]> {
+        let (w, ew) = (self.approx[3], self.err[3]);
+        // |x/w - X/W| <= (ex + |x/w| ew) / (w - ew) for |x - X| <= ex,
+        // |w - W| <= ew, w > ew
+        let q = [0, 1, 2].map(|k| self.approx[k] / w);
+        let room = (w - ew) * MEASURE_UNITS;
+        (w > ew && (0..3).all(|k| self.err[k] + q[k].abs() * ew <= room)).then_some(q)
+    }
+
     /// [`Lazy::classify`] without keeping the exact point.
     fn classify_shared(&self, planes: &[Plane], plane: &Plane) -> Side {
         if let Some(s) = filter_side_err(&plane.approx(), &self.approx, &self.err) {
@@ -390,17 +401,21 @@ impl VertexRef<'_> {
     pub(crate) fn approx(self) -> [f64; 3] {
         if let VertexRef::Lazy(l, _) = self
             && l.exact.is_none()
+            && let Some(q) = l.measure()
         {
-            let (w, ew) = (l.approx[3], l.err[3]);
-            // |x/w - X/W| <= (ex + |x/w| ew) / (w - ew) for |x - X| <= ex,
-            // |w - W| <= ew, w > ew
-            let q = [0, 1, 2].map(|k| l.approx[k] / w);
-            let room = (w - ew) * MEASURE_UNITS;
-            if w > ew && (0..3).all(|k| l.err[k] + q[k].abs() * ew <= room) {
-                return q;
-            }
+            return q;
         }
         self.to_f64()
+    }
+
+    /// [`VertexRef::approx`] whether or not a lazy point's exact
+    /// coordinates were found (so the same bits however it was
+    /// classified before).
+    pub(crate) fn measure(self) -> [f64; 3] {
+        match self {
+            VertexRef::Lazy(l, _) => l.measure().unwrap_or_else(|| self.to_f64()),
+            _ => self.to_f64(),
+        }
     }
 
     /// The correctly rounded grid coordinates.
