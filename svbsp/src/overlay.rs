@@ -28,6 +28,8 @@ pub struct FaceOverlay {
     cells: Vec<(Piece, u32)>,
     /// Per cell, a box of grid points holding it.
     boxes: Vec<Box3>,
+    /// How many cells there were after the last [`FaceOverlay::join_cells`].
+    joined_at: usize,
 }
 
 /// A region of an [`FaceOverlay`]: cells of one count merged, as rings of
@@ -101,6 +103,7 @@ impl FaceOverlay {
             plane: support,
             cells: out,
             boxes: Vec::new(),
+            joined_at: 0,
         };
         o.boxes = (o.cells.iter()).map(|c| o.bounds_of(&c.0)).collect();
         Some(o)
@@ -202,7 +205,10 @@ impl FaceOverlay {
     /// are), in fewer cells, found faster. The parts of a cell of `self`
     /// that share a whole edge, have one count and make a convex union are
     /// joined (the cuts between `other`'s cells of one count are undone
-    /// where that leaves convex cells; the points keep their counts). A
+    /// where that leaves convex cells; the points keep their counts), and
+    /// each time the cells have doubled, so are any two cells of one
+    /// count that share a whole edge (cut apart once, of one count again
+    /// after later overlays). A
     /// cell of `self` whose box meets the boxes of `other`'s cells of one
     /// count only lies in those (they cover it) and takes that count whole
     /// without a test of its corners; so does, found without listing the
@@ -212,7 +218,55 @@ impl FaceOverlay {
     /// cover `self`, such a cell takes that count where
     /// [`FaceOverlay::plus`] would keep a part of it uncounted.
     pub fn plus_covering(self, other: &FaceOverlay) -> Option<FaceOverlay> {
-        (self.plane == other.plane).then(|| self.meet(other, true))
+        (self.plane == other.plane).then(|| {
+            let mut o = self.meet(other, true);
+            // (cells that came to one count in later overlays joined,
+            // each time the cells have doubled)
+            if o.len() >= 2 * o.joined_at.max(JOIN_FROM) {
+                o.join_cells();
+                o.joined_at = o.len();
+            }
+            o
+        })
+    }
+
+    /// Joins cells of one count that share a whole edge (its two corners
+    /// the same vertices) and make a convex union ([`joined`]), in one
+    /// pass over the shared edges in the order of their corners; a cell
+    /// joins several in turn. The points keep their counts.
+    fn join_cells(&mut self) {
+        let key = |u: u32, v: u32| (u64::from(u.min(v)) << 32) | u64::from(u.max(v));
+        let mut edges: Vec<(u64, u32)> = Vec::with_capacity(5 * self.cells.len());
+        for (i, (c, _)) in self.cells.iter().enumerate() {
+            let k = c.verts.len();
+            edges.extend((0..k).map(|e| (key(c.verts[e], c.verts[(e + 1) % k]), i as u32)));
+        }
+        edges.sort_unstable();
+        let mut gone = vec![false; self.cells.len()];
+        for w in edges.windows(2) {
+            let (i, j) = (w[0].1 as usize, w[1].1 as usize);
+            if w[0].0 != w[1].0 || i == j || gone[i] || gone[j] {
+                continue;
+            }
+            if self.cells[i].1 != self.cells[j].1 {
+                continue;
+            }
+            if let Some(p) = joined(&mut self.arena, &self.cells[i].0, &self.cells[j].0) {
+                self.cells[i].0 = p;
+                self.boxes[i] = union(self.boxes[i], self.boxes[j]);
+                gone[j] = true;
+            }
+        }
+        let mut k = 0;
+        self.cells.retain(|_| {
+            k += 1;
+            !gone[k - 1]
+        });
+        let mut k = 0;
+        self.boxes.retain(|_| {
+            k += 1;
+            !gone[k - 1]
+        });
     }
 
     /// The count whose cells' boxes cover the most (their faces' areas
@@ -525,6 +579,10 @@ enum Relation {
     Unknown,
 }
 
+/// How many cells [`FaceOverlay::plus_covering`] leaves before it first
+/// joins cells across the whole overlay.
+const JOIN_FROM: usize = 256;
+
 /// At most how many parts of one cell [`rejoin`] tries to put together
 /// (it tries every pair).
 const REJOIN: usize = 24;
@@ -829,6 +887,14 @@ mod tests {
             let c = overlay_of(&a).plus_covering(&overlay_of(&b)).unwrap();
             tiles_with_summed_counts(&c, &a, &b, 40)?;
             prop_assert!(c.len() <= o.len());
+            // overlaid again, its cells of one count joined across the
+            // whole overlay: as exact, in no more cells
+            let twice: Vec<(Polygon, u32)> = b.iter().map(|(p, n)| (p.clone(), 2 * n)).collect();
+            let mut d = c.clone().plus_covering(&overlay_of(&b)).unwrap();
+            let before = d.len();
+            d.join_cells();
+            tiles_with_summed_counts(&d, &a, &twice, 40)?;
+            prop_assert!(d.len() <= before);
             // corners for measuring: within 2^-20 grid units of the
             // correctly rounded ones, cell by cell
             let (exact, measured) = (c.all_corners(), c.measured_corners());
@@ -967,6 +1033,35 @@ mod tests {
             let want = count_in(&a, [x, y, 0]).unwrap() + count_in(&b, [x, y, 0]).unwrap();
             assert_eq!(count_at(&joined, [x, y, 0]), Some(want), "at {x}, {y}");
         }
+    }
+
+    #[test]
+    fn cells_that_come_to_one_count_later_are_joined() {
+        // the halves cut at x = 20 by a partition counted 1 left of it,
+        // then by one counted 1 right of it: every point counts 1 more
+        let halves = partition(square(60), &[upright([30, 0], [30, 60]).unwrap()], |_| 0);
+        let at = [upright([20, 0], [20, 60]).unwrap()];
+        let left = |first: bool| {
+            let cells = partition(square(60), &at, |_| 0);
+            (cells.into_iter())
+                .map(|(p, _)| {
+                    let low = p.vertices_f64().iter().all(|v| v[0] <= 20.0);
+                    (p, u32::from(low == first))
+                })
+                .collect::<Vec<_>>()
+        };
+        let o = (overlay_of(&halves).plus_covering(&overlay_of(&left(true))))
+            .and_then(|o| o.plus_covering(&overlay_of(&left(false))))
+            .unwrap();
+        // the left half's two parts, of one count now, are not joined yet
+        assert_eq!(o.len(), 3);
+        let mut joined = o.clone();
+        joined.join_cells();
+        assert_eq!(joined.len(), 2);
+        tiles_with_summed_counts(&joined, &halves, &[(square(60), 1)], 60).unwrap();
+        let mut areas: Vec<f64> = (0..2).map(|i| area(&joined.corners(i))).collect();
+        areas.sort_by(f64::total_cmp);
+        assert_eq!(areas, vec![1800.0, 1800.0]);
     }
 
     #[test]
