@@ -206,7 +206,7 @@ impl FaceOverlay {
     /// that share a whole edge, have one count and make a convex union are
     /// joined (the cuts between `other`'s cells of one count are undone
     /// where that leaves convex cells; the points keep their counts), and
-    /// each time the cells have doubled, so are any two cells of one
+    /// each time the cells have grown by a quarter, so are any two cells of one
     /// count that share a whole edge (cut apart once, of one count again
     /// after later overlays). A
     /// cell of `self` whose box meets the boxes of `other`'s cells of one
@@ -221,8 +221,8 @@ impl FaceOverlay {
         (self.plane == other.plane).then(|| {
             let mut o = self.meet(other, true);
             // (cells that came to one count in later overlays joined,
-            // each time the cells have doubled)
-            if o.len() >= 2 * o.joined_at.max(JOIN_FROM) {
+            // each time the cells have grown by a quarter)
+            if 4 * o.len() >= 5 * o.joined_at.max(JOIN_FROM) {
                 o.join_cells();
                 o.joined_at = o.len();
             }
