@@ -551,12 +551,8 @@ impl FastStatics {
                 (b, cells)
             })
             .collect();
-        let mut batch = Batch::new();
-        let mut cells = Vec::with_capacity(ranges.len());
-        for (b, c) in parts {
-            batch.append(&b);
-            cells.extend(c);
-        }
+        let batch = Batch::concat(&parts.iter().map(|(b, _)| b).collect::<Vec<_>>());
+        let cells: Vec<_> = parts.into_iter().flat_map(|(_, c)| c).collect();
         let mut frags = vec![0..0; ranges.len()];
         for (r, range) in batch.receiver_ranges() {
             frags[r as usize] = range;
@@ -944,18 +940,19 @@ impl Dynamic {
             || self.refine_receivers(&sh, &recs, &starts, &sopts, &meets),
             || for_moved.shade_all(moved, &sopts),
         );
-        let mut out = Batch::new();
+        let mut all: Vec<&Batch> = parts.iter().map(|(b, _)| b).collect();
+        all.push(&dynamic);
+        let out = Batch::concat(&all);
         let mut related_ranges = Vec::new();
+        let mut off = 0;
         for (b, done) in parts {
-            let off = out.len();
-            out.append(&b);
             related_ranges.extend(
                 done.into_iter()
                     .map(|(r, range, kept)| (r, range.start + off..range.end + off, kept)),
             );
+            off += b.len();
         }
-        let m0 = out.len();
-        out.append(&dynamic);
+        let m0 = off;
         stats.t_dynamic_shadows = t.elapsed();
         stats.dynamic_after_bsp = moved.len();
         stats.dynamic_shadow_polygons = out.len();
