@@ -437,7 +437,10 @@ impl Part {
                 let (planes, count) = cells.pop()?;
                 Some(Part::Whole(support, planes, count))
             }
-            _ => svbsp::FaceOverlay::new(support, cells).map(Part::Cells),
+            _ => svbsp::FaceOverlay::new(support, cells).map(|mut o| {
+                o.join();
+                Part::Cells(o)
+            }),
         }
     }
 

@@ -8,6 +8,7 @@
 
 use bsp_core::{Plane, Side};
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
 use crate::arena::pieces::{EdgeRef, Piece, PieceArena, VertexRef};
@@ -69,19 +70,38 @@ impl FaceOverlay {
         let s = arena.add_plane(support);
         let mut out = Vec::new();
         let mut sides = SmallVec::new();
+        // one arena plane for a plane and its opposite, one vertex where
+        // two of them meet: cells that share an edge share its corners
+        // (and can be joined)
+        let mut plane_at: FxHashMap<Plane, u32> = FxHashMap::default();
+        let mut meet_at: FxHashMap<(u32, u32), u32> = FxHashMap::default();
         for (planes, count) in cells {
             let planes = planes.as_ref();
             let k = planes.len();
             if k < 3 {
                 return None;
             }
-            let idx: SmallVec<[u32; 6]> = planes.iter().map(|&p| arena.add_plane(p)).collect();
+            let idx: SmallVec<[EdgeRef; 6]> = (planes.iter())
+                .map(|&p| {
+                    let flipped = p.normal().into_iter().find(|&c| c != 0) < Some(0);
+                    let key = if flipped { p.flip() } else { p };
+                    let i = *plane_at.entry(key).or_insert_with(|| arena.add_plane(key));
+                    EdgeRef::new(i, flipped)
+                })
+                .collect();
             let mut piece = Piece::default();
             for i in 0..k {
-                piece
-                    .verts
-                    .push(arena.add_meet([s, idx[(i + k - 1) % k], idx[i]])?);
-                piece.edges.push(EdgeRef::new(idx[i], false));
+                let (a, b) = (idx[(i + k - 1) % k].index(), idx[i].index());
+                let v = match meet_at.get(&(a.min(b), a.max(b))) {
+                    Some(&v) => v,
+                    None => {
+                        let v = arena.add_meet([s, a, b])?;
+                        meet_at.insert((a.min(b), a.max(b)), v);
+                        v
+                    }
+                };
+                piece.verts.push(v);
+                piece.edges.push(idx[i]);
             }
             // strictly convex: every corner strictly behind the planes of
             // the edges it is not on
@@ -223,11 +243,26 @@ impl FaceOverlay {
             // (cells that came to one count in later overlays joined,
             // each time the cells have grown by a quarter)
             if 4 * o.len() >= 5 * o.joined_at.max(JOIN_FROM) {
-                o.join_cells();
-                o.joined_at = o.len();
+                o.join();
             }
             o
         })
+    }
+
+    /// Joins cells of one count that share a whole edge (its two corners
+    /// the same vertices: [`FaceOverlay::new`] makes one vertex where two
+    /// planes meet) and make a convex union, pass after pass while a pass
+    /// joins more than a few. The points keep their counts; the cells
+    /// still tile what they tiled.
+    pub fn join(&mut self) {
+        loop {
+            let n = self.len();
+            self.join_cells();
+            if JOIN_AGAIN * self.len() >= (JOIN_AGAIN - 1) * n {
+                break;
+            }
+        }
+        self.joined_at = self.len();
     }
 
     /// Joins cells of one count that share a whole edge (its two corners
@@ -582,6 +617,10 @@ enum Relation {
 /// How many cells [`FaceOverlay::plus_covering`] leaves before it first
 /// joins cells across the whole overlay.
 const JOIN_FROM: usize = 256;
+
+/// [`FaceOverlay::join`] passes again while a pass joins more than one
+/// cell in this many.
+const JOIN_AGAIN: usize = 32;
 
 /// At most how many parts of one cell [`rejoin`] tries to put together
 /// (it tries every pair).
@@ -1055,13 +1094,66 @@ mod tests {
             .unwrap();
         // the left half's two parts, of one count now, are not joined yet
         assert_eq!(o.len(), 3);
+        // (the halves, given apart, share their corners on x = 30: a pass
+        // joins one pair of the three, the next the last two)
         let mut joined = o.clone();
         joined.join_cells();
         assert_eq!(joined.len(), 2);
         tiles_with_summed_counts(&joined, &halves, &[(square(60), 1)], 60).unwrap();
-        let mut areas: Vec<f64> = (0..2).map(|i| area(&joined.corners(i))).collect();
-        areas.sort_by(f64::total_cmp);
-        assert_eq!(areas, vec![1800.0, 1800.0]);
+        let areas: f64 = (0..2).map(|i| area(&joined.corners(i))).sum();
+        assert_eq!(areas, 3600.0);
+        joined.join();
+        assert_eq!(joined.len(), 1);
+        tiles_with_summed_counts(&joined, &halves, &[(square(60), 1)], 60).unwrap();
+        assert_eq!(area(&joined.corners(0)), 3600.0);
+    }
+
+    #[test]
+    fn cells_given_apart_share_corners_and_join_pass_after_pass() {
+        // three upright strips of one count, given as three cells: the
+        // cells share the corners where their planes meet, a first pass
+        // joins two of them, a second the third
+        let cuts = [
+            upright([20, 0], [20, 60]).unwrap(),
+            upright([40, 0], [40, 60]).unwrap(),
+        ];
+        let strips = partition(square(60), &cuts, |_| 1);
+        let mut once = overlay_of(&strips);
+        assert_eq!(once.len(), 3);
+        once.join_cells();
+        assert_eq!(once.len(), 2);
+        let mut o = overlay_of(&strips);
+        o.join();
+        assert_eq!(o.len(), 1);
+        assert_eq!(area(&o.corners(0)), 3600.0);
+        assert_eq!(o.corners(0).len(), 4);
+        tiles_with_summed_counts(&o, &strips, &[(square(60), 0)], 60).unwrap();
+        // a grid of cells of two counts in checks: no two of one count
+        // share an edge, none is joined; in stripes of two counts, each
+        // stripe comes to one cell
+        let grid: Vec<Plane> = [20, 40]
+            .into_iter()
+            .flat_map(|t| [upright([t, 0], [t, 60]), upright([0, t], [60, t])])
+            .flatten()
+            .collect();
+        let cells = partition(square(60), &grid, |_| 0);
+        let at = |p: &Polygon, k: usize| {
+            let v = p.vertices_f64();
+            (v.iter().map(|v| v[k]).sum::<f64>() / v.len() as f64 / 20.0) as u32
+        };
+        let checks: Vec<(Polygon, u32)> = (cells.iter())
+            .map(|(p, _)| (p.clone(), (at(p, 0) + at(p, 1)) % 2))
+            .collect();
+        let mut o = overlay_of(&checks);
+        o.join();
+        assert_eq!(o.len(), 9);
+        let stripes: Vec<(Polygon, u32)> = (cells.iter())
+            .map(|(p, _)| (p.clone(), at(p, 0) % 2))
+            .collect();
+        let mut o = overlay_of(&stripes);
+        o.join();
+        assert_eq!(o.len(), 3);
+        tiles_with_summed_counts(&o, &stripes, &[(square(60), 0)], 60).unwrap();
     }
 
     #[test]
