@@ -263,6 +263,14 @@ impl FaceOverlay {
             }
         }
         self.joined_at = self.len();
+        // the arena keeps the corners and planes of cells cut since; once
+        // it holds more vertices than the cells have corners, only what
+        // the cells use is kept
+        let corners: usize = self.cells.iter().map(|c| c.0.verts.len()).sum();
+        if self.arena.len() > corners {
+            let pieces = self.cells.iter_mut().map(|c| &mut c.0);
+            self.support = self.arena.compact(self.support, pieces);
+        }
     }
 
     /// Joins cells of one count that share a whole edge (its two corners
@@ -270,26 +278,53 @@ impl FaceOverlay {
     /// pass over the shared edges in the order of their corners; a cell
     /// joins several in turn. The points keep their counts.
     fn join_cells(&mut self) {
-        let key = |u: u32, v: u32| (u64::from(u.min(v)) << 32) | u64::from(u.max(v));
-        let mut edges: Vec<(u64, u32)> = Vec::with_capacity(5 * self.cells.len());
-        for (i, (c, _)) in self.cells.iter().enumerate() {
+        // each edge listed at its lower corner (a counting sort by the
+        // corners' dense numbers), then in each corner's list by its other
+        // corner
+        let n = self.arena.len();
+        let mut start = vec![0u32; n + 1];
+        let ends = |c: &Piece, e: usize| {
             let k = c.verts.len();
-            edges.extend((0..k).map(|e| (key(c.verts[e], c.verts[(e + 1) % k]), i as u32)));
+            let (u, v) = (c.verts[e], c.verts[(e + 1) % k]);
+            let (u, v) = (self.arena.dense(u), self.arena.dense(v));
+            (u.min(v), u.max(v) as u32)
+        };
+        for (c, _) in &self.cells {
+            for e in 0..c.verts.len() {
+                start[ends(c, e).0 + 1] += 1;
+            }
         }
-        edges.sort_unstable();
+        for i in 0..n {
+            start[i + 1] += start[i];
+        }
+        let mut at = start.clone();
+        let mut edges = vec![(0u32, 0u32); start[n] as usize];
+        for (i, (c, _)) in self.cells.iter().enumerate() {
+            for e in 0..c.verts.len() {
+                let (lo, hi) = ends(c, e);
+                edges[at[lo] as usize] = (hi, i as u32);
+                at[lo] += 1;
+            }
+        }
         let mut gone = vec![false; self.cells.len()];
-        for w in edges.windows(2) {
-            let (i, j) = (w[0].1 as usize, w[1].1 as usize);
-            if w[0].0 != w[1].0 || i == j || gone[i] || gone[j] {
-                continue;
+        for b in start.windows(2) {
+            let list = &mut edges[b[0] as usize..b[1] as usize];
+            if list.len() > 2 {
+                list.sort_unstable();
             }
-            if self.cells[i].1 != self.cells[j].1 {
-                continue;
-            }
-            if let Some(p) = joined(&mut self.arena, &self.cells[i].0, &self.cells[j].0) {
-                self.cells[i].0 = p;
-                self.boxes[i] = union(self.boxes[i], self.boxes[j]);
-                gone[j] = true;
+            for w in list.windows(2) {
+                let (i, j) = (w[0].1 as usize, w[1].1 as usize);
+                if w[0].0 != w[1].0 || i == j || gone[i] || gone[j] {
+                    continue;
+                }
+                if self.cells[i].1 != self.cells[j].1 {
+                    continue;
+                }
+                if let Some(p) = joined(&mut self.arena, &self.cells[i].0, &self.cells[j].0) {
+                    self.cells[i].0 = p;
+                    self.boxes[i] = union(self.boxes[i], self.boxes[j]);
+                    gone[j] = true;
+                }
             }
         }
         let mut k = 0;
@@ -931,9 +966,16 @@ mod tests {
             let twice: Vec<(Polygon, u32)> = b.iter().map(|(p, n)| (p.clone(), 2 * n)).collect();
             let mut d = c.clone().plus_covering(&overlay_of(&b)).unwrap();
             let before = d.len();
-            d.join_cells();
+            d.join();
             tiles_with_summed_counts(&d, &a, &twice, 40)?;
             prop_assert!(d.len() <= before);
+            // (its arena kept to what the cells use, and overlaid again
+            // from there)
+            let corners: usize = d.cells.iter().map(|c| c.0.verts.len()).sum();
+            prop_assert!(d.arena.len() <= corners);
+            let thrice: Vec<(Polygon, u32)> = b.iter().map(|(p, n)| (p.clone(), 3 * n)).collect();
+            let e = d.plus_covering(&overlay_of(&b)).unwrap();
+            tiles_with_summed_counts(&e, &a, &thrice, 40)?;
             // corners for measuring: within 2^-20 grid units of the
             // correctly rounded ones, cell by cell
             let (exact, measured) = (c.all_corners(), c.measured_corners());

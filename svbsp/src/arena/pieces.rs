@@ -649,6 +649,61 @@ impl PieceArena {
         }
     }
 
+    /// Keeps only the vertices and planes `pieces` use, and plane `keep`,
+    /// renumbering them (in the order first met: `keep` first, then each
+    /// piece's corners and edges in turn, a lazy vertex's planes with it).
+    /// Returns `keep`'s new index. The points and planes are the same
+    /// values, a lazy point keeps its exact coordinates if it had them.
+    pub(crate) fn compact<'a>(
+        &mut self,
+        keep: u32,
+        pieces: impl IntoIterator<Item = &'a mut Piece>,
+    ) -> u32 {
+        let old = std::mem::take(self);
+        let (grids, exacts) = (old.grid.len(), old.exact.len());
+        let mut lazy: Vec<Option<Lazy>> = old.lazy.into_iter().map(Some).collect();
+        let mut exact: Vec<Option<Implicit>> = old.exact.into_iter().map(Some).collect();
+        let mut plane_at = vec![u32::MAX; old.planes.len()];
+        let mut vertex_at = vec![u32::MAX; grids + exacts + lazy.len()];
+        let mut plane = |i: u32, new: &mut PieceArena| -> u32 {
+            let at = &mut plane_at[i as usize];
+            if *at == u32::MAX {
+                *at = new.planes.len() as u32;
+                new.planes.push(old.planes[i as usize]);
+                new.anchors.push(old.anchors[i as usize]);
+            }
+            *at
+        };
+        let keep = plane(keep, self);
+        for p in pieces {
+            for v in &mut p.verts {
+                let i = (*v & !TAG) as usize;
+                let d = match *v & TAG {
+                    0 => i,
+                    EXACT => grids + i,
+                    _ => grids + exacts + i,
+                };
+                if vertex_at[d] == u32::MAX {
+                    vertex_at[d] = match *v & TAG {
+                        0 => self.add_grid(old.grid[i]),
+                        EXACT => self.add_exact(exact[i].take().expect("each vertex once")),
+                        _ => {
+                            let mut l = lazy[i].take().expect("each vertex once");
+                            l.planes = l.planes.map(|j| plane(j, self));
+                            self.lazy.push(l);
+                            (self.lazy.len() - 1) as u32 | LAZY
+                        }
+                    };
+                }
+                *v = vertex_at[d];
+            }
+            for e in &mut p.edges {
+                *e = EdgeRef::new(plane(e.index(), self), e.flipped());
+            }
+        }
+        keep
+    }
+
     /// Vertex `id`.
     #[inline]
     pub(crate) fn vertex(&self, id: u32) -> VertexRef<'_> {
