@@ -428,15 +428,16 @@ impl Part {
 
     /// [`Part::new`] of the engine's pieces of a face, strictly convex by
     /// construction: a whole part is not checked again.
-    fn of_pieces(
+    fn of_pieces<P: AsRef<[bsp_core::Plane]>>(
         support: bsp_core::Plane,
-        mut cells: Vec<(SmallVec<[bsp_core::Plane; 6]>, u32)>,
+        cells: Vec<(P, u32)>,
     ) -> Option<Part> {
-        match cells.len() {
-            1 => {
-                let (planes, count) = cells.pop()?;
-                Some(Part::Whole(support, planes, count))
-            }
+        match &cells[..] {
+            [(planes, count)] => Some(Part::Whole(
+                support,
+                planes.as_ref().iter().copied().collect(),
+                *count,
+            )),
             _ => svbsp::FaceOverlay::new(support, cells).map(|mut o| {
                 o.join();
                 Part::Cells(o)

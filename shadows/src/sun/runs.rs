@@ -248,43 +248,7 @@ impl HoursRun {
             slot[f] = k;
         }
         let kept = |f: usize| keep.is_none_or(|k| k[f]);
-        // per face, per support plane of its parts: its pieces' planes
-        // and the suns each sees
-        type Parts = Vec<(bsp_core::Plane, Vec<(SmallVec<[bsp_core::Plane; 6]>, u32)>)>;
-        let mut parts: Vec<Parts> = vec![Vec::new(); order.len()];
-        for frag in run.batch.fragments() {
-            let f = frag.face() as usize;
-            if !kept(f) {
-                continue;
-            }
-            let seen = frag.lit_mask().count_ones();
-            let support = *frag.support();
-            let face = &mut parts[slot[f]];
-            let at = match face.iter().position(|(s, _)| *s == support) {
-                Some(at) => at,
-                None => {
-                    face.push((support, Vec::new()));
-                    face.len() - 1
-                }
-            };
-            let planes = frag
-                .piece_planes()
-                .expect("a study's run is shaded with its pieces' planes");
-            face[at]
-                .1
-                .extend(planes.map(|p| (p.iter().copied().collect(), seen)));
-        }
-        let cells: Vec<FaceCells> = parts
-            .into_iter()
-            .map(|face| {
-                (face.into_iter())
-                    .map(|(support, cells)| {
-                        Part::of_pieces(support, cells)
-                            .expect("the engine's pieces are strictly convex")
-                    })
-                    .collect()
-            })
-            .collect();
+        let cells = run_cells(&run.batch, &slot, order.len(), kept);
         out.cells = Some(cells);
         Ok(out)
     }
@@ -564,6 +528,70 @@ impl HoursRun {
         }
         (bytes.len().is_multiple_of(8) && next().is_none()).then_some(run)
     }
+}
+
+/// Per place in a run's lists (`slot[f]`: face `f`'s place, of
+/// `places`), the face's parts from the run's pieces, for the faces
+/// `kept` says: a counting sort of the batch's fragments by place, then
+/// each face's parts made on its own, faces in parallel.
+fn run_cells(
+    batch: &svbsp::Batch,
+    slot: &[usize],
+    places: usize,
+    kept: impl Fn(usize) -> bool,
+) -> Vec<FaceCells> {
+    let mut first = vec![0u32; places + 1];
+    for frag in batch.fragments() {
+        let f = frag.face() as usize;
+        if kept(f) {
+            first[slot[f] + 1] += 1;
+        }
+    }
+    for k in 0..places {
+        first[k + 1] += first[k];
+    }
+    let mut at = first.clone();
+    let mut frags = vec![0u32; first[places] as usize];
+    for (i, frag) in batch.fragments().enumerate() {
+        let f = frag.face() as usize;
+        if kept(f) {
+            frags[at[slot[f]] as usize] = i as u32;
+            at[slot[f]] += 1;
+        }
+    }
+    (0..places)
+        .into_par_iter()
+        .map(|k| face_parts(batch, &frags[first[k] as usize..first[k + 1] as usize]))
+        .collect()
+}
+
+/// A face's parts from its fragments `frags` of `batch`: per support
+/// plane, its pieces' planes (read in the batch, not copied) and the
+/// suns each sees.
+fn face_parts(batch: &svbsp::Batch, frags: &[u32]) -> FaceCells {
+    type Pieces<'a> = Vec<(&'a [bsp_core::Plane], u32)>;
+    let mut face: Vec<(bsp_core::Plane, Pieces<'_>)> = Vec::new();
+    for &i in frags {
+        let frag = batch.fragment(i as usize);
+        let seen = frag.lit_mask().count_ones();
+        let support = *frag.support();
+        let at = match face.iter().position(|(s, _)| *s == support) {
+            Some(at) => at,
+            None => {
+                face.push((support, Vec::new()));
+                face.len() - 1
+            }
+        };
+        let planes = frag
+            .piece_planes()
+            .expect("a study's run is shaded with its pieces' planes");
+        face[at].1.extend(planes.map(|p| (p, seen)));
+    }
+    (face.into_iter())
+        .map(|(support, cells)| {
+            Part::of_pieces(support, cells).expect("the engine's pieces are strictly convex")
+        })
+        .collect()
 }
 
 /// A face's parts (one overlay a support plane) overlaid with a later
