@@ -91,6 +91,12 @@ pub struct ShadeOptions {
     /// their correct rounding ([`Batch::rounded`]); a picture needs only
     /// the rounding.
     pub vertices: bool,
+    /// Merge a receiver's convex pieces of one set of flags into maximal
+    /// fragments (rings with holes). Without, each piece is a fragment
+    /// of its own (its ring the piece, its one piece itself): the same
+    /// points with the same flags, in more fragments, for a caller that
+    /// reads only the pieces and their areas (a sun study's run).
+    pub merge: bool,
 }
 
 impl Default for ShadeOptions {
@@ -99,6 +105,7 @@ impl Default for ShadeOptions {
             pieces: true,
             planes: false,
             vertices: true,
+            merge: true,
         }
     }
 }
@@ -113,6 +120,12 @@ impl ShadeOptions {
     /// Sets [`ShadeOptions::vertices`].
     pub fn with_vertices(mut self, vertices: bool) -> ShadeOptions {
         self.vertices = vertices;
+        self
+    }
+
+    /// Sets [`ShadeOptions::merge`].
+    pub fn with_merge(mut self, merge: bool) -> ShadeOptions {
+        self.merge = merge;
         self
     }
 
@@ -1126,7 +1139,12 @@ impl Batch {
         opts: &ShadeOptions,
     ) {
         let uniform = s.cur.iter().all(|(_, l)| *l == s.cur[0].1);
-        if single_polygon && uniform {
+        let whole = single_polygon && uniform;
+        if !opts.merge && !whole {
+            self.push_pieces(face, receiver, facing, support, s, opts);
+            return;
+        }
+        if whole {
             // one set of flags all over: the receiver's own polygon, whole
             s.remap.clear();
             s.remap.resize(s.arena.len(), u32::MAX);
@@ -1162,6 +1180,43 @@ impl Batch {
         s.rounded.clear();
         let regions = merge_cells(&s.arena, support, &s.pieces, &s.labels, &mut s.rounded);
         self.push_regions(face, receiver, facing, support, s, &regions, opts);
+    }
+
+    /// Appends each of the scratch's cells (`s.cur`) as a fragment of its
+    /// own ([`ShadeOptions::merge`] off).
+    fn push_pieces(
+        &mut self,
+        face: u32,
+        receiver: u32,
+        facing: u64,
+        support: &Plane,
+        s: &mut Scratch,
+        opts: &ShadeOptions,
+    ) {
+        s.remap.clear();
+        s.remap.resize(s.arena.len(), u32::MAX);
+        s.rounded.clear();
+        let cur = std::mem::take(&mut s.cur);
+        for (piece, lit) in &cur {
+            self.push_meta(face, receiver, *lit, facing, support);
+            let start = self.ring_verts.len();
+            for &v in &piece.verts {
+                let id = self.take_vertex(s, v, opts.vertices);
+                self.ring_verts.push(id);
+            }
+            self.ring_start.push(self.ring_verts.len() as u32);
+            if opts.pieces {
+                let copy: SmallVec<[u32; 8]> = self.ring_verts[start..].iter().copied().collect();
+                self.piece_verts.extend(copy);
+                self.piece_start.push(self.piece_verts.len() as u32);
+                if opts.planes {
+                    (self.piece_planes).extend(piece.edges.iter().map(|&e| s.arena.plane(e)));
+                }
+            }
+            self.close_fragment();
+        }
+        s.cur = cur;
+        s.cur.clear();
     }
 
     /// Appends merged regions of the scratch's cells (`s.pieces`, vertices

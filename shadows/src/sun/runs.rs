@@ -219,6 +219,7 @@ impl HoursRun {
             &svbsp::ShadeOptions::default()
                 .with_pieces(pieces.is_some())
                 .with_planes(pieces.is_some())
+                .with_merge(pieces.is_none())
                 .with_vertices(false),
         )?;
         let ids = part.map(|(own, _)| own.faces.clone());

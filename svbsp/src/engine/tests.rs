@@ -126,6 +126,42 @@ fn piece_planes_make_the_pieces_again() {
     assert!(mixed.fragments().all(|f| f.piece_planes().is_none()));
 }
 
+/// Without [`ShadeOptions::merge`] each piece is a fragment of its own:
+/// the same pieces, in the same order, with the same flags and planes,
+/// each fragment's ring its piece; a face whole stays one fragment.
+#[test]
+fn unmerged_fragments_are_the_pieces() {
+    let polys = [quad(0, 0, 8, 0), quad(4, 2, 4, 1), quad(6, -20, -10, 2)];
+    let lights = [Light::Point([3, 3, 8]), Light::Point([6, 1, 9])];
+    let shadows = LightVolumes::new(&polys, &lights).unwrap();
+    let opts = ShadeOptions::default().with_planes(true);
+    let merged = shadows.set().shade_all(&polys, &opts);
+    let apart = shadows
+        .set()
+        .shade_all(&polys, &opts.clone().with_merge(false));
+    // (the floor is cut, in more pieces than regions)
+    assert!(apart.len() > merged.len());
+    type Piece = (u32, u64, Vec<[f64; 3]>, Vec<Plane>);
+    let pieces = |b: &Batch| -> Vec<Piece> {
+        let mut out = Vec::new();
+        for f in b.fragments() {
+            for (corners, planes) in f.pieces().zip(f.piece_planes().unwrap()) {
+                let corners = corners.iter().map(|&v| b.rounded(v)).collect();
+                out.push((f.face(), f.lit_mask(), corners, planes.to_vec()));
+            }
+        }
+        out.sort_by(|a, b| (a.0, a.1, &a.2).partial_cmp(&(b.0, b.1, &b.2)).unwrap());
+        out
+    };
+    assert_eq!(pieces(&merged), pieces(&apart));
+    for f in apart.fragments() {
+        assert_eq!(f.rings().count(), 1);
+        assert_eq!(f.pieces().count(), 1);
+        assert_eq!(f.outer(), f.pieces().next().unwrap());
+    }
+    assert_eq!(apart.fragments().filter(|f| f.face() == 2).count(), 1);
+}
+
 /// Without [`ShadeOptions::vertices`] a batch keeps no exact vertex, and
 /// everything else the same: the fragments, their rings' vertex numbers,
 /// the roundings; `Batch::concat` of its parts is its `append`s'.
