@@ -234,7 +234,9 @@ impl FaceOverlay {
     /// without a test of its corners; so does, found without listing the
     /// cells near it, a cell whose box meets no box of `other`'s cells of
     /// other counts than the one whose cells' boxes cover the most (the
-    /// count of most of the face, as a rule). Where `other` does not
+    /// count of most of the face, as a rule); and so does a cell whose
+    /// overlapping cells of `other` (found exactly) are all of one count.
+    /// Where `other` does not
     /// cover `self`, such a cell takes that count where
     /// [`FaceOverlay::plus`] would keep a part of it uncounted.
     pub fn plus_covering(self, other: &FaceOverlay) -> Option<FaceOverlay> {
@@ -447,6 +449,18 @@ impl FaceOverlay {
             if let Some(j) = holder {
                 out.push((cell, count + other.cells[j as usize].1));
                 out_boxes.push(meet(bounds, boxes[j as usize]).unwrap_or(bounds));
+                continue;
+            }
+            // covered by the cells it overlaps (`other` covers it), all of
+            // one count: that count, whole
+            if covering
+                && let Some(&j) = hits.first()
+                && hits
+                    .iter()
+                    .all(|&k| other.cells[k as usize].1 == other.cells[j as usize].1)
+            {
+                out.push((cell, count + other.cells[j as usize].1));
+                out_boxes.push(bounds);
                 continue;
             }
             let (first, mark) = (out.len(), self.arena.mark());
