@@ -1140,35 +1140,29 @@ impl Batch {
     ) {
         let uniform = s.cur.iter().all(|(_, l)| *l == s.cur[0].1);
         let whole = single_polygon && uniform;
-        if !opts.merge && !whole {
-            self.push_pieces(face, receiver, facing, support, s, opts);
-            return;
-        }
-        if whole {
-            // one set of flags all over: the receiver's own polygon, whole
+        if whole || !opts.merge {
             s.remap.clear();
             s.remap.resize(s.arena.len(), u32::MAX);
             s.rounded.clear();
-            let lit = s.cur[0].1;
-            s.cur.clear();
-            let piece = std::mem::take(&mut s.whole);
-            self.push_meta(face, receiver, lit, facing, support);
-            for &v in &piece.verts {
-                let id = self.take_vertex(s, v, opts.vertices);
-                self.ring_verts.push(id);
-            }
-            self.ring_start.push(self.ring_verts.len() as u32);
-            if opts.pieces {
-                let n = piece.verts.len();
-                let start = self.ring_verts.len() - n;
-                let copy: SmallVec<[u32; 8]> = self.ring_verts[start..].iter().copied().collect();
-                self.piece_verts.extend(copy);
-                self.piece_start.push(self.piece_verts.len() as u32);
-                if opts.planes {
-                    (self.piece_planes).extend(piece.edges.iter().map(|&e| s.arena.plane(e)));
+            if whole {
+                // one set of flags all over: the receiver's own polygon,
+                // whole
+                let lit = s.cur[0].1;
+                s.cur.clear();
+                let piece = std::mem::take(&mut s.whole);
+                self.push_meta(face, receiver, lit, facing, support);
+                self.push_convex(s, &piece, opts);
+            } else {
+                // each piece a fragment of its own ([`ShadeOptions::merge`]
+                // off)
+                let cur = std::mem::take(&mut s.cur);
+                for (piece, lit) in &cur {
+                    self.push_meta(face, receiver, *lit, facing, support);
+                    self.push_convex(s, piece, opts);
                 }
+                s.cur = cur;
+                s.cur.clear();
             }
-            self.close_fragment();
             return;
         }
         s.pieces.clear();
@@ -1182,41 +1176,25 @@ impl Batch {
         self.push_regions(face, receiver, facing, support, s, &regions, opts);
     }
 
-    /// Appends each of the scratch's cells (`s.cur`) as a fragment of its
-    /// own ([`ShadeOptions::merge`] off).
-    fn push_pieces(
-        &mut self,
-        face: u32,
-        receiver: u32,
-        facing: u64,
-        support: &Plane,
-        s: &mut Scratch,
-        opts: &ShadeOptions,
-    ) {
-        s.remap.clear();
-        s.remap.resize(s.arena.len(), u32::MAX);
-        s.rounded.clear();
-        let cur = std::mem::take(&mut s.cur);
-        for (piece, lit) in &cur {
-            self.push_meta(face, receiver, *lit, facing, support);
-            let start = self.ring_verts.len();
-            for &v in &piece.verts {
-                let id = self.take_vertex(s, v, opts.vertices);
-                self.ring_verts.push(id);
-            }
-            self.ring_start.push(self.ring_verts.len() as u32);
-            if opts.pieces {
-                let copy: SmallVec<[u32; 8]> = self.ring_verts[start..].iter().copied().collect();
-                self.piece_verts.extend(copy);
-                self.piece_start.push(self.piece_verts.len() as u32);
-                if opts.planes {
-                    (self.piece_planes).extend(piece.edges.iter().map(|&e| s.arena.plane(e)));
-                }
-            }
-            self.close_fragment();
+    /// Closes the fragment begun by [`Batch::push_meta`] with one convex
+    /// piece of the scratch's arena: its ring, and (as `opts` asks) the
+    /// piece itself and its edge planes.
+    fn push_convex(&mut self, s: &mut Scratch, piece: &Piece, opts: &ShadeOptions) {
+        let start = self.ring_verts.len();
+        for &v in &piece.verts {
+            let id = self.take_vertex(s, v, opts.vertices);
+            self.ring_verts.push(id);
         }
-        s.cur = cur;
-        s.cur.clear();
+        self.ring_start.push(self.ring_verts.len() as u32);
+        if opts.pieces {
+            let copy: SmallVec<[u32; 8]> = self.ring_verts[start..].iter().copied().collect();
+            self.piece_verts.extend(copy);
+            self.piece_start.push(self.piece_verts.len() as u32);
+            if opts.planes {
+                (self.piece_planes).extend(piece.edges.iter().map(|&e| s.arena.plane(e)));
+            }
+        }
+        self.close_fragment();
     }
 
     /// Appends merged regions of the scratch's cells (`s.pieces`, vertices

@@ -91,15 +91,22 @@ fn uniform_faces_stay_whole_and_pieces_cover_fragments() {
     }
 }
 
+/// A floor, a square over it and a square far away, and the volumes of
+/// two point lights above.
+fn floor_square_far_two_lights() -> ([Polygon; 3], LightVolumes) {
+    let polys = [quad(0, 0, 8, 0), quad(4, 2, 4, 1), quad(6, -20, -10, 2)];
+    let lights = [Light::Point([3, 3, 8]), Light::Point([6, 1, 9])];
+    let shadows = LightVolumes::new(&polys, &lights).unwrap();
+    (polys, shadows)
+}
+
 /// With `planes`, each piece's edge planes make it again (the same
 /// corners, in turn, as the support plane's meets with them), for
 /// pieces that stayed whole and pieces of merged regions alike; and
 /// appending batches keeps them. Without, there are none.
 #[test]
 fn piece_planes_make_the_pieces_again() {
-    let polys = [quad(0, 0, 8, 0), quad(4, 2, 4, 1), quad(6, -20, -10, 2)];
-    let lights = [Light::Point([3, 3, 8]), Light::Point([6, 1, 9])];
-    let shadows = LightVolumes::new(&polys, &lights).unwrap();
+    let (polys, shadows) = floor_square_far_two_lights();
     let opts = ShadeOptions::default().with_planes(true);
     let whole = shadows.set().shade_all(&polys, &opts);
     let mut b = Batch::new();
@@ -127,13 +134,11 @@ fn piece_planes_make_the_pieces_again() {
 }
 
 /// Without [`ShadeOptions::merge`] each piece is a fragment of its own:
-/// the same pieces, in the same order, with the same flags and planes,
-/// each fragment's ring its piece; a face whole stays one fragment.
+/// the same pieces with the same flags, corners and planes, each
+/// fragment's ring its piece; a face whole stays one fragment.
 #[test]
 fn unmerged_fragments_are_the_pieces() {
-    let polys = [quad(0, 0, 8, 0), quad(4, 2, 4, 1), quad(6, -20, -10, 2)];
-    let lights = [Light::Point([3, 3, 8]), Light::Point([6, 1, 9])];
-    let shadows = LightVolumes::new(&polys, &lights).unwrap();
+    let (polys, shadows) = floor_square_far_two_lights();
     let opts = ShadeOptions::default().with_planes(true);
     let merged = shadows.set().shade_all(&polys, &opts);
     let apart = shadows
