@@ -427,7 +427,8 @@ impl Part {
     }
 
     /// [`Part::new`] of the engine's pieces of a face, strictly convex by
-    /// construction: a whole part is not checked again.
+    /// construction: a whole part is not checked again; the cells of
+    /// several are joined where they can be ([`svbsp::FaceOverlay::join`]).
     fn of_pieces<P: AsRef<[bsp_core::Plane]>>(
         support: bsp_core::Plane,
         cells: Vec<(P, u32)>,

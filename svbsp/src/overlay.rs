@@ -281,10 +281,10 @@ impl FaceOverlay {
     /// pass over the shared edges in the order of their corners (those
     /// whose two corners `near` marks, by [`PieceArena::dense`]; all if
     /// `None`); a cell joins several in turn. The points keep their
-    /// counts. Returns the marks
-    /// of the corners of the cells that joined others (`None` if none
-    /// did): a pass after this one can join no other pair, as every pair
-    /// it tried and left stays as it was.
+    /// counts. Returns the marks of the corners of the cells that joined
+    /// others (`None` if none did): a pass after this one, over the edges
+    /// between those, joins what a pass over all edges would, as every
+    /// other pair it tried and left stays as it was.
     fn join_cells_near(&mut self, near: Option<&[bool]>) -> Option<Vec<bool>> {
         // each edge listed at its lower corner (a counting sort by the
         // corners' dense numbers), then in each corner's list by its other

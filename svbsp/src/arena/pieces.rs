@@ -166,6 +166,18 @@ const TAG: u32 = 3 << 30;
 const EXACT: u32 = 1 << 30;
 const LAZY: u32 = 2 << 30;
 
+/// [`PieceArena::dense`] in an arena of `grids` grid and `exacts` exact
+/// vertices.
+#[inline]
+fn dense_of(id: u32, grids: usize, exacts: usize) -> usize {
+    let i = (id & !TAG) as usize;
+    match id & TAG {
+        0 => i,
+        EXACT => grids + i,
+        _ => grids + exacts + i,
+    }
+}
+
 /// An implicit vertex made by a split: the intersection of planes
 /// `planes` of its arena, with `f64` approximations `approx` of its
 /// homogeneous coordinates `(x, y, z, w)` (`w > 0`) and bounds `err` on
@@ -677,12 +689,7 @@ impl PieceArena {
         let keep = plane(keep, self);
         for p in pieces {
             for v in &mut p.verts {
-                let i = (*v & !TAG) as usize;
-                let d = match *v & TAG {
-                    0 => i,
-                    EXACT => grids + i,
-                    _ => grids + exacts + i,
-                };
+                let (i, d) = ((*v & !TAG) as usize, dense_of(*v, grids, exacts));
                 if vertex_at[d] == u32::MAX {
                     vertex_at[d] = match *v & TAG {
                         0 => self.add_grid(old.grid[i]),
@@ -739,12 +746,7 @@ impl PieceArena {
     /// vertex is added.
     #[inline]
     pub(crate) fn dense(&self, id: u32) -> usize {
-        let i = (id & !TAG) as usize;
-        match id & TAG {
-            0 => i,
-            EXACT => self.grid.len() + i,
-            _ => self.grid.len() + self.exact.len() + i,
-        }
+        dense_of(id, self.grid.len(), self.exact.len())
     }
 
     /// The plane of an edge, oriented.
