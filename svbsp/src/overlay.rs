@@ -453,13 +453,8 @@ impl FaceOverlay {
             }
             // covered by the cells it overlaps (`other` covers it), all of
             // one count: that count, whole
-            if covering
-                && let Some(&j) = hits.first()
-                && hits
-                    .iter()
-                    .all(|&k| other.cells[k as usize].1 == other.cells[j as usize].1)
-            {
-                out.push((cell, count + other.cells[j as usize].1));
+            if covering && let Some(n) = other.one_count(&hits) {
+                out.push((cell, count + n));
                 out_boxes.push(bounds);
                 continue;
             }
@@ -525,11 +520,11 @@ impl FaceOverlay {
     /// Whether `piece` (of this arena) and `theirs` (of `other`'s) are
     /// apart: a plane of either has all of the other in front of it or on
     /// it (two convex polygons that meet with area have no such plane).
-    fn apart(&self, piece: &Piece, other: &FaceOverlay, theirs: &Piece) -> bool {
-        (theirs.edges.iter()).any(|&e| {
-            let plane = other.arena.plane(e);
-            (piece.verts.iter()).all(|&v| self.arena.vertex(v).classify(&plane) != Side::Back)
-        }) || self.apart_by_own(piece, other, theirs)
+    fn apart(&mut self, piece: &Piece, other: &FaceOverlay, theirs: &Piece) -> bool {
+        matches!(
+            other.relate(theirs, piece, &mut self.arena),
+            Relation::Apart
+        ) || self.apart_by_own(piece, other, theirs)
     }
 
     /// Whether cell `theirs` of this overlay holds `piece` of `arena`
@@ -548,6 +543,16 @@ impl FaceOverlay {
             true => Relation::Holds,
             false => Relation::Unknown,
         }
+    }
+
+    /// The count of the listed cells if they all have one (`None` for no
+    /// cell).
+    fn one_count(&self, cells: &[u32]) -> Option<u32> {
+        let (&j, more) = cells.split_first()?;
+        let c = self.cells[j as usize].1;
+        more.iter()
+            .all(|&k| self.cells[k as usize].1 == c)
+            .then_some(c)
     }
 
     /// Whether a plane of `piece` (of this arena) has all of `theirs` (of
@@ -669,9 +674,7 @@ impl<'a> Near<'a> {
                 .list
                 .extend((0..other.len() as u32).filter(|&j| overlap(&bounds, &boxes[j as usize]))),
         }
-        let (&j, more) = self.list.split_first()?;
-        let c = other.cells[j as usize].1;
-        (self.covering && more.iter().all(|&k| other.cells[k as usize].1 == c)).then_some(c)
+        self.covering.then(|| other.one_count(&self.list)).flatten()
     }
 }
 
