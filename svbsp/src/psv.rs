@@ -35,6 +35,16 @@
 //! parallel; each is a function of its occluders alone, so the tree is
 //! the same for every thread count.
 //!
+//! The skeleton is made of the occluders that face the light only. Those
+//! turned away from it (the far side of an open scan, which no
+//! certificate lets the engine leave out) are mostly hidden by the ones
+//! that face it, so they are sent down the skeleton whole, by their grid
+//! corners' sides, to every leaf they reach, and go in there in their
+//! nearest-first turn: one hidden all over below the leaf by then is
+//! passed over without being cut, the others are first cut to the leaf's
+//! region as the skeleton would have cut them. Making the skeleton cut
+//! them all cost an open 150k-face bust a third of its tree's time.
+//!
 //! Every plane is an input-tier plane (an occluder's support plane, or the
 //! plane through the light and two grid vertices), so occluders and
 //! receivers are cut in the input tier: 256-bit vertices behind the `f64`
@@ -43,7 +53,7 @@
 use std::borrow::Borrow;
 
 use bsp_core::internals::SplitMix;
-use bsp_core::{GridPoint, Plane, Point, Polygon, SanityError, Side};
+use bsp_core::{Plane, Polygon, SanityError, Side};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 use std::sync::atomic::Ordering;
@@ -52,7 +62,9 @@ use crate::arena::pieces::{EdgeRef, Piece, PieceArena, Sides, Vertex};
 use crate::light::Light;
 
 pub(crate) mod filter;
+mod occluders;
 mod rests;
+use occluders::Occluders;
 use rests::Rests;
 
 /// A leaf: lit.
@@ -98,170 +110,6 @@ impl std::fmt::Display for VolumeError {
 }
 
 impl std::error::Error for VolumeError {}
-
-/// The occluders that face or back onto the light, nearest first, as
-/// flat arrays in chunks of [`OCCLUDER_CHUNK`] occluders (each chunk made
-/// on its own thread; joining them into one list took a serial pass over
-/// a scene's every plane).
-struct Occluders {
-    chunks: Vec<OccluderChunk>,
-    /// Each occluder's index in the input.
-    index: Vec<u32>,
-}
-
-/// Occluders per chunk of [`Occluders`] (a power of two).
-const OCCLUDER_CHUNK: usize = 1 << OCCLUDER_CHUNK_BITS;
-const OCCLUDER_CHUNK_BITS: u32 = 12;
-
-/// [`OCCLUDER_CHUNK`] consecutive occluders (fewer in the last chunk).
-struct OccluderChunk {
-    /// Vertices of the chunk's occluder `i`: `verts[start[i]..start[i + 1]]`.
-    verts: Vec<GridPoint>,
-    /// The shadow plane of each edge (edge `j` from vertex `j` to `j + 1`),
-    /// interior behind: also the occluder's edge planes as a polygon.
-    edges: Vec<Plane>,
-    start: Vec<u32>,
-    support: Vec<Plane>,
-    cap: Vec<Plane>,
-}
-
-impl Occluders {
-    fn len(&self) -> usize {
-        self.index.len()
-    }
-
-    /// Occluder `i`'s chunk and its index there.
-    #[inline]
-    fn at(&self, i: u32) -> (&OccluderChunk, usize) {
-        (
-            &self.chunks[(i >> OCCLUDER_CHUNK_BITS) as usize],
-            i as usize & (OCCLUDER_CHUNK - 1),
-        )
-    }
-
-    fn range(&self, i: u32) -> (&OccluderChunk, std::ops::Range<usize>) {
-        let (c, j) = self.at(i);
-        (c, c.start[j] as usize..c.start[j + 1] as usize)
-    }
-
-    /// The number of occluder `i`'s corners (and edges).
-    fn corners(&self, i: u32) -> usize {
-        self.range(i).1.len()
-    }
-
-    fn verts(&self, i: u32) -> &[GridPoint] {
-        let (c, r) = self.range(i);
-        &c.verts[r]
-    }
-
-    fn edges(&self, i: u32) -> &[Plane] {
-        let (c, r) = self.range(i);
-        &c.edges[r]
-    }
-
-    fn support(&self, i: u32) -> &Plane {
-        let (c, j) = self.at(i);
-        &c.support[j]
-    }
-
-    fn cap(&self, i: u32) -> &Plane {
-        let (c, j) = self.at(i);
-        &c.cap[j]
-    }
-
-    /// Prepares every polygon (in parallel) and orders them nearest
-    /// first, ties by input order.
-    fn new<P: Borrow<Polygon> + Sync>(
-        light: &Light,
-        polys: &[P],
-    ) -> Result<Occluders, VolumeError> {
-        let grid = |p: &Polygon| -> SmallVec<[GridPoint; 4]> {
-            p.vertices()
-                .iter()
-                .map(|v| match v {
-                    Point::Grid(g) => *g,
-                    Point::Implicit(_) => unreachable!("checked"),
-                })
-                .collect()
-        };
-        // the order first: keys of the polygons not edge-on
-        let keyed: Vec<Option<(f64, u32)>> = polys
-            .par_iter()
-            .enumerate()
-            .map(|(index, p)| {
-                let p = p.borrow();
-                if p.vertices().iter().any(|v| matches!(v, Point::Implicit(_))) {
-                    return Err(VolumeError::ImplicitOccluder { index });
-                }
-                if light.eval(p.support()) == 0 {
-                    return Ok(None);
-                }
-                Ok(Some((sort_key(light, &grid(p)), index as u32)))
-            })
-            .collect::<Result<_, _>>()?;
-        let mut order: Vec<(f64, u32)> = keyed.into_iter().flatten().collect();
-        order.par_sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        // then the planes, chunk by chunk in parallel
-        let chunks: Vec<OccluderChunk> = order
-            .par_chunks(OCCLUDER_CHUNK)
-            .map(|part| {
-                let mut c = OccluderChunk {
-                    verts: Vec::with_capacity(part.len() * 3),
-                    edges: Vec::with_capacity(part.len() * 3),
-                    start: Vec::with_capacity(part.len() + 1),
-                    support: Vec::with_capacity(part.len()),
-                    cap: Vec::with_capacity(part.len()),
-                };
-                c.start.push(0);
-                for &(_, i) in part {
-                    let p = polys[i as usize].borrow();
-                    let verts = grid(p);
-                    let k = verts.len();
-                    for j in 0..k {
-                        let e = light
-                            .edge_plane(verts[j], verts[(j + 1) % k], verts[(j + 2) % k])
-                            .expect("a light off the plane is off every edge line");
-                        c.edges.push(e);
-                    }
-                    c.verts.extend_from_slice(&verts);
-                    c.start.push(c.verts.len() as u32);
-                    let support = *p.support();
-                    c.support.push(support);
-                    c.cap.push(if light.eval(&support) > 0 {
-                        support
-                    } else {
-                        support.flip()
-                    });
-                }
-                c
-            })
-            .collect();
-        Ok(Occluders {
-            chunks,
-            index: order.iter().map(|o| o.1).collect(),
-        })
-    }
-}
-
-/// The insertion order's key of a polygon with grid vertices: its
-/// distance from the light (for a sun, its position along the direction),
-/// nearest first.
-fn sort_key(light: &Light, verts: &[GridPoint]) -> f64 {
-    match light {
-        Light::Point(l) => verts
-            .iter()
-            .map(|v| {
-                (0..3)
-                    .map(|j| (v[j] as f64 - l[j] as f64).powi(2))
-                    .sum::<f64>()
-            })
-            .fold(f64::INFINITY, f64::min),
-        Light::Directional(d) => -verts
-            .iter()
-            .map(|v| (0..3).map(|j| v[j] as f64 * d[j] as f64).sum::<f64>())
-            .fold(f64::NEG_INFINITY, f64::max),
-    }
-}
 
 /// A plane on a path from the root, with its side and an
 /// orientation-free key for quick comparison.
@@ -759,7 +607,12 @@ impl ShadowVolumes {
         let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
         let occ = Occluders::new(&light, occluders)?;
         let mut pool = Pool::default();
-        let list: Vec<Entry> = (0..occ.len() as u32).map(Entry::whole).collect();
+        // the skeleton is made of the occluders that face the light; those
+        // turned away are sent down it whole and go into its leaves in
+        // their turn ([`route_late`])
+        let (list, late): (Vec<u32>, Vec<u32>) =
+            (0..occ.len() as u32).partition(|&o| occ.faces[o as usize]);
+        let list: Vec<Entry> = list.into_iter().map(Entry::whole).collect();
         // the first levels one after the other, on one pool
         let mut top = Subtree {
             nodes: Vec::new(),
@@ -795,11 +648,13 @@ impl ShadowVolumes {
             }
         }
         let skeleton_top = top.nodes.len();
+        let late = route_late(&occ, &top.nodes, root, &ready, &late);
         // each pending region on its own pool, in parallel
         let parts: Vec<Region<T>> = ready
             .par_iter()
+            .zip(&late)
             .enumerate()
-            .map(|(i, task)| {
+            .map(|(i, (task, late))| {
                 let mut own = Pool::default();
                 let list = task
                     .list
@@ -812,7 +667,7 @@ impl ShadowVolumes {
                     list,
                 };
                 let seed = 0x5eed_5a0d ^ (i as u64 + 1);
-                build_region(&occ, &mut own, local, seed, record, stop)
+                build_region(&occ, &mut own, local, late, seed, record, stop)
             })
             .collect();
         drop(pool);
@@ -1142,13 +997,62 @@ type Region<T> = (Subtree, u32, usize, Vec<(u32, T)>);
 /// [`Rests::parts`] or [`Rests::reached`].
 type Record<T> = dyn Fn(Rests, &PieceArena) -> Vec<(u32, T)> + Sync;
 
+/// Per task of `tasks` (the open slots of the skeleton `nodes` below
+/// `root`), the occluders of `late` that reach it, in order: each goes
+/// down the nodes, whole, to the sides its corners lie on.
+fn route_late(
+    occ: &Occluders,
+    nodes: &[Node],
+    root: u32,
+    tasks: &[Task],
+    late: &[u32],
+) -> Vec<Vec<u32>> {
+    let mut lists = vec![Vec::new(); tasks.len()];
+    if late.is_empty() {
+        return lists;
+    }
+    // the task at each open slot of the nodes
+    let mut task_at = vec![[usize::MAX; 2]; nodes.len()];
+    for (t, task) in tasks.iter().enumerate() {
+        match task.slot {
+            None => {
+                lists[t] = late.to_vec();
+                return lists;
+            }
+            Some((id, side)) => task_at[id as usize][(side == Side::Back) as usize] = t,
+        }
+    }
+    let mut stack = Vec::new();
+    for &o in late {
+        let verts = occ.verts(o);
+        stack.push(root);
+        while let Some(id) = stack.pop() {
+            let n = &nodes[id as usize];
+            let sd = Sides::of_grid(verts, &n.plane);
+            // (an occluder is not in a plane through the light)
+            let front = sd.front || !sd.back;
+            for (reached, link, side) in [(sd.back, n.back, 1), (front, n.front, 0)] {
+                match (reached, link == LIT) {
+                    (true, true) => lists[task_at[id as usize][side]].push(o),
+                    (true, false) => stack.push(link),
+                    _ => {}
+                }
+            }
+        }
+    }
+    lists
+}
+
 /// The whole tree below one region, on its own pool: the rest of the
-/// skeleton, then each leaf's occluders inserted nearest first; with
-/// `record`, the lit parts of the occluders too (see [`rests`]).
+/// skeleton, then each leaf's occluders inserted nearest first, with
+/// those of `late` (turned away from the light, not in the skeleton) that
+/// reach the leaf whole among them; with `record`, the lit parts of the
+/// occluders too (see [`rests`]).
 fn build_region<T>(
     occ: &Occluders,
     pool: &mut Pool,
     task: Task,
+    late: &[u32],
     seed: u64,
     record: Option<&Record<T>>,
     stop: Option<&Stop>,
@@ -1176,12 +1080,50 @@ fn build_region<T>(
     tree.nodes.reserve(entries * 3);
     let mut scratch = InsertScratch::default();
     let mut rests = record.map(|_| Rests::default());
-    for leaf in &leaves {
+    let late = route_late(occ, &tree.nodes, root, &leaves, late);
+    for (leaf, late) in leaves.iter().zip(late) {
         // (a stopped build's regions are thrown away whole)
         if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
             break;
         }
-        for &e in &leaf.list {
+        // the leaf's parts and the late occluders, nearest first
+        let mut late = late.into_iter().peekable();
+        let mut next = leaf.list.iter().peekable();
+        loop {
+            let e = match (next.peek(), late.peek()) {
+                (Some(e), Some(&o)) if o < e.occ => late.next().map(Err),
+                (Some(_), _) => next.next().map(|&e| Ok(e)),
+                (None, _) => late.next().map(Err),
+            };
+            let e = match e {
+                None => break,
+                Some(Ok(e)) => e,
+                Some(Err(o)) => {
+                    let start = tree.link(leaf.slot, root);
+                    let sides = |p: &Plane| Sides::of_grid(occ.verts(o), p);
+                    let hidden = reach(
+                        &tree.nodes,
+                        start,
+                        sides,
+                        REACH_BUDGET,
+                        &mut scratch.links,
+                        &mut 0,
+                    );
+                    let clipped = match hidden {
+                        Some((false, _)) => None,
+                        _ => clip_to(occ, pool, o, &leaf.path, &mut scratch.sides),
+                    };
+                    match clipped {
+                        Some(e) => e,
+                        None => {
+                            if let Some(r) = rests.as_mut() {
+                                r.dark(o);
+                            }
+                            continue;
+                        }
+                    }
+                }
+            };
             let r = rests.as_mut();
             insert(&mut tree, &mut root, occ, pool, e, leaf, &mut scratch, r);
         }
@@ -1191,6 +1133,35 @@ fn build_region<T>(
         _ => Vec::new(),
     };
     (tree, root, skeleton, found)
+}
+
+/// Occluder `o` added whole to the pool and cut to the region of `path`
+/// (the sides of its planes the steps name), as the skeleton would have
+/// cut it; `None` where nothing of it is left.
+fn clip_to(
+    occ: &Occluders,
+    pool: &mut Pool,
+    o: u32,
+    path: &[Step],
+    sides: &mut SmallVec<[Side; 8]>,
+) -> Option<Entry> {
+    let mut e = pool.add_occluder(occ, o);
+    let sup = e.base + occ.corners(o) as u32;
+    for step in path {
+        let piece = &pool.pieces[e.piece as usize];
+        let sd = pool.arena.classify_into(piece, &step.plane, sides);
+        match (sd.front, sd.back, step.side) {
+            (true, true, side) => {
+                let cut = pool.arena.add_plane(step.plane);
+                let (f, b) = pool.arena.split(sup, piece, cut, sides);
+                pool.pieces.push(if side == Side::Front { f } else { b });
+                e.piece = (pool.pieces.len() - 1) as u32;
+            }
+            (false, true, Side::Front) | (true, false, Side::Back) => return None,
+            _ => {}
+        }
+    }
+    Some(e)
 }
 
 /// A plane through the light among the edge planes of a few occluders of

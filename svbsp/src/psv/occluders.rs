@@ -1,0 +1,179 @@
+//! The occluders of one light's tree, prepared in parallel: their grid
+//! corners, edge planes, support and cap, in insertion order.
+
+use std::borrow::Borrow;
+
+use bsp_core::{GridPoint, Plane, Point, Polygon};
+use rayon::prelude::*;
+use smallvec::SmallVec;
+
+use super::VolumeError;
+use crate::light::Light;
+
+/// The occluders that face or back onto the light, nearest first, as
+/// flat arrays in chunks of [`OCCLUDER_CHUNK`] occluders (each chunk made
+/// on its own thread; joining them into one list took a serial pass over
+/// a scene's every plane).
+pub(super) struct Occluders {
+    chunks: Vec<OccluderChunk>,
+    /// Each occluder's index in the input.
+    pub(super) index: Vec<u32>,
+    /// Per occluder: it faces the light (else it is turned away).
+    pub(super) faces: Vec<bool>,
+}
+
+/// Occluders per chunk of [`Occluders`] (a power of two).
+const OCCLUDER_CHUNK: usize = 1 << OCCLUDER_CHUNK_BITS;
+const OCCLUDER_CHUNK_BITS: u32 = 12;
+
+/// [`OCCLUDER_CHUNK`] consecutive occluders (fewer in the last chunk).
+struct OccluderChunk {
+    /// Vertices of the chunk's occluder `i`: `verts[start[i]..start[i + 1]]`.
+    verts: Vec<GridPoint>,
+    /// The shadow plane of each edge (edge `j` from vertex `j` to `j + 1`),
+    /// interior behind: also the occluder's edge planes as a polygon.
+    edges: Vec<Plane>,
+    start: Vec<u32>,
+    support: Vec<Plane>,
+    cap: Vec<Plane>,
+}
+
+impl Occluders {
+    pub(super) fn len(&self) -> usize {
+        self.index.len()
+    }
+
+    /// Occluder `i`'s chunk and its index there.
+    #[inline]
+    fn at(&self, i: u32) -> (&OccluderChunk, usize) {
+        (
+            &self.chunks[(i >> OCCLUDER_CHUNK_BITS) as usize],
+            i as usize & (OCCLUDER_CHUNK - 1),
+        )
+    }
+
+    fn range(&self, i: u32) -> (&OccluderChunk, std::ops::Range<usize>) {
+        let (c, j) = self.at(i);
+        (c, c.start[j] as usize..c.start[j + 1] as usize)
+    }
+
+    /// The number of occluder `i`'s corners (and edges).
+    pub(super) fn corners(&self, i: u32) -> usize {
+        self.range(i).1.len()
+    }
+
+    pub(super) fn verts(&self, i: u32) -> &[GridPoint] {
+        let (c, r) = self.range(i);
+        &c.verts[r]
+    }
+
+    pub(super) fn edges(&self, i: u32) -> &[Plane] {
+        let (c, r) = self.range(i);
+        &c.edges[r]
+    }
+
+    pub(super) fn support(&self, i: u32) -> &Plane {
+        let (c, j) = self.at(i);
+        &c.support[j]
+    }
+
+    pub(super) fn cap(&self, i: u32) -> &Plane {
+        let (c, j) = self.at(i);
+        &c.cap[j]
+    }
+
+    /// Prepares every polygon (in parallel) and orders them nearest
+    /// first, ties by input order.
+    pub(super) fn new<P: Borrow<Polygon> + Sync>(
+        light: &Light,
+        polys: &[P],
+    ) -> Result<Occluders, VolumeError> {
+        let grid = |p: &Polygon| -> SmallVec<[GridPoint; 4]> {
+            p.vertices()
+                .iter()
+                .map(|v| match v {
+                    Point::Grid(g) => *g,
+                    Point::Implicit(_) => unreachable!("checked"),
+                })
+                .collect()
+        };
+        // the order first: keys of the polygons not edge-on
+        let keyed: Vec<Option<(bool, f64, u32)>> = polys
+            .par_iter()
+            .enumerate()
+            .map(|(index, p)| {
+                let p = p.borrow();
+                if p.vertices().iter().any(|v| matches!(v, Point::Implicit(_))) {
+                    return Err(VolumeError::ImplicitOccluder { index });
+                }
+                let side = light.eval(p.support());
+                if side == 0 {
+                    return Ok(None);
+                }
+                Ok(Some((side > 0, sort_key(light, &grid(p)), index as u32)))
+            })
+            .collect::<Result<_, _>>()?;
+        let mut order: Vec<(bool, f64, u32)> = keyed.into_iter().flatten().collect();
+        order.par_sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.2.cmp(&b.2)));
+        // then the planes, chunk by chunk in parallel
+        let chunks: Vec<OccluderChunk> = order
+            .par_chunks(OCCLUDER_CHUNK)
+            .map(|part| {
+                let mut c = OccluderChunk {
+                    verts: Vec::with_capacity(part.len() * 3),
+                    edges: Vec::with_capacity(part.len() * 3),
+                    start: Vec::with_capacity(part.len() + 1),
+                    support: Vec::with_capacity(part.len()),
+                    cap: Vec::with_capacity(part.len()),
+                };
+                c.start.push(0);
+                for &(_, _, i) in part {
+                    let p = polys[i as usize].borrow();
+                    let verts = grid(p);
+                    let k = verts.len();
+                    for j in 0..k {
+                        let e = light
+                            .edge_plane(verts[j], verts[(j + 1) % k], verts[(j + 2) % k])
+                            .expect("a light off the plane is off every edge line");
+                        c.edges.push(e);
+                    }
+                    c.verts.extend_from_slice(&verts);
+                    c.start.push(c.verts.len() as u32);
+                    let support = *p.support();
+                    c.support.push(support);
+                    c.cap.push(if light.eval(&support) > 0 {
+                        support
+                    } else {
+                        support.flip()
+                    });
+                }
+                c
+            })
+            .collect();
+        Ok(Occluders {
+            chunks,
+            index: order.iter().map(|o| o.2).collect(),
+            faces: order.iter().map(|o| o.0).collect(),
+        })
+    }
+}
+
+/// The insertion order's key of a polygon with grid vertices: its
+/// distance from the light (for a sun, its position along the direction),
+/// nearest first.
+fn sort_key(light: &Light, verts: &[GridPoint]) -> f64 {
+    match light {
+        Light::Point(l) => verts
+            .iter()
+            .map(|v| {
+                (0..3)
+                    .map(|j| (v[j] as f64 - l[j] as f64).powi(2))
+                    .sum::<f64>()
+            })
+            .fold(f64::INFINITY, f64::min),
+        Light::Directional(d) => -verts
+            .iter()
+            .map(|v| (0..3).map(|j| v[j] as f64 * d[j] as f64).sum::<f64>())
+            .fold(f64::NEG_INFINITY, f64::max),
+    }
+}
