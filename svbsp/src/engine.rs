@@ -468,6 +468,7 @@ impl<'a> ShadowSet<'a> {
                     crate::psv::REACH_BUDGET,
                     &mut s.links,
                     &mut 0,
+                    None,
                 ) {
                     Some((true, false)) => {}
                     Some((false, true)) => now &= !bit,

@@ -378,7 +378,10 @@ pub(crate) const REACH_BUDGET: usize = 1024;
 ///
 /// `fork` is set to the first node with vertices strictly on both sides
 /// of its plane (left at `root` where there is none): above it the piece
-/// goes one way only, so an exact descent may start there.
+/// goes one way only, so an exact descent may start there. With `trail`,
+/// the nodes passed one way before the fork and the side taken at each
+/// are written there (up to a cap the piece lies in or is behind, where
+/// an insertion does more than pass).
 pub(crate) fn reach(
     nodes: &[Node],
     root: u32,
@@ -386,10 +389,11 @@ pub(crate) fn reach(
     budget: usize,
     stack: &mut Vec<u32>,
     fork: &mut u32,
+    mut trail: Option<&mut Vec<(u32, Side)>>,
 ) -> Option<(bool, bool)> {
     let (mut lit, mut shadow) = (false, false);
     let mut visits = 0;
-    let mut forked = false;
+    let (mut forked, mut trailed) = (false, false);
     *fork = root;
     stack.clear();
     stack.push(root);
@@ -411,6 +415,17 @@ pub(crate) fn reach(
             let s = sides(&n.plane);
             if s.front && s.back && !forked {
                 (*fork, forked) = (link, true);
+            }
+            if let Some(t) = trail.as_deref_mut()
+                && !forked
+                && !trailed
+            {
+                match (n.cap, s.front, s.back) {
+                    (true, false, _) => trailed = true,
+                    (_, true, true) => {}
+                    (false, false, true) => t.push((link, Side::Back)),
+                    _ => t.push((link, Side::Front)),
+                }
             }
             match (n.cap, s.front, s.back) {
                 // a cap: behind it is hidden, in it or in front is not
@@ -1108,6 +1123,7 @@ fn build_region<T>(
                         REACH_BUDGET,
                         &mut scratch.links,
                         &mut 0,
+                        None,
                     );
                     let clipped = match hidden {
                         Some((false, _)) => None,
@@ -1219,6 +1235,8 @@ type Visit = (Piece, u32, usize, Option<(u32, Side)>, bool);
 struct InsertScratch {
     stack: Vec<Visit>,
     links: Vec<u32>,
+    /// The nodes [`reach`] saw a piece pass one way, and its sides there.
+    trail: Vec<(u32, Side)>,
     path: Vec<Step>,
     sides: SmallVec<[Side; 8]>,
 }
@@ -1243,6 +1261,7 @@ fn insert(
     let piece = pool.pieces[e.piece as usize].clone();
     // an occluder hidden all over below the leaf adds nothing: found
     // without cutting it
+    s.trail.clear();
     if let Some((false, _)) = reach(
         &tree.nodes,
         start_link,
@@ -1250,6 +1269,7 @@ fn insert(
         REACH_BUDGET,
         &mut s.links,
         &mut 0,
+        Some(&mut s.trail),
     ) {
         if let Some(r) = rests {
             r.dark(e.occ);
@@ -1262,8 +1282,15 @@ fn insert(
     s.stack.clear();
     s.path.clear();
     s.path.extend_from_slice(&leaf.path);
-    s.stack
-        .push((piece, start_link, leaf.path.len(), leaf.slot, false));
+    // the walk starts below the nodes the quick test saw it pass one way
+    let (mut link, mut edge) = (start_link, leaf.slot);
+    for &(id, side) in &s.trail {
+        let n = &tree.nodes[id as usize];
+        s.path.push(Step::new(n.plane, side));
+        edge = Some((id, side));
+        link = if side == Side::Front { n.front } else { n.back };
+    }
+    s.stack.push((piece, link, s.path.len(), edge, false));
     let arena = &mut pool.arena;
     let changes = rests.as_ref().map(|r| r.changes);
     let mut first = true;

@@ -52,6 +52,7 @@ pub(crate) fn filter(
         super::REACH_BUDGET,
         links,
         &mut fork,
+        None,
     ) {
         Some((true, false)) => return out.push((piece, true)),
         Some((false, true)) => return out.push((piece, false)),
