@@ -43,7 +43,11 @@
 //! nearest-first turn: one hidden all over below the leaf by then is
 //! passed over without being cut, the others are first cut to the leaf's
 //! region as the skeleton would have cut them. Making the skeleton cut
-//! them all cost an open 150k-face bust a third of its tree's time.
+//! them all cost an open 150k-face bust a third of its tree's time. The
+//! price is paid where the faces turned away are not hidden: a terrain
+//! with half its triangles flipped at random builds its tree in about
+//! 1.2 times the time; and where they are most of the occluders
+//! ([`LATE_PER_FRONT`]) the skeleton is made of all of them, as before.
 //!
 //! Every plane is an input-tier plane (an occluder's support plane, or the
 //! plane through the light and two grid vertices), so occluders and
@@ -176,6 +180,12 @@ fn on_path(path: &[Step], e: &Plane) -> bool {
 /// earlier occluders grafted, so a leaf's cost grows faster than its
 /// size; the skeleton's cuts are what a smaller leaf pays.)
 const LEAF_SIZE: usize = 96;
+/// At most this many occluders turned away from the light per occluder
+/// that faces it, for those turned away to go down the skeleton whole
+/// (module docs): a scene turned away from its light (a terrain whose
+/// faces point down, lit from above, 2.9 times as long without this)
+/// needs them in the skeleton.
+const LATE_PER_FRONT: usize = 2;
 /// Occluders drawn per skeleton node, each offering its edge planes.
 const CANDIDATES: usize = 4;
 /// Occluders each candidate plane is scored on.
@@ -625,8 +635,12 @@ impl ShadowVolumes {
         // the skeleton is made of the occluders that face the light; those
         // turned away are sent down it whole and go into its leaves in
         // their turn ([`route_late`])
+        // (unless those turned away are most of them: then they are what
+        // hides, and the skeleton cuts them all, as it cuts the others)
+        let fronts = occ.faces.iter().filter(|&&f| f).count();
+        let defer = occ.len() - fronts <= LATE_PER_FRONT * fronts;
         let (list, late): (Vec<u32>, Vec<u32>) =
-            (0..occ.len() as u32).partition(|&o| occ.faces[o as usize]);
+            (0..occ.len() as u32).partition(|&o| occ.faces[o as usize] || !defer);
         let list: Vec<Entry> = list.into_iter().map(Entry::whole).collect();
         // the first levels one after the other, on one pool
         let mut top = Subtree {
