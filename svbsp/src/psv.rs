@@ -44,10 +44,13 @@
 //! passed over without being cut, the others are first cut to the leaf's
 //! region as the skeleton would have cut them. Making the skeleton cut
 //! them all cost an open 150k-face bust a third of its tree's time. The
-//! price is paid where the faces turned away are not hidden: a terrain
-//! with half its triangles flipped at random builds its tree in about
-//! 1.2 times the time; and where they are most of the occluders
-//! ([`LATE_PER_FRONT`]) the skeleton is made of all of them, as before.
+//! price is paid where the faces turned away are not hidden (a terrain
+//! with half its triangles flipped at random built its tree in 1.2 times
+//! the time), so each region keeps count ([`late`]): once it has seen
+//! that few of them are hidden, a leaf's are cut to it like the others
+//! and the leaf split further as the skeleton would have split it; and
+//! where they are most of the occluders ([`LATE_PER_FRONT`]) the skeleton
+//! is made of all of them, as before.
 //!
 //! Every plane is an input-tier plane (an occluder's support plane, or the
 //! plane through the light and two grid vertices), so occluders and
@@ -66,8 +69,10 @@ use crate::arena::pieces::{EdgeRef, Piece, PieceArena, Sides, Vertex};
 use crate::light::Light;
 
 pub(crate) mod filter;
+mod late;
 mod occluders;
 mod rests;
+use late::{LATE_PER_FRONT, LateTally, merged, route_late};
 use occluders::Occluders;
 use rests::Rests;
 
@@ -180,12 +185,6 @@ fn on_path(path: &[Step], e: &Plane) -> bool {
 /// earlier occluders grafted, so a leaf's cost grows faster than its
 /// size; the skeleton's cuts are what a smaller leaf pays.)
 const LEAF_SIZE: usize = 96;
-/// At most this many occluders turned away from the light per occluder
-/// that faces it, for those turned away to go down the skeleton whole
-/// (module docs): a scene turned away from its light (a terrain whose
-/// faces point down, lit from above, 2.9 times as long without this)
-/// needs them in the skeleton.
-const LATE_PER_FRONT: usize = 2;
 /// Occluders drawn per skeleton node, each offering its edge planes.
 const CANDIDATES: usize = 4;
 /// Occluders each candidate plane is scored on.
@@ -1026,52 +1025,6 @@ type Region<T> = (Subtree, u32, usize, Vec<(u32, T)>);
 /// [`Rests::parts`] or [`Rests::reached`].
 type Record<T> = dyn Fn(Rests, &PieceArena) -> Vec<(u32, T)> + Sync;
 
-/// Per task of `tasks` (the open slots of the skeleton `nodes` below
-/// `root`), the occluders of `late` that reach it, in order: each goes
-/// down the nodes, whole, to the sides its corners lie on.
-fn route_late(
-    occ: &Occluders,
-    nodes: &[Node],
-    root: u32,
-    tasks: &[Task],
-    late: &[u32],
-) -> Vec<Vec<u32>> {
-    let mut lists = vec![Vec::new(); tasks.len()];
-    if late.is_empty() {
-        return lists;
-    }
-    // the task at each open slot of the nodes
-    let mut task_at = vec![[usize::MAX; 2]; nodes.len()];
-    for (t, task) in tasks.iter().enumerate() {
-        match task.slot {
-            None => {
-                lists[t] = late.to_vec();
-                return lists;
-            }
-            Some((id, side)) => task_at[id as usize][(side == Side::Back) as usize] = t,
-        }
-    }
-    let mut stack = Vec::new();
-    for &o in late {
-        let verts = occ.verts(o);
-        stack.push(root);
-        while let Some(id) = stack.pop() {
-            let n = &nodes[id as usize];
-            let sd = Sides::of_grid(verts, &n.plane);
-            // (an occluder is not in a plane through the light)
-            let front = sd.front || !sd.back;
-            for (reached, link, side) in [(sd.back, n.back, 1), (front, n.front, 0)] {
-                match (reached, link == LIT) {
-                    (true, true) => lists[task_at[id as usize][side]].push(o),
-                    (true, false) => stack.push(link),
-                    _ => {}
-                }
-            }
-        }
-    }
-    lists
-}
-
 /// The whole tree below one region, on its own pool: the rest of the
 /// skeleton, then each leaf's occluders inserted nearest first, with
 /// those of `late` (turned away from the light, not in the skeleton) that
@@ -1110,11 +1063,39 @@ fn build_region<T>(
     let mut scratch = InsertScratch::default();
     let mut rests = record.map(|_| Rests::default());
     let late = route_late(occ, &tree.nodes, root, &leaves, late);
-    for (leaf, late) in leaves.iter().zip(late) {
+    // the leaves in order, each with the late occluders that reach it
+    let mut todo: Vec<(Task, Vec<u32>)> = leaves.into_iter().zip(late).collect();
+    todo.reverse();
+    let mut tally = LateTally::default();
+    let mut splits = 0;
+    while let Some((leaf, late)) = todo.pop() {
         // (a stopped build's regions are thrown away whole)
         if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
             break;
         }
+        if !late.is_empty() && tally.cut() {
+            // mostly not hidden in this region: cut like the others, the
+            // leaf split as the skeleton splits
+            let cut: Vec<Entry> = (late.iter())
+                .filter_map(|&o| clip_to(occ, pool, o, &leaf.path, &mut sides))
+                .collect();
+            let list = merged(&leaf.list, &cut);
+            let mut sub = vec![Task { list, ..leaf }];
+            let mut done = Vec::new();
+            while let Some(t) = sub.pop() {
+                match split_task(occ, pool, t, &mut rng, &mut sides, &mut tree, &mut root) {
+                    Ok((front, back)) => {
+                        splits += 1;
+                        sub.push(back);
+                        sub.push(front);
+                    }
+                    Err(t) => done.push(t),
+                }
+            }
+            todo.extend(done.into_iter().rev().map(|t| (t, Vec::new())));
+            continue;
+        }
+        let leaf = &leaf;
         // the leaf's parts and the late occluders, nearest first
         let mut late = late.into_iter().peekable();
         let mut next = leaf.list.iter().peekable();
@@ -1139,6 +1120,7 @@ fn build_region<T>(
                         &mut 0,
                         None,
                     );
+                    tally.count(matches!(hidden, Some((false, _))));
                     let clipped = match hidden {
                         Some((false, _)) => None,
                         _ => clip_to(occ, pool, o, &leaf.path, &mut scratch.sides),
@@ -1162,7 +1144,7 @@ fn build_region<T>(
         (Some(r), Some(make)) => make(r, &pool.arena),
         _ => Vec::new(),
     };
-    (tree, root, skeleton, found)
+    (tree, root, skeleton + splits, found)
 }
 
 /// Occluder `o` added whole to the pool and cut to the region of `path`
