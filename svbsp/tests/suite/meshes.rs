@@ -24,6 +24,16 @@ struct MeshRun {
     checked: Checked,
 }
 
+impl MeshRun {
+    /// Every light lights part of the scene and leaves part of it dark.
+    fn assert_each_light_lights_and_darkens(&self) {
+        for j in 0..self.lights.len() {
+            let (lit, dark) = self.checked.count(j);
+            assert!(lit > 0 && dark > 0, "light {j}: {lit} lit, {dark} dark");
+        }
+    }
+}
+
 /// Loads `name`, keeps the faces `keep` accepts, snaps them and the point
 /// lights onto one fitted grid, and checks the shadows.
 fn check_mesh(
@@ -106,11 +116,8 @@ fn teapot_open_soup() {
         ],
         60,
     );
+    run.assert_each_light_lights_and_darkens();
     let c = &run.checked;
-    for j in 0..run.lights.len() {
-        let (lit, dark) = c.count(j);
-        assert!(lit > 0 && dark > 0, "light {j}: {lit} lit, {dark} dark");
-    }
     assert!(c.flags.cast > 0 && c.flags.lit > 0, "{:?}", c.flags);
 }
 
@@ -181,11 +188,7 @@ fn teapot_double_sided() {
         ],
         60,
     );
-    let c = &run.checked;
-    for j in 0..run.lights.len() {
-        let (lit, dark) = c.count(j);
-        assert!(lit > 0 && dark > 0, "light {j}: {lit} lit, {dark} dark");
-    }
+    run.assert_each_light_lights_and_darkens();
 }
 
 #[test]
@@ -225,10 +228,7 @@ fn terrain_half_flipped() {
         ],
         40,
     );
+    run.assert_each_light_lights_and_darkens();
     let c = &run.checked;
-    for j in 0..run.lights.len() {
-        let (lit, dark) = c.count(j);
-        assert!(lit > 0 && dark > 0, "light {j}: {lit} lit, {dark} dark");
-    }
     assert!(c.flags.cast > 0 && c.flags.lit > 0, "{:?}", c.flags);
 }
