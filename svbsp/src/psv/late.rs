@@ -24,6 +24,9 @@ pub(super) const LATE_PER_FRONT: usize = 2;
 /// a hundred, a soup one in three, a city's walls turned from the sun
 /// about one in two).
 const LATE_TRIAL: usize = 64;
+/// The share of a region's tested late occluders, one in this many,
+/// found hidden that keeps them going into its leaves whole
+/// ([`LATE_TRIAL`]).
 const LATE_HIDDEN: usize = 4;
 /// How a region's late occluders fared so far: tested by the quick reach
 /// test, and found hidden by it.
