@@ -1,7 +1,9 @@
 //! Files written whole or not at all: under a temporary name beside the
 //! file, renamed into place when complete. A failed or interrupted run
 //! leaves no half-written file, and an existing file of the same name is
-//! kept until the new one is complete.
+//! kept until the new one is complete. The file is on disk before it is
+//! renamed; a long one is written back in parts as it grows (a thread
+//! syncs what was written so far), so that the last wait is short.
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
