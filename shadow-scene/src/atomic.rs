@@ -103,7 +103,11 @@ impl AtomicFile {
         self.finish_writeback()?;
         let file = self.writer().get_ref().try_clone()?;
         self.flushed = self.written;
-        self.writeback = Some(std::thread::spawn(move || file.sync_data()));
+        // (a thread that cannot be had leaves the work to the commit)
+        self.writeback = std::thread::Builder::new()
+            .name("atomic-file-writeback".into())
+            .spawn(move || file.sync_data())
+            .ok();
         Ok(())
     }
 
