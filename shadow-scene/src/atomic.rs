@@ -101,9 +101,12 @@ impl AtomicFile {
             return Ok(());
         }
         self.finish_writeback()?;
-        let file = self.writer().get_ref().try_clone()?;
         self.flushed = self.written;
-        // (a thread that cannot be had leaves the work to the commit)
+        // (a handle or a thread that cannot be had leaves the work to the
+        // commit)
+        let Ok(file) = self.writer().get_ref().try_clone() else {
+            return Ok(());
+        };
         self.writeback = std::thread::Builder::new()
             .name("atomic-file-writeback".into())
             .spawn(move || file.sync_data())
