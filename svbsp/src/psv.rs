@@ -1046,18 +1046,8 @@ fn build_region<T>(
     let mut root = LIT;
     let mut rng = SplitMix(seed);
     let mut sides = SmallVec::new();
-    let mut leaves = Vec::new();
-    let mut stack = vec![task];
-    while let Some(task) = stack.pop() {
-        match split_task(occ, pool, task, &mut rng, &mut sides, &mut tree, &mut root) {
-            Ok((front, back)) => {
-                stack.push(back);
-                stack.push(front);
-            }
-            Err(task) => leaves.push(task),
-        }
-    }
-    let skeleton = tree.nodes.len();
+    let (leaves, mut skeleton) =
+        split_down(occ, pool, task, &mut rng, &mut sides, &mut tree, &mut root);
     let entries: usize = leaves.iter().map(|l| l.list.len()).sum();
     tree.nodes.reserve(entries * 3);
     let mut scratch = InsertScratch::default();
@@ -1067,7 +1057,6 @@ fn build_region<T>(
     let mut todo: Vec<(Task, Vec<u32>)> = leaves.into_iter().zip(late).collect();
     todo.reverse();
     let mut tally = LateTally::default();
-    let mut splits = 0;
     while let Some((leaf, late)) = todo.pop() {
         // (a stopped build's regions are thrown away whole)
         if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
@@ -1080,18 +1069,10 @@ fn build_region<T>(
                 .filter_map(|&o| clip_to(occ, pool, o, &leaf.path, &mut sides))
                 .collect();
             let list = merged(&leaf.list, &cut);
-            let mut sub = vec![Task { list, ..leaf }];
-            let mut done = Vec::new();
-            while let Some(t) = sub.pop() {
-                match split_task(occ, pool, t, &mut rng, &mut sides, &mut tree, &mut root) {
-                    Ok((front, back)) => {
-                        splits += 1;
-                        sub.push(back);
-                        sub.push(front);
-                    }
-                    Err(t) => done.push(t),
-                }
-            }
+            let task = Task { list, ..leaf };
+            let (done, splits) =
+                split_down(occ, pool, task, &mut rng, &mut sides, &mut tree, &mut root);
+            skeleton += splits;
             todo.extend(done.into_iter().rev().map(|t| (t, Vec::new())));
             continue;
         }
@@ -1144,7 +1125,34 @@ fn build_region<T>(
         (Some(r), Some(make)) => make(r, &pool.arena),
         _ => Vec::new(),
     };
-    (tree, root, skeleton + splits, found)
+    (tree, root, skeleton, found)
+}
+
+/// `task` split as the skeleton splits ([`split_task`]) down to its
+/// leaves, front first, the nodes added to `tree`; and how many splits
+/// that took.
+fn split_down(
+    occ: &Occluders,
+    pool: &mut Pool,
+    task: Task,
+    rng: &mut SplitMix,
+    sides: &mut SmallVec<[Side; 8]>,
+    tree: &mut Subtree,
+    root: &mut u32,
+) -> (Vec<Task>, usize) {
+    let (mut leaves, mut splits) = (Vec::new(), 0);
+    let mut stack = vec![task];
+    while let Some(task) = stack.pop() {
+        match split_task(occ, pool, task, rng, sides, tree, root) {
+            Ok((front, back)) => {
+                splits += 1;
+                stack.push(back);
+                stack.push(front);
+            }
+            Err(task) => leaves.push(task),
+        }
+    }
+    (leaves, splits)
 }
 
 /// Occluder `o` added whole to the pool and cut to the region of `path`
