@@ -193,40 +193,30 @@ fn teapot_double_sided() {
 
 #[test]
 fn terrain_half_flipped() {
-    // a rolling height field whose triangles are turned up or down at
-    // random: the faces turned away from the light are about as many as
-    // those facing it and mostly not hidden, so a region soon stops
-    // sending them whole to its leaves and cuts them like the others
-    let n = 56;
-    let height = |i: usize, j: usize| {
-        let (x, y) = (i as f64 / 9.0, j as f64 / 7.0);
-        5.0 * x.sin() * y.cos() + 2.0 * (1.7 * x + 2.3 * y).sin()
-    };
-    let at = |i: usize, j: usize| DVec3::new(i as f64, j as f64, height(i, j));
-    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-    let mut loops = Vec::new();
-    for i in 0..n - 1 {
-        for j in 0..n - 1 {
-            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-            for mut tri in [vec![a, b, c], vec![a, c, d]] {
-                state = state
-                    .wrapping_mul(6_364_136_223_846_793_005)
-                    .wrapping_add(1_442_695_040_888_963_407);
-                if state >> 63 == 1 {
-                    tri.reverse();
-                }
-                loops.push(tri);
+    // the bench's terrain (a height field with boxes on it) with its
+    // faces turned up or down at random: the faces turned away from the
+    // light are about as many as those facing it and mostly not hidden,
+    // so a region soon stops sending them whole to its leaves and cuts
+    // them like the others
+    let mut rng = bsp_fixtures::Rng::new(0x9e37_79b9_7f4a_7c15);
+    let loops: Vec<Vec<DVec3>> = bsp_fixtures::scenes::terrain(4000)
+        .faces
+        .into_iter()
+        .map(|mut f| {
+            if rng.next_u64() >> 63 == 1 {
+                f.reverse();
             }
-        }
-    }
+            f
+        })
+        .collect();
     let run = check_loops(
         "terrain, half flipped",
         loops,
         &[
-            WorldLight::Point(DVec3::new(-12.0, 30.0, 16.0)),
+            WorldLight::Point(DVec3::new(-14.0, 9.0, 7.0)),
             WorldLight::Sun([3, -2, 1]),
         ],
-        40,
+        24,
     );
     run.assert_each_light_lights_and_darkens();
     let c = &run.checked;
