@@ -214,8 +214,13 @@ impl CellGrid {
     /// The cells a box meets, per axis from and to (inclusive).
     fn range(&self, b: Box3) -> ([usize; 3], [usize; 3]) {
         let at = |k: usize, v: i64| {
-            let off = i128::from(v.clamp(self.lo[k], self.lo[k] + self.extent[k] - 1) - self.lo[k]);
-            (off * self.n[k] as i128 / i128::from(self.extent[k])) as usize
+            let off = (v.clamp(self.lo[k], self.lo[k] + self.extent[k] - 1) - self.lo[k]) as u64;
+            // (in 64 bits where the product fits, a hardware division; `i128`
+            // division is a library call)
+            match off.checked_mul(self.n[k] as u64) {
+                Some(p) => (p / self.extent[k] as u64) as usize,
+                None => (u128::from(off) * self.n[k] as u128 / self.extent[k] as u128) as usize,
+            }
         };
         (
             [0, 1, 2].map(|k| at(k, b[k][0])),

@@ -187,8 +187,8 @@ fn penumbra_boxes(lights: &[Light], o: &[GridPoint], scene: Box3, parts: usize) 
                     .max()
                     .unwrap_or(0);
                 [
-                    ob[k][0] + lo.div_euclid(q) as i64,
-                    ob[k][1] - (-hi).div_euclid(q) as i64,
+                    ob[k][0] + floor_ceil(lo, q).0 as i64,
+                    ob[k][1] + floor_ceil(hi, q).1 as i64,
                 ]
             });
             [0, 1, 2].map(|k| [b[k][0].max(scene[k][0]), b[k][1].min(scene[k][1])])
@@ -253,8 +253,8 @@ pub(crate) fn slab_box(lights: &[Light], o: &[GridPoint], plane: &Plane) -> InSl
         let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
         for k in 0..3 {
             let x = c[k].checked_mul(den)?.checked_add(r[k].checked_mul(num)?)?;
-            let lo = i64::try_from(x.div_euclid(den)).ok()?;
-            let hi = i64::try_from(-(-x).div_euclid(den)).ok()?;
+            let (lo, hi) = floor_ceil(x, den);
+            let (lo, hi) = (i64::try_from(lo).ok()?, i64::try_from(hi).ok()?);
             b[k] = [b[k][0].min(lo), b[k][1].max(hi)];
         }
         any = true;
@@ -300,6 +300,22 @@ pub(crate) fn slab_box(lights: &[Light], o: &[GridPoint], plane: &Plane) -> InSl
     }
 }
 
+/// `⌊x / den⌋` and `⌈x / den⌉` for `den > 0`, by one division (a
+/// hardware one where both fit in 64 bits; `i128`'s `div_euclid` pairs
+/// are library calls, two for each rounding).
+#[inline]
+fn floor_ceil(x: i128, den: i128) -> (i128, i128) {
+    debug_assert!(den > 0);
+    let (q, r) = match (i64::try_from(x), i64::try_from(den)) {
+        (Ok(x), Ok(den)) => (i128::from(x / den), i128::from(x % den)),
+        _ => {
+            let q = x / den;
+            (q, x - q * den)
+        }
+    };
+    (q - i128::from(r < 0), q + i128::from(r > 0))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -307,6 +323,20 @@ mod tests {
 
     fn plane_z(z: i32) -> Plane {
         Plane::through([0, 0, z], [1, 0, z], [0, 1, z]).unwrap()
+    }
+
+    proptest! {
+        #[test]
+        fn floor_and_ceil_by_one_division_round_as_div_euclid(
+            x in (i128::MIN + 1)..=i128::MAX,
+            den in 1..i128::MAX,
+            small in any::<i64>(),
+            small_den in 1..i64::MAX,
+        ) {
+            for (x, den) in [(x, den), (i128::from(small), i128::from(small_den)), (x, i128::from(small_den))] {
+                prop_assert_eq!(floor_ceil(x, den), (x.div_euclid(den), -(-x).div_euclid(den)));
+            }
+        }
     }
 
     #[test]
