@@ -100,17 +100,18 @@ fn gcd64(a: u64, b: u64) -> u64 {
         return a;
     }
     let shift = (a | b).trailing_zeros();
-    let (mut a, mut b) = (a >> a.trailing_zeros(), b);
-    loop {
-        // a odd; min and max compile to conditional moves
-        b >>= b.trailing_zeros();
+    let (mut a, mut b) = (a >> a.trailing_zeros(), b >> b.trailing_zeros());
+    while a != b {
+        // both odd. The shift of the difference is counted from `a - b`
+        // wrapped (the same trailing zeros as `b - a`), beside the min and
+        // max (conditional moves), not after them: a shorter chain of
+        // dependent instructions a step
+        let s = a.wrapping_sub(b).trailing_zeros();
         let (lo, hi) = (a.min(b), a.max(b));
         a = lo;
-        b = hi - lo;
-        if b == 0 {
-            return a << shift;
-        }
+        b = (hi - lo) >> s;
     }
+    a << shift
 }
 
 fn gcd(mut a: u128, mut b: u128) -> u128 {
