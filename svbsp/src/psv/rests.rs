@@ -26,6 +26,8 @@
 //! ([`super::ShadowVolumes::build_reached`]).
 
 use bsp_core::{Polygon, Side};
+use std::collections::hash_map::Entry;
+
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
@@ -53,10 +55,20 @@ struct Rest {
     sup: u32,
 }
 
-/// The parts resting at each lit leaf of one region's subtree.
+/// The end of a leaf's list of parts at rest.
+const END: u32 = u32::MAX;
+
+/// The parts resting at each lit leaf of one region's subtree: one list
+/// of every part, each leaf's parts chained through it in the order they
+/// came to rest (no list of its own a leaf: most leaves get one part, and
+/// a list each was an allocation each).
 #[derive(Default)]
 pub(super) struct Rests {
-    at: FxHashMap<u64, Vec<Rest>>,
+    /// Per leaf with parts at rest, its first and last in `parts`.
+    at: FxHashMap<u64, (u32, u32)>,
+    /// The parts, each with the next of its leaf's (`END`: none); a part
+    /// that walked on from its leaf is left behind empty.
+    parts: Vec<(Rest, u32)>,
     /// Counts every part put at rest with a vertex or an edge plane an
     /// insertion made, and every cut of a part at rest, so that an
     /// insertion that kept none of its arena's new vertices and planes can
@@ -73,9 +85,32 @@ impl Rests {
     /// lit leaf of `slot`; `new`: it has a vertex or an edge plane the
     /// arena must keep.
     pub(super) fn rest(&mut self, slot: Slot, piece: Piece, occ: u32, sup: u32, new: bool) {
-        let r = Rest { piece, occ, sup };
-        self.at.entry(key(slot)).or_default().push(r);
+        self.push(key(slot), Rest { piece, occ, sup });
         self.changes += new as u64;
+    }
+
+    /// Chains `r` to the end of the parts at rest at leaf `key`.
+    fn push(&mut self, key: u64, r: Rest) {
+        let i = self.parts.len() as u32;
+        self.parts.push((r, END));
+        match self.at.entry(key) {
+            Entry::Occupied(mut e) => {
+                let (_, last) = e.get_mut();
+                self.parts[*last as usize].1 = i;
+                *last = i;
+            }
+            Entry::Vacant(e) => {
+                e.insert((i, i));
+            }
+        }
+    }
+
+    /// The parts at rest at leaf `key`, first to last, as indices.
+    fn chain(&self, key: u64) -> impl Iterator<Item = u32> + '_ {
+        let first = self.at.get(&key).map_or(END, |&(f, _)| f);
+        std::iter::successors(Some(first).filter(|&i| i != END), move |&i| {
+            Some(self.parts[i as usize].1).filter(|&n| n != END)
+        })
     }
 
     /// Notes that a part of occluder `occ` ended in shadow.
@@ -94,18 +129,20 @@ impl Rests {
         arena: &mut PieceArena,
         sides: &mut SmallVec<[Side; 8]>,
     ) {
-        let Some(list) = self.at.remove(&key(slot)) else {
+        let Some((mut next, _)) = self.at.remove(&key(slot)) else {
             return;
         };
         let start = tree.link(slot, root);
         let mut stack = std::mem::take(&mut self.stack);
-        for Rest { piece, occ, sup } in list {
+        while next != END {
+            let (rest, after) = &mut self.parts[next as usize];
+            let (piece, occ, sup) = (std::mem::take(&mut rest.piece), rest.occ, rest.sup);
+            next = *after;
             stack.push((piece, start, slot));
             while let Some((mut p, mut link, mut at)) = stack.pop() {
                 loop {
                     if link == LIT {
-                        let r = Rest { piece: p, occ, sup };
-                        self.at.entry(key(at)).or_default().push(r);
+                        self.push(key(at), Rest { piece: p, occ, sup });
                         break;
                     }
                     if link == SHADOW {
@@ -178,8 +215,9 @@ impl Rests {
     /// `Some(true)` if all of it rests lit, `Some(false)` if all of it
     /// ended in shadow, `None` for both; in the order of the occluders.
     pub(super) fn reached(self, _: &PieceArena) -> Vec<(u32, Option<bool>)> {
-        let mut marks: Vec<(u32, bool)> = (self.at.values().flatten())
-            .map(|r| (r.occ, true))
+        let mut marks: Vec<(u32, bool)> = (self.at.keys())
+            .flat_map(|&k| self.chain(k))
+            .map(|i| (self.parts[i as usize].0.occ, true))
             .chain(self.dark.iter().map(|&o| (o, false)))
             .collect();
         marks.sort_unstable();
@@ -197,9 +235,10 @@ impl Rests {
     /// `f` of every part at rest, with its occluder, leaf by leaf in the
     /// order of their slots.
     fn each<T>(self, mut f: impl FnMut(&Rest) -> T) -> Vec<(u32, T)> {
-        let mut slots: Vec<(u64, Vec<Rest>)> = self.at.into_iter().collect();
-        slots.sort_unstable_by_key(|s| s.0);
-        (slots.iter().flat_map(|s| &s.1))
+        let mut slots: Vec<u64> = self.at.keys().copied().collect();
+        slots.sort_unstable();
+        (slots.iter().flat_map(|&k| self.chain(k)))
+            .map(|i| &self.parts[i as usize].0)
             .map(|r| (r.occ, f(r)))
             .collect()
     }
