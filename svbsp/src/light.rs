@@ -211,6 +211,24 @@ impl Light {
             Side::On => None,
         }
     }
+
+    /// [`Light::edge_plane`] of the edge `a → b` of a convex polygon whose
+    /// vertices run counter-clockwise about its support plane, where
+    /// `facing` says whether the light is strictly in front of that plane
+    /// ([`Light::faces`]; the light must not lie in it): no vertex is
+    /// classified. For a vertex `c` of the polygon off the edge's line,
+    /// the plane through the light `L`, `a` and `b` has at `c` the sign of
+    /// `det(a − L, b − L, c − L) = (a − L) · ((b − a) × (c − a))`, and
+    /// `(b − a) × (c − a)` is a positive multiple of the support's
+    /// normal `N`: the sign of `−(N · L + d)`, the same for every edge (for
+    /// a sun `D`, `((b − a) × D) · (c − a) = −((b − a) × (c − a)) · D`).
+    /// So the inside is behind the plane as made exactly when the light
+    /// faces the polygon.
+    #[inline]
+    pub fn edge_plane_facing(&self, a: GridPoint, b: GridPoint, facing: bool) -> Option<Plane> {
+        let p = self.plane_with(a, b)?;
+        Some(if facing { p } else { p.flip() })
+    }
 }
 
 /// A light as given in input units.
@@ -557,6 +575,37 @@ mod tests {
             place_lights(&g, &many).unwrap_err(),
             LightError::TooMany(MAX_LIGHTS + 1)
         );
+    }
+
+    proptest::proptest! {
+        /// The orientation from the light's side of the support plane is
+        /// the one the classified vertex gives, for lights on both sides,
+        /// points and suns, triangles turned either way.
+        #[test]
+        fn edge_planes_facing_agree_with_the_classified_ones(
+            t in proptest::array::uniform3(proptest::array::uniform3(-1000i32..1000)),
+            l in proptest::array::uniform3(-2000i32..2000),
+            sun in proptest::bool::ANY,
+        ) {
+            let Ok(support) = Plane::through(t[0], t[1], t[2]) else {
+                return Ok(());
+            };
+            let light = match sun {
+                true => Light::Directional(l),
+                false => Light::Point(l),
+            };
+            if light.eval(&support) == 0 {
+                return Ok(());
+            }
+            let facing = light.faces(&support);
+            for j in 0..3 {
+                let (a, b, c) = (t[j], t[(j + 1) % 3], t[(j + 2) % 3]);
+                proptest::prop_assert_eq!(
+                    light.edge_plane_facing(a, b, facing),
+                    light.edge_plane(a, b, c)
+                );
+            }
+        }
     }
 
     #[test]

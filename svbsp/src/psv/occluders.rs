@@ -131,21 +131,22 @@ impl Occluders {
                     let p = polys[i as usize].borrow();
                     let verts = grid(p);
                     let k = verts.len();
+                    let support = *p.support();
+                    let facing = light.eval(&support) > 0;
                     for j in 0..k {
                         let e = light
-                            .edge_plane(verts[j], verts[(j + 1) % k], verts[(j + 2) % k])
+                            .edge_plane_facing(verts[j], verts[(j + 1) % k], facing)
                             .expect("a light off the plane is off every edge line");
+                        debug_assert_eq!(
+                            Some(e),
+                            light.edge_plane(verts[j], verts[(j + 1) % k], verts[(j + 2) % k])
+                        );
                         c.edges.push(e);
                     }
                     c.verts.extend_from_slice(&verts);
                     c.start.push(c.verts.len() as u32);
-                    let support = *p.support();
                     c.support.push(support);
-                    c.cap.push(if light.eval(&support) > 0 {
-                        support
-                    } else {
-                        support.flip()
-                    });
+                    c.cap.push(if facing { support } else { support.flip() });
                 }
                 c
             })
