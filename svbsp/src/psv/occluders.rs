@@ -5,7 +5,6 @@ use std::borrow::Borrow;
 
 use bsp_core::{GridPoint, Plane, Point, Polygon};
 use rayon::prelude::*;
-use smallvec::SmallVec;
 
 use super::VolumeError;
 use crate::light::Light;
@@ -88,15 +87,6 @@ impl Occluders {
         light: &Light,
         polys: &[P],
     ) -> Result<Occluders, VolumeError> {
-        let grid = |p: &Polygon| -> SmallVec<[GridPoint; 4]> {
-            p.vertices()
-                .iter()
-                .map(|v| match v {
-                    Point::Grid(g) => *g,
-                    Point::Implicit(_) => unreachable!("checked"),
-                })
-                .collect()
-        };
         // the order first: keys of the polygons not edge-on
         let keyed: Vec<Option<(bool, f64, u32)>> = polys
             .par_iter()
@@ -110,7 +100,11 @@ impl Occluders {
                 if side == 0 {
                     return Ok(None);
                 }
-                Ok(Some((side > 0, sort_key(light, &grid(p)), index as u32)))
+                Ok(Some((
+                    side > 0,
+                    sort_key(light, grid_points(p)),
+                    index as u32,
+                )))
             })
             .collect::<Result<_, _>>()?;
         let mut order: Vec<(bool, f64, u32)> = keyed.into_iter().flatten().collect();
@@ -129,7 +123,9 @@ impl Occluders {
                 c.start.push(0);
                 for &(_, _, i) in part {
                     let p = polys[i as usize].borrow();
-                    let verts = grid(p);
+                    let first = c.verts.len();
+                    c.verts.extend(grid_points(p));
+                    let verts = &c.verts[first..];
                     let k = verts.len();
                     let support = *p.support();
                     let facing = light.eval(&support) > 0;
@@ -143,7 +139,6 @@ impl Occluders {
                         );
                         c.edges.push(e);
                     }
-                    c.verts.extend_from_slice(&verts);
                     c.start.push(c.verts.len() as u32);
                     c.support.push(support);
                     c.cap.push(if facing { support } else { support.flip() });
@@ -159,13 +154,20 @@ impl Occluders {
     }
 }
 
+/// The grid vertices of a polygon checked to have no other kind.
+fn grid_points(p: &Polygon) -> impl Iterator<Item = GridPoint> + '_ {
+    p.vertices().iter().map(|v| match v {
+        Point::Grid(g) => *g,
+        Point::Implicit(_) => unreachable!("checked"),
+    })
+}
+
 /// The insertion order's key of a polygon with grid vertices: its
 /// distance from the light (for a sun, its position along the direction),
 /// nearest first.
-fn sort_key(light: &Light, verts: &[GridPoint]) -> f64 {
+fn sort_key(light: &Light, verts: impl Iterator<Item = GridPoint>) -> f64 {
     match light {
         Light::Point(l) => verts
-            .iter()
             .map(|v| {
                 (0..3)
                     .map(|j| (v[j] as f64 - l[j] as f64).powi(2))
@@ -173,7 +175,6 @@ fn sort_key(light: &Light, verts: &[GridPoint]) -> f64 {
             })
             .fold(f64::INFINITY, f64::min),
         Light::Directional(d) => -verts
-            .iter()
             .map(|v| (0..3).map(|j| v[j] as f64 * d[j] as f64).sum::<f64>())
             .fold(f64::NEG_INFINITY, f64::max),
     }
