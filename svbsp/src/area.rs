@@ -489,9 +489,15 @@ fn shadow_volume(from: Light, o: &GridPolygon) -> Option<HalfSpaces> {
     let n = v.len();
     let mut hs = Vec::with_capacity(n + 1);
     hs.push((*o.support(), far));
+    // (its edge planes oriented by the side of its plane `from` is on)
+    let facing = far == Side::Back;
     for i in 0..n {
         // `from` is off the occluder's plane: never on a line of its edges
-        let h = from.edge_plane(v[i], v[(i + 1) % n], v[(i + 2) % n])?;
+        let h = from.edge_plane_facing(v[i], v[(i + 1) % n], facing)?;
+        debug_assert_eq!(
+            Some(h),
+            from.edge_plane(v[i], v[(i + 1) % n], v[(i + 2) % n])
+        );
         hs.push((h, Side::Back));
     }
     Some(hs)
@@ -774,7 +780,7 @@ impl AreaLight {
             // a light of one point: the volume is its shadow volume
             one.clone()?
         } else {
-            self.penumbra_volume(&light_sides, o)
+            self.penumbra_volume(&light_sides, o, &from_corner)
         };
         Some(Regions {
             penumbra,
@@ -784,8 +790,15 @@ impl AreaLight {
     }
 
     /// The half-spaces of an occluder's penumbra volume (see the module
-    /// docs), for a light of several corners.
-    fn penumbra_volume(&self, light_sides: &[Side], o: &Occluder) -> HalfSpaces {
+    /// docs), for a light of several corners, whose shadow volumes from
+    /// each corner are `from_corner` ([`shadow_volume`]: their edge planes
+    /// are the planes through a corner and an edge, made once).
+    fn penumbra_volume(
+        &self,
+        light_sides: &[Side],
+        o: &Occluder,
+        from_corner: &[Option<HalfSpaces>],
+    ) -> HalfSpaces {
         let (lv, ov) = (self.corners(), o.polygon.vertices());
         let mut penumbra = HalfSpaces::new();
         // the occluder's plane bounds the volume where the light is on one side
@@ -800,10 +813,18 @@ impl AreaLight {
         let (nl, no) = (lv.len(), ov.len());
         for i in 0..nl {
             for j in 0..no {
-                let planes = [
-                    lv[i].plane_with(ov[j], ov[(j + 1) % no]),
-                    edge_corner_plane(lv[i], lv[(i + 1) % nl], ov[j]),
-                ];
+                // the corner's shadow plane of edge `j` as made, unoriented
+                // (`shadow_volume` flips it where the corner is behind the
+                // occluder's plane)
+                let through = match &from_corner[i] {
+                    Some(hs) => Some(match light_sides[i] {
+                        Side::Front => hs[j + 1].0,
+                        _ => hs[j + 1].0.flip(),
+                    }),
+                    None => lv[i].plane_with(ov[j], ov[(j + 1) % no]),
+                };
+                debug_assert_eq!(through, lv[i].plane_with(ov[j], ov[(j + 1) % no]));
+                let planes = [through, edge_corner_plane(lv[i], lv[(i + 1) % nl], ov[j])];
                 for h in planes.into_iter().flatten() {
                     if let Some(inside) = separating(&h, lv, ov) {
                         penumbra.push((h, inside));
