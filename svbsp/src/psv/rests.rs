@@ -25,9 +25,9 @@
 //! light reaches all over, not at all, or in part
 //! ([`super::ShadowVolumes::build_reached`]).
 
-use bsp_core::{Polygon, Side};
 use std::collections::hash_map::Entry;
 
+use bsp_core::{Polygon, Side};
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
