@@ -542,22 +542,34 @@ struct Loops {
 
 impl Loops {
     fn new(polys: &[Polygon]) -> Result<Loops, SurfaceDefect> {
-        // each polygon's grid corners read in parallel (a pass over every
-        // polygon, which is large), then laid end to end
-        let corners = crate::par::map_placed(polys.len(), |i| {
-            polys[i]
-                .vertices()
-                .iter()
-                .map(|v| v.as_grid())
-                .collect::<Option<SmallVec<[GridPoint; 4]>>>()
+        // runs of polygons' grid corners read in parallel (a pass over
+        // every polygon, which is large), each run's laid end to end with
+        // its polygons' corner counts, then the runs' (a list per polygon
+        // laid end to end on one thread took as long as the reading)
+        let runs = crate::par::fold_runs(polys.len(), |r| {
+            let mut pts: Vec<GridPoint> = Vec::with_capacity(3 * r.len());
+            let mut counts: Vec<u32> = Vec::with_capacity(r.len());
+            for i in r {
+                let before = pts.len();
+                for v in polys[i].vertices() {
+                    pts.push(v.as_grid().ok_or(SurfaceDefect::NotGrid { polygon: i })?);
+                }
+                counts.push((pts.len() - before) as u32);
+            }
+            Ok((pts, counts))
         });
         let mut start = Vec::with_capacity(polys.len() + 1);
         let mut pts: Vec<GridPoint> = Vec::with_capacity(polys.len() * 3);
-        for (i, c) in corners.iter().enumerate() {
-            start.push(pts.len() as u32);
-            pts.extend_from_slice(c.as_ref().ok_or(SurfaceDefect::NotGrid { polygon: i })?);
+        // (the runs in order: the first polygon off the grid is the first)
+        for run in runs {
+            let (run_pts, counts) = run?;
+            let mut at = pts.len() as u32;
+            for n in counts {
+                start.push(at);
+                at += n;
+            }
+            pts.extend_from_slice(&run_pts);
         }
-        drop(corners);
         start.push(pts.len() as u32);
         Ok(Loops::numbered(start, pts))
     }
@@ -1047,6 +1059,26 @@ fn cones_apart(g: [V; 4]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A polygon with a corner off the grid is named, the first in order
+    /// when there are several (the corners are read in parallel runs).
+    #[test]
+    fn the_first_polygon_off_the_grid_is_named() {
+        let square = |z: i32| poly(&[[0, 0, z], [4, 0, z], [4, 4, z], [0, 4, z]]);
+        // cut at x = 1/3: the pieces' corners on the cut are off the grid
+        let cut = crate::Plane::new([3, 0, 0], -1).unwrap();
+        let off_grid = |z: i32| match square(z).split(&cut) {
+            crate::Split::Spanning { back, .. } => back,
+            _ => unreachable!("the plane crosses the square"),
+        };
+        let mut polys: Vec<Polygon> = (0..40).map(square).collect();
+        polys[17] = off_grid(17);
+        polys[29] = off_grid(29);
+        assert_eq!(
+            certify_solid_boundary(&polys),
+            Err(SurfaceDefect::NotGrid { polygon: 17 })
+        );
+    }
 
     fn poly(p: &[GridPoint]) -> Polygon {
         Polygon::from_grid_points(p, 0).unwrap()
