@@ -121,14 +121,14 @@ impl Occluders {
                     cap: Vec::with_capacity(part.len()),
                 };
                 c.start.push(0);
-                for &(_, _, i) in part {
+                // (whether it faces the light, as its key found it)
+                for &(facing, _, i) in part {
                     let p = polys[i as usize].borrow();
                     let first = c.verts.len();
                     c.verts.extend(grid_points(p));
                     let verts = &c.verts[first..];
                     let k = verts.len();
                     let support = *p.support();
-                    let facing = light.eval(&support) > 0;
                     for j in 0..k {
                         let e = light
                             .edge_plane_facing(verts[j], verts[(j + 1) % k], facing)
