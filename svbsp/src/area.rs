@@ -766,12 +766,22 @@ impl AreaLight {
         out
     }
 
-    /// The occluder's regions (see [`Regions`]); `None` where it lies in
-    /// the light's plane and hides none of it.
+    /// The occluder's regions (see [`Regions`]); `None` where it hides
+    /// none of the light: where it lies in the light's plane, or has no
+    /// point strictly on the side a polygon light emits to. (A point that
+    /// sees any of the light lies strictly on that side, so its open
+    /// segment to a light point does too, and cannot meet such an
+    /// occluder; the volumes' separating planes alone would not say so
+    /// where the occluder touches the light's plane.)
     pub(crate) fn regions(&self, o: &Occluder) -> Option<Regions> {
         let lv = self.corners();
         let light_sides: Vec<Side> = lv.iter().map(|l| sign(l.eval(o.plane()))).collect();
         if light_sides.iter().all(|&s| s == Side::On) {
+            return None;
+        }
+        if let Some(plane) = self.plane()
+            && (o.corners().iter()).all(|&c| plane.classify_grid(c) != Side::Front)
+        {
             return None;
         }
         let from_corner: Vec<Option<HalfSpaces>> =
