@@ -845,6 +845,25 @@ fn an_occluder_touching_the_lights_plane_from_behind_hides_nothing() {
         Occluder::new(&[[-40, -40, 0], [40, -40, 0], [40, 40, 0], [-40, 40, 0]]).unwrap(),
         Occluder::new(&above).unwrap(),
     ];
+    // and a wall facing the light beside it, crossing the light's plane:
+    // its part below that plane sees all of the light (the near lists let
+    // the occluder meet this wall, and 92.5 of its 96 half-units came out
+    // penumbra), the rest is behind the light
+    let wall = [[8, 16, 0], [12, 16, 0], [12, 16, 14], [8, 16, 14]];
+    let walled = [
+        Occluder::new(&wall).unwrap(),
+        Occluder::new(&above).unwrap(),
+    ];
+    let below = Occluder::new(&[[8, 16, 0], [12, 16, 0], [12, 16, 12], [8, 16, 12]]).unwrap();
+    let mut want: [Q; 4] = std::array::from_fn(|_| Q::zero());
+    want[AreaClass::Lit as usize] = Q::from_integer(96.into());
+    want[AreaClass::Umbra as usize] = Q::from_integer(16.into());
+    assert_eq!(class_areas(&light.classify_faces(&walled)[0]), want);
+    assert_eq!(class_areas(&light.classify_face(&walled[0], &walled)), want);
+    assert_eq!(
+        class_areas(&light.classify_face(&below, &walled))[0],
+        want[0]
+    );
     for fragments in [
         light.classify_face(&faces[0], &faces),
         light.classify_faces(&faces).swap_remove(0),
