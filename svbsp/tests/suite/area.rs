@@ -642,19 +642,7 @@ fn sun_disc_fragments_agree_with_sampled_directions() {
             let Some(f) = fragments.iter().find(|f| strictly_inside(&f.polygon, x)) else {
                 continue;
             };
-            let hx = HPoint::grid(x.map(i64::from));
-            let lit: Vec<Verdict> = samples.iter().map(|s| scene.verdict(s, 0, &hx)).collect();
-            match f.class {
-                AreaClass::Lit => assert!(
-                    all_are(&lit, Verdict::Lit),
-                    "{x:?} is lit, yet a direction of the disc is blocked"
-                ),
-                AreaClass::Umbra => assert!(
-                    all_are(&lit, Verdict::Shadowed),
-                    "{x:?} is umbra, yet a direction of the disc is open"
-                ),
-                AreaClass::Penumbra | AreaClass::Undecided => {}
-            }
+            assert_disc_agrees(&scene, &samples, x, f.class, "");
             *met.entry(f.class).or_insert(0) += 1;
         }
     }
@@ -662,6 +650,35 @@ fn sun_disc_fragments_agree_with_sampled_directions() {
         assert!(met.contains_key(&class), "{class:?} never met: {met:?}");
     }
     assert!(shares > 10, "{shares} penumbra shares checked");
+}
+
+/// A sun disc's class at grid point `x` of face 0 of `scene` against the
+/// ray oracle's verdicts for `directions` over the true disc: lit where
+/// none is blocked, umbra where every one is (penumbra and undecided may
+/// be either). `what` names the scene in the message.
+fn assert_disc_agrees(
+    scene: &Scene,
+    directions: &[Light],
+    x: [i32; 3],
+    class: AreaClass,
+    what: &str,
+) {
+    let hx = HPoint::grid(x.map(i64::from));
+    let seen: Vec<Verdict> = directions
+        .iter()
+        .map(|s| scene.verdict(s, 0, &hx))
+        .collect();
+    match class {
+        AreaClass::Lit => assert!(
+            all_are(&seen, Verdict::Lit),
+            "{what} {x:?} is lit, yet a direction of the disc is blocked"
+        ),
+        AreaClass::Umbra => assert!(
+            all_are(&seen, Verdict::Shadowed),
+            "{what} {x:?} is umbra, yet a direction of the disc is open"
+        ),
+        AreaClass::Penumbra | AreaClass::Undecided => {}
+    }
 }
 
 /// The share of a sun disc a penumbra fragment sees, at the grid point
@@ -1531,21 +1548,7 @@ fn real_meshes_over_a_ground_agree_with_the_view() {
                 assert_agrees(light, (x, &plane), &faces, f.class);
                 continue;
             }
-            let hx = HPoint::grid(x.map(i64::from));
-            let seen: Vec<Verdict> = (directions.iter())
-                .map(|s| scene.verdict(s, 0, &hx))
-                .collect();
-            match f.class {
-                AreaClass::Lit => assert!(
-                    all_are(&seen, Verdict::Lit),
-                    "{name}: {x:?} is lit, yet a direction of the disc is blocked"
-                ),
-                AreaClass::Umbra => assert!(
-                    all_are(&seen, Verdict::Shadowed),
-                    "{name}: {x:?} is umbra, yet a direction of the disc is open"
-                ),
-                AreaClass::Penumbra | AreaClass::Undecided => {}
-            }
+            assert_disc_agrees(&scene, &directions, x, f.class, name);
         }
         assert!(hunt().is_some() || met.len() >= 3, "{name}: {met:?}");
     }

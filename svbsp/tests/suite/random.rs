@@ -137,6 +137,27 @@ fn big_light() -> impl Strategy<Value = Light> {
     ]
 }
 
+/// The scene and lights the generators describe (at least `min_faces`
+/// faces, else the case is rejected), checked by [`check`] with `opts`.
+fn check_generated(
+    faces: &[FaceGen],
+    lights: &[LightGen],
+    t: &Transform,
+    opts: &Opts,
+    min_faces: usize,
+) -> Result<(), TestCaseError> {
+    let loops = make_faces(faces, t);
+    prop_assume!(loops.len() >= min_faces);
+    let lights = make_lights(lights, &loops, t);
+    let polys = polygons(&loops).map_err(TestCaseError::fail)?;
+    match check(&polys, &scene_of(&loops), &lights, opts) {
+        Ok(_) => Ok(()),
+        Err(e) => Err(TestCaseError::fail(format!(
+            "{e}\nloops: {loops:?}\nlights: {lights:?}"
+        ))),
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig {
         cases: cases(384),
@@ -149,17 +170,8 @@ proptest! {
         lights in proptest::collection::vec(light_gen(), 1..=3),
         t in transform(),
     ) {
-        let loops = make_faces(&faces, &t);
-        prop_assume!(!loops.is_empty());
-        let lights = make_lights(&lights, &loops, &t);
-        let polys = polygons(&loops).map_err(TestCaseError::fail)?;
         let opts = Opts { seeds: vec![1, 2], ..Opts::default() };
-        let r = check(&polys, &scene_of(&loops), &lights, &opts);
-        if let Err(e) = r {
-            return Err(TestCaseError::fail(format!(
-                "{e}\nloops: {loops:?}\nlights: {lights:?}"
-            )));
-        }
+        check_generated(&faces, &lights, &t, &opts, 1)?;
     }
 }
 
@@ -180,17 +192,8 @@ proptest! {
         lights in proptest::collection::vec(light_gen(), 1..=2),
         t in transform(),
     ) {
-        let loops = make_faces(&faces, &t);
-        prop_assume!(loops.len() > 100);
-        let lights = make_lights(&lights, &loops, &t);
-        let polys = polygons(&loops).map_err(TestCaseError::fail)?;
         let opts = Opts { seeds: vec![1], sample: Sample::PerKind(24), ..Opts::default() };
-        let r = check(&polys, &scene_of(&loops), &lights, &opts);
-        if let Err(e) = r {
-            return Err(TestCaseError::fail(format!(
-                "{e}\nloops: {loops:?}\nlights: {lights:?}"
-            )));
-        }
+        check_generated(&faces, &lights, &t, &opts, 101)?;
     }
 }
 
