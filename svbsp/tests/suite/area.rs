@@ -428,7 +428,10 @@ fn classified_faces_agree_with_the_view() {
         AreaClass::Umbra,
         AreaClass::Undecided,
     ] {
-        assert!(met.contains_key(&class), "{class:?} never met: {met:?}");
+        assert!(
+            hunt().is_some() || met.contains_key(&class),
+            "{class:?} never met: {met:?}"
+        );
     }
 }
 
@@ -647,9 +650,15 @@ fn sun_disc_fragments_agree_with_sampled_directions() {
         }
     }
     for class in [AreaClass::Lit, AreaClass::Penumbra, AreaClass::Umbra] {
-        assert!(met.contains_key(&class), "{class:?} never met: {met:?}");
+        assert!(
+            hunt().is_some() || met.contains_key(&class),
+            "{class:?} never met: {met:?}"
+        );
     }
-    assert!(shares > 10, "{shares} penumbra shares checked");
+    assert!(
+        hunt().is_some() || shares > 10,
+        "{shares} penumbra shares checked"
+    );
 }
 
 /// A sun disc's class at grid point `x` of face 0 of `scene` against the
@@ -1157,7 +1166,10 @@ fn a_mesh_cut_both_ways_agrees_with_the_view() {
         AreaClass::Umbra,
         AreaClass::Undecided,
     ] {
-        assert!(met.contains_key(&class), "{class:?} never met: {met:?}");
+        assert!(
+            hunt().is_some() || met.contains_key(&class),
+            "{class:?} never met: {met:?}"
+        );
     }
 }
 
@@ -1454,7 +1466,10 @@ fn a_ground_under_a_field_of_occluders_agrees_with_the_view() {
         *met.entry(f.class(0)).or_insert(0) += 1;
     }
     for class in [AreaClass::Lit, AreaClass::Penumbra, AreaClass::Umbra] {
-        assert!(met.contains_key(&class), "{class:?} never met: {met:?}");
+        assert!(
+            hunt().is_some() || met.contains_key(&class),
+            "{class:?} never met: {met:?}"
+        );
     }
     // the shares at the penumbra fragments' centroids, asked of the run
     let volumes = svbsp::SoftVolumes::new(std::slice::from_ref(&light), &faces).unwrap();
