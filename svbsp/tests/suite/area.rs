@@ -925,7 +925,7 @@ fn crowded_scenes_classify_as_with_every_occluder() {
     use crate::scenes::{FaceGen, Transform, make_faces};
     let mut rng = rng(0x0c40_3d5e);
     let (mut classes, mut viewed) = (std::collections::HashSet::new(), 0);
-    for _ in 0..4 {
+    for _ in 0..2 {
         let pt = |rng: &mut Rng, lo: i32, hi: i32| {
             [0; 3].map(|_: i32| lo + below(rng, (hi - lo + 1) as u64))
         };
@@ -995,7 +995,7 @@ fn crowded_scenes_classify_as_with_every_occluder() {
         }
     }
     assert!(
-        hunt().is_some() || classes.len() >= 3 && viewed > 100,
+        hunt().is_some() || classes.len() >= 3 && viewed > 50,
         "{classes:?}, {viewed} viewed"
     );
 }

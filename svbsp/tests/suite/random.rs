@@ -177,7 +177,7 @@ proptest! {
 
 proptest! {
     #![proptest_config(ProptestConfig {
-        cases: cases(3),
+        cases: cases(2),
         ..ProptestConfig::default()
     })]
 
@@ -188,11 +188,11 @@ proptest! {
     /// sampled for the ray oracle (each face's tiling is checked whole).
     #[test]
     fn crowded_scenes_match_the_ray_oracle(
-        faces in proptest::collection::vec(crowd_face_gen(), 160..=320),
+        faces in proptest::collection::vec(crowd_face_gen(), 120..=200),
         lights in proptest::collection::vec(light_gen(), 1..=2),
         t in transform(),
     ) {
-        let opts = Opts { seeds: vec![1], sample: Sample::PerKind(24), ..Opts::default() };
+        let opts = Opts { seeds: vec![1], sample: Sample::PerKind(16), ..Opts::default() };
         check_generated(&faces, &lights, &t, &opts, 101)?;
     }
 }
