@@ -13,24 +13,11 @@ use svbsp::{AreaClass, AreaLight, Light, Occluder, Visibility};
 
 use num_traits::{Signed, Zero};
 
+use crate::harness::{hunt, rng};
+use crate::meshes::mesh_loops;
 use crate::oracle::{HPoint, Q, Scene, Verdict, twice_area_vector};
 
 /// A number in `0..n`.
-/// The random scenes' generator: `default`, or with `SVBSP_SEED` in the
-/// environment (for longer hunts, as `SVBSP_CASES` for the properties)
-/// another stream for every test.
-fn rng(default: u64) -> Rng {
-    Rng::new(hunt().map_or(default, |h| default ^ h.wrapping_mul(0x9e37_79b9_7f4a_7c15)))
-}
-
-/// `SVBSP_SEED`, when a hunt sets it. A hunt looks for wrong answers
-/// only: the checks that the default scenes meet every class are left out.
-fn hunt() -> Option<u64> {
-    std::env::var("SVBSP_SEED")
-        .ok()
-        .and_then(|s| s.parse().ok())
-}
-
 fn below(rng: &mut Rng, n: u64) -> i32 {
     (rng.next_u64() % n) as i32
 }
@@ -1523,9 +1510,7 @@ fn real_meshes_over_a_ground_agree_with_the_view() {
         None => names[0],
         Some(_) => names[below(&mut rng, names.len() as u64) as usize],
     };
-    let path = format!("{}/../data/meshes/{name}", env!("CARGO_MANIFEST_DIR"));
-    let mesh = shadow_scene::read_obj(std::path::Path::new(&path)).unwrap();
-    let loops = mesh.face_loops();
+    let loops = mesh_loops(name);
     let pts: Vec<DVec3> = loops.iter().flatten().copied().collect();
     let (lo, hi) = pts
         .iter()

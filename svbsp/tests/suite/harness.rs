@@ -102,6 +102,22 @@ impl Checked {
     }
 }
 
+/// `SVBSP_SEED`, when a hunt sets it (for longer hunts, as `SVBSP_CASES`
+/// for the properties). A hunt looks for wrong answers only: the checks
+/// that the default scenes meet every class are left out.
+pub(crate) fn hunt() -> Option<u64> {
+    std::env::var("SVBSP_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+}
+
+/// A random scenes' generator: `default`, or under a hunt another stream
+/// for every test.
+pub(crate) fn rng(default: u64) -> bsp_fixtures::Rng {
+    let h = hunt().map_or(0, |h| h.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    bsp_fixtures::Rng::new(default ^ h)
+}
+
 /// Input loops as convex polygons tagged with their index.
 pub(crate) fn polygons(loops: &[Vec<[i32; 3]>]) -> Result<Vec<Polygon>, String> {
     loops

@@ -8,7 +8,7 @@ use glam::DVec3;
 use shadow_scene::read_obj;
 use svbsp::Light;
 
-use crate::harness::{Checked, Opts, Sample, check};
+use crate::harness::{Checked, Opts, Sample, check, hunt, rng};
 use crate::oracle::Scene;
 
 /// A light in input units (point) or a grid direction (sun).
@@ -47,7 +47,7 @@ fn check_mesh(
 }
 
 /// The face loops of mesh `name` of `data/meshes`.
-fn mesh_loops(name: &str) -> Vec<Vec<DVec3>> {
+pub(crate) fn mesh_loops(name: &str) -> Vec<Vec<DVec3>> {
     let path = format!("{}/../data/meshes/{name}", env!("CARGO_MANIFEST_DIR"));
     let mesh = read_obj(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
     mesh.face_loops()
@@ -230,10 +230,7 @@ fn terrain_half_flipped() {
 /// the teapot; a hunt (`SVBSP_SEED`) draws others for every mesh here.
 #[test]
 fn real_meshes_under_random_lights() {
-    let hunt = std::env::var("SVBSP_SEED")
-        .ok()
-        .and_then(|s| s.parse::<u64>().ok());
-    let meshes: &[&str] = match hunt {
+    let meshes: &[&str] = match hunt() {
         None => &["teapot.obj"],
         Some(_) => &[
             "teapot.obj",
@@ -242,8 +239,7 @@ fn real_meshes_under_random_lights() {
             "pyvista_nut.obj",
         ],
     };
-    let mut rng =
-        bsp_fixtures::Rng::new(0x7ea_9075 ^ hunt.unwrap_or(0).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    let mut rng = rng(0x7ea_9075);
     let mut unit = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
     for name in meshes {
         let loops = mesh_loops(name);
