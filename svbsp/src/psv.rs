@@ -72,7 +72,7 @@ pub(crate) mod filter;
 mod late;
 mod occluders;
 mod rests;
-use late::{LATE_PER_FRONT, LateTally, merged, route_late};
+use late::{LateTally, merged, route_late};
 use occluders::Occluders;
 use rests::Rests;
 
@@ -242,7 +242,7 @@ impl Pool {
         let verts = occ.verts(o);
         let k = verts.len();
         let mut piece = Piece::default();
-        for (j, (&v, e)) in verts.iter().zip(occ.edges(o)).enumerate() {
+        for (j, (&v, e)) in verts.iter().zip(occ.edges(o).iter()).enumerate() {
             piece.verts.push(self.arena.add_grid(v));
             let plane = self.arena.add_edge_plane(*e, v, verts[(j + 1) % k]);
             piece.edges.push(EdgeRef::new(plane, false));
@@ -636,10 +636,8 @@ impl ShadowVolumes {
         // their turn ([`route_late`])
         // (unless those turned away are most of them: then they are what
         // hides, and the skeleton cuts them all, as it cuts the others)
-        let fronts = occ.faces.iter().filter(|&&f| f).count();
-        let defer = occ.len() - fronts <= LATE_PER_FRONT * fronts;
         let (list, late): (Vec<u32>, Vec<u32>) =
-            (0..occ.len() as u32).partition(|&o| occ.faces[o as usize] || !defer);
+            (0..occ.len() as u32).partition(|&o| occ.faces[o as usize] || !occ.defer);
         let list: Vec<Entry> = list.into_iter().map(Entry::whole).collect();
         // the first levels one after the other, on one pool
         let mut top = Subtree {
@@ -1203,7 +1201,7 @@ fn choose_split(
     let mut best: Option<(u64, Plane)> = None;
     for _ in 0..CANDIDATES {
         let o = task.list[rng.below(n)].occ;
-        for e in occ.edges(o) {
+        for e in occ.edges(o).iter() {
             if on_path(&task.path, e) {
                 continue;
             }
