@@ -17,6 +17,7 @@
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// How many runs `0..n` is cut into: at most 64 a thread, so that uneven
 /// runs balance (rayon splits the runs among the threads as they steal
@@ -115,6 +116,33 @@ pub fn try_map<T: Send, E: Send>(
     f: impl Fn(usize) -> Result<T, E> + Sync,
 ) -> Result<Vec<T>, E> {
     map(n, f).into_iter().collect()
+}
+
+/// `[f(0), f(1), …]`, computed in parallel and started in the order of
+/// `costs`, the largest first (ties by index): for a few items of uneven
+/// and roughly known cost, where an item started last and large keeps one
+/// thread busy after the others have run out of work. Each thread takes
+/// the next item of that order when it is free; the values come back in
+/// index order.
+pub fn map_largest_first<T: Send>(costs: &[u64], f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let n = costs.len();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| costs[b].cmp(&costs[a]).then(a.cmp(&b)));
+    let next = AtomicUsize::new(0);
+    let slots: Vec<Mutex<Option<T>>> = (0..n).map(|_| Mutex::new(None)).collect();
+    // every call takes one item of the order, whichever index the loop
+    // gave it
+    for_each(n, |_| {
+        let i = order[next.fetch_add(1, Ordering::Relaxed)];
+        let v = f(i);
+        *slots[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(v);
+    });
+    slots
+        .into_iter()
+        .map(|s| {
+            (s.into_inner().unwrap_or_else(|e| e.into_inner())).expect("each index is taken once")
+        })
+        .collect()
 }
 
 /// `f` applied to every item of `items`, moved in, in parallel, in order.
@@ -238,6 +266,25 @@ mod tests {
     }
 
     #[test]
+    fn the_largest_start_first() {
+        // one thread: the calls come one after the other, in the order
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let started = Mutex::new(Vec::new());
+        let costs = [3, 9, 1, 9, 4];
+        let out = pool.install(|| {
+            map_largest_first(&costs, |i| {
+                started.lock().unwrap().push(i);
+                10 * i
+            })
+        });
+        assert_eq!(out, [0, 10, 20, 30, 40]);
+        assert_eq!(started.into_inner().unwrap(), [1, 3, 4, 0, 2]);
+    }
+
+    #[test]
     fn loops_give_the_sequential_answer_for_every_pool() {
         for pool in pools() {
             pool.install(|| {
@@ -251,6 +298,8 @@ mod tests {
                     assert_eq!(first_bad, if n > 6 { Err(6) } else { Ok(items.clone()) });
                     let odd: Vec<usize> = (0..n).filter(|i| i % 2 == 1).collect();
                     assert_eq!(filter_map(n, |i| (i % 2 == 1).then_some(i)), odd);
+                    let costs: Vec<u64> = (0..n as u64).map(|i| (i * 7) % 5).collect();
+                    assert_eq!(map_largest_first(&costs, |i| i * i), want);
                     let flat: Vec<usize> = (0..n).flat_map(|i| vec![i; i % 3]).collect();
                     assert_eq!(flat_map(n, |i| vec![i; i % 3]), flat);
                     let sums = fold_runs(n, |r| r.sum::<usize>());
