@@ -103,16 +103,16 @@ impl LightVolumes {
 
     /// Certifies the parts of `occluders` ([`bsp_core::certify_solid_parts`],
     /// which has steps on one thread) while the first two lights' trees
-    /// are built over the occluders they face, in `order`: the faces a
-    /// light's tree keeps whatever the parts are. Where the certified
-    /// parts leave out every other face (a scene of closed meshes lit
-    /// from outside, and open faces toward the light), such a tree is the
-    /// one the parts ask for, and is kept; otherwise it is built again.
-    /// A light is not guessed for where the pairing of the parts' edges
-    /// (the certificate's first step) finds a face it does not face in an
-    /// open part (an open scan), and a guess is given up as soon as the
-    /// parts say it fails. The parts, and per light the faces its tree
-    /// was built over with the tree.
+    /// are built over the occluders no certificate can leave out, in
+    /// `order`: the faces toward the light, and those of the parts the
+    /// pairing of the edges (the certificate's first step) finds open.
+    /// Where the certified parts leave out every other face (closed
+    /// meshes lit from outside, open scans, and both), such a tree is the
+    /// one the parts ask for, and is kept; otherwise it is built again,
+    /// and a guess is given up as soon as the parts say it fails. (An
+    /// open scan was not guessed for, and waited for the certificate's
+    /// serial steps with the other core idle.) The parts, and per light
+    /// the faces its tree was built over with the tree.
     fn new_certifying(
         occluders: &[Polygon],
         order: &[usize],
@@ -120,32 +120,25 @@ impl LightVolumes {
         build: &Build,
     ) -> (bsp_core::SolidParts, Guessed) {
         let paired = bsp_core::pair_solid_parts(occluders);
-        // per light: the faces it faces, if every other face may be left out
-        let guess = |l: &Light| -> Option<Vec<usize>> {
-            let mut faced = Vec::with_capacity(order.len());
-            for &i in order {
-                match l.faces(occluders[i].support()) {
-                    true => faced.push(i),
-                    false if paired.open(i) => return None,
-                    false => {}
-                }
-            }
-            Some(faced)
+        // per light: the faces it faces, and those of open parts
+        let guess = |l: &Light| -> Vec<usize> {
+            (order.iter().copied())
+                .filter(|&i| l.faces(occluders[i].support()) || paired.open(i))
+                .collect()
         };
-        let first: Vec<(Light, Vec<usize>)> = (lights.iter().take(2))
-            .map_while(|l| guess(l).map(|f| (*l, f)))
-            .collect();
+        let first: Vec<(Light, Vec<usize>)> =
+            (lights.iter().take(2)).map(|l| (*l, guess(l))).collect();
         if first.is_empty() {
             return (paired.certify(), Vec::new());
         }
         let stops = [Stop::new(false), Stop::new(false)];
         let certify = || {
             let solids = paired.certify();
-            for ((l, _), stop) in first.iter().zip(&stops) {
-                let holds = (order.iter()).all(|&i| {
-                    let s = occluders[i].support();
-                    l.faces(s) || l.leaves_out(&solids, i, s)
-                });
+            for ((l, faced), stop) in first.iter().zip(&stops) {
+                // (the faces the parts keep, as `new_built` finds them)
+                let holds = (order.iter().copied())
+                    .filter(|&i| !l.leaves_out(&solids, i, occluders[i].support()))
+                    .eq(faced.iter().copied());
                 if !holds {
                     stop.store(true, std::sync::atomic::Ordering::Relaxed);
                 }
