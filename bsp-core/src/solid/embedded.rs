@@ -677,7 +677,7 @@ impl Loops {
         let lenient = open.is_some();
         let runs = runs(n_ids, n_ids, |vs| {
             let mut run = Run {
-                joins: Vec::with_capacity(3 * vs.len()),
+                joins: Vec::with_capacity(2 * vs.len()),
                 certified: vec![false; vs.len()],
                 open: Vec::new(),
                 error: None,
@@ -700,10 +700,12 @@ impl Loops {
                     continue;
                 }
                 // successor: the corner whose prev is this corner's next;
-                // the polygons across each edge are one part
+                // the polygons across each edge are one part (joined at
+                // the edge's lower end: its other end joins them too, or,
+                // where its edges do not pair up, all its polygons)
                 let succ =
                     |c: &(u32, u32, u32)| around.binary_search_by_key(&c.1, |d| d.0).unwrap_or(0);
-                for c in &around {
+                for c in around.iter().filter(|c| c.1 > v as u32) {
                     let d = &around[succ(c)];
                     run.joins.push([
                         self.corner_poly[c.2 as usize],
