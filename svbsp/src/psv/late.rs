@@ -75,32 +75,23 @@ pub(super) fn route_late(
             Some((id, side)) => task_at[id as usize][(side == Side::Back) as usize] = t,
         }
     }
-    // runs of them in parallel (a scan's far side is half its faces),
-    // each its (task, occluder) pairs in order, then dealt out in order
-    let runs = bsp_core::par::fold_runs(late.len(), |r| {
-        let mut stack = Vec::new();
-        let mut reach: Vec<(u32, u32)> = Vec::with_capacity(2 * r.len());
-        for &o in &late[r] {
-            let verts = occ.verts(o);
-            stack.push(root);
-            while let Some(id) = stack.pop() {
-                let n = &nodes[id as usize];
-                let sd = Sides::of_grid(verts, &n.plane);
-                // (an occluder is not in a plane through the light)
-                let front = sd.front || !sd.back;
-                for (reached, link, side) in [(sd.back, n.back, 1), (front, n.front, 0)] {
-                    match (reached, link == LIT) {
-                        (true, true) => reach.push((task_at[id as usize][side] as u32, o)),
-                        (true, false) => stack.push(link),
-                        _ => {}
-                    }
+    let mut stack = Vec::new();
+    for &o in late {
+        let verts = occ.verts(o);
+        stack.push(root);
+        while let Some(id) = stack.pop() {
+            let n = &nodes[id as usize];
+            let sd = Sides::of_grid(verts, &n.plane);
+            // (an occluder is not in a plane through the light)
+            let front = sd.front || !sd.back;
+            for (reached, link, side) in [(sd.back, n.back, 1), (front, n.front, 0)] {
+                match (reached, link == LIT) {
+                    (true, true) => lists[task_at[id as usize][side]].push(o),
+                    (true, false) => stack.push(link),
+                    _ => {}
                 }
             }
         }
-        reach
-    });
-    for (t, o) in runs.into_iter().flatten() {
-        lists[t as usize].push(o);
     }
     lists
 }
