@@ -203,10 +203,11 @@ fn rounding_only_batches_drop_nothing_else() {
 }
 
 /// The trees built while the parts are certified (over the faces each
-/// light faces, kept where the certified parts leave out every other
-/// face) are the trees built after certifying: where the guess holds
-/// (closed boxes lit from outside, an open floor facing the lights) and
-/// where it does not (an open face turned away, a light inside a box).
+/// light faces and those of open parts, kept where the certified parts
+/// leave out every other face) are the trees built after certifying:
+/// where the guess holds (closed boxes lit from outside, an open floor
+/// facing the lights, an open face turned away) and where it does not (a
+/// light inside a box, with and without the open faces).
 #[test]
 fn trees_built_while_certifying_are_those_built_after() {
     let poly = |l: &Vec<[i32; 3]>, tag: u32| Polygon::from_grid_points(l, tag).unwrap();
@@ -227,17 +228,21 @@ fn trees_built_while_certifying_are_those_built_after() {
     let inside = [Light::Point([3, 3, 3]), Light::Directional([-1, 2, 7])];
     let solids_of = |p: &[Polygon]| bsp_core::certify_solid_parts(p);
     // whether the guess holds for a light: every face it does not face
-    // is left out
+    // is in an open part or left out
     let holds = |p: &[Polygon], l: &Light| {
-        let s = solids_of(p);
-        (0..p.len()).all(|i| l.faces(p[i].support()) || l.leaves_out(&s, i, p[i].support()))
+        let (s, paired) = (solids_of(p), bsp_core::pair_solid_parts(p));
+        (0..p.len()).all(|i| {
+            l.faces(p[i].support()) || paired.open(i) || l.leaves_out(&s, i, p[i].support())
+        })
     };
     assert!(holds(&closed, &above[0]) && holds(&closed, &above[1]));
-    assert!(!holds(&open, &above[0]) && !holds(&closed, &inside[0]));
+    assert!(holds(&open, &above[0]) && holds(&open, &above[2]));
+    assert!(!holds(&closed, &inside[0]) && !holds(&open, &inside[0]));
     for (polys, lights) in [
         (&closed, &above[..]),
         (&open, &above[..]),
         (&closed, &inside[..]),
+        (&open, &inside[..]),
     ] {
         let solids = solids_of(polys);
         let order: Vec<usize> = (0..polys.len()).collect();
