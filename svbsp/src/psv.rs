@@ -49,7 +49,7 @@
 //! the time), so each region keeps count ([`late`]): once it has seen
 //! that few of them are hidden, a leaf's are cut to it like the others
 //! and the leaf split further as the skeleton would have split it; and
-//! where they are most of the occluders ([`LATE_PER_FRONT`]) the skeleton
+//! where they are most of the occluders (`occluders::LATE_PER_FRONT`) the skeleton
 //! is made of all of them, as before.
 //!
 //! Every plane is an input-tier plane (an occluder's support plane, or the

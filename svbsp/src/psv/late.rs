@@ -9,12 +9,6 @@ use super::occluders::Occluders;
 use super::{Entry, LIT, Node, Task};
 use crate::arena::pieces::Sides;
 
-/// At most this many occluders turned away from the light per occluder
-/// that faces it, for those turned away to go down the skeleton whole
-/// (module docs): a scene turned away from its light (a terrain whose
-/// faces point down, lit from above, 2.9 times as long without this)
-/// needs them in the skeleton.
-pub(super) const LATE_PER_FRONT: usize = 2;
 /// Late occluders a region tests before it judges them: while at least
 /// one in [`LATE_HIDDEN`] of those tested is found hidden, they go into
 /// its leaves whole; past that, a leaf's are cut to it like the others

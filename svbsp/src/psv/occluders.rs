@@ -7,7 +7,6 @@ use bsp_core::{GridPoint, Plane, Point, Polygon};
 use rayon::prelude::*;
 
 use super::VolumeError;
-use super::late::LATE_PER_FRONT;
 use crate::light::Light;
 
 /// The occluders that face or back onto the light, nearest first, as
@@ -32,6 +31,13 @@ pub(super) struct Occluders {
     /// else the skeleton is made of all.
     pub(super) defer: bool,
 }
+
+/// At most this many occluders turned away from the light per occluder
+/// that faces it, for those turned away to go down the skeleton whole
+/// (`psv`'s module docs): a scene turned away from its light (a terrain whose
+/// faces point down, lit from above, 2.9 times as long without this)
+/// needs them in the skeleton.
+pub(super) const LATE_PER_FRONT: usize = 2;
 
 /// Occluders per chunk of [`Occluders`] (a power of two).
 const OCCLUDER_CHUNK: usize = 1 << OCCLUDER_CHUNK_BITS;
