@@ -63,18 +63,25 @@ pub fn fold_runs<A: Send>(n: usize, f: impl Fn(Range<usize>) -> A + Sync) -> Vec
 /// [`fold_runs`], telling `f` the number of its run too.
 fn fold_numbered_runs<A: Send>(n: usize, f: impl Fn(usize, Range<usize>) -> A + Sync) -> Vec<A> {
     let runs = run_count(n);
-    let slots: Vec<Mutex<Option<A>>> = (0..runs).map(|_| Mutex::new(None)).collect();
-    each_run(n, &|k, r| {
-        let a = f(k, r);
-        *slots[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(a);
-    });
-    slots
-        .into_iter()
-        .map(|s| {
-            s.into_inner()
-                .unwrap_or_else(|e| e.into_inner())
-                .expect("every run ran")
-        })
+    let slots = empty_slots(runs);
+    each_run(n, &|k, r| fill(&slots[k], f(k, r)));
+    filled(slots)
+}
+
+/// `n` empty places for values made on the pool's threads.
+fn empty_slots<A>(n: usize) -> Vec<Mutex<Option<A>>> {
+    (0..n).map(|_| Mutex::new(None)).collect()
+}
+
+/// Puts `a` in its place.
+fn fill<A>(slot: &Mutex<Option<A>>, a: A) {
+    *slot.lock().unwrap_or_else(|e| e.into_inner()) = Some(a);
+}
+
+/// The values of places that a loop filled, in order.
+fn filled<A>(slots: Vec<Mutex<Option<A>>>) -> Vec<A> {
+    (slots.into_iter())
+        .map(|s| (s.into_inner().unwrap_or_else(|e| e.into_inner())).expect("every place filled"))
         .collect()
 }
 
@@ -129,20 +136,14 @@ pub fn map_largest_first<T: Send>(costs: &[u64], f: impl Fn(usize) -> T + Sync) 
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&a, &b| costs[b].cmp(&costs[a]).then(a.cmp(&b)));
     let next = AtomicUsize::new(0);
-    let slots: Vec<Mutex<Option<T>>> = (0..n).map(|_| Mutex::new(None)).collect();
+    let slots = empty_slots(n);
     // every call takes one item of the order, whichever index the loop
     // gave it
     for_each(n, |_| {
         let i = order[next.fetch_add(1, Ordering::Relaxed)];
-        let v = f(i);
-        *slots[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(v);
+        fill(&slots[i], f(i));
     });
-    slots
-        .into_iter()
-        .map(|s| {
-            (s.into_inner().unwrap_or_else(|e| e.into_inner())).expect("each index is taken once")
-        })
-        .collect()
+    filled(slots)
 }
 
 /// `f` applied to every item of `items`, moved in, in parallel, in order.

@@ -52,11 +52,8 @@ impl LightVolumes {
         let build = |l: Light, index: Vec<usize>| -> Result<Reached, VolumeError> {
             Ok(build_until(l, index, None)?.expect("no stop"))
         };
-        let kept = |l: Light, solids: &bsp_core::SolidParts| -> Vec<usize> {
-            (order.iter().copied())
-                .filter(|&i| !l.leaves_out(solids, i, occluders[i].support()))
-                .collect()
-        };
+        let kept =
+            |l: Light, solids: &bsp_core::SolidParts| kept(occluders, order, &l, solids).collect();
         let (owned, first) = match solids {
             Some(_) => (None, Vec::new()),
             None => {
@@ -135,10 +132,7 @@ impl LightVolumes {
         let certify = || {
             let solids = paired.certify();
             for ((l, faced), stop) in first.iter().zip(&stops) {
-                // (the faces the parts keep, as `new_built` finds them)
-                let holds = (order.iter().copied())
-                    .filter(|&i| !l.leaves_out(&solids, i, occluders[i].support()))
-                    .eq(faced.iter().copied());
+                let holds = kept(occluders, order, l, &solids).eq(faced.iter().copied());
                 if !holds {
                     stop.store(true, std::sync::atomic::Ordering::Relaxed);
                 }
@@ -158,4 +152,15 @@ impl LightVolumes {
         };
         rayon::join(certify, guessed)
     }
+}
+
+/// The faces of `order` (in that order) that light `l`'s tree keeps: all
+/// but those the certified parts `solids` leave out.
+fn kept<'a>(
+    occluders: &'a [Polygon],
+    order: &'a [usize],
+    l: &'a Light,
+    solids: &'a bsp_core::SolidParts,
+) -> impl Iterator<Item = usize> + 'a {
+    (order.iter().copied()).filter(move |&i| !l.leaves_out(solids, i, occluders[i].support()))
 }
