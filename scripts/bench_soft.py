@@ -9,9 +9,20 @@ For each, the median wall time of a few runs of the release binary (the
 README's first command builds it) and the error of the lit and umbra
 areas against the exact ones, in percent of the room's area below the
 light's plane (the area light shines down only; the point lights light
-the walls above it too). At most 64 lights fit one run, so N stops at 64.
+the walls above it too).
 
-    python3 scripts/bench_soft.py [--runs 5]
+At most 64 lights fit one run. N = 256 (a 16 x 16 lattice) is measured
+as four runs of 64 (the four interleaved 8 x 8 sub-lattices): a point is
+lit by all 256 where it is lit by all of each run's 64, so the area lit
+by all is that of the intersection, face by face, of the four runs'
+fragments lit by all (and so for the umbra), found with `shapely` in
+each face's plane. Its time is the four runs' together. The same
+intersection of four runs of 16 is checked against the one run of 64
+(N = 64 both ways must agree to rounding).
+
+    python3 scripts/bench_soft.py [--runs 5] [--no-256]
+
+(N = 256 needs `pip install shapely`; without it that row is skipped.)
 """
 import argparse
 import json
@@ -72,10 +83,97 @@ def areas(doc):
     return total, lit, umbra
 
 
+def lattice(k, x0, y0, step=1, offset=(0, 0)):
+    """`--light` arguments of a k x k lattice of cell centres over the
+    light, every `step`-th cell from `offset` in each direction."""
+    args = []
+    for i in range(offset[0], k, step):
+        for j in range(offset[1], k, step):
+            x = x0 + (i + 0.5) * 2 * HALF / k
+            y = y0 + (j + 0.5) * 2 * HALF / k
+            args += ["--light", f"{x},{y},{Z}"]
+    return args
+
+
+def face_frame(ring):
+    """The axis a face's plane is projected along (its normal's largest
+    component) and the factor from projected area to true area."""
+    n = [0.0, 0.0, 0.0]
+    for i, a in enumerate(ring):
+        b = ring[(i + 1) % len(ring)]
+        n[0] += (a[1] - b[1]) * (a[2] + b[2])
+        n[1] += (a[2] - b[2]) * (a[0] + b[0])
+        n[2] += (a[0] - b[0]) * (a[1] + b[1])
+    norm = sum(c * c for c in n) ** 0.5
+    # (a face at 45 degrees has two equal components: rounded, the first
+    # is taken in every run, so that the runs' projections agree)
+    axis = max(range(3), key=lambda k: (round(abs(n[k]) / norm, 9), -k))
+    return axis, norm / abs(n[axis])
+
+
+def face_regions(doc):
+    """Per face: its projection axis, area factor, and the unions of its
+    fragments lit by every light and hidden from every light, below the
+    light's plane, as `shapely` geometry in the face's projected plane."""
+    from shapely.geometry import Polygon, box
+    from shapely.ops import unary_union
+
+    faces = {}
+    for f in doc["fragments"]:
+        faces.setdefault(f["face"], []).append(f)
+    out = {}
+    for face, frags in faces.items():
+        axis, scale = face_frame(frags[0]["vertices"])
+        keep = [k for k in range(3) if k != axis]
+
+        def flat(ring):
+            return [(p[keep[0]], p[keep[1]]) for p in ring]
+
+        # below the light's plane: z is a projected coordinate unless the
+        # face is horizontal, when the whole face is on one side
+        if axis == 2:
+            below = None if frags[0]["vertices"][0][2] <= Z else box(0, 0, 0, 0)
+        else:
+            big = 1e6
+            below = box(-big, -big, big, Z)
+        lit, umbra = [], []
+        for f in frags:
+            g = Polygon(flat(f["vertices"]), [flat(h) for h in f.get("holes", [])])
+            if below is not None:
+                g = g.intersection(below)
+            if all(f["lit"]):
+                lit.append(g)
+            elif all(f["umbra"]):
+                umbra.append(g)
+        out[face] = (scale, unary_union(lit), unary_union(umbra))
+    return out
+
+
+def joint_areas(docs):
+    """The areas lit by every light of every run and hidden from every
+    light of every run: the intersection, face by face, of the runs'
+    regions (`face_regions`)."""
+    regions = [face_regions(d) for d in docs]
+    lit = umbra = 0.0
+    for face in set().union(*regions):
+        per = [r.get(face) for r in regions]
+        if any(p is None for p in per):
+            continue
+        scale = per[0][0]
+        a, b = per[0][1], per[0][2]
+        for p in per[1:]:
+            a, b = a.intersection(p[1]), b.intersection(p[2])
+        lit += scale * a.area
+        umbra += scale * b.area
+    return lit, umbra
+
+
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--runs", type=int, default=5)
-    runs = p.parse_args().runs
+    p.add_argument("--no-256", action="store_true", help="skip N = 256 (four runs of 64)")
+    opts = p.parse_args()
+    runs = opts.runs
     if not os.path.exists(BIN):
         sys.exit(f"build first: cargo build --release -p shadow-cli ({BIN})")
     d = tempfile.mkdtemp()
@@ -90,17 +188,36 @@ def main():
     print("|---|---|---|---|")
     print(f"| exact (`--area-light`) | {t_exact:.3f} | 0 | 0 |")
     for k in (2, 4, 6, 8):
-        args = []
-        for i in range(k):
-            for j in range(k):
-                x = x0 + (i + 0.5) * 2 * HALF / k
-                y = y0 + (j + 0.5) * 2 * HALF / k
-                args += ["--light", f"{x},{y},{Z}"]
-        t = timed(args, out, runs)
+        t = timed(lattice(k, x0, y0), out, runs)
         tot, l, u = areas(json.load(open(out)))
         assert abs(tot - total) < 1e-6 * total, (tot, total)
         print(f"| {k * k} point lights | {t:.3f} | {100 * (l - lit) / total:+.2f} % | "
               f"{100 * (u - umbra) / total:+.2f} % |")
+        if k == 8:
+            lit64, umbra64 = l, u
+    if opts.no_256:
+        return
+    try:
+        import shapely  # noqa: F401
+    except ImportError:
+        print("(N = 256 skipped: pip install shapely)")
+        return
+    subs = [(a, b) for a in range(2) for b in range(2)]
+
+    def four(k):
+        t, docs = 0.0, []
+        for s in subs:
+            t += timed(lattice(k, x0, y0, 2, s), out, runs)
+            docs.append(json.load(open(out)))
+        return t, joint_areas(docs)
+
+    # the four-run intersection checked where one run can do it too
+    _, (l, u) = four(8)
+    assert abs(l - lit64) < 1e-9 * total and abs(u - umbra64) < 1e-9 * total, (
+        l, lit64, u, umbra64)
+    t, (l, u) = four(16)
+    print(f"| 256 point lights (four runs of 64) | {t:.3f} | {100 * (l - lit) / total:+.2f} % | "
+          f"{100 * (u - umbra) / total:+.2f} % |")
 
 
 if __name__ == "__main__":
