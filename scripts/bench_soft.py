@@ -50,9 +50,10 @@ def timed(args, out, runs):
     return statistics.median(run(args, out) for _ in range(runs))
 
 
-def area_below(ring, z):
-    """The area of a planar ring's part with z <= `z` (Sutherland-Hodgman
-    and Newell: right for non-convex rings too)."""
+def clip_below(ring, z):
+    """A planar ring's part with z <= `z` (Sutherland-Hodgman: right for
+    non-convex rings too, whose clipped part may then run along z = `z`
+    more than once)."""
     clipped = []
     for i, a in enumerate(ring):
         b = ring[(i + 1) % len(ring)]
@@ -61,13 +62,23 @@ def area_below(ring, z):
         if (a[2] <= z) != (b[2] <= z):
             t = (z - a[2]) / (b[2] - a[2])
             clipped.append([a[k] + t * (b[k] - a[k]) for k in range(3)])
+    return clipped
+
+
+def newell(ring):
+    """Twice a planar ring's vector area (Newell's normal)."""
     n = [0.0, 0.0, 0.0]
-    for i, a in enumerate(clipped):
-        b = clipped[(i + 1) % len(clipped)]
+    for i, a in enumerate(ring):
+        b = ring[(i + 1) % len(ring)]
         n[0] += (a[1] - b[1]) * (a[2] + b[2])
         n[1] += (a[2] - b[2]) * (a[0] + b[0])
         n[2] += (a[0] - b[0]) * (a[1] + b[1])
-    return 0.5 * sum(c * c for c in n) ** 0.5
+    return n
+
+
+def area_below(ring, z):
+    """The area of a planar ring's part with z <= `z`."""
+    return 0.5 * sum(c * c for c in newell(clip_below(ring, z))) ** 0.5
 
 
 def areas(doc):
@@ -98,12 +109,7 @@ def lattice(k, x0, y0, step=1, offset=(0, 0)):
 def face_frame(ring):
     """The axis a face's plane is projected along (its normal's largest
     component) and the factor from projected area to true area."""
-    n = [0.0, 0.0, 0.0]
-    for i, a in enumerate(ring):
-        b = ring[(i + 1) % len(ring)]
-        n[0] += (a[1] - b[1]) * (a[2] + b[2])
-        n[1] += (a[2] - b[2]) * (a[0] + b[0])
-        n[2] += (a[0] - b[0]) * (a[1] + b[1])
+    n = newell(ring)
     norm = sum(c * c for c in n) ** 0.5
     # (a face at 45 degrees has two equal components: rounded, the first
     # is taken in every run, so that the runs' projections agree)
@@ -112,10 +118,10 @@ def face_frame(ring):
 
 
 def face_regions(doc):
-    """Per face: its projection axis, area factor, and the unions of its
-    fragments lit by every light and hidden from every light, below the
-    light's plane, as `shapely` geometry in the face's projected plane."""
-    from shapely.geometry import Polygon, box
+    """Per face: its area factor, and the unions of its fragments lit by
+    every light and hidden from every light, below the light's plane, as
+    `shapely` geometry in the face's projected plane."""
+    from shapely.geometry import Polygon
     from shapely.ops import unary_union
 
     faces = {}
@@ -127,20 +133,17 @@ def face_regions(doc):
         keep = [k for k in range(3) if k != axis]
 
         def flat(ring):
-            return [(p[keep[0]], p[keep[1]]) for p in ring]
+            # (clipped in space, where z is always a coordinate)
+            ring = clip_below(ring, Z)
+            if len(ring) < 3:
+                return Polygon()
+            return Polygon([(p[keep[0]], p[keep[1]]) for p in ring]).buffer(0)
 
-        # below the light's plane: z is a projected coordinate unless the
-        # face is horizontal, when the whole face is on one side
-        if axis == 2:
-            below = None if frags[0]["vertices"][0][2] <= Z else box(0, 0, 0, 0)
-        else:
-            big = 1e6
-            below = box(-big, -big, big, Z)
         lit, umbra = [], []
         for f in frags:
-            g = Polygon(flat(f["vertices"]), [flat(h) for h in f.get("holes", [])])
-            if below is not None:
-                g = g.intersection(below)
+            g = flat(f["vertices"])
+            for h in f.get("holes", []):
+                g = g.difference(flat(h))
             if all(f["lit"]):
                 lit.append(g)
             elif all(f["umbra"]):
