@@ -1004,6 +1004,13 @@ fn crowded_scenes_classify_as_with_every_occluder() {
                     let Some(f) = fast[i].iter().find(|f| strictly_inside(&f.polygon, x)) else {
                         continue;
                     };
+                    // (where another face pierces this one, a point on
+                    // the line they cross at sees the light past it: a
+                    // set of zero area inside its fragment, whose class is
+                    // that of the points around it; `SVBSP_SEED=51`)
+                    if pierced(&faces, face, x) {
+                        continue;
+                    }
                     match turned {
                         true => assert_ne!(f.class, AreaClass::Lit, "{x:?}"),
                         false => assert_agrees(light, (x, face.plane()), &faces, f.class),
@@ -1017,6 +1024,18 @@ fn crowded_scenes_classify_as_with_every_occluder() {
         hunt().is_some() || classes.len() >= 3 && viewed > 50,
         "{classes:?}, {viewed} viewed"
     );
+}
+
+/// Whether grid point `x` of `face` lies in the plane of an occluder not
+/// in `face`'s plane (either way round). An occluder through `x` hides
+/// from it only the light points in its own plane, no area, so the exact
+/// view there can differ from the view at the points around it.
+fn pierced(faces: &[Occluder], face: &Occluder, x: [i32; 3]) -> bool {
+    let p = face.plane();
+    faces.iter().any(|o| {
+        let q = o.plane();
+        *q != *p && *q != p.flip() && q.classify_grid(x) == Side::On
+    })
 }
 
 /// Grid points of `face`'s plane in its box, from `tries` random points
