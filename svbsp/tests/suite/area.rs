@@ -1031,11 +1031,8 @@ fn crowded_scenes_classify_as_with_every_occluder() {
 /// from it only the light points in its own plane, no area, so the exact
 /// view there can differ from the view at the points around it.
 fn pierced(faces: &[Occluder], face: &Occluder, x: [i32; 3]) -> bool {
-    let p = face.plane();
-    faces.iter().any(|o| {
-        let q = o.plane();
-        *q != *p && *q != p.flip() && q.classify_grid(x) == Side::On
-    })
+    (faces.iter().map(Occluder::plane))
+        .any(|q| !q.is_coincident(face.plane()) && q.classify_grid(x) == Side::On)
 }
 
 /// Grid points of `face`'s plane in its box, from `tries` random points
