@@ -673,7 +673,10 @@ fn soft_json(extra: &[&str], name: &str) -> Value {
 /// occluder at height 1, the umbra on the floor is `[0.35, 1.15]²`, the
 /// penumbra reaches `[0.15, 1.35]²`; the occluder's top is lit. Every
 /// fragment has one flag per light, penumbra fragments the share of the
-/// light they see, and the areas add up.
+/// light they see, and the areas add up. The floor is cut only where a
+/// class changes: one lit fragment with the penumbra as its hole, one
+/// penumbra fragment round the umbra (its share from about 0 at its
+/// hole's corners to about 1 at its outer ones), one umbra fragment.
 #[test]
 fn an_area_light_gives_umbra_and_penumbra_in_closed_form() {
     let doc = soft_json(&[], "soft_area.json");
@@ -686,7 +689,12 @@ fn an_area_light_gives_umbra_and_penumbra_in_closed_form() {
     assert!(near(first("lit_area"), 2.56 + 0.25), "{s}");
     assert_eq!(first("undecided_area"), 0.0);
     let mut shares = 0;
+    let holes = |f: &Value| f.get("holes").map_or(0, |h| h.as_array().unwrap().len());
+    let mut floor_holes = Vec::new();
     for f in doc["fragments"].as_array().unwrap() {
+        if f["face"] == 0 {
+            floor_holes.push(holes(f));
+        }
         let (lit, umbra) = (
             f["lit"][0].as_bool().unwrap(),
             f["umbra"][0].as_bool().unwrap(),
@@ -706,9 +714,13 @@ fn an_area_light_gives_umbra_and_penumbra_in_closed_form() {
             (0.0..=1.0).contains(&v) && 0.0 <= lo && lo <= hi && hi <= 1.0,
             "{f}"
         );
+        assert!(lo < 0.05 && hi > 0.95 && lo < v && v < hi, "{f}");
+        assert_eq!(holes(f), 1, "{f}");
         shares += 1;
     }
-    assert!(shares >= 4, "{shares} penumbra fragments");
+    assert_eq!(shares, 1, "{shares} penumbra fragments");
+    floor_holes.sort_unstable();
+    assert_eq!(floor_holes, [0, 1, 1], "the floor's fragments' holes");
 }
 
 /// A point light among soft lights is classified exactly as alone: lit

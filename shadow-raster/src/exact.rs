@@ -123,17 +123,14 @@ fn soft(
     let mut fragments = SoftFragments::default();
     for (r, frags) in run.fragments().into_iter().enumerate() {
         for f in frags {
-            let ring: Vec<DVec3> = f
-                .polygon
-                .vertices_f64()
-                .into_iter()
-                .map(|c| grid.to_world(c))
+            let rings: Vec<Vec<DVec3>> = (f.rings.iter())
+                .map(|r| r.iter().map(|p| grid.to_world(p.to_f64())).collect())
                 .collect();
             fragments
                 .side
                 .push((scene.face[prims[r]], *occluders[r].plane()));
             fragments.receiver.push(r as u32);
-            fragments.rings.push(ring);
+            fragments.rings.push(rings);
             fragments.cut.push(f);
         }
     }
@@ -178,12 +175,13 @@ fn soft(
 }
 
 /// The fragments of [`soft`]: per fragment its face's side, the receiver
-/// it was cut from, its ring in input units, and the fragment.
+/// it was cut from, its rings (outer first) in input units, and the
+/// fragment.
 #[derive(Default)]
 struct SoftFragments {
     side: Vec<(u32, Plane)>,
     receiver: Vec<u32>,
-    rings: Vec<Vec<DVec3>>,
+    rings: Vec<Vec<Vec<DVec3>>>,
     cut: Vec<SoftFragment>,
 }
 
@@ -197,7 +195,7 @@ impl Drawable for SoftFragments {
     }
 
     fn rings(&self, i: usize) -> Vec<Vec<DVec3>> {
-        vec![self.rings[i].clone()]
+        self.rings[i].clone()
     }
 
     /// All of a light seen whole, none of one not seen, and in penumbra

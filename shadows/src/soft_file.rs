@@ -158,15 +158,16 @@ pub fn draw_soft_shadows(
     let grid = scene.grid;
     let mut of_faces = Vec::new();
     for (frags, &face) in fragments.iter().zip(&faces_of) {
-        for f in frags {
+        // (each convex piece shaded by its own shares)
+        for (f, p) in frags
+            .iter()
+            .flat_map(|f| f.pieces.iter().map(move |p| (f, p)))
+        {
             let soft: Vec<(usize, &Share)> = (0..scene.lights.len())
                 .filter(|&j| matches!(f.class(j), AreaClass::Penumbra | AreaClass::Undecided))
-                .filter_map(|j| Some((j, f.visible[j].as_ref()?)))
+                .filter_map(|j| Some((j, p.visible[j].as_ref()?)))
                 .collect();
-            let piece: Vec<DVec3> = f
-                .polygon
-                .vertices_f64()
-                .into_iter()
+            let piece: Vec<DVec3> = (p.polygon.vertices_f64().into_iter())
                 .map(|c| grid.to_world(c))
                 .collect();
             let ramps = soft
@@ -179,7 +180,7 @@ pub fn draw_soft_shadows(
                 lit: f.lit,
                 shares: soft.iter().map(|&(j, s)| (j, s.centroid)).collect(),
                 ramps,
-                normal: unit_normal(f.polygon.support()),
+                normal: unit_normal(p.polygon.support()),
                 pieces: vec![piece],
             });
         }
@@ -394,25 +395,25 @@ pub(crate) fn soft_shadows_on(
 }
 
 /// The area of `fragments` weighted by the share of light `j` each sees:
-/// a lit one whole, a penumbra (or undecided) one by the share at its
-/// centroid, an umbra one not at all.
+/// a lit one whole, each convex piece of a penumbra (or undecided) one by
+/// the share at the piece's centroid, an umbra one not at all.
 fn seen_area(fragments: &[SoftFragment], j: usize, grid: &Grid) -> f64 {
     let mut seen = 0.0;
     for f in fragments {
-        let share = match f.class(j) {
-            AreaClass::Lit => 1.0,
-            AreaClass::Umbra => continue,
-            AreaClass::Penumbra | AreaClass::Undecided => {
-                f.visible[j].as_ref().map_or(0.0, |s| s.centroid)
-            }
-        };
-        let world: Vec<DVec3> = f
-            .polygon
-            .vertices_f64()
-            .iter()
-            .map(|&c| grid.to_world(c))
-            .collect();
-        seen += share * svbsp::polygon_area(&world);
+        let class = f.class(j);
+        for p in &f.pieces {
+            let share = match class {
+                AreaClass::Lit => 1.0,
+                AreaClass::Umbra => continue,
+                AreaClass::Penumbra | AreaClass::Undecided => {
+                    p.visible[j].as_ref().map_or(0.0, |s| s.centroid)
+                }
+            };
+            let world: Vec<DVec3> = (p.polygon.vertices_f64().iter())
+                .map(|&c| grid.to_world(c))
+                .collect();
+            seen += share * svbsp::polygon_area(&world);
+        }
     }
     seen
 }
@@ -441,8 +442,9 @@ impl SoftShadows {
     }
 
     /// The area of `face` weighted by the share of light `light` it sees:
-    /// its lit area, and each penumbra fragment's area times the share of
-    /// the light seen at its centroid (the irradiance's share for an area
+    /// its lit area, and each convex piece of its penumbra fragments
+    /// times the share of the light seen at the piece's centroid (the
+    /// irradiance's share for an area
     /// light, the disc's for a sun disc; exact back-projection, `f64`).
     pub fn seen_area(&self, face: usize, light: usize) -> f64 {
         self.classes[face * self.lights.len() + light][4]

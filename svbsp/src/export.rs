@@ -1046,9 +1046,16 @@ pub struct SoftWritten {
 pub fn soft_areas(fragments: &[Vec<SoftFragment>], lights: usize, grid: &Grid) -> SoftAreas {
     let mut areas = SoftAreas::new(lights);
     for f in fragments.iter().flatten() {
-        areas.add(f, polygon_area(&in_world(&f.polygon, grid)));
+        areas.add(f, soft_area(f, grid));
     }
     areas
+}
+
+/// A soft fragment's area in input units: the sum of its convex pieces'.
+pub fn soft_area(f: &SoftFragment, grid: &Grid) -> f64 {
+    (f.pieces.iter())
+        .map(|p| polygon_area(&in_world(&p.polygon, grid)))
+        .sum()
 }
 
 /// A polygon's corners in input units.
@@ -1149,7 +1156,7 @@ pub fn write_soft(
             )?;
             writeln!(
                 out,
-                "# each fragment convex, faces in input order, vertices welded"
+                "# each fragment as its convex pieces, faces in input order, vertices welded"
             )?;
         }
     }
@@ -1157,30 +1164,42 @@ pub fn write_soft(
     let mut ids = Vec::new();
     for (k, frags) in fragments.iter().enumerate() {
         for f in frags {
-            let world = in_world(&f.polygon, grid);
-            if world.iter().any(|v| !v.is_finite()) {
+            let rings: Vec<Vec<DVec3>> = (f.rings.iter())
+                .map(|r| r.iter().map(|p| grid.to_world(p.to_f64())).collect())
+                .collect();
+            let pieces: Vec<Vec<DVec3>> = (f.pieces.iter())
+                .map(|p| in_world(&p.polygon, grid))
+                .collect();
+            if rings
+                .iter()
+                .chain(&pieces)
+                .flatten()
+                .any(|v| !v.is_finite())
+            {
                 return Err(io::Error::other(ExportError::NonFiniteVertex {
                     face: faces_of[k],
                     step: grid.step(),
                 }));
             }
-            let area = polygon_area(&world);
+            let area = pieces.iter().map(|p| polygon_area(p)).sum();
             areas.add(f, area);
             text.clear();
             match format {
                 FragmentFormat::Json => {
-                    soft_json(&mut text, f, faces_of[k], &world, area, n, count == 0);
+                    soft_json(&mut text, f, faces_of[k], &rings, area, n, count == 0);
                 }
                 FragmentFormat::Obj => {
                     if group != Some(soft_key(f)) {
                         group = Some(soft_key(f));
                         writeln!(text, "g {}", soft_group(f, n))?;
                     }
-                    ids.clear();
-                    for &p in &world {
-                        ids.push(obj.vertex(&mut text, p));
+                    for piece in &pieces {
+                        ids.clear();
+                        for &p in piece {
+                            ids.push(obj.vertex(&mut text, p));
+                        }
+                        obj.face(&mut text, &ids);
                     }
-                    obj.face(&mut text, &ids);
                 }
             }
             out.write_all(&text)?;
@@ -1200,12 +1219,13 @@ pub fn write_soft(
     })
 }
 
-/// One soft fragment as a JSON object, preceded by `,\n` unless `first`.
+/// One soft fragment as a JSON object, preceded by `,\n` unless `first`:
+/// its outer ring (`vertices`) and holes in input units (`rings`).
 fn soft_json(
     s: &mut Vec<u8>,
     f: &SoftFragment,
     face: u32,
-    world: &[DVec3],
+    rings: &[Vec<DVec3>],
     area: f64,
     lights: usize,
     first: bool,
@@ -1213,14 +1233,28 @@ fn soft_json(
     s.extend_from_slice(if first { b"\n" } else { b",\n" });
     s.extend_from_slice(b"{\"face\":");
     s.extend_from_slice(itoa::Buffer::new().format(face).as_bytes());
-    s.extend_from_slice(b",\"vertices\":[");
-    for (i, &p) in world.iter().enumerate() {
-        if i > 0 {
-            s.push(b',');
+    let ring = |s: &mut Vec<u8>, r: &[DVec3]| {
+        s.push(b'[');
+        for (i, &p) in r.iter().enumerate() {
+            if i > 0 {
+                s.push(b',');
+            }
+            push_point(s, p);
         }
-        push_point(s, p);
+        s.push(b']');
+    };
+    s.extend_from_slice(b",\"vertices\":");
+    ring(s, &rings[0]);
+    if rings.len() > 1 {
+        s.extend_from_slice(b",\"holes\":[");
+        for (k, r) in rings[1..].iter().enumerate() {
+            if k > 0 {
+                s.push(b',');
+            }
+            ring(s, r);
+        }
+        s.push(b']');
     }
-    s.push(b']');
     let flags = |s: &mut Vec<u8>, key: &[u8], mask: u64| {
         s.extend_from_slice(key);
         for j in 0..lights {
@@ -1237,6 +1271,7 @@ fn soft_json(
     };
     flags(s, b",\"lit\":[", f.lit);
     flags(s, b",\"umbra\":[", f.umbra);
+    flags(s, b",\"undecided\":[", f.undecided);
     let shares = |s: &mut Vec<u8>, key: &[u8], pick: fn(&crate::Share) -> f64| {
         s.extend_from_slice(key);
         for (j, v) in f.visible.iter().enumerate() {

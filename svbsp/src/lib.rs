@@ -79,8 +79,8 @@ pub use light::{
 pub use overlay::{FaceOverlay, OverlayRegion};
 pub use psv::{LitParts, ShadowVolumes, VolumeError, VolumeSanity};
 pub use soft::{
-    Share, SoftFragment, SoftLight, SoftShape, SoftVolumes, place_soft_lights, shared_soft_grid,
-    soft_shadows, soft_shadows_with,
+    Share, SoftFragment, SoftLight, SoftPiece, SoftShape, SoftVolumes, place_soft_lights,
+    shared_soft_grid, soft_shadows, soft_shadows_with,
 };
 pub use wide::{WPoint, WidePlane};
 

@@ -5,9 +5,87 @@
 //! Two polygons that share an edge share two vertex keys (their
 //! vertices' correctly rounded coordinates), so candidates are found by
 //! hashing; whether they merge is decided exactly (`Polygon::merge`).
+//!
+//! Convex unions are not maximal: [`merge_regions`] then unites a face's
+//! pieces of one label into maximal connected regions, with holes.
 
-use bsp_core::Polygon;
+use bsp_core::{Point, Polygon};
 use smallvec::SmallVec;
+
+use crate::arena::pieces::PieceArena;
+use crate::arena::regions::merge_cells;
+
+/// A maximal connected region of equally labelled polygons
+/// ([`merge_regions`]).
+#[derive(Clone, Debug)]
+pub(crate) struct LabelledRegion<T> {
+    /// The polygons' label.
+    pub(crate) label: T,
+    /// The outer ring, counter-clockwise seen from the front of the
+    /// polygons' plane, then the holes, each clockwise; corners only (no
+    /// two consecutive edges collinear), exact.
+    pub(crate) rings: Vec<Vec<Point>>,
+    /// The polygons whose union it is (indices into the input), in
+    /// increasing order.
+    pub(crate) cells: Vec<u32>,
+}
+
+/// Merges convex polygons of one plane (with one orientation), which tile
+/// a region without overlap, into maximal connected regions of equal
+/// labels: the exact region merge of the point lights' fragments
+/// (`arena::regions::merge_cells`), whose pieces may meet at T-junctions.
+/// Regions come in the order of their first polygon.
+pub(crate) fn merge_regions<T: Copy + PartialEq>(items: &[(Polygon, T)]) -> Vec<LabelledRegion<T>> {
+    let Some((first, _)) = items.first() else {
+        return Vec::new();
+    };
+    if items.len() == 1 {
+        return vec![LabelledRegion {
+            label: items[0].1,
+            rings: vec![first.vertices().to_vec()],
+            cells: vec![0],
+        }];
+    }
+    let mut arena = PieceArena::default();
+    let support = *first.support();
+    let cells: Vec<_> = items.iter().map(|(p, _)| arena.add_polygon(p)).collect();
+    // each arena vertex's point as the polygons hold it (shared, not made
+    // again from the arena's)
+    let mut points: Vec<Option<&Point>> = vec![None; arena.len()];
+    for ((p, _), c) in items.iter().zip(&cells) {
+        for (v, &id) in p.vertices().iter().zip(&c.verts) {
+            points[arena.dense(id)] = Some(v);
+        }
+    }
+    // each distinct label a number (a face has few)
+    let mut distinct: Vec<T> = Vec::new();
+    let labels: Vec<u64> = items
+        .iter()
+        .map(|(_, l)| match distinct.iter().position(|d| d == l) {
+            Some(i) => i as u64,
+            None => {
+                distinct.push(*l);
+                distinct.len() as u64 - 1
+            }
+        })
+        .collect();
+    let mut rounded = Vec::new();
+    let point = |id: &u32| match points[arena.dense(*id)] {
+        Some(p) => p.clone(),
+        None => arena.vertex(*id).to_owned().to_point(),
+    };
+    merge_cells(&arena, &support, &cells, &labels, &mut rounded)
+        .into_iter()
+        .map(|r| LabelledRegion {
+            label: distinct[r.label as usize],
+            rings: std::iter::once(&r.outer)
+                .chain(&r.holes)
+                .map(|ring| ring.iter().map(point).collect())
+                .collect(),
+            cells: r.cells,
+        })
+        .collect()
+}
 
 /// The vertices' correctly rounded coordinates, as bits: equal exact
 /// points have equal keys, so two polygons that share an edge share two.

@@ -7,12 +7,13 @@
 //! ([`AreaLight::classify_face`]'s cuts, by planes through grid points
 //! only), so the classes are exact for every light at once; pieces of one
 //! face with the same classes are then merged where their union is
-//! convex. Points and suns take part as the limits of area lights
+//! convex, and these convex pieces into maximal connected regions (with
+//! holes), the fragments: a face is cut only where a class changes. Points and suns take part as the limits of area lights
 //! ([`AreaLight::point`], [`AreaLight::sun`]): lit or umbra.
 
 use std::borrow::Cow;
 
-use bsp_core::{Grid, GridPoint, MAX_COORD, Plane, Polygon, Side};
+use bsp_core::{Grid, GridPoint, MAX_COORD, Plane, Point, Polygon, Side};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
@@ -22,30 +23,55 @@ use crate::blockers::{coplanar_blockers, coplanar_blockers_of, plane_key};
 use crate::boxes::{Box3, CellGrid, EMPTY, EVERYWHERE, Reach, grid_box, meet};
 use crate::engine::{LightVolumes, Scratch, ShadowSet};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
-use crate::merging::merge_convex;
+use crate::merging::{merge_convex, merge_regions};
 use crate::near::{InSlab, near_lists, slab_box};
 
 /// The share of a polygon light's irradiance that arrives on a penumbra
-/// fragment ([`crate::LightView::fraction`]): at the grid point nearest its
-/// centroid, and at the grid points nearest its corners (each, and the
+/// fragment ([`crate::LightView::fraction`]): at the grid point nearest a
+/// point of it, and at the grid points nearest its corners (each, and the
 /// least and most).
+///
+/// For a convex piece ([`SoftPiece`]) the point is its centroid (the mean
+/// of its corners). A fragment is a maximal region that may not be convex
+/// (its centroid may lie outside it): its point is that of its largest
+/// piece, and its corners are those of its rings, in ring order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Share {
-    /// At the centroid.
+    /// At the centroid (of a fragment: of its largest piece).
     pub centroid: f64,
     /// The least at a corner.
     pub min: f64,
     /// The most at a corner.
     pub max: f64,
-    /// At each corner, in the fragment's vertex order.
+    /// At each corner, in vertex order (of a fragment: its outer ring's
+    /// corners, then each hole's).
     pub corners: Vec<f64>,
 }
 
-/// A piece of a face with one class per light.
+/// A convex piece of a [`SoftFragment`]: what its shading is interpolated
+/// over.
 #[derive(Clone, Debug)]
-pub struct SoftFragment {
+pub struct SoftPiece {
     /// The piece: convex, with exact corners.
     pub polygon: Polygon,
+    /// Per light, as [`SoftFragment::visible`], for this piece.
+    pub visible: Vec<Option<Share>>,
+}
+
+/// A piece of a face with one class per light: a maximal connected region
+/// of the face where every light's class is the same (the face is cut
+/// only where a class changes), which need not be convex and may have
+/// holes.
+#[derive(Clone, Debug)]
+pub struct SoftFragment {
+    /// The boundary: the outer ring, counter-clockwise seen from the
+    /// front of the face, then the holes, each clockwise; exact corners
+    /// only (no two consecutive edges collinear).
+    pub rings: Vec<Vec<Point>>,
+    /// Convex pieces whose union the fragment is (one, when it is
+    /// convex), each with its own shares: what a picture's shading is
+    /// interpolated over.
+    pub pieces: Vec<SoftPiece>,
     /// Bit `i`: light `i` is wholly seen ([`AreaClass::Lit`]).
     pub lit: u64,
     /// Bit `i`: none of light `i` is seen ([`AreaClass::Umbra`]).
@@ -569,28 +595,79 @@ fn soft_face(
             Some(Viewed { points, fractions })
         })
         .collect();
-    let fragment = |((polygon, c), probes): ((Polygon, Classes), Vec<Option<Probes>>)| {
+    let piece = |(polygon, probes): (Polygon, Vec<Option<Probes>>)| {
         let visible = probes
             .iter()
             .zip(&values)
             .map(|(p, v)| Some(p.as_ref()?.share(v.as_ref()?)))
             .collect();
-        SoftFragment {
-            polygon,
-            lit: c.lit,
-            umbra: c.umbra,
-            undecided: c.undecided,
-            visible,
-        }
+        SoftPiece { polygon, visible }
     };
-    match many {
-        true => fragments
-            .into_par_iter()
-            .zip(probes)
-            .map(fragment)
-            .collect(),
-        false => fragments.into_iter().zip(probes).map(fragment).collect(),
+    // the convex pieces merged into maximal regions, the fragments
+    let regions = merge_regions(&fragments);
+    let pieces: Vec<(Polygon, Vec<Option<Probes>>)> =
+        fragments.into_iter().map(|(p, _)| p).zip(probes).collect();
+    let mut pieces: Vec<Option<SoftPiece>> = match many {
+        true => pieces.into_par_iter().map(piece).map(Some).collect(),
+        false => pieces.into_iter().map(piece).map(Some).collect(),
+    };
+    regions
+        .into_iter()
+        .map(|r| {
+            let pieces: Vec<SoftPiece> = (r.cells.iter())
+                .map(|&c| pieces[c as usize].take().expect("a piece is in one region"))
+                .collect();
+            let visible = match pieces.len() {
+                1 => pieces[0].visible.clone(),
+                _ => region_shares(&r.rings, &pieces, &values),
+            };
+            SoftFragment {
+                rings: r.rings,
+                pieces,
+                lit: r.label.lit,
+                umbra: r.label.umbra,
+                undecided: r.label.undecided,
+                visible,
+            }
+        })
+        .collect()
+}
+
+/// A region's [`Share`] per light, of its `pieces` (several, convex) and
+/// the values at their probe points: at the centroid of its largest piece
+/// (a non-convex region's centroid may lie outside it), and at the
+/// corners of its `rings` (corners of its pieces, so probed).
+fn region_shares(
+    rings: &[Vec<Point>],
+    pieces: &[SoftPiece],
+    values: &[Option<Viewed>],
+) -> Vec<Option<Share>> {
+    let area = |p: &Polygon| {
+        let v: Vec<DVec3> = (p.vertices_f64().iter())
+            .map(|&c| DVec3::from_array(c))
+            .collect();
+        crate::polygon_area(&v)
+    };
+    let mut largest = 0;
+    let mut most = f64::NEG_INFINITY;
+    for (i, p) in pieces.iter().enumerate() {
+        let a = area(&p.polygon);
+        if a > most {
+            (largest, most) = (i, a);
+        }
     }
+    let corners: Vec<GridPoint> = rings
+        .iter()
+        .flatten()
+        .map(|p| nearest(p.to_f64()))
+        .collect();
+    (0..values.len())
+        .map(|k| {
+            let viewed = values[k].as_ref()?;
+            let centroid = pieces[largest].visible[k].as_ref()?.centroid;
+            Some(Probes::share_at(viewed, centroid, &corners))
+        })
+        .collect()
 }
 
 /// The occluders near `face` (numbers `near` into `regions`, `reach` and
@@ -668,22 +745,37 @@ impl Probes {
     /// The fragment's [`Share`] from the values at its points (nothing
     /// reachable counts as 0).
     fn share(&self, viewed: &Viewed) -> Share {
-        let at = |x: &GridPoint| {
-            let i = viewed.points.binary_search(x).ok()?;
-            viewed.fractions[i]
-        };
-        let corners: Vec<f64> = self.corners.iter().map(|x| at(x).unwrap_or(0.0)).collect();
+        let centroid = viewed.at(&self.centroid).unwrap_or(0.0);
+        Probes::share_at(viewed, centroid, &self.corners)
+    }
+
+    /// The [`Share`] of value `centroid` at the centroid and the values
+    /// of `viewed` at `corners` (nothing reachable counts as 0).
+    fn share_at(viewed: &Viewed, centroid: f64, corners: &[GridPoint]) -> Share {
+        let corners: Vec<f64> = corners
+            .iter()
+            .map(|x| viewed.at(x).unwrap_or(0.0))
+            .collect();
         let (min, max) = corners
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &f| {
                 (lo.min(f), hi.max(f))
             });
         Share {
-            centroid: at(&self.centroid).unwrap_or(0.0),
+            centroid,
             min,
             max,
             corners,
         }
+    }
+}
+
+impl Viewed {
+    /// The value at probe point `x`, if it was viewed and reaches the
+    /// light.
+    fn at(&self, x: &GridPoint) -> Option<f64> {
+        let i = self.points.binary_search(x).ok()?;
+        self.fractions[i]
     }
 }
 

@@ -198,6 +198,56 @@ fn ground(r: i32) -> Vec<[i32; 3]> {
     vec![[-r, -r, 0], [r, -r, 0], [r, r, 0], [-r, r, 0]]
 }
 
+/// A face is cut only where a class changes (#30): under a square light
+/// and under a sun disc, a ground with one square roof over it is three
+/// fragments, whatever convex pieces the cutting made: the lit one with
+/// the penumbra as its hole, the penumbra with the umbra as its hole, and
+/// the umbra. The roof is one lit fragment. Each fragment's rings (outer
+/// counter-clockwise, holes clockwise) hold exactly its pieces' area.
+#[test]
+fn a_face_is_cut_only_where_a_class_changes() {
+    let roof = [[-20, -20, 40], [20, -20, 40], [20, 20, 40], [-20, 20, 40]];
+    let faces = [
+        Occluder::new(&ground(200)).unwrap(),
+        Occluder::new(&roof).unwrap(),
+    ];
+    let lights = [
+        AreaLight::new(&square_light(-10, -10, 20, 100)).unwrap(),
+        AreaLight::sun_disc(DVec3::new(0.1, 0.2, 1.0), 2f64.to_radians()).unwrap(),
+    ];
+    for light in lights {
+        let all = svbsp::soft_shadows(std::slice::from_ref(&light), &faces).unwrap();
+        let holes = |class| -> Vec<usize> {
+            (all[0].iter().filter(|f| f.class(0) == class))
+                .map(|f| f.rings.len() - 1)
+                .collect()
+        };
+        assert_eq!(holes(AreaClass::Lit), [1]);
+        assert_eq!(holes(AreaClass::Penumbra), [1]);
+        assert_eq!(holes(AreaClass::Umbra), [0]);
+        assert_eq!(all[0].len(), 3);
+        assert!(all[0].iter().any(|f| f.pieces.len() > 1), "nothing merged");
+        assert_eq!(all[1].len(), 1);
+        assert_eq!(all[1][0].class(0), AreaClass::Lit);
+        for f in all.iter().flatten() {
+            let mut rings: [Q; 3] = std::array::from_fn(|_| Q::zero());
+            for ring in &f.rings {
+                let exact: Vec<HPoint> = (ring.iter())
+                    .map(|v| HPoint::of_vertex(&svbsp::Vertex::from_point(v)))
+                    .collect();
+                let a = twice_area_vector(&exact);
+                (0..3).for_each(|k| rings[k] += &a[k]);
+            }
+            let mut pieces: [Q; 3] = std::array::from_fn(|_| Q::zero());
+            for p in &f.pieces {
+                let a = twice_area_vector(&exact_corners(&p.polygon));
+                (0..3).for_each(|k| pieces[k] += &a[k]);
+            }
+            assert_eq!(rings, pieces);
+        }
+    }
+}
+
 /// A square occluder half-way under a square light: seen from below its
 /// centre it hides the middle quarter; two occluders whose shadows only
 /// together cover the light (each alone leaves some of it) make umbra.
@@ -314,8 +364,20 @@ fn on_the_ground<'a>(
 ) -> Option<([i32; 3], &'a svbsp::SoftFragment)> {
     let w = 2 * r as u64;
     let x = [below(rng, w) - r, below(rng, w) - r, 0];
-    let f = fragments.iter().find(|f| strictly_inside(&f.polygon, x))?;
-    Some((x, f))
+    Some((x, soft_at(fragments, x)?))
+}
+
+/// The fragment of `fragments` one of whose convex pieces holds grid
+/// point `x` strictly inside.
+fn soft_at(fragments: &[svbsp::SoftFragment], x: [i32; 3]) -> Option<&svbsp::SoftFragment> {
+    (fragments.iter()).find(|f| f.pieces.iter().any(|p| strictly_inside(&p.polygon, x)))
+}
+
+/// The convex pieces of soft fragments, with their fragments.
+fn soft_pieces(
+    fragments: &[svbsp::SoftFragment],
+) -> impl Iterator<Item = (&svbsp::SoftPiece, &svbsp::SoftFragment)> {
+    (fragments.iter()).flat_map(|f| f.pieces.iter().map(move |p| (p, f)))
 }
 
 /// `f` on a pool of its own of `threads` threads.
@@ -689,16 +751,20 @@ fn check_disc_shares(
 ) -> usize {
     let fragments = &svbsp::soft_shadows(std::slice::from_ref(sun), occluders).unwrap()[0];
     let mut checked = 0;
-    for f in fragments
-        .iter()
-        .filter(|f| f.class(0) == AreaClass::Penumbra)
-    {
-        let v = f.polygon.vertices_f64();
+    for (p, f) in soft_pieces(fragments).filter(|(_, f)| f.class(0) == AreaClass::Penumbra) {
+        // a fragment's share is its largest piece's
+        let whole = f.visible[0].as_ref().unwrap().centroid;
+        assert!(
+            f.pieces
+                .iter()
+                .any(|p| p.visible[0].as_ref().unwrap().centroid == whole)
+        );
+        let v = p.polygon.vertices_f64();
         let c = v
             .iter()
             .fold([0.0; 3], |s, p| [0, 1, 2].map(|k| s[k] + p[k]));
         let x = c.map(|s| (s / v.len() as f64).round() as i32);
-        if !strictly_inside(&f.polygon, x) {
+        if !strictly_inside(&p.polygon, x) {
             continue;
         }
         let hx = HPoint::grid(x.map(i64::from));
@@ -707,7 +773,7 @@ fn check_disc_shares(
             .filter(|s| !matches!(scene.verdict(s, 0, &hx), Verdict::Shadowed))
             .count();
         let want = open as f64 / lattice.len() as f64;
-        let got = f.visible[0].as_ref().unwrap().centroid;
+        let got = p.visible[0].as_ref().unwrap().centroid;
         assert!(
             (got - want).abs() < 0.15,
             "{x:?}: share {got}, the lattice's {want}"
@@ -760,7 +826,7 @@ fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
     let ground_fragments = &all[0];
     assert!(tile_by_area(
         faces[0].corners(),
-        ground_fragments.iter().map(|f| &f.polygon)
+        soft_pieces(ground_fragments).map(|(p, _)| &p.polygon)
     ));
     let mut checked = 0;
     let mut kinds = std::collections::HashSet::new();
@@ -786,9 +852,16 @@ fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
         }
     }
     // another order of the faces, and one thread
-    let key = |fs: &[svbsp::SoftFragment]| -> Vec<(Vec<[f64; 3]>, u64, u64, u64)> {
+    type Key = (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>, u64, u64, u64);
+    let key = |fs: &[svbsp::SoftFragment]| -> Vec<Key> {
         fs.iter()
-            .map(|f| (f.polygon.vertices_f64(), f.lit, f.umbra, f.undecided))
+            .map(|f| {
+                let ring = (f.rings.iter().flatten()).map(|p| p.to_f64()).collect();
+                let pieces = (f.pieces.iter())
+                    .map(|p| p.polygon.vertices_f64())
+                    .collect();
+                (ring, pieces, f.lit, f.umbra, f.undecided)
+            })
             .collect()
     };
     let mut order: Vec<usize> = (0..faces.len()).collect();
@@ -1167,7 +1240,8 @@ fn a_mesh_cut_both_ways_agrees_with_the_view() {
     // near have their boxes narrowed to the slab round their plane)
     let soft = svbsp::soft_shadows(std::slice::from_ref(&light), &faces).unwrap();
     for i in (0..faces.len()).step_by(10).chain([0]) {
-        let a = class_areas_of(soft[i].iter().map(|f| (&f.polygon, f.class(0) as usize)));
+        let a =
+            class_areas_of(soft_pieces(&soft[i]).map(|(p, f)| (&p.polygon, f.class(0) as usize)));
         let b = class_areas(&light.classify_face(&faces[i], &faces));
         assert!(
             a[lit] == b[lit] && a[penumbra] == b[penumbra],
@@ -1375,7 +1449,7 @@ fn inner_occluders_decide_joint_umbra_only_where_it_is() {
                 z,
             ],
         };
-        let Some(f) = all[0].iter().find(|f| strictly_inside(&f.polygon, x)) else {
+        let Some(f) = soft_at(&all[0], x) else {
             continue;
         };
         let class = f.class(0);
@@ -1400,9 +1474,16 @@ fn inner_occluders_decide_joint_umbra_only_where_it_is() {
         svbsp::soft_shadows(std::slice::from_ref(&light), &shuffled)
     })
     .unwrap();
-    let key = |fs: &[svbsp::SoftFragment]| -> Vec<(Vec<[f64; 3]>, u64, u64, u64)> {
+    type Key = (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>, u64, u64, u64);
+    let key = |fs: &[svbsp::SoftFragment]| -> Vec<Key> {
         fs.iter()
-            .map(|f| (f.polygon.vertices_f64(), f.lit, f.umbra, f.undecided))
+            .map(|f| {
+                let ring = (f.rings.iter().flatten()).map(|p| p.to_f64()).collect();
+                let pieces = (f.pieces.iter())
+                    .map(|p| p.polygon.vertices_f64())
+                    .collect();
+                (ring, pieces, f.lit, f.umbra, f.undecided)
+            })
             .collect()
     };
     for (s, &i) in order.iter().enumerate() {
@@ -1462,13 +1543,17 @@ fn a_ground_under_a_field_of_occluders_agrees_with_the_view() {
         })
         .unwrap()
     };
-    // each fragment's corners, classes and centroid share's bits
-    type Key = (Vec<[f64; 3]>, u64, u64, Option<u64>);
+    // each fragment's corners, pieces, classes and centroid share's bits
+    type Key = (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>, u64, u64, Option<u64>);
     let key = |fs: &[svbsp::SoftFragment]| -> Vec<Key> {
         fs.iter()
             .map(|f| {
                 let share = f.visible[0].as_ref().map(|s| s.centroid.to_bits());
-                (f.polygon.vertices_f64(), f.lit, f.umbra, share)
+                let ring = (f.rings.iter().flatten()).map(|p| p.to_f64()).collect();
+                let pieces = (f.pieces.iter())
+                    .map(|p| p.polygon.vertices_f64())
+                    .collect();
+                (ring, pieces, f.lit, f.umbra, share)
             })
             .collect()
     };
@@ -1480,7 +1565,7 @@ fn a_ground_under_a_field_of_occluders_agrees_with_the_view() {
     let ground_fragments = &one[0];
     assert!(tile_by_area(
         faces[0].corners(),
-        ground_fragments.iter().map(|f| &f.polygon)
+        soft_pieces(ground_fragments).map(|(p, _)| &p.polygon)
     ));
     // the gaps between the triangles, seen from the ground, are wider
     // than the light: every corner hidden means hidden by one triangle,
@@ -1506,12 +1591,11 @@ fn a_ground_under_a_field_of_occluders_agrees_with_the_view() {
             "{class:?} never met: {met:?}"
         );
     }
-    // the shares at the penumbra fragments' centroids, asked of the run
+    // the shares at the penumbra pieces' centroids, asked of the run
     let volumes = svbsp::SoftVolumes::new(std::slice::from_ref(&light), &faces).unwrap();
     let (mut asked, mut dark) = (0, 0);
-    for f in ground_fragments
-        .iter()
-        .filter(|f| f.visible[0].is_some())
+    for (f, _) in soft_pieces(ground_fragments)
+        .filter(|(p, _)| p.visible[0].is_some())
         .step_by(16)
     {
         let c = f.polygon.vertices_f64();
@@ -1533,7 +1617,7 @@ fn a_ground_under_a_field_of_occluders_agrees_with_the_view() {
     }
     assert!(
         asked > 20 && dark > 0,
-        "{asked} penumbra fragments asked, {dark} dark"
+        "{asked} penumbra pieces asked, {dark} dark"
     );
 }
 
