@@ -48,7 +48,10 @@ pub(crate) fn merge_regions<T: Copy + PartialEq>(items: &[(Polygon, T)]) -> Vec<
     }
     let mut arena = PieceArena::default();
     let support = *first.support();
-    let cells: Vec<_> = items.iter().map(|(p, _)| arena.add_polygon(p)).collect();
+    let mut shared = rustc_hash::FxHashMap::default();
+    let cells: Vec<_> = (items.iter())
+        .map(|(p, _)| arena.add_polygon_sharing(p, &mut shared))
+        .collect();
     // each arena vertex's point as the polygons hold it (shared, not made
     // again from the arena's)
     let mut points: Vec<Option<&Point>> = vec![None; arena.len()];

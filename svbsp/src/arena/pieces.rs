@@ -631,14 +631,6 @@ impl PieceArena {
         Some((self.lazy.len() - 1) as u32 | LAZY)
     }
 
-    /// Adds a vertex, returning its id.
-    pub(crate) fn add_vertex(&mut self, v: Vertex) -> u32 {
-        match v {
-            Vertex::Grid(g) => self.add_grid(g),
-            Vertex::Implicit(i) => self.add_exact(i),
-        }
-    }
-
     /// Copies vertex `id` of another arena into this one (a lazy vertex
     /// with its three planes).
     pub(crate) fn copy_vertex(&mut self, from: &PieceArena, id: u32) -> u32 {
@@ -759,11 +751,33 @@ impl PieceArena {
     /// A piece from a polygon lying on this arena's support plane: its
     /// vertices and edge planes are copied into the arena.
     pub(crate) fn add_polygon(&mut self, p: &Polygon) -> Piece {
+        self.add_polygon_sharing(p, &mut rustc_hash::FxHashMap::default())
+    }
+
+    /// [`PieceArena::add_polygon`], an implicit vertex added once for all
+    /// the polygons that share it (one allocation, `shared` mapping it to
+    /// its id): the pieces of a cut face share their split vertices.
+    pub(crate) fn add_polygon_sharing(
+        &mut self,
+        p: &Polygon,
+        shared: &mut rustc_hash::FxHashMap<*const Implicit, u32>,
+    ) -> Piece {
         let mut c = Piece::default();
         let vs = p.vertices();
         let k = vs.len();
         for (i, (v, e)) in vs.iter().zip(p.edge_planes()).enumerate() {
-            c.verts.push(self.add_vertex(Vertex::from_point(v)));
+            let id = match v {
+                Point::Grid(g) => self.add_grid(*g),
+                Point::Implicit(a) => match shared.get(&std::sync::Arc::as_ptr(a)) {
+                    Some(&id) => id,
+                    None => {
+                        let id = self.add_exact((**a).clone());
+                        shared.insert(std::sync::Arc::as_ptr(a), id);
+                        id
+                    }
+                },
+            };
+            c.verts.push(id);
             let plane = match (v, &vs[(i + 1) % k]) {
                 (Point::Grid(a), Point::Grid(b)) => self.add_edge_plane(*e, *a, *b),
                 _ => self.add_plane(*e),
