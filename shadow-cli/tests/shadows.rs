@@ -660,13 +660,17 @@ fn flags_that_do_not_apply_are_noted() {
 /// Runs `shadow shadows` on the floor and occluder with an area light
 /// (0.2 × 0.2 at height 2 over the occluder's centre) and more flags.
 fn soft_json(extra: &[&str], name: &str) -> Value {
-    let input = floor_and_occluder();
+    soft_json_of(&floor_and_occluder(), extra, name)
+}
+
+/// [`soft_json`] of the scene `input`.
+fn soft_json_of(input: &Path, extra: &[&str], name: &str) -> Value {
     let mut args = vec![
         "--area-light",
         "0.65,0.65,2;0.65,0.85,2;0.85,0.85,2;0.85,0.65,2",
     ];
     args.extend(extra);
-    shadows_json(&input, &args, name)
+    shadows_json(input, &args, name)
 }
 
 /// The area light's regions in closed form: from height 2 through the
@@ -721,6 +725,39 @@ fn an_area_light_gives_umbra_and_penumbra_in_closed_form() {
     assert_eq!(shares, 1, "{shares} penumbra fragments");
     floor_holes.sort_unstable();
     assert_eq!(floor_holes, [0, 1, 1], "the floor's fragments' holes");
+}
+
+/// Two occluders at two heights that only together hide the area light
+/// from a strip of the floor: that strip is one fragment flagged
+/// `undecided` (penumbra that may be umbra), its area the summary's
+/// `undecided_area`, apart from the decided penumbra beside it.
+#[test]
+fn undecided_fragments_are_flagged_and_counted() {
+    let input = scratch("joint.obj");
+    std::fs::write(
+        &input,
+        "v 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\n\
+         v 0.5 0.5 1\nv 0.76 0.5 1\nv 0.76 1 1\nv 0.5 1 1\n\
+         v 0.74 0.5 1.1\nv 1 0.5 1.1\nv 1 1 1.1\nv 0.74 1 1.1\n\
+         f 1 2 3 4\nf 5 6 7 8\nf 9 10 11 12\n",
+    )
+    .unwrap();
+    let doc = soft_json_of(&input, &[], "joint.json");
+    let want = doc["summary"]["undecided_area"][0].as_f64().unwrap();
+    assert!(want > 0.1, "{}", doc["summary"]);
+    let mut got = Vec::new();
+    for f in doc["fragments"].as_array().unwrap() {
+        if f["undecided"][0].as_bool().unwrap() {
+            assert_eq!(
+                (&f["lit"][0], &f["umbra"][0]),
+                (&false.into(), &false.into()),
+                "{f}"
+            );
+            got.push(f["area"].as_f64().unwrap());
+        }
+    }
+    assert_eq!(got.len(), 1, "{got:?}");
+    assert!((got[0] - want).abs() < 1e-12, "{got:?} against {want}");
 }
 
 /// A point light among soft lights is classified exactly as alone: lit

@@ -8,7 +8,8 @@
 //! only), so the classes are exact for every light at once; pieces of one
 //! face with the same classes are then merged where their union is
 //! convex, and these convex pieces into maximal connected regions (with
-//! holes), the fragments: a face is cut only where a class changes. Points and suns take part as the limits of area lights
+//! holes), the fragments: a face is cut only where a class changes.
+//! Points and suns take part as the limits of area lights
 //! ([`AreaLight::point`], [`AreaLight::sun`]): lit or umbra.
 
 use std::borrow::Cow;
