@@ -54,6 +54,8 @@ run lines --scene room -o lines.svg
 # soft lights in pictures, and shadow art
 SOFT="0.7,0.1,2.45;0.7,0.5,2.45;1.1,0.5,2.45;1.1,0.1,2.45"
 run render --scene room --size 320x180 --area-light "$SOFT" -o render_soft.png
+run shadows --scene room --area-light "$SOFT" --sun-disc 0.3,-0.2,1:2 -o soft.json
+run shadows --scene room --area-light "$SOFT" -o soft.obj
 run render --scene room --size 320x180 --area-light "$SOFT" --sun-disc 0.3,-0.2,1:2 \
   --method pcss -o render_pcss.png
 run compare --scene room --panel 160x90 --area-light "$SOFT" --methods sampled:4,pcss \
