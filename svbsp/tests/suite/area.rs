@@ -373,6 +373,22 @@ fn soft_at(fragments: &[svbsp::SoftFragment], x: [i32; 3]) -> Option<&svbsp::Sof
     (fragments.iter()).find(|f| f.pieces.iter().any(|p| strictly_inside(&p.polygon, x)))
 }
 
+/// A soft fragment's ring corners, pieces' corners and classes.
+type SoftKey = (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>, u64, u64, u64);
+
+/// [`SoftKey`]s of soft fragments, for comparing runs.
+fn soft_keys(fs: &[svbsp::SoftFragment]) -> Vec<SoftKey> {
+    fs.iter()
+        .map(|f| {
+            let ring = (f.rings.iter().flatten()).map(|p| p.to_f64()).collect();
+            let pieces = (f.pieces.iter())
+                .map(|p| p.polygon.vertices_f64())
+                .collect();
+            (ring, pieces, f.lit, f.umbra, f.undecided)
+        })
+        .collect()
+}
+
 /// The convex pieces of soft fragments, with their fragments.
 fn soft_pieces(
     fragments: &[svbsp::SoftFragment],
@@ -852,25 +868,13 @@ fn soft_shadows_of_several_lights_agree_with_each_light_alone() {
         }
     }
     // another order of the faces, and one thread
-    type Key = (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>, u64, u64, u64);
-    let key = |fs: &[svbsp::SoftFragment]| -> Vec<Key> {
-        fs.iter()
-            .map(|f| {
-                let ring = (f.rings.iter().flatten()).map(|p| p.to_f64()).collect();
-                let pieces = (f.pieces.iter())
-                    .map(|p| p.polygon.vertices_f64())
-                    .collect();
-                (ring, pieces, f.lit, f.umbra, f.undecided)
-            })
-            .collect()
-    };
     let mut order: Vec<usize> = (0..faces.len()).collect();
     order.reverse();
     order.swap(0, 2);
     let shuffled: Vec<Occluder> = order.iter().map(|&i| faces[i].clone()).collect();
     let one = on_threads(1, || svbsp::soft_shadows(&lights, &shuffled)).unwrap();
     for (s, &i) in order.iter().enumerate() {
-        assert_eq!(key(&one[s]), key(&all[i]), "face {i}");
+        assert_eq!(soft_keys(&one[s]), soft_keys(&all[i]), "face {i}");
     }
 }
 
@@ -1474,20 +1478,8 @@ fn inner_occluders_decide_joint_umbra_only_where_it_is() {
         svbsp::soft_shadows(std::slice::from_ref(&light), &shuffled)
     })
     .unwrap();
-    type Key = (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>, u64, u64, u64);
-    let key = |fs: &[svbsp::SoftFragment]| -> Vec<Key> {
-        fs.iter()
-            .map(|f| {
-                let ring = (f.rings.iter().flatten()).map(|p| p.to_f64()).collect();
-                let pieces = (f.pieces.iter())
-                    .map(|p| p.polygon.vertices_f64())
-                    .collect();
-                (ring, pieces, f.lit, f.umbra, f.undecided)
-            })
-            .collect()
-    };
     for (s, &i) in order.iter().enumerate() {
-        assert_eq!(key(&one[s]), key(&all[i]), "face {i}");
+        assert_eq!(soft_keys(&one[s]), soft_keys(&all[i]), "face {i}");
     }
 }
 
