@@ -106,6 +106,11 @@ class SoftShadows:
     def mesh(self) -> Mesh: ...
     @property
     def lights(self) -> List[_AnyLight]: ...
+    def fragments(self) -> Dict[str, npt.NDArray[Any]]:
+        """Each fragment a maximal region of one face with one class per light (bits in the order given):
+        ``face`` (F,), ``lit``, ``umbra``, ``undecided`` (F,) uint64 bits, ``visible`` (F, L) float64
+        (NaN where not penumbra of an area light or sun disc), ``rings`` (F+1,), ``ring_points`` (R+1,),
+        ``points`` (P, 3)."""
     def write(self, path: _Path) -> None:
         """JSON or OBJ, by the extension (the CLI's files; lights numbered points and suns first)."""
 

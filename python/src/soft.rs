@@ -5,9 +5,9 @@ use bsp_shadows::soft_file::{SoftClass, SoftShadows as Computed};
 use bsp_shadows::{DVec3, Light, SoftSpec};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyDict, PyList};
 
-use crate::{LightError, Mesh, PointLight, Reduced, Sun, light_list, remade, run, to_py};
+use crate::{LightError, Mesh, PointLight, Reduced, Rings, Sun, light_list, remade, run, to_py};
 
 type Point = (f64, f64, f64);
 
@@ -201,6 +201,47 @@ impl SoftShadows {
     #[getter]
     fn fragment_count(&self) -> usize {
         self.shadows.fragment_count()
+    }
+
+    /// Every fragment (a maximal region of one face with one class per
+    /// light) as arrays, its lights in the order given: `face` (F,) int64;
+    /// `lit`, `umbra`, `undecided` (F,) uint64, bit i set where light i is
+    /// seen whole, not at all, or in penumbra that may be umbra (penumbra
+    /// is neither lit nor umbra); `visible` (F, L) float64, the share of
+    /// an area light's or a sun disc's irradiance at a penumbra fragment's
+    /// centroid (of its largest convex piece), NaN elsewhere; `rings`
+    /// (F+1,) int64, fragment f's rings are `rings[f]:rings[f+1]` (outer
+    /// first, then holes); `ring_points` (R+1,) int64, ring r's points are
+    /// `points[ring_points[r]:ring_points[r+1]]`; `points` (P, 3) float64.
+    fn fragments<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let n = self.order.len();
+        let given = |mask: u64| -> u64 {
+            (self.order.iter().enumerate())
+                .filter(|&(_, &l)| mask >> l & 1 == 1)
+                .fold(0, |m, (i, _)| m | 1 << i)
+        };
+        let (mut face, mut lit, mut umbra, mut undecided) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut visible, mut rings, mut packed) = (Vec::new(), vec![0i64], Rings::default());
+        for f in self.shadows.fragments() {
+            face.push(f.face as i64);
+            lit.push(given(f.lit));
+            umbra.push(given(f.umbra));
+            undecided.push(given(f.undecided));
+            (self.order.iter()).for_each(|&l| visible.push(f.visible[l].unwrap_or(f64::NAN)));
+            f.rings.iter().for_each(|r| packed.push(r));
+            rings.push(packed.count() as i64);
+        }
+        let count = face.len();
+        let d = PyDict::new(py);
+        d.set_item("face", face.into_pyarray(py))?;
+        d.set_item("lit", lit.into_pyarray(py))?;
+        d.set_item("umbra", umbra.into_pyarray(py))?;
+        d.set_item("undecided", undecided.into_pyarray(py))?;
+        d.set_item("visible", visible.into_pyarray(py).reshape([count, n])?)?;
+        d.set_item("rings", rings.into_pyarray(py))?;
+        packed.put(&d)?;
+        Ok(d)
     }
 
     /// Writes the fragments as JSON or OBJ (groups `lit`, `penumbra`,

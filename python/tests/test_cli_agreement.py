@@ -96,6 +96,25 @@ def test_soft_shadows_equal_the_cli_json(tmp_path, shadow_bin, teapot):
     total = s.lit_area + s.penumbra_area + s.umbra_area
     assert np.allclose(total, s.face_area[:, None], rtol=1e-9, atol=1e-12)
     assert s.fragment_count == len(cli["fragments"])
+    # the fragments as arrays: the CLI's regions, bits and shares, the
+    # lights in the order given
+    frags = s.fragments()
+    assert (frags["face"] == [f["face"] for f in cli["fragments"]]).all()
+    for key in ["lit", "umbra", "undecided"]:
+        bits = [sum(1 << i for i, c in enumerate(cols) if f[key][c]) for f in cli["fragments"]]
+        assert (frags[key] == np.array(bits, dtype=np.uint64)).all(), key
+    shares = [[np.nan if f["visible"][c] is None else f["visible"][c] for c in cols]
+              for f in cli["fragments"]]
+    assert np.array_equal(frags["visible"], np.array(shares), equal_nan=True)
+    assert np.isfinite(frags["visible"][:, 0]).any()
+    rings = frags["rings"]
+    for i, f in enumerate(cli["fragments"]):
+        want = [f["vertices"]] + f.get("holes", [])
+        assert rings[i + 1] - rings[i] == len(want)
+        for r, ring in zip(range(rings[i], rings[i + 1]), want):
+            a, b = frags["ring_points"][r], frags["ring_points"][r + 1]
+            assert (frags["points"][a:b] == np.array(ring)).all()
+    assert any(len(f.get("holes", [])) > 0 for f in cli["fragments"])
     s.write(tmp_path / "py.json")
     assert (tmp_path / "py.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
     again = pickle.loads(pickle.dumps(s))

@@ -308,6 +308,28 @@ pub struct SoftShadows {
     area: Vec<f64>,
 }
 
+/// One fragment of a [`SoftShadows`] ([`SoftShadows::fragments`]): a
+/// maximal region of one face with one class per light, as the JSON file
+/// has it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SoftRegion {
+    /// The face (its index in the mesh).
+    pub face: usize,
+    /// Bit `i` set: light `i` is seen whole.
+    pub lit: u64,
+    /// Bit `i` set: none of light `i` is seen.
+    pub umbra: u64,
+    /// Bit `i` set: penumbra of light `i` that may be umbra (undecided).
+    pub undecided: u64,
+    /// Per light, for penumbra of a polygon light or a sun disc, the share
+    /// of its irradiance that arrives at the fragment's centroid (of its
+    /// largest convex piece, [`svbsp::Share`]); `None` otherwise.
+    pub visible: Vec<Option<f64>>,
+    /// The outer boundary, counter-clockwise seen from the face's front,
+    /// then the holes; in the mesh's units.
+    pub rings: Vec<Vec<DVec3>>,
+}
+
 /// A face's area in one class of a light ([`SoftShadows::area_of`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SoftClass {
@@ -453,6 +475,25 @@ impl SoftShadows {
     /// The area of `face`.
     pub fn face_area(&self, face: usize) -> f64 {
         self.area[face]
+    }
+
+    /// Every fragment, in the file's order, its lights numbered as in the
+    /// file (points and suns first, then those with extent).
+    pub fn fragments(&self) -> impl Iterator<Item = SoftRegion> + '_ {
+        (self.fragments.iter().zip(&self.faces_of)).flat_map(move |(frags, &face)| {
+            frags.iter().map(move |f| SoftRegion {
+                face: face as usize,
+                lit: f.lit,
+                umbra: f.umbra,
+                undecided: f.undecided,
+                visible: (f.visible.iter())
+                    .map(|v| v.as_ref().map(|s| s.centroid))
+                    .collect(),
+                rings: (f.rings.iter())
+                    .map(|r| r.iter().map(|p| self.grid.to_world(p.to_f64())).collect())
+                    .collect(),
+            })
+        })
     }
 
     /// How many fragments the faces were cut into.
