@@ -762,7 +762,8 @@ fn projection(g: &Face) -> (usize, bool) {
 /// runs counter-clockwise about the face's normal).
 pub(crate) fn area_of(g: &Face, verts: &[HPoint]) -> Q {
     let (a, den) = area2(verts);
-    Q::new(zdot(&a, &g.n), den * zdot(&g.n, &g.n))
+    // (unreduced: a sum of areas reduces once per term, not twice)
+    Q::new_raw(zdot(&a, &g.n), den * zdot(&g.n, &g.n))
 }
 
 /// Checks that convex pieces tile their faces exactly: each piece is
