@@ -227,3 +227,69 @@ fn shadow_files_by_both_algorithms_agree() {
         assert!((l - lit[0]).abs() <= 1e-9 * lit[0], "{lit:?}");
     }
 }
+
+/// Soft shadows' fragments through the facade: a ground under a square
+/// roof and a square area light is three regions (lit with the penumbra
+/// as its hole, penumbra with the umbra as its hole, umbra), the roof one
+/// lit region; per face and class the rings' areas are the face's areas,
+/// and only penumbra has a share.
+#[test]
+fn soft_fragments_are_regions_with_the_faces_areas() {
+    let path = std::env::temp_dir().join(format!("facade_soft_{}.obj", std::process::id()));
+    std::fs::write(
+        &path,
+        "v -5 -5 0\nv 5 -5 0\nv 5 5 0\nv -5 5 0\n\
+         v -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+         f 1 2 3 4\nf 5 6 7 8\n",
+    )
+    .unwrap();
+    let mesh = bsp_shadows::read_mesh(&path).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    let lamp = [(-0.5, -0.5), (-0.5, 0.5), (0.5, 0.5), (0.5, -0.5)];
+    let soft = [bsp_shadows::SoftSpec::Area(
+        lamp.iter().map(|&(x, y)| DVec3::new(x, y, 3.0)).collect(),
+    )];
+    let s = bsp_shadows::soft_file::soft_shadows(&mesh, &[], &soft).unwrap();
+    let frags: Vec<_> = s.fragments().collect();
+    assert_eq!(frags.len(), s.fragment_count());
+    let ground: Vec<_> = frags.iter().filter(|f| f.face == 0).collect();
+    let holes = |lit: u64, umbra: u64| -> Vec<usize> {
+        (ground.iter())
+            .filter(|f| (f.lit, f.umbra) == (lit, umbra))
+            .map(|f| f.rings.len() - 1)
+            .collect()
+    };
+    assert_eq!(ground.len(), 3);
+    assert_eq!(holes(1, 0), [1]);
+    assert_eq!(holes(0, 0), [1]);
+    assert_eq!(holes(0, 1), [0]);
+    let roof: Vec<_> = frags.iter().filter(|f| f.face == 1).collect();
+    assert!(roof.len() == 1 && roof[0].lit == 1);
+    use bsp_shadows::soft_file::SoftClass;
+    for face in 0..2 {
+        for (class, lit, umbra) in [
+            (SoftClass::Lit, 1, 0),
+            (SoftClass::Penumbra, 0, 0),
+            (SoftClass::Umbra, 0, 1),
+        ] {
+            let got: f64 = (frags.iter())
+                .filter(|f| f.face == face && (f.lit, f.umbra) == (lit, umbra))
+                .map(|f| {
+                    ring_area(&f.rings[0]) - f.rings[1..].iter().map(|r| ring_area(r)).sum::<f64>()
+                })
+                .sum();
+            let want = s.area_of(face, 0, class);
+            assert!(
+                (got - want).abs() <= 1e-9 * (1.0 + want),
+                "{face} {class:?}: {got} {want}"
+            );
+        }
+    }
+    for f in &frags {
+        let penumbra = f.lit == 0 && f.umbra == 0;
+        assert_eq!(f.visible[0].is_some(), penumbra);
+        if let Some(v) = f.visible[0] {
+            assert!(v > 0.0 && v < 1.0, "{v}");
+        }
+    }
+}
