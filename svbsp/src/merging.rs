@@ -39,12 +39,27 @@ pub(crate) fn merge_regions<T: Copy + PartialEq>(items: &[(Polygon, T)]) -> Vec<
     let Some((first, _)) = items.first() else {
         return Vec::new();
     };
-    if items.len() == 1 {
-        return vec![LabelledRegion {
-            label: items[0].1,
-            rings: vec![first.vertices().to_vec()],
-            cells: vec![0],
-        }];
+    // each distinct label a number (a face has few)
+    let mut distinct: Vec<T> = Vec::new();
+    let labels: Vec<u64> = items
+        .iter()
+        .map(|(_, l)| match distinct.iter().position(|d| d == l) {
+            Some(i) => i as u64,
+            None => {
+                distinct.push(*l);
+                distinct.len() as u64 - 1
+            }
+        })
+        .collect();
+    if distinct.len() == items.len() {
+        // no two polygons of one label: each is its own region
+        return (items.iter().enumerate())
+            .map(|(i, (p, l))| LabelledRegion {
+                label: *l,
+                rings: vec![p.vertices().to_vec()],
+                cells: vec![i as u32],
+            })
+            .collect();
     }
     let mut arena = PieceArena::default();
     let support = *first.support();
@@ -60,18 +75,6 @@ pub(crate) fn merge_regions<T: Copy + PartialEq>(items: &[(Polygon, T)]) -> Vec<
             points[arena.dense(id)] = Some(v);
         }
     }
-    // each distinct label a number (a face has few)
-    let mut distinct: Vec<T> = Vec::new();
-    let labels: Vec<u64> = items
-        .iter()
-        .map(|(_, l)| match distinct.iter().position(|d| d == l) {
-            Some(i) => i as u64,
-            None => {
-                distinct.push(*l);
-                distinct.len() as u64 - 1
-            }
-        })
-        .collect();
     let mut rounded = Vec::new();
     let point = |id: &u32| match points[arena.dense(*id)] {
         Some(p) => p.clone(),
