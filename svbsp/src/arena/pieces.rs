@@ -751,7 +751,7 @@ impl PieceArena {
     /// A piece from a polygon lying on this arena's support plane: its
     /// vertices and edge planes are copied into the arena.
     pub(crate) fn add_polygon(&mut self, p: &Polygon) -> Piece {
-        self.add_polygon_sharing(p, &mut rustc_hash::FxHashMap::default())
+        self.add_polygon_with(p, |arena, a| arena.add_exact((**a).clone()))
     }
 
     /// [`PieceArena::add_polygon`], an implicit vertex added once for all
@@ -762,20 +762,27 @@ impl PieceArena {
         p: &Polygon,
         shared: &mut rustc_hash::FxHashMap<*const Implicit, u32>,
     ) -> Piece {
+        self.add_polygon_with(p, |arena, a| {
+            *(shared.entry(std::sync::Arc::as_ptr(a)))
+                .or_insert_with(|| arena.add_exact((**a).clone()))
+        })
+    }
+
+    /// [`PieceArena::add_polygon`], each implicit vertex's id given by
+    /// `implicit`.
+    #[inline]
+    fn add_polygon_with(
+        &mut self,
+        p: &Polygon,
+        mut implicit: impl FnMut(&mut PieceArena, &std::sync::Arc<Implicit>) -> u32,
+    ) -> Piece {
         let mut c = Piece::default();
         let vs = p.vertices();
         let k = vs.len();
         for (i, (v, e)) in vs.iter().zip(p.edge_planes()).enumerate() {
             let id = match v {
                 Point::Grid(g) => self.add_grid(*g),
-                Point::Implicit(a) => match shared.get(&std::sync::Arc::as_ptr(a)) {
-                    Some(&id) => id,
-                    None => {
-                        let id = self.add_exact((**a).clone());
-                        shared.insert(std::sync::Arc::as_ptr(a), id);
-                        id
-                    }
-                },
+                Point::Implicit(a) => implicit(self, a),
             };
             c.verts.push(id);
             let plane = match (v, &vs[(i + 1) % k]) {
