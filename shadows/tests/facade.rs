@@ -235,16 +235,19 @@ fn shadow_files_by_both_algorithms_agree() {
 /// and only penumbra has a share.
 #[test]
 fn soft_fragments_are_regions_with_the_faces_areas() {
-    let path = std::env::temp_dir().join(format!("facade_soft_{}.obj", std::process::id()));
-    std::fs::write(
-        &path,
-        "v -5 -5 0\nv 5 -5 0\nv 5 5 0\nv -5 5 0\n\
-         v -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
-         f 1 2 3 4\nf 5 6 7 8\n",
-    )
-    .unwrap();
-    let mesh = bsp_shadows::read_mesh(&path).unwrap();
-    std::fs::remove_file(&path).unwrap();
+    // a ground of side 10 and a roof of side 2 at height 1
+    let square =
+        |r: f64, z: f64| [(-r, -r), (r, -r), (r, r), (-r, r)].map(|(x, y)| DVec3::new(x, y, z));
+    let face = |first: u32| bsp_shadows::Face {
+        vertices: (first..first + 4).collect(),
+        line: 0,
+        group: 0,
+    };
+    let mesh = Mesh {
+        positions: [square(5.0, 0.0), square(1.0, 1.0)].concat(),
+        faces: vec![face(0), face(4)],
+        groups: vec!["default".to_string()],
+    };
     let lamp = [(-0.5, -0.5), (-0.5, 0.5), (0.5, 0.5), (0.5, -0.5)];
     let soft = [bsp_shadows::SoftSpec::Area(
         lamp.iter().map(|&(x, y)| DVec3::new(x, y, 3.0)).collect(),
