@@ -123,9 +123,7 @@ fn soft(
     let mut fragments = SoftFragments::default();
     for (r, frags) in run.fragments().into_iter().enumerate() {
         for f in frags {
-            let rings: Vec<Vec<DVec3>> = (f.rings.iter())
-                .map(|r| r.iter().map(|p| grid.to_world(p.to_f64())).collect())
-                .collect();
+            let rings = f.rings_in(&grid);
             fragments
                 .side
                 .push((scene.face[prims[r]], *occluders[r].plane()));

@@ -489,9 +489,7 @@ impl SoftShadows {
                 visible: (f.visible.iter())
                     .map(|v| v.as_ref().map(|s| s.centroid))
                     .collect(),
-                rings: (f.rings.iter())
-                    .map(|r| r.iter().map(|p| self.grid.to_world(p.to_f64())).collect())
-                    .collect(),
+                rings: f.rings_in(&self.grid),
             })
         })
     }

@@ -220,12 +220,17 @@ fn push_point(s: &mut Vec<u8>, p: DVec3) {
 }
 
 fn push_ring(s: &mut Vec<u8>, ring: &[u32], world: &[DVec3]) {
+    push_points(s, ring.iter().map(|&v| world[v as usize]));
+}
+
+/// Points as a JSON array of `[x, y, z]`.
+fn push_points(s: &mut Vec<u8>, points: impl Iterator<Item = DVec3>) {
     s.push(b'[');
-    for (i, &v) in ring.iter().enumerate() {
+    for (i, p) in points.enumerate() {
         if i > 0 {
             s.push(b',');
         }
-        push_point(s, world[v as usize]);
+        push_point(s, p);
     }
     s.push(b']');
 }
@@ -1162,45 +1167,38 @@ pub fn write_soft(
     }
     let mut text = Vec::new();
     let mut ids = Vec::new();
+    let mut piece = Vec::new();
     for (k, frags) in fragments.iter().enumerate() {
         for f in frags {
-            let rings: Vec<Vec<DVec3>> = (f.rings.iter())
-                .map(|r| r.iter().map(|p| grid.to_world(p.to_f64())).collect())
-                .collect();
-            let pieces: Vec<Vec<DVec3>> = (f.pieces.iter())
-                .map(|p| in_world(&p.polygon, grid))
-                .collect();
-            if rings
-                .iter()
-                .chain(&pieces)
-                .flatten()
-                .any(|v| !v.is_finite())
-            {
-                return Err(io::Error::other(ExportError::NonFiniteVertex {
-                    face: faces_of[k],
-                    step: grid.step(),
-                }));
-            }
-            let area = pieces.iter().map(|p| polygon_area(p)).sum();
-            areas.add(f, area);
             text.clear();
-            match format {
-                FragmentFormat::Json => {
-                    soft_json(&mut text, f, faces_of[k], &rings, area, n, count == 0);
+            if format == FragmentFormat::Obj && group != Some(soft_key(f)) {
+                group = Some(soft_key(f));
+                writeln!(text, "g {}", soft_group(f, n))?;
+            }
+            // (the rings' corners are corners of the pieces: finite with them)
+            let mut area = 0.0;
+            for p in &f.pieces {
+                piece.clear();
+                piece.extend(p.polygon.vertices_f64().iter().map(|&c| grid.to_world(c)));
+                if piece.iter().any(|v| !v.is_finite()) {
+                    return Err(io::Error::other(ExportError::NonFiniteVertex {
+                        face: faces_of[k],
+                        step: grid.step(),
+                    }));
                 }
-                FragmentFormat::Obj => {
-                    if group != Some(soft_key(f)) {
-                        group = Some(soft_key(f));
-                        writeln!(text, "g {}", soft_group(f, n))?;
+                area += polygon_area(&piece);
+                if format == FragmentFormat::Obj {
+                    ids.clear();
+                    for &v in &piece {
+                        ids.push(obj.vertex(&mut text, v));
                     }
-                    for piece in &pieces {
-                        ids.clear();
-                        for &p in piece {
-                            ids.push(obj.vertex(&mut text, p));
-                        }
-                        obj.face(&mut text, &ids);
-                    }
+                    obj.face(&mut text, &ids);
                 }
+            }
+            areas.add(f, area);
+            if format == FragmentFormat::Json {
+                let rings = f.rings_in(grid);
+                soft_json(&mut text, f, faces_of[k], &rings, area, n, count == 0);
             }
             out.write_all(&text)?;
             count += 1;
@@ -1233,16 +1231,7 @@ fn soft_json(
     s.extend_from_slice(if first { b"\n" } else { b",\n" });
     s.extend_from_slice(b"{\"face\":");
     s.extend_from_slice(itoa::Buffer::new().format(face).as_bytes());
-    let ring = |s: &mut Vec<u8>, r: &[DVec3]| {
-        s.push(b'[');
-        for (i, &p) in r.iter().enumerate() {
-            if i > 0 {
-                s.push(b',');
-            }
-            push_point(s, p);
-        }
-        s.push(b']');
-    };
+    let ring = |s: &mut Vec<u8>, r: &[DVec3]| push_points(s, r.iter().copied());
     s.extend_from_slice(b",\"vertices\":");
     ring(s, &rings[0]);
     if rings.len() > 1 {

@@ -76,9 +76,8 @@ pub(crate) fn merge_regions<T: Copy + PartialEq>(items: &[(Polygon, T)]) -> Vec<
         }
     }
     let mut rounded = Vec::new();
-    let point = |id: &u32| match points[arena.dense(*id)] {
-        Some(p) => p.clone(),
-        None => arena.vertex(*id).to_owned().to_point(),
+    let point = |id: &u32| {
+        (points[arena.dense(*id)].expect("every arena vertex is a polygon's corner")).clone()
     };
     merge_cells(&arena, &support, &cells, &labels, &mut rounded)
         .into_iter()

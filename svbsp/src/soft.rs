@@ -99,6 +99,14 @@ impl SoftFragment {
             AreaClass::Penumbra
         }
     }
+
+    /// Its [`SoftFragment::rings`] in input units (`grid`'s), each corner
+    /// correctly rounded once.
+    pub fn rings_in(&self, grid: &Grid) -> Vec<Vec<DVec3>> {
+        (self.rings.iter())
+            .map(|r| r.iter().map(|p| grid.to_world(p.to_f64())).collect())
+            .collect()
+    }
 }
 
 /// Per light, the classes as bits.
