@@ -357,7 +357,7 @@ impl SolidParts {
 /// assert!(parts.boundary(6).is_none()); // the ground is open
 /// ```
 pub fn certify_solid_parts(polys: &[Polygon]) -> SolidParts {
-    pair_solid_parts(polys).certify()
+    pair_parts(polys, true).certify()
 }
 
 /// The first step of [`certify_solid_parts`]: the polygons' edges paired
@@ -386,6 +386,16 @@ pub fn certify_solid_parts(polys: &[Polygon]) -> SolidParts {
 /// assert_eq!(paired.certify(), certify_solid_parts(&scene));
 /// ```
 pub fn pair_solid_parts(polys: &[Polygon]) -> PairedParts {
+    pair_parts(polys, false)
+}
+
+/// [`pair_solid_parts`], the stars certified now (`stars_now`, as
+/// [`certify_solid_parts`] wants, in the same pass over the vertices) or
+/// in [`PairedParts::certify`], there only at the vertices of closed
+/// parts: so a caller that waits for the pairing alone (the shadows'
+/// guessed trees) does not wait for the stars, and an open scan's are
+/// never made.
+fn pair_parts(polys: &[Polygon], stars_now: bool) -> PairedParts {
     let Ok(loops) = Loops::new(polys) else {
         return PairedParts {
             n: polys.len(),
@@ -393,8 +403,9 @@ pub fn pair_solid_parts(polys: &[Polygon]) -> PairedParts {
         };
     };
     let mut open = vec![false; polys.len()];
+    let stars = loops.stars();
     let (mut parts_of, certified) = loops
-        .pair_all(true, Some(&mut open))
+        .pair_all(&stars, stars_now, Some(&mut open))
         .expect("lenient pairing reports no error");
     // an open part is no candidate: its triangles are not made (a scan
     // with a hole has none to make)
@@ -411,8 +422,9 @@ pub fn pair_solid_parts(polys: &[Polygon]) -> PairedParts {
         n: polys.len(),
         paired: Some(Paired {
             loops,
+            stars,
             parts_of,
-            certified,
+            certified: stars_now.then_some(certified),
             open_root,
             open,
         }),
@@ -431,9 +443,12 @@ pub struct PairedParts {
 #[derive(Debug)]
 struct Paired {
     loops: Loops,
+    /// The corners at each point.
+    stars: Stars,
     parts_of: UnionFind,
-    /// Per point: its star certified embedded.
-    certified: Vec<bool>,
+    /// Per point: its star certified embedded; `None` until
+    /// [`PairedParts::certify`] certifies the closed parts' stars.
+    certified: Option<Vec<bool>>,
     /// Per root: its part is open.
     open_root: Vec<bool>,
     /// Per polygon: its part is open.
@@ -452,10 +467,11 @@ impl PairedParts {
     pub fn certify(self) -> SolidParts {
         let Some(Paired {
             loops,
+            stars,
             mut parts_of,
             certified,
             open_root,
-            ..
+            open,
         }) = self.paired
         else {
             return SolidParts {
@@ -463,6 +479,8 @@ impl PairedParts {
                 parts: vec![None; self.n],
             };
         };
+        let certified =
+            certified.unwrap_or_else(|| loops.certified_stars(&stars, |i| !open[i as usize]));
         certify_paired(self.n, &loops, &mut parts_of, &certified, &open_root)
     }
 }
@@ -524,6 +542,20 @@ fn certify_paired(
     SolidParts {
         part_of: root.iter().map(|&r| number[r as usize]).collect(),
         parts,
+    }
+}
+
+/// The corners at each point of [`Loops`]: point `v`'s are
+/// `corners[first[v]..first[v + 1]]`.
+#[derive(Debug)]
+struct Stars {
+    first: Vec<u32>,
+    corners: Vec<u32>,
+}
+
+impl Stars {
+    fn star(&self, v: usize) -> &[u32] {
+        &self.corners[self.first[v] as usize..self.first[v + 1] as usize]
     }
 }
 
@@ -637,7 +669,25 @@ impl Loops {
     /// across its outgoing edge. The polygons' edge-connected parts, and
     /// per vertex whether its star is certified embedded (with `stars`).
     fn closed_and_oriented(&self, stars: bool) -> Result<(UnionFind, Vec<bool>), SurfaceDefect> {
-        self.pair_all(stars, None)
+        self.pair_all(&self.stars(), stars, None)
+    }
+
+    /// The corners at each point, by a counting sort.
+    fn stars(&self) -> Stars {
+        let mut first = vec![0u32; self.n_ids + 1];
+        for &v in &self.ids {
+            first[v as usize + 1] += 1;
+        }
+        for k in 1..first.len() {
+            first[k] += first[k - 1];
+        }
+        let mut fill = first.clone();
+        let mut corners = vec![0u32; self.pts.len()];
+        for (g, &v) in self.ids.iter().enumerate() {
+            corners[fill[v as usize] as usize] = g as u32;
+            fill[v as usize] += 1;
+        }
+        Stars { first, corners }
     }
 
     /// [`Loops::closed_and_oriented`]; with `open`, a vertex whose edges
@@ -646,25 +696,11 @@ impl Loops {
     /// every polygon it meets there), and the other vertices go on.
     fn pair_all(
         &self,
+        at: &Stars,
         stars: bool,
         mut open: Option<&mut Vec<bool>>,
     ) -> Result<(UnionFind, Vec<bool>), SurfaceDefect> {
-        let (ids, n_ids) = (&self.ids, self.n_ids);
-        // the corners at each vertex, by a counting sort
-        let mut first = vec![0u32; n_ids + 1];
-        for &v in ids {
-            first[v as usize + 1] += 1;
-        }
-        for k in 1..first.len() {
-            first[k] += first[k - 1];
-        }
-        let mut fill = first.clone();
-        let mut corners = vec![0u32; self.pts.len()];
-        for (g, &v) in ids.iter().enumerate() {
-            corners[fill[v as usize] as usize] = g as u32;
-            fill[v as usize] += 1;
-        }
-        drop(fill);
+        let n_ids = self.n_ids;
         // the vertices in runs, in parallel: each run's joins of polygons
         // (across the edges at its vertices, or all of a star that does
         // not pair up), its stars certified, and its first error
@@ -685,7 +721,7 @@ impl Loops {
             let mut around: Vec<(u32, u32, u32)> = Vec::new();
             let mut order: Vec<u32> = Vec::new();
             for v in vs.clone() {
-                let star = &corners[first[v] as usize..first[v + 1] as usize];
+                let star = at.star(v);
                 if let Err(e) = self.pair_edges(v as u32, star, &mut around) {
                     if !lenient {
                         run.error = Some(e);
@@ -712,24 +748,8 @@ impl Loops {
                         self.corner_poly[d.2 as usize],
                     ]);
                 }
-                // one cycle around the vertex: its corners in order
-                order.clear();
-                let mut c = 0;
-                loop {
-                    order.push(around[c].2);
-                    c = succ(&around[c]);
-                    if c == 0 || order.len() > around.len() {
-                        break;
-                    }
-                }
-                if stars && order.len() == around.len() {
-                    run.certified[v - vs.start] =
-                        star_embedded(self.pts[order[0] as usize], &order, |g| {
-                            (
-                                self.pts[self.next_of(g as usize)],
-                                self.pts[self.prev_of(g as usize)],
-                            )
-                        });
+                if stars {
+                    run.certified[v - vs.start] = self.star_certified(&around, &mut order);
                 }
             }
             run
@@ -753,6 +773,47 @@ impl Loops {
             certified.extend(run.certified);
         }
         Ok((parts_of, certified))
+    }
+
+    /// Per point: its star certified embedded (see [`star_embedded`]),
+    /// made only where `keep` takes the polygon of its first corner (the
+    /// others `false`).
+    fn certified_stars(&self, at: &Stars, keep: impl Fn(u32) -> bool + Sync) -> Vec<bool> {
+        let runs = runs(self.n_ids, self.n_ids, |vs| {
+            let (mut around, mut order) = (Vec::new(), Vec::new());
+            (vs.map(|v| {
+                let star = at.star(v);
+                keep(self.corner_poly[star[0] as usize])
+                    && self.pair_edges(v as u32, star, &mut around).is_ok()
+                    && self.star_certified(&around, &mut order)
+            }))
+            .collect::<Vec<bool>>()
+        });
+        runs.concat()
+    }
+
+    /// Whether the corners `around` a vertex (as [`Loops::pair_edges`]
+    /// leaves them) form one cycle, ordered into `order`, whose star is
+    /// certified embedded.
+    fn star_certified(&self, around: &[(u32, u32, u32)], order: &mut Vec<u32>) -> bool {
+        // successor: the corner whose prev is this corner's next
+        let succ = |c: &(u32, u32, u32)| around.binary_search_by_key(&c.1, |d| d.0).unwrap_or(0);
+        order.clear();
+        let mut c = 0;
+        loop {
+            order.push(around[c].2);
+            c = succ(&around[c]);
+            if c == 0 || order.len() > around.len() {
+                break;
+            }
+        }
+        order.len() == around.len()
+            && star_embedded(self.pts[order[0] as usize], order, |g| {
+                (
+                    self.pts[self.next_of(g as usize)],
+                    self.pts[self.prev_of(g as usize)],
+                )
+            })
     }
 
     /// The corners `star` at vertex `v` as (prev, next, corner), sorted by

@@ -69,22 +69,34 @@ pub(super) fn route_late(
             Some((id, side)) => task_at[id as usize][(side == Side::Back) as usize] = t,
         }
     }
-    let mut stack = Vec::new();
-    for &o in late {
-        let verts = occ.verts(o);
-        stack.push(root);
-        while let Some(id) = stack.pop() {
-            let n = &nodes[id as usize];
-            let sd = Sides::of_grid(verts, &n.plane);
-            // (an occluder is not in a plane through the light)
-            let front = sd.front || !sd.back;
-            for (reached, link, side) in [(sd.back, n.back, 1), (front, n.front, 0)] {
-                match (reached, link == LIT) {
-                    (true, true) => lists[task_at[id as usize][side]].push(o),
-                    (true, false) => stack.push(link),
-                    _ => {}
+    // runs of the late occluders in parallel (an open scan has tens of
+    // thousands, and the other core waited), each run's lists then laid
+    // end to end in order: the same lists for every thread count
+    let runs = bsp_core::par::fold_runs(late.len(), |r| {
+        let mut own = vec![Vec::new(); tasks.len()];
+        let mut stack = Vec::new();
+        for &o in &late[r] {
+            let verts = occ.verts(o);
+            stack.push(root);
+            while let Some(id) = stack.pop() {
+                let n = &nodes[id as usize];
+                let sd = Sides::of_grid(verts, &n.plane);
+                // (an occluder is not in a plane through the light)
+                let front = sd.front || !sd.back;
+                for (reached, link, side) in [(sd.back, n.back, 1), (front, n.front, 0)] {
+                    match (reached, link == LIT) {
+                        (true, true) => own[task_at[id as usize][side]].push(o),
+                        (true, false) => stack.push(link),
+                        _ => {}
+                    }
                 }
             }
+        }
+        own
+    });
+    for run in runs {
+        for (list, part) in lists.iter_mut().zip(run) {
+            list.extend_from_slice(&part);
         }
     }
     lists
