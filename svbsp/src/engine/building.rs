@@ -3,6 +3,7 @@
 //! closed parts are certified.
 
 use bsp_core::Polygon;
+use rayon::prelude::*;
 
 use super::LightVolumes;
 use crate::engine::ShadowError;
@@ -117,9 +118,10 @@ impl LightVolumes {
         build: &Build,
     ) -> (bsp_core::SolidParts, Guessed) {
         let paired = bsp_core::pair_solid_parts(occluders);
-        // per light: the faces it faces, and those of open parts
+        // per light: the faces it faces, and those of open parts (in
+        // parallel: the trees wait for it)
         let guess = |l: &Light| -> Vec<usize> {
-            (order.iter().copied())
+            (order.par_iter().copied())
                 .filter(|&i| l.faces(occluders[i].support()) || paired.open(i))
                 .collect()
         };
