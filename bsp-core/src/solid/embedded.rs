@@ -1241,6 +1241,9 @@ mod tests {
     /// polygons.
     fn certified_parts(polys: &[Polygon]) -> Vec<bool> {
         let parts = certify_solid_parts(polys);
+        // the same parts with the stars certified after the pairing, at
+        // the closed parts' points only
+        assert_eq!(pair_solid_parts(polys).certify(), parts);
         // parts numbered in the order of their first polygons, each
         // polygon with its part's certificate
         let mut firsts: Vec<usize> = Vec::new();
