@@ -118,7 +118,14 @@ impl<'a> Reader<'a> {
         let positions = array(root.get("vertices"), "/vertices")?
             .iter()
             .enumerate()
-            .map(|(i, v)| Ok(point(Some(v), &format!("/vertices/{i}"))? * scale + translate))
+            .map(|(i, v)| {
+                // (the path for an error is made only for one)
+                let p = match quick_point(v) {
+                    Some(p) => p,
+                    None => point(Some(v), &format!("/vertices/{i}"))?,
+                };
+                Ok(p * scale + translate)
+            })
             .collect::<Result<Vec<DVec3>, String>>()?;
         let templates = match root.get("geometry-templates") {
             None | Some(Value::Null) => None,
@@ -346,6 +353,15 @@ fn rings(surface: &Value, at: &str, count: usize) -> Result<Vec<Vec<u32>>, Strin
         .iter()
         .enumerate()
         .map(|(j, ring)| {
+            // a ring of three indices or more, each in range, as it is
+            // (the path for an error is made only for one: a path a
+            // vertex was most of a city's reading)
+            if let Value::Array(r) = ring
+                && r.len() >= 3
+                && let Some(quick) = r.iter().map(|v| quick_index(v, count)).collect()
+            {
+                return Ok(quick);
+            }
             let at = format!("{at}/{j}");
             let ring = array(Some(ring), &at)?;
             if ring.len() < 3 {
@@ -357,6 +373,25 @@ fn rings(surface: &Value, at: &str, count: usize) -> Result<Vec<Vec<u32>>, Strin
                 .collect()
         })
         .collect()
+}
+
+/// [`index`] where `v` is a vertex index below `count`, else `None`.
+fn quick_index(v: &Value, count: usize) -> Option<u32> {
+    v.as_u64()
+        .filter(|&i| (i as usize) < count)
+        .map(|i| i as u32)
+}
+
+/// [`point`] where `v` is three finite numbers, else `None`.
+fn quick_point(v: &Value) -> Option<DVec3> {
+    match v {
+        Value::Array(l) if l.len() == 3 => {
+            let (x, y, z) = (l[0].as_f64()?, l[1].as_f64()?, l[2].as_f64()?);
+            let p = DVec3::new(x, y, z);
+            p.is_finite().then_some(p)
+        }
+        _ => None,
+    }
 }
 
 /// A vertex index below `count`.
