@@ -417,7 +417,8 @@ impl ObjWriter {
 
 /// Receivers shaded per round of [`FragmentFile::stream`]: each round is
 /// shaded and formatted in parallel (in chunks of [`CHUNK`]; the large
-/// receivers of every round from the start), then written.
+/// receivers of every round from the start), then written while the next
+/// round is shaded (so two rounds are held at once).
 const ROUND: usize = CHUNK * 32;
 
 /// What [`FragmentFile::stream`] did.
@@ -427,7 +428,8 @@ pub struct Streamed {
     pub fragments: usize,
     /// Receivers shaded.
     pub receivers: usize,
-    /// Time spent shading and formatting (in parallel).
+    /// Time not spent writing: shading and formatting (in parallel, a
+    /// round's beside the writing of the one before).
     pub shading: Duration,
     /// Time spent writing.
     pub writing: Duration,
@@ -568,8 +570,9 @@ impl FragmentFile {
     /// Shades the receivers `ranges` of `polys` (see [`crate::receivers`]) on
     /// `grid` by `shadows` and writes
     /// its fragments, round by round: each round's chunks are shaded and
-    /// formatted in parallel, then written in order, so the file is the
-    /// same for every thread count and memory stays bounded. `done(n)` is
+    /// formatted in parallel, then written in order while the next round
+    /// is shaded, so the file is the same for every thread count and
+    /// memory stays bounded (two rounds at most). `done(n)` is
     /// told of every `n` receivers shaded (for a progress bar). A vertex
     /// that is not finite in input units is an
     /// [`io::ErrorKind::InvalidData`] error carrying the [`ExportError`].
@@ -636,8 +639,7 @@ impl FragmentFile {
                 })
             });
             // each round written on this thread while the next is shaded
-            // beside it (the writing had left a core idle: an open scan's
-            // shading and writing 0.96x in wall time)
+            // beside it (the writing alone had left a core idle)
             let starts: Vec<usize> = (0..ranges.len()).step_by(round).collect();
             let mut pending = starts.first().map(|&start| shade_round(start));
             for k in 1..=starts.len() {
