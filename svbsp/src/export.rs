@@ -875,6 +875,49 @@ mod tests {
         }
     }
 
+    /// A vertex that leaves `f64` in input units is an error, however the
+    /// rounds fall: the write that meets it returns while the next round
+    /// is being shaded, and nothing is left waiting.
+    #[test]
+    fn a_vertex_beyond_f64_stops_the_stream_with_its_error() {
+        let (_, lights, polys, shadows) = tiles_scene(24);
+        let ranges = crate::receivers(&polys);
+        // a step of 2^1000 input units: every grid coordinate but 0 is
+        // beyond f64 once scaled back
+        let huge = Grid::new(DVec3::ZERO, -1000).unwrap();
+        let opts = crate::ShadeOptions::default();
+        for (threads, round, chunk) in [(1, 4, 2), (2, 1, 1), (2, 4, 2), (2, 64, 8)] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut out = Vec::new();
+            let format = FragmentFormat::Json;
+            let faces = polys.len();
+            let mut file =
+                FragmentFile::begin(&mut out, format, &lights, faces, ("", &[])).unwrap();
+            let scene = (&polys[..], &ranges[..], &huge);
+            let e = pool
+                .install(|| {
+                    file.stream_by(
+                        &mut out,
+                        shadows.set(),
+                        scene,
+                        &opts,
+                        |_| {},
+                        (round, chunk),
+                    )
+                })
+                .unwrap_err();
+            assert_eq!(e.kind(), io::ErrorKind::InvalidData);
+            let inner = e.into_inner().unwrap().downcast::<ExportError>().unwrap();
+            assert!(matches!(
+                *inner,
+                ExportError::NonFiniteVertex { face: 0, .. }
+            ));
+        }
+    }
+
     #[test]
     fn runs_cover_the_receivers_in_order_with_each_large_one_alone() {
         use crate::schedule::runs;
