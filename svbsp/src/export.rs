@@ -840,10 +840,7 @@ mod tests {
             let (expected, _) =
                 file_of_faces(format, &grid, &lights, &[&whole], false, polys.len());
             for (threads, round, chunk) in [(1, 8, 3), (2, 8, 3), (2, 64, 5), (2, 1, 1)] {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .unwrap();
+                let pool = pool_of(threads);
                 let mut out = Vec::new();
                 let notes = ["a".to_string(), "b".to_string()];
                 let head = ("test", &notes[..]);
@@ -875,6 +872,14 @@ mod tests {
         }
     }
 
+    /// A pool of `threads` threads for one test's runs.
+    fn pool_of(threads: usize) -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+    }
+
     /// A vertex that leaves `f64` in input units is an error, however the
     /// rounds fall: the write that meets it returns while the next round
     /// is being shaded, and nothing is left waiting.
@@ -887,10 +892,7 @@ mod tests {
         let huge = Grid::new(DVec3::ZERO, -1000).unwrap();
         let opts = crate::ShadeOptions::default();
         for (threads, round, chunk) in [(1, 4, 2), (2, 1, 1), (2, 4, 2), (2, 64, 8)] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
+            let pool = pool_of(threads);
             let mut out = Vec::new();
             let format = FragmentFormat::Json;
             let faces = polys.len();
