@@ -77,6 +77,7 @@ pub use bnum::types::I256;
 /// blocks of merging. Everything here is exact and tested, but shaped for
 /// those crates' inner loops; it may change with them, without notice.
 pub mod internals {
+    pub use crate::kernel::plane::gcd128;
     pub use crate::kernel::{
         ConvexFace, ConvexParts, GridPolygon, Homogeneous, MAX_NORMAL_BITS, MAX_OFFSET_BITS, Parts,
         PointRef, approx, check_convex, filter_ring_area, filter_side, filter_side_err,

@@ -125,6 +125,27 @@ fn gcd64(a: u64, b: u64) -> u64 {
     a << shift
 }
 
+/// Binary gcd of two `u128`s (`gcd(0, b) = b`): shifts and subtractions,
+/// in 64 bits ([`gcd64`]) once both fit (Euclid's steps in 128 bits are
+/// each a library call for the remainder).
+pub fn gcd128(a: u128, b: u128) -> u128 {
+    if a == 0 || b == 0 {
+        return a | b;
+    }
+    let shift = (a | b).trailing_zeros();
+    let (mut a, mut b) = (a >> a.trailing_zeros(), b >> b.trailing_zeros());
+    // both odd from here on
+    while a != b {
+        if let (Ok(x), Ok(y)) = (u64::try_from(a), u64::try_from(b)) {
+            return u128::from(gcd64(x, y)) << shift;
+        }
+        let (lo, hi) = (a.min(b), a.max(b));
+        a = lo;
+        b = (hi - lo) >> (hi - lo).trailing_zeros();
+    }
+    a << shift
+}
+
 /// Euclid's gcd in 128 bits: the reference the tests hold the binary one
 /// and [`Plane::new`] to.
 #[cfg(test)]
@@ -455,6 +476,50 @@ mod tests {
         }
         assert_eq!(std::mem::align_of::<Plane>(), 8);
         assert_eq!(std::mem::size_of::<Plane>(), 48);
+    }
+
+    /// The binary gcd is Euclid's, on both sides of 64 bits and at the
+    /// edges of 128.
+    #[test]
+    fn binary_gcd_is_euclids() {
+        fn euclid(mut a: u128, mut b: u128) -> u128 {
+            while b != 0 {
+                (a, b) = (b, a % b);
+            }
+            a
+        }
+        let mut x: u128 = 0x9e37_79b9_7f4a_7c15_f39c_c060_5ced_c834;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let edges = [
+            0,
+            1,
+            2,
+            3,
+            6,
+            1 << 64,
+            (1 << 64) - 1,
+            u128::MAX,
+            u128::MAX - 1,
+            1 << 127,
+        ];
+        for &a in &edges {
+            for &b in &edges {
+                assert_eq!(gcd128(a, b), euclid(a, b), "{a} {b}");
+            }
+        }
+        for k in 0..20_000 {
+            // sizes from a few bits to 128, with shared factors
+            let (r, s, t) = (next(), next(), next());
+            let f = (t >> (t % 128) as u32).max(1) >> (k % 40);
+            let a = (r >> (r % 128) as u32).wrapping_mul(f.max(1));
+            let b = (s >> (s % 128) as u32).wrapping_mul(f.max(1));
+            assert_eq!(gcd128(a, b), euclid(a, b), "{a} {b}");
+        }
     }
 
     #[test]

@@ -22,7 +22,7 @@ use num_rational::BigRational;
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
-use bsp_core::internals::{UnionFind, filter_ring_area};
+use bsp_core::internals::{UnionFind, filter_ring_area, gcd128};
 use bsp_core::{I256, Plane};
 
 use super::pieces::{EdgeRef, Piece, PieceArena, Vertex};
@@ -52,37 +52,6 @@ struct LineKey {
     a: i128,
     b: i128,
     c: I256,
-}
-
-/// Binary gcd (`gcd(0, b) = b`): shifts and subtractions, in 64 bits
-/// once both fit (Euclid's steps were each a library call for a 128-bit
-/// remainder, about a fortieth of a city's run).
-fn gcd(a: u128, b: u128) -> u128 {
-    if a == 0 || b == 0 {
-        return a | b;
-    }
-    let shift = (a | b).trailing_zeros();
-    let (mut a, mut b) = (a >> a.trailing_zeros(), b >> b.trailing_zeros());
-    // both odd from here on
-    while a != b {
-        if let (Ok(x), Ok(y)) = (u64::try_from(a), u64::try_from(b)) {
-            return u128::from(gcd_odd64(x, y)) << shift;
-        }
-        let (lo, hi) = (a.min(b), a.max(b));
-        a = lo;
-        b = (hi - lo) >> (hi - lo).trailing_zeros();
-    }
-    a << shift
-}
-
-/// The gcd of two odd `u64`s, binary.
-fn gcd_odd64(mut a: u64, mut b: u64) -> u64 {
-    while a != b {
-        let (lo, hi) = (a.min(b), a.max(b));
-        a = lo;
-        b = (hi - lo) >> (hi - lo).trailing_zeros();
-    }
-    a
 }
 
 /// The coordinate axes `(u, v)` of the support plane's projection, and its
@@ -117,14 +86,14 @@ fn line_key(support: &Plane, e: &Plane) -> LineKey {
         a != 0 || b != 0,
         "an edge plane parallel to its support plane"
     );
-    let g = gcd(a.unsigned_abs(), b.unsigned_abs());
+    let g = gcd128(a.unsigned_abs(), b.unsigned_abs());
     // (a gcd of 1, the usual one, divides nothing: the 256-bit remainder
     // and divisions are left out)
     let (mut a, mut b, mut c) = if g == 1 {
         (a, b, c)
     } else {
         let cm = (c.unsigned_abs() % bnum::types::U256::from(g)).as_::<u128>();
-        let g = gcd(g, cm) as i128;
+        let g = gcd128(g, cm) as i128;
         (a / g, b / g, c / I256::from(g))
     };
     if a < 0 || (a == 0 && b < 0) {
@@ -1051,50 +1020,6 @@ fn signed_area_sign(points: &Points<'_>, l: &[u32], u: usize, v: usize) -> i32 {
 mod tests {
     use super::*;
     use bsp_core::Polygon;
-
-    /// The binary gcd is Euclid's, on both sides of 64 bits and at the
-    /// edges of 128.
-    #[test]
-    fn binary_gcd_is_euclids() {
-        fn euclid(mut a: u128, mut b: u128) -> u128 {
-            while b != 0 {
-                (a, b) = (b, a % b);
-            }
-            a
-        }
-        let mut x: u128 = 0x9e37_79b9_7f4a_7c15_f39c_c060_5ced_c834;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
-        let edges = [
-            0,
-            1,
-            2,
-            3,
-            6,
-            1 << 64,
-            (1 << 64) - 1,
-            u128::MAX,
-            u128::MAX - 1,
-            1 << 127,
-        ];
-        for &a in &edges {
-            for &b in &edges {
-                assert_eq!(gcd(a, b), euclid(a, b), "{a} {b}");
-            }
-        }
-        for k in 0..20_000 {
-            // sizes from a few bits to 128, with shared factors
-            let (r, s, t) = (next(), next(), next());
-            let f = (t >> (t % 128) as u32).max(1) >> (k % 40);
-            let a = (r >> (r % 128) as u32).wrapping_mul(f.max(1));
-            let b = (s >> (s % 128) as u32).wrapping_mul(f.max(1));
-            assert_eq!(gcd(a, b), euclid(a, b), "{a} {b}");
-        }
-    }
 
     fn square_cells(
         n: i32,
