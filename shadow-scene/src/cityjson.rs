@@ -375,14 +375,16 @@ fn rings(surface: &Value, at: &str, count: usize) -> Result<Vec<Vec<u32>>, Strin
         .collect()
 }
 
-/// [`index`] where `v` is a vertex index below `count`, else `None`.
+/// [`index`] where `v` is a vertex index below `count`, else `None` (the
+/// check alone, with no path for an error's message).
 fn quick_index(v: &Value, count: usize) -> Option<u32> {
     v.as_u64()
         .filter(|&i| (i as usize) < count)
         .map(|i| i as u32)
 }
 
-/// [`point`] where `v` is three finite numbers, else `None`.
+/// [`point`] where `v` is three finite numbers, else `None` (the check
+/// alone, with no path for an error's message).
 fn quick_point(v: &Value) -> Option<DVec3> {
     match v {
         Value::Array(l) if l.len() == 3 => {
@@ -396,8 +398,10 @@ fn quick_point(v: &Value) -> Option<DVec3> {
 
 /// A vertex index below `count`.
 fn index(v: &Value, at: &str, count: usize) -> Result<u32, String> {
+    if let Some(i) = quick_index(v, count) {
+        return Ok(i);
+    }
     match v.as_u64() {
-        Some(i) if (i as usize) < count => Ok(i as u32),
         Some(i) if count == 0 => Err(format!("{at}: vertex {i}, but the file has no vertices")),
         Some(i) => Err(format!("{at}: vertex {i} out of range (0..={})", count - 1)),
         None => Err(format!("{at}: `{v}` is not a vertex index")),
@@ -406,14 +410,11 @@ fn index(v: &Value, at: &str, count: usize) -> Result<u32, String> {
 
 /// Three finite numbers.
 fn point(v: Option<&Value>, at: &str) -> Result<DVec3, String> {
-    let list = array(v, at)?;
-    let xyz: Vec<f64> = list.iter().filter_map(Value::as_f64).collect();
-    match xyz.as_slice() {
-        [x, y, z] if list.len() == 3 && xyz.iter().all(|c| c.is_finite()) => {
-            Ok(DVec3::new(*x, *y, *z))
-        }
-        _ => Err(format!("{at}: three finite numbers expected")),
+    if let Some(p) = v.and_then(quick_point) {
+        return Ok(p);
     }
+    array(v, at)?;
+    Err(format!("{at}: three finite numbers expected"))
 }
 
 fn array<'v>(v: Option<&'v Value>, at: &str) -> Result<&'v Vec<Value>, String> {
