@@ -126,7 +126,7 @@ fn gcd64(a: u64, b: u64) -> u64 {
 }
 
 /// Binary gcd of two `u128`s (`gcd(0, b) = b`): shifts and subtractions,
-/// in 64 bits ([`gcd64`]) once both fit (Euclid's steps in 128 bits are
+/// in 64 bits (the binary `gcd64`) once both fit (Euclid's steps in 128 bits are
 /// each a library call for the remainder).
 pub fn gcd128(a: u128, b: u128) -> u128 {
     if a == 0 || b == 0 {
