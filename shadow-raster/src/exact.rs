@@ -117,8 +117,11 @@ fn soft(
             Some((i, Occluder::of_polygon(&seen)?))
         })
         .unzip();
+    // (a pixel reads its fragment's share, or its own: the pieces' are
+    // not needed)
     let run = SoftVolumes::new(&area, &occluders)
-        .map_err(|e| RasterError::Shadows(ShadowError::Light(e)))?;
+        .map_err(|e| RasterError::Shadows(ShadowError::Light(e)))?
+        .regions_only();
     let grid = scene.grid;
     let mut fragments = SoftFragments::default();
     for (r, frags) in run.fragments().into_iter().enumerate() {

@@ -123,8 +123,10 @@ type Shaded = (
     Vec<Vec<SoftFragment>>,
 );
 
-/// Every face of `scene` cut for its lights, timed ([`Shaded`]).
-fn shade(scene: &SoftScene, progress: &dyn Progress) -> Result<Shaded, Error> {
+/// Every face of `scene` cut for its lights, timed ([`Shaded`]); with
+/// `pieces`, each fragment's convex pieces get their own shares (what a
+/// picture is shaded by), else only the fragments (what the files hold).
+fn shade(scene: &SoftScene, progress: &dyn Progress, pieces: bool) -> Result<Shaded, Error> {
     let (occluders, faces_of): (Vec<Occluder>, Vec<u32>) = scene
         .polys
         .iter()
@@ -134,8 +136,11 @@ fn shade(scene: &SoftScene, progress: &dyn Progress) -> Result<Shaded, Error> {
     let start = Instant::now();
     let lights: Vec<AreaLight> = scene.lights.iter().map(|l| l.light.clone()).collect();
     let on_face = |n: usize| progress.advance(n as u64);
-    let fragments =
-        svbsp::soft_shadows_with(&lights, &occluders, &on_face).map_err(Error::Light)?;
+    let fragments = match pieces {
+        true => svbsp::soft_shadows_with(&lights, &occluders, &on_face),
+        false => svbsp::soft_regions_with(&lights, &occluders, &on_face),
+    }
+    .map_err(Error::Light)?;
     Ok((vec![("shadows", start.elapsed())], faces_of, fragments))
 }
 
@@ -152,7 +157,7 @@ pub fn draw_soft_shadows(
     out: &mut dyn Write,
     progress: &dyn Progress,
 ) -> Result<SoftFile, Error> {
-    let (mut phases, faces_of, fragments) = shade(scene, progress)?;
+    let (mut phases, faces_of, fragments) = shade(scene, progress, true)?;
     progress.phase("drawing", 1);
     let start = Instant::now();
     let grid = scene.grid;
@@ -234,7 +239,7 @@ pub fn write_soft_shadows(
     out: &mut dyn Write,
     progress: &dyn Progress,
 ) -> Result<SoftFile, Error> {
-    let (mut phases, faces_of, fragments) = shade(scene, progress)?;
+    let (mut phases, faces_of, fragments) = shade(scene, progress, false)?;
     progress.phase("writing", 1);
     let start = Instant::now();
     let notes: Vec<String> = scene.lights.iter().map(|l| l.shape.to_string()).collect();
@@ -392,7 +397,7 @@ pub(crate) fn soft_shadows_on(
         lights: &all,
         polys,
     };
-    let (_, faces_of, fragments) = shade(&scene, &crate::shadow_file::NoProgress)?;
+    let (_, faces_of, fragments) = shade(&scene, &crate::shadow_file::NoProgress, true)?;
     let n = all.len();
     let (mut classes, mut area) = (vec![[0.0; 5]; faces * n], vec![0.0; faces]);
     for (frags, &face) in fragments.iter().zip(&faces_of) {

@@ -80,7 +80,7 @@ pub use overlay::{FaceOverlay, OverlayRegion};
 pub use psv::{LitParts, ShadowVolumes, VolumeError, VolumeSanity};
 pub use soft::{
     Share, SoftFragment, SoftLight, SoftPiece, SoftShape, SoftVolumes, place_soft_lights,
-    shared_soft_grid, soft_shadows, soft_shadows_with,
+    shared_soft_grid, soft_regions_with, soft_shadows, soft_shadows_with,
 };
 pub use wide::{WPoint, WidePlane};
 

@@ -10,6 +10,7 @@
 //! pieces of one label into maximal connected regions, with holes.
 
 use bsp_core::{Point, Polygon};
+use rayon::prelude::*;
 use smallvec::SmallVec;
 
 use crate::arena::pieces::PieceArena;
@@ -104,16 +105,21 @@ pub(crate) fn vertex_keys(p: &Polygon) -> Vec<[u64; 3]> {
 /// Merges polygons of equal labels pairwise where their union is convex
 /// (`Polygon::merge`, exact), until none do; only pairs that share two
 /// vertex keys are tried. Deterministic: the order of the input decides.
-pub(crate) fn merge_convex<T: Copy + PartialEq>(items: Vec<(Polygon, T)>) -> Vec<(Polygon, T)> {
-    let items = items
-        .into_iter()
-        .map(|(polygon, label)| Keyed {
-            keys: vertex_keys(&polygon),
-            polygon,
-            label,
-            extra: (),
-        })
-        .collect();
+pub(crate) fn merge_convex<T: Copy + PartialEq + Send>(
+    items: Vec<(Polygon, T)>,
+) -> Vec<(Polygon, T)> {
+    let keyed = |(polygon, label): (Polygon, T)| Keyed {
+        keys: vertex_keys(&polygon),
+        polygon,
+        label,
+        extra: (),
+    };
+    // (the keys round every exact vertex: a face of many pieces, such as
+    // a ground under a mesh, rounds them on every thread, in order)
+    let items = match items.len() >= crate::schedule::PARALLEL_CELLS {
+        true => items.into_par_iter().map(keyed).collect(),
+        false => items.into_iter().map(keyed).collect(),
+    };
     merge_keyed(items, |_, _| ())
         .into_iter()
         .map(|m| (m.polygon, m.label))

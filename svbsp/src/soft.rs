@@ -24,7 +24,7 @@ use crate::blockers::{coplanar_blockers, coplanar_blockers_of, plane_key};
 use crate::boxes::{Box3, CellGrid, EMPTY, EVERYWHERE, Reach, grid_box, meet};
 use crate::engine::{LightVolumes, Scratch, ShadowSet};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
-use crate::merging::{merge_convex, merge_regions};
+use crate::merging::{LabelledRegion, merge_convex, merge_regions};
 use crate::near::{InSlab, near_lists, slab_box};
 
 /// The share of a polygon light's irradiance that arrives on a penumbra
@@ -175,6 +175,20 @@ pub fn soft_shadows_with(
     Ok(fragments)
 }
 
+/// [`soft_shadows_with`] for what reads each fragment's shares only: the
+/// fragments' pieces carry none ([`SoftVolumes::regions_only`]), and
+/// everything else is the same.
+pub fn soft_regions_with(
+    lights: &[AreaLight],
+    faces: &[Occluder],
+    on_faces: &(dyn Fn(usize) + Sync),
+) -> Result<Vec<Vec<SoftFragment>>, LightError> {
+    let run = SoftVolumes::new(lights, faces)?.regions_only();
+    let fragments = run.fragments_with(on_faces);
+    run.free_later();
+    Ok(fragments)
+}
+
 /// A soft-shadow run of `lights` over `faces`, every face an occluder
 /// and a receiver (see [`soft_shadows`]): what it builds once (each
 /// occluder's volumes, the occluders near each face, the lights' corner
@@ -217,6 +231,9 @@ pub struct SoftVolumes<'a> {
     /// Per light, per face: strictly outside a closed part that holds the
     /// light (umbra, whole; [`crate::sealed`]); empty for none.
     sealed: Vec<Vec<bool>>,
+    /// Whether each convex piece of a fragment gets its own shares
+    /// ([`SoftVolumes::regions_only`]).
+    piece_shares: bool,
 }
 
 impl std::fmt::Debug for SoftVolumes<'_> {
@@ -271,6 +288,7 @@ impl<'a> SoftVolumes<'a> {
         SoftVolumes {
             cores,
             sealed,
+            piece_shares: true,
             corners,
             backs: SolidBacks::new(faces, &sources, &solids),
             lights,
@@ -302,6 +320,17 @@ impl<'a> SoftVolumes<'a> {
                 blockers, regions, near, reach, corners, backs, cores, sealed,
             ))
         });
+    }
+
+    /// The run with fragments whose convex pieces carry no shares of
+    /// their own (every [`SoftPiece::visible`] `None`); each fragment's
+    /// [`SoftFragment::visible`] is the same as without. For what reads
+    /// the fragments' shares only (the files): the probe points inside a
+    /// fragment of many pieces are never viewed, and on a ground under a
+    /// mesh those are most of them.
+    pub fn regions_only(mut self) -> Self {
+        self.piece_shares = false;
+        self
     }
 
     /// Every face cut into fragments of one class per light, in face
@@ -517,6 +546,31 @@ fn soft_face(
     face: &Occluder,
     scratch: &mut Scratch,
 ) -> Vec<SoftFragment> {
+    let fragments = merge_convex(cut_face(run, i, face, scratch));
+    let shading = Shading {
+        run,
+        i,
+        face,
+        // (a face of many fragments, such as a ground, rounds their
+        // corners on every thread)
+        many: fragments.len() >= crate::schedule::PARALLEL_CELLS,
+        // (a probe point lies near the face when its fragment is not huge)
+        near_face: fragments.iter().all(|(p, _)| p.len() < MAX_PROBED_CORNERS),
+    };
+    match run.piece_shares {
+        true => shading.with_pieces(fragments),
+        false => shading.regions_only(fragments),
+    }
+}
+
+/// Face `i` of `run`, `face`, cut into convex pieces of one class per
+/// light.
+fn cut_face(
+    run: &SoftVolumes<'_>,
+    i: usize,
+    face: &Occluder,
+    scratch: &mut Scratch,
+) -> Vec<(Polygon, Classes)> {
     let SoftVolumes {
         lights,
         regions,
@@ -552,93 +606,205 @@ fn soft_face(
             .map(|(p, c, class)| (p, c.with(k, class)))
             .collect();
     }
-    let fragments = merge_convex(pieces);
-    // per light, the grid points nearest the penumbra fragments' centroids
-    // and corners (neighbours share corners), each viewed once, in
-    // parallel; then each fragment's share from its points
-    let probes_of = |(polygon, c): &(Polygon, Classes)| -> Vec<Option<Probes>> {
+    pieces
+}
+
+/// The shares of one face's convex pieces (merged where their union is
+/// convex): per light, the grid points nearest the penumbra fragments'
+/// centroids and corners (neighbours share corners), each viewed once, in
+/// parallel; then each fragment's share from its points.
+struct Shading<'r, 'a> {
+    run: &'r SoftVolumes<'a>,
+    i: usize,
+    face: &'r Occluder,
+    many: bool,
+    near_face: bool,
+}
+
+impl Shading<'_, '_> {
+    /// Whether pieces of classes `c` have a share of light `k`.
+    fn wanted(&self, c: &Classes, k: usize) -> bool {
+        (c.lit | c.umbra) >> k & 1 == 0 && has_share(&self.run.lights[k])
+    }
+
+    /// Per light, the share at every point of `probes` (the probes per
+    /// piece or region, per light).
+    fn view(&self, probes: &[Vec<Option<Probes>>]) -> Vec<Option<Viewed>> {
+        let lights = self.run.lights;
         (0..lights.len())
             .map(|k| {
-                let penumbra = (c.lit | c.umbra) >> k & 1 == 0;
-                (penumbra && has_share(&lights[k])).then(|| Probes::of(polygon))
+                let mut points: Vec<GridPoint> = probes
+                    .iter()
+                    .filter_map(|p| p[k].as_ref())
+                    .flat_map(|p| std::iter::once(p.centroid).chain(p.corners.iter().copied()))
+                    .collect();
+                if points.is_empty() {
+                    return None;
+                }
+                points.sort_unstable();
+                points.dedup();
+                // (a box of what each volume holds of the face's slab costs a
+                // few hundred operations; it pays where many points look)
+                let slab = points.len() >= 32;
+                let probing = match self.near_face {
+                    true => Probing::NearFace { slab },
+                    false => Probing::Anywhere,
+                };
+                let hiders = self.run.hiders(k, self.i, probing);
+                // (one point a task when stolen: the points are sorted, so the
+                // dear ones, deep in a mesh's penumbra, lie together, and a
+                // run of them must not be left to one thread)
+                let fractions = points
+                    .par_iter()
+                    .with_max_len(1)
+                    .map(|&x| fraction_at(&lights[k], self.face, &hiders, x))
+                    .collect();
+                Some(Viewed { points, fractions })
             })
             .collect()
-    };
-    // (a face of many fragments, such as a ground, rounds their corners
-    // on every thread)
-    let many = fragments.len() >= crate::schedule::PARALLEL_CELLS;
-    let probes: Vec<Vec<Option<Probes>>> = match many {
-        true => fragments.par_iter().map(probes_of).collect(),
-        false => fragments.iter().map(probes_of).collect(),
-    };
-    // (a probe point lies near the face when its fragment is not huge)
-    let near_face = fragments.iter().all(|(p, _)| p.len() < MAX_PROBED_CORNERS);
-    let values: Vec<Option<Viewed>> = (0..lights.len())
-        .map(|k| {
-            let mut points: Vec<GridPoint> = probes
-                .iter()
-                .filter_map(|p| p[k].as_ref())
-                .flat_map(|p| std::iter::once(p.centroid).chain(p.corners.iter().copied()))
-                .collect();
-            if points.is_empty() {
-                return None;
+    }
+
+    /// The fragments with every piece's shares.
+    fn with_pieces(&self, fragments: Vec<(Polygon, Classes)>) -> Vec<SoftFragment> {
+        let n = self.run.lights.len();
+        let probes_of = |(polygon, c): &(Polygon, Classes)| -> Vec<Option<Probes>> {
+            (0..n)
+                .map(|k| self.wanted(c, k).then(|| Probes::of(polygon)))
+                .collect()
+        };
+        let probes: Vec<Vec<Option<Probes>>> = match self.many {
+            true => fragments.par_iter().map(probes_of).collect(),
+            false => fragments.iter().map(probes_of).collect(),
+        };
+        // the convex pieces merged into maximal regions, the fragments (a
+        // face of many, such as a ground, merges them on one thread: beside
+        // its shares, which need no regions)
+        let (values, regions) = match self.many {
+            true => rayon::join(|| self.view(&probes), || merge_regions(&fragments)),
+            false => (self.view(&probes), merge_regions(&fragments)),
+        };
+        let piece = |(polygon, probes): (Polygon, Vec<Option<Probes>>)| SoftPiece {
+            visible: shares(&probes, &values),
+            polygon,
+        };
+        let pieces: Vec<(Polygon, Vec<Option<Probes>>)> =
+            fragments.into_iter().map(|(p, _)| p).zip(probes).collect();
+        let mut pieces: Vec<Option<SoftPiece>> = match self.many {
+            true => pieces.into_par_iter().map(piece).map(Some).collect(),
+            false => pieces.into_iter().map(piece).map(Some).collect(),
+        };
+        regions
+            .into_iter()
+            .map(|r| {
+                let pieces: Vec<SoftPiece> = (r.cells.iter())
+                    .map(|&c| pieces[c as usize].take().expect("a piece is in one region"))
+                    .collect();
+                let visible = match pieces.len() {
+                    1 => pieces[0].visible.clone(),
+                    _ => region_shares(&r.rings, &pieces, &values),
+                };
+                fragment(r, pieces, visible)
+            })
+            .collect()
+    }
+
+    /// The fragments with only their own shares
+    /// ([`SoftVolumes::regions_only`]): each region's points are the
+    /// centroid of its largest piece and its rings' corners (a piece's own
+    /// corners where it is the region), as [`Shading::with_pieces`] takes
+    /// them; the points inside a region of many pieces are never viewed.
+    fn regions_only(&self, fragments: Vec<(Polygon, Classes)>) -> Vec<SoftFragment> {
+        let n = self.run.lights.len();
+        let regions = merge_regions(&fragments);
+        let region_probes = |r: &LabelledRegion<Classes>| -> Vec<Option<Probes>> {
+            if !(0..n).any(|k| self.wanted(&r.label, k)) {
+                return vec![None; n];
             }
-            points.sort_unstable();
-            points.dedup();
-            // (a box of what each volume holds of the face's slab costs a
-            // few hundred operations; it pays where many points look)
-            let slab = points.len() >= 32;
-            let probing = match near_face {
-                true => Probing::NearFace { slab },
-                false => Probing::Anywhere,
+            let probes = match &r.cells[..] {
+                &[one] => Probes::of(&fragments[one as usize].0),
+                cells => {
+                    let largest = largest(cells.iter().map(|&c| &fragments[c as usize].0));
+                    Probes {
+                        centroid: Probes::of(&fragments[cells[largest] as usize].0).centroid,
+                        corners: ring_corners(&r.rings),
+                    }
+                }
             };
-            let hiders = run.hiders(k, i, probing);
-            // (one point a task when stolen: the points are sorted, so the
-            // dear ones, deep in a mesh's penumbra, lie together, and a
-            // run of them must not be left to one thread)
-            let fractions = points
-                .par_iter()
-                .with_max_len(1)
-                .map(|&x| fraction_at(&lights[k], face, &hiders, x))
-                .collect();
-            Some(Viewed { points, fractions })
-        })
-        .collect();
-    let piece = |(polygon, probes): (Polygon, Vec<Option<Probes>>)| {
-        let visible = probes
-            .iter()
-            .zip(&values)
-            .map(|(p, v)| Some(p.as_ref()?.share(v.as_ref()?)))
+            (0..n)
+                .map(|k| self.wanted(&r.label, k).then(|| probes.clone()))
+                .collect()
+        };
+        let probes: Vec<Vec<Option<Probes>>> = match self.many {
+            true => regions.par_iter().map(region_probes).collect(),
+            false => regions.iter().map(region_probes).collect(),
+        };
+        let values = self.view(&probes);
+        let mut polygons: Vec<Option<Polygon>> =
+            fragments.into_iter().map(|(p, _)| Some(p)).collect();
+        (regions.into_iter().zip(&probes))
+            .map(|(r, probes)| {
+                let pieces = (r.cells.iter())
+                    .map(|&c| SoftPiece {
+                        polygon: polygons[c as usize]
+                            .take()
+                            .expect("a piece is in one region"),
+                        visible: vec![None; n],
+                    })
+                    .collect();
+                let visible = shares(probes, &values);
+                fragment(r, pieces, visible)
+            })
+            .collect()
+    }
+}
+
+/// Per light, the [`Share`] of the values at `probes`.
+fn shares(probes: &[Option<Probes>], values: &[Option<Viewed>]) -> Vec<Option<Share>> {
+    (probes.iter().zip(values))
+        .map(|(p, v)| Some(p.as_ref()?.share(v.as_ref()?)))
+        .collect()
+}
+
+/// The fragment of region `r` of convex `pieces`, with shares `visible`.
+fn fragment(
+    r: LabelledRegion<Classes>,
+    pieces: Vec<SoftPiece>,
+    visible: Vec<Option<Share>>,
+) -> SoftFragment {
+    SoftFragment {
+        rings: r.rings,
+        pieces,
+        lit: r.label.lit,
+        umbra: r.label.umbra,
+        undecided: r.label.undecided,
+        visible,
+    }
+}
+
+/// The index of the largest of `pieces` by area (the first of equal
+/// ones), in `f64`: the piece whose centroid a region's share is taken at.
+fn largest<'p>(pieces: impl Iterator<Item = &'p Polygon>) -> usize {
+    let area = |p: &Polygon| {
+        let v: Vec<DVec3> = (p.vertices_f64().iter())
+            .map(|&c| DVec3::from_array(c))
             .collect();
-        SoftPiece { polygon, visible }
+        crate::polygon_area(&v)
     };
-    // the convex pieces merged into maximal regions, the fragments
-    let regions = merge_regions(&fragments);
-    let pieces: Vec<(Polygon, Vec<Option<Probes>>)> =
-        fragments.into_iter().map(|(p, _)| p).zip(probes).collect();
-    let mut pieces: Vec<Option<SoftPiece>> = match many {
-        true => pieces.into_par_iter().map(piece).map(Some).collect(),
-        false => pieces.into_iter().map(piece).map(Some).collect(),
-    };
-    regions
-        .into_iter()
-        .map(|r| {
-            let pieces: Vec<SoftPiece> = (r.cells.iter())
-                .map(|&c| pieces[c as usize].take().expect("a piece is in one region"))
-                .collect();
-            let visible = match pieces.len() {
-                1 => pieces[0].visible.clone(),
-                _ => region_shares(&r.rings, &pieces, &values),
-            };
-            SoftFragment {
-                rings: r.rings,
-                pieces,
-                lit: r.label.lit,
-                umbra: r.label.umbra,
-                undecided: r.label.undecided,
-                visible,
-            }
-        })
+    let mut largest = 0;
+    let mut most = f64::NEG_INFINITY;
+    for (i, p) in pieces.enumerate() {
+        let a = area(p);
+        if a > most {
+            (largest, most) = (i, a);
+        }
+    }
+    largest
+}
+
+/// The grid points nearest a region's ring corners, in ring order.
+fn ring_corners(rings: &[Vec<Point>]) -> Vec<GridPoint> {
+    (rings.iter().flatten())
+        .map(|p| nearest(p.to_f64()))
         .collect()
 }
 
@@ -651,25 +817,8 @@ fn region_shares(
     pieces: &[SoftPiece],
     values: &[Option<Viewed>],
 ) -> Vec<Option<Share>> {
-    let area = |p: &Polygon| {
-        let v: Vec<DVec3> = (p.vertices_f64().iter())
-            .map(|&c| DVec3::from_array(c))
-            .collect();
-        crate::polygon_area(&v)
-    };
-    let mut largest = 0;
-    let mut most = f64::NEG_INFINITY;
-    for (i, p) in pieces.iter().enumerate() {
-        let a = area(&p.polygon);
-        if a > most {
-            (largest, most) = (i, a);
-        }
-    }
-    let corners: Vec<GridPoint> = rings
-        .iter()
-        .flatten()
-        .map(|p| nearest(p.to_f64()))
-        .collect();
+    let largest = largest(pieces.iter().map(|p| &p.polygon));
+    let corners = ring_corners(rings);
     (0..values.len())
         .map(|k| {
             let viewed = values[k].as_ref()?;
@@ -727,6 +876,7 @@ fn in_slab(reach: Reach, lights: &[Light], o: &Occluder, face: &Occluder) -> Opt
 
 /// The grid points nearest a fragment's centroid and corners, where its
 /// visible share is taken.
+#[derive(Clone)]
 struct Probes {
     centroid: GridPoint,
     corners: Vec<GridPoint>,

@@ -1521,14 +1521,7 @@ fn a_light_sealed_in_a_closed_box_leaves_the_outside_in_umbra() {
 #[test]
 fn a_ground_under_a_field_of_occluders_agrees_with_the_view() {
     let light = AreaLight::new(&square_light(-2, -2, 4, 96)).unwrap();
-    let mut faces = vec![Occluder::new(&ground(240)).unwrap()];
-    for i in -17..17 {
-        for j in -17..17 {
-            let (x, y) = (i * 10, j * 10);
-            faces.push(Occluder::new(&[[x, y, 20], [x + 7, y, 20], [x, y + 7, 21]]).unwrap());
-        }
-    }
-    assert!(faces.len() > 1100);
+    let faces = field_of_occluders(17);
     let run = |threads: usize| {
         on_threads(threads, || {
             svbsp::soft_shadows(std::slice::from_ref(&light), &faces)
@@ -1610,6 +1603,75 @@ fn a_ground_under_a_field_of_occluders_agrees_with_the_view() {
     assert!(
         asked > 20 && dark > 0,
         "{asked} penumbra pieces asked, {dark} dark"
+    );
+}
+
+/// A ground of side 480 and `(2 n)²` small triangles 20 above it, on a
+/// grid of step 10.
+fn field_of_occluders(n: i32) -> Vec<Occluder> {
+    let mut faces = vec![Occluder::new(&ground(240)).unwrap()];
+    for i in -n..n {
+        for j in -n..n {
+            let (x, y) = (i * 10, j * 10);
+            faces.push(Occluder::new(&[[x, y, 20], [x + 7, y, 20], [x, y + 7, 21]]).unwrap());
+        }
+    }
+    faces
+}
+
+/// The files' run (`soft_regions_with`: no shares for the pieces) gives
+/// every fragment, its pieces and its shares (centroid, least, most and
+/// each ring corner's, to the bit) as the full run does, under two square
+/// lights together; on a ground whose regions are made of
+/// many pieces, so a region's shares come from its rings' corners and its
+/// largest piece's centroid.
+#[test]
+fn the_files_run_gives_the_fragments_shares_of_the_full_run() {
+    let lights = [
+        AreaLight::new(&square_light(-2, -2, 4, 96)).unwrap(),
+        AreaLight::new(&square_light(30, -20, 3, 80)).unwrap(),
+    ];
+    let faces = field_of_occluders(8);
+    let full = svbsp::soft_shadows(&lights, &faces).unwrap();
+    let lean = svbsp::soft_regions_with(&lights, &faces, &|_| {}).unwrap();
+    let bits = |s: &Option<svbsp::Share>| {
+        s.as_ref().map(|s| {
+            let corners: Vec<u64> = s.corners.iter().map(|c| c.to_bits()).collect();
+            (
+                s.centroid.to_bits(),
+                s.min.to_bits(),
+                s.max.to_bits(),
+                corners,
+            )
+        })
+    };
+    let (mut shared, mut of_many) = (0, 0);
+    assert_eq!(full.len(), lean.len());
+    for (a, b) in full.iter().zip(&lean) {
+        assert_eq!(a.len(), b.len());
+        for (f, g) in a.iter().zip(b) {
+            assert_eq!((f.lit, f.umbra, f.undecided), (g.lit, g.umbra, g.undecided));
+            let ring = |f: &svbsp::SoftFragment| -> Vec<Vec<[f64; 3]>> {
+                (f.rings.iter())
+                    .map(|r| r.iter().map(|p| p.to_f64()).collect())
+                    .collect()
+            };
+            assert_eq!(ring(f), ring(g));
+            assert_eq!(f.pieces.len(), g.pieces.len());
+            for (p, q) in f.pieces.iter().zip(&g.pieces) {
+                assert_eq!(p.polygon.vertices_f64(), q.polygon.vertices_f64());
+                assert!(q.visible.iter().all(Option::is_none));
+            }
+            for (s, t) in f.visible.iter().zip(&g.visible) {
+                assert_eq!(bits(s), bits(t));
+                shared += usize::from(s.is_some());
+                of_many += usize::from(s.is_some() && f.pieces.len() > 1);
+            }
+        }
+    }
+    assert!(
+        shared > 100 && of_many > 5,
+        "{shared} shares, {of_many} of regions of many pieces"
     );
 }
 
