@@ -47,7 +47,7 @@ use crate::boxes::{Box3, Near, Reach, ReachIndex, Scan, Scans, grid_box, polygon
 use crate::light::{
     AreaLightError, Light, MAX_DISC_RADIUS, cross, plane_along, quantize_direction,
 };
-use crate::merging::{Keyed, merge_convex, merge_keyed, vertex_keys};
+use crate::merging::{Keyed, merge_convex, merge_keyed, merge_keyed_parts, vertex_keys};
 
 /// A light with extent, or its limit, as a convex set of light points
 /// given by its corners ([`Light`]s, all of one kind):
@@ -727,7 +727,8 @@ impl AreaLight {
             }
         }
         if known {
-            pieces = merge_pieces(pieces);
+            // (a face's whole: its other work waits for this merge)
+            pieces = merge_pieces(pieces, true);
             // occluders with a corner in their plane first: they hide that
             // corner (for lack of a seen neighbourhood of it), and every
             // piece that ends up hiding all corners must meet every umbra
@@ -957,14 +958,14 @@ impl Cutting<'_, '_> {
 
     /// `first` cut by every occluder in turn, its parts alike after an
     /// occluder merged again as they pile up (so later occluders meet few).
-    fn family<K: Copy + PartialEq>(&self, first: Piece<K>) -> Vec<Piece<K>> {
+    fn family<K: Copy + PartialEq + Send + Sync>(&self, first: Piece<K>) -> Vec<Piece<K>> {
         let near = self.index.as_ref().map(|index| index.near(&first.bbox));
         self.family_among(first, near.as_deref())
     }
 
     /// [`Cutting::family`], with the index's answer for `first`'s box
     /// (`near`) where there is an index.
-    fn family_among<K: Copy + PartialEq>(
+    fn family_among<K: Copy + PartialEq + Send + Sync>(
         &self,
         first: Piece<K>,
         near: Option<&[u32]>,
@@ -1019,7 +1020,7 @@ impl Cutting<'_, '_> {
             parts.iter().for_each(|p| scans.push(scan(p)));
             pieces.append(&mut parts);
             if pieces.len() > 16 && pieces.len() > 2 * merged {
-                pieces = merge_pieces(pieces);
+                pieces = merge_pieces(pieces, false);
                 scans = Scans::new(pieces.iter().map(scan));
                 merged = pieces.len();
             }
@@ -1240,8 +1241,13 @@ fn cut_piece<K: Copy>(r: &Regions, piece: Piece<K>, all: u64, next: &mut Vec<Pie
 }
 
 /// Pieces of equal label and state merged where their union is convex
-/// (their keys kept; a merged piece's box is its parts' boxes' union).
-fn merge_pieces<K: Copy + PartialEq>(pieces: Vec<Piece<K>>) -> Vec<Piece<K>> {
+/// (their keys kept; a merged piece's box is its parts' boxes' union);
+/// with `parts`, many in parts in parallel ([`merge_keyed_parts`]: the
+/// same pieces).
+fn merge_pieces<K: Copy + PartialEq + Send + Sync>(
+    pieces: Vec<Piece<K>>,
+    parts: bool,
+) -> Vec<Piece<K>> {
     let items = pieces
         .into_iter()
         .map(|p| Keyed {
@@ -1251,21 +1257,25 @@ fn merge_pieces<K: Copy + PartialEq>(pieces: Vec<Piece<K>>) -> Vec<Piece<K>> {
             extra: p.bbox,
         })
         .collect();
-    merge_keyed(items, |a: &Box3, b: &Box3| crate::boxes::union(*a, *b))
-        .into_iter()
-        .map(|m| {
-            let (label, not_lit, hidden, umbra) = m.label;
-            Piece {
-                polygon: m.polygon,
-                bbox: m.extra,
-                label,
-                not_lit,
-                hidden,
-                umbra,
-                keys: Some(m.keys),
-            }
-        })
-        .collect()
+    let join = |a: &Box3, b: &Box3| crate::boxes::union(*a, *b);
+    match parts {
+        true => merge_keyed_parts(items, join),
+        false => merge_keyed(items, join),
+    }
+    .into_iter()
+    .map(|m| {
+        let (label, not_lit, hidden, umbra) = m.label;
+        Piece {
+            polygon: m.polygon,
+            bbox: m.extra,
+            label,
+            not_lit,
+            hidden,
+            umbra,
+            keys: Some(m.keys),
+        }
+    })
+    .collect()
 }
 
 /// `parts` cut by the shadow volume `hs` of light corner `i`, the parts

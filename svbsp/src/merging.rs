@@ -105,25 +105,39 @@ pub(crate) fn vertex_keys(p: &Polygon) -> Vec<[u64; 3]> {
 /// Merges polygons of equal labels pairwise where their union is convex
 /// (`Polygon::merge`, exact), until none do; only pairs that share two
 /// vertex keys are tried. Deterministic: the order of the input decides.
-pub(crate) fn merge_convex<T: Copy + PartialEq + Send>(
-    items: Vec<(Polygon, T)>,
-) -> Vec<(Polygon, T)> {
-    let keyed = |(polygon, label): (Polygon, T)| Keyed {
-        keys: vertex_keys(&polygon),
-        polygon,
-        label,
-        extra: (),
-    };
-    // (the keys round every exact vertex: a face of many pieces, such as
-    // a ground under a mesh, rounds them on every thread, in order)
-    let items = match items.len() >= crate::schedule::PARALLEL_CELLS {
-        true => items.into_par_iter().map(keyed).collect(),
-        false => items.into_iter().map(keyed).collect(),
-    };
+pub(crate) fn merge_convex<T: Copy + PartialEq>(items: Vec<(Polygon, T)>) -> Vec<(Polygon, T)> {
+    let items = items.into_iter().map(keyed).collect();
     merge_keyed(items, |_, _| ())
         .into_iter()
         .map(|m| (m.polygon, m.label))
         .collect()
+}
+
+/// [`merge_convex`] of a face's pieces whose other work waits for it (a
+/// ground under a mesh): their keys made on every thread, in order, and
+/// many merged in parts in parallel ([`merge_keyed_parts`]); the same
+/// polygons.
+pub(crate) fn merge_convex_parts<T: Copy + PartialEq + Send + Sync>(
+    items: Vec<(Polygon, T)>,
+) -> Vec<(Polygon, T)> {
+    let items = match items.len() >= crate::schedule::PARALLEL_CELLS {
+        true => items.into_par_iter().map(keyed).collect(),
+        false => items.into_iter().map(keyed).collect(),
+    };
+    merge_keyed_parts(items, |_, _| ())
+        .into_iter()
+        .map(|m| (m.polygon, m.label))
+        .collect()
+}
+
+/// A polygon with its vertex keys, to merge.
+fn keyed<T>((polygon, label): (Polygon, T)) -> Keyed<T, ()> {
+    Keyed {
+        keys: vertex_keys(&polygon),
+        polygon,
+        label,
+        extra: (),
+    }
 }
 
 /// A polygon to merge: its label, its vertex keys, and something that two
@@ -150,9 +164,98 @@ pub(crate) struct Keyed<T, X> {
 /// up as the pass began: the one that grows is never a partner of those
 /// after it, and the one it takes is dead).
 pub(crate) fn merge_keyed<T: Copy + PartialEq, X>(
-    mut items: Vec<Keyed<T, X>>,
+    items: Vec<Keyed<T, X>>,
     join: impl Fn(&X, &X) -> X,
 ) -> Vec<Keyed<T, X>> {
+    merge_part(items, &join)
+}
+
+/// [`merge_keyed`] for a caller that has both cores to itself (a face of
+/// many pieces whose other work waits for the merge): many polygons
+/// (from [`PARALLEL_MERGE`] on) are merged in parts, in parallel: the
+/// polygons of one label linked by shared keys, each part in index order.
+/// A merged polygon's corners are its two parts', so a polygon's
+/// partners, then and later, are all in its part, and what happens in
+/// one part never changes what happens in another: the same polygons as
+/// merged all at once, in the same order. (Inside work that is parallel
+/// already, finding the parts only costs.)
+pub(crate) fn merge_keyed_parts<T: Copy + PartialEq + Send + Sync, X: Send>(
+    items: Vec<Keyed<T, X>>,
+    join: impl Fn(&X, &X) -> X + Sync,
+) -> Vec<Keyed<T, X>> {
+    if items.len() < PARALLEL_MERGE {
+        return merge_part(items, &join);
+    }
+    // the parts: polygons of one label sharing a key
+    let mut parts = bsp_core::internals::UnionFind::new(items.len());
+    let mut at: rustc_hash::FxHashMap<[u64; 3], SmallVec<[u32; 4]>> = Default::default();
+    at.reserve(items.len() * 2);
+    for (i, item) in items.iter().enumerate() {
+        for k in &item.keys {
+            at.entry(*k).or_default().push(i as u32);
+        }
+    }
+    for list in at.values() {
+        for (n, &i) in list.iter().enumerate() {
+            if let Some(&j) =
+                (list[..n].iter()).find(|&&j| items[j as usize].label == items[i as usize].label)
+            {
+                parts.union(i, j);
+            }
+        }
+    }
+    drop(at);
+    // each part's polygons in index order, the parts in order of their
+    // first polygon
+    let mut part_of: rustc_hash::FxHashMap<u32, usize> = Default::default();
+    let mut members: Vec<Vec<(u32, Keyed<T, X>)>> = Vec::new();
+    for (i, item) in items.into_iter().enumerate() {
+        let root = parts.find(i as u32);
+        let p = *part_of.entry(root).or_insert_with(|| {
+            members.push(Vec::new());
+            members.len() - 1
+        });
+        members[p].push((i as u32, item));
+    }
+    let merged: Vec<Vec<(u32, Keyed<T, X>)>> = members
+        .into_par_iter()
+        .map(|part| {
+            let (index, mut items): (Vec<u32>, Vec<Keyed<T, X>>) = part.into_iter().unzip();
+            let dead = merge_in_place(&mut items, &join);
+            (index.into_iter().zip(items).zip(dead))
+                .filter_map(|(item, d)| (!d).then_some(item))
+                .collect()
+        })
+        .collect();
+    let mut all: Vec<(u32, Keyed<T, X>)> = merged.into_iter().flatten().collect();
+    all.sort_unstable_by_key(|&(i, _)| i);
+    all.into_iter().map(|(_, item)| item).collect()
+}
+
+/// From this many polygons on, [`merge_keyed`] merges its parts in
+/// parallel.
+const PARALLEL_MERGE: usize = 1024;
+
+/// [`merge_keyed`] of one part (or of all polygons), on one thread.
+fn merge_part<T: Copy + PartialEq, X>(
+    mut items: Vec<Keyed<T, X>>,
+    join: &impl Fn(&X, &X) -> X,
+) -> Vec<Keyed<T, X>> {
+    let dead = merge_in_place(&mut items, join);
+    let mut k = 0;
+    items.retain(|_| {
+        k += 1;
+        !dead[k - 1]
+    });
+    items
+}
+
+/// [`merge_part`] in place: each merged polygon at the place of its
+/// first part, and whether each polygon was merged into an earlier one.
+fn merge_in_place<T: Copy + PartialEq, X>(
+    items: &mut [Keyed<T, X>],
+    join: &impl Fn(&X, &X) -> X,
+) -> Vec<bool> {
     // each key to the live polygons with it, once for each time it is one
     // of their keys (a vertex is a corner of a few polygons: no list
     // allocated for it)
@@ -219,12 +322,7 @@ pub(crate) fn merge_keyed<T: Copy + PartialEq, X>(
         active.sort_unstable();
         active.dedup();
     }
-    let mut k = 0;
-    items.retain(|_| {
-        k += 1;
-        !dead[k - 1]
-    });
-    items
+    dead
 }
 
 /// Takes polygon `i` off the lists of `keys`, once for each time a key
@@ -294,7 +392,8 @@ mod tests {
     /// A grid of unit squares, each cut into two triangles along a
     /// random diagonal, with random labels of two kinds, in a random
     /// order: the merge gives what passes over everything give, polygon
-    /// for polygon and label for label, in the same order.
+    /// for polygon and label for label, in the same order; and so does
+    /// the merge in parts.
     #[test]
     fn later_passes_visit_only_what_changed_and_give_the_same() {
         let mut state = 0x5eed_u64;
@@ -305,8 +404,13 @@ mod tests {
             state % n
         };
         let mut merged_some = 0;
-        for round in 0..20 {
-            let side = 4 + round % 9;
+        // (the last rounds have more triangles than one thread merges, so
+        // `merge_convex_parts` merges them in parts)
+        for round in 0..23 {
+            let side = match round {
+                0..20 => 4 + round % 9,
+                _ => 24 + 6 * (round - 20),
+            };
             let mut items: Vec<(Polygon, u8)> = Vec::new();
             for x in 0..side {
                 for y in 0..side {
@@ -326,13 +430,18 @@ mod tests {
                 items.swap(i, draw(i as u64 + 1) as usize);
             }
             let want = every_pass(items.clone());
-            let got = merge_convex(items.clone());
-            assert_eq!(got.len(), want.len(), "round {round}");
-            for ((p, a), (q, b)) in got.iter().zip(&want) {
-                assert_eq!(a, b);
-                assert_eq!(p.vertices_f64(), q.vertices_f64(), "round {round}");
+            for got in [
+                merge_convex(items.clone()),
+                merge_convex_parts(items.clone()),
+            ] {
+                assert_eq!(got.len(), want.len(), "round {round}");
+                for ((p, a), (q, b)) in got.iter().zip(&want) {
+                    assert_eq!(a, b);
+                    assert_eq!(p.vertices_f64(), q.vertices_f64(), "round {round}");
+                }
             }
-            merged_some += usize::from(got.len() < items.len() / 2);
+            assert_eq!(items.len() >= PARALLEL_MERGE, round >= 20);
+            merged_some += usize::from(want.len() < items.len() / 2);
         }
         assert!(
             merged_some > 10,

@@ -24,7 +24,7 @@ use crate::blockers::{coplanar_blockers, coplanar_blockers_of, plane_key};
 use crate::boxes::{Box3, CellGrid, EMPTY, EVERYWHERE, Reach, grid_box, meet};
 use crate::engine::{LightVolumes, Scratch, ShadowSet};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
-use crate::merging::{LabelledRegion, merge_convex, merge_regions};
+use crate::merging::{LabelledRegion, merge_convex_parts, merge_regions};
 use crate::near::{InSlab, near_lists, slab_box};
 
 /// The share of a polygon light's irradiance that arrives on a penumbra
@@ -546,7 +546,7 @@ fn soft_face(
     face: &Occluder,
     scratch: &mut Scratch,
 ) -> Vec<SoftFragment> {
-    let fragments = merge_convex(cut_face(run, i, face, scratch));
+    let fragments = merge_convex_parts(cut_face(run, i, face, scratch));
     let shading = Shading {
         run,
         i,
