@@ -353,7 +353,7 @@ impl<'a> SoftVolumes<'a> {
         let done: Vec<Vec<SoftFragment>> = order
             .par_iter()
             .map_init(Scratch::default, |scratch, &i| {
-                let fragments = soft_face(self, i, &self.faces[i], scratch);
+                let fragments = soft_face(self, (i, large.contains(&i)), &self.faces[i], scratch);
                 on_faces(1);
                 fragments
             })
@@ -376,7 +376,7 @@ impl<'a> SoftVolumes<'a> {
             return vec![None; points.len()];
         }
         let f = &self.faces[face];
-        let hiders = self.hiders(light, face, Probing::Anywhere);
+        let hiders = self.hiders(light, face, (Probing::Anywhere, points.len()));
         // (one point a task when stolen: neighbouring points cost alike,
         // and the dear ones, deep in a mesh's penumbra, lie together)
         points
@@ -388,7 +388,7 @@ impl<'a> SoftVolumes<'a> {
 
     /// The occluders near face `face` that may hide some of light
     /// `light`, found by point, for points `probing` says where.
-    fn hiders(&self, light: usize, face: usize, probing: Probing) -> Hiders<'_> {
+    fn hiders(&self, light: usize, face: usize, probing: (Probing, usize)) -> Hiders<'_> {
         let near = self.near[light][face].iter().filter_map(|&j| {
             let j = j as usize;
             let r = self.regions[light][j].as_ref()?;
@@ -506,10 +506,14 @@ impl AreaLight {
                         class: AreaClass::Umbra,
                     }];
                 }
-                let others =
-                    near_occluders(near, (regions, reach, &run.blockers), self.corners(), face)
-                        .into_iter()
-                        .chain(crate::cores::cores_at(cores, face));
+                let others = near_occluders(
+                    near,
+                    (regions, reach, &run.blockers),
+                    self.corners(),
+                    (face, true),
+                )
+                .into_iter()
+                .chain(crate::cores::cores_at(cores, face));
                 let mut seen = corner_cells(set.as_ref(), (face, i, faces.len()), scratch);
                 self.classify_with(face, others, Some(&mut seen))
             })
@@ -542,11 +546,11 @@ fn corner_cells<'a, 't: 'a>(
 /// The fragments of face `i` of `run`, `face`.
 fn soft_face(
     run: &SoftVolumes<'_>,
-    i: usize,
+    (i, large): (usize, bool),
     face: &Occluder,
     scratch: &mut Scratch,
 ) -> Vec<SoftFragment> {
-    let fragments = merge_convex_parts(cut_face(run, i, face, scratch));
+    let fragments = merge_convex_parts(cut_face(run, (i, large), face, scratch));
     let shading = Shading {
         run,
         i,
@@ -567,7 +571,7 @@ fn soft_face(
 /// light.
 fn cut_face(
     run: &SoftVolumes<'_>,
-    i: usize,
+    (i, large): (usize, bool),
     face: &Occluder,
     scratch: &mut Scratch,
 ) -> Vec<(Polygon, Classes)> {
@@ -593,7 +597,7 @@ fn cut_face(
             near[k],
             (&regions[k], &reach[k], &run.blockers),
             light.corners(),
-            face,
+            (face, large),
         );
         let occluders = occluders
             .into_iter()
@@ -650,7 +654,7 @@ impl Shading<'_, '_> {
                     true => Probing::NearFace { slab },
                     false => Probing::Anywhere,
                 };
-                let hiders = self.run.hiders(k, self.i, probing);
+                let hiders = self.run.hiders(k, self.i, (probing, points.len()));
                 // (one point a task when stolen: the points are sorted, so the
                 // dear ones, deep in a mesh's penumbra, lie together, and a
                 // run of them must not be left to one thread)
@@ -837,12 +841,12 @@ fn near_occluders<'r>(
     near: &[u32],
     (regions, reach, blockers): (&'r [Option<Regions>], &[Reach], &[Occluder]),
     light: &[Light],
-    face: &Occluder,
+    (face, large): (&Occluder, bool),
 ) -> Vec<(&'r Regions, Reach)> {
     let occluder = |&j: &u32| {
         let r = regions[j as usize].as_ref()?;
         let reach = reach[j as usize];
-        match near.len() > TIGHTENED {
+        match large && near.len() > TIGHTENED {
             true => Some((r, in_slab(reach, light, &blockers[j as usize], face)?)),
             false => Some((r, reach)),
         }
@@ -1056,9 +1060,16 @@ enum Probing {
 /// one the whole face is inside needs no test.
 struct Hiders<'a> {
     occluders: Vec<Hider<'a>>,
-    grid: CellGrid,
+    /// Their boxes in cells, where many points ask ([`FEW_POINTS`]);
+    /// else each point passes over them all.
+    grid: Option<CellGrid>,
     backs: &'a SolidBacks,
 }
+
+/// For at most this many points, a face's [`Hiders`] are passed over one
+/// by one: a grid of their boxes costs more than it saves (a small face
+/// of a scan under a near light has thousands, and four points).
+const FEW_POINTS: usize = 16;
 
 /// A face's near occluders with their volumes, boxes and
 /// [`SolidBacks::of`], and the run's [`SolidBacks`].
@@ -1074,7 +1085,7 @@ impl<'a> Hiders<'a> {
         face: &Occluder,
         light: &[Light],
         (occluders, backs): Near<'a>,
-        probing: Probing,
+        (probing, points): (Probing, usize),
     ) -> Hiders<'a> {
         // points near the face lie within 1 of its box, and in the slab
         // of `slab_box` around its plane
@@ -1099,7 +1110,7 @@ impl<'a> Hiders<'a> {
         };
         let boxes: Vec<Box3> = occluders.iter().map(|o| o.2).collect();
         Hiders {
-            grid: CellGrid::new(face_box, &boxes),
+            grid: (points > FEW_POINTS).then(|| CellGrid::new(face_box, &boxes)),
             occluders,
             backs,
         }
@@ -1115,7 +1126,7 @@ impl<'a> Hiders<'a> {
         let mut found = Vec::new();
         // per part met: whether `x` lies outside it
         let mut outside: Vec<(u32, bool)> = Vec::new();
-        self.grid.visit([0, 1, 2].map(|k| [at[k], at[k]]), |i| {
+        let test = |i: u32| {
             let (o, tests, b, back) = &self.occluders[i as usize];
             let in_box = (0..3).all(|k| b[k][0] <= at[k] && at[k] <= b[k][1]);
             if !in_box || !tests.iter().all(|(h, s)| h.classify_grid(x) == *s) {
@@ -1137,7 +1148,11 @@ impl<'a> Hiders<'a> {
                 }
             }
             found.push((i, *o));
-        });
+        };
+        match &self.grid {
+            Some(grid) => grid.visit([0, 1, 2].map(|k| [at[k], at[k]]), test),
+            None => (0..self.occluders.len() as u32).for_each(test),
+        }
         // a point meets one cell, but keep the order whatever the grid
         found.sort_unstable_by_key(|&(i, _)| i);
         found.dedup_by_key(|&mut (i, _)| i);
