@@ -1092,8 +1092,11 @@ impl<'a> Hiders<'a> {
         let face_box = grid_box(face.corners());
         let near = face_box.map(|[lo, hi]| [lo - 1, hi + 1]);
         let hider = |(o, r, b, back): (&'a Occluder, &'a Regions, Box3, _)| {
-            let Probing::NearFace { slab } = probing else {
-                return Some((o, Cow::Borrowed(&r.penumbra[..]), b, back));
+            // (for a few points, every half-space tested at each costs less
+            // than finding those that matter near the face)
+            let slab = match probing {
+                Probing::NearFace { slab } if points > FEW_POINTS => slab,
+                _ => return Some((o, Cow::Borrowed(&r.penumbra[..]), b, back)),
             };
             let tests = face_tests(face.corners(), &r.penumbra)?;
             let b = match slab.then(|| slab_box(light, o.corners(), face.plane())) {
