@@ -232,7 +232,7 @@ pub(crate) fn merge_keyed_parts<T: Copy + PartialEq + Send + Sync, X: Send>(
     all.into_iter().map(|(_, item)| item).collect()
 }
 
-/// From this many polygons on, [`merge_keyed`] merges its parts in
+/// From this many polygons on, [`merge_keyed_parts`] merges its parts in
 /// parallel.
 const PARALLEL_MERGE: usize = 1024;
 

@@ -387,8 +387,8 @@ impl<'a> SoftVolumes<'a> {
     }
 
     /// The occluders near face `face` that may hide some of light
-    /// `light`, found by point, for points `probing` says where.
-    fn hiders(&self, light: usize, face: usize, probing: (Probing, usize)) -> Hiders<'_> {
+    /// `light`, found by point, for `points` points `probing` says where.
+    fn hiders(&self, light: usize, face: usize, (probing, points): (Probing, usize)) -> Hiders<'_> {
         let near = self.near[light][face].iter().filter_map(|&j| {
             let j = j as usize;
             let r = self.regions[light][j].as_ref()?;
@@ -403,7 +403,7 @@ impl<'a> SoftVolumes<'a> {
             &self.faces[face],
             self.lights[light].corners(),
             (near.collect(), &self.backs),
-            probing,
+            (probing, points),
         )
     }
 }
@@ -833,10 +833,12 @@ fn region_shares(
 }
 
 /// The occluders near `face` (numbers `near` into `regions`, `reach` and
-/// `blockers`) with their volumes and boxes: for a face with many, the
-/// boxes narrowed to what the volumes hold of the slab round its plane
-/// ([`in_slab`]; one that holds none is left out), in parallel for a
-/// face with very many (a ground under a mesh). In `near`'s order.
+/// `blockers`) with their volumes and boxes: for a `large` face (one
+/// scheduled first, of many pieces) with many, the boxes narrowed to
+/// what the volumes hold of the slab round its plane ([`in_slab`]; one
+/// that holds none is left out: a small face of one piece would pay more
+/// for the narrowing than its cutting saves), in parallel for a face
+/// with very many (a ground under a mesh). In `near`'s order.
 fn near_occluders<'r>(
     near: &[u32],
     (regions, reach, blockers): (&'r [Option<Regions>], &[Reach], &[Occluder]),
@@ -861,7 +863,7 @@ fn near_occluders<'r>(
 /// parallel (their boxes narrowed, their tests for its points).
 const PARALLEL_OCCLUDERS: usize = 1024;
 
-/// A face with more occluders near it than this has their boxes
+/// A large face with more occluders near it than this has their boxes
 /// ([`Reach`]) narrowed to what their volumes hold of the slab round its
 /// plane before its pieces are cut.
 const TIGHTENED: usize = 128;
@@ -1079,8 +1081,8 @@ type Near<'a> = (
 );
 
 impl<'a> Hiders<'a> {
-    /// The hiders of `face` among `occluders`, for points `probing` says
-    /// where.
+    /// The hiders of `face` among `occluders`, for `points` points
+    /// `probing` says where.
     fn new(
         face: &Occluder,
         light: &[Light],
