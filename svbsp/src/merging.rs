@@ -164,10 +164,16 @@ pub(crate) struct Keyed<T, X> {
 /// up as the pass began: the one that grows is never a partner of those
 /// after it, and the one it takes is dead).
 pub(crate) fn merge_keyed<T: Copy + PartialEq, X>(
-    items: Vec<Keyed<T, X>>,
+    mut items: Vec<Keyed<T, X>>,
     join: impl Fn(&X, &X) -> X,
 ) -> Vec<Keyed<T, X>> {
-    merge_part(items, &join)
+    let dead = merge_in_place(&mut items, &join);
+    let mut k = 0;
+    items.retain(|_| {
+        k += 1;
+        !dead[k - 1]
+    });
+    items
 }
 
 /// [`merge_keyed`] for a caller that has both cores to itself (a face of
@@ -184,7 +190,7 @@ pub(crate) fn merge_keyed_parts<T: Copy + PartialEq + Send + Sync, X: Send>(
     join: impl Fn(&X, &X) -> X + Sync,
 ) -> Vec<Keyed<T, X>> {
     if items.len() < PARALLEL_MERGE {
-        return merge_part(items, &join);
+        return merge_keyed(items, &join);
     }
     // the parts: polygons of one label sharing a key
     let mut parts = bsp_core::internals::UnionFind::new(items.len());
@@ -236,21 +242,7 @@ pub(crate) fn merge_keyed_parts<T: Copy + PartialEq + Send + Sync, X: Send>(
 /// parallel.
 const PARALLEL_MERGE: usize = 1024;
 
-/// [`merge_keyed`] of one part (or of all polygons), on one thread.
-fn merge_part<T: Copy + PartialEq, X>(
-    mut items: Vec<Keyed<T, X>>,
-    join: &impl Fn(&X, &X) -> X,
-) -> Vec<Keyed<T, X>> {
-    let dead = merge_in_place(&mut items, join);
-    let mut k = 0;
-    items.retain(|_| {
-        k += 1;
-        !dead[k - 1]
-    });
-    items
-}
-
-/// [`merge_part`] in place: each merged polygon at the place of its
+/// [`merge_keyed`] in place: each merged polygon at the place of its
 /// first part, and whether each polygon was merged into an earlier one.
 fn merge_in_place<T: Copy + PartialEq, X>(
     items: &mut [Keyed<T, X>],
