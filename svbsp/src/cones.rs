@@ -20,8 +20,11 @@
 //! allowed), those are exactly the light points in its cone: the ray to
 //! `q` meets it before the light's plane. Where it lies on the light's
 //! plane or beyond, it hides no area of the light; a sun is beyond every
-//! occluder. An occluder crossing the light's plane, or a face's plane
-//! that cuts the light, is left to the general paths
+//! occluder. What lies behind the point's face is cut off by the plane
+//! through `x` parallel to the face's (its normal, below `2^55` too): the
+//! face's own plane where `x` lies on it, and for a probe point rounded
+//! off it, the half-space its irradiance is taken over. An occluder
+//! crossing the light's plane is left to the general paths
 //! (`AreaLight::view_among`, which cuts exact polygons in space, and the
 //! sun's chart in `soft.rs`).
 
@@ -137,12 +140,7 @@ pub(crate) fn seen_share<'o>(
     normal: DVec3,
     hiders: impl Iterator<Item = &'o Occluder>,
 ) -> Option<Option<f64>> {
-    let side = light.classify_grid(x);
-    if side != Side::Front
-        || corners
-            .iter()
-            .any(|&l| face.classify_grid(l) != Side::Front)
-    {
+    if light.classify_grid(x) != Side::Front {
         return None;
     }
     // every occluder wholly on `x`'s side of the light's plane, or on it
@@ -165,7 +163,17 @@ pub(crate) fn seen_share<'o>(
         }
     }
     let mut pool = Pool::default();
-    let light_cone = pool.add(&light_cone(corners.iter().map(|&c| from(x, c)))?);
+    let mut light_cone = pool.add(&light_cone(corners.iter().map(|&c| from(x, c)))?);
+    // what lies in front of the face, seen from `x`: beyond the plane
+    // through `x` parallel to the face's
+    let front = face.normal();
+    let s = sides(&pool, light_cone, &front);
+    if s.iter().all(|&v| v <= 0) {
+        return Some(None);
+    }
+    if s.contains(&-1) {
+        light_cone = keep(&mut pool, light_cone, &s, 1, front);
+    }
     let all = form_factor(normal, pool.rays(light_cone));
     if all <= 0.0 {
         return Some(None);
@@ -711,8 +719,10 @@ mod tests {
         /// Where it applies, the cones see what the general path sees:
         /// fully lit and nothing seen alike, else a seen part of exactly
         /// the same area on the light's plane (exact rationals; the two
-        /// shares are `f64` sums over differently cut pieces). It does not
-        /// apply where an occluder crosses the light's plane.
+        /// shares are `f64` sums over differently cut pieces), on the
+        /// ground and on faces through `x` tilted so that their plane
+        /// cuts the light, or leaves it all behind. It does not apply
+        /// where an occluder crosses the light's plane.
         #[test]
         fn the_cones_see_what_the_general_path_sees(
             scale in prop_oneof![Just(1), Just(3), Just(1 << 19)],
@@ -721,24 +731,28 @@ mod tests {
             field in (-30i32..0, -30i32..0, 1i32..12, 1usize..6),
             z in prop::collection::vec(10i32..80, 1..6),
             loose in prop::collection::vec(prop::array::uniform3((-40i32..40, -40i32..40, 5i32..103)), 0..6),
+            tilt in prop_oneof![Just((0, 1)), Just((8, 1)), Just((30, 1)), Just((-60, 1)), Just((1, 0)), Just((-8, -7))],
         ) {
             let (lx, ly, size, lz) = light;
             // clockwise seen from above: it shines down
             let corners = [[lx, ly, lz], [lx, ly + size, lz], [lx + size, ly + size, lz], [lx + size, ly, lz]]
                 .map(|c| c.map(|v| v * scale));
             let light = AreaLight::new(&corners).unwrap();
-            let ground = Plane::through([0, 0, 0], [1, 0, 0], [0, 1, 0]).unwrap();
             let x = [x.0 * scale, x.1 * scale, 0];
+            // the face through `x`: the ground turned about the x axis
+            let (p, q) = tilt;
+            let ground = Plane::through(x, [x[0] + 1, x[1], x[2]], [x[0], x[1] + q, x[2] + p]).unwrap();
+            let normal = DVec3::from_array(ground.normal().map(|c| c as f64)).normalize();
             let hiders = scene(scale, field, &z, &loose);
             let crosses = hiders.iter().any(|o| {
                 let s = o.corners().iter().map(|&c| light.plane().unwrap().classify_grid(c));
                 let s: Vec<Side> = s.collect();
                 s.contains(&Side::Front) && s.contains(&Side::Back)
             });
-            let quick = seen_share(light.grid_corners().unwrap(), light.plane().unwrap(), &ground, x, DVec3::Z, hiders.iter());
+            let quick = seen_share(light.grid_corners().unwrap(), light.plane().unwrap(), &ground, x, normal, hiders.iter());
             prop_assert_eq!(quick.is_none(), crosses);
             if let Some(quick) = quick {
-                let (view, slow) = general(&light, &ground, x, DVec3::Z, &hiders).unzip();
+                let (view, slow) = general(&light, &ground, x, normal, &hiders).unzip();
                 let slow = slow.flatten();
                 match (quick, slow) {
                     (Some(q), Some(s)) if q == 1.0 || s == 1.0 || q == 0.0 || s == 0.0 => prop_assert_eq!(q, s),
