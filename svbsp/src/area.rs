@@ -43,7 +43,7 @@ use bsp_core::{FaceDefect, GridPoint, MAX_COORD, Plane, Polygon, PolygonSide, Si
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::boxes::{Box3, Near, Reach, ReachIndex, Scan, Scans, grid_box, polygon_box};
+use crate::boxes::{Box3, EMPTY, Near, Reach, ReachIndex, Scan, Scans, grid_box, polygon_box};
 use crate::light::{
     AreaLightError, Light, MAX_DISC_RADIUS, cross, plane_along, quantize_direction,
 };
@@ -731,8 +731,14 @@ impl AreaLight {
             pieces = merge_pieces(pieces, true);
             // occluders with a corner in their plane first: they hide that
             // corner (for lack of a seen neighbourhood of it), and every
-            // piece that ends up hiding all corners must meet every umbra
-            regions.sort_by_key(|(r, _)| r.from_corner.iter().all(Option::is_some));
+            // piece that ends up hiding all corners must meet every umbra;
+            // then those that cut by their umbra only (the inner occluders,
+            // whose penumbra box is empty): under a closed mesh one of them
+            // takes at once what the faces' small umbrae would cut into
+            // thousands of pieces
+            regions.sort_by_key(|(r, reach)| {
+                (r.from_corner.iter().all(Option::is_some), reach[0] != EMPTY)
+            });
         }
         // pieces whose class no occluder can change stay as they are (with
         // their corners known: umbra, or seeing some corners and hiding
