@@ -1396,6 +1396,55 @@ mod tests {
         }
     }
 
+    /// The occluders that cut by their umbra only (inner occluders: an
+    /// empty penumbra box) cut a face's pieces before the others, wherever
+    /// they stand in the list: under a large one, the small umbrae of the
+    /// others meet nothing left to cut, and the pieces are those of the
+    /// list with it first.
+    #[test]
+    fn umbra_only_occluders_cut_first() {
+        let light = AreaLight::new(&[[-8, -8, 90], [-8, 8, 90], [8, 8, 90], [8, -8, 90]]).unwrap();
+        let ground =
+            Occluder::new(&[[-60, -60, 0], [60, -60, 0], [60, 60, 0], [-60, 60, 0]]).unwrap();
+        let wide = grid_box(&[[-100, -100, -1], [100, 100, 100]]);
+        // sixteen squares each with an umbra of its own on the ground
+        let mut occluders: Vec<(Regions, Reach)> = Vec::new();
+        for i in 0..4 {
+            for j in 0..4 {
+                let (x, y) = (-18 + 9 * i, -18 + 9 * j);
+                let q = [
+                    [x, y, 10],
+                    [x + 8, y, 10],
+                    [x + 8, y + 8, 10],
+                    [x, y + 8, 10],
+                ];
+                let o = Occluder::new(&q).unwrap();
+                occluders.push((light.regions(&o).unwrap(), [wide, wide]));
+            }
+        }
+        let core =
+            Occluder::new(&[[-40, -40, 30], [40, -40, 30], [40, 40, 30], [-40, 40, 30]]).unwrap();
+        let core = (light.regions(&core).unwrap(), [EMPTY, wide]);
+        let cut = |list: Vec<&(Regions, Reach)>| {
+            // (the corners' trees say the whole ground hides every corner)
+            let mut hidden = |p: &Polygon| Some(vec![(p.clone(), 0u64)]);
+            let pieces = vec![(ground.to_polygon(), ())];
+            let list = list.into_iter().map(|(r, b)| (r, *b));
+            light.cut(&ground, pieces, list, Some(&mut hidden))
+        };
+        let last = cut(occluders.iter().chain([&core]).collect());
+        let first = cut([&core].into_iter().chain(occluders.iter()).collect());
+        assert_eq!(last.len(), first.len());
+        for (a, b) in last.iter().zip(&first) {
+            assert_eq!(a.0.vertices_f64(), b.0.vertices_f64());
+            assert_eq!(a.2, b.2);
+        }
+        // the core's umbra whole, the rest of the ground in a few pieces
+        let umbra = last.iter().filter(|p| p.2 == AreaClass::Umbra).count();
+        assert!(umbra < occluders.len(), "{umbra} umbra pieces");
+        assert!(umbra >= 1 && last.iter().any(|p| p.2 == AreaClass::Undecided));
+    }
+
     /// The umbra volume with one plane per occluder edge holds exactly
     /// the points in every corner's shadow volume: random triangles and
     /// quads under a square light and a sun disc, at random grid points.
