@@ -173,6 +173,16 @@ impl CellGrid {
         CellGrid::of_side(scene, [side; 3], faces)
     }
 
+    /// [`CellGrid::new`] over the boxes `items` (each with its index) only,
+    /// within `scene`, which holds them.
+    pub(crate) fn of_items(scene: Box3, items: &[(u32, Box3)]) -> CellGrid {
+        let mut grid = CellGrid::empty(scene, items.len());
+        for &(i, b) in items {
+            grid.insert(i, b);
+        }
+        grid
+    }
+
     /// A grid of cells about `side` long per axis (longer where that
     /// would make more than about two cells per face), none listed.
     fn of_side(scene: Box3, mut side: [f64; 3], faces: usize) -> CellGrid {

@@ -26,7 +26,21 @@ pub(crate) fn near_lists(
     let Some(scene) = boxes.iter().copied().reduce(union) else {
         return (Vec::new(), Vec::new());
     };
-    let grid = CellGrid::new(scene, &boxes);
+    // the faces as wide as the scene on two axes (a ground) apart, the
+    // others in a grid over their own box: cells of about one face each
+    // where the faces are (a grid over the ground's box would put the
+    // whole mesh in a few of its cells, each visited by every occluder)
+    let wide_face = |b: &Box3| {
+        (0..3)
+            .filter(|&k| 4 * (b[k][1] - b[k][0]) > scene[k][1] - scene[k][0])
+            .count()
+            >= 2
+    };
+    let (wide, small): (Vec<(u32, Box3)>, Vec<(u32, Box3)>) = (boxes.iter().enumerate())
+        .map(|(i, b)| (i as u32, *b))
+        .partition(|(_, b)| wide_face(b));
+    let small_box = small.iter().map(|(_, b)| *b).reduce(union).unwrap_or(scene);
+    let grid = CellGrid::of_items(small_box, &small);
     let reaches: Vec<Reach> = occluders
         .par_iter()
         .map(|f| {
@@ -53,11 +67,18 @@ pub(crate) fn near_lists(
                 // the cells of the parts only (not of their whole box),
                 // each face once before the exact test
                 for part in &parts {
-                    grid.visit(*part, |i| {
-                        if overlap(&boxes[i as usize], part) {
-                            hit.push(i);
-                        }
-                    });
+                    if overlap(part, &small_box) {
+                        grid.visit(*part, |i| {
+                            if overlap(&boxes[i as usize], part) {
+                                hit.push(i);
+                            }
+                        });
+                    }
+                    hit.extend(
+                        wide.iter()
+                            .filter(|(_, b)| overlap(b, part))
+                            .map(|&(i, _)| i),
+                    );
                 }
                 hit.sort_unstable();
                 hit.dedup();
