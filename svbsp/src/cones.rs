@@ -163,17 +163,10 @@ pub(crate) fn seen_share<'o>(
         }
     }
     let mut pool = Pool::default();
-    let mut light_cone = pool.add(&light_cone(corners.iter().map(|&c| from(x, c)))?);
-    // what lies in front of the face, seen from `x`: beyond the plane
-    // through `x` parallel to the face's
-    let front = face.normal();
-    let s = sides(&pool, light_cone, &front);
-    if s.iter().all(|&v| v <= 0) {
+    let whole = pool.add(&light_cone(corners.iter().map(|&c| from(x, c)))?);
+    let Some(light_cone) = in_front(&mut pool, whole, face) else {
         return Some(None);
-    }
-    if s.contains(&-1) {
-        light_cone = keep(&mut pool, light_cone, &s, 1, front);
-    }
+    };
     let all = form_factor(normal, pool.rays(light_cone));
     if all <= 0.0 {
         return Some(None);
@@ -218,16 +211,10 @@ pub(crate) fn sky_seen_share<'o>(
 ) -> Option<Option<f64>> {
     let dirs = || sky.iter().map(|d| d.map(i64::from));
     let mut pool = Pool::default();
-    let mut light = pool.add(&light_cone(dirs())?);
-    // the directions in front of the face
-    let front = face.normal();
-    let s = sides(&pool, light, &front);
-    if s.iter().all(|&v| v <= 0) {
+    let whole = pool.add(&light_cone(dirs())?);
+    let Some(light) = in_front(&mut pool, whole, face) else {
         return Some(None);
-    }
-    if s.contains(&-1) {
-        light = keep(&mut pool, light, &s, 1, front);
-    }
+    };
     // a sun is beyond every occluder: each hides its whole cone
     let cones = hiders.filter_map(|o| occluder_cone(o.corners(), x));
     let c = dirs()
@@ -260,6 +247,21 @@ pub(crate) fn sky_seen_share<'o>(
     tests::SEEN.with(|s| *s.borrow_mut() = cones_of(&pool, &seen));
     let left: f64 = seen.iter().map(|&p| area(pool.rays(p))).sum();
     Some(Some((left / all).clamp(0.0, 1.0)))
+}
+
+/// What of the cone `light` lies in front of the face of plane `face`,
+/// seen from the apex: beyond the plane through it parallel to the
+/// face's; `None` where nothing does.
+fn in_front(pool: &mut Pool, light: Piece, face: &Plane) -> Option<Piece> {
+    let front = face.normal();
+    let s = sides(pool, light, &front);
+    if s.iter().all(|&v| v <= 0) {
+        return None;
+    }
+    Some(match s.contains(&-1) {
+        true => keep(pool, light, &s, 1, front),
+        false => light,
+    })
 }
 
 /// What of `light` lies outside every cone of `cones` (in their order),
