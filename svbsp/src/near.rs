@@ -36,7 +36,7 @@ pub(crate) fn near_lists(
             .count()
             >= 2
     };
-    let (wide, small): (Vec<(u32, Box3)>, Vec<(u32, Box3)>) = (boxes.iter().enumerate())
+    let (wide, small): (Vec<_>, Vec<_>) = (boxes.iter().enumerate())
         .map(|(i, b)| (i as u32, *b))
         .partition(|(_, b)| wide_face(b));
     let small_box = small.iter().map(|(_, b)| *b).reduce(union).unwrap_or(scene);
