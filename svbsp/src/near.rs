@@ -1,8 +1,9 @@
 //! Which occluders may hide part of a light from which faces: a box of
 //! each occluder's penumbra volume within the scene, and a uniform grid of
-//! the faces' boxes to find the faces it meets, so a scene of `n` faces is
-//! not `n²` pairs. Boxes only ever let through more pairs than the exact
-//! tests keep: the exact signs decide (see [`crate::area`]).
+//! the faces' boxes to find the faces it meets (the faces as wide as the
+//! scene, a ground, tested apart), so a scene of `n` faces is not `n²`
+//! pairs. Boxes only ever let through more pairs than the exact tests
+//! keep: the exact signs decide (see [`crate::area`]).
 
 use bsp_core::{GridPoint, Plane};
 use rayon::prelude::*;
