@@ -702,13 +702,17 @@ impl AreaLight {
             }
         }
         let mut regions: Vec<(&Regions, Reach)> = occluders.collect();
+        // with no occluder having a corner in its plane, a cell that sees
+        // one corner and not another is penumbra whatever the others: the
+        // corners' cells need not say which (`cells_settling`)
+        let flat = regions.iter().any(|(r, _)| flat_corners(r) != 0);
         let n = self.corners().len();
         let all = u64::MAX >> (64 - n);
         let behind = (0..n).fold(0u64, |m, i| m | u64::from(behind_face[i]) << i);
         let mut pieces = Vec::with_capacity(front.len());
         let mut known = corners.is_some();
         for (polygon, label) in front {
-            let Some(cells) = corners.as_mut().and_then(|c| c(&polygon)) else {
+            let Some(cells) = corners.as_mut().and_then(|c| c(&polygon, !flat)) else {
                 known = false;
                 pieces.push(Piece::new(polygon, label, behind, false));
                 continue;
@@ -743,7 +747,6 @@ impl AreaLight {
         // pieces whose class no occluder can change stay as they are (with
         // their corners known: umbra, or seeing some corners and hiding
         // others while no occluder has a corner in its plane)
-        let flat = regions.iter().any(|(r, _)| flat_corners(r) != 0);
         let (active, done): (Vec<Piece<K>>, Vec<Piece<K>>) = pieces
             .into_iter()
             .partition(|p| !known || !p.umbra && (p.hidden == 0 || p.hidden == all || flat));
@@ -1326,7 +1329,7 @@ fn separating(h: &Plane, lv: &[Light], ov: &[GridPoint]) -> Option<Side> {
 
 /// The convex parts of a polygon with the light corners each sees (bit
 /// `i`: corner `i`), where that is known.
-pub(crate) type SeenCorners<'a> = dyn FnMut(&Polygon) -> Option<Vec<(Polygon, u64)>> + 'a;
+pub(crate) type SeenCorners<'a> = dyn FnMut(&Polygon, bool) -> Option<Vec<(Polygon, u64)>> + 'a;
 
 #[cfg(test)]
 mod tests {
@@ -1427,7 +1430,7 @@ mod tests {
         let core = (light.regions(&core).unwrap(), [EMPTY, wide]);
         let cut = |list: Vec<&(Regions, Reach)>| {
             // (the corners' trees say the whole ground hides every corner)
-            let mut hidden = |p: &Polygon| Some(vec![(p.clone(), 0u64)]);
+            let mut hidden = |p: &Polygon, _: bool| Some(vec![(p.clone(), 0u64)]);
             let pieces = vec![(ground.to_polygon(), ())];
             let list = list.into_iter().map(|(r, b)| (r, *b));
             light.cut(&ground, pieces, list, Some(&mut hidden))

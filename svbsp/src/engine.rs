@@ -678,6 +678,12 @@ pub struct Scratch {
     remap: Vec<u32>,
     pieces: Vec<Piece>,
     labels: Vec<u64>,
+    /// Whether a cell that some light it was filtered through reaches and
+    /// another does not (a light the receiver turns from counting as one
+    /// that does not) goes through no more trees: an area light's corner
+    /// cells, where such a cell is penumbra whatever the other corners
+    /// ([`ShadowSet::cells_settling`]).
+    settle_mixed: bool,
 }
 
 /// A receiver's convex cells with their flags (bit `j`: lit by light

@@ -534,13 +534,17 @@ fn corner_cells<'a, 't: 'a>(
     set: Option<&'a ShadowSet<'t>>,
     (face, i, faces): (&'a Occluder, usize, usize),
     scratch: &'a mut Scratch,
-) -> impl FnMut(&Polygon) -> Option<Vec<(Polygon, u64)>> + 'a {
-    move |p: &Polygon| {
+) -> impl FnMut(&Polygon, bool) -> Option<Vec<(Polygon, u64)>> + 'a {
+    move |p: &Polygon, settle: bool| {
         let c = face.corners();
         let whole = p.vertices().len() == c.len()
             && (p.vertices().iter().zip(c))
                 .all(|(v, g)| matches!(v, bsp_core::Point::Grid(v) if v == g));
-        set?.cells_known(p, whole.then_some(i), faces, scratch)
+        let index = whole.then_some(i);
+        match settle {
+            true => set?.cells_settling(p, index, faces, scratch),
+            false => set?.cells_known(p, index, faces, scratch),
+        }
     }
 }
 

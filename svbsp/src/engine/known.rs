@@ -170,6 +170,25 @@ impl ShadowSet<'_> {
         self.cells_from(poly, &Start::Uniform(flags), filter, scratch)
     }
 
+    /// [`ShadowSet::cells_known`] for an area light's corner cells where a
+    /// cell's class is settled once it sees one corner and not another
+    /// (penumbra, whatever the others): such a cell goes through no more
+    /// corners' trees, and its flags for those stay as they began (set
+    /// where the light faces the receiver). Its other cells are exactly
+    /// those of `cells_known`, flags and all.
+    pub(crate) fn cells_settling(
+        &self,
+        poly: &Polygon,
+        index: Option<usize>,
+        occluders: usize,
+        scratch: &mut Scratch,
+    ) -> Option<Vec<(Polygon, u64)>> {
+        scratch.settle_mixed = true;
+        let cells = self.cells_known(poly, index, occluders, scratch);
+        scratch.settle_mixed = false;
+        cells
+    }
+
     /// For a receiver of the polygons `range` (the first `first`): the
     /// flags of the lights facing it, less those its trees' building found
     /// reach none of it, and the lights to filter it through (those that

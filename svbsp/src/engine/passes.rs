@@ -37,25 +37,42 @@ impl ShadowSet<'_> {
             .filter(|(_, j)| mask & 1 << j != 0)
             .copied()
             .collect();
+        let all = u64::MAX >> (64 - self.lights.len().clamp(1, 64));
+        let mut pending = trees.iter().fold(0u64, |m, &(_, j)| m | 1 << j);
         let mut changed = false;
         for (k, &tree) in trees.iter().enumerate() {
+            let settle = s.settle_mixed.then_some((all, pending));
             if k > 0 && s.cur.len() >= PARALLEL_CELLS {
-                return pass_runs(s, &trees[k..]) | changed;
+                return pass_runs(s, &trees[k..], settle) | changed;
             }
-            changed |= pass(s, tree);
+            changed |= pass(s, tree, settle);
+            pending &= !(1 << tree.1);
         }
         changed
     }
 }
 
+/// Whether `flags` has, among the lights of `all` not `pending` (their
+/// bits final), one set and one clear.
+fn mixed(flags: u64, (all, pending): (u64, u64)) -> bool {
+    let known = all & !pending;
+    flags & known != 0 && !flags & known != 0
+}
+
 /// The cells of `s.cur` whose flag for light `j` is set through `sv`,
-/// the tree of light `j`; whether a cell was cut or lost the light.
-pub(super) fn pass(s: &mut Scratch, (sv, j): (&ShadowVolumes, usize)) -> bool {
+/// the tree of light `j`; whether a cell was cut or lost the light. With
+/// `settle` (the lights of the set, and those whose trees are still to
+/// come, `j`'s among them), a cell already [`mixed`] stays as it is.
+pub(super) fn pass(
+    s: &mut Scratch,
+    (sv, j): (&ShadowVolumes, usize),
+    settle: Option<(u64, u64)>,
+) -> bool {
     let bit = 1u64 << j;
     let mut changed = false;
     s.next.clear();
     for (piece, flags) in s.cur.drain(..) {
-        if flags & bit == 0 {
+        if flags & bit == 0 || settle.is_some_and(|m| mixed(flags, m)) {
             s.next.push((piece, flags));
             continue;
         }
@@ -83,7 +100,11 @@ pub(super) fn pass(s: &mut Scratch, (sv, j): (&ShadowVolumes, usize)) -> bool {
 /// [`pass`] of every tree of `trees` in turn, over runs of `s.cur` in
 /// parallel, each on its own copy of the arena; the cells and the
 /// arena's additions put back in the runs' order.
-pub(super) fn pass_runs(s: &mut Scratch, trees: &[(&ShadowVolumes, usize)]) -> bool {
+pub(super) fn pass_runs(
+    s: &mut Scratch,
+    trees: &[(&ShadowVolumes, usize)],
+    settle: Option<(u64, u64)>,
+) -> bool {
     let n = s.cur.len();
     let runs = (n / MIN_RUN).clamp(1, MAX_RUNS);
     let size = n.div_ceil(runs);
@@ -99,7 +120,12 @@ pub(super) fn pass_runs(s: &mut Scratch, trees: &[(&ShadowVolumes, usize)]) -> b
                 cur: cells.to_vec(),
                 ..Scratch::default()
             };
-            let changed = trees.iter().fold(false, |c, &t| pass(&mut own, t) | c);
+            let mut changed = false;
+            let mut at = settle;
+            for &t in trees {
+                changed |= pass(&mut own, t, at);
+                at = at.map(|(all, pending)| (all, pending & !(1 << t.1)));
+            }
             (own, changed)
         })
         .collect();

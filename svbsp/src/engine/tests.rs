@@ -322,7 +322,7 @@ fn a_large_face_passes_its_cells_in_runs_as_one_by_one() {
     );
     let changed_one = rest
         .iter()
-        .fold(false, |c, &t| passes::pass(&mut one, t) | c);
+        .fold(false, |c, &t| passes::pass(&mut one, t, None) | c);
     let expected = corners(&one);
     for threads in [1, 3] {
         let mut runs = Scratch::default();
@@ -332,7 +332,7 @@ fn a_large_face_passes_its_cells_in_runs_as_one_by_one() {
             .unwrap()
             .install(|| {
                 first(&mut runs);
-                passes::pass_runs(&mut runs, &rest)
+                passes::pass_runs(&mut runs, &rest, None)
             });
         assert_eq!(changed, changed_one);
         let got = corners(&runs);
@@ -402,4 +402,66 @@ fn the_pairing_finds_open_parts() {
     assert!(open[..6].iter().all(|o| !o));
     assert!(open[6..].iter().all(|&o| o));
     assert_eq!(paired.certify(), bsp_core::certify_solid_parts(&scene));
+}
+
+/// An area light's corner cells, settling (`ShadowSet::cells_settling`):
+/// a cell that sees one corner and not another goes through no more
+/// trees, so a ground under a grid of roofs comes out in fewer cells, and
+/// the cells cover the same area seeing every corner, seeing none, and
+/// seeing some (to rounding).
+#[test]
+fn settled_corner_cells_cover_what_the_full_cells_do() {
+    let mut polys = vec![quad(0, -40, 104, 0)];
+    for i in 0..12 {
+        for j in 0..12 {
+            let (x, y) = (i * 6, j * 6);
+            let roof = [[x, y, 5], [x + 3, y, 5], [x + 3, y + 2, 5], [x, y + 2, 5]];
+            polys.push(Polygon::from_grid_points(&roof, (1 + i * 12 + j) as u32).unwrap());
+        }
+    }
+    // the corners of a small square light above the roofs
+    let lights = [
+        Light::Point([30, 30, 40]),
+        Light::Point([34, 30, 40]),
+        Light::Point([34, 34, 40]),
+        Light::Point([30, 34, 40]),
+    ];
+    let shadows = LightVolumes::new(&polys, &lights).unwrap();
+    let set = shadows.set();
+    let by_class = |cells: &[(Polygon, u64)]| {
+        let mut area = [0.0f64; 3];
+        for (p, flags) in cells {
+            let v = p.vertices_f64();
+            let twice = (1..v.len() - 1)
+                .map(|i| {
+                    let (a, b, c) = (v[0], v[i], v[i + 1]);
+                    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+                })
+                .sum::<f64>();
+            let class = match flags & 0b1111 {
+                0b1111 => 0,
+                0 => 1,
+                _ => 2,
+            };
+            area[class] += twice.abs() / 2.0;
+        }
+        area
+    };
+    let full = set.cells_known(&polys[0], None, polys.len(), &mut Scratch::default());
+    let settled = set.cells_settling(&polys[0], None, polys.len(), &mut Scratch::default());
+    let (full, settled) = (full.unwrap(), settled.unwrap());
+    assert!(
+        settled.len() < full.len(),
+        "{} against {}",
+        settled.len(),
+        full.len()
+    );
+    let (a, b) = (by_class(&full), by_class(&settled));
+    assert!(a[2] > 1.0, "some ground sees some corners: {a:?}");
+    for k in 0..3 {
+        assert!(
+            (a[k] - b[k]).abs() <= 1e-9 * a[k].max(1.0),
+            "{a:?} against {b:?}"
+        );
+    }
 }
