@@ -704,7 +704,7 @@ impl AreaLight {
         let mut regions: Vec<(&Regions, Reach)> = occluders.collect();
         // with no occluder having a corner in its plane, a cell that sees
         // one corner and not another is penumbra whatever the others: the
-        // corners' cells need not say which (`cells_settling`)
+        // corners' cells need not say which (`ShadowSet::cells_known` settling)
         let flat = regions.iter().any(|(r, _)| flat_corners(r) != 0);
         let n = self.corners().len();
         let all = u64::MAX >> (64 - n);

@@ -682,7 +682,7 @@ pub struct Scratch {
     /// another does not (a light the receiver turns from counting as one
     /// that does not) goes through no more trees: an area light's corner
     /// cells, where such a cell is penumbra whatever the other corners
-    /// ([`ShadowSet::cells_settling`]).
+    /// ([`ShadowSet::cells_known`]).
     settle_mixed: bool,
 }
 

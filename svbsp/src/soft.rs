@@ -540,11 +540,7 @@ fn corner_cells<'a, 't: 'a>(
         let whole = p.vertices().len() == c.len()
             && (p.vertices().iter().zip(c))
                 .all(|(v, g)| matches!(v, bsp_core::Point::Grid(v) if v == g));
-        let index = whole.then_some(i);
-        match settle {
-            true => set?.cells_settling(p, index, faces, scratch),
-            false => set?.cells_known(p, index, faces, scratch),
-        }
+        set?.cells_known(p, (whole.then_some(i), faces), settle, scratch)
     }
 }
 

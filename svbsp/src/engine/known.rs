@@ -155,36 +155,28 @@ impl ShadowSet<'_> {
     /// them ([`LightVolumes::set_for_occluders`] over `occluders`
     /// polygons): the same cells, filtered only through the trees of the
     /// lights that reach part of it.
+    ///
+    /// With `settle` (an area light's corner cells, where a cell that sees
+    /// one corner and not another is penumbra whatever the others), such a
+    /// cell goes through no more corners' trees, and its flags for those
+    /// stay as they began (set where the light faces the receiver); the
+    /// other cells are exactly those without, flags and all.
     pub(crate) fn cells_known(
         &self,
         poly: &Polygon,
-        index: Option<usize>,
-        occluders: usize,
+        (index, occluders): (Option<usize>, usize),
+        settle: bool,
         scratch: &mut Scratch,
     ) -> Option<Vec<(Polygon, u64)>> {
+        scratch.settle_mixed = settle;
         let known = !self.reached.is_empty() && self.reached.iter().all(|r| r.len() == occluders);
-        let Some(i) = index.filter(|_| known) else {
-            return self.cells(poly, scratch);
+        let cells = match index.filter(|_| known) {
+            None => self.cells(poly, scratch),
+            Some(i) => {
+                let (flags, filter) = self.known_flags(poly, i..i + 1);
+                self.cells_from(poly, &Start::Uniform(flags), filter, scratch)
+            }
         };
-        let (flags, filter) = self.known_flags(poly, i..i + 1);
-        self.cells_from(poly, &Start::Uniform(flags), filter, scratch)
-    }
-
-    /// [`ShadowSet::cells_known`] for an area light's corner cells where a
-    /// cell's class is settled once it sees one corner and not another
-    /// (penumbra, whatever the others): such a cell goes through no more
-    /// corners' trees, and its flags for those stay as they began (set
-    /// where the light faces the receiver). Its other cells are exactly
-    /// those of `cells_known`, flags and all.
-    pub(crate) fn cells_settling(
-        &self,
-        poly: &Polygon,
-        index: Option<usize>,
-        occluders: usize,
-        scratch: &mut Scratch,
-    ) -> Option<Vec<(Polygon, u64)>> {
-        scratch.settle_mixed = true;
-        let cells = self.cells_known(poly, index, occluders, scratch);
         scratch.settle_mixed = false;
         cells
     }

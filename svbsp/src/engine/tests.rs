@@ -273,14 +273,8 @@ fn trees_built_while_certifying_are_those_built_after() {
     }
 }
 
-/// A ground under a grid of small roofs, lit by three lights: cut by the
-/// first into more cells than [`passes::PARALLEL_CELLS`], its cells go
-/// through the other two trees in parallel runs
-/// ([`passes::pass_runs`]) and come out as the one-by-one passes make
-/// them: the same cells in the same order, the same exact corners, the
-/// same flags, on one thread and on three.
-#[test]
-fn a_large_face_passes_its_cells_in_runs_as_one_by_one() {
+/// A ground (polygon 0) under a grid of 12 × 12 small roofs.
+fn ground_under_roofs() -> Vec<Polygon> {
     let mut polys = vec![quad(0, -40, 104, 0)];
     for i in 0..12 {
         for j in 0..12 {
@@ -289,6 +283,18 @@ fn a_large_face_passes_its_cells_in_runs_as_one_by_one() {
             polys.push(Polygon::from_grid_points(&roof, (1 + i * 12 + j) as u32).unwrap());
         }
     }
+    polys
+}
+
+/// A ground under a grid of small roofs, lit by three lights: cut by the
+/// first into more cells than [`passes::PARALLEL_CELLS`], its cells go
+/// through the other two trees in parallel runs
+/// ([`passes::pass_runs`]) and come out as the one-by-one passes make
+/// them: the same cells in the same order, the same exact corners, the
+/// same flags, on one thread and on three.
+#[test]
+fn a_large_face_passes_its_cells_in_runs_as_one_by_one() {
+    let polys = ground_under_roofs();
     let lights = [
         Light::Point([31, 29, 40]),
         Light::Point([50, 10, 33]),
@@ -404,21 +410,14 @@ fn the_pairing_finds_open_parts() {
     assert_eq!(paired.certify(), bsp_core::certify_solid_parts(&scene));
 }
 
-/// An area light's corner cells, settling (`ShadowSet::cells_settling`):
+/// An area light's corner cells, settling (`ShadowSet::cells_known`):
 /// a cell that sees one corner and not another goes through no more
 /// trees, so a ground under a grid of roofs comes out in fewer cells, and
 /// the cells cover the same area seeing every corner, seeing none, and
 /// seeing some (to rounding).
 #[test]
 fn settled_corner_cells_cover_what_the_full_cells_do() {
-    let mut polys = vec![quad(0, -40, 104, 0)];
-    for i in 0..12 {
-        for j in 0..12 {
-            let (x, y) = (i * 6, j * 6);
-            let roof = [[x, y, 5], [x + 3, y, 5], [x + 3, y + 2, 5], [x, y + 2, 5]];
-            polys.push(Polygon::from_grid_points(&roof, (1 + i * 12 + j) as u32).unwrap());
-        }
-    }
+    let polys = ground_under_roofs();
     // the corners of a small square light above the roofs
     let lights = [
         Light::Point([30, 30, 40]),
@@ -447,8 +446,18 @@ fn settled_corner_cells_cover_what_the_full_cells_do() {
         }
         area
     };
-    let full = set.cells_known(&polys[0], None, polys.len(), &mut Scratch::default());
-    let settled = set.cells_settling(&polys[0], None, polys.len(), &mut Scratch::default());
+    let full = set.cells_known(
+        &polys[0],
+        (None, polys.len()),
+        false,
+        &mut Scratch::default(),
+    );
+    let settled = set.cells_known(
+        &polys[0],
+        (None, polys.len()),
+        true,
+        &mut Scratch::default(),
+    );
     let (full, settled) = (full.unwrap(), settled.unwrap());
     assert!(
         settled.len() < full.len(),
