@@ -488,6 +488,10 @@ impl AreaLight {
     pub fn classify_faces(&self, faces: &[Occluder]) -> Vec<Vec<AreaFragment>> {
         // the run's shared parts for this one light, built as for several
         let run = SoftVolumes::build(std::slice::from_ref(self), faces);
+        // (only the large faces' occluder boxes are narrowed, as in
+        // `SoftVolumes::fragments_with`: the narrowing only prunes)
+        let area: Vec<f64> = faces.iter().map(|f| grid_area(f.corners())).collect();
+        let large = crate::schedule::large_first(&area);
         let set = run.corners[0].as_ref().map(LightVolumes::set_for_occluders);
         let (regions, reach, cores, sealed) = (
             &run.regions[0],
@@ -511,7 +515,7 @@ impl AreaLight {
                     near,
                     (regions, reach, &run.blockers),
                     self.corners(),
-                    (face, true),
+                    (face, large.contains(&i)),
                 )
                 .into_iter()
                 .chain(crate::cores::cores_at(cores, face));
