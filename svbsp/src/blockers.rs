@@ -85,7 +85,7 @@ pub(crate) fn coplanar_blockers_of(faces: &[Occluder]) -> (Vec<Occluder>, Vec<Ve
 }
 
 /// A plane up to orientation ([`plane_key`]).
-type PlaneKey = ([i64; 3], i128);
+pub(crate) type PlaneKey = ([i64; 3], i128);
 
 /// One plane's polygons merged until no two that share an edge have a
 /// convex union.

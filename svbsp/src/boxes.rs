@@ -258,6 +258,54 @@ impl CellGrid {
     }
 }
 
+impl CellGrid {
+    /// The grid with every cell's list packed into one list, in cell
+    /// order, each entry `item` of the listed index: a visit then reads
+    /// one run of memory per row of cells, the entries' data inline.
+    pub(crate) fn packed<T>(self, item: impl Fn(u32) -> T) -> PackedGrid<T> {
+        let mut starts = Vec::with_capacity(self.cells.len() + 1);
+        let mut items = Vec::with_capacity(self.cells.iter().map(Vec::len).sum());
+        starts.push(0);
+        for cell in &self.cells {
+            items.extend(cell.iter().map(|&i| item(i)));
+            starts.push(items.len() as u32);
+        }
+        PackedGrid {
+            grid: CellGrid {
+                cells: Vec::new(),
+                ..self
+            },
+            starts,
+            items,
+        }
+    }
+}
+
+/// A [`CellGrid`] whose cells' entries lie in one list ([`CellGrid::packed`]).
+pub(crate) struct PackedGrid<T> {
+    /// The cells' layout (its lists left empty).
+    grid: CellGrid,
+    /// Where each cell's entries start in `items`, and the end.
+    starts: Vec<u32>,
+    items: Vec<T>,
+}
+
+impl<T> PackedGrid<T> {
+    /// Calls `f` with every entry of a cell that `b` meets (an entry may
+    /// come more than once).
+    pub(crate) fn visit(&self, b: Box3, mut f: impl FnMut(&T)) {
+        let (lo, hi) = self.grid.range(b);
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                // a row's cells are adjacent: one run of entries
+                let (first, last) = (self.grid.cell([x, y, lo[2]]), self.grid.cell([x, y, hi[2]]));
+                let run = self.starts[first] as usize..self.starts[last + 1] as usize;
+                self.items[run].iter().for_each(&mut f);
+            }
+        }
+    }
+}
+
 /// The occluders' [`Reach`]es near one face, indexed by a [`CellGrid`]
 /// over the face's box: for a box within the face, the occluders whose
 /// boxes may meet it, in their order (a superset of those that do). A

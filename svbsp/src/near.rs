@@ -9,7 +9,7 @@ use bsp_core::{GridPoint, Plane};
 use rayon::prelude::*;
 
 use crate::area::{HalfSpaces, Occluder, Regions};
-use crate::blockers::plane_key;
+use crate::blockers::{PlaneKey, plane_key};
 use crate::boxes::{Box3, CellGrid, Reach, grid_box, overlap, union};
 use crate::light::Light;
 
@@ -24,6 +24,9 @@ pub(crate) fn near_lists(
 ) -> (Vec<Vec<u32>>, Vec<Reach>) {
     let boxes: Vec<Box3> = faces.iter().map(|f| grid_box(f.corners())).collect();
     let planes: Vec<_> = faces.iter().map(|f| plane_key(f.plane())).collect();
+    // (a hash of each face's plane inline in the grid: most faces met are
+    // in another plane than the occluder's, told without reading theirs)
+    let hashes: Vec<u32> = planes.iter().map(plane_hash).collect();
     let Some(scene) = boxes.iter().copied().reduce(union) else {
         return (Vec::new(), Vec::new());
     };
@@ -41,7 +44,9 @@ pub(crate) fn near_lists(
         .map(|(i, b)| (i as u32, *b))
         .partition(|(_, b)| wide_face(b));
     let small_box = small.iter().map(|(_, b)| *b).reduce(union).unwrap_or(scene);
-    let grid = CellGrid::of_items(small_box, &small);
+    // (each face's box inline, in 32 bits: grid points are)
+    let grid = CellGrid::of_items(small_box, &small)
+        .packed(|i| (i, narrow(&boxes[i as usize]), hashes[i as usize]));
     let reaches: Vec<Reach> = occluders
         .par_iter()
         .map(|f| {
@@ -53,46 +58,60 @@ pub(crate) fn near_lists(
         .collect();
     // per occluder the faces it may reach, then turned into per face the
     // occluders (in index order): four bytes a pair in each form, and each
-    // occluder's list freed as it is turned
+    // occluder's list freed as it is turned. A face met by several parts'
+    // boxes (or cells) is tested once: `seen` holds, per face, the last
+    // occluder that tested it (one list per run of occluders a thread
+    // takes), and a face's exact test does not depend on the part.
     let hits: Vec<Vec<u32>> = regions
         .par_iter()
         .enumerate()
-        .map(|(j, r)| {
-            let mut hit = Vec::new();
-            if let Some(r) = r {
-                let reach = reaches[j][0];
-                let plane = plane_key(occluders[j].plane());
-                // the sweep in a few boxes: most faces in the whole box
-                // lie beside the volume where it is still narrow
-                let parts = penumbra_boxes(lights, occluders[j].corners(), scene, SWEEP_PARTS);
-                // the cells of the parts only (not of their whole box),
-                // each face once before the exact test
-                for part in &parts {
-                    if overlap(part, &small_box) {
-                        grid.visit(*part, |i| {
-                            if overlap(&boxes[i as usize], part) {
-                                hit.push(i);
+        .map_init(
+            || vec![u32::MAX; faces.len()],
+            |seen, (j, r)| {
+                let mut hit = Vec::new();
+                if let Some(r) = r {
+                    let reach = reaches[j][0];
+                    let plane = plane_key(occluders[j].plane());
+                    let hash = plane_hash(&plane);
+                    let mut test = |i: u32, b: &Box3, h: u32| {
+                        let last = &mut seen[i as usize];
+                        if *last == j as u32 {
+                            return;
+                        }
+                        *last = j as u32;
+                        let f = i as usize;
+                        // (the inline box first: the others read the face)
+                        if overlap(b, &reach)
+                            && (h != hash || planes[f] != plane)
+                            && !outside(faces[f].corners(), &r.penumbra)
+                        {
+                            hit.push(i);
+                        }
+                    };
+                    // the sweep in a few boxes: most faces in the whole box
+                    // lie beside the volume where it is still narrow
+                    let parts = penumbra_boxes(lights, occluders[j].corners(), scene, SWEEP_PARTS);
+                    // the cells of the parts only (not of their whole box)
+                    for part in &parts {
+                        if overlap(part, &small_box) {
+                            grid.visit(*part, |&(i, b, h)| {
+                                let b = widen(&b);
+                                if overlap(&b, part) {
+                                    test(i, &b, h);
+                                }
+                            });
+                        }
+                        for (i, b) in &wide {
+                            if overlap(b, part) {
+                                test(*i, b, hashes[*i as usize]);
                             }
-                        });
+                        }
                     }
-                    hit.extend(
-                        wide.iter()
-                            .filter(|(_, b)| overlap(b, part))
-                            .map(|&(i, _)| i),
-                    );
+                    hit.shrink_to_fit();
                 }
-                hit.sort_unstable();
-                hit.dedup();
-                hit.retain(|&i| {
-                    let i = i as usize;
-                    planes[i] != plane
-                        && overlap(&boxes[i], &reach)
-                        && !outside(faces[i].corners(), &r.penumbra)
-                });
-                hit.shrink_to_fit();
-            }
-            hit
-        })
+                hit
+            },
+        )
         .collect();
     let mut counts = vec![0usize; faces.len()];
     for &i in hits.iter().flatten() {
@@ -105,6 +124,27 @@ pub(crate) fn near_lists(
         }
     }
     (near, reaches)
+}
+
+/// A hash of a plane's key, in 32 bits: keys with other hashes differ.
+fn plane_hash(key: &PlaneKey) -> u32 {
+    use std::hash::{Hash, Hasher};
+    let mut h = rustc_hash::FxHasher::default();
+    key.hash(&mut h);
+    h.finish() as u32
+}
+
+/// A box of grid points in 32 bits a coordinate.
+type NarrowBox = [[i32; 2]; 3];
+
+/// `b`, a box of grid points, in 32 bits a coordinate.
+fn narrow(b: &Box3) -> NarrowBox {
+    b.map(|r| r.map(|v| v as i32))
+}
+
+/// A box of [`narrow`] in 64 bits again.
+fn widen(b: &NarrowBox) -> Box3 {
+    b.map(|r| r.map(i64::from))
 }
 
 /// A box holding the part of occluder `o`'s umbra volume inside `scene`:
