@@ -19,7 +19,7 @@ use rayon::prelude::*;
 use crate::area::{AreaClass, AreaFragment, AreaLight, Occluder, Regions};
 use crate::backs::SolidBacks;
 use crate::blockers::{coplanar_blockers, coplanar_blockers_of, plane_key};
-use crate::boxes::{EMPTY, EVERYWHERE, Reach, meet};
+use crate::boxes::{Box3, EMPTY, EVERYWHERE, Reach, meet};
 use crate::engine::{LightVolumes, Scratch, ShadowSet};
 use crate::light::{Light, LightError, LightSpec, MAX_LIGHTS, PlacedLight, SoftSpec};
 use crate::merging::{LabelledRegion, merge_convex_parts, merge_regions};
@@ -377,7 +377,7 @@ impl<'a> SoftVolumes<'a> {
             return vec![None; points.len()];
         }
         let f = &self.faces[face];
-        let hiders = self.hiders(light, face, (Probing::Anywhere, points.len()));
+        let hiders = self.hiders(light, face, (Probing::Anywhere, points.len()), None);
         // (one point a task when stolen: neighbouring points cost alike,
         // and the dear ones, deep in a mesh's penumbra, lie together)
         points
@@ -389,21 +389,39 @@ impl<'a> SoftVolumes<'a> {
 
     /// The occluders near face `face` that may hide some of light
     /// `light`, found by point, for `points` points `probing` says where.
-    fn hiders(&self, light: usize, face: usize, (probing, points): (Probing, usize)) -> Hiders<'_> {
-        let near = self.near[light][face].iter().filter_map(|&j| {
+    ///
+    /// Where the face's cut `narrowed` its near occluders' boxes to the
+    /// slab round its plane, and the hiders would narrow them to that
+    /// slab too (points near the face, many of them), they take those
+    /// boxes and occluders instead of finding them again.
+    fn hiders(
+        &self,
+        light: usize,
+        face: usize,
+        (probing, points): (Probing, usize),
+        narrowed: Option<&[(u32, Box3)]>,
+    ) -> Hiders<'_> {
+        let hider = |(j, b): (u32, Box3)| {
             let j = j as usize;
             let r = self.regions[light][j].as_ref()?;
-            Some((
-                &self.blockers[j],
-                r,
-                self.reach[light][j][0],
-                self.backs.of(j),
-            ))
-        });
+            Some((&self.blockers[j], r, b, self.backs.of(j)))
+        };
+        let (probing, near) = match (probing, narrowed) {
+            (Probing::NearFace { slab: true }, Some(n)) if Hiders::narrows(points) => (
+                Probing::NearFace { slab: false },
+                n.iter().copied().filter_map(hider).collect(),
+            ),
+            _ => (
+                probing,
+                (self.near[light][face].iter())
+                    .filter_map(|&j| hider((j, self.reach[light][j as usize][0])))
+                    .collect(),
+            ),
+        };
         Hiders::new(
             &self.faces[face],
             self.lights[light].corners(),
-            (near.collect(), &self.backs),
+            (near, &self.backs),
             (probing, points),
         )
     }
@@ -517,6 +535,7 @@ impl AreaLight {
                     self.corners(),
                     (face, large.contains(&i)),
                 )
+                .0
                 .into_iter()
                 .chain(crate::cores::cores_at(cores, face));
                 let mut seen = corner_cells(set.as_ref(), (face, i, faces.len()), scratch);
@@ -555,11 +574,13 @@ fn soft_face(
     face: &Occluder,
     scratch: &mut Scratch,
 ) -> Vec<SoftFragment> {
-    let fragments = merge_convex_parts(cut_face(run, (i, large), face, scratch));
+    let (pieces, narrowed) = cut_face(run, (i, large), face, scratch);
+    let fragments = merge_convex_parts(pieces);
     let shading = Shading {
         run,
         i,
         face,
+        narrowed,
         // (a face of many fragments, such as a ground, rounds their
         // corners on every thread)
         many: fragments.len() >= crate::schedule::PARALLEL_CELLS,
@@ -579,7 +600,7 @@ fn cut_face(
     (i, large): (usize, bool),
     face: &Occluder,
     scratch: &mut Scratch,
-) -> Vec<(Polygon, Classes)> {
+) -> (Vec<(Polygon, Classes)>, Vec<Option<Narrowed>>) {
     let SoftVolumes {
         lights,
         regions,
@@ -589,6 +610,7 @@ fn cut_face(
     } = run;
     let near: Vec<&[u32]> = run.near.iter().map(|n| &n[i][..]).collect();
     let mut pieces = vec![(face.to_polygon(), Classes::default())];
+    let mut narrowed = vec![None; lights.len()];
     for (k, light) in lights.iter().enumerate() {
         if run.sealed[k].get(i) == Some(&true) {
             pieces = pieces
@@ -598,12 +620,13 @@ fn cut_face(
             continue;
         }
         // the inner occluders last: they cut only what stays undecided
-        let occluders = near_occluders(
+        let (occluders, narrow) = near_occluders(
             near[k],
             (&regions[k], &reach[k], &run.blockers),
             light.corners(),
             (face, large),
         );
+        narrowed[k] = narrow;
         let occluders = occluders
             .into_iter()
             .chain(crate::cores::cores_at(&run.cores[k], face));
@@ -615,7 +638,7 @@ fn cut_face(
             .map(|(p, c, class)| (p, c.with(k, class)))
             .collect();
     }
-    pieces
+    (pieces, narrowed)
 }
 
 /// The shares of one face's convex pieces (merged where their union is
@@ -626,6 +649,8 @@ struct Shading<'r, 'a> {
     run: &'r SoftVolumes<'a>,
     i: usize,
     face: &'r Occluder,
+    /// Per light, the near occluders' boxes the cut narrowed, if it did.
+    narrowed: Vec<Option<Narrowed>>,
     many: bool,
     near_face: bool,
 }
@@ -659,7 +684,12 @@ impl Shading<'_, '_> {
                     true => Probing::NearFace { slab },
                     false => Probing::Anywhere,
                 };
-                let hiders = self.run.hiders(k, self.i, (probing, points.len()));
+                let hiders = self.run.hiders(
+                    k,
+                    self.i,
+                    (probing, points.len()),
+                    self.narrowed[k].as_deref(),
+                );
                 // (one point a task when stolen: the points are sorted, so the
                 // dear ones, deep in a mesh's penumbra, lie together, and a
                 // run of them must not be left to one thread)
@@ -849,20 +879,32 @@ fn near_occluders<'r>(
     (regions, reach, blockers): (&'r [Option<Regions>], &[Reach], &[Occluder]),
     light: &[Light],
     (face, large): (&Occluder, bool),
-) -> Vec<(&'r Regions, Reach)> {
+) -> (Vec<(&'r Regions, Reach)>, Option<Narrowed>) {
+    let narrow = large && near.len() > TIGHTENED;
     let occluder = |&j: &u32| {
         let r = regions[j as usize].as_ref()?;
         let reach = reach[j as usize];
-        match large && near.len() > TIGHTENED {
-            true => Some((r, in_slab(reach, light, &blockers[j as usize], face)?)),
-            false => Some((r, reach)),
+        match narrow {
+            true => Some((j, r, in_slab(reach, light, &blockers[j as usize], face)?)),
+            false => Some((j, r, reach)),
         }
     };
-    match near.len() > PARALLEL_OCCLUDERS {
+    let kept: Vec<(u32, &Regions, Reach)> = match near.len() > PARALLEL_OCCLUDERS {
         true => near.par_iter().filter_map(occluder).collect(),
         false => near.iter().filter_map(occluder).collect(),
-    }
+    };
+    let narrowed = narrow.then(|| kept.iter().map(|&(j, _, reach)| (j, reach[0])).collect());
+    (
+        kept.into_iter().map(|(_, r, reach)| (r, reach)).collect(),
+        narrowed,
+    )
 }
+
+/// A face's near occluders (by number) that [`near_occluders`] kept when
+/// it narrowed their boxes to the slab round the face's plane, each with
+/// its penumbra volume's box so narrowed: what [`Hiders`] would find
+/// again for points near the face ([`SoftVolumes::hiders`]).
+type Narrowed = Vec<(u32, Box3)>;
 
 /// A face with more occluders near it than this has them prepared in
 /// parallel (their boxes narrowed, their tests for its points).

@@ -79,6 +79,13 @@ pub(super) type Near<'a> = (
 );
 
 impl<'a> Hiders<'a> {
+    /// Whether [`Hiders::new`] for `points` points with
+    /// [`Probing::NearFace`] `{ slab: true }` narrows the occluders' boxes
+    /// to the slab round the face's plane ([`slab_box`]).
+    pub(super) fn narrows(points: usize) -> bool {
+        points > FEW_POINTS
+    }
+
     /// The hiders of `face` among `occluders`, for `points` points
     /// `probing` says where.
     pub(super) fn new(
@@ -95,7 +102,7 @@ impl<'a> Hiders<'a> {
             // (for a few points, every half-space tested at each costs less
             // than finding those that matter near the face)
             let slab = match probing {
-                Probing::NearFace { slab } if points > FEW_POINTS => slab,
+                Probing::NearFace { slab } if Hiders::narrows(points) => slab,
                 _ => return Some((o, Cow::Borrowed(&r.penumbra[..]), b, back)),
             };
             let tests = face_tests(face.corners(), &r.penumbra)?;
