@@ -75,12 +75,21 @@ pub(crate) fn inner_occluders(
                 .filter(move |&(_, k, _)| lo < k && k < hi)
         })
         .collect();
+    // each part's faces, and its triangles indexed for the exact tests
+    let indexed: Vec<(Vec<&[GridPoint]>, PartShadows)> = parts
+        .par_iter()
+        .map(|(members, _)| {
+            let part: Vec<&[GridPoint]> = members.iter().map(|&i| faces[i].corners()).collect();
+            let shadows = PartShadows::new(&part, axis);
+            (part, shadows)
+        })
+        .collect();
     let mut cores: Vec<(Occluder, Box3)> = jobs
         .par_iter()
         .flat_map_iter(|&(p, k, each)| {
-            let (members, b) = &parts[p];
-            let part: Vec<&[GridPoint]> = members.iter().map(|&i| faces[i].corners()).collect();
-            let found = inner_polygons(&part, (axis, k), each);
+            let b = &parts[p].1;
+            let (part, shadows) = &indexed[p];
+            let found = inner_polygons((part, shadows), k, each);
             found
                 .into_iter()
                 .filter_map(move |q| Some((Occluder::new(&q).ok()?, *b)))
@@ -244,10 +253,11 @@ fn across(axis: usize) -> [usize; 2] {
 /// faces' corners) bounds: around the points furthest inside the slice,
 /// each outside the polygons before it, at most `each`.
 fn inner_polygons(
-    part: &[&[GridPoint]],
-    (axis, k): (usize, i64),
+    (part, shadows): (&[&[GridPoint]], &PartShadows),
+    k: i64,
     each: usize,
 ) -> Vec<Vec<GridPoint>> {
+    let axis = shadows.axis;
     let segments = slice(part, axis, k);
     let mut out: Vec<Vec<GridPoint>> = Vec::new();
     let mut taken: Vec<Vec<[i32; 2]>> = Vec::new();
@@ -261,7 +271,7 @@ fn inner_polygons(
         if taken.iter().any(|h| holds(h, centre)) {
             continue;
         }
-        if let Some((q, h)) = inner_polygon(part, (axis, k), &segments, centre) {
+        if let Some((q, h)) = inner_polygon(shadows, k, &segments, centre) {
             out.push(q);
             taken.push(h);
         }
@@ -272,11 +282,12 @@ fn inner_polygons(
 /// The convex polygon around `centre` (see [`inner_polygons`]), and its
 /// corners in the slice's coordinates; `None` where no guess passes.
 fn inner_polygon(
-    part: &[&[GridPoint]],
-    (axis, k): (usize, i64),
+    shadows: &PartShadows,
+    k: i64,
     segments: &[[[f64; 2]; 2]],
     centre: [f64; 2],
 ) -> Option<(Vec<GridPoint>, Vec<[i32; 2]>)> {
+    let axis = shadows.axis;
     let reach: Vec<f64> = (0..RAYS)
         .map(|i| ray_reach(segments, centre, direction(i)))
         .collect::<Option<_>>()?;
@@ -295,7 +306,7 @@ fn inner_polygon(
                 g
             })
             .collect();
-        inside(part, axis, &q).then_some((q, hull))
+        (shadows.placed(&q) == Some(1)).then_some((q, hull))
     })
 }
 
@@ -476,13 +487,6 @@ fn hull(points: &[[f64; 2]]) -> Option<Vec<[i32; 2]>> {
     (h.len() >= 3).then_some(h)
 }
 
-/// Whether the convex polygon `q` (grid corners in the plane
-/// `x[axis] = k`) lies strictly inside the solid the closed, oriented,
-/// embedded part `part` bounds ([`placed`] is 1).
-fn inside(part: &[&[GridPoint]], axis: usize, q: &[GridPoint]) -> bool {
-    placed(part, axis, q) == Some(1)
-}
-
 /// How many times the closed, oriented, embedded part `part` (its faces'
 /// grid corners) winds around the convex polygon `q` (grid corners, one
 /// plane; or a segment or a point) where no triangle of `q` meets a
@@ -515,43 +519,157 @@ pub(crate) fn placed(part: &[&[GridPoint]], axis: usize, q: &[GridPoint]) -> Opt
 /// component. `None` where the ray meets an edge, a corner or `p` lies
 /// on a face (degenerate: another point is tried).
 fn winding(part: &[&[GridPoint]], axis: usize, p: GridPoint) -> Option<i64> {
-    let [u, v] = across(axis);
-    let d = |a: GridPoint, b: GridPoint| [0, 1, 2].map(|c| i64::from(a[c]) - i64::from(b[c]));
     let mut w = 0;
     for f in part {
         for j in 1..f.len() - 1 {
-            let t = [f[0], f[j], f[j + 1]];
-            // the turns of p's shadow about the shadow's edges
-            let turn = |a: GridPoint, b: GridPoint| {
-                let (e, x) = (d(b, a), d(p, a));
-                e[u] * x[v] - e[v] * x[u]
-            };
-            let s = [turn(t[0], t[1]), turn(t[1], t[2]), turn(t[2], t[0])];
-            let strictly = s.iter().all(|&x| x > 0) || s.iter().all(|&x| x < 0);
-            if !strictly {
-                if s.iter().any(|&x| x > 0) && s.iter().any(|&x| x < 0) {
-                    continue; // outside the shadow
-                }
-                return None; // on its boundary (or a shadow of no area)
-            }
-            let (e1, e2) = (d(t[1], t[0]), d(t[2], t[0]));
-            let n = [
-                e1[1] * e2[2] - e1[2] * e2[1],
-                e1[2] * e2[0] - e1[0] * e2[2],
-                e1[0] * e2[1] - e1[1] * e2[0],
-            ];
-            let x = d(p, t[0]);
-            let side: i128 = (0..3).map(|c| i128::from(n[c]) * i128::from(x[c])).sum();
-            // the ray meets the plane at `-side / n[axis]` past p
-            if side == 0 {
-                return None;
-            }
-            if (side < 0) == (n[axis] > 0) {
-                w += n[axis].signum();
-            }
+            w += crossing(&[f[0], f[j], f[j + 1]], axis, p)?;
         }
     }
     Some(w)
+}
+
+/// What fan triangle `t` adds to [`winding`] at `p`: the sign of its
+/// normal's `axis` component where its shadow holds `p`'s strictly and
+/// the ray from `p` meets it past `p`, else 0; `None` where `p`'s shadow
+/// lies on its shadow's boundary (or the shadow has no area and `p`'s
+/// lies on its line), or `p` on its plane.
+fn crossing(t: &[GridPoint; 3], axis: usize, p: GridPoint) -> Option<i64> {
+    let [u, v] = across(axis);
+    let d = |a: GridPoint, b: GridPoint| [0, 1, 2].map(|c| i64::from(a[c]) - i64::from(b[c]));
+    // the turns of p's shadow about the shadow's edges
+    let turn = |a: GridPoint, b: GridPoint| {
+        let (e, x) = (d(b, a), d(p, a));
+        e[u] * x[v] - e[v] * x[u]
+    };
+    let s = [turn(t[0], t[1]), turn(t[1], t[2]), turn(t[2], t[0])];
+    let strictly = s.iter().all(|&x| x > 0) || s.iter().all(|&x| x < 0);
+    if !strictly {
+        if s.iter().any(|&x| x > 0) && s.iter().any(|&x| x < 0) {
+            return Some(0); // outside the shadow
+        }
+        return None; // on its boundary (or a shadow of no area)
+    }
+    let (e1, e2) = (d(t[1], t[0]), d(t[2], t[0]));
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
+    let x = d(p, t[0]);
+    let side: i128 = (0..3).map(|c| i128::from(n[c]) * i128::from(x[c])).sum();
+    // the ray meets the plane at `-side / n[axis]` past p
+    if side == 0 {
+        return None;
+    }
+    Some(match (side < 0) == (n[axis] > 0) {
+        true => n[axis].signum(),
+        false => 0,
+    })
+}
+
+/// A closed part's fan triangles indexed for [`placed`] across one axis:
+/// a grid over their faces' boxes, and one over those boxes drawn across
+/// the axis (the axis' extent left out), each triangle listed in the
+/// cells of its face's box; the triangles whose shadow has no area apart
+/// from the second, checked at every point. It answers as [`placed`]
+/// over the whole part does:
+/// - the triangles a polygon `q` in a plane across the axis is tested
+///   against are those of the faces whose box meets `q`'s, as there;
+/// - at a point `p`, a triangle whose shadow has area and whose face's
+///   box (so its own) holds `p`'s shadow not even on its boundary adds
+///   nothing: its three turns sum to twice its shadow's signed area, so
+///   some turn has the area's sign and, `p` being outside, some the
+///   other ([`crossing`] gives 0).
+pub(crate) struct PartShadows {
+    axis: usize,
+    /// Each fan triangle and its face's box.
+    tris: Vec<([GridPoint; 3], Box3)>,
+    /// The triangles whose shadow has no area.
+    flat: Vec<u32>,
+    /// The other triangles by their faces' boxes drawn across the axis.
+    grid: CellGrid,
+    /// Every triangle by its face's box (a polygon across the axis meets
+    /// the cells of one layer).
+    boxes: CellGrid,
+}
+
+impl PartShadows {
+    /// The fan triangles of the faces of `part` (grid corners), across
+    /// `axis`.
+    pub(crate) fn new(part: &[&[GridPoint]], axis: usize) -> PartShadows {
+        let [u, v] = across(axis);
+        let flatten = |mut b: Box3| {
+            b[axis] = [0, 0];
+            b
+        };
+        let mut tris = Vec::new();
+        for f in part {
+            let b = grid_box(f);
+            for j in 1..f.len() - 1 {
+                tris.push(([f[0], f[j], f[j + 1]], b));
+            }
+        }
+        let area = |t: &[GridPoint; 3]| {
+            let e = |a: GridPoint, b: GridPoint, k: usize| i64::from(b[k]) - i64::from(a[k]);
+            e(t[0], t[1], u) * e(t[0], t[2], v) - e(t[0], t[1], v) * e(t[0], t[2], u)
+        };
+        let (flat, shadowed): (Vec<u32>, Vec<u32>) =
+            (0..tris.len() as u32).partition(|&i| area(&tris[i as usize].0) == 0);
+        let items: Vec<(u32, Box3)> = (shadowed.iter())
+            .map(|&i| (i, flatten(tris[i as usize].1)))
+            .collect();
+        let scene = items.iter().map(|(_, b)| *b).reduce(crate::boxes::union);
+        let grid = CellGrid::of_items(scene.unwrap_or([[0, 0]; 3]), &items);
+        let all: Vec<(u32, Box3)> = (tris.iter().enumerate())
+            .map(|(i, (_, b))| (i as u32, *b))
+            .collect();
+        let scene = all.iter().map(|(_, b)| *b).reduce(crate::boxes::union);
+        let boxes = CellGrid::of_items(scene.unwrap_or([[0, 0]; 3]), &all);
+        PartShadows {
+            axis,
+            tris,
+            flat,
+            grid,
+            boxes,
+        }
+    }
+
+    /// [`placed`] of `q` over the part indexed.
+    pub(crate) fn placed(&self, q: &[GridPoint]) -> Option<i64> {
+        let qb = grid_box(q);
+        let tris_q: Vec<[GridPoint; 3]> = match q.len() {
+            0 => return None,
+            1 | 2 => vec![[q[0], q[q.len() - 1], q[0]]],
+            _ => (1..q.len() - 1).map(|j| [q[0], q[j], q[j + 1]]).collect(),
+        };
+        let mut apart = true;
+        self.boxes.visit(qb, |i| {
+            let (t, b) = &self.tris[i as usize];
+            apart &= !overlap(b, &qb) || tris_q.iter().all(|s| triangles_disjoint(s, t));
+        });
+        if !apart {
+            return None;
+        }
+        q.iter().find_map(|&p| self.winding(p))
+    }
+
+    /// [`winding`] of the part indexed at `p`.
+    fn winding(&self, p: GridPoint) -> Option<i64> {
+        let mut at = [
+            [i64::from(p[0]); 2],
+            [i64::from(p[1]); 2],
+            [i64::from(p[2]); 2],
+        ];
+        at[self.axis] = [0, 0];
+        let mut w = Some(0);
+        let mut add = |i: u32| {
+            w = w.and_then(|w| Some(w + crossing(&self.tris[i as usize].0, self.axis, p)?));
+        };
+        self.flat.iter().for_each(|&i| add(i));
+        // (a point meets one cell: each triangle once)
+        self.grid.visit(at, &mut add);
+        w
+    }
 }
 
 #[cfg(test)]
@@ -592,10 +710,16 @@ mod tests {
     fn inner_polygons_lie_inside() {
         let faces = octahedron(64, 2);
         let part: Vec<&[GridPoint]> = faces.iter().map(|f| &f[..]).collect();
+        let inside = |part: &[&[GridPoint]], axis, q: &[GridPoint]| {
+            let indexed = PartShadows::new(part, axis).placed(q);
+            assert_eq!(indexed, placed(part, axis, q));
+            indexed == Some(1)
+        };
         let mut found = 0;
         for axis in 0..3 {
+            let shadows = PartShadows::new(&part, axis);
             for k in [-40, -10, 0, 7, 33] {
-                for q in inner_polygons(&part, (axis, k), PER_SLICE) {
+                for q in inner_polygons((&part, &shadows), k, PER_SLICE) {
                     found += 1;
                     // every corner strictly inside |x| + |y| + |z| < 64
                     for c in &q {
@@ -622,6 +746,61 @@ mod tests {
         let part: Vec<&[GridPoint]> = inverted.iter().map(|f| &f[..]).collect();
         assert_eq!(winding(&part, 0, [3, 1, 2]), Some(-1));
         assert!(!inside(&part, 0, &[[3, 1, 2], [3, 5, 2], [3, 1, 6]]));
+    }
+
+    /// The indexed part places every polygon and point as the whole part
+    /// does: random triangles, segments and points in slices across each
+    /// axis, on the grid of the solid's corners (so many lie on its faces,
+    /// edges and corners, and many shadows meet at theirs), with a wall of
+    /// triangles whose shadows have no area (upright to the axis).
+    #[test]
+    fn the_indexed_part_places_as_the_whole_part() {
+        let mut faces = octahedron(16, 2);
+        // a closed, thin upright box: faces of no area across the z axis
+        let b = |x: i32, y: i32, z: i32| [x, y, z];
+        let (x0, x1, y0, y1, z0, z1) = (20, 28, 2, 3, -6, 6);
+        let quad = |a, b, c, d| vec![a, b, c, d];
+        faces.extend([
+            quad(b(x0, y0, z0), b(x0, y1, z0), b(x1, y1, z0), b(x1, y0, z0)),
+            quad(b(x0, y0, z1), b(x1, y0, z1), b(x1, y1, z1), b(x0, y1, z1)),
+            quad(b(x0, y0, z0), b(x1, y0, z0), b(x1, y0, z1), b(x0, y0, z1)),
+            quad(b(x0, y1, z0), b(x0, y1, z1), b(x1, y1, z1), b(x1, y1, z0)),
+            quad(b(x0, y0, z0), b(x0, y0, z1), b(x0, y1, z1), b(x0, y1, z0)),
+            quad(b(x1, y0, z0), b(x1, y1, z0), b(x1, y1, z1), b(x1, y0, z1)),
+        ]);
+        let part: Vec<&[GridPoint]> = faces.iter().map(|f| &f[..]).collect();
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |n: i32| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % (2 * n as u64 + 1)) as i32 - n
+        };
+        let (mut decided, mut inside) = (0, 0);
+        for axis in 0..3 {
+            let shadows = PartShadows::new(&part, axis);
+            for _ in 0..400 {
+                let k = next(20);
+                let corners = 1 + (next(1) + 1) as usize;
+                // (small ones near the centre lie inside the solid)
+                let r = if next(1) == 0 { 5 } else { 30 };
+                let q: Vec<GridPoint> = (0..corners)
+                    .map(|_| {
+                        let mut c = [next(r), next(r), next(r)];
+                        c[axis] = k;
+                        c
+                    })
+                    .collect();
+                let whole = placed(&part, axis, &q);
+                assert_eq!(shadows.placed(&q), whole, "{q:?} across axis {axis}");
+                decided += usize::from(whole.is_some());
+                inside += usize::from(whole == Some(1));
+            }
+        }
+        assert!(
+            decided > 300 && inside > 20,
+            "{decided} decided, {inside} inside"
+        );
     }
 
     /// A certified closed part gets inner occluders across the light's
