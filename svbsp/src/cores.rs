@@ -748,15 +748,10 @@ mod tests {
         assert!(!inside(&part, 0, &[[3, 1, 2], [3, 5, 2], [3, 1, 6]]));
     }
 
-    /// The indexed part places every polygon and point as the whole part
-    /// does: random triangles, segments and points in slices across each
-    /// axis, on the grid of the solid's corners (so many lie on its faces,
-    /// edges and corners, and many shadows meet at theirs), with a wall of
-    /// triangles whose shadows have no area (upright to the axis).
-    #[test]
-    fn the_indexed_part_places_as_the_whole_part() {
+    /// A closed octahedron and, beside it, a closed thin upright box, whose
+    /// faces' shadows across the z axis have no area.
+    fn two_parts() -> Vec<Vec<GridPoint>> {
         let mut faces = octahedron(16, 2);
-        // a closed, thin upright box: faces of no area across the z axis
         let b = |x: i32, y: i32, z: i32| [x, y, z];
         let (x0, x1, y0, y1, z0, z1) = (20, 28, 2, 3, -6, 6);
         let quad = |a, b, c, d| vec![a, b, c, d];
@@ -768,39 +763,52 @@ mod tests {
             quad(b(x0, y0, z0), b(x0, y0, z1), b(x0, y1, z1), b(x0, y1, z0)),
             quad(b(x1, y0, z0), b(x1, y1, z0), b(x1, y1, z1), b(x1, y0, z1)),
         ]);
-        let part: Vec<&[GridPoint]> = faces.iter().map(|f| &f[..]).collect();
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = |n: i32| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed % (2 * n as u64 + 1)) as i32 - n
-        };
-        let (mut decided, mut inside) = (0, 0);
-        for axis in 0..3 {
-            let shadows = PartShadows::new(&part, axis);
-            for _ in 0..400 {
-                let k = next(20);
-                let corners = 1 + (next(1) + 1) as usize;
-                // (small ones near the centre lie inside the solid)
-                let r = if next(1) == 0 { 5 } else { 30 };
-                let q: Vec<GridPoint> = (0..corners)
-                    .map(|_| {
-                        let mut c = [next(r), next(r), next(r)];
-                        c[axis] = k;
-                        c
-                    })
-                    .collect();
-                let whole = placed(&part, axis, &q);
-                assert_eq!(shadows.placed(&q), whole, "{q:?} across axis {axis}");
-                decided += usize::from(whole.is_some());
-                inside += usize::from(whole == Some(1));
-            }
+        faces
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(1200))]
+        /// The indexed part places every polygon and point as the whole
+        /// part does: triangles, segments and points in a slice across each
+        /// axis, on the grid of the solids' corners (so many lie on faces,
+        /// edges and corners, and many shadows meet at theirs), small ones
+        /// near the octahedron's centre (inside it).
+        #[test]
+        fn the_indexed_part_places_as_the_whole_part(
+            axis in 0usize..3,
+            k in -20i32..=20,
+            small in proptest::prelude::any::<bool>(),
+            q in proptest::collection::vec(proptest::array::uniform3(-30i32..=30), 1..4),
+        ) {
+            let faces = two_parts();
+            let part: Vec<&[GridPoint]> = faces.iter().map(|f| &f[..]).collect();
+            let q: Vec<GridPoint> = (q.into_iter())
+                .map(|c| {
+                    let mut c = if small { c.map(|x| x / 6) } else { c };
+                    c[axis] = k;
+                    c
+                })
+                .collect();
+            proptest::prop_assert_eq!(PartShadows::new(&part, axis).placed(&q), placed(&part, axis, &q));
         }
-        assert!(
-            decided > 300 && inside > 20,
-            "{decided} decided, {inside} inside"
-        );
+    }
+
+    /// The three answers, indexed as whole: inside the octahedron, outside
+    /// both parts, and on the line of the upright box's shadow (no area),
+    /// which no winding decides.
+    #[test]
+    fn the_indexed_part_gives_each_answer() {
+        let faces = two_parts();
+        let part: Vec<&[GridPoint]> = faces.iter().map(|f| &f[..]).collect();
+        let shadows = PartShadows::new(&part, 2);
+        for (q, answer) in [
+            (vec![[1, 1, 3], [2, 1, 3], [1, 0, 3]], Some(1)),
+            (vec![[40, 40, 0]], Some(0)),
+            (vec![[24, 2, 9]], None),
+        ] {
+            assert_eq!(placed(&part, 2, &q), answer, "{q:?}");
+            assert_eq!(shadows.placed(&q), answer, "{q:?}");
+        }
     }
 
     /// A certified closed part gets inner occluders across the light's
