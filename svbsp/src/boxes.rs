@@ -256,9 +256,7 @@ impl CellGrid {
             }
         }
     }
-}
 
-impl CellGrid {
     /// The grid with every cell's list packed into one list, in cell
     /// order, each entry `item` of the listed index: a visit then reads
     /// one run of memory per row of cells, the entries' data inline.

@@ -495,11 +495,7 @@ fn hull(points: &[[f64; 2]]) -> Option<Vec<[i32; 2]>> {
 /// corner of `q` is degenerate for the ray along `axis` ([`winding`]).
 pub(crate) fn placed(part: &[&[GridPoint]], axis: usize, q: &[GridPoint]) -> Option<i64> {
     let qb = grid_box(q);
-    let tris_q: Vec<[GridPoint; 3]> = match q.len() {
-        0 => return None,
-        1 | 2 => vec![[q[0], q[q.len() - 1], q[0]]],
-        _ => (1..q.len() - 1).map(|j| [q[0], q[j], q[j + 1]]).collect(),
-    };
+    let tris_q = fan(q)?;
     let apart = part.iter().filter(|f| overlap(&grid_box(f), &qb)).all(|f| {
         (1..f.len() - 1).all(|j| {
             let t = [f[0], f[j], f[j + 1]];
@@ -510,6 +506,16 @@ pub(crate) fn placed(part: &[&[GridPoint]], axis: usize, q: &[GridPoint]) -> Opt
         return None;
     }
     q.iter().find_map(|&p| winding(part, axis, p))
+}
+
+/// The fan triangles of the convex polygon `q` (a segment or a point as
+/// one triangle of no area); `None` for no corners.
+fn fan(q: &[GridPoint]) -> Option<Vec<[GridPoint; 3]>> {
+    Some(match q.len() {
+        0 => return None,
+        1 | 2 => vec![[q[0], q[q.len() - 1], q[0]]],
+        _ => (1..q.len() - 1).map(|j| [q[0], q[j], q[j + 1]]).collect(),
+    })
 }
 
 /// The number of times the closed, outward part `part` winds around grid
@@ -637,11 +643,7 @@ impl PartShadows {
     /// [`placed`] of `q` over the part indexed.
     pub(crate) fn placed(&self, q: &[GridPoint]) -> Option<i64> {
         let qb = grid_box(q);
-        let tris_q: Vec<[GridPoint; 3]> = match q.len() {
-            0 => return None,
-            1 | 2 => vec![[q[0], q[q.len() - 1], q[0]]],
-            _ => (1..q.len() - 1).map(|j| [q[0], q[j], q[j + 1]]).collect(),
-        };
+        let tris_q = fan(q)?;
         let mut apart = true;
         self.boxes.visit(qb, |i| {
             let (t, b) = &self.tris[i as usize];
