@@ -431,13 +431,17 @@ impl Scene {
         let mut hit = false;
         let mut degenerate = false;
         for (fi, f) in self.faces.iter().enumerate() {
-            if fi == own || f.key.0 == g.key.0 {
-                // the segment or ray leaves the plane of `own` at once
+            if fi == own {
                 continue;
             }
             let apart = (0..3)
                 .any(|a| hi[a].is_some_and(|h| f.lo[a] > h) || lo[a].is_some_and(|l| f.hi[a] < l));
-            if apart || !f.near(&xf, &dir, tmax) {
+            // (the planes' keys compared last: rationals compare by
+            // division, far dearer than the filters that pass over most
+            // faces)
+            if apart || !f.near(&xf, &dir, tmax) || f.key.0 == g.key.0 {
+                // the segment or ray leaves the plane of `own` at once, or
+                // cannot come near the face
                 continue;
             }
             let ex = f.eval(x);
