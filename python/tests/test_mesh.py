@@ -89,6 +89,11 @@ def test_bad_input_raises_with_a_message(tmp_path):
         bs.shadows(bs.Mesh(v, f), [bs.Sun((0, 0, 0))])
     with pytest.raises(bs.LightError):
         bs.shadows(bs.Mesh(v, f), [bs.Sun((0, 0, 1))] * 65)
+    nan = float("nan")
+    with pytest.raises(bs.LightError, match="light 1: a coordinate is not finite"):
+        bs.shadows(bs.Mesh(v, f), [bs.Sun((0, 0, 1)), bs.PointLight((nan, 0, 3))])
+    with pytest.raises(bs.LightError, match="light 0: a coordinate is not finite"):
+        bs.soft_shadows(bs.Mesh(v, f), [bs.AreaLight([(0, 0, 3), (1, 0, 3), (0, nan, 3)])])
     assert issubclass(bs.MeshError, ValueError)
     # faces left out on the grid are said, not only zeros
     far = np.vstack([v, v + 1e9])

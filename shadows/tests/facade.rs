@@ -156,6 +156,44 @@ fn errors_keep_their_causes() {
     assert!(matches!(e, Error::Light(_)), "{e}");
 }
 
+/// A light with a NaN or infinite coordinate is named as such, whatever
+/// kind it is (not "outside the grid", nor "a zero direction").
+#[test]
+fn lights_not_finite_are_named() {
+    use bsp_shadows::SoftSpec;
+    let not_finite = |index: usize| format!("light {index}: a coordinate is not finite");
+    for bad in [f64::NAN, f64::INFINITY] {
+        let lights = [
+            Light::Point(DVec3::new(0.0, 0.0, 3.0)),
+            Light::Sun(DVec3::new(0.0, bad, 1.0)),
+        ];
+        let e = bsp_shadows::shadows(&sphere(), &lights).unwrap_err();
+        assert!(e.to_string().contains(&not_finite(1)), "{e}");
+        let e = bsp_shadows::shadows(&sphere(), &[Light::Point(DVec3::new(bad, 0.0, 3.0))])
+            .unwrap_err();
+        assert!(e.to_string().contains(&not_finite(0)), "{e}");
+        let area = |z: f64| {
+            SoftSpec::Area(
+                [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5)]
+                    .map(|(x, y)| DVec3::new(x, y, z))
+                    .to_vec(),
+            )
+        };
+        let disc = |d: DVec3| SoftSpec::SunDisc {
+            direction: d,
+            radius_deg: 0.2666,
+        };
+        let cases = [
+            vec![area(3.0), area(bad)],
+            vec![area(3.0), disc(DVec3::new(bad, 0.0, 1.0))],
+        ];
+        for soft in cases {
+            let e = bsp_shadows::soft_file::soft_shadows(&sphere(), &[], &soft).unwrap_err();
+            assert!(e.to_string().contains(&not_finite(1)), "{e}");
+        }
+    }
+}
+
 /// Counts the phases and steps a job reports.
 #[derive(Default)]
 struct Heard {

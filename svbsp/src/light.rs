@@ -40,6 +40,13 @@ pub enum LightError {
         /// The grid's origin, in input units.
         centre: DVec3,
     },
+    /// Placing lights given in input units: a coordinate of light `index`
+    /// (a position, a direction or an area light's corner) is NaN or
+    /// infinite.
+    NotFinite {
+        /// The light's number.
+        index: usize,
+    },
     /// Placing lights given in input units: sun `index` has no direction.
     ZeroSun {
         /// The light's number.
@@ -74,6 +81,12 @@ impl std::fmt::Display for LightError {
                  sun",
                 centre.x, centre.y, centre.z
             ),
+            LightError::NotFinite { index } => {
+                write!(
+                    f,
+                    "light {index}: a coordinate is not finite (NaN or infinite)"
+                )
+            }
             LightError::ZeroSun { index } => write!(f, "light {index}: the sun direction is zero"),
             LightError::Grid(e) => write!(f, "cannot fit a grid to the scene and its lights: {e}"),
             LightError::Extent { index, cause } => write!(f, "light {index}: {cause}"),
@@ -331,6 +344,9 @@ pub fn place_lights(grid: &Grid, lights: &[LightSpec]) -> Result<Vec<PlacedLight
         .iter()
         .enumerate()
         .map(|(index, spec)| match *spec {
+            LightSpec::Point(p) | LightSpec::Sun(p) if !p.is_finite() => {
+                Err(LightError::NotFinite { index })
+            }
             LightSpec::Point(p) => {
                 let g = grid.snap(p).map_err(|_| LightError::FarPoint {
                     index,
@@ -570,6 +586,23 @@ mod tests {
         );
         let e = place_lights(&g, &[LightSpec::Sun(DVec3::ZERO)]).unwrap_err();
         assert_eq!(e, LightError::ZeroSun { index: 0 });
+        // not "outside the grid" or "zero": what is wrong, and where
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let lights = [
+                LightSpec::Point(DVec3::new(0.5, 0.5, 2.0)),
+                LightSpec::Point(DVec3::new(0.5, bad, 2.0)),
+                LightSpec::Sun(DVec3::new(bad, 0.0, 1.0)),
+            ];
+            let g = shared_grid(&scene, &lights).unwrap();
+            let e = place_lights(&g, &lights).unwrap_err();
+            assert_eq!(e, LightError::NotFinite { index: 1 });
+            assert_eq!(
+                e.to_string(),
+                "light 1: a coordinate is not finite (NaN or infinite)"
+            );
+            let e = place_lights(&g, &lights[2..]).unwrap_err();
+            assert_eq!(e, LightError::NotFinite { index: 0 });
+        }
         let many = vec![LightSpec::Sun(DVec3::Z); MAX_LIGHTS + 1];
         assert_eq!(
             place_lights(&g, &many).unwrap_err(),

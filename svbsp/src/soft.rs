@@ -1268,6 +1268,12 @@ pub fn place_soft_lights(
         let index = out.len();
         let extent = |cause| LightError::Extent { index, cause };
         let (light, shape) = match spec {
+            SoftSpec::Area(corners) if corners.iter().any(|c| !c.is_finite()) => {
+                return Err(LightError::NotFinite { index });
+            }
+            SoftSpec::SunDisc { direction, .. } if !direction.is_finite() => {
+                return Err(LightError::NotFinite { index });
+            }
             SoftSpec::Area(corners) => {
                 let far = |_| LightError::FarPoint {
                     index,
