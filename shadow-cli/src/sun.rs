@@ -74,7 +74,7 @@ pub(crate) struct SunHoursArgs {
     /// Days from one studied day to the next.
     #[arg(long, value_name = "DAYS", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     every: u32,
-    /// Minutes between suns, each at its interval's midpoint [default: 10].
+    /// Minutes between suns, each at its interval's midpoint, from 1/60 (a second) to 1440 [default: 10].
     #[arg(long, value_name = "MIN")]
     step: Option<f64>,
     /// The days' clock, hours east of UTC [default: 0].

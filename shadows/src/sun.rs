@@ -228,6 +228,10 @@ fn spa(
     Ok((p.azimuth(), p.elevation_angle()))
 }
 
+/// The finest step of a study's suns: one second, in minutes (a day of
+/// at most 86,400 suns).
+pub const MIN_STEP_MINUTES: f64 = 1.0 / 60.0;
+
 /// The suns of a study: on each of `dates`, the midpoints of the day's
 /// `step_minutes`-long intervals from 00:00 to 24:00 at `utc_offset_hours`,
 /// those with the sun's centre above the horizon. The midpoint rule: a
@@ -242,9 +246,12 @@ pub fn study_suns(
     step_minutes: f64,
     utc_offset_hours: f64,
 ) -> Result<Vec<SunPosition>, SunError> {
-    if !(step_minutes > 0.0 && step_minutes <= 1440.0) {
+    // (the times are whole milliseconds, and a day of steps under a
+    // second is a hang rather than a study: 1e-9 minutes made 1.4e12 suns)
+    if !((MIN_STEP_MINUTES..=1440.0).contains(&step_minutes)) {
         return Err(SunError(format!(
-            "a step of {step_minutes} minutes: from above 0 to 1440"
+            "a step of {step_minutes} minutes: from one second ({MIN_STEP_MINUTES:.4}) to 1440 \
+             (the sun path's exact hours need no step: `--exact-time`)"
         )));
     }
     let offset = (utc_offset_hours.abs() < 24.0)

@@ -153,6 +153,12 @@ fn a_day_of_suns_and_the_hours_of_a_yard() {
     let hourly = study_suns(&site, &day, 60.0, 0.0).unwrap();
     assert!((11..=13).contains(&hourly.len()), "{}", hourly.len());
     assert!(study_suns(&site, &day, 0.0, 0.0).is_err());
+    // a step under a second is refused at once (1e-9 minutes hung,
+    // making 1.4e12 suns)
+    for tiny in [1e-9, 0.0166, -5.0, f64::NAN, 1441.0] {
+        let e = study_suns(&site, &day, tiny, 0.0).unwrap_err().to_string();
+        assert!(e.contains("from one second (0.0167) to 1440"), "{e}");
+    }
     let offset = study_suns(&site, &day, 60.0, 30.0).unwrap_err().to_string();
     assert!(
         offset.contains("30 hours: it must lie strictly between -24 and 24"),
