@@ -87,8 +87,14 @@ def read_mesh(path) -> Mesh:
 
 def box(lo: Sequence[float], hi: Sequence[float]) -> Mesh:
     """The axis-aligned box from corner ``lo`` to corner ``hi``, as six
-    outward-facing quads."""
+    outward-facing quads. ``lo`` must lie below ``hi`` on every axis
+    (``MeshError`` otherwise: a box turned inside out, or flat, is no
+    solid)."""
     (x0, y0, z0), (x1, y1, z1) = lo, hi
+    if not (x0 < x1 and y0 < y1 and z0 < z1):
+        raise MeshError(
+            f"box: lo {tuple(lo)} must lie below hi {tuple(hi)} on every axis"
+        )
     vertices = np.array(
         [[x, y, z] for z in (z0, z1) for y in (y0, y1) for x in (x0, x1)],
         dtype=np.float64,

@@ -90,6 +90,9 @@ def test_bad_input_raises_with_a_message(tmp_path):
     with pytest.raises(bs.LightError):
         bs.shadows(bs.Mesh(v, f), [bs.Sun((0, 0, 1))] * 65)
     nan = float("nan")
+    for lo, hi in [((1, 0, 0), (0, 1, 1)), ((0, 0, 0), (1, 1, 0)), ((0, 0, 0), (1, nan, 1))]:
+        with pytest.raises(bs.MeshError, match="must lie below hi"):
+            bs.box(lo, hi)
     with pytest.raises(bs.LightError, match="light 1: a coordinate is not finite"):
         bs.shadows(bs.Mesh(v, f), [bs.Sun((0, 0, 1)), bs.PointLight((nan, 0, 3))])
     with pytest.raises(bs.LightError, match="light 0: a coordinate is not finite"):
