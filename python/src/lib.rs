@@ -247,6 +247,50 @@ fn points<'py>(py: Python<'py>, array: &Bound<'py, PyAny>, what: &str) -> PyResu
     Ok(out)
 }
 
+/// Sensors from an array of shape `(n, 3)` (points) or `(n, 6)` (points
+/// and their surfaces' normals, which must not be zero).
+fn sensors<'py>(
+    py: Python<'py>,
+    array: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<Vec<bsp_shadows::sun::Sensor>> {
+    use bsp_shadows::sun::Sensor;
+    let np = py.import("numpy")?;
+    let a = aligned(&np, array, "float64")?;
+    let a: PyReadonlyArray2<'py, f64> = a.extract().map_err(|_| {
+        MeshError::new_err(format!(
+            "{what}: an array of shape (n, 3) or (n, 6) of numbers"
+        ))
+    })?;
+    let shape = a.shape();
+    if shape[1] != 3 && shape[1] != 6 {
+        return Err(MeshError::new_err(format!(
+            "{what}: shape ({}, {}), not (n, 3) (points) or (n, 6) (points and normals)",
+            shape[0], shape[1]
+        )));
+    }
+    let flat = a.as_slice()?;
+    (flat.chunks_exact(shape[1]).enumerate())
+        .map(|(i, row)| {
+            if let Some(x) = row.iter().find(|x| !x.is_finite()) {
+                return Err(MeshError::new_err(format!(
+                    "{what}: row {i} is not finite ({x})"
+                )));
+            }
+            let normal = (row.len() == 6).then(|| DVec3::new(row[3], row[4], row[5]));
+            if normal == Some(DVec3::ZERO) {
+                return Err(MeshError::new_err(format!(
+                    "{what}: row {i}'s normal is zero"
+                )));
+            }
+            Ok(Sensor {
+                position: DVec3::new(row[0], row[1], row[2]),
+                normal,
+            })
+        })
+        .collect()
+}
+
 /// The first index of the whole-number array `a` (in C order) that
 /// numpy's cast to `int64` would not keep (a `uint64` above `2^63 - 1`, a
 /// float beyond `±2^63`): its flat position and its value as text.
@@ -1019,8 +1063,10 @@ fn site_and_days(
 }
 
 /// Each sensor's sun-on intervals on each day, in closed form (no time
-/// sampling: `bsp_shadows::sun::sensor_intervals`): per sensor, per day,
-/// an array of shape (n, 2) of hours of the day's clock.
+/// sampling: `bsp_shadows::sun::sensor_intervals_facing`): per sensor,
+/// per day, an array of shape (n, 2) of hours of the day's clock. The
+/// sensors are points `(p, 3)`, or points with their surfaces' normals
+/// `(p, 6)` (the sun counted only in front of the surface).
 #[pyfunction]
 #[pyo3(signature = (scene, points, lat, lon, dates, utc_offset=0.0, north=0.0, up="z", height=0.0))]
 #[allow(clippy::too_many_arguments)] // (Python keywords, each with a default)
@@ -1037,10 +1083,12 @@ fn sensor_intervals<'py>(
     height: f64,
 ) -> PyResult<Vec<Vec<Bound<'py, PyArray2<f64>>>>> {
     let (site, days) = site_and_days(lat, lon, dates, north, up, height)?;
-    let at = crate::points(py, points, "points")?;
+    let at = crate::sensors(py, points, "points")?;
     let paths =
         sun::day_paths(&site, &days, utc_offset).map_err(|e| BspError::new_err(e.to_string()))?;
-    let on = run(py, || sun::sensor_intervals(scene.mesh(), &at, &paths));
+    let on = run(py, || {
+        sun::sensor_intervals_facing(scene.mesh(), &at, &paths)
+    });
     on.into_iter()
         .map(|days| {
             days.into_iter()
@@ -1140,15 +1188,21 @@ impl SunHours {
     }
 
     /// `(p,)`: the exact sun-hours at each of `points` (`(p, 3)`), among
-    /// the mesh's faces.
+    /// the mesh's faces; or of sensors `(p, 6)`, each point with its
+    /// surface's normal, counting only the suns in front of it.
     fn per_sensor<'py>(
         &self,
         py: Python<'py>,
         points: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let at = crate::points(py, points, "points")?;
+        let at = crate::sensors(py, points, "points")?;
         let h = run(py, || {
-            bsp_shadows::sun::sensor_hours(self.mesh.mesh(), &at, &self.suns, self.step_hours)
+            bsp_shadows::sun::sensor_hours_facing(
+                self.mesh.mesh(),
+                &at,
+                &self.suns,
+                self.step_hours,
+            )
         });
         Ok(h.map_err(to_py)?.into_pyarray(py))
     }

@@ -192,6 +192,24 @@ def test_sensor_intervals_in_closed_form_agree_with_sampled_hours():
     # the refraction left out and the steps at shadow edges, for two days
     assert np.abs(exact - sampled).max() < 0.75, (exact, sampled)
     assert exact[1] < exact[2] - 2.0
+    # sensors that face a way: up, as points; down, no sun; east, its
+    # morning only, sampled and exact alike
+    for n, check in [((0, 0, 1), "same"), ((0, 0, -1), "none"), ((1, 0, 0), "less")]:
+        facing = np.hstack([points, np.tile(np.array(n, float), (3, 1))])
+        f_sampled = study.per_sensor(facing)
+        f_on = bs.sensor_intervals(m, facing, lat=52.01, lon=4.36, dates=days)
+        f_exact = np.array([sum((iv[:, 1] - iv[:, 0]).sum() for iv in d) for d in f_on])
+        assert np.abs(f_exact - f_sampled).max() < 0.75, (n, f_exact, f_sampled)
+        if check == "same":
+            assert (f_sampled == sampled).all() and np.allclose(f_exact, exact)
+        elif check == "none":
+            assert (f_sampled == 0).all() and (f_exact == 0).all()
+        else:
+            assert (f_sampled < sampled - 1.0).all() and (f_sampled > 0).all(), (f_sampled, sampled)
+    with pytest.raises(bs.MeshError, match="normal is zero"):
+        study.per_sensor(np.array([[0.0, 0, 0, 0, 0, 0]]))
+    with pytest.raises(bs.MeshError, match=r"not \(n, 3\) \(points\) or \(n, 6\)"):
+        study.per_sensor(np.zeros((1, 4)))
 
 
 def test_a_sun_disc_study_matches_point_suns_on_a_lone_box():

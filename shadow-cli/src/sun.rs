@@ -86,7 +86,7 @@ pub(crate) struct SunHoursArgs {
     /// Also say how much of each group (or of the regions) sees at least H hours.
     #[arg(long, value_name = "H")]
     min_hours: Option<f64>,
-    /// Hours at points instead of faces: a file of x,y,z lines (a header line may lead).
+    /// Hours at sensors instead of faces: a file of x,y,z lines, or x,y,z,nx,ny,nz with the normal of the surface a sensor stands for (it then counts only the suns in front of it; a header line may lead).
     #[arg(long, value_name = "FILE")]
     sensors: Option<PathBuf>,
     /// Hours of the cells of these faces instead (a group, or ids such as 1,4,7-9): every step's lit parts overlaid.

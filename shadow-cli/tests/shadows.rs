@@ -1284,9 +1284,26 @@ fn sunhours_writes_every_faces_hours() {
         .collect();
     assert_eq!(text.lines().next(), Some("sensor,x,y,z,sun_hours"));
     assert!(hours[0] == top && hours[1] == 0.0, "{text}");
+    // a sensor given its surface's normal counts the suns in front of it:
+    // above the cube facing up, every sun; facing down, none
+    std::fs::write(
+        &points,
+        "x,y,z,nx,ny,nz\n0.5,0.5,2,0,0,1\n0.5,0.5,2,0,0,-1\n",
+    )
+    .unwrap();
+    let o = run(&csv, &["--sensors", points.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let facing: Vec<f64> = (text.lines().skip(1))
+        .map(|l| l.rsplit(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(facing, [top, 0.0], "{text}");
     std::fs::write(&points, "0.5,0.5\n").unwrap();
     let o = run(&json, &["--sensors", points.to_str().unwrap()]);
-    crate::assert_failed_with(&o, &["sensors.csv:1:", "a point is x,y,z"]);
+    crate::assert_failed_with(
+        &o,
+        &["sensors.csv:1:", "a sensor is x,y,z or x,y,z,nx,ny,nz"],
+    );
     // a heat map to look at: every face, its corners coloured
     let heat = scratch("hours.obj");
     let o = run(&heat, &[]);

@@ -77,7 +77,7 @@ pub use obj::{
     MAX_FACE_VERTICES, ObjNotes, parse_obj, parse_obj_notes, read_obj, read_obj_notes, write_obj,
 };
 pub use palette::{Rgb, face_colors};
-pub use points::{parse_points, read_points};
+pub use points::{Sensor, parse_points, parse_sensors, read_points, read_sensors};
 pub use rings::triangulate_rings;
 pub use scan::{MAX_SUBDIVISIONS, bunny, sqrt3_subdivide};
 pub use scenes::{ROOM_STAGING, SCENE_NAMES, Staging, room, scene, scene_named};

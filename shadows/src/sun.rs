@@ -20,9 +20,10 @@ mod runs;
 pub(crate) mod tiles;
 pub use exact_time::{
     Interval, SunPath, day_paths, hides, interval_hours, intervals_json, sensor_intervals,
-    study_plan, triangles,
+    sensor_intervals_facing, study_plan, triangles,
 };
 use glam::DVec3;
+pub use shadow_scene::Sensor;
 use smallvec::SmallVec;
 
 use crate::shadow_file::{NoProgress, Progress};
@@ -755,30 +756,61 @@ fn face_hours(
 /// `step_hours`: per sensor, the suns no face hides from its grid point,
 /// exactly ([`svbsp::LightVolumes::reaching`]; a point on a shadow's edge is
 /// reached), counted. A sensor on a face counts the suns in front of it
-/// and behind it alike: give sensors a little off their surface.
+/// and behind it alike: give sensors a little off their surface, or give
+/// them their surface's normal ([`sensor_hours_facing`]).
 pub fn sensor_hours(
     mesh: &crate::Mesh,
     sensors: &[DVec3],
     suns: &[DVec3],
     step_hours: f64,
 ) -> Result<Vec<f64>, crate::Error> {
+    let sensors: Vec<Sensor> = (sensors.iter())
+        .map(|&position| Sensor {
+            position,
+            normal: None,
+        })
+        .collect();
+    sensor_hours_facing(mesh, &sensors, suns, step_hours)
+}
+
+/// [`sensor_hours`] of sensors that may stand for a surface: one with a
+/// normal `n` counts only the suns strictly in front of it (`n · d > 0`
+/// for the direction `d` toward the sun, in `f64`: a sun in the surface's
+/// plane grazes it and is not counted), as Ladybug's "Direct Sun Hours"
+/// counts a sensor's suns.
+pub fn sensor_hours_facing(
+    mesh: &crate::Mesh,
+    sensors: &[Sensor],
+    suns: &[DVec3],
+    step_hours: f64,
+) -> Result<Vec<f64>, crate::Error> {
     use crate::Error;
     let all: Vec<crate::Light> = suns.iter().map(|&d| crate::Light::Sun(d)).collect();
-    let positions = [&mesh.positions[..], sensors].concat();
+    let points: Vec<DVec3> = sensors.iter().map(|s| s.position).collect();
+    let positions = [&mesh.positions[..], &points].concat();
     let grid = svbsp::shared_grid(&positions, &all).map_err(Error::Light)?;
-    let at: Vec<bsp_core::GridPoint> = (sensors.iter().enumerate())
+    let at: Vec<bsp_core::GridPoint> = (points.iter().enumerate())
         .map(|(index, &p)| grid.snap(p).map_err(|cause| Error::Sensor { index, cause }))
         .collect::<Result<_, _>>()?;
     let (polys, _) = crate::import_mesh(&grid, mesh).map_err(Error::Import)?;
     let solids = bsp_core::certify_solid_parts(&polys);
     let mut seen = vec![0u32; sensors.len()];
-    for batch in all.chunks(svbsp::MAX_LIGHTS) {
+    for (batch, dirs) in all
+        .chunks(svbsp::MAX_LIGHTS)
+        .zip(suns.chunks(svbsp::MAX_LIGHTS))
+    {
         let placed = svbsp::place_lights(&grid, batch).map_err(Error::Light)?;
         let kernel: Vec<svbsp::Light> = placed.iter().map(|l| l.light).collect();
         let trees =
             crate::face_trees(&polys, &kernel, &at, &solids, None).map_err(Error::Shadow)?;
-        for (n, &g) in seen.iter_mut().zip(&at) {
-            *n += trees.reaching(g).count_ones();
+        for ((n, &g), s) in seen.iter_mut().zip(&at).zip(sensors) {
+            // the batch's suns in front of the sensor's surface
+            let facing = s.normal.map_or(u64::MAX, |normal| {
+                (dirs.iter().enumerate())
+                    .filter(|(_, d)| normal.dot(**d) > 0.0)
+                    .fold(0u64, |m, (i, _)| m | 1 << i)
+            });
+            *n += (trees.reaching(g) & facing).count_ones();
         }
     }
     Ok(seen
@@ -787,11 +819,12 @@ pub fn sensor_hours(
         .collect())
 }
 
-/// The sun-hours at the points of the file `path`
-/// ([`shadow_scene::read_points`]) among the faces of `mesh`
-/// ([`sensor_hours`]), as text in `format` ([`sensors_csv`],
+/// The sun-hours at the sensors of the file `path`
+/// ([`shadow_scene::read_sensors`]: points, each with its surface's
+/// normal where given) among the faces of `mesh`
+/// ([`sensor_hours_facing`]), as text in `format` ([`sensors_csv`],
 /// [`sensors_json`], [`sensors_obj`]; not as a picture); and how many
-/// points there are.
+/// sensors there are.
 pub fn sensor_hours_file(
     mesh: &crate::Mesh,
     path: &std::path::Path,
@@ -805,8 +838,9 @@ pub fn sensor_hours_file(
             why: SENSORS_NOT_A_PICTURE,
         });
     }
-    let points = shadow_scene::read_points(path).map_err(crate::Error::File)?;
-    let hours = sensor_hours(mesh, &points, suns, step_hours)?;
+    let sensors = shadow_scene::read_sensors(path).map_err(crate::Error::File)?;
+    let hours = sensor_hours_facing(mesh, &sensors, suns, step_hours)?;
+    let points: Vec<DVec3> = sensors.iter().map(|s| s.position).collect();
     let text = match format {
         HoursFormat::Csv => sensors_csv(&points, &hours),
         HoursFormat::Json => sensors_json(&points, &hours, suns.len()),

@@ -33,12 +33,19 @@
 //! model's own error is the drift above within an hour, a few seconds
 //! where a shadow's edge meets the sensor at a glancing angle). A sensor on a face does not see that
 //! face as an occluder (it lies in its plane), and, as with the sampled
-//! study, counts the sun on either side of it.
+//! study, counts the sun on either side of it, unless it is given its
+//! surface's normal `n`: then only while `n · d(H) > 0`, one more arc.
 
 use chrono::NaiveDate;
 use glam::DVec3;
 
-use super::{SunError, SunSite, Up};
+use super::{Sensor, SunError, SunSite, Up};
+
+/// The length below which a sensor's interval is the rounding of two
+/// arcs that end together, not sun: under a microsecond (about 280,000
+/// times `f64`'s spacing at 24 hours), far below the model's own error
+/// (seconds, above).
+const SLIVER_HOURS: f64 = 1e-9;
 
 /// Hours of the day's clock, `[from, to)`, from its midnight.
 pub type Interval = (f64, f64);
@@ -247,6 +254,23 @@ pub fn sensor_intervals(
     sensors: &[DVec3],
     paths: &[SunPath],
 ) -> Vec<Vec<Vec<Interval>>> {
+    let sensors: Vec<Sensor> = (sensors.iter())
+        .map(|&position| Sensor {
+            position,
+            normal: None,
+        })
+        .collect();
+    sensor_intervals_facing(mesh, &sensors, paths)
+}
+
+/// [`sensor_intervals`] of sensors that may stand for a surface: one with
+/// a normal `n` has the sun on only while it is strictly in front of
+/// that surface (`n · d(H) > 0`, one more arc of the model's).
+pub fn sensor_intervals_facing(
+    mesh: &crate::Mesh,
+    sensors: &[Sensor],
+    paths: &[SunPath],
+) -> Vec<Vec<Vec<Interval>>> {
     let tris = triangles(mesh);
     // each day's hours of sun above the horizon, and the hours they touch
     let days: Vec<(Vec<Interval>, Vec<usize>)> = paths
@@ -260,7 +284,7 @@ pub fn sensor_intervals(
         })
         .collect();
     bsp_core::par::map(sensors.len(), |i| {
-        let x = sensors[i];
+        let x = sensors[i].position;
         let mut scratch = Default::default();
         (paths.iter().zip(&days))
             .map(|(path, (up_hours, up))| {
@@ -269,7 +293,17 @@ pub fn sensor_intervals(
                     path.hidden_by(x, t, up, &mut hidden, &mut scratch);
                 }
                 hidden.sort_by(|p, q| p.0.total_cmp(&q.0));
-                subtract(up_hours, &merged(hidden))
+                let mut on = subtract(up_hours, &merged(hidden));
+                if let Some(n) = sensors[i].normal {
+                    let mut facing = Vec::new();
+                    intersect_into(&on, &path.when(n, 0.0), &mut facing);
+                    on = facing;
+                }
+                // (arcs found apart may overlap by an ulp where they end
+                // together: the horizon's and a surface's facing down, or
+                // two triangles' sun-off arcs, left 1e-15 h of "sun")
+                on.retain(|(a, b)| b - a > SLIVER_HOURS);
+                on
             })
             .collect()
     })

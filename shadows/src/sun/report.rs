@@ -8,7 +8,7 @@ use super::{
     HeatView, HoursFormat, RegionFaces, SENSORS_NOT_A_PICTURE, SunPath, bre209_text,
     clip_to_outline, disc_study, faces_study, groups_in_sun_text, interval_hours, intervals_json,
     region_in_sun_text, region_study, regions_csv, regions_json, regions_obj, regions_ply,
-    regions_png, sensor_hours_file, sensor_intervals, sensors_csv, sensors_obj, sensors_ply,
+    regions_png, sensor_hours_file, sensor_intervals_facing, sensors_csv, sensors_obj, sensors_ply,
 };
 
 /// What `shadow sunhours` writes and says of a study.
@@ -47,10 +47,10 @@ pub enum HoursOf<'a> {
         /// The disc's angular radius, degrees.
         radius_deg: f64,
     },
-    /// The points of this file ([`sensor_hours_file`]).
+    /// The sensors of this file ([`sensor_hours_file`]).
     Sensors(&'a std::path::Path),
-    /// The points of this file, each day's sun-on intervals in closed
-    /// form on these paths ([`sensor_intervals`]; JSON lists them).
+    /// The sensors of this file, each day's sun-on intervals in closed
+    /// form on these paths ([`sensor_intervals_facing`]; JSON lists them).
     ExactSensors {
         /// The file.
         path: &'a std::path::Path,
@@ -187,8 +187,9 @@ pub fn hours_report(
             ))
         }
         HoursOf::ExactSensors { path, paths } => {
-            let points = shadow_scene::read_points(path).map_err(crate::Error::File)?;
-            let on = sensor_intervals(mesh, &points, paths);
+            let sensors = shadow_scene::read_sensors(path).map_err(crate::Error::File)?;
+            let on = sensor_intervals_facing(mesh, &sensors, paths);
+            let points: Vec<DVec3> = sensors.iter().map(|s| s.position).collect();
             let text = match format {
                 HoursFormat::Json => intervals_json(&points, paths, &on),
                 HoursFormat::Csv => sensors_csv(&points, &interval_hours(&on)),

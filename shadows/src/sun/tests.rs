@@ -226,6 +226,66 @@ fn a_day_of_suns_and_the_hours_of_a_yard() {
     assert_eq!(at[5], full);
 }
 
+/// A sensor given its surface's normal counts only the suns strictly in
+/// front of it: each its own count, exactly, over several runs of suns;
+/// facing up, every sun (each is above the horizon), as a sensor with
+/// no normal; facing down, none. From a file of six columns too.
+#[test]
+fn sensors_with_a_normal_count_the_suns_in_front_of_them() {
+    let (mesh, suns, step, _) = equinox_study();
+    let points = yard_sensors();
+    let plain = sensor_hours(&mesh, &points, &suns, step).unwrap();
+    let normals = [
+        DVec3::Z,
+        DVec3::NEG_Z,
+        DVec3::X,
+        DVec3::new(0.3, -1.0, 0.2),
+        DVec3::Y,
+    ];
+    for n in normals {
+        let sensors: Vec<Sensor> = (points.iter())
+            .map(|&position| Sensor {
+                position,
+                normal: Some(n),
+            })
+            .collect();
+        let at = sensor_hours_facing(&mesh, &sensors, &suns, step).unwrap();
+        for (p, h) in points.iter().zip(&at) {
+            let own = (suns.iter())
+                .filter(|&&d| !blocked(*p, d) && n.dot(d) > 0.0)
+                .count() as f64
+                * step;
+            assert_eq!(*h, own, "at {p} facing {n}");
+        }
+        match n {
+            DVec3::Z => assert_eq!(at, plain),
+            DVec3::NEG_Z => assert!(at.iter().all(|&h| h == 0.0)),
+            // the south-east wall of a sensor sees part of the day, an
+            // east one its morning only
+            _ => assert!(at[5] > 0.0 && at[5] < plain[5], "{n}: {at:?}"),
+        }
+    }
+    let file = std::env::temp_dir().join(format!("facing-{}.csv", std::process::id()));
+    let text: String = (points.iter())
+        .map(|p| format!("{},{},{},1,0,0\n", p.x, p.y, p.z))
+        .collect();
+    std::fs::write(&file, format!("x,y,z,nx,ny,nz\n{text}")).unwrap();
+    let (csv, n) = sensor_hours_file(&mesh, &file, &suns, step, HoursFormat::Csv).unwrap();
+    std::fs::remove_file(&file).unwrap();
+    let east: Vec<Sensor> = (points.iter())
+        .map(|&position| Sensor {
+            position,
+            normal: Some(DVec3::X),
+        })
+        .collect();
+    let want = sensor_hours_facing(&mesh, &east, &suns, step).unwrap();
+    assert_eq!(n, points.len());
+    let got: Vec<f64> = (csv.lines().skip(1))
+        .map(|l| l.rsplit(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(got, want);
+}
+
 /// A day without sun (a polar night) still gives every face its area,
 /// and no hours: the same areas as a day of suns.
 #[test]
@@ -276,7 +336,7 @@ fn runs_files_and_heat_maps_of_a_yard() {
     let e = sensor_hours_file(&mesh, &file, &suns, step, HoursFormat::Json).unwrap_err();
     assert!(
         e.to_string()
-            .ends_with(".csv:1: `1 2` has 2 numbers; a point is x,y,z"),
+            .ends_with(".csv:1: `1 2` has 2 numbers; a sensor is x,y,z or x,y,z,nx,ny,nz"),
         "{e}"
     );
     std::fs::remove_file(&file).unwrap();

@@ -122,6 +122,44 @@ fn exact_hours_agree_with_the_engine_sampled_every_minute() {
     }
 }
 
+/// Sensors facing a way: the exact intervals hold only the suns in
+/// front of the surface, as the engine's minute-by-minute count of the
+/// same sensors says (within the ends' half steps); facing up, the same
+/// intervals as with no normal, facing down none.
+#[test]
+fn exact_hours_of_sensors_facing_a_way_agree_with_the_engine() {
+    let mesh = yard();
+    let site = SunSite::new(51.48, 0.0);
+    let days = [day(2026, 3, 21), day(2026, 6, 21)];
+    let suns: Vec<DVec3> = days.iter().flat_map(|&d| minute_suns(&site, d)).collect();
+    let paths = day_paths(&site, &days, 0.0).unwrap();
+    let points = yard_sensors();
+    let plain = sensor_intervals(&mesh, &points, &paths);
+    for n in [DVec3::Z, DVec3::NEG_Z, DVec3::X, DVec3::new(-0.2, 1.0, 0.5)] {
+        let sensors: Vec<Sensor> = (points.iter())
+            .map(|&position| Sensor {
+                position,
+                normal: Some(n),
+            })
+            .collect();
+        let sampled = crate::sun::sensor_hours_facing(&mesh, &sensors, &suns, 1.0 / 60.0).unwrap();
+        let exact = sensor_intervals_facing(&mesh, &sensors, &paths);
+        for ((on, e), s) in exact.iter().zip(interval_hours(&exact)).zip(&sampled) {
+            let ends: usize = on.iter().map(Vec::len).sum();
+            let bound = ends as f64 * (0.5 + 0.1) / 60.0;
+            assert!((e - s).abs() <= bound, "{n}: {e} against {s} ({ends} ends)");
+        }
+        match n {
+            DVec3::Z => assert_eq!(exact, plain),
+            DVec3::NEG_Z => assert!(exact.iter().flatten().all(Vec::is_empty), "{exact:?}"),
+            _ => {
+                let (e, p) = (interval_hours(&exact), interval_hours(&plain));
+                assert!(e[5] > 1.0 && e[5] < p[5] - 1.0, "{n}: {e:?} {p:?}");
+            }
+        }
+    }
+}
+
 #[test]
 fn polar_day_and_polar_night() {
     let ground = crate::Mesh {
