@@ -8,12 +8,20 @@ use crate::SceneError;
 
 /// Reads a file of points ([`parse_points`]).
 pub fn read_points(path: &Path) -> Result<Vec<DVec3>, SceneError> {
-    let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-        path: shown.clone(),
-        source,
-    })?;
+    let (text, shown) = read_text(path)?;
     parse_points(&text, &shown)
+}
+
+/// A file's text, and its path as messages name it.
+fn read_text(path: &Path) -> Result<(String, String), SceneError> {
+    let shown = path.display().to_string();
+    match std::fs::read_to_string(path) {
+        Ok(text) => Ok((text, shown)),
+        Err(source) => Err(SceneError::Io {
+            path: shown,
+            source,
+        }),
+    }
 }
 
 /// Points from text, one a line: `x,y,z` or `x y z` (commas, spaces or
@@ -49,11 +57,7 @@ pub struct Sensor {
 
 /// Reads a file of sensors ([`parse_sensors`]).
 pub fn read_sensors(path: &Path) -> Result<Vec<Sensor>, SceneError> {
-    let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-        path: shown.clone(),
-        source,
-    })?;
+    let (text, shown) = read_text(path)?;
     parse_sensors(&text, &shown)
 }
 

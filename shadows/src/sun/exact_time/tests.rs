@@ -103,23 +103,37 @@ fn minute_suns(site: &SunSite, date: NaiveDate) -> Vec<DVec3> {
         .collect()
 }
 
-#[test]
-fn exact_hours_agree_with_the_engine_sampled_every_minute() {
-    let mesh = yard();
+/// The yard at Greenwich on the equinox and the solstice: the mesh, the
+/// suns of every minute, the days' paths.
+fn two_days_of_minutes() -> (crate::Mesh, Vec<DVec3>, Vec<SunPath>) {
     let site = SunSite::new(51.48, 0.0);
     let days = [day(2026, 3, 21), day(2026, 6, 21)];
     let suns: Vec<DVec3> = days.iter().flat_map(|&d| minute_suns(&site, d)).collect();
+    (yard(), suns, day_paths(&site, &days, 0.0).unwrap())
+}
+
+/// Each sensor's exact hours within the minute steps' bound of its
+/// sampled ones: half a step at each end of each interval, and the
+/// model's seconds.
+fn assert_near_minutes(exact: &[Vec<Vec<Interval>>], sampled: &[f64], what: &str) {
+    for ((on, e), s) in exact.iter().zip(interval_hours(exact)).zip(sampled) {
+        let ends: usize = on.iter().map(Vec::len).sum();
+        let bound = ends as f64 * (0.5 + 0.1) / 60.0;
+        assert!(
+            (e - s).abs() <= bound,
+            "{what}: {e} against {s} ({ends} ends)"
+        );
+    }
+}
+
+#[test]
+fn exact_hours_agree_with_the_engine_sampled_every_minute() {
+    let (mesh, suns, paths) = two_days_of_minutes();
     // (sensors on the ground, as the engine snaps them)
     let sensors = yard_sensors();
     let sampled = sensor_hours(&mesh, &sensors, &suns, 1.0 / 60.0).unwrap();
-    let paths = day_paths(&site, &days, 0.0).unwrap();
     let exact = sensor_intervals(&mesh, &sensors, &paths);
-    for ((on, e), s) in exact.iter().zip(interval_hours(&exact)).zip(&sampled) {
-        // half a step at each end of each interval, and the model's seconds
-        let ends: usize = on.iter().map(Vec::len).sum();
-        let bound = ends as f64 * (0.5 + 0.1) / 60.0;
-        assert!((e - s).abs() <= bound, "{e} against {s} ({ends} ends)");
-    }
+    assert_near_minutes(&exact, &sampled, "no normal");
 }
 
 /// Sensors facing a way: the exact intervals hold only the suns in
@@ -128,11 +142,7 @@ fn exact_hours_agree_with_the_engine_sampled_every_minute() {
 /// intervals as with no normal, facing down none.
 #[test]
 fn exact_hours_of_sensors_facing_a_way_agree_with_the_engine() {
-    let mesh = yard();
-    let site = SunSite::new(51.48, 0.0);
-    let days = [day(2026, 3, 21), day(2026, 6, 21)];
-    let suns: Vec<DVec3> = days.iter().flat_map(|&d| minute_suns(&site, d)).collect();
-    let paths = day_paths(&site, &days, 0.0).unwrap();
+    let (mesh, suns, paths) = two_days_of_minutes();
     let points = yard_sensors();
     let plain = sensor_intervals(&mesh, &points, &paths);
     for n in [DVec3::Z, DVec3::NEG_Z, DVec3::X, DVec3::new(-0.2, 1.0, 0.5)] {
@@ -144,11 +154,7 @@ fn exact_hours_of_sensors_facing_a_way_agree_with_the_engine() {
             .collect();
         let sampled = crate::sun::sensor_hours_facing(&mesh, &sensors, &suns, 1.0 / 60.0).unwrap();
         let exact = sensor_intervals_facing(&mesh, &sensors, &paths);
-        for ((on, e), s) in exact.iter().zip(interval_hours(&exact)).zip(&sampled) {
-            let ends: usize = on.iter().map(Vec::len).sum();
-            let bound = ends as f64 * (0.5 + 0.1) / 60.0;
-            assert!((e - s).abs() <= bound, "{n}: {e} against {s} ({ends} ends)");
-        }
+        assert_near_minutes(&exact, &sampled, &format!("facing {n}"));
         match n {
             DVec3::Z => assert_eq!(exact, plain),
             DVec3::NEG_Z => assert!(exact.iter().flatten().all(Vec::is_empty), "{exact:?}"),
