@@ -493,7 +493,10 @@ fn hull(points: &[[f64; 2]]) -> Option<Vec<[i32; 2]>> {
 /// triangle of the part's faces: 1 strictly inside the solid it bounds, 0
 /// strictly outside. `None` where they meet or may meet, or where every
 /// corner of `q` is degenerate for the ray along `axis` ([`winding`]).
-pub(crate) fn placed(part: &[&[GridPoint]], axis: usize, q: &[GridPoint]) -> Option<i64> {
+/// The reference [`PartShadows::placed`] is checked against: every face
+/// of the part, one by one.
+#[cfg(test)]
+fn placed(part: &[&[GridPoint]], axis: usize, q: &[GridPoint]) -> Option<i64> {
     let qb = grid_box(q);
     let tris_q = fan(q)?;
     let apart = part.iter().filter(|f| overlap(&grid_box(f), &qb)).all(|f| {
@@ -523,7 +526,9 @@ fn fan(q: &[GridPoint]) -> Option<Vec<[GridPoint; 3]>> {
 /// each fan triangle whose shadow on the plane across `axis` holds `p`'s
 /// strictly, met past `p`, counts the sign of its normal's `axis`
 /// component. `None` where the ray meets an edge, a corner or `p` lies
-/// on a face (degenerate: another point is tried).
+/// on a face (degenerate: another point is tried). The reference
+/// [`PartShadows`]'s own is checked against.
+#[cfg(test)]
 fn winding(part: &[&[GridPoint]], axis: usize, p: GridPoint) -> Option<i64> {
     let mut w = 0;
     for f in part {
@@ -621,16 +626,21 @@ impl PartShadows {
         };
         let (flat, shadowed): (Vec<u32>, Vec<u32>) =
             (0..tris.len() as u32).partition(|&i| area(&tris[i as usize].0) == 0);
-        let items: Vec<(u32, Box3)> = (shadowed.iter())
-            .map(|&i| (i, flatten(tris[i as usize].1)))
-            .collect();
-        let scene = items.iter().map(|(_, b)| *b).reduce(crate::boxes::union);
-        let grid = CellGrid::of_items(scene.unwrap_or([[0, 0]; 3]), &items);
-        let all: Vec<(u32, Box3)> = (tris.iter().enumerate())
-            .map(|(i, (_, b))| (i as u32, *b))
-            .collect();
-        let scene = all.iter().map(|(_, b)| *b).reduce(crate::boxes::union);
-        let boxes = CellGrid::of_items(scene.unwrap_or([[0, 0]; 3]), &all);
+        // a grid over the boxes of `items`
+        let index = |items: Vec<(u32, Box3)>| {
+            let scene = items.iter().map(|(_, b)| *b).reduce(crate::boxes::union);
+            CellGrid::of_items(scene.unwrap_or([[0, 0]; 3]), &items)
+        };
+        let grid = index(
+            (shadowed.iter())
+                .map(|&i| (i, flatten(tris[i as usize].1)))
+                .collect(),
+        );
+        let boxes = index(
+            (tris.iter().enumerate())
+                .map(|(i, (_, b))| (i as u32, *b))
+                .collect(),
+        );
         PartShadows {
             axis,
             tris,

@@ -7,7 +7,8 @@
 //! occluders. So every face certified to lie strictly outside the solid
 //! is umbra for that light, whole: the per-occluder tests of
 //! [`crate::area`] would leave it undecided (every light corner hidden,
-//! by different faces). Both are certified exactly ([`placed`]): no
+//! by different faces). Both are certified exactly
+//! ([`PartShadows::placed`], the part's triangles indexed once): no
 //! triangle of the light (or the face) meets a triangle of the part's
 //! faces, and the part winds once round the light and not round the face.
 
@@ -16,7 +17,7 @@ use rayon::prelude::*;
 
 use crate::area::{AreaLight, Occluder};
 use crate::boxes::{grid_box, overlap};
-use crate::cores::{certified_parts, placed};
+use crate::cores::{PartShadows, certified_parts};
 use crate::light::Light;
 
 /// At most this many pairs of (face near the part, part's face) are
@@ -41,15 +42,16 @@ pub(crate) fn sealed_faces(
     let lb = grid_box(&corners);
     let contains = |b: &[[i64; 2]; 3]| (0..3).all(|k| b[k][0] < lb[k][0] && lb[k][1] < b[k][1]);
     let parts = certified_parts(faces, solids, 1);
-    let Some((members, pb)) = parts.iter().find(|(m, b)| {
-        contains(b) && {
-            let part: Vec<&[GridPoint]> = m.iter().map(|&i| faces[i].corners()).collect();
-            placed(&part, 0, &corners) == Some(1)
+    let Some((members, pb, shadows)) = parts.iter().find_map(|(m, b)| {
+        if !contains(b) {
+            return None;
         }
+        let part: Vec<&[GridPoint]> = m.iter().map(|&i| faces[i].corners()).collect();
+        let shadows = PartShadows::new(&part, 0);
+        (shadows.placed(&corners) == Some(1)).then_some((m, b, shadows))
     }) else {
         return Vec::new();
     };
-    let part: Vec<&[GridPoint]> = members.iter().map(|&i| faces[i].corners()).collect();
     let mut own = vec![false; faces.len()];
     for &i in members {
         own[i] = true;
@@ -58,14 +60,14 @@ pub(crate) fn sealed_faces(
         .iter()
         .filter(|f| overlap(&grid_box(f.corners()), pb))
         .count();
-    let exact = near.saturating_mul(part.len()) <= MAX_PAIRS;
+    let exact = near.saturating_mul(members.len()) <= MAX_PAIRS;
     faces
         .par_iter()
         .enumerate()
         .map(|(i, f)| {
             !own[i]
                 && (!overlap(&grid_box(f.corners()), pb)
-                    || exact && placed(&part, 0, f.corners()) == Some(0))
+                    || exact && shadows.placed(f.corners()) == Some(0))
         })
         .collect()
 }
