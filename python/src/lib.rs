@@ -221,23 +221,12 @@ fn whole_indices<'py>(
 
 /// `array` as points, `(n, 3)` float64.
 fn points<'py>(py: Python<'py>, array: &Bound<'py, PyAny>, what: &str) -> PyResult<Vec<DVec3>> {
-    let np = py.import("numpy")?;
-    let a = aligned(&np, array, "float64")?;
-    let a: PyReadonlyArray2<'py, f64> = a
-        .extract()
-        .map_err(|_| MeshError::new_err(format!("{what}: an array of shape (n, 3) of numbers")))?;
-    let shape = a.shape();
-    if shape[1] != 3 {
-        return Err(MeshError::new_err(format!(
-            "{what}: shape ({}, {}), not (n, 3)",
-            shape[0], shape[1]
-        )));
-    }
-    let flat = a.as_slice()?;
-    let out: Vec<DVec3> = flat
-        .chunks_exact(3)
-        .map(|p| DVec3::new(p[0], p[1], p[2]))
-        .collect();
+    let out: Vec<DVec3> = rows(py, array, what, (&[3], "(n, 3)"), |flat, _| {
+        Ok(flat
+            .chunks_exact(3)
+            .map(|p| DVec3::new(p[0], p[1], p[2]))
+            .collect())
+    })?;
     if let Some(i) = out.iter().position(|p| !p.is_finite()) {
         return Err(MeshError::new_err(format!(
             "{what}: row {i} is not finite ({}, {}, {})",
@@ -245,6 +234,31 @@ fn points<'py>(py: Python<'py>, array: &Bound<'py, PyAny>, what: &str) -> PyResu
         )));
     }
     Ok(out)
+}
+
+/// `read` of the numbers of a 2-D array of `float64` (converted if need
+/// be, not copied where it is one), in C order, and its row width, which
+/// must be one of `widths` (`shape` says which in errors).
+fn rows<'py, T>(
+    py: Python<'py>,
+    array: &Bound<'py, PyAny>,
+    what: &str,
+    (widths, shape): (&[usize], &str),
+    read: impl FnOnce(&[f64], usize) -> PyResult<T>,
+) -> PyResult<T> {
+    let np = py.import("numpy")?;
+    let a = aligned(&np, array, "float64")?;
+    let a: PyReadonlyArray2<'py, f64> = a
+        .extract()
+        .map_err(|_| MeshError::new_err(format!("{what}: an array of shape {shape} of numbers")))?;
+    let dims = a.shape();
+    if !widths.contains(&dims[1]) {
+        return Err(MeshError::new_err(format!(
+            "{what}: shape ({}, {}), not {shape}",
+            dims[0], dims[1]
+        )));
+    }
+    read(a.as_slice()?, dims[1])
 }
 
 /// Sensors from an array of shape `(n, 3)` (points) or `(n, 6)` (points
@@ -255,40 +269,28 @@ fn sensors<'py>(
     what: &str,
 ) -> PyResult<Vec<bsp_shadows::sun::Sensor>> {
     use bsp_shadows::sun::Sensor;
-    let np = py.import("numpy")?;
-    let a = aligned(&np, array, "float64")?;
-    let a: PyReadonlyArray2<'py, f64> = a.extract().map_err(|_| {
-        MeshError::new_err(format!(
-            "{what}: an array of shape (n, 3) or (n, 6) of numbers"
-        ))
-    })?;
-    let shape = a.shape();
-    if shape[1] != 3 && shape[1] != 6 {
-        return Err(MeshError::new_err(format!(
-            "{what}: shape ({}, {}), not (n, 3) (points) or (n, 6) (points and normals)",
-            shape[0], shape[1]
-        )));
-    }
-    let flat = a.as_slice()?;
-    (flat.chunks_exact(shape[1]).enumerate())
-        .map(|(i, row)| {
-            if let Some(x) = row.iter().find(|x| !x.is_finite()) {
-                return Err(MeshError::new_err(format!(
-                    "{what}: row {i} is not finite ({x})"
-                )));
-            }
-            let normal = (row.len() == 6).then(|| DVec3::new(row[3], row[4], row[5]));
-            if normal == Some(DVec3::ZERO) {
-                return Err(MeshError::new_err(format!(
-                    "{what}: row {i}'s normal is zero"
-                )));
-            }
-            Ok(Sensor {
-                position: DVec3::new(row[0], row[1], row[2]),
-                normal,
+    let shape = "(n, 3) (points) or (n, 6) (points and normals)";
+    rows(py, array, what, (&[3, 6], shape), |flat, width| {
+        (flat.chunks_exact(width).enumerate())
+            .map(|(i, row)| {
+                if let Some(x) = row.iter().find(|x| !x.is_finite()) {
+                    return Err(MeshError::new_err(format!(
+                        "{what}: row {i} is not finite ({x})"
+                    )));
+                }
+                let normal = (row.len() == 6).then(|| DVec3::new(row[3], row[4], row[5]));
+                if normal == Some(DVec3::ZERO) {
+                    return Err(MeshError::new_err(format!(
+                        "{what}: row {i}'s normal is zero"
+                    )));
+                }
+                Ok(Sensor {
+                    position: DVec3::new(row[0], row[1], row[2]),
+                    normal,
+                })
             })
-        })
-        .collect()
+            .collect()
+    })
 }
 
 /// The first index of the whole-number array `a` (in C order) that
