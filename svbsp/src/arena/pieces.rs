@@ -267,19 +267,16 @@ impl Lazy {
         Implicit::from_planes(a, b, c).expect("a lazy point's planes meet in one point")
     }
 
-    /// Exact side of `plane`: the filter on the approximations; then `On`
-    /// if `plane` is one of the three planes the point was made from; then
+    /// Exact side of `plane` where the filter on the approximations
+    /// (`filter_side_err`, which the caller ran) could not tell: `On` if
+    /// `plane` is one of the three planes the point was made from; then
     /// the exact coordinates, computed once and kept.
-    #[inline]
-    fn classify(
+    fn classify_unfiltered(
         &mut self,
         planes: &[Plane],
         anchors: &[Option<[GridPoint; 2]>],
         plane: &Plane,
     ) -> Side {
-        if let Some(s) = filter_side_err(&plane.approx(), &self.approx, &self.err) {
-            return s;
-        }
         if self.on_by_construction(planes, anchors, plane) {
             return Side::On;
         }
@@ -807,13 +804,35 @@ impl PieceArena {
         }
     }
 
-    /// [`PieceArena::classify`] of an implicit vertex.
+    /// [`PieceArena::classify`] of an implicit vertex: the filter on its
+    /// `f64` coordinates, which decides nearly every call, in a leaf
+    /// function with no frame to speak of; the exact arithmetic (256-bit
+    /// products and a kept exact point, whose frame is several hundred
+    /// bytes) in [`PieceArena::classify_implicit_exactly`].
     #[inline(never)]
     fn classify_implicit(&mut self, id: u32, plane: &Plane) -> Side {
         let i = (id & !TAG) as usize;
+        let filtered = match id & TAG {
+            EXACT => self.exact[i].classify_filtered(plane),
+            _ => {
+                let l = &self.lazy[i];
+                filter_side_err(&plane.approx(), &l.approx, &l.err)
+            }
+        };
+        match filtered {
+            Some(s) => s,
+            None => self.classify_implicit_exactly(id, plane),
+        }
+    }
+
+    /// [`PieceArena::classify_implicit`] where the filter cannot tell.
+    #[cold]
+    #[inline(never)]
+    fn classify_implicit_exactly(&mut self, id: u32, plane: &Plane) -> Side {
+        let i = (id & !TAG) as usize;
         match id & TAG {
-            EXACT => self.exact[i].classify(plane),
-            _ => self.lazy[i].classify(&self.planes, &self.anchors, plane),
+            EXACT => self.exact[i].classify_exact(plane),
+            _ => self.lazy[i].classify_unfiltered(&self.planes, &self.anchors, plane),
         }
     }
 
