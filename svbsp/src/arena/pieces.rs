@@ -809,7 +809,7 @@ impl PieceArena {
     /// function with no frame to speak of; the exact arithmetic (256-bit
     /// products and a kept exact point, whose frame is several hundred
     /// bytes) in [`PieceArena::classify_implicit_exactly`].
-    #[inline(never)]
+    #[inline]
     fn classify_implicit(&mut self, id: u32, plane: &Plane) -> Side {
         let i = (id & !TAG) as usize;
         let filtered = match id & TAG {
