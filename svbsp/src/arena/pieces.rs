@@ -794,8 +794,10 @@ impl PieceArena {
     /// The exact side of vertex `id` relative to `plane` (a lazy vertex
     /// keeps its exact coordinates if they had to be computed).
     ///
-    /// A grid vertex, the common case, is classified inline; the others
-    /// out of line, so that the callers' loops carry no frame for them.
+    /// A grid vertex is classified inline, and so is an implicit one
+    /// the floating-point filter decides; the exact arithmetic the filter
+    /// leaves is out of line, so that the callers' loops carry no frame
+    /// for it.
     #[inline]
     pub(crate) fn classify(&mut self, id: u32, plane: &Plane) -> Side {
         match id & TAG {
@@ -805,10 +807,10 @@ impl PieceArena {
     }
 
     /// [`PieceArena::classify`] of an implicit vertex: the filter on its
-    /// `f64` coordinates, which decides nearly every call, in a leaf
-    /// function with no frame to speak of; the exact arithmetic (256-bit
-    /// products and a kept exact point, whose frame is several hundred
-    /// bytes) in [`PieceArena::classify_implicit_exactly`].
+    /// `f64` coordinates, which decides nearly every call, inline; the
+    /// exact arithmetic (256-bit products and a kept exact point, whose
+    /// frame is several hundred bytes) out of line, in
+    /// [`PieceArena::classify_implicit_exactly`].
     #[inline]
     fn classify_implicit(&mut self, id: u32, plane: &Plane) -> Side {
         let i = (id & !TAG) as usize;
