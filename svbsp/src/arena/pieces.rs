@@ -325,7 +325,8 @@ impl Lazy {
         (w > ew && (0..3).all(|k| self.err[k] + q[k].abs() * ew <= room)).then_some(q)
     }
 
-    /// [`Lazy::classify`] without keeping the exact point.
+    /// Exact side of `plane` without keeping the exact point: the filter,
+    /// then `On` for one of the point's three planes, then the exact side.
     fn classify_shared(&self, planes: &[Plane], plane: &Plane) -> Side {
         if let Some(s) = filter_side_err(&plane.approx(), &self.approx, &self.err) {
             return s;
