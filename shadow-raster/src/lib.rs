@@ -15,7 +15,7 @@
 //!   into an [`Image`] (PNG) and a mask of the first light (PGM).
 //! - [`render_fragments`]: the same image from exact fragments computed
 //!   elsewhere (a [`svbsp::Batch`]), e.g. one frame of an animation.
-//! - [`compare`]: every method on one camera, with the share of pixels
+//! - [`compare()`]: every method on one camera, with the share of pixels
 //!   where each disagrees with `exact`, and its time.
 //! - [`hidden_lines`]: Roberts' hidden-line algorithm for convex polyhedra.
 //! - [`svg`]: SVG pictures by the painter's algorithm in a BSP tree's

@@ -539,7 +539,8 @@ fn winding(part: &[&[GridPoint]], axis: usize, p: GridPoint) -> Option<i64> {
     Some(w)
 }
 
-/// What fan triangle `t` adds to [`winding`] at `p`: the sign of its
+/// What fan triangle `t` adds to the winding number (`winding`, the
+/// tests' reference, and [`PartShadows`]' own) at `p`: the sign of its
 /// normal's `axis` component where its shadow holds `p`'s strictly and
 /// the ray from `p` meets it past `p`, else 0; `None` where `p`'s shadow
 /// lies on its shadow's boundary (or the shadow has no area and `p`'s
@@ -578,11 +579,11 @@ fn crossing(t: &[GridPoint; 3], axis: usize, p: GridPoint) -> Option<i64> {
     })
 }
 
-/// A closed part's fan triangles indexed for [`placed`] across one axis:
+/// A closed part's fan triangles indexed for `placed` (the tests' reference) across one axis:
 /// a grid over their faces' boxes, and one over those boxes drawn across
 /// the axis (the axis' extent left out), each triangle listed in the
 /// cells of its face's box; the triangles whose shadow has no area apart
-/// from the second, checked at every point. It answers as [`placed`]
+/// from the second, checked at every point. It answers as `placed`
 /// over the whole part does:
 /// - the triangles a polygon `q` in a plane across the axis is tested
 ///   against are those of the faces whose box meets `q`'s, as there;
@@ -650,7 +651,7 @@ impl PartShadows {
         }
     }
 
-    /// [`placed`] of `q` over the part indexed.
+    /// The tests' reference `placed` of `q`, over the part indexed.
     pub(crate) fn placed(&self, q: &[GridPoint]) -> Option<i64> {
         let qb = grid_box(q);
         let tris_q = fan(q)?;
@@ -665,7 +666,7 @@ impl PartShadows {
         q.iter().find_map(|&p| self.winding(p))
     }
 
-    /// [`winding`] of the part indexed at `p`.
+    /// The tests' reference `winding` of the part, indexed, at `p`.
     fn winding(&self, p: GridPoint) -> Option<i64> {
         let mut at = [
             [i64::from(p[0]); 2],

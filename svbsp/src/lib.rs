@@ -15,7 +15,7 @@
 //! filter. Faces are independent and shaded in parallel (rayon); the
 //! output does not depend on the thread count.
 //!
-//! [`chin_feiner`] is Chin & Feiner's (1989) BSP-ordered algorithm, on
+//! [`chin_feiner()`] is Chin & Feiner's (1989) BSP-ordered algorithm, on
 //! which the core paper's dynamic pipeline builds; its shadow planes pass
 //! through split edges and need a wider tier (see `docs/architecture.md`).
 //! The two agree exactly on every face's lit area (tested).

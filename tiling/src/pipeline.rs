@@ -26,7 +26,7 @@
 //!   shadow-volume tree over the moved faces and the related static
 //!   polygons (the tree does not depend on an order), through which the
 //!   moved faces are shaded; each related static face's static cells are
-//!   refined through the same tree ([`svbsp::LightVolumes::refine`]).
+//!   refined through the same tree ([`svbsp::ShadowSet::refine`]).
 //!
 //! Either way the frame's fragments are exact, and every face's lit area
 //! is exactly what [`svbsp::shadow_fragments`] computes from scratch on

@@ -667,7 +667,7 @@ impl Wide {
         if neg { -v } else { v }
     }
 
-    /// The same value as a [`I256`].
+    /// The same value as a [`I256`](bnum::types::I256).
     #[inline]
     pub(crate) fn to_i256(self) -> bnum::types::I256 {
         let digits = [

@@ -1,5 +1,5 @@
 //! Walking a tree: painter's order from a viewpoint (explicit stack, or
-//! recursion up to [`RECURSION_LIMIT`](super::RECURSION_LIMIT) levels),
+//! recursion up to [`super::RECURSION_LIMIT`] levels),
 //! and exact point membership.
 
 use crate::kernel::{Plane, Point, Polygon, Side, ViewPoint};

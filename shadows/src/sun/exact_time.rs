@@ -398,7 +398,8 @@ fn intersect(p: &[Interval], q: &[Interval]) -> Vec<Interval> {
     out
 }
 
-/// [`intersect`] written to `out` (cleared first).
+/// The intersection of two sorted, disjoint interval lists (the tests'
+/// `intersect`), written to `out` (cleared first).
 fn intersect_into(p: &[Interval], q: &[Interval], out: &mut Vec<Interval>) {
     out.clear();
     let (mut i, mut j) = (0, 0);

@@ -7,7 +7,7 @@
 //! the scene is done. Past the first light, each cell's walk through a
 //! tree is its own: runs of cells go through the remaining trees on
 //! copies of the arena, whose additions are then appended in the runs'
-//! order ([`PieceArena::append_since`]). The cells come out in the same
+//! order ([`PieceArena::append_since`](crate::arena::pieces::PieceArena::append_since)). The cells come out in the same
 //! order, each the same polygon with the same flags, for any number of
 //! threads.
 
