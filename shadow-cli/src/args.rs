@@ -139,7 +139,8 @@ impl CameraArgs {
         quiet: bool,
     ) -> SvgViewpoint {
         let (at, framed) = self.viewpoint(mesh, staging, size, fov_deg);
-        if framed && !quiet {
+        // (a framed eye beyond f64's range is refused by the caller)
+        if framed && !quiet && at.eye.is_finite() {
             let bounds = mesh.bounds().unwrap_or_default();
             eprintln!("note: camera {}", viewpoint_flags(&at, bounds));
             // most scans are Y-up: a mesh taller along y than along z may be

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use clap::Args;
 use shadow_raster::svg::SvgViewpoint;
 use shadow_scene::ROOM_STAGING;
@@ -63,6 +63,13 @@ pub(crate) fn view(args: &ViewArgs) -> Result<()> {
     let staging = args.source.staging(bounds);
     let image = (args.image.size(), args.image.fov);
     let at = args.camera.pick(&prepared.mesh, staging, image, args.quiet);
+    if !at.eye.is_finite() {
+        bail!(
+            "{name}: the scene spans {:.3e} units, so a camera that frames it would stand beyond \
+             f64's range; give --eye and --target, or scale the scene below about 1e150",
+            (bounds.1 - bounds.0).max_element()
+        );
+    }
     let out = prepared.draw(&at).map_err(facade_error)?;
     write_file(&args.output, out.svg.as_bytes())?;
     emit(&format!(

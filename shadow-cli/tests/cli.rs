@@ -507,6 +507,12 @@ fn huge_and_tiny_coordinates_are_clear_errors_or_exact() {
     let never = never.to_str().unwrap();
     let o = shadow(&["csg", "union", h, h, "-o", never]);
     assert_failed_with(&o, &["huge_tetra.obj", "volume does not fit in f64"]);
+    // a view frames the scene: its eye would stand beyond f64's range
+    let svg = scratch("hostile_coordinates.svg");
+    let o = shadow(&["view", h, "-o", svg.to_str().unwrap()]);
+    assert_failed_with(&o, &["huge_tetra.obj", "spans 1.000e300 units", "--eye"]);
+    assert!(!stderr(&o).contains("NaN"), "{}", stderr(&o));
+    assert!(!svg.exists());
     let o = shadow(&["shadows", t, "--sun", "0,0,1", "-o", out]);
     assert_failed_with(&o, &["too small"]);
     let o = shadow(&["csg", "union", t, t, "-o", never]);
