@@ -279,15 +279,8 @@ fn sensors<'py>(
                     )));
                 }
                 let normal = (row.len() == 6).then(|| DVec3::new(row[3], row[4], row[5]));
-                if normal == Some(DVec3::ZERO) {
-                    return Err(MeshError::new_err(format!(
-                        "{what}: row {i}'s normal is zero"
-                    )));
-                }
-                Ok(Sensor {
-                    position: DVec3::new(row[0], row[1], row[2]),
-                    normal,
-                })
+                Sensor::new(DVec3::new(row[0], row[1], row[2]), normal)
+                    .ok_or_else(|| MeshError::new_err(format!("{what}: row {i}'s normal is zero")))
             })
             .collect()
     })

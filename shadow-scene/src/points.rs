@@ -55,6 +55,29 @@ pub struct Sensor {
     pub normal: Option<DVec3>,
 }
 
+impl Sensor {
+    /// A sensor at `position`, facing `normal` where given; `None` for a
+    /// zero normal, which faces no way.
+    pub fn new(position: DVec3, normal: Option<DVec3>) -> Option<Sensor> {
+        (normal != Some(DVec3::ZERO)).then_some(Sensor { position, normal })
+    }
+
+    /// The sensors' positions, in order.
+    pub fn positions(sensors: &[Sensor]) -> Vec<DVec3> {
+        sensors.iter().map(|s| s.position).collect()
+    }
+}
+
+/// A point as a sensor that counts the sun from every side.
+impl From<DVec3> for Sensor {
+    fn from(position: DVec3) -> Sensor {
+        Sensor {
+            position,
+            normal: None,
+        }
+    }
+}
+
 /// Reads a file of sensors ([`parse_sensors`]).
 pub fn read_sensors(path: &Path) -> Result<Vec<Sensor>, SceneError> {
     let (text, shown) = read_text(path)?;
@@ -82,17 +105,13 @@ pub fn parse_sensors(text: &str, path_for_messages: &str) -> Result<Vec<Sensor>,
     rows.into_iter()
         .map(|(line, r)| {
             let normal = (r.len() == 6).then(|| DVec3::from_slice(&r[3..]));
-            if normal == Some(DVec3::ZERO) {
+            Sensor::new(DVec3::from_slice(&r), normal).ok_or_else(|| {
                 let text = r.iter().map(f64::to_string).collect::<Vec<_>>().join(",");
-                return Err(SceneError::Parse {
+                SceneError::Parse {
                     path: path_for_messages.to_string(),
                     line,
                     message: format!("`{text}`: the sensor's normal is zero"),
-                });
-            }
-            Ok(Sensor {
-                position: DVec3::from_slice(&r),
-                normal,
+                }
             })
         })
         .collect()

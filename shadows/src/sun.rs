@@ -764,12 +764,7 @@ pub fn sensor_hours(
     suns: &[DVec3],
     step_hours: f64,
 ) -> Result<Vec<f64>, crate::Error> {
-    let sensors: Vec<Sensor> = (sensors.iter())
-        .map(|&position| Sensor {
-            position,
-            normal: None,
-        })
-        .collect();
+    let sensors: Vec<Sensor> = sensors.iter().map(|&p| p.into()).collect();
     sensor_hours_facing(mesh, &sensors, suns, step_hours)
 }
 
@@ -786,7 +781,7 @@ pub fn sensor_hours_facing(
 ) -> Result<Vec<f64>, crate::Error> {
     use crate::Error;
     let all: Vec<crate::Light> = suns.iter().map(|&d| crate::Light::Sun(d)).collect();
-    let points: Vec<DVec3> = sensors.iter().map(|s| s.position).collect();
+    let points = Sensor::positions(sensors);
     let positions = [&mesh.positions[..], &points].concat();
     let grid = svbsp::shared_grid(&positions, &all).map_err(Error::Light)?;
     let at: Vec<bsp_core::GridPoint> = (points.iter().enumerate())
@@ -840,7 +835,7 @@ pub fn sensor_hours_file(
     }
     let sensors = shadow_scene::read_sensors(path).map_err(crate::Error::File)?;
     let hours = sensor_hours_facing(mesh, &sensors, suns, step_hours)?;
-    let points: Vec<DVec3> = sensors.iter().map(|s| s.position).collect();
+    let points = Sensor::positions(&sensors);
     let text = match format {
         HoursFormat::Csv => sensors_csv(&points, &hours),
         HoursFormat::Json => sensors_json(&points, &hours, suns.len()),

@@ -254,12 +254,7 @@ pub fn sensor_intervals(
     sensors: &[DVec3],
     paths: &[SunPath],
 ) -> Vec<Vec<Vec<Interval>>> {
-    let sensors: Vec<Sensor> = (sensors.iter())
-        .map(|&position| Sensor {
-            position,
-            normal: None,
-        })
-        .collect();
+    let sensors: Vec<Sensor> = sensors.iter().map(|&p| p.into()).collect();
     sensor_intervals_facing(mesh, &sensors, paths)
 }
 

@@ -189,7 +189,7 @@ pub fn hours_report(
         HoursOf::ExactSensors { path, paths } => {
             let sensors = shadow_scene::read_sensors(path).map_err(crate::Error::File)?;
             let on = sensor_intervals_facing(mesh, &sensors, paths);
-            let points: Vec<DVec3> = sensors.iter().map(|s| s.position).collect();
+            let points = super::Sensor::positions(&sensors);
             let text = match format {
                 HoursFormat::Json => intervals_json(&points, paths, &on),
                 HoursFormat::Csv => sensors_csv(&points, &interval_hours(&on)),
