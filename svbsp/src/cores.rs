@@ -579,12 +579,12 @@ fn crossing(t: &[GridPoint; 3], axis: usize, p: GridPoint) -> Option<i64> {
     })
 }
 
-/// A closed part's fan triangles indexed for `placed` (the tests' reference) across one axis:
-/// a grid over their faces' boxes, and one over those boxes drawn across
-/// the axis (the axis' extent left out), each triangle listed in the
-/// cells of its face's box; the triangles whose shadow has no area apart
-/// from the second, checked at every point. It answers as `placed`
-/// over the whole part does:
+/// A closed part's fan triangles indexed across one axis: a grid over
+/// their faces' boxes, and one over those boxes drawn across the axis
+/// (the axis' extent left out), each triangle listed in the cells of its
+/// face's box; the triangles whose shadow has no area apart from the
+/// second, checked at every point. It answers as the tests' reference
+/// `placed` over the whole part does:
 /// - the triangles a polygon `q` in a plane across the axis is tested
 ///   against are those of the faces whose box meets `q`'s, as there;
 /// - at a point `p`, a triangle whose shadow has area and whose face's
@@ -651,7 +651,9 @@ impl PartShadows {
         }
     }
 
-    /// The tests' reference `placed` of `q`, over the part indexed.
+    /// Whether the convex polygon `q` lies strictly inside the solid the
+    /// part bounds (1) or strictly outside it (0), as the tests' reference
+    /// `placed` answers, over the part indexed.
     pub(crate) fn placed(&self, q: &[GridPoint]) -> Option<i64> {
         let qb = grid_box(q);
         let tris_q = fan(q)?;
@@ -666,7 +668,8 @@ impl PartShadows {
         q.iter().find_map(|&p| self.winding(p))
     }
 
-    /// The tests' reference `winding` of the part, indexed, at `p`.
+    /// The part's winding number round `p`, as the tests' reference
+    /// `winding` counts it, over the part indexed.
     fn winding(&self, p: GridPoint) -> Option<i64> {
         let mut at = [
             [i64::from(p[0]); 2],
